@@ -1,0 +1,85 @@
+# wobble: the only build system. `make demo` and `make test` are the two set-up commands.
+CC      ?= gcc
+BUILD   ?= build
+PREFIX  ?= /usr/local
+OPT     ?= -O2
+# Debian packages the build needs; `make deps` installs the missing ones
+PKGS    := liblua5.4-dev libcjson-dev pkg-config
+PCMODS  := lua5.4 libcjson
+
+CFLAGS_BASE := -std=c11 $(OPT) -g -Wall -Wextra -Werror -fopenmp -D_GNU_SOURCE \
+               -DWB_ROOT='"$(CURDIR)"' -DWB_PREFIX='"$(PREFIX)"'
+CFLAGS  += $(CFLAGS_BASE) $(EXTRA_CFLAGS)
+LDFLAGS += -fopenmp $(EXTRA_LDFLAGS)
+PC_CFLAGS = $(shell pkg-config --cflags $(PCMODS) 2>/dev/null)
+PC_LIBS   = $(shell pkg-config --libs $(PCMODS) 2>/dev/null)
+
+ALL_SRC  := $(wildcard src/*.c)
+# the core: no Lua, no GL, no command line
+CORE_SRC := $(filter-out src/lua_% src/main.c src/render% src/progress.c,$(ALL_SRC))
+APP_SRC  := $(filter-out $(CORE_SRC),$(ALL_SRC))
+CORE_OBJ := $(CORE_SRC:src/%.c=$(BUILD)/obj/%.o)
+APP_OBJ  := $(APP_SRC:src/%.c=$(BUILD)/obj/%.o)
+UNIT_SRC := $(wildcard tests/unit/*.c)
+
+.PHONY: all build deps check-deps test asan bench demo install clean
+all: check-deps
+	@$(MAKE) --no-print-directory build
+
+build: $(BUILD)/libwobble.a $(BUILD)/wobble $(BUILD)/unit_tests
+
+check-deps:
+	@pkg-config --exists $(PCMODS) 2>/dev/null || $(MAKE) --no-print-directory deps
+
+deps:
+	@missing=""; for p in $(PKGS); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing Debian packages:$$missing"; \
+	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $$missing; \
+	else echo "all Debian packages present"; fi
+
+$(BUILD)/obj/%.o: src/%.c src/*.h | $(BUILD)/obj
+	$(CC) $(CFLAGS) $(PC_CFLAGS) -c $< -o $@
+
+$(BUILD)/obj:
+	@mkdir -p $@
+
+$(BUILD)/libwobble.a: $(CORE_OBJ)
+	ar rcs $@ $^
+
+$(BUILD)/wobble: $(APP_OBJ) $(BUILD)/libwobble.a
+	$(CC) $(LDFLAGS) -o $@ $(APP_OBJ) $(BUILD)/libwobble.a $(PC_LIBS) -lm
+
+# C unit tests of the core alone: links only libwobble.a
+$(BUILD)/unit_tests: $(UNIT_SRC) $(wildcard tests/unit/*.h) $(BUILD)/libwobble.a
+	$(CC) $(CFLAGS) -Isrc -o $@ $(UNIT_SRC) $(BUILD)/libwobble.a $(LDFLAGS) -lm
+
+test: check-deps
+	@$(MAKE) --no-print-directory build
+	@sh tests/run_all.sh $(BUILD)
+
+asan: check-deps
+	@$(MAKE) --no-print-directory BUILD=build-asan OPT=-O1 \
+	  EXTRA_CFLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" \
+	  EXTRA_LDFLAGS="-fsanitize=address,undefined" build
+	@ASAN_OPTIONS=detect_leaks=1 sh tests/run_all.sh build-asan
+
+bench: check-deps
+	@$(MAKE) --no-print-directory OPT="-O3 -march=native" BUILD=build-bench build
+	@build-bench/wobble bench
+
+demo: check-deps
+	@$(MAKE) --no-print-directory build
+	$(BUILD)/wobble run scripts/cloth_clothesline.lua
+
+install: all
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/wobble/lua/wobble
+	install -m 755 $(BUILD)/wobble $(DESTDIR)$(PREFIX)/bin/wobble
+	install -m 644 lua/wobble/*.lua $(DESTDIR)$(PREFIX)/share/wobble/lua/wobble/
+	install -d $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include
+	install -m 644 $(BUILD)/libwobble.a $(DESTDIR)$(PREFIX)/lib/
+	install -m 644 src/wobble.h $(DESTDIR)$(PREFIX)/include/
+
+clean:
+	rm -rf build build-asan build-bench out

@@ -1,0 +1,219 @@
+/* wobble.h: the public C API of the wobble core (libwobble.a).
+ *
+ * One line per function, grouped as the Lua API is (DESIGN.md §3): the Lua name
+ * w:foo(...) maps to wb_world_foo(w, ...), c:foo() to wb_distance_foo(w, c, ...).
+ * The core has no Lua, no GL and no I/O side effects.
+ *
+ * Conventions
+ *   - particle ids are 0-based here (Lua adds 1);
+ *   - vectors are wb_real[3], quaternions wb_real[4] as (w, x, y, z);
+ *   - constraint and collider handles carry a generation: a stale one is detected
+ *     by wb_*_valid() and asserted on elsewhere (contract bug);
+ *   - functions that can fail on external input return WB_OK or a negative
+ *     wb_status and change nothing when they fail.
+ */
+#ifndef WOBBLE_H
+#define WOBBLE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#define WB_VERSION "0.1.0"
+
+#ifdef WB_FLOAT
+typedef float wb_real;
+#else
+typedef double wb_real; /* the reference thesis names 32-bit floats as its weakness */
+#endif
+
+/* hard limits: a request past them is an error, never an attempt to allocate */
+#define WB_MAX_PARTICLES (1 << 24)
+#define WB_MAX_CONSTRAINTS (1 << 26)
+#define WB_MAX_COLLIDERS (1 << 16)
+#define WB_MAX_SUBSTEPS 10000
+#define WB_MAX_ITERATIONS 10000
+#define WB_MAX_THREADS 256
+
+typedef enum wb_status {
+    WB_OK = 0,
+    WB_ERR_NOMEM = -1,     /* allocation failed */
+    WB_ERR_LIMIT = -2,     /* a WB_MAX_* limit would be exceeded */
+    WB_ERR_ARG = -3,       /* an argument is out of its range (see wb_last_error) */
+} wb_status;
+
+typedef enum wb_solver { WB_SOLVER_GAUSS_SEIDEL = 0, WB_SOLVER_JACOBI = 1 } wb_solver;
+
+typedef enum wb_shape {
+    WB_SHAPE_PLANE = 0, WB_SHAPE_SPHERE, WB_SHAPE_BOX, WB_SHAPE_CAPSULE, WB_SHAPE_COUNT
+} wb_shape;
+
+typedef struct wb_world wb_world;
+
+/* handles: index into the world's slot array + generation (0 never valid) */
+typedef struct wb_distance_id { uint32_t index; uint32_t gen; } wb_distance_id;
+typedef struct wb_collider_id { uint32_t index; uint32_t gen; } wb_collider_id;
+
+/* ---- world ---------------------------------------------------------------- */
+typedef struct wb_world_def {
+    wb_real gravity[3];   /* m/s^2, default (0,-9.81,0) */
+    wb_real dt;           /* frame length in seconds, default 1/60 */
+    int substeps;         /* default 10 */
+    int iterations;       /* constraint passes per substep, default 1 */
+    wb_real damping;      /* linear velocity drag, 1/s: v *= max(0, 1 - damping*h) per substep */
+    wb_solver solver;     /* default Gauss-Seidel */
+    wb_real relaxation;   /* Jacobi over-relaxation factor omega, default 1 */
+    int threads;          /* default 1; results are bit-identical for any value */
+} wb_world_def;
+
+wb_world_def wb_world_default_def(void);                      /* the defaults above */
+const char *wb_world_def_check(const wb_world_def *def);      /* NULL, or what is wrong ("dt must be > 0") */
+wb_world *wb_world_create(const wb_world_def *def);           /* NULL when out of memory; def must pass check */
+void wb_world_destroy(wb_world *w);                           /* NULL is fine */
+wb_world_def wb_world_get_def(const wb_world *w);             /* current settings */
+wb_status wb_world_set_def(wb_world *w, const wb_world_def *def); /* change settings between steps */
+
+void wb_world_step(wb_world *w);                              /* one frame of dt, all substeps */
+double wb_world_time(const wb_world *w);                      /* seconds simulated */
+int64_t wb_world_frame(const wb_world *w);                    /* frames stepped */
+
+/* ---- particles ------------------------------------------------------------- */
+/* add a particle; mass 0 makes it immovable. Returns its id, or a negative wb_status */
+int32_t wb_particle_add(wb_world *w, const wb_real pos[3], const wb_real vel[3], wb_real mass, wb_real radius);
+int32_t wb_particle_count(const wb_world *w);
+void wb_particle_position(const wb_world *w, int32_t p, wb_real out[3]);
+void wb_particle_set_position(wb_world *w, int32_t p, const wb_real pos[3]); /* teleport: velocity unchanged */
+void wb_particle_velocity(const wb_world *w, int32_t p, wb_real out[3]);
+void wb_particle_set_velocity(wb_world *w, int32_t p, const wb_real vel[3]);
+wb_real wb_particle_mass(const wb_world *w, int32_t p);       /* as created; 0 = immovable */
+wb_real wb_particle_radius(const wb_world *w, int32_t p);
+void wb_particle_pin(wb_world *w, int32_t p, const wb_real *pos); /* fix in place (at pos when not NULL) */
+void wb_particle_unpin(wb_world *w, int32_t p);               /* free again (its own mass back) */
+bool wb_particle_pinned(const wb_world *w, int32_t p);
+const wb_real *wb_particle_positions(const wb_world *w);      /* (n x 3), valid until the next add */
+
+/* ---- distance constraints (XPBD) -------------------------------------------------- */
+typedef struct wb_distance_def {
+    wb_real compliance;   /* alpha, m/N (inverse stiffness); 0 = rigid */
+    wb_real damping;      /* beta, Macklin et al. 2016 eq. 26; acts when compliance > 0 */
+    wb_real rest;         /* rest length; < 0 means the current distance */
+    wb_real yield;        /* plastic yield strain; 0 = elastic */
+    wb_real creep;        /* plastic flow rate, 1/s, when past yield */
+    wb_real break_strain; /* tensile strain that breaks it; 0 = unbreakable */
+} wb_distance_def;
+
+wb_distance_def wb_distance_default_def(void);                /* rigid, rest = current, elastic, unbreakable */
+const char *wb_distance_def_check(const wb_distance_def *def); /* NULL or what is wrong */
+/* connect two distinct particles; returns the handle, or index 0 / gen 0 with *status set */
+wb_distance_id wb_distance_add(wb_world *w, int32_t a, int32_t b, const wb_distance_def *def, wb_status *status);
+bool wb_distance_valid(const wb_world *w, wb_distance_id c);  /* false for stale or removed handles */
+void wb_distance_remove(wb_world *w, wb_distance_id c);
+wb_real wb_distance_force(const wb_world *w, wb_distance_id c); /* N, |lambda|/h^2 of the last substep */
+wb_real wb_distance_rest(const wb_world *w, wb_distance_id c);  /* current (plastic) rest length */
+wb_real wb_distance_length(const wb_world *w, wb_distance_id c);
+bool wb_distance_broken(const wb_world *w, wb_distance_id c);
+void wb_distance_particles(const wb_world *w, wb_distance_id c, int32_t *a, int32_t *b);
+int32_t wb_distance_count(const wb_world *w);                 /* live constraints, broken included */
+/* iterate: the i-th live constraint for i in [0, count) (order stable between edits) */
+wb_distance_id wb_distance_at(const wb_world *w, int32_t i);
+
+/* ---- colliders (kinematic: the script moves them) -------------------------------- */
+typedef struct wb_collider_def {
+    wb_shape shape;
+    wb_real normal[3], offset;    /* plane: points x with n.x = offset, normal need not be unit */
+    wb_real center[3];            /* sphere, box */
+    wb_real radius;               /* sphere, capsule */
+    wb_real half[3];              /* box half extents */
+    wb_real rotation[4];          /* box: (w,x,y,z), normalised on add */
+    wb_real a[3], b[3];           /* capsule segment */
+    wb_real friction;             /* Coulomb coefficient (static = dynamic) */
+    wb_real restitution;          /* 0..1 */
+} wb_collider_def;
+
+wb_collider_def wb_collider_default_def(wb_shape shape);      /* a unit-ish shape at the origin */
+const char *wb_collider_def_check(const wb_collider_def *def); /* NULL or what is wrong ("radius must be > 0") */
+wb_collider_id wb_collider_add(wb_world *w, const wb_collider_def *def, wb_status *status);
+bool wb_collider_valid(const wb_world *w, wb_collider_id c);
+void wb_collider_remove(wb_world *w, wb_collider_id c);
+wb_shape wb_collider_shape(const wb_world *w, wb_collider_id c);
+/* The pose set between steps is reached at the end of the next step: the collider
+ * sweeps there substep by substep, pushing particles (no tunnelling). */
+void wb_collider_set_position(wb_world *w, wb_collider_id c, const wb_real p[3]);
+void wb_collider_set_rotation(wb_world *w, wb_collider_id c, const wb_real q[4]);
+void wb_collider_set_velocity(wb_world *w, wb_collider_id c, const wb_real v[3]);   /* moves it by v*dt per frame */
+void wb_collider_set_angular_velocity(wb_world *w, wb_collider_id c, const wb_real om[3]);
+void wb_collider_position(const wb_world *w, wb_collider_id c, wb_real out[3]);
+void wb_collider_rotation(const wb_world *w, wb_collider_id c, wb_real out[4]);
+void wb_collider_velocity(const wb_world *w, wb_collider_id c, wb_real out[3]);
+void wb_collider_get_def(const wb_world *w, wb_collider_id c, wb_collider_def *out); /* shape + current pose */
+int32_t wb_collider_count(const wb_world *w);
+wb_collider_id wb_collider_at(const wb_world *w, int32_t i);
+/* signed distance from p to the collider surface at its current pose (negative inside) */
+wb_real wb_collider_distance(const wb_world *w, wb_collider_id c, const wb_real p[3]);
+
+/* ---- builders: particles are contiguous [first, first+count) --------------------------- */
+typedef struct wb_body { int32_t first, count; } wb_body;
+
+typedef struct wb_cloth_def {
+    wb_real origin[3];    /* corner; the cloth spans +x by size[0] and +z by size[1] */
+    wb_real size[2];
+    int res[2];           /* particles along x and z (>= 2) */
+    wb_real mass;         /* total, spread evenly */
+    wb_real radius;
+    bool shear;           /* one diagonal per cell, alternating */
+    wb_real bend;         /* < 0: none; else compliance of skip-one bending links */
+    wb_distance_def link; /* options of every constraint made */
+} wb_cloth_def;
+
+typedef struct wb_rope_def {
+    wb_real from[3], to[3];
+    int segments;         /* >= 1; segments + 1 particles */
+    wb_real mass, radius;
+    wb_distance_def link;
+} wb_rope_def;
+
+typedef struct wb_lattice_def {
+    wb_real min[3], max[3];
+    int res[3];           /* particles per axis (>= 2) */
+    wb_real mass, radius;
+    wb_distance_def link; /* edges, face and body diagonals of every cell */
+} wb_lattice_def;
+
+wb_cloth_def wb_cloth_default_def(void);
+wb_rope_def wb_rope_default_def(void);
+wb_lattice_def wb_lattice_default_def(void);
+wb_status wb_cloth(wb_world *w, const wb_cloth_def *def, wb_body *out);     /* WB_ERR_ARG: see wb_last_error */
+wb_status wb_rope(wb_world *w, const wb_rope_def *def, wb_body *out);
+wb_status wb_lattice(wb_world *w, const wb_lattice_def *def, wb_body *out);
+
+/* ---- queries ---------------------------------------------------------------------- */
+void wb_world_energy(const wb_world *w, wb_real *kinetic, wb_real *potential); /* J; potential = gravity + elastic */
+void wb_world_momentum(const wb_world *w, wb_real out[3]);          /* movable particles */
+void wb_world_angular_momentum(const wb_world *w, wb_real out[3]);  /* about the origin */
+bool wb_world_bounds(const wb_world *w, wb_real min[3], wb_real max[3]); /* false when no particles */
+wb_real wb_world_max_strain(const wb_world *w);                     /* max |len-rest|/rest over live constraints */
+uint64_t wb_world_hash(const wb_world *w);                          /* FNV-1a of the whole state */
+
+typedef struct wb_stats {
+    int32_t particles, distances, broken, colliders;
+    int32_t colours;          /* batches of the last colouring */
+    int32_t contacts;         /* collider contacts in the last substep */
+    int64_t projections;      /* constraint projections in the last step */
+    double step_ms;           /* wall time of the last step */
+    double solve_ms;          /* of which constraint projection */
+    int64_t warnings;         /* numerical trouble detected so far */
+} wb_stats;
+wb_stats wb_world_stats(const wb_world *w);
+
+/* numerical trouble: counted, the last message kept; the step restores the previous
+ * frame's particles when a position or velocity turns non-finite */
+int64_t wb_world_warnings(const wb_world *w);
+const char *wb_world_last_warning(const wb_world *w);  /* "" when none */
+
+/* events buffered during the last step (never a callback inside the solver) */
+int32_t wb_world_break_count(const wb_world *w);                   /* constraints broken in the last step */
+wb_distance_id wb_world_break_at(const wb_world *w, int32_t i);
+
+const char *wb_last_error(void);   /* message of the last WB_ERR_ARG in this thread */
+
+#endif

@@ -1,0 +1,49 @@
+/* wobble_lua.h: what the Lua binding (lua_*.c), the runtime (sandbox, budgets,
+ * paths) and the command line (main.c) share. Not part of the public core API. */
+#ifndef WOBBLE_LUA_H
+#define WOBBLE_LUA_H
+
+#include <lua.h>
+#include <lauxlib.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "wobble.h"
+
+/* ---- the module (lua_wobble.c) ---------------------------------------------------- */
+int luaopen_wobble(lua_State *L);   /* pushes the `wobble` table; registers every userdata type */
+
+/* ---- the runtime (lua_runtime.c): configuration of the running script ----------------- */
+typedef struct wb_runtime {
+    const char *scene_dir;     /* folder of the scene script (absolute) */
+    const char *out_dir;       /* --out, default "out" (absolute once created) */
+    const char *lib_dir;       /* folder holding wobble/*.lua */
+    int unsafe;                /* --unsafe: no sandbox */
+    int quiet;                 /* --quiet: no progress, no summaries */
+    int threads;               /* --threads N, 0 when not given */
+    int64_t frame_cap;         /* --frames N: w:run stops after N frames; -1 = none */
+    double time_budget;        /* seconds of wall time; 0 = none */
+    size_t memory_budget;      /* bytes the Lua heap may use; 0 = none */
+} wb_runtime;
+
+wb_runtime *wb_rt_get(lua_State *L);   /* the runtime of this state (never NULL after wb_rt_open) */
+
+/* Resolve a path a script names, under the sandbox rules of DESIGN §4. write=0: the
+ * file is read (scene folder, assets folders, output folder); write=1: it is written
+ * (only under the output folder; a relative path is taken inside it; parent folders
+ * are created). Returns buf, or NULL with *err set to a message naming the path. */
+const char *wb_rt_path(lua_State *L, const char *path, int write, char *buf, size_t n, const char **err);
+
+/* raise a budget error: the command line exits with code 3 (DESIGN §4) */
+int wb_rt_budget_error(lua_State *L, const char *fmt, ...);
+
+/* called by the binding after every simulated frame (w:step, each frame of w:run):
+ * checks the time budget (raises a budget error) and runs frame hooks (recording) */
+void wb_rt_after_frame(lua_State *L, int world_index);
+
+/* ---- progress (progress.c): a bar on a terminal, silent otherwise or with --quiet ---- */
+void wb_progress_begin(lua_State *L, const char *what, int64_t total);
+void wb_progress_update(lua_State *L, int64_t done);
+void wb_progress_end(lua_State *L);
+
+#endif
