@@ -1,0 +1,191 @@
+/* builders.c: cloth, rope and lattice bodies made of particles and distance links.
+ * Each checks its whole definition and reserves all memory first, so a failing
+ * builder changes nothing. */
+#include "core.h"
+
+wb_cloth_def wb_cloth_default_def(void)
+{
+    wb_cloth_def d;
+    memset(&d, 0, sizeof d);
+    d.size[0] = d.size[1] = 1;
+    d.res[0] = d.res[1] = 10;
+    d.mass = 1;
+    d.radius = 0.02;
+    d.shear = true;
+    d.bend = -1;
+    d.link = wb_distance_default_def();
+    return d;
+}
+
+wb_rope_def wb_rope_default_def(void)
+{
+    wb_rope_def d;
+    memset(&d, 0, sizeof d);
+    v3_set(d.to, 1, 0, 0);
+    d.segments = 10;
+    d.mass = 1;
+    d.radius = 0.02;
+    d.link = wb_distance_default_def();
+    return d;
+}
+
+wb_lattice_def wb_lattice_default_def(void)
+{
+    wb_lattice_def d;
+    memset(&d, 0, sizeof d);
+    v3_set(d.max, 1, 1, 1);
+    d.res[0] = d.res[1] = d.res[2] = 4;
+    d.mass = 1;
+    d.radius = 0.02;
+    d.link = wb_distance_default_def();
+    return d;
+}
+
+static int fin(wb_real x) { return isfinite(x); }
+
+static wb_status bad(const char *msg)
+{
+    wb__set_error("%s", msg);
+    return WB_ERR_ARG;
+}
+
+static wb_status check_common(wb_real mass, wb_real radius, const wb_distance_def *link)
+{
+    if (!(mass > 0) || !fin(mass)) return bad("mass must be > 0");
+    if (!(radius >= 0) || !fin(radius)) return bad("radius must be >= 0");
+    const char *e = wb_distance_def_check(link);
+    return e ? bad(e) : WB_OK;
+}
+
+/* link a-b with the builder's options; cannot fail after wb__reserve */
+static void link(wb_world *w, int32_t a, int32_t b, const wb_distance_def *def)
+{
+    wb_distance_add(w, a, b, def, NULL);
+}
+
+wb_status wb_cloth(wb_world *w, const wb_cloth_def *d, wb_body *out)
+{
+    wb_status st = check_common(d->mass, d->radius, &d->link);
+    if (st) return st;
+    const int nx = d->res[0], nz = d->res[1];
+    if (nx < 2 || nz < 2) return bad("res must be at least {2,2}");
+    if ((int64_t)nx * nz > WB_MAX_PARTICLES) return bad("res is too large (more than 16777216 particles)");
+    if (!fin(d->origin[0]) || !fin(d->origin[1]) || !fin(d->origin[2])) return bad("origin must be finite");
+    if (!(d->size[0] > 0 && d->size[1] > 0) || !fin(d->size[0]) || !fin(d->size[1])) return bad("size must be > 0");
+    if (!(d->bend < 0 || fin(d->bend))) return bad("bend must be a finite compliance >= 0");
+    const int64_t np = (int64_t)nx * nz;
+    int64_t nd = (int64_t)(nx - 1) * nz + (int64_t)nx * (nz - 1);
+    if (d->shear) nd += (int64_t)(nx - 1) * (nz - 1);
+    if (d->bend >= 0) nd += (int64_t)(nx - 2 > 0 ? nx - 2 : 0) * nz + (int64_t)nx * (nz - 2 > 0 ? nz - 2 : 0);
+    if ((st = wb__reserve(w, np, nd)) != WB_OK) return st;
+
+    const int32_t first = w->m.np;
+    const wb_real m = d->mass / (wb_real)np;
+    for (int j = 0; j < nz; j++)
+        for (int i = 0; i < nx; i++) {
+            wb_real p[3] = { d->origin[0] + d->size[0] * i / (nx - 1), d->origin[1],
+                             d->origin[2] + d->size[1] * j / (nz - 1) };
+            wb_particle_add(w, p, NULL, m, d->radius);
+        }
+#define ID(i, j) (first + (i) + (j) * nx)
+    for (int j = 0; j < nz; j++)
+        for (int i = 0; i < nx; i++) {
+            if (i + 1 < nx) link(w, ID(i, j), ID(i + 1, j), &d->link);
+            if (j + 1 < nz) link(w, ID(i, j), ID(i, j + 1), &d->link);
+            if (d->shear && i + 1 < nx && j + 1 < nz) {
+                /* alternate the diagonal so the cloth has no preferred shear direction */
+                if ((i + j) % 2 == 0) link(w, ID(i, j), ID(i + 1, j + 1), &d->link);
+                else link(w, ID(i + 1, j), ID(i, j + 1), &d->link);
+            }
+        }
+    if (d->bend >= 0) {
+        wb_distance_def bl = d->link;
+        bl.compliance = d->bend;
+        for (int j = 0; j < nz; j++)
+            for (int i = 0; i < nx; i++) {
+                if (i + 2 < nx) link(w, ID(i, j), ID(i + 2, j), &bl);
+                if (j + 2 < nz) link(w, ID(i, j), ID(i, j + 2), &bl);
+            }
+    }
+#undef ID
+    out->first = first;
+    out->count = (int32_t)np;
+    return WB_OK;
+}
+
+wb_status wb_rope(wb_world *w, const wb_rope_def *d, wb_body *out)
+{
+    wb_status st = check_common(d->mass, d->radius, &d->link);
+    if (st) return st;
+    if (d->segments < 1) return bad("segments must be >= 1");
+    if (d->segments >= WB_MAX_PARTICLES) return bad("segments is too large");
+    for (int i = 0; i < 3; i++)
+        if (!fin(d->from[i]) || !fin(d->to[i])) return bad("from and to must be finite");
+    const int n = d->segments + 1;
+    if ((st = wb__reserve(w, n, d->segments)) != WB_OK) return st;
+    const int32_t first = w->m.np;
+    for (int i = 0; i < n; i++) {
+        wb_real t = (wb_real)i / d->segments, p[3];
+        for (int c = 0; c < 3; c++) p[c] = d->from[c] + (d->to[c] - d->from[c]) * t;
+        wb_particle_add(w, p, NULL, d->mass / n, d->radius);
+    }
+    for (int i = 0; i + 1 < n; i++) link(w, first + i, first + i + 1, &d->link);
+    out->first = first;
+    out->count = n;
+    return WB_OK;
+}
+
+wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
+{
+    wb_status st = check_common(d->mass, d->radius, &d->link);
+    if (st) return st;
+    const int nx = d->res[0], ny = d->res[1], nz = d->res[2];
+    if (nx < 2 || ny < 2 || nz < 2) return bad("res must be at least {2,2,2}");
+    if ((int64_t)nx * ny * nz > WB_MAX_PARTICLES / 8) return bad("res is too large");
+    for (int i = 0; i < 3; i++) {
+        if (!fin(d->min[i]) || !fin(d->max[i])) return bad("min and max must be finite");
+        if (!(d->max[i] > d->min[i])) return bad("max must be greater than min on every axis");
+    }
+    const int64_t np = (int64_t)nx * ny * nz;
+    /* per cell: 12 edges shared, 6 face diagonals (2 per face) shared, 4 body diagonals */
+    const int64_t cells = (int64_t)(nx - 1) * (ny - 1) * (nz - 1);
+    const int64_t nd = (int64_t)(nx - 1) * ny * nz + (int64_t)nx * (ny - 1) * nz + (int64_t)nx * ny * (nz - 1) +
+                       2 * ((int64_t)(nx - 1) * (ny - 1) * nz + (int64_t)(nx - 1) * ny * (nz - 1) + (int64_t)nx * (ny - 1) * (nz - 1)) +
+                       4 * cells;
+    if ((st = wb__reserve(w, np, nd)) != WB_OK) return st;
+    const int32_t first = w->m.np;
+    const wb_real m = d->mass / (wb_real)np;
+    for (int k = 0; k < nz; k++)
+        for (int j = 0; j < ny; j++)
+            for (int i = 0; i < nx; i++) {
+                wb_real p[3] = { d->min[0] + (d->max[0] - d->min[0]) * i / (nx - 1),
+                                 d->min[1] + (d->max[1] - d->min[1]) * j / (ny - 1),
+                                 d->min[2] + (d->max[2] - d->min[2]) * k / (nz - 1) };
+                wb_particle_add(w, p, NULL, m, d->radius);
+            }
+#define ID(i, j, k) (first + (i) + ((j) + (k) * ny) * nx)
+    /* every pair of corners of a cell, each pair made once: offsets (di,dj,dk) in {0,1}^3
+     * between corner c and c+offset, plus the crossing diagonals of faces and body */
+    for (int k = 0; k < nz; k++)
+        for (int j = 0; j < ny; j++)
+            for (int i = 0; i < nx; i++) {
+                const int a = ID(i, j, k);
+                const int ex = i + 1 < nx, ey = j + 1 < ny, ez = k + 1 < nz;
+                if (ex) link(w, a, ID(i + 1, j, k), &d->link);
+                if (ey) link(w, a, ID(i, j + 1, k), &d->link);
+                if (ez) link(w, a, ID(i, j, k + 1), &d->link);
+                if (ex && ey) { link(w, a, ID(i + 1, j + 1, k), &d->link); link(w, ID(i + 1, j, k), ID(i, j + 1, k), &d->link); }
+                if (ex && ez) { link(w, a, ID(i + 1, j, k + 1), &d->link); link(w, ID(i + 1, j, k), ID(i, j, k + 1), &d->link); }
+                if (ey && ez) { link(w, a, ID(i, j + 1, k + 1), &d->link); link(w, ID(i, j + 1, k), ID(i, j, k + 1), &d->link); }
+                if (ex && ey && ez) {
+                    link(w, a, ID(i + 1, j + 1, k + 1), &d->link);
+                    link(w, ID(i + 1, j, k), ID(i, j + 1, k + 1), &d->link);
+                    link(w, ID(i, j + 1, k), ID(i + 1, j, k + 1), &d->link);
+                    link(w, ID(i, j, k + 1), ID(i + 1, j + 1, k), &d->link);
+                }
+            }
+#undef ID
+    out->first = first;
+    out->count = (int32_t)np;
+    return WB_OK;
+}

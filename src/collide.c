@@ -1,0 +1,425 @@
+/* collide.c: kinematic colliders (plane, sphere, oriented box, capsule) and their
+ * projection, friction and restitution.
+ *
+ * A collider sweeps from its pose at the end of the last step to the pose the script
+ * set, substep by substep, so a fast collider pushes particles instead of passing
+ * through them. Friction follows Müller et al. 2020 ("Detailed rigid body simulation
+ * with extended position based dynamics"): static at position level, dynamic at
+ * velocity level, with the normal impulse taken from the penetration depth. */
+#include <assert.h>
+#include <stdlib.h>
+
+#include "core.h"
+
+/* ---- quaternions ------------------------------------------------------------------- */
+void q_normalize(wb_real q[4])
+{
+    wb_real n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (n == 0) { q[0] = 1; q[1] = q[2] = q[3] = 0; return; }
+    for (int i = 0; i < 4; i++) q[i] /= n;
+}
+
+void q_rotate(const wb_real q[4], const wb_real v[3], wb_real out[3])
+{
+    /* v + 2 u x (u x v + w v), u = (x, y, z) */
+    const wb_real *u = &q[1];
+    wb_real t[3], c[3];
+    v3_cross(t, u, v);
+    v3_madd(t, v, q[0]);
+    v3_cross(c, u, t);
+    wb_real r[3] = { v[0] + 2 * c[0], v[1] + 2 * c[1], v[2] + 2 * c[2] };
+    v3_copy(out, r);
+}
+
+void q_rotate_inv(const wb_real q[4], const wb_real v[3], wb_real out[3])
+{
+    wb_real c[4] = { q[0], -q[1], -q[2], -q[3] };
+    q_rotate(c, v, out);
+}
+
+void q_slerp(const wb_real a[4], const wb_real b[4], wb_real t, wb_real out[4])
+{
+    wb_real d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3], s = 1;
+    if (d < 0) { d = -d; s = -1; } /* the short way round */
+    wb_real wa, wb;
+    if (d > (wb_real)0.9995) {
+        wa = 1 - t;
+        wb = t;
+    } else {
+        wb_real th = acos(d), sn = sin(th);
+        wa = sin((1 - t) * th) / sn;
+        wb = sin(t * th) / sn;
+    }
+    wb_real r[4];
+    for (int i = 0; i < 4; i++) r[i] = wa * a[i] + s * wb * b[i];
+    q_normalize(r);
+    memcpy(out, r, sizeof r);
+}
+
+void q_integrate(const wb_real q[4], const wb_real om[3], wb_real h, wb_real out[4])
+{
+    wb_real n = v3_len(om);
+    if (n == 0) { if (out != q) memcpy(out, q, 4 * sizeof(wb_real)); return; }
+    /* exact rotation by |om| h about om: dq * q */
+    wb_real half = n * h / 2, s = sin(half) / n;
+    wb_real dq[4] = { cos(half), om[0] * s, om[1] * s, om[2] * s };
+    wb_real r[4] = {
+        dq[0] * q[0] - dq[1] * q[1] - dq[2] * q[2] - dq[3] * q[3],
+        dq[0] * q[1] + dq[1] * q[0] + dq[2] * q[3] - dq[3] * q[2],
+        dq[0] * q[2] - dq[1] * q[3] + dq[2] * q[0] + dq[3] * q[1],
+        dq[0] * q[3] + dq[1] * q[2] - dq[2] * q[1] + dq[3] * q[0],
+    };
+    q_normalize(r);
+    memcpy(out, r, sizeof r);
+}
+
+/* ---- collider API -------------------------------------------------------------------- */
+wb_collider_def wb_collider_default_def(wb_shape shape)
+{
+    wb_collider_def d;
+    memset(&d, 0, sizeof d);
+    d.shape = shape;
+    v3_set(d.normal, 0, 1, 0);
+    d.radius = 0.5;
+    v3_set(d.half, 0.5, 0.5, 0.5);
+    d.rotation[0] = 1;
+    v3_set(d.a, 0, -0.5, 0);
+    v3_set(d.b, 0, 0.5, 0);
+    return d;
+}
+
+static int fin3(const wb_real *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
+const char *wb_collider_def_check(const wb_collider_def *d)
+{
+    if ((unsigned)d->shape >= WB_SHAPE_COUNT) return "unknown shape";
+    if (!(d->friction >= 0) || !isfinite(d->friction)) return "friction must be >= 0";
+    if (!(d->restitution >= 0 && d->restitution <= 1)) return "restitution must be in [0, 1]";
+    switch (d->shape) {
+    case WB_SHAPE_PLANE:
+        if (!fin3(d->normal) || !isfinite(d->offset)) return "normal and offset must be finite";
+        if (!(v3_len(d->normal) > 1e-12)) return "normal must not be zero";
+        break;
+    case WB_SHAPE_SPHERE:
+        if (!fin3(d->center)) return "center must be finite";
+        if (!(d->radius > 0) || !isfinite(d->radius)) return "radius must be > 0";
+        break;
+    case WB_SHAPE_BOX:
+        if (!fin3(d->center)) return "center must be finite";
+        if (!(d->half[0] > 0 && d->half[1] > 0 && d->half[2] > 0) || !fin3(d->half)) return "half extents must be > 0";
+        if (!fin3(&d->rotation[1]) || !isfinite(d->rotation[0])) return "rotation must be finite";
+        if (!(d->rotation[0] * d->rotation[0] + v3_dot(&d->rotation[1], &d->rotation[1]) > 1e-24)) return "rotation must not be zero";
+        break;
+    case WB_SHAPE_CAPSULE:
+        if (!fin3(d->a) || !fin3(d->b)) return "a and b must be finite";
+        if (!(d->radius > 0) || !isfinite(d->radius)) return "radius must be > 0";
+        break;
+    default:
+        break;
+    }
+    return NULL;
+}
+
+wb_collider_id wb_collider_add(wb_world *w, const wb_collider_def *def, wb_status *status)
+{
+    wb_collider_id none = { 0, 0 };
+    wb_status dummy;
+    if (!status) status = &dummy;
+    const char *err = wb_collider_def_check(def);
+    if (err) { wb__set_error("%s", err); *status = WB_ERR_ARG; return none; }
+    wb_model *m = &w->m;
+    int32_t slot = -1;
+    for (int32_t i = 0; i < m->nc; i++)
+        if (!(m->c_gen[i] & 1u)) { slot = i; break; }
+    if (slot < 0) {
+        if (m->nc >= WB_MAX_COLLIDERS) { *status = WB_ERR_LIMIT; return none; }
+        int32_t cap = m->cap_c, cap2 = m->cap_c, cap3 = m->cap_c;
+        wb_cshape *sh = wb__grow(m->c_shape, &cap, m->nc + 1, sizeof *sh);
+        if (!sh) { *status = WB_ERR_NOMEM; return none; }
+        m->c_shape = sh;
+        uint32_t *gen = wb__grow(m->c_gen, &cap2, m->nc + 1, sizeof *gen);
+        if (!gen) { *status = WB_ERR_NOMEM; return none; }
+        m->c_gen = gen;
+        wb_collider_pose *po = wb__grow(w->s.c_pose, &cap3, m->nc + 1, sizeof *po);
+        if (!po) { *status = WB_ERR_NOMEM; return none; }
+        w->s.c_pose = po;
+        m->cap_c = cap;
+        slot = m->nc++;
+        m->c_gen[slot] = 0;
+    }
+    wb_cshape *s = &m->c_shape[slot];
+    wb_collider_pose *p = &w->s.c_pose[slot];
+    memset(s, 0, sizeof *s);
+    memset(p, 0, sizeof *p);
+    s->shape = def->shape;
+    s->friction = def->friction;
+    s->restitution = def->restitution;
+    p->q[0] = 1;
+    switch (def->shape) {
+    case WB_SHAPE_PLANE: {
+        wb_real n = v3_len(def->normal);
+        v3_scale(s->n, def->normal, 1 / n);
+        v3_scale(p->p, s->n, def->offset / n); /* the plane passes through its position */
+        break;
+    }
+    case WB_SHAPE_SPHERE:
+        s->radius = def->radius;
+        v3_copy(p->p, def->center);
+        break;
+    case WB_SHAPE_BOX:
+        v3_copy(s->half, def->half);
+        v3_copy(p->p, def->center);
+        memcpy(p->q, def->rotation, sizeof p->q);
+        q_normalize(p->q);
+        break;
+    case WB_SHAPE_CAPSULE: {
+        s->radius = def->radius;
+        wb_real c[3] = { (def->a[0] + def->b[0]) / 2, (def->a[1] + def->b[1]) / 2, (def->a[2] + def->b[2]) / 2 };
+        v3_copy(p->p, c);
+        v3_sub(s->a, def->a, c);
+        v3_sub(s->b, def->b, c);
+        break;
+    }
+    default:
+        break;
+    }
+    v3_copy(p->p0, p->p);
+    memcpy(p->q0, p->q, sizeof p->q);
+    m->c_gen[slot]++;
+    *status = WB_OK;
+    wb_collider_id id = { (uint32_t)slot + 1, m->c_gen[slot] };
+    return id;
+}
+
+bool wb_collider_valid(const wb_world *w, wb_collider_id c)
+{
+    if (c.index == 0 || c.index > (uint32_t)w->m.nc) return false;
+    uint32_t g = w->m.c_gen[c.index - 1];
+    return (g & 1u) && g == c.gen;
+}
+
+#define CSLOT(w, c) (assert(wb_collider_valid((w), (c))), (int32_t)(c).index - 1)
+
+void wb_collider_remove(wb_world *w, wb_collider_id c) { w->m.c_gen[CSLOT(w, c)]++; }
+wb_shape wb_collider_shape(const wb_world *w, wb_collider_id c) { return w->m.c_shape[CSLOT(w, c)].shape; }
+
+void wb_collider_set_position(wb_world *w, wb_collider_id c, const wb_real p[3]) { v3_copy(w->s.c_pose[CSLOT(w, c)].p, p); }
+void wb_collider_set_velocity(wb_world *w, wb_collider_id c, const wb_real v[3]) { v3_copy(w->s.c_pose[CSLOT(w, c)].v, v); }
+void wb_collider_set_angular_velocity(wb_world *w, wb_collider_id c, const wb_real om[3]) { v3_copy(w->s.c_pose[CSLOT(w, c)].om, om); }
+void wb_collider_position(const wb_world *w, wb_collider_id c, wb_real out[3]) { v3_copy(out, w->s.c_pose[CSLOT(w, c)].p); }
+void wb_collider_rotation(const wb_world *w, wb_collider_id c, wb_real out[4]) { memcpy(out, w->s.c_pose[CSLOT(w, c)].q, 4 * sizeof(wb_real)); }
+void wb_collider_velocity(const wb_world *w, wb_collider_id c, wb_real out[3]) { v3_copy(out, w->s.c_pose[CSLOT(w, c)].v); }
+
+void wb_collider_set_rotation(wb_world *w, wb_collider_id c, const wb_real q[4])
+{
+    wb_real *t = w->s.c_pose[CSLOT(w, c)].q;
+    memcpy(t, q, 4 * sizeof(wb_real));
+    q_normalize(t);
+}
+
+void wb_collider_get_def(const wb_world *w, wb_collider_id c, wb_collider_def *out)
+{
+    int32_t i = CSLOT(w, c);
+    const wb_cshape *s = &w->m.c_shape[i];
+    const wb_collider_pose *p = &w->s.c_pose[i];
+    *out = wb_collider_default_def(s->shape);
+    out->friction = s->friction;
+    out->restitution = s->restitution;
+    out->radius = s->radius;
+    v3_copy(out->half, s->half);
+    v3_copy(out->center, p->p);
+    memcpy(out->rotation, p->q, sizeof out->rotation);
+    q_rotate(p->q, s->n, out->normal);
+    out->offset = v3_dot(out->normal, p->p);
+    q_rotate(p->q, s->a, out->a);
+    v3_add(out->a, out->a, p->p);
+    q_rotate(p->q, s->b, out->b);
+    v3_add(out->b, out->b, p->p);
+}
+
+int32_t wb_collider_count(const wb_world *w)
+{
+    int32_t n = 0;
+    for (int32_t i = 0; i < w->m.nc; i++) n += (int32_t)(w->m.c_gen[i] & 1u);
+    return n;
+}
+
+wb_collider_id wb_collider_at(const wb_world *w, int32_t i)
+{
+    for (int32_t s = 0; s < w->m.nc; s++) {
+        if (!(w->m.c_gen[s] & 1u)) continue;
+        if (i-- == 0) { wb_collider_id id = { (uint32_t)s + 1, w->m.c_gen[s] }; return id; }
+    }
+    wb_collider_id none = { 0, 0 };
+    return none;
+}
+
+/* ---- signed distances ------------------------------------------------------------------ */
+/* distance from x (world) to the surface of shape s at pose (p, q); n: outward unit normal */
+wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real q[4],
+                           const wb_real x[3], wb_real n[3])
+{
+    wb_real r[3], l[3], nl[3];
+    v3_sub(r, x, p);
+    q_rotate_inv(q, r, l);
+    wb_real dist;
+    switch (s->shape) {
+    case WB_SHAPE_PLANE:
+        v3_copy(nl, s->n);
+        dist = v3_dot(l, s->n);
+        break;
+    case WB_SHAPE_SPHERE: {
+        wb_real len = v3_len(l);
+        if (len > 0) v3_scale(nl, l, 1 / len);
+        else v3_set(nl, 0, 1, 0);
+        dist = len - s->radius;
+        break;
+    }
+    case WB_SHAPE_CAPSULE: {
+        wb_real ab[3], al[3], c[3];
+        v3_sub(ab, s->b, s->a);
+        v3_sub(al, l, s->a);
+        wb_real ll = v3_dot(ab, ab), t = ll > 0 ? clampr(v3_dot(al, ab) / ll, 0, 1) : 0;
+        v3_copy(c, s->a);
+        v3_madd(c, ab, t);
+        v3_sub(c, l, c);
+        wb_real len = v3_len(c);
+        if (len > 0) v3_scale(nl, c, 1 / len);
+        else v3_set(nl, 0, 1, 0);
+        dist = len - s->radius;
+        break;
+    }
+    case WB_SHAPE_BOX: {
+        wb_real d[3], o[3] = { 0, 0, 0 };
+        int inside = 1;
+        for (int i = 0; i < 3; i++) {
+            d[i] = fabs(l[i]) - s->half[i];
+            if (d[i] > 0) { o[i] = l[i] > 0 ? d[i] : -d[i]; inside = 0; }
+        }
+        if (!inside) {
+            dist = v3_len(o);
+            v3_scale(nl, o, 1 / dist);
+        } else {
+            /* nearest face */
+            int k = d[0] > d[1] ? (d[0] > d[2] ? 0 : 2) : (d[1] > d[2] ? 1 : 2);
+            v3_set(nl, 0, 0, 0);
+            nl[k] = l[k] >= 0 ? 1 : -1;
+            dist = d[k];
+        }
+        break;
+    }
+    default:
+        v3_set(nl, 0, 1, 0);
+        dist = INFINITY;
+        break;
+    }
+    q_rotate(q, nl, n);
+    return dist;
+}
+
+void wb__collider_pose_at(const wb_collider_pose *cp, wb_real t, wb_real p[3], wb_real q[4])
+{
+    for (int i = 0; i < 3; i++) p[i] = cp->p0[i] + (cp->p[i] - cp->p0[i]) * t;
+    q_slerp(cp->q0, cp->q, t, q);
+}
+
+wb_real wb_collider_distance(const wb_world *w, wb_collider_id c, const wb_real x[3])
+{
+    int32_t i = CSLOT(w, c);
+    wb_real n[3];
+    return wb__shape_distance(&w->m.c_shape[i], w->s.c_pose[i].p, w->s.c_pose[i].q, x, n);
+}
+
+/* ---- projection ------------------------------------------------------------------------- */
+/* push every movable particle out of every collider at the substep's end pose; record
+ * the contacts for the velocity pass */
+void wb__collide(wb_world *w, wb_real h, wb_real f0, wb_real f1, wb_real dt)
+{
+    (void)dt;
+    wb_model *m = &w->m;
+    wb_cache *k = &w->k;
+    k->ncontacts = 0;
+    if (m->nc == 0) { k->last_contacts = 0; return; }
+    wb_real *sub = wb__grow(k->c_sub, &k->cap_c_sub, 14 * m->nc, sizeof(wb_real));
+    if (!sub) { wb__warn(w, "out of memory in collision"); return; }
+    k->c_sub = sub;
+    for (int32_t c = 0; c < m->nc; c++) {
+        if (!(m->c_gen[c] & 1u)) continue;
+        wb__collider_pose_at(&w->s.c_pose[c], f0, &sub[14 * c], &sub[14 * c + 3]);
+        wb__collider_pose_at(&w->s.c_pose[c], f1, &sub[14 * c + 7], &sub[14 * c + 10]);
+    }
+    wb_real *x = w->s.x;
+    const wb_real *xp = w->s.x_prev, *v = w->s.v;
+    for (int32_t i = 0; i < m->np; i++) {
+        if (m->w[i] == 0) continue;
+        wb_real *xi = &x[3 * i];
+        for (int32_t c = 0; c < m->nc; c++) {
+            if (!(m->c_gen[c] & 1u)) continue;
+            const wb_cshape *s = &m->c_shape[c];
+            const wb_real *p0 = &sub[14 * c], *q0 = &sub[14 * c + 3], *p1 = &sub[14 * c + 7], *q1 = &sub[14 * c + 10];
+            wb_real n[3];
+            wb_real dist = wb__shape_distance(s, p1, q1, xi, n);
+            wb_real depth = m->radius[i] - dist;
+            if (!(depth > 0)) continue;
+            v3_madd(xi, n, depth);
+            /* the surface point's motion over the substep, carried rigidly by the collider */
+            wb_real vc[3] = { 0, 0, 0 };
+            if (memcmp(p0, p1, 3 * sizeof(wb_real)) || memcmp(q0, q1, 4 * sizeof(wb_real))) {
+                wb_real r[3], l[3], x0[3];
+                v3_sub(r, xi, p1);
+                q_rotate_inv(q1, r, l);
+                q_rotate(q0, l, x0);
+                v3_add(x0, x0, p0);
+                v3_sub(vc, xi, x0);
+                v3_scale(vc, vc, 1 / h);
+            }
+            /* static friction: undo the tangential slip when it is within the cone */
+            if (s->friction > 0) {
+                wb_real slip[3];
+                v3_sub(slip, xi, &xp[3 * i]);
+                v3_madd(slip, vc, -h);
+                v3_madd(slip, n, -v3_dot(slip, n));
+                if (v3_len(slip) < s->friction * depth) v3_madd(xi, slip, -1);
+            }
+            wb_contact *ct = wb__grow(k->contacts, &k->cap_contacts, k->ncontacts + 1, sizeof *ct);
+            if (!ct) { wb__warn(w, "out of memory recording contacts"); continue; }
+            k->contacts = ct;
+            ct = &k->contacts[k->ncontacts++];
+            ct->p = i;
+            ct->c = c;
+            v3_copy(ct->n, n);
+            ct->depth = depth;
+            v3_copy(ct->vc, vc);
+            wb_real rel[3];
+            v3_sub(rel, &v[3 * i], vc);
+            ct->vn_pre = v3_dot(rel, n);
+        }
+    }
+    k->last_contacts = k->ncontacts;
+}
+
+/* dynamic friction and restitution on the velocities the positions imply */
+void wb__collide_velocities(wb_world *w, wb_real h)
+{
+    wb_cache *k = &w->k;
+    const wb_real g = v3_len(w->m.def.gravity);
+    for (int32_t i = 0; i < k->ncontacts; i++) {
+        const wb_contact *ct = &k->contacts[i];
+        const wb_cshape *s = &w->m.c_shape[ct->c];
+        wb_real *v = &w->s.v[3 * ct->p], rel[3], vt[3];
+        v3_sub(rel, v, ct->vc);
+        const wb_real vn = v3_dot(rel, ct->n);
+        v3_copy(vt, rel);
+        v3_madd(vt, ct->n, -vn);
+        const wb_real vt_len = v3_len(vt);
+        if (s->friction > 0 && vt_len > 0) {
+            wb_real dv = s->friction * ct->depth / h;
+            v3_madd(v, vt, -(dv < vt_len ? dv : vt_len) / vt_len);
+        }
+        if (ct->vn_pre < 0) {
+            /* no bounce below 2|g|h: resting contact must not jitter */
+            wb_real e = -ct->vn_pre > 2 * g * h ? s->restitution : 0;
+            v3_madd(v, ct->n, -e * ct->vn_pre - vn);
+        }
+    }
+}

@@ -1,0 +1,146 @@
+/* core.h: the world's internals, shared by the core files only.
+ *
+ * Model / state split (MuJoCo's mjModel / mjData): the model holds what a step does
+ * not change (masses, topology, compliances, collider shapes, colour batches); the
+ * state holds what it does (positions, velocities, plastic rest lengths, broken flags,
+ * collider poses, time). The step reads the model and writes the state; the solver
+ * cache (packed batches, multipliers, contacts) is scratch rebuilt from both. */
+#ifndef WB_CORE_H
+#define WB_CORE_H
+
+#include <math.h>
+#include <string.h>
+
+#include "wobble.h"
+
+/* ---- small vector helpers ---------------------------------------------------------- */
+static inline void v3_set(wb_real *o, wb_real x, wb_real y, wb_real z) { o[0] = x; o[1] = y; o[2] = z; }
+static inline void v3_copy(wb_real *o, const wb_real *a) { o[0] = a[0]; o[1] = a[1]; o[2] = a[2]; }
+static inline void v3_add(wb_real *o, const wb_real *a, const wb_real *b) { o[0] = a[0] + b[0]; o[1] = a[1] + b[1]; o[2] = a[2] + b[2]; }
+static inline void v3_sub(wb_real *o, const wb_real *a, const wb_real *b) { o[0] = a[0] - b[0]; o[1] = a[1] - b[1]; o[2] = a[2] - b[2]; }
+static inline void v3_scale(wb_real *o, const wb_real *a, wb_real s) { o[0] = a[0] * s; o[1] = a[1] * s; o[2] = a[2] * s; }
+static inline void v3_madd(wb_real *o, const wb_real *a, wb_real s) { o[0] += a[0] * s; o[1] += a[1] * s; o[2] += a[2] * s; }
+static inline wb_real v3_dot(const wb_real *a, const wb_real *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static inline wb_real v3_len(const wb_real *a) { return sqrt(v3_dot(a, a)); }
+static inline void v3_cross(wb_real *o, const wb_real *a, const wb_real *b)
+{
+    wb_real x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2], z = a[0] * b[1] - a[1] * b[0];
+    o[0] = x; o[1] = y; o[2] = z;
+}
+static inline wb_real clampr(wb_real x, wb_real lo, wb_real hi) { return x < lo ? lo : x > hi ? hi : x; }
+
+/* quaternions (w, x, y, z) */
+void q_normalize(wb_real q[4]);
+void q_rotate(const wb_real q[4], const wb_real v[3], wb_real out[3]);      /* q v q* */
+void q_rotate_inv(const wb_real q[4], const wb_real v[3], wb_real out[3]);  /* q* v q */
+void q_slerp(const wb_real a[4], const wb_real b[4], wb_real t, wb_real out[4]);
+void q_integrate(const wb_real q[4], const wb_real om[3], wb_real h, wb_real out[4]);
+
+/* ---- model ----------------------------------------------------------------------- */
+typedef struct wb_cshape {
+    wb_shape shape;
+    wb_real n[3];          /* plane: unit normal in the collider frame */
+    wb_real radius;        /* sphere, capsule */
+    wb_real half[3];       /* box */
+    wb_real a[3], b[3];    /* capsule segment in the collider frame */
+    wb_real friction, restitution;
+} wb_cshape;
+
+typedef struct wb_model {
+    wb_world_def def;
+
+    int32_t np, cap_p;
+    wb_real *inv_mass;     /* (np) as created; 0 = immovable */
+    wb_real *w;            /* (np) what the solver uses: 0 while pinned */
+    wb_real *radius;       /* (np) */
+    uint8_t *pinned;       /* (np) */
+
+    /* distance constraints by slot; a slot is live while d_gen is odd */
+    int32_t nd, cap_d, nd_live;
+    int32_t *d_ij;         /* (nd x 2) particles */
+    wb_real *d_alpha;      /* (nd) compliance */
+    wb_real *d_beta;       /* (nd) damping */
+    wb_real *d_yield, *d_creep, *d_break; /* (nd) plasticity and breaking */
+    uint32_t *d_gen;       /* (nd) generation: odd = live */
+    int32_t *d_free;       /* free slots (stack) */
+    int32_t nfree;
+
+    /* colliders by slot */
+    int32_t nc, cap_c;
+    wb_cshape *c_shape; /* (nc) */
+    uint32_t *c_gen;       /* (nc) odd = live */
+
+    int topology_dirty;    /* colour batches must be rebuilt */
+} wb_model;
+
+/* ---- state ----------------------------------------------------------------------- */
+typedef struct wb_collider_pose {
+    wb_real p[3], q[4];    /* pose now (set by the script, reached at the end of the next step) */
+    wb_real p0[3], q0[4];  /* pose at the end of the last step: start of the next sweep */
+    wb_real v[3], om[3];   /* velocities the script set */
+} wb_collider_pose;
+
+typedef struct wb_state {
+    wb_real *x, *x_prev, *v; /* (np x 3) */
+    wb_real *d_rest;       /* (nd) rest lengths (plastic flow changes them) */
+    uint8_t *d_broken;     /* (nd) */
+    wb_collider_pose *c_pose; /* (nc) */
+    double time;
+    int64_t frame;
+    int64_t warnings;
+    char last_warning[160];
+} wb_state;
+
+/* ---- solver cache: packed colour batches and per-step scratch ------------------------ */
+typedef struct wb_contact {
+    int32_t p, c;          /* particle, collider slot */
+    wb_real n[3];          /* unit normal, out of the collider */
+    wb_real depth;         /* correction applied along n this substep */
+    wb_real vc[3];         /* collider surface velocity at the contact */
+    wb_real vn_pre;        /* normal velocity relative to the surface before the solve */
+} wb_contact;
+
+typedef struct wb_cache {
+    int32_t ns;            /* packed constraints (live and not broken) */
+    int32_t ncolours;
+    int32_t *colour_start; /* (ncolours + 1) batch ranges */
+    int32_t serial_start;  /* batches from here on are projected serially (overflow colours) */
+    int32_t *s_a, *s_b;    /* (ns) particles */
+    wb_real *s_rest, *s_alpha, *s_beta; /* (ns) */
+    wb_real *s_lambda;     /* (ns) multipliers of the current substep */
+    int32_t *s_slot;       /* (ns) constraint slot of each packed entry */
+    int32_t *slot_pack;    /* (nd) packed index of each slot, -1 when not packed */
+    int any_damping;
+    wb_real *dx;           /* (np x 3) Jacobi accumulators */
+    int32_t *ncount;       /* (np) Jacobi: constraints per particle */
+    wb_real *x_save, *v_save; /* (np x 3) last finite frame, for recovery */
+    wb_real *c_sub;        /* (nc x 14) collider poses at the substep's start and end */
+    int32_t cap_c_sub;
+    wb_contact *contacts;
+    int32_t ncontacts, cap_contacts;
+    wb_distance_id *breaks;
+    int32_t nbreaks, cap_breaks;
+    int32_t last_contacts;
+    int64_t projections;
+    double step_ms, solve_ms;
+} wb_cache;
+
+struct wb_world {
+    wb_model m;
+    wb_state s;
+    wb_cache k;
+};
+
+/* internal entry points */
+wb_status wb__colour(wb_world *w);                 /* colour.c: rebuild batches if dirty */
+void wb__collide(wb_world *w, wb_real h, wb_real t0, wb_real t1, wb_real dt); /* collide.c */
+void wb__collide_velocities(wb_world *w, wb_real h);
+void wb__collider_pose_at(const wb_collider_pose *cp, wb_real t, wb_real p[3], wb_real q[4]);
+wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real q[4],
+                           const wb_real x[3], wb_real n[3]);
+wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra); /* world.c */
+void *wb__grow(void *ptr, int32_t *cap, int32_t need, size_t elem); /* world.c: realloc helper */
+void wb__set_error(const char *fmt, ...);
+void wb__warn(wb_world *w, const char *fmt, ...);
+
+#endif

@@ -1,0 +1,125 @@
+/* query.c: read-only measures of a world: energy, momenta, bounds, strain, hash, stats. */
+#include "core.h"
+
+static wb_real mass_of(const wb_world *w, int32_t i) { return w->m.w[i] > 0 ? 1 / w->m.w[i] : 0; }
+
+static int live(const wb_world *w, int32_t s) { return (w->m.d_gen[s] & 1u) && !w->s.d_broken[s]; }
+
+static wb_real slot_length(const wb_world *w, int32_t s)
+{
+    wb_real d[3];
+    v3_sub(d, &w->s.x[3 * w->m.d_ij[2 * s + 1]], &w->s.x[3 * w->m.d_ij[2 * s]]);
+    return v3_len(d);
+}
+
+void wb_world_energy(const wb_world *w, wb_real *kinetic, wb_real *potential)
+{
+    /* pinned and immovable particles do not move: they carry no energy that changes */
+    wb_real ke = 0, pe = 0;
+    const wb_real *g = w->m.def.gravity;
+    for (int32_t i = 0; i < w->m.np; i++) {
+        wb_real m = mass_of(w, i);
+        if (m == 0) continue;
+        ke += (wb_real)0.5 * m * v3_dot(&w->s.v[3 * i], &w->s.v[3 * i]);
+        pe -= m * v3_dot(g, &w->s.x[3 * i]);
+    }
+    /* elastic: U = C^2 / (2 alpha) for compliant constraints (alpha = 1/k) */
+    for (int32_t s = 0; s < w->m.nd; s++) {
+        if (!live(w, s) || w->m.d_alpha[s] <= 0) continue;
+        wb_real c = slot_length(w, s) - w->s.d_rest[s];
+        pe += c * c / (2 * w->m.d_alpha[s]);
+    }
+    *kinetic = ke;
+    *potential = pe;
+}
+
+void wb_world_momentum(const wb_world *w, wb_real out[3])
+{
+    v3_set(out, 0, 0, 0);
+    for (int32_t i = 0; i < w->m.np; i++) v3_madd(out, &w->s.v[3 * i], mass_of(w, i));
+}
+
+void wb_world_angular_momentum(const wb_world *w, wb_real out[3])
+{
+    v3_set(out, 0, 0, 0);
+    for (int32_t i = 0; i < w->m.np; i++) {
+        wb_real l[3];
+        v3_cross(l, &w->s.x[3 * i], &w->s.v[3 * i]);
+        v3_madd(out, l, mass_of(w, i));
+    }
+}
+
+bool wb_world_bounds(const wb_world *w, wb_real mn[3], wb_real mx[3])
+{
+    if (w->m.np == 0) return false;
+    v3_copy(mn, w->s.x);
+    v3_copy(mx, w->s.x);
+    for (int32_t i = 1; i < w->m.np; i++)
+        for (int c = 0; c < 3; c++) {
+            wb_real x = w->s.x[3 * i + c];
+            if (x < mn[c]) mn[c] = x;
+            if (x > mx[c]) mx[c] = x;
+        }
+    return true;
+}
+
+wb_real wb_world_max_strain(const wb_world *w)
+{
+    wb_real best = 0;
+    for (int32_t s = 0; s < w->m.nd; s++) {
+        if (!live(w, s) || w->s.d_rest[s] <= 0) continue;
+        wb_real e = fabs(slot_length(w, s) - w->s.d_rest[s]) / w->s.d_rest[s];
+        if (e > best) best = e;
+    }
+    return best;
+}
+
+/* FNV-1a over the bytes of the state: bit-identical states, identical hashes */
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++) { h ^= b[i]; h *= 1099511628211ull; }
+    return h;
+}
+
+uint64_t wb_world_hash(const wb_world *w)
+{
+    const wb_model *m = &w->m;
+    const wb_state *s = &w->s;
+    uint64_t h = 14695981039346656037ull;
+    h = fnv(h, &m->np, sizeof m->np);
+    h = fnv(h, s->x, sizeof(wb_real) * 3 * (size_t)m->np);
+    h = fnv(h, s->v, sizeof(wb_real) * 3 * (size_t)m->np);
+    h = fnv(h, m->pinned, (size_t)m->np);
+    for (int32_t i = 0; i < m->nd; i++) {
+        if (!(m->d_gen[i] & 1u)) continue;
+        h = fnv(h, &s->d_rest[i], sizeof s->d_rest[i]);
+        h = fnv(h, &s->d_broken[i], 1);
+    }
+    for (int32_t c = 0; c < m->nc; c++) {
+        if (!(m->c_gen[c] & 1u)) continue;
+        h = fnv(h, s->c_pose[c].p, sizeof s->c_pose[c].p);
+        h = fnv(h, s->c_pose[c].q, sizeof s->c_pose[c].q);
+    }
+    h = fnv(h, &s->time, sizeof s->time);
+    h = fnv(h, &s->frame, sizeof s->frame);
+    return h;
+}
+
+wb_stats wb_world_stats(const wb_world *w)
+{
+    wb_stats st;
+    memset(&st, 0, sizeof st);
+    st.particles = w->m.np;
+    st.distances = w->m.nd_live;
+    for (int32_t s = 0; s < w->m.nd; s++)
+        if ((w->m.d_gen[s] & 1u) && w->s.d_broken[s]) st.broken++;
+    st.colliders = wb_collider_count(w);
+    st.colours = w->k.ncolours;
+    st.contacts = w->k.last_contacts;
+    st.projections = w->k.projections;
+    st.step_ms = w->k.step_ms;
+    st.solve_ms = w->k.solve_ms;
+    st.warnings = w->s.warnings;
+    return st;
+}

@@ -1,0 +1,227 @@
+/* solver.c: the step (Macklin et al. 2019, "Small steps in physics simulation").
+ *
+ * Per frame, `substeps` times: predict, project the constraints `iterations` times
+ * (XPBD, Gauss-Seidel over colour batches or Jacobi), project collisions, update
+ * velocities, then friction and restitution at velocity level. Plastic flow, breaking
+ * and the finiteness check run once per frame. */
+#include <stdio.h>
+#include <time.h>
+
+#include "core.h"
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+/* Project the distance constraints [b, e) of the packed arrays (XPBD, Macklin et al.
+ * 2016 eq. 18 with the damping of eq. 26). With dx == NULL positions are updated in
+ * place (Gauss-Seidel); otherwise corrections accumulate into dx (Jacobi). The caller
+ * guarantees that no two constraints in [b, e) write the same particle when it runs
+ * the range in parallel. */
+static void project_distances(const wb_cache *k, const wb_real *restrict wv, wb_real *restrict x,
+                              const wb_real *restrict xp, wb_real *restrict dx, int32_t b, int32_t e,
+                              wb_real h, wb_real inv_h2)
+{
+    const int32_t *restrict sa = k->s_a, *restrict sb = k->s_b;
+    const wb_real *restrict rest = k->s_rest, *restrict alpha = k->s_alpha, *restrict beta = k->s_beta;
+    wb_real *restrict lambda = k->s_lambda;
+    wb_real *out = dx ? dx : x;
+    const int damping = k->any_damping;
+    for (int32_t i = b; i < e; i++) {
+        const int32_t a = 3 * sa[i], c = 3 * sb[i];
+        const wb_real wa = wv[a / 3], wc = wv[c / 3], wsum = wa + wc;
+        if (wsum == 0) continue;
+        const wb_real d0 = x[c] - x[a], d1 = x[c + 1] - x[a + 1], d2 = x[c + 2] - x[a + 2];
+        const wb_real len2 = d0 * d0 + d1 * d1 + d2 * d2;
+        if (len2 < (wb_real)1e-24) continue; /* coincident: no direction to push along */
+        const wb_real len = sqrt(len2), inv_len = 1 / len;
+        const wb_real at = alpha[i] * inv_h2;
+        wb_real num = rest[i] - len - at * lambda[i];
+        wb_real den = wsum + at;
+        if (damping && beta[i] > 0 && at > 0) {
+            /* gamma = alpha~ beta~ / h with beta~ = h^2 beta */
+            const wb_real gamma = at * beta[i] * h;
+            const wb_real rel = ((x[c] - xp[c]) - (x[a] - xp[a])) * d0 + ((x[c + 1] - xp[c + 1]) - (x[a + 1] - xp[a + 1])) * d1 +
+                                ((x[c + 2] - xp[c + 2]) - (x[a + 2] - xp[a + 2])) * d2;
+            num -= gamma * rel * inv_len;
+            den += gamma * wsum;
+        }
+        const wb_real dl = num / den;
+        lambda[i] += dl;
+        const wb_real s = dl * inv_len;
+        out[a] -= wa * s * d0; out[a + 1] -= wa * s * d1; out[a + 2] -= wa * s * d2;
+        out[c] += wc * s * d0; out[c + 1] += wc * s * d1; out[c + 2] += wc * s * d2;
+    }
+}
+
+/* one pass over every batch; batches before serial_start are conflict-free */
+static void project_batches(wb_world *w, wb_real *dx, wb_real h, wb_real inv_h2)
+{
+    wb_cache *k = &w->k;
+    const int threads = w->m.def.threads;
+    for (int32_t c = 0; c < k->ncolours; c++) {
+        const int32_t b = k->colour_start[c], e = k->colour_start[c + 1];
+        if (c >= k->serial_start || threads == 1 || e - b < 512) {
+            project_distances(k, w->m.w, w->s.x, w->s.x_prev, dx, b, e, h, inv_h2);
+            continue;
+        }
+        /* split the batch into contiguous chunks, one per thread: disjoint writes */
+        #pragma omp parallel for num_threads(threads) schedule(static)
+        for (int t = 0; t < threads; t++) {
+            const int32_t n = e - b;
+            const int32_t lo = b + (int32_t)((int64_t)n * t / threads), hi = b + (int32_t)((int64_t)n * (t + 1) / threads);
+            project_distances(k, w->m.w, w->s.x, w->s.x_prev, dx, lo, hi, h, inv_h2);
+        }
+    }
+}
+
+static void solve_constraints(wb_world *w, wb_real h)
+{
+    wb_cache *k = &w->k;
+    const wb_world_def *d = &w->m.def;
+    const wb_real inv_h2 = 1 / (h * h);
+    const int32_t np = w->m.np;
+    for (int it = 0; it < d->iterations; it++) {
+        if (d->solver == WB_SOLVER_GAUSS_SEIDEL) {
+            project_batches(w, NULL, h, inv_h2);
+            continue;
+        }
+        /* Jacobi: every correction from the same positions, averaged per particle
+         * (Macklin et al. 2014) and over-relaxed by omega */
+        memset(k->dx, 0, sizeof(wb_real) * 3 * (size_t)np);
+        project_batches(w, k->dx, h, inv_h2);
+        const wb_real omega = d->relaxation;
+        for (int32_t i = 0; i < np; i++) {
+            if (k->ncount[i] == 0) continue;
+            const wb_real s = omega / k->ncount[i];
+            v3_madd(&w->s.x[3 * i], &k->dx[3 * i], s);
+        }
+    }
+    k->projections += (int64_t)k->ns * d->iterations;
+}
+
+static void predict(wb_world *w, wb_real h)
+{
+    const wb_world_def *d = &w->m.def;
+    const wb_real keep = d->damping > 0 ? (d->damping * h < 1 ? 1 - d->damping * h : 0) : 1;
+    const wb_real g0 = d->gravity[0] * h, g1 = d->gravity[1] * h, g2 = d->gravity[2] * h;
+    wb_real *restrict x = w->s.x, *restrict xp = w->s.x_prev, *restrict v = w->s.v;
+    const wb_real *restrict wv = w->m.w;
+    for (int32_t i = 0; i < w->m.np; i++) {
+        wb_real *xi = &x[3 * i], *vi = &v[3 * i];
+        v3_copy(&xp[3 * i], xi);
+        if (wv[i] == 0) continue;
+        vi[0] = (vi[0] + g0) * keep; vi[1] = (vi[1] + g1) * keep; vi[2] = (vi[2] + g2) * keep;
+        xi[0] += h * vi[0]; xi[1] += h * vi[1]; xi[2] += h * vi[2];
+    }
+}
+
+static void update_velocities(wb_world *w, wb_real h)
+{
+    const wb_real inv_h = 1 / h;
+    wb_real *restrict x = w->s.x, *restrict xp = w->s.x_prev, *restrict v = w->s.v;
+    const wb_real *restrict wv = w->m.w;
+    for (int32_t i = 0; i < 3 * w->m.np; i++)
+        v[i] = wv[i / 3] > 0 ? (x[i] - xp[i]) * inv_h : 0;
+}
+
+/* plastic flow and breaking, once per frame on the frame's final lengths */
+static void plasticity_and_breaking(wb_world *w)
+{
+    wb_model *m = &w->m;
+    wb_cache *k = &w->k;
+    const wb_real dt = m->def.dt;
+    for (int32_t i = 0; i < k->ns; i++) {
+        const int32_t s = k->s_slot[i];
+        if (m->d_break[s] <= 0 && m->d_yield[s] <= 0) continue;
+        wb_real d[3];
+        v3_sub(d, &w->s.x[3 * k->s_b[i]], &w->s.x[3 * k->s_a[i]]);
+        const wb_real len = v3_len(d), rest = k->s_rest[i];
+        if (rest <= 0) continue;
+        const wb_real strain = (len - rest) / rest;
+        if (m->d_break[s] > 0 && strain > m->d_break[s]) {
+            w->s.d_broken[s] = 1;
+            m->topology_dirty = 1;
+            wb_distance_id id = { (uint32_t)s + 1, m->d_gen[s] };
+            wb_distance_id *q = wb__grow(k->breaks, &k->cap_breaks, k->nbreaks + 1, sizeof *q);
+            if (q) { k->breaks = q; k->breaks[k->nbreaks++] = id; }
+            continue;
+        }
+        const wb_real a = fabs(strain), y = m->d_yield[s];
+        if (y > 0 && a > y) {
+            /* flow towards the current length by the part of the strain past yield */
+            const wb_real rate = m->d_creep[s] * dt < 1 ? m->d_creep[s] * dt : 1;
+            const wb_real r = rest + rate * (len - rest) * (a - y) / a;
+            k->s_rest[i] = r;
+            w->s.d_rest[s] = r;
+        }
+    }
+}
+
+/* non-finite values never propagate: restore the frame's start and report */
+static void check_finite(wb_world *w)
+{
+    const int32_t n = 3 * w->m.np;
+    const wb_real *x = w->s.x, *v = w->s.v;
+    for (int32_t i = 0; i < n; i++) {
+        if (isfinite(x[i]) && isfinite(v[i])) continue;
+        wb__warn(w, "frame %lld: particle %d became non-finite; its frame was undone (reduce dt, "
+                    "raise substeps or compliance)", (long long)w->s.frame, i / 3 + 1);
+        memcpy(w->s.x, w->k.x_save, sizeof(wb_real) * (size_t)n);
+        memcpy(w->s.x_prev, w->k.x_save, sizeof(wb_real) * (size_t)n);
+        memcpy(w->s.v, w->k.v_save, sizeof(wb_real) * (size_t)n);
+        return;
+    }
+}
+
+void wb_world_step(wb_world *w)
+{
+    const double t_begin = now_ms();
+    wb_cache *k = &w->k;
+    if (wb__colour(w) != WB_OK) {
+        wb__warn(w, "frame %lld: out of memory colouring the constraints; frame skipped", (long long)w->s.frame);
+        return;
+    }
+    const wb_world_def *d = &w->m.def;
+    const wb_real dt = d->dt, h = dt / d->substeps;
+    const int32_t np = w->m.np;
+    memcpy(k->x_save, w->s.x, sizeof(wb_real) * 3 * (size_t)np);
+    memcpy(k->v_save, w->s.v, sizeof(wb_real) * 3 * (size_t)np);
+    k->nbreaks = 0;
+    k->projections = 0;
+
+    /* kinematic colliders: where the script's velocities take them by the frame's end */
+    for (int32_t c = 0; c < w->m.nc; c++) {
+        if (!(w->m.c_gen[c] & 1u)) continue;
+        wb_collider_pose *cp = &w->s.c_pose[c];
+        v3_madd(cp->p, cp->v, dt);
+        q_integrate(cp->q, cp->om, dt, cp->q);
+    }
+
+    double solve = 0;
+    for (int sub = 0; sub < d->substeps; sub++) {
+        predict(w, h);
+        double t0 = now_ms();
+        memset(k->s_lambda, 0, sizeof(wb_real) * (size_t)k->ns);
+        solve_constraints(w, h);
+        solve += now_ms() - t0;
+        wb__collide(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps, dt);
+        update_velocities(w, h);
+        wb__collide_velocities(w, h);
+    }
+
+    for (int32_t c = 0; c < w->m.nc; c++) {
+        wb_collider_pose *cp = &w->s.c_pose[c];
+        v3_copy(cp->p0, cp->p);
+        memcpy(cp->q0, cp->q, sizeof cp->q);
+    }
+    plasticity_and_breaking(w);
+    w->s.frame++;
+    w->s.time += dt;
+    check_finite(w);
+    k->solve_ms = solve;
+    k->step_ms = now_ms() - t_begin;
+}

@@ -1,0 +1,357 @@
+/* world.c: world lifetime, settings, particles and distance constraints. */
+#include <assert.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "core.h"
+
+static _Thread_local char wb_err[256];
+
+void wb__set_error(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(wb_err, sizeof wb_err, fmt, ap);
+    va_end(ap);
+}
+
+const char *wb_last_error(void) { return wb_err; }
+
+void wb__warn(wb_world *w, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(w->s.last_warning, sizeof w->s.last_warning, fmt, ap);
+    va_end(ap);
+    w->s.warnings++;
+}
+
+int64_t wb_world_warnings(const wb_world *w) { return w->s.warnings; }
+const char *wb_world_last_warning(const wb_world *w) { return w->s.last_warning; }
+
+/* grow *ptr to hold need elements (doubling); NULL on failure, *ptr untouched */
+void *wb__grow(void *ptr, int32_t *cap, int32_t need, size_t elem)
+{
+    if (need <= *cap) return ptr;
+    int64_t c = *cap ? *cap : 16;
+    while (c < need) c *= 2;
+    void *q = realloc(ptr, (size_t)c * elem);
+    if (!q) return NULL;
+    *cap = (int32_t)c;
+    return q;
+}
+
+static int finite3(const wb_real *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
+/* ---- world ---------------------------------------------------------------------- */
+wb_world_def wb_world_default_def(void)
+{
+    wb_world_def d;
+    memset(&d, 0, sizeof d);
+    v3_set(d.gravity, 0, -9.81, 0);
+    d.dt = 1.0 / 60.0;
+    d.substeps = 10;
+    d.iterations = 1;
+    d.damping = 0;
+    d.solver = WB_SOLVER_GAUSS_SEIDEL;
+    d.relaxation = 1;
+    d.threads = 1;
+    return d;
+}
+
+const char *wb_world_def_check(const wb_world_def *d)
+{
+    if (!finite3(d->gravity)) return "gravity must be finite";
+    if (!(d->dt > 0) || !isfinite(d->dt) || d->dt > 10) return "dt must be in (0, 10] seconds";
+    if (d->substeps < 1 || d->substeps > WB_MAX_SUBSTEPS) return "substeps must be in 1..10000";
+    if (d->iterations < 1 || d->iterations > WB_MAX_ITERATIONS) return "iterations must be in 1..10000";
+    if (!(d->damping >= 0) || !isfinite(d->damping)) return "damping must be >= 0";
+    if (d->solver != WB_SOLVER_GAUSS_SEIDEL && d->solver != WB_SOLVER_JACOBI) return "unknown solver";
+    if (!(d->relaxation > 0 && d->relaxation < 2)) return "relaxation must be in (0, 2)";
+    if (d->threads < 1 || d->threads > WB_MAX_THREADS) return "threads must be in 1..256";
+    return NULL;
+}
+
+wb_world *wb_world_create(const wb_world_def *def)
+{
+    assert(wb_world_def_check(def) == NULL);
+    wb_world *w = calloc(1, sizeof *w);
+    if (!w) return NULL;
+    w->m.def = *def;
+    return w;
+}
+
+void wb_world_destroy(wb_world *w)
+{
+    if (!w) return;
+    wb_model *m = &w->m;
+    wb_state *s = &w->s;
+    wb_cache *k = &w->k;
+    void *ptrs[] = { m->inv_mass, m->w, m->radius, m->pinned, m->d_ij, m->d_alpha, m->d_beta,
+                     m->d_yield, m->d_creep, m->d_break, m->d_gen, m->d_free, m->c_shape, m->c_gen,
+                     s->x, s->x_prev, s->v, s->d_rest, s->d_broken, s->c_pose,
+                     k->colour_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda,
+                     k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->contacts, k->c_sub,
+                     k->breaks };
+    for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
+    free(w);
+}
+
+wb_world_def wb_world_get_def(const wb_world *w) { return w->m.def; }
+
+wb_status wb_world_set_def(wb_world *w, const wb_world_def *def)
+{
+    const char *err = wb_world_def_check(def);
+    if (err) { wb__set_error("%s", err); return WB_ERR_ARG; }
+    w->m.def = *def;
+    return WB_OK;
+}
+
+double wb_world_time(const wb_world *w) { return w->s.time; }
+int64_t wb_world_frame(const wb_world *w) { return w->s.frame; }
+
+/* ---- particles ------------------------------------------------------------------- */
+/* every per-particle array grows together; on failure nothing is lost */
+static wb_status grow_particles(wb_world *w, int32_t need)
+{
+    wb_model *m = &w->m;
+    if (need <= m->cap_p) return WB_OK;
+    if (need > WB_MAX_PARTICLES) return WB_ERR_LIMIT;
+    int32_t cap = m->cap_p ? m->cap_p : 64;
+    while (cap < need) cap = cap > WB_MAX_PARTICLES / 2 ? WB_MAX_PARTICLES : cap * 2;
+    struct { void **p; size_t elem; } arr[] = {
+        { (void **)&m->inv_mass, sizeof(wb_real) }, { (void **)&m->w, sizeof(wb_real) },
+        { (void **)&m->radius, sizeof(wb_real) }, { (void **)&m->pinned, 1 },
+        { (void **)&w->s.x, 3 * sizeof(wb_real) }, { (void **)&w->s.x_prev, 3 * sizeof(wb_real) },
+        { (void **)&w->s.v, 3 * sizeof(wb_real) }, { (void **)&w->k.dx, 3 * sizeof(wb_real) },
+        { (void **)&w->k.x_save, 3 * sizeof(wb_real) }, { (void **)&w->k.v_save, 3 * sizeof(wb_real) },
+        { (void **)&w->k.ncount, sizeof(int32_t) },
+    };
+    for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
+        void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
+        if (!q) return WB_ERR_NOMEM; /* arrays already grown are merely larger: still valid */
+        *arr[i].p = q;
+    }
+    m->cap_p = cap;
+    return WB_OK;
+}
+
+int32_t wb_particle_add(wb_world *w, const wb_real pos[3], const wb_real vel[3], wb_real mass, wb_real radius)
+{
+    assert(finite3(pos) && (!vel || finite3(vel)) && mass >= 0 && radius >= 0);
+    wb_model *m = &w->m;
+    wb_status st = grow_particles(w, m->np + 1);
+    if (st != WB_OK) return st;
+    int32_t i = m->np++;
+    m->inv_mass[i] = mass > 0 ? 1 / mass : 0;
+    m->w[i] = m->inv_mass[i];
+    m->radius[i] = radius;
+    m->pinned[i] = 0;
+    v3_copy(&w->s.x[3 * i], pos);
+    v3_copy(&w->s.x_prev[3 * i], pos);
+    if (vel && mass > 0) v3_copy(&w->s.v[3 * i], vel);
+    else v3_set(&w->s.v[3 * i], 0, 0, 0);
+    m->topology_dirty = 1; /* Jacobi counts and scratch sizes */
+    return i;
+}
+
+int32_t wb_particle_count(const wb_world *w) { return w->m.np; }
+const wb_real *wb_particle_positions(const wb_world *w) { return w->s.x; }
+
+#define CHECK_P(w, p) assert((p) >= 0 && (p) < (w)->m.np)
+
+void wb_particle_position(const wb_world *w, int32_t p, wb_real out[3]) { CHECK_P(w, p); v3_copy(out, &w->s.x[3 * p]); }
+void wb_particle_velocity(const wb_world *w, int32_t p, wb_real out[3]) { CHECK_P(w, p); v3_copy(out, &w->s.v[3 * p]); }
+wb_real wb_particle_mass(const wb_world *w, int32_t p) { CHECK_P(w, p); return w->m.inv_mass[p] > 0 ? 1 / w->m.inv_mass[p] : 0; }
+wb_real wb_particle_radius(const wb_world *w, int32_t p) { CHECK_P(w, p); return w->m.radius[p]; }
+bool wb_particle_pinned(const wb_world *w, int32_t p) { CHECK_P(w, p); return w->m.pinned[p] != 0; }
+
+void wb_particle_set_position(wb_world *w, int32_t p, const wb_real pos[3])
+{
+    CHECK_P(w, p);
+    assert(finite3(pos));
+    v3_copy(&w->s.x[3 * p], pos);
+    v3_copy(&w->s.x_prev[3 * p], pos);
+}
+
+void wb_particle_set_velocity(wb_world *w, int32_t p, const wb_real vel[3])
+{
+    CHECK_P(w, p);
+    assert(finite3(vel));
+    if (w->m.w[p] > 0) v3_copy(&w->s.v[3 * p], vel); /* an immovable particle keeps v = 0 */
+}
+
+void wb_particle_pin(wb_world *w, int32_t p, const wb_real *pos)
+{
+    CHECK_P(w, p);
+    if (pos) wb_particle_set_position(w, p, pos);
+    w->m.pinned[p] = 1;
+    w->m.w[p] = 0;
+    v3_set(&w->s.v[3 * p], 0, 0, 0);
+}
+
+void wb_particle_unpin(wb_world *w, int32_t p)
+{
+    CHECK_P(w, p);
+    w->m.pinned[p] = 0;
+    w->m.w[p] = w->m.inv_mass[p];
+}
+
+/* ---- distance constraints --------------------------------------------------------- */
+wb_distance_def wb_distance_default_def(void)
+{
+    wb_distance_def d = { 0, 0, -1, 0, 0, 0 };
+    return d;
+}
+
+const char *wb_distance_def_check(const wb_distance_def *d)
+{
+    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return "compliance must be >= 0";
+    if (!(d->damping >= 0) || !isfinite(d->damping)) return "damping must be >= 0";
+    if (!isfinite(d->rest)) return "rest must be finite";
+    if (!(d->yield >= 0) || !isfinite(d->yield)) return "yield must be >= 0";
+    if (!(d->creep >= 0) || !isfinite(d->creep)) return "creep must be >= 0";
+    if (!(d->break_strain >= 0) || !isfinite(d->break_strain)) return "break_strain must be >= 0";
+    return NULL;
+}
+
+static int slot_live(uint32_t gen) { return gen & 1u; }
+
+static wb_status grow_distances(wb_world *w, int32_t need)
+{
+    wb_model *m = &w->m;
+    if (need <= m->cap_d) return WB_OK;
+    if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    int32_t cap = m->cap_d ? m->cap_d : 64;
+    while (cap < need) cap = cap > WB_MAX_CONSTRAINTS / 2 ? WB_MAX_CONSTRAINTS : cap * 2;
+    struct { void **p; size_t elem; } arr[] = {
+        { (void **)&m->d_ij, 2 * sizeof(int32_t) }, { (void **)&m->d_alpha, sizeof(wb_real) },
+        { (void **)&m->d_beta, sizeof(wb_real) }, { (void **)&m->d_yield, sizeof(wb_real) },
+        { (void **)&m->d_creep, sizeof(wb_real) }, { (void **)&m->d_break, sizeof(wb_real) },
+        { (void **)&m->d_gen, sizeof(uint32_t) }, { (void **)&m->d_free, sizeof(int32_t) },
+        { (void **)&w->s.d_rest, sizeof(wb_real) }, { (void **)&w->s.d_broken, 1 },
+        { (void **)&w->k.slot_pack, sizeof(int32_t) },
+    };
+    for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
+        void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
+        if (!q) return WB_ERR_NOMEM; /* arrays already grown are merely larger */
+        *arr[i].p = q;
+    }
+    m->cap_d = cap;
+    return WB_OK;
+}
+
+/* room for np_extra more particles and nd_extra more constraints: after it succeeds,
+ * adding them cannot fail, so a builder never leaves half a body behind */
+wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra)
+{
+    if (w->m.np + np_extra > WB_MAX_PARTICLES || w->m.nd + nd_extra > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    wb_status st = grow_particles(w, w->m.np + (int32_t)np_extra);
+    if (st == WB_OK) st = grow_distances(w, w->m.nd + (int32_t)nd_extra);
+    return st;
+}
+
+wb_distance_id wb_distance_add(wb_world *w, int32_t a, int32_t b, const wb_distance_def *def, wb_status *status)
+{
+    wb_distance_id none = { 0, 0 };
+    wb_status dummy;
+    if (!status) status = &dummy;
+    const char *err = wb_distance_def_check(def);
+    if (err || a < 0 || b < 0 || a >= w->m.np || b >= w->m.np || a == b) {
+        wb__set_error("%s", err ? err : a == b ? "a constraint needs two distinct particles" : "particle out of range");
+        *status = WB_ERR_ARG;
+        return none;
+    }
+    wb_model *m = &w->m;
+    int32_t slot;
+    if (m->nfree > 0) {
+        slot = m->d_free[--m->nfree];
+    } else {
+        wb_status st = grow_distances(w, m->nd + 1);
+        if (st != WB_OK) { *status = st; return none; }
+        slot = m->nd++;
+        m->d_gen[slot] = 0;
+    }
+    const wb_real *xa = &w->s.x[3 * a], *xb = &w->s.x[3 * b];
+    wb_real d[3];
+    v3_sub(d, xb, xa);
+    m->d_ij[2 * slot] = a;
+    m->d_ij[2 * slot + 1] = b;
+    m->d_alpha[slot] = def->compliance;
+    m->d_beta[slot] = def->damping;
+    m->d_yield[slot] = def->yield;
+    m->d_creep[slot] = def->creep;
+    m->d_break[slot] = def->break_strain;
+    m->d_gen[slot]++; /* even -> odd: live */
+    w->s.d_rest[slot] = def->rest >= 0 ? def->rest : v3_len(d);
+    w->s.d_broken[slot] = 0;
+    w->k.slot_pack[slot] = -1;
+    m->nd_live++;
+    m->topology_dirty = 1;
+    *status = WB_OK;
+    wb_distance_id id = { (uint32_t)slot + 1, m->d_gen[slot] };
+    return id;
+}
+
+bool wb_distance_valid(const wb_world *w, wb_distance_id c)
+{
+    if (c.index == 0 || c.index > (uint32_t)w->m.nd) return false;
+    uint32_t g = w->m.d_gen[c.index - 1];
+    return slot_live(g) && g == c.gen;
+}
+
+#define SLOT(w, c) (assert(wb_distance_valid((w), (c))), (int32_t)(c).index - 1)
+
+void wb_distance_remove(wb_world *w, wb_distance_id c)
+{
+    int32_t s = SLOT(w, c);
+    w->m.d_gen[s]++; /* odd -> even: dead, old handles stale */
+    w->m.d_free[w->m.nfree++] = s;
+    w->m.nd_live--;
+    w->m.topology_dirty = 1;
+}
+
+wb_real wb_distance_force(const wb_world *w, wb_distance_id c)
+{
+    int32_t s = SLOT(w, c);
+    int32_t k = w->k.slot_pack[s];
+    if (k < 0 || w->m.topology_dirty) return 0;
+    wb_real h = w->m.def.dt / w->m.def.substeps;
+    return fabs(w->k.s_lambda[k]) / (h * h);
+}
+
+wb_real wb_distance_rest(const wb_world *w, wb_distance_id c) { return w->s.d_rest[SLOT(w, c)]; }
+bool wb_distance_broken(const wb_world *w, wb_distance_id c) { return w->s.d_broken[SLOT(w, c)] != 0; }
+
+wb_real wb_distance_length(const wb_world *w, wb_distance_id c)
+{
+    int32_t s = SLOT(w, c);
+    wb_real d[3];
+    v3_sub(d, &w->s.x[3 * w->m.d_ij[2 * s + 1]], &w->s.x[3 * w->m.d_ij[2 * s]]);
+    return v3_len(d);
+}
+
+void wb_distance_particles(const wb_world *w, wb_distance_id c, int32_t *a, int32_t *b)
+{
+    int32_t s = SLOT(w, c);
+    *a = w->m.d_ij[2 * s];
+    *b = w->m.d_ij[2 * s + 1];
+}
+
+int32_t wb_distance_count(const wb_world *w) { return w->m.nd_live; }
+
+wb_distance_id wb_distance_at(const wb_world *w, int32_t i)
+{
+    /* live slots in slot order: O(nd) scan, fine for inspection and export */
+    for (int32_t s = 0; s < w->m.nd; s++) {
+        if (!slot_live(w->m.d_gen[s])) continue;
+        if (i-- == 0) { wb_distance_id id = { (uint32_t)s + 1, w->m.d_gen[s] }; return id; }
+    }
+    wb_distance_id none = { 0, 0 };
+    return none;
+}
+
+/* ---- events --------------------------------------------------------------------------- */
+int32_t wb_world_break_count(const wb_world *w) { return w->k.nbreaks; }
+wb_distance_id wb_world_break_at(const wb_world *w, int32_t i) { assert(i >= 0 && i < w->k.nbreaks); return w->k.breaks[i]; }
