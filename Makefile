@@ -7,7 +7,7 @@ OPT     ?= -O2
 PKGS    := liblua5.4-dev libcjson-dev pkg-config
 PCMODS  := lua5.4 libcjson
 
-CFLAGS_BASE := -std=c11 $(OPT) -g -Wall -Wextra -Werror -fopenmp -D_GNU_SOURCE \
+CFLAGS_BASE := -std=c11 $(OPT) -g -Wall -Wextra -Werror -fopenmp -fno-math-errno -D_GNU_SOURCE \
                -DWB_ROOT='"$(CURDIR)"' -DWB_PREFIX='"$(PREFIX)"'
 CFLAGS  += $(CFLAGS_BASE) $(EXTRA_CFLAGS)
 LDFLAGS += -fopenmp $(EXTRA_LDFLAGS)

@@ -331,68 +331,77 @@ wb_real wb_collider_distance(const wb_world *w, wb_collider_id c, const wb_real 
 }
 
 /* ---- projection ------------------------------------------------------------------------- */
+/* one contact: push particle i out along n by depth, static friction, record it */
+static void resolve(wb_world *w, int32_t i, int32_t c, const wb_real n[3], wb_real depth, wb_real h,
+                    const wb_real *p0, const wb_real *q0, const wb_real *p1, const wb_real *q1, int moving)
+{
+    const wb_cshape *s = &w->m.c_shape[c];
+    wb_real *xi = &w->s.x[3 * i];
+    v3_madd(xi, n, depth);
+    /* the surface point's motion over the substep, carried rigidly by the collider */
+    wb_real vc[3] = { 0, 0, 0 };
+    if (moving) {
+        wb_real r[3], l[3], x0[3];
+        v3_sub(r, xi, p1);
+        q_rotate_inv(q1, r, l);
+        q_rotate(q0, l, x0);
+        v3_add(x0, x0, p0);
+        v3_sub(vc, xi, x0);
+        v3_scale(vc, vc, 1 / h);
+    }
+    /* static friction: undo the tangential slip when it is within the friction cone */
+    if (s->friction > 0) {
+        wb_real slip[3];
+        v3_sub(slip, xi, &w->s.x_prev[3 * i]);
+        v3_madd(slip, vc, -h);
+        v3_madd(slip, n, -v3_dot(slip, n));
+        if (v3_len(slip) < s->friction * depth) v3_madd(xi, slip, -1);
+    }
+    wb_contact *ct = &w->k.contacts[w->k.ncontacts++];
+    ct->p = i;
+    ct->c = c;
+    v3_copy(ct->n, n);
+    ct->depth = depth;
+    v3_copy(ct->vc, vc);
+    wb_real rel[3];
+    v3_sub(rel, &w->s.v[3 * i], vc);
+    ct->vn_pre = v3_dot(rel, n);
+}
+
 /* push every movable particle out of every collider at the substep's end pose; record
- * the contacts for the velocity pass */
+ * the contacts for the velocity pass. Collider by collider: a particle meets the
+ * colliders in the same order either way, and the plane's loop stays tight. */
 void wb__collide(wb_world *w, wb_real h, wb_real f0, wb_real f1, wb_real dt)
 {
     (void)dt;
     wb_model *m = &w->m;
     wb_cache *k = &w->k;
     k->ncontacts = 0;
-    if (m->nc == 0) { k->last_contacts = 0; return; }
-    wb_real *sub = wb__grow(k->c_sub, &k->cap_c_sub, 14 * m->nc, sizeof(wb_real));
-    if (!sub) { wb__warn(w, "out of memory in collision"); return; }
-    k->c_sub = sub;
+    const wb_real *x = w->s.x, *wv = m->w, *rad = m->radius;
     for (int32_t c = 0; c < m->nc; c++) {
         if (!(m->c_gen[c] & 1u)) continue;
-        wb__collider_pose_at(&w->s.c_pose[c], f0, &sub[14 * c], &sub[14 * c + 3]);
-        wb__collider_pose_at(&w->s.c_pose[c], f1, &sub[14 * c + 7], &sub[14 * c + 10]);
-    }
-    wb_real *x = w->s.x;
-    const wb_real *xp = w->s.x_prev, *v = w->s.v;
-    for (int32_t i = 0; i < m->np; i++) {
-        if (m->w[i] == 0) continue;
-        wb_real *xi = &x[3 * i];
-        for (int32_t c = 0; c < m->nc; c++) {
-            if (!(m->c_gen[c] & 1u)) continue;
-            const wb_cshape *s = &m->c_shape[c];
-            const wb_real *p0 = &sub[14 * c], *q0 = &sub[14 * c + 3], *p1 = &sub[14 * c + 7], *q1 = &sub[14 * c + 10];
-            wb_real n[3];
-            wb_real dist = wb__shape_distance(s, p1, q1, xi, n);
-            wb_real depth = m->radius[i] - dist;
-            if (!(depth > 0)) continue;
-            v3_madd(xi, n, depth);
-            /* the surface point's motion over the substep, carried rigidly by the collider */
-            wb_real vc[3] = { 0, 0, 0 };
-            if (memcmp(p0, p1, 3 * sizeof(wb_real)) || memcmp(q0, q1, 4 * sizeof(wb_real))) {
-                wb_real r[3], l[3], x0[3];
-                v3_sub(r, xi, p1);
-                q_rotate_inv(q1, r, l);
-                q_rotate(q0, l, x0);
-                v3_add(x0, x0, p0);
-                v3_sub(vc, xi, x0);
-                v3_scale(vc, vc, 1 / h);
+        /* room for every particle touching this collider: no check in the loop */
+        wb_contact *ct = wb__grow(k->contacts, &k->cap_contacts, k->ncontacts + m->np, sizeof *ct);
+        if (!ct) { wb__warn(w, "out of memory recording contacts"); return; }
+        k->contacts = ct;
+        const wb_cshape *s = &m->c_shape[c];
+        wb_real p0[3], q0[4], p1[3], q1[4], n[3];
+        wb__collider_pose_at(&w->s.c_pose[c], f0, p0, q0);
+        wb__collider_pose_at(&w->s.c_pose[c], f1, p1, q1);
+        const int moving = memcmp(p0, p1, sizeof p0) || memcmp(q0, q1, sizeof q0);
+        if (s->shape == WB_SHAPE_PLANE) {
+            q_rotate(q1, s->n, n);
+            const wb_real off = v3_dot(n, p1);
+            for (int32_t i = 0; i < m->np; i++) {
+                const wb_real depth = rad[i] + off - v3_dot(n, &x[3 * i]);
+                if (depth > 0 && wv[i] > 0) resolve(w, i, c, n, depth, h, p0, q0, p1, q1, moving);
             }
-            /* static friction: undo the tangential slip when it is within the cone */
-            if (s->friction > 0) {
-                wb_real slip[3];
-                v3_sub(slip, xi, &xp[3 * i]);
-                v3_madd(slip, vc, -h);
-                v3_madd(slip, n, -v3_dot(slip, n));
-                if (v3_len(slip) < s->friction * depth) v3_madd(xi, slip, -1);
-            }
-            wb_contact *ct = wb__grow(k->contacts, &k->cap_contacts, k->ncontacts + 1, sizeof *ct);
-            if (!ct) { wb__warn(w, "out of memory recording contacts"); continue; }
-            k->contacts = ct;
-            ct = &k->contacts[k->ncontacts++];
-            ct->p = i;
-            ct->c = c;
-            v3_copy(ct->n, n);
-            ct->depth = depth;
-            v3_copy(ct->vc, vc);
-            wb_real rel[3];
-            v3_sub(rel, &v[3 * i], vc);
-            ct->vn_pre = v3_dot(rel, n);
+            continue;
+        }
+        for (int32_t i = 0; i < m->np; i++) {
+            if (wv[i] == 0) continue;
+            const wb_real depth = rad[i] - wb__shape_distance(s, p1, q1, &x[3 * i], n);
+            if (depth > 0) resolve(w, i, c, n, depth, h, p0, q0, p1, q1, moving);
         }
     }
     k->last_contacts = k->ncontacts;
