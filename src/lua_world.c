@@ -250,18 +250,58 @@ static int w_step(lua_State *L)
     return 0;
 }
 
-/* closes the progress bar of a w:run, on return or on error (a to-be-closed value) */
-#define WBL_PROGRESS "wobble.progress_guard"
-typedef struct progress_guard { int active; } progress_guard;
+/* the state of a w:run, kept on the stack so on_frame may yield (lua_callk); as a
+ * to-be-closed value it also ends the progress bar on return or on error */
+#define WBL_RUN "wobble.run_state"
+typedef struct run_state {
+    int active;          /* the progress bar is open */
+    int has_fn;          /* on_frame given (stack slot 3) */
+    int64_t n, done;
+} run_state;
 
-static int guard_close(lua_State *L)
+static int run_close(lua_State *L)
 {
-    progress_guard *g = (progress_guard *)luaL_checkudata(L, 1, WBL_PROGRESS);
-    if (g->active) {
-        g->active = 0;
+    run_state *r = (run_state *)luaL_checkudata(L, 1, WBL_RUN);
+    if (r->active) {
+        r->active = 0;
         wb_progress_end(L);
     }
     return 0;
+}
+
+/* the value on_frame returned (popped): `return false` stops the run */
+static bool run_stops(lua_State *L)
+{
+    bool stop = lua_isboolean(L, -1) && !lua_toboolean(L, -1);
+    lua_pop(L, 1);
+    return stop;
+}
+
+/* stack: 1 world, 2 options, 3 on_frame or nil, 4 run state */
+static int run_loop(lua_State *L, int status, lua_KContext ctx)
+{
+    run_state *r = (run_state *)lua_touserdata(L, 4);
+    (void)ctx;
+    if (status == LUA_YIELD && run_stops(L)) goto done; /* resumed after on_frame yielded */
+    while (r->done < r->n) {
+        wb_world *w = toworld(L); /* on_frame may have closed it */
+        wb_world_step(w);
+        r->done++;
+        wbl_after_frame(L, 1);
+        wb_progress_update(L, r->done);
+        if (r->has_fn) {
+            lua_pushvalue(L, 3);
+            lua_pushvalue(L, 1);
+            lua_pushinteger(L, (lua_Integer)wb_world_frame(w));
+            lua_pushnumber(L, wb_world_time(w));
+            lua_callk(L, 3, 1, 0, run_loop);
+            if (run_stops(L)) break;
+        }
+    }
+done:
+    lua_closeslot(L, 4);
+    lua_pushinteger(L, (lua_Integer)r->done);
+    return 1;
 }
 
 static const char *const run_keys[] = { "frames", "seconds", "on_frame", NULL };
@@ -289,37 +329,20 @@ static int w_run(lua_State *L)
     bool has_fn = !lua_isnil(L, -1);
     if (has_fn && !lua_isfunction(L, -1) && !luaL_getmetafield(L, -1, "__call"))
         wbl_fielderror(L, 2, "on_frame", "function expected, got %s", luaL_typename(L, -1));
-    lua_settop(L, 3); /* 3: on_frame or nil */
+    lua_settop(L, 3);
+    /* --frames N on the command line caps every run */
     wb_runtime *rt = wb_rt_get(L);
     if (rt && rt->frame_cap >= 0 && n > rt->frame_cap) n = rt->frame_cap;
 
-    progress_guard *g = (progress_guard *)lua_newuserdatauv(L, sizeof *g, 0); /* 4 */
-    g->active = 0;
-    luaL_setmetatable(L, WBL_PROGRESS);
+    run_state *r = (run_state *)lua_newuserdatauv(L, sizeof *r, 0);
+    memset(r, 0, sizeof *r);
+    luaL_setmetatable(L, WBL_RUN);
     lua_toclose(L, 4);
-    g->active = 1;
+    r->n = n;
+    r->has_fn = has_fn;
+    r->active = 1;
     wb_progress_begin(L, "run", n);
-    int64_t done = 0;
-    while (done < n) {
-        w = toworld(L); /* on_frame may have closed it */
-        wb_world_step(w);
-        done++;
-        wbl_after_frame(L, 1);
-        wb_progress_update(L, done);
-        if (has_fn) {
-            lua_pushvalue(L, 3);
-            lua_pushvalue(L, 1);
-            lua_pushinteger(L, (lua_Integer)wb_world_frame(w));
-            lua_pushnumber(L, wb_world_time(w));
-            lua_call(L, 3, 1);
-            bool stop = lua_isboolean(L, -1) && !lua_toboolean(L, -1); /* `return false` stops */
-            lua_pop(L, 1);
-            if (stop) break;
-        }
-    }
-    lua_closeslot(L, 4);
-    lua_pushinteger(L, (lua_Integer)done);
-    return 1;
+    return run_loop(L, LUA_OK, 0);
 }
 
 static int w_time(lua_State *L)
@@ -518,10 +541,10 @@ void wbl_open_world(lua_State *L)
     luaL_setfuncs(L, world_methods, 0);
     lua_setfield(L, -2, "__index");
     lua_pop(L, 1);
-    luaL_newmetatable(L, WBL_PROGRESS);
-    lua_pushcfunction(L, guard_close);
+    luaL_newmetatable(L, WBL_RUN);
+    lua_pushcfunction(L, run_close);
     lua_setfield(L, -2, "__close");
-    lua_pushcfunction(L, guard_close); /* a coroutine abandoned mid-run still ends its bar */
+    lua_pushcfunction(L, run_close); /* a coroutine abandoned mid-run still ends its bar */
     lua_setfield(L, -2, "__gc");
     lua_pop(L, 1);
 }
