@@ -6,11 +6,17 @@
 #include "lua_util.h"
 
 /* ---- the body table -------------------------------------------------------------- */
-void wbl_push_body(lua_State *L, int world_index, wb_body b, int32_t constraints)
+/* the body table and its particles array are allocated before the core builds, so
+ * a Lua memory error cannot leave particles the script has no body for */
+void wbl_body_begin(lua_State *L, int64_t count)
+{
+    lua_createtable(L, 0, 5);
+    lua_createtable(L, count > 0 && count <= WB_MAX_PARTICLES ? (int)count : 0, 0);
+}
+
+void wbl_body_end(lua_State *L, int world_index, wb_body b, int32_t constraints)
 {
     world_index = lua_absindex(L, world_index);
-    lua_createtable(L, 0, 5);
-    lua_createtable(L, b.count, 0);
     for (int32_t i = 0; i < b.count; i++) {
         lua_pushinteger(L, (lua_Integer)b.first + i + 1);
         lua_rawseti(L, -2, (lua_Integer)i + 1);
@@ -25,6 +31,13 @@ void wbl_push_body(lua_State *L, int world_index, wb_body b, int32_t constraints
     lua_pushvalue(L, world_index);
     lua_setfield(L, -2, "world");
     luaL_setmetatable(L, WBL_BODY);
+}
+
+void wbl_push_body(lua_State *L, int world_index, wb_body b, int32_t constraints)
+{
+    world_index = lua_absindex(L, world_index);
+    wbl_body_begin(L, b.count);
+    wbl_body_end(L, world_index, b, constraints);
 }
 
 /* push body.world and body.particles (at top-1, top); returns the world */
@@ -106,13 +119,14 @@ static int body_tostring(lua_State *L)
 
 /* ---- builders ------------------------------------------------------------------------- */
 /* run a builder, then push the body; the constraint count is the core's difference */
-#define BUILD(L, w, call, what)                                                     \
+#define BUILD(L, w, call, what, np)                                                 \
     do {                                                                            \
         wb_body b_;                                                                 \
+        wbl_body_begin(L, np);                                                      \
         int32_t nd0_ = wb_distance_count(w);                                        \
         wb_status st_ = call(w, &d, &b_);                                           \
         if (st_ != WB_OK) return wbl_status_error(L, 2, st_, what);                 \
-        wbl_push_body(L, 1, b_, wb_distance_count(w) - nd0_);                       \
+        wbl_body_end(L, 1, b_, wb_distance_count(w) - nd0_);                        \
         return 1;                                                                   \
     } while (0)
 
@@ -156,7 +170,7 @@ static int w_cloth(lua_State *L)
     if ((int64_t)d.res[0] * d.res[1] > WB_MAX_PARTICLES)
         return wbl_fielderror(L, 2, "res", "%d x %d particles is too many (limit %d)", d.res[0], d.res[1],
                               (int)WB_MAX_PARTICLES);
-    BUILD(L, w, wb_cloth, "cloth");
+    BUILD(L, w, wb_cloth, "cloth", (int64_t)d.res[0] * d.res[1]);
 }
 
 static const char *const rope_keys[] = {
@@ -175,7 +189,7 @@ static int w_rope(lua_State *L)
     read_mass_radius(L, &d.mass, &d.radius);
     wbl_read_link(L, 2, &d.link);
     check_link(L, &d.link);
-    BUILD(L, w, wb_rope, "rope");
+    BUILD(L, w, wb_rope, "rope", (int64_t)d.segments + 1);
 }
 
 static const char *const lattice_keys[] = {
@@ -202,7 +216,7 @@ static int w_lattice(lua_State *L)
     if ((int64_t)d.res[0] * d.res[1] * d.res[2] > WB_MAX_PARTICLES)
         return wbl_fielderror(L, 2, "res", "%d x %d x %d particles is too many (limit %d)", d.res[0], d.res[1],
                               d.res[2], (int)WB_MAX_PARTICLES);
-    BUILD(L, w, wb_lattice, "lattice");
+    BUILD(L, w, wb_lattice, "lattice", (int64_t)d.res[0] * d.res[1] * d.res[2]);
 }
 
 static const luaL_Reg body_methods[] = {

@@ -14,7 +14,7 @@ static const char *const shape_keys[WB_SHAPE_COUNT][8] = {
     [WB_SHAPE_CAPSULE] = { "shape", "a", "b", "radius", "friction", "restitution", NULL },
 };
 
-void wbl_push_collider(lua_State *L, int world_index, wb_collider_id id)
+wb_collider_id *wbl_push_collider(lua_State *L, int world_index, wb_collider_id id)
 {
     world_index = lua_absindex(L, world_index);
     wbl_collider *c = (wbl_collider *)lua_newuserdatauv(L, sizeof *c, 1);
@@ -22,6 +22,7 @@ void wbl_push_collider(lua_State *L, int world_index, wb_collider_id id)
     lua_pushvalue(L, world_index);
     lua_setiuservalue(L, -2, 1);
     luaL_setmetatable(L, WBL_COLLIDER);
+    return &c->id;
 }
 
 static wb_world *checkcollider(lua_State *L, int arg, wb_collider_id *id)
@@ -56,10 +57,11 @@ static int w_collider(lua_State *L)
     wbl_optreal(L, 2, "restitution", &d.restitution);
     const char *err = wb_collider_def_check(&d);
     if (err) return luaL_argerror(L, 2, err);
+    wb_collider_id none = { 0, 0 };
+    wb_collider_id *id = wbl_push_collider(L, 1, none); /* first: Lua may run out of memory */
     wb_status st = WB_OK;
-    wb_collider_id id = wb_collider_add(w, &d, &st);
+    *id = wb_collider_add(w, &d, &st);
     if (st != WB_OK) return wbl_status_error(L, 2, st, "collider");
-    wbl_push_collider(L, 1, id);
     return 1;
 }
 

@@ -5,7 +5,7 @@
 
 typedef struct wbl_distance { wb_distance_id id; } wbl_distance;
 
-void wbl_push_distance(lua_State *L, int world_index, wb_distance_id id)
+wb_distance_id *wbl_push_distance(lua_State *L, int world_index, wb_distance_id id)
 {
     world_index = lua_absindex(L, world_index);
     wbl_distance *c = (wbl_distance *)lua_newuserdatauv(L, sizeof *c, 1);
@@ -13,6 +13,7 @@ void wbl_push_distance(lua_State *L, int world_index, wb_distance_id id)
     lua_pushvalue(L, world_index);
     lua_setiuservalue(L, -2, 1);
     luaL_setmetatable(L, WBL_DISTANCE);
+    return &c->id;
 }
 
 /* the world of a live handle; raises for a removed constraint or a closed world */
@@ -47,10 +48,11 @@ static int w_distance(lua_State *L)
     }
     const char *err = wb_distance_def_check(&d);
     if (err) return luaL_argerror(L, 4, err);
+    wb_distance_id none = { 0, 0 };
+    wb_distance_id *id = wbl_push_distance(L, 1, none); /* first: Lua may run out of memory */
     wb_status st = WB_OK;
-    wb_distance_id id = wb_distance_add(w, a, b, &d, &st);
+    *id = wb_distance_add(w, a, b, &d, &st);
     if (st != WB_OK) return wbl_status_error(L, 4, st, "distance constraint");
-    wbl_push_distance(L, 1, id);
     return 1;
 }
 

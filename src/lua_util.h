@@ -77,9 +77,14 @@ void wbl_read_link(lua_State *L, int arg, wb_distance_def *d);
 int wbl_status_error(lua_State *L, int arg, wb_status st, const char *what);
 
 /* ---- handles and bodies ------------------------------------------------------------ */
-void wbl_push_distance(lua_State *L, int world_index, wb_distance_id id);
-void wbl_push_collider(lua_State *L, int world_index, wb_collider_id id);
-/* push a body table {particles, first, count, world, constraint_count} */
+/* push a handle of the world at world_index; returns where its id is kept, so a
+ * caller can push the handle before creating the object (no leak on memory error) */
+wb_distance_id *wbl_push_distance(lua_State *L, int world_index, wb_distance_id id);
+wb_collider_id *wbl_push_collider(lua_State *L, int world_index, wb_collider_id id);
+/* push a body table {particles, first, count, world, constraint_count}; or in two
+ * halves around the core's builder: begin allocates for `count` particles (pushes 2) */
 void wbl_push_body(lua_State *L, int world_index, wb_body b, int32_t constraints);
+void wbl_body_begin(lua_State *L, int64_t count);
+void wbl_body_end(lua_State *L, int world_index, wb_body b, int32_t constraints);
 
 #endif
