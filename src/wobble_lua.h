@@ -17,7 +17,7 @@ int luaopen_wobble(lua_State *L);   /* pushes the `wobble` table; registers ever
 typedef struct wb_runtime {
     const char *scene_dir;     /* folder of the scene script (absolute) */
     const char *out_dir;       /* --out, default "out" (absolute once created) */
-    const char *lib_dir;       /* folder holding wobble/*.lua */
+    const char *lib_dir;       /* folder holding wobble/<module>.lua */
     int unsafe;                /* --unsafe: no sandbox */
     int quiet;                 /* --quiet: no progress, no summaries */
     int threads;               /* --threads N, 0 when not given */
@@ -40,6 +40,17 @@ int wb_rt_budget_error(lua_State *L, const char *fmt, ...);
 /* called by the binding after every simulated frame (w:step, each frame of w:run):
  * checks the time budget (raises a budget error) and runs frame hooks (recording) */
 void wb_rt_after_frame(lua_State *L, int world_index);
+
+/* life cycle and helpers for main.c (and embedders) */
+lua_State *wb_rt_open(const wb_runtime *cfg); /* standard libraries, sandbox unless cfg->unsafe, budgets,
+                                                 `wobble` global + package.loaded, wobble.args = {};
+                                                 NULL (message on stderr) on failure */
+void wb_rt_close(lua_State *L);               /* lua_close + free the runtime */
+int wb_rt_budget_hit(lua_State *L);           /* 1 once a budget error was raised: exit code 3 */
+int wb_rt_msgh(lua_State *L);                 /* lua_pcall message handler: message (any value) + traceback */
+void wb_rt_add_frame_hook(lua_State *L, int index); /* wb_rt_after_frame calls the function at index(w) */
+const char *wb_rt_lib_dir(void);              /* the folder holding wobble/test.lua, or NULL */
+const char *wb_rt_project_root(void);         /* the source tree (tests/bench, assets), or NULL */
 
 /* ---- progress (progress.c): a bar on a terminal, silent otherwise or with --quiet ---- */
 void wb_progress_begin(lua_State *L, const char *what, int64_t total);

@@ -1,0 +1,77 @@
+#!/bin/sh
+# tests/run_all.sh BUILD_DIR: the whole suite behind `make test` and `make asan`.
+#   (a) BUILD_DIR/unit_tests                    C unit tests of the core
+#   (b) wobble test tests/scenarios tests/validation   Lua scenario and validation tests
+#   (c) every scripts/*.lua for 5 frames        one test per example scene (pass = exit 0)
+#   (d) tests/cli/run.sh                        the command line in separate processes
+# Each part prints its output and ends with "N passed, N failed"; a part that crashes
+# or prints no such line counts as a failure, never as zero tests. The last line is
+# the sum, "N passed, N failed"; the exit status is 1 when anything failed.
+BUILD=${1:-build}
+cd "$(dirname "$0")/.." || exit 2
+TMP=$(mktemp -d "${TMPDIR:-/tmp}/wobble-tests.XXXXXX") || exit 2
+trap 'rm -rf "$TMP"' EXIT
+trap 'exit 130' INT TERM
+total_pass=0 total_fail=0
+
+# part NAME COMMAND...: run COMMAND (output shown as it comes), add its summary line
+part() {
+    part_name=$1
+    shift
+    echo "== $part_name"
+    { "$@"; echo $? >"$TMP/rc"; } 2>&1 | tee "$TMP/log"
+    part_rc=$(cat "$TMP/rc" 2>/dev/null || echo 127)
+    part_last=$(tail -n 1 "$TMP/log")
+    part_p=$(echo "$part_last" | sed -n 's/^\([0-9][0-9]*\) passed, \([0-9][0-9]*\) failed$/\1/p')
+    part_f=$(echo "$part_last" | sed -n 's/^\([0-9][0-9]*\) passed, \([0-9][0-9]*\) failed$/\2/p')
+    if [ -z "$part_p" ]; then
+        echo "!! $part_name: no \"N passed, N failed\" line at the end (exit code $part_rc): one failure"
+        total_fail=$((total_fail + 1))
+        return
+    fi
+    total_pass=$((total_pass + part_p))
+    total_fail=$((total_fail + part_f))
+    if [ "$part_rc" -ne 0 ] && [ "$part_f" -eq 0 ]; then
+        echo "!! $part_name: exit code $part_rc although no test failed: one failure"
+        total_fail=$((total_fail + 1))
+    fi
+}
+
+# the example scenes, a few frames each; the time limit keeps a hung scene from
+# hanging the suite
+examples() {
+    ex_n=0 ex_p=0 ex_f=0
+    for ex in scripts/*.lua; do
+        [ -e "$ex" ] || continue
+        ex_n=$((ex_n + 1))
+        if "$BUILD/wobble" run "$ex" --frames 5 --quiet --time-limit 600 --out "$TMP/out-examples" \
+            >"$TMP/example.log" 2>&1; then
+            ex_p=$((ex_p + 1))
+            echo "ok $ex_n - $ex"
+        else
+            ex_rc=$?
+            ex_f=$((ex_f + 1))
+            echo "not ok $ex_n - $ex (exit code $ex_rc)"
+            sed 's/^/  # /' "$TMP/example.log"
+        fi
+    done
+    echo "$ex_p passed, $ex_f failed"
+}
+
+if [ -e "$BUILD/unit_tests" ]; then
+    part "C unit tests ($BUILD/unit_tests)" "$BUILD/unit_tests"
+else
+    echo "== C unit tests: $BUILD/unit_tests not built, skipped"
+fi
+
+lua_dirs=""
+for d in tests/scenarios tests/validation; do
+    [ -d "$d" ] && lua_dirs="$lua_dirs $d"
+done
+# shellcheck disable=SC2086  # the folder list is meant to split
+part "scenario and validation tests" "$BUILD/wobble" test --out "$TMP/out-tests" $lua_dirs
+part "example scenes (scripts/*.lua, 5 frames)" examples
+part "command line (tests/cli/run.sh)" sh tests/cli/run.sh "$BUILD"
+
+echo "$total_pass passed, $total_fail failed"
+[ "$total_fail" -eq 0 ]
