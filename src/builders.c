@@ -1,6 +1,8 @@
 /* builders.c: cloth, rope and lattice bodies made of particles and distance links.
  * Each checks its whole definition and reserves all memory first, so a failing
  * builder changes nothing. */
+#include <stdlib.h>
+
 #include "core.h"
 
 wb_cloth_def wb_cloth_default_def(void)
@@ -77,7 +79,8 @@ wb_status wb_cloth(wb_world *w, const wb_cloth_def *d, wb_body *out)
     int64_t nd = (int64_t)(nx - 1) * nz + (int64_t)nx * (nz - 1);
     if (d->shear) nd += (int64_t)(nx - 1) * (nz - 1);
     if (d->bend >= 0) nd += (int64_t)(nx - 2 > 0 ? nx - 2 : 0) * nz + (int64_t)nx * (nz - 2 > 0 ? nz - 2 : 0);
-    if ((st = wb__reserve(w, np, nd)) != WB_OK) return st;
+    const int64_t ntri = 2 * (int64_t)(nx - 1) * (nz - 1);
+    if ((st = wb__reserve(w, np, nd)) != WB_OK || (st = wb__surface_reserve(w, (int32_t)ntri)) != WB_OK) return st;
 
     const int32_t first = w->m.np;
     const wb_real m = d->mass / (wb_real)np;
@@ -106,6 +109,20 @@ wb_status wb_cloth(wb_world *w, const wb_cloth_def *d, wb_body *out)
                 if (i + 2 < nx) link(w, ID(i, j), ID(i + 2, j), &bl);
                 if (j + 2 < nz) link(w, ID(i, j), ID(i, j + 2), &bl);
             }
+    }
+    /* the sheet, split along the shear diagonals so shading follows the links */
+    int32_t *tri = malloc(sizeof *tri * 3 * (size_t)ntri);
+    if (tri) {
+        int32_t *t = tri;
+        for (int j = 0; j + 1 < nz; j++)
+            for (int i = 0; i + 1 < nx; i++) {
+                const int32_t a = ID(i, j), b = ID(i + 1, j), c = ID(i + 1, j + 1), e = ID(i, j + 1);
+                if ((i + j) % 2 == 0) { t[0] = a; t[1] = e; t[2] = c; t[3] = a; t[4] = c; t[5] = b; }
+                else { t[0] = a; t[1] = e; t[2] = b; t[3] = b; t[4] = e; t[5] = c; }
+                t += 6;
+            }
+        wb_surface_add(w, tri, (int32_t)ntri);
+        free(tri);
     }
 #undef ID
     out->first = first;
@@ -152,7 +169,8 @@ wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
     const int64_t nd = (int64_t)(nx - 1) * ny * nz + (int64_t)nx * (ny - 1) * nz + (int64_t)nx * ny * (nz - 1) +
                        2 * ((int64_t)(nx - 1) * (ny - 1) * nz + (int64_t)(nx - 1) * ny * (nz - 1) + (int64_t)nx * (ny - 1) * (nz - 1)) +
                        4 * cells;
-    if ((st = wb__reserve(w, np, nd)) != WB_OK) return st;
+    const int64_t ntri = 4 * ((int64_t)(nx - 1) * (ny - 1) + (int64_t)(ny - 1) * (nz - 1) + (int64_t)(nz - 1) * (nx - 1));
+    if ((st = wb__reserve(w, np, nd)) != WB_OK || (st = wb__surface_reserve(w, (int32_t)ntri)) != WB_OK) return st;
     const int32_t first = w->m.np;
     const wb_real m = d->mass / (wb_real)np;
     for (int k = 0; k < nz; k++)
@@ -184,6 +202,32 @@ wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
                     link(w, ID(i, j, k + 1), ID(i + 1, j + 1, k), &d->link);
                 }
             }
+    /* the hull: each of the six faces as a grid of quads, wound outwards */
+    int32_t *tri = malloc(sizeof *tri * 3 * (size_t)ntri);
+    if (tri) {
+        int32_t *t = tri;
+        const int n[3] = { nx, ny, nz };
+        for (int a = 0; a < 3; a++) {
+            const int u = (a + 1) % 3, v = (a + 2) % 3; /* u x v points along +a */
+            for (int side = 0; side < 2; side++)
+                for (int iv = 0; iv + 1 < n[v]; iv++)
+                    for (int iu = 0; iu + 1 < n[u]; iu++) {
+                        int32_t q[4];
+                        for (int c = 0; c < 4; c++) {
+                            int ix[3];
+                            ix[a] = side ? n[a] - 1 : 0;
+                            ix[u] = iu + (c == 1 || c == 2);
+                            ix[v] = iv + (c >= 2);
+                            q[c] = ID(ix[0], ix[1], ix[2]);
+                        }
+                        if (side) { t[0] = q[0]; t[1] = q[1]; t[2] = q[2]; t[3] = q[0]; t[4] = q[2]; t[5] = q[3]; }
+                        else { t[0] = q[0]; t[1] = q[2]; t[2] = q[1]; t[3] = q[0]; t[4] = q[3]; t[5] = q[2]; }
+                        t += 6;
+                    }
+        }
+        wb_surface_add(w, tri, (int32_t)ntri);
+        free(tri);
+    }
 #undef ID
     out->first = first;
     out->count = (int32_t)np;

@@ -71,6 +71,12 @@ typedef struct wb_model {
     uint32_t *c_gen;       /* (nc) odd = live */
 
     int topology_dirty;    /* colour batches must be rebuilt */
+
+    /* surfaces: triangles over particles, concatenated */
+    int32_t nsurf, cap_surf;
+    int32_t *surf_start;   /* (nsurf + 1) triangle ranges */
+    int32_t ntri, cap_tri; /* cap_tri counts ints */
+    int32_t *tri;          /* (ntri x 3) particle ids */
 } wb_model;
 
 /* ---- state ----------------------------------------------------------------------- */
@@ -139,6 +145,7 @@ void wb__collider_pose_at(const wb_collider_pose *cp, wb_real t, wb_real p[3], w
 wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real q[4],
                            const wb_real x[3], wb_real n[3]);
 wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra); /* world.c */
+wb_status wb__surface_reserve(wb_world *w, int32_t ntri);
 void *wb__grow(void *ptr, int32_t *cap, int32_t need, size_t elem); /* world.c: realloc helper */
 void wb__set_error(const char *fmt, ...);
 void wb__warn(wb_world *w, const char *fmt, ...);

@@ -74,6 +74,18 @@ wb_real wb_world_max_strain(const wb_world *w)
     return best;
 }
 
+int32_t wb_world_distance_pairs(const wb_world *w, int32_t *ij, wb_real *strain)
+{
+    int32_t n = 0;
+    for (int32_t s = 0; s < w->m.nd; s++) {
+        if (!live(w, s)) continue;
+        if (ij) { ij[2 * n] = w->m.d_ij[2 * s]; ij[2 * n + 1] = w->m.d_ij[2 * s + 1]; }
+        if (strain) strain[n] = w->s.d_rest[s] > 0 ? (slot_length(w, s) - w->s.d_rest[s]) / w->s.d_rest[s] : 0;
+        n++;
+    }
+    return n;
+}
+
 /* FNV-1a over the bytes of the state: bit-identical states, identical hashes */
 static uint64_t fnv(uint64_t h, const void *p, size_t n)
 {

@@ -186,12 +186,22 @@ wb_status wb_cloth(wb_world *w, const wb_cloth_def *def, wb_body *out);     /* W
 wb_status wb_rope(wb_world *w, const wb_rope_def *def, wb_body *out);
 wb_status wb_lattice(wb_world *w, const wb_lattice_def *def, wb_body *out);
 
+/* ---- surfaces: triangles over particles, for drawing and export ------------------------ */
+/* builders register theirs (the cloth's sheet, the lattice's hull); returns the surface
+ * index or a negative wb_status; tri is (ntri x 3) particle ids */
+int32_t wb_surface_add(wb_world *w, const int32_t *tri, int32_t ntri);
+int32_t wb_surface_count(const wb_world *w);
+const int32_t *wb_surface_triangles(const wb_world *w, int32_t s, int32_t *ntri); /* valid until the next add */
+
 /* ---- queries ---------------------------------------------------------------------- */
 void wb_world_energy(const wb_world *w, wb_real *kinetic, wb_real *potential); /* J; potential = gravity + elastic */
 void wb_world_momentum(const wb_world *w, wb_real out[3]);          /* movable particles */
 void wb_world_angular_momentum(const wb_world *w, wb_real out[3]);  /* about the origin */
 bool wb_world_bounds(const wb_world *w, wb_real min[3], wb_real max[3]); /* false when no particles */
 wb_real wb_world_max_strain(const wb_world *w);                     /* max |len-rest|/rest over live constraints */
+/* every live, unbroken constraint at once (for drawing): particle pairs (n x 2) and
+ * signed strains (len-rest)/rest (n), either may be NULL; returns n */
+int32_t wb_world_distance_pairs(const wb_world *w, int32_t *ij, wb_real *strain);
 uint64_t wb_world_hash(const wb_world *w);                          /* FNV-1a of the whole state */
 
 typedef struct wb_stats {

@@ -89,7 +89,7 @@ void wb_world_destroy(wb_world *w)
     wb_state *s = &w->s;
     wb_cache *k = &w->k;
     void *ptrs[] = { m->inv_mass, m->w, m->radius, m->pinned, m->d_ij, m->d_alpha, m->d_beta,
-                     m->d_yield, m->d_creep, m->d_break, m->d_gen, m->d_free, m->c_shape, m->c_gen,
+                     m->d_yield, m->d_creep, m->d_break, m->d_gen, m->d_free, m->c_shape, m->c_gen, m->surf_start, m->tri,
                      s->x, s->x_prev, s->v, s->d_rest, s->d_broken, s->c_pose,
                      k->colour_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda,
                      k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->contacts, k->c_sub,
@@ -355,3 +355,43 @@ wb_distance_id wb_distance_at(const wb_world *w, int32_t i)
 /* ---- events --------------------------------------------------------------------------- */
 int32_t wb_world_break_count(const wb_world *w) { return w->k.nbreaks; }
 wb_distance_id wb_world_break_at(const wb_world *w, int32_t i) { assert(i >= 0 && i < w->k.nbreaks); return w->k.breaks[i]; }
+
+/* ---- surfaces ------------------------------------------------------------------------ */
+/* room for one more surface of ntri triangles: after it, wb_surface_add cannot fail
+ * for lack of memory (builders reserve before they add anything) */
+wb_status wb__surface_reserve(wb_world *w, int32_t ntri)
+{
+    wb_model *m = &w->m;
+    if (ntri < 0 || (int64_t)m->ntri + ntri > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    int32_t *st = wb__grow(m->surf_start, &m->cap_surf, m->nsurf + 2, sizeof *st);
+    if (!st) return WB_ERR_NOMEM;
+    m->surf_start = st;
+    int32_t *t = wb__grow(m->tri, &m->cap_tri, 3 * (m->ntri + ntri), sizeof *t);
+    if (!t) return WB_ERR_NOMEM;
+    m->tri = t;
+    return WB_OK;
+}
+
+int32_t wb_surface_add(wb_world *w, const int32_t *tri, int32_t ntri)
+{
+    wb_model *m = &w->m;
+    if (ntri < 0) { wb__set_error("negative triangle count"); return WB_ERR_ARG; }
+    for (int32_t i = 0; i < 3 * ntri; i++)
+        if (tri[i] < 0 || tri[i] >= m->np) { wb__set_error("triangle corner out of range"); return WB_ERR_ARG; }
+    wb_status st = wb__surface_reserve(w, ntri);
+    if (st != WB_OK) return st;
+    if (m->nsurf == 0) m->surf_start[0] = 0;
+    memcpy(&m->tri[3 * m->ntri], tri, sizeof *tri * 3 * (size_t)ntri);
+    m->ntri += ntri;
+    m->surf_start[++m->nsurf] = m->ntri;
+    return m->nsurf - 1;
+}
+
+int32_t wb_surface_count(const wb_world *w) { return w->m.nsurf; }
+
+const int32_t *wb_surface_triangles(const wb_world *w, int32_t s, int32_t *ntri)
+{
+    assert(s >= 0 && s < w->m.nsurf);
+    *ntri = w->m.surf_start[s + 1] - w->m.surf_start[s];
+    return &w->m.tri[3 * w->m.surf_start[s]];
+}
