@@ -1,0 +1,98 @@
+/* main.c: the table of unit tests and the runner.
+ *
+ *   build-ut/unit_tests            run every test
+ *   build-ut/unit_tests NAME...    run the tests whose name contains one of NAME
+ *
+ * Output: "1..N", then "ok N - name" / "not ok N - name" (failed checks as
+ * "#   file:line: ..." lines before it), and last exactly "N passed, N failed".
+ * Exit status 1 when any test failed. */
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "test.h"
+
+/* every test, in the order they run: add a line here for each TEST() */
+#define TEST_LIST(X)                             \
+    X(world_def_defaults)                        \
+    X(world_def_check_messages)                  \
+    X(distance_and_collider_def_check_messages)  \
+    X(particle_add_get_set)                      \
+    X(particle_immovable_and_pin)                \
+    X(distance_handles)                          \
+    X(collider_handles)                          \
+    X(builder_cloth_counts)                      \
+    X(builder_cloth_shear_alternates)            \
+    X(builder_rope_counts)                       \
+    X(builder_lattice_counts)                    \
+    X(builder_failure_changes_nothing)           \
+    X(colour_batches_valid)                      \
+    X(colour_broken_constraints_unpacked)        \
+    X(collider_distance_plane)                   \
+    X(collider_distance_sphere)                  \
+    X(collider_distance_box_rotated)             \
+    X(collider_distance_capsule)                 \
+    X(collider_sweep_pushes_not_tunnels)         \
+    X(collider_sweep_by_velocity_pushes)         \
+    X(collider_resting_contact_no_bounce)        \
+    X(free_fall_exact)                           \
+    X(determinism_threads_gauss_seidel)          \
+    X(determinism_threads_jacobi)                \
+    X(nan_recovery_huge_velocity)                \
+    X(nan_recovery_subnormal_mass)               \
+    X(xpbd_static_force_balance)                 \
+    X(world_damping_keeps_static_equilibrium)    \
+    X(world_damping_terminal_velocity)           \
+    X(world_step_empty)
+
+#define DECLARE(name) TEST(name);
+#define ENTRY(name) { #name, test_##name },
+TEST_LIST(DECLARE)
+static const test_case tests[] = { TEST_LIST(ENTRY) };
+
+int test_failures;
+
+void test_fail(const char *file, int line, const char *fmt, ...)
+{
+    test_failures++;
+    va_list ap;
+    va_start(ap, fmt);
+    printf("#   %s:%d: ", file, line);
+    vprintf(fmt, ap);
+    printf("\n");
+    va_end(ap);
+    fflush(stdout);
+}
+
+static int selected(const char *name, int argc, char **argv)
+{
+    if (argc < 2) return 1;
+    for (int i = 1; i < argc; i++)
+        if (strstr(name, argv[i])) return 1;
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const int n = (int)(sizeof tests / sizeof tests[0]);
+    int total = 0;
+    for (int i = 0; i < n; i++) total += selected(tests[i].name, argc, argv);
+    printf("1..%d\n", total);
+    int passed = 0, failed = 0, k = 0;
+    for (int i = 0; i < n; i++) {
+        if (!selected(tests[i].name, argc, argv)) continue;
+        test_failures = 0;
+        tests[i].fn();
+        k++;
+        if (test_failures == 0) {
+            passed++;
+            printf("ok %d - %s\n", k, tests[i].name);
+        } else {
+            failed++;
+            printf("not ok %d - %s\n", k, tests[i].name);
+        }
+        fflush(stdout);
+    }
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed ? 1 : 0;
+}

@@ -1,0 +1,149 @@
+/* test_colour.c: validity of the colour batches (white-box: includes core.h).
+ *
+ * After a step, the packed constraints must satisfy:
+ *   - batches before serial_start share no particle with inv_mass > 0 (they run in
+ *     parallel and in any order, so two writers of one particle would race);
+ *   - every live, unbroken constraint is packed exactly once, with its own particles
+ *     and parameters, and slot_pack / s_slot are inverse maps;
+ *   - batch ranges are contiguous, increasing and cover [0, ns). */
+#include <stdlib.h>
+
+#include "core.h"
+#include "test.h"
+
+static void check_colouring(wb_world *w)
+{
+    const wb_model *m = &w->m;
+    const wb_cache *k = &w->k;
+    /* a break at the end of the last step marks the batches dirty: rebuild as a step would */
+    REQUIRE(wb__colour(w) == WB_OK);
+    REQUIRE(!m->topology_dirty);
+    /* ranges */
+    REQUIRE(k->ncolours >= 0 && k->serial_start >= 0 && k->serial_start <= k->ncolours);
+    CHECK_EQ(k->ncolours > 0 ? k->colour_start[0] : 0, 0);
+    CHECK_EQ(k->ncolours > 0 ? k->colour_start[k->ncolours] : 0, k->ns);
+    for (int32_t c = 0; c < k->ncolours; c++) CHECK(k->colour_start[c] < k->colour_start[c + 1]);
+    /* conflict-free batches */
+    int32_t *owner = malloc(sizeof(int32_t) * (size_t)(m->np > 0 ? m->np : 1));
+    REQUIRE(owner);
+    for (int32_t i = 0; i < m->np; i++) owner[i] = -1;
+    int conflicts = 0;
+    for (int32_t c = 0; c < k->serial_start; c++)
+        for (int32_t i = k->colour_start[c]; i < k->colour_start[c + 1]; i++) {
+            const int32_t ends[2] = { k->s_a[i], k->s_b[i] };
+            for (int e = 0; e < 2; e++) {
+                const int32_t p = ends[e];
+                if (m->inv_mass[p] == 0) continue;
+                if (owner[p] == c) conflicts++;
+                owner[p] = c;
+            }
+        }
+    CHECK_EQ(conflicts, 0);
+    free(owner);
+    /* packed exactly once */
+    int32_t live = 0;
+    int bad_map = 0, bad_data = 0;
+    for (int32_t s = 0; s < m->nd; s++) {
+        const int is_live = (m->d_gen[s] & 1u) && !w->s.d_broken[s];
+        const int32_t i = k->slot_pack[s];
+        if (!is_live) { if (i != -1) bad_map++; continue; }
+        live++;
+        if (i < 0 || i >= k->ns || k->s_slot[i] != s) { bad_map++; continue; }
+        if (k->s_a[i] != m->d_ij[2 * s] || k->s_b[i] != m->d_ij[2 * s + 1] || k->s_rest[i] != w->s.d_rest[s] ||
+            k->s_alpha[i] != m->d_alpha[s] || k->s_beta[i] != m->d_beta[s])
+            bad_data++;
+    }
+    CHECK_EQ(live, k->ns);
+    for (int32_t i = 0; i < k->ns; i++) {
+        const int32_t s = k->s_slot[i];
+        if (s < 0 || s >= m->nd || k->slot_pack[s] != i) bad_map++;
+    }
+    CHECK_EQ(bad_map, 0);
+    CHECK_EQ(bad_data, 0);
+}
+
+TEST(colour_batches_valid)
+{
+    wb_world_def wd = wb_world_default_def();
+    wb_world *w = wb_world_create(&wd);
+    REQUIRE(w);
+    /* a cloth with shear and bend, a lattice, and a rope with a pinned end */
+    wb_cloth_def cd = wb_cloth_default_def();
+    cd.res[0] = 17; cd.res[1] = 13;
+    cd.bend = 1e-4;
+    wb_body cloth, lat, rope;
+    REQUIRE(wb_cloth(w, &cd, &cloth) == WB_OK);
+    wb_lattice_def ld = wb_lattice_default_def();
+    ld.min[1] = 2; ld.max[1] = 3;
+    REQUIRE(wb_lattice(w, &ld, &lat) == WB_OK);
+    wb_rope_def rd = wb_rope_default_def();
+    rd.from[1] = rd.to[1] = 5;
+    REQUIRE(wb_rope(w, &rd, &rope) == WB_OK);
+    wb_particle_pin(w, rope.first, NULL);
+    /* a star around an immovable hub: the hub never conflicts, so 80 spokes fit one batch */
+    wb_real hub_p[3] = { 0, 8, 0 };
+    const int32_t hub = wb_particle_add(w, hub_p, NULL, 0, 0);
+    wb_distance_def dd = wb_distance_default_def();
+    for (int i = 0; i < 80; i++) {
+        wb_real p[3] = { cos(i * 0.1), 9, sin(i * 0.1) };
+        const int32_t q = wb_particle_add(w, p, NULL, 1, 0);
+        REQUIRE(wb_distance_add(w, hub, q, &dd, NULL).index != 0);
+    }
+    wb_world_step(w);
+    check_colouring(w);
+    CHECK(w->k.ncolours >= 4);
+
+    /* a star around a movable hub with 100 spokes needs 100 colours: past the 64 of
+     * the bit mask the rest go to the serial batch */
+    hub_p[1] = 12;
+    const int32_t hub2 = wb_particle_add(w, hub_p, NULL, 1, 0);
+    for (int i = 0; i < 100; i++) {
+        wb_real p[3] = { 2 + cos(i * 0.1), 13, sin(i * 0.1) };
+        const int32_t q = wb_particle_add(w, p, NULL, 1, 0);
+        REQUIRE(wb_distance_add(w, hub2, q, &dd, NULL).index != 0);
+    }
+    wb_world_step(w);
+    check_colouring(w);
+    CHECK(w->k.serial_start < w->k.ncolours);
+
+    /* edits: remove every third constraint, add a few, break none: rebuilt and valid */
+    int32_t n = wb_distance_count(w);
+    wb_distance_id *ids = malloc(sizeof *ids * (size_t)n);
+    REQUIRE(ids);
+    for (int32_t i = 0; i < n; i++) ids[i] = wb_distance_at(w, i);
+    for (int32_t i = 0; i < n; i += 3) wb_distance_remove(w, ids[i]);
+    free(ids);
+    for (int i = 0; i < 10; i++) wb_distance_add(w, cloth.first + i, cloth.first + 40 + i, &dd, NULL);
+    wb_world_step(w);
+    check_colouring(w);
+    CHECK_EQ(wb_world_warnings(w), 0);
+    wb_world_destroy(w);
+}
+
+TEST(colour_broken_constraints_unpacked)
+{
+    /* a rope whose links break: broken links are left out of the batches */
+    wb_world_def wd = wb_world_default_def();
+    wb_world *w = wb_world_create(&wd);
+    REQUIRE(w);
+    wb_rope_def rd = wb_rope_default_def();
+    rd.segments = 6;
+    rd.link.compliance = 1e-2; /* soft: the top link holds ~0.84 N, stretching ~0.5 of its length */
+    rd.link.break_strain = 0.01;
+    wb_body rope;
+    REQUIRE(wb_rope(w, &rd, &rope) == WB_OK);
+    wb_particle_pin(w, rope.first, NULL);
+    int broke = 0;
+    for (int f = 0; f < 120; f++) {
+        wb_world_step(w);
+        broke += wb_world_break_count(w);
+        for (int32_t i = 0; i < wb_world_break_count(w); i++) CHECK(wb_distance_broken(w, wb_world_break_at(w, i)));
+    }
+    CHECK(broke > 0);
+    check_colouring(w);
+    wb_stats st = wb_world_stats(w);
+    CHECK_EQ(st.broken, broke);
+    CHECK_EQ(st.distances, 6);
+    CHECK_EQ(w->k.ns, 6 - broke);
+    wb_world_destroy(w);
+}
