@@ -4,8 +4,8 @@ BUILD   ?= build
 PREFIX  ?= /usr/local
 OPT     ?= -O2
 # Debian packages the build needs; `make deps` installs the missing ones
-PKGS    := liblua5.4-dev libcjson-dev pkg-config
-PCMODS  := lua5.4 libcjson
+PKGS    := liblua5.4-dev libcjson-dev libassimp-dev libosmesa6-dev libstb-dev ffmpeg pkg-config
+PCMODS  := lua5.4 libcjson assimp osmesa
 
 CFLAGS_BASE := -std=c11 $(OPT) -g -Wall -Wextra -Werror -fopenmp -fno-math-errno -D_GNU_SOURCE \
                -DWB_ROOT='"$(CURDIR)"' -DWB_PREFIX='"$(PREFIX)"'
@@ -15,8 +15,8 @@ PC_CFLAGS = $(shell pkg-config --cflags $(PCMODS) 2>/dev/null)
 PC_LIBS   = $(shell pkg-config --libs $(PCMODS) 2>/dev/null)
 
 ALL_SRC  := $(wildcard src/*.c)
-# the core: no Lua, no GL, no command line
-CORE_SRC := $(filter-out src/lua_% src/main.c src/render% src/progress.c,$(ALL_SRC))
+# the core: no Lua, no GL, no file formats, no command line
+CORE_SRC := $(filter-out src/lua_% src/main.c src/render% src/io_% src/progress.c,$(ALL_SRC))
 APP_SRC  := $(filter-out $(CORE_SRC),$(ALL_SRC))
 CORE_OBJ := $(CORE_SRC:src/%.c=$(BUILD)/obj/%.o)
 APP_OBJ  := $(APP_SRC:src/%.c=$(BUILD)/obj/%.o)
