@@ -9,12 +9,7 @@
 
 #include <stdbool.h>
 
-/* wobble_lua.h has a slash-star inside a comment (lib_dir): silenced here so the
- * binding builds with -Werror until that header is fixed */
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wcomment"
 #include "wobble_lua.h"
-#pragma GCC diagnostic pop
 
 /* registry names of the userdata (and body table) metatables */
 #define WBL_WORLD "wobble.world"
