@@ -316,7 +316,7 @@ wb_real wb_distance_force(const wb_world *w, wb_distance_id c)
 {
     int32_t s = SLOT(w, c);
     int32_t k = w->k.slot_pack[s];
-    if (k < 0 || w->m.topology_dirty) return 0;
+    if (k < 0 || k >= w->k.ns) return 0; /* not stepped since it was made */
     wb_real h = w->m.def.dt / w->m.def.substeps;
     return fabs(w->k.s_lambda[k]) / (h * h);
 }
