@@ -273,7 +273,8 @@ const char *wb_rt_path(lua_State *L, const char *path, int write, char *buf, siz
                 return *err = "writing outside the output folder; use --out DIR or --unsafe", NULL;
             return *err = rt->err, NULL;
         }
-        if (make_parents(c)) {
+        /* never outside the output folder, not even with --unsafe: no surprise folders */
+        if (under(c, rt->out) && make_parents(c)) {
             snprintf(rt->err, sizeof rt->err, "cannot create the folders of %s: %s", c, strerror(errno));
             return *err = rt->err, NULL;
         }

@@ -112,7 +112,7 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
             o->rt.frame_cap = (int64_t)v;
         } else if (!strcmp(name, "--threads")) {
             if (parse_number(val, 0, WB_MAX_THREADS, &v) || v != (int)v)
-                return usage_error("--threads expects a whole number from 0 to " "256" ", got '%s'", val);
+                return usage_error("--threads expects a whole number from 0 to 256, got '%s'", val);
             o->rt.threads = (int)v;
         } else if (!strcmp(name, "--time-limit")) {
             if (parse_number(val, 0, 1e9, &v)) return usage_error("--time-limit expects seconds, got '%s'", val);
@@ -322,6 +322,16 @@ static void tap_result(tap *t, int code, const char *file, const char *name, con
     fflush(stdout);
 }
 
+/* how many cases the chunk registered with wobble.test */
+static int case_count(lua_State *L) {
+    int top = lua_gettop(L), n = 0;
+    lua_getfield(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
+    if (lua_getfield(L, -1, "wobble.test") == LUA_TTABLE && lua_getfield(L, -1, "cases") == LUA_TTABLE)
+        n = (int)lua_rawlen(L, -1);
+    lua_settop(L, top);
+    return n;
+}
+
 /* run the cases a chunk registered with wobble.test; returns how many there were */
 static int run_cases(lua_State *L, const char *file, tap *t) {
     int top = lua_gettop(L);
@@ -458,7 +468,7 @@ static int cmd_test(const opts *o) {
         }
         if (S_ISDIR(st.st_mode)) collect(paths[i], &files, 0);
         else list_add(&files, paths[i]);
-        qsort(files.v, (size_t)files.n, sizeof *files.v, cmp_str);
+        if (files.n > 1) qsort(files.v, (size_t)files.n, sizeof *files.v, cmp_str);
         if (files.n == 0) printf("# no *.lua files under %s\n", paths[i]);
         for (int k = 0; k < files.n; k++) test_file(files.v[k], o, &t);
         nfiles += files.n;
@@ -488,7 +498,11 @@ static int run_scene(const opts *o, const char *path) {
         print_error(msg);
     } else {
         tap t = { 0, 0, 0, 0 };
-        if (run_cases(L, path, &t) > 0) printf("1..%d\n%d passed, %d failed\n", t.n, t.passed, t.failed);
+        if (case_count(L) > 0) {
+            printf("TAP version 13\n");
+            run_cases(L, path, &t);
+            printf("1..%d\n%d passed, %d failed\n", t.n, t.passed, t.failed);
+        }
         code = t.code;
         if (wb_rt_budget_hit(L) && code < EXIT_BUDGET) {
             fprintf(stderr, "wobble: %s: a time or memory budget was exceeded\n", path);
@@ -509,7 +523,7 @@ static int cmd_bench(opts *o) {
     snprintf(dir, sizeof dir, "%s/tests/bench", root);
     list files = { 0 };
     collect(dir, &files, 1);
-    qsort(files.v, (size_t)files.n, sizeof *files.v, cmp_str);
+    if (files.n > 1) qsort(files.v, (size_t)files.n, sizeof *files.v, cmp_str);
     if (files.n == 0) {
         fprintf(stderr, "wobble: no benchmark scenes in %s\n", dir);
         list_free(&files);
