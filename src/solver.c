@@ -103,6 +103,7 @@ static void solve_constraints(wb_world *w, wb_real h)
         }
         /* Jacobi: every correction from the same positions, averaged per particle
          * (Macklin et al. 2014) and over-relaxed by omega */
+        if (np == 0) break;
         memset(k->dx, 0, sizeof(wb_real) * 3 * (size_t)np);
         project_batches(w, k->dx, h, inv_h2);
         const wb_real omega = d->relaxation;
@@ -126,7 +127,8 @@ static void predict(wb_world *w, wb_real h)
         wb_real *xi = &x[3 * i], *vi = &v[3 * i];
         v3_copy(&xp[3 * i], xi);
         if (wv[i] == 0) continue;
-        vi[0] = (vi[0] + g0) * keep; vi[1] = (vi[1] + g1) * keep; vi[2] = (vi[2] + g2) * keep;
+        /* drag on the velocity only: a body at rest still weighs m g */
+        vi[0] = vi[0] * keep + g0; vi[1] = vi[1] * keep + g1; vi[2] = vi[2] * keep + g2;
         xi[0] += h * vi[0]; xi[1] += h * vi[1]; xi[2] += h * vi[2];
     }
 }
@@ -202,8 +204,10 @@ void wb_world_step(wb_world *w)
     const wb_world_def *d = &w->m.def;
     const wb_real dt = d->dt, h = dt / d->substeps;
     const int32_t np = w->m.np;
-    memcpy(k->x_save, w->s.x, sizeof(wb_real) * 3 * (size_t)np);
-    memcpy(k->v_save, w->s.v, sizeof(wb_real) * 3 * (size_t)np);
+    if (np > 0) { /* (memcpy from a NULL array of an empty world is undefined) */
+        memcpy(k->x_save, w->s.x, sizeof(wb_real) * 3 * (size_t)np);
+        memcpy(k->v_save, w->s.v, sizeof(wb_real) * 3 * (size_t)np);
+    }
     k->nbreaks = 0;
     k->projections = 0;
 
@@ -219,7 +223,7 @@ void wb_world_step(wb_world *w)
     for (int sub = 0; sub < d->substeps; sub++) {
         predict(w, h);
         double t0 = now_ms();
-        memset(k->s_lambda, 0, sizeof(wb_real) * (size_t)k->ns);
+        if (k->ns > 0) memset(k->s_lambda, 0, sizeof(wb_real) * (size_t)k->ns);
         solve_constraints(w, h);
         solve += now_ms() - t0;
         wb__collide(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps, dt);
