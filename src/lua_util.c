@@ -304,7 +304,9 @@ int wbl_status_error(lua_State *L, int arg, wb_status st, const char *what)
 {
     switch (st) {
     case WB_ERR_NOMEM:
-        return wb_rt_budget_error(L, "out of memory: %s", what);
+        if (wb_rt_get(L)->memory_budget == 0) return wb_rt_budget_error(L, "out of memory: %s", what);
+        return wb_rt_budget_error(L, "out of memory: %s (the memory budget is %d MB; raise it with --memory-limit MB)",
+                                  what, (int)(wb_rt_get(L)->memory_budget >> 20));
     case WB_ERR_LIMIT:
         return luaL_argerror(L, arg, lua_pushfstring(L,
             "%s: too large (limits: %d particles, %d constraints, %d colliders per world)",

@@ -59,6 +59,8 @@ int wbl_world_new(lua_State *L)
     /* --threads on the command line is the default a script can still override */
     wb_runtime *rt = wb_rt_get(L);
     if (rt && rt->threads > 0) d.threads = rt->threads;
+    /* the world's arrays live outside the Lua heap: give them the same budget */
+    if (rt) d.memory_limit = rt->memory_budget;
     if (!lua_isnoneornil(L, 1)) read_world_def(L, 1, &d);
     const char *err = wb_world_def_check(&d);
     if (err) return luaL_argerror(L, 1, err);

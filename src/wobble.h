@@ -64,6 +64,7 @@ typedef struct wb_world_def {
     wb_solver solver;     /* default Gauss-Seidel */
     wb_real relaxation;   /* Jacobi over-relaxation factor omega, default 1 */
     int threads;          /* default 1; results are bit-identical for any value */
+    size_t memory_limit;  /* bytes the particle and constraint arrays may take; 0 = no limit */
 } wb_world_def;
 
 wb_world_def wb_world_default_def(void);                      /* the defaults above */

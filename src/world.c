@@ -112,6 +112,17 @@ double wb_world_time(const wb_world *w) { return w->s.time; }
 int64_t wb_world_frame(const wb_world *w) { return w->s.frame; }
 
 /* ---- particles ------------------------------------------------------------------- */
+/* bytes per particle and per constraint over all the arrays that grow with them
+ * (model, state and solver cache), for the memory limit */
+#define PARTICLE_BYTES (21 * sizeof(wb_real) + 5 + 8)
+#define CONSTRAINT_BYTES (10 * sizeof(wb_real) + 33)
+
+static int over_limit(const wb_world *w, int64_t cap_p, int64_t cap_d)
+{
+    const size_t lim = w->m.def.memory_limit;
+    return lim > 0 && (double)cap_p * PARTICLE_BYTES + (double)cap_d * CONSTRAINT_BYTES > (double)lim;
+}
+
 /* every per-particle array grows together; on failure nothing is lost */
 static wb_status grow_particles(wb_world *w, int32_t need)
 {
@@ -120,6 +131,8 @@ static wb_status grow_particles(wb_world *w, int32_t need)
     if (need > WB_MAX_PARTICLES) return WB_ERR_LIMIT;
     int32_t cap = m->cap_p ? m->cap_p : 64;
     while (cap < need) cap = cap > WB_MAX_PARTICLES / 2 ? WB_MAX_PARTICLES : cap * 2;
+    if (over_limit(w, need, m->cap_d)) return WB_ERR_NOMEM;
+    if (over_limit(w, cap, m->cap_d)) cap = need; /* exact fit when doubling would cross the limit */
     struct { void **p; size_t elem; } arr[] = {
         { (void **)&m->inv_mass, sizeof(wb_real) }, { (void **)&m->w, sizeof(wb_real) },
         { (void **)&m->radius, sizeof(wb_real) }, { (void **)&m->pinned, 1 },
@@ -225,6 +238,8 @@ static wb_status grow_distances(wb_world *w, int32_t need)
     if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     int32_t cap = m->cap_d ? m->cap_d : 64;
     while (cap < need) cap = cap > WB_MAX_CONSTRAINTS / 2 ? WB_MAX_CONSTRAINTS : cap * 2;
+    if (over_limit(w, m->cap_p, need)) return WB_ERR_NOMEM;
+    if (over_limit(w, m->cap_p, cap)) cap = need;
     struct { void **p; size_t elem; } arr[] = {
         { (void **)&m->d_ij, 2 * sizeof(int32_t) }, { (void **)&m->d_alpha, sizeof(wb_real) },
         { (void **)&m->d_beta, sizeof(wb_real) }, { (void **)&m->d_yield, sizeof(wb_real) },
