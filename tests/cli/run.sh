@@ -104,6 +104,8 @@ run run $F/memory_bomb.lua --memory-limit 32
 check "memory limit" 3 err "memory limit of 32 MB exceeded"
 run run $F/memory_pcall.lua --memory-limit 32
 check "memory limit through pcall" 3 err "memory limit of 32 MB exceeded"
+run run $F/huge_cloth.lua --memory-limit 256
+check "a world past the memory budget" 3 err "huge_cloth.lua:3: out of memory: cloth (the memory budget is 256 MB" !out "should not get here"
 
 # ---- options and the runtime
 run run $F/args.lua --set n=3 --set x=0.5 --set hex=0x10 --set name=cloth --set on=true --set off=false \
