@@ -486,9 +486,17 @@ static void wrap(lua_State *L, int t, const char *name, lua_CFunction f) {
     lua_setfield(L, t, name);
 }
 
-static void drop(lua_State *L, int t, const char *name) {
+/* a refused function raises a message naming it, rather than "attempt to call a nil
+ * value", so the script's author learns why and what to do */
+static int sb_refused(lua_State *L) {
+    return luaL_error(L, "%s is not available in the sandbox (--unsafe allows it)",
+                      lua_tostring(L, lua_upvalueindex(1)));
+}
+
+static void drop(lua_State *L, int t, const char *lib, const char *name) {
     t = lua_absindex(L, t);
-    lua_pushnil(L);
+    lua_pushfstring(L, "%s.%s", lib, name);
+    lua_pushcclosure(L, sb_refused, 1);
     lua_setfield(L, t, name);
 }
 
@@ -526,20 +534,20 @@ static void open_sandbox(lua_State *L) {
     lua_pushglobaltable(L);
     wrap(L, -1, "load", sb_load);
     lua_getfield(L, -1, "io");
-    drop(L, -1, "popen");
+    drop(L, -1, "io", "popen");
     lua_pop(L, 1);
     lua_getfield(L, -1, "os");
-    drop(L, -1, "execute");
-    drop(L, -1, "tmpname");
-    drop(L, -1, "setlocale");  /* process-wide: would change how every number is printed and parsed */
+    drop(L, -1, "os", "execute");
+    drop(L, -1, "os", "tmpname");
+    drop(L, -1, "os", "setlocale");  /* process-wide: would change how every number is printed and parsed */
     lua_pushcfunction(L, sb_os_exit);
     lua_setfield(L, -2, "exit");
     lua_pop(L, 1);
     lua_getfield(L, -1, "string");
-    drop(L, -1, "dump");
+    drop(L, -1, "string", "dump");
     lua_pop(L, 1);
     lua_getfield(L, -1, "package");
-    drop(L, -1, "loadlib");
+    drop(L, -1, "package", "loadlib");
     lua_pushliteral(L, "");
     lua_setfield(L, -2, "cpath");
     lua_createtable(L, 2, 0);  /* searchers: preload, then Lua files through the rules */
