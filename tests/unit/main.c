@@ -43,6 +43,7 @@
     X(xpbd_static_force_balance)                 \
     X(world_damping_keeps_static_equilibrium)    \
     X(world_damping_terminal_velocity)           \
+    X(step_never_writes_immovable)               \
     X(world_step_empty)
 
 #define DECLARE(name) TEST(name);
