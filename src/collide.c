@@ -319,6 +319,11 @@ wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real
 
 void wb__collider_pose_at(const wb_collider_pose *cp, wb_real t, wb_real p[3], wb_real q[4])
 {
+    if (t >= 1) { /* exactly the pose the script set, not p0 + (p - p0) rounded */
+        v3_copy(p, cp->p);
+        memcpy(q, cp->q, 4 * sizeof(wb_real));
+        return;
+    }
     for (int i = 0; i < 3; i++) p[i] = cp->p0[i] + (cp->p[i] - cp->p0[i]) * t;
     q_slerp(cp->q0, cp->q, t, q);
 }

@@ -34,6 +34,7 @@ wb_status wb__colour(wb_world *w)
         !realloc_n((void **)&k->s_a, ns, sizeof(int32_t)) || !realloc_n((void **)&k->s_b, ns, sizeof(int32_t)) ||
         !realloc_n((void **)&k->s_rest, ns, sizeof(wb_real)) || !realloc_n((void **)&k->s_alpha, ns, sizeof(wb_real)) ||
         !realloc_n((void **)&k->s_beta, ns, sizeof(wb_real)) || !realloc_n((void **)&k->s_lambda, ns, sizeof(wb_real)) ||
+        !realloc_n((void **)&k->s_jac, ns, sizeof(wb_real)) ||
         !realloc_n((void **)&k->s_slot, ns, sizeof(int32_t)) ||
         !realloc_n((void **)&k->colour_start, MAX_COLOURS + 2, sizeof(int32_t))) {
         free(used);
@@ -88,6 +89,13 @@ wb_status wb__colour(wb_world *w)
         k->ncount[a]++;
         k->ncount[b]++;
         if (m->d_beta[s] > 0 && m->d_alpha[s] > 0) k->any_damping = 1;
+    }
+    /* Jacobi: a constraint's share is set by its busier movable end (an immovable
+     * hub must not shrink its spokes' corrections) */
+    for (int32_t i = 0; i < ns; i++) {
+        const int32_t a = k->s_a[i], b = k->s_b[i];
+        const int32_t na = m->inv_mass[a] > 0 ? k->ncount[a] : 1, nb = m->inv_mass[b] > 0 ? k->ncount[b] : 1;
+        k->s_jac[i] = (wb_real)1 / (na > nb ? na : nb);
     }
     free(used);
     free(colour);

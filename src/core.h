@@ -114,11 +114,12 @@ typedef struct wb_cache {
     int32_t *s_a, *s_b;    /* (ns) particles */
     wb_real *s_rest, *s_alpha, *s_beta; /* (ns) */
     wb_real *s_lambda;     /* (ns) multipliers of the current substep */
+    wb_real *s_jac;        /* (ns) Jacobi scale 1/max(n_a, n_b), n = constraints at a movable end */
     int32_t *s_slot;       /* (ns) constraint slot of each packed entry */
     int32_t *slot_pack;    /* (nd) packed index of each slot, -1 when not packed */
     int any_damping;
     wb_real *dx;           /* (np x 3) Jacobi accumulators */
-    int32_t *ncount;       /* (np) Jacobi: constraints per particle */
+    int32_t *ncount;       /* (np) constraints per particle (for s_jac) */
     wb_real *x_save, *v_save; /* (np x 3) last finite frame, for recovery */
     wb_real *c_sub;        /* (nc x 14) collider poses at the substep's start and end */
     int32_t cap_c_sub;

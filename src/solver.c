@@ -17,18 +17,24 @@ static double now_ms(void)
 }
 
 /* Project the distance constraints [b, e) of the packed arrays (XPBD, Macklin et al.
- * 2016 eq. 18 with the damping of eq. 26). With dx == NULL positions are updated in
- * place (Gauss-Seidel); otherwise corrections accumulate into dx (Jacobi). The caller
- * guarantees that no two constraints in [b, e) write the same particle when it runs the
- * range in parallel. `damped` is a compile-time constant at each call: the undamped
- * loop does not pay for eq. 26. (A branch-free `omp simd` version with AVX-512
- * gathers and scatters measured slower than this scalar loop.) */
+ * 2016 eq. 18 with the damping of eq. 26). Gauss-Seidel updates positions in place;
+ * Jacobi (out = dx) accumulates corrections computed from the same positions, each
+ * scaled by omega / max(n_a, n_b) (k->s_jac) for both its ends, so that a pair's
+ * corrections stay equal and opposite (momentum) and lambda is the multiplier
+ * actually applied (force readback). Particles with w = 0 are never written, not
+ * even with 0: -0.0 would turn +0.0, and immovable particles may be shared inside
+ * a batch. The caller guarantees that no two constraints in [b, e) write the same
+ * movable particle when it runs the range in parallel. `damped` and `jacobi` are
+ * compile-time constants at each call. (A branch-free `omp simd` version with
+ * AVX-512 gathers and scatters measured slower than this scalar loop.) */
 static inline __attribute__((always_inline)) void
 project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
-              wb_real *out, int32_t b, int32_t e, wb_real h, wb_real inv_h2, const int damped)
+              wb_real *out, int32_t b, int32_t e, wb_real h, wb_real inv_h2, wb_real omega,
+              const int damped, const int jacobi)
 {
     const int32_t *restrict sa = k->s_a, *restrict sb = k->s_b;
     const wb_real *restrict rest = k->s_rest, *restrict alpha = k->s_alpha, *restrict beta = k->s_beta;
+    const wb_real *restrict jac = k->s_jac;
     wb_real *restrict lambda = k->s_lambda;
     for (int32_t i = b; i < e; i++) {
         const int32_t ia = sa[i], ic = sb[i];
@@ -52,21 +58,34 @@ project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const w
             den += gamma * wsum;
         }
         /* s = dlambda / len, so the correction is s * d without normalising d */
-        const wb_real s = num / (den * len);
+        wb_real s = num / (den * len);
+        if (jacobi) s *= omega * jac[i];
         lambda[i] += s * len;
-        wb_real *oa = &out[3 * ia], *oc = &out[3 * ic];
-        const wb_real sa_ = wa * s, sc_ = wc * s;
-        oa[0] -= sa_ * d0; oa[1] -= sa_ * d1; oa[2] -= sa_ * d2;
-        oc[0] += sc_ * d0; oc[1] += sc_ * d1; oc[2] += sc_ * d2;
+        if (wa > 0) {
+            wb_real *oa = &out[3 * ia];
+            const wb_real f = wa * s;
+            oa[0] -= f * d0; oa[1] -= f * d1; oa[2] -= f * d2;
+        }
+        if (wc > 0) {
+            wb_real *oc = &out[3 * ic];
+            const wb_real f = wc * s;
+            oc[0] += f * d0; oc[1] += f * d1; oc[2] += f * d2;
+        }
     }
 }
 
-static void project_distances(const wb_cache *k, const wb_real *wv, wb_real *x, const wb_real *xp,
-                              wb_real *dx, int32_t b, int32_t e, wb_real h, wb_real inv_h2)
+static void project_distances(const wb_world *w, wb_real *dx, int32_t b, int32_t e, wb_real h, wb_real inv_h2)
 {
-    wb_real *out = dx ? dx : x;
-    if (k->any_damping) project_range(k, wv, x, xp, out, b, e, h, inv_h2, 1);
-    else project_range(k, wv, x, xp, out, b, e, h, inv_h2, 0);
+    const wb_cache *k = &w->k;
+    const wb_real *wv = w->m.w, *xp = w->s.x_prev, omega = w->m.def.relaxation;
+    wb_real *x = w->s.x;
+    if (dx) {
+        if (k->any_damping) project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1);
+        else project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1);
+    } else {
+        if (k->any_damping) project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0);
+        else project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0);
+    }
 }
 
 /* one pass over every batch; batches before serial_start are conflict-free */
@@ -77,7 +96,7 @@ static void project_batches(wb_world *w, wb_real *dx, wb_real h, wb_real inv_h2)
     for (int32_t c = 0; c < k->ncolours; c++) {
         const int32_t b = k->colour_start[c], e = k->colour_start[c + 1];
         if (c >= k->serial_start || threads == 1 || e - b < 512) {
-            project_distances(k, w->m.w, w->s.x, w->s.x_prev, dx, b, e, h, inv_h2);
+            project_distances(w, dx, b, e, h, inv_h2);
             continue;
         }
         /* split the batch into contiguous chunks, one per thread: disjoint writes */
@@ -85,7 +104,7 @@ static void project_batches(wb_world *w, wb_real *dx, wb_real h, wb_real inv_h2)
         for (int t = 0; t < threads; t++) {
             const int32_t n = e - b;
             const int32_t lo = b + (int32_t)((int64_t)n * t / threads), hi = b + (int32_t)((int64_t)n * (t + 1) / threads);
-            project_distances(k, w->m.w, w->s.x, w->s.x_prev, dx, lo, hi, h, inv_h2);
+            project_distances(w, dx, lo, hi, h, inv_h2);
         }
     }
 }
@@ -101,17 +120,14 @@ static void solve_constraints(wb_world *w, wb_real h)
             project_batches(w, NULL, h, inv_h2);
             continue;
         }
-        /* Jacobi: every correction from the same positions, averaged per particle
-         * (Macklin et al. 2014) and over-relaxed by omega */
+        /* Jacobi: every correction from the same positions, scaled per constraint
+         * (see project_range), then applied at once */
         if (np == 0) break;
         memset(k->dx, 0, sizeof(wb_real) * 3 * (size_t)np);
         project_batches(w, k->dx, h, inv_h2);
-        const wb_real omega = d->relaxation;
-        for (int32_t i = 0; i < np; i++) {
-            if (k->ncount[i] == 0) continue;
-            const wb_real s = omega / k->ncount[i];
-            v3_madd(&w->s.x[3 * i], &k->dx[3 * i], s);
-        }
+        const wb_real *wv = w->m.w;
+        for (int32_t i = 0; i < np; i++)
+            if (wv[i] > 0) v3_add(&w->s.x[3 * i], &w->s.x[3 * i], &k->dx[3 * i]);
     }
     k->projections += (int64_t)k->ns * d->iterations;
 }
@@ -177,20 +193,23 @@ static void plasticity_and_breaking(wb_world *w)
     }
 }
 
-/* non-finite values never propagate: restore the frame's start and report */
-static void check_finite(wb_world *w)
+/* non-finite values never propagate: restore the frame's start and report. Returns 1
+ * when the frame was finite. Time still advances: kinematic colliders keep their
+ * script's schedule. */
+static int check_finite(wb_world *w)
 {
     const int32_t n = 3 * w->m.np;
     const wb_real *x = w->s.x, *v = w->s.v;
     for (int32_t i = 0; i < n; i++) {
         if (isfinite(x[i]) && isfinite(v[i])) continue;
         wb__warn(w, "frame %lld: particle %d became non-finite; its frame was undone (reduce dt, "
-                    "raise substeps or compliance)", (long long)w->s.frame, i / 3 + 1);
+                    "raise substeps or compliance)", (long long)w->s.frame + 1, i / 3 + 1);
         memcpy(w->s.x, w->k.x_save, sizeof(wb_real) * (size_t)n);
         memcpy(w->s.x_prev, w->k.x_save, sizeof(wb_real) * (size_t)n);
         memcpy(w->s.v, w->k.v_save, sizeof(wb_real) * (size_t)n);
-        return;
+        return 0;
     }
+    return 1;
 }
 
 void wb_world_step(wb_world *w)
@@ -236,10 +255,10 @@ void wb_world_step(wb_world *w)
         v3_copy(cp->p0, cp->p);
         memcpy(cp->q0, cp->q, sizeof cp->q);
     }
-    plasticity_and_breaking(w);
+    /* a frame gone non-finite is undone before it can bend or break anything */
+    if (check_finite(w)) plasticity_and_breaking(w);
     w->s.frame++;
     w->s.time += dt;
-    check_finite(w);
     k->solve_ms = solve;
     k->step_ms = now_ms() - t_begin;
 }
