@@ -335,35 +335,54 @@ wb_real wb_collider_distance(const wb_world *w, wb_collider_id c, const wb_real 
     return wb__shape_distance(&w->m.c_shape[i], w->s.c_pose[i].p, w->s.c_pose[i].q, x, n);
 }
 
-/* ---- projection ------------------------------------------------------------------------- */
-/* one contact: push particle i out along n by depth, static friction, record it */
-static void resolve(wb_world *w, int32_t i, int32_t c, const wb_real n[3], wb_real depth, wb_real h,
-                    const wb_real *p0, const wb_real *q0, const wb_real *p1, const wb_real *q1, int moving)
+/* ---- projection and velocities ---------------------------------------------------------- */
+/* a collider's poses over one substep, worked out once for all particles */
+typedef struct sub_pose {
+    const wb_cshape *s;
+    int32_t slot;
+    int moving;
+    wb_real p0[3], q0[4], p1[3], q1[4];
+    wb_real n[3], off;     /* plane: world normal and offset at the substep's end */
+} sub_pose;
+
+typedef struct contact {
+    const sub_pose *c;
+    wb_real n[3];          /* unit normal, out of the collider */
+    wb_real depth;         /* correction applied along n this substep */
+    wb_real vc[3];         /* collider surface velocity at the contact */
+    wb_real vn_pre;        /* normal velocity relative to the surface before the solve */
+} contact;
+
+/* more simultaneous contacts than this on one particle keep their position
+ * correction but lose their velocity pass (friction, restitution) */
+#define MAX_CONTACTS 16
+
+/* push particle i out along n by depth and apply static friction */
+static void resolve(wb_world *w, int32_t i, const sub_pose *c, const wb_real n[3], wb_real depth, wb_real h,
+                    contact *ct)
 {
-    const wb_cshape *s = &w->m.c_shape[c];
     wb_real *xi = &w->s.x[3 * i];
     v3_madd(xi, n, depth);
     /* the surface point's motion over the substep, carried rigidly by the collider */
     wb_real vc[3] = { 0, 0, 0 };
-    if (moving) {
+    if (c->moving) {
         wb_real r[3], l[3], x0[3];
-        v3_sub(r, xi, p1);
-        q_rotate_inv(q1, r, l);
-        q_rotate(q0, l, x0);
-        v3_add(x0, x0, p0);
+        v3_sub(r, xi, c->p1);
+        q_rotate_inv(c->q1, r, l);
+        q_rotate(c->q0, l, x0);
+        v3_add(x0, x0, c->p0);
         v3_sub(vc, xi, x0);
         v3_scale(vc, vc, 1 / h);
     }
     /* static friction: undo the tangential slip when it is within the friction cone */
-    if (s->friction > 0) {
+    if (c->s->friction > 0) {
         wb_real slip[3];
         v3_sub(slip, xi, &w->s.x_prev[3 * i]);
         v3_madd(slip, vc, -h);
         v3_madd(slip, n, -v3_dot(slip, n));
-        if (v3_len(slip) < s->friction * depth) v3_madd(xi, slip, -1);
+        if (v3_len(slip) < c->s->friction * depth) v3_madd(xi, slip, -1);
     }
-    wb_contact *ct = &w->k.contacts[w->k.ncontacts++];
-    ct->p = i;
+    if (!ct) return;
     ct->c = c;
     v3_copy(ct->n, n);
     ct->depth = depth;
@@ -373,67 +392,80 @@ static void resolve(wb_world *w, int32_t i, int32_t c, const wb_real n[3], wb_re
     ct->vn_pre = v3_dot(rel, n);
 }
 
-/* push every movable particle out of every collider at the substep's end pose; record
- * the contacts for the velocity pass. Collider by collider: a particle meets the
- * colliders in the same order either way, and the plane's loop stays tight. */
-void wb__collide(wb_world *w, wb_real h, wb_real f0, wb_real f1, wb_real dt)
+/* dynamic friction and restitution on the velocity the positions imply */
+static void contact_velocity(wb_real v[3], const contact *ct, wb_real h, wb_real g)
 {
-    (void)dt;
-    wb_model *m = &w->m;
-    wb_cache *k = &w->k;
-    k->ncontacts = 0;
-    const wb_real *x = w->s.x, *wv = m->w, *rad = m->radius;
-    for (int32_t c = 0; c < m->nc; c++) {
-        if (!(m->c_gen[c] & 1u)) continue;
-        /* room for every particle touching this collider: no check in the loop */
-        wb_contact *ct = wb__grow(k->contacts, &k->cap_contacts, k->ncontacts + m->np, sizeof *ct);
-        if (!ct) { wb__warn(w, "out of memory recording contacts"); return; }
-        k->contacts = ct;
-        const wb_cshape *s = &m->c_shape[c];
-        wb_real p0[3], q0[4], p1[3], q1[4], n[3];
-        wb__collider_pose_at(&w->s.c_pose[c], f0, p0, q0);
-        wb__collider_pose_at(&w->s.c_pose[c], f1, p1, q1);
-        const int moving = memcmp(p0, p1, sizeof p0) || memcmp(q0, q1, sizeof q0);
-        if (s->shape == WB_SHAPE_PLANE) {
-            q_rotate(q1, s->n, n);
-            const wb_real off = v3_dot(n, p1);
-            for (int32_t i = 0; i < m->np; i++) {
-                const wb_real depth = rad[i] + off - v3_dot(n, &x[3 * i]);
-                if (depth > 0 && wv[i] > 0) resolve(w, i, c, n, depth, h, p0, q0, p1, q1, moving);
-            }
-            continue;
-        }
-        for (int32_t i = 0; i < m->np; i++) {
-            if (wv[i] == 0) continue;
-            const wb_real depth = rad[i] - wb__shape_distance(s, p1, q1, &x[3 * i], n);
-            if (depth > 0) resolve(w, i, c, n, depth, h, p0, q0, p1, q1, moving);
-        }
+    const wb_cshape *s = ct->c->s;
+    wb_real rel[3], vt[3];
+    v3_sub(rel, v, ct->vc);
+    const wb_real vn = v3_dot(rel, ct->n);
+    v3_copy(vt, rel);
+    v3_madd(vt, ct->n, -vn);
+    const wb_real vt_len = v3_len(vt);
+    if (s->friction > 0 && vt_len > 0) {
+        /* the normal impulse per unit mass is depth / h: |dv_t| <= mu |dv_n| */
+        const wb_real dv = s->friction * ct->depth / h;
+        v3_madd(v, vt, -(dv < vt_len ? dv : vt_len) / vt_len);
     }
-    k->last_contacts = k->ncontacts;
+    if (ct->vn_pre < 0) {
+        /* no bounce below 2|g|h: resting contact must not jitter */
+        const wb_real e = -ct->vn_pre > 2 * g * h ? s->restitution : 0;
+        v3_madd(v, ct->n, -e * ct->vn_pre - vn);
+    }
 }
 
-/* dynamic friction and restitution on the velocities the positions imply */
-void wb__collide_velocities(wb_world *w, wb_real h)
+/* One pass per particle after the constraints: push it out of every collider at the
+ * collider's substep-end pose, set v = (x - x_prev) / h, then friction and
+ * restitution for the contacts it has. Particles are independent here, so the pass
+ * runs in parallel with results identical for any thread count. */
+void wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1)
 {
+    wb_model *m = &w->m;
     wb_cache *k = &w->k;
-    const wb_real g = v3_len(w->m.def.gravity);
-    for (int32_t i = 0; i < k->ncontacts; i++) {
-        const wb_contact *ct = &k->contacts[i];
-        const wb_cshape *s = &w->m.c_shape[ct->c];
-        wb_real *v = &w->s.v[3 * ct->p], rel[3], vt[3];
-        v3_sub(rel, v, ct->vc);
-        const wb_real vn = v3_dot(rel, ct->n);
-        v3_copy(vt, rel);
-        v3_madd(vt, ct->n, -vn);
-        const wb_real vt_len = v3_len(vt);
-        if (s->friction > 0 && vt_len > 0) {
-            wb_real dv = s->friction * ct->depth / h;
-            v3_madd(v, vt, -(dv < vt_len ? dv : vt_len) / vt_len);
-        }
-        if (ct->vn_pre < 0) {
-            /* no bounce below 2|g|h: resting contact must not jitter */
-            wb_real e = -ct->vn_pre > 2 * g * h ? s->restitution : 0;
-            v3_madd(v, ct->n, -e * ct->vn_pre - vn);
-        }
+    int32_t nlive = 0;
+    sub_pose *cs = wb__grow(k->c_sub, &k->cap_c_sub, m->nc > 0 ? m->nc : 1, sizeof *cs);
+    if (!cs) { wb__warn(w, "out of memory in collision"); return; }
+    k->c_sub = cs;
+    for (int32_t c = 0; c < m->nc; c++) {
+        if (!(m->c_gen[c] & 1u)) continue;
+        sub_pose *sp = &cs[nlive++];
+        sp->s = &m->c_shape[c];
+        sp->slot = c;
+        wb__collider_pose_at(&w->s.c_pose[c], f0, sp->p0, sp->q0);
+        wb__collider_pose_at(&w->s.c_pose[c], f1, sp->p1, sp->q1);
+        sp->moving = memcmp(sp->p0, sp->p1, sizeof sp->p0) || memcmp(sp->q0, sp->q1, sizeof sp->q0);
+        q_rotate(sp->q1, sp->s->n, sp->n);
+        sp->off = v3_dot(sp->n, sp->p1);
     }
+    const wb_real inv_h = 1 / h, g = v3_len(m->def.gravity);
+    const wb_real *wv = m->w, *rad = m->radius;
+    wb_real *x = w->s.x, *xp = w->s.x_prev, *v = w->s.v;
+    const int32_t np = m->np;
+    const int threads = m->def.threads;
+    int64_t ncontacts = 0;
+    #pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : ncontacts) if (threads > 1 && np >= 4096)
+    for (int32_t i = 0; i < np; i++) {
+        wb_real *xi = &x[3 * i], *vi = &v[3 * i];
+        const wb_real *pi = &xp[3 * i];
+        if (wv[i] == 0) { v3_set(vi, 0, 0, 0); continue; } /* pinned and immovable: at rest */
+        contact ct[MAX_CONTACTS];
+        int nct = 0;
+        for (int32_t c = 0; c < nlive; c++) {
+            const sub_pose *sp = &cs[c];
+            wb_real n[3], depth;
+            if (sp->s->shape == WB_SHAPE_PLANE) {
+                depth = rad[i] + sp->off - v3_dot(sp->n, xi);
+                v3_copy(n, sp->n);
+            } else {
+                depth = rad[i] - wb__shape_distance(sp->s, sp->p1, sp->q1, xi, n);
+            }
+            if (!(depth > 0)) continue;
+            resolve(w, i, sp, n, depth, h, nct < MAX_CONTACTS ? &ct[nct] : NULL);
+            nct++;
+        }
+        for (int c = 0; c < 3; c++) vi[c] = (xi[c] - pi[c]) * inv_h;
+        for (int c = 0; c < nct && c < MAX_CONTACTS; c++) contact_velocity(vi, &ct[c], h, g);
+        ncontacts += nct;
+    }
+    k->last_contacts = (int32_t)ncontacts;
 }

@@ -4,7 +4,7 @@
  * not change (masses, topology, compliances, collider shapes, colour batches); the
  * state holds what it does (positions, velocities, plastic rest lengths, broken flags,
  * collider poses, time). The step reads the model and writes the state; the solver
- * cache (packed batches, multipliers, contacts) is scratch rebuilt from both. */
+ * cache (packed batches, multipliers) is scratch rebuilt from both. */
 #ifndef WB_CORE_H
 #define WB_CORE_H
 
@@ -98,14 +98,6 @@ typedef struct wb_state {
 } wb_state;
 
 /* ---- solver cache: packed colour batches and per-step scratch ------------------------ */
-typedef struct wb_contact {
-    int32_t p, c;          /* particle, collider slot */
-    wb_real n[3];          /* unit normal, out of the collider */
-    wb_real depth;         /* correction applied along n this substep */
-    wb_real vc[3];         /* collider surface velocity at the contact */
-    wb_real vn_pre;        /* normal velocity relative to the surface before the solve */
-} wb_contact;
-
 typedef struct wb_cache {
     int32_t ns;            /* packed constraints (live and not broken) */
     int32_t ncolours;
@@ -121,10 +113,8 @@ typedef struct wb_cache {
     wb_real *dx;           /* (np x 3) Jacobi accumulators */
     int32_t *ncount;       /* (np) constraints per particle (for s_jac) */
     wb_real *x_save, *v_save; /* (np x 3) last finite frame, for recovery */
-    wb_real *c_sub;        /* (nc x 14) collider poses at the substep's start and end */
+    void *c_sub;           /* (nc) collider poses at the substep's start and end (collide.c) */
     int32_t cap_c_sub;
-    wb_contact *contacts;
-    int32_t ncontacts, cap_contacts;
     wb_distance_id *breaks;
     int32_t nbreaks, cap_breaks;
     int32_t last_contacts;
@@ -140,8 +130,8 @@ struct wb_world {
 
 /* internal entry points */
 wb_status wb__colour(wb_world *w);                 /* colour.c: rebuild batches if dirty */
-void wb__collide(wb_world *w, wb_real h, wb_real t0, wb_real t1, wb_real dt); /* collide.c */
-void wb__collide_velocities(wb_world *w, wb_real h);
+/* collide.c: collisions, then v = (x - x_prev)/h, friction and restitution */
+void wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1);
 void wb__collider_pose_at(const wb_collider_pose *cp, wb_real t, wb_real p[3], wb_real q[4]);
 wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real q[4],
                            const wb_real x[3], wb_real n[3]);

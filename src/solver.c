@@ -149,16 +149,6 @@ static void predict(wb_world *w, wb_real h)
     }
 }
 
-static void update_velocities(wb_world *w, wb_real h)
-{
-    const wb_real inv_h = 1 / h;
-    wb_real *restrict x = w->s.x, *restrict xp = w->s.x_prev, *restrict v = w->s.v;
-    const wb_real *restrict wv = w->m.w;
-    for (int32_t i = 0; i < w->m.np; i++) {
-        const wb_real f = wv[i] > 0 ? inv_h : 0; /* pinned and immovable: at rest */
-        for (int c = 3 * i; c < 3 * i + 3; c++) v[c] = (x[c] - xp[c]) * f;
-    }
-}
 
 /* plastic flow and breaking, once per frame on the frame's final lengths */
 static void plasticity_and_breaking(wb_world *w)
@@ -245,9 +235,7 @@ void wb_world_step(wb_world *w)
         if (k->ns > 0) memset(k->s_lambda, 0, sizeof(wb_real) * (size_t)k->ns);
         solve_constraints(w, h);
         solve += now_ms() - t0;
-        wb__collide(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps, dt);
-        update_velocities(w, h);
-        wb__collide_velocities(w, h);
+        wb__collide_and_update(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
     }
 
     for (int32_t c = 0; c < w->m.nc; c++) {

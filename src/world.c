@@ -92,7 +92,7 @@ void wb_world_destroy(wb_world *w)
                      m->d_yield, m->d_creep, m->d_break, m->d_gen, m->d_free, m->c_shape, m->c_gen, m->surf_start, m->tri,
                      s->x, s->x_prev, s->v, s->d_rest, s->d_broken, s->c_pose,
                      k->colour_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda, k->s_jac,
-                     k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->contacts, k->c_sub,
+                     k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->c_sub,
                      k->breaks };
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
     free(w);
