@@ -2,6 +2,7 @@
  * module table. The runtime preloads it as the global `wobble` (and adds its own
  * fields, such as wobble.args). */
 #include "lua_util.h"
+#include "render.h"
 
 static const luaL_Reg wobble_funcs[] = {
     { "world", wbl_world_new },
@@ -17,6 +18,7 @@ int luaopen_wobble(lua_State *L)
     wbl_open_body(L);
 
     luaL_newlib(L, wobble_funcs);
+    wbl_open_renderer(L);   /* wobble.renderer, wobble.probe, wobble.read_png; w:run's plot */
     lua_pushliteral(L, WB_VERSION);
     lua_setfield(L, -2, "version");
     /* the core's hard limits, so scripts can size things without trial and error */

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "lua_util.h"
+#include "render.h"
 
 static const char *const solver_names[] = { "gauss-seidel", "jacobi", NULL };
 
@@ -279,7 +280,7 @@ static bool run_stops(lua_State *L)
     return stop;
 }
 
-/* stack: 1 world, 2 options, 3 on_frame or nil, 4 run state */
+/* stack: 1 world, 2 options, 3 on_frame or nil, 4 run state, 5 plot sampler or nil */
 static int run_loop(lua_State *L, int status, lua_KContext ctx)
 {
     run_state *r = (run_state *)lua_touserdata(L, 4);
@@ -290,6 +291,7 @@ static int run_loop(lua_State *L, int status, lua_KContext ctx)
         wb_world_step(w);
         r->done++;
         wbl_after_frame(L, 1);
+        wbl_plot_frame(L, 5, 1);
         wb_progress_update(L, r->done);
         if (r->has_fn) {
             lua_pushvalue(L, 3);
@@ -301,12 +303,13 @@ static int run_loop(lua_State *L, int status, lua_KContext ctx)
         }
     }
 done:
+    wbl_plot_finish(L, 5);   /* plot = "x.png": the chart of the run */
     lua_closeslot(L, 4);
     lua_pushinteger(L, (lua_Integer)r->done);
     return 1;
 }
 
-static const char *const run_keys[] = { "frames", "seconds", "on_frame", NULL };
+static const char *const run_keys[] = { "frames", "seconds", "on_frame", "plot", NULL };
 
 static int w_run(lua_State *L)
 {
@@ -342,6 +345,7 @@ static int w_run(lua_State *L)
     lua_toclose(L, 4);
     r->n = n;
     r->has_fn = has_fn;
+    wbl_plot_push(L, 2, "plot", 1);   /* slot 5: the plot's sampler, or nil */
     r->active = 1;
     wb_progress_begin(L, "run", n);
     return run_loop(L, LUA_OK, 0);
