@@ -227,4 +227,94 @@ wb_distance_id wb_world_break_at(const wb_world *w, int32_t i);
 
 const char *wb_last_error(void);   /* message of the last WB_ERR_ARG in this thread */
 
+/* ==== meshes, particle graphs from meshes, skinning, snapshots (issue 3) ================== */
+
+/* ---- meshes (mesh.c): triangle meshes in memory; file formats live outside the core ---- */
+typedef struct wb_mesh {
+    int32_t nv, nt;
+    wb_real *v;           /* (nv x 3) positions */
+    wb_real *n;           /* (nv x 3) unit normals: area-weighted mean of the faces around */
+    int32_t *tri;         /* (nt x 3) vertex ids, counter-clockwise seen from outside */
+} wb_mesh;
+
+/* copy vertices and triangles (triangles repeating a corner are dropped), compute normals;
+ * NULL with *status set (WB_ERR_ARG: non-finite vertex, corner out of range; see wb_last_error) */
+wb_mesh *wb_mesh_create(const wb_real *v, int32_t nv, const int32_t *tri, int32_t nt, wb_status *status);
+wb_mesh *wb_mesh_copy(const wb_mesh *m);                      /* NULL when out of memory */
+void wb_mesh_destroy(wb_mesh *m);                             /* NULL is fine */
+/* merge vertices closer than tol (0: identical positions only), first occurrence kept, order
+ * kept; triangles that collapse are dropped, normals recomputed. remap (old nv) may be NULL */
+wb_status wb_mesh_weld(wb_mesh *m, wb_real tol, int32_t *remap);
+void wb_mesh_compute_normals(wb_mesh *m);
+bool wb_mesh_bounds(const wb_mesh *m, wb_real min[3], wb_real max[3]); /* false when empty */
+void wb_mesh_transform(wb_mesh *m, wb_real scale, const wb_real offset[3]); /* v = v * scale + offset */
+/* the unique undirected edges (a < b, sorted); *ij (n x 2) is malloc'd, the caller frees it;
+ * returns n or a negative wb_status */
+int32_t wb_mesh_edges(const wb_mesh *m, int32_t **ij);
+/* vertex clustering on a uniform grid whose cell size is searched so that about `target`
+ * cells are occupied: cluster[v] in [0, n), numbered by first vertex; returns n or < 0 */
+int32_t wb_mesh_cluster(const wb_mesh *m, int32_t target, int32_t *cluster);
+
+/* ---- k-d tree (kdtree.c): K nearest neighbours over a fixed point set -------------------- */
+typedef struct wb_kdtree wb_kdtree;
+wb_kdtree *wb_kdtree_build(const wb_real *pts, int32_t n);    /* copies (n x 3) points; NULL on no memory */
+void wb_kdtree_destroy(wb_kdtree *t);
+/* the k nearest points to q, nearest first, ties by lower index: ids and squared distances
+ * (either may be NULL); returns min(k, n) */
+int wb_kdtree_knn(const wb_kdtree *t, const wb_real q[3], int k, int32_t *ids, wb_real *dist2);
+
+/* ---- particle graph from a mesh (from_mesh.c) ------------------------------------------- */
+typedef struct wb_from_mesh_def {
+    wb_real mass, radius; /* total mass spread evenly; particle radius */
+    int32_t target;       /* 0: a particle per vertex; else about this many, by vertex clustering */
+    int neighbours;       /* also link each particle to its k nearest (volume for hollow shells) */
+    bool surface;         /* register the (clustered) triangles as a surface */
+    wb_distance_def link; /* options of every constraint made (rest = current length) */
+} wb_from_mesh_def;
+
+wb_from_mesh_def wb_from_mesh_default_def(void);              /* mass 1, radius 0.02, every vertex, surface */
+/* a particle per (clustered) vertex, a distance constraint per edge; out->count particles */
+wb_status wb_from_mesh(wb_world *w, const wb_mesh *m, const wb_from_mesh_def *def, wb_body *out);
+
+/* ---- skinning (skin.c): linear blend skinning of a mesh over particles ------------------- */
+/* Each vertex binds to its `bones` nearest particles (k-d tree) with weights that sum to 1
+ * and fall off with distance. A bone's frame follows its particle and the rotation of its
+ * neighbourhood (its `neighbours` nearest particles at bind time), extracted with Müller
+ * et al. 2016 warm-started from the last update. */
+typedef struct wb_skin wb_skin;
+typedef struct wb_skin_def {
+    int bones;            /* particles per vertex, 1..16, default 4 */
+    int neighbours;       /* particles whose motion gives a bone's rotation, 1..32, default 8 */
+    int iterations;       /* max rotation-extraction iterations per update, default 50 (a warm start
+                           * converges in one or two; a sudden large turn needs tens) */
+} wb_skin_def;
+
+wb_skin_def wb_skin_default_def(void);
+const char *wb_skin_def_check(const wb_skin_def *def);        /* NULL or what is wrong */
+/* bind m (copied) to the particles ids[0..n) at their current positions; NULL with *status */
+wb_skin *wb_skin_create(const wb_world *w, const wb_mesh *m, const int32_t *ids, int32_t n,
+                        const wb_skin_def *def, wb_status *status);
+void wb_skin_destroy(wb_skin *s);                             /* NULL is fine */
+/* Bring the bones up to the particles' positions (a no-op when they have not moved since
+ * the last update); the binding calls it after every frame so the warm start stays close */
+void wb_skin_update_bones(wb_skin *s, const wb_world *w);
+/* the deformed vertices (nv x 3), updated when the particles moved; valid until the next call */
+const wb_real *wb_skin_vertices(wb_skin *s, const wb_world *w);
+const wb_real *wb_skin_normals(wb_skin *s, const wb_world *w); /* (nv x 3) of the deformed mesh */
+const wb_mesh *wb_skin_rest(const wb_skin *s);                /* the bound mesh, rest pose */
+int32_t wb_skin_bone_count(const wb_skin *s);                 /* particles bound */
+int32_t wb_skin_bone_particle(const wb_skin *s, int32_t b);
+void wb_skin_bone_rotation(const wb_skin *s, int32_t b, wb_real q[4]); /* at the last update */
+/* vertex v's particles and weights (arrays of wb_skin_def.bones); returns how many */
+int wb_skin_influences(const wb_skin *s, int32_t v, int32_t *particles, wb_real *weights);
+
+/* rotational part of A (3 x 3, row-major) after Müller et al. 2016, "A robust method to
+ * extract the rotational part of deformations": q (w,x,y,z) is the warm start and the result */
+void wb_extract_rotation(const wb_real A[9], wb_real q[4], int max_iter);
+void wb_quat_to_matrix(const wb_real q[4], wb_real R[9]);     /* row-major */
+
+/* ---- snapshots (snapshot.c) --------------------------------------------------------------- */
+/* an exact copy: same hash, and the two step bit-identically; NULL when out of memory */
+wb_world *wb_world_clone(const wb_world *w);
+
 #endif

@@ -44,6 +44,20 @@
     X(world_damping_keeps_static_equilibrium)    \
     X(world_damping_terminal_velocity)           \
     X(step_never_writes_immovable)               \
+    X(mesh_weld_stl_cube)                        \
+    X(mesh_weld_tolerance_and_degenerates)       \
+    X(mesh_create_rejects_bad_input)             \
+    X(kdtree_matches_brute_force)                \
+    X(mesh_cluster_target)                       \
+    X(from_mesh_graph)                           \
+    X(world_clone_exact)                         \
+    X(rotation_extraction_matches_polar)         \
+    X(rotation_extraction_warm_start)            \
+    X(skin_rest_pose_reproduces_mesh)            \
+    X(skin_weights_sum_to_one_and_fall_off)      \
+    X(skin_rigid_motion_is_rigid)                \
+    X(skin_follows_simulation)                   \
+    X(skin_bad_definitions)                      \
     X(world_step_empty)
 
 #define DECLARE(name) TEST(name);

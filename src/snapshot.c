@@ -1,0 +1,407 @@
+/* snapshot.c: a world to and from flat arrays (wb_image, snapshot.h): exact copies,
+ * the JSON snapshot's restore, and appending a particle config to a world.
+ *
+ * Exact means bit for bit: the restored world has every model and state array of the
+ * original, constraint and collider slots in the same order with the same generations
+ * and free lists, so it colours its constraints into the same batches and steps the
+ * same. The solver cache is not copied; it is rebuilt from the model before the next
+ * step, as after any topology edit. */
+#include <stdlib.h>
+
+#include "core.h"
+#include "snapshot.h"
+
+static int fin3(const wb_real *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
+/* calloc of n elements, never of 0 bytes (so NULL always means out of memory) */
+static void *zalloc(int64_t n, size_t elem) { return calloc((size_t)(n > 0 ? n : 1), elem); }
+
+wb_status wb_image_alloc(wb_image *g, int32_t np, int32_t nd, int32_t nfree, int32_t nc, int32_t nsurf, int32_t ntri)
+{
+    memset(g, 0, sizeof *g);
+    g->def = wb_world_default_def();
+    g->np = np;
+    g->nd = nd;
+    g->nfree = nfree;
+    g->nc = nc;
+    g->nsurf = nsurf;
+    g->ntri = ntri;
+    g->x = zalloc(3 * (int64_t)np, sizeof *g->x);
+    g->v = zalloc(3 * (int64_t)np, sizeof *g->v);
+    g->inv_mass = zalloc(np, sizeof *g->inv_mass);
+    g->radius = zalloc(np, sizeof *g->radius);
+    g->pinned = zalloc(np, 1);
+    g->d_ij = zalloc(2 * (int64_t)nd, sizeof *g->d_ij);
+    g->d_alpha = zalloc(nd, sizeof(wb_real));
+    g->d_beta = zalloc(nd, sizeof(wb_real));
+    g->d_yield = zalloc(nd, sizeof(wb_real));
+    g->d_creep = zalloc(nd, sizeof(wb_real));
+    g->d_break = zalloc(nd, sizeof(wb_real));
+    g->d_rest = zalloc(nd, sizeof(wb_real));
+    g->d_broken = zalloc(nd, 1);
+    g->d_gen = zalloc(nd, sizeof *g->d_gen);
+    g->d_free = zalloc(nfree, sizeof *g->d_free);
+    g->c = zalloc(nc, sizeof *g->c);
+    g->c_gen = zalloc(nc, sizeof *g->c_gen);
+    g->surf_start = zalloc((int64_t)nsurf + 1, sizeof *g->surf_start);
+    g->tri = zalloc(3 * (int64_t)ntri, sizeof *g->tri);
+    if (!g->x || !g->v || !g->inv_mass || !g->radius || !g->pinned || !g->d_ij || !g->d_alpha || !g->d_beta ||
+        !g->d_yield || !g->d_creep || !g->d_break || !g->d_rest || !g->d_broken || !g->d_gen || !g->d_free ||
+        !g->c || !g->c_gen || !g->surf_start || !g->tri) {
+        wb_image_free(g);
+        return WB_ERR_NOMEM;
+    }
+    for (int32_t i = 0; i < nd; i++) g->d_gen[i] = 1;
+    for (int32_t i = 0; i < nc; i++) {
+        g->c_gen[i] = 1;
+        g->c[i].q[0] = g->c[i].q0[0] = 1;
+    }
+    return WB_OK;
+}
+
+void wb_image_free(wb_image *g)
+{
+    void *p[] = { g->x, g->v, g->inv_mass, g->radius, g->pinned, g->d_ij, g->d_alpha, g->d_beta, g->d_yield,
+                  g->d_creep, g->d_break, g->d_rest, g->d_broken, g->d_gen, g->d_free, g->c, g->c_gen,
+                  g->surf_start, g->tri };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    memset(g, 0, sizeof *g);
+}
+
+wb_status wb_image_of(const wb_world *w, wb_image *g)
+{
+    const wb_model *m = &w->m;
+    const wb_state *s = &w->s;
+    wb_status st = wb_image_alloc(g, m->np, m->nd, m->nfree, m->nc, m->nsurf, m->ntri);
+    if (st != WB_OK) return st;
+    g->def = m->def;
+    const size_t np = (size_t)m->np, nd = (size_t)m->nd;
+    if (np) {
+        memcpy(g->x, s->x, 3 * np * sizeof *g->x);
+        memcpy(g->v, s->v, 3 * np * sizeof *g->v);
+        memcpy(g->inv_mass, m->inv_mass, np * sizeof *g->inv_mass);
+        memcpy(g->radius, m->radius, np * sizeof *g->radius);
+        memcpy(g->pinned, m->pinned, np);
+    }
+    if (nd) {
+        memcpy(g->d_ij, m->d_ij, 2 * nd * sizeof *g->d_ij);
+        memcpy(g->d_alpha, m->d_alpha, nd * sizeof(wb_real));
+        memcpy(g->d_beta, m->d_beta, nd * sizeof(wb_real));
+        memcpy(g->d_yield, m->d_yield, nd * sizeof(wb_real));
+        memcpy(g->d_creep, m->d_creep, nd * sizeof(wb_real));
+        memcpy(g->d_break, m->d_break, nd * sizeof(wb_real));
+        memcpy(g->d_rest, s->d_rest, nd * sizeof(wb_real));
+        memcpy(g->d_broken, s->d_broken, nd);
+        memcpy(g->d_gen, m->d_gen, nd * sizeof *g->d_gen);
+    }
+    if (m->nfree) memcpy(g->d_free, m->d_free, (size_t)m->nfree * sizeof *g->d_free);
+    for (int32_t i = 0; i < m->nc; i++) {
+        const wb_cshape *cs = &m->c_shape[i];
+        const wb_collider_pose *cp = &s->c_pose[i];
+        wb_image_collider *c = &g->c[i];
+        c->shape = cs->shape;
+        v3_copy(c->n, cs->n);
+        c->radius = cs->radius;
+        v3_copy(c->half, cs->half);
+        v3_copy(c->a, cs->a);
+        v3_copy(c->b, cs->b);
+        c->friction = cs->friction;
+        c->restitution = cs->restitution;
+        v3_copy(c->p, cp->p);
+        memcpy(c->q, cp->q, sizeof c->q);
+        v3_copy(c->p0, cp->p0);
+        memcpy(c->q0, cp->q0, sizeof c->q0);
+        v3_copy(c->v, cp->v);
+        v3_copy(c->om, cp->om);
+        g->c_gen[i] = m->c_gen[i];
+    }
+    if (m->nsurf) memcpy(g->surf_start, m->surf_start, ((size_t)m->nsurf + 1) * sizeof *g->surf_start);
+    if (m->ntri) memcpy(g->tri, m->tri, 3 * (size_t)m->ntri * sizeof *g->tri);
+    g->time = s->time;
+    g->frame = s->frame;
+    g->warnings = s->warnings;
+    memcpy(g->last_warning, s->last_warning, sizeof g->last_warning);
+    return WB_OK;
+}
+
+/* ---- checks ---------------------------------------------------------------------------- */
+static const char *check_collider(const wb_image_collider *c)
+{
+    if ((unsigned)c->shape >= WB_SHAPE_COUNT) return "unknown collider shape";
+    if (!(c->friction >= 0) || !isfinite(c->friction)) return "collider friction must be >= 0";
+    if (!(c->restitution >= 0 && c->restitution <= 1)) return "collider restitution must be in [0, 1]";
+    if (!fin3(c->n) || !fin3(c->half) || !fin3(c->a) || !fin3(c->b) || !isfinite(c->radius)) return "collider shape must be finite";
+    if (!fin3(c->p) || !fin3(c->p0) || !fin3(c->v) || !fin3(c->om)) return "collider pose must be finite";
+    for (int i = 0; i < 4; i++)
+        if (!isfinite(c->q[i]) || !isfinite(c->q0[i])) return "collider rotation must be finite";
+    if (c->q[0] * c->q[0] + v3_dot(&c->q[1], &c->q[1]) < 1e-24) return "collider rotation must not be zero";
+    if (c->q0[0] * c->q0[0] + v3_dot(&c->q0[1], &c->q0[1]) < 1e-24) return "collider rotation must not be zero";
+    if ((c->shape == WB_SHAPE_SPHERE || c->shape == WB_SHAPE_CAPSULE) && !(c->radius > 0)) return "collider radius must be > 0";
+    if (c->shape == WB_SHAPE_BOX && !(c->half[0] > 0 && c->half[1] > 0 && c->half[2] > 0)) return "box half extents must be > 0";
+    if (c->shape == WB_SHAPE_PLANE && !(v3_len(c->n) > 1e-12)) return "plane normal must not be zero";
+    return NULL;
+}
+
+const char *wb_image_check(const wb_image *g)
+{
+    const char *e = wb_world_def_check(&g->def);
+    if (e) return e;
+    if (g->np < 0 || g->np > WB_MAX_PARTICLES) return "too many particles";
+    if (g->nd < 0 || g->nd > WB_MAX_CONSTRAINTS) return "too many constraints";
+    if (g->nc < 0 || g->nc > WB_MAX_COLLIDERS) return "too many colliders";
+    if (g->nsurf < 0 || g->ntri < 0 || g->ntri > WB_MAX_CONSTRAINTS) return "too many triangles";
+    for (int32_t i = 0; i < g->np; i++) {
+        if (!fin3(&g->x[3 * i]) || !fin3(&g->v[3 * i])) return "particle position and velocity must be finite";
+        if (!(g->inv_mass[i] >= 0) || !isfinite(g->inv_mass[i])) return "particle mass must be >= 0";
+        if (!(g->radius[i] >= 0) || !isfinite(g->radius[i])) return "particle radius must be >= 0";
+    }
+    int32_t dead = 0;
+    for (int32_t i = 0; i < g->nd; i++) {
+        if (!(g->d_gen[i] & 1u)) { dead++; continue; }
+        const int32_t a = g->d_ij[2 * i], b = g->d_ij[2 * i + 1];
+        if (a < 0 || b < 0 || a >= g->np || b >= g->np) return "constraint particle out of range";
+        if (a == b) return "a constraint needs two distinct particles";
+        wb_distance_def d = { g->d_alpha[i], g->d_beta[i], g->d_rest[i], g->d_yield[i], g->d_creep[i], g->d_break[i] };
+        if ((e = wb_distance_def_check(&d))) return e;
+        if (!(g->d_rest[i] >= 0)) return "rest length must be >= 0";
+    }
+    /* the free list is exactly the dead slots, each once */
+    if (g->nfree != dead) return "the free constraint slots do not match the dead ones";
+    for (int32_t i = 0; i < g->nfree; i++) {
+        const int32_t s = g->d_free[i];
+        if (s < 0 || s >= g->nd || (g->d_gen[s] & 1u)) return "a free constraint slot is not a dead one";
+        for (int32_t j = 0; j < i; j++)
+            if (g->d_free[j] == s) return "a free constraint slot is listed twice";
+    }
+    for (int32_t i = 0; i < g->nc; i++)
+        if ((g->c_gen[i] & 1u) && (e = check_collider(&g->c[i]))) return e;
+    if (g->nsurf > 0 && (g->surf_start[0] != 0 || g->surf_start[g->nsurf] != g->ntri)) return "surface ranges do not cover the triangles";
+    for (int32_t i = 0; i < g->nsurf; i++)
+        if (g->surf_start[i + 1] < g->surf_start[i]) return "surface ranges are not in order";
+    if (g->nsurf == 0 && g->ntri != 0) return "triangles without a surface";
+    for (int64_t i = 0; i < 3 * (int64_t)g->ntri; i++)
+        if (g->tri[i] < 0 || g->tri[i] >= g->np) return "surface corner out of range";
+    if (!isfinite(g->time) || g->frame < 0 || g->warnings < 0) return "time, frame and warnings must be finite and >= 0";
+    return NULL;
+}
+
+/* ---- exact restore ----------------------------------------------------------------------- */
+static wb_status grow_colliders(wb_world *w, int32_t need)
+{
+    wb_model *m = &w->m;
+    if (need <= m->cap_c) return WB_OK;
+    /* the three arrays share cap_c (as collide.c grows them): grow them alike */
+    int32_t c1 = m->cap_c, c2 = m->cap_c, c3 = m->cap_c;
+    wb_cshape *sh = wb__grow(m->c_shape, &c1, need, sizeof *sh);
+    if (!sh) return WB_ERR_NOMEM;
+    m->c_shape = sh;
+    uint32_t *gen = wb__grow(m->c_gen, &c2, need, sizeof *gen);
+    if (!gen) return WB_ERR_NOMEM;
+    m->c_gen = gen;
+    wb_collider_pose *po = wb__grow(w->s.c_pose, &c3, need, sizeof *po);
+    if (!po) return WB_ERR_NOMEM;
+    w->s.c_pose = po;
+    m->cap_c = c1;
+    return WB_OK;
+}
+
+static void put_collider(wb_world *w, int32_t slot, const wb_image_collider *c)
+{
+    wb_cshape *cs = &w->m.c_shape[slot];
+    wb_collider_pose *cp = &w->s.c_pose[slot];
+    memset(cs, 0, sizeof *cs);
+    cs->shape = c->shape;
+    v3_copy(cs->n, c->n);
+    cs->radius = c->radius;
+    v3_copy(cs->half, c->half);
+    v3_copy(cs->a, c->a);
+    v3_copy(cs->b, c->b);
+    cs->friction = c->friction;
+    cs->restitution = c->restitution;
+    v3_copy(cp->p, c->p);
+    memcpy(cp->q, c->q, sizeof cp->q);
+    v3_copy(cp->p0, c->p0);
+    memcpy(cp->q0, c->q0, sizeof cp->q0);
+    v3_copy(cp->v, c->v);
+    v3_copy(cp->om, c->om);
+}
+
+static wb_status reserve_surfaces(wb_world *w, int32_t nsurf, int32_t ntri)
+{
+    wb_model *m = &w->m;
+    if (nsurf == 0) return WB_OK;
+    wb_status st = wb__surface_reserve(w, ntri);
+    if (st != WB_OK) return st;
+    int32_t *ss = wb__grow(m->surf_start, &m->cap_surf, m->nsurf + nsurf + 1, sizeof *ss);
+    if (!ss) return WB_ERR_NOMEM;
+    m->surf_start = ss;
+    return WB_OK;
+}
+
+/* copy the image's surfaces after w's, corners shifted by `shift` (space reserved) */
+static void put_surfaces(wb_world *w, const wb_image *g, int32_t shift)
+{
+    wb_model *m = &w->m;
+    if (g->nsurf == 0) return;
+    if (m->nsurf == 0) m->surf_start[0] = 0;
+    for (int64_t i = 0; i < 3 * (int64_t)g->ntri; i++) m->tri[3 * (int64_t)m->ntri + i] = g->tri[i] + shift;
+    for (int32_t s = 1; s <= g->nsurf; s++) m->surf_start[m->nsurf + s] = m->ntri + g->surf_start[s];
+    m->nsurf += g->nsurf;
+    m->ntri += g->ntri;
+}
+
+wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
+{
+    wb_status dummy;
+    if (!status) status = &dummy;
+    const char *e = wb_image_check(g);
+    if (e) {
+        wb__set_error("%s", e);
+        *status = WB_ERR_ARG;
+        return NULL;
+    }
+    wb_world *w = wb_world_create(&g->def);
+    wb_status st = w ? wb__reserve(w, g->np, g->nd) : WB_ERR_NOMEM;
+    if (st == WB_OK) st = grow_colliders(w, g->nc);
+    if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
+    if (st != WB_OK) {
+        wb_world_destroy(w);
+        *status = st;
+        return NULL;
+    }
+    wb_model *m = &w->m;
+    wb_state *s = &w->s;
+    const size_t np = (size_t)g->np, nd = (size_t)g->nd;
+    m->np = g->np;
+    if (np) {
+        memcpy(s->x, g->x, 3 * np * sizeof *s->x);
+        memcpy(s->x_prev, g->x, 3 * np * sizeof *s->x);
+        memcpy(s->v, g->v, 3 * np * sizeof *s->v);
+        memcpy(m->inv_mass, g->inv_mass, np * sizeof *m->inv_mass);
+        memcpy(m->radius, g->radius, np * sizeof *m->radius);
+        memcpy(m->pinned, g->pinned, np);
+    }
+    for (size_t i = 0; i < np; i++) m->w[i] = g->pinned[i] ? 0 : g->inv_mass[i];
+    m->nd = g->nd;
+    m->nd_live = 0;
+    if (nd) {
+        memcpy(m->d_ij, g->d_ij, 2 * nd * sizeof *m->d_ij);
+        memcpy(m->d_alpha, g->d_alpha, nd * sizeof(wb_real));
+        memcpy(m->d_beta, g->d_beta, nd * sizeof(wb_real));
+        memcpy(m->d_yield, g->d_yield, nd * sizeof(wb_real));
+        memcpy(m->d_creep, g->d_creep, nd * sizeof(wb_real));
+        memcpy(m->d_break, g->d_break, nd * sizeof(wb_real));
+        memcpy(s->d_rest, g->d_rest, nd * sizeof(wb_real));
+        memcpy(s->d_broken, g->d_broken, nd);
+        memcpy(m->d_gen, g->d_gen, nd * sizeof *m->d_gen);
+    }
+    for (size_t i = 0; i < nd; i++) {
+        w->k.slot_pack[i] = -1;
+        m->nd_live += (int32_t)(g->d_gen[i] & 1u);
+    }
+    m->nfree = g->nfree;
+    if (g->nfree) memcpy(m->d_free, g->d_free, (size_t)g->nfree * sizeof *m->d_free);
+    m->nc = g->nc;
+    for (int32_t i = 0; i < g->nc; i++) {
+        put_collider(w, i, &g->c[i]);
+        m->c_gen[i] = g->c_gen[i];
+    }
+    put_surfaces(w, g, 0);
+    s->time = g->time;
+    s->frame = g->frame;
+    s->warnings = g->warnings;
+    memcpy(s->last_warning, g->last_warning, sizeof s->last_warning);
+    s->last_warning[sizeof s->last_warning - 1] = '\0';
+    m->topology_dirty = 1;
+    *status = WB_OK;
+    return w;
+}
+
+wb_world *wb_world_clone(const wb_world *w)
+{
+    wb_image g;
+    if (wb_image_of(w, &g) != WB_OK) return NULL;
+    wb_world *c = wb_world_from_image(&g, NULL);
+    wb_image_free(&g);
+    return c;
+}
+
+/* ---- append (w:load_particles) ------------------------------------------------------------ */
+wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
+{
+    const char *e = wb_image_check(g);
+    if (e) {
+        wb__set_error("%s", e);
+        return WB_ERR_ARG;
+    }
+    wb_model *m = &w->m;
+    int32_t live_d = 0, live_c = 0, dead_c = 0;
+    for (int32_t i = 0; i < g->nd; i++) live_d += (int32_t)(g->d_gen[i] & 1u);
+    for (int32_t i = 0; i < g->nc; i++) live_c += (int32_t)(g->c_gen[i] & 1u);
+    for (int32_t i = 0; i < m->nc; i++) dead_c += !(m->c_gen[i] & 1u);
+    const int32_t new_c = live_c > dead_c ? live_c - dead_c : 0;
+    if ((int64_t)m->nc + new_c > WB_MAX_COLLIDERS || (int64_t)m->ntri + g->ntri > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    /* everything reserved first: after this nothing can fail */
+    wb_status st = wb__reserve(w, g->np, live_d);
+    if (st == WB_OK) st = grow_colliders(w, m->nc + new_c);
+    if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
+    if (st != WB_OK) return st;
+
+    const int32_t first = m->np;
+    for (int32_t i = 0; i < g->np; i++) {
+        wb_particle_add(w, &g->x[3 * i], &g->v[3 * i], g->inv_mass[i] > 0 ? 1 / g->inv_mass[i] : 0, g->radius[i]);
+        /* the exact inverse mass (1/(1/m) need not give m back), and the velocity even of a
+         * particle added as immovable is 0 as the image says */
+        m->inv_mass[first + i] = g->inv_mass[i];
+        m->pinned[first + i] = g->pinned[i];
+        m->w[first + i] = g->pinned[i] ? 0 : g->inv_mass[i];
+        memcpy(&w->s.v[3 * (first + i)], &g->v[3 * i], 3 * sizeof(wb_real));
+    }
+    for (int32_t i = 0; i < g->nd; i++) {
+        if (!(g->d_gen[i] & 1u)) continue;
+        wb_distance_def d = { g->d_alpha[i], g->d_beta[i], g->d_rest[i], g->d_yield[i], g->d_creep[i], g->d_break[i] };
+        wb_distance_id id = wb_distance_add(w, first + g->d_ij[2 * i], first + g->d_ij[2 * i + 1], &d, NULL);
+        w->s.d_broken[id.index - 1] = g->d_broken[i];
+    }
+    for (int32_t i = 0; i < g->nc; i++) {
+        if (!(g->c_gen[i] & 1u)) continue;
+        int32_t slot = -1;
+        for (int32_t k = 0; k < m->nc && slot < 0; k++)
+            if (!(m->c_gen[k] & 1u)) slot = k;
+        if (slot < 0) {
+            slot = m->nc++;
+            m->c_gen[slot] = 0;
+        }
+        put_collider(w, slot, &g->c[i]);
+        m->c_gen[slot]++;
+    }
+    put_surfaces(w, g, first);
+    m->topology_dirty = 1;
+    out->first = first;
+    out->count = g->np;
+    return WB_OK;
+}
+
+/* a collider given as w:collider{...} would make it (world-frame def -> own frame + pose),
+ * through the same code path, so the two cannot differ by a rounding */
+wb_status wb_image_collider_from_def(const wb_collider_def *d, wb_image_collider *out)
+{
+    const char *e = wb_collider_def_check(d);
+    if (e) {
+        wb__set_error("%s", e);
+        return WB_ERR_ARG;
+    }
+    wb_world_def wd = wb_world_default_def();
+    wb_world *w = wb_world_create(&wd);
+    if (!w) return WB_ERR_NOMEM;
+    wb_status st = WB_OK;
+    wb_collider_id id = wb_collider_add(w, d, &st);
+    if (st == WB_OK) {
+        wb_image g;
+        st = wb_image_of(w, &g);
+        if (st == WB_OK) *out = g.c[id.index - 1];
+        wb_image_free(&g);
+    }
+    wb_world_destroy(w);
+    return st;
+}
