@@ -443,6 +443,11 @@ bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n)
     lua_pushcfunction(L, record_hook);
     wb_rt_add_frame_hook(L, -1);
     lua_settop(L, top);
+    /* w:run's progress bar says where the frames go */
+    const char *slash = strrchr(path, '/');
+    char note[96];
+    snprintf(note, sizeof note, "recording %s", slash && slash[1] ? slash + 1 : path);
+    wb_progress_note(L, note);
     return true;
 }
 

@@ -2,6 +2,7 @@
  * TAP 13, run the benchmark scenes. Exit codes: 0 ok, 1 a test or expectation
  * failed, 2 script or input error, 3 a budget was exceeded. */
 #include "wobble_lua.h"
+#include "render.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -26,6 +27,7 @@ static const char usage_text[] =
     "\n"
     "options of run, test and bench:\n"
     "  --frames N          w:run stops after N frames\n"
+    "  --record OUT        (run) draw every frame into OUT: .mp4, .gif or a folder of PNGs\n"
     "  --out DIR           output folder, the only place a script writes (default out)\n"
     "  --set key=value     wobble.args.key = value (numbers, true/false converted); repeatable\n"
     "  --threads N         solver threads\n"
@@ -40,6 +42,7 @@ static const char usage_text[] =
 typedef struct opts {
     wb_runtime rt;
     const char **sets, **pos;  /* --set values, positional arguments */
+    const char *record;        /* run --record OUT, or NULL */
     int nsets, npos;
     int json;                  /* bench --json */
 } opts;
@@ -89,8 +92,7 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
         memcpy(name, a, nl);
         name[nl] = 0;
         int flag = !strcmp(name, "--unsafe") || !strcmp(name, "--quiet") || !strcmp(name, "--json");
-        if (!strcmp(name, "--record") || !strcmp(name, "--watch"))
-            return usage_error("%s is not implemented yet", name);
+        if (!strcmp(name, "--watch")) return usage_error("%s is not implemented yet", name);
         if (flag) {
             if (eq) return usage_error("%s takes no value", name);
             if (!strcmp(name, "--json") && strcmp(cmd, "bench")) return usage_error("unknown option %s", a);
@@ -100,8 +102,9 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
             continue;
         }
         if (strcmp(name, "--frames") && strcmp(name, "--out") && strcmp(name, "--set") && strcmp(name, "--threads") &&
-            strcmp(name, "--time-limit") && strcmp(name, "--memory-limit"))
+            strcmp(name, "--time-limit") && strcmp(name, "--memory-limit") && strcmp(name, "--record"))
             return usage_error("unknown option %s", a);
+        if (!strcmp(name, "--record") && strcmp(cmd, "run")) return usage_error("%s is an option of run", name);
         if (eq) val = eq + 1;
         else if (i + 1 < argc) val = argv[++i];
         else return usage_error("%s needs a value", name);
@@ -120,6 +123,9 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
         } else if (!strcmp(name, "--memory-limit")) {
             if (parse_number(val, 0, 1e9, &v)) return usage_error("--memory-limit expects megabytes, got '%s'", val);
             o->rt.memory_budget = (size_t)(v * 1048576.0);  /* 0: none */
+        } else if (!strcmp(name, "--record")) {
+            if (!*val) return usage_error("%s", "--record expects a file (.mp4, .gif) or a folder");
+            o->record = val;
         } else if (!strcmp(name, "--out")) {
             if (!*val) return usage_error("%s", "--out expects a folder");
             o->rt.out_dir = val;
@@ -492,6 +498,14 @@ static int run_scene(const opts *o, const char *path) {
         fprintf(stderr, "wobble: %s\n", err);
         return EXIT_SCRIPT;
     }
+    char rerr[1024];
+    /* --record: every frame the scene steps is drawn and encoded (the path is the
+     * user's choice, not the sandbox's); the file is finished even after an error */
+    if (o->record && !wbl_record_begin(L, o->record, rerr, sizeof rerr)) {
+        fprintf(stderr, "wobble: %s\n", rerr);
+        wb_rt_close(L);
+        return EXIT_SCRIPT;
+    }
     int status = run_file(L, path), code = EXIT_PASS;
     if (status != LUA_OK) {
         code = failure(L, status, path, &msg);
@@ -508,6 +522,10 @@ static int run_scene(const opts *o, const char *path) {
             fprintf(stderr, "wobble: %s: a time or memory budget was exceeded\n", path);
             code = EXIT_BUDGET;
         }
+    }
+    if (o->record && !wbl_record_end(L, rerr, sizeof rerr)) {
+        fprintf(stderr, "wobble: --record: %s\n", rerr);
+        if (code == EXIT_PASS) code = EXIT_SCRIPT;
     }
     wb_rt_close(L);
     return code;

@@ -18,6 +18,7 @@ static struct {
     char what[32];
     int64_t total, done;
     double t0, last;
+    char note[96];      /* shown after the label of every bar ("recording out.mp4") */
 } bar;
 
 static double now(void) {
@@ -28,7 +29,7 @@ static double now(void) {
 
 static void draw(double t) {
     double el = t - bar.t0, fps = el > 0 ? (double)bar.done / el : 0;
-    fprintf(stderr, "\r%s ", bar.what);
+    fprintf(stderr, "\r%s%s%s ", bar.what, bar.note[0] ? ", " : "", bar.note);
     if (bar.total > 0) {
         int64_t fill = bar.done >= bar.total ? BAR_WIDTH : bar.done * BAR_WIDTH / bar.total;
         fputc('[', stderr);
@@ -74,4 +75,9 @@ void wb_progress_end(lua_State *L) {
         fputc('\n', stderr);
     }
     bar.on = bar.drawn = 0;
+}
+
+void wb_progress_note(lua_State *L, const char *note) {
+    (void)L;
+    snprintf(bar.note, sizeof bar.note, "%s", note ? note : "");
 }

@@ -329,7 +329,9 @@ static bool spawn_encoder(wb_recorder *rec, char *err, size_t n)
     sigaddset(&def, SIGPIPE);
     posix_spawnattr_setsigmask(&at, &none);
     posix_spawnattr_setsigdefault(&at, &def);
-    posix_spawnattr_setflags(&at, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
+    /* its own process group: a stalled encoder is killed with whatever it started */
+    posix_spawnattr_setpgroup(&at, 0);
+    posix_spawnattr_setflags(&at, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETPGROUP);
     int e = posix_spawnp(&rec->pid, prog, &fa, &at, (char *const *)argv, environ);
     posix_spawn_file_actions_destroy(&fa);
     posix_spawnattr_destroy(&at);
@@ -396,7 +398,7 @@ static void wait_queue(wb_recorder *rec, int below)
             char s[32];
             snprintf(s, sizeof s, "%g", rec->timeout);
             fail(rec, "the encoder took no frame for %s s and was stopped%s", s, "");
-            kill(rec->pid, SIGKILL);
+            kill(-rec->pid, SIGKILL);
             t0 = now();
         }
     }
@@ -469,7 +471,7 @@ bool wb_recorder_close(wb_recorder *rec, char *err, size_t n)
         pid_t k;
         while ((k = waitpid(rec->pid, &status, WNOHANG)) == 0) {
             if (now() - t0 > 5 * rec->timeout) {
-                kill(rec->pid, SIGKILL);
+                kill(-rec->pid, SIGKILL);
                 fail(rec, "the encoder did not finish the file and was stopped%s%s", "", "");
             }
             struct timespec ts = { 0, 5000000 };

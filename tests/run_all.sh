@@ -4,6 +4,7 @@
 #   (b) wobble test tests/scenarios tests/validation   Lua scenario and validation tests
 #   (c) every scripts/*.lua for 5 frames        one test per example scene (pass = exit 0)
 #   (d) tests/cli/run.sh                        the command line in separate processes
+#   (e) tests/render/run.sh                     wobble run --record, encoders that fail
 # Each part prints its output and ends with "N passed, N failed"; a part that crashes
 # or prints no such line counts as a failure, never as zero tests. The last line is
 # the sum, "N passed, N failed"; the exit status is 1 when anything failed.
@@ -72,6 +73,7 @@ done
 part "scenario and validation tests" "$BUILD/wobble" test --out "$TMP/out-tests" $lua_dirs
 part "example scenes (scripts/*.lua, 5 frames)" examples
 part "command line (tests/cli/run.sh)" sh tests/cli/run.sh "$BUILD"
+part "recording from the command line (tests/render/run.sh)" sh tests/render/run.sh "$BUILD"
 
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]

@@ -57,8 +57,8 @@ run frobnicate
 check "unknown command" 2 err "unknown command 'frobnicate'" err "usage: wobble"
 run run $F/args.lua --no-such-option
 check "unknown option" 2 err "unknown option --no-such-option"
-run run $F/args.lua --record out.mp4
-check "--record is not there yet" 2 err "--record is not implemented yet"
+run run $F/args.lua --record out.avi
+check "--record checks the extension (more in tests/render/run.sh)" 2 err "unknown extension '.avi'"
 run sweep x.lua
 check "sweep is not there yet" 2 err "not implemented yet"
 run run

@@ -1,0 +1,76 @@
+#!/bin/sh
+# tests/render/run.sh BUILD_DIR: `wobble run --record OUT` from outside, one process
+# per check: the video's frame count and format (ffprobe), numbered PNG folders, and
+# encoders that fail (missing, exiting at once, never reading) giving a clear error
+# and exit code 2 instead of a hang. WOBBLE_FFMPEG names the encoder program.
+# Last line: "N passed, N failed"; exit status 1 when a check failed.
+BUILD=${1:-build}
+cd "$(dirname "$0")/../.." || exit 2
+W="$BUILD/wobble"
+F=tests/render/fixtures
+TMP=$(mktemp -d "${TMPDIR:-/tmp}/wobble-render.XXXXXX") || exit 2
+trap 'rm -rf "$TMP"' EXIT INT TERM
+n=0 passed=0 failed=0
+
+# COND; ok NAME $?: one check, passed when the condition before it held
+ok() {
+    name=$1
+    n=$((n + 1))
+    if [ "$2" = 0 ]; then
+        passed=$((passed + 1))
+        echo "ok $n - $name"
+    else
+        failed=$((failed + 1))
+        echo "not ok $n - $name"
+        sed 's/^/  # stderr: /' "$TMP/err" | head -n 10
+    fi
+}
+
+run() {
+    "$@" >"$TMP/out" 2>"$TMP/err"
+    code=$?
+}
+
+frames() {  # frames of a video, through ffprobe
+    ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames -of csv=p=0 "$1"
+}
+field() {   # one stream field of a video
+    ffprobe -v error -select_streams v:0 -show_entries stream="$2" -of csv=p=0 "$1"
+}
+
+run "$W" run $F/swing.lua --quiet --record "$TMP/swing.mp4"
+[ "$code" = 0 ]; ok "--record .mp4: exit 0" $?
+[ "$(frames "$TMP/swing.mp4")" = 15 ]; ok "--record .mp4: 15 frames (w:run and w:step)" $?
+[ "$(field "$TMP/swing.mp4" codec_name)" = h264 ] && [ "$(field "$TMP/swing.mp4" pix_fmt)" = yuv420p ] && [ "$(field "$TMP/swing.mp4" width)" = 1280 ] && [ "$(field "$TMP/swing.mp4" height)" = 720 ]; ok "--record .mp4: H.264, yuv420p, 1280x720" $?
+[ ! -s "$TMP/err" ]; ok "--record --quiet prints nothing" $?
+
+run "$W" run $F/swing.lua --frames 5 --record "$TMP/swing.gif"
+[ "$code" = 0 ] && [ "$(frames "$TMP/swing.gif")" = 8 ]; ok "--record .gif with --frames 5: 5 + 3 frames" $?
+grep -q "recorded 8 frames to $TMP/swing.gif" "$TMP/err"; ok "--record says where the frames went" $?
+
+run "$W" run $F/swing.lua --quiet --frames 2 --record "$TMP/pngs/"
+[ "$code" = 0 ] && [ -s "$TMP/pngs/frame_000000.png" ] && [ -s "$TMP/pngs/frame_000004.png" ] && [ ! -e "$TMP/pngs/frame_000005.png" ]; ok "--record folder/: numbered PNGs" $?
+
+run "$W" run $F/swing.lua --record "$TMP/swing.avi"
+[ "$code" = 2 ] && grep -q "unknown extension '.avi'" "$TMP/err"; ok "--record .avi: exit 2, the extension named" $?
+
+run "$W" run $F/swing.lua --record "$TMP/no/such/dir/x.mp4"
+[ "$code" = 2 ] && grep -q "cannot write" "$TMP/err" && [ ! -s "$TMP/out" ]; ok "--record into a missing folder: exit 2 before running" $?
+
+run "$W" test tests/scenarios/api_run.lua --record "$TMP/x.mp4"
+[ "$code" = 2 ] && grep -q "option of run" "$TMP/err"; ok "--record is an option of run only" $?
+
+run env WOBBLE_FFMPEG=/nonexistent/ffmpeg "$W" run $F/swing.lua --record "$TMP/missing.mp4"
+[ "$code" = 2 ] && grep -q "is not installed" "$TMP/err"; ok "missing ffmpeg: exit 2, says so" $?
+[ ! -e "$TMP/missing.mp4" ]; ok "missing ffmpeg: no empty file left" $?
+
+run env WOBBLE_FFMPEG=false "$W" run $F/swing.lua --record "$TMP/false.mp4"
+[ "$code" = 2 ] && grep -q "exited with status 1" "$TMP/err"; ok "an encoder that exits at once: exit 2, its status named" $?
+
+start=$(date +%s)
+run env WOBBLE_FFMPEG="$PWD/$F/stall.sh" WOBBLE_ENCODER_TIMEOUT=1 timeout 60 "$W" run $F/swing.lua --record "$TMP/stall.mp4"
+took=$(( $(date +%s) - start ))
+[ "$code" = 2 ] && grep -q "took no frame" "$TMP/err" && [ "$took" -lt 30 ]; ok "an encoder that never reads: stopped after the timeout, exit 2 (took ${took}s)" $?
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
