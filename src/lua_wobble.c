@@ -1,6 +1,7 @@
 /* lua_wobble.c: the `wobble` module: registers every userdata type and pushes the
  * module table. The runtime preloads it as the global `wobble` (and adds its own
  * fields, such as wobble.args). */
+#include "lua_mesh.h"
 #include "lua_util.h"
 #include "render.h"
 
@@ -18,6 +19,9 @@ int luaopen_wobble(lua_State *L)
     wbl_open_body(L);
 
     luaL_newlib(L, wobble_funcs);
+    wbl_open_mesh(L);       /* wobble.mesh, wobble.load_mesh; w:from_mesh */
+    wbl_open_skin(L);       /* w:skin, w:skins and the skin handle */
+    wbl_open_io(L);         /* wobble.load; w:load_particles, w:save, recorders (after skin) */
     wbl_open_renderer(L);   /* wobble.renderer, wobble.probe, wobble.read_png; w:run's plot */
     lua_pushliteral(L, WB_VERSION);
     lua_setfield(L, -2, "version");

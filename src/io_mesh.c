@@ -1,0 +1,295 @@
+/* io_mesh.c: meshes from and to files. Reading is assimp's (OBJ, glTF 2, PLY, STL, FBX,
+ * Collada, ...): triangulated, node transforms applied, every mesh of the file merged,
+ * then welded by position and given fresh normals by the core (mesh.c). OBJ and PLY are
+ * written here, vertex order kept (Blender's Mesh Cache matches points by index); other
+ * formats go through assimp's exporter.
+ *
+ * Every file assimp opens, the one named and any it pulls in (an OBJ's .mtl, a glTF's
+ * .bin), goes through a wrapper that asks the caller's `allow` first: a model file cannot
+ * read past the sandbox by naming "../../etc/passwd" as a buffer. */
+#include <assimp/cexport.h>
+#include <assimp/cfileio.h>
+#include <assimp/cimport.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+
+#include "io.h"
+
+/* ---- assimp's file access through the sandbox ---------------------------------------------- */
+typedef struct guard {
+    wbio_allow_fn allow;
+    void *ud;
+    char refused[512];     /* the first refusal, reported if the import then fails */
+} guard;
+
+static size_t f_read(struct aiFile *f, char *buf, size_t size, size_t n) { return fread(buf, size, n, (FILE *)f->UserData); }
+static size_t f_write(struct aiFile *f, const char *buf, size_t size, size_t n) { return fwrite(buf, size, n, (FILE *)f->UserData); }
+static size_t f_tell(struct aiFile *f) { long p = ftell((FILE *)f->UserData); return p < 0 ? 0 : (size_t)p; }
+static void f_flush(struct aiFile *f) { fflush((FILE *)f->UserData); }
+
+static size_t f_size(struct aiFile *f)
+{
+    struct stat st;
+    return fstat(fileno((FILE *)f->UserData), &st) == 0 ? (size_t)st.st_size : 0;
+}
+
+static enum aiReturn f_seek(struct aiFile *f, size_t off, enum aiOrigin o)
+{
+    int whence = o == aiOrigin_SET ? SEEK_SET : o == aiOrigin_CUR ? SEEK_CUR : SEEK_END;
+    return fseek((FILE *)f->UserData, (long)off, whence) == 0 ? aiReturn_SUCCESS : aiReturn_FAILURE;
+}
+
+static struct aiFile *f_open(struct aiFileIO *io, const char *path, const char *mode)
+{
+    guard *g = (guard *)io->UserData;
+    const int write = strpbrk(mode, "wa+") != NULL;
+    char why[512];
+    if (g->allow && !g->allow(g->ud, path, write, why, sizeof why)) {
+        if (!g->refused[0]) snprintf(g->refused, sizeof g->refused, "%s", why);
+        return NULL;
+    }
+    struct stat st;
+    if (!write && (stat(path, &st) != 0 || S_ISDIR(st.st_mode))) return NULL;
+    FILE *fp = fopen(path, mode);
+    struct aiFile *f = fp ? calloc(1, sizeof *f) : NULL;
+    if (!f) {
+        if (fp) fclose(fp);
+        return NULL;
+    }
+    f->ReadProc = f_read;
+    f->WriteProc = f_write;
+    f->TellProc = f_tell;
+    f->FileSizeProc = f_size;
+    f->SeekProc = f_seek;
+    f->FlushProc = f_flush;
+    f->UserData = (aiUserData)fp;
+    return f;
+}
+
+static void f_close(struct aiFileIO *io, struct aiFile *f)
+{
+    (void)io;
+    if (!f) return;
+    fclose((FILE *)f->UserData);
+    free(f);
+}
+
+/* ---- reading --------------------------------------------------------------------------------- */
+static void count_scene(const struct aiScene *sc, int64_t *nv, int64_t *nt)
+{
+    *nv = *nt = 0;
+    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
+        const struct aiMesh *m = sc->mMeshes[i];
+        if (!(m->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
+        *nv += m->mNumVertices;
+        for (unsigned f = 0; f < m->mNumFaces; f++) *nt += m->mFaces[f].mNumIndices == 3;
+    }
+}
+
+wb_mesh *wbio_load_mesh(const char *path, const char *shown, const wbio_mesh_opts *o,
+                        wbio_allow_fn allow, void *ud, char *err, size_t errn)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) { snprintf(err, errn, "%s: %s", shown, strerror(errno)); return NULL; }
+    if (S_ISDIR(st.st_mode)) { snprintf(err, errn, "%s: is a folder, not a file", shown); return NULL; }
+    if (st.st_size == 0) { snprintf(err, errn, "%s: empty file", shown); return NULL; }
+    guard g = { allow, ud, "" };
+    struct aiFileIO io = { f_open, f_close, (aiUserData)&g };
+    const unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType |
+                           aiProcess_ValidateDataStructure;
+    const struct aiScene *sc = aiImportFileEx(path, flags, &io);
+    if (!sc) {
+        const char *why = g.refused[0] ? g.refused : aiGetErrorString();
+        /* assimp's validator words a file without meshes as a broken scene */
+        if (!g.refused[0] && why && strstr(why, "mNumMeshes is 0")) why = "no triangles in this file";
+        snprintf(err, errn, "%s: %s", shown, why && *why ? why : "cannot read this file");
+        return NULL;
+    }
+    int64_t nv, nt;
+    count_scene(sc, &nv, &nt);
+    if ((sc->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || nt == 0) {
+        snprintf(err, errn, "%s: no triangles in this file", shown);
+        aiReleaseImport(sc);
+        return NULL;
+    }
+    if (nv > WB_MAX_PARTICLES || nt > WB_MAX_CONSTRAINTS) {
+        snprintf(err, errn, "%s: too large (%lld vertices, %lld triangles)", shown, (long long)nv, (long long)nt);
+        aiReleaseImport(sc);
+        return NULL;
+    }
+    wb_real *v = malloc(sizeof *v * 3 * (size_t)nv);
+    int32_t *tri = malloc(sizeof *tri * 3 * (size_t)nt);
+    int32_t base = 0, t = 0;
+    for (unsigned i = 0; v && tri && i < sc->mNumMeshes; i++) {
+        const struct aiMesh *m = sc->mMeshes[i];
+        if (!(m->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
+        for (unsigned k = 0; k < m->mNumVertices; k++) {
+            v[3 * (base + k)] = (wb_real)m->mVertices[k].x * o->scale;
+            v[3 * (base + k) + 1] = (wb_real)m->mVertices[k].y * o->scale;
+            v[3 * (base + k) + 2] = (wb_real)m->mVertices[k].z * o->scale;
+        }
+        for (unsigned f = 0; f < m->mNumFaces; f++) {
+            const struct aiFace *fc = &m->mFaces[f];
+            if (fc->mNumIndices != 3) continue;
+            for (int c = 0; c < 3; c++) tri[3 * t + c] = base + (int32_t)fc->mIndices[c];
+            t++;
+        }
+        base += (int32_t)m->mNumVertices;
+    }
+    aiReleaseImport(sc);
+    wb_status status = WB_ERR_NOMEM;
+    wb_mesh *mesh = v && tri ? wb_mesh_create(v, (int32_t)nv, tri, t, &status) : NULL;
+    free(v);
+    free(tri);
+    if (mesh && o->weld) {
+        /* files repeat a vertex per face it touches (an STL cube has 36): merge by position */
+        wb_real mn[3], mx[3], diag = 0, tol = o->tol;
+        if (wb_mesh_bounds(mesh, mn, mx))
+            diag = sqrt((mx[0] - mn[0]) * (mx[0] - mn[0]) + (mx[1] - mn[1]) * (mx[1] - mn[1]) + (mx[2] - mn[2]) * (mx[2] - mn[2]));
+        if (tol < 0) tol = 1e-6 * diag;
+        status = wb_mesh_weld(mesh, tol, NULL);
+        if (status != WB_OK) {
+            wb_mesh_destroy(mesh);
+            mesh = NULL;
+        }
+    }
+    if (!mesh) {
+        snprintf(err, errn, "%s: %s", shown, status == WB_ERR_NOMEM ? "out of memory" : wb_last_error());
+        return NULL;
+    }
+    if (mesh->nt == 0) {
+        snprintf(err, errn, "%s: no triangles in this file (all degenerate)", shown);
+        wb_mesh_destroy(mesh);
+        return NULL;
+    }
+    return mesh;
+}
+
+/* ---- writing ---------------------------------------------------------------------------------- */
+int wbio_write_obj(FILE *f, const wb_mesh *m, const wb_real *v, const wb_real *n)
+{
+    if (!v) v = m->v;
+    if (!n) n = m->n;
+    fprintf(f, "# wobble %s: %d vertices, %d triangles\n", WB_VERSION, m->nv, m->nt);
+    for (int32_t i = 0; i < m->nv; i++) fprintf(f, "v %.9g %.9g %.9g\n", v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+    for (int32_t i = 0; i < m->nv; i++) fprintf(f, "vn %.6g %.6g %.6g\n", n[3 * i], n[3 * i + 1], n[3 * i + 2]);
+    for (int32_t i = 0; i < m->nt; i++) {
+        const int32_t *t = &m->tri[3 * i];
+        fprintf(f, "f %d//%d %d//%d %d//%d\n", t[0] + 1, t[0] + 1, t[1] + 1, t[1] + 1, t[2] + 1, t[2] + 1);
+    }
+    return ferror(f) ? -1 : 0;
+}
+
+int wbio_write_ply(FILE *f, const wb_mesh *m, const wb_real *v, const wb_real *n)
+{
+    if (!v) v = m->v;
+    if (!n) n = m->n;
+    fprintf(f, "ply\nformat ascii 1.0\ncomment wobble %s\nelement vertex %d\n"
+               "property float x\nproperty float y\nproperty float z\n"
+               "property float nx\nproperty float ny\nproperty float nz\n"
+               "element face %d\nproperty list uchar int vertex_indices\nend_header\n",
+            WB_VERSION, m->nv, m->nt);
+    for (int32_t i = 0; i < m->nv; i++)
+        fprintf(f, "%.9g %.9g %.9g %.6g %.6g %.6g\n", v[3 * i], v[3 * i + 1], v[3 * i + 2], n[3 * i], n[3 * i + 1], n[3 * i + 2]);
+    for (int32_t i = 0; i < m->nt; i++) fprintf(f, "3 %d %d %d\n", m->tri[3 * i], m->tri[3 * i + 1], m->tri[3 * i + 2]);
+    return ferror(f) ? -1 : 0;
+}
+
+static const char *extension(const char *path)
+{
+    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+    return dot && (!slash || dot > slash) ? dot + 1 : "";
+}
+
+/* a one-mesh scene built by hand for assimp's exporter (which copies what it is given) */
+static int export_assimp(const wb_mesh *m, const wb_real *v, const char *path, const char *format,
+                         guard *g, char *msg, size_t n)
+{
+    struct aiScene sc;
+    struct aiNode root;
+    struct aiMesh mesh;
+    struct aiMaterial mat;
+    struct aiMesh *meshes[1] = { &mesh };
+    struct aiMaterial *mats[1] = { &mat };
+    unsigned mesh_index = 0;
+    memset(&sc, 0, sizeof sc);
+    memset(&root, 0, sizeof root);
+    memset(&mesh, 0, sizeof mesh);
+    memset(&mat, 0, sizeof mat);
+    for (int i = 0; i < 4; i++) (&root.mTransformation.a1)[5 * i] = 1; /* identity */
+    strcpy(root.mName.data, "wobble");
+    root.mName.length = 6;
+    root.mNumMeshes = 1;
+    root.mMeshes = &mesh_index;
+    mesh.mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+    mesh.mNumVertices = (unsigned)m->nv;
+    mesh.mNumFaces = (unsigned)m->nt;
+    mesh.mVertices = malloc(sizeof *mesh.mVertices * (size_t)(m->nv ? m->nv : 1));
+    mesh.mNormals = malloc(sizeof *mesh.mNormals * (size_t)(m->nv ? m->nv : 1));
+    mesh.mFaces = malloc(sizeof *mesh.mFaces * (size_t)(m->nt ? m->nt : 1));
+    unsigned *idx = malloc(sizeof *idx * 3 * (size_t)(m->nt ? m->nt : 1));
+    int rc = -1;
+    if (mesh.mVertices && mesh.mNormals && mesh.mFaces && idx) {
+        for (int32_t i = 0; i < m->nv; i++) {
+            mesh.mVertices[i].x = (ai_real)v[3 * i];
+            mesh.mVertices[i].y = (ai_real)v[3 * i + 1];
+            mesh.mVertices[i].z = (ai_real)v[3 * i + 2];
+            mesh.mNormals[i].x = (ai_real)m->n[3 * i];
+            mesh.mNormals[i].y = (ai_real)m->n[3 * i + 1];
+            mesh.mNormals[i].z = (ai_real)m->n[3 * i + 2];
+        }
+        for (int32_t i = 0; i < m->nt; i++) {
+            for (int c = 0; c < 3; c++) idx[3 * i + c] = (unsigned)m->tri[3 * i + c];
+            mesh.mFaces[i].mNumIndices = 3;
+            mesh.mFaces[i].mIndices = &idx[3 * i];
+        }
+        sc.mRootNode = &root;
+        sc.mNumMeshes = 1;
+        sc.mMeshes = meshes;
+        sc.mNumMaterials = 1;
+        sc.mMaterials = mats;
+        struct aiFileIO io = { f_open, f_close, (aiUserData)g };
+        if (aiExportSceneEx(&sc, format, path, &io, 0) == aiReturn_SUCCESS) rc = 0;
+        else snprintf(msg, n, "%s", g->refused[0] ? g->refused : aiGetErrorString());
+    } else {
+        snprintf(msg, n, "out of memory");
+    }
+    free(mesh.mVertices);
+    free(mesh.mNormals);
+    free(mesh.mFaces);
+    free(idx);
+    return rc;
+}
+
+int wbio_save_mesh(const wb_mesh *m, const wb_real *v, const char *path, const char *shown,
+                   wbio_allow_fn allow, void *ud, char *err, size_t errn)
+{
+    static const char *const formats[][2] = { { "stl", "stlb" }, { "gltf", "gltf2" }, { "glb", "glb2" },
+                                              { "fbx", "fbxa" }, { "dae", "collada" }, { NULL, NULL } };
+    const char *ext = extension(path);
+    if (!v) v = m->v;
+    if (!strcasecmp(ext, "obj") || !strcasecmp(ext, "ply")) {
+        FILE *f = fopen(path, "w");
+        if (!f) { snprintf(err, errn, "%s: %s", shown, strerror(errno)); return -1; }
+        int rc = strcasecmp(ext, "obj") ? wbio_write_ply(f, m, v, NULL) : wbio_write_obj(f, m, v, NULL);
+        if (fclose(f) != 0) rc = -1;
+        if (rc) snprintf(err, errn, "%s: %s", shown, strerror(errno ? errno : EIO));
+        return rc;
+    }
+    for (int i = 0; formats[i][0]; i++) {
+        if (strcasecmp(ext, formats[i][0])) continue;
+        guard g = { allow, ud, "" };
+        char msg[512] = "";
+        if (export_assimp(m, v, path, formats[i][1], &g, msg, sizeof msg) == 0) return 0;
+        snprintf(err, errn, "%s: %s", shown, msg[0] ? msg : "assimp could not write it");
+        return -1;
+    }
+    snprintf(err, errn, "%s: unknown mesh format '.%s' (expected .obj, .ply, .stl, .gltf, .glb, .fbx or .dae)", shown, ext);
+    return -1;
+}
