@@ -245,6 +245,28 @@ static int save_as(lua_State *L, const char *ext)
 static int s_save(lua_State *L) { return save_as(L, NULL); }
 static int s_save_obj(lua_State *L) { return save_as(L, ".obj"); }
 
+/* s:bounds() -> minx, miny, minz, maxx, maxy, maxz of the deformed mesh now */
+static int s_bounds(lua_State *L)
+{
+    wb_world *w;
+    wb_skin *s = wbl_checkskin(L, 1, &w);
+    const wb_real *v = wb_skin_vertices(s, w);
+    const int32_t nv = wb_skin_rest(s)->nv;
+    if (nv == 0) {
+        lua_pushnil(L);
+        return 1;
+    }
+    wb_real lo[3] = { v[0], v[1], v[2] }, hi[3] = { v[0], v[1], v[2] };
+    for (int32_t i = 1; i < nv; i++)
+        for (int k = 0; k < 3; k++) {
+            if (v[3 * i + k] < lo[k]) lo[k] = v[3 * i + k];
+            if (v[3 * i + k] > hi[k]) hi[k] = v[3 * i + k];
+        }
+    wbl_pushreals(L, lo, 3);
+    wbl_pushreals(L, hi, 3);
+    return 6;
+}
+
 static int s_update(lua_State *L)
 {
     wb_world *w;
@@ -336,6 +358,7 @@ static const luaL_Reg skin_methods[] = {
     { "vertex_count", s_vertex_count },
     { "triangle_count", s_triangle_count },
     { "mesh", s_mesh },
+    { "bounds", s_bounds },
     { "save", s_save },
     { "save_obj", s_save_obj },
     { "update", s_update },
