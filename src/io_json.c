@@ -8,292 +8,19 @@
  *     "defaults": {...}, "snapshot": {...} }
  *
  * Errors name the file, line and column and the key path ("logo.json:12:7:
- * particles[3].mass: number expected, got string"). cJSON gives the position of a syntax
- * error but keeps no positions in its tree, so a second pass over the (valid) text records
- * the offset of every value in document order, which is also the order of a pre-order
- * walk of cJSON's tree. Keys are case-sensitive; an unknown or repeated key is an error
- * (cJSON itself keeps duplicates). The whole file is checked before anything is built. */
-#include <cJSON.h>
+ * particles[3].mass: number expected, got string"; how, in io_json_value.c). The whole
+ * file is read and checked into a wb_image before anything is built. */
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
 
-#include "io.h"
+#include "io_json.h"
 
 #define MAX_FILE (1ll << 31) /* 2 GiB: a snapshot of WB_MAX_PARTICLES fits; larger is not ours */
-
-/* ---- the text and the positions of its values --------------------------------------------- */
-typedef struct scan {
-    const char *t, *p;
-    int32_t n, cap;
-    int32_t *voff;       /* (n) offset of each value, in document order */
-    int32_t *koff;       /* (n) offset of its key, -1 outside objects */
-    int oom;
-} scan;
-
-static void sk_ws(scan *s)
-{
-    while (*s->p && (unsigned char)*s->p <= 32) s->p++;
-}
-
-static void sk_string(scan *s)
-{
-    s->p++;
-    while (*s->p && *s->p != '"') s->p += (*s->p == '\\' && s->p[1]) ? 2 : 1;
-    if (*s->p) s->p++;
-}
-
-/* the text is valid JSON (cJSON parsed it), so this only has to find where values start */
-static void sk_value(scan *s, int32_t key)
-{
-    sk_ws(s);
-    if (s->n == s->cap) {
-        int32_t cap = s->cap ? 2 * s->cap : 1024;
-        int32_t *v = realloc(s->voff, sizeof *v * (size_t)cap), *k = v ? realloc(s->koff, sizeof *k * (size_t)cap) : NULL;
-        if (v) s->voff = v;
-        if (!v || !k) { s->oom = 1; return; }
-        s->koff = k;
-        s->cap = cap;
-    }
-    s->voff[s->n] = (int32_t)(s->p - s->t);
-    s->koff[s->n++] = key;
-    const char open = *s->p;
-    if (open == '{' || open == '[') {
-        s->p++;
-        for (;;) {
-            sk_ws(s);
-            if (*s->p == '}' || *s->p == ']' || !*s->p || s->oom) break;
-            int32_t k = -1;
-            if (open == '{') {
-                k = (int32_t)(s->p - s->t);
-                sk_string(s);
-                sk_ws(s);
-                if (*s->p == ':') s->p++;
-            }
-            sk_value(s, k);
-            sk_ws(s);
-            if (*s->p == ',') s->p++;
-        }
-        if (*s->p) s->p++;
-    } else if (open == '"') {
-        sk_string(s);
-    } else {
-        while (*s->p && (isalnum((unsigned char)*s->p) || strchr("+-.", *s->p))) s->p++;
-    }
-}
-
-/* every cJSON item's pre-order index goes into its valueint, a field this reader never uses
- * for anything else (numbers are read from valuedouble) */
-static void number_items(cJSON *it, int32_t *k)
-{
-    for (; it; it = it->next) {
-        it->valueint = (*k)++;
-        number_items(it->child, k);
-    }
-}
-
-/* ---- errors with positions and key paths ----------------------------------------------------- */
-typedef struct kp {            /* a key path, as a chain up to the root */
-    const struct kp *up;
-    const char *key;           /* NULL: an array index */
-    int64_t index;
-} kp;
-
-typedef struct rd {
-    const char *shown, *text;
-    const scan *pos;           /* NULL when positions are unknown */
-    char *err;
-    size_t errn;
-} rd;
-
-static void kp_format(const kp *k, char *buf, size_t n)
-{
-    const kp *chain[64];
-    int depth = 0;
-    for (; k && depth < 64; k = k->up) chain[depth++] = k;
-    size_t len = 0;
-    buf[0] = '\0';
-    for (int i = depth - 1; i >= 0 && len < n; i--) {
-        if (chain[i]->key) len += (size_t)snprintf(buf + len, n - len, "%s%s", len ? "." : "", chain[i]->key);
-        else len += (size_t)snprintf(buf + len, n - len, "[%lld]", (long long)chain[i]->index);
-    }
-}
-
-static void line_col(const char *t, int32_t off, int *line, int *col)
-{
-    *line = 1;
-    *col = 1;
-    for (int32_t i = 0; i < off && t[i]; i++) {
-        if (t[i] == '\n') { (*line)++; *col = 1; }
-        else (*col)++;
-    }
-}
-
-/* "shown:line:col: key.path" of the item (at its key when at_key, else at its value) */
-static void where_of(const rd *r, const cJSON *it, int at_key, const kp *path, char *buf, size_t n)
-{
-    char keys[200], pos[48] = "";
-    kp_format(path, keys, sizeof keys);
-    if (it && r->pos && it->valueint >= 0 && it->valueint < r->pos->n) {
-        int32_t off = r->pos->voff[it->valueint];
-        if (at_key && r->pos->koff[it->valueint] >= 0) off = r->pos->koff[it->valueint];
-        int line, col;
-        line_col(r->text, off, &line, &col);
-        snprintf(pos, sizeof pos, ":%d:%d", line, col);
-    }
-    snprintf(buf, n, "%s%s%s%s", r->shown, pos, keys[0] ? ": " : "", keys);
-}
-
-static int fail(rd *r, const cJSON *it, int at_key, const kp *path, const char *fmt, ...)
-{
-    char msg[256], where[300];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    where_of(r, it, at_key, path, where, sizeof where);
-    snprintf(r->err, r->errn, "%s: %s", where, msg);
-    return -1;
-}
-
-static const char *type_name(const cJSON *it)
-{
-    if (cJSON_IsObject(it)) return "object";
-    if (cJSON_IsArray(it)) return "array";
-    if (cJSON_IsString(it)) return "string";
-    if (cJSON_IsNumber(it)) return "number";
-    if (cJSON_IsBool(it)) return "boolean";
-    return "null";
-}
-
-/* ---- typed values --------------------------------------------------------------------------- */
-static int get_real(rd *r, const cJSON *it, const kp *p, wb_real *out)
-{
-    if (!cJSON_IsNumber(it)) return fail(r, it, 0, p, "number expected, got %s", type_name(it));
-    if (!isfinite(it->valuedouble)) return fail(r, it, 0, p, "number out of range");
-    *out = (wb_real)it->valuedouble;
-    return 0;
-}
-
-static int get_int(rd *r, const cJSON *it, const kp *p, int64_t lo, int64_t hi, int64_t *out)
-{
-    if (!cJSON_IsNumber(it)) return fail(r, it, 0, p, "integer expected, got %s", type_name(it));
-    const double d = it->valuedouble;
-    if (!(d == floor(d)) || !isfinite(d)) return fail(r, it, 0, p, "integer expected, got %.17g", d);
-    if (d < (double)lo || d > (double)hi)
-        return fail(r, it, 0, p, "%.17g out of range (%lld..%lld)", d, (long long)lo, (long long)hi);
-    *out = (int64_t)d;
-    return 0;
-}
-
-static int get_bool(rd *r, const cJSON *it, const kp *p, bool *out)
-{
-    if (!cJSON_IsBool(it)) return fail(r, it, 0, p, "true or false expected, got %s", type_name(it));
-    *out = cJSON_IsTrue(it);
-    return 0;
-}
-
-static int get_string(rd *r, const cJSON *it, const kp *p, const char **out)
-{
-    if (!cJSON_IsString(it)) return fail(r, it, 0, p, "string expected, got %s", type_name(it));
-    *out = it->valuestring;
-    return 0;
-}
-
-static int get_array(rd *r, const cJSON *it, const kp *p, int64_t max, int32_t *count)
-{
-    if (!cJSON_IsArray(it)) return fail(r, it, 0, p, "array expected, got %s", type_name(it));
-    int64_t n = 0;
-    for (const cJSON *c = it->child; c; c = c->next) n++;
-    if (n > max) return fail(r, it, 0, p, "too many entries (%lld, at most %lld)", (long long)n, (long long)max);
-    *count = (int32_t)n;
-    return 0;
-}
-
-/* an array of exactly n finite numbers */
-static int get_vec(rd *r, const cJSON *it, const kp *p, int n, wb_real *out)
-{
-    int32_t count;
-    if (!cJSON_IsArray(it)) return fail(r, it, 0, p, "array of %d numbers expected, got %s", n, type_name(it));
-    if (get_array(r, it, p, 16, &count) || count != n)
-        return fail(r, it, 0, p, "array of %d numbers expected, got %d value%s", n, count, count == 1 ? "" : "s");
-    int i = 0;
-    for (const cJSON *c = it->child; c; c = c->next, i++) {
-        kp e = { p, NULL, i };
-        if (get_real(r, c, &e, &out[i])) return -1;
-    }
-    return 0;
-}
-
-/* the object's keys: each one of `keys` (NULL-terminated), none twice; found[i] = the value */
-static int get_object(rd *r, const cJSON *obj, const kp *p, const char *const keys[], const cJSON **found)
-{
-    if (!cJSON_IsObject(obj)) return fail(r, obj, 0, p, "object expected, got %s", type_name(obj));
-    int nk = 0;
-    while (keys[nk]) found[nk++] = NULL;
-    for (const cJSON *c = obj->child; c; c = c->next) {
-        int i = 0;
-        while (i < nk && strcmp(c->string, keys[i]) != 0) i++;
-        kp here = { p, c->string, 0 };
-        if (i == nk) {
-            for (int j = 0; j < nk; j++)
-                if (strcasecmp(c->string, keys[j]) == 0)
-                    return fail(r, c, 1, &here, "unknown key '%s' (keys are case-sensitive: '%s')", c->string, keys[j]);
-            char list[400];
-            size_t len = 0;
-            for (int j = 0; j < nk && len < sizeof list; j++)
-                len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", j ? ", " : "", keys[j]);
-            return fail(r, c, 1, &here, "unknown key '%s' (expected one of: %s)", c->string, list);
-        }
-        if (found[i]) {
-            int line = 0, col = 0;
-            if (r->pos) line_col(r->text, r->pos->koff[found[i]->valueint], &line, &col);
-            return fail(r, c, 1, &here, "duplicate key '%s' (first at line %d, column %d)", c->string, line, col);
-        }
-        found[i] = c;
-    }
-    return 0;
-}
-
-static int missing(rd *r, const cJSON *obj, const kp *p, const char *key)
-{
-    return fail(r, obj, 0, p, "missing key '%s'", key);
-}
-
-/* optional fields: absent leaves *out alone */
-static int opt_real(rd *r, const cJSON *f, const kp *up, const char *key, wb_real *out)
-{
-    if (!f) return 0;
-    kp p = { up, key, 0 };
-    return get_real(r, f, &p, out);
-}
-
-static int opt_nonneg(rd *r, const cJSON *f, const kp *up, const char *key, wb_real *out)
-{
-    if (!f) return 0;
-    kp p = { up, key, 0 };
-    if (get_real(r, f, &p, out)) return -1;
-    return *out < 0 ? fail(r, f, 0, &p, "must be >= 0") : 0;
-}
-
-static int opt_int(rd *r, const cJSON *f, const kp *up, const char *key, int64_t lo, int64_t hi, int64_t *out)
-{
-    if (!f) return 0;
-    kp p = { up, key, 0 };
-    return get_int(r, f, &p, lo, hi, out);
-}
-
-static int opt_vec(rd *r, const cJSON *f, const kp *up, const char *key, int n, wb_real *out)
-{
-    if (!f) return 0;
-    kp p = { up, key, 0 };
-    return get_vec(r, f, &p, n, out);
-}
 
 /* ---- sections --------------------------------------------------------------------------------- */
 typedef struct defaults {
@@ -310,11 +37,11 @@ static int read_defaults(rd *r, const cJSON *it, defaults *d)
     d->radius = 0.02;
     d->link = wb_distance_default_def();
     if (!it) return 0;
-    if (get_object(r, it, &p, keys, f)) return -1;
-    return opt_nonneg(r, f[0], &p, "mass", &d->mass) || opt_nonneg(r, f[1], &p, "radius", &d->radius) ||
-           opt_nonneg(r, f[2], &p, "compliance", &d->link.compliance) || opt_nonneg(r, f[3], &p, "damping", &d->link.damping) ||
-           opt_nonneg(r, f[4], &p, "yield", &d->link.yield) || opt_nonneg(r, f[5], &p, "creep", &d->link.creep) ||
-           opt_nonneg(r, f[6], &p, "break_strain", &d->link.break_strain) ? -1 : 0;
+    if (jv_get_object(r, it, &p, keys, f)) return -1;
+    return jv_opt_nonneg(r, f[0], &p, "mass", &d->mass) || jv_opt_nonneg(r, f[1], &p, "radius", &d->radius) ||
+           jv_opt_nonneg(r, f[2], &p, "compliance", &d->link.compliance) || jv_opt_nonneg(r, f[3], &p, "damping", &d->link.damping) ||
+           jv_opt_nonneg(r, f[4], &p, "yield", &d->link.yield) || jv_opt_nonneg(r, f[5], &p, "creep", &d->link.creep) ||
+           jv_opt_nonneg(r, f[6], &p, "break_strain", &d->link.break_strain) ? -1 : 0;
 }
 
 static const char *const solver_names[] = { "gauss-seidel", "jacobi" };
@@ -326,23 +53,23 @@ static int read_world(rd *r, const cJSON *it, const kp *up, wb_world_def *d)
     const cJSON *f[9];
     kp p = { up, "world", 0 };
     int64_t i;
-    if (get_object(r, it, &p, keys, f)) return -1;
-    if (opt_vec(r, f[0], &p, "gravity", 3, d->gravity) || opt_real(r, f[1], &p, "dt", &d->dt)) return -1;
-    if (f[2]) { if (opt_int(r, f[2], &p, "substeps", 1, WB_MAX_SUBSTEPS, &i)) return -1; d->substeps = (int)i; }
-    if (f[3]) { if (opt_int(r, f[3], &p, "iterations", 1, WB_MAX_ITERATIONS, &i)) return -1; d->iterations = (int)i; }
-    if (opt_real(r, f[4], &p, "damping", &d->damping)) return -1;
+    if (jv_get_object(r, it, &p, keys, f)) return -1;
+    if (jv_opt_vec(r, f[0], &p, "gravity", 3, d->gravity) || jv_opt_real(r, f[1], &p, "dt", &d->dt)) return -1;
+    if (f[2]) { if (jv_opt_int(r, f[2], &p, "substeps", 1, WB_MAX_SUBSTEPS, &i)) return -1; d->substeps = (int)i; }
+    if (f[3]) { if (jv_opt_int(r, f[3], &p, "iterations", 1, WB_MAX_ITERATIONS, &i)) return -1; d->iterations = (int)i; }
+    if (jv_opt_real(r, f[4], &p, "damping", &d->damping)) return -1;
     if (f[5]) {
         kp q = { &p, "solver", 0 };
         const char *s = "";
-        if (get_string(r, f[5], &q, &s)) return -1;
+        if (jv_get_string(r, f[5], &q, &s)) return -1;
         if (strcmp(s, solver_names[0]) && strcmp(s, solver_names[1]))
-            return fail(r, f[5], 0, &q, "unknown solver '%s' (expected gauss-seidel or jacobi)", s);
+            return jv_fail(r, f[5], 0, &q, "unknown solver '%s' (expected gauss-seidel or jacobi)", s);
         d->solver = strcmp(s, solver_names[0]) ? WB_SOLVER_JACOBI : WB_SOLVER_GAUSS_SEIDEL;
     }
-    if (opt_real(r, f[6], &p, "relaxation", &d->relaxation)) return -1;
-    if (f[7]) { if (opt_int(r, f[7], &p, "threads", 1, WB_MAX_THREADS, &i)) return -1; d->threads = (int)i; }
+    if (jv_opt_real(r, f[6], &p, "relaxation", &d->relaxation)) return -1;
+    if (f[7]) { if (jv_opt_int(r, f[7], &p, "threads", 1, WB_MAX_THREADS, &i)) return -1; d->threads = (int)i; }
     const char *e = wb_world_def_check(d);
-    return e ? fail(r, it, 0, &p, "%s", e) : 0;
+    return e ? jv_fail(r, it, 0, &p, "%s", e) : 0;
 }
 
 /* "generations": [...] of a slot table; counts the live (odd) ones */
@@ -353,7 +80,7 @@ static int read_generations(rd *r, const cJSON *it, const kp *p, int32_t n, uint
     for (const cJSON *c = it->child; c; c = c->next, i++) {
         kp e = { p, NULL, i };
         int64_t g;
-        if (get_int(r, c, &e, 0, UINT32_MAX, &g)) return -1;
+        if (jv_get_int(r, c, &e, 0, UINT32_MAX, &g)) return -1;
         gen[i] = (uint32_t)g;
         *live += (int32_t)(g & 1);
     }
@@ -378,26 +105,26 @@ static int scan_snapshot(rd *r, sections *s)
     s->nd = s->ncons;
     s->nc = s->ncol;
     if (!s->snapshot) return 0;
-    if (get_object(r, s->snapshot, &p, keys, f)) return -1;
-    if (!f[0]) return missing(r, s->snapshot, &p, "world");
+    if (jv_get_object(r, s->snapshot, &p, keys, f)) return -1;
+    if (!f[0]) return jv_missing(r, s->snapshot, &p, "world");
     s->world = f[0];
     for (int i = 0; i < 4; i++) s->clock[i] = f[1 + i];
     if (f[5]) {
         kp q = { &p, "distance_slots", 0 };
-        if (get_object(r, f[5], &q, dkeys, g)) return -1;
-        if (!g[0]) return missing(r, f[5], &q, "generations");
-        if (!g[1]) return missing(r, f[5], &q, "free");
+        if (jv_get_object(r, f[5], &q, dkeys, g)) return -1;
+        if (!g[0]) return jv_missing(r, f[5], &q, "generations");
+        if (!g[1]) return jv_missing(r, f[5], &q, "free");
         kp a = { &q, "generations", 0 }, b = { &q, "free", 0 };
-        if (get_array(r, g[0], &a, WB_MAX_CONSTRAINTS, &s->nd) || get_array(r, g[1], &b, WB_MAX_CONSTRAINTS, &s->nfree)) return -1;
+        if (jv_get_array(r, g[0], &a, WB_MAX_CONSTRAINTS, &s->nd) || jv_get_array(r, g[1], &b, WB_MAX_CONSTRAINTS, &s->nfree)) return -1;
         s->dgen = g[0];
         s->dfree = g[1];
     }
     if (f[6]) {
         kp q = { &p, "collider_slots", 0 };
-        if (get_object(r, f[6], &q, ckeys, g)) return -1;
-        if (!g[0]) return missing(r, f[6], &q, "generations");
+        if (jv_get_object(r, f[6], &q, ckeys, g)) return -1;
+        if (!g[0]) return jv_missing(r, f[6], &q, "generations");
         kp a = { &q, "generations", 0 };
-        if (get_array(r, g[0], &a, WB_MAX_COLLIDERS, &s->nc)) return -1;
+        if (jv_get_array(r, g[0], &a, WB_MAX_COLLIDERS, &s->nc)) return -1;
         s->cgen = g[0];
     }
     return 0;
@@ -408,16 +135,16 @@ static int read_snapshot(rd *r, const sections *s, wb_image *g)
     kp p = { NULL, "snapshot", 0 };
     if (read_world(r, s->world, &p, &g->def)) return -1;
     int64_t i;
-    if (opt_real(r, s->clock[0], &p, "time", &(wb_real){ 0 })) return -1;
+    if (jv_opt_real(r, s->clock[0], &p, "time", &(wb_real){ 0 })) return -1;
     if (s->clock[0]) g->time = s->clock[0]->valuedouble; /* a double, whatever wb_real is */
-    if (opt_int(r, s->clock[1], &p, "frame", 0, (int64_t)1 << 53, &i)) return -1;
+    if (jv_opt_int(r, s->clock[1], &p, "frame", 0, (int64_t)1 << 53, &i)) return -1;
     if (s->clock[1]) g->frame = i;
-    if (opt_int(r, s->clock[2], &p, "warnings", 0, (int64_t)1 << 53, &i)) return -1;
+    if (jv_opt_int(r, s->clock[2], &p, "warnings", 0, (int64_t)1 << 53, &i)) return -1;
     if (s->clock[2]) g->warnings = i;
     if (s->clock[3]) {
         kp q = { &p, "last_warning", 0 };
         const char *msg = "";
-        if (get_string(r, s->clock[3], &q, &msg)) return -1;
+        if (jv_get_string(r, s->clock[3], &q, &msg)) return -1;
         snprintf(g->last_warning, sizeof g->last_warning, "%s", msg);
     }
     kp ds = { &p, "distance_slots", 0 }, cs = { &p, "collider_slots", 0 };
@@ -426,25 +153,25 @@ static int read_snapshot(rd *r, const sections *s, wb_image *g)
         int32_t live;
         if (read_generations(r, s->dgen, &a, s->nd, g->d_gen, &live)) return -1;
         if (live != s->ncons)
-            return fail(r, s->dgen, 0, &a, "%d live slots, but \"constraints\" has %d entries", live, s->ncons);
+            return jv_fail(r, s->dgen, 0, &a, "%d live slots, but \"constraints\" has %d entries", live, s->ncons);
         int32_t k = 0;
         for (const cJSON *c = s->dfree->child; c; c = c->next, k++) {
             kp e = { &b, NULL, k };
             int64_t slot;
-            if (get_int(r, c, &e, 0, s->nd > 0 ? s->nd - 1 : 0, &slot)) return -1;
-            if (s->nd == 0 || (g->d_gen[slot] & 1u)) return fail(r, c, 0, &e, "slot %lld is live, not free", (long long)slot);
+            if (jv_get_int(r, c, &e, 0, s->nd > 0 ? s->nd - 1 : 0, &slot)) return -1;
+            if (s->nd == 0 || (g->d_gen[slot] & 1u)) return jv_fail(r, c, 0, &e, "slot %lld is live, not free", (long long)slot);
             for (int32_t j = 0; j < k; j++)
-                if (g->d_free[j] == (int32_t)slot) return fail(r, c, 0, &e, "slot %lld is listed twice", (long long)slot);
+                if (g->d_free[j] == (int32_t)slot) return jv_fail(r, c, 0, &e, "slot %lld is listed twice", (long long)slot);
             g->d_free[k] = (int32_t)slot;
         }
         if (s->nd - live != s->nfree)
-            return fail(r, s->dfree, 0, &b, "%d free slots listed, but %d slots are dead", s->nfree, s->nd - live);
+            return jv_fail(r, s->dfree, 0, &b, "%d free slots listed, but %d slots are dead", s->nfree, s->nd - live);
     }
     if (s->cgen) {
         kp a = { &cs, "generations", 0 };
         int32_t live;
         if (read_generations(r, s->cgen, &a, s->nc, g->c_gen, &live)) return -1;
-        if (live != s->ncol) return fail(r, s->cgen, 0, &a, "%d live slots, but \"colliders\" has %d entries", live, s->ncol);
+        if (live != s->ncol) return jv_fail(r, s->cgen, 0, &a, "%d live slots, but \"colliders\" has %d entries", live, s->ncol);
     }
     return 0;
 }
@@ -459,17 +186,17 @@ static int read_particles(rd *r, const sections *s, const defaults *d, wb_image 
         kp p = { &top, NULL, i };
         wb_real mass = d->mass, radius = d->radius;
         bool pinned = false;
-        if (get_object(r, c, &p, keys, f)) return -1;
-        if (!f[0]) return missing(r, c, &p, "position");
-        if (opt_vec(r, f[0], &p, "position", 3, &g->x[3 * i]) || opt_vec(r, f[1], &p, "velocity", 3, &g->v[3 * i]) ||
-            opt_nonneg(r, f[2], &p, "mass", &mass) || opt_nonneg(r, f[4], &p, "radius", &radius))
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "position");
+        if (jv_opt_vec(r, f[0], &p, "position", 3, &g->x[3 * i]) || jv_opt_vec(r, f[1], &p, "velocity", 3, &g->v[3 * i]) ||
+            jv_opt_nonneg(r, f[2], &p, "mass", &mass) || jv_opt_nonneg(r, f[4], &p, "radius", &radius))
             return -1;
         g->inv_mass[i] = mass > 0 ? 1 / mass : 0;
         /* inv_mass (w:save writes it) is exact where 1/mass might not round-trip */
-        if (opt_nonneg(r, f[3], &p, "inv_mass", &g->inv_mass[i])) return -1;
+        if (jv_opt_nonneg(r, f[3], &p, "inv_mass", &g->inv_mass[i])) return -1;
         if (f[5]) {
             kp q = { &p, "pinned", 0 };
-            if (get_bool(r, f[5], &q, &pinned)) return -1;
+            if (jv_get_bool(r, f[5], &q, &pinned)) return -1;
         }
         g->radius[i] = radius;
         g->pinned[i] = pinned;
@@ -488,24 +215,24 @@ static int read_constraints(rd *r, const sections *s, const defaults *d, wb_imag
     for (const cJSON *c = s->constraints->child; c; c = c->next, i++) {
         const cJSON *f[10];
         kp p = { &top, NULL, i };
-        if (get_object(r, c, &p, keys, f)) return -1;
-        if (!f[0]) return missing(r, c, &p, "type");
-        if (!f[1]) return missing(r, c, &p, "particles");
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "type");
+        if (!f[1]) return jv_missing(r, c, &p, "particles");
         kp tp = { &p, "type", 0 }, pp = { &p, "particles", 0 };
         const char *type = "";
-        if (get_string(r, f[0], &tp, &type)) return -1;
-        if (strcmp(type, "distance") != 0) return fail(r, f[0], 0, &tp, "unknown constraint type '%s' (expected distance)", type);
+        if (jv_get_string(r, f[0], &tp, &type)) return -1;
+        if (strcmp(type, "distance") != 0) return jv_fail(r, f[0], 0, &tp, "unknown constraint type '%s' (expected distance)", type);
         int32_t n;
-        if (get_array(r, f[1], &pp, 16, &n)) return -1;
-        if (n != 2) return fail(r, f[1], 0, &pp, "a distance constraint joins 2 particles, got %d", n);
+        if (jv_get_array(r, f[1], &pp, 16, &n)) return -1;
+        if (n != 2) return jv_fail(r, f[1], 0, &pp, "a distance constraint joins 2 particles, got %d", n);
         int64_t ab[2];
         int k = 0;
         for (const cJSON *e = f[1]->child; e; e = e->next, k++) {
             kp q = { &pp, NULL, k };
-            if (g->np == 0) return fail(r, e, 0, &q, "there are no particles");
-            if (get_int(r, e, &q, 0, g->np - 1, &ab[k])) return -1;
+            if (g->np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
+            if (jv_get_int(r, e, &q, 0, g->np - 1, &ab[k])) return -1;
         }
-        if (ab[0] == ab[1]) return fail(r, f[1], 0, &pp, "a constraint needs two distinct particles");
+        if (ab[0] == ab[1]) return jv_fail(r, f[1], 0, &pp, "a constraint needs two distinct particles");
         /* the i-th live slot (all slots are live in a plain config) */
         do slot++; while (!(g->d_gen[slot] & 1u));
         wb_distance_def l = d->link;
@@ -513,13 +240,13 @@ static int read_constraints(rd *r, const sections *s, const defaults *d, wb_imag
         wb_real dx[3] = { xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2] };
         l.rest = sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
         bool broken = false;
-        if (opt_nonneg(r, f[2], &p, "rest", &l.rest) || opt_nonneg(r, f[3], &p, "compliance", &l.compliance) ||
-            opt_nonneg(r, f[4], &p, "damping", &l.damping) || opt_nonneg(r, f[5], &p, "yield", &l.yield) ||
-            opt_nonneg(r, f[6], &p, "creep", &l.creep) || opt_nonneg(r, f[7], &p, "break_strain", &l.break_strain))
+        if (jv_opt_nonneg(r, f[2], &p, "rest", &l.rest) || jv_opt_nonneg(r, f[3], &p, "compliance", &l.compliance) ||
+            jv_opt_nonneg(r, f[4], &p, "damping", &l.damping) || jv_opt_nonneg(r, f[5], &p, "yield", &l.yield) ||
+            jv_opt_nonneg(r, f[6], &p, "creep", &l.creep) || jv_opt_nonneg(r, f[7], &p, "break_strain", &l.break_strain))
             return -1;
         if (f[8]) {
             kp q = { &p, "broken", 0 };
-            if (get_bool(r, f[8], &q, &broken)) return -1;
+            if (jv_get_bool(r, f[8], &q, &broken)) return -1;
         }
         g->d_ij[2 * slot] = (int32_t)ab[0];
         g->d_ij[2 * slot + 1] = (int32_t)ab[1];
@@ -540,9 +267,9 @@ static const char *const shape_names[] = { "plane", "sphere", "box", "capsule", 
  * are, and must come back bit for bit) */
 static int get_quat(rd *r, const cJSON *it, const kp *p, wb_real q[4])
 {
-    if (get_vec(r, it, p, 4, q)) return -1;
+    if (jv_get_vec(r, it, p, 4, q)) return -1;
     const wb_real n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
-    if (!(n2 > 1e-24)) return fail(r, it, 0, p, "rotation must not be zero");
+    if (!(n2 > 1e-24)) return jv_fail(r, it, 0, p, "rotation must not be zero");
     if (fabs(n2 - 1) > 1e-12)
         for (int i = 0; i < 4; i++) q[i] /= sqrt(n2);
     return 0;
@@ -554,15 +281,15 @@ static int read_pose(rd *r, const cJSON *it, const kp *up, wb_image_collider *c)
                                         "angular_velocity", NULL };
     const cJSON *f[7];
     kp p = { up, "pose", 0 };
-    if (get_object(r, it, &p, keys, f)) return -1;
-    if (!f[0]) return missing(r, it, &p, "position");
-    if (!f[1]) return missing(r, it, &p, "rotation");
+    if (jv_get_object(r, it, &p, keys, f)) return -1;
+    if (!f[0]) return jv_missing(r, it, &p, "position");
+    if (!f[1]) return jv_missing(r, it, &p, "rotation");
     kp q1 = { &p, "rotation", 0 }, q2 = { &p, "start_rotation", 0 };
-    if (opt_vec(r, f[0], &p, "position", 3, c->p) || get_quat(r, f[1], &q1, c->q)) return -1;
+    if (jv_opt_vec(r, f[0], &p, "position", 3, c->p) || get_quat(r, f[1], &q1, c->q)) return -1;
     memcpy(c->p0, c->p, sizeof c->p0);
     memcpy(c->q0, c->q, sizeof c->q0);
-    if (opt_vec(r, f[2], &p, "start_position", 3, c->p0) || (f[3] && get_quat(r, f[3], &q2, c->q0)) ||
-        opt_vec(r, f[4], &p, "velocity", 3, c->v) || opt_vec(r, f[5], &p, "angular_velocity", 3, c->om))
+    if (jv_opt_vec(r, f[2], &p, "start_position", 3, c->p0) || (f[3] && get_quat(r, f[3], &q2, c->q0)) ||
+        jv_opt_vec(r, f[4], &p, "velocity", 3, c->v) || jv_opt_vec(r, f[5], &p, "angular_velocity", 3, c->om))
         return -1;
     return 0;
 }
@@ -577,14 +304,14 @@ static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider 
     static const char *const world_keys[WB_SHAPE_COUNT] = { "normal offset", "center radius", "center half rotation", "a b radius" };
     static const char *const local_keys[WB_SHAPE_COUNT] = { "normal", "radius", "half", "a b radius" };
     const cJSON *f[13];
-    if (get_object(r, it, p, keys, f)) return -1;
-    if (!f[0]) return missing(r, it, p, "shape");
+    if (jv_get_object(r, it, p, keys, f)) return -1;
+    if (!f[0]) return jv_missing(r, it, p, "shape");
     kp sp = { p, "shape", 0 };
     const char *name = "";
-    if (get_string(r, f[0], &sp, &name)) return -1;
+    if (jv_get_string(r, f[0], &sp, &name)) return -1;
     int shape = 0;
     while (shape_names[shape] && strcmp(name, shape_names[shape])) shape++;
-    if (!shape_names[shape]) return fail(r, f[0], 0, &sp, "unknown shape '%s' (expected plane, sphere, box or capsule)", name);
+    if (!shape_names[shape]) return jv_fail(r, f[0], 0, &sp, "unknown shape '%s' (expected plane, sphere, box or capsule)", name);
     const int local = f[11] != NULL;
     const char *allowed = (local ? local_keys : world_keys)[shape];
     for (int i = 1; i <= 8; i++) {
@@ -595,15 +322,15 @@ static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider 
         while (hit && ((hit > allowed && hit[-1] != ' ') || (hit[kl] && hit[kl] != ' '))) hit = strstr(hit + 1, k);
         if (!hit) {
             kp kk = { p, k, 0 };
-            if (local) return fail(r, f[i], 1, &kk, "a %s with a pose takes %s in its own frame, not '%s'", name, allowed, k);
-            return fail(r, f[i], 1, &kk, "a %s takes %s (and friction, restitution, pose), not '%s'", name, allowed, k);
+            if (local) return jv_fail(r, f[i], 1, &kk, "a %s with a pose takes %s in its own frame, not '%s'", name, allowed, k);
+            return jv_fail(r, f[i], 1, &kk, "a %s takes %s (and friction, restitution, pose), not '%s'", name, allowed, k);
         }
     }
     wb_collider_def d = wb_collider_default_def((wb_shape)shape);
-    if (opt_vec(r, f[1], p, "normal", 3, d.normal) || opt_real(r, f[2], p, "offset", &d.offset) ||
-        opt_vec(r, f[3], p, "center", 3, d.center) || opt_real(r, f[4], p, "radius", &d.radius) ||
-        opt_vec(r, f[5], p, "half", 3, d.half) || opt_vec(r, f[7], p, "a", 3, d.a) || opt_vec(r, f[8], p, "b", 3, d.b) ||
-        opt_nonneg(r, f[9], p, "friction", &d.friction) || opt_nonneg(r, f[10], p, "restitution", &d.restitution))
+    if (jv_opt_vec(r, f[1], p, "normal", 3, d.normal) || jv_opt_real(r, f[2], p, "offset", &d.offset) ||
+        jv_opt_vec(r, f[3], p, "center", 3, d.center) || jv_opt_real(r, f[4], p, "radius", &d.radius) ||
+        jv_opt_vec(r, f[5], p, "half", 3, d.half) || jv_opt_vec(r, f[7], p, "a", 3, d.a) || jv_opt_vec(r, f[8], p, "b", 3, d.b) ||
+        jv_opt_nonneg(r, f[9], p, "friction", &d.friction) || jv_opt_nonneg(r, f[10], p, "restitution", &d.restitution))
         return -1;
     if (f[6]) {
         kp q = { p, "rotation", 0 };
@@ -611,8 +338,8 @@ static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider 
     }
     if (!local) {
         wb_status st = wb_image_collider_from_def(&d, c);
-        if (st == WB_ERR_NOMEM) return fail(r, it, 0, p, "out of memory");
-        return st != WB_OK ? fail(r, it, 0, p, "%s", wb_last_error()) : 0;
+        if (st == WB_ERR_NOMEM) return jv_fail(r, it, 0, p, "out of memory");
+        return st != WB_OK ? jv_fail(r, it, 0, p, "%s", wb_last_error()) : 0;
     }
     /* own frame: the values are the collider's internals, as w:save wrote them */
     memset(c, 0, sizeof *c);
@@ -622,7 +349,7 @@ static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider 
     switch (c->shape) {
     case WB_SHAPE_PLANE: {
         wb_real n2 = d.normal[0] * d.normal[0] + d.normal[1] * d.normal[1] + d.normal[2] * d.normal[2];
-        if (!(n2 > 1e-24)) return fail(r, f[1] ? f[1] : it, 0, p, "normal must not be zero");
+        if (!(n2 > 1e-24)) return jv_fail(r, f[1] ? f[1] : it, 0, p, "normal must not be zero");
         for (int i = 0; i < 3; i++) c->n[i] = fabs(n2 - 1) > 1e-12 ? d.normal[i] / sqrt(n2) : d.normal[i];
         break;
     }
@@ -636,10 +363,10 @@ static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider 
     }
     if (read_pose(r, f[11], p, c)) return -1;
     if (c->shape == WB_SHAPE_BOX && !(c->half[0] > 0 && c->half[1] > 0 && c->half[2] > 0))
-        return fail(r, it, 0, p, "half extents must be > 0");
+        return jv_fail(r, it, 0, p, "half extents must be > 0");
     if ((c->shape == WB_SHAPE_SPHERE || c->shape == WB_SHAPE_CAPSULE) && !(c->radius > 0))
-        return fail(r, it, 0, p, "radius must be > 0");
-    if (c->restitution > 1) return fail(r, f[10], 0, p, "restitution must be in [0, 1]");
+        return jv_fail(r, it, 0, p, "radius must be > 0");
+    if (c->restitution > 1) return jv_fail(r, f[10], 0, p, "restitution must be in [0, 1]");
     return 0;
 }
 
@@ -667,22 +394,22 @@ static int read_surfaces(rd *r, const sections *s, wb_image *g, int32_t *ntri)
         const cJSON *f[2];
         kp p = { &top, NULL, i }, tp = { &p, "triangles", 0 };
         int32_t n;
-        if (get_object(r, c, &p, keys, f)) return -1;
-        if (!f[0]) return missing(r, c, &p, "triangles");
-        if (get_array(r, f[0], &tp, 3ll * WB_MAX_CONSTRAINTS, &n)) return -1;
-        if (n % 3) return fail(r, f[0], 0, &tp, "%d corners is not a whole number of triangles", n);
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "triangles");
+        if (jv_get_array(r, f[0], &tp, 3ll * WB_MAX_CONSTRAINTS, &n)) return -1;
+        if (n % 3) return jv_fail(r, f[0], 0, &tp, "%d corners is not a whole number of triangles", n);
         if (g) {
             g->surf_start[i] = t;
             int32_t k = 0;
             for (const cJSON *e = f[0]->child; e; e = e->next, k++) {
                 kp q = { &tp, NULL, k };
                 int64_t v;
-                if (g->np == 0) return fail(r, e, 0, &q, "there are no particles");
-                if (get_int(r, e, &q, 0, g->np - 1, &v)) return -1;
+                if (g->np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
+                if (jv_get_int(r, e, &q, 0, g->np - 1, &v)) return -1;
                 g->tri[3 * (int64_t)t + k] = (int32_t)v;
             }
         }
-        if ((int64_t)t + n / 3 > WB_MAX_CONSTRAINTS) return fail(r, f[0], 0, &tp, "too many triangles");
+        if ((int64_t)t + n / 3 > WB_MAX_CONSTRAINTS) return jv_fail(r, f[0], 0, &tp, "too many triangles");
         t += n / 3;
     }
     if (g) g->surf_start[i] = t;
@@ -700,17 +427,17 @@ static int read_parts(rd *r, const sections *s, wbio_config *cfg)
         kp p = { &top, NULL, i }, np = { &p, "name", 0 };
         const char *name = "";
         int64_t first, count;
-        if (get_object(r, c, &p, keys, f)) return -1;
-        if (!f[0]) return missing(r, c, &p, "name");
-        if (!f[1]) return missing(r, c, &p, "first");
-        if (!f[2]) return missing(r, c, &p, "count");
-        if (get_string(r, f[0], &np, &name) || opt_int(r, f[1], &p, "first", 0, s->np, &first) ||
-            opt_int(r, f[2], &p, "count", 0, s->np - first, &count))
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "name");
+        if (!f[1]) return jv_missing(r, c, &p, "first");
+        if (!f[2]) return jv_missing(r, c, &p, "count");
+        if (jv_get_string(r, f[0], &np, &name) || jv_opt_int(r, f[1], &p, "first", 0, s->np, &first) ||
+            jv_opt_int(r, f[2], &p, "count", 0, s->np - first, &count))
             return -1;
         for (int32_t j = 0; j < i; j++)
-            if (!strcmp(cfg->parts[j].name, name)) return fail(r, f[0], 0, &np, "a part named '%s' already exists", name);
+            if (!strcmp(cfg->parts[j].name, name)) return jv_fail(r, f[0], 0, &np, "a part named '%s' already exists", name);
         cfg->parts[i].name = strdup(name);
-        if (!cfg->parts[i].name) return fail(r, c, 0, &p, "out of memory");
+        if (!cfg->parts[i].name) return jv_fail(r, c, 0, &p, "out of memory");
         cfg->parts[i].first = (int32_t)first;
         cfg->parts[i].count = (int32_t)count;
         cfg->nparts = i + 1;
@@ -732,29 +459,29 @@ static int read_skins(rd *r, const sections *s, wbio_config *cfg)
         cfg->nskins = i + 1;
         k->scale = 1;
         k->def = wb_skin_default_def();
-        if (get_object(r, c, &p, keys, f)) return -1;
-        if (!f[0]) return missing(r, c, &p, "mesh");
-        if (get_string(r, f[0], &mp, &mesh) || opt_real(r, f[1], &p, "scale", &k->scale)) return -1;
-        if (!(k->scale > 0)) return fail(r, f[1], 0, &p, "scale must be > 0");
-        if (f[2]) { if (opt_int(r, f[2], &p, "bones", 1, 16, &v)) return -1; k->def.bones = (int)v; }
-        if (f[3]) { if (opt_int(r, f[3], &p, "neighbours", 1, 32, &v)) return -1; k->def.neighbours = (int)v; }
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "mesh");
+        if (jv_get_string(r, f[0], &mp, &mesh) || jv_opt_real(r, f[1], &p, "scale", &k->scale)) return -1;
+        if (!(k->scale > 0)) return jv_fail(r, f[1], 0, &p, "scale must be > 0");
+        if (f[2]) { if (jv_opt_int(r, f[2], &p, "bones", 1, 16, &v)) return -1; k->def.bones = (int)v; }
+        if (f[3]) { if (jv_opt_int(r, f[3], &p, "neighbours", 1, 32, &v)) return -1; k->def.neighbours = (int)v; }
         k->mesh = strdup(mesh);
-        if (!k->mesh) return fail(r, c, 0, &p, "out of memory");
-        where_of(r, f[0], 0, &mp, k->where, sizeof k->where); /* for messages about loading it */
+        if (!k->mesh) return jv_fail(r, c, 0, &p, "out of memory");
+        jv_where_of(r, f[0], 0, &mp, k->where, sizeof k->where); /* for messages about loading it */
         if (f[4]) {
             kp pp = { &p, "particles", 0 };
-            if (get_array(r, f[4], &pp, s->np, &k->nids)) return -1;
-            if (k->nids == 0) return fail(r, f[4], 0, &pp, "a skin needs at least one particle");
+            if (jv_get_array(r, f[4], &pp, s->np, &k->nids)) return -1;
+            if (k->nids == 0) return jv_fail(r, f[4], 0, &pp, "a skin needs at least one particle");
             k->ids = malloc(sizeof *k->ids * (size_t)k->nids);
-            if (!k->ids) return fail(r, c, 0, &p, "out of memory");
+            if (!k->ids) return jv_fail(r, c, 0, &p, "out of memory");
             int32_t j = 0;
             for (const cJSON *e = f[4]->child; e; e = e->next, j++) {
                 kp q = { &pp, NULL, j };
-                if (get_int(r, e, &q, 0, s->np - 1, &v)) return -1;
+                if (jv_get_int(r, e, &q, 0, s->np - 1, &v)) return -1;
                 k->ids[j] = (int32_t)v;
             }
         } else if (s->np == 0) {
-            return fail(r, c, 0, &p, "a skin needs at least one particle");
+            return jv_fail(r, c, 0, &p, "a skin needs at least one particle");
         }
     }
     return 0;
@@ -769,25 +496,25 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
     sections s;
     defaults d;
     memset(&s, 0, sizeof s);
-    if (!cJSON_IsObject(root)) return fail(r, root, 0, NULL, "a particle config is a JSON object, got %s", type_name(root));
-    if (get_object(r, root, NULL, keys, f)) return -1;
+    if (!cJSON_IsObject(root)) return jv_fail(r, root, 0, NULL, "a particle config is a JSON object, got %s", jv_type_name(root));
+    if (jv_get_object(r, root, NULL, keys, f)) return -1;
     kp fp = { NULL, "format", 0 }, vp = { NULL, "version", 0 };
     const char *str = "";
     int64_t version;
-    if (!f[0]) return fail(r, root, 0, NULL, "missing key 'format' (a particle config starts with "
+    if (!f[0]) return jv_fail(r, root, 0, NULL, "missing key 'format' (a particle config starts with "
                                               "\"format\": \"" WBIO_FORMAT "\", \"version\": 1)");
-    if (get_string(r, f[0], &fp, &str)) return -1;
-    if (strcmp(str, WBIO_FORMAT)) return fail(r, f[0], 0, &fp, "'%s' is not a particle config (expected '" WBIO_FORMAT "')", str);
-    if (!f[1]) return missing(r, root, NULL, "version");
-    if (get_int(r, f[1], &vp, INT32_MIN, INT32_MAX, &version)) return -1;
+    if (jv_get_string(r, f[0], &fp, &str)) return -1;
+    if (strcmp(str, WBIO_FORMAT)) return jv_fail(r, f[0], 0, &fp, "'%s' is not a particle config (expected '" WBIO_FORMAT "')", str);
+    if (!f[1]) return jv_missing(r, root, NULL, "version");
+    if (jv_get_int(r, f[1], &vp, INT32_MIN, INT32_MAX, &version)) return -1;
     if (version != WBIO_VERSION)
-        return fail(r, f[1], 0, &vp, "version %lld is not supported (this wobble reads version %d)", (long long)version, WBIO_VERSION);
+        return jv_fail(r, f[1], 0, &vp, "version %lld is not supported (this wobble reads version %d)", (long long)version, WBIO_VERSION);
     if (f[2]) {
         kp dp = { NULL, "description", 0 };
-        if (get_string(r, f[2], &dp, &str)) return -1;
+        if (jv_get_string(r, f[2], &dp, &str)) return -1;
     }
     if (read_defaults(r, f[3], &d)) return -1;
-    if (!f[4]) return missing(r, root, NULL, "particles");
+    if (!f[4]) return jv_missing(r, root, NULL, "particles");
     struct { const cJSON **dst; int32_t *n; int64_t max; int k; } arrays[] = {
         { &s.particles, &s.np, WB_MAX_PARTICLES, 4 }, { &s.constraints, &s.ncons, WB_MAX_CONSTRAINTS, 5 },
         { &s.colliders, &s.ncol, WB_MAX_COLLIDERS, 6 }, { &s.surfaces, &s.nsurf, WB_MAX_CONSTRAINTS, 7 },
@@ -797,14 +524,14 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
         const cJSON *it = f[arrays[i].k];
         kp ap = { NULL, keys[arrays[i].k], 0 };
         *arrays[i].dst = it;
-        if (it && get_array(r, it, &ap, arrays[i].max, arrays[i].n)) return -1;
+        if (it && jv_get_array(r, it, &ap, arrays[i].max, arrays[i].n)) return -1;
     }
     s.snapshot = f[10];
     if (scan_snapshot(r, &s) || read_surfaces(r, &s, NULL, &s.ntri)) return -1;
     if (wb_image_alloc(&cfg->img, s.np, s.nd, s.nfree, s.nc, s.nsurf, s.ntri) != WB_OK ||
         !(cfg->parts = calloc((size_t)s.nparts + 1, sizeof *cfg->parts)) ||
         !(cfg->skins = calloc((size_t)s.nskins + 1, sizeof *cfg->skins)))
-        return fail(r, NULL, 0, NULL, "out of memory");
+        return jv_fail(r, NULL, 0, NULL, "out of memory");
     cfg->snapshot = s.snapshot != NULL;
     /* the snapshot first: its slot tables say where the constraints and colliders go */
     if ((s.snapshot && read_snapshot(r, &s, &cfg->img)) || read_particles(r, &s, &d, &cfg->img) ||
@@ -813,7 +540,7 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
         return -1;
     /* every value was checked where it was read: this is the last line of defence */
     const char *e = wb_image_check(&cfg->img);
-    return e ? fail(r, root, 0, NULL, "%s", e) : 0;
+    return e ? jv_fail(r, root, 0, NULL, "%s", e) : 0;
 }
 
 static char *read_text(const char *path, const char *shown, size_t *len, char *err, size_t errn)
@@ -864,7 +591,7 @@ int wbio_read_config(const char *path, const char *shown, wbio_config *cfg, char
     const char *nul = memchr(text, '\0', len), *end = NULL, *p = text;
     while (*p && (unsigned char)*p <= 32) p++;
     if (nul) {
-        line_col(text, (int32_t)(nul - text), &line, &col);
+        jv_line_col(text, (int32_t)(nul - text), &line, &col);
         snprintf(err, errn, "%s:%d:%d: not a text file (a NUL byte)", shown, line, col);
     } else if (!*p) {
         snprintf(err, errn, "%s: empty file (a particle config is a JSON object)", shown);
@@ -873,14 +600,14 @@ int wbio_read_config(const char *path, const char *shown, wbio_config *cfg, char
         const int32_t off = end ? (int32_t)(end - text) : 0;
         char near[24] = "";
         for (int i = 0; i < 20 && end && end[i] && end[i] != '\n'; i++) near[i] = isprint((unsigned char)end[i]) ? end[i] : '?';
-        line_col(text, off, &line, &col);
+        jv_line_col(text, off, &line, &col);
         if (end && *end) snprintf(err, errn, "%s:%d:%d: JSON syntax error near '%s'", shown, line, col, near);
         else snprintf(err, errn, "%s:%d:%d: JSON syntax error: unexpected end of file", shown, line, col);
     } else {
         if (!strncmp(s.p, "\xEF\xBB\xBF", 3)) s.p += 3; /* cJSON skips a UTF-8 byte-order mark too */
-        sk_value(&s, -1);
+        jv_sk_value(&s, -1);
         int32_t k = 0;
-        number_items(root, &k);
+        jv_number_items(root, &k);
         r.pos = !s.oom && k == s.n ? &s : NULL; /* without positions, messages still name the key */
         rc = read_root(&r, root, cfg);
     }
