@@ -63,15 +63,19 @@ asan: check-deps
 	@$(MAKE) --no-print-directory BUILD=build-asan OPT=-O1 \
 	  EXTRA_CFLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" \
 	  EXTRA_LDFLAGS="-fsanitize=address,undefined" build
-	@ASAN_OPTIONS=detect_leaks=1 sh tests/run_all.sh build-asan
+	@ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/render/lsan.supp:print_suppressions=0 \
+	  sh tests/run_all.sh build-asan
 
 bench: check-deps
 	@$(MAKE) --no-print-directory OPT="-O3 -march=native" BUILD=build-bench build
 	@build-bench/wobble bench
 
+# the clothesline, 6 s at 1280x720 with every layer, as an H.264 video
 demo: check-deps
 	@$(MAKE) --no-print-directory build
-	$(BUILD)/wobble run scripts/cloth_clothesline.lua
+	@mkdir -p out
+	$(BUILD)/wobble run scripts/cloth_clothesline.lua --set seconds=6 --record out/clothesline.mp4
+	@echo "demo video: $(CURDIR)/out/clothesline.mp4"
 
 install: all
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/wobble/lua/wobble

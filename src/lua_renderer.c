@@ -10,6 +10,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "lua_mesh.h"
 #include "lua_util.h"
 #include "render.h"
 
@@ -130,10 +131,40 @@ static void stop_recording(lua_State *L, wbl_renderer *u)
     if (!wb_recorder_close(rec, err, sizeof err)) luaL_error(L, "%s", err);
 }
 
-/* draw and, when recording, add the frame; false + message instead of raising */
-static bool draw_frame(wbl_renderer *u, const wb_world *w, const wb_draw_opts *o, char *err, size_t n)
+/* the skins made on the world at world_index, for drawing (an array in a userdata left
+ * on the stack, collected with it); *n their count */
+static wb_draw_skin *world_skins(lua_State *L, int world_index, int *n)
 {
-    if (!wb_renderer_draw(u->r, w, o, err, n)) return false;
+    wbl_push_world_skins(L, world_index);
+    int len = (int)lua_rawlen(L, -1), k = 0;
+    wb_draw_skin *sk = (wb_draw_skin *)lua_newuserdatauv(L, sizeof *sk * (size_t)(len ? len : 1), 0);
+    for (int i = 1; i <= len; i++) {
+        lua_rawgeti(L, -2, i);
+        wb_world *w = NULL;
+        wb_skin *s = wbl_toskin(L, -1, &w);
+        lua_pop(L, 1);
+        if (!s) continue;   /* closed */
+        const wb_mesh *m = wb_skin_rest(s);
+        sk[k].v = wb_skin_vertices(s, w);
+        sk[k].n = wb_skin_normals(s, w);
+        sk[k].tri = m->tri;
+        sk[k].nv = m->nv;
+        sk[k].nt = m->nt;
+        k++;
+    }
+    *n = k;
+    return sk;
+}
+
+/* draw and, when recording, add the frame; false + message instead of raising */
+static bool draw_frame(lua_State *L, wbl_renderer *u, int world_index, const wb_draw_opts *o, char *err, size_t n)
+{
+    int top = lua_gettop(L), nsk = 0;
+    wb_world *w = wbl_checkworld(L, world_index);
+    wb_draw_skin *sk = o->skins ? world_skins(L, world_index, &nsk) : NULL;
+    bool ok = wb_renderer_draw(u->r, w, o, sk, nsk, err, n);
+    lua_settop(L, top);
+    if (!ok) return false;
     u->draws++;
     if (u->rec) {
         if (!u->fps_set && !wb_recorder_started(u->rec)) wb_recorder_set_fps(u->rec, 1.0 / wb_world_get_def(w).dt);
@@ -145,7 +176,7 @@ static bool draw_frame(wbl_renderer *u, const wb_world *w, const wb_draw_opts *o
 static int r_draw(lua_State *L)
 {
     wbl_renderer *u = checkrenderer(L, 1);
-    wb_world *w = wbl_checkworld(L, 2);
+    wbl_checkworld(L, 2);
     wbl_checkopts(L, 3, draw_keys, true);
     wb_draw_opts o = wb_draw_default_opts();
     if (!lua_isnoneornil(L, 3)) {
@@ -167,7 +198,7 @@ static int r_draw(lua_State *L)
         }
     }
     char err[1024];
-    if (!draw_frame(u, w, &o, err, sizeof err)) {
+    if (!draw_frame(L, u, 2, &o, err, sizeof err)) {
         /* a failed frame ends the recording: closing it gets the encoder's own words */
         if (u->rec) stop_recording(L, u);
         return luaL_error(L, "%s", err);
@@ -400,10 +431,10 @@ static int record_hook(lua_State *L)
     } else if (!lua_rawequal(L, -1, 1)) {
         return 0;
     }
-    wb_world *w = wbl_checkworld(L, 1);
+    wbl_checkworld(L, 1);
     wb_draw_opts o = wb_draw_default_opts();
     char err[1024];
-    if (!draw_frame(u, w, &o, err, sizeof err)) {
+    if (!draw_frame(L, u, 1, &o, err, sizeof err)) {
         wb_recorder *rec = u->rec;
         u->rec = NULL;
         char more[1024];

@@ -23,7 +23,7 @@ struct wb_renderer {
     bool fixed;
     double eye[3], target[3], up[3], fov;
     bool have_box;
-    double box_lo[3], box_hi[3];
+    double view_lo[3], view_hi[3];/* what the default camera frames: eases after the scene */
     /* the last frame's camera and view-projection (row-major 4x4, doubles) */
     double cam_eye[3], cam_target[3], cam_up[3], cam_fov, vp[16];
     /* scratch, grown as needed */
@@ -55,71 +55,13 @@ static const float col_sky_bottom[3] = { 0.89f, 0.90f, 0.92f };
 static const float col_surface[][3] = {
     { 0.91f, 0.42f, 0.24f }, { 0.26f, 0.64f, 0.56f }, { 0.56f, 0.44f, 0.80f }, { 0.86f, 0.70f, 0.28f },
 };
+static const float col_skin[3] = { 0.86f, 0.76f, 0.62f };
 static const double light_dir[3] = { -0.40, 0.80, 0.45 };   /* towards the light: upper left, in front */
 
 wb_draw_opts wb_draw_default_opts(void)
 {
     wb_draw_opts o = { true, true, true, true, true, true, true, 0.05, 1.5 };
     return o;
-}
-
-/* ---- small vector and matrix helpers (doubles; matrices row-major m[r*4+c]) ---- */
-static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-static void cross3(const double a[3], const double b[3], double o[3])
-{
-    double t[3] = { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
-    memcpy(o, t, sizeof t);
-}
-
-static double norm3(double a[3])
-{
-    double l = sqrt(dot3(a, a));
-    if (l > 0) a[0] /= l, a[1] /= l, a[2] /= l;
-    return l;
-}
-
-static void mat_mul(const double a[16], const double b[16], double o[16])
-{
-    double t[16];
-    for (int i = 0; i < 4; i++)
-        for (int j = 0; j < 4; j++) {
-            double s = 0;
-            for (int k = 0; k < 4; k++) s += a[i * 4 + k] * b[k * 4 + j];
-            t[i * 4 + j] = s;
-        }
-    memcpy(o, t, sizeof t);
-}
-
-static void look_at(const double eye[3], const double target[3], const double up[3], double m[16])
-{
-    double f[3] = { target[0] - eye[0], target[1] - eye[1], target[2] - eye[2] }, s[3], u[3];
-    norm3(f);
-    cross3(f, up, s);
-    norm3(s);
-    cross3(s, f, u);
-    double t[16] = { s[0], s[1], s[2], -dot3(s, eye), u[0], u[1], u[2], -dot3(u, eye),
-                     -f[0], -f[1], -f[2], dot3(f, eye), 0, 0, 0, 1 };
-    memcpy(m, t, sizeof t);
-}
-
-static void perspective(double fovy_deg, double aspect, double zn, double zf, double m[16])
-{
-    double f = 1 / tan(fovy_deg * M_PI / 360);
-    double t[16] = { f / aspect, 0, 0, 0, 0, f, 0, 0, 0, 0, (zf + zn) / (zn - zf), 2 * zf * zn / (zn - zf), 0, 0, -1, 0 };
-    memcpy(m, t, sizeof t);
-}
-
-static void ortho(double r, double zn, double zf, double m[16])
-{
-    double t[16] = { 1 / r, 0, 0, 0, 0, 1 / r, 0, 0, 0, 0, -2 / (zf - zn), -(zf + zn) / (zf - zn), 0, 0, 0, 1 };
-    memcpy(m, t, sizeof t);
-}
-
-static void to_gl(const double m[16], float o[16])   /* row-major doubles -> column-major floats */
-{
-    for (int r = 0; r < 4; r++)
-        for (int c = 0; c < 4; c++) o[c * 4 + r] = (float)m[r * 4 + c];
 }
 
 static float lin(float c) { return c * c; }   /* the shaders output with gamma 2 */
@@ -217,6 +159,7 @@ void wb_renderer_camera(wb_renderer *r, const double eye[3], const double target
     memcpy(r->target, target, sizeof r->target);
     memcpy(r->up, up, sizeof r->up);
     r->fov = fov;
+    r->have_box = false;   /* a new shot: the extent starts again */
 }
 
 void wb_renderer_auto_camera(wb_renderer *r)
@@ -255,17 +198,6 @@ static void box_add(box *b, const double p[3], double r)
         if (!b->any || p[k] + r > b->hi[k]) b->hi[k] = p[k] + r;
     }
     b->any = true;
-}
-
-/* a quaternion (w,x,y,z) as a rotation matrix (row-major 3x3) */
-static void quat_mat(const wb_real q[4], double m[9])
-{
-    double w = q[0], x = q[1], y = q[2], z = q[3], l = sqrt(w * w + x * x + y * y + z * z);
-    if (l > 0) w /= l, x /= l, y /= l, z /= l;
-    double t[9] = { 1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-                    2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                    2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y) };
-    memcpy(m, t, sizeof t);
 }
 
 /* particles and the finite colliders; an upward plane below is pulled in when it is
@@ -324,7 +256,7 @@ static box scene_box(const wb_world *w)
  * box allows with a margin */
 static void frame_box(wb_renderer *r, const double lo[3], const double hi[3])
 {
-    double dir[3] = { 0.45, 0.38, 1.0 }, up[3] = { 0, 1, 0 }, c[3], s[3], u[3], f[3];
+    double dir[3] = { 0.35, 0.3, 1.0 }, up[3] = { 0, 1, 0 }, c[3], s[3], u[3], f[3];
     norm3(dir);
     for (int k = 0; k < 3; k++) c[k] = 0.5 * (lo[k] + hi[k]), f[k] = -dir[k];
     cross3(f, up, s);
@@ -432,18 +364,21 @@ static bool build_instances(wb_renderer *r, const wb_world *w, const wb_draw_opt
 }
 
 /* per-particle smooth normals of every surface (area-weighted face normals) */
-static bool build_surfaces(wb_renderer *r, const wb_world *w, size_t *nidx)
+/* vertices: the particles, then every skin's; indices: the surfaces', then the skins' */
+static bool build_surfaces(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, const wb_draw_skin *sk,
+                           int nsk, size_t *nidx)
 {
-    int32_t np = wb_particle_count(w), ns = wb_surface_count(w);
+    int32_t np = wb_particle_count(w), ns = o->surfaces ? wb_surface_count(w) : 0;
     const wb_real *x = wb_particle_positions(w);
-    size_t total = 0;
+    size_t total = 0, nv = (size_t)np;
     for (int32_t s = 0; s < ns; s++) {
         int32_t nt = 0;
         wb_surface_triangles(w, s, &nt);
         total += 3 * (size_t)nt;
     }
+    for (int i = 0; i < nsk; i++) total += 3 * (size_t)sk[i].nt, nv += (size_t)sk[i].nv;
     *nidx = total;
-    if (!grow(&r->sv, &r->sv_cap, 6 * (size_t)np + 6, sizeof *r->sv) ||
+    if (!grow(&r->sv, &r->sv_cap, 6 * nv + 6, sizeof *r->sv) ||
         !grow(&r->si, &r->si_cap, total + 1, sizeof *r->si) ||
         !grow(&r->on_surface, &r->flag_cap, (size_t)np + 1, 1))
         return false;
@@ -472,6 +407,14 @@ static bool build_surfaces(wb_renderer *r, const wb_world *w, size_t *nidx)
         for (int c = 0; c < 3; c++) r->sv[6 * i + c] = (float)x[3 * i + c], r->sv[6 * i + 3 + c] = (float)a[c];
     }
     free(acc);
+    size_t base = (size_t)np;   /* skins: their own (deformed) vertices and normals */
+    for (int i = 0; i < nsk; i++) {
+        for (int32_t v = 0; v < sk[i].nv; v++)
+            for (int c = 0; c < 3; c++)
+                r->sv[6 * (base + v) + c] = (float)sk[i].v[3 * v + c], r->sv[6 * (base + v) + 3 + c] = (float)sk[i].n[3 * v + c];
+        for (int32_t t = 0; t < 3 * sk[i].nt; t++) r->si[k++] = (GLuint)(base + (size_t)sk[i].tri[t]);
+        base += (size_t)sk[i].nv;
+    }
     return true;
 }
 
@@ -529,7 +472,7 @@ static void draw_meshes(wb_renderer *r, const size_t first[G_COUNT], const size_
     }
 }
 
-static void draw_surfaces(wb_renderer *r, const wb_world *w, GLuint prog)
+static void draw_surfaces(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, const wb_draw_skin *sk, int nsk)
 {
     glBindVertexArray(r->gl.vao_surf);
     /* constant instance attributes: identity model and normal matrices, one colour each */
@@ -537,13 +480,13 @@ static void draw_surfaces(wb_renderer *r, const wb_world *w, GLuint prog)
     glVertexAttrib4f(4, 0, 0, 1, 0), glVertexAttrib4f(5, 0, 0, 0, 1);
     glVertexAttrib3f(6, 1, 0, 0), glVertexAttrib3f(7, 0, 1, 0), glVertexAttrib3f(8, 0, 0, 1);
     size_t off = 0;
-    int32_t ns = wb_surface_count(w);
-    (void)prog;
-    for (int32_t s = 0; s < ns; s++) {
+    int32_t ns = o->surfaces ? wb_surface_count(w) : 0;
+    for (int32_t s = 0; s < ns + nsk; s++) {
         int32_t nt = 0;
-        wb_surface_triangles(w, s, &nt);
+        if (s < ns) wb_surface_triangles(w, s, &nt);
+        else nt = sk[s - ns].nt;
         float c[3];
-        lin3(col_surface[s % 4], c);
+        lin3(s < ns ? col_surface[s % 4] : col_skin, c);
         glVertexAttrib4f(9, c[0], c[1], c[2], 0.12f);
         glDrawElements(GL_TRIANGLES, 3 * nt, GL_UNSIGNED_INT, (const void *)(off * sizeof(GLuint)));
         off += 3 * (size_t)nt;
@@ -626,16 +569,22 @@ static void background_cpu(wb_renderer *r)
     }
 }
 
-bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, char *err, size_t n)
+bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, const wb_draw_skin *skins,
+                      int nskins, char *err, size_t n)
 {
     /* camera and extent */
     box cur = scene_box(w);
     if (!r->have_box) {
-        memcpy(r->box_lo, cur.lo, sizeof r->box_lo);
-        memcpy(r->box_hi, cur.hi, sizeof r->box_hi);
+        memcpy(r->view_lo, cur.lo, sizeof r->view_lo);
+        memcpy(r->view_hi, cur.hi, sizeof r->view_hi);
         r->have_box = true;
     } else {
-        for (int k = 0; k < 3; k++) r->box_lo[k] = fmin(r->box_lo[k], cur.lo[k]), r->box_hi[k] = fmax(r->box_hi[k], cur.hi[k]);
+        /* the camera follows what is there now, eased (a fifth of a second at 60
+         * draws a second) so a video neither jumps nor shakes */
+        for (int k = 0; k < 3; k++) {
+            r->view_lo[k] += 0.08 * (cur.lo[k] - r->view_lo[k]);
+            r->view_hi[k] += 0.08 * (cur.hi[k] - r->view_hi[k]);
+        }
     }
     if (r->fixed) {
         memcpy(r->cam_eye, r->eye, sizeof r->eye);
@@ -643,11 +592,11 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
         memcpy(r->cam_up, r->up, sizeof r->up);
         r->cam_fov = r->fov;
     } else {
-        frame_box(r, r->box_lo, r->box_hi);
+        frame_box(r, r->view_lo, r->view_hi);
     }
     double c[3], R = 0;
     for (int k = 0; k < 3; k++) {
-        double lo = r->fixed ? cur.lo[k] : r->box_lo[k], hi = r->fixed ? cur.hi[k] : r->box_hi[k];
+        double lo = fmin(cur.lo[k], r->view_lo[k]), hi = fmax(cur.hi[k], r->view_hi[k]);
         c[k] = 0.5 * (lo + hi);
         R += 0.25 * (hi - lo) * (hi - lo);
     }
@@ -671,15 +620,18 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     /* layers */
     size_t first[G_COUNT], count[G_COUNT], nidx = 0, nseg = 0;
     int32_t np = wb_particle_count(w);
-    bool surfaces = o->surfaces && wb_surface_count(w) > 0 && np > 0;
-    if (surfaces && !build_surfaces(r, w, &nidx)) goto oom;
+    if (!o->skins) nskins = 0;
+    bool surfaces = (o->surfaces && wb_surface_count(w) > 0 && np > 0) || nskins > 0;
+    if (surfaces && !build_surfaces(r, w, o, skins, nskins, &nidx)) goto oom;
     if (!build_instances(r, w, o, R, surfaces, first, count)) goto oom;
     if (o->constraints && !build_segments(r, w, o, &nseg)) goto oom;
     wb_gl *g = &r->gl;
     size_t ninst = first[G_COUNT - 1] + count[G_COUNT - 1];
     wb_gl_upload(GL_ARRAY_BUFFER, g->vbo_inst, &g->inst_cap, r->inst, ninst * sizeof *r->inst);
     if (surfaces) {
-        wb_gl_upload(GL_ARRAY_BUFFER, g->vbo_surf, &g->surf_cap, r->sv, 6 * (size_t)np * sizeof *r->sv);
+        size_t nv = (size_t)np;
+        for (int i = 0; i < nskins; i++) nv += (size_t)skins[i].nv;
+        wb_gl_upload(GL_ARRAY_BUFFER, g->vbo_surf, &g->surf_cap, r->sv, 6 * nv * sizeof *r->sv);
         glBindVertexArray(g->vao_surf);
         wb_gl_upload(GL_ELEMENT_ARRAY_BUFFER, g->ebo_surf, &g->surf_idx_cap, r->si, nidx * sizeof *r->si);
         glBindVertexArray(g->vao_surf);   /* growing re-specified the buffer: bind it again */
@@ -709,7 +661,7 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     glUseProgram(g->prog_depth);
     set_mat(g->prog_depth, "u_vp", lvp);
     draw_meshes(r, first, count);
-    if (surfaces) draw_surfaces(r, w, g->prog_depth);
+    if (surfaces) draw_surfaces(r, w, o, skins, nskins);
     glDisable(GL_POLYGON_OFFSET_FILL);
 
     /* the picture */
@@ -748,7 +700,7 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     }
     if (!planes && o->grid) {
         wb_real up[3] = { 0, 1, 0 };
-        if (plane_quad(up, (r->fixed ? cur.lo[1] : r->box_lo[1]), c, ext, quad, center, gu, gv, gn))
+        if (plane_quad(up, fmin(cur.lo[1], r->view_lo[1]), c, ext, quad, center, gu, gv, gn))
             draw_grid(r, quad, center, gu, gv, gn, spacing, ext);
     }
     glDisable(GL_BLEND);
@@ -761,7 +713,7 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
         glUniform1i(glGetUniformLocation(g->prog_mesh, "u_two_sided"), 1);
         glEnable(GL_POLYGON_OFFSET_FILL);
         glPolygonOffset(1, 2);
-        draw_surfaces(r, w, g->prog_mesh);
+        draw_surfaces(r, w, o, skins, nskins);
         glDisable(GL_POLYGON_OFFSET_FILL);
     }
     if (nseg) {

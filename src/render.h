@@ -57,7 +57,11 @@ const char *wb_renderer_info(const wb_renderer *r);       /* "OpenGL 4.5 (Core P
  * default, which frames everything the world has shown since */
 void wb_renderer_camera(wb_renderer *r, const double eye[3], const double target[3], const double up[3], double fov);
 void wb_renderer_auto_camera(wb_renderer *r);
-bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, char *err, size_t n);
+/* a skinned mesh to draw with the world (the skins belong to the Lua side): deformed
+ * vertices and normals (nv x 3), triangles (nt x 3) */
+typedef struct wb_draw_skin { const wb_real *v, *n; const int32_t *tri; int32_t nv, nt; } wb_draw_skin;
+bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, const wb_draw_skin *skins,
+                      int nskins, char *err, size_t n);
 const uint8_t *wb_renderer_pixels(const wb_renderer *r);  /* the last frame, RGB */
 /* world point -> pixel coordinates of the last frame (x right, y down, pixel (i,j)
  * covers [i,i+1) x [j,j+1)); false when behind the camera or nothing drawn yet */

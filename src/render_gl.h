@@ -6,8 +6,12 @@
 #define GL_GLEXT_PROTOTYPES
 #include <GL/glcorearb.h>
 
+#include <math.h>
 #include <stdbool.h>
 #include <stddef.h>
+#include <string.h>
+
+#include "wobble.h"
 
 /* meshes in one vertex buffer (position, normal) and one index buffer */
 enum { MESH_SPHERE_LO, MESH_SPHERE_HI, MESH_CYLINDER, MESH_BOX, MESH_COUNT };
@@ -43,5 +47,75 @@ void wb_gl_free(wb_gl *g);
 void wb_gl_upload(GLenum target, GLuint buf, size_t *cap, const void *data, size_t bytes);
 /* point the instance attributes of vao_mesh at instance `first` of vbo_inst */
 void wb_gl_inst_attribs(const wb_gl *g, size_t first);
+
+/* ---- small vector and matrix helpers (doubles; matrices row-major m[r*4+c]) ---- */
+static inline double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+static inline void cross3(const double a[3], const double b[3], double o[3])
+{
+    double t[3] = { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
+    memcpy(o, t, sizeof t);
+}
+
+static inline double norm3(double a[3])
+{
+    double l = sqrt(dot3(a, a));
+    if (l > 0) a[0] /= l, a[1] /= l, a[2] /= l;
+    return l;
+}
+
+static inline void mat_mul(const double a[16], const double b[16], double o[16])
+{
+    double t[16];
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            double s = 0;
+            for (int k = 0; k < 4; k++) s += a[i * 4 + k] * b[k * 4 + j];
+            t[i * 4 + j] = s;
+        }
+    memcpy(o, t, sizeof t);
+}
+
+static inline void look_at(const double eye[3], const double target[3], const double up[3], double m[16])
+{
+    double f[3] = { target[0] - eye[0], target[1] - eye[1], target[2] - eye[2] }, s[3], u[3];
+    norm3(f);
+    cross3(f, up, s);
+    norm3(s);
+    cross3(s, f, u);
+    double t[16] = { s[0], s[1], s[2], -dot3(s, eye), u[0], u[1], u[2], -dot3(u, eye),
+                     -f[0], -f[1], -f[2], dot3(f, eye), 0, 0, 0, 1 };
+    memcpy(m, t, sizeof t);
+}
+
+static inline void perspective(double fovy_deg, double aspect, double zn, double zf, double m[16])
+{
+    double f = 1 / tan(fovy_deg * M_PI / 360);
+    double t[16] = { f / aspect, 0, 0, 0, 0, f, 0, 0, 0, 0, (zf + zn) / (zn - zf), 2 * zf * zn / (zn - zf), 0, 0, -1, 0 };
+    memcpy(m, t, sizeof t);
+}
+
+static inline void ortho(double r, double zn, double zf, double m[16])
+{
+    double t[16] = { 1 / r, 0, 0, 0, 0, 1 / r, 0, 0, 0, 0, -2 / (zf - zn), -(zf + zn) / (zf - zn), 0, 0, 0, 1 };
+    memcpy(m, t, sizeof t);
+}
+
+static inline void to_gl(const double m[16], float o[16])   /* row-major doubles -> column-major floats */
+{
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 4; c++) o[c * 4 + r] = (float)m[r * 4 + c];
+}
+
+/* a quaternion (w,x,y,z) as a rotation matrix (row-major 3x3) */
+static inline void quat_mat(const wb_real q[4], double m[9])
+{
+    double w = q[0], x = q[1], y = q[2], z = q[3], l = sqrt(w * w + x * x + y * y + z * z);
+    if (l > 0) w /= l, x /= l, y /= l, z /= l;
+    double t[9] = { 1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+                    2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                    2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y) };
+    memcpy(m, t, sizeof t);
+}
 
 #endif

@@ -171,3 +171,31 @@ test("the null backend draws nothing but keeps the camera", function()
   expect.eq(select(2, n:info()), 1)
   n:close()
 end)
+
+test("skins are drawn as smooth-shaded meshes and follow their particles", function()
+  local w = wobble.world{ gravity = {0, 0, 0} }
+  local ids = {}
+  for _, p in ipairs{ {-0.5, 0.5, 0}, {0.5, 0.5, 0}, {0.5, 1.5, 0}, {-0.5, 1.5, 0} } do
+    ids[#ids + 1] = w:particle{ pos = p, radius = 0.01 }
+  end
+  local quad = wobble.mesh{ vertices = { {-0.5, 0.5, 0}, {0.5, 0.5, 0}, {0.5, 1.5, 0}, {-0.5, 1.5, 0} },
+                            triangles = { {1, 2, 3}, {1, 3, 4} } }
+  w:skin(quad, ids, { bones = 1, neighbours = 3 })
+  r:camera{ eye = {0, 1, 4}, target = {0, 1, 0} }
+  r:draw(w, { grid = false })
+  local cr, cg, cb = at{ 0, 1, 0 }
+  expect.gt(cr, cb + 30, "the skin's clay colour"); expect.gt(cr, 120)
+  r:draw(w, { grid = false, skins = false })
+  local sr, _, sb = at{ 0, 1, 0 }
+  expect.gt(sb, sr + 20, "skins = false: the sky")
+  -- move every particle by +1.2 in x: the skin goes with them
+  for _, id in ipairs(ids) do
+    local x, y, z = w:position(id)
+    w:set_position(id, x + 1.2, y, z)
+  end
+  r:draw(w, { grid = false })
+  local mr, _, mb = at{ 1.2, 1, 0 }
+  expect.gt(mr, mb + 30, "the skin moved with its particles")
+  local or_, _, ob = at{ 0, 1, 0 }
+  expect.gt(ob, or_ + 20, "and left the sky behind")
+end)
