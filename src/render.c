@@ -668,20 +668,15 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     glBindFramebuffer(GL_FRAMEBUFFER, g->fbo_ms);
     glViewport(0, 0, r->w, r->h);
     glClear(GL_DEPTH_BUFFER_BIT);
-    glDisable(GL_DEPTH_TEST);
-    glUseProgram(g->prog_bg);
-    glUniform3f(glGetUniformLocation(g->prog_bg, "u_top"), col_sky_top[0], col_sky_top[1], col_sky_top[2]);
-    glUniform3f(glGetUniformLocation(g->prog_bg, "u_bottom"), col_sky_bottom[0], col_sky_bottom[1], col_sky_bottom[2]);
-    glBindVertexArray(g->vao_empty);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
     glEnable(GL_DEPTH_TEST);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, g->tex_shadow);
 
     /* the ground: every plane collider, or a floor under the scene */
     light_uniforms(g->prog_grid, r->vp, lvp, r->cam_eye, L, bias, true);
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glUniform3f(glGetUniformLocation(g->prog_grid, "u_top"), col_sky_top[0], col_sky_top[1], col_sky_top[2]);
+    glUniform3f(glGetUniformLocation(g->prog_grid, "u_bottom"), col_sky_bottom[0], col_sky_bottom[1], col_sky_bottom[2]);
+    glUniform1f(glGetUniformLocation(g->prog_grid, "u_height"), (float)r->h);
     double spacing = nice_step(R / 6), center[3], gu[3], gv[3], gn[3];
     float quad[12];
     int planes = 0;
@@ -703,7 +698,6 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
         if (plane_quad(up, fmin(cur.lo[1], r->view_lo[1]), c, ext, quad, center, gu, gv, gn))
             draw_grid(r, quad, center, gu, gv, gn, spacing, ext);
     }
-    glDisable(GL_BLEND);
 
     /* solids, then the surfaces pushed back a little so links on them stay visible */
     light_uniforms(g->prog_mesh, r->vp, lvp, r->cam_eye, L, bias, true);
@@ -724,6 +718,16 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
         glBindVertexArray(g->vao_line);
         glDrawArraysInstanced(GL_TRIANGLES, 0, 6, (GLsizei)nseg);
     }
+    /* the sky last, behind everything: only uncovered pixels pass the depth test */
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
+    glUseProgram(g->prog_bg);
+    glUniform3f(glGetUniformLocation(g->prog_bg, "u_top"), col_sky_top[0], col_sky_top[1], col_sky_top[2]);
+    glUniform3f(glGetUniformLocation(g->prog_bg, "u_bottom"), col_sky_bottom[0], col_sky_bottom[1], col_sky_bottom[2]);
+    glBindVertexArray(g->vao_empty);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
 
     /* resolve into the backend's buffer and keep the frame */
     glBindFramebuffer(GL_READ_FRAMEBUFFER, g->fbo_ms);

@@ -136,8 +136,11 @@ static const char grid_fs[] =
     "uniform float u_extent;\n"
     "uniform vec3 u_base;\n"
     "out vec4 o_col;\n"
-    "float grid(vec2 uv) {\n"
-    "  vec2 g = abs(fract(uv - 0.5) - 0.5) / max(fwidth(uv), vec2(1e-6));\n"
+    "uniform vec3 u_top;\n"
+    "uniform vec3 u_bottom;\n"
+    "uniform float u_height;\n"
+    "float grid(vec2 uv, vec2 fw) {\n"
+    "  vec2 g = abs(fract(uv - 0.5) - 0.5) / max(fw, vec2(1e-6));\n"
     "  return 1.0 - min(min(g.x, g.y), 1.0);\n"
     "}\n"
     "void main() {\n"
@@ -146,10 +149,14 @@ static const char grid_fs[] =
     "  if (a <= 0.0) discard;\n"
     "  vec2 uv = vec2(dot(d, u_gu), dot(d, u_gv)) / u_spacing;\n"
     "  vec3 base = u_base;\n"
-    "  base = mix(base, base * 0.62, grid(uv) * 0.7);\n"
-    "  base = mix(base, base * 0.45, grid(uv / 5.0));\n"
+    "  vec2 fw = fwidth(uv);\n"
+    "  base = mix(base, base * 0.62, grid(uv, fw) * 0.7);\n"
+    "  base = mix(base, base * 0.45, grid(uv / 5.0, fw / 5.0));\n"
     "  vec3 n = dot(u_eye - v_pos, u_gn) >= 0.0 ? u_gn : -u_gn;\n"  /* the side seen */
-    "  o_col = to_srgb(lit_matte(base, n, v_pos), a);\n"
+    /* opaque: faded into the sky's colour here, so the sky is drawn last and only
+     * where nothing else is (the cheapest pixels are those never shaded) */
+    "  vec3 sky = mix(u_bottom, u_top, clamp(gl_FragCoord.y / u_height, 0.0, 1.0));\n"
+    "  o_col = vec4(mix(sky, to_srgb(lit_matte(base, n, v_pos), 1.0).rgb, a), 1.0);\n"
     "}\n";
 
 /* the sky: a vertical gradient over a full-screen triangle */
@@ -159,7 +166,7 @@ static const char bg_vs[] =
     "void main() {\n"
     "  vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);\n"
     "  v_t = p.y * 0.5 + 0.5;\n"
-    "  gl_Position = vec4(p, 0.999, 1.0);\n"
+    "  gl_Position = vec4(p, 1.0, 1.0);\n"  /* at the far plane: drawn where the depth is still clear */
     "}\n";
 
 static const char bg_fs[] =
