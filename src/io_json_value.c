@@ -187,7 +187,7 @@ int jv_get_array(rd *r, const cJSON *it, const kp *p, int64_t max, int32_t *coun
 /* an array of exactly n finite numbers */
 int jv_get_vec(rd *r, const cJSON *it, const kp *p, int n, wb_real *out)
 {
-    int32_t count;
+    int32_t count = 0;
     if (!cJSON_IsArray(it)) return jv_fail(r, it, 0, p, "array of %d numbers expected, got %s", n, jv_type_name(it));
     if (jv_get_array(r, it, p, 16, &count) || count != n)
         return jv_fail(r, it, 0, p, "array of %d numbers expected, got %d value%s", n, count, count == 1 ? "" : "s");
