@@ -1,10 +1,12 @@
 -- cloth_clothesline.lua: the reference thesis's clothesline (its Figure 12).
--- A square of cloth hangs from two pegs on a line and swings in the wind of its own
--- fall; its links stretch under its weight (drawn red once rendering lands).
+-- A square of cloth pegged to a line at its corners and middle falls, swings and
+-- comes to hang; the links stretch under its weight and are drawn red where they do.
+-- Air drag (world damping) lets it settle: --set drag=0 keeps it swinging.
 -- Run: build/wobble run scripts/cloth_clothesline.lua [--set res=40] [--set seconds=4]
+--      build/wobble run scripts/cloth_clothesline.lua --record out/clothesline.mp4
 local args = wobble.args
 local res = args.res or 30
-local w = wobble.world{ gravity = {0, -9.81, 0}, substeps = 20, iterations = 1 }
+local w = wobble.world{ gravity = {0, -9.81, 0}, substeps = 20, iterations = 1, damping = args.drag or 0.5 }
 
 -- the line: a thin capsule the cloth is pegged under
 w:collider{ shape = "capsule", a = {-1.5, 2.02, 0}, b = {1.5, 2.02, 0}, radius = 0.01 }
