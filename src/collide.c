@@ -14,8 +14,11 @@
 /* ---- quaternions ------------------------------------------------------------------- */
 void q_normalize(wb_real q[4])
 {
+    /* scaled first: components of 1e200 must not overflow to inf when squared */
+    wb_real m = fmax(fmax(fabs(q[0]), fabs(q[1])), fmax(fabs(q[2]), fabs(q[3])));
+    if (m == 0 || !isfinite(m)) { q[0] = 1; q[1] = q[2] = q[3] = 0; return; }
+    for (int i = 0; i < 4; i++) q[i] /= m;
     wb_real n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    if (n == 0) { q[0] = 1; q[1] = q[2] = q[3] = 0; return; }
     for (int i = 0; i < 4; i++) q[i] /= n;
 }
 
@@ -58,7 +61,7 @@ void q_slerp(const wb_real a[4], const wb_real b[4], wb_real t, wb_real out[4])
 
 void q_integrate(const wb_real q[4], const wb_real om[3], wb_real h, wb_real out[4])
 {
-    wb_real n = v3_len(om);
+    wb_real n = v3_len_safe(om);
     if (n == 0) { if (out != q) memcpy(out, q, 4 * sizeof(wb_real)); return; }
     /* exact rotation by |om| h about om: dq * q */
     wb_real half = n * h / 2, s = sin(half) / n;
@@ -98,7 +101,7 @@ const char *wb_collider_def_check(const wb_collider_def *d)
     switch (d->shape) {
     case WB_SHAPE_PLANE:
         if (!fin3(d->normal) || !isfinite(d->offset)) return "normal and offset must be finite";
-        if (!(v3_len(d->normal) > 1e-12)) return "normal must not be zero";
+        if (!(v3_len_safe(d->normal) > 1e-12)) return "normal must not be zero";
         break;
     case WB_SHAPE_SPHERE:
         if (!fin3(d->center)) return "center must be finite";
@@ -108,7 +111,7 @@ const char *wb_collider_def_check(const wb_collider_def *d)
         if (!fin3(d->center)) return "center must be finite";
         if (!(d->half[0] > 0 && d->half[1] > 0 && d->half[2] > 0) || !fin3(d->half)) return "half extents must be > 0";
         if (!fin3(&d->rotation[1]) || !isfinite(d->rotation[0])) return "rotation must be finite";
-        if (!(d->rotation[0] * d->rotation[0] + v3_dot(&d->rotation[1], &d->rotation[1]) > 1e-24)) return "rotation must not be zero";
+        if (!(fmax(fabs(d->rotation[0]), v3_len_safe(&d->rotation[1])) > 1e-12)) return "rotation must not be zero";
         break;
     case WB_SHAPE_CAPSULE:
         if (!fin3(d->a) || !fin3(d->b)) return "a and b must be finite";
@@ -157,7 +160,7 @@ wb_collider_id wb_collider_add(wb_world *w, const wb_collider_def *def, wb_statu
     p->q[0] = 1;
     switch (def->shape) {
     case WB_SHAPE_PLANE: {
-        wb_real n = v3_len(def->normal);
+        wb_real n = v3_len_safe(def->normal);
         v3_scale(s->n, def->normal, 1 / n);
         v3_scale(p->p, s->n, def->offset / n); /* the plane passes through its position */
         break;

@@ -22,6 +22,14 @@ static inline void v3_scale(wb_real *o, const wb_real *a, wb_real s) { o[0] = a[
 static inline void v3_madd(wb_real *o, const wb_real *a, wb_real s) { o[0] += a[0] * s; o[1] += a[1] * s; o[2] += a[2] * s; }
 static inline wb_real v3_dot(const wb_real *a, const wb_real *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 static inline wb_real v3_len(const wb_real *a) { return sqrt(v3_dot(a, a)); }
+/* |a| without overflow for huge components (1e300 squared is inf) */
+static inline wb_real v3_len_safe(const wb_real *a)
+{
+    wb_real m = fmax(fabs(a[0]), fmax(fabs(a[1]), fabs(a[2])));
+    if (m == 0 || !isfinite(m)) return m;
+    wb_real b[3] = { a[0] / m, a[1] / m, a[2] / m };
+    return m * v3_len(b);
+}
 static inline void v3_cross(wb_real *o, const wb_real *a, const wb_real *b)
 {
     wb_real x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2], z = a[0] * b[1] - a[1] * b[0];
@@ -71,6 +79,7 @@ typedef struct wb_model {
     uint32_t *c_gen;       /* (nc) odd = live */
 
     int topology_dirty;    /* colour batches must be rebuilt */
+    size_t charged;        /* bytes charged to def.memory */
 
     /* surfaces: triangles over particles, concatenated */
     int32_t nsurf, cap_surf;
@@ -117,6 +126,11 @@ typedef struct wb_cache {
     int32_t cap_c_sub;
     wb_distance_id *breaks;
     int32_t nbreaks, cap_breaks;
+    wb_real *c_save;       /* (nc x 7) collider poses at the frame's start, for undo */
+    int32_t cap_c_save;
+    wb_real h_last;        /* substep length of the last step (force readback) */
+    int (*interrupt)(void *);
+    void *interrupt_ud;
     int32_t last_contacts;
     int64_t projections;
     double step_ms, solve_ms;

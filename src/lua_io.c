@@ -155,6 +155,7 @@ static int l_load(lua_State *L)
         c->img.def = wb_world_default_def();
         if (rt && rt->threads > 0) c->img.def.threads = rt->threads;
     }
+    c->img.def.memory = &wb_rt_get(L)->memory; /* a loaded world is charged like any other */
     wbl_world *ud = (wbl_world *)lua_newuserdatauv(L, sizeof *ud, 0); /* 4 */
     ud->w = NULL;
     ud->warned = 0;

@@ -25,7 +25,6 @@ typedef struct rt_state {
     char cwd[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], lib[PATH_MAX];
     char roots[MAX_ROOTS][PATH_MAX];  /* canonical folders a script may read */
     int nroots;
-    size_t mem_used;                  /* bytes of the Lua heap */
     int mem_refused;                  /* the last growing allocation was refused */
     int mem_over;                     /* refused twice in a row: the budget is exhausted */
     int budget_hit;                   /* a budget error was raised; it is raised again at every step */
@@ -49,7 +48,7 @@ static rt_state *rt_from(lua_State *L) {
 wb_runtime *wb_rt_get(lua_State *L) {
     /* a state opened without the runtime (embedding, `require "wobble"` from lua) gets
      * permissive defaults so the binding never has to test for NULL */
-    static wb_runtime plain = { ".", "out", NULL, 1, 0, 0, -1, 0, 0 };
+    static wb_runtime plain = { ".", "out", NULL, 1, 0, 0, -1, 0, 0, { 0, 0 } };
     rt_state *rt = rt_from(L);
     return rt ? &rt->pub : &plain;
 }
@@ -67,14 +66,15 @@ static void *rt_alloc(void *ud, void *ptr, size_t osize, size_t nsize) {
     size_t old = ptr ? osize : 0;  /* for a new block osize is a type tag */
     if (nsize == 0) {
         free(ptr);
-        rt->mem_used -= old;
+        rt->pub.memory.used -= old;
         return NULL;
     }
     size_t limit = rt->pub.memory_budget;
     if (limit && nsize > old) {
         if (rt->mem_over) limit = limit > SIZE_MAX - MEM_SLACK ? SIZE_MAX : limit + MEM_SLACK;
         size_t grow = nsize - old;
-        if (grow > limit || rt->mem_used > limit - grow) {
+        /* one account for the Lua heap and every world's arrays */
+        if (grow > limit || rt->pub.memory.used > limit - grow) {
             /* Lua collects garbage and asks again once: only the second refusal is final */
             if (rt->mem_refused) rt->mem_over = 1;
             rt->mem_refused = 1;
@@ -83,7 +83,7 @@ static void *rt_alloc(void *ud, void *ptr, size_t osize, size_t nsize) {
     }
     void *p = realloc(ptr, nsize);
     if (!p) return NULL;
-    rt->mem_used = rt->mem_used - old + nsize;
+    rt->pub.memory.used = rt->pub.memory.used - old + nsize;
     if (nsize > old) rt->mem_refused = 0;
     return p;
 }
@@ -117,6 +117,23 @@ static void check_budgets(lua_State *L, rt_state *rt) {
                            rt->pub.memory_budget / 1048576.0);
     if (rt->pub.time_budget > 0 && now() - rt->t0 > rt->pub.time_budget)
         wb_rt_budget_error(L, "time limit of %g s exceeded (--time-limit SECONDS)", rt->pub.time_budget);
+}
+
+void wb_rt_check_budgets(lua_State *L) {
+    rt_state *rt = rt_from(L);
+    if (rt) check_budgets(L, rt);
+}
+
+/* called from inside a step, outside Lua: reads the clock and flags only */
+static int rt_interrupt(void *ud) {
+    const rt_state *rt = ud;
+    return rt->budget_hit || rt->mem_over || (rt->pub.time_budget > 0 && now() - rt->t0 > rt->pub.time_budget);
+}
+
+void wb_rt_interrupt(lua_State *L, int (**fn)(void *), void **ud) {
+    rt_state *rt = rt_from(L);
+    *fn = rt ? rt_interrupt : NULL;
+    *ud = rt;
 }
 
 static void rt_hook(lua_State *L, lua_Debug *ar) {
@@ -632,6 +649,8 @@ lua_State *wb_rt_open(const wb_runtime *cfg) {
     char full[PATH_MAX];
     if (!rt) return NULL;
     rt->pub = *cfg;
+    rt->pub.memory.limit = cfg->memory_budget;
+    rt->pub.memory.used = 0;
     const char *lib = cfg->lib_dir ? cfg->lib_dir : wb_rt_lib_dir();
     const char *root = wb_rt_project_root();
     if (!getcwd(rt->cwd, sizeof rt->cwd) ||
@@ -677,7 +696,7 @@ void wb_rt_close(lua_State *L) {
     if (!L) return;
     rt_state *rt = rt_from(L);
     lua_sethook(L, NULL, 0, 0);          /* finalizers must run, budget or not */
-    if (rt) rt->pub.memory_budget = 0;
+    if (rt) rt->pub.memory_budget = rt->pub.memory.limit = 0;
     lua_close(L);
     free(rt);
 }

@@ -318,6 +318,22 @@ int wbl_status_error(lua_State *L, int arg, wb_status st, const char *what)
     }
 }
 
+/* ---- stepping ---------------------------------------------------------------------------- */
+void wbl_step(lua_State *L, wb_world *w)
+{
+    int (*fn)(void *);
+    void *ud;
+    wb_rt_interrupt(L, &fn, &ud);
+    wb_world_set_interrupt(w, fn, ud);
+    wb_status st = wb_world_step(w);
+    wb_world_set_interrupt(w, NULL, NULL); /* the runtime may be gone before the world is */
+    if (st == WB_ERR_INTERRUPTED) {
+        wb_rt_check_budgets(L);
+        luaL_error(L, "step interrupted"); /* (a budget was spent: not reached) */
+    }
+    if (st == WB_ERR_NOMEM) wb_rt_budget_error(L, "out of memory stepping the world");
+}
+
 /* ---- after a frame -------------------------------------------------------------------- */
 void wbl_after_frame(lua_State *L, int world_index)
 {

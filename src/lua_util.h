@@ -35,6 +35,9 @@ void wbl_add_world_methods(lua_State *L, const luaL_Reg *l);
 /* ---- the world --------------------------------------------------------------- */
 wbl_world *wbl_checkworld_ud(lua_State *L, int arg);  /* open or closed */
 wb_world *wbl_checkworld(lua_State *L, int arg);      /* raises when closed */
+/* one frame of w, stoppable by the runtime's budgets (a spent budget raises its
+ * error; the frame is then undone) */
+void wbl_step(lua_State *L, wb_world *w);
 /* after each frame: report the first warning once, then the runtime's frame hook */
 void wbl_after_frame(lua_State *L, int world_index);
 

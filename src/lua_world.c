@@ -60,8 +60,8 @@ int wbl_world_new(lua_State *L)
     /* --threads on the command line is the default a script can still override */
     wb_runtime *rt = wb_rt_get(L);
     if (rt && rt->threads > 0) d.threads = rt->threads;
-    /* the world's arrays live outside the Lua heap: give them the same budget */
-    if (rt) d.memory_limit = rt->memory_budget;
+    /* the world's arrays live outside the Lua heap: charge them to the same budget */
+    if (rt) d.memory = &rt->memory;
     if (!lua_isnoneornil(L, 1)) read_world_def(L, 1, &d);
     const char *err = wb_world_def_check(&d);
     if (err) return luaL_argerror(L, 1, err);
@@ -248,7 +248,7 @@ static int w_pinned(lua_State *L)
 /* ---- stepping ------------------------------------------------------------------------ */
 static int w_step(lua_State *L)
 {
-    wb_world_step(toworld(L));
+    wbl_step(L, toworld(L));
     wbl_after_frame(L, 1);
     return 0;
 }
@@ -288,7 +288,7 @@ static int run_loop(lua_State *L, int status, lua_KContext ctx)
     if (status == LUA_YIELD && run_stops(L)) goto done; /* resumed after on_frame yielded */
     while (r->done < r->n) {
         wb_world *w = toworld(L); /* on_frame may have closed it */
-        wb_world_step(w);
+        wbl_step(L, w);
         r->done++;
         wbl_after_frame(L, 1);
         wbl_plot_frame(L, 5, 1);

@@ -103,6 +103,8 @@ uint64_t wb_world_hash(const wb_world *w)
     h = fnv(h, s->x, sizeof(wb_real) * 3 * (size_t)m->np);
     h = fnv(h, s->v, sizeof(wb_real) * 3 * (size_t)m->np);
     h = fnv(h, m->pinned, (size_t)m->np);
+    h = fnv(h, m->inv_mass, sizeof(wb_real) * (size_t)m->np);
+    h = fnv(h, m->radius, sizeof(wb_real) * (size_t)m->np);
     for (int32_t i = 0; i < m->nd; i++) {
         if (!(m->d_gen[i] & 1u)) continue;
         h = fnv(h, &s->d_rest[i], sizeof s->d_rest[i]);
@@ -110,8 +112,7 @@ uint64_t wb_world_hash(const wb_world *w)
     }
     for (int32_t c = 0; c < m->nc; c++) {
         if (!(m->c_gen[c] & 1u)) continue;
-        h = fnv(h, s->c_pose[c].p, sizeof s->c_pose[c].p);
-        h = fnv(h, s->c_pose[c].q, sizeof s->c_pose[c].q);
+        h = fnv(h, &s->c_pose[c], sizeof s->c_pose[c]); /* pose, sweep start, velocities */
     }
     h = fnv(h, &s->time, sizeof s->time);
     h = fnv(h, &s->frame, sizeof s->frame);

@@ -183,32 +183,77 @@ static void plasticity_and_breaking(wb_world *w)
     }
 }
 
-/* non-finite values never propagate: restore the frame's start and report. Returns 1
- * when the frame was finite. Time still advances: kinematic colliders keep their
- * script's schedule. */
+/* put the particles back as they were at the frame's start; the multipliers of the
+ * abandoned frame mean nothing (and may be NaN): force() reads 0 until the next step */
+static void undo_particles(wb_world *w)
+{
+    const size_t n = 3 * (size_t)w->m.np;
+    if (n > 0) {
+        memcpy(w->s.x, w->k.x_save, sizeof(wb_real) * n);
+        memcpy(w->s.x_prev, w->k.x_save, sizeof(wb_real) * n);
+        memcpy(w->s.v, w->k.v_save, sizeof(wb_real) * n);
+    }
+    if (w->k.ns > 0) memset(w->k.s_lambda, 0, sizeof(wb_real) * (size_t)w->k.ns);
+}
+
+/* the colliders' poses at the frame's start, before their velocities move them */
+static int save_colliders(wb_world *w)
+{
+    wb_cache *k = &w->k;
+    wb_real *c = wb__grow(k->c_save, &k->cap_c_save, 7 * (w->m.nc > 0 ? w->m.nc : 1), sizeof *c);
+    if (!c) return 0;
+    k->c_save = c;
+    for (int32_t i = 0; i < w->m.nc; i++) {
+        v3_copy(&c[7 * i], w->s.c_pose[i].p);
+        memcpy(&c[7 * i + 3], w->s.c_pose[i].q, 4 * sizeof(wb_real));
+    }
+    return 1;
+}
+
+static void restore_collider(wb_world *w, int32_t i)
+{
+    wb_collider_pose *cp = &w->s.c_pose[i];
+    v3_copy(cp->p, &w->k.c_save[7 * i]);
+    memcpy(cp->q, &w->k.c_save[7 * i + 3], 4 * sizeof(wb_real));
+}
+
+/* non-finite values never propagate: a particle gone non-finite undoes the frame's
+ * particles; a collider driven to a non-finite pose (absurd velocities) goes back and
+ * stops. Returns 1 when the particles were finite. Time still advances: kinematic
+ * colliders keep their script's schedule. */
 static int check_finite(wb_world *w)
 {
+    for (int32_t c = 0; c < w->m.nc; c++) {
+        wb_collider_pose *cp = &w->s.c_pose[c];
+        if (!(w->m.c_gen[c] & 1u)) continue;
+        if (isfinite(cp->p[0]) && isfinite(cp->p[1]) && isfinite(cp->p[2]) && isfinite(cp->q[0]) &&
+            isfinite(cp->q[1]) && isfinite(cp->q[2]) && isfinite(cp->q[3]))
+            continue;
+        wb__warn(w, "frame %lld: collider %d moved to a non-finite pose; it was put back and its "
+                    "velocities set to zero", (long long)w->s.frame + 1, c + 1);
+        restore_collider(w, c);
+        v3_set(cp->v, 0, 0, 0);
+        v3_set(cp->om, 0, 0, 0);
+    }
     const int32_t n = 3 * w->m.np;
     const wb_real *x = w->s.x, *v = w->s.v;
     for (int32_t i = 0; i < n; i++) {
         if (isfinite(x[i]) && isfinite(v[i])) continue;
         wb__warn(w, "frame %lld: particle %d became non-finite; its frame was undone (reduce dt, "
                     "raise substeps or compliance)", (long long)w->s.frame + 1, i / 3 + 1);
-        memcpy(w->s.x, w->k.x_save, sizeof(wb_real) * (size_t)n);
-        memcpy(w->s.x_prev, w->k.x_save, sizeof(wb_real) * (size_t)n);
-        memcpy(w->s.v, w->k.v_save, sizeof(wb_real) * (size_t)n);
+        undo_particles(w);
         return 0;
     }
     return 1;
 }
 
-void wb_world_step(wb_world *w)
+wb_status wb_world_step(wb_world *w)
 {
     const double t_begin = now_ms();
     wb_cache *k = &w->k;
-    if (wb__colour(w) != WB_OK) {
-        wb__warn(w, "frame %lld: out of memory colouring the constraints; frame skipped", (long long)w->s.frame);
-        return;
+    if (wb__colour(w) != WB_OK || !save_colliders(w)) {
+        wb__warn(w, "frame %lld: out of memory preparing the step; frame skipped", (long long)w->s.frame + 1);
+        return WB_ERR_NOMEM;
     }
     const wb_world_def *d = &w->m.def;
     const wb_real dt = d->dt, h = dt / d->substeps;
@@ -219,6 +264,7 @@ void wb_world_step(wb_world *w)
     }
     k->nbreaks = 0;
     k->projections = 0;
+    k->h_last = h;
 
     /* kinematic colliders: where the script's velocities take them by the frame's end */
     for (int32_t c = 0; c < w->m.nc; c++) {
@@ -230,6 +276,13 @@ void wb_world_step(wb_world *w)
 
     double solve = 0;
     for (int sub = 0; sub < d->substeps; sub++) {
+        if (k->interrupt && k->interrupt(k->interrupt_ud)) {
+            /* abandoned: the world is left as the frame found it */
+            undo_particles(w);
+            for (int32_t c = 0; c < w->m.nc; c++) restore_collider(w, c);
+            k->step_ms = now_ms() - t_begin;
+            return WB_ERR_INTERRUPTED;
+        }
         predict(w, h);
         double t0 = now_ms();
         if (k->ns > 0) memset(k->s_lambda, 0, sizeof(wb_real) * (size_t)k->ns);
@@ -238,15 +291,16 @@ void wb_world_step(wb_world *w)
         wb__collide_and_update(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
     }
 
+    /* a frame gone non-finite is undone before it can bend or break anything */
+    if (check_finite(w)) plasticity_and_breaking(w);
     for (int32_t c = 0; c < w->m.nc; c++) {
         wb_collider_pose *cp = &w->s.c_pose[c];
         v3_copy(cp->p0, cp->p);
         memcpy(cp->q0, cp->q, sizeof cp->q);
     }
-    /* a frame gone non-finite is undone before it can bend or break anything */
-    if (check_finite(w)) plasticity_and_breaking(w);
     w->s.frame++;
     w->s.time += dt;
     k->solve_ms = solve;
     k->step_ms = now_ms() - t_begin;
+    return WB_OK;
 }

@@ -40,6 +40,7 @@ typedef enum wb_status {
     WB_ERR_NOMEM = -1,     /* allocation failed */
     WB_ERR_LIMIT = -2,     /* a WB_MAX_* limit would be exceeded */
     WB_ERR_ARG = -3,       /* an argument is out of its range (see wb_last_error) */
+    WB_ERR_INTERRUPTED = -4, /* the interrupt callback stopped a step: the frame was undone */
 } wb_status;
 
 typedef enum wb_solver { WB_SOLVER_GAUSS_SEIDEL = 0, WB_SOLVER_JACOBI = 1 } wb_solver;
@@ -49,6 +50,11 @@ typedef enum wb_shape {
 } wb_shape;
 
 typedef struct wb_world wb_world;
+
+/* A memory budget several worlds share (and, in the command line, the Lua heap): each
+ * world charges its particle and constraint arrays to it and gives them back when
+ * destroyed; growth past `limit` (0 = none) fails with WB_ERR_NOMEM. */
+typedef struct wb_memory { size_t limit, used; } wb_memory;
 
 /* handles: index into the world's slot array + generation (0 never valid) */
 typedef struct wb_distance_id { uint32_t index; uint32_t gen; } wb_distance_id;
@@ -64,7 +70,7 @@ typedef struct wb_world_def {
     wb_solver solver;     /* default Gauss-Seidel */
     wb_real relaxation;   /* Jacobi over-relaxation factor omega, default 1 */
     int threads;          /* default 1; results are bit-identical for any value */
-    size_t memory_limit;  /* bytes the particle and constraint arrays may take; 0 = no limit */
+    wb_memory *memory;    /* budget the world's arrays are charged to; NULL = none (not copied by set_def) */
 } wb_world_def;
 
 wb_world_def wb_world_default_def(void);                      /* the defaults above */
@@ -74,12 +80,16 @@ void wb_world_destroy(wb_world *w);                           /* NULL is fine */
 wb_world_def wb_world_get_def(const wb_world *w);             /* current settings */
 wb_status wb_world_set_def(wb_world *w, const wb_world_def *def); /* change settings between steps */
 
-void wb_world_step(wb_world *w);                              /* one frame of dt, all substeps */
+wb_status wb_world_step(wb_world *w);                         /* one frame of dt, all substeps */
+/* polled once per substep; a nonzero answer abandons the step (WB_ERR_INTERRUPTED),
+ * leaving the world as it was before it: a time budget can stop a long frame */
+void wb_world_set_interrupt(wb_world *w, int (*fn)(void *ud), void *ud);
 double wb_world_time(const wb_world *w);                      /* seconds simulated */
 int64_t wb_world_frame(const wb_world *w);                    /* frames stepped */
 
 /* ---- particles ------------------------------------------------------------- */
-/* add a particle; mass 0 makes it immovable. Returns its id, or a negative wb_status */
+/* add a particle; mass 0 makes it immovable. Returns its id, or a negative wb_status
+ * (WB_ERR_ARG for a mass so small that 1/mass overflows) */
 int32_t wb_particle_add(wb_world *w, const wb_real pos[3], const wb_real vel[3], wb_real mass, wb_real radius);
 int32_t wb_particle_count(const wb_world *w);
 void wb_particle_position(const wb_world *w, int32_t p, wb_real out[3]);

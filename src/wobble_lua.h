@@ -23,7 +23,8 @@ typedef struct wb_runtime {
     int threads;               /* --threads N, 0 when not given */
     int64_t frame_cap;         /* --frames N: w:run stops after N frames; -1 = none */
     double time_budget;        /* seconds of wall time; 0 = none */
-    size_t memory_budget;      /* bytes the Lua heap may use; 0 = none */
+    size_t memory_budget;      /* bytes the Lua heap and the worlds' arrays may use together; 0 = none */
+    wb_memory memory;          /* that budget's account: worlds are charged to it (wb_world_def.memory) */
 } wb_runtime;
 
 wb_runtime *wb_rt_get(lua_State *L);   /* the runtime of this state (never NULL after wb_rt_open) */
@@ -33,6 +34,14 @@ wb_runtime *wb_rt_get(lua_State *L);   /* the runtime of this state (never NULL 
  * (only under the output folder; a relative path is taken inside it; parent folders
  * are created). Returns buf, or NULL with *err set to a message naming the path. */
 const char *wb_rt_path(lua_State *L, const char *path, int write, char *buf, size_t n, const char **err);
+
+/* the interrupt a world polls once per substep (wb_world_set_interrupt): it answers
+ * true once a budget of this state is spent, so a long step cannot outrun
+ * --time-limit. *fn is NULL for a state opened without the runtime. */
+void wb_rt_interrupt(lua_State *L, int (**fn)(void *), void **ud);
+
+/* raise the budget error that is due (time or memory), if any */
+void wb_rt_check_budgets(lua_State *L);
 
 /* raise a budget error: the command line exits with code 3 (DESIGN §4) */
 int wb_rt_budget_error(lua_State *L, const char *fmt, ...);

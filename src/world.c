@@ -86,13 +86,14 @@ void wb_world_destroy(wb_world *w)
 {
     if (!w) return;
     wb_model *m = &w->m;
+    if (m->def.memory) m->def.memory->used -= m->charged;
     wb_state *s = &w->s;
     wb_cache *k = &w->k;
     void *ptrs[] = { m->inv_mass, m->w, m->radius, m->pinned, m->d_ij, m->d_alpha, m->d_beta,
                      m->d_yield, m->d_creep, m->d_break, m->d_gen, m->d_free, m->c_shape, m->c_gen, m->surf_start, m->tri,
                      s->x, s->x_prev, s->v, s->d_rest, s->d_broken, s->c_pose,
                      k->colour_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda, k->s_jac,
-                     k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->c_sub,
+                     k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->c_sub, k->c_save,
                      k->breaks };
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
     free(w);
@@ -104,11 +105,19 @@ wb_status wb_world_set_def(wb_world *w, const wb_world_def *def)
 {
     const char *err = wb_world_def_check(def);
     if (err) { wb__set_error("%s", err); return WB_ERR_ARG; }
+    wb_memory *mem = w->m.def.memory; /* charged to it: a world keeps its budget */
     w->m.def = *def;
+    w->m.def.memory = mem;
     return WB_OK;
 }
 
 double wb_world_time(const wb_world *w) { return w->s.time; }
+
+void wb_world_set_interrupt(wb_world *w, int (*fn)(void *ud), void *ud)
+{
+    w->k.interrupt = fn;
+    w->k.interrupt_ud = ud;
+}
 int64_t wb_world_frame(const wb_world *w) { return w->s.frame; }
 
 /* ---- particles ------------------------------------------------------------------- */
@@ -117,10 +126,18 @@ int64_t wb_world_frame(const wb_world *w) { return w->s.frame; }
 #define PARTICLE_BYTES (21 * sizeof(wb_real) + 5 + 8)
 #define CONSTRAINT_BYTES (10 * sizeof(wb_real) + 33)
 
-static int over_limit(const wb_world *w, int64_t cap_p, int64_t cap_d)
+/* charge the arrays at capacities (cap_p, cap_d) to the budget; 0 when it would pass
+ * the limit (nothing charged then) */
+static int charge(wb_world *w, int64_t cap_p, int64_t cap_d)
 {
-    const size_t lim = w->m.def.memory_limit;
-    return lim > 0 && (double)cap_p * PARTICLE_BYTES + (double)cap_d * CONSTRAINT_BYTES > (double)lim;
+    wb_memory *mem = w->m.def.memory;
+    if (!mem) return 1;
+    const double want = (double)cap_p * PARTICLE_BYTES + (double)cap_d * CONSTRAINT_BYTES;
+    const double used = (double)mem->used - (double)w->m.charged + want;
+    if (mem->limit > 0 && used > (double)mem->limit) return 0;
+    mem->used = (size_t)used;
+    w->m.charged = (size_t)want;
+    return 1;
 }
 
 /* every per-particle array grows together; on failure nothing is lost */
@@ -131,8 +148,10 @@ static wb_status grow_particles(wb_world *w, int32_t need)
     if (need > WB_MAX_PARTICLES) return WB_ERR_LIMIT;
     int32_t cap = m->cap_p ? m->cap_p : 64;
     while (cap < need) cap = cap > WB_MAX_PARTICLES / 2 ? WB_MAX_PARTICLES : cap * 2;
-    if (over_limit(w, need, m->cap_d)) return WB_ERR_NOMEM;
-    if (over_limit(w, cap, m->cap_d)) cap = need; /* exact fit when doubling would cross the limit */
+    if (!charge(w, cap, m->cap_d)) {
+        cap = need; /* exact fit when doubling would cross the limit */
+        if (!charge(w, cap, m->cap_d)) return WB_ERR_NOMEM;
+    }
     struct { void **p; size_t elem; } arr[] = {
         { (void **)&m->inv_mass, sizeof(wb_real) }, { (void **)&m->w, sizeof(wb_real) },
         { (void **)&m->radius, sizeof(wb_real) }, { (void **)&m->pinned, 1 },
@@ -153,6 +172,10 @@ static wb_status grow_particles(wb_world *w, int32_t need)
 int32_t wb_particle_add(wb_world *w, const wb_real pos[3], const wb_real vel[3], wb_real mass, wb_real radius)
 {
     assert(finite3(pos) && (!vel || finite3(vel)) && mass >= 0 && radius >= 0);
+    if (mass > 0 && !isfinite(1 / mass)) {
+        wb__set_error("mass %g is too small (its inverse overflows)", (double)mass);
+        return WB_ERR_ARG;
+    }
     wb_model *m = &w->m;
     wb_status st = grow_particles(w, m->np + 1);
     if (st != WB_OK) return st;
@@ -238,8 +261,10 @@ static wb_status grow_distances(wb_world *w, int32_t need)
     if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     int32_t cap = m->cap_d ? m->cap_d : 64;
     while (cap < need) cap = cap > WB_MAX_CONSTRAINTS / 2 ? WB_MAX_CONSTRAINTS : cap * 2;
-    if (over_limit(w, m->cap_p, need)) return WB_ERR_NOMEM;
-    if (over_limit(w, m->cap_p, cap)) cap = need;
+    if (!charge(w, m->cap_p, cap)) {
+        cap = need;
+        if (!charge(w, m->cap_p, cap)) return WB_ERR_NOMEM;
+    }
     struct { void **p; size_t elem; } arr[] = {
         { (void **)&m->d_ij, 2 * sizeof(int32_t) }, { (void **)&m->d_alpha, sizeof(wb_real) },
         { (void **)&m->d_beta, sizeof(wb_real) }, { (void **)&m->d_yield, sizeof(wb_real) },
@@ -332,7 +357,7 @@ wb_real wb_distance_force(const wb_world *w, wb_distance_id c)
     int32_t s = SLOT(w, c);
     int32_t k = w->k.slot_pack[s];
     if (k < 0 || k >= w->k.ns) return 0; /* not stepped since it was made */
-    wb_real h = w->m.def.dt / w->m.def.substeps;
+    const wb_real h = w->k.h_last; /* of the step that made lambda, whatever dt is now */
     return fabs(w->k.s_lambda[k]) / (h * h);
 }
 

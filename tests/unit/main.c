@@ -39,7 +39,7 @@
     X(determinism_threads_gauss_seidel)          \
     X(determinism_threads_jacobi)                \
     X(nan_recovery_huge_velocity)                \
-    X(nan_recovery_subnormal_mass)               \
+    X(subnormal_mass_refused)               \
     X(xpbd_static_force_balance)                 \
     X(world_damping_keeps_static_equilibrium)    \
     X(world_damping_terminal_velocity)           \
@@ -58,7 +58,14 @@
     X(skin_rigid_motion_is_rigid)                \
     X(skin_follows_simulation)                   \
     X(skin_bad_definitions)                      \
-    X(world_step_empty)
+    X(world_step_empty)                          \
+    X(step_interrupt_leaves_world_unchanged)     \
+    X(force_reads_the_step_that_made_it)         \
+    X(force_zero_after_an_undone_frame)          \
+    X(collider_huge_inputs_normalised)           \
+    X(collider_absurd_velocity_recovers)         \
+    X(hash_covers_collider_velocity_mass_radius) \
+    X(memory_budget_shared_by_worlds)
 
 #define DECLARE(name) TEST(name);
 #define ENTRY(name) { #name, test_##name },
