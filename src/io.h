@@ -54,10 +54,13 @@ typedef struct wbio_mesh_opts {
     wb_real scale;         /* multiplies every coordinate */
     bool weld;             /* merge vertices by position */
     wb_real tol;           /* their distance; < 0: 1e-6 of the bounds' diagonal */
+    double timeout;        /* seconds for the import (a child process); 0: $WOBBLE_IMPORT_TIMEOUT or 60 */
 } wbio_mesh_opts;
 
 /* any format assimp reads, triangulated, node transforms applied, all meshes of the file
- * merged, welded, normals recomputed. NULL with a message on a missing, empty or corrupt file */
+ * merged, welded, normals recomputed. NULL with a message on a missing, empty or corrupt file.
+ * assimp runs in a forked child: a file that crashes or hangs it is "the importer failed
+ * (crashed|timed out ...)", never the caller's crash */
 wb_mesh *wbio_load_mesh(const char *path, const char *shown, const wbio_mesh_opts *o,
                         wbio_allow_fn allow, void *ud, char *err, size_t errn);
 /* by extension: .obj and .ply written here (vertex order kept, as Blender's Mesh Cache

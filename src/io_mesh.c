@@ -17,7 +17,12 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <poll.h>
+#include <signal.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "io.h"
 
@@ -81,6 +86,16 @@ static void f_close(struct aiFileIO *io, struct aiFile *f)
 }
 
 /* ---- reading --------------------------------------------------------------------------------- */
+/* assimp 5.2 is not safe on damaged input: a PLY cut in its header loops forever, one cut in
+ * its body trips an ai_assert (abort), fuzzed binary PLY and Collada files segfault. So the
+ * import runs in a child process that sends the bare arrays back over a pipe; the parent
+ * waits with a wall-clock limit and turns a crash, an abort or a hang into an error. */
+typedef struct import_head {
+    int32_t ok;            /* 1: nv, nt and the arrays follow; 0: a message of len bytes */
+    int32_t len;
+    int64_t nv, nt;
+} import_head;
+
 static void count_scene(const struct aiScene *sc, int64_t *nv, int64_t *nt)
 {
     *nv = *nt = 0;
@@ -92,13 +107,28 @@ static void count_scene(const struct aiScene *sc, int64_t *nv, int64_t *nt)
     }
 }
 
-wb_mesh *wbio_load_mesh(const char *path, const char *shown, const wbio_mesh_opts *o,
-                        wbio_allow_fn allow, void *ud, char *err, size_t errn)
+static int write_all(int fd, const void *buf, size_t n)
 {
-    struct stat st;
-    if (stat(path, &st) != 0) { snprintf(err, errn, "%s: %s", shown, strerror(errno)); return NULL; }
-    if (S_ISDIR(st.st_mode)) { snprintf(err, errn, "%s: is a folder, not a file", shown); return NULL; }
-    if (st.st_size == 0) { snprintf(err, errn, "%s: empty file", shown); return NULL; }
+    const char *p = buf;
+    while (n > 0) {
+        ssize_t k = write(fd, p, n);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) return -1;
+        p += k;
+        n -= (size_t)k;
+    }
+    return 0;
+}
+
+static void child_fail(int fd, const char *why)
+{
+    import_head h = { 0, (int32_t)strlen(why), 0, 0 };
+    if (write_all(fd, &h, sizeof h) == 0) write_all(fd, why, (size_t)h.len);
+}
+
+/* the child's whole work: import, flatten every triangle mesh into one pair of arrays */
+static void child_import(int fd, const char *path, wbio_allow_fn allow, void *ud)
+{
     guard g = { allow, ud, "" };
     struct aiFileIO io = { f_open, f_close, (aiUserData)&g };
     const unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType |
@@ -108,31 +138,35 @@ wb_mesh *wbio_load_mesh(const char *path, const char *shown, const wbio_mesh_opt
         const char *why = g.refused[0] ? g.refused : aiGetErrorString();
         /* assimp's validator words a file without meshes as a broken scene */
         if (!g.refused[0] && why && strstr(why, "mNumMeshes is 0")) why = "no triangles in this file";
-        snprintf(err, errn, "%s: %s", shown, why && *why ? why : "cannot read this file");
-        return NULL;
+        child_fail(fd, why && *why ? why : "cannot read this file");
+        return;
     }
     int64_t nv, nt;
     count_scene(sc, &nv, &nt);
     if ((sc->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || nt == 0) {
-        snprintf(err, errn, "%s: no triangles in this file", shown);
-        aiReleaseImport(sc);
-        return NULL;
+        child_fail(fd, "no triangles in this file");
+        return;
     }
     if (nv > WB_MAX_PARTICLES || nt > WB_MAX_CONSTRAINTS) {
-        snprintf(err, errn, "%s: too large (%lld vertices, %lld triangles)", shown, (long long)nv, (long long)nt);
-        aiReleaseImport(sc);
-        return NULL;
+        char why[128];
+        snprintf(why, sizeof why, "too large (%lld vertices, %lld triangles)", (long long)nv, (long long)nt);
+        child_fail(fd, why);
+        return;
     }
     wb_real *v = malloc(sizeof *v * 3 * (size_t)nv);
     int32_t *tri = malloc(sizeof *tri * 3 * (size_t)nt);
+    if (!v || !tri) {
+        child_fail(fd, "out of memory");
+        return;
+    }
     int32_t base = 0, t = 0;
-    for (unsigned i = 0; v && tri && i < sc->mNumMeshes; i++) {
+    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
         const struct aiMesh *m = sc->mMeshes[i];
         if (!(m->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
         for (unsigned k = 0; k < m->mNumVertices; k++) {
-            v[3 * (base + k)] = (wb_real)m->mVertices[k].x * o->scale;
-            v[3 * (base + k) + 1] = (wb_real)m->mVertices[k].y * o->scale;
-            v[3 * (base + k) + 2] = (wb_real)m->mVertices[k].z * o->scale;
+            v[3 * (base + k)] = (wb_real)m->mVertices[k].x;
+            v[3 * (base + k) + 1] = (wb_real)m->mVertices[k].y;
+            v[3 * (base + k) + 2] = (wb_real)m->mVertices[k].z;
         }
         for (unsigned f = 0; f < m->mNumFaces; f++) {
             const struct aiFace *fc = &m->mFaces[f];
@@ -142,9 +176,151 @@ wb_mesh *wbio_load_mesh(const char *path, const char *shown, const wbio_mesh_opt
         }
         base += (int32_t)m->mNumVertices;
     }
-    aiReleaseImport(sc);
+    import_head h = { 1, 0, nv, t };
+    if (write_all(fd, &h, sizeof h) == 0 && write_all(fd, v, sizeof *v * 3 * (size_t)nv) == 0)
+        write_all(fd, tri, sizeof *tri * 3 * (size_t)t);
+    /* no aiReleaseImport or free: the process ends now */
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* read n bytes before the deadline: 0, -1 end of file or error, -2 time is up */
+static int read_all(int fd, void *buf, size_t n, double deadline)
+{
+    char *p = buf;
+    while (n > 0) {
+        double left = deadline - now_s();
+        if (left <= 0) return -2;
+        struct pollfd pf = { fd, POLLIN, 0 };
+        int r = poll(&pf, 1, left > 1e6 ? 1000000000 : (int)(left * 1000) + 1);
+        if (r < 0 && errno == EINTR) continue;
+        if (r < 0) return -1;
+        if (r == 0) continue;
+        ssize_t k = read(fd, p, n);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) return -1;
+        p += k;
+        n -= (size_t)k;
+    }
+    return 0;
+}
+
+static double import_timeout(const wbio_mesh_opts *o)
+{
+    if (o->timeout > 0) return o->timeout;
+    const char *t = getenv("WOBBLE_IMPORT_TIMEOUT");
+    return t && atof(t) > 0 ? atof(t) : 60;
+}
+
+/* run the import in a child; arrays (malloc'd) or a message in why */
+static int import_isolated(const char *path, const wbio_mesh_opts *o, wbio_allow_fn allow, void *ud,
+                           wb_real **v, int64_t *nv, int32_t **tri, int64_t *nt, char *why, size_t whyn)
+{
+    *v = NULL;
+    *tri = NULL;
+    int fds[2];
+    if (pipe(fds) != 0) { snprintf(why, whyn, "cannot start the importer: %s", strerror(errno)); return -1; }
+    fflush(NULL);   /* the child must not write the parent's buffered output a second time */
+    pid_t pid = fork();
+    if (pid < 0) {
+        snprintf(why, whyn, "cannot start the importer: %s", strerror(errno));
+        close(fds[0]);
+        close(fds[1]);
+        return -1;
+    }
+    if (pid == 0) {
+        close(fds[0]);
+        signal(SIGPIPE, SIG_DFL);
+        child_import(fds[1], path, allow, ud);
+        _exit(0);   /* no atexit handlers: they belong to the parent (Lua, the renderer) */
+    }
+    close(fds[1]);
+    const double deadline = now_s() + import_timeout(o);
+    import_head h;
+    int r = read_all(fds[0], &h, sizeof h, deadline);
+    if (r == 0 && h.ok == 1) {
+        if (h.nv < 1 || h.nt < 1 || h.nv > WB_MAX_PARTICLES || h.nt > WB_MAX_CONSTRAINTS) r = -1;
+        else {
+            *v = malloc(sizeof **v * 3 * (size_t)h.nv);
+            *tri = malloc(sizeof **tri * 3 * (size_t)h.nt);
+            if (!*v || !*tri) r = -3;
+            else if ((r = read_all(fds[0], *v, sizeof **v * 3 * (size_t)h.nv, deadline)) == 0)
+                r = read_all(fds[0], *tri, sizeof **tri * 3 * (size_t)h.nt, deadline);
+        }
+        *nv = h.nv;
+        *nt = h.nt;
+    } else if (r == 0) {
+        char msg[512];
+        size_t len = h.len < 0 ? 0 : (size_t)h.len < sizeof msg - 1 ? (size_t)h.len : sizeof msg - 1;
+        if ((r = read_all(fds[0], msg, len, deadline)) == 0) {
+            msg[len] = 0;
+            snprintf(why, whyn, "%s", msg);
+            r = -4;
+        }
+    }
+    if (r == -2 || r == -3) kill(pid, SIGKILL);
+    close(fds[0]);
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
+    if (r == 0) return 0;
+    free(*v);
+    free(*tri);
+    *v = NULL;
+    *tri = NULL;
+    if (r == -2) snprintf(why, whyn, "the importer failed (timed out after %g s)", import_timeout(o));
+    else if (r == -3) snprintf(why, whyn, "out of memory");
+    else if (r == -1) snprintf(why, whyn, "the importer failed (crashed%s%s)",
+                               WIFSIGNALED(status) ? ": " : "", WIFSIGNALED(status) ? strsignal(WTERMSIG(status)) : "");
+    return -1;
+}
+
+/* a PLY cut inside its header sends assimp into an endless loop: caught here at once
+ * rather than after the importer's timeout. 1 when the file is a PLY without end_header */
+static int ply_header_cut(const char *path)
+{
+    enum { HEAD = 65536 };   /* far more than any real header */
+    FILE *f = fopen(path, "rb");
+    char *buf = f ? malloc(HEAD) : NULL;
+    if (!buf) {
+        if (f) fclose(f);
+        return 0;
+    }
+    size_t n = fread(buf, 1, HEAD, f);
+    fclose(f);
+    int cut = n >= 4 && memcmp(buf, "ply", 3) == 0 && (buf[3] == '\n' || buf[3] == '\r') &&
+              memmem(buf, n, "end_header", 10) == NULL;
+    free(buf);
+    return cut;
+}
+
+wb_mesh *wbio_load_mesh(const char *path, const char *shown, const wbio_mesh_opts *o,
+                        wbio_allow_fn allow, void *ud, char *err, size_t errn)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) { snprintf(err, errn, "%s: %s", shown, strerror(errno)); return NULL; }
+    if (S_ISDIR(st.st_mode)) { snprintf(err, errn, "%s: is a folder, not a file", shown); return NULL; }
+    if (st.st_size == 0) { snprintf(err, errn, "%s: empty file", shown); return NULL; }
+    if (allow) {
+        char why[512];
+        if (!allow(ud, path, 0, why, sizeof why)) { snprintf(err, errn, "%s: %s", shown, why); return NULL; }
+    }
+    if (ply_header_cut(path)) { snprintf(err, errn, "%s: PLY header without end_header (a cut file?)", shown); return NULL; }
+    wb_real *v;
+    int32_t *tri;
+    int64_t nv, nt;
+    char why[512];
+    if (import_isolated(path, o, allow, ud, &v, &nv, &tri, &nt, why, sizeof why) != 0) {
+        snprintf(err, errn, "%s: %s", shown, why);
+        return NULL;
+    }
+    for (int64_t i = 0; i < 3 * nv; i++) v[i] *= o->scale;
     wb_status status = WB_ERR_NOMEM;
-    wb_mesh *mesh = v && tri ? wb_mesh_create(v, (int32_t)nv, tri, t, &status) : NULL;
+    wb_mesh *mesh = wb_mesh_create(v, (int32_t)nv, tri, (int32_t)nt, &status);
     free(v);
     free(tri);
     if (mesh && o->weld) {

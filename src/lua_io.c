@@ -70,7 +70,7 @@ static const char *load_skin_meshes(lua_State *L, const char *config_path, const
         else snprintf(rel, sizeof rel, "%.*s/%s", dir_len, config_path, k->mesh);
         if (!wb_rt_path(L, rel, 0, path, sizeof path, &perr))
             return lua_pushfstring(L, "%s: %s", k->where, perr ? perr : "refused");
-        wbio_mesh_opts o = { k->scale, true, -1 };
+        wbio_mesh_opts o = { k->scale, true, -1, 0 };
         wb_mesh **slot = wbl_push_mesh_slot(L);
         *slot = wbio_load_mesh(path, k->mesh, &o, wbl_allow, L, err, sizeof err);
         if (!*slot) return lua_pushfstring(L, "%s: %s", k->where, err);

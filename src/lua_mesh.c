@@ -105,13 +105,13 @@ static int l_mesh(lua_State *L)
     return 1;
 }
 
-/* ---- wobble.load_mesh(path, {scale, weld}) ---------------------------------------------------- */
-static const char *const load_keys[] = { "scale", "weld", NULL };
+/* ---- wobble.load_mesh(path, {scale, weld, timeout}) ------------------------------------------- */
+static const char *const load_keys[] = { "scale", "weld", "timeout", NULL };
 
 static int l_load_mesh(lua_State *L)
 {
     const char *name = luaL_checkstring(L, 1);
-    wbio_mesh_opts o = { 1, true, -1 };
+    wbio_mesh_opts o = { 1, true, -1, 0 };
     if (wbl_checkopts(L, 2, load_keys, true)) {
         if (wbl_optreal(L, 2, "scale", &o.scale) && !(o.scale > 0)) return wbl_fielderror(L, 2, "scale", "must be > 0");
         lua_getfield(L, 2, "weld");
@@ -119,6 +119,9 @@ static int l_load_mesh(lua_State *L)
         else if (!lua_isnil(L, -1) && wbl_optreal(L, 2, "weld", &o.tol) && o.tol < 0)
             return wbl_fielderror(L, 2, "weld", "tolerance must be >= 0");
         lua_pop(L, 1);
+        wb_real t = 0;
+        if (wbl_optreal(L, 2, "timeout", &t) && !(t > 0)) return wbl_fielderror(L, 2, "timeout", "must be > 0");
+        o.timeout = t;
     }
     char path[4096], err[1024];
     wbl_path(L, name, 0, path, sizeof path);

@@ -172,6 +172,25 @@ test("corrupt files of every format fail cleanly", function()
   bad(write("mesh_load/truncated.glb", "glTF" .. string.pack("<I4I4", 2, 5000) .. string.rep("x", 40)))
 end)
 
+test("files that crash or hang assimp fail cleanly (the import runs in a child process)", function()
+  -- assets/torus.ply cut in its header (assimp loops forever) and in its body (assimp
+  -- aborts on an ai_assert); fuzzed files of the review that segfaulted, aborted or hung it
+  local f = assert(io.open("assets/torus.ply", "rb"))
+  local torus = f:read("a")
+  f:close()
+  bad(write("mesh_load/cut_header.ply", torus:sub(1, 100)), "without end_header")
+  bad(write("mesh_load/cut_body.ply", torus:sub(1, 300000)), "the importer failed (crashed")
+  bad("mesh_fixtures/bin_header_cut.ply", "without end_header")
+  bad("mesh_fixtures/aborts.ply", "the importer failed (crashed")
+  bad("mesh_fixtures/segfaults.dae", "the importer failed (crashed")
+  local m, err = wobble.load_mesh("mesh_fixtures/hangs.ply", { timeout = 0.5 })
+  expect.eq(m, nil)
+  expect.truthy(err:find("mesh_fixtures/hangs.ply: the importer failed (timed out", 1, true), err)
+  -- and the process goes on: a good file still loads
+  expect.eq(assert(wobble.load_mesh("assets/torus.ply")):vertex_count(), 6144)
+  expect.error(function() wobble.load_mesh("assets/torus.ply", { timeout = 0 }) end, "field 'timeout': must be > 0")
+end)
+
 test("a file cannot pull in a file outside the sandbox", function()
   -- a glTF whose buffer is /etc/passwd: the sandbox answers, not assimp's file system
   local m, err = wobble.load_mesh(write("mesh_load/escape.gltf", gltf("../../../../../../../../etc/passwd")))
