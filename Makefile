@@ -3,9 +3,14 @@ CC      ?= gcc
 BUILD   ?= build
 PREFIX  ?= /usr/local
 OPT     ?= -O2
-# Debian packages the build needs; `make deps` installs the missing ones
-PKGS    := liblua5.4-dev libcjson-dev libassimp-dev libosmesa6-dev libstb-dev ffmpeg pkg-config
+# Debian packages the build and the tests need; `make deps` installs the missing ones
+PKGS    := gcc make libc6-dev pkg-config liblua5.4-dev libcjson-dev libassimp-dev libosmesa6-dev \
+           libstb-dev ffmpeg
 PCMODS  := lua5.4 libcjson assimp osmesa
+# shell code setting `missing` to the packages of PKGS that are not installed ("ii";
+# a removed package whose configuration files remain is not); dpkg-query is quick
+MISSING  = missing=""; for p in $(PKGS); do \
+	     dpkg-query -W -f='$${db:Status-Abbrev}' $$p 2>/dev/null | grep -q '^ii' || missing="$$missing $$p"; done
 
 CFLAGS_BASE := -std=c11 $(OPT) -g -Wall -Wextra -Werror -fopenmp -fno-math-errno -D_GNU_SOURCE \
                -DWB_ROOT='"$(CURDIR)"' -DWB_PREFIX='"$(PREFIX)"'
@@ -28,11 +33,14 @@ all: check-deps
 
 build: $(BUILD)/libwobble.a $(BUILD)/wobble $(BUILD)/unit_tests
 
+# quiet when every package is there; without dpkg (not Debian) the libraries are
+# looked up with pkg-config instead
 check-deps:
-	@pkg-config --exists $(PCMODS) 2>/dev/null || $(MAKE) --no-print-directory deps
+	@if command -v dpkg-query >/dev/null 2>&1; then $(MISSING); [ -z "$$missing" ]; \
+	else pkg-config --exists $(PCMODS) 2>/dev/null; fi || $(MAKE) --no-print-directory deps
 
 deps:
-	@missing=""; for p in $(PKGS); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	@$(MISSING); \
 	if [ -n "$$missing" ]; then \
 	  echo "installing Debian packages:$$missing"; \
 	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
@@ -81,9 +89,11 @@ install: all
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/wobble/lua/wobble
 	install -m 755 $(BUILD)/wobble $(DESTDIR)$(PREFIX)/bin/wobble
 	install -m 644 lua/wobble/*.lua $(DESTDIR)$(PREFIX)/share/wobble/lua/wobble/
+	install -m 644 -D -t $(DESTDIR)$(PREFIX)/share/wobble/bench tests/bench/*.lua
 	install -d $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include
 	install -m 644 $(BUILD)/libwobble.a $(DESTDIR)$(PREFIX)/lib/
 	install -m 644 src/wobble.h $(DESTDIR)$(PREFIX)/include/
 
+# build folders only: out/ holds the user's videos and results
 clean:
-	rm -rf build build-asan build-bench out
+	rm -rf build build-asan build-bench $(BUILD)

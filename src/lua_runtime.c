@@ -176,6 +176,17 @@ void wb_rt_after_frame(lua_State *L, int world_index) {
     lua_pop(L, 1);
 }
 
+/* does the message's first line carry a position, "chunk:line:"? */
+static int has_position(const char *msg) {
+    for (const char *s = msg; *s && *s != '\n'; s++) {
+        if (*s != ':' || s[1] < '0' || s[1] > '9') continue;
+        const char *d = s + 1;
+        while (*d >= '0' && *d <= '9') d++;
+        if (*d == ':') return 1;
+    }
+    return 0;
+}
+
 int wb_rt_msgh(lua_State *L) {
     const char *msg = lua_tostring(L, 1);
     if (!msg) {  /* error(table), error(nil), ...: still say something */
@@ -184,6 +195,15 @@ int wb_rt_msgh(lua_State *L) {
         else
             msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
     }
+    /* errors Lua raises inside C functions ("C stack overflow", "attempt to yield from
+     * outside a coroutine") have no position: name the innermost Lua line */
+    lua_Debug ar;
+    if (!has_position(msg))
+        for (int level = 1; lua_getstack(L, level, &ar); level++)
+            if (lua_getinfo(L, "Sl", &ar) && ar.currentline > 0) {
+                msg = lua_pushfstring(L, "%s:%d: %s", ar.short_src, ar.currentline, msg);
+                break;
+            }
     luaL_traceback(L, L, msg, 1);
     return 1;
 }
@@ -552,6 +572,7 @@ static void open_sandbox(lua_State *L) {
     wrap(L, -1, "load", sb_load);
     lua_getfield(L, -1, "io");
     drop(L, -1, "io", "popen");
+    drop(L, -1, "io", "tmpfile");  /* a file outside the output folder */
     lua_pop(L, 1);
     lua_getfield(L, -1, "os");
     drop(L, -1, "os", "execute");

@@ -7,6 +7,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,7 +23,8 @@ static const char usage_text[] =
     "  wobble test [PATH...] [options] run scenario tests (.lua files, folders searched\n"
     "                                  recursively; default tests/); TAP 13 on stdout,\n"
     "                                  last line \"N passed, N failed\"\n"
-    "  wobble bench [--json]           run the benchmark scenes (tests/bench/*.lua)\n"
+    "  wobble bench [--json]           run the benchmark scenes (tests/bench/*.lua, or\n"
+    "                                  share/wobble/bench of an installed wobble)\n"
     "  wobble --version | --help\n"
     "\n"
     "options of run, test and bench:\n"
@@ -30,11 +32,12 @@ static const char usage_text[] =
     "  --record OUT        (run) draw every frame into OUT: .mp4, .gif or a folder of PNGs\n"
     "  --out DIR           output folder, the only place a script writes (default out)\n"
     "  --set key=value     wobble.args.key = value (numbers, true/false converted); repeatable\n"
-    "  --threads N         solver threads\n"
+    "  --threads N         default thread count of new worlds, 1 to 256 (default 1)\n"
     "  --unsafe            no sandbox: any path, os.execute, io.popen, C modules, debug\n"
     "  --quiet             no progress bar\n"
     "  --time-limit S      stop after S seconds of wall time (exit code 3)\n"
-    "  --memory-limit MB   limit of the Lua heap, default 4096 (exit code 3)\n"
+    "  --memory-limit MB   limit of the Lua heap and all worlds together, default 4096\n"
+    "                      (exit code 3)\n"
     "\n"
     "exit codes: 0 ok, 1 a test or expectation failed, 2 script or input error,\n"
     "            3 time or memory budget exceeded\n";
@@ -63,6 +66,18 @@ static int parse_number(const char *s, double lo, double hi, double *out) {
     if (!*s || *end || errno || !(v >= lo && v <= hi)) return -1;
     *out = v;
     return 0;
+}
+
+/* Would Lua read s as an infinite number (1e999)? Lua converts with strtod, refuses
+ * "inf" and "nan" (any n/N) and allows surrounding spaces; a --set value that does
+ * not convert stays a string and is fine. */
+static int overflows(const char *s) {
+    char *end;
+    if (strpbrk(s, "nN")) return 0;
+    double v = strtod(s, &end);
+    if (end == s) return 0;
+    while (*end == ' ' || (*end >= '\t' && *end <= '\r')) end++;
+    return !*end && !isfinite(v);
 }
 
 static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
@@ -114,8 +129,8 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
                 return usage_error("--frames expects a whole number of frames, got '%s'", val);
             o->rt.frame_cap = (int64_t)v;
         } else if (!strcmp(name, "--threads")) {
-            if (parse_number(val, 0, WB_MAX_THREADS, &v) || v != (int)v)
-                return usage_error("--threads expects a whole number from 0 to 256, got '%s'", val);
+            if (parse_number(val, 1, WB_MAX_THREADS, &v) || v != (int)v)
+                return usage_error("--threads expects a whole number from 1 to 256, got '%s'", val);
             o->rt.threads = (int)v;
         } else if (!strcmp(name, "--time-limit")) {
             if (parse_number(val, 0, 1e9, &v)) return usage_error("--time-limit expects seconds, got '%s'", val);
@@ -132,6 +147,7 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
         } else {
             const char *e = strchr(val, '=');
             if (!e || e == val) return usage_error("--set expects key=value, got '%s'", val);
+            if (overflows(e + 1)) return usage_error("--set %s: the number is out of range (not finite)", val);
             o->sets[o->nsets++] = val;
         }
     }
@@ -154,6 +170,35 @@ static int is_expectation(lua_State *L, int idx) {
     }
     lua_pop(L, 2);
     return r;
+}
+
+/* The first expectation that failed although the script caught its error (pcall, a
+ * coroutine), as a message pushed on the stack; NULL (nothing pushed) when none. A
+ * caught failure still fails: otherwise pcall(expect.eq, 1, 2) would pass a test. */
+static const char *caught_failure(lua_State *L) {
+    const char *msg = NULL;
+    int top = lua_gettop(L);
+    lua_getfield(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
+    if (lua_getfield(L, -1, "wobble.test") == LUA_TTABLE && lua_getfield(L, -1, "_first_failure") == LUA_TSTRING)
+        msg = lua_pushfstring(L, "%s (an expectation failed and the script caught its error; a failed "
+                                 "expectation fails the test all the same)", lua_tostring(L, -1));
+    if (msg) {
+        lua_replace(L, top + 1);
+        lua_settop(L, top + 1);
+    } else {
+        lua_settop(L, top);
+    }
+    return msg;
+}
+
+/* forget caught failures before the next case */
+static void clear_caught(lua_State *L) {
+    lua_getfield(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
+    if (lua_getfield(L, -1, "wobble.test") == LUA_TTABLE) {
+        lua_pushnil(L);
+        lua_setfield(L, -2, "_first_failure");
+    }
+    lua_pop(L, 2);
 }
 
 static int msgh(lua_State *L) {
@@ -356,13 +401,18 @@ static int run_cases(lua_State *L, const char *file, tap *t) {
         lua_setfield(L, m, "_count");
         lua_pushnil(L);
         lua_setfield(L, m, "_last_failure");
+        lua_pushnil(L);
+        lua_setfield(L, m, "_first_failure");
         lua_pushboolean(L, 1);
         lua_setfield(L, m, "_running");
         lua_getfield(L, -2, "fn");
         int status = pcall_top(L);
         lua_pushboolean(L, 0);
         lua_setfield(L, m, "_running");
-        if (status == LUA_OK) {
+        const char *caught;
+        if (status == LUA_OK && (caught = caught_failure(L))) {
+            tap_result(t, EXIT_FAILED, file, name, caught);
+        } else if (status == LUA_OK) {
             lua_getfield(L, m, "_count");
             int count = (int)lua_tointeger(L, -1);
             lua_pop(L, 1);
@@ -445,11 +495,19 @@ static void test_file(const char *path, const opts *o, tap *t) {
         return;
     }
     int status = run_file(L, path);
+    const char *caught;
     if (status != LUA_OK) {
         const char *msg;
         int code = failure(L, status, path, &msg);
         tap_result(t, code, path, "loading the file", msg);
-    } else if (run_cases(L, path, t) == 0) {
+        wb_rt_close(L);
+        return;
+    }
+    if ((caught = caught_failure(L))) {  /* an expectation at the top of the file */
+        tap_result(t, EXIT_FAILED, path, "loading the file", caught);
+        clear_caught(L);
+    }
+    if (run_cases(L, path, t) == 0) {
         tap_result(t, EXIT_FAILED, path, "no test cases",
                    "the file defines no test cases: call test(name, function() ... end)");
     }
@@ -512,6 +570,12 @@ static int run_scene(const opts *o, const char *path) {
         print_error(msg);
     } else {
         tap t = { 0, 0, 0, 0 };
+        const char *caught = caught_failure(L);
+        if (caught) {  /* an expectation of the scene itself */
+            print_error(caught);
+            t.code = EXIT_FAILED;
+            clear_caught(L);
+        }
         if (case_count(L) > 0) {
             printf("TAP version 13\n");
             run_cases(L, path, &t);
@@ -531,14 +595,28 @@ static int run_scene(const opts *o, const char *path) {
     return code;
 }
 
+/* the benchmark scenes: installed beside the Lua library (share/wobble/bench, so an
+ * installed command needs no source tree), else tests/bench of the project */
+static int bench_dir(char dir[PATH_MAX]) {
+    const char *lib = wb_rt_lib_dir(), *root = wb_rt_project_root();
+    char p[PATH_MAX];
+    struct stat st;
+    if (lib && snprintf(p, sizeof p, "%s/../bench", lib) < (int)sizeof p && realpath(p, dir) &&
+        stat(dir, &st) == 0 && S_ISDIR(st.st_mode))
+        return 0;
+    if (root && snprintf(p, sizeof p, "%s/tests/bench", root) < (int)sizeof p && realpath(p, dir) &&
+        stat(dir, &st) == 0 && S_ISDIR(st.st_mode))
+        return 0;
+    return -1;
+}
+
 static int cmd_bench(opts *o) {
-    const char *root = wb_rt_project_root();
     char dir[PATH_MAX], cwd[PATH_MAX];
-    if (!root) {
-        fprintf(stderr, "wobble: cannot find the project folder holding tests/bench\n");
+    if (bench_dir(dir)) {
+        fprintf(stderr, "wobble: cannot find the benchmark scenes (share/wobble/bench of an installed wobble, "
+                        "or tests/bench of the project)\n");
         return EXIT_SCRIPT;
     }
-    snprintf(dir, sizeof dir, "%s/tests/bench", root);
     list files = { 0 };
     collect(dir, &files, 1);
     if (files.n > 1) qsort(files.v, (size_t)files.n, sizeof *files.v, cmp_str);

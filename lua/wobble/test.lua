@@ -15,9 +15,10 @@
 -- protected call. A failed expectation raises an error located at the line that called
 -- expect.*; a case that calls no expect.* at all fails ("no expectations"), so a test
 -- that checks nothing cannot pass. Every expect.* takes an optional last message that
--- is put in front of the failure text.
+-- is put in front of the failure text. A failed expectation fails its case even when
+-- the script catches the error (pcall, a coroutine): the runner checks _first_failure.
 
-local M = { cases = {}, _count = 0, _running = false, _last_failure = nil }
+local M = { cases = {}, _count = 0, _running = false, _last_failure = nil, _first_failure = nil }
 
 local type, tostring, select, pcall, error = type, tostring, select, pcall, error
 local abs, huge, mtype = math.abs, math.huge, math.type
@@ -67,10 +68,15 @@ end
 -- ---- failing ----------------------------------------------------------------------
 
 -- "file:line: " of the code that called expect.*: the level error() counts from its
--- caller: 1 pcall, 2 where, 3 fail, 4 expect.x, 5 the code that called expect.x
+-- caller: 1 pcall, 2 where, 3 fail, 4 expect.x, 5 the code that called expect.x. When
+-- that is a C function (pcall(expect.eq, 1, 2)) the Lua code that called it is named.
 local function where()
-  local _, e = pcall(error, "", 5)
-  return type(e) == "string" and e or ""
+  for level = 5, 12 do
+    local _, e = pcall(error, "", level)
+    if type(e) ~= "string" then break end
+    if e ~= "" then return e end
+  end
+  return ""
 end
 
 -- every expect.* calls fail directly (never as a tail call), so the level is fixed
@@ -78,6 +84,7 @@ local function fail(msg, user)
   if user ~= nil then msg = tostring(user) .. ": " .. msg end
   local full = where() .. msg
   M._last_failure = full  -- lets the runner tell a failed expectation from a script error
+  if M._first_failure == nil then M._first_failure = full end  -- survives a pcall around expect.*
   error(full, 0)
 end
 
@@ -191,9 +198,10 @@ function expect.error(fn, pattern, msg)
   if type(fn) ~= "function" and not (getmetatable(fn) or {}).__call then
     error("bad argument to 'expect.error': function expected, got " .. type(fn), 2)
   end
-  local saved = M._last_failure
+  local saved, saved_first = M._last_failure, M._first_failure
   local ok, err = pcall(fn)
-  M._last_failure = saved  -- an expectation failing inside fn was caught here
+  -- an expectation failing inside fn was expected here (tests of expect itself)
+  M._last_failure, M._first_failure = saved, saved_first
   if ok then
     fail("expected an error, but the function returned normally", msg)
   elseif pattern ~= nil then

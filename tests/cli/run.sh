@@ -69,6 +69,12 @@ run run $F/args.lua --frames many
 check "--frames wants a number" 2 err "--frames expects a whole number"
 run run $F/args.lua --set novalue
 check "--set wants key=value" 2 err "--set expects key=value"
+run run $F/args.lua --set a=1e999
+check "--set refuses a number that is not finite" 2 err "--set a=1e999: the number is out of range"
+run run $F/args.lua --set a=-1e400
+check "--set refuses -inf too" 2 err "--set a=-1e400: the number is out of range"
+run run $F/args.lua --threads 0
+check "--threads 0 is refused" 2 err "--threads expects a whole number from 1 to 256, got '0'"
 
 # ---- script errors: file:line, traceback, exit 2
 run run $F/syntax_error.lua
@@ -94,6 +100,16 @@ run run $F/expect_fail.lua
 check "failed expectation in a scene: exit 1" 1 err "$F/expect_fail.lua:4: expected 3, got 2" !err "wobble/test.lua"
 run run $F/os_exit.lua
 check "os.exit is refused" 2 err "os.exit is not available in the sandbox"
+# errors Lua raises inside C functions carry no position of their own
+run run $F/run_recursion.lua
+check "recursion through w:run: file:line of the stack overflow" 2 \
+    err "$F/run_recursion.lua:4: C stack overflow" err "stack traceback:"
+run run $F/yield_on_frame.lua
+check "yield in on_frame outside a coroutine: file:line" 2 \
+    err "$F/yield_on_frame.lua:4: attempt to yield from outside a coroutine"
+run run $F/expect_caught.lua
+check "a failed expectation caught by pcall still fails the scene: exit 1" 1 \
+    out "caught: true" err "$F/expect_caught.lua:3: expected 3 < 2" err "the script caught its error"
 
 # ---- budgets: exit 3, even when the script swallows errors
 run run $F/busy_loop.lua --time-limit 0.3
@@ -106,6 +122,19 @@ run run $F/memory_pcall.lua --memory-limit 32
 check "memory limit through pcall" 3 err "memory limit of 32 MB exceeded"
 run run $F/huge_cloth.lua --memory-limit 256
 check "a world past the memory budget" 3 err "huge_cloth.lua:3: out of memory: cloth (the memory budget is 256 MB" !out "should not get here"
+# one world fits in the budget, eight do not: the budget is shared, not per world
+run run $F/many_worlds.lua --memory-limit 256
+check "eight big worlds share one memory budget" 3 out "world 1" err "many_worlds.lua:6: out of memory" \
+    !out "world 8" !out "should not get here"
+# the interrupt is polled inside the step: a step of minutes ends within seconds
+t0=$(date +%s)
+run run $F/slow_step.lua --time-limit 1
+t1=$(date +%s)
+check "--time-limit stops a single long w:step" 3 err "slow_step.lua:5: time limit of 1 s exceeded" \
+    !out "should not get here"
+[ $((t1 - t0)) -le 20 ]
+code=$?
+check "--time-limit 1 ends a step of minutes within seconds ($((t1 - t0)) s)" 0
 
 # ---- options and the runtime
 run run $F/args.lua --set n=3 --set x=0.5 --set hex=0x10 --set name=cloth --set on=true --set off=false \
@@ -160,6 +189,13 @@ check "test: the last line is the summary" 0
 [ "$(head -n 1 "$TMP/out")" = "TAP version 13" ]
 code=$?
 check "test: the first line is the TAP version" 0
+run test $F/tap_caught.lua
+check "test: a failed expectation fails its case even when pcall catches it" 1 \
+    out "not ok 1 - $F/tap_caught.lua: pcall around a failing expectation" \
+    out "  message: \"$F/tap_caught.lua:4: expected 2, got 1 (an expectation failed and the script caught its error" \
+    out "not ok 2 - $F/tap_caught.lua: a failing expectation in a coroutine" \
+    out "ok 3 - $F/tap_caught.lua: expect.error of a failing expectation passes" \
+    out "ok 4 - $F/tap_caught.lua: the next case starts clean" out "2 passed, 2 failed"
 run test $F/tap_top_error.lua
 check "test: an error at the top of a file is a script error" 2 \
     out "not ok 1 - $F/tap_top_error.lua: loading the file" out "tap_top_error.lua:4: attempt to index" out "0 passed, 1 failed"
@@ -173,6 +209,69 @@ check "test: folders are searched, sorted, fixtures and _files skipped" 0 \
     out "ok 1 - $F/tapdir/a.lua: a" out "ok 2 - $F/tapdir/sub/b.lua: b" out "2 passed, 0 failed" !out "_helper" !out "skip.lua"
 run test $F/tapdir/a.lua $F/missing_dir
 check "test: a missing path fails" 2 out "cannot open $F/missing_dir" out "1 passed, 1 failed"
+
+# ---- the README's examples, taken from README.md as they are printed there
+# readme_block MARKER: the ```lua block of README.md whose first line is MARKER
+readme_block() {
+    awk -v m="$1" 'on && /^```/ {exit} on {print} prev == "```lua" && $0 == m {on = 1; print} {prev = $0}' README.md
+}
+mkdir -p "$TMP/readme"
+readme_block "-- tests/scenarios/rope_hangs.lua" >"$TMP/readme/rope_hangs.lua"
+run test "$TMP/readme/rope_hangs.lua" --out "$TMP/readme/out"
+check "README: the scene test example runs as printed" 0 out "ok 1 - " out "1 passed, 0 failed"
+[ "$(grep -c . "$TMP/readme/rope_hangs.lua")" -ge 5 ]
+code=$?
+check "README: the scene test example was found" 0
+readme_block "-- drape.lua" >"$TMP/readme/drape.lua"
+run run "$TMP/readme/drape.lua" --frames 5 --out "$TMP/readme/out"
+check "README: the first scene runs as printed" 0 !err ""
+[ "$(grep -c . "$TMP/readme/drape.lua")" -ge 5 ]
+code=$?
+check "README: the first scene was found" 0
+
+# ---- make: deps, clean, install (the Makefile's own rules, with stand-ins for apt)
+if command -v make >/dev/null 2>&1; then
+    mkdir -p "$TMP/fakebin"
+    # every package installed but $FAKE_MISSING; apt-get only logs what it was asked
+    printf '#!/bin/sh\nfor pkg; do :; done\n[ "$pkg" = "$FAKE_MISSING" ] && exit 1\nprintf "ii "\n' \
+        >"$TMP/fakebin/dpkg-query"
+    printf '#!/bin/sh\necho "apt-get $*" >>"$FAKE_LOG"\n' >"$TMP/fakebin/apt-get"
+    printf '#!/bin/sh\nexec "$@"\n' >"$TMP/fakebin/sudo"
+    chmod +x "$TMP/fakebin/dpkg-query" "$TMP/fakebin/apt-get" "$TMP/fakebin/sudo"
+    for pkg in none libstb-dev ffmpeg gcc; do
+        rm -f "$TMP/apt.log"
+        PATH="$TMP/fakebin:$PATH" FAKE_MISSING=$pkg FAKE_LOG="$TMP/apt.log" \
+            make -s --no-print-directory check-deps >"$TMP/out" 2>"$TMP/err"
+        code=$?
+        cat "$TMP/apt.log" >>"$TMP/err" 2>/dev/null
+        if [ "$pkg" = none ]; then
+            check "make check-deps: quiet when every package is there" 0 !out "" !err ""
+        else
+            check "make check-deps: a missing $pkg is installed" 0 out "installing Debian packages: $pkg" \
+                err "install -y -qq $pkg"
+        fi
+    done
+    # make clean: the build folders go, the user's out/ stays
+    mkdir -p "$TMP/proj/out" "$TMP/proj/build/obj" "$TMP/proj/build-asan" "$TMP/proj/build-bench" "$TMP/proj/build-x"
+    echo video >"$TMP/proj/out/demo.mp4"
+    make -s --no-print-directory -C "$TMP/proj" -f "$PWD/Makefile" clean BUILD=build-x >"$TMP/out" 2>"$TMP/err" &&
+        [ -f "$TMP/proj/out/demo.mp4" ] && ! [ -e "$TMP/proj/build" ] && ! [ -e "$TMP/proj/build-asan" ] &&
+        ! [ -e "$TMP/proj/build-bench" ] && ! [ -e "$TMP/proj/build-x" ]
+    code=$?
+    check "make clean removes the build folders and keeps out/" 0
+    # an installed wobble runs its benchmark without the source tree's tests/bench
+    # (-o all: install what $BUILD holds, build nothing)
+    make -s --no-print-directory -o all install PREFIX="$TMP/inst" BUILD="$BUILD" >"$TMP/out" 2>"$TMP/err"
+    code=$?
+    check "make install" 0
+    [ -f "$TMP/inst/share/wobble/bench/cloth128.lua" ]
+    code=$?
+    check "make install installs the benchmark scenes" 0
+    "$TMP/inst/bin/wobble" bench --frames 1 --set frames=1 --out "$TMP/bench-out" --quiet >"$TMP/out" 2>"$TMP/err"
+    code=$?
+    check "an installed wobble bench runs the installed scenes" 0 out "share/wobble/bench/cloth128.lua" \
+        out "cloth128" !out "tests/bench"
+fi
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -21,7 +21,7 @@ test("near, rel: fail outside, NaN never passes, %.17g digits", function()
 end)
 
 test("failures name the line of the expect call", function()
-  local at, err = here(), select(2, pcall(function() expect.eq(1, 2) end))
+  local at, err = here(), expect.error(function() expect.eq(1, 2) end)
   expect.eq(err, at .. "expected 2, got 1")
   expect.truthy(at:find("cli_harness.lua:%d+: $"), at)
 end)
