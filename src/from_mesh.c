@@ -179,6 +179,12 @@ wb_status wb_from_mesh(wb_world *w, const wb_mesh *m, const wb_from_mesh_def *d,
     if (d->neighbours < 0 || d->neighbours > 32) return bad("neighbours must be in 0..32");
     if (m->nv == 0) return bad("the mesh has no vertices");
     if (m->nv > WB_MAX_PARTICLES) return WB_ERR_LIMIT;
+    /* the core asserts finite particle positions: refuse here, with the vertex named */
+    for (int32_t i = 0; i < 3 * m->nv; i++)
+        if (!isfinite(m->v[i])) {
+            wb__set_error("mesh vertex %d is not finite", i / 3 + 1);
+            return WB_ERR_ARG;
+        }
 
     plan p;
     memset(&p, 0, sizeof p);

@@ -5,6 +5,7 @@
  * read is an expected failure: load_mesh returns nil and "file: reason" (liolib's style);
  * misuse (a wrong argument type) raises. */
 #include <limits.h>
+#include <math.h>
 #include <string.h>
 
 #include "io.h"
@@ -193,6 +194,12 @@ static int m_transform(lua_State *L)
     wbl_checkopts(L, 2, transform_keys, false);
     if (wbl_optreal(L, 2, "scale", &s) && s == 0) return wbl_fielderror(L, 2, "scale", "must not be 0");
     wbl_optvec(L, 2, "translate", 3, t);
+    /* checked before anything moves: a mesh with an infinite vertex would reach the core
+     * (w:from_mesh, w:skin) as inf and NaN */
+    for (int32_t i = 0; i < m->nv; i++)
+        for (int c = 0; c < 3; c++)
+            if (!isfinite(m->v[3 * i + c] * s + t[c]))
+                return luaL_error(L, "transform: vertex %d would not be finite", (int)i + 1);
     wb_mesh_transform(m, s, t);
     lua_settop(L, 1);
     return 1;

@@ -11,7 +11,9 @@
  * A_j = sum_k (x_k - c)(x0_k - c0)^T with Müller et al. 2016, warm-started from the last
  * update. A vertex moves to v' = sum_j w_j (x_j + R_j (v - x0_j)): at the bind pose that
  * is v itself, and under a rigid motion of all particles it is the same rigid motion. */
+#include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "core.h"
 
@@ -53,9 +55,9 @@ void wb_quat_to_matrix(const wb_real q[4], wb_real R[9])
  * of deformations": turn R towards A by omega = sum_i r_i x a_i / |sum_i r_i . a_i| (r_i,
  * a_i the columns), the exact rotation by |omega| about omega each time. It needs no SVD,
  * never flips to a reflection, and from a close warm start converges in a few steps. */
-void wb_extract_rotation(const wb_real A[9], wb_real q[4], int max_iter)
+/* returns 1 when it stopped at a stationary point (the update vanished), 0 out of steps */
+static int muller(const wb_real A[9], wb_real q[4], int max_iter)
 {
-    q_normalize(q);
     for (int it = 0; it < max_iter; it++) {
         wb_real R[9], om[3] = { 0, 0, 0 }, dot = 0;
         wb_quat_to_matrix(q, R);
@@ -68,9 +70,62 @@ void wb_extract_rotation(const wb_real A[9], wb_real q[4], int max_iter)
         }
         v3_scale(om, om, 1 / (fabs(dot) + (wb_real)1e-9));
         const wb_real angle = v3_len(om);
-        if (angle < (wb_real)1e-12) break;
+        if (angle < (wb_real)1e-12) return 1;
         q_integrate(q, om, 1, q); /* q <- rot(|om|, om/|om|) q */
     }
+    return 0;
+}
+
+/* trace(R^T A): the polar rotation is the one that makes it largest */
+static wb_real trace_rta(const wb_real q[4], const wb_real A[9])
+{
+    wb_real R[9], t = 0;
+    wb_quat_to_matrix(q, R);
+    for (int i = 0; i < 9; i++) t += R[i] * A[i];
+    return t;
+}
+
+/* q <- q rot(pi, e_k) for the k that gives the largest trace(R^T A), if that beats q's
+ * own; 1 when q changed */
+static int best_half_turn(const wb_real A[9], wb_real q[4])
+{
+    wb_real best[4], bt = trace_rta(q, A) + (wb_real)1e-9;
+    int found = 0;
+    for (int k = 0; k < 3; k++) {
+        const wb_real e[3] = { k == 0, k == 1, k == 2 }, v[3] = { q[1], q[2], q[3] };
+        wb_real c[4], x[3];
+        v3_cross(x, v, e);
+        c[0] = -q[1 + k];
+        for (int j = 0; j < 3; j++) c[1 + j] = q[0] * e[j] + x[j];
+        const wb_real t = trace_rta(c, A);
+        if (t > bt) {
+            bt = t;
+            memcpy(best, c, sizeof best);
+            found = 1;
+        }
+    }
+    if (found) memcpy(q, best, sizeof best);
+    return found;
+}
+
+void wb_extract_rotation(const wb_real A_in[9], wb_real q[4], int max_iter)
+{
+    q_normalize(q);
+    /* A over its Frobenius norm: the iteration's thresholds are absolute, so without this
+     * a 1e-6-sized cage (A ~ 1e-12) would stop at once and a huge one never */
+    wb_real A[9], f = 0;
+    for (int i = 0; i < 9; i++) f += A_in[i] * A_in[i];
+    f = sqrt(f);
+    if (!(f > 0) || !isfinite(f) || max_iter <= 0) return;
+    for (int i = 0; i < 9; i++) A[i] = A_in[i] / f;
+    /* the update vanishes wherever R^T A is symmetric, which includes the saddles half a
+     * turn from the answer (a cage turned by exactly pi from the warm start stays put),
+     * and near them it crawls. A start that a half turn about a coordinate axis improves
+     * is begun from that turn instead (near the answer none does, so a warm start is
+     * kept); a stationary end that such a turn beats was a saddle: go on from there */
+    best_half_turn(A, q);
+    for (int round = 0; round < 4; round++)
+        if (!muller(A, q, max_iter) || !best_half_turn(A, q)) break;
 }
 
 /* ---- binding ------------------------------------------------------------------------- */
@@ -135,6 +190,9 @@ wb_skin *wb_skin_create(const wb_world *w, const wb_mesh *m, const int32_t *ids,
     if (n < 1) { wb__set_error("a skin needs at least one particle"); return NULL; }
     for (int32_t i = 0; i < n; i++)
         if (ids[i] < 0 || ids[i] >= w->m.np) { wb__set_error("particle %d out of range", ids[i] + 1); return NULL; }
+    /* a non-finite vertex would give every weight and every deformed position NaN */
+    for (int32_t i = 0; i < 3 * m->nv; i++)
+        if (!isfinite(m->v[i])) { wb__set_error("mesh vertex %d is not finite", i / 3 + 1); return NULL; }
     *status = WB_ERR_NOMEM;
     wb_skin *s = calloc(1, sizeof *s);
     if (!s) return NULL;

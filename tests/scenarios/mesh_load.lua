@@ -237,6 +237,11 @@ test("methods check their arguments; close is safe twice", function()
   expect.error(function() m:vertex(9) end, "vertex 9 out of range (1..8)")
   expect.error(function() m:triangle(0) end, "triangle 0 out of range (1..12)")
   expect.error(function() m:transform{ scale = 0 } end, "must not be 0")
+  -- a transform that overflows is refused before anything moves (from_mesh and skin
+  -- would get inf and NaN)
+  local huge = wobble.mesh{ vertices = V, triangles = F }:transform{ scale = 1e200 }
+  expect.error(function() huge:transform{ scale = 1e200 } end, "vertex 2 would not be finite")
+  expect.eq({ huge:vertex(7) }, { 1e200, 1e200, 1e200 })
   m:transform{ scale = 2, translate = { 1, 0, 0 } }
   expect.eq({ m:vertex(7) }, { 3, 2, 2 })
   local c = m:copy()

@@ -58,6 +58,9 @@
     X(skin_rigid_motion_is_rigid)                \
     X(skin_follows_simulation)                   \
     X(skin_bad_definitions)                      \
+    X(skin_follows_half_turns)                   \
+    X(skin_rotation_independent_of_scale)        \
+    X(skin_and_from_mesh_refuse_nonfinite_vertices) \
     X(world_step_empty)                          \
     X(step_interrupt_leaves_world_unchanged)     \
     X(force_reads_the_step_that_made_it)         \

@@ -314,3 +314,112 @@ TEST(skin_bad_definitions)
     wb_mesh_destroy(m);
     wb_world_destroy(w);
 }
+
+/* the skin of a bumpy sphere on a res^3 lattice over [0, size]^3, the particles turned
+ * by R about the cage's centre: the largest vertex error over the mesh's size */
+static double turned_cage_error(int res, double size, const double R[9])
+{
+    wb_world_def wd = wb_world_default_def();
+    wb_world *w = wb_world_create(&wd);
+    wb_mesh *m = bumpy_sphere(60, 30);
+    wb_lattice_def ld = wb_lattice_default_def();
+    ld.res[0] = ld.res[1] = ld.res[2] = res;
+    for (int k = 0; k < 3; k++) ld.min[k] = 0, ld.max[k] = size;
+    wb_body b;
+    if (!w || !m || wb_lattice(w, &ld, &b) != WB_OK) return 1e30;
+    wb_mesh_transform(m, size, NULL);
+    int32_t *ids = malloc(sizeof *ids * (size_t)b.count);
+    for (int32_t i = 0; i < b.count; i++) ids[i] = b.first + i;
+    wb_skin_def sd = wb_skin_default_def();
+    wb_skin *s = wb_skin_create(w, m, ids, b.count, &sd, NULL);
+    if (!s) return 1e30;
+    const double c = size / 2;
+    for (int32_t i = 0; i < b.count; i++) {
+        wb_real x[3], y[3];
+        wb_particle_position(w, ids[i], x);
+        for (int k = 0; k < 3; k++)
+            y[k] = c + R[3 * k] * (x[0] - c) + R[3 * k + 1] * (x[1] - c) + R[3 * k + 2] * (x[2] - c);
+        wb_particle_set_position(w, ids[i], y);
+    }
+    const wb_real *v = wb_skin_vertices(s, w);
+    double err = 0;
+    for (int32_t i = 0; i < m->nv; i++) {
+        const wb_real *x = &m->v[3 * i];
+        for (int k = 0; k < 3; k++) {
+            const double want = c + R[3 * k] * (x[0] - c) + R[3 * k + 1] * (x[1] - c) + R[3 * k + 2] * (x[2] - c);
+            err = fmax(err, fabs(v[3 * i + k] - want) / size);
+        }
+    }
+    wb_skin_destroy(s);
+    wb_mesh_destroy(m);
+    wb_world_destroy(w);
+    free(ids);
+    return err;
+}
+
+static void axis_rotation(const double u_in[3], double t, double R[9])
+{
+    const double n = sqrt(u_in[0] * u_in[0] + u_in[1] * u_in[1] + u_in[2] * u_in[2]);
+    const double u[3] = { u_in[0] / n, u_in[1] / n, u_in[2] / n }, c = cos(t), s = sin(t);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) R[3 * i + j] = (i == j) * c + (1 - c) * u[i] * u[j];
+    R[1] -= s * u[2]; R[2] += s * u[1];
+    R[3] += s * u[2]; R[5] -= s * u[0];
+    R[6] -= s * u[1]; R[7] += s * u[0];
+}
+
+TEST(skin_follows_half_turns)
+{
+    /* Müller's update is zero at the saddle half a turn from the warm start: a cage turned
+     * by exactly pi must still be followed, about coordinate axes and an oblique one */
+    const double axes[4][3] = { { 0, 1, 0 }, { 1, 0, 0 }, { 0, 0, 1 }, { 1, 2, 3 } };
+    for (int a = 0; a < 4; a++) {
+        double R[9];
+        axis_rotation(axes[a], 3.14159265358979323846, R);
+        CHECK_NEAR(turned_cage_error(4, 1, R), 0, 1e-6);
+        /* and the extraction alone, from identity, on A = R */
+        wb_real A[9], q[4] = { 1, 0, 0, 0 }, M[9];
+        for (int i = 0; i < 9; i++) A[i] = R[i];
+        wb_extract_rotation(A, q, 50);
+        wb_quat_to_matrix(q, M);
+        double e = 0;
+        for (int i = 0; i < 9; i++) e = fmax(e, fabs(M[i] - R[i]));
+        CHECK_NEAR(e, 0, 1e-9);
+    }
+}
+
+TEST(skin_rotation_independent_of_scale)
+{
+    /* the same rigid turn of a cage 1e-6 across and of one 1e6 across */
+    double R[9];
+    const double u[3] = { 0.3, -1, 0.5 };
+    axis_rotation(u, 0.7, R);
+    CHECK_NEAR(turned_cage_error(4, 1e-6, R), 0, 1e-6);
+    CHECK_NEAR(turned_cage_error(4, 1e6, R), 0, 1e-6);
+}
+
+TEST(skin_and_from_mesh_refuse_nonfinite_vertices)
+{
+    wb_world_def wd = wb_world_default_def();
+    wb_world *w = wb_world_create(&wd);
+    REQUIRE(w);
+    const wb_real p[3] = { 0, 0, 0 };
+    wb_particle_add(w, p, NULL, 1, 0);
+    wb_mesh *m = bumpy_sphere(8, 4);
+    REQUIRE(m);
+    wb_mesh_transform(m, 1e200, NULL);
+    wb_mesh_transform(m, 1e200, NULL); /* now inf (and NaN normals) */
+    wb_skin_def d = wb_skin_default_def();
+    int32_t id = 0;
+    wb_status st = WB_OK;
+    CHECK(wb_skin_create(w, m, &id, 1, &d, &st) == NULL);
+    CHECK_EQ(st, WB_ERR_ARG);
+    CHECK_HAS(wb_last_error(), "not finite");
+    wb_from_mesh_def fd = wb_from_mesh_default_def();
+    wb_body b;
+    CHECK_EQ(wb_from_mesh(w, m, &fd, &b), WB_ERR_ARG);
+    CHECK_HAS(wb_last_error(), "not finite");
+    CHECK_EQ(wb_particle_count(w), 1);
+    wb_mesh_destroy(m);
+    wb_world_destroy(w);
+}
