@@ -186,9 +186,19 @@ wb_status wb_from_mesh(wb_world *w, const wb_mesh *m, const wb_from_mesh_def *d,
             return WB_ERR_ARG;
         }
 
+    /* a particle per welded vertex: a flat-shaded mesh repeats a corner per face, and
+     * unwelded it would fall apart into loose triangles (a copy, the caller's mesh stays) */
+    wb_mesh *wm = wb_mesh_copy(m);
+    if (!wm) return WB_ERR_NOMEM;
+    wb_status st = wb_mesh_weld(wm, wb_mesh_weld_tolerance(wm), NULL);
+    if (st != WB_OK) {
+        wb_mesh_destroy(wm);
+        return st;
+    }
     plan p;
     memset(&p, 0, sizeof p);
-    wb_status st = plan_particles(m, d->target, &p);
+    st = plan_particles(wm, d->target, &p);
+    wb_mesh_destroy(wm);
     if (st == WB_OK) st = plan_links(&p, d->neighbours);
     if (st == WB_OK && p.nd > (size_t)WB_MAX_CONSTRAINTS) st = WB_ERR_LIMIT;
     if (st == WB_OK) st = wb__reserve(w, p.np, (int64_t)p.nd);

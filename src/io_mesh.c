@@ -325,11 +325,7 @@ wb_mesh *wbio_load_mesh(const char *path, const char *shown, const wbio_mesh_opt
     free(tri);
     if (mesh && o->weld) {
         /* files repeat a vertex per face it touches (an STL cube has 36): merge by position */
-        wb_real mn[3], mx[3], diag = 0, tol = o->tol;
-        if (wb_mesh_bounds(mesh, mn, mx))
-            diag = sqrt((mx[0] - mn[0]) * (mx[0] - mn[0]) + (mx[1] - mn[1]) * (mx[1] - mn[1]) + (mx[2] - mn[2]) * (mx[2] - mn[2]));
-        if (tol < 0) tol = 1e-6 * diag;
-        status = wb_mesh_weld(mesh, tol, NULL);
+        status = wb_mesh_weld(mesh, o->tol < 0 ? wb_mesh_weld_tolerance(mesh) : o->tol, NULL);
         if (status != WB_OK) {
             wb_mesh_destroy(mesh);
             mesh = NULL;

@@ -94,7 +94,8 @@ static int l_mesh(lua_State *L)
             wbl_fielderror(L, 1, "triangles", "entry %lld: vertex %d out of range (1..%lld)", (long long)(i / 3 + 1), (int)tri[i] + 1, (long long)nv);
     wb_real weld = -1;
     lua_getfield(L, 1, "weld");
-    if (lua_isboolean(L, -1)) weld = lua_toboolean(L, -1) ? 0 : -1;
+    /* true: the same default as load_mesh, near-coincident vertices merged too */
+    if (lua_isboolean(L, -1)) weld = lua_toboolean(L, -1) ? -2 : -1;
     else if (!lua_isnil(L, -1) && wbl_optreal(L, 1, "weld", &weld) && weld < 0)
         return wbl_fielderror(L, 1, "weld", "tolerance must be >= 0");
     lua_pop(L, 1);
@@ -102,6 +103,7 @@ static int l_mesh(lua_State *L)
     wb_status st;
     *slot = wb_mesh_create(v, (int32_t)nv, tri, (int32_t)nt, &st);
     if (!*slot) return wbl_status_error(L, 1, st, "mesh");
+    if (weld == -2) weld = wb_mesh_weld_tolerance(*slot);
     if (weld >= 0 && (st = wb_mesh_weld(*slot, weld, NULL)) != WB_OK) return wbl_status_error(L, 1, st, "mesh");
     return 1;
 }

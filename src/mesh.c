@@ -105,6 +105,14 @@ bool wb_mesh_bounds(const wb_mesh *m, wb_real mn[3], wb_real mx[3])
     return true;
 }
 
+wb_real wb_mesh_weld_tolerance(const wb_mesh *m)
+{
+    wb_real mn[3], mx[3];
+    if (!wb_mesh_bounds(m, mn, mx)) return 0;
+    const wb_real d[3] = { mx[0] - mn[0], mx[1] - mn[1], mx[2] - mn[2] };
+    return 1e-6 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+}
+
 void wb_mesh_transform(wb_mesh *m, wb_real scale, const wb_real offset[3])
 {
     for (int32_t i = 0; i < m->nv; i++)

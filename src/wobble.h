@@ -322,6 +322,9 @@ int wb_skin_influences(const wb_skin *s, int32_t v, int32_t *particles, wb_real 
  * extract the rotational part of deformations": q (w,x,y,z) is the warm start and the result */
 void wb_extract_rotation(const wb_real A[9], wb_real q[4], int max_iter);
 void wb_quat_to_matrix(const wb_real q[4], wb_real R[9]);     /* row-major */
+/* the weld distance used unless one is given (wobble.load_mesh, wobble.mesh{weld = true},
+ * wb_from_mesh): 1e-6 of the bounding box's diagonal, 0 for an empty mesh */
+wb_real wb_mesh_weld_tolerance(const wb_mesh *m);
 
 /* ---- snapshots (snapshot.c) --------------------------------------------------------------- */
 /* an exact copy: same hash, and the two step bit-identically; NULL when out of memory */

@@ -57,6 +57,26 @@ test("a cube: 8 particles, 18 links at rest, mass spread evenly", function()
   expect.eq(faces, 12)
 end)
 
+test("a particle per welded vertex: a flat-shaded quad is one piece", function()
+  -- two triangles with a corner each of their own, as a flat-shaded export writes them;
+  -- the second copy of the shared edge is 1e-9 off (a float round trip)
+  local m = wobble.mesh{ vertices = { 0,0,0, 1,0,0, 1,1,0,  0,0,0, 1,1e-9 + 1,0, 0,1,0 },
+                         triangles = { 1,2,3, 4,5,6 } }
+  expect.eq(m:vertex_count(), 6, "wobble.mesh keeps the vertices unless asked")
+  local w = wobble.world{}
+  local b = w:from_mesh(m)
+  expect.eq(b.count, 4)
+  expect.eq(b.constraint_count, 5)
+  expect.eq(m:vertex_count(), 6, "the caller's mesh is not welded")
+  -- weld = true means what load_mesh does: within 1e-6 of the bounding box's diagonal
+  local welded = wobble.mesh{ vertices = { 0,0,0, 1,0,0, 1,1,0,  0,0,0, 1,1e-9 + 1,0, 0,1,0 },
+                              triangles = { 1,2,3, 4,5,6 }, weld = true }
+  expect.eq(welded:vertex_count(), 4)
+  local apart = wobble.mesh{ vertices = { 0,0,0, 1,0,0, 1,1,0,  0,0,0, 1,1.001,0, 0,1,0 },
+                             triangles = { 1,2,3, 4,5,6 }, weld = true }
+  expect.eq(apart:vertex_count(), 5, "1e-3 apart is not welded")
+end)
+
 test("builder options reach every constraint", function()
   local w = wobble.world{}
   w:from_mesh(wobble.mesh{ vertices = V, triangles = F },
