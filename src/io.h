@@ -73,10 +73,11 @@ int wbio_write_ply(FILE *f, const wb_mesh *m, const wb_real *v, const wb_real *n
 
 /* ---- exports (io_export.c) -------------------------------------------------------------------- */
 /* PC2 point cache (Blender's Mesh Cache modifier): header, then float32 xyz per point per
- * sample; the header's sample count is kept current after every sample */
+ * sample; the header's sample count is kept current after every sample. sample_rate: frames
+ * per sample (a sample every `every` frames) */
 typedef struct wbio_pc2 wbio_pc2;
 wbio_pc2 *wbio_pc2_open(const char *path, const char *shown, int32_t npoints, double start_frame,
-                        char *err, size_t errn);
+                        double sample_rate, char *err, size_t errn);
 int wbio_pc2_write(wbio_pc2 *p, const wb_real *pts, char *err, size_t errn); /* (npoints x 3) */
 int wbio_pc2_close(wbio_pc2 *p, char *err, size_t errn);     /* NULL is fine; frees */
 int32_t wbio_pc2_samples(const wbio_pc2 *p);

@@ -37,7 +37,8 @@ static uint32_t float_bits(float x)
     return u;
 }
 
-wbio_pc2 *wbio_pc2_open(const char *path, const char *shown, int32_t npoints, double start_frame, char *err, size_t errn)
+wbio_pc2 *wbio_pc2_open(const char *path, const char *shown, int32_t npoints, double start_frame, double sample_rate,
+                        char *err, size_t errn)
 {
     wbio_pc2 *p = calloc(1, sizeof *p);
     if (p) p->buf = malloc(sizeof *p->buf * 3 * (size_t)(npoints > 0 ? npoints : 1));
@@ -60,7 +61,7 @@ wbio_pc2 *wbio_pc2_open(const char *path, const char *shown, int32_t npoints, do
     le32(h + 12, 1);                       /* file version */
     le32(h + 16, (uint32_t)npoints);
     le32(h + 20, float_bits((float)start_frame));
-    le32(h + 24, float_bits(1.0f));        /* one sample per frame */
+    le32(h + 24, float_bits((float)sample_rate)); /* frames per sample */
     le32(h + 28, 0);                       /* samples: patched as they come */
     if (fwrite(h, 1, sizeof h, p->f) != sizeof h) {
         snprintf(err, errn, "%s: %s", shown, strerror(errno));

@@ -305,7 +305,7 @@ static int start_pc2(lua_State *L, wbl_rec *r, int rec_idx, const wb_mesh *rest,
     wbl_path(L, name, 1, path, sizeof path);
     lua_getiuservalue(L, rec_idx, 1);
     const double start = (double)wb_world_frame(wbl_checkworld(L, -1));
-    r->pc2 = wbio_pc2_open(path, name, rest->nv, start, err, sizeof err);
+    r->pc2 = wbio_pc2_open(path, name, rest->nv, start, (double)r->every, err, sizeof err);
     if (!r->pc2) return fail_with(L, err);
     r->closed = 0;
     if (rec_write(L, rec_idx, r, err, sizeof err)) { /* the pose now is the first sample */

@@ -106,10 +106,20 @@ test("every = k, a PLY rest mesh, and no rest mesh", function()
   local c = pc2("export_pc2/rope.pc2")
   expect.eq(c.n, 5)
   expect.eq(c.samples, 3)
+  expect.eq(c.rate, 5) -- frames per sample
   expect.truthy(read("export_pc2/rope.ply"):find("^ply\nformat ascii 1.0\n"))
   local r2 = assert(w:record_pc2("export_pc2/norest.pc2", { rest = false }))
   r2:close()
+  expect.eq(pc2("export_pc2/norest.pc2").rate, 1)
   expect.eq(io.open("export_pc2/norest.obj"), nil)
+  -- a skin's cache too: {every = 3} is a sample rate of 3
+  local m = wobble.mesh{ vertices = { {0, 1, 0}, {1, 1, 0}, {0.5, 1.5, 0} }, triangles = { {1, 2, 3} } }
+  local s3 = w:skin(m, b, { bones = 2 })
+  local r3 = assert(s3:record_pc2("export_pc2/skin3.pc2", { every = 3, rest = false }))
+  r3:close()
+  local c3 = pc2("export_pc2/skin3.pc2")
+  expect.eq(c3.rate, 3)
+  expect.eq(c3.start, w:frame())
   expect.eq(pc2("export_pc2/norest.pc2").n, w:particle_count())
 end)
 
