@@ -229,6 +229,21 @@ wbio_vtk *wbio_vtk_open(const char *pvd_path, const char *dir, const char *rel_d
     return v;
 }
 
+/* text for a double-quoted XML attribute: & < > " ' as entities */
+static void xml_attr(FILE *f, const char *s)
+{
+    for (; *s; s++) {
+        switch (*s) {
+        case '&': fputs("&amp;", f); break;
+        case '<': fputs("&lt;", f); break;
+        case '>': fputs("&gt;", f); break;
+        case '"': fputs("&quot;", f); break;
+        case '\'': fputs("&apos;", f); break;
+        default: fputc(*s, f);
+        }
+    }
+}
+
 int wbio_vtk_write(wbio_vtk *v, const wb_world *w, char *err, size_t errn)
 {
     char path[4200], name[64];
@@ -249,7 +264,9 @@ int wbio_vtk_write(wbio_vtk *v, const wb_world *w, char *err, size_t errn)
         snprintf(err, errn, "%s: %s", path, strerror(errno ? errno : EIO));
         return -1;
     }
-    fprintf(v->pvd, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"%s/%s\"/>\n", wb_world_time(w), v->rel, name);
+    fprintf(v->pvd, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"", wb_world_time(w));
+    xml_attr(v->pvd, v->rel);
+    fprintf(v->pvd, "/%s\"/>\n", name);
     fflush(v->pvd);
     v->frames++;
     return 0;

@@ -85,3 +85,20 @@ test("bad arguments", function()
   expect.eq(ok, nil)
   expect.truthy(err:find("^export_vtk: "), err)
 end)
+
+test("the .pvd stays valid XML for names with & < > \" '", function()
+  local w = wobble.world{}
+  w:particle{ pos = {0, 1, 0} }
+  local rec = assert(w:record_vtk([[export_vtk/a&b<c>d"e'f]]))
+  w:run{ frames = 1 }
+  rec:close()
+  local pvd = read([[export_vtk/a&b<c>d"e'f.pvd]])
+  local files = {}
+  for file in pvd:gmatch('file="([^"]*)"') do files[#files + 1] = file end
+  expect.eq(#files, 2)
+  expect.eq(files[1], "a&amp;b&lt;c&gt;d&quot;e&apos;f/frame_000000.vtp")
+  expect.eq(pvd:find("a&b", 1, true), nil)
+  expect.eq(pvd:find("b<c", 1, true), nil)
+  -- the frames are where the (unescaped) name says
+  expect.truthy(read([[export_vtk/a&b<c>d"e'f/frame_000001.vtp]]):find("<VTKFile", 1, true))
+end)
