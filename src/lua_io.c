@@ -95,7 +95,7 @@ static void make_skins(lua_State *L, int world_index, int meshes, const wbio_con
     }
 }
 
-/* w:load_particles(path) -> body (with .parts and .skins), or nil and "file:line:col: key: reason" */
+/* w:load_particles(path) -> body (with .parts, .skins and .colliders), or nil and "file:line:col: key: reason" */
 static int w_load_particles(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
@@ -113,12 +113,29 @@ static int w_load_particles(lua_State *L)
     }
     int32_t live = 0;
     for (int32_t i = 0; i < c->img.nd; i++) live += (int32_t)(c->img.d_gen[i] & 1u);
+    /* 5: the collider slots live before, so the new ones can be told apart after */
+    uint32_t top = 0;
+    for (int32_t i = 0; i < wb_collider_count(w); i++)
+        if (wb_collider_at(w, i).index > top) top = wb_collider_at(w, i).index;
+    unsigned char *was = (unsigned char *)lua_newuserdatauv(L, (size_t)top + 1, 0);
+    memset(was, 0, (size_t)top + 1);
+    for (int32_t i = 0; i < wb_collider_count(w); i++) was[wb_collider_at(w, i).index] = 1;
     wbl_body_begin(L, c->img.np);
     wb_body b;
     wb_status st = wb_world_append_image(w, &c->img, &b);
     if (st == WB_ERR_ARG) return fail_with(L, lua_pushfstring(L, "%s: %s", name, wb_last_error()));
     if (st != WB_OK) return wbl_status_error(L, 2, st, "load_particles");
-    wbl_body_end(L, 1, b, live); /* 5: the body */
+    wbl_body_end(L, 1, b, live); /* 6: the body */
+    /* body.colliders: the colliders the config made, in slot order (= the config's order:
+     * free slots are reused lowest first, then new ones appended) */
+    lua_newtable(L);
+    for (int32_t i = 0, k = 0; i < wb_collider_count(w); i++) {
+        const wb_collider_id id = wb_collider_at(w, i);
+        if (id.index <= top && was[id.index]) continue;
+        wbl_push_collider(L, 1, id);
+        lua_rawseti(L, -2, ++k);
+    }
+    lua_setfield(L, 6, "colliders");
     /* body.parts: an array of part bodies, also indexed by name */
     lua_createtable(L, c->nparts, c->nparts);
     for (int32_t i = 0; i < c->nparts; i++) {
@@ -130,11 +147,11 @@ static int w_load_particles(lua_State *L)
         lua_setfield(L, -3, c->parts[i].name);
         lua_rawseti(L, -2, i + 1);
     }
-    lua_setfield(L, 5, "parts");
+    lua_setfield(L, 6, "parts");
     lua_createtable(L, c->nskins, 0);
     make_skins(L, 1, 4, c, b.first, b.count);
-    lua_setfield(L, 5, "skins");
-    lua_settop(L, 5);
+    lua_setfield(L, 6, "skins");
+    lua_settop(L, 6);
     return 1;
 }
 
@@ -167,6 +184,31 @@ static int l_load(lua_State *L)
     lua_createtable(L, c->nskins, 0);
     make_skins(L, 4, 3, c, 0, c->img.np);
     lua_settop(L, 4);
+    return 1;
+}
+
+/* w:colliders() / w:distances(): live handles in slot order (those of a loaded world too) */
+static int w_colliders(lua_State *L)
+{
+    wb_world *w = wbl_checkworld(L, 1);
+    const int32_t n = wb_collider_count(w);
+    lua_createtable(L, n, 0);
+    for (int32_t i = 0; i < n; i++) {
+        wbl_push_collider(L, 1, wb_collider_at(w, i));
+        lua_rawseti(L, -2, i + 1);
+    }
+    return 1;
+}
+
+static int w_distances(lua_State *L)
+{
+    wb_world *w = wbl_checkworld(L, 1);
+    const int32_t n = wb_distance_count(w);
+    lua_createtable(L, n, 0);
+    for (int32_t i = 0; i < n; i++) {
+        wbl_push_distance(L, 1, wb_distance_at(w, i));
+        lua_rawseti(L, -2, i + 1);
+    }
     return 1;
 }
 
@@ -502,6 +544,8 @@ static const luaL_Reg world_methods[] = {
     { "record_pc2", w_record_pc2 },
     { "record_vtk", w_record_vtk },
     { "save_vtp", w_save_vtp },
+    { "colliders", w_colliders },
+    { "distances", w_distances },
     { NULL, NULL }
 };
 

@@ -133,3 +133,48 @@ test("saving where it cannot", function()
   w:close()
   expect.error(function() w:save("json_snapshot/closed.json") end, "closed world")
 end)
+
+test("a loaded world gives handles: w:colliders() and w:distances() in slot order", function()
+  local w, press = scene("gauss-seidel")
+  for f = 1, 20 do
+    drive(press, f)
+    w:step()
+  end
+  expect.eq(w:save("json_snapshot/handles.json"), true)
+  local v = assert(wobble.load("json_snapshot/handles.json"))
+  local wc, vc = w:colliders(), v:colliders()
+  expect.eq(#wc, w:stats().colliders)
+  expect.eq(#vc, v:stats().colliders)
+  expect.eq(#vc, 4) -- plane, sphere, box, capsule: the removed sphere's slot is skipped
+  expect.truthy(wc[3] == press, "the original's handles are the ones it made")
+  for i = 1, #vc do
+    expect.eq(vc[i]:shape(), wc[i]:shape())
+    expect.eq({ vc[i]:position() }, { wc[i]:position() })
+    expect.truthy(vc[i]:world() == v)
+  end
+  local wd, vd = w:distances(), v:distances()
+  expect.eq(#wd, w:stats().distances)
+  expect.eq(#vd, #wd)
+  for i = 1, #vd, 37 do
+    expect.eq({ vd[i]:particles() }, { wd[i]:particles() })
+    expect.eq(vd[i]:rest(), wd[i]:rest())
+  end
+  -- the press of the loaded world, driven through its handle, moves as the original does
+  local vpress = vc[3]
+  expect.eq(vpress:shape(), "box")
+  for f = 21, 40 do
+    drive(press, f)
+    drive(vpress, f)
+    w:step()
+    v:step()
+  end
+  local x, y = vpress:position()
+  expect.near(x, 0.1 * math.sin(4), 1e-12)
+  expect.near(y, 1.9 - 0.035 * 40, 1e-12, "the loaded press moved")
+  expect.eq(v:hash(), w:hash())
+  -- a handle from the list is live: removing through it removes the collider
+  vc[2]:remove()
+  expect.eq(#v:colliders(), 3)
+  expect.eq(#wobble.world{}:colliders(), 0)
+  expect.eq(#wobble.world{}:distances(), 0)
+end)
