@@ -150,7 +150,9 @@ static int w_skin(lua_State *L)
     wb_skin_def d = wb_skin_default_def();
     if (wbl_checkopts(L, 4, skin_keys, true)) {
         wbl_optint(L, 4, "bones", 1, 16, &d.bones);
-        wbl_optint(L, 4, "neighbours", 1, 32, &d.neighbours);
+        /* at least 2: a bone's neighbourhood of one other particle is collinear, and the
+         * rotation of a collinear neighbourhood is not defined */
+        wbl_optint(L, 4, "neighbours", 2, 32, &d.neighbours);
         wbl_optint(L, 4, "iterations", 1, 1000, &d.iterations);
     }
     lua_settop(L, 4);
@@ -330,11 +332,33 @@ static int s_world(lua_State *L)
     return 1;
 }
 
+/* s:close() (also __gc/__close): frees the skin and takes it off its world's list, so the
+ * list (which holds its skins strongly, for the frame hook and the renderer) only ever
+ * holds open skins */
 static int s_close(lua_State *L)
 {
     wbl_skin *u = (wbl_skin *)luaL_checkudata(L, 1, WBL_SKIN);
+    if (!u->s) return 0;
     wb_skin_destroy(u->s);
     u->s = NULL;
+    lua_settop(L, 1);
+    if (lua_getiuservalue(L, 1, 1) == LUA_TNIL) return 0; /* 2: the world */
+    push_list(L, 2, 0);                                  /* 3 */
+    if (!lua_istable(L, 3)) return 0;
+    const lua_Integer n = (lua_Integer)lua_rawlen(L, 3);
+    for (lua_Integer i = 1; i <= n; i++) {
+        lua_rawgeti(L, 3, i);
+        const int found = lua_rawequal(L, -1, 1);
+        lua_pop(L, 1);
+        if (!found) continue;
+        for (lua_Integer j = i; j < n; j++) { /* shift the rest down: order kept */
+            lua_rawgeti(L, 3, j + 1);
+            lua_rawseti(L, 3, j);
+        }
+        lua_pushnil(L);
+        lua_rawseti(L, 3, n);
+        break;
+    }
     return 0;
 }
 

@@ -181,3 +181,38 @@ test("bad arguments are errors", function()
   w:close()
   expect.error(function() s2:vertex(1) end, "closed world")
 end)
+
+test("a closed skin leaves its world's list (bind and close, again and again)", function()
+  local w = wobble.world{ gravity = {0, 0, 0} }
+  local cage = w:lattice{ min = {0, 0, 0}, max = {1, 1, 1}, res = {3, 3, 3} }
+  local m = blob(20, 10)
+  local keep = w:skin(m, cage, { bones = 2 })
+  for i = 1, 10 do
+    local s = w:skin(m, cage, { bones = 2 })
+    expect.eq(#w:skins(), 2)
+    s:close()
+    expect.eq(#w:skins(), 1)
+  end
+  expect.eq(w:skins()[1], keep)
+  -- closing from the middle of the list keeps the others, in order
+  local a, b, c = w:skin(m, cage), w:skin(m, cage), w:skin(m, cage)
+  b:close()
+  local list = w:skins()
+  expect.eq(#list, 3)
+  expect.truthy(list[1] == keep and list[2] == a and list[3] == c, "order kept")
+  keep:close(); a:close(); c:close()
+  expect.eq(#w:skins(), 0)
+  w:step() -- the frame hook has no skin to update
+  -- __close does the same
+  do
+    local s <close> = w:skin(m, cage)
+    expect.eq(#w:skins(), 1)
+  end
+  expect.eq(#w:skins(), 0)
+end)
+
+test("neighbours: at least 2 (one neighbour is a collinear neighbourhood)", function()
+  local w, cage, m = rig()
+  expect.error(function() w:skin(m, cage, { neighbours = 1 }) end, "field 'neighbours': 1 out of range (2..32)")
+  expect.eq(#w:skin(m, cage, { neighbours = 2 }):bones(), 125)
+end)
