@@ -135,7 +135,7 @@ static int read_snapshot(rd *r, const sections *s, wb_image *g)
     kp p = { NULL, "snapshot", 0 };
     if (read_world(r, s->world, &p, &g->def)) return -1;
     int64_t i;
-    if (jv_opt_real(r, s->clock[0], &p, "time", &(wb_real){ 0 })) return -1;
+    if (jv_opt_nonneg(r, s->clock[0], &p, "time", &(wb_real){ 0 })) return -1;
     if (s->clock[0]) g->time = s->clock[0]->valuedouble; /* a double, whatever wb_real is */
     if (jv_opt_int(r, s->clock[1], &p, "frame", 0, (int64_t)1 << 53, &i)) return -1;
     if (s->clock[1]) g->frame = i;
@@ -155,15 +155,20 @@ static int read_snapshot(rd *r, const sections *s, wb_image *g)
         if (live != s->ncons)
             return jv_fail(r, s->dgen, 0, &a, "%d live slots, but \"constraints\" has %d entries", live, s->ncons);
         int32_t k = 0;
-        for (const cJSON *c = s->dfree->child; c; c = c->next, k++) {
+        /* a mark per slot, so a long free list is checked for repeats in linear time */
+        uint8_t *seen = s->nfree > 0 ? calloc((size_t)(s->nd > 0 ? s->nd : 1), 1) : NULL;
+        if (s->nfree > 0 && !seen) return jv_fail(r, s->dfree, 0, &b, "out of memory");
+        int bad = 0;
+        for (const cJSON *c = s->dfree->child; c && !bad; c = c->next, k++) {
             kp e = { &b, NULL, k };
             int64_t slot;
-            if (jv_get_int(r, c, &e, 0, s->nd > 0 ? s->nd - 1 : 0, &slot)) return -1;
-            if (s->nd == 0 || (g->d_gen[slot] & 1u)) return jv_fail(r, c, 0, &e, "slot %lld is live, not free", (long long)slot);
-            for (int32_t j = 0; j < k; j++)
-                if (g->d_free[j] == (int32_t)slot) return jv_fail(r, c, 0, &e, "slot %lld is listed twice", (long long)slot);
-            g->d_free[k] = (int32_t)slot;
+            if (jv_get_int(r, c, &e, 0, s->nd > 0 ? s->nd - 1 : 0, &slot)) bad = -1;
+            else if (s->nd == 0 || (g->d_gen[slot] & 1u)) bad = jv_fail(r, c, 0, &e, "slot %lld is live, not free", (long long)slot);
+            else if (seen[slot]++) bad = jv_fail(r, c, 0, &e, "slot %lld is listed twice", (long long)slot);
+            else g->d_free[k] = (int32_t)slot;
         }
+        free(seen);
+        if (bad) return -1;
         if (s->nd - live != s->nfree)
             return jv_fail(r, s->dfree, 0, &b, "%d free slots listed, but %d slots are dead", s->nfree, s->nd - live);
     }
@@ -464,7 +469,7 @@ static int read_skins(rd *r, const sections *s, wbio_config *cfg)
         if (jv_get_string(r, f[0], &mp, &mesh) || jv_opt_real(r, f[1], &p, "scale", &k->scale)) return -1;
         if (!(k->scale > 0)) return jv_fail(r, f[1], 0, &p, "scale must be > 0");
         if (f[2]) { if (jv_opt_int(r, f[2], &p, "bones", 1, 16, &v)) return -1; k->def.bones = (int)v; }
-        if (f[3]) { if (jv_opt_int(r, f[3], &p, "neighbours", 1, 32, &v)) return -1; k->def.neighbours = (int)v; }
+        if (f[3]) { if (jv_opt_int(r, f[3], &p, "neighbours", 2, 32, &v)) return -1; k->def.neighbours = (int)v; }
         k->mesh = strdup(mesh);
         if (!k->mesh) return jv_fail(r, c, 0, &p, "out of memory");
         jv_where_of(r, f[0], 0, &mp, k->where, sizeof k->where); /* for messages about loading it */

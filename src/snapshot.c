@@ -165,13 +165,19 @@ const char *wb_image_check(const wb_image *g)
         if ((e = wb_distance_def_check(&d))) return e;
         if (!(g->d_rest[i] >= 0)) return "rest length must be >= 0";
     }
-    /* the free list is exactly the dead slots, each once */
+    /* the free list is exactly the dead slots, each once (a mark per slot: linear) */
     if (g->nfree != dead) return "the free constraint slots do not match the dead ones";
-    for (int32_t i = 0; i < g->nfree; i++) {
-        const int32_t s = g->d_free[i];
-        if (s < 0 || s >= g->nd || (g->d_gen[s] & 1u)) return "a free constraint slot is not a dead one";
-        for (int32_t j = 0; j < i; j++)
-            if (g->d_free[j] == s) return "a free constraint slot is listed twice";
+    if (g->nfree > 0) {
+        uint8_t *seen = calloc((size_t)g->nd, 1);
+        if (!seen) return "out of memory checking the free constraint slots";
+        const char *fe = NULL;
+        for (int32_t i = 0; i < g->nfree && !fe; i++) {
+            const int32_t s = g->d_free[i];
+            if (s < 0 || s >= g->nd || (g->d_gen[s] & 1u)) fe = "a free constraint slot is not a dead one";
+            else if (seen[s]++) fe = "a free constraint slot is listed twice";
+        }
+        free(seen);
+        if (fe) return fe;
     }
     for (int32_t i = 0; i < g->nc; i++)
         if ((g->c_gen[i] & 1u) && (e = check_collider(&g->c[i]))) return e;
@@ -181,7 +187,7 @@ const char *wb_image_check(const wb_image *g)
     if (g->nsurf == 0 && g->ntri != 0) return "triangles without a surface";
     for (int64_t i = 0; i < 3 * (int64_t)g->ntri; i++)
         if (g->tri[i] < 0 || g->tri[i] >= g->np) return "surface corner out of range";
-    if (!isfinite(g->time) || g->frame < 0 || g->warnings < 0) return "time, frame and warnings must be finite and >= 0";
+    if (!(g->time >= 0) || !isfinite(g->time) || g->frame < 0 || g->warnings < 0) return "time, frame and warnings must be finite and >= 0";
     return NULL;
 }
 
@@ -363,11 +369,12 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
         wb_distance_id id = wb_distance_add(w, first + g->d_ij[2 * i], first + g->d_ij[2 * i + 1], &d, NULL);
         w->s.d_broken[id.index - 1] = g->d_broken[i];
     }
+    int32_t scan = 0; /* dead slots are taken lowest first: the scan never goes back */
     for (int32_t i = 0; i < g->nc; i++) {
         if (!(g->c_gen[i] & 1u)) continue;
         int32_t slot = -1;
-        for (int32_t k = 0; k < m->nc && slot < 0; k++)
-            if (!(m->c_gen[k] & 1u)) slot = k;
+        for (; scan < m->nc && slot < 0; scan++)
+            if (!(m->c_gen[scan] & 1u)) slot = scan;
         if (slot < 0) {
             slot = m->nc++;
             m->c_gen[slot] = 0;

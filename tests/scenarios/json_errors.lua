@@ -151,6 +151,12 @@ test("snapshot sections are checked too", function()
       "snapshot.distance_slots.free[0]: slot 0 is live, not free")
   bad(TWO .. ' "snapshot": {"world": {}, "collider_slots": {"generations": [2]}}, "colliders": [{"shape": "plane"}]}',
       "0 live slots, but \"colliders\" has 1 entries")
+  -- a dead slot listed twice (the free list's length then does not match: 2 dead, 3 listed)
+  bad(TWO .. ' "constraints": [{"type": "distance", "particles": [0, 1]}],\n'
+          .. ' "snapshot": {"world": {}, "distance_slots": {"generations": [2, 1, 2], "free": [0, 2, 0]}}}',
+      "snapshot.distance_slots.free[2]: slot 0 is listed twice")
+  bad(TWO .. ' "snapshot": {"world": {}, "time": -5}}', "snapshot.time: must be >= 0")
+  bad(TWO .. ' "skins": [{"mesh": "x.obj", "neighbours": 1}]}', "skins[0].neighbours: 1 out of range (2..32)")
 end)
 
 test("files that are not there", function()

@@ -178,3 +178,24 @@ test("a loaded world gives handles: w:colliders() and w:distances() in slot orde
   expect.eq(#wobble.world{}:colliders(), 0)
   expect.eq(#wobble.world{}:distances(), 0)
 end)
+
+test("a snapshot with 20000 removed constraints: the free list loads (linear checks)", function()
+  local w = wobble.world{ gravity = {0, 0, 0} }
+  local rope = w:rope{ from = {0, 0, 0}, to = {250, 0, 0}, segments = 25000 }
+  local links = w:distances()
+  expect.eq(#links, 25000)
+  for i = 1, 20000 do links[i]:remove() end
+  expect.eq(w:stats().distances, 5000)
+  expect.eq(w:save("json_snapshot/holes.json"), true)
+  local v = assert(wobble.load("json_snapshot/holes.json"))
+  expect.eq(v:hash(), w:hash())
+  expect.eq(v:stats().distances, 5000)
+  -- the free list came back in the same order: new constraints take the same slots
+  local a, b = w:distance(rope.first, rope.first + 2), v:distance(rope.first, rope.first + 2)
+  expect.eq(w:hash(), v:hash())
+  expect.truthy(w:distances()[1] == a and v:distances()[1] == b, "a removed slot is reused first")
+  -- the same file as a particle config (the free list checked, then ignored)
+  local u = wobble.world{}
+  local body = assert(u:load_particles("json_snapshot/holes.json"))
+  expect.eq(body.constraint_count, 5000)
+end)
