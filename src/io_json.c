@@ -583,6 +583,22 @@ static char *read_text(const char *path, const char *shown, size_t *len, char *e
     return NULL;
 }
 
+/* how many arrays and objects are open at `end` (strings skipped): cJSON stops at the
+ * bracket that goes past CJSON_NESTING_LIMIT, which is no syntax error of the file's */
+static int json_depth(const char *text, const char *end)
+{
+    int depth = 0, in_string = 0;
+    for (const char *p = text; p < end; p++) {
+        if (in_string) {
+            if (*p == '\\' && p + 1 < end) p++;
+            else if (*p == '"') in_string = 0;
+        } else if (*p == '"') in_string = 1;
+        else if (*p == '[' || *p == '{') depth++;
+        else if (*p == ']' || *p == '}') depth--;
+    }
+    return depth;
+}
+
 int wbio_read_config(const char *path, const char *shown, wbio_config *cfg, char *err, size_t errn)
 {
     memset(cfg, 0, sizeof *cfg);
@@ -606,7 +622,10 @@ int wbio_read_config(const char *path, const char *shown, wbio_config *cfg, char
         char near[24] = "";
         for (int i = 0; i < 20 && end && end[i] && end[i] != '\n'; i++) near[i] = isprint((unsigned char)end[i]) ? end[i] : '?';
         jv_line_col(text, off, &line, &col);
-        if (end && *end) snprintf(err, errn, "%s:%d:%d: JSON syntax error near '%s'", shown, line, col, near);
+        if (end && *end && json_depth(text, end) >= CJSON_NESTING_LIMIT)
+            snprintf(err, errn, "%s:%d:%d: JSON nested too deeply (more than %d levels of arrays and objects)", shown,
+                     line, col, CJSON_NESTING_LIMIT);
+        else if (end && *end) snprintf(err, errn, "%s:%d:%d: JSON syntax error near '%s'", shown, line, col, near);
         else snprintf(err, errn, "%s:%d:%d: JSON syntax error: unexpected end of file", shown, line, col);
     } else {
         if (!strncmp(s.p, "\xEF\xBB\xBF", 3)) s.p += 3; /* cJSON skips a UTF-8 byte-order mark too */

@@ -54,7 +54,13 @@ test("syntax errors: cJSON's error position as line and column", function()
   bad(HEAD .. ' "particles": [\n', NAME .. ":3:1: JSON syntax error: unexpected end of file")
   bad(HEAD .. ' "particles": []\n} trailing', NAME .. ":3:3: JSON syntax error near 'trailing'")
   bad(HEAD .. " 'particles': []}", NAME .. ":2:3: JSON syntax error near 'particles'") -- cJSON points past the quote
-  bad("", NAME .. ": empty file")
+  -- deeper than cJSON's limit (1000): said so, at the bracket where it gave up
+  local deep = HEAD .. ' "description": ' .. string.rep("[", 1200) .. string.rep("]", 1200) .. ', "particles": []}'
+  local err = bad(deep, "JSON nested too deeply (more than 1000 levels of arrays and objects)")
+  expect.truthy(err:find(NAME .. ":2:", 1, true), err)
+  -- brackets inside strings do not count; a plain syntax error stays one
+  bad(HEAD .. ' "description": "' .. string.rep("[", 1200) .. '", "particles": [,]}', "JSON syntax error near ',]}'")
+  bad(HEAD .. ' "description": ' .. string.rep("[", 10) .. ',' .. string.rep("]", 10) .. ', "particles": []}', "JSON syntax error near")
   bad("  \n\t\n", NAME .. ": empty file")
   bad(HEAD .. ' "particles": []}\0', NAME .. ":2:18: not a text file (a NUL byte)")
 end)
