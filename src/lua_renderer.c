@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -21,7 +22,42 @@ typedef struct wbl_renderer {
     wb_recorder *rec;     /* the recording, or NULL */
     bool fps_set;         /* r:record{fps = ...}: the world's dt does not decide */
     int64_t draws;
+    /* the buffers live outside the Lua heap: charged to the runtime's memory budget */
+    wb_memory *mem;
+    size_t charged, rec_charged;
 } wbl_renderer;
+
+static bool over_budget(const wb_memory *m, size_t bytes)
+{
+    return m->limit && (bytes > m->limit || m->used > m->limit - bytes);
+}
+
+/* charge `bytes` more to the budget (*slot keeps what this use holds); raises a budget
+ * error naming `what` when the budget would be passed */
+static void charge(lua_State *L, wbl_renderer *u, size_t *slot, size_t bytes, const char *what)
+{
+    wb_memory *m = u->mem;
+    if (over_budget(m, bytes))
+        wb_rt_budget_error(L, "%s needs about %.0f MB, over the memory budget of %.0f MB (--memory-limit MB)", what,
+                           bytes / 1048576.0, m->limit / 1048576.0);
+    m->used += bytes;
+    *slot += bytes;
+}
+
+static void release(wbl_renderer *u, size_t *slot)
+{
+    u->mem->used -= *slot < u->mem->used ? *slot : u->mem->used;
+    *slot = 0;
+}
+
+/* finish the recording (the frames' memory is given back); false with the message */
+static bool end_recording(wbl_renderer *u, char *err, size_t n)
+{
+    wb_recorder *rec = u->rec;
+    u->rec = NULL;
+    release(u, &u->rec_charged);
+    return wb_recorder_close(rec, err, n);
+}
 
 static wbl_renderer *checkud(lua_State *L, int arg)
 {
@@ -60,8 +96,11 @@ static int l_renderer(lua_State *L)
     }
     wbl_renderer *u = (wbl_renderer *)lua_newuserdatauv(L, sizeof *u, 0);
     memset(u, 0, sizeof *u);
+    u->mem = &wb_rt_get(L)->memory;
     luaL_setmetatable(L, WBL_RENDERER);
-    char err[512];
+    char err[512], what[64];
+    snprintf(what, sizeof what, "a %dx%d renderer", w, h);
+    charge(L, u, &u->charged, wb_renderer_bytes(be, w, h, samples), what);
     u->r = wb_renderer_create(be, w, h, samples, err, sizeof err);
     if (!u->r) return luaL_error(L, "wobble.renderer: %s", err);
     return 1;
@@ -120,15 +159,13 @@ static int r_get_camera(lua_State *L)
 
 /* ---- drawing and recording ---------------------------------------------------------------- */
 static const char *const draw_keys[] = { "particles", "constraints", "colliders", "surfaces", "skins", "pins",
-                                         "grid", "strain_scale", "line_width", NULL };
+                                         "grid", "cage", "strain_scale", "line_width", NULL };
 
 /* finish the recording; raises with the encoder's message when it failed */
 static void stop_recording(lua_State *L, wbl_renderer *u)
 {
     char err[1024];
-    wb_recorder *rec = u->rec;
-    u->rec = NULL;
-    if (!wb_recorder_close(rec, err, sizeof err)) luaL_error(L, "%s", err);
+    if (!end_recording(u, err, sizeof err)) luaL_error(L, "%s", err);
 }
 
 /* the skins made on the world at world_index, for drawing (an array in a userdata left
@@ -150,6 +187,7 @@ static wb_draw_skin *world_skins(lua_State *L, int world_index, int *n)
         sk[k].tri = m->tri;
         sk[k].nv = m->nv;
         sk[k].nt = m->nt;
+        sk[k].skin = s;
         k++;
     }
     *n = k;
@@ -187,6 +225,7 @@ static int r_draw(lua_State *L)
         wbl_optbool(L, 3, "skins", &o.skins);
         wbl_optbool(L, 3, "pins", &o.pins);
         wbl_optbool(L, 3, "grid", &o.grid);
+        wbl_optbool(L, 3, "cage", &o.cage);
         wb_real v;
         if (wbl_optreal(L, 3, "strain_scale", &v)) {
             if (!(v > 0)) return wbl_fielderror(L, 3, "strain_scale", "must be > 0");
@@ -210,6 +249,9 @@ static int r_save_png(lua_State *L)
 {
     wbl_renderer *u = checkrenderer(L, 1);
     char buf[PATH_MAX], err[PATH_MAX + 128];
+    const char *given = luaL_checkstring(L, 2), *e = strrchr(given, '.');
+    if (!e || strchr(e, '/') || strcasecmp(e, ".png") != 0)   /* a PNG by any other name surprises */
+        return luaL_argerror(L, 2, lua_pushfstring(L, "a .png file name expected, got '%s'", given));
     const char *path = script_path(L, 2, 1, buf, sizeof buf);
     if (!u->draws) return luaL_error(L, "nothing to save: call r:draw(world) first");
     int w, h;
@@ -231,12 +273,18 @@ static int r_record(lua_State *L)
     bool has_fps = !lua_isnoneornil(L, 3) && wbl_optreal(L, 3, "fps", &fps);
     if (has_fps && !(fps > 0 && fps <= 1000)) return wbl_fielderror(L, 3, "fps", "must be in (0, 1000]");
     if (u->rec) return luaL_error(L, "already recording to %s: call r:stop() first", wb_recorder_path(u->rec));
-    if (wb_media_of(lua_tostring(L, 2), err, sizeof err) == WB_MEDIA_NONE) return luaL_argerror(L, 2, err);
+    const char *given = lua_tostring(L, 2);
+    if (wb_media_of(given, NULL, err, sizeof err) == WB_MEDIA_NONE) return luaL_argerror(L, 2, err);
     const char *path = script_path(L, 2, 1, buf, sizeof buf);
+    wb_media kind = wb_media_of(given, path, err, sizeof err);   /* the name decides, not where it leads */
     int w, h;
     wb_renderer_size(u->r, &w, &h);
-    u->rec = wb_recorder_open(path, w, h, err, sizeof err);
-    if (!u->rec) return luaL_error(L, "%s", err);
+    charge(L, u, &u->rec_charged, wb_recorder_bytes(w, h), "recording");
+    u->rec = wb_recorder_open(path, kind, w, h, err, sizeof err);
+    if (!u->rec) {
+        release(u, &u->rec_charged);
+        return luaL_error(L, "%s", err);
+    }
     u->fps_set = has_fps;
     if (has_fps) wb_recorder_set_fps(u->rec, fps);
     return 0;
@@ -324,25 +372,24 @@ static int r_info(lua_State *L)
     return 2;
 }
 
+static void destroy(wbl_renderer *u)
+{
+    wb_renderer_destroy(u->r);
+    u->r = NULL;
+    if (u->mem) release(u, &u->charged);
+}
+
 /* __gc, __close and r:close(): a recording is finished; at collection its failure can
  * only be printed */
 static int r_close(lua_State *L)
 {
     wbl_renderer *u = checkud(L, 1);
     bool gc = lua_toboolean(L, lua_upvalueindex(1));
-    if (u->rec) {
-        char err[1024];
-        wb_recorder *rec = u->rec;
-        u->rec = NULL;
-        if (!wb_recorder_close(rec, err, sizeof err)) {
-            wb_renderer_destroy(u->r);
-            u->r = NULL;
-            if (gc) fprintf(stderr, "wobble: %s\n", err);
-            else return luaL_error(L, "%s", err);
-        }
-    }
-    wb_renderer_destroy(u->r);
-    u->r = NULL;
+    char err[1024];
+    bool ok = !u->rec || end_recording(u, err, sizeof err);
+    destroy(u);
+    if (!ok && gc) fprintf(stderr, "wobble: %s\n", err);
+    else if (!ok) return luaL_error(L, "%s", err);
     return 0;
 }
 
@@ -360,7 +407,7 @@ static int r_tostring(lua_State *L)
 }
 
 /* ---- media files ---------------------------------------------------------------------------- */
-/* wobble.probe(path) -> {width, height, frames, codec, pix_fmt} or nil, message */
+/* wobble.probe(path) -> {width, height, frames, codec, pix_fmt, duration} or nil, message */
 static int l_probe(lua_State *L)
 {
     char buf[PATH_MAX], err[PATH_MAX + 128];
@@ -371,7 +418,7 @@ static int l_probe(lua_State *L)
         lua_pushstring(L, err);
         return 2;
     }
-    lua_createtable(L, 0, 5);
+    lua_createtable(L, 0, 6);
     lua_pushinteger(L, mi.width);
     lua_setfield(L, -2, "width");
     lua_pushinteger(L, mi.height);
@@ -382,6 +429,8 @@ static int l_probe(lua_State *L)
     lua_setfield(L, -2, "codec");
     lua_pushstring(L, mi.pix_fmt);
     lua_setfield(L, -2, "pix_fmt");
+    lua_pushnumber(L, mi.duration);
+    lua_setfield(L, -2, "duration");
     return 1;
 }
 
@@ -392,6 +441,28 @@ static int l_read_png(lua_State *L)
     const char *path = script_path(L, 1, 0, buf, sizeof buf);
     int w, h;
     uint8_t *px = wb_image_read_png(path, &w, &h, err, sizeof err);
+    if (!px) {
+        luaL_pushfail(L);
+        lua_pushstring(L, err);
+        return 2;
+    }
+    lua_pushinteger(L, w);
+    lua_pushinteger(L, h);
+    lua_pushlstring(L, (const char *)px, (size_t)w * h * 3);
+    free(px);
+    return 3;
+}
+
+/* wobble.read_frame(path [, index = 0]) -> width, height, RGB string of that frame of a
+ * video (decoded by ffmpeg); or nil, message */
+static int l_read_frame(lua_State *L)
+{
+    char buf[PATH_MAX], err[PATH_MAX + 128];
+    const char *path = script_path(L, 1, 0, buf, sizeof buf);
+    lua_Integer index = luaL_optinteger(L, 2, 0);
+    luaL_argcheck(L, index >= 0, 2, "frame index must be >= 0");
+    int w, h;
+    uint8_t *px = wb_media_read_frame(path, (int64_t)index, &w, &h, err, sizeof err);
     if (!px) {
         luaL_pushfail(L);
         lua_pushstring(L, err);
@@ -435,10 +506,8 @@ static int record_hook(lua_State *L)
     wb_draw_opts o = wb_draw_default_opts();
     char err[1024];
     if (!draw_frame(L, u, 1, &o, err, sizeof err)) {
-        wb_recorder *rec = u->rec;
-        u->rec = NULL;
         char more[1024];
-        if (!wb_recorder_close(rec, more, sizeof more)) return luaL_error(L, "--record: %s", more);
+        if (!end_recording(u, more, sizeof more)) return luaL_error(L, "--record: %s", more);
         return luaL_error(L, "--record: %s", err);
     }
     return 0;
@@ -447,7 +516,8 @@ static int record_hook(lua_State *L)
 bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n)
 {
     char e[PATH_MAX + 256];
-    if (wb_media_of(path, e, sizeof e) == WB_MEDIA_NONE) {
+    wb_media kind = wb_media_of(path, NULL, e, sizeof e);
+    if (kind == WB_MEDIA_NONE) {
         snprintf(err, n, "--record: %s", e);
         return false;
     }
@@ -461,8 +531,18 @@ bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n)
     wbl_renderer *u = checkud(L, -1);
     int w, h;
     wb_renderer_size(u->r, &w, &h);
-    u->rec = wb_recorder_open(path, w, h, e, sizeof e);
+    size_t bytes = wb_recorder_bytes(w, h);
+    if (over_budget(u->mem, bytes)) {
+        snprintf(err, n, "--record: the frames need about %.0f MB, over the memory budget of %.0f MB (--memory-limit MB)",
+                 bytes / 1048576.0, u->mem->limit / 1048576.0);
+        lua_settop(L, top);
+        return false;
+    }
+    u->mem->used += bytes;
+    u->rec_charged = bytes;
+    u->rec = wb_recorder_open(path, kind, w, h, e, sizeof e);
     if (!u->rec) {
+        release(u, &u->rec_charged);
         snprintf(err, n, "--record: %s", e);
         lua_settop(L, top);
         return false;
@@ -492,18 +572,13 @@ bool wbl_record_end(lua_State *L, char *err, size_t n)
             char path[PATH_MAX];
             snprintf(path, sizeof path, "%s", wb_recorder_path(u->rec));
             int64_t frames = wb_recorder_frames(u->rec);
-            wb_recorder *rec = u->rec;
-            u->rec = NULL;
-            ok = wb_recorder_close(rec, err, n);
+            ok = end_recording(u, err, n);
             if (ok && !wb_rt_get(L)->quiet) {
                 if (frames) fprintf(stderr, "wobble: recorded %lld frames to %s\n", (long long)frames, path);
                 else fprintf(stderr, "wobble: --record: the scene stepped no frame, nothing written to %s\n", path);
             }
         }
-        if (u) {
-            wb_renderer_destroy(u->r);
-            u->r = NULL;
-        }
+        if (u) destroy(u);
     }
     lua_settop(L, top);
     return ok;
@@ -548,6 +623,8 @@ void wbl_open_renderer(lua_State *L)
     lua_setfield(L, -2, "probe");
     lua_pushcfunction(L, l_read_png);
     lua_setfield(L, -2, "read_png");
+    lua_pushcfunction(L, l_read_frame);
+    lua_setfield(L, -2, "read_frame");
     lua_pushcfunction(L, l_clock);
     lua_setfield(L, -2, "clock");
     wbl_open_plot(L);

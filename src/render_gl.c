@@ -330,6 +330,17 @@ void wb_gl_upload(GLenum target, GLuint buf, size_t *cap, const void *data, size
     if (bytes) glBufferSubData(target, 0, (GLsizeiptr)bytes, data);
 }
 
+void wb_gl_surf_attribs(const wb_gl *g)
+{
+    glBindVertexArray(g->vao_surf);
+    glBindBuffer(GL_ARRAY_BUFFER, g->vbo_surf);
+    for (GLuint a = 0; a < 3; a++) glEnableVertexAttribArray(a == 2 ? 9 : a);
+    const GLsizei stride = WB_SV * sizeof(float);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, (const void *)0);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride, (const void *)(3 * sizeof(float)));
+    glVertexAttribPointer(9, 4, GL_FLOAT, GL_FALSE, stride, (const void *)(6 * sizeof(float)));
+}
+
 void wb_gl_inst_attribs(const wb_gl *g, size_t first)
 {
     glBindVertexArray(g->vao_mesh);
@@ -444,15 +455,12 @@ bool wb_gl_init(wb_gl *g, int w, int h, int *samples, char *err, size_t n)
     wb_gl_upload(GL_ARRAY_BUFFER, g->vbo_inst, &g->inst_cap, NULL, 64 * sizeof(wb_inst));
     wb_gl_inst_attribs(g, 0);
 
-    /* surfaces: per-particle position and normal; the instance attributes stay
-     * disabled and take constant values (identity model, the surface's colour) */
+    /* surfaces: per-vertex position, normal and colour; the other instance
+     * attributes stay disabled and take constant values (identity model) */
     glBindVertexArray(g->vao_surf);
     wb_gl_upload(GL_ARRAY_BUFFER, g->vbo_surf, &g->surf_cap, NULL, 4096);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g->ebo_surf);
-    glEnableVertexAttribArray(0);
-    glEnableVertexAttribArray(1);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), (const void *)0);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), (const void *)(3 * sizeof(float)));
+    wb_gl_surf_attribs(g);
 
     glBindVertexArray(g->vao_line);
     wb_gl_upload(GL_ARRAY_BUFFER, g->vbo_seg, &g->seg_cap, NULL, 4096);

@@ -9,6 +9,7 @@
 #include <math.h>
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "wobble.h"
@@ -28,6 +29,42 @@ typedef struct wb_seg {
     float a[3], b[3], c[4];
 } wb_seg;
 
+/* surface vertices: position, normal, colour (linear RGB) and shine: WB_SV floats */
+#define WB_SV 10
+
+/* instance groups, by mesh: particle spheres, collider spheres and capsule caps,
+ * capsule bodies, boxes */
+enum { WB_G_LO, WB_G_HI, WB_G_CYL, WB_G_BOX, WB_G_COUNT };
+
+/* what the layers draw this frame (render_layers.c), and its scratch */
+typedef struct wb_layers {
+    wb_inst *inst;                                  /* first[g], count[g] of each group */
+    size_t first[WB_G_COUNT], count[WB_G_COUNT], inst_cap;
+    wb_seg *seg;                                    /* the links */
+    size_t nseg, seg_cap;
+    bool surfaces;                                  /* anything in sv / si */
+    float *sv;                                      /* nv vertices of WB_SV floats */
+    size_t nv, sv_cap;
+    GLuint *si;                                     /* nidx indices, triangles */
+    size_t nidx, si_cap;
+    int32_t *pairs, npairs;                         /* distance constraints, their strains */
+    wb_real *strain;
+    size_t pair_cap;
+    float *vstrain;                                 /* per particle: the strain its surface shows */
+    size_t vstrain_cap;
+    uint8_t *flags;                                 /* per particle: on a surface, under a skin */
+    size_t flag_cap;
+} wb_layers;
+
+struct wb_draw_opts;
+struct wb_draw_skin;
+/* fill l for world w (unit: the scene's size, for points without a radius); false:
+ * out of memory */
+bool wb_layers_build(wb_layers *l, const wb_world *w, const struct wb_draw_opts *o, const struct wb_draw_skin *sk,
+                     int nsk, double unit);
+void wb_layers_free(wb_layers *l);
+void wb_lin3(const float srgb[3], float lin[3]);   /* the shaders' gamma 2 */
+
 typedef struct wb_gl {
     GLuint prog_mesh, prog_depth, prog_line, prog_grid, prog_bg;
     GLuint vao_mesh, vao_surf, vao_line, vao_grid, vao_empty;
@@ -45,6 +82,8 @@ bool wb_gl_init(wb_gl *g, int w, int h, int *samples, char *err, size_t n);
 void wb_gl_free(wb_gl *g);
 /* make buffer `buf` (of `target`) hold `bytes` from data, growing it when needed */
 void wb_gl_upload(GLenum target, GLuint buf, size_t *cap, const void *data, size_t bytes);
+/* point vao_surf's attributes at vbo_surf (after it was re-specified by growing) */
+void wb_gl_surf_attribs(const wb_gl *g);
 /* point the instance attributes of vao_mesh at instance `first` of vbo_inst */
 void wb_gl_inst_attribs(const wb_gl *g, size_t first);
 

@@ -8,9 +8,10 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <math.h>
 #include <pthread.h>
 #include <signal.h>
-#include <spawn.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,8 +39,6 @@
 #include <stb/stb_image.h>
 #pragma GCC diagnostic pop
 
-extern char **environ;
-
 #define NSLOT 3   /* frames queued for the writer thread */
 
 /* ---- PNG ------------------------------------------------------------------------------ */
@@ -64,20 +63,54 @@ static void mem_write(void *ctx, void *data, int size)
     m->n += (size_t)size;
 }
 
-/* write all of data to path, checking every step (fclose reports a full disk late) */
+/* write all of data to f, checking every step (fclose reports a full disk late) */
+static bool write_stream(FILE *f, const void *data, size_t n, int *e)
+{
+    bool ok = fwrite(data, 1, n, f) == n;
+    *e = ok ? 0 : errno ? errno : EIO;
+    if (fclose(f) != 0 && ok) ok = false, *e = errno;
+    return ok;
+}
+
+/* write data to path without ever losing what was there: into a new file next to it,
+ * renamed over the path once complete, so a failure removes only that new file. A
+ * path that exists and is no regular file (a device, a pipe) is written in place and
+ * never removed. */
 static bool write_file(const char *path, const void *data, size_t n, char *err, size_t en)
 {
-    FILE *f = fopen(path, "wb");
-    if (!f) {
-        snprintf(err, en, "cannot write %s: %s", path, strerror(errno));
+    static _Atomic unsigned seq;
+    char real[PATH_MAX], tmp[PATH_MAX + 64];
+    struct stat st;
+    int e = 0;
+    /* a symlink: replace its target, not the link */
+    if (lstat(path, &st) == 0 && S_ISLNK(st.st_mode) && realpath(path, real)) path = real;
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        FILE *f = fopen(path, "wb");
+        if (f && write_stream(f, data, n, &e)) return true;
+        snprintf(err, en, "cannot write %s: %s", path, strerror(f ? e : errno));
         return false;
     }
-    bool ok = fwrite(data, 1, n, f) == n;
-    int e = errno;
-    if (fclose(f) != 0 && ok) ok = false, e = errno;
+    const char *slash = strrchr(path, '/');
+    int dl = slash ? (int)(slash - path + 1) : 0, fd = -1;
+    for (int tries = 0; fd < 0 && tries < 100; tries++) {
+        if (snprintf(tmp, sizeof tmp, "%.*s.%s.%ld-%u.tmp", dl, path, path + dl, (long)getpid(), seq++) >= (int)sizeof tmp) {
+            snprintf(err, en, "cannot write %s: path too long", path);
+            return false;
+        }
+        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd < 0 && errno != EEXIST) break;
+    }
+    FILE *f = fd >= 0 ? fdopen(fd, "wb") : NULL;
+    if (!f) {
+        snprintf(err, en, "cannot write %s: %s", path, strerror(errno));
+        if (fd >= 0) close(fd), unlink(tmp);
+        return false;
+    }
+    bool ok = write_stream(f, data, n, &e);
+    if (ok && rename(tmp, path) != 0) ok = false, e = errno;
     if (!ok) {
         snprintf(err, en, "cannot write %s: %s", path, strerror(e));
-        remove(path);
+        unlink(tmp);
     }
     return ok;
 }
@@ -120,21 +153,21 @@ static const char *ext_of(const char *path)
     return dot && dot != base ? dot : NULL;
 }
 
-wb_media wb_media_of(const char *path, char *err, size_t n)
+wb_media wb_media_of(const char *given, const char *path, char *err, size_t n)
 {
-    size_t len = strlen(path);
+    size_t len = strlen(given);
     struct stat st;
     if (len == 0) {
         snprintf(err, n, "empty path");
         return WB_MEDIA_NONE;
     }
-    if (path[len - 1] == '/' || (stat(path, &st) == 0 && S_ISDIR(st.st_mode))) return WB_MEDIA_FOLDER;
-    const char *e = ext_of(path);
+    if (given[len - 1] == '/' || (stat(path ? path : given, &st) == 0 && S_ISDIR(st.st_mode))) return WB_MEDIA_FOLDER;
+    const char *e = ext_of(given);
     if (!e) return WB_MEDIA_FOLDER;
     if (!strcasecmp(e, ".mp4")) return WB_MEDIA_MP4;
     if (!strcasecmp(e, ".gif")) return WB_MEDIA_GIF;
     snprintf(err, n, "cannot record to '%s': unknown extension '%s' (expected .mp4, .gif, or a folder for PNG frames)",
-             path, e);
+             given, e);
     return WB_MEDIA_NONE;
 }
 
@@ -142,6 +175,9 @@ wb_media wb_media_of(const char *path, char *err, size_t n)
 struct wb_recorder {
     wb_media kind;
     char path[PATH_MAX];
+    bool created;                 /* the file at path is ours (dev, ino): made by open */
+    dev_t dev;
+    ino_t ino;
     int w, h;
     double fps, timeout;
     size_t bytes;                 /* of one frame */
@@ -165,14 +201,18 @@ static const char *ffmpeg_prog(void)
     return p && *p ? p : "ffmpeg";
 }
 
-wb_recorder *wb_recorder_open(const char *path, int w, int h, char *err, size_t n)
+wb_recorder *wb_recorder_open(const char *path, wb_media kind, int w, int h, char *err, size_t n)
 {
-    wb_media kind = wb_media_of(path, err, n);
-    if (kind == WB_MEDIA_NONE) return NULL;
+    if (kind == WB_MEDIA_NONE) {
+        snprintf(err, n, "cannot record to '%s': no media kind", path);
+        return NULL;
+    }
     if (strlen(path) >= PATH_MAX - 32) {
         snprintf(err, n, "path too long");
         return NULL;
     }
+    struct stat made;
+    bool created = false;
     /* find out now that the destination is unusable, not at the first frame */
     if (kind == WB_MEDIA_FOLDER) {
         if (mkdir(path, 0777) != 0 && errno != EEXIST) {
@@ -184,11 +224,16 @@ wb_recorder *wb_recorder_open(const char *path, int w, int h, char *err, size_t 
             return NULL;
         }
     } else {
-        int fd = open(path, O_WRONLY | O_CREAT | O_CLOEXEC, 0666);
+        /* a file made here is removed again when no frame comes; one that was there
+         * before (or anything not a regular file) is never removed */
+        created = true;
+        int fd = open(path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd < 0 && errno == EEXIST) created = false, fd = open(path, O_WRONLY | O_CLOEXEC);
         if (fd < 0) {
             snprintf(err, n, "cannot write %s: %s", path, strerror(errno));
             return NULL;
         }
+        if (fstat(fd, &made) != 0) created = false;
         close(fd);
     }
     wb_recorder *rec = calloc(1, sizeof *rec);
@@ -197,6 +242,8 @@ wb_recorder *wb_recorder_open(const char *path, int w, int h, char *err, size_t 
         return NULL;
     }
     rec->kind = kind;
+    rec->created = created;
+    if (created) rec->dev = made.st_dev, rec->ino = made.st_ino;
     snprintf(rec->path, sizeof rec->path, "%s", path);
     rec->w = w, rec->h = h;
     rec->fps = 60;
@@ -208,6 +255,8 @@ wb_recorder *wb_recorder_open(const char *path, int w, int h, char *err, size_t 
     pthread_cond_init(&rec->cv, NULL);
     return rec;
 }
+
+size_t wb_recorder_bytes(int w, int h) { return NSLOT * (size_t)w * (size_t)h * 3; }
 
 void wb_recorder_set_fps(wb_recorder *rec, double fps)
 {
@@ -282,7 +331,7 @@ static void *writer(void *p)
 /* ffmpeg reading raw RGB on stdin, its stderr into a temporary file */
 static bool spawn_encoder(wb_recorder *rec, char *err, size_t n)
 {
-    char size[32], rate[32], out[PATH_MAX + 16], tmpl[PATH_MAX];
+    char size[32], rate[32], out[PATH_MAX + 16], tmpl[PATH_MAX], gif_vf[160];
     snprintf(size, sizeof size, "%dx%d", rec->w, rec->h);
     snprintf(rate, sizeof rate, "%.6g", rec->fps);
     /* "file:" so neither a leading '-' nor a colon in the name means something else */
@@ -299,9 +348,13 @@ static bool spawn_encoder(wb_recorder *rec, char *err, size_t n)
                               "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-movflags", "+faststart", "-f", "mp4" };
         for (size_t k = 0; k < sizeof mp4 / sizeof *mp4; k++) argv[a++] = mp4[k];
     } else {
-        /* a palette per frame: nothing buffered for the whole stream */
-        const char *gif[] = { "-vf", "split[a][b];[a]palettegen=stats_mode=single[p];[b][p]paletteuse=new=1",
-                              "-loop", "0", "-f", "gif" };
+        /* a GIF's delays are whole centiseconds and players show one under 2 cs as 10:
+         * resample to 100/d frames a second, d >= 2 (60 fps becomes 50), so it plays at
+         * the right speed; a palette per frame: nothing buffered for the whole stream */
+        double d = fmax(2, ceil(100 / rec->fps - 1e-9));
+        snprintf(gif_vf, sizeof gif_vf, "fps=100/%.0f,split[a][b];[a]palettegen=stats_mode=single[p];"
+                 "[b][p]paletteuse=new=1", d);
+        const char *gif[] = { "-vf", gif_vf, "-loop", "0", "-f", "gif" };
         for (size_t k = 0; k < sizeof gif / sizeof *gif; k++) argv[a++] = gif[k];
     }
     argv[a++] = out;
@@ -316,25 +369,8 @@ static bool spawn_encoder(wb_recorder *rec, char *err, size_t n)
         snprintf(err, n, "cannot start %s: %s", prog, strerror(errno));
         return false;
     }
-    posix_spawn_file_actions_t fa;
-    posix_spawnattr_t at;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_adddup2(&fa, pfd[0], 0);
-    posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
-    posix_spawn_file_actions_adddup2(&fa, rec->errfd, 2);
-    posix_spawnattr_init(&at);
-    sigset_t none, def;
-    sigemptyset(&none);
-    sigemptyset(&def);
-    sigaddset(&def, SIGPIPE);
-    posix_spawnattr_setsigmask(&at, &none);
-    posix_spawnattr_setsigdefault(&at, &def);
     /* its own process group: a stalled encoder is killed with whatever it started */
-    posix_spawnattr_setpgroup(&at, 0);
-    posix_spawnattr_setflags(&at, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETPGROUP);
-    int e = posix_spawnp(&rec->pid, prog, &fa, &at, (char *const *)argv, environ);
-    posix_spawn_file_actions_destroy(&fa);
-    posix_spawnattr_destroy(&at);
+    int fds[3] = { pfd[0], -1, rec->errfd }, e = wb_spawn(prog, argv, fds, true, &rec->pid);
     close(pfd[0]);
     if (e != 0) {
         close(pfd[1]);
@@ -452,6 +488,15 @@ static void encoder_says(wb_recorder *rec, char *out, size_t n)
     memcpy(out, s, strlen(s) + 1);
 }
 
+/* remove the empty file the recorder made, if it is still that one */
+static void remove_ours(const wb_recorder *rec)
+{
+    struct stat st;
+    if (rec->created && lstat(rec->path, &st) == 0 && S_ISREG(st.st_mode) && st.st_dev == rec->dev &&
+        st.st_ino == rec->ino && st.st_size == 0)
+        unlink(rec->path);
+}
+
 bool wb_recorder_close(wb_recorder *rec, char *err, size_t n)
 {
     if (!rec) return true;
@@ -498,87 +543,10 @@ bool wb_recorder_close(wb_recorder *rec, char *err, size_t n)
         ok = false;
     }
     if (rec->errfd >= 0) close(rec->errfd);
-    if (!rec->started && rec->kind != WB_MEDIA_FOLDER) remove(rec->path);   /* no frames: no empty file */
+    if (!rec->started) remove_ours(rec);   /* no frames: no empty file */
     for (int k = 0; k < NSLOT; k++) free(rec->slot[k]);
     pthread_mutex_destroy(&rec->mu);
     pthread_cond_destroy(&rec->cv);
     free(rec);
     return ok;
-}
-
-/* ---- probing ------------------------------------------------------------------------------ */
-bool wb_media_probe(const char *path, wb_media_info *info, char *err, size_t n)
-{
-    memset(info, 0, sizeof *info);
-    const char *e = ext_of(path);
-    if (e && !strcasecmp(e, ".png")) {
-        int comp;
-        if (!stbi_info(path, &info->width, &info->height, &comp)) {
-            snprintf(err, n, "%s is not a readable PNG (%s)", path, stbi_failure_reason());
-            return false;
-        }
-        info->frames = 1;
-        snprintf(info->codec, sizeof info->codec, "png");
-        snprintf(info->pix_fmt, sizeof info->pix_fmt, comp == 4 ? "rgba" : comp == 3 ? "rgb24" : "gray");
-        return true;
-    }
-    if (access(path, R_OK) != 0) {
-        snprintf(err, n, "cannot read %s: %s", path, strerror(errno));
-        return false;
-    }
-    const char *prog = getenv("WOBBLE_FFPROBE");
-    if (!prog || !*prog) prog = "ffprobe";
-    char in[PATH_MAX + 16];
-    snprintf(in, sizeof in, "file:%s%s", path[0] == '/' ? "" : "./", path);
-    const char *argv[] = { prog, "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
-                           "stream=width,height,codec_name,pix_fmt,nb_read_frames", "-of",
-                           "default=noprint_wrappers=1", in, NULL };
-    int pfd[2];
-    if (pipe2(pfd, O_CLOEXEC) != 0) {
-        snprintf(err, n, "cannot run %s: %s", prog, strerror(errno));
-        return false;
-    }
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_adddup2(&fa, pfd[1], 1);
-    posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
-    pid_t pid;
-    int se = posix_spawnp(&pid, prog, &fa, NULL, (char *const *)argv, environ);
-    posix_spawn_file_actions_destroy(&fa);
-    close(pfd[1]);
-    if (se != 0) {
-        close(pfd[0]);
-        snprintf(err, n, "cannot run %s: %s", prog, strerror(se));
-        return false;
-    }
-    char out[2048];
-    size_t got = 0;
-    for (;;) {
-        ssize_t k = read(pfd[0], out + got, sizeof out - 1 - got);
-        if (k < 0 && errno == EINTR) continue;
-        if (k <= 0) break;
-        got += (size_t)k;
-        if (got == sizeof out - 1) break;
-    }
-    out[got] = 0;
-    close(pfd[0]);
-    int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
-    for (char *line = strtok(out, "\n"); line; line = strtok(NULL, "\n")) {
-        char *eq = strchr(line, '=');
-        if (!eq) continue;
-        *eq = 0;
-        const char *v = eq + 1;
-        if (!strcmp(line, "width")) info->width = atoi(v);
-        else if (!strcmp(line, "height")) info->height = atoi(v);
-        else if (!strcmp(line, "nb_read_frames")) info->frames = atoll(v);
-        else if (!strcmp(line, "codec_name")) snprintf(info->codec, sizeof info->codec, "%s", v);
-        else if (!strcmp(line, "pix_fmt")) snprintf(info->pix_fmt, sizeof info->pix_fmt, "%s", v);
-    }
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || !info->codec[0]) {
-        snprintf(err, n, "%s: not a video %s can read", path, prog);
-        return false;
-    }
-    return true;
 }

@@ -158,7 +158,7 @@ void wb_text(uint8_t *rgb, int w, int h, int x, int y, const char *s, const uint
 }
 
 /* ---- the chart ------------------------------------------------------------------------- */
-static double nice(double x)
+double wb_nice_step(double x)
 {
     double p = pow(10, floor(log10(x))), m = x / p;
     return (m < 1.5 ? 1 : m < 3.5 ? 2 : m < 7.5 ? 5 : 10) * p;
@@ -174,7 +174,7 @@ typedef struct panel { int x0, y0, x1, y1; double lo, hi; } panel;
 
 static void ticks(double lo, double hi, int want, double *first, double *step)
 {
-    *step = nice((hi - lo) / want);
+    *step = wb_nice_step((hi - lo) / want);
     *first = ceil(lo / *step - 1e-9) * *step;
 }
 

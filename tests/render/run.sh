@@ -34,6 +34,12 @@ run() {
 frames() {  # frames of a video, through ffprobe
     ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames -of csv=p=0 "$1"
 }
+duration() {   # seconds a player takes for it
+    ffprobe -v error -show_entries format=duration -of csv=p=0 "$1"
+}
+near() {   # near VALUE EXPECTED TOLERANCE
+    awk -v v="$1" -v e="$2" -v t="$3" 'BEGIN { d = v - e; exit !(v != "" && d <= t && -d <= t) }'
+}
 field() {   # one stream field of a video
     ffprobe -v error -select_streams v:0 -show_entries stream="$2" -of csv=p=0 "$1"
 }
@@ -45,7 +51,8 @@ run "$W" run $F/swing.lua --quiet --record "$TMP/swing.mp4"
 [ ! -s "$TMP/err" ]; ok "--record --quiet prints nothing" $?
 
 run "$W" run $F/swing.lua --frames 5 --record "$TMP/swing.gif"
-[ "$code" = 0 ] && [ "$(frames "$TMP/swing.gif")" = 8 ]; ok "--record .gif with --frames 5: 5 + 3 frames" $?
+# 8 frames at 60 fps last 0.133 s; a GIF shows them at 50 fps (2 cs a frame): 7 frames, 0.14 s
+[ "$code" = 0 ] && [ "$(frames "$TMP/swing.gif")" = 7 ] && near "$(duration "$TMP/swing.gif")" 0.14 0.015; ok "--record .gif with --frames 5: 5 + 3 frames, as long as they last" $?
 grep -q "recorded 8 frames to $TMP/swing.gif" "$TMP/err"; ok "--record says where the frames went" $?
 
 run "$W" run $F/swing.lua --quiet --frames 2 --record "$TMP/pngs/"
@@ -71,6 +78,40 @@ start=$(date +%s)
 run env WOBBLE_FFMPEG="$PWD/$F/stall.sh" WOBBLE_ENCODER_TIMEOUT=1 timeout 60 "$W" run $F/swing.lua --record "$TMP/stall.mp4"
 took=$(( $(date +%s) - start ))
 [ "$code" = 2 ] && grep -q "took no frame" "$TMP/err" && [ "$took" -lt 30 ]; ok "an encoder that never reads: stopped after the timeout, exit 2 (took ${took}s)" $?
+
+# files that were there before are never deleted by a failed write or recording
+mkdir -p "$TMP/keep"
+echo precious >"$TMP/keep/old.png"
+# a file size limit of 2 KB: the PNG write fails part way (SIGXFSZ ignored: EFBIG)
+run sh -c 'trap "" XFSZ; ulimit -f 4; exec "$@"' sh "$W" run $F/save_png.lua --quiet --out "$TMP/keep"
+[ "$code" = 2 ] && grep -q "cannot write .*old.png" "$TMP/err"; ok "a PNG write that fails part way: exit 2, the file named" $?
+[ "$(cat "$TMP/keep/old.png")" = precious ] && [ "$(ls -A "$TMP/keep")" = old.png ]; ok "... the old file is intact and nothing else is left" $?
+run "$W" run $F/save_png.lua --quiet --out "$TMP/keep"
+[ "$code" = 0 ] && [ "$(head -c 4 "$TMP/keep/old.png" | tail -c 3)" = PNG ] && [ "$(ls -A "$TMP/keep")" = old.png ]; ok "the same write without the limit replaces it" $?
+
+echo precious >"$TMP/keep/old.mp4"
+run env WOBBLE_FFMPEG=/nonexistent/ffmpeg "$W" run $F/swing.lua --record "$TMP/keep/old.mp4"
+[ "$code" = 2 ] && [ "$(cat "$TMP/keep/old.mp4")" = precious ]; ok "a recording that fails before its first frame leaves an existing file alone" $?
+printf 'local w = wobble.world{}\n' >"$TMP/nostep.lua"
+run "$W" run "$TMP/nostep.lua" --record "$TMP/keep/old.mp4"
+[ "$code" = 0 ] && [ "$(cat "$TMP/keep/old.mp4")" = precious ] && grep -q "nothing written" "$TMP/err"; ok "a scene that steps no frame leaves an existing file alone" $?
+run "$W" run "$TMP/nostep.lua" --record "$TMP/keep/new.mp4"
+[ "$code" = 0 ] && [ ! -e "$TMP/keep/new.mp4" ]; ok "... and removes the empty file it made" $?
+
+# the encoder gets no descriptor of the script's (fds.sh fails when it sees held.txt)
+run env WOBBLE_FFMPEG="$PWD/$F/fds.sh" "$W" run $F/record.lua --quiet --out "$TMP/fds"
+[ "$code" = 0 ]; ok "the encoder does not inherit the script's open files" $?
+
+# the format comes from the name the script gave, not from where a symlink leads
+mkdir -p "$TMP/link/data" && : >"$TMP/link/data/clip" && ln -s data/clip "$TMP/link/v.mp4"
+run "$W" run $F/record.lua --quiet --out "$TMP/link" --set name=v.mp4
+[ "$code" = 0 ] && [ "$(field "$TMP/link/data/clip" codec_name)" = h264 ] && [ "$(frames "$TMP/link/data/clip")" = 3 ]; ok "r:record(v.mp4), a symlink to a file without extension: an MP4" $?
+
+# the renderer's buffers count against --memory-limit
+run "$W" run $F/big.lua --memory-limit 64
+[ "$code" = 3 ] && grep -q "4096x4096 renderer needs about .* MB, over the memory budget of 64 MB" "$TMP/err"; ok "a renderer too large for --memory-limit: exit 3, says why" $?
+run "$W" run $F/big.lua --memory-limit 64 --set width=320 --set height=240
+[ "$code" = 0 ]; ok "a small one fits" $?
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -52,26 +52,77 @@ test("a sphere collider appears where the camera sees its centre, and only with 
   expect.gt(math.abs(nr - cr) + math.abs(ng - cg) + math.abs(nb - cb), 60, "without colliders the sky shows there")
 end)
 
-test("box and capsule colliders follow their poses", function()
-  local w = wobble.world{}
-  local box = w:collider{ shape = "box", center = {-1, 1, 0}, half = {0.3, 0.3, 0.3} }
-  w:collider{ shape = "capsule", a = {0.8, 0.6, 0}, b = {0.8, 1.4, 0}, radius = 0.15 }
-  r:camera{ eye = {0, 1, 5}, target = {0, 1, 0} }
+-- the colour at world point p with and without colliders: a collider is there when the
+-- two differ (the sky and the ground are the same in both) and it is grey
+local function collider_at(w, p)
   r:draw(w, { grid = false })
-  local sky_r, _, sky_b = at{ 0, 1.9, 0 }
-  expect.gt(sky_b, sky_r + 20)
-  for _, p in ipairs{ { -1, 1, 0.3 }, { 0.8, 1.0, 0.15 }, { 0.8, 1.4, 0.1 } } do
-    local cr, cg, cb = at(p)
-    expect.truthy(is_grey(cr, cg, cb, 50, 235), "a collider is drawn at " .. table.concat(p, ","))
+  local cr, cg, cb = at(p)
+  r:draw(w, { grid = false, colliders = false })
+  local nr, ng, nb = at(p)
+  local diff = math.abs(cr - nr) + math.abs(cg - ng) + math.abs(cb - nb)
+  return diff > 30 and is_grey(cr, cg, cb, 40, 235), diff
+end
+
+test("box and capsule colliders are drawn at their poses, rotations included", function()
+  local w = wobble.world{}
+  local c, s = math.cos(math.pi / 8), math.sin(math.pi / 8)   -- 45 degrees about z
+  -- a box turned 45 degrees about z (a diamond seen from the front), an upright capsule,
+  -- and a capsule lying along x
+  local box = w:collider{ shape = "box", center = {-1, 1, 0}, half = {0.3, 0.3, 0.3}, rotation = {c, 0, 0, s} }
+  w:collider{ shape = "capsule", a = {0.8, 0.6, 0}, b = {0.8, 1.4, 0}, radius = 0.15 }
+  w:collider{ shape = "capsule", a = {-0.6, 0.2, 0}, b = {0.4, 0.2, 0}, radius = 0.1 }
+  r:camera{ eye = {0, 1, 5}, target = {0, 1, 0} }
+  local inside = {
+    { -1, 1, 0.3, "the box's centre" }, { -0.62, 1, 0.3, "the box's right corner, beyond an unturned box" },
+    { -1, 1.38, 0.3, "the box's top corner" },
+    { 0.8, 1.0, 0.15, "the upright capsule's middle" }, { 0.8, 1.48, 0.1, "its upper cap" },
+    { 0.8, 0.5, 0.08, "its lower cap" }, { -0.1, 0.2, 0.1, "the lying capsule's middle" },
+    { 0.47, 0.2, 0.05, "its end cap" },
+  }
+  for _, p in ipairs(inside) do
+    local yes, diff = collider_at(w, p)
+    expect.truthy(yes, p[4] .. " is drawn (difference " .. diff .. ")")
   end
-  -- move the box: it is drawn at its new place after a step
+  local outside = {
+    { -0.73, 1.27, 0.3, "the corner an unturned box would have" }, { 1.05, 1.0, 0, "right of the capsule" },
+    { 0.8, 1.65, 0, "above its cap" }, { -0.1, 0.4, 0, "above the lying capsule" },
+  }
+  for _, p in ipairs(outside) do
+    local yes, diff = collider_at(w, p)
+    expect.falsy(yes, p[4] .. " is empty (difference " .. diff .. ")")
+  end
+  -- move the box: it is drawn at its new place after a step, and gone from the old one
   box:set_position(0, 1, 0)
   w:step()
-  r:draw(w, { grid = false })
-  local nr, ng, nb = at{ 0, 1, 0.3 }
-  expect.truthy(is_grey(nr, ng, nb, 50, 235), "the box moved")
-  local or_, _, ob = at{ -1, 1, 0.3 }
-  expect.gt(ob, or_ + 20, "sky where the box was")
+  expect.truthy(collider_at(w, { 0, 1, 0.3 }), "the box moved")
+  expect.falsy(collider_at(w, { -1, 1, 0.3 }), "and left its old place")
+end)
+
+test("the key light shades solids and casts their shadows on the ground", function()
+  local w = wobble.world{}
+  w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0 }
+  w:collider{ shape = "sphere", center = {0, 1, 0}, radius = 0.4 }
+  r:camera{ eye = {1, 3, 4}, target = {0.2, 0.4, 0} }
+  r:draw(w)
+  local function brightness(p)
+    local cr, cg, cb = at(p)
+    return cr + cg + cb
+  end
+  -- the light comes from (-0.4, 0.8, 0.45): the sphere's side towards it is bright,
+  -- the side away from it has the ambient light only
+  local function on_sphere(nx, ny, nz)
+    local l = math.sqrt(nx * nx + ny * ny + nz * nz)
+    return { 0.4 * nx / l, 1 + 0.4 * ny / l, 0.4 * nz / l }
+  end
+  local lit, dark = brightness(on_sphere(-0.4, 0.8, 0.45)), brightness(on_sphere(0.6, -0.5, 0.6))
+  expect.gt(lit, dark + 150, "the lit side is brighter than the side away from the light")
+  -- the shadow: the ground where the light's ray through the centre lands is darker
+  -- with the sphere than without it
+  local shadow = { 0.4 / 0.8, 0, -0.45 / 0.8 }
+  local with = brightness(shadow)
+  r:draw(w, { colliders = false })
+  local without = brightness(shadow)
+  expect.lt(with, without - 90, "the sphere's shadow on the ground")
 end)
 
 test("a cloth is a shaded two-sided surface where its particles are", function()
