@@ -14,6 +14,28 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+/* the folders above a path named on the command line (`--record out/run1/v.mp4`), made
+ * as `--out` would be: the user chose the path */
+static int make_parents(const char *path, char *err, size_t n)
+{
+    char p[PATH_MAX];
+    if (snprintf(p, sizeof p, "%s", path) >= (int)sizeof p) {
+        snprintf(err, n, "%s: path too long", path);
+        return -1;
+    }
+    for (char *c = p + 1; *c; c++) {
+        if (*c != '/') continue;
+        *c = 0;
+        if (mkdir(p, 0777) != 0 && errno != EEXIST) {
+            const int e = errno;
+            snprintf(err, n, "cannot make the folder %.900s: %s", p, strerror(e));
+            return -1;
+        }
+        *c = '/';
+    }
+    return 0;
+}
+
 enum { EXIT_PASS = 0, EXIT_FAILED = 1, EXIT_SCRIPT = 2, EXIT_BUDGET = 3 };
 
 static const char usage_text[] =
@@ -559,6 +581,11 @@ static int run_scene(const opts *o, const char *path) {
     char rerr[1024];
     /* --record: every frame the scene steps is drawn and encoded (the path is the
      * user's choice, not the sandbox's); the file is finished even after an error */
+    if (o->record && make_parents(o->record, rerr, sizeof rerr) != 0) {
+        fprintf(stderr, "wobble: --record: %s\n", rerr);
+        wb_rt_close(L);
+        return EXIT_SCRIPT;
+    }
     if (o->record && !wbl_record_begin(L, o->record, rerr, sizeof rerr)) {
         fprintf(stderr, "wobble: %s\n", rerr);
         wb_rt_close(L);

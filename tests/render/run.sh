@@ -61,8 +61,11 @@ run "$W" run $F/swing.lua --quiet --frames 2 --record "$TMP/pngs/"
 run "$W" run $F/swing.lua --record "$TMP/swing.avi"
 [ "$code" = 2 ] && grep -q "unknown extension '.avi'" "$TMP/err"; ok "--record .avi: exit 2, the extension named" $?
 
-run "$W" run $F/swing.lua --record "$TMP/no/such/dir/x.mp4"
-[ "$code" = 2 ] && grep -q "cannot write" "$TMP/err" && [ ! -s "$TMP/out" ]; ok "--record into a missing folder: exit 2 before running" $?
+run "$W" run $F/swing.lua --quiet --frames 2 --record "$TMP/no/such/dir/x.gif"
+[ "$code" = 0 ] && [ "$(frames "$TMP/no/such/dir/x.gif")" -ge 2 ]; ok "--record into a missing folder: the folders are made (as --out does)" $?
+: > "$TMP/afile"
+run "$W" run $F/swing.lua --record "$TMP/afile/x.mp4"
+[ "$code" = 2 ] && grep -q "cannot write $TMP/afile/x.mp4: Not a directory" "$TMP/err" && [ ! -s "$TMP/out" ]; ok "--record under a file: exit 2 before running" $?
 
 run "$W" test tests/scenarios/api_run.lua --record "$TMP/x.mp4"
 [ "$code" = 2 ] && grep -q "option of run" "$TMP/err"; ok "--record is an option of run only" $?
