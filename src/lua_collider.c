@@ -27,14 +27,11 @@ wb_collider_id *wbl_push_collider(lua_State *L, int world_index, wb_collider_id 
 
 static wb_world *checkcollider(lua_State *L, int arg, wb_collider_id *id)
 {
-    wbl_collider *c = (wbl_collider *)luaL_checkudata(L, arg, WBL_COLLIDER);
-    lua_getiuservalue(L, arg, 1);
-    wbl_world *ud = (wbl_world *)lua_touserdata(L, -1);
-    lua_pop(L, 1);
-    if (!ud || !ud->w || !wb_collider_valid(ud->w, c->id))
-        luaL_error(L, "stale collider handle (removed or world closed)");
+    wb_world *w;
+    wbl_collider *c = (wbl_collider *)wbl_handle(L, arg, WBL_COLLIDER, &w);
+    if (!w || !wb_collider_valid(w, c->id)) luaL_error(L, "stale collider handle (removed or world closed)");
     *id = c->id;
-    return ud->w;
+    return w;
 }
 
 static int w_collider(lua_State *L)
@@ -178,10 +175,9 @@ static int col_remove(lua_State *L)
 
 static int col_valid(lua_State *L)
 {
-    wbl_collider *c = (wbl_collider *)luaL_checkudata(L, 1, WBL_COLLIDER);
-    lua_getiuservalue(L, 1, 1);
-    wbl_world *ud = (wbl_world *)lua_touserdata(L, -1);
-    lua_pushboolean(L, ud && ud->w && wb_collider_valid(ud->w, c->id));
+    wb_world *w;
+    wbl_collider *c = (wbl_collider *)wbl_handle(L, 1, WBL_COLLIDER, &w);
+    lua_pushboolean(L, w && wb_collider_valid(w, c->id));
     return 1;
 }
 
@@ -194,14 +190,13 @@ static int col_world(lua_State *L)
 
 static int col_tostring(lua_State *L)
 {
-    wbl_collider *c = (wbl_collider *)luaL_checkudata(L, 1, WBL_COLLIDER);
-    lua_getiuservalue(L, 1, 1);
-    wbl_world *ud = (wbl_world *)lua_touserdata(L, -1);
-    if (!ud || !ud->w || !wb_collider_valid(ud->w, c->id)) {
+    wb_world *w;
+    wbl_collider *c = (wbl_collider *)wbl_handle(L, 1, WBL_COLLIDER, &w);
+    if (!w || !wb_collider_valid(w, c->id)) {
         lua_pushfstring(L, "wobble.collider: %p (stale)", (void *)c);
         return 1;
     }
-    wb_shape s = wb_collider_shape(ud->w, c->id);
+    wb_shape s = wb_collider_shape(w, c->id);
     lua_pushfstring(L, "wobble.collider: %p (%s)", (void *)c,
                     s >= 0 && s < WB_SHAPE_COUNT ? shape_names[s] : "?");
     return 1;
@@ -209,16 +204,7 @@ static int col_tostring(lua_State *L)
 
 static int col_eq(lua_State *L)
 {
-    wbl_collider *a = (wbl_collider *)luaL_testudata(L, 1, WBL_COLLIDER);
-    wbl_collider *b = (wbl_collider *)luaL_testudata(L, 2, WBL_COLLIDER);
-    if (!a || !b || a->id.index != b->id.index || a->id.gen != b->id.gen) {
-        lua_pushboolean(L, 0);
-        return 1;
-    }
-    lua_getiuservalue(L, 1, 1);
-    lua_getiuservalue(L, 2, 1);
-    lua_pushboolean(L, lua_rawequal(L, -1, -2));
-    return 1;
+    return wbl_handle_eq(L, WBL_COLLIDER, sizeof(wb_collider_id));
 }
 
 static const luaL_Reg collider_methods[] = {

@@ -19,14 +19,11 @@ wb_distance_id *wbl_push_distance(lua_State *L, int world_index, wb_distance_id 
 /* the world of a live handle; raises for a removed constraint or a closed world */
 static wb_world *checkdistance(lua_State *L, int arg, wb_distance_id *id)
 {
-    wbl_distance *c = (wbl_distance *)luaL_checkudata(L, arg, WBL_DISTANCE);
-    lua_getiuservalue(L, arg, 1);
-    wbl_world *ud = (wbl_world *)lua_touserdata(L, -1);
-    lua_pop(L, 1); /* the handle itself still references the world */
-    if (!ud || !ud->w || !wb_distance_valid(ud->w, c->id))
-        luaL_error(L, "stale constraint handle (removed or world closed)");
+    wb_world *w;
+    wbl_distance *c = (wbl_distance *)wbl_handle(L, arg, WBL_DISTANCE, &w);
+    if (!w || !wb_distance_valid(w, c->id)) luaL_error(L, "stale constraint handle (removed or world closed)");
     *id = c->id;
-    return ud->w;
+    return w;
 }
 
 static const char *const distance_keys[] = {
@@ -132,10 +129,9 @@ static int c_remove(lua_State *L)
 /* c:valid() -> false once removed or its world closed (never raises) */
 static int c_valid(lua_State *L)
 {
-    wbl_distance *c = (wbl_distance *)luaL_checkudata(L, 1, WBL_DISTANCE);
-    lua_getiuservalue(L, 1, 1);
-    wbl_world *ud = (wbl_world *)lua_touserdata(L, -1);
-    lua_pushboolean(L, ud && ud->w && wb_distance_valid(ud->w, c->id));
+    wb_world *w;
+    wbl_distance *c = (wbl_distance *)wbl_handle(L, 1, WBL_DISTANCE, &w);
+    lua_pushboolean(L, w && wb_distance_valid(w, c->id));
     return 1;
 }
 
@@ -148,33 +144,23 @@ static int c_world(lua_State *L)
 
 static int c_tostring(lua_State *L)
 {
-    wbl_distance *c = (wbl_distance *)luaL_checkudata(L, 1, WBL_DISTANCE);
-    lua_getiuservalue(L, 1, 1);
-    wbl_world *ud = (wbl_world *)lua_touserdata(L, -1);
-    if (!ud || !ud->w || !wb_distance_valid(ud->w, c->id)) {
+    wb_world *w;
+    wbl_distance *c = (wbl_distance *)wbl_handle(L, 1, WBL_DISTANCE, &w);
+    if (!w || !wb_distance_valid(w, c->id)) {
         lua_pushfstring(L, "wobble.distance: %p (stale)", (void *)c);
         return 1;
     }
     int32_t a, b;
-    wb_distance_particles(ud->w, c->id, &a, &b);
+    wb_distance_particles(w, c->id, &a, &b);
     lua_pushfstring(L, "wobble.distance: %p (%d-%d%s)", (void *)c, (int)a + 1, (int)b + 1,
-                    wb_distance_broken(ud->w, c->id) ? ", broken" : "");
+                    wb_distance_broken(w, c->id) ? ", broken" : "");
     return 1;
 }
 
 /* two handles are equal when they name the same constraint of the same world */
 static int c_eq(lua_State *L)
 {
-    wbl_distance *a = (wbl_distance *)luaL_testudata(L, 1, WBL_DISTANCE);
-    wbl_distance *b = (wbl_distance *)luaL_testudata(L, 2, WBL_DISTANCE);
-    if (!a || !b || a->id.index != b->id.index || a->id.gen != b->id.gen) {
-        lua_pushboolean(L, 0);
-        return 1;
-    }
-    lua_getiuservalue(L, 1, 1);
-    lua_getiuservalue(L, 2, 1);
-    lua_pushboolean(L, lua_rawequal(L, -1, -2));
-    return 1;
+    return wbl_handle_eq(L, WBL_DISTANCE, sizeof(wb_distance_id));
 }
 
 static const luaL_Reg distance_methods[] = {

@@ -318,6 +318,31 @@ int wbl_status_error(lua_State *L, int arg, wb_status st, const char *what)
     }
 }
 
+/* ---- handles ----------------------------------------------------------------------------- */
+void *wbl_handle(lua_State *L, int arg, const char *tname, wb_world **w)
+{
+    void *h = luaL_checkudata(L, arg, tname);
+    lua_getiuservalue(L, arg, 1);
+    wbl_world *ud = (wbl_world *)lua_touserdata(L, -1);
+    lua_pop(L, 1); /* the handle itself still references the world */
+    *w = ud ? ud->w : NULL;
+    return h;
+}
+
+/* equal when they name the same object of the same world */
+int wbl_handle_eq(lua_State *L, const char *tname, size_t size)
+{
+    void *a = luaL_testudata(L, 1, tname), *b = luaL_testudata(L, 2, tname);
+    if (!a || !b || memcmp(a, b, size) != 0) {
+        lua_pushboolean(L, 0);
+        return 1;
+    }
+    lua_getiuservalue(L, 1, 1);
+    lua_getiuservalue(L, 2, 1);
+    lua_pushboolean(L, lua_rawequal(L, -1, -2));
+    return 1;
+}
+
 /* ---- stepping ---------------------------------------------------------------------------- */
 void wbl_step(lua_State *L, wb_world *w)
 {

@@ -35,6 +35,12 @@ void wbl_add_world_methods(lua_State *L, const luaL_Reg *l);
 /* ---- the world --------------------------------------------------------------- */
 wbl_world *wbl_checkworld_ud(lua_State *L, int arg);  /* open or closed */
 wb_world *wbl_checkworld(lua_State *L, int arg);      /* raises when closed */
+/* handles (constraints, colliders): an id userdata whose user value is its world's
+ * userdata. wbl_handle checks the type and gives the world (NULL once closed);
+ * wbl_handle_eq is __eq for a handle type whose ids are `size` bytes. */
+void *wbl_handle(lua_State *L, int arg, const char *tname, wb_world **w);
+int wbl_handle_eq(lua_State *L, const char *tname, size_t size);
+
 /* one frame of w, stoppable by the runtime's budgets (a spent budget raises its
  * error; the frame is then undone) */
 void wbl_step(lua_State *L, wb_world *w);
