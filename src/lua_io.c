@@ -204,9 +204,12 @@ static int w_distances(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
     const int32_t n = wb_distance_count(w);
+    /* the ids in a Lua-owned buffer: nothing leaks if pushing the handles fails */
+    wb_distance_id *ids = (wb_distance_id *)lua_newuserdatauv(L, sizeof *ids * (size_t)(n > 0 ? n : 1), 0);
+    wb_distance_ids(w, ids);
     lua_createtable(L, n, 0);
     for (int32_t i = 0; i < n; i++) {
-        wbl_push_distance(L, 1, wb_distance_at(w, i));
+        wbl_push_distance(L, 1, ids[i]);
         lua_rawseti(L, -2, i + 1);
     }
     return 1;

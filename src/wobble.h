@@ -127,6 +127,9 @@ void wb_distance_particles(const wb_world *w, wb_distance_id c, int32_t *a, int3
 int32_t wb_distance_count(const wb_world *w);                 /* live constraints, broken included */
 /* iterate: the i-th live constraint for i in [0, count) (order stable between edits) */
 wb_distance_id wb_distance_at(const wb_world *w, int32_t i);
+/* every live constraint's handle in slot order, at once (out holds wb_distance_count):
+ * wb_distance_at is a scan, so a loop over it is quadratic */
+int32_t wb_distance_ids(const wb_world *w, wb_distance_id *out);
 
 /* ---- colliders (kinematic: the script moves them) -------------------------------- */
 typedef struct wb_collider_def {

@@ -392,6 +392,14 @@ wb_distance_id wb_distance_at(const wb_world *w, int32_t i)
     return none;
 }
 
+int32_t wb_distance_ids(const wb_world *w, wb_distance_id *out)
+{
+    int32_t n = 0;
+    for (int32_t s = 0; s < w->m.nd; s++)
+        if (slot_live(w->m.d_gen[s])) { out[n].index = (uint32_t)s + 1; out[n].gen = w->m.d_gen[s]; n++; }
+    return n;
+}
+
 /* ---- events --------------------------------------------------------------------------- */
 int32_t wb_world_break_count(const wb_world *w) { return w->k.nbreaks; }
 wb_distance_id wb_world_break_at(const wb_world *w, int32_t i) { assert(i >= 0 && i < w->k.nbreaks); return w->k.breaks[i]; }

@@ -68,7 +68,8 @@
     X(collider_huge_inputs_normalised)           \
     X(collider_absurd_velocity_recovers)         \
     X(hash_covers_collider_velocity_mass_radius) \
-    X(memory_budget_shared_by_worlds)
+    X(memory_budget_shared_by_worlds)           \
+    X(distance_ids_match_distance_at)
 
 #define DECLARE(name) TEST(name);
 #define ENTRY(name) { #name, test_##name },

@@ -178,3 +178,29 @@ TEST(memory_budget_shared_by_worlds)
     wb_world_destroy(b);
     CHECK_EQ(mem.used, 0);
 }
+
+TEST(distance_ids_match_distance_at)
+{
+    /* the bulk listing is the same as the one-at-a-time scan, holes and reused slots
+     * included */
+    wb_world_def d = wb_world_default_def();
+    wb_world *w = wb_world_create(&d);
+    REQUIRE(w);
+    wb_rope_def r = wb_rope_default_def();
+    r.segments = 20;
+    wb_body b;
+    REQUIRE(wb_rope(w, &r, &b) == WB_OK);
+    wb_distance_remove(w, wb_distance_at(w, 3));
+    wb_distance_remove(w, wb_distance_at(w, 10));
+    wb_distance_def dd = wb_distance_default_def();
+    wb_distance_add(w, 0, 5, &dd, NULL); /* reuses a freed slot */
+    wb_distance_id ids[32];
+    const int32_t n = wb_distance_ids(w, ids);
+    CHECK_EQ(n, wb_distance_count(w));
+    CHECK_EQ(n, 19);
+    for (int32_t i = 0; i < n; i++) {
+        const wb_distance_id a = wb_distance_at(w, i);
+        CHECK(ids[i].index == a.index && ids[i].gen == a.gen && wb_distance_valid(w, ids[i]));
+    }
+    wb_world_destroy(w);
+}
