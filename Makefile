@@ -12,17 +12,19 @@ PCMODS  := lua5.4 libcjson assimp osmesa
 MISSING  = missing=""; for p in $(PKGS); do \
 	     dpkg-query -W -f='$${db:Status-Abbrev}' $$p 2>/dev/null | grep -q '^ii' || missing="$$missing $$p"; done
 
-CFLAGS_BASE := -std=c11 $(OPT) -g -Wall -Wextra -Werror -fopenmp -fno-math-errno -D_GNU_SOURCE \
+CFLAGS_BASE := -std=c11 $(OPT) -g -Wall -Wextra -Werror -fopenmp -fno-math-errno -D_GNU_SOURCE -Isrc \
                -DWB_ROOT='"$(CURDIR)"' -DWB_PREFIX='"$(PREFIX)"'
 CFLAGS  += $(CFLAGS_BASE) $(EXTRA_CFLAGS)
 LDFLAGS += -fopenmp $(EXTRA_LDFLAGS)
 PC_CFLAGS = $(shell pkg-config --cflags $(PCMODS) 2>/dev/null)
 PC_LIBS   = $(shell pkg-config --libs $(PCMODS) 2>/dev/null)
 
-ALL_SRC  := $(wildcard src/*.c)
+# one folder per layer (DESIGN.md §1): cli -> lua -> {render, io} -> core -> wobble.h
+LAYERS   := core io render lua cli
 # the core: no Lua, no GL, no file formats, no command line
-CORE_SRC := $(filter-out src/lua_% src/main.c src/render% src/io_% src/progress.c,$(ALL_SRC))
-APP_SRC  := $(filter-out $(CORE_SRC),$(ALL_SRC))
+CORE_SRC := $(wildcard src/core/*.c)
+APP_SRC  := $(foreach l,io render lua cli,$(wildcard src/$(l)/*.c))
+HEADERS  := $(wildcard src/*.h src/*/*.h)
 CORE_OBJ := $(CORE_SRC:src/%.c=$(BUILD)/obj/%.o)
 APP_OBJ  := $(APP_SRC:src/%.c=$(BUILD)/obj/%.o)
 UNIT_SRC := $(wildcard tests/unit/*.c)
@@ -47,10 +49,10 @@ deps:
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $$missing; \
 	else echo "all Debian packages present"; fi
 
-$(BUILD)/obj/%.o: src/%.c src/*.h | $(BUILD)/obj
+$(BUILD)/obj/%.o: src/%.c $(HEADERS) | $(addprefix $(BUILD)/obj/,$(LAYERS))
 	$(CC) $(CFLAGS) $(PC_CFLAGS) -c $< -o $@
 
-$(BUILD)/obj:
+$(addprefix $(BUILD)/obj/,$(LAYERS)):
 	@mkdir -p $@
 
 $(BUILD)/libwobble.a: $(CORE_OBJ)
@@ -61,7 +63,7 @@ $(BUILD)/wobble: $(APP_OBJ) $(BUILD)/libwobble.a
 
 # C unit tests of the core alone: links only libwobble.a
 $(BUILD)/unit_tests: $(UNIT_SRC) $(wildcard tests/unit/*.h) $(BUILD)/libwobble.a
-	$(CC) $(CFLAGS) -Isrc -o $@ $(UNIT_SRC) $(BUILD)/libwobble.a $(LDFLAGS) -lm
+	$(CC) $(CFLAGS) -o $@ $(UNIT_SRC) $(BUILD)/libwobble.a $(LDFLAGS) -lm
 
 test: check-deps
 	@$(MAKE) --no-print-directory build

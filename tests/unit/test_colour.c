@@ -8,7 +8,7 @@
  *   - batch ranges are contiguous, increasing and cover [0, ns). */
 #include <stdlib.h>
 
-#include "core.h"
+#include "core/core.h"
 #include "test.h"
 
 static void check_colouring(wb_world *w)

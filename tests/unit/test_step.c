@@ -3,7 +3,7 @@
 #include <float.h>
 #include <stdlib.h>
 
-#include "core.h"
+#include "core/core.h"
 #include "test.h"
 
 TEST(free_fall_exact)

@@ -1,0 +1,712 @@
+/* main.c: the `wobble` command line (DESIGN §4): run a scene, run scenario tests as
+ * TAP 13, run the benchmark scenes. Exit codes: 0 ok, 1 a test or expectation
+ * failed, 2 script or input error, 3 a budget was exceeded. */
+#include "lua/wobble_lua.h"
+#include "render/render.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* the folders above a path named on the command line (`--record out/run1/v.mp4`), made
+ * as `--out` would be: the user chose the path */
+static int make_parents(const char *path, char *err, size_t n)
+{
+    char p[PATH_MAX];
+    if (snprintf(p, sizeof p, "%s", path) >= (int)sizeof p) {
+        snprintf(err, n, "%s: path too long", path);
+        return -1;
+    }
+    for (char *c = p + 1; *c; c++) {
+        if (*c != '/') continue;
+        *c = 0;
+        if (mkdir(p, 0777) != 0 && errno != EEXIST) {
+            const int e = errno;
+            snprintf(err, n, "cannot make the folder %.900s: %s", p, strerror(e));
+            return -1;
+        }
+        *c = '/';
+    }
+    return 0;
+}
+
+enum { EXIT_PASS = 0, EXIT_FAILED = 1, EXIT_SCRIPT = 2, EXIT_BUDGET = 3 };
+
+static const char usage_text[] =
+    "usage: wobble <command> [options]\n"
+    "\n"
+    "  wobble run SCENE.lua [options]  run a scene script\n"
+    "  wobble test [PATH...] [options] run scenario tests (.lua files, folders searched\n"
+    "                                  recursively; default tests/); TAP 13 on stdout,\n"
+    "                                  last line \"N passed, N failed\"\n"
+    "  wobble bench [--json]           run the benchmark scenes (tests/bench/*.lua, or\n"
+    "                                  share/wobble/bench of an installed wobble)\n"
+    "  wobble --version | --help\n"
+    "\n"
+    "options of run, test and bench:\n"
+    "  --frames N          w:run stops after N frames\n"
+    "  --record OUT        (run) draw every frame into OUT: .mp4, .gif or a folder of PNGs\n"
+    "  --out DIR           output folder, the only place a script writes (default out)\n"
+    "  --set key=value     wobble.args.key = value (numbers, true/false converted); repeatable\n"
+    "  --threads N         default thread count of new worlds, 1 to 256 (default 1)\n"
+    "  --unsafe            no sandbox: any path, os.execute, io.popen, C modules, debug\n"
+    "  --quiet             no progress bar\n"
+    "  --time-limit S      stop after S seconds of wall time (exit code 3)\n"
+    "  --memory-limit MB   limit of the Lua heap and all worlds together, default 4096\n"
+    "                      (exit code 3)\n"
+    "\n"
+    "exit codes: 0 ok, 1 a test or expectation failed, 2 script or input error,\n"
+    "            3 time or memory budget exceeded\n";
+
+typedef struct opts {
+    wb_runtime rt;
+    const char **sets, **pos;  /* --set values, positional arguments */
+    const char *record;        /* run --record OUT, or NULL */
+    int nsets, npos;
+    int json;                  /* bench --json */
+} opts;
+
+static int usage_error(const char *fmt, const char *arg) {
+    fprintf(stderr, "wobble: ");
+    fprintf(stderr, fmt, arg);
+    fprintf(stderr, "\n\n%s", usage_text);
+    return EXIT_SCRIPT;
+}
+
+/* ---- options ------------------------------------------------------------------------- */
+
+static int parse_number(const char *s, double lo, double hi, double *out) {
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (!*s || *end || errno || !(v >= lo && v <= hi)) return -1;
+    *out = v;
+    return 0;
+}
+
+/* Would Lua read s as an infinite number (1e999)? Lua converts with strtod, refuses
+ * "inf" and "nan" (any n/N) and allows surrounding spaces; a --set value that does
+ * not convert stays a string and is fine. */
+static int overflows(const char *s) {
+    char *end;
+    if (strpbrk(s, "nN")) return 0;
+    double v = strtod(s, &end);
+    if (end == s) return 0;
+    while (*end == ' ' || (*end >= '\t' && *end <= '\r')) end++;
+    return !*end && !isfinite(v);
+}
+
+static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
+    memset(o, 0, sizeof *o);
+    o->rt.out_dir = "out";
+    o->rt.frame_cap = -1;
+    o->rt.open_module = luaopen_wobble;
+    o->rt.memory_budget = (size_t)4096 << 20;
+    o->sets = calloc((size_t)argc + 1, sizeof *o->sets);  /* + bench --json */
+    o->pos = calloc((size_t)argc, sizeof *o->pos);
+    if (!o->sets || !o->pos) return usage_error("%s", "out of memory");
+    int only_pos = 0;
+    for (int i = 2; i < argc; i++) {
+        char *a = argv[i], name[64];
+        const char *val = NULL;
+        if (only_pos || a[0] != '-' || !a[1]) {
+            o->pos[o->npos++] = a;
+            continue;
+        }
+        if (strcmp(a, "--") == 0) {
+            only_pos = 1;
+            continue;
+        }
+        /* --name value or --name=value */
+        const char *eq = strchr(a, '=');
+        size_t nl = eq ? (size_t)(eq - a) : strlen(a);
+        if (nl >= sizeof name) return usage_error("unknown option %s", a);
+        memcpy(name, a, nl);
+        name[nl] = 0;
+        int flag = !strcmp(name, "--unsafe") || !strcmp(name, "--quiet") || !strcmp(name, "--json");
+        if (!strcmp(name, "--watch")) return usage_error("%s is not implemented yet", name);
+        if (flag) {
+            if (eq) return usage_error("%s takes no value", name);
+            if (!strcmp(name, "--json") && strcmp(cmd, "bench")) return usage_error("unknown option %s", a);
+            if (!strcmp(name, "--unsafe")) o->rt.unsafe = 1;
+            else if (!strcmp(name, "--quiet")) o->rt.quiet = 1;
+            else o->json = 1;
+            continue;
+        }
+        if (strcmp(name, "--frames") && strcmp(name, "--out") && strcmp(name, "--set") && strcmp(name, "--threads") &&
+            strcmp(name, "--time-limit") && strcmp(name, "--memory-limit") && strcmp(name, "--record"))
+            return usage_error("unknown option %s", a);
+        if (!strcmp(name, "--record") && strcmp(cmd, "run")) return usage_error("%s is an option of run", name);
+        if (eq) val = eq + 1;
+        else if (i + 1 < argc) val = argv[++i];
+        else return usage_error("%s needs a value", name);
+        double v;
+        if (!strcmp(name, "--frames")) {
+            if (parse_number(val, 0, 1e15, &v) || v != (int64_t)v)
+                return usage_error("--frames expects a whole number of frames, got '%s'", val);
+            o->rt.frame_cap = (int64_t)v;
+        } else if (!strcmp(name, "--threads")) {
+            if (parse_number(val, 1, WB_MAX_THREADS, &v) || v != (int)v)
+                return usage_error("--threads expects a whole number from 1 to 256, got '%s'", val);
+            o->rt.threads = (int)v;
+        } else if (!strcmp(name, "--time-limit")) {
+            if (parse_number(val, 0, 1e9, &v)) return usage_error("--time-limit expects seconds, got '%s'", val);
+            o->rt.time_budget = v;
+        } else if (!strcmp(name, "--memory-limit")) {
+            if (parse_number(val, 0, 1e9, &v)) return usage_error("--memory-limit expects megabytes, got '%s'", val);
+            o->rt.memory_budget = (size_t)(v * 1048576.0);  /* 0: none */
+        } else if (!strcmp(name, "--record")) {
+            if (!*val) return usage_error("%s", "--record expects a file (.mp4, .gif) or a folder");
+            o->record = val;
+        } else if (!strcmp(name, "--out")) {
+            if (!*val) return usage_error("%s", "--out expects a folder");
+            o->rt.out_dir = val;
+        } else {
+            const char *e = strchr(val, '=');
+            if (!e || e == val) return usage_error("--set expects key=value, got '%s'", val);
+            if (overflows(e + 1)) return usage_error("--set %s: the number is out of range (not finite)", val);
+            o->sets[o->nsets++] = val;
+        }
+    }
+    return EXIT_PASS;
+}
+
+/* ---- running chunks ------------------------------------------------------------------- */
+
+static int assertion_failed;  /* the last error was an expectation of wobble.test */
+
+/* is the value at idx the message of the harness's last failed expectation? */
+static int is_expectation(lua_State *L, int idx) {
+    idx = lua_absindex(L, idx);
+    lua_getfield(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
+    int r = 0;
+    if (lua_getfield(L, -1, "wobble.test") == LUA_TTABLE) {
+        lua_getfield(L, -1, "_last_failure");
+        r = lua_rawequal(L, -1, idx);
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 2);
+    return r;
+}
+
+/* The first expectation that failed although the script caught its error (pcall, a
+ * coroutine), as a message pushed on the stack; NULL (nothing pushed) when none. A
+ * caught failure still fails: otherwise pcall(expect.eq, 1, 2) would pass a test. */
+static const char *caught_failure(lua_State *L) {
+    const char *msg = NULL;
+    int top = lua_gettop(L);
+    lua_getfield(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
+    if (lua_getfield(L, -1, "wobble.test") == LUA_TTABLE && lua_getfield(L, -1, "_first_failure") == LUA_TSTRING)
+        msg = lua_pushfstring(L, "%s (an expectation failed and the script caught its error; a failed "
+                                 "expectation fails the test all the same)", lua_tostring(L, -1));
+    if (msg) {
+        lua_replace(L, top + 1);
+        lua_settop(L, top + 1);
+    } else {
+        lua_settop(L, top);
+    }
+    return msg;
+}
+
+/* forget caught failures before the next case */
+static void clear_caught(lua_State *L) {
+    lua_getfield(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
+    if (lua_getfield(L, -1, "wobble.test") == LUA_TTABLE) {
+        lua_pushnil(L);
+        lua_setfield(L, -2, "_first_failure");
+    }
+    lua_pop(L, 2);
+}
+
+static int msgh(lua_State *L) {
+    if (lua_type(L, 1) == LUA_TSTRING && is_expectation(L, 1)) assertion_failed = 1;
+    return wb_rt_msgh(L);
+}
+
+/* call the function on top (no arguments, no results); on error leaves the message and
+ * traceback on the stack */
+static int pcall_top(lua_State *L) {
+    int base = lua_gettop(L);
+    lua_pushcfunction(L, msgh);
+    lua_insert(L, base);
+    assertion_failed = 0;
+    int status = lua_pcall(L, 0, 0, base);
+    lua_remove(L, base);
+    return status;
+}
+
+static int run_file(lua_State *L, const char *path) {
+    /* the chunk name is the path as given, so messages read "scripts/x.lua:12: ..." */
+    int status = luaL_loadfilex(L, path, wb_rt_get(L)->unsafe ? NULL : "t");
+    if (status == LUA_OK) status = pcall_top(L);
+    return status;
+}
+
+/* message of a failed call (on top) and the exit code it stands for */
+static int failure(lua_State *L, int status, const char *path, const char **msg) {
+    int budget = wb_rt_budget_hit(L);
+    *msg = lua_tostring(L, -1);
+    if (status == LUA_ERRMEM || !*msg) {
+        const wb_runtime *rt = wb_rt_get(L);
+        /* memory errors skip the message handler: no line, but the file */
+        if (budget) *msg = lua_pushfstring(L, "%s: memory limit of %d MB exceeded (--memory-limit MB)", path,
+                                           (int)(rt->memory_budget >> 20));
+        else *msg = lua_pushfstring(L, "%s: not enough memory", path);
+    }
+    return budget ? EXIT_BUDGET : assertion_failed ? EXIT_FAILED : EXIT_SCRIPT;
+}
+
+typedef struct prep { const opts *o; int harness_globals; } prep;
+
+/* runs protected: wobble.args from --set; `test` and `expect` globals for wobble test */
+static int prepare(lua_State *L) {
+    const prep *p = lua_touserdata(L, 1);
+    if (lua_getglobal(L, "wobble") == LUA_TTABLE) {
+        lua_newtable(L);
+        for (int i = 0; i < p->o->nsets; i++) {
+            const char *kv = p->o->sets[i], *e = strchr(kv, '=');
+            lua_pushlstring(L, kv, (size_t)(e - kv));
+            const char *v = e + 1;
+            if (!strcmp(v, "true") || !strcmp(v, "false")) lua_pushboolean(L, v[0] == 't');
+            else if (!lua_stringtonumber(L, v)) lua_pushstring(L, v);
+            lua_rawset(L, -3);
+        }
+        lua_setfield(L, -2, "args");
+    }
+    if (p->harness_globals) {
+        lua_getglobal(L, "require");
+        lua_pushliteral(L, "wobble.test");
+        lua_call(L, 1, 1);
+        lua_getfield(L, -1, "test");
+        lua_setglobal(L, "test");
+        lua_getfield(L, -1, "expect");
+        lua_setglobal(L, "expect");
+    }
+    return 0;
+}
+
+static lua_State *open_state(const opts *o, const char *script, int harness, const char **err) {
+    static char dir[PATH_MAX];
+    wb_runtime cfg = o->rt;
+    snprintf(dir, sizeof dir, "%s", script);
+    char *slash = strrchr(dir, '/');
+    if (!slash) strcpy(dir, ".");
+    else if (slash == dir) dir[1] = 0;
+    else *slash = 0;
+    cfg.scene_dir = dir;
+    lua_State *L = wb_rt_open(&cfg);
+    *err = NULL;
+    if (!L) return *err = "cannot start the Lua runtime", NULL;
+    prep p = { o, harness };
+    lua_pushcfunction(L, prepare);
+    lua_pushlightuserdata(L, &p);
+    if (lua_pcall(L, 1, 0, 0) != LUA_OK) {
+        static char buf[1024];
+        snprintf(buf, sizeof buf, "%s", lua_tostring(L, -1) ? lua_tostring(L, -1) : "error while starting");
+        wb_rt_close(L);
+        return *err = buf, NULL;
+    }
+    return L;
+}
+
+/* ---- TAP -------------------------------------------------------------------------------- */
+
+typedef struct tap { int n, passed, failed, code; } tap;
+
+static void yaml_string(const char *s, size_t n) {
+    putchar('"');
+    for (size_t i = 0; i < n; i++) {
+        unsigned char c = (unsigned char)s[i];
+        if (c == '"' || c == '\\') printf("\\%c", c);
+        else if (c == '\n') printf("\\n");
+        else if (c == '\t') printf("\\t");
+        else if (c < 0x20) printf("\\x%02x", c);
+        else putchar(c);
+    }
+    putchar('"');
+}
+
+/* frames of the harness itself and of the C error function tell the reader nothing */
+static int noise(const char *line, size_t n) {
+    static const char *const pats[] = { "[C]: in function 'error'", "wobble/test.lua:", "[C]: in ?" };
+    for (size_t i = 0; i < sizeof pats / sizeof *pats; i++) {
+        size_t pl = strlen(pats[i]);
+        for (size_t k = 0; k + pl <= n; k++)
+            if (!memcmp(line + k, pats[i], pl)) return 1;
+    }
+    return 0;
+}
+
+/* a script error on stderr: the message, then the traceback without the noise */
+static void print_error(const char *msg) {
+    const char *tb = strstr(msg, "\nstack traceback:\n");
+    if (!tb) {
+        fprintf(stderr, "%s\n", msg);
+        return;
+    }
+    fprintf(stderr, "%.*s\nstack traceback:\n", (int)(tb - msg), msg);
+    for (const char *s = tb + 18; *s;) {
+        const char *e = strchr(s, '\n');
+        size_t n = e ? (size_t)(e - s) : strlen(s);
+        if (!noise(s, n)) fprintf(stderr, "%.*s\n", (int)n, s);
+        if (!e) break;
+        s = e + 1;
+    }
+}
+
+static void tap_result(tap *t, int code, const char *file, const char *name, const char *err) {
+    t->n++;
+    if (code == EXIT_PASS) t->passed++;
+    else t->failed++;
+    if (code > t->code) t->code = code;
+    printf("%sok %d - %s: ", code == EXIT_PASS ? "" : "not ", t->n, file);
+    for (const char *s = name; *s; s++) {  /* '#' starts a TAP directive */
+        if (*s == '#') putchar('\\');
+        putchar(*s == '\n' ? ' ' : *s);
+    }
+    putchar('\n');
+    if (err) {
+        const char *tb = strstr(err, "\nstack traceback:\n");
+        printf("  ---\n  message: ");
+        yaml_string(err, tb ? (size_t)(tb - err) : strlen(err));
+        putchar('\n');
+        if (tb) {
+            int header = 0;
+            for (const char *s = tb + 18; *s;) {
+                const char *e = strchr(s, '\n');
+                size_t n = e ? (size_t)(e - s) : strlen(s);
+                if (!noise(s, n)) {
+                    if (!header) printf("  traceback: |-\n");
+                    header = 1;
+                    while (n && *s == '\t') s++, n--;
+                    printf("    %.*s\n", (int)n, s);
+                }
+                s += n + (e != NULL);
+                if (!e) break;
+            }
+        }
+        printf("  ...\n");
+    }
+    fflush(stdout);
+}
+
+/* how many cases the chunk registered with wobble.test */
+static int case_count(lua_State *L) {
+    int top = lua_gettop(L), n = 0;
+    lua_getfield(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
+    if (lua_getfield(L, -1, "wobble.test") == LUA_TTABLE && lua_getfield(L, -1, "cases") == LUA_TTABLE)
+        n = (int)lua_rawlen(L, -1);
+    lua_settop(L, top);
+    return n;
+}
+
+/* run the cases a chunk registered with wobble.test; returns how many there were */
+static int run_cases(lua_State *L, const char *file, tap *t) {
+    int top = lua_gettop(L);
+    lua_getfield(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
+    if (lua_getfield(L, -1, "wobble.test") != LUA_TTABLE || lua_getfield(L, -1, "cases") != LUA_TTABLE) {
+        lua_settop(L, top);
+        return 0;
+    }
+    int m = top + 2, cases = top + 3;
+    int n = (int)lua_rawlen(L, cases);
+    for (int i = 1; i <= n; i++) {
+        lua_rawgeti(L, cases, i);
+        lua_getfield(L, -1, "name");
+        const char *name = lua_tostring(L, -1) ? lua_tostring(L, -1) : "?";
+        lua_pushinteger(L, 0);
+        lua_setfield(L, m, "_count");
+        lua_pushnil(L);
+        lua_setfield(L, m, "_last_failure");
+        lua_pushnil(L);
+        lua_setfield(L, m, "_first_failure");
+        lua_pushboolean(L, 1);
+        lua_setfield(L, m, "_running");
+        lua_getfield(L, -2, "fn");
+        int status = pcall_top(L);
+        lua_pushboolean(L, 0);
+        lua_setfield(L, m, "_running");
+        const char *caught;
+        if (status == LUA_OK && (caught = caught_failure(L))) {
+            tap_result(t, EXIT_FAILED, file, name, caught);
+        } else if (status == LUA_OK) {
+            lua_getfield(L, m, "_count");
+            int count = (int)lua_tointeger(L, -1);
+            lua_pop(L, 1);
+            if (count == 0)
+                tap_result(t, EXIT_FAILED, file, name,
+                           "no expectations: a test case must call expect.* at least once");
+            else tap_result(t, wb_rt_budget_hit(L) ? EXIT_BUDGET : EXIT_PASS, file, name, NULL);
+        } else {
+            const char *msg;
+            int code = failure(L, status, file, &msg);
+            /* an error inside a case is a failed test; only file-level trouble is a script error */
+            tap_result(t, code == EXIT_SCRIPT ? EXIT_FAILED : code, file, name, msg);
+        }
+        lua_settop(L, cases);
+        if (wb_rt_budget_hit(L)) break;  /* every further instruction would fail too */
+    }
+    lua_settop(L, top);
+    return n;
+}
+
+/* ---- test files -------------------------------------------------------------------------- */
+
+typedef struct list { char **v; int n, cap; } list;
+
+static int list_add(list *l, const char *s) {
+    if (l->n == l->cap) {
+        int cap = l->cap ? 2 * l->cap : 16;
+        char **v = realloc(l->v, (size_t)cap * sizeof *v);
+        if (!v) return -1;
+        l->v = v;
+        l->cap = cap;
+    }
+    return (l->v[l->n] = strdup(s)) ? (l->n++, 0) : -1;
+}
+
+static int cmp_str(const void *a, const void *b) {
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+static int ends_with(const char *s, const char *suffix) {
+    size_t n = strlen(s), k = strlen(suffix);
+    return n >= k && !strcmp(s + n - k, suffix);
+}
+
+/* *.lua below dir, skipping hidden and _private entries, benchmarks and fixtures (scenes
+ * that tests run in a separate process, some of them failing on purpose) */
+static void collect(const char *dir, list *out, int depth) {
+    DIR *d = opendir(dir);
+    struct dirent *e;
+    if (!d || depth > 32) {
+        if (d) closedir(d);
+        return;
+    }
+    while ((e = readdir(d))) {
+        char p[PATH_MAX];
+        struct stat st;
+        if (e->d_name[0] == '.' || e->d_name[0] == '_') continue;
+        if (snprintf(p, sizeof p, "%s%s%s", dir, ends_with(dir, "/") ? "" : "/", e->d_name) >= (int)sizeof p ||
+            stat(p, &st) != 0)
+            continue;
+        if (S_ISDIR(st.st_mode)) {
+            if (strcmp(e->d_name, "bench") && strcmp(e->d_name, "fixtures")) collect(p, out, depth + 1);
+        } else if (S_ISREG(st.st_mode) && ends_with(e->d_name, ".lua")) {
+            list_add(out, p);
+        }
+    }
+    closedir(d);
+}
+
+static void list_free(list *l) {
+    for (int i = 0; i < l->n; i++) free(l->v[i]);
+    free(l->v);
+}
+
+static void test_file(const char *path, const opts *o, tap *t) {
+    const char *err;
+    lua_State *L = open_state(o, path, 1, &err);
+    if (!L) {
+        tap_result(t, EXIT_SCRIPT, path, "loading the file", err);
+        return;
+    }
+    int status = run_file(L, path);
+    const char *caught;
+    if (status != LUA_OK) {
+        const char *msg;
+        int code = failure(L, status, path, &msg);
+        tap_result(t, code, path, "loading the file", msg);
+        wb_rt_close(L);
+        return;
+    }
+    if ((caught = caught_failure(L))) {  /* an expectation at the top of the file */
+        tap_result(t, EXIT_FAILED, path, "loading the file", caught);
+        clear_caught(L);
+    }
+    if (run_cases(L, path, t) == 0) {
+        tap_result(t, EXIT_FAILED, path, "no test cases",
+                   "the file defines no test cases: call test(name, function() ... end)");
+    }
+    wb_rt_close(L);
+}
+
+static int cmd_test(const opts *o) {
+    static const char *const deflt[] = { "tests/" };
+    const char *const *paths = o->npos ? o->pos : deflt;
+    int np = o->npos ? o->npos : 1, nfiles = 0;
+    tap t = { 0, 0, 0, 0 };
+    printf("TAP version 13\n");
+    fflush(stdout);
+    for (int i = 0; i < np; i++) {
+        struct stat st;
+        list files = { 0 };
+        if (stat(paths[i], &st) != 0) {
+            char msg[PATH_MAX + 64];
+            snprintf(msg, sizeof msg, "cannot open %s: %s", paths[i], strerror(errno));
+            tap_result(&t, EXIT_SCRIPT, paths[i], "loading the file", msg);
+            continue;
+        }
+        if (S_ISDIR(st.st_mode)) collect(paths[i], &files, 0);
+        else list_add(&files, paths[i]);
+        if (files.n > 1) qsort(files.v, (size_t)files.n, sizeof *files.v, cmp_str);
+        if (files.n == 0) printf("# no *.lua files under %s\n", paths[i]);
+        for (int k = 0; k < files.n; k++) test_file(files.v[k], o, &t);
+        nfiles += files.n;
+        list_free(&files);
+    }
+    if (nfiles == 0 && t.failed == 0) {
+        fprintf(stderr, "wobble: no test files found\n");
+        t.code = EXIT_SCRIPT;
+    }
+    printf("1..%d\n%d passed, %d failed\n", t.n, t.passed, t.failed);
+    return t.code;
+}
+
+/* ---- run and bench ----------------------------------------------------------------------- */
+
+/* run one scene; test cases it registered run afterwards as TAP */
+static int run_scene(const opts *o, const char *path) {
+    const char *err, *msg;
+    lua_State *L = open_state(o, path, 0, &err);
+    if (!L) {
+        fprintf(stderr, "wobble: %s\n", err);
+        return EXIT_SCRIPT;
+    }
+    char rerr[1024];
+    /* --record: every frame the scene steps is drawn and encoded (the path is the
+     * user's choice, not the sandbox's); the file is finished even after an error */
+    if (o->record && make_parents(o->record, rerr, sizeof rerr) != 0) {
+        fprintf(stderr, "wobble: --record: %s\n", rerr);
+        wb_rt_close(L);
+        return EXIT_SCRIPT;
+    }
+    if (o->record && !wbl_record_begin(L, o->record, rerr, sizeof rerr)) {
+        fprintf(stderr, "wobble: %s\n", rerr);
+        wb_rt_close(L);
+        return EXIT_SCRIPT;
+    }
+    int status = run_file(L, path), code = EXIT_PASS;
+    if (status != LUA_OK) {
+        code = failure(L, status, path, &msg);
+        print_error(msg);
+    } else {
+        tap t = { 0, 0, 0, 0 };
+        const char *caught = caught_failure(L);
+        if (caught) {  /* an expectation of the scene itself */
+            print_error(caught);
+            t.code = EXIT_FAILED;
+            clear_caught(L);
+        }
+        if (case_count(L) > 0) {
+            printf("TAP version 13\n");
+            run_cases(L, path, &t);
+            printf("1..%d\n%d passed, %d failed\n", t.n, t.passed, t.failed);
+        }
+        code = t.code;
+        if (wb_rt_budget_hit(L) && code < EXIT_BUDGET) {
+            fprintf(stderr, "wobble: %s: a time or memory budget was exceeded\n", path);
+            code = EXIT_BUDGET;
+        }
+    }
+    if (o->record && !wbl_record_end(L, rerr, sizeof rerr)) {
+        fprintf(stderr, "wobble: --record: %s\n", rerr);
+        if (code == EXIT_PASS) code = EXIT_SCRIPT;
+    }
+    wb_rt_close(L);
+    return code;
+}
+
+/* the benchmark scenes: installed beside the Lua library (share/wobble/bench, so an
+ * installed command needs no source tree), else tests/bench of the project */
+static int bench_dir(char dir[PATH_MAX]) {
+    const char *lib = wb_rt_lib_dir(), *root = wb_rt_project_root();
+    char p[PATH_MAX];
+    struct stat st;
+    if (lib && snprintf(p, sizeof p, "%s/../bench", lib) < (int)sizeof p && realpath(p, dir) &&
+        stat(dir, &st) == 0 && S_ISDIR(st.st_mode))
+        return 0;
+    if (root && snprintf(p, sizeof p, "%s/tests/bench", root) < (int)sizeof p && realpath(p, dir) &&
+        stat(dir, &st) == 0 && S_ISDIR(st.st_mode))
+        return 0;
+    return -1;
+}
+
+static int cmd_bench(opts *o) {
+    char dir[PATH_MAX], cwd[PATH_MAX];
+    if (bench_dir(dir)) {
+        fprintf(stderr, "wobble: cannot find the benchmark scenes (share/wobble/bench of an installed wobble, "
+                        "or tests/bench of the project)\n");
+        return EXIT_SCRIPT;
+    }
+    list files = { 0 };
+    collect(dir, &files, 1);
+    if (files.n > 1) qsort(files.v, (size_t)files.n, sizeof *files.v, cmp_str);
+    if (files.n == 0) {
+        fprintf(stderr, "wobble: no benchmark scenes in %s\n", dir);
+        list_free(&files);
+        return EXIT_SCRIPT;
+    }
+    /* a benchmark scene reads wobble.args.json */
+    if (o->json) o->sets[o->nsets++] = "json=true";
+    size_t cl = getcwd(cwd, sizeof cwd) ? strlen(cwd) : 0;
+    int code = EXIT_PASS;
+    for (int i = 0; i < files.n; i++) {
+        const char *p = files.v[i];
+        if (cl > 1 && !strncmp(p, cwd, cl) && p[cl] == '/') p += cl + 1;  /* shorter messages */
+        if (!o->json) {
+            printf("# %s\n", p);
+            fflush(stdout);
+        }
+        int c = run_scene(o, p);
+        if (c > code) code = c;
+    }
+    list_free(&files);
+    return code;
+}
+
+int main(int argc, char **argv) {
+    setvbuf(stdout, NULL, _IOLBF, 0);  /* TAP lines and script output in order through a pipe */
+    if (argc < 2) {
+        fputs(usage_text, stderr);
+        return EXIT_SCRIPT;
+    }
+    const char *cmd = argv[1];
+    if (!strcmp(cmd, "--version") || !strcmp(cmd, "-v")) {
+        printf("wobble %s\n", WB_VERSION);
+        return EXIT_PASS;
+    }
+    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
+        fputs(usage_text, stdout);
+        return EXIT_PASS;
+    }
+    if (!strcmp(cmd, "sweep") || !strcmp(cmd, "collect")) {
+        fprintf(stderr, "wobble: '%s' is not implemented yet\n", cmd);
+        return EXIT_SCRIPT;
+    }
+    if (strcmp(cmd, "run") && strcmp(cmd, "test") && strcmp(cmd, "bench"))
+        return usage_error(cmd[0] == '-' ? "unknown option %s" : "unknown command '%s'", cmd);
+    opts o;
+    int code = parse_opts(argc, argv, cmd, &o);
+    if (code == EXIT_PASS) {
+        if (!strcmp(cmd, "run")) {
+            if (o.npos != 1) code = usage_error("%s", o.npos ? "run takes one scene script" : "run needs a scene script");
+            else code = run_scene(&o, o.pos[0]);
+        } else if (!strcmp(cmd, "test")) {
+            code = cmd_test(&o);
+        } else if (o.npos) {
+            code = usage_error("bench takes no file names: it runs tests/bench/*.lua, got '%s'", o.pos[0]);
+        } else {
+            code = cmd_bench(&o);
+        }
+    }
+    free(o.sets);
+    free(o.pos);
+    return code;
+}

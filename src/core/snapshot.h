@@ -1,0 +1,70 @@
+/* snapshot.h: a world as flat arrays (an "image"), for the JSON reader and writer and for
+ * exact copies. Internal: it shows the slot layout (generations, free lists), which the
+ * public API hides behind handles. Everything here is plain data over public types, so
+ * io/json.c needs no core internals. */
+#ifndef WB_SNAPSHOT_H
+#define WB_SNAPSHOT_H
+
+#include "wobble.h"
+
+/* a collider: its shape in its own frame and its full pose */
+typedef struct wb_image_collider {
+    wb_shape shape;
+    wb_real n[3];          /* plane: unit normal in the collider frame */
+    wb_real radius;        /* sphere, capsule */
+    wb_real half[3];       /* box */
+    wb_real a[3], b[3];    /* capsule segment in the collider frame */
+    wb_real friction, restitution;
+    wb_real p[3], q[4];    /* pose now */
+    wb_real p0[3], q0[4];  /* pose at the end of the last step: start of the next sweep */
+    wb_real v[3], om[3];   /* velocities the script set */
+} wb_image_collider;
+
+typedef struct wb_image {
+    wb_world_def def;
+
+    int32_t np;
+    wb_real *x, *v;        /* (np x 3) */
+    wb_real *inv_mass;     /* (np) as created; 0 = immovable */
+    wb_real *radius;       /* (np) */
+    uint8_t *pinned;       /* (np) */
+
+    /* distance constraints by slot: a slot is live while its generation is odd */
+    int32_t nd;
+    int32_t *d_ij;         /* (nd x 2) */
+    wb_real *d_alpha, *d_beta, *d_yield, *d_creep, *d_break, *d_rest; /* (nd) */
+    uint8_t *d_broken;     /* (nd) */
+    uint32_t *d_gen;       /* (nd) */
+    int32_t nfree;
+    int32_t *d_free;       /* (nfree) free slots, in stack order */
+
+    int32_t nc;
+    wb_image_collider *c;  /* (nc) by slot */
+    uint32_t *c_gen;       /* (nc) odd = live */
+
+    int32_t nsurf;
+    int32_t *surf_start;   /* (nsurf + 1) */
+    int32_t ntri;
+    int32_t *tri;          /* (ntri x 3) */
+
+    double time;
+    int64_t frame, warnings;
+    char last_warning[160];
+} wb_image;
+
+/* allocate the arrays for these counts (zeroed; generations 1, i.e. live); WB_ERR_NOMEM */
+wb_status wb_image_alloc(wb_image *img, int32_t np, int32_t nd, int32_t nfree, int32_t nc, int32_t nsurf, int32_t ntri);
+void wb_image_free(wb_image *img);                     /* and zero it; fine on a zeroed image */
+wb_status wb_image_of(const wb_world *w, wb_image *img); /* a full copy of the world */
+/* NULL, or what is inconsistent (an index out of range, a free list that does not match
+ * the dead slots, a non-finite value, ...): a reader's last line of defence */
+const char *wb_image_check(const wb_image *img);
+/* the world the image describes, exactly (same hash, same future); NULL with *status */
+wb_world *wb_world_from_image(const wb_image *img, wb_status *status);
+/* add the image's particles, live constraints, live colliders and surfaces to w, ids
+ * shifted after w's particles; all or nothing. out: the new particles' range */
+wb_status wb_world_append_image(wb_world *w, const wb_image *img, wb_body *out);
+/* the collider w:collider{...} would make from a world-frame def, in its own frame + pose */
+wb_status wb_image_collider_from_def(const wb_collider_def *d, wb_image_collider *out);
+
+#endif

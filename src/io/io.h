@@ -1,0 +1,98 @@
+/* io.h: file formats, linked into the command and kept out of the core (libwobble.a):
+ * JSON particle configs and snapshots (json.c, cJSON), meshes (mesh.c, assimp),
+ * exports for other tools (export.c: PC2, VTK).
+ *
+ * Callers resolve paths first (the Lua binding through the sandbox, wb_sandbox_path); `shown`
+ * is the name error messages print, as the script wrote it. Functions that can fail
+ * return 0 or -1 with a one-line message in err[errn], never crash on bad input and
+ * change nothing they were given. */
+#ifndef WB_IO_H
+#define WB_IO_H
+
+#include <stdio.h>
+
+#include "core/snapshot.h"
+#include "wobble.h"
+
+/* may the file at path be opened (write = 0 read, 1 write)? 1 yes; 0 no, with a reason
+ * in err. Files a format pulls in by itself (an OBJ's .mtl, a glTF's .bin) ask too. */
+typedef int (*wbio_allow_fn)(void *ud, const char *path, int write, char *err, size_t errn);
+
+/* ---- JSON particle configs and snapshots (json.c) ------------------------------------- */
+#define WBIO_FORMAT "wobble-particles"
+#define WBIO_VERSION 1
+
+typedef struct wbio_part { char *name; int32_t first, count; } wbio_part;
+
+typedef struct wbio_skin_spec {
+    char *mesh;            /* path as written, relative to the config's folder */
+    wb_real scale;
+    wb_skin_def def;
+    int32_t *ids;          /* (nids) particles of the config, 0-based; NULL = all */
+    int32_t nids;
+    char where[160];       /* "file:line:col: skins[i].mesh" for messages about the mesh */
+} wbio_skin_spec;
+
+typedef struct wbio_config {
+    wb_image img;          /* particles, constraints, colliders, surfaces (+ snapshot state) */
+    int snapshot;          /* the file had a "snapshot" section: img.def, slots, clock are its */
+    int32_t nparts;
+    wbio_part *parts;
+    int32_t nskins;
+    wbio_skin_spec *skins;
+} wbio_config;
+
+/* read and check the whole file; on error nothing is allocated (cfg zeroed) */
+int wbio_read_config(const char *path, const char *shown, wbio_config *cfg, char *err, size_t errn);
+void wbio_config_free(wbio_config *cfg);
+/* the full state (a superset of the config format) so that wobble.load restores it exactly;
+ * written to a temporary file and renamed, so a failure leaves no half file */
+int wbio_write_snapshot(const wb_world *w, const char *path, const char *shown, char *err, size_t errn);
+
+/* ---- meshes (mesh.c) --------------------------------------------------------------------- */
+typedef struct wbio_mesh_opts {
+    wb_real scale;         /* multiplies every coordinate */
+    bool weld;             /* merge vertices by position */
+    wb_real tol;           /* their distance; < 0: 1e-6 of the bounds' diagonal */
+    double timeout;        /* seconds for the import (a child process); 0: $WOBBLE_IMPORT_TIMEOUT or 60 */
+} wbio_mesh_opts;
+
+/* any format assimp reads, triangulated, node transforms applied, all meshes of the file
+ * merged, welded, normals recomputed. NULL with a message on a missing, empty or corrupt file.
+ * assimp runs in a forked child: a file that crashes or hangs it is "the importer failed
+ * (crashed|timed out ...)", never the caller's crash */
+wb_mesh *wbio_load_mesh(const char *path, const char *shown, const wbio_mesh_opts *o,
+                        wbio_allow_fn allow, void *ud, char *err, size_t errn);
+/* by extension: .obj and .ply written here (vertex order kept, as Blender's Mesh Cache
+ * needs), .stl .gltf .glb .fbx .dae through assimp's exporter. v overrides m->v when given
+ * (a deformed pose of the same mesh) */
+int wbio_save_mesh(const wb_mesh *m, const wb_real *v, const char *path, const char *shown,
+                   wbio_allow_fn allow, void *ud, char *err, size_t errn);
+int wbio_write_obj(FILE *f, const wb_mesh *m, const wb_real *v, const wb_real *n);
+int wbio_write_ply(FILE *f, const wb_mesh *m, const wb_real *v, const wb_real *n);
+
+/* ---- exports (export.c) -------------------------------------------------------------------- */
+/* PC2 point cache (Blender's Mesh Cache modifier): header, then float32 xyz per point per
+ * sample; the header's sample count is kept current after every sample. sample_rate: frames
+ * per sample (a sample every `every` frames) */
+typedef struct wbio_pc2 wbio_pc2;
+wbio_pc2 *wbio_pc2_open(const char *path, const char *shown, int32_t npoints, double start_frame,
+                        double sample_rate, char *err, size_t errn);
+int wbio_pc2_write(wbio_pc2 *p, const wb_real *pts, char *err, size_t errn); /* (npoints x 3) */
+int wbio_pc2_close(wbio_pc2 *p, char *err, size_t errn);     /* NULL is fine; frees */
+int32_t wbio_pc2_samples(const wbio_pc2 *p);
+
+/* VTK series for ParaView: a .pvd collection and one .vtp PolyData per frame in a folder
+ * beside it (points = particles with velocity, speed, strain, mass, pinned; cells = the
+ * particles, the constraints and the surfaces' triangles) */
+typedef struct wbio_vtk wbio_vtk;
+/* pvd_path: the .pvd file; dir: the folder for the .vtp files (exists); rel_dir: that
+ * folder as the .pvd names it (relative, so the series can be moved) */
+wbio_vtk *wbio_vtk_open(const char *pvd_path, const char *dir, const char *rel_dir, const char *shown,
+                        char *err, size_t errn);
+int wbio_vtk_write(wbio_vtk *v, const wb_world *w, char *err, size_t errn);
+int wbio_vtk_close(wbio_vtk *v, char *err, size_t errn);     /* NULL is fine; frees */
+int32_t wbio_vtk_frames(const wbio_vtk *v);
+int wbio_write_vtp(FILE *f, const wb_world *w);               /* one frame */
+
+#endif

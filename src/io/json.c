@@ -1,0 +1,657 @@
+/* json.c: JSON particle configs (the reference thesis's second import method) and
+ * snapshots, through cJSON. The schema is in the README ("Particle configs"); in short:
+ *
+ *   { "format": "wobble-particles", "version": 1,
+ *     "particles": [ {"position": [x,y,z], "mass": 1, "pinned": false}, ... ],
+ *     "constraints": [ {"type": "distance", "particles": [0, 1], "compliance": 0}, ... ],
+ *     "colliders": [...], "surfaces": [...], "parts": [...], "skins": [...],
+ *     "defaults": {...}, "snapshot": {...} }
+ *
+ * Errors name the file, line and column and the key path ("logo.json:12:7:
+ * particles[3].mass: number expected, got string"; how, in json_value.c). The whole
+ * file is read and checked into a wb_image before anything is built. */
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+
+#include "json.h"
+
+#define MAX_FILE (1ll << 31) /* 2 GiB: a snapshot of WB_MAX_PARTICLES fits; larger is not ours */
+
+/* ---- sections --------------------------------------------------------------------------------- */
+typedef struct defaults {
+    wb_real mass, radius;
+    wb_distance_def link;
+} defaults;
+
+static int read_defaults(rd *r, const cJSON *it, defaults *d)
+{
+    static const char *const keys[] = { "mass", "radius", "compliance", "damping", "yield", "creep", "break_strain", NULL };
+    const cJSON *f[8];
+    kp p = { NULL, "defaults", 0 };
+    d->mass = 1;
+    d->radius = 0.02;
+    d->link = wb_distance_default_def();
+    if (!it) return 0;
+    if (jv_get_object(r, it, &p, keys, f)) return -1;
+    return jv_opt_nonneg(r, f[0], &p, "mass", &d->mass) || jv_opt_nonneg(r, f[1], &p, "radius", &d->radius) ||
+           jv_opt_nonneg(r, f[2], &p, "compliance", &d->link.compliance) || jv_opt_nonneg(r, f[3], &p, "damping", &d->link.damping) ||
+           jv_opt_nonneg(r, f[4], &p, "yield", &d->link.yield) || jv_opt_nonneg(r, f[5], &p, "creep", &d->link.creep) ||
+           jv_opt_nonneg(r, f[6], &p, "break_strain", &d->link.break_strain) ? -1 : 0;
+}
+
+static const char *const solver_names[] = { "gauss-seidel", "jacobi" };
+
+/* the "world" settings of a snapshot */
+static int read_world(rd *r, const cJSON *it, const kp *up, wb_world_def *d)
+{
+    static const char *const keys[] = { "gravity", "dt", "substeps", "iterations", "damping", "solver", "relaxation", "threads", NULL };
+    const cJSON *f[9];
+    kp p = { up, "world", 0 };
+    int64_t i;
+    if (jv_get_object(r, it, &p, keys, f)) return -1;
+    if (jv_opt_vec(r, f[0], &p, "gravity", 3, d->gravity) || jv_opt_real(r, f[1], &p, "dt", &d->dt)) return -1;
+    if (f[2]) { if (jv_opt_int(r, f[2], &p, "substeps", 1, WB_MAX_SUBSTEPS, &i)) return -1; d->substeps = (int)i; }
+    if (f[3]) { if (jv_opt_int(r, f[3], &p, "iterations", 1, WB_MAX_ITERATIONS, &i)) return -1; d->iterations = (int)i; }
+    if (jv_opt_real(r, f[4], &p, "damping", &d->damping)) return -1;
+    if (f[5]) {
+        kp q = { &p, "solver", 0 };
+        const char *s = "";
+        if (jv_get_string(r, f[5], &q, &s)) return -1;
+        if (strcmp(s, solver_names[0]) && strcmp(s, solver_names[1]))
+            return jv_fail(r, f[5], 0, &q, "unknown solver '%s' (expected gauss-seidel or jacobi)", s);
+        d->solver = strcmp(s, solver_names[0]) ? WB_SOLVER_JACOBI : WB_SOLVER_GAUSS_SEIDEL;
+    }
+    if (jv_opt_real(r, f[6], &p, "relaxation", &d->relaxation)) return -1;
+    if (f[7]) { if (jv_opt_int(r, f[7], &p, "threads", 1, WB_MAX_THREADS, &i)) return -1; d->threads = (int)i; }
+    const char *e = wb_world_def_check(d);
+    return e ? jv_fail(r, it, 0, &p, "%s", e) : 0;
+}
+
+/* "generations": [...] of a slot table; counts the live (odd) ones */
+static int read_generations(rd *r, const cJSON *it, const kp *p, int32_t n, uint32_t *gen, int32_t *live)
+{
+    int32_t i = 0;
+    *live = 0;
+    for (const cJSON *c = it->child; c; c = c->next, i++) {
+        kp e = { p, NULL, i };
+        int64_t g;
+        if (jv_get_int(r, c, &e, 0, UINT32_MAX, &g)) return -1;
+        gen[i] = (uint32_t)g;
+        *live += (int32_t)(g & 1);
+    }
+    (void)n;
+    return 0;
+}
+
+typedef struct sections {      /* the top-level values, checked for type */
+    const cJSON *particles, *constraints, *colliders, *surfaces, *parts, *skins, *snapshot;
+    const cJSON *world, *dgen, *dfree, *cgen, *clock[4];
+    int32_t np, ncons, ncol, nsurf, ntri, nparts, nskins, nd, nfree, nc;
+} sections;
+
+/* the snapshot section's shape (its values are read once the image exists) */
+static int scan_snapshot(rd *r, sections *s)
+{
+    static const char *const keys[] = { "world", "time", "frame", "warnings", "last_warning", "distance_slots", "collider_slots", NULL };
+    static const char *const dkeys[] = { "generations", "free", NULL };
+    static const char *const ckeys[] = { "generations", NULL };
+    const cJSON *f[8], *g[3];
+    kp p = { NULL, "snapshot", 0 };
+    s->nd = s->ncons;
+    s->nc = s->ncol;
+    if (!s->snapshot) return 0;
+    if (jv_get_object(r, s->snapshot, &p, keys, f)) return -1;
+    if (!f[0]) return jv_missing(r, s->snapshot, &p, "world");
+    s->world = f[0];
+    for (int i = 0; i < 4; i++) s->clock[i] = f[1 + i];
+    if (f[5]) {
+        kp q = { &p, "distance_slots", 0 };
+        if (jv_get_object(r, f[5], &q, dkeys, g)) return -1;
+        if (!g[0]) return jv_missing(r, f[5], &q, "generations");
+        if (!g[1]) return jv_missing(r, f[5], &q, "free");
+        kp a = { &q, "generations", 0 }, b = { &q, "free", 0 };
+        if (jv_get_array(r, g[0], &a, WB_MAX_CONSTRAINTS, &s->nd) || jv_get_array(r, g[1], &b, WB_MAX_CONSTRAINTS, &s->nfree)) return -1;
+        s->dgen = g[0];
+        s->dfree = g[1];
+    }
+    if (f[6]) {
+        kp q = { &p, "collider_slots", 0 };
+        if (jv_get_object(r, f[6], &q, ckeys, g)) return -1;
+        if (!g[0]) return jv_missing(r, f[6], &q, "generations");
+        kp a = { &q, "generations", 0 };
+        if (jv_get_array(r, g[0], &a, WB_MAX_COLLIDERS, &s->nc)) return -1;
+        s->cgen = g[0];
+    }
+    return 0;
+}
+
+static int read_snapshot(rd *r, const sections *s, wb_image *g)
+{
+    kp p = { NULL, "snapshot", 0 };
+    if (read_world(r, s->world, &p, &g->def)) return -1;
+    int64_t i;
+    if (jv_opt_nonneg(r, s->clock[0], &p, "time", &(wb_real){ 0 })) return -1;
+    if (s->clock[0]) g->time = s->clock[0]->valuedouble; /* a double, whatever wb_real is */
+    if (jv_opt_int(r, s->clock[1], &p, "frame", 0, (int64_t)1 << 53, &i)) return -1;
+    if (s->clock[1]) g->frame = i;
+    if (jv_opt_int(r, s->clock[2], &p, "warnings", 0, (int64_t)1 << 53, &i)) return -1;
+    if (s->clock[2]) g->warnings = i;
+    if (s->clock[3]) {
+        kp q = { &p, "last_warning", 0 };
+        const char *msg = "";
+        if (jv_get_string(r, s->clock[3], &q, &msg)) return -1;
+        snprintf(g->last_warning, sizeof g->last_warning, "%s", msg);
+    }
+    kp ds = { &p, "distance_slots", 0 }, cs = { &p, "collider_slots", 0 };
+    if (s->dgen) {
+        kp a = { &ds, "generations", 0 }, b = { &ds, "free", 0 };
+        int32_t live;
+        if (read_generations(r, s->dgen, &a, s->nd, g->d_gen, &live)) return -1;
+        if (live != s->ncons)
+            return jv_fail(r, s->dgen, 0, &a, "%d live slots, but \"constraints\" has %d entries", live, s->ncons);
+        int32_t k = 0;
+        /* a mark per slot, so a long free list is checked for repeats in linear time */
+        uint8_t *seen = s->nfree > 0 ? calloc((size_t)(s->nd > 0 ? s->nd : 1), 1) : NULL;
+        if (s->nfree > 0 && !seen) return jv_fail(r, s->dfree, 0, &b, "out of memory");
+        int bad = 0;
+        for (const cJSON *c = s->dfree->child; c && !bad; c = c->next, k++) {
+            kp e = { &b, NULL, k };
+            int64_t slot;
+            if (jv_get_int(r, c, &e, 0, s->nd > 0 ? s->nd - 1 : 0, &slot)) bad = -1;
+            else if (s->nd == 0 || (g->d_gen[slot] & 1u)) bad = jv_fail(r, c, 0, &e, "slot %lld is live, not free", (long long)slot);
+            else if (seen[slot]++) bad = jv_fail(r, c, 0, &e, "slot %lld is listed twice", (long long)slot);
+            else g->d_free[k] = (int32_t)slot;
+        }
+        free(seen);
+        if (bad) return -1;
+        if (s->nd - live != s->nfree)
+            return jv_fail(r, s->dfree, 0, &b, "%d free slots listed, but %d slots are dead", s->nfree, s->nd - live);
+    }
+    if (s->cgen) {
+        kp a = { &cs, "generations", 0 };
+        int32_t live;
+        if (read_generations(r, s->cgen, &a, s->nc, g->c_gen, &live)) return -1;
+        if (live != s->ncol) return jv_fail(r, s->cgen, 0, &a, "%d live slots, but \"colliders\" has %d entries", live, s->ncol);
+    }
+    return 0;
+}
+
+static int read_particles(rd *r, const sections *s, const defaults *d, wb_image *g)
+{
+    static const char *const keys[] = { "position", "velocity", "mass", "inv_mass", "radius", "pinned", NULL };
+    kp top = { NULL, "particles", 0 };
+    int32_t i = 0;
+    for (const cJSON *c = s->particles->child; c; c = c->next, i++) {
+        const cJSON *f[7];
+        kp p = { &top, NULL, i };
+        wb_real mass = d->mass, radius = d->radius;
+        bool pinned = false;
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "position");
+        if (jv_opt_vec(r, f[0], &p, "position", 3, &g->x[3 * i]) || jv_opt_vec(r, f[1], &p, "velocity", 3, &g->v[3 * i]) ||
+            jv_opt_nonneg(r, f[2], &p, "mass", &mass) || jv_opt_nonneg(r, f[4], &p, "radius", &radius))
+            return -1;
+        g->inv_mass[i] = mass > 0 ? 1 / mass : 0;
+        /* inv_mass (w:save writes it) is exact where 1/mass might not round-trip */
+        if (jv_opt_nonneg(r, f[3], &p, "inv_mass", &g->inv_mass[i])) return -1;
+        if (f[5]) {
+            kp q = { &p, "pinned", 0 };
+            if (jv_get_bool(r, f[5], &q, &pinned)) return -1;
+        }
+        g->radius[i] = radius;
+        g->pinned[i] = pinned;
+        if (g->inv_mass[i] == 0 || pinned) g->v[3 * i] = g->v[3 * i + 1] = g->v[3 * i + 2] = 0;
+    }
+    return 0;
+}
+
+static int read_constraints(rd *r, const sections *s, const defaults *d, wb_image *g)
+{
+    static const char *const keys[] = { "type", "particles", "rest", "compliance", "damping", "yield", "creep",
+                                        "break_strain", "broken", NULL };
+    kp top = { NULL, "constraints", 0 };
+    int32_t i = 0, slot = -1;
+    if (!s->constraints) return 0;
+    for (const cJSON *c = s->constraints->child; c; c = c->next, i++) {
+        const cJSON *f[10];
+        kp p = { &top, NULL, i };
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "type");
+        if (!f[1]) return jv_missing(r, c, &p, "particles");
+        kp tp = { &p, "type", 0 }, pp = { &p, "particles", 0 };
+        const char *type = "";
+        if (jv_get_string(r, f[0], &tp, &type)) return -1;
+        if (strcmp(type, "distance") != 0) return jv_fail(r, f[0], 0, &tp, "unknown constraint type '%s' (expected distance)", type);
+        int32_t n;
+        if (jv_get_array(r, f[1], &pp, 16, &n)) return -1;
+        if (n != 2) return jv_fail(r, f[1], 0, &pp, "a distance constraint joins 2 particles, got %d", n);
+        int64_t ab[2];
+        int k = 0;
+        for (const cJSON *e = f[1]->child; e; e = e->next, k++) {
+            kp q = { &pp, NULL, k };
+            if (g->np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
+            if (jv_get_int(r, e, &q, 0, g->np - 1, &ab[k])) return -1;
+        }
+        if (ab[0] == ab[1]) return jv_fail(r, f[1], 0, &pp, "a constraint needs two distinct particles");
+        /* the i-th live slot (all slots are live in a plain config) */
+        do slot++; while (!(g->d_gen[slot] & 1u));
+        wb_distance_def l = d->link;
+        const wb_real *xa = &g->x[3 * ab[0]], *xb = &g->x[3 * ab[1]];
+        wb_real dx[3] = { xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2] };
+        l.rest = sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
+        bool broken = false;
+        if (jv_opt_nonneg(r, f[2], &p, "rest", &l.rest) || jv_opt_nonneg(r, f[3], &p, "compliance", &l.compliance) ||
+            jv_opt_nonneg(r, f[4], &p, "damping", &l.damping) || jv_opt_nonneg(r, f[5], &p, "yield", &l.yield) ||
+            jv_opt_nonneg(r, f[6], &p, "creep", &l.creep) || jv_opt_nonneg(r, f[7], &p, "break_strain", &l.break_strain))
+            return -1;
+        if (f[8]) {
+            kp q = { &p, "broken", 0 };
+            if (jv_get_bool(r, f[8], &q, &broken)) return -1;
+        }
+        g->d_ij[2 * slot] = (int32_t)ab[0];
+        g->d_ij[2 * slot + 1] = (int32_t)ab[1];
+        g->d_alpha[slot] = l.compliance;
+        g->d_beta[slot] = l.damping;
+        g->d_yield[slot] = l.yield;
+        g->d_creep[slot] = l.creep;
+        g->d_break[slot] = l.break_strain;
+        g->d_rest[slot] = l.rest;
+        g->d_broken[slot] = broken;
+    }
+    return 0;
+}
+
+static const char *const shape_names[] = { "plane", "sphere", "box", "capsule", NULL };
+
+/* a rotation as given, normalised only when it is not already unit (a snapshot's rotations
+ * are, and must come back bit for bit) */
+static int get_quat(rd *r, const cJSON *it, const kp *p, wb_real q[4])
+{
+    if (jv_get_vec(r, it, p, 4, q)) return -1;
+    const wb_real n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+    if (!(n2 > 1e-24)) return jv_fail(r, it, 0, p, "rotation must not be zero");
+    if (fabs(n2 - 1) > 1e-12)
+        for (int i = 0; i < 4; i++) q[i] /= sqrt(n2);
+    return 0;
+}
+
+static int read_pose(rd *r, const cJSON *it, const kp *up, wb_image_collider *c)
+{
+    static const char *const keys[] = { "position", "rotation", "start_position", "start_rotation", "velocity",
+                                        "angular_velocity", NULL };
+    const cJSON *f[7];
+    kp p = { up, "pose", 0 };
+    if (jv_get_object(r, it, &p, keys, f)) return -1;
+    if (!f[0]) return jv_missing(r, it, &p, "position");
+    if (!f[1]) return jv_missing(r, it, &p, "rotation");
+    kp q1 = { &p, "rotation", 0 }, q2 = { &p, "start_rotation", 0 };
+    if (jv_opt_vec(r, f[0], &p, "position", 3, c->p) || get_quat(r, f[1], &q1, c->q)) return -1;
+    memcpy(c->p0, c->p, sizeof c->p0);
+    memcpy(c->q0, c->q, sizeof c->q0);
+    if (jv_opt_vec(r, f[2], &p, "start_position", 3, c->p0) || (f[3] && get_quat(r, f[3], &q2, c->q0)) ||
+        jv_opt_vec(r, f[4], &p, "velocity", 3, c->v) || jv_opt_vec(r, f[5], &p, "angular_velocity", 3, c->om))
+        return -1;
+    return 0;
+}
+
+/* Two forms: as w:collider{...} takes it (world frame), or, with "pose", the shape in the
+ * collider's own frame plus its full pose (what w:save writes, exact) */
+static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider *c)
+{
+    static const char *const keys[] = { "shape", "normal", "offset", "center", "radius", "half", "rotation", "a", "b",
+                                        "friction", "restitution", "pose", NULL };
+    /* which keys each shape takes, world form / own-frame form (pose) */
+    static const char *const world_keys[WB_SHAPE_COUNT] = { "normal offset", "center radius", "center half rotation", "a b radius" };
+    static const char *const local_keys[WB_SHAPE_COUNT] = { "normal", "radius", "half", "a b radius" };
+    const cJSON *f[13];
+    if (jv_get_object(r, it, p, keys, f)) return -1;
+    if (!f[0]) return jv_missing(r, it, p, "shape");
+    kp sp = { p, "shape", 0 };
+    const char *name = "";
+    if (jv_get_string(r, f[0], &sp, &name)) return -1;
+    int shape = 0;
+    while (shape_names[shape] && strcmp(name, shape_names[shape])) shape++;
+    if (!shape_names[shape]) return jv_fail(r, f[0], 0, &sp, "unknown shape '%s' (expected plane, sphere, box or capsule)", name);
+    const int local = f[11] != NULL;
+    const char *allowed = (local ? local_keys : world_keys)[shape];
+    for (int i = 1; i <= 8; i++) {
+        if (!f[i]) continue;
+        const char *k = keys[i], *hit = strstr(allowed, k);
+        const size_t kl = strlen(k);
+        /* a whole word of the list */
+        while (hit && ((hit > allowed && hit[-1] != ' ') || (hit[kl] && hit[kl] != ' '))) hit = strstr(hit + 1, k);
+        if (!hit) {
+            kp kk = { p, k, 0 };
+            if (local) return jv_fail(r, f[i], 1, &kk, "a %s with a pose takes %s in its own frame, not '%s'", name, allowed, k);
+            return jv_fail(r, f[i], 1, &kk, "a %s takes %s (and friction, restitution, pose), not '%s'", name, allowed, k);
+        }
+    }
+    wb_collider_def d = wb_collider_default_def((wb_shape)shape);
+    if (jv_opt_vec(r, f[1], p, "normal", 3, d.normal) || jv_opt_real(r, f[2], p, "offset", &d.offset) ||
+        jv_opt_vec(r, f[3], p, "center", 3, d.center) || jv_opt_real(r, f[4], p, "radius", &d.radius) ||
+        jv_opt_vec(r, f[5], p, "half", 3, d.half) || jv_opt_vec(r, f[7], p, "a", 3, d.a) || jv_opt_vec(r, f[8], p, "b", 3, d.b) ||
+        jv_opt_nonneg(r, f[9], p, "friction", &d.friction) || jv_opt_nonneg(r, f[10], p, "restitution", &d.restitution))
+        return -1;
+    if (f[6]) {
+        kp q = { p, "rotation", 0 };
+        if (get_quat(r, f[6], &q, d.rotation)) return -1;
+    }
+    if (!local) {
+        wb_status st = wb_image_collider_from_def(&d, c);
+        if (st == WB_ERR_NOMEM) return jv_fail(r, it, 0, p, "out of memory");
+        return st != WB_OK ? jv_fail(r, it, 0, p, "%s", wb_last_error()) : 0;
+    }
+    /* own frame: the values are the collider's internals, as w:save wrote them */
+    memset(c, 0, sizeof *c);
+    c->shape = (wb_shape)shape;
+    c->friction = d.friction;
+    c->restitution = d.restitution;
+    switch (c->shape) {
+    case WB_SHAPE_PLANE: {
+        wb_real n2 = d.normal[0] * d.normal[0] + d.normal[1] * d.normal[1] + d.normal[2] * d.normal[2];
+        if (!(n2 > 1e-24)) return jv_fail(r, f[1] ? f[1] : it, 0, p, "normal must not be zero");
+        for (int i = 0; i < 3; i++) c->n[i] = fabs(n2 - 1) > 1e-12 ? d.normal[i] / sqrt(n2) : d.normal[i];
+        break;
+    }
+    case WB_SHAPE_BOX: memcpy(c->half, d.half, sizeof c->half); break;
+    case WB_SHAPE_CAPSULE:
+        memcpy(c->a, d.a, sizeof c->a);
+        memcpy(c->b, d.b, sizeof c->b);
+        c->radius = d.radius;
+        break;
+    default: c->radius = d.radius; break;
+    }
+    if (read_pose(r, f[11], p, c)) return -1;
+    if (c->shape == WB_SHAPE_BOX && !(c->half[0] > 0 && c->half[1] > 0 && c->half[2] > 0))
+        return jv_fail(r, it, 0, p, "half extents must be > 0");
+    if ((c->shape == WB_SHAPE_SPHERE || c->shape == WB_SHAPE_CAPSULE) && !(c->radius > 0))
+        return jv_fail(r, it, 0, p, "radius must be > 0");
+    if (c->restitution > 1) return jv_fail(r, f[10], 0, p, "restitution must be in [0, 1]");
+    return 0;
+}
+
+static int read_colliders(rd *r, const sections *s, wb_image *g)
+{
+    kp top = { NULL, "colliders", 0 };
+    int32_t i = 0, slot = -1;
+    if (!s->colliders) return 0;
+    for (const cJSON *c = s->colliders->child; c; c = c->next, i++) {
+        kp p = { &top, NULL, i };
+        do slot++; while (!(g->c_gen[slot] & 1u));
+        if (read_collider(r, c, &p, &g->c[slot])) return -1;
+    }
+    return 0;
+}
+
+/* "surfaces": [ {"triangles": [a,b,c, ...]}, ... ]: first pass counts, second fills */
+static int read_surfaces(rd *r, const sections *s, wb_image *g, int32_t *ntri)
+{
+    static const char *const keys[] = { "triangles", NULL };
+    kp top = { NULL, "surfaces", 0 };
+    int32_t i = 0, t = 0;
+    if (!s->surfaces) { *ntri = 0; return 0; }
+    for (const cJSON *c = s->surfaces->child; c; c = c->next, i++) {
+        const cJSON *f[2];
+        kp p = { &top, NULL, i }, tp = { &p, "triangles", 0 };
+        int32_t n;
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "triangles");
+        if (jv_get_array(r, f[0], &tp, 3ll * WB_MAX_CONSTRAINTS, &n)) return -1;
+        if (n % 3) return jv_fail(r, f[0], 0, &tp, "%d corners is not a whole number of triangles", n);
+        if (g) {
+            g->surf_start[i] = t;
+            int32_t k = 0;
+            for (const cJSON *e = f[0]->child; e; e = e->next, k++) {
+                kp q = { &tp, NULL, k };
+                int64_t v;
+                if (g->np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
+                if (jv_get_int(r, e, &q, 0, g->np - 1, &v)) return -1;
+                g->tri[3 * (int64_t)t + k] = (int32_t)v;
+            }
+        }
+        if ((int64_t)t + n / 3 > WB_MAX_CONSTRAINTS) return jv_fail(r, f[0], 0, &tp, "too many triangles");
+        t += n / 3;
+    }
+    if (g) g->surf_start[i] = t;
+    *ntri = t;
+    return 0;
+}
+
+static int read_parts(rd *r, const sections *s, wbio_config *cfg)
+{
+    static const char *const keys[] = { "name", "first", "count", NULL };
+    kp top = { NULL, "parts", 0 };
+    int32_t i = 0;
+    for (const cJSON *c = s->parts ? s->parts->child : NULL; c; c = c->next, i++) {
+        const cJSON *f[4];
+        kp p = { &top, NULL, i }, np = { &p, "name", 0 };
+        const char *name = "";
+        int64_t first, count;
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "name");
+        if (!f[1]) return jv_missing(r, c, &p, "first");
+        if (!f[2]) return jv_missing(r, c, &p, "count");
+        if (jv_get_string(r, f[0], &np, &name) || jv_opt_int(r, f[1], &p, "first", 0, s->np, &first) ||
+            jv_opt_int(r, f[2], &p, "count", 0, s->np - first, &count))
+            return -1;
+        for (int32_t j = 0; j < i; j++)
+            if (!strcmp(cfg->parts[j].name, name)) return jv_fail(r, f[0], 0, &np, "a part named '%s' already exists", name);
+        cfg->parts[i].name = strdup(name);
+        if (!cfg->parts[i].name) return jv_fail(r, c, 0, &p, "out of memory");
+        cfg->parts[i].first = (int32_t)first;
+        cfg->parts[i].count = (int32_t)count;
+        cfg->nparts = i + 1;
+    }
+    return 0;
+}
+
+static int read_skins(rd *r, const sections *s, wbio_config *cfg)
+{
+    static const char *const keys[] = { "mesh", "scale", "bones", "neighbours", "particles", NULL };
+    kp top = { NULL, "skins", 0 };
+    int32_t i = 0;
+    for (const cJSON *c = s->skins ? s->skins->child : NULL; c; c = c->next, i++) {
+        const cJSON *f[6];
+        kp p = { &top, NULL, i }, mp = { &p, "mesh", 0 };
+        wbio_skin_spec *k = &cfg->skins[i];
+        const char *mesh = "";
+        int64_t v;
+        cfg->nskins = i + 1;
+        k->scale = 1;
+        k->def = wb_skin_default_def();
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "mesh");
+        if (jv_get_string(r, f[0], &mp, &mesh) || jv_opt_real(r, f[1], &p, "scale", &k->scale)) return -1;
+        if (!(k->scale > 0)) return jv_fail(r, f[1], 0, &p, "scale must be > 0");
+        if (f[2]) { if (jv_opt_int(r, f[2], &p, "bones", 1, 16, &v)) return -1; k->def.bones = (int)v; }
+        if (f[3]) { if (jv_opt_int(r, f[3], &p, "neighbours", 2, 32, &v)) return -1; k->def.neighbours = (int)v; }
+        k->mesh = strdup(mesh);
+        if (!k->mesh) return jv_fail(r, c, 0, &p, "out of memory");
+        jv_where_of(r, f[0], 0, &mp, k->where, sizeof k->where); /* for messages about loading it */
+        if (f[4]) {
+            kp pp = { &p, "particles", 0 };
+            if (jv_get_array(r, f[4], &pp, s->np, &k->nids)) return -1;
+            if (k->nids == 0) return jv_fail(r, f[4], 0, &pp, "a skin needs at least one particle");
+            k->ids = malloc(sizeof *k->ids * (size_t)k->nids);
+            if (!k->ids) return jv_fail(r, c, 0, &p, "out of memory");
+            int32_t j = 0;
+            for (const cJSON *e = f[4]->child; e; e = e->next, j++) {
+                kp q = { &pp, NULL, j };
+                if (jv_get_int(r, e, &q, 0, s->np - 1, &v)) return -1;
+                k->ids[j] = (int32_t)v;
+            }
+        } else if (s->np == 0) {
+            return jv_fail(r, c, 0, &p, "a skin needs at least one particle");
+        }
+    }
+    return 0;
+}
+
+/* ---- the file ---------------------------------------------------------------------------------- */
+static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
+{
+    static const char *const keys[] = { "format", "version", "description", "defaults", "particles", "constraints",
+                                        "colliders", "surfaces", "parts", "skins", "snapshot", NULL };
+    const cJSON *f[12];
+    sections s;
+    defaults d;
+    memset(&s, 0, sizeof s);
+    if (!cJSON_IsObject(root)) return jv_fail(r, root, 0, NULL, "a particle config is a JSON object, got %s", jv_type_name(root));
+    if (jv_get_object(r, root, NULL, keys, f)) return -1;
+    kp fp = { NULL, "format", 0 }, vp = { NULL, "version", 0 };
+    const char *str = "";
+    int64_t version;
+    if (!f[0]) return jv_fail(r, root, 0, NULL, "missing key 'format' (a particle config starts with "
+                                              "\"format\": \"" WBIO_FORMAT "\", \"version\": 1)");
+    if (jv_get_string(r, f[0], &fp, &str)) return -1;
+    if (strcmp(str, WBIO_FORMAT)) return jv_fail(r, f[0], 0, &fp, "'%s' is not a particle config (expected '" WBIO_FORMAT "')", str);
+    if (!f[1]) return jv_missing(r, root, NULL, "version");
+    if (jv_get_int(r, f[1], &vp, INT32_MIN, INT32_MAX, &version)) return -1;
+    if (version != WBIO_VERSION)
+        return jv_fail(r, f[1], 0, &vp, "version %lld is not supported (this wobble reads version %d)", (long long)version, WBIO_VERSION);
+    if (f[2]) {
+        kp dp = { NULL, "description", 0 };
+        if (jv_get_string(r, f[2], &dp, &str)) return -1;
+    }
+    if (read_defaults(r, f[3], &d)) return -1;
+    if (!f[4]) return jv_missing(r, root, NULL, "particles");
+    struct { const cJSON **dst; int32_t *n; int64_t max; int k; } arrays[] = {
+        { &s.particles, &s.np, WB_MAX_PARTICLES, 4 }, { &s.constraints, &s.ncons, WB_MAX_CONSTRAINTS, 5 },
+        { &s.colliders, &s.ncol, WB_MAX_COLLIDERS, 6 }, { &s.surfaces, &s.nsurf, WB_MAX_CONSTRAINTS, 7 },
+        { &s.parts, &s.nparts, 1 << 20, 8 }, { &s.skins, &s.nskins, 1 << 10, 9 },
+    };
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++) {
+        const cJSON *it = f[arrays[i].k];
+        kp ap = { NULL, keys[arrays[i].k], 0 };
+        *arrays[i].dst = it;
+        if (it && jv_get_array(r, it, &ap, arrays[i].max, arrays[i].n)) return -1;
+    }
+    s.snapshot = f[10];
+    if (scan_snapshot(r, &s) || read_surfaces(r, &s, NULL, &s.ntri)) return -1;
+    if (wb_image_alloc(&cfg->img, s.np, s.nd, s.nfree, s.nc, s.nsurf, s.ntri) != WB_OK ||
+        !(cfg->parts = calloc((size_t)s.nparts + 1, sizeof *cfg->parts)) ||
+        !(cfg->skins = calloc((size_t)s.nskins + 1, sizeof *cfg->skins)))
+        return jv_fail(r, NULL, 0, NULL, "out of memory");
+    cfg->snapshot = s.snapshot != NULL;
+    /* the snapshot first: its slot tables say where the constraints and colliders go */
+    if ((s.snapshot && read_snapshot(r, &s, &cfg->img)) || read_particles(r, &s, &d, &cfg->img) ||
+        read_constraints(r, &s, &d, &cfg->img) || read_colliders(r, &s, &cfg->img) ||
+        read_surfaces(r, &s, &cfg->img, &s.ntri) || read_parts(r, &s, cfg) || read_skins(r, &s, cfg))
+        return -1;
+    /* every value was checked where it was read: this is the last line of defence */
+    const char *e = wb_image_check(&cfg->img);
+    return e ? jv_fail(r, root, 0, NULL, "%s", e) : 0;
+}
+
+static char *read_text(const char *path, const char *shown, size_t *len, char *err, size_t errn)
+{
+    FILE *fp = fopen(path, "rb");
+    struct stat st;
+    if (!fp) { snprintf(err, errn, "%s: %s", shown, strerror(errno)); return NULL; }
+    if (fstat(fileno(fp), &st) == 0 && S_ISDIR(st.st_mode)) {
+        snprintf(err, errn, "%s: is a folder, not a file", shown);
+        fclose(fp);
+        return NULL;
+    }
+    size_t cap = 1 << 16, n = 0;
+    char *t = malloc(cap);
+    while (t) {
+        if (n + 1 >= cap) {
+            char *u = cap < (size_t)MAX_FILE ? realloc(t, cap * 2) : NULL;
+            if (!u) break;
+            t = u;
+            cap *= 2;
+        }
+        size_t got = fread(t + n, 1, cap - n - 1, fp);
+        n += got;
+        if (got == 0) {
+            if (ferror(fp)) { snprintf(err, errn, "%s: %s", shown, strerror(errno)); free(t); fclose(fp); return NULL; }
+            t[n] = '\0';
+            fclose(fp);
+            *len = n;
+            return t;
+        }
+    }
+    snprintf(err, errn, "%s: %s", shown, t ? "too large (2 GiB at most)" : "out of memory");
+    free(t);
+    fclose(fp);
+    return NULL;
+}
+
+/* how many arrays and objects are open at `end` (strings skipped): cJSON stops at the
+ * bracket that goes past CJSON_NESTING_LIMIT, which is no syntax error of the file's */
+static int json_depth(const char *text, const char *end)
+{
+    int depth = 0, in_string = 0;
+    for (const char *p = text; p < end; p++) {
+        if (in_string) {
+            if (*p == '\\' && p + 1 < end) p++;
+            else if (*p == '"') in_string = 0;
+        } else if (*p == '"') in_string = 1;
+        else if (*p == '[' || *p == '{') depth++;
+        else if (*p == ']' || *p == '}') depth--;
+    }
+    return depth;
+}
+
+int wbio_read_config(const char *path, const char *shown, wbio_config *cfg, char *err, size_t errn)
+{
+    memset(cfg, 0, sizeof *cfg);
+    size_t len = 0;
+    char *text = read_text(path, shown, &len, err, errn);
+    if (!text) return -1;
+    scan s = { text, text, 0, 0, NULL, NULL, 0 };
+    rd r = { shown, text, NULL, err, errn };
+    int rc = -1, line, col;
+    cJSON *root = NULL;
+    const char *nul = memchr(text, '\0', len), *end = NULL, *p = text;
+    while (*p && (unsigned char)*p <= 32) p++;
+    if (nul) {
+        jv_line_col(text, (int32_t)(nul - text), &line, &col);
+        snprintf(err, errn, "%s:%d:%d: not a text file (a NUL byte)", shown, line, col);
+    } else if (!*p) {
+        snprintf(err, errn, "%s: empty file (a particle config is a JSON object)", shown);
+    } else if (!(root = cJSON_ParseWithOpts(text, &end, 1))) {
+        /* cJSON's error pointer, turned into a line and column */
+        const int32_t off = end ? (int32_t)(end - text) : 0;
+        char near[24] = "";
+        for (int i = 0; i < 20 && end && end[i] && end[i] != '\n'; i++) near[i] = isprint((unsigned char)end[i]) ? end[i] : '?';
+        jv_line_col(text, off, &line, &col);
+        if (end && *end && json_depth(text, end) >= CJSON_NESTING_LIMIT)
+            snprintf(err, errn, "%s:%d:%d: JSON nested too deeply (more than %d levels of arrays and objects)", shown,
+                     line, col, CJSON_NESTING_LIMIT);
+        else if (end && *end) snprintf(err, errn, "%s:%d:%d: JSON syntax error near '%s'", shown, line, col, near);
+        else snprintf(err, errn, "%s:%d:%d: JSON syntax error: unexpected end of file", shown, line, col);
+    } else {
+        if (!strncmp(s.p, "\xEF\xBB\xBF", 3)) s.p += 3; /* cJSON skips a UTF-8 byte-order mark too */
+        jv_sk_value(&s, -1);
+        int32_t k = 0;
+        jv_number_items(root, &k);
+        r.pos = !s.oom && k == s.n ? &s : NULL; /* without positions, messages still name the key */
+        rc = read_root(&r, root, cfg);
+    }
+    cJSON_Delete(root);
+    free(s.voff);
+    free(s.koff);
+    free(text);
+    if (rc) wbio_config_free(cfg);
+    return rc;
+}
+
+void wbio_config_free(wbio_config *cfg)
+{
+    wb_image_free(&cfg->img);
+    for (int32_t i = 0; cfg->parts && i < cfg->nparts; i++) free(cfg->parts[i].name);
+    for (int32_t i = 0; cfg->skins && i < cfg->nskins; i++) {
+        free(cfg->skins[i].mesh);
+        free(cfg->skins[i].ids);
+    }
+    free(cfg->parts);
+    free(cfg->skins);
+    memset(cfg, 0, sizeof *cfg);
+}

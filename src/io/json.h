@@ -1,0 +1,66 @@
+/* json.h: the JSON machinery shared by the particle-config reader (json.c) and its
+ * value layer (json_value.c): where each value of the text is, key paths, and typed
+ * reads that fail with "file:line:col: key.path: reason". Private to io_json*.c. */
+#ifndef WB_IO_JSON_H
+#define WB_IO_JSON_H
+
+#include <cJSON.h>
+
+#include "io.h"
+
+/* the offset of every value of a (valid) JSON text, in document order */
+typedef struct scan {
+    const char *t, *p;
+    int32_t n, cap;
+    int32_t *voff;       /* (n) offset of each value, in document order */
+    int32_t *koff;       /* (n) offset of its key, -1 outside objects */
+    int oom;
+} scan;
+
+/* a key path, as a chain of links up to the root: "particles[3].position[1]" */
+typedef struct kp {            /* a key path, as a chain up to the root */
+    const struct kp *up;
+    const char *key;           /* NULL: an array index */
+    int64_t index;
+} kp;
+
+/* a reader: the file's name as shown, its text, the positions (NULL when unknown) and
+ * where the message goes */
+typedef struct rd {
+    const char *shown, *text;
+    const scan *pos;           /* NULL when positions are unknown */
+    char *err;
+    size_t errn;
+} rd;
+
+/* positions: record every value of text (valid JSON) from s->p on, then number cJSON's
+ * items in the same pre-order (their valueint holds the index) */
+void jv_sk_value(scan *s, int32_t key);
+void jv_number_items(cJSON *it, int32_t *k);
+void jv_line_col(const char *t, int32_t off, int *line, int *col);
+
+/* messages: "shown:line:col: key.path" of an item (its key when at_key), and failing
+ * with it; every reader function returns 0, or -1 after jv_fail */
+void jv_where_of(const rd *r, const cJSON *it, int at_key, const kp *path, char *buf, size_t n);
+int jv_fail(rd *r, const cJSON *it, int at_key, const kp *path, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+int jv_missing(rd *r, const cJSON *obj, const kp *p, const char *key);
+const char *jv_type_name(const cJSON *it);
+
+/* typed values: the item must be of the type (numbers finite, integers in [lo, hi]) */
+int jv_get_real(rd *r, const cJSON *it, const kp *p, wb_real *out);
+int jv_get_int(rd *r, const cJSON *it, const kp *p, int64_t lo, int64_t hi, int64_t *out);
+int jv_get_bool(rd *r, const cJSON *it, const kp *p, bool *out);
+int jv_get_string(rd *r, const cJSON *it, const kp *p, const char **out);
+int jv_get_array(rd *r, const cJSON *it, const kp *p, int64_t max, int32_t *count);
+int jv_get_vec(rd *r, const cJSON *it, const kp *p, int n, wb_real *out); /* exactly n numbers */
+/* an object whose keys are all in `keys` (NULL-terminated), none twice: found[i] = value */
+int jv_get_object(rd *r, const cJSON *obj, const kp *p, const char *const keys[], const cJSON **found);
+
+/* optional fields (f may be NULL: *out untouched); key names the field under up */
+int jv_opt_real(rd *r, const cJSON *f, const kp *up, const char *key, wb_real *out);
+int jv_opt_nonneg(rd *r, const cJSON *f, const kp *up, const char *key, wb_real *out);
+int jv_opt_int(rd *r, const cJSON *f, const kp *up, const char *key, int64_t lo, int64_t hi, int64_t *out);
+int jv_opt_vec(rd *r, const cJSON *f, const kp *up, const char *key, int n, wb_real *out);
+
+#endif

@@ -1,0 +1,225 @@
+/* json_write.c: w:save: the full state as a particle config plus a "snapshot" section
+ * (settings, clock, slot tables), so that wobble.load restores it bit for bit. Doubles are
+ * written with "%.17g", which round-trips every double through strtod (cJSON's reader). */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "io.h"
+
+typedef struct out {
+    FILE *f;
+    int bad;               /* a non-finite number was met */
+} out;
+
+static void num(out *o, double x)
+{
+    if (!isfinite(x)) { o->bad = 1; x = 0; }
+    fprintf(o->f, "%.17g", x);
+}
+
+static void vec(out *o, const wb_real *v, int n)
+{
+    fputc('[', o->f);
+    for (int i = 0; i < n; i++) {
+        if (i) fputs(", ", o->f);
+        num(o, (double)v[i]);
+    }
+    fputc(']', o->f);
+}
+
+static void str(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\') fprintf(f, "\\%c", c);
+        else if (c < 32) fprintf(f, "\\u%04x", c);
+        else fputc(c, f);
+    }
+    fputc('"', f);
+}
+
+static void ints(FILE *f, const char *indent, const uint32_t *u, const int32_t *s, int32_t n)
+{
+    fputc('[', f);
+    for (int32_t i = 0; i < n; i++) {
+        if (i) fputs(i % 24 ? ", " : ",\n", f);
+        if (i && i % 24 == 0) fputs(indent, f);
+        if (u) fprintf(f, "%u", u[i]);
+        else fprintf(f, "%d", s[i]);
+    }
+    fputc(']', f);
+}
+
+static void write_snapshot(out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    const wb_world_def *d = &g->def;
+    fputs("  \"snapshot\": {\n    \"world\": {\"gravity\": ", f);
+    vec(o, d->gravity, 3);
+    fputs(", \"dt\": ", f);
+    num(o, d->dt);
+    fprintf(f, ", \"substeps\": %d, \"iterations\": %d, \"damping\": ", d->substeps, d->iterations);
+    num(o, d->damping);
+    fprintf(f, ", \"solver\": \"%s\", \"relaxation\": ", d->solver == WB_SOLVER_JACOBI ? "jacobi" : "gauss-seidel");
+    num(o, d->relaxation);
+    fprintf(f, ", \"threads\": %d},\n    \"time\": ", d->threads);
+    num(o, g->time);
+    fprintf(f, ", \"frame\": %lld, \"warnings\": %lld, \"last_warning\": ", (long long)g->frame, (long long)g->warnings);
+    str(f, g->last_warning);
+    fputs(",\n    \"distance_slots\": {\"generations\": ", f);
+    ints(f, "      ", g->d_gen, NULL, g->nd);
+    fputs(", \"free\": ", f);
+    ints(f, "      ", NULL, g->d_free, g->nfree);
+    fputs("},\n    \"collider_slots\": {\"generations\": ", f);
+    ints(f, "      ", g->c_gen, NULL, g->nc);
+    fputs("}\n  },\n", f);
+}
+
+static void write_particles(out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    fputs("  \"particles\": [", f);
+    for (int32_t i = 0; i < g->np; i++) {
+        fputs(i ? ",\n    {\"position\": " : "\n    {\"position\": ", f);
+        vec(o, &g->x[3 * i], 3);
+        fputs(", \"velocity\": ", f);
+        vec(o, &g->v[3 * i], 3);
+        /* mass for people, inv_mass for the exact restore */
+        fputs(", \"mass\": ", f);
+        num(o, g->inv_mass[i] > 0 ? 1 / g->inv_mass[i] : 0);
+        fputs(", \"inv_mass\": ", f);
+        num(o, g->inv_mass[i]);
+        fputs(", \"radius\": ", f);
+        num(o, g->radius[i]);
+        fprintf(f, ", \"pinned\": %s}", g->pinned[i] ? "true" : "false");
+    }
+    fputs(g->np ? "\n  ],\n" : "],\n", f);
+}
+
+static void write_constraints(out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    int first = 1;
+    fputs("  \"constraints\": [", f);
+    for (int32_t i = 0; i < g->nd; i++) {
+        if (!(g->d_gen[i] & 1u)) continue;
+        fprintf(f, "%s    {\"type\": \"distance\", \"particles\": [%d, %d], \"rest\": ", first ? "\n" : ",\n",
+                g->d_ij[2 * i], g->d_ij[2 * i + 1]);
+        first = 0;
+        num(o, g->d_rest[i]);
+        fputs(", \"compliance\": ", f);
+        num(o, g->d_alpha[i]);
+        fputs(", \"damping\": ", f);
+        num(o, g->d_beta[i]);
+        fputs(", \"yield\": ", f);
+        num(o, g->d_yield[i]);
+        fputs(", \"creep\": ", f);
+        num(o, g->d_creep[i]);
+        fputs(", \"break_strain\": ", f);
+        num(o, g->d_break[i]);
+        fprintf(f, ", \"broken\": %s}", g->d_broken[i] ? "true" : "false");
+    }
+    fputs(first ? "],\n" : "\n  ],\n", f);
+}
+
+static void write_colliders(out *o, const wb_image *g)
+{
+    static const char *const names[] = { "plane", "sphere", "box", "capsule" };
+    FILE *f = o->f;
+    int first = 1;
+    fputs("  \"colliders\": [", f);
+    for (int32_t i = 0; i < g->nc; i++) {
+        if (!(g->c_gen[i] & 1u)) continue;
+        const wb_image_collider *c = &g->c[i];
+        fprintf(f, "%s    {\"shape\": \"%s\", ", first ? "\n" : ",\n", names[c->shape]);
+        first = 0;
+        /* the shape in the collider's own frame: what the pose carries */
+        switch (c->shape) {
+        case WB_SHAPE_PLANE: fputs("\"normal\": ", f); vec(o, c->n, 3); break;
+        case WB_SHAPE_SPHERE: fputs("\"radius\": ", f); num(o, c->radius); break;
+        case WB_SHAPE_BOX: fputs("\"half\": ", f); vec(o, c->half, 3); break;
+        default:
+            fputs("\"a\": ", f); vec(o, c->a, 3);
+            fputs(", \"b\": ", f); vec(o, c->b, 3);
+            fputs(", \"radius\": ", f); num(o, c->radius);
+            break;
+        }
+        fputs(", \"friction\": ", f);
+        num(o, c->friction);
+        fputs(", \"restitution\": ", f);
+        num(o, c->restitution);
+        fputs(",\n     \"pose\": {\"position\": ", f);
+        vec(o, c->p, 3);
+        fputs(", \"rotation\": ", f);
+        vec(o, c->q, 4);
+        fputs(", \"start_position\": ", f);
+        vec(o, c->p0, 3);
+        fputs(", \"start_rotation\": ", f);
+        vec(o, c->q0, 4);
+        fputs(", \"velocity\": ", f);
+        vec(o, c->v, 3);
+        fputs(", \"angular_velocity\": ", f);
+        vec(o, c->om, 3);
+        fputs("}}", f);
+    }
+    fputs(first ? "],\n" : "\n  ],\n", f);
+}
+
+static void write_surfaces(out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    fputs("  \"surfaces\": [", f);
+    for (int32_t s = 0; s < g->nsurf; s++) {
+        const int32_t a = g->surf_start[s], b = g->surf_start[s + 1];
+        fputs(s ? ",\n    {\"triangles\": " : "\n    {\"triangles\": ", f);
+        ints(f, "      ", NULL, &g->tri[3 * (int64_t)a], 3 * (b - a));
+        fputc('}', f);
+    }
+    fputs(g->nsurf ? "\n  ]\n" : "]\n", f);
+}
+
+int wbio_write_snapshot(const wb_world *w, const char *path, const char *shown, char *err, size_t errn)
+{
+    wb_image g;
+    if (wb_image_of(w, &g) != WB_OK) {
+        snprintf(err, errn, "%s: out of memory", shown);
+        return -1;
+    }
+    /* a temporary file beside the target, renamed over it once complete */
+    char tmp[4200];
+    if (snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid()) >= (int)sizeof tmp) {
+        snprintf(err, errn, "%s: path too long", shown);
+        wb_image_free(&g);
+        return -1;
+    }
+    out o = { fopen(tmp, "wb"), 0 };
+    if (!o.f) {
+        snprintf(err, errn, "%s: %s", shown, strerror(errno));
+        wb_image_free(&g);
+        return -1;
+    }
+    setvbuf(o.f, NULL, _IOFBF, 1 << 20);
+    fprintf(o.f, "{\n  \"format\": \"%s\",\n  \"version\": %d,\n  \"description\": \"wobble %s snapshot at frame %lld\",\n",
+            WBIO_FORMAT, WBIO_VERSION, WB_VERSION, (long long)g.frame);
+    write_snapshot(&o, &g);
+    write_particles(&o, &g);
+    write_constraints(&o, &g);
+    write_colliders(&o, &g);
+    write_surfaces(&o, &g);
+    fputs("}\n", o.f);
+    int werr = ferror(o.f) ? errno : 0;
+    if (fclose(o.f) != 0 && !werr) werr = errno ? errno : EIO;
+    wb_image_free(&g);
+    if (o.bad || werr || rename(tmp, path) != 0) {
+        if (!werr && !o.bad) werr = errno;
+        snprintf(err, errn, "%s: %s", shown, o.bad ? "the state holds a non-finite number" : strerror(werr));
+        remove(tmp);
+        return -1;
+    }
+    return 0;
+}

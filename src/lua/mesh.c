@@ -1,0 +1,334 @@
+/* mesh.c: the mesh userdata: wobble.mesh{vertices, triangles}, wobble.load_mesh(path)
+ * and their methods, and w:from_mesh(m, {...}), the particle graph of a mesh.
+ *
+ * Vertex and triangle ids are 1-based here as everywhere in Lua. A file that cannot be
+ * read is an expected failure: load_mesh returns nil and "file: reason" (liolib's style);
+ * misuse (a wrong argument type) raises. */
+#include <limits.h>
+#include <math.h>
+#include <string.h>
+
+#include "io/io.h"
+#include "mesh.h"
+#include "sandbox.h"
+
+typedef struct wbl_mesh { wb_mesh *m; } wbl_mesh;
+
+wb_mesh **wbl_push_mesh_slot(lua_State *L)
+{
+    wbl_mesh *u = (wbl_mesh *)lua_newuserdatauv(L, sizeof *u, 0);
+    u->m = NULL;
+    luaL_setmetatable(L, WBL_MESH);
+    return &u->m;
+}
+
+wb_mesh *wbl_checkmesh(lua_State *L, int arg)
+{
+    wbl_mesh *u = (wbl_mesh *)luaL_checkudata(L, arg, WBL_MESH);
+    if (!u->m) luaL_argerror(L, arg, "mesh is closed");
+    return u->m;
+}
+
+static int vertex_id(lua_State *L, const wb_mesh *m, int arg)
+{
+    lua_Integer i = wbl_checkint(L, arg);
+    if (i < 1 || i > m->nv) luaL_argerror(L, arg, lua_pushfstring(L, "vertex %I out of range (1..%d)", i, (int)m->nv));
+    return (int)(i - 1);
+}
+
+/* ---- wobble.mesh{vertices = ..., triangles = ...} -------------------------------------------- */
+/* a list of n-tuples, nested ({{x,y,z}, ...}) or flat ({x,y,z, x,y,z, ...}), as numbers */
+static lua_Integer read_tuples(lua_State *L, int arg, const char *key, int n, int integral, void **out)
+{
+    lua_getfield(L, arg, key);
+    if (!lua_istable(L, -1)) wbl_fielderror(L, arg, key, "table expected, got %s", luaL_typename(L, -1));
+    const int t = lua_gettop(L);
+    const lua_Integer len = (lua_Integer)lua_rawlen(L, t);
+    const int nested = len > 0 && (lua_rawgeti(L, t, 1), lua_istable(L, -1));
+    if (len > 0) lua_pop(L, 1);
+    const lua_Integer count = nested ? len : len / n;
+    if (!nested && len % n) wbl_fielderror(L, arg, key, "a flat list needs a multiple of %d numbers, got %lld", n, (long long)len);
+    if (count > (integral ? WB_MAX_CONSTRAINTS : WB_MAX_PARTICLES)) wbl_fielderror(L, arg, key, "too many entries");
+    void *buf = lua_newuserdatauv(L, (size_t)(count > 0 ? count : 1) * (size_t)n * (integral ? sizeof(int32_t) : sizeof(wb_real)), 0);
+    for (lua_Integer i = 0; i < count; i++) {
+        if (nested) {
+            lua_rawgeti(L, t, i + 1);
+            if (!lua_istable(L, -1) || lua_rawlen(L, -1) != (size_t)n)
+                wbl_fielderror(L, arg, key, "entry %lld: table of %d %s expected", (long long)i + 1, n, integral ? "integers" : "numbers");
+        }
+        for (int c = 0; c < n; c++) {
+            if (nested) lua_rawgeti(L, -1, c + 1);
+            else lua_rawgeti(L, t, i * n + c + 1);
+            int isnum = lua_type(L, -1) == LUA_TNUMBER, isint = 0;
+            lua_Integer iv = isnum ? lua_tointegerx(L, -1, &isint) : 0;
+            lua_Number x = isnum ? lua_tonumber(L, -1) : 0;
+            if (integral && !isint)
+                wbl_fielderror(L, arg, key, "entry %lld: integer expected, got %s", (long long)i + 1, luaL_typename(L, -1));
+            if (!integral && (!isnum || x != x || x - x != 0))
+                wbl_fielderror(L, arg, key, "entry %lld: finite number expected, got %s", (long long)i + 1, isnum ? "a non-finite one" : luaL_typename(L, -1));
+            if (integral) {
+                if (iv < 1 || iv > INT32_MAX) wbl_fielderror(L, arg, key, "entry %lld: vertex %lld out of range", (long long)i + 1, (long long)iv);
+                ((int32_t *)buf)[i * n + c] = (int32_t)(iv - 1);
+            } else {
+                ((wb_real *)buf)[i * n + c] = (wb_real)x;
+            }
+            lua_pop(L, 1);
+        }
+        if (nested) lua_pop(L, 1);
+    }
+    lua_replace(L, t); /* keep the buffer where the list was: collected with the stack */
+    *out = buf;
+    return count;
+}
+
+static const char *const mesh_keys[] = { "vertices", "triangles", "weld", NULL };
+
+static int l_mesh(lua_State *L)
+{
+    wbl_checkopts(L, 1, mesh_keys, false);
+    void *v, *t;
+    lua_Integer nv = read_tuples(L, 1, "vertices", 3, 0, &v);
+    lua_Integer nt = read_tuples(L, 1, "triangles", 3, 1, &t);
+    const int32_t *tri = t;
+    for (lua_Integer i = 0; i < 3 * nt; i++)
+        if (tri[i] >= nv)
+            wbl_fielderror(L, 1, "triangles", "entry %lld: vertex %d out of range (1..%lld)", (long long)(i / 3 + 1), (int)tri[i] + 1, (long long)nv);
+    wb_real weld = -1;
+    lua_getfield(L, 1, "weld");
+    /* true: the same default as load_mesh, near-coincident vertices merged too */
+    if (lua_isboolean(L, -1)) weld = lua_toboolean(L, -1) ? -2 : -1;
+    else if (!lua_isnil(L, -1) && wbl_optreal(L, 1, "weld", &weld) && weld < 0)
+        return wbl_fielderror(L, 1, "weld", "tolerance must be >= 0");
+    lua_pop(L, 1);
+    wb_mesh **slot = wbl_push_mesh_slot(L);
+    wb_status st;
+    *slot = wb_mesh_create(v, (int32_t)nv, tri, (int32_t)nt, &st);
+    if (!*slot) return wbl_status_error(L, 1, st, "mesh");
+    if (weld == -2) weld = wb_mesh_weld_tolerance(*slot);
+    if (weld >= 0 && (st = wb_mesh_weld(*slot, weld, NULL)) != WB_OK) return wbl_status_error(L, 1, st, "mesh");
+    return 1;
+}
+
+/* ---- wobble.load_mesh(path, {scale, weld, timeout}) ------------------------------------------- */
+static const char *const load_keys[] = { "scale", "weld", "timeout", NULL };
+
+static int l_load_mesh(lua_State *L)
+{
+    const char *name = luaL_checkstring(L, 1);
+    wbio_mesh_opts o = { 1, true, -1, 0 };
+    if (wbl_checkopts(L, 2, load_keys, true)) {
+        if (wbl_optreal(L, 2, "scale", &o.scale) && !(o.scale > 0)) return wbl_fielderror(L, 2, "scale", "must be > 0");
+        lua_getfield(L, 2, "weld");
+        if (lua_isboolean(L, -1)) o.weld = lua_toboolean(L, -1);
+        else if (!lua_isnil(L, -1) && wbl_optreal(L, 2, "weld", &o.tol) && o.tol < 0)
+            return wbl_fielderror(L, 2, "weld", "tolerance must be >= 0");
+        lua_pop(L, 1);
+        wb_real t = 0;
+        if (wbl_optreal(L, 2, "timeout", &t) && !(t > 0)) return wbl_fielderror(L, 2, "timeout", "must be > 0");
+        o.timeout = t;
+    }
+    char path[4096], err[1024];
+    wbl_path(L, name, 0, path, sizeof path);
+    wb_mesh **slot = wbl_push_mesh_slot(L);
+    *slot = wbio_load_mesh(path, name, &o, wbl_allow, L, err, sizeof err);
+    if (!*slot) {
+        luaL_pushfail(L);
+        lua_pushstring(L, err);
+        return 2;
+    }
+    return 1;
+}
+
+/* ---- methods ---------------------------------------------------------------------------------- */
+static int m_vertex_count(lua_State *L)
+{
+    lua_pushinteger(L, wbl_checkmesh(L, 1)->nv);
+    return 1;
+}
+
+static int m_triangle_count(lua_State *L)
+{
+    lua_pushinteger(L, wbl_checkmesh(L, 1)->nt);
+    return 1;
+}
+
+static int m_vertex(lua_State *L)
+{
+    const wb_mesh *m = wbl_checkmesh(L, 1);
+    wbl_pushreals(L, &m->v[3 * vertex_id(L, m, 2)], 3);
+    return 3;
+}
+
+static int m_normal(lua_State *L)
+{
+    const wb_mesh *m = wbl_checkmesh(L, 1);
+    wbl_pushreals(L, &m->n[3 * vertex_id(L, m, 2)], 3);
+    return 3;
+}
+
+static int m_triangle(lua_State *L)
+{
+    const wb_mesh *m = wbl_checkmesh(L, 1);
+    lua_Integer i = wbl_checkint(L, 2);
+    if (i < 1 || i > m->nt) return luaL_argerror(L, 2, lua_pushfstring(L, "triangle %I out of range (1..%d)", i, (int)m->nt));
+    for (int c = 0; c < 3; c++) lua_pushinteger(L, (lua_Integer)m->tri[3 * (i - 1) + c] + 1);
+    return 3;
+}
+
+static int m_bounds(lua_State *L)
+{
+    wb_real lo[3], hi[3];
+    if (!wb_mesh_bounds(wbl_checkmesh(L, 1), lo, hi)) {
+        lua_pushnil(L);
+        return 1;
+    }
+    wbl_pushreals(L, lo, 3);
+    wbl_pushreals(L, hi, 3);
+    return 6;
+}
+
+static const char *const transform_keys[] = { "scale", "translate", NULL };
+
+/* m:transform{scale = s, translate = {x,y,z}}: in place, returns m */
+static int m_transform(lua_State *L)
+{
+    wb_mesh *m = wbl_checkmesh(L, 1);
+    wb_real s = 1, t[3] = { 0, 0, 0 };
+    wbl_checkopts(L, 2, transform_keys, false);
+    if (wbl_optreal(L, 2, "scale", &s) && s == 0) return wbl_fielderror(L, 2, "scale", "must not be 0");
+    wbl_optvec(L, 2, "translate", 3, t);
+    /* checked before anything moves: a mesh with an infinite vertex would reach the core
+     * (w:from_mesh, w:skin) as inf and NaN */
+    for (int32_t i = 0; i < m->nv; i++)
+        for (int c = 0; c < 3; c++)
+            if (!isfinite(m->v[3 * i + c] * s + t[c]))
+                return luaL_error(L, "transform: vertex %d would not be finite", (int)i + 1);
+    wb_mesh_transform(m, s, t);
+    lua_settop(L, 1);
+    return 1;
+}
+
+static int m_copy(lua_State *L)
+{
+    const wb_mesh *m = wbl_checkmesh(L, 1);
+    wb_mesh **slot = wbl_push_mesh_slot(L);
+    *slot = wb_mesh_copy(m);
+    if (!*slot) return wb_rt_budget_error(L, "out of memory copying a mesh");
+    return 1;
+}
+
+/* m:save(path) by extension, m:save_obj(path): true, or nil and "file: reason" */
+static int save_as(lua_State *L, const char *ext)
+{
+    const wb_mesh *m = wbl_checkmesh(L, 1);
+    const char *name = luaL_checkstring(L, 2);
+    char path[4096], err[1024];
+    if (ext) {
+        const char *dot = strrchr(name, '.');
+        if (!dot || strcmp(dot, ext)) return luaL_argerror(L, 2, lua_pushfstring(L, "a %s file name expected", ext));
+    }
+    wbl_path(L, name, 1, path, sizeof path);
+    if (wbio_save_mesh(m, NULL, path, name, wbl_allow, L, err, sizeof err)) {
+        luaL_pushfail(L);
+        lua_pushstring(L, err);
+        return 2;
+    }
+    lua_pushboolean(L, 1);
+    return 1;
+}
+
+static int m_save(lua_State *L) { return save_as(L, NULL); }
+static int m_save_obj(lua_State *L) { return save_as(L, ".obj"); }
+
+static int m_close(lua_State *L)
+{
+    wbl_mesh *u = (wbl_mesh *)luaL_checkudata(L, 1, WBL_MESH);
+    wb_mesh_destroy(u->m);
+    u->m = NULL;
+    return 0;
+}
+
+static int m_tostring(lua_State *L)
+{
+    wbl_mesh *u = (wbl_mesh *)luaL_checkudata(L, 1, WBL_MESH);
+    if (!u->m) lua_pushfstring(L, "wobble.mesh: %p (closed)", (void *)u);
+    else lua_pushfstring(L, "wobble.mesh: %p (%d vertices, %d triangles)", (void *)u, (int)u->m->nv, (int)u->m->nt);
+    return 1;
+}
+
+/* ---- w:from_mesh(m, {...}) --------------------------------------------------------------------- */
+static const char *const from_mesh_keys[] = {
+    "mass", "radius", "target", "neighbours", "surface",
+    "compliance", "damping", "yield", "creep", "break_strain", NULL
+};
+
+static int w_from_mesh(lua_State *L)
+{
+    wb_world *w = wbl_checkworld(L, 1);
+    const wb_mesh *m = wbl_checkmesh(L, 2);
+    wb_from_mesh_def d = wb_from_mesh_default_def();
+    if (wbl_checkopts(L, 3, from_mesh_keys, true)) {
+        if (wbl_optreal(L, 3, "mass", &d.mass) && !(d.mass > 0)) return wbl_fielderror(L, 3, "mass", "must be > 0");
+        if (wbl_optreal(L, 3, "radius", &d.radius) && d.radius < 0) return wbl_fielderror(L, 3, "radius", "must be >= 0");
+        wbl_optint(L, 3, "target", 1, WB_MAX_PARTICLES, &d.target);
+        wbl_optint(L, 3, "neighbours", 0, 32, &d.neighbours);
+        wbl_optbool(L, 3, "surface", &d.surface);
+        wbl_read_link(L, 3, &d.link);
+        const char *e = wb_distance_def_check(&d.link);
+        if (e) return luaL_argerror(L, 3, e);
+    }
+    lua_settop(L, 3);
+    const int32_t nd0 = wb_distance_count(w);
+    wbl_body_begin(L, d.target > 0 && d.target < m->nv ? d.target : m->nv);
+    wb_body b;
+    wb_status st = wb_from_mesh(w, m, &d, &b);
+    if (st != WB_OK) return wbl_status_error(L, st == WB_ERR_ARG ? 2 : 3, st, "from_mesh");
+    wbl_body_end(L, 1, b, wb_distance_count(w) - nd0);
+    return 1;
+}
+
+static const luaL_Reg mesh_methods[] = {
+    { "vertex_count", m_vertex_count },
+    { "triangle_count", m_triangle_count },
+    { "vertex", m_vertex },
+    { "normal", m_normal },
+    { "triangle", m_triangle },
+    { "bounds", m_bounds },
+    { "transform", m_transform },
+    { "copy", m_copy },
+    { "save", m_save },
+    { "save_obj", m_save_obj },
+    { "close", m_close },
+    { NULL, NULL }
+};
+
+static const luaL_Reg mesh_meta[] = {
+    { "__index", NULL },
+    { "__gc", m_close },
+    { "__close", m_close },
+    { "__tostring", m_tostring },
+    { NULL, NULL }
+};
+
+static const luaL_Reg module_funcs[] = {
+    { "mesh", l_mesh },
+    { "load_mesh", l_load_mesh },
+    { NULL, NULL }
+};
+
+static const luaL_Reg world_methods[] = {
+    { "from_mesh", w_from_mesh },
+    { NULL, NULL }
+};
+
+void wbl_open_mesh(lua_State *L)
+{
+    luaL_newmetatable(L, WBL_MESH);
+    luaL_setfuncs(L, mesh_meta, 0);
+    luaL_newlibtable(L, mesh_methods);
+    luaL_setfuncs(L, mesh_methods, 0);
+    lua_setfield(L, -2, "__index");
+    lua_pop(L, 1);
+    luaL_setfuncs(L, module_funcs, 0); /* into the module table at the top */
+    wbl_add_world_methods(L, world_methods);
+}

@@ -1,0 +1,632 @@
+/* renderer.c: wobble.renderer{...} and its methods (camera, draw, save_png,
+ * record, pixels for tests), wobble.probe and wobble.read_png, and the recording
+ * behind `wobble run --record OUT`. Every path a script names goes through the
+ * sandbox (wb_sandbox_path); --record's path is the user's own. */
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "mesh.h"
+#include "util.h"
+#include "render/render.h"
+#include "sandbox.h"
+
+#define WBL_RENDERER "wobble.renderer"
+
+typedef struct wbl_renderer {
+    wb_renderer *r;       /* NULL once closed: __gc and __close may run twice */
+    wb_recorder *rec;     /* the recording, or NULL */
+    bool fps_set;         /* r:record{fps = ...}: the world's dt does not decide */
+    int64_t draws;
+    /* the buffers live outside the Lua heap: charged to the runtime's memory budget */
+    wb_memory *mem;
+    size_t charged, rec_charged;
+} wbl_renderer;
+
+static bool over_budget(const wb_memory *m, size_t bytes)
+{
+    return m->limit && (bytes > m->limit || m->used > m->limit - bytes);
+}
+
+/* charge `bytes` more to the budget (*slot keeps what this use holds); raises a budget
+ * error naming `what` when the budget would be passed */
+static void charge(lua_State *L, wbl_renderer *u, size_t *slot, size_t bytes, const char *what)
+{
+    wb_memory *m = u->mem;
+    if (over_budget(m, bytes))
+        wb_rt_budget_error(L, "%s needs about %.0f MB, over the memory budget of %.0f MB (--memory-limit MB)", what,
+                           bytes / 1048576.0, m->limit / 1048576.0);
+    m->used += bytes;
+    *slot += bytes;
+}
+
+static void release(wbl_renderer *u, size_t *slot)
+{
+    u->mem->used -= *slot < u->mem->used ? *slot : u->mem->used;
+    *slot = 0;
+}
+
+/* finish the recording (the frames' memory is given back); false with the message */
+static bool end_recording(wbl_renderer *u, char *err, size_t n)
+{
+    wb_recorder *rec = u->rec;
+    u->rec = NULL;
+    release(u, &u->rec_charged);
+    return wb_recorder_close(rec, err, n);
+}
+
+static wbl_renderer *checkud(lua_State *L, int arg)
+{
+    return (wbl_renderer *)luaL_checkudata(L, arg, WBL_RENDERER);
+}
+
+static wbl_renderer *checkrenderer(lua_State *L, int arg)
+{
+    wbl_renderer *u = checkud(L, arg);
+    if (!u->r) luaL_error(L, "attempt to use a closed renderer");
+    return u;
+}
+
+/* a script's path, resolved for writing or reading; raises the sandbox's message */
+static const char *script_path(lua_State *L, int arg, int write, char *buf, size_t n)
+{
+    const char *err, *p = wb_sandbox_path(L, luaL_checkstring(L, arg), write, buf, n, &err);
+    if (!p) luaL_error(L, "%s", err);
+    return p;
+}
+
+/* ---- creation ------------------------------------------------------------------------ */
+static const char *const renderer_keys[] = { "width", "height", "samples", "backend", NULL };
+static const char *const backend_names[] = { "osmesa", "null", NULL };
+
+static int l_renderer(lua_State *L)
+{
+    int w = 1280, h = 720, samples = 4;
+    wbl_checkopts(L, 1, renderer_keys, true);
+    const wb_backend *be = &wb_backend_osmesa;
+    if (!lua_isnoneornil(L, 1)) {
+        wbl_optint(L, 1, "width", 1, WB_RENDER_MAX_SIZE, &w);
+        wbl_optint(L, 1, "height", 1, WB_RENDER_MAX_SIZE, &h);
+        wbl_optint(L, 1, "samples", 1, 16, &samples);
+        if (wbl_optenum(L, 1, "backend", "backend", backend_names) == 1) be = &wb_backend_null;
+    }
+    wbl_renderer *u = (wbl_renderer *)lua_newuserdatauv(L, sizeof *u, 0);
+    memset(u, 0, sizeof *u);
+    u->mem = &wb_rt_get(L)->memory;
+    luaL_setmetatable(L, WBL_RENDERER);
+    char err[512], what[64];
+    snprintf(what, sizeof what, "a %dx%d renderer", w, h);
+    charge(L, u, &u->charged, wb_renderer_bytes(be, w, h, samples), what);
+    u->r = wb_renderer_create(be, w, h, samples, err, sizeof err);
+    if (!u->r) return luaL_error(L, "wobble.renderer: %s", err);
+    return 1;
+}
+
+/* ---- camera --------------------------------------------------------------------------- */
+static const char *const camera_keys[] = { "eye", "target", "up", "fov", NULL };
+
+/* r:camera{eye, target, up = {0,1,0}, fov = 40}; r:camera() frames the world again */
+static int r_camera(lua_State *L)
+{
+    wbl_renderer *u = checkrenderer(L, 1);
+    if (lua_isnoneornil(L, 2)) {
+        wb_renderer_auto_camera(u->r);
+        return 0;
+    }
+    wbl_checkopts(L, 2, camera_keys, false);
+    wb_real eye[3], target[3], up[3] = { 0, 1, 0 }, fov = 40;
+    if (!wbl_optvec(L, 2, "eye", 3, eye)) return wbl_fielderror(L, 2, "eye", "missing ({x,y,z} expected)");
+    if (!wbl_optvec(L, 2, "target", 3, target)) return wbl_fielderror(L, 2, "target", "missing ({x,y,z} expected)");
+    wbl_optvec(L, 2, "up", 3, up);
+    if (wbl_optreal(L, 2, "fov", &fov) && !(fov > 0 && fov < 180))
+        return wbl_fielderror(L, 2, "fov", "must be between 0 and 180 degrees");
+    double e[3], t[3], v[3], d[3], c[3];
+    for (int k = 0; k < 3; k++) e[k] = eye[k], t[k] = target[k], v[k] = up[k], d[k] = t[k] - e[k];
+    double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), vl = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (!(dl > 0)) return luaL_argerror(L, 2, "eye and target must differ");
+    c[0] = d[1] * v[2] - d[2] * v[1], c[1] = d[2] * v[0] - d[0] * v[2], c[2] = d[0] * v[1] - d[1] * v[0];
+    if (!(vl > 0) || sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) < 1e-9 * dl * vl)
+        return wbl_fielderror(L, 2, "up", "must not be zero or along the line of sight");
+    wb_renderer_camera(u->r, e, t, v, fov);
+    return 0;
+}
+
+/* the camera of the last frame: {eye = {..}, target = {..}, up = {..}, fov = n} */
+static int r_get_camera(lua_State *L)
+{
+    wbl_renderer *u = checkrenderer(L, 1);
+    double e[3], t[3], v[3], fov;
+    wb_renderer_get_camera(u->r, e, t, v, &fov);
+    lua_createtable(L, 0, 4);
+    const double *vs[3] = { e, t, v };
+    const char *names[3] = { "eye", "target", "up" };
+    for (int i = 0; i < 3; i++) {
+        lua_createtable(L, 3, 0);
+        for (int k = 0; k < 3; k++) {
+            lua_pushnumber(L, vs[i][k]);
+            lua_rawseti(L, -2, k + 1);
+        }
+        lua_setfield(L, -2, names[i]);
+    }
+    lua_pushnumber(L, fov);
+    lua_setfield(L, -2, "fov");
+    return 1;
+}
+
+/* ---- drawing and recording ---------------------------------------------------------------- */
+static const char *const draw_keys[] = { "particles", "constraints", "colliders", "surfaces", "skins", "pins",
+                                         "grid", "cage", "strain_scale", "line_width", NULL };
+
+/* finish the recording; raises with the encoder's message when it failed */
+static void stop_recording(lua_State *L, wbl_renderer *u)
+{
+    char err[1024];
+    if (!end_recording(u, err, sizeof err)) luaL_error(L, "%s", err);
+}
+
+/* the skins made on the world at world_index, for drawing (an array in a userdata left
+ * on the stack, collected with it); *n their count */
+static wb_draw_skin *world_skins(lua_State *L, int world_index, int *n)
+{
+    wbl_push_world_skins(L, world_index);
+    int len = (int)lua_rawlen(L, -1), k = 0;
+    wb_draw_skin *sk = (wb_draw_skin *)lua_newuserdatauv(L, sizeof *sk * (size_t)(len ? len : 1), 0);
+    for (int i = 1; i <= len; i++) {
+        lua_rawgeti(L, -2, i);
+        wb_world *w = NULL;
+        wb_skin *s = wbl_toskin(L, -1, &w);
+        lua_pop(L, 1);
+        if (!s) continue;   /* closed */
+        const wb_mesh *m = wb_skin_rest(s);
+        sk[k].v = wb_skin_vertices(s, w);
+        sk[k].n = wb_skin_normals(s, w);
+        sk[k].tri = m->tri;
+        sk[k].nv = m->nv;
+        sk[k].nt = m->nt;
+        sk[k].skin = s;
+        k++;
+    }
+    *n = k;
+    return sk;
+}
+
+/* draw and, when recording, add the frame; false + message instead of raising */
+static bool draw_frame(lua_State *L, wbl_renderer *u, int world_index, const wb_draw_opts *o, char *err, size_t n)
+{
+    int top = lua_gettop(L), nsk = 0;
+    wb_world *w = wbl_checkworld(L, world_index);
+    wb_draw_skin *sk = o->skins ? world_skins(L, world_index, &nsk) : NULL;
+    bool ok = wb_renderer_draw(u->r, w, o, sk, nsk, err, n);
+    lua_settop(L, top);
+    if (!ok) return false;
+    u->draws++;
+    if (u->rec) {
+        if (!u->fps_set && !wb_recorder_started(u->rec)) wb_recorder_set_fps(u->rec, 1.0 / wb_world_get_def(w).dt);
+        if (!wb_recorder_add(u->rec, wb_renderer_pixels(u->r), err, n)) return false;
+    }
+    return true;
+}
+
+static int r_draw(lua_State *L)
+{
+    wbl_renderer *u = checkrenderer(L, 1);
+    wbl_checkworld(L, 2);
+    wbl_checkopts(L, 3, draw_keys, true);
+    wb_draw_opts o = wb_draw_default_opts();
+    if (!lua_isnoneornil(L, 3)) {
+        wbl_optbool(L, 3, "particles", &o.particles);
+        wbl_optbool(L, 3, "constraints", &o.constraints);
+        wbl_optbool(L, 3, "colliders", &o.colliders);
+        wbl_optbool(L, 3, "surfaces", &o.surfaces);
+        wbl_optbool(L, 3, "skins", &o.skins);
+        wbl_optbool(L, 3, "pins", &o.pins);
+        wbl_optbool(L, 3, "grid", &o.grid);
+        wbl_optbool(L, 3, "cage", &o.cage);
+        wb_real v;
+        if (wbl_optreal(L, 3, "strain_scale", &v)) {
+            if (!(v > 0)) return wbl_fielderror(L, 3, "strain_scale", "must be > 0");
+            o.strain_scale = v;
+        }
+        if (wbl_optreal(L, 3, "line_width", &v)) {
+            if (!(v > 0 && v <= 64)) return wbl_fielderror(L, 3, "line_width", "must be in (0, 64] pixels");
+            o.line_width = v;
+        }
+    }
+    char err[1024];
+    if (!draw_frame(L, u, 2, &o, err, sizeof err)) {
+        /* a failed frame ends the recording: closing it gets the encoder's own words */
+        if (u->rec) stop_recording(L, u);
+        return luaL_error(L, "%s", err);
+    }
+    return 0;
+}
+
+static int r_save_png(lua_State *L)
+{
+    wbl_renderer *u = checkrenderer(L, 1);
+    char buf[PATH_MAX], err[PATH_MAX + 128];
+    const char *given = luaL_checkstring(L, 2), *e = strrchr(given, '.');
+    if (!e || strchr(e, '/') || strcasecmp(e, ".png") != 0)   /* a PNG by any other name surprises */
+        return luaL_argerror(L, 2, lua_pushfstring(L, "a .png file name expected, got '%s'", given));
+    const char *path = script_path(L, 2, 1, buf, sizeof buf);
+    if (!u->draws) return luaL_error(L, "nothing to save: call r:draw(world) first");
+    int w, h;
+    wb_renderer_size(u->r, &w, &h);
+    if (!wb_image_write_png(path, wb_renderer_pixels(u->r), w, h, err, sizeof err)) return luaL_error(L, "%s", err);
+    return 0;
+}
+
+static const char *const record_keys[] = { "fps", NULL };
+
+/* r:record(path [, {fps}]): every later r:draw adds a frame until r:stop() */
+static int r_record(lua_State *L)
+{
+    wbl_renderer *u = checkrenderer(L, 1);
+    char buf[PATH_MAX], err[PATH_MAX + 256];
+    luaL_checkstring(L, 2);
+    wbl_checkopts(L, 3, record_keys, true);
+    wb_real fps = 0;
+    bool has_fps = !lua_isnoneornil(L, 3) && wbl_optreal(L, 3, "fps", &fps);
+    if (has_fps && !(fps > 0 && fps <= 1000)) return wbl_fielderror(L, 3, "fps", "must be in (0, 1000]");
+    if (u->rec) return luaL_error(L, "already recording to %s: call r:stop() first", wb_recorder_path(u->rec));
+    const char *given = lua_tostring(L, 2);
+    if (wb_media_of(given, NULL, err, sizeof err) == WB_MEDIA_NONE) return luaL_argerror(L, 2, err);
+    const char *path = script_path(L, 2, 1, buf, sizeof buf);
+    wb_media kind = wb_media_of(given, path, err, sizeof err);   /* the name decides, not where it leads */
+    int w, h;
+    wb_renderer_size(u->r, &w, &h);
+    charge(L, u, &u->rec_charged, wb_recorder_bytes(w, h), "recording");
+    u->rec = wb_recorder_open(path, kind, w, h, err, sizeof err);
+    if (!u->rec) {
+        release(u, &u->rec_charged);
+        return luaL_error(L, "%s", err);
+    }
+    u->fps_set = has_fps;
+    if (has_fps) wb_recorder_set_fps(u->rec, fps);
+    return 0;
+}
+
+/* r:stop() -> path, frames: finish the file; raises when the encoder failed */
+static int r_stop(lua_State *L)
+{
+    wbl_renderer *u = checkrenderer(L, 1);
+    if (!u->rec) return luaL_error(L, "not recording");
+    lua_pushstring(L, wb_recorder_path(u->rec));
+    lua_pushinteger(L, (lua_Integer)wb_recorder_frames(u->rec));
+    stop_recording(L, u);
+    return 2;
+}
+
+static int r_recording(lua_State *L)
+{
+    wbl_renderer *u = checkrenderer(L, 1);
+    if (!u->rec) {
+        lua_pushnil(L);
+        return 1;
+    }
+    lua_pushstring(L, wb_recorder_path(u->rec));
+    lua_pushinteger(L, (lua_Integer)wb_recorder_frames(u->rec));
+    return 2;
+}
+
+/* ---- reading the frame back -------------------------------------------------------------- */
+static int r_size(lua_State *L)
+{
+    int w, h;
+    wb_renderer_size(checkrenderer(L, 1)->r, &w, &h);
+    lua_pushinteger(L, w);
+    lua_pushinteger(L, h);
+    return 2;
+}
+
+/* r:pixel(x, y) -> r, g, b (0..255); x, y from the top left, 0-based, as r:project gives */
+static int r_pixel(lua_State *L)
+{
+    wbl_renderer *u = checkrenderer(L, 1);
+    int w, h;
+    wb_renderer_size(u->r, &w, &h);
+    lua_Number fx = luaL_checknumber(L, 2), fy = luaL_checknumber(L, 3);
+    if (!(fx >= 0 && fx < w)) return luaL_argerror(L, 2, lua_pushfstring(L, "x out of range [0, %d)", w));
+    if (!(fy >= 0 && fy < h)) return luaL_argerror(L, 3, lua_pushfstring(L, "y out of range [0, %d)", h));
+    const uint8_t *p = wb_renderer_pixels(u->r) + 3 * ((size_t)floor(fy) * (size_t)w + (size_t)floor(fx));
+    for (int k = 0; k < 3; k++) lua_pushinteger(L, p[k]);
+    return 3;
+}
+
+/* r:image() -> the last frame as a string of RGB bytes, top row first */
+static int r_image(lua_State *L)
+{
+    wbl_renderer *u = checkrenderer(L, 1);
+    int w, h;
+    wb_renderer_size(u->r, &w, &h);
+    lua_pushlstring(L, (const char *)wb_renderer_pixels(u->r), (size_t)w * h * 3);
+    return 1;
+}
+
+/* r:project(x, y, z) -> px, py, depth (pixel coordinates of the last frame) or nil */
+static int r_project(lua_State *L)
+{
+    wbl_renderer *u = checkrenderer(L, 1);
+    wb_real p[3];
+    wbl_checkreals(L, 2, 3, p);
+    double q[3] = { p[0], p[1], p[2] }, x, y, d;
+    if (!wb_renderer_project(u->r, q, &x, &y, &d)) {
+        lua_pushnil(L);
+        return 1;
+    }
+    lua_pushnumber(L, x);
+    lua_pushnumber(L, y);
+    lua_pushnumber(L, d);
+    return 3;
+}
+
+static int r_info(lua_State *L)
+{
+    wbl_renderer *u = checkrenderer(L, 1);
+    lua_pushstring(L, wb_renderer_info(u->r));
+    lua_pushinteger(L, wb_renderer_samples(u->r));
+    return 2;
+}
+
+static void destroy(wbl_renderer *u)
+{
+    wb_renderer_destroy(u->r);
+    u->r = NULL;
+    if (u->mem) release(u, &u->charged);
+}
+
+/* __gc, __close and r:close(): a recording is finished; at collection its failure can
+ * only be printed */
+static int r_close(lua_State *L)
+{
+    wbl_renderer *u = checkud(L, 1);
+    bool gc = lua_toboolean(L, lua_upvalueindex(1));
+    char err[1024];
+    bool ok = !u->rec || end_recording(u, err, sizeof err);
+    destroy(u);
+    if (!ok && gc) fprintf(stderr, "wobble: %s\n", err);
+    else if (!ok) return luaL_error(L, "%s", err);
+    return 0;
+}
+
+static int r_tostring(lua_State *L)
+{
+    wbl_renderer *u = checkud(L, 1);
+    if (!u->r) {
+        lua_pushfstring(L, "wobble.renderer: %p (closed)", (void *)u);
+        return 1;
+    }
+    int w, h;
+    wb_renderer_size(u->r, &w, &h);
+    lua_pushfstring(L, "wobble.renderer: %p (%dx%d)", (void *)u, w, h);
+    return 1;
+}
+
+/* ---- media files ---------------------------------------------------------------------------- */
+/* wobble.probe(path) -> {width, height, frames, codec, pix_fmt, duration} or nil, message */
+static int l_probe(lua_State *L)
+{
+    char buf[PATH_MAX], err[PATH_MAX + 128];
+    const char *path = script_path(L, 1, 0, buf, sizeof buf);
+    wb_media_info mi;
+    if (!wb_media_probe(path, &mi, err, sizeof err)) {
+        luaL_pushfail(L);
+        lua_pushstring(L, err);
+        return 2;
+    }
+    lua_createtable(L, 0, 6);
+    lua_pushinteger(L, mi.width);
+    lua_setfield(L, -2, "width");
+    lua_pushinteger(L, mi.height);
+    lua_setfield(L, -2, "height");
+    lua_pushinteger(L, (lua_Integer)mi.frames);
+    lua_setfield(L, -2, "frames");
+    lua_pushstring(L, mi.codec);
+    lua_setfield(L, -2, "codec");
+    lua_pushstring(L, mi.pix_fmt);
+    lua_setfield(L, -2, "pix_fmt");
+    lua_pushnumber(L, mi.duration);
+    lua_setfield(L, -2, "duration");
+    return 1;
+}
+
+/* wobble.read_png(path) -> width, height, RGB string; or nil, message */
+static int l_read_png(lua_State *L)
+{
+    char buf[PATH_MAX], err[PATH_MAX + 128];
+    const char *path = script_path(L, 1, 0, buf, sizeof buf);
+    int w, h;
+    uint8_t *px = wb_image_read_png(path, &w, &h, err, sizeof err);
+    if (!px) {
+        luaL_pushfail(L);
+        lua_pushstring(L, err);
+        return 2;
+    }
+    lua_pushinteger(L, w);
+    lua_pushinteger(L, h);
+    lua_pushlstring(L, (const char *)px, (size_t)w * h * 3);
+    free(px);
+    return 3;
+}
+
+/* wobble.read_frame(path [, index = 0]) -> width, height, RGB string of that frame of a
+ * video (decoded by ffmpeg); or nil, message */
+static int l_read_frame(lua_State *L)
+{
+    char buf[PATH_MAX], err[PATH_MAX + 128];
+    const char *path = script_path(L, 1, 0, buf, sizeof buf);
+    lua_Integer index = luaL_optinteger(L, 2, 0);
+    luaL_argcheck(L, index >= 0, 2, "frame index must be >= 0");
+    int w, h;
+    uint8_t *px = wb_media_read_frame(path, (int64_t)index, &w, &h, err, sizeof err);
+    if (!px) {
+        luaL_pushfail(L);
+        lua_pushstring(L, err);
+        return 2;
+    }
+    lua_pushinteger(L, w);
+    lua_pushinteger(L, h);
+    lua_pushlstring(L, (const char *)px, (size_t)w * h * 3);
+    free(px);
+    return 3;
+}
+
+/* wobble.clock() -> seconds of wall time (monotonic): for timing frames, where
+ * os.clock() would add up the renderer's threads */
+static int l_clock(lua_State *L)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    lua_pushnumber(L, (lua_Number)ts.tv_sec + ts.tv_nsec * 1e-9);
+    return 1;
+}
+
+/* ---- wobble run --record OUT ------------------------------------------------------------------ */
+static const char rec_key = 0;   /* registry: {renderer = ud, world = the world recorded} */
+
+static int record_hook(lua_State *L)
+{
+    if (lua_rawgetp(L, LUA_REGISTRYINDEX, &rec_key) != LUA_TTABLE) return 0;
+    lua_getfield(L, -1, "renderer");
+    wbl_renderer *u = (wbl_renderer *)luaL_testudata(L, -1, WBL_RENDERER);
+    if (!u || !u->r) return 0;
+    /* the first world that steps is the one recorded: frames of two worlds would
+     * interleave */
+    if (lua_getfield(L, -2, "world") == LUA_TNIL) {
+        lua_pushvalue(L, 1);
+        lua_setfield(L, -4, "world");
+    } else if (!lua_rawequal(L, -1, 1)) {
+        return 0;
+    }
+    wbl_checkworld(L, 1);
+    wb_draw_opts o = wb_draw_default_opts();
+    char err[1024];
+    if (!draw_frame(L, u, 1, &o, err, sizeof err)) {
+        char more[1024];
+        if (!end_recording(u, more, sizeof more)) return luaL_error(L, "--record: %s", more);
+        return luaL_error(L, "--record: %s", err);
+    }
+    return 0;
+}
+
+bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n)
+{
+    char e[PATH_MAX + 256];
+    wb_media kind = wb_media_of(path, NULL, e, sizeof e);
+    if (kind == WB_MEDIA_NONE) {
+        snprintf(err, n, "--record: %s", e);
+        return false;
+    }
+    int top = lua_gettop(L);
+    lua_pushcfunction(L, l_renderer);
+    if (lua_pcall(L, 0, 1, 0) != LUA_OK) {
+        snprintf(err, n, "--record: %s", lua_tostring(L, -1) ? lua_tostring(L, -1) : "cannot create the renderer");
+        lua_settop(L, top);
+        return false;
+    }
+    wbl_renderer *u = checkud(L, -1);
+    int w, h;
+    wb_renderer_size(u->r, &w, &h);
+    size_t bytes = wb_recorder_bytes(w, h);
+    if (over_budget(u->mem, bytes)) {
+        snprintf(err, n, "--record: the frames need about %.0f MB, over the memory budget of %.0f MB (--memory-limit MB)",
+                 bytes / 1048576.0, u->mem->limit / 1048576.0);
+        lua_settop(L, top);
+        return false;
+    }
+    u->mem->used += bytes;
+    u->rec_charged = bytes;
+    u->rec = wb_recorder_open(path, kind, w, h, e, sizeof e);
+    if (!u->rec) {
+        release(u, &u->rec_charged);
+        snprintf(err, n, "--record: %s", e);
+        lua_settop(L, top);
+        return false;
+    }
+    lua_createtable(L, 0, 2);
+    lua_pushvalue(L, -2);
+    lua_setfield(L, -2, "renderer");
+    lua_rawsetp(L, LUA_REGISTRYINDEX, &rec_key);
+    lua_pushcfunction(L, record_hook);
+    wb_rt_add_frame_hook(L, -1);
+    lua_settop(L, top);
+    /* w:run's progress bar says where the frames go */
+    const char *slash = strrchr(path, '/');
+    char note[96];
+    snprintf(note, sizeof note, "recording %s", slash && slash[1] ? slash + 1 : path);
+    wb_progress_note(L, note);
+    return true;
+}
+
+bool wbl_record_end(lua_State *L, char *err, size_t n)
+{
+    int top = lua_gettop(L);
+    bool ok = true;
+    if (lua_rawgetp(L, LUA_REGISTRYINDEX, &rec_key) == LUA_TTABLE && lua_getfield(L, -1, "renderer") == LUA_TUSERDATA) {
+        wbl_renderer *u = (wbl_renderer *)luaL_testudata(L, -1, WBL_RENDERER);
+        if (u && u->rec) {
+            char path[PATH_MAX];
+            snprintf(path, sizeof path, "%s", wb_recorder_path(u->rec));
+            int64_t frames = wb_recorder_frames(u->rec);
+            ok = end_recording(u, err, n);
+            if (ok && !wb_rt_get(L)->quiet) {
+                if (frames) fprintf(stderr, "wobble: recorded %lld frames to %s\n", (long long)frames, path);
+                else fprintf(stderr, "wobble: --record: the scene stepped no frame, nothing written to %s\n", path);
+            }
+        }
+        if (u) destroy(u);
+    }
+    lua_settop(L, top);
+    return ok;
+}
+
+/* ---- registration ------------------------------------------------------------------------------ */
+static const luaL_Reg renderer_methods[] = {
+    { "camera", r_camera },
+    { "get_camera", r_get_camera },
+    { "draw", r_draw },
+    { "save_png", r_save_png },
+    { "record", r_record },
+    { "stop", r_stop },
+    { "recording", r_recording },
+    { "size", r_size },
+    { "pixel", r_pixel },
+    { "image", r_image },
+    { "project", r_project },
+    { "info", r_info },
+    { "close", r_close },
+    { NULL, NULL }
+};
+
+void wbl_open_renderer(lua_State *L)
+{
+    luaL_newmetatable(L, WBL_RENDERER);
+    lua_pushboolean(L, 1);   /* upvalue: called as a finalizer, errors are printed */
+    lua_pushcclosure(L, r_close, 1);
+    lua_setfield(L, -2, "__gc");
+    lua_pushcfunction(L, r_close);
+    lua_setfield(L, -2, "__close");
+    lua_pushcfunction(L, r_tostring);
+    lua_setfield(L, -2, "__tostring");
+    luaL_newlibtable(L, renderer_methods);
+    luaL_setfuncs(L, renderer_methods, 0);
+    lua_setfield(L, -2, "__index");
+    lua_pop(L, 1);
+    /* the module table is on top when luaopen_wobble calls this */
+    lua_pushcfunction(L, l_renderer);
+    lua_setfield(L, -2, "renderer");
+    lua_pushcfunction(L, l_probe);
+    lua_setfield(L, -2, "probe");
+    lua_pushcfunction(L, l_read_png);
+    lua_setfield(L, -2, "read_png");
+    lua_pushcfunction(L, l_read_frame);
+    lua_setfield(L, -2, "read_frame");
+    lua_pushcfunction(L, l_clock);
+    lua_setfield(L, -2, "clock");
+    wbl_open_plot(L);
+}

@@ -1,0 +1,94 @@
+/* util.h: helpers shared by the Lua binding files (lua_*.c).
+ *
+ * Argument checking follows one rule: check everything before changing anything,
+ * and raise `bad argument #n to 'f' (...)` through luaL_argerror so the message
+ * carries the script's file:line. Numbers are strict (a string "1" is refused, as
+ * is NaN or an infinity); option tables are checked for unknown keys. */
+#ifndef WB_LUA_UTIL_H
+#define WB_LUA_UTIL_H
+
+#include <stdbool.h>
+
+#include "wobble_lua.h"
+
+/* registry names of the userdata (and body table) metatables */
+#define WBL_WORLD "wobble.world"
+#define WBL_DISTANCE "wobble.distance"
+#define WBL_COLLIDER "wobble.collider"
+#define WBL_BODY "wobble.body"
+
+/* the world userdata: w is NULL once closed, so __gc/__close can run twice */
+typedef struct wbl_world {
+    wb_world *w;
+    int warned;          /* the first numerical warning was printed */
+} wbl_world;
+
+/* ---- registration (one per binding file; luaopen_wobble calls them in order) ---- */
+void wbl_open_world(lua_State *L);     /* world.c: must run first */
+void wbl_open_distance(lua_State *L);  /* distance.c */
+void wbl_open_collider(lua_State *L);  /* collider.c */
+void wbl_open_body(lua_State *L);      /* body.c: builders + body metatable */
+int wbl_world_new(lua_State *L);       /* wobble.world{...} */
+/* add methods to the world's method table (used by the per-type files) */
+void wbl_add_world_methods(lua_State *L, const luaL_Reg *l);
+
+/* ---- the world --------------------------------------------------------------- */
+wbl_world *wbl_checkworld_ud(lua_State *L, int arg);  /* open or closed */
+wb_world *wbl_checkworld(lua_State *L, int arg);      /* raises when closed */
+/* handles (constraints, colliders): an id userdata whose user value is its world's
+ * userdata. wbl_handle checks the type and gives the world (NULL once closed);
+ * wbl_handle_eq is __eq for a handle type whose ids are `size` bytes. */
+void *wbl_handle(lua_State *L, int arg, const char *tname, wb_world **w);
+int wbl_handle_eq(lua_State *L, const char *tname, size_t size);
+
+/* one frame of w, stoppable by the runtime's budgets (a spent budget raises its
+ * error; the frame is then undone) */
+void wbl_step(lua_State *L, wb_world *w);
+/* after each frame: report the first warning once, then the runtime's frame hook */
+void wbl_after_frame(lua_State *L, int world_index);
+
+/* ---- numbers, ids, vectors ----------------------------------------------------- */
+const char *wbl_numstr(char *buf, size_t n, double x);       /* "nan", "inf", "1.5" */
+wb_real wbl_checkreal(lua_State *L, int arg);                /* a finite number */
+lua_Integer wbl_checkint(lua_State *L, int arg);             /* an integral number */
+int32_t wbl_checkparticle(lua_State *L, const wb_world *w, int arg); /* Lua id -> 0-based */
+int32_t wbl_particle_id(lua_State *L, const wb_world *w, int arg, lua_Integer id); /* same, checked value */
+void wbl_checkvec(lua_State *L, int arg, int n, wb_real *out); /* a table of exactly n finite numbers */
+void wbl_checkreals(lua_State *L, int arg, int n, wb_real *out); /* n finite numbers at arg.. */
+void wbl_pushreals(lua_State *L, const wb_real *v, int n);
+
+/* ---- option tables (the table at `arg`) --------------------------------------- */
+/* arg must be a table (or, when optional, nil/none: returns false); every key must be
+ * a string in the NULL-terminated `keys`, else the error names it and lists the keys */
+bool wbl_checkopts(lua_State *L, int arg, const char *const keys[], bool optional);
+/* fields: return false when absent (nil), else check and store */
+bool wbl_optreal(lua_State *L, int arg, const char *key, wb_real *out);
+bool wbl_optinteger(lua_State *L, int arg, const char *key, lua_Integer lo, lua_Integer hi, lua_Integer *out);
+bool wbl_optint(lua_State *L, int arg, const char *key, lua_Integer lo, lua_Integer hi, int *out);
+bool wbl_optbool(lua_State *L, int arg, const char *key, bool *out);
+bool wbl_optvec(lua_State *L, int arg, const char *key, int n, wb_real *out);
+bool wbl_optivec(lua_State *L, int arg, const char *key, int n, lua_Integer lo, lua_Integer hi, int *out);
+/* a string among `names` (NULL-terminated); returns its index, or -1 when absent */
+int wbl_optenum(lua_State *L, int arg, const char *key, const char *what, const char *const names[]);
+int wbl_enum_index(lua_State *L, int arg, const char *s, const char *what, const char *const names[]);
+int wbl_fielderror(lua_State *L, int arg, const char *key, const char *fmt, ...);
+
+/* distance constraint options shared by w:distance and the builders (rest excluded) */
+extern const char *const wbl_link_keys[];   /* compliance, damping, yield, creep, break_strain */
+void wbl_read_link(lua_State *L, int arg, wb_distance_def *d);
+
+/* a failed core call: WB_ERR_ARG / WB_ERR_LIMIT -> argument error, NOMEM -> budget error */
+int wbl_status_error(lua_State *L, int arg, wb_status st, const char *what);
+
+/* ---- handles and bodies ------------------------------------------------------------ */
+/* push a handle of the world at world_index; returns where its id is kept, so a
+ * caller can push the handle before creating the object (no leak on memory error) */
+wb_distance_id *wbl_push_distance(lua_State *L, int world_index, wb_distance_id id);
+wb_collider_id *wbl_push_collider(lua_State *L, int world_index, wb_collider_id id);
+/* push a body table {particles, first, count, world, constraint_count}; or in two
+ * halves around the core's builder: begin allocates for `count` particles (pushes 2) */
+void wbl_push_body(lua_State *L, int world_index, wb_body b, int32_t constraints);
+void wbl_body_begin(lua_State *L, int64_t count);
+void wbl_body_end(lua_State *L, int world_index, wb_body b, int32_t constraints);
+
+#endif

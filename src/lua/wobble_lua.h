@@ -1,0 +1,67 @@
+/* wobble_lua.h: what the Lua binding (lua_*.c), the runtime (sandbox, budgets,
+ * paths) and the command line (main.c) share. Not part of the public core API. */
+#ifndef WOBBLE_LUA_H
+#define WOBBLE_LUA_H
+
+#include <lua.h>
+#include <lauxlib.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "wobble.h"
+
+/* ---- the module (wobble.c) ---------------------------------------------------- */
+int luaopen_wobble(lua_State *L);   /* pushes the `wobble` table; registers every userdata type */
+
+/* ---- the runtime (lua/runtime.c): configuration of the running script ----------------- */
+typedef struct wb_runtime {
+    const char *scene_dir;     /* folder of the scene script (absolute) */
+    const char *out_dir;       /* --out, default "out" (absolute once created) */
+    const char *lib_dir;       /* folder holding wobble/<module>.lua */
+    int unsafe;                /* --unsafe: no sandbox */
+    int quiet;                 /* --quiet: no progress, no summaries */
+    int threads;               /* --threads N, 0 when not given */
+    int64_t frame_cap;         /* --frames N: w:run stops after N frames; -1 = none */
+    double time_budget;        /* seconds of wall time; 0 = none */
+    size_t memory_budget;      /* bytes the Lua heap and the worlds' arrays may use together; 0 = none */
+    wb_memory memory;          /* that budget's account: worlds are charged to it (wb_world_def.memory) */
+    lua_CFunction open_module; /* opens the `wobble` table (luaopen_wobble): given by the caller, so the
+                                  runtime, which the binding uses, does not depend on the binding */
+} wb_runtime;
+
+wb_runtime *wb_rt_get(lua_State *L);   /* the runtime of this state (never NULL after wb_rt_open) */
+
+
+/* the interrupt a world polls once per substep (wb_world_set_interrupt): it answers
+ * true once a budget of this state is spent, so a long step cannot outrun
+ * --time-limit. *fn is NULL for a state opened without the runtime. */
+void wb_rt_interrupt(lua_State *L, int (**fn)(void *), void **ud);
+
+/* raise the budget error that is due (time or memory), if any */
+void wb_rt_check_budgets(lua_State *L);
+
+/* raise a budget error: the command line exits with code 3 (DESIGN §4) */
+int wb_rt_budget_error(lua_State *L, const char *fmt, ...);
+
+/* called by the binding after every simulated frame (w:step, each frame of w:run):
+ * checks the time budget (raises a budget error) and runs frame hooks (recording) */
+void wb_rt_after_frame(lua_State *L, int world_index);
+
+/* life cycle and helpers for main.c (and embedders) */
+lua_State *wb_rt_open(const wb_runtime *cfg); /* standard libraries, sandbox unless cfg->unsafe, budgets,
+                                                 `wobble` global + package.loaded, wobble.args = {};
+                                                 NULL (message on stderr) on failure */
+void wb_rt_close(lua_State *L);               /* lua_close + free the runtime */
+int wb_rt_budget_hit(lua_State *L);           /* 1 once a budget error was raised: exit code 3 */
+int wb_rt_msgh(lua_State *L);                 /* lua_pcall message handler: message (any value) + traceback */
+void wb_rt_add_frame_hook(lua_State *L, int index); /* wb_rt_after_frame calls the function at index(w) */
+const char *wb_rt_lib_dir(void);              /* the folder holding wobble/test.lua, or NULL */
+const char *wb_rt_project_root(void);         /* the source tree (tests/bench, assets), or NULL */
+
+/* ---- progress (progress.c): a bar on a terminal, silent otherwise or with --quiet ---- */
+void wb_progress_begin(lua_State *L, const char *what, int64_t total);
+void wb_progress_update(lua_State *L, int64_t done);
+void wb_progress_end(lua_State *L);
+void wb_progress_note(lua_State *L, const char *note);   /* shown after every bar's label; NULL clears */
+
+#endif

@@ -1,0 +1,315 @@
+/* layers.c: what each layer draws, built on the CPU every frame: instances of
+ * the solid meshes (particles, pins, colliders), the surfaces' and skins' vertices
+ * (position, smooth normal, colour) and triangles, and the links as coloured
+ * segments. Strain colours follow the reference thesis's Figure 12: grey at rest, red
+ * stretched (links also blue compressed); with the links drawn, surfaces take the
+ * colour of their stretch, so a dense cloth shows it rather than a fence of lines. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render.h"
+#include "gl.h"
+
+/* colours, sRGB */
+static const float col_particle[3] = { 0.22f, 0.47f, 0.80f };
+static const float col_pin[3] = { 0.98f, 0.68f, 0.08f };
+static const float col_collider[3] = { 0.55f, 0.58f, 0.64f };
+static const float col_rest[3] = { 0.40f, 0.40f, 0.42f };
+static const float col_tension[3] = { 0.92f, 0.08f, 0.06f };
+static const float col_compress[3] = { 0.12f, 0.32f, 0.92f };
+/* a surface coloured by strain: light and neutral at rest, so red and blue stand out */
+static const float col_cloth[3] = { 0.68f, 0.68f, 0.67f };
+static const float col_surface[][3] = {
+    { 0.91f, 0.42f, 0.24f }, { 0.26f, 0.64f, 0.56f }, { 0.56f, 0.44f, 0.80f }, { 0.86f, 0.70f, 0.28f },
+};
+static const float col_skin[3] = { 0.86f, 0.76f, 0.62f };
+static const float surface_shine = 0.12f;
+
+enum { F_SURFACE = 1, F_HIDDEN = 2 };   /* per particle: on a drawn surface; covered by a drawn skin */
+
+void wb_lin3(const float s[3], float o[3])
+{
+    for (int k = 0; k < 3; k++) o[k] = s[k] * s[k];   /* the shaders output with gamma 2 */
+}
+
+/* grow *p to hold n elements of size sz */
+static bool grow(void *pp, size_t *cap, size_t n, size_t sz)
+{
+    void **p = pp;
+    if (n <= *cap) return true;
+    size_t c = *cap ? *cap : 256;
+    while (c < n) c *= 2;
+    void *q = realloc(*p, c * sz);
+    if (!q) return false;
+    *p = q;
+    *cap = c;
+    return true;
+}
+
+void wb_layers_free(wb_layers *l)
+{
+    free(l->inst);
+    free(l->seg);
+    free(l->sv);
+    free(l->si);
+    free(l->pairs);
+    free(l->strain);
+    free(l->vstrain);
+    free(l->flags);
+    memset(l, 0, sizeof *l);
+}
+
+/* ---- instances -------------------------------------------------------------------------- */
+/* model = T(p) * [c0 c1 c2] (columns already scaled), normal matrix = columns / scale^2 */
+static void inst_set(wb_inst *in, const double p[3], const double cols[3][3], const float rgb[3], float shine)
+{
+    memset(in, 0, sizeof *in);
+    for (int c = 0; c < 3; c++) {
+        double l2 = dot3(cols[c], cols[c]);
+        for (int r = 0; r < 3; r++) {
+            in->m[c * 4 + r] = (float)cols[c][r];
+            in->n[c * 3 + r] = (float)(l2 > 0 ? cols[c][r] / l2 : 0);
+        }
+    }
+    for (int r = 0; r < 3; r++) in->m[12 + r] = (float)p[r];
+    in->m[15] = 1;
+    wb_lin3(rgb, in->c);
+    in->c[3] = shine;
+}
+
+static void inst_sphere(wb_inst *in, const double p[3], double rad, const float rgb[3], float shine)
+{
+    double cols[3][3] = { { rad, 0, 0 }, { 0, rad, 0 }, { 0, 0, rad } };
+    inst_set(in, p, cols, rgb, shine);
+}
+
+/* a unit cylinder (y in 0..1) from a to b */
+static void inst_cylinder(wb_inst *in, const double a[3], const double b[3], double rad, const float rgb[3])
+{
+    double y[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] }, d[3], x[3], z[3];
+    memcpy(d, y, sizeof d);
+    double len = norm3(d);
+    if (len <= 0) d[0] = 0, d[1] = 1, d[2] = 0;
+    double pick[3] = { fabs(d[0]) < 0.9 ? 1 : 0, fabs(d[0]) < 0.9 ? 0 : 1, 0 };
+    cross3(d, pick, x);
+    norm3(x);
+    cross3(x, d, z);
+    double cols[3][3] = { { x[0] * rad, x[1] * rad, x[2] * rad }, { y[0], y[1], y[2] }, { z[0] * rad, z[1] * rad, z[2] * rad } };
+    if (len <= 0) cols[1][1] = 1e-9;
+    inst_set(in, a, cols, rgb, 0.35f);
+}
+
+/* instances grouped by mesh: particle spheres, collider spheres and capsule caps,
+ * capsule bodies, boxes. Particles of a drawn surface are shown by the surface (a
+ * sphere per cloth vertex hides the cloth), those under a skin by the skin. */
+static bool build_instances(wb_layers *l, const wb_world *w, const wb_draw_opts *o, double unit)
+{
+    int32_t np = wb_particle_count(w), nc = wb_collider_count(w);
+    size_t need = (size_t)np + 3 * (size_t)nc;
+    if (!grow(&l->inst, &l->inst_cap, need + 1, sizeof *l->inst)) return false;
+    const wb_real *x = wb_particle_positions(w);
+    size_t k = 0;
+    l->first[WB_G_LO] = 0;
+    for (int32_t i = 0; i < np; i++) {
+        bool pin = wb_particle_pinned(w, i);
+        double p[3] = { x[3 * i], x[3 * i + 1], x[3 * i + 2] }, rad = wb_particle_radius(w, i);
+        if (!isfinite(p[0] + p[1] + p[2])) continue;
+        if (rad <= 0) rad = 0.004 * unit;   /* a point still shows */
+        if (pin && o->pins) inst_sphere(&l->inst[k++], p, fmax(1.6 * rad, 0.006 * unit), col_pin, 0.5f);
+        else if (o->particles && !l->flags[i]) inst_sphere(&l->inst[k++], p, rad, col_particle, 0.5f);
+    }
+    l->count[WB_G_LO] = k;
+    for (int g = WB_G_HI; g < WB_G_COUNT; g++) {
+        l->first[g] = k;
+        for (int32_t i = 0; o->colliders && i < nc; i++) {
+            wb_collider_def d;
+            wb_collider_get_def(w, wb_collider_at(w, i), &d);
+            double c[3] = { d.center[0], d.center[1], d.center[2] };
+            double a[3] = { d.a[0], d.a[1], d.a[2] }, b[3] = { d.b[0], d.b[1], d.b[2] };
+            if (g == WB_G_HI && d.shape == WB_SHAPE_SPHERE) {
+                inst_sphere(&l->inst[k++], c, d.radius, col_collider, 0.35f);
+            } else if (g == WB_G_HI && d.shape == WB_SHAPE_CAPSULE) {
+                inst_sphere(&l->inst[k++], a, d.radius, col_collider, 0.35f);
+                inst_sphere(&l->inst[k++], b, d.radius, col_collider, 0.35f);
+            } else if (g == WB_G_CYL && d.shape == WB_SHAPE_CAPSULE) {
+                inst_cylinder(&l->inst[k++], a, b, d.radius, col_collider);
+            } else if (g == WB_G_BOX && d.shape == WB_SHAPE_BOX) {
+                double m[9], cols[3][3];
+                quat_mat(d.rotation, m);
+                for (int cc = 0; cc < 3; cc++)
+                    for (int rr = 0; rr < 3; rr++) cols[cc][rr] = m[rr * 3 + cc] * d.half[cc];
+                inst_set(&l->inst[k++], c, cols, col_collider, 0.35f);
+            }
+        }
+        l->count[g] = k - l->first[g];
+    }
+    return true;
+}
+
+/* ---- strain ------------------------------------------------------------------------------ */
+/* grey at rest, shading to red stretched and blue compressed, fully at +-strain_scale */
+static void strain_colour(double strain, double scale, const float rest[3], float out[3])
+{
+    float ten[3], com[3];
+    wb_lin3(col_tension, ten), wb_lin3(col_compress, com);
+    double t = strain / scale;
+    t = t > 1 ? 1 : t < -1 ? -1 : t;
+    const float *to = t >= 0 ? ten : com;
+    for (int c = 0; c < 3; c++) out[c] = (float)(rest[c] + (to[c] - rest[c]) * fabs(t));
+}
+
+/* the distance constraints and their strains, and per particle the strain its
+ * surface shows (l->vstrain[0..np); the rest is scratch) */
+static bool load_pairs(wb_layers *l, const wb_world *w)
+{
+    int32_t n = wb_world_distance_pairs(w, NULL, NULL), np = wb_particle_count(w);
+    size_t had = l->pair_cap;
+    if (!grow(&l->pairs, &l->pair_cap, 2 * (size_t)n + 2, sizeof *l->pairs)) return false;
+    if (l->pair_cap != had || !l->strain) {   /* the strains share the capacity count */
+        void *q = realloc(l->strain, (l->pair_cap / 2 + 1) * sizeof *l->strain);
+        if (!q) return false;
+        l->strain = q;
+    }
+    if (!grow(&l->vstrain, &l->vstrain_cap, 3 * (size_t)np + 1, sizeof *l->vstrain)) return false;
+    l->npairs = wb_world_distance_pairs(w, l->pairs, l->strain);
+    /* the largest stretch at each particle (compression in a sheet is its folds, which
+     * the shading shows: in colour it would be noise), then averaged over its links'
+     * other ends: peaks stay, the checkerboard of stretched and sheared links goes */
+    float *peak = l->vstrain + np, *count = l->vstrain + 2 * (size_t)np, *v = l->vstrain;
+    memset(peak, 0, 2 * (size_t)np * sizeof *peak);
+    for (int32_t i = 0; i < l->npairs; i++)
+        for (int e = 0; e < 2; e++) {
+            float *pk = &peak[l->pairs[2 * i + e]];
+            if (l->strain[i] > *pk) *pk = (float)l->strain[i];
+        }
+    memcpy(v, peak, (size_t)np * sizeof *v);
+    for (int32_t i = 0; i < np; i++) count[i] = 1;
+    for (int32_t i = 0; i < l->npairs; i++) {
+        int32_t a = l->pairs[2 * i], b = l->pairs[2 * i + 1];
+        v[a] += peak[b], count[a]++;
+        v[b] += peak[a], count[b]++;
+    }
+    for (int32_t i = 0; i < np; i++) v[i] /= count[i];
+    return true;
+}
+
+/* links as segments; those touching a drawn surface are shown by its colour (a dense
+ * cloth's links would cover it like a fence; a block's inner links would poke through
+ * its hull as dots), those under a skin not at all */
+static bool build_segments(wb_layers *l, const wb_world *w, const wb_draw_opts *o)
+{
+    if (!grow(&l->seg, &l->seg_cap, (size_t)l->npairs + 1, sizeof *l->seg)) return false;
+    const wb_real *x = wb_particle_positions(w);
+    float rest[3];
+    wb_lin3(col_rest, rest);
+    size_t k = 0;
+    for (int32_t i = 0; i < l->npairs; i++) {
+        int32_t a = l->pairs[2 * i], b = l->pairs[2 * i + 1];
+        if (((l->flags[a] | l->flags[b]) & F_SURFACE) || (l->flags[a] & l->flags[b] & F_HIDDEN)) continue;
+        wb_seg *s = &l->seg[k++];
+        for (int c = 0; c < 3; c++) s->a[c] = (float)x[3 * a + c], s->b[c] = (float)x[3 * b + c];
+        strain_colour(l->strain[i], o->strain_scale, rest, s->c);
+        s->c[3] = 1;
+    }
+    l->nseg = k;
+    return true;
+}
+
+/* ---- surfaces ------------------------------------------------------------------------------ */
+static void put_vertex(float *v, const double p[3], const double n[3], const float col[3])
+{
+    for (int c = 0; c < 3; c++) v[c] = (float)p[c], v[3 + c] = (float)n[c], v[6 + c] = col[c];
+    v[9] = surface_shine;
+}
+
+/* vertices: the particles, then every skin's; indices: the surfaces' triangles (those
+ * not wholly under a drawn skin), then the skins'. Smooth normals: area-weighted. */
+static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *o, const wb_draw_skin *sk, int nsk)
+{
+    int32_t np = wb_particle_count(w), ns = o->surfaces ? wb_surface_count(w) : 0;
+    const wb_real *x = wb_particle_positions(w);
+    size_t total = 0, nv = (size_t)np;
+    for (int32_t s = 0; s < ns; s++) {
+        int32_t nt = 0;
+        wb_surface_triangles(w, s, &nt);
+        total += 3 * (size_t)nt;
+    }
+    for (int i = 0; i < nsk; i++) total += 3 * (size_t)sk[i].nt, nv += (size_t)sk[i].nv;
+    if (!grow(&l->sv, &l->sv_cap, WB_SV * nv + WB_SV, sizeof *l->sv) || !grow(&l->si, &l->si_cap, total + 1, sizeof *l->si))
+        return false;
+    double *acc = calloc((size_t)np * 3 + 3, sizeof *acc);
+    int16_t *owner = malloc(((size_t)np + 1) * sizeof *owner);   /* the first surface a particle is on */
+    if (!acc || !owner) {
+        free(acc), free(owner);
+        return false;
+    }
+    memset(owner, 0xff, ((size_t)np + 1) * sizeof *owner);
+    size_t k = 0;
+    for (int32_t s = 0; s < ns; s++) {
+        int32_t nt = 0;
+        const int32_t *t = wb_surface_triangles(w, s, &nt);
+        for (int32_t i = 0; i < nt; i++) {
+            const int32_t *v = t + 3 * i;
+            if (l->flags[v[0]] & l->flags[v[1]] & l->flags[v[2]] & F_HIDDEN) continue;
+            double e1[3], e2[3], fn[3];
+            for (int c = 0; c < 3; c++) e1[c] = x[3 * v[1] + c] - x[3 * v[0] + c], e2[c] = x[3 * v[2] + c] - x[3 * v[0] + c];
+            cross3(e1, e2, fn);
+            for (int j = 0; j < 3; j++) {
+                for (int c = 0; c < 3; c++) acc[3 * v[j] + c] += fn[c];
+                l->si[k++] = (GLuint)v[j];
+                l->flags[v[j]] |= F_SURFACE;
+                if (owner[v[j]] < 0) owner[v[j]] = (int16_t)(s % 4);
+            }
+        }
+    }
+    float cloth[3];
+    wb_lin3(col_cloth, cloth);
+    for (int32_t i = 0; i < np; i++) {
+        double p[3] = { x[3 * i], x[3 * i + 1], x[3 * i + 2] };
+        float col[3];
+        if (o->constraints) strain_colour(l->vstrain[i], o->strain_scale, cloth, col);
+        else wb_lin3(col_surface[owner[i] < 0 ? 0 : owner[i]], col);
+        norm3(acc + 3 * i);
+        put_vertex(l->sv + WB_SV * i, p, acc + 3 * i, col);
+    }
+    free(acc);
+    free(owner);
+    size_t base = (size_t)np;   /* skins: their own (deformed) vertices and normals */
+    float skin[3];
+    wb_lin3(col_skin, skin);
+    for (int i = 0; i < nsk; i++) {
+        for (int32_t v = 0; v < sk[i].nv; v++) {
+            double p[3] = { sk[i].v[3 * v], sk[i].v[3 * v + 1], sk[i].v[3 * v + 2] };
+            double n[3] = { sk[i].n[3 * v], sk[i].n[3 * v + 1], sk[i].n[3 * v + 2] };
+            put_vertex(l->sv + WB_SV * (base + v), p, n, skin);
+        }
+        for (int32_t t = 0; t < 3 * sk[i].nt; t++) l->si[k++] = (GLuint)(base + (size_t)sk[i].tri[t]);
+        base += (size_t)sk[i].nv;
+    }
+    l->nv = nv;
+    l->nidx = k;
+    return true;
+}
+
+bool wb_layers_build(wb_layers *l, const wb_world *w, const wb_draw_opts *o, const wb_draw_skin *sk, int nsk,
+                     double unit)
+{
+    int32_t np = wb_particle_count(w);
+    if (!grow(&l->flags, &l->flag_cap, (size_t)np + 1, 1)) return false;
+    memset(l->flags, 0, (size_t)np + 1);
+    /* the particles a drawn skin is bound to are its cage: the skin shows them */
+    for (int i = 0; !o->cage && i < nsk; i++)
+        for (int32_t b = 0; sk[i].skin && b < wb_skin_bone_count(sk[i].skin); b++) {
+            int32_t p = wb_skin_bone_particle(sk[i].skin, b);
+            if (p >= 0 && p < np) l->flags[p] |= F_HIDDEN;
+        }
+    l->npairs = 0;
+    if (o->constraints && !load_pairs(l, w)) return false;
+    l->nv = l->nidx = l->nseg = 0;
+    l->surfaces = (o->surfaces && wb_surface_count(w) > 0 && np > 0) || nsk > 0;
+    if (l->surfaces && !build_surfaces(l, w, o, sk, nsk)) return false;
+    if (!build_instances(l, w, o, unit)) return false;
+    if (o->constraints && !build_segments(l, w, o)) return false;
+    return true;
+}

@@ -1,0 +1,552 @@
+/* media.c: images and videos. PNG through stb_image_write (fast compression,
+ * every write checked: a full disk is an error, not a short file); MP4 (H.264,
+ * yuv420p) and GIF by piping raw RGB frames to the ffmpeg program; a folder of
+ * numbered PNGs. Frames are encoded on a writer thread so the caller simulates the
+ * next frame meanwhile. A failed encoder is an error, never a hang: SIGPIPE is
+ * blocked on the writer thread (EPIPE instead), the exit status is checked, and an
+ * encoder that stops taking frames is killed after a timeout. */
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <math.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "render.h"
+
+/* stb's implementation, once in the program, without its warnings */
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
+#pragma GCC diagnostic ignored "-Wdouble-promotion"
+#pragma GCC diagnostic ignored "-Wcast-qual"
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#define STBI_WRITE_NO_STDIO
+#include <stb/stb_image_write.h>
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_ONLY_PNG
+#include <stb/stb_image.h>
+#pragma GCC diagnostic pop
+
+#define NSLOT 3   /* frames queued for the writer thread */
+
+/* ---- PNG ------------------------------------------------------------------------------ */
+typedef struct membuf { unsigned char *p; size_t n, cap; bool oom; } membuf;
+
+static void mem_write(void *ctx, void *data, int size)
+{
+    membuf *m = ctx;
+    if (m->oom || size <= 0) return;
+    if (m->n + (size_t)size > m->cap) {
+        size_t cap = m->cap ? m->cap : 65536;
+        while (cap < m->n + (size_t)size) cap *= 2;
+        unsigned char *q = realloc(m->p, cap);
+        if (!q) {
+            m->oom = true;
+            return;
+        }
+        m->p = q;
+        m->cap = cap;
+    }
+    memcpy(m->p + m->n, data, (size_t)size);
+    m->n += (size_t)size;
+}
+
+/* write all of data to f, checking every step (fclose reports a full disk late) */
+static bool write_stream(FILE *f, const void *data, size_t n, int *e)
+{
+    bool ok = fwrite(data, 1, n, f) == n;
+    *e = ok ? 0 : errno ? errno : EIO;
+    if (fclose(f) != 0 && ok) ok = false, *e = errno;
+    return ok;
+}
+
+/* write data to path without ever losing what was there: into a new file next to it,
+ * renamed over the path once complete, so a failure removes only that new file. A
+ * path that exists and is no regular file (a device, a pipe) is written in place and
+ * never removed. */
+static bool write_file(const char *path, const void *data, size_t n, char *err, size_t en)
+{
+    static _Atomic unsigned seq;
+    char real[PATH_MAX], tmp[PATH_MAX + 64];
+    struct stat st;
+    int e = 0;
+    /* a symlink: replace its target, not the link */
+    if (lstat(path, &st) == 0 && S_ISLNK(st.st_mode) && realpath(path, real)) path = real;
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        FILE *f = fopen(path, "wb");
+        if (f && write_stream(f, data, n, &e)) return true;
+        snprintf(err, en, "cannot write %s: %s", path, strerror(f ? e : errno));
+        return false;
+    }
+    const char *slash = strrchr(path, '/');
+    int dl = slash ? (int)(slash - path + 1) : 0, fd = -1;
+    for (int tries = 0; fd < 0 && tries < 100; tries++) {
+        if (snprintf(tmp, sizeof tmp, "%.*s.%s.%ld-%u.tmp", dl, path, path + dl, (long)getpid(), seq++) >= (int)sizeof tmp) {
+            snprintf(err, en, "cannot write %s: path too long", path);
+            return false;
+        }
+        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd < 0 && errno != EEXIST) break;
+    }
+    FILE *f = fd >= 0 ? fdopen(fd, "wb") : NULL;
+    if (!f) {
+        snprintf(err, en, "cannot write %s: %s", path, strerror(errno));
+        if (fd >= 0) close(fd), unlink(tmp);
+        return false;
+    }
+    bool ok = write_stream(f, data, n, &e);
+    if (ok && rename(tmp, path) != 0) ok = false, e = errno;
+    if (!ok) {
+        snprintf(err, en, "cannot write %s: %s", path, strerror(e));
+        unlink(tmp);
+    }
+    return ok;
+}
+
+static bool png_encode(membuf *m, const uint8_t *rgb, int w, int h)
+{
+    /* level 1: about as small as 8 for rendered frames, several times faster */
+    stbi_write_png_compression_level = 1;
+    return stbi_write_png_to_func(mem_write, m, w, h, 3, rgb, w * 3) && !m->oom;
+}
+
+bool wb_image_write_png(const char *path, const uint8_t *rgb, int w, int h, char *err, size_t n)
+{
+    membuf m = { 0 };
+    bool ok = png_encode(&m, rgb, w, h);
+    if (!ok) snprintf(err, n, "out of memory encoding %s", path);
+    else ok = write_file(path, m.p, m.n, err, n);
+    free(m.p);
+    return ok;
+}
+
+uint8_t *wb_image_read_png(const char *path, int *w, int *h, char *err, size_t n)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, n, "cannot open %s: %s", path, strerror(errno));
+        return NULL;
+    }
+    int comp = 0;
+    uint8_t *px = stbi_load_from_file(f, w, h, &comp, 3);
+    fclose(f);
+    if (!px) snprintf(err, n, "%s is not a PNG image we can read (%s)", path, stbi_failure_reason());
+    return px;
+}
+
+/* ---- what a path records to --------------------------------------------------------- */
+static const char *ext_of(const char *path)
+{
+    const char *slash = strrchr(path, '/'), *base = slash ? slash + 1 : path, *dot = strrchr(base, '.');
+    return dot && dot != base ? dot : NULL;
+}
+
+wb_media wb_media_of(const char *given, const char *path, char *err, size_t n)
+{
+    size_t len = strlen(given);
+    struct stat st;
+    if (len == 0) {
+        snprintf(err, n, "empty path");
+        return WB_MEDIA_NONE;
+    }
+    if (given[len - 1] == '/' || (stat(path ? path : given, &st) == 0 && S_ISDIR(st.st_mode))) return WB_MEDIA_FOLDER;
+    const char *e = ext_of(given);
+    if (!e) return WB_MEDIA_FOLDER;
+    if (!strcasecmp(e, ".mp4")) return WB_MEDIA_MP4;
+    if (!strcasecmp(e, ".gif")) return WB_MEDIA_GIF;
+    snprintf(err, n, "cannot record to '%s': unknown extension '%s' (expected .mp4, .gif, or a folder for PNG frames)",
+             given, e);
+    return WB_MEDIA_NONE;
+}
+
+/* ---- the recorder ---------------------------------------------------------------------- */
+struct wb_recorder {
+    wb_media kind;
+    char path[PATH_MAX];
+    bool created;                 /* the file at path is ours (dev, ino): made by open */
+    dev_t dev;
+    ino_t ino;
+    int w, h;
+    double fps, timeout;
+    size_t bytes;                 /* of one frame */
+    bool started;
+    pid_t pid;                    /* ffmpeg, or 0 */
+    int fd, errfd;                /* its stdin (our end) and its stderr (a temporary file) */
+    pthread_t th;
+    bool thread_on;
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    uint8_t *slot[NSLOT];
+    int head, queued;
+    bool stop, failed;
+    char msg[768];
+    int64_t frames, written;
+};
+
+static const char *ffmpeg_prog(void)
+{
+    const char *p = getenv("WOBBLE_FFMPEG");   /* tests point it at a failing program */
+    return p && *p ? p : "ffmpeg";
+}
+
+wb_recorder *wb_recorder_open(const char *path, wb_media kind, int w, int h, char *err, size_t n)
+{
+    if (kind == WB_MEDIA_NONE) {
+        snprintf(err, n, "cannot record to '%s': no media kind", path);
+        return NULL;
+    }
+    if (strlen(path) >= PATH_MAX - 32) {
+        snprintf(err, n, "path too long");
+        return NULL;
+    }
+    struct stat made;
+    bool created = false;
+    /* find out now that the destination is unusable, not at the first frame */
+    if (kind == WB_MEDIA_FOLDER) {
+        if (mkdir(path, 0777) != 0 && errno != EEXIST) {
+            snprintf(err, n, "cannot create the folder %s: %s", path, strerror(errno));
+            return NULL;
+        }
+        if (access(path, W_OK) != 0) {
+            snprintf(err, n, "cannot write into %s: %s", path, strerror(errno));
+            return NULL;
+        }
+    } else {
+        /* a file made here is removed again when no frame comes; one that was there
+         * before (or anything not a regular file) is never removed */
+        created = true;
+        int fd = open(path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd < 0 && errno == EEXIST) created = false, fd = open(path, O_WRONLY | O_CLOEXEC);
+        if (fd < 0) {
+            snprintf(err, n, "cannot write %s: %s", path, strerror(errno));
+            return NULL;
+        }
+        if (fstat(fd, &made) != 0) created = false;
+        close(fd);
+    }
+    wb_recorder *rec = calloc(1, sizeof *rec);
+    if (!rec) {
+        snprintf(err, n, "out of memory");
+        return NULL;
+    }
+    rec->kind = kind;
+    rec->created = created;
+    if (created) rec->dev = made.st_dev, rec->ino = made.st_ino;
+    snprintf(rec->path, sizeof rec->path, "%s", path);
+    rec->w = w, rec->h = h;
+    rec->fps = 60;
+    rec->bytes = (size_t)w * (size_t)h * 3;
+    rec->fd = rec->errfd = -1;
+    const char *t = getenv("WOBBLE_ENCODER_TIMEOUT");
+    rec->timeout = t && atof(t) > 0 ? atof(t) : 60;
+    pthread_mutex_init(&rec->mu, NULL);
+    pthread_cond_init(&rec->cv, NULL);
+    return rec;
+}
+
+size_t wb_recorder_bytes(int w, int h) { return NSLOT * (size_t)w * (size_t)h * 3; }
+
+void wb_recorder_set_fps(wb_recorder *rec, double fps)
+{
+    if (!rec->started && fps > 0) rec->fps = fps;
+}
+
+bool wb_recorder_started(const wb_recorder *rec) { return rec->started; }
+int64_t wb_recorder_frames(const wb_recorder *rec) { return rec->frames; }
+const char *wb_recorder_path(const wb_recorder *rec) { return rec->path; }
+
+static void fail(wb_recorder *rec, const char *fmt, const char *a, const char *b)
+{
+    if (rec->failed) return;
+    rec->failed = true;
+    snprintf(rec->msg, sizeof rec->msg, fmt, a, b);
+}
+
+static bool write_all(int fd, const uint8_t *p, size_t n, int *e)
+{
+    while (n) {
+        ssize_t k = write(fd, p, n);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) {
+            *e = k < 0 ? errno : EIO;
+            return false;
+        }
+        p += k;
+        n -= (size_t)k;
+    }
+    return true;
+}
+
+/* one frame out (writer thread, no lock held); false with rec->msg-worthy text in m */
+static bool emit(wb_recorder *rec, const uint8_t *rgb, int64_t index, char *m, size_t mn)
+{
+    if (rec->kind == WB_MEDIA_FOLDER) {
+        char p[PATH_MAX + 32];
+        snprintf(p, sizeof p, "%s%sframe_%06lld.png", rec->path, rec->path[strlen(rec->path) - 1] == '/' ? "" : "/",
+                 (long long)index);
+        return wb_image_write_png(p, rgb, rec->w, rec->h, m, mn);
+    }
+    int e = 0;
+    if (write_all(rec->fd, rgb, rec->bytes, &e)) return true;
+    snprintf(m, mn, "%s", strerror(e));
+    return false;
+}
+
+static void *writer(void *p)
+{
+    wb_recorder *rec = p;
+    char m[512];
+    pthread_mutex_lock(&rec->mu);
+    for (;;) {
+        while (!rec->queued && !rec->stop) pthread_cond_wait(&rec->cv, &rec->mu);
+        if (!rec->queued) break;
+        const uint8_t *buf = rec->slot[rec->head];
+        int64_t index = rec->written;
+        bool skip = rec->failed;   /* after a failure frames are dropped, callers are told */
+        pthread_mutex_unlock(&rec->mu);
+        bool ok = skip || emit(rec, buf, index, m, sizeof m);
+        pthread_mutex_lock(&rec->mu);
+        if (!ok) fail(rec, "%s%s", m, "");
+        rec->head = (rec->head + 1) % NSLOT;
+        rec->queued--;
+        rec->written++;
+        pthread_cond_broadcast(&rec->cv);
+    }
+    pthread_mutex_unlock(&rec->mu);
+    return NULL;
+}
+
+/* ffmpeg reading raw RGB on stdin, its stderr into a temporary file */
+static bool spawn_encoder(wb_recorder *rec, char *err, size_t n)
+{
+    char size[32], rate[32], out[PATH_MAX + 16], tmpl[PATH_MAX], gif_vf[160];
+    snprintf(size, sizeof size, "%dx%d", rec->w, rec->h);
+    snprintf(rate, sizeof rate, "%.6g", rec->fps);
+    /* "file:" so neither a leading '-' nor a colon in the name means something else */
+    snprintf(out, sizeof out, "file:%s%s", rec->path[0] == '/' ? "" : "./", rec->path);
+    const char *prog = ffmpeg_prog();
+    const char *argv[48];
+    int a = 0;
+    const char *head[] = { prog, "-hide_banner", "-loglevel", "error", "-nostdin", "-y", "-f", "rawvideo",
+                           "-pixel_format", "rgb24", "-video_size", size, "-framerate", rate, "-i", "pipe:0", "-an" };
+    for (size_t k = 0; k < sizeof head / sizeof *head; k++) argv[a++] = head[k];
+    if (rec->kind == WB_MEDIA_MP4) {
+        /* yuv420p plays everywhere but needs even sizes: pad odd ones by a pixel */
+        const char *mp4[] = { "-c:v", "libx264", "-preset", "veryfast", "-crf", "18", "-pix_fmt", "yuv420p",
+                              "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-movflags", "+faststart", "-f", "mp4" };
+        for (size_t k = 0; k < sizeof mp4 / sizeof *mp4; k++) argv[a++] = mp4[k];
+    } else {
+        /* a GIF's delays are whole centiseconds and players show one under 2 cs as 10:
+         * resample to 100/d frames a second, d >= 2 (60 fps becomes 50), so it plays at
+         * the right speed; a palette per frame: nothing buffered for the whole stream */
+        double d = fmax(2, ceil(100 / rec->fps - 1e-9));
+        snprintf(gif_vf, sizeof gif_vf, "fps=100/%.0f,split[a][b];[a]palettegen=stats_mode=single[p];"
+                 "[b][p]paletteuse=new=1", d);
+        const char *gif[] = { "-vf", gif_vf, "-loop", "0", "-f", "gif" };
+        for (size_t k = 0; k < sizeof gif / sizeof *gif; k++) argv[a++] = gif[k];
+    }
+    argv[a++] = out;
+    argv[a] = NULL;
+
+    const char *tmp = getenv("TMPDIR");
+    snprintf(tmpl, sizeof tmpl, "%s/wobble-ffmpeg-XXXXXX", tmp && *tmp ? tmp : "/tmp");
+    rec->errfd = mkostemp(tmpl, O_CLOEXEC);
+    if (rec->errfd >= 0) unlink(tmpl);
+    int pfd[2];
+    if (rec->errfd < 0 || pipe2(pfd, O_CLOEXEC) != 0) {
+        snprintf(err, n, "cannot start %s: %s", prog, strerror(errno));
+        return false;
+    }
+    /* its own process group: a stalled encoder is killed with whatever it started */
+    int fds[3] = { pfd[0], -1, rec->errfd }, e = wb_spawn(prog, argv, fds, true, &rec->pid);
+    close(pfd[0]);
+    if (e != 0) {
+        close(pfd[1]);
+        rec->pid = 0;
+        if (e == ENOENT)
+            snprintf(err, n, "cannot record %s: the program '%s' is not installed (Debian package ffmpeg; "
+                             "or record to a folder of PNGs)", rec->path, prog);
+        else snprintf(err, n, "cannot start %s: %s", prog, strerror(e));
+        return false;
+    }
+    rec->fd = pfd[1];
+    return true;
+}
+
+static bool start(wb_recorder *rec, char *err, size_t n)
+{
+    for (int k = 0; k < NSLOT; k++)
+        if (!(rec->slot[k] = malloc(rec->bytes))) {
+            snprintf(err, n, "out of memory for the frames of %s", rec->path);
+            return false;
+        }
+    if (rec->kind != WB_MEDIA_FOLDER && !spawn_encoder(rec, err, n)) return false;
+    /* the writer thread is born with SIGPIPE blocked: a dead encoder gives EPIPE; the
+     * signal left pending on that thread goes away with it */
+    sigset_t pipe_only, old;
+    sigemptyset(&pipe_only);
+    sigaddset(&pipe_only, SIGPIPE);
+    pthread_sigmask(SIG_BLOCK, &pipe_only, &old);
+    int e = pthread_create(&rec->th, NULL, writer, rec);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    if (e != 0) {
+        snprintf(err, n, "cannot start the writer thread: %s", strerror(e));
+        return false;
+    }
+    rec->thread_on = true;
+    rec->started = true;
+    return true;
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* wait (lock held) until the queue has fewer than `below` frames or a failure; an
+ * encoder that takes nothing for the timeout is killed, so the writer sees EPIPE */
+static void wait_queue(wb_recorder *rec, int below)
+{
+    double t0 = now();
+    int64_t seen = rec->written;
+    while (rec->queued >= below && !(rec->failed && below > 0)) {
+        struct timespec ts;
+        clock_gettime(CLOCK_REALTIME, &ts);
+        ts.tv_nsec += 100000000;
+        if (ts.tv_nsec >= 1000000000) ts.tv_sec++, ts.tv_nsec -= 1000000000;
+        pthread_cond_timedwait(&rec->cv, &rec->mu, &ts);
+        if (rec->written != seen) seen = rec->written, t0 = now();
+        else if (rec->pid > 0 && now() - t0 > rec->timeout) {
+            char s[32];
+            snprintf(s, sizeof s, "%g", rec->timeout);
+            fail(rec, "the encoder took no frame for %s s and was stopped%s", s, "");
+            kill(-rec->pid, SIGKILL);
+            t0 = now();
+        }
+    }
+}
+
+bool wb_recorder_add(wb_recorder *rec, const uint8_t *rgb, char *err, size_t n)
+{
+    if (!rec->started && rec->failed) {   /* the encoder never started: say why again */
+        snprintf(err, n, "%s", rec->msg);
+        return false;
+    }
+    if (!rec->started && !start(rec, err, n)) {
+        rec->failed = true;
+        snprintf(rec->msg, sizeof rec->msg, "%s", err);
+        return false;
+    }
+    pthread_mutex_lock(&rec->mu);
+    wait_queue(rec, NSLOT);
+    bool ok = !rec->failed;
+    if (ok) {
+        memcpy(rec->slot[(rec->head + rec->queued) % NSLOT], rgb, rec->bytes);
+        rec->queued++;
+        rec->frames++;
+        pthread_cond_broadcast(&rec->cv);
+    } else {
+        snprintf(err, n, "recording %s failed: %s", rec->path, rec->msg);
+    }
+    pthread_mutex_unlock(&rec->mu);
+    return ok;
+}
+
+/* the last lines ffmpeg wrote on stderr, on one line */
+static void encoder_says(wb_recorder *rec, char *out, size_t n)
+{
+    char buf[4096];
+    out[0] = 0;
+    off_t end = lseek(rec->errfd, 0, SEEK_END);
+    if (end <= 0) return;
+    off_t from = end > (off_t)sizeof buf - 1 ? end - (off_t)sizeof buf + 1 : 0;
+    ssize_t k = pread(rec->errfd, buf, sizeof buf - 1, from);
+    if (k <= 0) return;
+    buf[k] = 0;
+    while (k > 0 && (buf[k - 1] == '\n' || buf[k - 1] == '\r' || buf[k - 1] == ' ')) buf[--k] = 0;
+    char *s = buf;
+    for (int lines = 0; k > 0 && lines < 3; k--)   /* the last three lines */
+        if (buf[k - 1] == '\n' && ++lines == 3) s = buf + k;
+    for (char *c = s; *c; c++)
+        if (*c == '\n' || *c == '\r') *c = ' ';
+    size_t len = strlen(s);
+    if (len >= n) s += len - (n - 1);   /* the end says most */
+    memcpy(out, s, strlen(s) + 1);
+}
+
+/* remove the empty file the recorder made, if it is still that one */
+static void remove_ours(const wb_recorder *rec)
+{
+    struct stat st;
+    if (rec->created && lstat(rec->path, &st) == 0 && S_ISREG(st.st_mode) && st.st_dev == rec->dev &&
+        st.st_ino == rec->ino && st.st_size == 0)
+        unlink(rec->path);
+}
+
+bool wb_recorder_close(wb_recorder *rec, char *err, size_t n)
+{
+    if (!rec) return true;
+    bool ok = true;
+    if (rec->thread_on) {
+        pthread_mutex_lock(&rec->mu);
+        wait_queue(rec, 1);   /* drain (with the encoder's timeout) */
+        rec->stop = true;
+        pthread_cond_broadcast(&rec->cv);
+        pthread_mutex_unlock(&rec->mu);
+        pthread_join(rec->th, NULL);
+    }
+    if (rec->fd >= 0) close(rec->fd);   /* end of input: ffmpeg finishes the file */
+    if (rec->pid > 0) {
+        int status = 0;
+        double t0 = now();
+        pid_t k;
+        while ((k = waitpid(rec->pid, &status, WNOHANG)) == 0) {
+            if (now() - t0 > 5 * rec->timeout) {
+                kill(-rec->pid, SIGKILL);
+                fail(rec, "the encoder did not finish the file and was stopped%s%s", "", "");
+            }
+            struct timespec ts = { 0, 5000000 };
+            nanosleep(&ts, NULL);
+        }
+        char says[512];
+        encoder_says(rec, says, sizeof says);
+        bool exited_ok = k == rec->pid && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+        if (!exited_ok || rec->failed) {
+            char how[64];
+            if (k == rec->pid && WIFEXITED(status)) snprintf(how, sizeof how, "exited with status %d", WEXITSTATUS(status));
+            else if (k == rec->pid && WIFSIGNALED(status)) snprintf(how, sizeof how, "was killed by signal %d", WTERMSIG(status));
+            else snprintf(how, sizeof how, "was lost");
+            /* what ffmpeg said explains a broken pipe better than EPIPE does */
+            char m[sizeof rec->msg];
+            snprintf(m, sizeof m, "%s", rec->msg);
+            snprintf(err, n, "recording %s failed: %s %s%s%s%s%s", rec->path, ffmpeg_prog(), exited_ok ? "finished" : how,
+                     *says ? ": " : "", says, rec->failed && *m ? "; " : "", rec->failed ? m : "");
+            ok = false;
+        }
+    } else if (rec->failed) {
+        if (rec->started) snprintf(err, n, "recording %s failed: %s", rec->path, rec->msg);
+        else snprintf(err, n, "%s", rec->msg);   /* the start's message says it all */
+        ok = false;
+    }
+    if (rec->errfd >= 0) close(rec->errfd);
+    if (!rec->started) remove_ours(rec);   /* no frames: no empty file */
+    for (int k = 0; k < NSLOT; k++) free(rec->slot[k]);
+    pthread_mutex_destroy(&rec->mu);
+    pthread_cond_destroy(&rec->cv);
+    free(rec);
+    return ok;
+}

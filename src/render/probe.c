@@ -1,0 +1,153 @@
+/* probe.c: reading media back through the helper programs (started by wb_spawn,
+ * spawn.c): facts through ffprobe, a decoded
+ * frame through ffmpeg, so tests can compare a video's pixels with what was drawn. */
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <signal.h>
+#include <spawn.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "render.h"
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#include <stb/stb_image.h>   /* declarations only: the implementation is in media.c */
+#pragma GCC diagnostic pop
+
+/* run argv[0] and collect its standard output (malloc'd, NUL added, *len bytes; what
+ * passes max is read and dropped so the program never blocks); *ok: it exited 0 */
+static char *capture(const char *const argv[], size_t max, size_t *len, bool *ok, char *err, size_t n)
+{
+    int pfd[2];
+    *ok = false;
+    if (pipe2(pfd, O_CLOEXEC) != 0) {
+        snprintf(err, n, "cannot run %s: %s", argv[0], strerror(errno));
+        return NULL;
+    }
+    pid_t pid;
+    int fds[3] = { -1, pfd[1], -1 }, se = wb_spawn(argv[0], argv, fds, false, &pid);
+    close(pfd[1]);
+    if (se != 0) {
+        close(pfd[0]);
+        snprintf(err, n, "cannot run %s: %s", argv[0], strerror(se));
+        return NULL;
+    }
+    size_t got = 0, cap = 4096;
+    char *out = malloc(cap + 1), drop[4096];
+    for (;;) {
+        if (out && got == cap && cap < max) {
+            size_t c = cap * 2 < max ? cap * 2 : max;
+            char *q = realloc(out, c + 1);
+            if (!q) free(out);
+            out = q, cap = c;
+        }
+        bool keep = out && got < cap;
+        ssize_t k = read(pfd[0], keep ? out + got : drop, keep ? cap - got : sizeof drop);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) break;
+        if (keep) got += (size_t)k;
+    }
+    close(pfd[0]);
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
+    if (!out) {
+        snprintf(err, n, "out of memory reading what %s wrote", argv[0]);
+        return NULL;
+    }
+    out[got] = 0;
+    *len = got;
+    *ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    return out;
+}
+
+static const char *tool(const char *env, const char *dflt)
+{
+    const char *p = getenv(env);   /* tests point these at failing programs */
+    return p && *p ? p : dflt;
+}
+
+/* "file:" so neither a leading '-' nor a colon in the name means something else */
+static void ff_input(char *in, size_t n, const char *path)
+{
+    snprintf(in, n, "file:%s%s", path[0] == '/' ? "" : "./", path);
+}
+
+bool wb_media_probe(const char *path, wb_media_info *info, char *err, size_t n)
+{
+    memset(info, 0, sizeof *info);
+    const char *e = strrchr(path, '.');
+    if (e && !strchr(e, '/') && !strcasecmp(e, ".png")) {
+        int comp;
+        if (!stbi_info(path, &info->width, &info->height, &comp)) {
+            snprintf(err, n, "%s is not a readable PNG (%s)", path, stbi_failure_reason());
+            return false;
+        }
+        info->frames = 1;
+        snprintf(info->codec, sizeof info->codec, "png");
+        snprintf(info->pix_fmt, sizeof info->pix_fmt, comp == 4 ? "rgba" : comp == 3 ? "rgb24" : "gray");
+        return true;
+    }
+    if (access(path, R_OK) != 0) {
+        snprintf(err, n, "cannot read %s: %s", path, strerror(errno));
+        return false;
+    }
+    const char *prog = tool("WOBBLE_FFPROBE", "ffprobe");
+    char in[PATH_MAX + 16];
+    ff_input(in, sizeof in, path);
+    const char *argv[] = { prog, "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                           "stream=width,height,codec_name,pix_fmt,nb_read_frames:format=duration", "-of",
+                           "default=noprint_wrappers=1", in, NULL };
+    size_t len;
+    bool ok;
+    char *out = capture(argv, 65536, &len, &ok, err, n);
+    if (!out) return false;
+    char *save = NULL;
+    for (char *line = strtok_r(out, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
+        char *eq = strchr(line, '=');
+        if (!eq) continue;
+        *eq = 0;
+        const char *v = eq + 1;
+        if (!strcmp(line, "width")) info->width = atoi(v);
+        else if (!strcmp(line, "height")) info->height = atoi(v);
+        else if (!strcmp(line, "nb_read_frames")) info->frames = atoll(v);
+        else if (!strcmp(line, "duration")) info->duration = atof(v);
+        else if (!strcmp(line, "codec_name")) snprintf(info->codec, sizeof info->codec, "%s", v);
+        else if (!strcmp(line, "pix_fmt")) snprintf(info->pix_fmt, sizeof info->pix_fmt, "%s", v);
+    }
+    free(out);
+    if (!ok || !info->codec[0]) {
+        snprintf(err, n, "%s: not a video %s can read", path, prog);
+        return false;
+    }
+    return true;
+}
+
+uint8_t *wb_media_read_frame(const char *path, int64_t index, int *w, int *h, char *err, size_t n)
+{
+    if (access(path, R_OK) != 0) {
+        snprintf(err, n, "cannot read %s: %s", path, strerror(errno));
+        return NULL;
+    }
+    const char *prog = tool("WOBBLE_FFMPEG", "ffmpeg");
+    char in[PATH_MAX + 16], select[64];
+    ff_input(in, sizeof in, path);
+    snprintf(select, sizeof select, "select=eq(n\\,%lld)", (long long)index);
+    /* the frame as a PNG on stdout: it carries its own size */
+    const char *argv[] = { prog, "-v", "error", "-nostdin", "-i", in, "-vf", select, "-fps_mode", "passthrough",
+                           "-frames:v", "1", "-f", "image2pipe", "-c:v", "png", "pipe:1", NULL };
+    size_t len;
+    bool ok;
+    char *out = capture(argv, (size_t)1 << 30, &len, &ok, err, n);
+    if (!out) return NULL;
+    int comp;
+    uint8_t *px = ok && len ? stbi_load_from_memory((const unsigned char *)out, (int)len, w, h, &comp, 3) : NULL;
+    free(out);
+    if (!px) snprintf(err, n, "%s: no frame %lld (%s could not decode it)", path, (long long)index, prog);
+    return px;
+}

@@ -1,0 +1,544 @@
+/* render.c: draws a world: the camera and the scene's bounds, the layers' data (built
+ * by layers.c) uploaded, and the passes (shadow map, ground, solids, surfaces,
+ * links, sky), then resolves the multisample target into the backend's buffer and
+ * keeps the frame as RGB, top row first. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render.h"
+#include "gl.h"
+
+struct wb_renderer {
+    const wb_backend *be;
+    void *ctx;
+    int w, h, samples;
+    bool gl_ready;
+    wb_gl gl;
+    char info[192];
+    uint8_t *rgb;                 /* the last frame */
+    bool drawn;
+    /* camera: fixed by the script, or framing everything shown since the reset */
+    bool fixed;
+    double eye[3], target[3], up[3], fov;
+    bool have_box;
+    double view_lo[3], view_hi[3];/* what the default camera frames (follow_box) */
+    const wb_world *box_world;    /* the world it was taken from, at frame box_frame */
+    int64_t box_frame;
+    /* the last frame's camera and view-projection (row-major 4x4, doubles) */
+    double cam_eye[3], cam_target[3], cam_up[3], cam_fov, vp[16];
+    wb_layers layers;             /* what the layers draw, rebuilt every frame */
+};
+
+/* colours, sRGB (the layers' own are in layers.c) */
+static const float col_ground[3] = { 0.80f, 0.80f, 0.78f };
+static const float col_sky_top[3] = { 0.50f, 0.61f, 0.75f };
+static const float col_sky_bottom[3] = { 0.89f, 0.90f, 0.92f };
+static const double light_dir[3] = { -0.40, 0.80, 0.45 };   /* towards the light: upper left, in front */
+/* the default camera's box shrinks by this part of the way per draw: about half a
+ * second to settle at 60 draws a second */
+static const double box_shrink = 0.03;
+
+wb_draw_opts wb_draw_default_opts(void)
+{
+    wb_draw_opts o = { true, true, true, true, true, true, true, false, 0.02, 1.5 };
+    return o;
+}
+
+/* ---- life cycle -------------------------------------------------------------------------- */
+wb_renderer *wb_renderer_create(const wb_backend *be, int width, int height, int samples, char *err, size_t n)
+{
+    if (width < 1 || height < 1 || width > WB_RENDER_MAX_SIZE || height > WB_RENDER_MAX_SIZE) {
+        snprintf(err, n, "size %dx%d out of range (1..%d)", width, height, WB_RENDER_MAX_SIZE);
+        return NULL;
+    }
+    wb_renderer *r = calloc(1, sizeof *r);
+    if (r) r->rgb = calloc((size_t)width * (size_t)height, 3);
+    if (!r || !r->rgb) {
+        if (r) free(r);
+        snprintf(err, n, "out of memory for a %dx%d renderer", width, height);
+        return NULL;
+    }
+    r->be = be;
+    r->w = width, r->h = height;
+    r->samples = samples;
+    r->up[1] = 1;
+    r->fov = 40;
+    r->ctx = be->create(width, height, err, n);
+    if (!r->ctx) {
+        wb_renderer_destroy(r);
+        return NULL;
+    }
+    if (be->gl) {
+        if (!wb_gl_init(&r->gl, width, height, &r->samples, err, n)) {
+            wb_renderer_destroy(r);
+            return NULL;
+        }
+        r->gl_ready = true;
+        snprintf(r->info, sizeof r->info, "OpenGL %s, %s", (const char *)glGetString(GL_VERSION),
+                 (const char *)glGetString(GL_RENDERER));
+    } else {
+        r->samples = 1;
+        snprintf(r->info, sizeof r->info, "null backend (no pixels)");
+    }
+    return r;
+}
+
+size_t wb_renderer_bytes(const wb_backend *be, int width, int height, int samples)
+{
+    size_t px = (size_t)width * (size_t)height, shadow = px > 1920 * 1080 ? 2048 : 1024;
+    if (!be->gl) return 3 * px;
+    /* RGB frame, the backend's RGBA, colour and depth per sample, the depth shadow map */
+    return px * (3 + 4 + 8 * (size_t)(samples > 1 ? samples : 1)) + 4 * shadow * shadow;
+}
+
+void wb_renderer_destroy(wb_renderer *r)
+{
+    if (!r) return;
+    if (r->ctx) {
+        if (r->gl_ready && r->be->make_current(r->ctx)) wb_gl_free(&r->gl);
+        r->be->destroy(r->ctx);
+    }
+    free(r->rgb);
+    wb_layers_free(&r->layers);
+    free(r);
+}
+
+void wb_renderer_size(const wb_renderer *r, int *width, int *height)
+{
+    *width = r->w;
+    *height = r->h;
+}
+
+int wb_renderer_samples(const wb_renderer *r) { return r->samples; }
+const char *wb_renderer_info(const wb_renderer *r) { return r->info; }
+const uint8_t *wb_renderer_pixels(const wb_renderer *r) { return r->rgb; }
+
+void wb_renderer_camera(wb_renderer *r, const double eye[3], const double target[3], const double up[3], double fov)
+{
+    r->fixed = true;
+    memcpy(r->eye, eye, sizeof r->eye);
+    memcpy(r->target, target, sizeof r->target);
+    memcpy(r->up, up, sizeof r->up);
+    r->fov = fov;
+    r->have_box = false;   /* a new shot: the extent starts again */
+}
+
+void wb_renderer_auto_camera(wb_renderer *r)
+{
+    r->fixed = false;
+    r->have_box = false;
+}
+
+void wb_renderer_get_camera(const wb_renderer *r, double eye[3], double target[3], double up[3], double *fov)
+{
+    memcpy(eye, r->cam_eye, sizeof r->cam_eye);
+    memcpy(target, r->cam_target, sizeof r->cam_target);
+    memcpy(up, r->cam_up, sizeof r->cam_up);
+    *fov = r->cam_fov;
+}
+
+bool wb_renderer_project(const wb_renderer *r, const double p[3], double *x, double *y, double *depth)
+{
+    if (!r->drawn) return false;
+    double c[4];
+    for (int i = 0; i < 4; i++) c[i] = r->vp[i * 4] * p[0] + r->vp[i * 4 + 1] * p[1] + r->vp[i * 4 + 2] * p[2] + r->vp[i * 4 + 3];
+    if (c[3] <= 1e-12) return false;
+    *x = (c[0] / c[3] * 0.5 + 0.5) * r->w;
+    *y = (0.5 - c[1] / c[3] * 0.5) * r->h;
+    if (depth) *depth = c[3];
+    return true;
+}
+
+/* ---- the scene's extent ----------------------------------------------------------------- */
+typedef struct box { double lo[3], hi[3]; bool any; } box;
+
+static void box_add(box *b, const double p[3], double r)
+{
+    for (int k = 0; k < 3; k++) {
+        if (!b->any || p[k] - r < b->lo[k]) b->lo[k] = p[k] - r;
+        if (!b->any || p[k] + r > b->hi[k]) b->hi[k] = p[k] + r;
+    }
+    b->any = true;
+}
+
+/* how much a plane's normal points up (n.y / |n|; 0 when degenerate) */
+static double up_part(const wb_real n[3])
+{
+    double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    return l > 0 ? n[1] / l : 0;
+}
+
+/* a plane collider facing (nearly) straight up: the ground; *height: where it is */
+static bool floor_height(const wb_collider_def *d, double *height)
+{
+    if (d->shape != WB_SHAPE_PLANE || up_part(d->normal) < 0.9) return false;
+    *height = d->offset / sqrt(d->normal[0] * d->normal[0] + d->normal[1] * d->normal[1] + d->normal[2] * d->normal[2]);
+    return true;
+}
+
+/* particles and the finite colliders; an upward plane below is pulled in when it is
+ * near, so the ground the scene rests on is in the picture */
+static box scene_box(const wb_world *w)
+{
+    box b = { { 0 }, { 0 }, false };
+    int32_t np = wb_particle_count(w);
+    const wb_real *x = wb_particle_positions(w);
+    for (int32_t i = 0; i < np; i++) {
+        double p[3] = { x[3 * i], x[3 * i + 1], x[3 * i + 2] };
+        if (isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])) box_add(&b, p, wb_particle_radius(w, i));
+    }
+    int32_t nc = wb_collider_count(w);
+    for (int32_t i = 0; i < nc; i++) {
+        wb_collider_def d;
+        wb_collider_get_def(w, wb_collider_at(w, i), &d);
+        double c[3] = { d.center[0], d.center[1], d.center[2] };
+        if (d.shape == WB_SHAPE_SPHERE) {
+            box_add(&b, c, d.radius);
+        } else if (d.shape == WB_SHAPE_BOX) {
+            double m[9];
+            quat_mat(d.rotation, m);
+            for (int k = 0; k < 8; k++) {
+                double s[3] = { k & 1 ? d.half[0] : -d.half[0], k & 2 ? d.half[1] : -d.half[1],
+                                k & 4 ? d.half[2] : -d.half[2] };
+                double p[3];
+                for (int r = 0; r < 3; r++) p[r] = c[r] + m[r * 3] * s[0] + m[r * 3 + 1] * s[1] + m[r * 3 + 2] * s[2];
+                box_add(&b, p, 0);
+            }
+        } else if (d.shape == WB_SHAPE_CAPSULE) {
+            double a[3] = { d.a[0], d.a[1], d.a[2] }, e[3] = { d.b[0], d.b[1], d.b[2] };
+            box_add(&b, a, d.radius);
+            box_add(&b, e, d.radius);
+        }
+    }
+    if (!b.any) {
+        double o[3] = { 0, 0, 0 };
+        box_add(&b, o, 1);
+    }
+    double ext = 0;
+    for (int k = 0; k < 3; k++) ext = fmax(ext, b.hi[k] - b.lo[k]);
+    ext = fmax(ext, 1e-3);
+    double lo_ground = b.lo[1];
+    for (int32_t i = 0; i < nc; i++) {
+        wb_collider_def d;
+        wb_collider_get_def(w, wb_collider_at(w, i), &d);
+        double h;
+        if (!floor_height(&d, &h)) continue;
+        /* the gap down to the floor: closed when under ext, then less and less of it up
+         * to 2 ext, so a body nearing the ground zooms out smoothly instead of in one jump */
+        double g = b.lo[1] - h, pull = g <= ext ? g : g < 2 * ext ? 2 * ext - g : 0;
+        if (g > 0) lo_ground = fmin(lo_ground, b.lo[1] - pull);
+    }
+    b.lo[1] = lo_ground;
+    return b;
+}
+
+/* the default camera: a three-quarter view from the front right, as close as the
+ * box allows with a margin */
+static void frame_box(wb_renderer *r, const double lo[3], const double hi[3])
+{
+    double dir[3] = { 0.35, 0.3, 1.0 }, up[3] = { 0, 1, 0 }, c[3], s[3], u[3], f[3];
+    norm3(dir);
+    for (int k = 0; k < 3; k++) c[k] = 0.5 * (lo[k] + hi[k]), f[k] = -dir[k];
+    cross3(f, up, s);
+    norm3(s);
+    cross3(s, f, u);
+    double ty = tan(r->fov * M_PI / 360) * 0.9, tx = ty * r->w / r->h, dist = 1e-3;
+    for (int k = 0; k < 8; k++) {
+        double p[3] = { (k & 1 ? hi[0] : lo[0]) - c[0], (k & 2 ? hi[1] : lo[1]) - c[1], (k & 4 ? hi[2] : lo[2]) - c[2] };
+        double z = dot3(p, dir);
+        dist = fmax(dist, fmax(z + fabs(dot3(p, s)) / tx, z + fabs(dot3(p, u)) / ty));
+    }
+    for (int k = 0; k < 3; k++) r->cam_eye[k] = c[k] + dir[k] * dist, r->cam_target[k] = c[k], r->cam_up[k] = up[k];
+    r->cam_fov = r->fov;
+}
+
+/* ---- passes ------------------------------------------------------------------------------ */
+static void set_mat(GLuint prog, const char *name, const double m[16])
+{
+    float f[16];
+    to_gl(m, f);
+    glUniformMatrix4fv(glGetUniformLocation(prog, name), 1, GL_FALSE, f);
+}
+
+static void set_vec(GLuint prog, const char *name, double x, double y, double z)
+{
+    glUniform3f(glGetUniformLocation(prog, name), (float)x, (float)y, (float)z);
+}
+
+static void draw_meshes(wb_renderer *r)
+{
+    static const int mesh_of[WB_G_COUNT] = { MESH_SPHERE_LO, MESH_SPHERE_HI, MESH_CYLINDER, MESH_BOX };
+    const wb_layers *l = &r->layers;
+    for (int g = 0; g < WB_G_COUNT; g++) {
+        if (!l->count[g]) continue;
+        wb_gl_inst_attribs(&r->gl, l->first[g]);
+        glDrawElementsInstanced(GL_TRIANGLES, r->gl.mesh_count[mesh_of[g]], GL_UNSIGNED_INT,
+                                (const void *)((size_t)r->gl.mesh_first[mesh_of[g]] * sizeof(GLuint)),
+                                (GLsizei)l->count[g]);
+    }
+}
+
+static void draw_surfaces(wb_renderer *r)
+{
+    glBindVertexArray(r->gl.vao_surf);
+    /* constant instance attributes: identity model and normal matrices */
+    glVertexAttrib4f(2, 1, 0, 0, 0), glVertexAttrib4f(3, 0, 1, 0, 0);
+    glVertexAttrib4f(4, 0, 0, 1, 0), glVertexAttrib4f(5, 0, 0, 0, 1);
+    glVertexAttrib3f(6, 1, 0, 0), glVertexAttrib3f(7, 0, 1, 0), glVertexAttrib3f(8, 0, 0, 1);
+    glDrawElements(GL_TRIANGLES, (GLsizei)r->layers.nidx, GL_UNSIGNED_INT, (const void *)0);
+}
+
+/* a plane as a square of half size ext around the point nearest c; returns false
+ * when the normal is degenerate */
+static bool plane_quad(const wb_real nrm[3], double offset, const double c[3], double ext, float quad[12],
+                       double center[3], double gu[3], double gv[3], double gn[3])
+{
+    double n[3] = { nrm[0], nrm[1], nrm[2] };
+    double l = norm3(n);
+    if (l <= 0) return false;
+    double d = offset / l, h = dot3(n, c) - d;
+    for (int k = 0; k < 3; k++) center[k] = c[k] - h * n[k], gn[k] = n[k];
+    if (fabs(up_part(nrm)) >= 0.9) {   /* level (a floor or a ceiling): lines along x and z */
+        double x[3] = { 1, 0, 0 };
+        cross3(x, n, gv);
+        norm3(gv);
+        cross3(n, gv, gu);
+    } else {
+        double y[3] = { 0, 1, 0 };
+        cross3(n, y, gu);
+        norm3(gu);
+        cross3(gu, n, gv);
+    }
+    static const int sx[4] = { -1, 1, -1, 1 }, sy[4] = { -1, -1, 1, 1 };
+    for (int v = 0; v < 4; v++)
+        for (int k = 0; k < 3; k++) quad[3 * v + k] = (float)(center[k] + ext * (sx[v] * gu[k] + sy[v] * gv[k]));
+    return true;
+}
+
+static void draw_grid(wb_renderer *r, const float quad[12], const double center[3], const double gu[3],
+                      const double gv[3], const double gn[3], double spacing, double ext)
+{
+    GLuint p = r->gl.prog_grid;
+    glBindVertexArray(r->gl.vao_grid);
+    glBindBuffer(GL_ARRAY_BUFFER, r->gl.vbo_grid);
+    glBufferSubData(GL_ARRAY_BUFFER, 0, 12 * sizeof(float), quad);
+    set_vec(p, "u_center", center[0], center[1], center[2]);
+    set_vec(p, "u_gu", gu[0], gu[1], gu[2]);
+    set_vec(p, "u_gv", gv[0], gv[1], gv[2]);
+    set_vec(p, "u_gn", gn[0], gn[1], gn[2]);
+    glUniform1f(glGetUniformLocation(p, "u_spacing"), (float)spacing);
+    glUniform1f(glGetUniformLocation(p, "u_extent"), (float)ext);
+    float g[3];
+    wb_lin3(col_ground, g);
+    glUniform3f(glGetUniformLocation(p, "u_base"), g[0], g[1], g[2]);
+    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+}
+
+/* uniforms of the lit programs */
+static void light_uniforms(GLuint p, const double vp[16], const double lvp[16], const double eye[3],
+                           const double L[3], double bias, bool shadows)
+{
+    glUseProgram(p);
+    set_mat(p, "u_vp", vp);
+    set_mat(p, "u_lvp", lvp);
+    set_vec(p, "u_eye", eye[0], eye[1], eye[2]);
+    set_vec(p, "u_light", L[0], L[1], L[2]);
+    glUniform1f(glGetUniformLocation(p, "u_bias"), (float)bias);
+    glUniform1i(glGetUniformLocation(p, "u_shadows"), shadows);
+    glUniform1i(glGetUniformLocation(p, "u_smap"), 0);
+}
+
+static void background_cpu(wb_renderer *r)
+{
+    for (int y = 0; y < r->h; y++) {
+        double t = r->h > 1 ? 1 - (double)y / (r->h - 1) : 1;
+        uint8_t c[3];
+        for (int k = 0; k < 3; k++) c[k] = (uint8_t)lrint(255 * (col_sky_bottom[k] + (col_sky_top[k] - col_sky_bottom[k]) * t));
+        for (int x = 0; x < r->w; x++) memcpy(r->rgb + 3 * ((size_t)y * r->w + x), c, 3);
+    }
+}
+
+/* what the default camera frames: the union of the current extent and the eased one,
+ * so whatever is there now is always in the picture; the box grows at once and only
+ * shrinks eased (a video neither shakes nor cuts a falling body off). Another world,
+ * or the same one started again, starts afresh. */
+static void follow_box(wb_renderer *r, const wb_world *w, const box *cur)
+{
+    int64_t frame = wb_world_frame(w);
+    if (!r->have_box || w != r->box_world || frame < r->box_frame) {
+        memcpy(r->view_lo, cur->lo, sizeof r->view_lo);
+        memcpy(r->view_hi, cur->hi, sizeof r->view_hi);
+        r->have_box = true;
+    } else {
+        for (int k = 0; k < 3; k++) {
+            r->view_lo[k] = fmin(cur->lo[k], r->view_lo[k] + box_shrink * (cur->lo[k] - r->view_lo[k]));
+            r->view_hi[k] = fmax(cur->hi[k], r->view_hi[k] + box_shrink * (cur->hi[k] - r->view_hi[k]));
+        }
+    }
+    r->box_world = w;
+    r->box_frame = frame;
+}
+
+bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, const wb_draw_skin *skins,
+                      int nskins, char *err, size_t n)
+{
+    /* camera and extent */
+    box cur = scene_box(w);
+    follow_box(r, w, &cur);
+    if (r->fixed) {
+        memcpy(r->cam_eye, r->eye, sizeof r->eye);
+        memcpy(r->cam_target, r->target, sizeof r->target);
+        memcpy(r->cam_up, r->up, sizeof r->up);
+        r->cam_fov = r->fov;
+    } else {
+        frame_box(r, r->view_lo, r->view_hi);
+    }
+    double c[3], R = 0;
+    for (int k = 0; k < 3; k++) {
+        double lo = fmin(cur.lo[k], r->view_lo[k]), hi = fmax(cur.hi[k], r->view_hi[k]);
+        c[k] = 0.5 * (lo + hi);
+        R += 0.25 * (hi - lo) * (hi - lo);
+    }
+    R = fmax(sqrt(R), 1e-3);
+    double ext = 4 * R, to_c[3] = { c[0] - r->cam_eye[0], c[1] - r->cam_eye[1], c[2] - r->cam_eye[2] };
+    double dc = sqrt(dot3(to_c, to_c)), zf = dc + 2 * ext, zn = fmax(zf * 2e-4, 0.5 * (dc - 1.5 * R));
+    double view[16], proj[16];
+    look_at(r->cam_eye, r->cam_target, r->cam_up, view);
+    perspective(r->cam_fov, (double)r->w / r->h, zn, zf, proj);
+    mat_mul(proj, view, r->vp);
+    r->drawn = true;
+    if (!r->be->gl) {
+        background_cpu(r);
+        return true;
+    }
+    if (!r->be->make_current(r->ctx)) {
+        snprintf(err, n, "cannot make the renderer's GL context current");
+        return false;
+    }
+
+    /* layers */
+    wb_layers *l = &r->layers;
+    if (!o->skins) nskins = 0;
+    if (!wb_layers_build(l, w, o, skins, nskins, R)) {
+        snprintf(err, n, "out of memory drawing %d particles", (int)wb_particle_count(w));
+        return false;
+    }
+    wb_gl *g = &r->gl;
+    size_t ninst = l->first[WB_G_COUNT - 1] + l->count[WB_G_COUNT - 1];
+    wb_gl_upload(GL_ARRAY_BUFFER, g->vbo_inst, &g->inst_cap, l->inst, ninst * sizeof *l->inst);
+    bool surfaces = l->surfaces && l->nidx > 0;
+    if (surfaces) {
+        wb_gl_upload(GL_ARRAY_BUFFER, g->vbo_surf, &g->surf_cap, l->sv, WB_SV * l->nv * sizeof *l->sv);
+        glBindVertexArray(g->vao_surf);
+        wb_gl_upload(GL_ELEMENT_ARRAY_BUFFER, g->ebo_surf, &g->surf_idx_cap, l->si, l->nidx * sizeof *l->si);
+        glBindVertexArray(g->vao_surf);   /* growing re-specified the buffers: bind them again */
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g->ebo_surf);
+        wb_gl_surf_attribs(g);
+    }
+    size_t nseg = l->nseg;
+    if (nseg) wb_gl_upload(GL_ARRAY_BUFFER, g->vbo_seg, &g->seg_cap, l->seg, nseg * sizeof *l->seg);
+
+    /* the shadow map: an orthographic view along the light over the scene's sphere */
+    double L[3] = { light_dir[0], light_dir[1], light_dir[2] }, lvp[16], lview[16], lproj[16];
+    norm3(L);
+    double leye[3] = { c[0] + 2 * R * L[0], c[1] + 2 * R * L[1], c[2] + 2 * R * L[2] }, lup[3] = { 0, 1, 0 };
+    if (fabs(L[1]) > 0.99) lup[1] = 0, lup[2] = 1;
+    look_at(leye, c, lup, lview);
+    ortho(R, 0.01 * R, 4 * R, lproj);
+    mat_mul(lproj, lview, lvp);
+    double bias = 3 * R / g->shadow_size;   /* normal offset: a few texels against acne */
+    glBindFramebuffer(GL_FRAMEBUFFER, g->fbo_shadow);
+    glViewport(0, 0, g->shadow_size, g->shadow_size);
+    glEnable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(2, 4);
+    glUseProgram(g->prog_depth);
+    set_mat(g->prog_depth, "u_vp", lvp);
+    draw_meshes(r);
+    if (surfaces) draw_surfaces(r);
+    glDisable(GL_POLYGON_OFFSET_FILL);
+
+    /* the picture */
+    glBindFramebuffer(GL_FRAMEBUFFER, g->fbo_ms);
+    glViewport(0, 0, r->w, r->h);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, g->tex_shadow);
+
+    /* the ground: every plane collider, or a floor under the scene */
+    light_uniforms(g->prog_grid, r->vp, lvp, r->cam_eye, L, bias, true);
+    glUniform3f(glGetUniformLocation(g->prog_grid, "u_top"), col_sky_top[0], col_sky_top[1], col_sky_top[2]);
+    glUniform3f(glGetUniformLocation(g->prog_grid, "u_bottom"), col_sky_bottom[0], col_sky_bottom[1], col_sky_bottom[2]);
+    glUniform1f(glGetUniformLocation(g->prog_grid, "u_height"), (float)r->h);
+    double spacing = wb_nice_step(R / 6), center[3], gu[3], gv[3], gn[3];
+    float quad[12];
+    int planes = 0;
+    int32_t nc = wb_collider_count(w);
+    for (int32_t i = 0; i < nc && (o->colliders || o->grid); i++) {
+        wb_collider_def d;
+        wb_collider_get_def(w, wb_collider_at(w, i), &d);
+        double h;
+        if (d.shape != WB_SHAPE_PLANE || !(o->colliders || (o->grid && floor_height(&d, &h)))) continue;
+        if (plane_quad(d.normal, d.offset, c, ext, quad, center, gu, gv, gn)) {
+            draw_grid(r, quad, center, gu, gv, gn, spacing, ext);
+            planes++;
+        }
+    }
+    if (!planes && o->grid) {
+        wb_real up[3] = { 0, 1, 0 };
+        if (plane_quad(up, fmin(cur.lo[1], r->view_lo[1]), c, ext, quad, center, gu, gv, gn))
+            draw_grid(r, quad, center, gu, gv, gn, spacing, ext);
+    }
+
+    /* solids, then the surfaces pushed back a little so links on them stay visible */
+    light_uniforms(g->prog_mesh, r->vp, lvp, r->cam_eye, L, bias, true);
+    glUniform1i(glGetUniformLocation(g->prog_mesh, "u_two_sided"), 0);
+    draw_meshes(r);
+    if (surfaces) {
+        glUniform1i(glGetUniformLocation(g->prog_mesh, "u_two_sided"), 1);
+        glEnable(GL_POLYGON_OFFSET_FILL);
+        glPolygonOffset(1, 2);
+        draw_surfaces(r);
+        glDisable(GL_POLYGON_OFFSET_FILL);
+    }
+    if (nseg) {
+        glUseProgram(g->prog_line);
+        set_mat(g->prog_line, "u_vp", r->vp);
+        glUniform2f(glGetUniformLocation(g->prog_line, "u_half"), 0.5f * r->w, 0.5f * r->h);
+        glUniform1f(glGetUniformLocation(g->prog_line, "u_width"), (float)(o->line_width * fmax(r->h / 720.0, 0.5)));
+        glBindVertexArray(g->vao_line);
+        glDrawArraysInstanced(GL_TRIANGLES, 0, 6, (GLsizei)nseg);
+    }
+    /* the sky last, behind everything: only uncovered pixels pass the depth test */
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
+    glUseProgram(g->prog_bg);
+    glUniform3f(glGetUniformLocation(g->prog_bg, "u_top"), col_sky_top[0], col_sky_top[1], col_sky_top[2]);
+    glUniform3f(glGetUniformLocation(g->prog_bg, "u_bottom"), col_sky_bottom[0], col_sky_bottom[1], col_sky_bottom[2]);
+    glBindVertexArray(g->vao_empty);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+
+    /* resolve into the backend's buffer and keep the frame */
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, g->fbo_ms);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    glBlitFramebuffer(0, 0, r->w, r->h, 0, 0, r->w, r->h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glBindVertexArray(0);
+    glFinish();
+    GLenum e = glGetError();
+    if (e != GL_NO_ERROR) {
+        snprintf(err, n, "OpenGL error 0x%04x while drawing", (unsigned)e);
+        return false;
+    }
+    const uint8_t *px = r->be->pixels(r->ctx);
+    size_t npx = (size_t)r->w * r->h;
+    for (size_t i = 0; i < npx; i++) memcpy(r->rgb + 3 * i, px + 4 * i, 3);
+    return true;
+}

@@ -1,0 +1,168 @@
+/* render.h: rendering and media (DESIGN §3, issue 4). Not part of the core: the
+ * renderer reads a world through the public API of wobble.h only.
+ *
+ *   wb_renderer   an OpenGL 3.3 core pipeline (render.c, gl.c) behind a
+ *                 backend that only makes a context (osmesa.c; null.c
+ *                 for tests that need no pixels)
+ *   wb_image_*    PNG files (media.c, stb_image_write)
+ *   wb_recorder   MP4 / GIF through the ffmpeg program, or a folder of PNGs
+ *   wb_media_*    facts and frames of a video through ffprobe / ffmpeg (probe.c)
+ *   wb_plot       energy / strain charts as PNG (plot.c)
+ *
+ * Images are RGB8, top row first, stride width*3. Errors: functions that can fail
+ * return false (or NULL) and write a message into err[n]. */
+#ifndef WB_RENDER_H
+#define WB_RENDER_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <sys/types.h>
+
+#include "wobble.h"
+
+#define WB_RENDER_MAX_SIZE 8192   /* width and height */
+
+/* ---- backends: context creation only ------------------------------------------- */
+typedef struct wb_backend {
+    const char *name;
+    bool gl;   /* false: no GL at all (the null backend): frames are the background */
+    /* a current GL 3.3 core context with a w x h RGBA8 default framebuffer */
+    void *(*create)(int w, int h, char *err, size_t n);
+    bool (*make_current)(void *ctx);
+    /* after glFinish: the default framebuffer, RGBA8, top row first (stride w*4) */
+    const uint8_t *(*pixels)(void *ctx);
+    void (*destroy)(void *ctx);
+} wb_backend;
+
+extern const wb_backend wb_backend_osmesa;
+extern const wb_backend wb_backend_null;
+const wb_backend *wb_backend_find(const char *name);   /* "osmesa", "null"; NULL when unknown */
+
+/* ---- the renderer ----------------------------------------------------------------- */
+typedef struct wb_renderer wb_renderer;
+
+typedef struct wb_draw_opts {
+    bool particles, constraints, colliders, surfaces, skins, pins, grid;
+    bool cage;             /* also the particles, links and surfaces a drawn skin covers */
+    double strain_scale;   /* |strain| drawn fully red (tension) / blue (compression) */
+    double line_width;     /* pixels at 720 rows; scaled with the height */
+} wb_draw_opts;
+
+/* every layer on but the cage, strain_scale 0.02, line_width 1.5 */
+wb_draw_opts wb_draw_default_opts(void);
+
+wb_renderer *wb_renderer_create(const wb_backend *be, int width, int height, int samples, char *err, size_t n);
+void wb_renderer_destroy(wb_renderer *r);
+/* about how many bytes such a renderer's buffers take (its frame, the backend's, the
+ * multisample target, the shadow map), for a memory budget */
+size_t wb_renderer_bytes(const wb_backend *be, int width, int height, int samples);
+void wb_renderer_size(const wb_renderer *r, int *width, int *height);
+int wb_renderer_samples(const wb_renderer *r);            /* MSAA samples in use (1 = none) */
+const char *wb_renderer_info(const wb_renderer *r);       /* "OpenGL 4.5 (Core Profile) Mesa ..., llvmpipe" */
+/* a fixed camera (fov: vertical, degrees); wb_renderer_auto_camera goes back to the
+ * default, which keeps all of the world drawn in the frame: its box grows with the
+ * scene at once and shrinks eased; drawing another world (or the same one restarted,
+ * its frame count lower) frames afresh */
+void wb_renderer_camera(wb_renderer *r, const double eye[3], const double target[3], const double up[3], double fov);
+void wb_renderer_auto_camera(wb_renderer *r);
+/* a skinned mesh to draw with the world (the skins belong to the Lua side): deformed
+ * vertices and normals (nv x 3), triangles (nt x 3), the skin */
+typedef struct wb_draw_skin {
+    const wb_real *v, *n;
+    const int32_t *tri;
+    int32_t nv, nt;
+    const wb_skin *skin;   /* the particles it is bound to are hidden unless opts.cage; may be NULL */
+} wb_draw_skin;
+bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, const wb_draw_skin *skins,
+                      int nskins, char *err, size_t n);
+const uint8_t *wb_renderer_pixels(const wb_renderer *r);  /* the last frame, RGB */
+/* world point -> pixel coordinates of the last frame (x right, y down, pixel (i,j)
+ * covers [i,i+1) x [j,j+1)); false when behind the camera or nothing drawn yet */
+bool wb_renderer_project(const wb_renderer *r, const double p[3], double *x, double *y, double *depth);
+/* the camera of the last frame */
+void wb_renderer_get_camera(const wb_renderer *r, double eye[3], double target[3], double up[3], double *fov);
+
+/* ---- images ------------------------------------------------------------------------ */
+bool wb_image_write_png(const char *path, const uint8_t *rgb, int w, int h, char *err, size_t n);
+/* RGB8 pixels of a PNG (malloc'd, free()), NULL with a message */
+uint8_t *wb_image_read_png(const char *path, int *w, int *h, char *err, size_t n);
+
+/* ---- recording ---------------------------------------------------------------------- */
+typedef enum wb_media { WB_MEDIA_NONE = 0, WB_MEDIA_MP4, WB_MEDIA_GIF, WB_MEDIA_FOLDER } wb_media;
+typedef struct wb_recorder wb_recorder;
+
+/* what a name records to, decided by the name the user gave (a symlink's target may be
+ * called anything): .mp4 (H.264), .gif, a folder (ends in '/', has no extension, or
+ * `path`, where the name resolves to (NULL: the name itself), exists as one);
+ * WB_MEDIA_NONE with a message for anything else */
+wb_media wb_media_of(const char *given, const char *path, char *err, size_t n);
+/* record `kind` (from wb_media_of) to path: the destination is checked (writable) now,
+ * the encoder starts with the first frame. A file made here is removed again when no
+ * frame comes; a file that was there is never removed. */
+wb_recorder *wb_recorder_open(const char *path, wb_media kind, int w, int h, char *err, size_t n);
+/* about how many bytes a recording of w x h frames holds (the queued frames) */
+size_t wb_recorder_bytes(int w, int h);
+/* frames per second of the file; settable until the first frame (default 60) */
+void wb_recorder_set_fps(wb_recorder *rec, double fps);
+bool wb_recorder_started(const wb_recorder *rec);
+/* queue one frame (copied): encoding runs on a thread while the caller simulates */
+bool wb_recorder_add(wb_recorder *rec, const uint8_t *rgb, char *err, size_t n);
+int64_t wb_recorder_frames(const wb_recorder *rec);
+const char *wb_recorder_path(const wb_recorder *rec);
+/* finish the file (waits for the encoder, checks its exit status) and free rec;
+ * false with a message when anything failed on the way. NULL is fine. */
+bool wb_recorder_close(wb_recorder *rec, char *err, size_t n);
+
+/* media facts through ffprobe (or the PNG header): frames, size, codec, duration in
+ * seconds as players will see it (0 for a PNG) */
+typedef struct wb_media_info {
+    int width, height;
+    int64_t frames;
+    double duration;
+    char codec[32], pix_fmt[32];
+} wb_media_info;
+bool wb_media_probe(const char *path, wb_media_info *info, char *err, size_t n);
+/* frame `index` (0 first) of a video decoded by ffmpeg: RGB8, top row first (malloc'd,
+ * free()), NULL with a message. For tests that compare a file with what was drawn. */
+uint8_t *wb_media_read_frame(const char *path, int64_t index, int *w, int *h, char *err, size_t n);
+
+/* start prog (found through PATH) with argv, its stdin, stdout and stderr the
+ * descriptors fds[0..2] (-1: /dev/null) and no other descriptor of ours; SIGPIPE
+ * default, no signal blocked; in a process group of its own when `group`. Returns 0
+ * or an errno (ENOENT: no such program). probe.c; the recorder uses it too. */
+int wb_spawn(const char *prog, const char *const argv[], const int fds[3], bool group, pid_t *pid);
+
+/* ---- plots --------------------------------------------------------------------------- */
+typedef struct wb_plot wb_plot;
+wb_plot *wb_plot_create(void);
+void wb_plot_destroy(wb_plot *p);
+bool wb_plot_sample(wb_plot *p, const wb_world *w);   /* false: out of memory */
+int64_t wb_plot_samples(const wb_plot *p);
+/* chart of kinetic, potential and total energy, maximum strain and constraint
+ * error (RMS |length - rest|) over time, as a w x h RGB image (malloc'd) */
+uint8_t *wb_plot_render(const wb_plot *p, int w, int h, const char *title);
+
+/* a round step near x > 0: 1, 2 or 5 times a power of ten (axis ticks, grid lines) */
+double wb_nice_step(double x);
+
+/* draw text into an RGB image with stb_easy_font (scale 1 = about 6 x 11 pixels) */
+void wb_text(uint8_t *rgb, int w, int h, int x, int y, const char *s, const uint8_t colour[3], int scale);
+int wb_text_width(const char *s, int scale);
+
+/* ---- the Lua side (lua/renderer.c, lua/plot.c) --------------------------------------- */
+typedef struct lua_State lua_State;
+void wbl_open_renderer(lua_State *L);   /* wobble.renderer, probe, read_png, read_frame, clock */
+/* `wobble run --record OUT`: every frame any w:run / w:step makes is drawn (default
+ * camera, every layer) and added to OUT, a path of the user's choice */
+bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n);
+bool wbl_record_end(lua_State *L, char *err, size_t n);   /* finish the file; prints where it went */
+/* w:run{plot = path}: push a plot sampler for the path in field `key` of the options
+ * at `opts` (nil when absent; the path is checked through the sandbox now, and the
+ * world's state sampled); sample after each frame; write the PNG when the run ends */
+void wbl_open_plot(lua_State *L);   /* called by wbl_open_renderer */
+void wbl_plot_push(lua_State *L, int opts, const char *key, int world);
+void wbl_plot_frame(lua_State *L, int plot, int world);
+void wbl_plot_finish(lua_State *L, int plot);
+
+#endif
