@@ -166,10 +166,21 @@ static const char *display(const wb_sandbox *sb, const char *path) {
     return path;
 }
 
+/* A file name must be a string. The io library would turn a number into a name itself,
+ * after a check that only looked at strings (io.output(4242) made ./4242 anywhere), and
+ * a zero byte would cut the name the rules see short of the name the caller meant. */
+static const char *name_arg(lua_State *L, int arg) {
+    size_t len;
+    if (lua_type(L, arg) != LUA_TSTRING) luaL_typeerror(L, arg, "file name (a string)");
+    const char *s = lua_tolstring(L, arg, &len);
+    if (strlen(s) != len) luaL_argerror(L, arg, "file name contains a zero byte");
+    return s;
+}
+
 /* replace the path argument at arg by its resolved form, or raise the rule's message */
 static void check_arg(lua_State *L, int arg, int write) {
     char buf[PATH_MAX];
-    const char *err, *p = wb_sandbox_path(L, luaL_checkstring(L, arg), write, buf, sizeof buf, &err);
+    const char *err, *p = wb_sandbox_path(L, name_arg(L, arg), write, buf, sizeof buf, &err);
     if (!p) luaL_error(L, "%s", err);
     lua_pushstring(L, p);
     lua_replace(L, arg);
@@ -190,18 +201,24 @@ static int sb_io_open(lua_State *L) {
     return call_original(L);
 }
 
-static int sb_read_arg1(lua_State *L) {  /* io.lines, io.input: a file name is read */
-    if (lua_type(L, 1) == LUA_TSTRING) check_arg(L, 1, 0);
+static int sb_io_lines(lua_State *L) {  /* io.lines(): the default input; else a file name, read */
+    if (!lua_isnoneornil(L, 1)) check_arg(L, 1, 0);
     return call_original(L);
 }
+
+/* io.input / io.output: nothing (the current file), a file name, or an open file handle */
+static int handle_or_name(lua_State *L, int write) {
+    if (lua_isnoneornil(L, 1) || luaL_testudata(L, 1, LUA_FILEHANDLE)) return call_original(L);
+    if (lua_type(L, 1) != LUA_TSTRING) luaL_typeerror(L, 1, "file name or file handle");
+    check_arg(L, 1, write);
+    return call_original(L);
+}
+
+static int sb_io_input(lua_State *L) { return handle_or_name(L, 0); }
+static int sb_io_output(lua_State *L) { return handle_or_name(L, 1); }
 
 static int sb_os_remove(lua_State *L) {
     check_arg(L, 1, 1);
-    return call_original(L);
-}
-
-static int sb_io_output(lua_State *L) {
-    if (lua_type(L, 1) == LUA_TSTRING) check_arg(L, 1, 1);
     return call_original(L);
 }
 
@@ -250,9 +267,20 @@ static int load_text(lua_State *L, const char *path) {
     if (ch == '#') {
         while ((ch = getc(r.f)) != EOF && ch != '\n') {}
         r.pending = ch == '\n';
-    } else if (ch != EOF) {
-        ungetc(ch, r.f);
+        ch = ch == EOF ? EOF : getc(r.f);
     }
+    /* a precompiled chunk (after a "#!" line too, as lua's own loadfile reads it) is
+     * bytecode, which the VM does not verify: refused in the sandbox, named here */
+    if (ch == LUA_SIGNATURE[0]) {
+        r.pending = 0;
+        if (!sb->unsafe) {
+            fclose(r.f);
+            lua_pushfstring(L, "cannot load %s: it is a precompiled (binary) chunk, not allowed in the sandbox "
+                               "(--unsafe allows it)", display(sb, path));
+            return LUA_ERRSYNTAX;
+        }
+    }
+    if (ch != EOF) ungetc(ch, r.f);
     lua_pushfstring(L, "@%s", display(sb, path));
     int status = lua_load(L, read_file, &r, lua_tostring(L, -1), sb->unsafe ? NULL : "t");
     lua_remove(L, -2);
@@ -363,8 +391,8 @@ static void open_paths(lua_State *L) {
     lua_setfield(L, -2, "dofile");
     lua_getfield(L, -1, "io");
     wrap(L, -1, "open", sb_io_open);
-    wrap(L, -1, "lines", sb_read_arg1);
-    wrap(L, -1, "input", sb_read_arg1);
+    wrap(L, -1, "lines", sb_io_lines);
+    wrap(L, -1, "input", sb_io_input);
     wrap(L, -1, "output", sb_io_output);
     lua_pop(L, 1);
     lua_getfield(L, -1, "os");

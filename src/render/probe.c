@@ -72,10 +72,57 @@ static const char *tool(const char *env, const char *dflt)
     return p && *p ? p : dflt;
 }
 
-/* "file:" so neither a leading '-' nor a colon in the name means something else */
+/* "file:" so neither a leading '-' nor a colon in the name means something else
+ * ("concat:", "subfile:", "http:" name a file of that name, nothing more) */
 static void ff_input(char *in, size_t n, const char *path)
 {
     snprintf(in, n, "file:%s%s", path[0] == '/' ? "" : "./", path);
+}
+
+/* The demuxer ffmpeg / ffprobe must use for a file, chosen here from its first bytes,
+ * never by ffmpeg's own guess and never from its name: ffmpeg would also take formats
+ * that open other files (HLS and DASH playlists, ffconcat lists, image2 name patterns,
+ * tee, ...), files the sandbox never saw, whatever the name says. Only plain
+ * containers that hold their own frames are let through. NULL, and err set: refused. */
+static const char *demuxer_of(const char *path, char *err, size_t n)
+{
+    unsigned char b[16] = { 0 };
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, n, "cannot read %s: %s", path, strerror(errno));
+        return NULL;
+    }
+    size_t got = fread(b, 1, sizeof b, f);
+    fclose(f);
+    static const char *const boxes[] = { "ftyp", "moov", "mdat", "free", "skip", "wide" };  /* ISO BMFF */
+    if (got >= 8 && !memcmp(b, "\x89PNG\r\n\x1a\n", 8)) return "png_pipe";   /* one image, no name pattern */
+    if (got >= 6 && (!memcmp(b, "GIF87a", 6) || !memcmp(b, "GIF89a", 6))) return "gif";
+    if (got >= 4 && !memcmp(b, "\x1a\x45\xdf\xa3", 4)) return "matroska";     /* and webm */
+    if (got >= 12 && !memcmp(b, "RIFF", 4) && !memcmp(b + 8, "AVI ", 4)) return "avi";
+    for (size_t i = 0; got >= 8 && i < sizeof boxes / sizeof *boxes; i++)
+        if (!memcmp(b + 4, boxes[i], 4)) return "mov";                          /* mp4, mov, m4v */
+    const char *what = got >= 7 && !memcmp(b, "#EXTM3U", 7) ? " (an HLS playlist)"
+                       : got >= 8 && !memcmp(b, "ffconcat", 8) ? " (an ffconcat list)"
+                       : got >= 1 && b[0] == '<' ? " (XML: a DASH manifest or the like)" : "";
+    snprintf(err, n, "%s is not a media file wobble reads%s: only mp4/mov, gif, png, mkv/webm and avi, known by "
+             "their contents; playlists and lists naming other files are refused", path, what);
+    return NULL;
+}
+
+/* the input's options: the demuxer demuxer_of chose, the file protocol only, and no
+ * external tracks ("drefs") in a mov; ffmpeg refuses an option its demuxer lacks, so
+ * that one goes to mov alone. Appends at argv[a], returns the new count. */
+static int input_args(const char **argv, int a, const char *fmt, const char *in)
+{
+    const char *head[] = { "-protocol_whitelist", "file", "-f", fmt };
+    for (size_t k = 0; k < sizeof head / sizeof *head; k++) argv[a++] = head[k];
+    if (!strcmp(fmt, "mov")) {
+        argv[a++] = "-enable_drefs";
+        argv[a++] = "0";
+    }
+    argv[a++] = "-i";
+    argv[a++] = in;
+    return a;
 }
 
 bool wb_media_probe(const char *path, wb_media_info *info, char *err, size_t n)
@@ -93,16 +140,17 @@ bool wb_media_probe(const char *path, wb_media_info *info, char *err, size_t n)
         snprintf(info->pix_fmt, sizeof info->pix_fmt, comp == 4 ? "rgba" : comp == 3 ? "rgb24" : "gray");
         return true;
     }
-    if (access(path, R_OK) != 0) {
-        snprintf(err, n, "cannot read %s: %s", path, strerror(errno));
-        return false;
-    }
+    const char *fmt = demuxer_of(path, err, n);
+    if (!fmt) return false;
     const char *prog = tool("WOBBLE_FFPROBE", "ffprobe");
     char in[PATH_MAX + 16];
     ff_input(in, sizeof in, path);
-    const char *argv[] = { prog, "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+    const char *argv[32] = { prog, "-v", "error" };
+    int a = input_args(argv, 3, fmt, in);
+    const char *tail[] = { "-count_frames", "-select_streams", "v:0", "-show_entries",
                            "stream=width,height,codec_name,pix_fmt,nb_read_frames:format=duration", "-of",
-                           "default=noprint_wrappers=1", in, NULL };
+                           "default=noprint_wrappers=1", NULL };
+    for (size_t k = 0; k < sizeof tail / sizeof *tail; k++) argv[a++] = tail[k];
     size_t len;
     bool ok;
     char *out = capture(argv, 65536, &len, &ok, err, n);
@@ -130,17 +178,18 @@ bool wb_media_probe(const char *path, wb_media_info *info, char *err, size_t n)
 
 uint8_t *wb_media_read_frame(const char *path, int64_t index, int *w, int *h, char *err, size_t n)
 {
-    if (access(path, R_OK) != 0) {
-        snprintf(err, n, "cannot read %s: %s", path, strerror(errno));
-        return NULL;
-    }
+    const char *fmt = demuxer_of(path, err, n);
+    if (!fmt) return NULL;
     const char *prog = tool("WOBBLE_FFMPEG", "ffmpeg");
     char in[PATH_MAX + 16], select[64];
     ff_input(in, sizeof in, path);
     snprintf(select, sizeof select, "select=eq(n\\,%lld)", (long long)index);
-    /* the frame as a PNG on stdout: it carries its own size */
-    const char *argv[] = { prog, "-v", "error", "-nostdin", "-i", in, "-vf", select, "-fps_mode", "passthrough",
-                           "-frames:v", "1", "-f", "image2pipe", "-c:v", "png", "pipe:1", NULL };
+    /* the frame as a PNG on stdout: it carries its own size; the input as in probe */
+    const char *argv[32] = { prog, "-v", "error", "-nostdin" };
+    int a = input_args(argv, 4, fmt, in);
+    const char *tail[] = { "-vf", select, "-fps_mode", "passthrough", "-frames:v", "1", "-f", "image2pipe",
+                           "-c:v", "png", "pipe:1", NULL };
+    for (size_t k = 0; k < sizeof tail / sizeof *tail; k++) argv[a++] = tail[k];
     size_t len;
     bool ok;
     char *out = capture(argv, (size_t)1 << 30, &len, &ok, err, n);
