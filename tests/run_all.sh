@@ -4,6 +4,7 @@
 #   (b) wobble test tests/scenarios tests/validation   Lua scenario and validation tests
 #   (c) every scripts/*.lua for 5 frames        one test per example scene (pass = exit 0)
 #   (d) tests/cli/run.sh                        the command line in separate processes
+#       tests/cli/sandbox.sh                    escapes from the file rules, in separate processes
 #   (e) tests/render/run.sh                     wobble run --record, encoders that fail
 #   (f) tests/layers.sh                         the layers of DESIGN §1: no upward call, no circle
 # Each part prints its output and ends with "N passed, N failed"; a part that crashes
@@ -74,6 +75,7 @@ done
 part "scenario and validation tests" "$BUILD/wobble" test --out "$TMP/out-tests" $lua_dirs
 part "example scenes (scripts/*.lua, 5 frames)" examples
 part "command line (tests/cli/run.sh)" sh tests/cli/run.sh "$BUILD"
+part "sandbox escapes (tests/cli/sandbox.sh)" sh tests/cli/sandbox.sh "$BUILD"
 part "recording from the command line (tests/render/run.sh)" sh tests/render/run.sh "$BUILD"
 part "layers (tests/layers.sh)" sh tests/layers.sh "$BUILD"
 

@@ -1,0 +1,142 @@
+#!/bin/sh
+# tests/cli/sandbox.sh BUILD_DIR: escapes from the file rules of DESIGN §4 that need a
+# process of their own: files made in the current folder, --unsafe, a real precompiled
+# chunk (made by string.dump under --unsafe), media that names a file outside the
+# allowed folders. The Lua side is in tests/scenarios/sandbox_escapes.lua.
+# Every run happens in a scratch folder, so nothing can land in the checkout.
+# Last line: "N passed, N failed"; exit status 1 when a check failed.
+BUILD=${1:-build}
+cd "$(dirname "$0")/../.." || exit 2
+case $BUILD in /*) W=$BUILD/wobble ;; *) W=$PWD/$BUILD/wobble ;; esac
+TMP=$(mktemp -d "${TMPDIR:-/tmp}/wobble-sandbox.XXXXXX") || exit 2
+trap 'rm -rf "$TMP"' EXIT INT TERM
+S=$TMP/scene WD=$TMP/work RD=$TMP/read
+mkdir -p "$S" "$WD" "$RD" "$TMP/secret"
+n=0 passed=0 failed=0
+
+# run DIR ARGS...: wobble in folder DIR; stdout in $TMP/out, stderr in $TMP/err, exit code in $code
+run() {
+    dir=$1
+    shift
+    (cd "$dir" && "$W" "$@") >"$TMP/out" 2>"$TMP/err"
+    code=$?
+}
+
+# result NAME WHY: one TAP line; WHY empty means passed
+result() {
+    n=$((n + 1))
+    if [ -z "$2" ]; then
+        passed=$((passed + 1))
+        echo "ok $n - $1"
+    else
+        failed=$((failed + 1))
+        echo "not ok $n - $1"
+        echo "  # $2"
+        head -n 10 "$TMP/out" | sed 's/^/  # stdout: /'
+        head -n 10 "$TMP/err" | sed 's/^/  # stderr: /'
+    fi
+}
+
+# check NAME CODE [STREAM TEXT]...: as in tests/cli/run.sh (!STREAM: must not contain);
+# STREAM "none" names a file that must not exist
+check() {
+    name=$1 want=$2
+    shift 2
+    why=""
+    [ "$code" = "$want" ] || why="exit code $code, expected $want"
+    while [ $# -ge 2 ]; do
+        case $1 in
+        none) if [ -e "$2" ]; then why="${why:+$why; }$2 was created"; fi ;;
+        !*) if grep -qF -- "$2" "$TMP/${1#!}"; then why="${why:+$why; }${1#!} has '$2'"; fi ;;
+        *) if ! grep -qF -- "$2" "$TMP/$1"; then why="${why:+$why; }$1 lacks '$2'"; fi ;;
+        esac
+        shift 2
+    done
+    result "$name" "$why"
+}
+
+# ---- a number as a file name: refused in both modes, nothing made in the current folder
+cat >"$S/number.lua" <<'EOF'
+local calls = {
+  output = function() io.output(4242); io.write("escaped\n"); io.close() end,
+  input = function() io.input(4242); print(io.read("l")) end,
+  lines = function() for l in io.lines(4242) do print(l) end end,
+  open = function() assert(io.open(4242, "w")):write("escaped\n") end,
+  loadfile = function() print(loadfile(4242)) end,
+  dofile = function() dofile(4242) end,
+}
+calls[wobble.args.call]()
+EOF
+printf 'secret-4242\nprint("secret-4242")\n' >"$RD/4242"
+for mode in "" --unsafe; do
+    for call in output open; do
+        run "$WD" run "$S/number.lua" --set call=$call $mode
+        check "io.$call(4242) ${mode:-sandboxed}: refused, no ./4242" 2 \
+            err "bad argument #1 to '$call' (file name" none "$WD/4242" none "$WD/out/4242"
+    done
+    for call in input lines loadfile dofile; do
+        run "$RD" run "$S/number.lua" --set call=$call $mode
+        check "$call(4242) ${mode:-sandboxed}: refused, ./4242 not read" 2 \
+            err "bad argument #1 to '$call' (file name" !out "secret-4242"
+    done
+done
+run "$WD" run "$S/number.lua" --set call=output
+check "the message names the script's line" 2 err "number.lua:2: bad argument #1 to 'output' (file name or file handle expected, got number)"
+
+# ---- precompiled chunks in files: refused in the sandbox, run with --unsafe
+cat >"$S/dump.lua" <<'EOF'
+local f = assert(io.open("chunk.luac", "wb"))
+f:write(string.dump(function() return 6 * 7 end))
+f:close()
+EOF
+cat >"$S/bin.lua" <<'EOF'
+local how, name = wobble.args.how, wobble.args.name
+local r
+if how == "loadfile" then r = assert(loadfile(name))()
+elseif how == "dofile" then r = dofile(name)
+else r = require((name:gsub("%.lua$", ""))) end
+print("chunk says " .. tostring(r))
+EOF
+run "$WD" run "$S/dump.lua" --unsafe --out "$TMP/dump"
+check "--unsafe: string.dump writes a binary chunk" 0
+head -c 5 "$TMP/dump/chunk.luac" 2>/dev/null | od -An -c | grep -q 'L   u   a'
+result "the chunk starts with ESC Lua" "$([ $? = 0 ] || echo "no binary chunk in $TMP/dump/chunk.luac")"
+cp "$TMP/dump/chunk.luac" "$S/binmod.lua" 2>/dev/null
+{ printf '#!/usr/bin/env wobble\n'; cat "$TMP/dump/chunk.luac"; } >"$S/shebangmod.lua" 2>/dev/null
+for file in binmod.lua shebangmod.lua; do
+    for how in loadfile dofile require; do
+        run "$WD" run "$S/bin.lua" --set how=$how --set name=$file
+        check "$how of a binary chunk ($file) is refused in the sandbox" 2 \
+            err "it is a precompiled (binary) chunk, not allowed in the sandbox (--unsafe allows it)" \
+            err "$file" !out "chunk says"
+        run "$WD" run "$S/bin.lua" --set how=$how --set name=$file --unsafe
+        check "$how of a binary chunk ($file) runs with --unsafe" 0 out "chunk says 42"
+    done
+done
+
+# ---- media naming other files: an HLS playlist (called .mp4) that plays a video kept
+# outside the allowed folders; refused in both modes (ffmpeg is not the sandbox's to lift)
+if ffmpeg -v error -y -f lavfi -i color=red:s=32x32:d=0.2 -pix_fmt yuv420p "$TMP/secret/s.mp4" </dev/null; then
+    cat >"$S/hls.lua" <<'EOF'
+local f = assert(io.open("evil.mp4", "w"))
+f:write("#EXTM3U\n#EXT-X-TARGETDURATION:1\n#EXTINF:1,\n" .. wobble.args.secret .. "\n#EXT-X-ENDLIST\n")
+f:close()
+local w, err = wobble.read_frame("evil.mp4")
+print(w and "LEAK read_frame " .. w or "refused: " .. err)
+local p, perr = wobble.probe("evil.mp4")
+print(p and "LEAK probe " .. p.width or "refused: " .. perr)
+print(wobble.read_frame(wobble.args.secret))
+EOF
+    run "$WD" run "$S/hls.lua" --set secret="$TMP/secret/s.mp4"
+    check "an HLS playlist naming a video outside is refused (the video itself too)" 2 \
+        out "evil.mp4 is not a media file wobble reads (an HLS playlist)" !out "LEAK" \
+        err "hls.lua:8: reading $TMP/secret/s.mp4 is outside the allowed folders"
+    run "$WD" run "$S/hls.lua" --set secret="$TMP/secret/s.mp4" --unsafe
+    check "--unsafe: the playlist is still refused, the video itself reads" 0 \
+        out "evil.mp4 is not a media file wobble reads (an HLS playlist)" !out "LEAK" out "32	32	"
+else
+    result "ffmpeg makes a test video" "ffmpeg failed"
+fi
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
