@@ -323,18 +323,16 @@ static int sb_dofile(lua_State *L) {
     return lua_gettop(L) - 1;
 }
 
-/* require's Lua searcher: package.path, but every candidate must lie in the library
- * folder or a readable folder, and only text is loaded */
-static int sb_searcher(lua_State *L) {
+/* The first file of the template list tpl for name (sep in name replaced by rep) that
+ * exists and that a script may read: the library folder or a readable folder. 1 and c
+ * filled; or 0 with "no file ..." pushed, the same for a refused file as for a missing
+ * one, so the search cannot tell whether a file exists elsewhere. */
+static int find_file(lua_State *L, const char *name, const char *tpl, const char *sep, const char *rep, char *c) {
     wb_sandbox *sb = sb_from(L);
-    const char *name = luaL_checkstring(L, 1);
-    lua_settop(L, 1);
-    lua_getfield(L, lua_upvalueindex(1), "path");           /* 2 */
-    const char *tpl = lua_tostring(L, 2);
-    if (!tpl) return luaL_error(L, "'package.path' must be a string");
-    const char *mod = luaL_gsub(L, name, ".", "/");        /* 3 */
-    lua_pushliteral(L, "");                                 /* 4: files tried */
-    char t[PATH_MAX], full[PATH_MAX], c[PATH_MAX];
+    int top = lua_gettop(L);
+    const char *mod = *sep && strstr(name, sep) ? luaL_gsub(L, name, sep, rep) : name;
+    lua_pushliteral(L, "");  /* files tried */
+    char t[PATH_MAX], full[PATH_MAX];
     for (const char *s = tpl; *s;) {
         const char *start = s, *e = strchr(s, ';');
         size_t len = e ? (size_t)(e - s) : strlen(s);
@@ -342,21 +340,50 @@ static int sb_searcher(lua_State *L) {
         if (len == 0 || len >= PATH_MAX) continue;
         memcpy(t, start, len);
         t[len] = 0;
-        const char *cand = luaL_gsub(L, t, "?", mod);     /* 5 */
-        int ok = join(full, sizeof full, sb->cwd, cand) == 0 && canon(full, c) == 0 && exists(c) &&
-                 (sb->unsafe || may_read(sb, c) || (sb->lib[0] && under(c, sb->lib)));
-        if (ok) {
-            if (load_text(L, c) != LUA_OK)
-                return luaL_error(L, "error loading module '%s' from file '%s':\n\t%s", name, display(sb, c),
-                                  lua_tostring(L, -1));
-            lua_pushstring(L, display(sb, c));
-            return 2;
+        const char *cand = luaL_gsub(L, t, "?", mod);
+        if (join(full, sizeof full, sb->cwd, cand) == 0 && canon(full, c) == 0 && exists(c) &&
+            (sb->unsafe || may_read(sb, c) || (sb->lib[0] && under(c, sb->lib)))) {
+            lua_settop(L, top);
+            return 1;
         }
-        lua_pushfstring(L, "%s%sno file '%s'", lua_tostring(L, 4), *lua_tostring(L, 4) ? "\n\t" : "", cand);
-        lua_replace(L, 4);
+        lua_pushfstring(L, "%s%sno file '%s'", lua_tostring(L, -2), *lua_tostring(L, -2) ? "\n\t" : "", cand);
+        lua_replace(L, -3);
         lua_pop(L, 1);
     }
-    return 1;
+    lua_copy(L, -1, top + 1);  /* below it, maybe, the name with sep replaced */
+    lua_settop(L, top + 1);
+    return 0;
+}
+
+/* require's Lua searcher: package.path through find_file, and only text is loaded */
+static int sb_searcher(lua_State *L) {
+    wb_sandbox *sb = sb_from(L);
+    const char *name = luaL_checkstring(L, 1);
+    char c[PATH_MAX];
+    lua_settop(L, 1);
+    lua_getfield(L, lua_upvalueindex(1), "path");
+    const char *tpl = lua_tostring(L, 2);
+    if (!tpl) return luaL_error(L, "'package.path' must be a string");
+    if (!find_file(L, name, tpl, ".", "/", c)) return 1;
+    if (load_text(L, c) != LUA_OK)
+        return luaL_error(L, "error loading module '%s' from file '%s':\n\t%s", name, display(sb, c),
+                          lua_tostring(L, -1));
+    lua_pushstring(L, display(sb, c));
+    return 2;
+}
+
+/* package.searchpath by the same rules: else it would tell whether any file exists */
+static int sb_searchpath(lua_State *L) {
+    const char *name = luaL_checkstring(L, 1), *tpl = luaL_checkstring(L, 2);
+    const char *sep = luaL_optstring(L, 3, "."), *rep = luaL_optstring(L, 4, "/");
+    char c[PATH_MAX];
+    if (find_file(L, name, tpl, sep, rep, c)) {
+        lua_pushstring(L, display(sb_from(L), c));
+        return 1;
+    }
+    luaL_pushfail(L);
+    lua_insert(L, -2);
+    return 2;
 }
 
 /* replace t[name] by a C closure over the original function */
@@ -430,6 +457,8 @@ static void open_libs(lua_State *L) {
     lua_pop(L, 1);
     lua_getfield(L, -1, "package");
     drop(L, -1, "package", "loadlib");
+    lua_pushcfunction(L, sb_searchpath);
+    lua_setfield(L, -2, "searchpath");
     lua_pushliteral(L, "");
     lua_setfield(L, -2, "cpath");
     lua_createtable(L, 2, 0);  /* searchers: preload, then Lua files through the rules */

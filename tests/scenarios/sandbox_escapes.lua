@@ -97,6 +97,16 @@ test("a precompiled chunk in a file is refused by loadfile and dofile", function
   expect.error(function() assert(load(bin)) end, "attempt to load a binary chunk")
 end)
 
+test("package.searchpath cannot tell whether a file exists outside the allowed folders", function()
+  local f, err = package.searchpath("passwd", "/etc/?")
+  expect.eq(f, nil)
+  expect.eq(err, "no file '/etc/passwd'", "the same answer as for a file that is not there")
+  expect.eq(select(2, package.searchpath("etc.passwd", "/?")), "no file '/etc/passwd'")
+  expect.eq(select(2, package.searchpath("no-such-file", "/etc/?")), "no file '/etc/no-such-file'")
+  -- the library folder is still searched
+  expect.truthy(package.searchpath("wobble.test", package.path):match("wobble/test%.lua$"))
+end)
+
 -- ---- media: ffmpeg / ffprobe read the one file named, nothing it names
 
 local r = wobble.renderer{ width = 16, height = 16, backend = "null" }
