@@ -256,7 +256,8 @@ static const char *read_file(lua_State *L, void *ud, size_t *size) {
     return *size ? r->buf : NULL;
 }
 
-static int load_text(lua_State *L, const char *path) {
+/* mode: what the caller allows ("t", "b", "bt"; NULL: both), narrowed to text in the sandbox */
+static int load_text(lua_State *L, const char *path, const char *mode) {
     wb_sandbox *sb = sb_from(L);
     file_reader r = { fopen(path, "r"), 0, '\n', "" };
     if (!r.f) {
@@ -282,7 +283,8 @@ static int load_text(lua_State *L, const char *path) {
     }
     if (ch != EOF) ungetc(ch, r.f);
     lua_pushfstring(L, "@%s", display(sb, path));
-    int status = lua_load(L, read_file, &r, lua_tostring(L, -1), sb->unsafe ? NULL : "t");
+    if (!mode) mode = "bt";
+    int status = lua_load(L, read_file, &r, lua_tostring(L, -1), sb->unsafe || !strchr(mode, 't') ? mode : "t");
     lua_remove(L, -2);
     fclose(r.f);
     return status;
@@ -292,10 +294,10 @@ static int sb_loadfile(lua_State *L) {
     int env = !lua_isnone(L, 3);
     int status;
     if (lua_isnoneornil(L, 1)) {
-        status = luaL_loadfilex(L, NULL, sb_from(L)->unsafe ? NULL : "t");  /* stdin */
+        status = luaL_loadfilex(L, NULL, sb_from(L)->unsafe ? luaL_optstring(L, 2, NULL) : "t");  /* stdin */
     } else {
         check_arg(L, 1, 0);
-        status = load_text(L, lua_tostring(L, 1));
+        status = load_text(L, lua_tostring(L, 1), luaL_optstring(L, 2, NULL));
     }
     if (status != LUA_OK) {  /* nil, message */
         luaL_pushfail(L);
@@ -316,7 +318,7 @@ static int sb_dofile(lua_State *L) {
         status = luaL_loadfilex(L, NULL, sb_from(L)->unsafe ? NULL : "t");
     } else {
         check_arg(L, 1, 0);
-        status = load_text(L, lua_tostring(L, 1));
+        status = load_text(L, lua_tostring(L, 1), NULL);
     }
     if (status != LUA_OK) return lua_error(L);
     lua_call(L, 0, LUA_MULTRET);
@@ -365,7 +367,7 @@ static int sb_searcher(lua_State *L) {
     const char *tpl = lua_tostring(L, 2);
     if (!tpl) return luaL_error(L, "'package.path' must be a string");
     if (!find_file(L, name, tpl, ".", "/", c)) return 1;
-    if (load_text(L, c) != LUA_OK)
+    if (load_text(L, c, NULL) != LUA_OK)
         return luaL_error(L, "error loading module '%s' from file '%s':\n\t%s", name, display(sb, c),
                           lua_tostring(L, -1));
     lua_pushstring(L, display(sb, c));

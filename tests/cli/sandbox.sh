@@ -93,6 +93,7 @@ cat >"$S/bin.lua" <<'EOF'
 local how, name = wobble.args.how, wobble.args.name
 local r
 if how == "loadfile" then r = assert(loadfile(name))()
+elseif how == "loadfile_t" then r = assert(loadfile(name, "t"))()
 elseif how == "dofile" then r = dofile(name)
 else r = require((name:gsub("%.lua$", ""))) end
 print("chunk says " .. tostring(r))
@@ -113,6 +114,8 @@ for file in binmod.lua shebangmod.lua; do
         check "$how of a binary chunk ($file) runs with --unsafe" 0 out "chunk says 42"
     done
 done
+run "$WD" run "$S/bin.lua" --set how=loadfile_t --set name=binmod.lua --unsafe
+check "--unsafe: loadfile(name, 't') still refuses a binary chunk" 2 err "attempt to load a binary chunk (mode is 't')"
 
 # ---- media naming other files: an HLS playlist (called .mp4) that plays a video kept
 # outside the allowed folders; refused in both modes (ffmpeg is not the sandbox's to lift)

@@ -97,6 +97,14 @@ test("a precompiled chunk in a file is refused by loadfile and dofile", function
   expect.error(function() assert(load(bin)) end, "attempt to load a binary chunk")
 end)
 
+test("loadfile keeps the mode it is given: 'b' loads no text", function()
+  write("text.lua", "return 1\n")
+  local f, err = loadfile(D .. "text.lua", "b")
+  expect.eq(f, nil)
+  expect.truthy(err:find("attempt to load a text chunk (mode is 'b')", 1, true), err)
+  expect.eq(loadfile(D .. "text.lua", "t")(), 1)
+end)
+
 test("package.searchpath cannot tell whether a file exists outside the allowed folders", function()
   local f, err = package.searchpath("passwd", "/etc/?")
   expect.eq(f, nil)
