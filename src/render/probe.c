@@ -93,7 +93,12 @@ static const char *demuxer_of(const char *path, char *err, size_t n)
         return NULL;
     }
     size_t got = fread(b, 1, sizeof b, f);
+    int bad = got < sizeof b && ferror(f) ? errno : 0;  /* a folder: EISDIR */
     fclose(f);
+    if (bad) {
+        snprintf(err, n, "cannot read %s: %s", path, strerror(bad));
+        return NULL;
+    }
     static const char *const boxes[] = { "ftyp", "moov", "mdat", "free", "skip", "wide" };  /* ISO BMFF */
     if (got >= 8 && !memcmp(b, "\x89PNG\r\n\x1a\n", 8)) return "png_pipe";   /* one image, no name pattern */
     if (got >= 6 && (!memcmp(b, "GIF87a", 6) || !memcmp(b, "GIF89a", 6))) return "gif";

@@ -160,6 +160,13 @@ test("a playlist or list naming another file is refused, whatever its name", fun
   end
 end)
 
+test("a folder is not a video", function()
+  local w, err = wobble.read_frame("sandbox_escapes")
+  expect.eq(w, nil)
+  expect.truthy(err:find("cannot read .*sandbox_escapes: Is a directory"), err)
+  expect.eq(wobble.probe("sandbox_escapes"), nil)
+end)
+
 test("protocols in a name are only a name", function()
   record("concat:clip.mp4", 2)  -- a file of that name: read as the file it is
   expect.eq(wobble.read_frame(D .. "concat:clip.mp4"), 16)
