@@ -114,6 +114,26 @@ code=0
 check "README: the set-up's first command, as root, installs make and git" 0 \
     out "apt-get install -y make git"
 
+# ---- the README's first scene, as printed, does what the README says: the cloth drapes
+# over the sphere (some of it rests on the sphere's top), it does not slide off
+awk 'on && /^```/ {exit} on {print} prev == "```lua" && $0 == "-- drape.lua" {on = 1; print} {prev = $0}' \
+    README.md >"$TMP/drape.lua"
+cat >>"$TMP/drape.lua" <<'LUA'
+test("the cloth rests on the sphere's top", function()
+  local on_top = 0
+  for _, p in ipairs(cloth.particles) do
+    local x, y, z = w:position(p)
+    local above = math.sqrt(x * x + (y - 0.5) ^ 2 + z * z) - 0.4
+    if x * x + z * z < 0.2 ^ 2 and y > 0.5 and above < 0.05 then on_top = on_top + 1 end
+  end
+  expect.gt(on_top, 10, "particles of the cloth lying on the sphere's top")
+end)
+LUA
+"$W" test "$TMP/drape.lua" --quiet --out "$TMP/drape-out" >"$TMP/out" 2>"$TMP/err"
+code=$?
+[ "$(grep -c . "$TMP/drape.lua")" -ge 15 ] || code="$code (the README's drape.lua was not found)"
+check "README: the first scene drapes the cloth over the sphere" 0 out "1 passed, 0 failed"
+
 # ---- wobble bench --frames N: every benchmark scene runs N frames
 "$W" bench --frames 2 --json --quiet --time-limit 300 --out "$TMP/bench" >"$TMP/out" 2>"$TMP/err"
 code=$?
