@@ -41,13 +41,22 @@ check-deps:
 	@if command -v dpkg-query >/dev/null 2>&1; then $(MISSING); [ -z "$$missing" ]; \
 	else pkg-config --exists $(PCMODS) 2>/dev/null; fi || $(MAKE) --no-print-directory deps
 
+# apt's output (about 1,400 lines for a fresh system) goes to $(DEPS_LOG), shown when it
+# fails; without root and without sudo it says what to run instead
+DEPS_LOG = $(BUILD)/deps.log
 deps:
 	@$(MISSING); \
-	if [ -n "$$missing" ]; then \
-	  echo "installing Debian packages:$$missing"; \
-	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
-	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $$missing; \
-	else echo "all Debian packages present"; fi
+	if [ -z "$$missing" ]; then echo "all Debian packages present"; exit 0; fi; \
+	if [ "$$(id -u)" = 0 ]; then SUDO=; \
+	elif command -v sudo >/dev/null 2>&1; then SUDO=sudo; \
+	else echo "wobble needs these Debian packages:$$missing" >&2; \
+	  echo "run as root (su -), then make again: apt-get update && apt-get install -y$$missing" >&2; exit 1; fi; \
+	mkdir -p $(BUILD) && : >$(DEPS_LOG); \
+	echo "installing Debian packages:$$missing (apt-get's output: $(DEPS_LOG))"; \
+	if $$SUDO apt-get update -qq >>$(DEPS_LOG) 2>&1 && \
+	  $$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >>$(DEPS_LOG) 2>&1; then \
+	  echo "installed:$$missing"; \
+	else echo "apt-get failed; the end of its output ($(DEPS_LOG)):" >&2; tail -n 20 $(DEPS_LOG) >&2; exit 1; fi
 
 $(BUILD)/obj/%.o: src/%.c $(HEADERS) | $(addprefix $(BUILD)/obj/,$(LAYERS))
 	$(CC) $(CFLAGS) $(PC_CFLAGS) -c $< -o $@

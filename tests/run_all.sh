@@ -3,10 +3,13 @@
 #   (a) BUILD_DIR/unit_tests                    C unit tests of the core
 #   (b) wobble test tests/scenarios tests/validation   Lua scenario and validation tests
 #   (c) every scripts/*.lua for 5 frames        one test per example scene (pass = exit 0)
+#       the scenes that check their claim       run in full under wobble test
+#       the output of (b)                       no warning/assert/error line that no test announced
 #   (d) tests/cli/run.sh                        the command line in separate processes
 #       tests/cli/sandbox.sh                    escapes from the file rules, in separate processes
 #   (e) tests/render/run.sh                     wobble run --record, encoders that fail
 #   (f) tests/layers.sh                         the layers of DESIGN §1: no upward call, no circle
+#   (g) tests/cli/firstrun.sh                   what a new user meets: make deps, bench --frames, print
 # Each part prints its output and ends with "N passed, N failed"; a part that crashes
 # or prints no such line counts as a failure, never as zero tests. The last line is
 # the sum, "N passed, N failed"; the exit status is 1 when anything failed.
@@ -61,6 +64,39 @@ examples() {
     echo "$ex_p passed, $ex_f failed"
 }
 
+# the example scenes that check what their header says (`if test then ... end` at their
+# end: the cloth rests on the sphere, the rope winds round its post, ...), in full
+checked_examples() {
+    # shellcheck disable=SC2046  # one file name per line, none with spaces
+    set -- $(grep -l '^if test then' scripts/*.lua 2>/dev/null)
+    if [ $# -eq 0 ]; then
+        echo "not ok 1 - no example scene checks its claim (if test then ... end)"
+        echo "0 passed, 1 failed"
+        return 1
+    fi
+    "$BUILD/wobble" test --quiet --time-limit 600 --out "$TMP/out-checked" "$@"
+}
+
+# expected_noise LOG: a line of LOG that looks like trouble (a warning, an assertion, an
+# error, an abort) must come from a test that announced it ("# expected on stderr: ..."
+# before its ok line); anything else alarming in a passing run is a finding
+expected_noise() {
+    awk '
+      /^# expected on stderr/ { allowed = 1; next }
+      /^(not )?ok [0-9]/ { allowed = 0; next }
+      /^#/ || /^  / { next }
+      !allowed && tolower($0) ~ /warning|assert|abort|error|fatal|core dumped|segmentation fault|sanitizer/ { print }
+    ' "$1" >"$TMP/noise"
+    if [ -s "$TMP/noise" ]; then
+        echo "not ok 1 - alarming lines no test announced as expected (print(\"expected on stderr: ...\") first):"
+        sed 's/^/  # /' "$TMP/noise"
+        echo "0 passed, 1 failed"
+        return 1
+    fi
+    echo "ok 1 - every warning, assertion or error line of the scenario tests was announced as expected"
+    echo "1 passed, 0 failed"
+}
+
 if [ -e "$BUILD/unit_tests" ]; then
     part "C unit tests ($BUILD/unit_tests)" "$BUILD/unit_tests"
 else
@@ -73,11 +109,15 @@ for d in tests/scenarios tests/validation; do
 done
 # shellcheck disable=SC2086  # the folder list is meant to split
 part "scenario and validation tests" "$BUILD/wobble" test --out "$TMP/out-tests" $lua_dirs
+cp "$TMP/log" "$TMP/scenarios.log"
+part "expected stderr of the scenario tests is labelled" expected_noise "$TMP/scenarios.log"
 part "example scenes (scripts/*.lua, 5 frames)" examples
+part "example scenes that check their claim, in full" checked_examples
 part "command line (tests/cli/run.sh)" sh tests/cli/run.sh "$BUILD"
 part "sandbox escapes (tests/cli/sandbox.sh)" sh tests/cli/sandbox.sh "$BUILD"
 part "recording from the command line (tests/render/run.sh)" sh tests/render/run.sh "$BUILD"
 part "layers (tests/layers.sh)" sh tests/layers.sh "$BUILD"
+part "first run (tests/cli/firstrun.sh)" sh tests/cli/firstrun.sh "$BUILD"
 
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]

@@ -17,6 +17,10 @@
 -- that checks nothing cannot pass. Every expect.* takes an optional last message that
 -- is put in front of the failure text. A failed expectation fails its case even when
 -- the script catches the error (pcall, a coroutine): the runner checks _first_failure.
+-- The runner also makes print write TAP comments ("# " before every line), so a test's
+-- output is never read as a result; a test that makes something write to stderr on
+-- purpose says so first, print("expected on stderr: ..."), and tests/run_all.sh checks
+-- that no other warning, assertion or error line shows up.
 
 local M = { cases = {}, _count = 0, _running = false, _last_failure = nil, _first_failure = nil }
 

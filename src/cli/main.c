@@ -50,7 +50,7 @@ static const char usage_text[] =
     "  wobble --version | --help\n"
     "\n"
     "options of run, test and bench:\n"
-    "  --frames N          w:run stops after N frames\n"
+    "  --frames N          w:run stops after N frames; bench: each scene runs N frames\n"
     "  --record OUT        (run) draw every frame into OUT: .mp4, .gif or a folder of PNGs\n"
     "  --out DIR           output folder, the only place a script writes (default out)\n"
     "  --set key=value     wobble.args.key = value (numbers, true/false converted); repeatable\n"
@@ -108,7 +108,7 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
     o->rt.frame_cap = -1;
     o->rt.open_module = luaopen_wobble;
     o->rt.memory_budget = (size_t)4096 << 20;
-    o->sets = calloc((size_t)argc + 1, sizeof *o->sets);  /* + bench --json */
+    o->sets = calloc((size_t)argc + 2, sizeof *o->sets);  /* + bench's json and frames */
     o->pos = calloc((size_t)argc, sizeof *o->pos);
     if (!o->sets || !o->pos) return usage_error("%s", "out of memory");
     int only_pos = 0;
@@ -262,6 +262,32 @@ static int failure(lua_State *L, int status, const char *path, const char **msg)
     return budget ? EXIT_BUDGET : assertion_failed ? EXIT_FAILED : EXIT_SCRIPT;
 }
 
+/* print inside a TAP stream (wobble test, and a scene's cases): every line a TAP comment
+ * "# ...", so that a consumer never reads a script's output as a test line ("ok 1") */
+static int tap_print(lua_State *L) {
+    int n = lua_gettop(L);
+    luaL_Buffer b;
+    luaL_buffinit(L, &b);
+    for (int i = 1; i <= n; i++) {
+        if (i > 1) luaL_addchar(&b, '\t');
+        luaL_tolstring(L, i, NULL);
+        luaL_addvalue(&b);
+    }
+    luaL_pushresult(&b);
+    size_t len, at = 0;
+    const char *s = lua_tolstring(L, -1, &len);
+    do {  /* each line, the empty one after a trailing newline too, as print shows it */
+        const char *e = memchr(s + at, '\n', len - at);
+        size_t k = e ? (size_t)(e - (s + at)) : len - at;
+        fputs(k ? "# " : "#", stdout);
+        fwrite(s + at, 1, k, stdout);
+        fputc('\n', stdout);
+        at += k + 1;
+    } while (at <= len);
+    fflush(stdout);
+    return 0;
+}
+
 typedef struct prep { const opts *o; int harness_globals; } prep;
 
 /* runs protected: wobble.args from --set; `test` and `expect` globals for wobble test */
@@ -287,6 +313,8 @@ static int prepare(lua_State *L) {
         lua_setglobal(L, "test");
         lua_getfield(L, -1, "expect");
         lua_setglobal(L, "expect");
+        lua_pushcfunction(L, tap_print);  /* the whole file is in the TAP stream */
+        lua_setglobal(L, "print");
     }
     return 0;
 }
@@ -606,6 +634,8 @@ static int run_scene(const opts *o, const char *path) {
         }
         if (case_count(L) > 0) {
             printf("TAP version 13\n");
+            lua_pushcfunction(L, tap_print);  /* the cases' output is in the TAP stream */
+            lua_setglobal(L, "print");
             run_cases(L, path, &t);
             printf("1..%d\n%d passed, %d failed\n", t.n, t.passed, t.failed);
         }
@@ -640,6 +670,7 @@ static int bench_dir(char dir[PATH_MAX]) {
 
 static int cmd_bench(opts *o) {
     char dir[PATH_MAX], cwd[PATH_MAX];
+    if (o->rt.frame_cap == 0) return usage_error("%s", "bench --frames expects at least 1 frame");
     if (bench_dir(dir)) {
         fprintf(stderr, "wobble: cannot find the benchmark scenes (share/wobble/bench of an installed wobble, "
                         "or tests/bench of the project)\n");
@@ -653,8 +684,14 @@ static int cmd_bench(opts *o) {
         list_free(&files);
         return EXIT_SCRIPT;
     }
-    /* a benchmark scene reads wobble.args.json */
+    /* a benchmark scene reads wobble.args.json and wobble.args.frames (--frames N wins
+     * over --set frames=M: the later value is kept) */
+    static char frames[40];
     if (o->json) o->sets[o->nsets++] = "json=true";
+    if (o->rt.frame_cap > 0) {
+        snprintf(frames, sizeof frames, "frames=%lld", (long long)o->rt.frame_cap);
+        o->sets[o->nsets++] = frames;
+    }
     size_t cl = getcwd(cwd, sizeof cwd) ? strlen(cwd) : 0;
     int code = EXIT_PASS;
     for (int i = 0; i < files.n; i++) {

@@ -187,6 +187,7 @@ test("numerical trouble is counted as a warning", function()
   -- a particle at the edge of the double range, pushed past it
   local p = w:particle{ pos = {1.797e308, 0, 0} }
   w:set_velocity(p, 1e308, 0, 0)
+  print("expected on stderr: a warning that particle 1 became non-finite (this overflow is on purpose)")
   w:step(); w:step()
   local n, msg = w:warnings()
   expect.truthy(n >= 1, "warnings counted")
