@@ -11,11 +11,12 @@
 # at least MUTATE_THRESHOLD percent (default 90) were killed, 1 below it, 2 when the
 # harness could not do its job (a mutation that no longer applies because the code
 # changed, one that does not compile, or a test subset failing without any mutation).
-# With IDs, only those mutations run. MUTATE_JOBS (default 2): make's -j.
+# With IDs, only those mutations run. MUTATE_JOBS (default 2): make's -j;
+# MUTATE_LIST: another list (to check which tests kill what).
 set -u
 cd "$(dirname "$0")/../.." || exit 2
 ROOT=$PWD
-LIST=tests/mutate/mutations.txt
+LIST=${MUTATE_LIST:-tests/mutate/mutations.txt}
 THRESHOLD=${MUTATE_THRESHOLD:-90}
 JOBS=${MUTATE_JOBS:-2}
 TIMEOUT=${MUTATE_TIMEOUT:-300}
@@ -125,7 +126,8 @@ for i in $sel; do
         broken=$((broken + 1))
     else
         # shellcheck disable=SC2086
-        by=$(run_tests $tests)
+        # (stderr: the shell's "Aborted" when a mutant crashes; the logs are in test.log)
+        by=$(run_tests $tests 2>/dev/null)
         if [ -n "$by" ]; then
             result="killed by $by"
             killed=$((killed + 1))
