@@ -115,13 +115,16 @@ for i in $sel; do
     obj=$T/build/obj/${file#src/}
     obj=${obj%.c}.o
     t0=$(date +%s)
+    # the command always; the unit tests (all recompiled when libwobble.a changes) when used
+    targets=build/wobble
+    case " $tests" in *" unit"*) targets="$targets build/unit_tests" ;; esac
     case $file in src/*.c) ;; *) printf '   %-28s %-26s %s\n' "$id" "$file" "BROKEN: not a .c file under src/"; broken=$((broken + 1)); continue ;; esac
     cp -p "$src" "$TMP/orig.c" && cp -p "$obj" "$TMP/orig.o" || exit 2
     sed -e "$(cat "$TMP/m$i.sed")" "$TMP/orig.c" >"$src"
     if cmp -s "$src" "$TMP/orig.c"; then
         result="BROKEN: the sed rule no longer applies (the code changed; update $LIST)"
         broken=$((broken + 1))
-    elif ! make -s -C "$T" -j"$JOBS" build >"$TMP/build.log" 2>&1; then
+    elif ! make -s -C "$T" -j"$JOBS" $targets >"$TMP/build.log" 2>&1; then
         result="BROKEN: the mutant does not compile ($(grep -m1 'error' "$TMP/build.log" | cut -c1-80))"
         broken=$((broken + 1))
     else
