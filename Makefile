@@ -29,7 +29,7 @@ CORE_OBJ := $(CORE_SRC:src/%.c=$(BUILD)/obj/%.o)
 APP_OBJ  := $(APP_SRC:src/%.c=$(BUILD)/obj/%.o)
 UNIT_SRC := $(wildcard tests/unit/*.c)
 
-.PHONY: all build deps check-deps test asan bench demo install clean
+.PHONY: all build deps check-deps test asan bench demo install clean mutate
 all: check-deps
 	@$(MAKE) --no-print-directory build
 
@@ -84,6 +84,11 @@ asan: check-deps
 	  EXTRA_LDFLAGS="-fsanitize=address,undefined" build
 	@ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/render/lsan.supp:print_suppressions=0 \
 	  sh tests/run_all.sh build-asan
+
+# mutation testing: each rule of tests/mutate/mutations.txt applied alone to a scratch
+# copy of the tree, its part of the suite run; fails below a 90% kill rate
+mutate: check-deps
+	@sh tests/mutate/run.sh $(MUTATIONS)
 
 bench: check-deps
 	@$(MAKE) --no-print-directory OPT="-O3 -march=native" BUILD=build-bench build

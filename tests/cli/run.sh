@@ -231,6 +231,10 @@ check "README: the first scene was found" 0
 
 # ---- make: deps, clean, install (the Makefile's own rules, with stand-ins for apt)
 if command -v make >/dev/null 2>&1; then
+    # these makes are a user's, typed in a shell: under `make -jN test` the outer make's
+    # MAKEFLAGS name a jobserver whose pipes it does not hand to this script, and the
+    # inner make would warn "jobserver unavailable" (it is not a recursive make of ours)
+    unset MAKEFLAGS MFLAGS MAKELEVEL
     mkdir -p "$TMP/fakebin"
     # every package installed but $FAKE_MISSING; apt-get only logs what it was asked
     printf '#!/bin/sh\nfor pkg; do :; done\n[ "$pkg" = "$FAKE_MISSING" ] && exit 1\nprintf "ii "\n' \
