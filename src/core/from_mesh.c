@@ -157,11 +157,10 @@ static wb_status plan_links(plan *p, int k)
     if (k > 0 && p->np > 1) {
         wb_kdtree *t = wb_kdtree_build(p->pos, p->np);
         if (!t) return WB_ERR_NOMEM;
-        int32_t ids[33];
+        int32_t ids[32]; /* k <= 32, checked by the caller; at most k per particle fit pairs */
         for (int32_t i = 0; i < p->np; i++) {
-            int got = wb_kdtree_knn(t, &p->pos[3 * i], k + 1, ids, NULL);
-            for (int j = 0; j < got; j++)
-                if (ids[j] != i) p->pairs[n++] = pair_key(i, ids[j]);
+            int got = wb_kdtree_knn_except(t, &p->pos[3 * i], k, i, ids, NULL);
+            for (int j = 0; j < got; j++) p->pairs[n++] = pair_key(i, ids[j]);
         }
         wb_kdtree_destroy(t);
     }

@@ -246,10 +246,10 @@ wb_skin *wb_skin_create(const wb_world *w, const wb_mesh *m, const int32_t *ids,
     for (int32_t b = 0; b < n; b++) {
         s->nbr_start[b] = e;
         if (!s->used[b]) continue;
-        int32_t id[MAX_NEIGHBOURS + 1];
-        int got = wb_kdtree_knn(t, &s->x0[3 * b], def->neighbours + 1, id, NULL);
-        for (int j = 0; j < got; j++)
-            if (id[j] != b) s->nbr[e++] = id[j];
+        /* at most `neighbours` others, what nbr has room for per bone */
+        int32_t id[MAX_NEIGHBOURS];
+        int got = wb_kdtree_knn_except(t, &s->x0[3 * b], def->neighbours, b, id, NULL);
+        for (int j = 0; j < got; j++) s->nbr[e++] = id[j];
     }
     s->nbr_start[n] = e;
     wb_kdtree_destroy(t);

@@ -44,8 +44,11 @@ project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const w
         const wb_real len2 = d0 * d0 + d1 * d1 + d2 * d2;
         /* immovable pair, or coincident particles: nothing to push along */
         if (wsum == 0 || len2 < (wb_real)1e-24) continue;
-        const wb_real len = sqrt(len2);
         const wb_real at = alpha[i] * inv_h2;
+        /* compliance/h^2 overflowed: the limit is a constraint with no stiffness (it would
+         * otherwise give inf * 0 = NaN below and undo the frame) */
+        if (isinf(at)) continue;
+        const wb_real len = sqrt(len2);
         wb_real num = rest[i] - len - at * lambda[i];
         wb_real den = wsum + at;
         if (damped) {
