@@ -122,7 +122,7 @@ static wb_status plan_particles(const wb_mesh *m, int32_t target, plan *p)
     p->np = n;
     p->pos = calloc((size_t)n * 3, sizeof *p->pos);
     cnt = calloc((size_t)n, sizeof *cnt);
-    int32_t *lead = malloc(sizeof *lead * (size_t)(n > 0 ? n : 1));
+    int32_t *lead = malloc(sizeof *lead * (size_t)n);
     if (!p->pos || !cnt || !lead) { free(lead); goto out; }
     /* the centroid as the cluster's first vertex plus the mean offset from it: a plain sum
      * of vertices near 1e308 overflows although the cluster is small */

@@ -164,6 +164,9 @@ const char *wb_image_check(const wb_image *g)
         wb_distance_def d = { g->d_alpha[i], g->d_beta[i], g->d_rest[i], g->d_yield[i], g->d_creep[i], g->d_break[i] };
         if ((e = wb_distance_def_check(&d))) return e;
         if (!(g->d_rest[i] >= 0)) return "rest length must be >= 0";
+        wb_real dx[3];
+        v3_sub(dx, &g->x[3 * b], &g->x[3 * a]);
+        if (!isfinite(v3_dot(dx, dx))) return "constraint particles are too far apart (their distance squared overflows)";
     }
     /* the free list is exactly the dead slots, each once (a mark per slot: linear) */
     if (g->nfree != dead) return "the free constraint slots do not match the dead ones";
