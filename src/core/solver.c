@@ -57,8 +57,15 @@ project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const w
             const wb_real *pa = &xp[3 * ia], *pc = &xp[3 * ic];
             const wb_real rel = ((xc[0] - pc[0]) - (xa[0] - pa[0])) * d0 + ((xc[1] - pc[1]) - (xa[1] - pa[1])) * d1 +
                                 ((xc[2] - pc[2]) - (xa[2] - pa[2])) * d2;
-            num -= gamma * rel / len;
-            den += gamma * wsum;
+            if (isinf(gamma)) {
+                /* alpha~ beta h overflowed: the limit gamma -> inf of num/den, a correction
+                 * that removes the relative velocity along d (inf * 0 would be NaN) */
+                num = -rel / len;
+                den = wsum;
+            } else {
+                num -= gamma * rel / len;
+                den += gamma * wsum;
+            }
         }
         /* s = dlambda / len, so the correction is s * d without normalising d */
         wb_real s = num / (den * len);

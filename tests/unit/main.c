@@ -25,7 +25,8 @@
     X(extreme_kdtree_knn_except_bounded_under_ties)      \
     X(extreme_from_mesh_neighbours_with_ties)            \
     X(extreme_skin_neighbours_with_ties)                 \
-    X(extreme_skin_refuses_vertices_out_of_range)
+    X(extreme_skin_refuses_vertices_out_of_range)        \
+    X(extreme_damping_overflow_is_the_infinitely_damped_limit)
 
 /* every test, in the order they run: add a line here for each TEST() */
 #define TEST_LIST(X)                             \

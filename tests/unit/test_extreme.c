@@ -338,3 +338,25 @@ TEST(extreme_skin_refuses_vertices_out_of_range)
     wb_mesh_destroy(m);
     wb_world_destroy(w);
 }
+
+TEST(extreme_damping_overflow_is_the_infinitely_damped_limit)
+{
+    /* compliance/h^2 * damping * h overflows: the limit, not inf * 0 = NaN */
+    wb_world *w = new_world();
+    const wb_real p[3] = { 0, 1, 0 }, q[3] = { 0, 2, 0 }, v[3] = { 0, 5, 0 };
+    wb_particle_add(w, p, NULL, 1, 0);
+    wb_particle_add(w, q, v, 1, 0);
+    wb_distance_def d = wb_distance_default_def();
+    d.compliance = 1;
+    d.damping = 1e308;
+    wb_distance_add(w, 0, 1, &d, NULL);
+    for (int i = 0; i < 10; i++) wb_world_step(w);
+    CHECK_EQ(wb_world_warnings(w), 0);
+    /* the damping cancels relative velocity along the link: they move together */
+    wb_real va[3], vb[3];
+    wb_particle_velocity(w, 0, va);
+    wb_particle_velocity(w, 1, vb);
+    CHECK_NEAR(va[1], vb[1], 1e-9);
+    CHECK(va[1] > -2); /* not free fall (-1.6 m/s): the upward push was shared */
+    wb_world_destroy(w);
+}
