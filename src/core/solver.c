@@ -186,7 +186,10 @@ static void plasticity_and_breaking(wb_world *w)
         if (y > 0 && a > y) {
             /* flow towards the current length by the part of the strain past yield */
             const wb_real rate = m->d_creep[s] * dt < 1 ? m->d_creep[s] * dt : 1;
-            const wb_real r = rest + rate * (len - rest) * (a - y) / a;
+            /* the part past yield, (a - y)/a; a rest so small that the strain overflows
+             * (inf/inf = NaN would poison the rest for good) flows as if a were huge: 1 */
+            const wb_real past = isinf(a) ? 1 : (a - y) / a;
+            const wb_real r = rest + rate * (len - rest) * past;
             k->s_rest[i] = r;
             w->s.d_rest[s] = r;
         }

@@ -360,3 +360,24 @@ TEST(extreme_damping_overflow_is_the_infinitely_damped_limit)
     CHECK(va[1] > -2); /* not free fall (-1.6 m/s): the upward push was shared */
     wb_world_destroy(w);
 }
+
+TEST(extreme_plastic_flow_of_a_tiny_rest_stays_finite)
+{
+    /* rest 1e-320 at length 1: the strain (len - rest)/rest overflows to inf, and the
+     * flow's (a - y)/a was inf/inf = NaN, a NaN rest that froze the world */
+    wb_world *w = new_world();
+    const wb_real p[3] = { 0, 0, 0 }, q[3] = { 1, 0, 0 };
+    wb_particle_add(w, p, NULL, 0, 0);
+    wb_particle_add(w, q, NULL, 0, 0);
+    wb_distance_def d = wb_distance_default_def();
+    d.rest = 1e-320;
+    d.yield = 0.1;
+    d.creep = 1;
+    wb_distance_id c = wb_distance_add(w, 0, 1, &d, NULL);
+    for (int i = 0; i < 3; i++) wb_world_step(w);
+    CHECK(isfinite(wb_distance_rest(w, c)));
+    CHECK(wb_distance_rest(w, c) > 1e-320);
+    CHECK(isfinite(wb_world_max_strain(w)));
+    CHECK_EQ(wb_world_warnings(w), 0);
+    wb_world_destroy(w);
+}
