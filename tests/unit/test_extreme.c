@@ -8,6 +8,8 @@
 #include "../../src/wobble.h"
 #include "test.h"
 
+static void v3_set_(wb_real *o, wb_real x, wb_real y, wb_real z) { o[0] = x; o[1] = y; o[2] = z; }
+
 static wb_world *new_world(void)
 {
     wb_world_def d = wb_world_default_def();
@@ -379,5 +381,33 @@ TEST(extreme_plastic_flow_of_a_tiny_rest_stays_finite)
     CHECK(wb_distance_rest(w, c) > 1e-320);
     CHECK(isfinite(wb_world_max_strain(w)));
     CHECK_EQ(wb_world_warnings(w), 0);
+    wb_world_destroy(w);
+}
+
+TEST(extreme_collider_derived_poses_finite)
+{
+    wb_world *w = new_world();
+    wb_status st;
+    /* a capsule whose ends are both at 1e308: its centre (a + b)/2 overflowed to inf */
+    wb_collider_def c = wb_collider_default_def(WB_SHAPE_CAPSULE);
+    v3_set_(c.a, 1e308, 0, 0);
+    v3_set_(c.b, 1e308, 1, 0);
+    wb_collider_id id = wb_collider_add(w, &c, &st);
+    REQUIRE(st == WB_OK);
+    wb_real p[3];
+    wb_collider_position(w, id, p);
+    CHECK(isfinite(p[0]) && p[0] == 1e308);
+    const wb_real x[3] = { 1e308, 0.5, 0 };
+    CHECK_NEAR(wb_collider_distance(w, id, x), -c.radius, 1e-12);
+    /* ends so far apart that |b - a|^2 overflows */
+    v3_set_(c.a, -1e200, 0, 0);
+    v3_set_(c.b, 1e200, 0, 0);
+    CHECK_HAS(wb_collider_def_check(&c), "too far apart");
+    /* a plane whose point offset/|normal| overflows */
+    wb_collider_def pl = wb_collider_default_def(WB_SHAPE_PLANE);
+    v3_set_(pl.normal, 0, 1e-10, 0);
+    pl.offset = 1e308;
+    CHECK_HAS(wb_collider_def_check(&pl), "offset");
+    CHECK_EQ(wb_collider_count(w), 1);
     wb_world_destroy(w);
 }
