@@ -138,6 +138,11 @@ static const char *check_collider(const wb_image_collider *c)
     if (c->q0[0] * c->q0[0] + v3_dot(&c->q0[1], &c->q0[1]) < 1e-24) return "collider rotation must not be zero";
     if ((c->shape == WB_SHAPE_SPHERE || c->shape == WB_SHAPE_CAPSULE) && !(c->radius > 0)) return "collider radius must be > 0";
     if (c->shape == WB_SHAPE_BOX && !(c->half[0] > 0 && c->half[1] > 0 && c->half[2] > 0)) return "box half extents must be > 0";
+    if (c->shape == WB_SHAPE_CAPSULE) {
+        wb_real ab[3];
+        v3_sub(ab, c->b, c->a);
+        if (!isfinite(v3_dot(ab, ab))) return "capsule ends are too far apart (|b - a| squared overflows)";
+    }
     if (c->shape == WB_SHAPE_PLANE && !(v3_len(c->n) > 1e-12)) return "plane normal must not be zero";
     return NULL;
 }

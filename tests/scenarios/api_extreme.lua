@@ -131,3 +131,49 @@ test("skin with neighbours tied at distance 0, and a vertex out of range", funct
   expect.error(function() w2:skin(wobble.mesh{ vertices = {{1e200, 0, 0}}, triangles = {} }, {far}) end,
                "bad argument #2 to 'skin' %(mesh vertex 1 is too far")
 end)
+
+test("colliders: a capsule at 1e308, ends too far apart, a snapshot of such ends", function()
+  local w = wobble.world{}
+  -- the centre (a + b)/2 overflowed to inf
+  local c = w:collider{ shape = "capsule", a = {1e308, 0, 0}, b = {1e308, 1, 0}, radius = 0.5 }
+  expect.eq(c:position(), 1e308)
+  expect.error(function() w:collider{ shape = "capsule", a = {-1e200, 0, 0}, b = {1e200, 0, 0}, radius = 1 } end,
+               "a and b are too far apart")
+  expect.error(function() w:collider{ shape = "plane", normal = {0, 1e-10, 0}, offset = 1e308 } end,
+               "offset / |normal| overflows")
+  -- a saved capsule's own-frame ends edited out of range are refused on load
+  local v = wobble.world{}
+  v:collider{ shape = "capsule", a = {0, 0, 0}, b = {1, 0, 0}, radius = 0.5 }
+  v:save("api_extreme/capsule.json")
+  local f = assert(io.open("api_extreme/capsule.json", "rb"))
+  local s = f:read("a")
+  f:close()
+  local edited = s:gsub('"a": %[%-0%.5, 0, 0%]', '"a": [-1e200, 0, 0]'):gsub('"b": %[0%.5, 0, 0%]', '"b": [1e200, 0, 0]')
+  expect.truthy(edited ~= s, "the snapshot was edited")
+  f = assert(io.open("api_extreme/capsule_far.json", "wb"))
+  f:write(edited)
+  f:close()
+  local loaded, err = wobble.load("api_extreme/capsule_far.json")
+  expect.eq(loaded, nil)
+  expect.truthy(err:find("too far apart", 1, true), err)
+end)
+
+test("JSON particle configs follow the same rules as w:distance", function()
+  local function config(name, constraint)
+    local f = assert(io.open("api_extreme/" .. name, "wb"))
+    f:write('{"format": "wobble-particles", "version": 1,\n',
+            ' "particles": [{"position": [-1e200, 0, 0]}, {"position": [1e200, 0, 0]}, {"position": [0, 1, 0]}, {"position": [1, 1, 0]}],\n',
+            ' "constraints": [' .. constraint .. ']}\n')
+    f:close()
+    return "api_extreme/" .. name
+  end
+  local w = wobble.world{}
+  local s = snapshot(w)
+  local body, err = w:load_particles(config("far.json", '{"type": "distance", "particles": [0, 1], "rest": 1}'))
+  expect.eq(body, nil)
+  expect.truthy(err:find("constraints[0].particles: the particles are too far apart", 1, true), err)
+  body, err = w:load_particles(config("rest.json", '{"type": "distance", "particles": [2, 3], "rest": 1e200}'))
+  expect.eq(body, nil)
+  expect.truthy(err:find("constraints[0].rest: rest must be below 1e154", 1, true), err)
+  unchanged(w, s)
+end)
