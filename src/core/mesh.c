@@ -135,10 +135,11 @@ wb_real wb_mesh_weld_tolerance(const wb_mesh *m)
     wb_real mn[3], mx[3];
     if (!wb_mesh_bounds(m, mn, mx)) return 0;
     const wb_real d[3] = { mx[0] - mn[0], mx[1] - mn[1], mx[2] - mn[2] };
-    const wb_real t = 1e-6 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    if (isfinite(t)) return t;
-    /* the box's diagonal squared (or the box itself: 1e308 - -1e308) overflows: the same
-     * tolerance from halved extents, scaled back (1e-6 of ~3.5e308 is finite) */
+    const wb_real dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    if ((dd >= DBL_MIN && isfinite(dd)) || (d[0] == 0 && d[1] == 0 && d[2] == 0)) return 1e-6 * sqrt(dd);
+    /* the diagonal squared underflows (a 1e-200 m mesh) or overflows (1e200 m): its length
+     * without squaring; when the box itself overflows (1e308 - -1e308), from halves */
+    if (isfinite(d[0]) && isfinite(d[1]) && isfinite(d[2])) return 1e-6 * v3_len_safe(d);
     const wb_real h[3] = { mx[0] / 2 - mn[0] / 2, mx[1] / 2 - mn[1] / 2, mx[2] / 2 - mn[2] / 2 };
     return 2e-6 * v3_len_safe(h);
 }

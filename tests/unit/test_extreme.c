@@ -179,6 +179,12 @@ TEST(extreme_weld_tolerance_of_huge_and_tiny_boxes)
     CHECK_EQ(m2->nv, 2);
     CHECK_EQ(wb_mesh_weld(m2, 6e302, NULL), WB_OK);
     CHECK_EQ(m2->nv, 1);
+    /* a 1e-200 m box: its diagonal squared underflows, the tolerance does not */
+    const wb_real v4[6] = { 0, 0, 0, 3e-200, 4e-200, 0 };
+    wb_mesh *m4 = wb_mesh_create(v4, 2, NULL, 0, NULL);
+    REQUIRE(m4 != NULL);
+    CHECK_NEAR(wb_mesh_weld_tolerance(m4) / 5e-206, 1, 1e-12);
+    wb_mesh_destroy(m4);
     /* and tiny: 5e-200 apart (squared: 0) is not within 1e-200 */
     const wb_real v3[6] = { 0, 0, 0, 5e-200, 0, 0 };
     wb_mesh *m3 = wb_mesh_create(v3, 2, NULL, 0, NULL);
