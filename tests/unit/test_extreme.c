@@ -417,3 +417,16 @@ TEST(extreme_collider_derived_poses_finite)
     CHECK_EQ(wb_collider_count(w), 1);
     wb_world_destroy(w);
 }
+
+TEST(extreme_cluster_refuses_overflowing_box)
+{
+    /* offsets from the box's minimum overflow (1e308 - -1e308): cell indices were
+     * (int64_t)floor(inf / h), undefined behaviour */
+    const wb_real v[9] = { -1e308, 0, 0, 1e308, 0, 0, 0, 1, 0 };
+    wb_mesh *m = wb_mesh_create(v, 3, NULL, 0, NULL);
+    REQUIRE(m != NULL);
+    int32_t cl[3];
+    CHECK_EQ(wb_mesh_cluster(m, 2, cl), WB_ERR_ARG);
+    CHECK_HAS(wb_last_error(), "too large");
+    wb_mesh_destroy(m);
+}
