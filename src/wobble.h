@@ -272,9 +272,15 @@ int32_t wb_mesh_cluster(const wb_mesh *m, int32_t target, int32_t *cluster);
 typedef struct wb_kdtree wb_kdtree;
 wb_kdtree *wb_kdtree_build(const wb_real *pts, int32_t n);    /* copies (n x 3) points; NULL on no memory */
 void wb_kdtree_destroy(wb_kdtree *t);
+#define WB_KDTREE_MAXK 64 /* a larger k is served as this many */
 /* the k nearest points to q, nearest first, ties by lower index: ids and squared distances
- * (either may be NULL); returns min(k, n) */
+ * (either may be NULL, else sized by the caller for k entries: never more are written);
+ * returns min(k, WB_KDTREE_MAXK, n) */
 int wb_kdtree_knn(const wb_kdtree *t, const wb_real q[3], int k, int32_t *ids, wb_real *dist2);
+/* the same over every point but `skip` (a point's own neighbours: asking for k + 1 and
+ * dropping the point itself overflows a k-sized buffer when ties at distance 0 rank a
+ * lower index before it); returns min(k, WB_KDTREE_MAXK, n - 1) for a valid skip */
+int wb_kdtree_knn_except(const wb_kdtree *t, const wb_real q[3], int k, int32_t skip, int32_t *ids, wb_real *dist2);
 
 /* ---- particle graph from a mesh (from_mesh.c) ------------------------------------------- */
 typedef struct wb_from_mesh_def {

@@ -115,6 +115,7 @@ part "example scenes (scripts/*.lua, 5 frames)" examples
 part "example scenes that check their claim, in full" checked_examples
 part "command line (tests/cli/run.sh)" sh tests/cli/run.sh "$BUILD"
 part "sandbox escapes (tests/cli/sandbox.sh)" sh tests/cli/sandbox.sh "$BUILD"
+part "extreme input from the command line (tests/cli/extreme.sh)" sh tests/cli/extreme.sh "$BUILD"
 part "recording from the command line (tests/render/run.sh)" sh tests/render/run.sh "$BUILD"
 part "layers (tests/layers.sh)" sh tests/layers.sh "$BUILD"
 part "first run (tests/cli/firstrun.sh)" sh tests/cli/firstrun.sh "$BUILD"

@@ -59,6 +59,73 @@ static wb_status check_common(wb_real mass, wb_real radius, const wb_distance_de
     return e ? bad(e) : WB_OK;
 }
 
+/* The rules every builder applies to what it derives, before it adds anything (the core
+ * asserts finite positions, and the solver works with squared lengths):
+ *  - every particle position finite (from + (to - from) t overflows long before the
+ *    endpoints do);
+ *  - the body's bounding-box diagonal squared finite: no link's length squared, and so
+ *    no computed rest length, can overflow;
+ *  - the mass per particle > 0 with a finite inverse (a tiny mass split over many
+ *    particles underflows to 0, which would make them immovable).
+ * `pos` gives particle i's position; `what` names the option at fault. */
+static wb_status check_derived(void (*pos)(const void *d, int64_t i, wb_real p[3]), const void *d, int64_t np,
+                               const char *what, wb_real mass)
+{
+    wb_real mn[3] = { INFINITY, INFINITY, INFINITY }, mx[3] = { -INFINITY, -INFINITY, -INFINITY };
+    for (int64_t i = 0; i < np; i++) {
+        wb_real p[3];
+        pos(d, i, p);
+        for (int c = 0; c < 3; c++) {
+            if (!fin(p[c])) {
+                wb__set_error("%s: particle %lld's position is not finite (the extent overflows)", what, (long long)i + 1);
+                return WB_ERR_ARG;
+            }
+            mn[c] = fmin(mn[c], p[c]);
+            mx[c] = fmax(mx[c], p[c]);
+        }
+    }
+    wb_real dd = 0;
+    for (int c = 0; c < 3; c++) {
+        const wb_real e = mx[c] - mn[c];
+        dd += e * e;
+    }
+    if (!fin(dd)) {
+        wb__set_error("%s: the body is too large (its extent squared overflows; links need finite squared lengths)", what);
+        return WB_ERR_ARG;
+    }
+    const wb_real m = mass / (wb_real)np;
+    if (!(m > 0) || !fin(1 / m)) {
+        wb__set_error("mass: %g over %lld particles is %g each, too small (its inverse overflows)", (double)mass,
+                      (long long)np, (double)m);
+        return WB_ERR_ARG;
+    }
+    return WB_OK;
+}
+
+static void cloth_pos(const void *dv, int64_t k, wb_real p[3])
+{
+    const wb_cloth_def *d = dv;
+    const int nx = d->res[0], nz = d->res[1], i = (int)(k % nx), j = (int)(k / nx);
+    p[0] = d->origin[0] + d->size[0] * i / (nx - 1);
+    p[1] = d->origin[1];
+    p[2] = d->origin[2] + d->size[1] * j / (nz - 1);
+}
+
+static void rope_pos(const void *dv, int64_t i, wb_real p[3])
+{
+    const wb_rope_def *d = dv;
+    const wb_real t = (wb_real)i / d->segments;
+    for (int c = 0; c < 3; c++) p[c] = d->from[c] + (d->to[c] - d->from[c]) * t;
+}
+
+static void lattice_pos(const void *dv, int64_t n, wb_real p[3])
+{
+    const wb_lattice_def *d = dv;
+    const int nx = d->res[0], ny = d->res[1], nz = d->res[2];
+    const int ix[3] = { (int)(n % nx), (int)(n / nx % ny), (int)(n / nx / ny) }, res[3] = { nx, ny, nz };
+    for (int c = 0; c < 3; c++) p[c] = d->min[c] + (d->max[c] - d->min[c]) * ix[c] / (res[c] - 1);
+}
+
 /* link a-b with the builder's options; cannot fail after wb__reserve */
 static void link(wb_world *w, int32_t a, int32_t b, const wb_distance_def *def)
 {
@@ -80,16 +147,16 @@ wb_status wb_cloth(wb_world *w, const wb_cloth_def *d, wb_body *out)
     if (d->shear) nd += (int64_t)(nx - 1) * (nz - 1);
     if (d->bend >= 0) nd += (int64_t)(nx - 2 > 0 ? nx - 2 : 0) * nz + (int64_t)nx * (nz - 2 > 0 ? nz - 2 : 0);
     const int64_t ntri = 2 * (int64_t)(nx - 1) * (nz - 1);
+    if ((st = check_derived(cloth_pos, d, np, "origin/size", d->mass)) != WB_OK) return st;
     if ((st = wb__reserve(w, np, nd)) != WB_OK || (st = wb__surface_reserve(w, (int32_t)ntri)) != WB_OK) return st;
 
     const int32_t first = w->m.np;
     const wb_real m = d->mass / (wb_real)np;
-    for (int j = 0; j < nz; j++)
-        for (int i = 0; i < nx; i++) {
-            wb_real p[3] = { d->origin[0] + d->size[0] * i / (nx - 1), d->origin[1],
-                             d->origin[2] + d->size[1] * j / (nz - 1) };
-            wb_particle_add(w, p, NULL, m, d->radius);
-        }
+    for (int64_t i = 0; i < np; i++) {
+        wb_real p[3];
+        cloth_pos(d, i, p);
+        wb_particle_add(w, p, NULL, m, d->radius);
+    }
 #define ID(i, j) (first + (i) + (j) * nx)
     for (int j = 0; j < nz; j++)
         for (int i = 0; i < nx; i++) {
@@ -139,11 +206,12 @@ wb_status wb_rope(wb_world *w, const wb_rope_def *d, wb_body *out)
     for (int i = 0; i < 3; i++)
         if (!fin(d->from[i]) || !fin(d->to[i])) return bad("from and to must be finite");
     const int n = d->segments + 1;
+    if ((st = check_derived(rope_pos, d, n, "from/to", d->mass)) != WB_OK) return st;
     if ((st = wb__reserve(w, n, d->segments)) != WB_OK) return st;
     const int32_t first = w->m.np;
     for (int i = 0; i < n; i++) {
-        wb_real t = (wb_real)i / d->segments, p[3];
-        for (int c = 0; c < 3; c++) p[c] = d->from[c] + (d->to[c] - d->from[c]) * t;
+        wb_real p[3];
+        rope_pos(d, i, p);
         wb_particle_add(w, p, NULL, d->mass / n, d->radius);
     }
     for (int i = 0; i + 1 < n; i++) link(w, first + i, first + i + 1, &d->link);
@@ -170,17 +238,15 @@ wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
                        2 * ((int64_t)(nx - 1) * (ny - 1) * nz + (int64_t)(nx - 1) * ny * (nz - 1) + (int64_t)nx * (ny - 1) * (nz - 1)) +
                        4 * cells;
     const int64_t ntri = 4 * ((int64_t)(nx - 1) * (ny - 1) + (int64_t)(ny - 1) * (nz - 1) + (int64_t)(nz - 1) * (nx - 1));
+    if ((st = check_derived(lattice_pos, d, np, "min/max", d->mass)) != WB_OK) return st;
     if ((st = wb__reserve(w, np, nd)) != WB_OK || (st = wb__surface_reserve(w, (int32_t)ntri)) != WB_OK) return st;
     const int32_t first = w->m.np;
     const wb_real m = d->mass / (wb_real)np;
-    for (int k = 0; k < nz; k++)
-        for (int j = 0; j < ny; j++)
-            for (int i = 0; i < nx; i++) {
-                wb_real p[3] = { d->min[0] + (d->max[0] - d->min[0]) * i / (nx - 1),
-                                 d->min[1] + (d->max[1] - d->min[1]) * j / (ny - 1),
-                                 d->min[2] + (d->max[2] - d->min[2]) * k / (nz - 1) };
-                wb_particle_add(w, p, NULL, m, d->radius);
-            }
+    for (int64_t i = 0; i < np; i++) {
+        wb_real p[3];
+        lattice_pos(d, i, p);
+        wb_particle_add(w, p, NULL, m, d->radius);
+    }
 #define ID(i, j, k) (first + (i) + ((j) + (k) * ny) * nx)
     /* every pair of corners of a cell, each pair made once: offsets (di,dj,dk) in {0,1}^3
      * between corner c and c+offset, plus the crossing diagonals of faces and body */

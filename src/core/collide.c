@@ -102,6 +102,8 @@ const char *wb_collider_def_check(const wb_collider_def *d)
     case WB_SHAPE_PLANE:
         if (!fin3(d->normal) || !isfinite(d->offset)) return "normal and offset must be finite";
         if (!(v3_len_safe(d->normal) > 1e-12)) return "normal must not be zero";
+        /* the plane's point is offset/|normal| along it */
+        if (!isfinite(d->offset / v3_len_safe(d->normal))) return "offset / |normal| overflows: offset must be finite over a unit normal";
         break;
     case WB_SHAPE_SPHERE:
         if (!fin3(d->center)) return "center must be finite";
@@ -115,6 +117,11 @@ const char *wb_collider_def_check(const wb_collider_def *d)
         break;
     case WB_SHAPE_CAPSULE:
         if (!fin3(d->a) || !fin3(d->b)) return "a and b must be finite";
+        {
+            /* distances to the segment square b - a */
+            const wb_real ab[3] = { d->b[0] - d->a[0], d->b[1] - d->a[1], d->b[2] - d->a[2] };
+            if (!isfinite(v3_dot(ab, ab))) return "a and b are too far apart (|b - a| squared overflows)";
+        }
         if (!(d->radius > 0) || !isfinite(d->radius)) return "radius must be > 0";
         break;
     default:
@@ -177,7 +184,8 @@ wb_collider_id wb_collider_add(wb_world *w, const wb_collider_def *def, wb_statu
         break;
     case WB_SHAPE_CAPSULE: {
         s->radius = def->radius;
-        wb_real c[3] = { (def->a[0] + def->b[0]) / 2, (def->a[1] + def->b[1]) / 2, (def->a[2] + def->b[2]) / 2 };
+        /* halves first: a + b overflows for a = b = 1e308 */
+        wb_real c[3] = { def->a[0] / 2 + def->b[0] / 2, def->a[1] / 2 + def->b[1] / 2, def->a[2] / 2 + def->b[2] / 2 };
         v3_copy(p->p, c);
         v3_sub(s->a, def->a, c);
         v3_sub(s->b, def->b, c);

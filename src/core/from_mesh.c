@@ -122,12 +122,25 @@ static wb_status plan_particles(const wb_mesh *m, int32_t target, plan *p)
     p->np = n;
     p->pos = calloc((size_t)n * 3, sizeof *p->pos);
     cnt = calloc((size_t)n, sizeof *cnt);
-    if (!p->pos || !cnt) goto out;
+    int32_t *lead = malloc(sizeof *lead * (size_t)n);
+    if (!p->pos || !cnt || !lead) { free(lead); goto out; }
+    /* the centroid as the cluster's first vertex plus the mean offset from it: a plain sum
+     * of vertices near 1e308 overflows although the cluster is small */
+    for (int32_t c = 0; c < n; c++) lead[c] = -1;
     for (int32_t i = 0; i < m->nv; i++) {
-        v3_add(&p->pos[3 * cl[i]], &p->pos[3 * cl[i]], &m->v[3 * i]);
-        cnt[cl[i]]++;
+        const int32_t c = cl[i];
+        if (lead[c] < 0) lead[c] = i;
+        wb_real r[3];
+        v3_sub(r, &m->v[3 * i], &m->v[3 * lead[c]]);
+        v3_add(&p->pos[3 * c], &p->pos[3 * c], r);
+        cnt[c]++;
     }
-    for (int32_t c = 0; c < n; c++) v3_scale(&p->pos[3 * c], &p->pos[3 * c], 1 / (wb_real)cnt[c]);
+    for (int32_t c = 0; c < n; c++) {
+        wb_real *x = &p->pos[3 * c];
+        v3_scale(x, x, 1 / (wb_real)cnt[c]);
+        v3_add(x, x, &m->v[3 * lead[c]]);
+    }
+    free(lead);
     int32_t nt = 0;
     for (int32_t i = 0; i < m->nt; i++) {
         int32_t a = cl[m->tri[3 * i]], b = cl[m->tri[3 * i + 1]], c = cl[m->tri[3 * i + 2]];
@@ -157,15 +170,39 @@ static wb_status plan_links(plan *p, int k)
     if (k > 0 && p->np > 1) {
         wb_kdtree *t = wb_kdtree_build(p->pos, p->np);
         if (!t) return WB_ERR_NOMEM;
-        int32_t ids[33];
+        int32_t ids[32]; /* k <= 32, checked by the caller; at most k per particle fit pairs */
         for (int32_t i = 0; i < p->np; i++) {
-            int got = wb_kdtree_knn(t, &p->pos[3 * i], k + 1, ids, NULL);
-            for (int j = 0; j < got; j++)
-                if (ids[j] != i) p->pairs[n++] = pair_key(i, ids[j]);
+            int got = wb_kdtree_knn_except(t, &p->pos[3 * i], k, i, ids, NULL);
+            for (int j = 0; j < got; j++) p->pairs[n++] = pair_key(i, ids[j]);
         }
         wb_kdtree_destroy(t);
     }
     p->nd = unique_u64(p->pairs, n);
+    return WB_OK;
+}
+
+/* what the plan derives obeys the builders' rules (builders.c): finite positions, a
+ * bounding box whose diagonal squared is finite (so no link's length squared, and no
+ * rest length, overflows), a mass per particle with a finite inverse */
+static wb_status check_plan(const plan *p, wb_real mass)
+{
+    wb_real mn[3] = { INFINITY, INFINITY, INFINITY }, mx[3] = { -INFINITY, -INFINITY, -INFINITY };
+    for (int32_t i = 0; i < p->np; i++)
+        for (int c = 0; c < 3; c++) {
+            const wb_real x = p->pos[3 * i + c];
+            if (!isfinite(x)) return bad("a particle position is not finite (the mesh's extent overflows)");
+            mn[c] = fmin(mn[c], x);
+            mx[c] = fmax(mx[c], x);
+        }
+    wb_real dd = 0;
+    for (int c = 0; c < 3; c++) dd += (mx[c] - mn[c]) * (mx[c] - mn[c]);
+    if (!isfinite(dd)) return bad("the mesh is too large (its extent squared overflows; links need finite squared lengths)");
+    const wb_real pm = mass / (wb_real)p->np;
+    if (!(pm > 0) || !isfinite(1 / pm)) {
+        wb__set_error("mass: %g over %d particles is %g each, too small (its inverse overflows)", (double)mass,
+                      (int)p->np, (double)pm);
+        return WB_ERR_ARG;
+    }
     return WB_OK;
 }
 
@@ -199,6 +236,7 @@ wb_status wb_from_mesh(wb_world *w, const wb_mesh *m, const wb_from_mesh_def *d,
     memset(&p, 0, sizeof p);
     st = plan_particles(wm, d->target, &p);
     wb_mesh_destroy(wm);
+    if (st == WB_OK) st = check_plan(&p, d->mass);
     if (st == WB_OK) st = plan_links(&p, d->neighbours);
     if (st == WB_OK && p.nd > (size_t)WB_MAX_CONSTRAINTS) st = WB_ERR_LIMIT;
     if (st == WB_OK) st = wb__reserve(w, p.np, (int64_t)p.nd);

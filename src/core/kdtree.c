@@ -98,6 +98,7 @@ void wb_kdtree_destroy(wb_kdtree *t)
 /* the k best so far, sorted by (dist2, id) */
 typedef struct knn {
     int k, n;
+    int32_t skip;   /* original index never offered (-1: none) */
     int32_t *id;
     wb_real *d2;
 } knn;
@@ -106,6 +107,7 @@ static int worse(wb_real da, int32_t ia, wb_real db, int32_t ib) { return da > d
 
 static void offer(knn *r, wb_real d2, int32_t id)
 {
+    if (id == r->skip) return;
     if (r->n == r->k && !worse(r->d2[r->n - 1], r->id[r->n - 1], d2, id)) return;
     int i = r->n < r->k ? r->n++ : r->n - 1;
     while (i > 0 && worse(r->d2[i - 1], r->id[i - 1], d2, id)) {
@@ -143,18 +145,23 @@ static void search(const wb_kdtree *t, const wb_real *q, int32_t lo, int32_t hi,
     for (int32_t i = lo; i < hi; i++) offer(r, dist2(q, &t->p[3 * i]), t->id[i]);
 }
 
-int wb_kdtree_knn(const wb_kdtree *t, const wb_real q[3], int k, int32_t *ids, wb_real *d2)
+/* k is the capacity of ids and d2: never more than k are written, whatever ties there are */
+int wb_kdtree_knn_except(const wb_kdtree *t, const wb_real q[3], int k, int32_t skip, int32_t *ids, wb_real *d2)
 {
-    enum { MAXK = 64 };
-    int32_t id_buf[MAXK];
-    wb_real d_buf[MAXK];
+    int32_t id_buf[WB_KDTREE_MAXK];
+    wb_real d_buf[WB_KDTREE_MAXK];
     if (k <= 0 || t->n == 0) return 0;
-    if (k > MAXK) k = MAXK;
-    knn r = { k, 0, id_buf, d_buf };
+    if (k > WB_KDTREE_MAXK) k = WB_KDTREE_MAXK;
+    knn r = { k, 0, skip, id_buf, d_buf };
     search(t, q, 0, t->n, &r);
     for (int i = 0; i < r.n; i++) {
         if (ids) ids[i] = r.id[i];
         if (d2) d2[i] = r.d2[i];
     }
     return r.n;
+}
+
+int wb_kdtree_knn(const wb_kdtree *t, const wb_real q[3], int k, int32_t *ids, wb_real *d2)
+{
+    return wb_kdtree_knn_except(t, q, k, -1, ids, d2);
 }

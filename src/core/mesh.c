@@ -1,5 +1,6 @@
 /* mesh.c: triangle meshes in memory: creation, welding by position, normals, edges and
  * vertex clustering. No file formats here (io/mesh.c reads and writes them). */
+#include <float.h>
 #include <stdlib.h>
 
 #include "core.h"
@@ -72,16 +73,40 @@ wb_mesh *wb_mesh_copy(const wb_mesh *src)
     return m;
 }
 
+/* a power of two s with (largest extent of the box) * s near 1, within [2^-1000, 2^1000]:
+ * edges scaled by it neither overflow nor underflow in a cross product, and the scaling is
+ * exact, so ordinary meshes get the same bits as unscaled */
+static wb_real extent_scale(const wb_mesh *m)
+{
+    wb_real mn[3], mx[3], e = 0;
+    if (!wb_mesh_bounds(m, mn, mx)) return 1;
+    for (int c = 0; c < 3; c++) e = fmax(e, mx[c] / 2 - mn[c] / 2); /* halves: no overflow */
+    if (!(e > 0) || !isfinite(e)) return 1;
+    int ex;
+    frexp(e, &ex);
+    ex = ex < -1000 ? -1000 : ex > 1000 ? 1000 : ex;
+    return ldexp(1, -ex);
+}
+
 void wb_mesh_compute_normals(wb_mesh *m)
 {
     if (m->nv) memset(m->n, 0, sizeof *m->n * 3 * (size_t)m->nv);
+    /* edges in units of the mesh's extent: a mesh of 1e-200 m (cross product underflows
+     * to 0) or 1e200 m (overflows to inf, then inf/inf = NaN) gets the same unit normals
+     * as one of 1 m */
+    const wb_real s = extent_scale(m);
     /* the unnormalised face normal is twice the area times the unit normal: summing it
      * weights each face by its area, so many thin slivers do not outvote one big face */
     for (int32_t i = 0; i < m->nt; i++) {
         const int32_t *t = &m->tri[3 * i];
+        const wb_real *a = &m->v[3 * t[0]], *b = &m->v[3 * t[1]], *c2 = &m->v[3 * t[2]];
         wb_real e1[3], e2[3], c[3];
-        v3_sub(e1, &m->v[3 * t[1]], &m->v[3 * t[0]]);
-        v3_sub(e2, &m->v[3 * t[2]], &m->v[3 * t[0]]);
+        for (int k = 0; k < 3; k++) {
+            /* scale before subtracting when shrinking (1e308 - -1e308 overflows), after when
+             * growing (tiny coordinates far from the origin keep their difference) */
+            e1[k] = s <= 1 ? b[k] * s - a[k] * s : (b[k] - a[k]) * s;
+            e2[k] = s <= 1 ? c2[k] * s - a[k] * s : (c2[k] - a[k]) * s;
+        }
         v3_cross(c, e1, e2);
         for (int k = 0; k < 3; k++) v3_add(&m->n[3 * t[k]], &m->n[3 * t[k]], c);
     }
@@ -110,7 +135,13 @@ wb_real wb_mesh_weld_tolerance(const wb_mesh *m)
     wb_real mn[3], mx[3];
     if (!wb_mesh_bounds(m, mn, mx)) return 0;
     const wb_real d[3] = { mx[0] - mn[0], mx[1] - mn[1], mx[2] - mn[2] };
-    return 1e-6 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    const wb_real dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    if ((dd >= DBL_MIN && isfinite(dd)) || (d[0] == 0 && d[1] == 0 && d[2] == 0)) return 1e-6 * sqrt(dd);
+    /* the diagonal squared underflows (a 1e-200 m mesh) or overflows (1e200 m): its length
+     * without squaring; when the box itself overflows (1e308 - -1e308), from halves */
+    if (isfinite(d[0]) && isfinite(d[1]) && isfinite(d[2])) return 1e-6 * v3_len_safe(d);
+    const wb_real h[3] = { mx[0] / 2 - mn[0] / 2, mx[1] / 2 - mn[1] / 2, mx[2] / 2 - mn[2] / 2 };
+    return 2e-6 * v3_len_safe(h);
 }
 
 void wb_mesh_transform(wb_mesh *m, wb_real scale, const wb_real offset[3])
@@ -213,7 +244,10 @@ wb_status wb_mesh_weld(wb_mesh *m, wb_real tol, int32_t *remap)
         grid_free(&g);
         return WB_ERR_NOMEM;
     }
+    /* d.d <= tol^2 squares lengths: for a tolerance whose square leaves the normal range
+     * (tol > 1e154 overflows, tol < 1e-154 underflows) compare in units of tol instead */
     const wb_real tol2 = tol * tol;
+    const int scaled = tol > 0 && !(tol2 >= DBL_MIN && isfinite(tol2));
     const int32_t nv_old = m->nv;
     int32_t nv = 0;
     for (int32_t i = 0; i < m->nv; i++) {
@@ -231,8 +265,10 @@ wb_status wb_mesh_weld(wb_mesh *m, wb_real tol, int32_t *remap)
                         if (memcmp(&g.cell[3 * e], cc, sizeof cc)) continue;
                         const int32_t k = g.val[e];
                         wb_real d[3];
-                        v3_sub(d, &m->v[3 * k], x);
-                        if ((tol > 0 ? v3_dot(d, d) <= tol2 : 1) && (best < 0 || k < best)) best = k;
+                        const wb_real *y = &m->v[3 * k];
+                        if (scaled) for (int q = 0; q < 3; q++) d[q] = y[q] / tol - x[q] / tol;
+                        else v3_sub(d, y, x);
+                        if ((tol > 0 ? v3_dot(d, d) <= (scaled ? 1 : tol2) : 1) && (best < 0 || k < best)) best = k;
                     }
                 }
         if (best >= 0) {
@@ -329,6 +365,11 @@ int32_t wb_mesh_cluster(const wb_mesh *m, int32_t target, int32_t *cluster)
     if (!wb_mesh_bounds(m, mn, mx)) return 0;
     v3_sub(d, mx, mn);
     const wb_real diag = v3_len(d);
+    if (!isfinite(diag)) {
+        /* cells are anchored at the minimum: offsets from it would overflow too */
+        wb__set_error("the mesh is too large to cluster (its bounding box's diagonal overflows)");
+        return WB_ERR_ARG;
+    }
     if (diag == 0 || target >= m->nv) {
         /* a single point is one cluster; a target past the vertex count keeps every vertex */
         for (int32_t i = 0; i < m->nv; i++) cluster[i] = diag == 0 ? 0 : i;

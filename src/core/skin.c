@@ -231,13 +231,24 @@ wb_skin *wb_skin_create(const wb_world *w, const wb_mesh *m, const int32_t *ids,
     wb_kdtree *t = wb_kdtree_build(s->x0, n);
     if (!t) { wb_skin_destroy(s); return NULL; }
     /* every vertex: its K nearest particles, one more for the weights' radius */
-    #pragma omp parallel for schedule(static) num_threads(s->threads) if (nv > 20000)
+    int32_t far = nv; /* the first vertex whose squared distance to a bone overflows */
+    #pragma omp parallel for schedule(static) num_threads(s->threads) if (nv > 20000) reduction(min : far)
     for (int32_t v = 0; v < nv; v++) {
         int32_t id[MAX_BONES + 1];
         wb_real d2[MAX_BONES + 1];
         int got = wb_kdtree_knn(t, &m->v[3 * v], k + 1, id, d2);
+        for (int j = 0; j < got; j++)
+            if (!isfinite(d2[j]) && v < far) far = v;
         vertex_weights(d2, got, k, &s->wt[(size_t)v * k]);
         for (int j = 0; j < k; j++) s->inf[(size_t)v * k + j] = j < got ? id[j] : 0;
+    }
+    if (far < nv) {
+        /* weights are d^2 / R^2 (inf / inf = NaN) and offsets v - x0 overflow: refuse */
+        wb_kdtree_destroy(t);
+        wb_skin_destroy(s);
+        wb__set_error("mesh vertex %d is too far from the particles (its squared distance overflows)", far + 1);
+        *status = WB_ERR_ARG;
+        return NULL;
     }
     for (size_t i = 0; i < (size_t)nv * k; i++)
         if (s->wt[i] > 0) s->used[s->inf[i]] = 1;
@@ -246,10 +257,10 @@ wb_skin *wb_skin_create(const wb_world *w, const wb_mesh *m, const int32_t *ids,
     for (int32_t b = 0; b < n; b++) {
         s->nbr_start[b] = e;
         if (!s->used[b]) continue;
-        int32_t id[MAX_NEIGHBOURS + 1];
-        int got = wb_kdtree_knn(t, &s->x0[3 * b], def->neighbours + 1, id, NULL);
-        for (int j = 0; j < got; j++)
-            if (id[j] != b) s->nbr[e++] = id[j];
+        /* at most `neighbours` others, what nbr has room for per bone */
+        int32_t id[MAX_NEIGHBOURS];
+        int got = wb_kdtree_knn_except(t, &s->x0[3 * b], def->neighbours, b, id, NULL);
+        for (int j = 0; j < got; j++) s->nbr[e++] = id[j];
     }
     s->nbr_start[n] = e;
     wb_kdtree_destroy(t);

@@ -138,6 +138,11 @@ static const char *check_collider(const wb_image_collider *c)
     if (c->q0[0] * c->q0[0] + v3_dot(&c->q0[1], &c->q0[1]) < 1e-24) return "collider rotation must not be zero";
     if ((c->shape == WB_SHAPE_SPHERE || c->shape == WB_SHAPE_CAPSULE) && !(c->radius > 0)) return "collider radius must be > 0";
     if (c->shape == WB_SHAPE_BOX && !(c->half[0] > 0 && c->half[1] > 0 && c->half[2] > 0)) return "box half extents must be > 0";
+    if (c->shape == WB_SHAPE_CAPSULE) {
+        wb_real ab[3];
+        v3_sub(ab, c->b, c->a);
+        if (!isfinite(v3_dot(ab, ab))) return "capsule ends are too far apart (|b - a| squared overflows)";
+    }
     if (c->shape == WB_SHAPE_PLANE && !(v3_len(c->n) > 1e-12)) return "plane normal must not be zero";
     return NULL;
 }
@@ -164,6 +169,9 @@ const char *wb_image_check(const wb_image *g)
         wb_distance_def d = { g->d_alpha[i], g->d_beta[i], g->d_rest[i], g->d_yield[i], g->d_creep[i], g->d_break[i] };
         if ((e = wb_distance_def_check(&d))) return e;
         if (!(g->d_rest[i] >= 0)) return "rest length must be >= 0";
+        wb_real dx[3];
+        v3_sub(dx, &g->x[3 * b], &g->x[3 * a]);
+        if (!isfinite(v3_dot(dx, dx))) return "constraint particles are too far apart (their distance squared overflows)";
     }
     /* the free list is exactly the dead slots, each once (a mark per slot: linear) */
     if (g->nfree != dead) return "the free constraint slots do not match the dead ones";

@@ -44,8 +44,11 @@ project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const w
         const wb_real len2 = d0 * d0 + d1 * d1 + d2 * d2;
         /* immovable pair, or coincident particles: nothing to push along */
         if (wsum == 0 || len2 < (wb_real)1e-24) continue;
-        const wb_real len = sqrt(len2);
         const wb_real at = alpha[i] * inv_h2;
+        /* compliance/h^2 overflowed: the limit is a constraint with no stiffness (it would
+         * otherwise give inf * 0 = NaN below and undo the frame) */
+        if (isinf(at)) continue;
+        const wb_real len = sqrt(len2);
         wb_real num = rest[i] - len - at * lambda[i];
         wb_real den = wsum + at;
         if (damped) {
@@ -54,8 +57,15 @@ project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const w
             const wb_real *pa = &xp[3 * ia], *pc = &xp[3 * ic];
             const wb_real rel = ((xc[0] - pc[0]) - (xa[0] - pa[0])) * d0 + ((xc[1] - pc[1]) - (xa[1] - pa[1])) * d1 +
                                 ((xc[2] - pc[2]) - (xa[2] - pa[2])) * d2;
-            num -= gamma * rel / len;
-            den += gamma * wsum;
+            if (isinf(gamma)) {
+                /* alpha~ beta h overflowed: the limit gamma -> inf of num/den, a correction
+                 * that removes the relative velocity along d (inf * 0 would be NaN) */
+                num = -rel / len;
+                den = wsum;
+            } else {
+                num -= gamma * rel / len;
+                den += gamma * wsum;
+            }
         }
         /* s = dlambda / len, so the correction is s * d without normalising d */
         wb_real s = num / (den * len);
@@ -176,7 +186,10 @@ static void plasticity_and_breaking(wb_world *w)
         if (y > 0 && a > y) {
             /* flow towards the current length by the part of the strain past yield */
             const wb_real rate = m->d_creep[s] * dt < 1 ? m->d_creep[s] * dt : 1;
-            const wb_real r = rest + rate * (len - rest) * (a - y) / a;
+            /* the part past yield, (a - y)/a; a rest so small that the strain overflows
+             * (inf/inf = NaN would poison the rest for good) flows as if a were huge: 1 */
+            const wb_real past = isinf(a) ? 1 : (a - y) / a;
+            const wb_real r = rest + rate * (len - rest) * past;
             k->s_rest[i] = r;
             w->s.d_rest[s] = r;
         }

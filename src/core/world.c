@@ -1,5 +1,6 @@
 /* world.c: world lifetime, settings, particles and distance constraints. */
 #include <assert.h>
+#include <float.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -66,6 +67,16 @@ const char *wb_world_def_check(const wb_world_def *d)
     if (!(d->dt > 0) || !isfinite(d->dt) || d->dt > 10) return "dt must be in (0, 10] seconds";
     if (d->substeps < 1 || d->substeps > WB_MAX_SUBSTEPS) return "substeps must be in 1..10000";
     if (d->iterations < 1 || d->iterations > WB_MAX_ITERATIONS) return "iterations must be in 1..10000";
+    /* the step divides by h^2 (compliance/h^2, force = lambda/h^2) with h = dt/substeps:
+     * h^2 must be a normal double (h >= 1.5e-154 s), else 1/h^2 overflows, 0 * inf turns
+     * every position NaN and every frame is undone */
+#ifdef WB_FLOAT
+    const wb_real h2_min = FLT_MIN;
+#else
+    const wb_real h2_min = DBL_MIN;
+#endif
+    const wb_real h = d->dt / d->substeps;
+    if (!(h * h >= h2_min)) return "dt/substeps is too short: h = dt/substeps must be >= 1.5e-154 s (h*h underflows)";
     if (!(d->damping >= 0) || !isfinite(d->damping)) return "damping must be >= 0";
     if (d->solver != WB_SOLVER_GAUSS_SEIDEL && d->solver != WB_SOLVER_JACOBI) return "unknown solver";
     if (!(d->relaxation > 0 && d->relaxation < 2)) return "relaxation must be in (0, 2)";
@@ -245,7 +256,8 @@ const char *wb_distance_def_check(const wb_distance_def *d)
 {
     if (!(d->compliance >= 0) || !isfinite(d->compliance)) return "compliance must be >= 0";
     if (!(d->damping >= 0) || !isfinite(d->damping)) return "damping must be >= 0";
-    if (!isfinite(d->rest)) return "rest must be finite";
+    /* the solver works with squared lengths: a rest whose square overflows can never be met */
+    if (!isfinite(d->rest) || !isfinite(d->rest * d->rest)) return "rest must be finite (and below 1e154)";
     if (!(d->yield >= 0) || !isfinite(d->yield)) return "yield must be >= 0";
     if (!(d->creep >= 0) || !isfinite(d->creep)) return "creep must be >= 0";
     if (!(d->break_strain >= 0) || !isfinite(d->break_strain)) return "break_strain must be >= 0";
@@ -303,6 +315,17 @@ wb_distance_id wb_distance_add(wb_world *w, int32_t a, int32_t b, const wb_dista
         *status = WB_ERR_ARG;
         return none;
     }
+    /* the rest it derives obeys the same rule as a given one: particles so far apart that
+     * their distance squared overflows would give an infinite rest and freeze the world */
+    const wb_real *xa = &w->s.x[3 * a], *xb = &w->s.x[3 * b];
+    wb_real d[3];
+    v3_sub(d, xb, xa);
+    const wb_real rest = def->rest >= 0 ? def->rest : v3_len(d);
+    if (!isfinite(v3_dot(d, d))) {
+        wb__set_error("particles %d and %d are too far apart (their distance squared overflows)", a + 1, b + 1);
+        *status = WB_ERR_ARG;
+        return none;
+    }
     wb_model *m = &w->m;
     int32_t slot;
     if (m->nfree > 0) {
@@ -313,9 +336,6 @@ wb_distance_id wb_distance_add(wb_world *w, int32_t a, int32_t b, const wb_dista
         slot = m->nd++;
         m->d_gen[slot] = 0;
     }
-    const wb_real *xa = &w->s.x[3 * a], *xb = &w->s.x[3 * b];
-    wb_real d[3];
-    v3_sub(d, xb, xa);
     m->d_ij[2 * slot] = a;
     m->d_ij[2 * slot + 1] = b;
     m->d_alpha[slot] = def->compliance;
@@ -324,7 +344,7 @@ wb_distance_id wb_distance_add(wb_world *w, int32_t a, int32_t b, const wb_dista
     m->d_creep[slot] = def->creep;
     m->d_break[slot] = def->break_strain;
     m->d_gen[slot]++; /* even -> odd: live */
-    w->s.d_rest[slot] = def->rest >= 0 ? def->rest : v3_len(d);
+    w->s.d_rest[slot] = rest;
     w->s.d_broken[slot] = 0;
     w->k.slot_pack[slot] = -1;
     m->nd_live++;

@@ -249,6 +249,14 @@ static int read_constraints(rd *r, const sections *s, const defaults *d, wb_imag
             jv_opt_nonneg(r, f[4], &p, "damping", &l.damping) || jv_opt_nonneg(r, f[5], &p, "yield", &l.yield) ||
             jv_opt_nonneg(r, f[6], &p, "creep", &l.creep) || jv_opt_nonneg(r, f[7], &p, "break_strain", &l.break_strain))
             return -1;
+        /* the solver squares lengths (wb_distance_add's rule): the particles' distance and
+         * the rest must have finite squares */
+        if (!isfinite(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]))
+            return jv_fail(r, f[1], 0, &pp, "the particles are too far apart (their distance squared overflows)");
+        if (!isfinite(l.rest * l.rest)) {
+            kp q = { &p, "rest", 0 };
+            return jv_fail(r, f[2] ? f[2] : f[1], 0, f[2] ? &q : &pp, "rest must be below 1e154 (its square overflows)");
+        }
         if (f[8]) {
             kp q = { &p, "broken", 0 };
             if (jv_get_bool(r, f[8], &q, &broken)) return -1;

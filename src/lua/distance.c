@@ -49,7 +49,9 @@ static int w_distance(lua_State *L)
     wb_distance_id *id = wbl_push_distance(L, 1, none); /* first: Lua may run out of memory */
     wb_status st = WB_OK;
     *id = wb_distance_add(w, a, b, &d, &st);
-    if (st != WB_OK) return wbl_status_error(L, 4, st, "distance constraint");
+    /* the options were checked above: an argument error now is about the particles
+     * (too far apart for a finite squared length) */
+    if (st != WB_OK) return wbl_status_error(L, st == WB_ERR_ARG ? 3 : 4, st, "distance constraint");
     return 1;
 }
 

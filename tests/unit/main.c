@@ -12,6 +12,25 @@
 
 #include "test.h"
 
+/* test_extreme.c: extreme but finite input */
+#define EXTREME_TESTS(X)                                 \
+    X(extreme_builders_refuse_overflowing_extents)       \
+    X(extreme_builders_refuse_underflowing_mass_per_particle) \
+    X(extreme_distance_refuses_overflowing_rest)         \
+    X(extreme_dt_that_cannot_step_refused)               \
+    X(extreme_compliance_over_h2_overflow_is_no_stiffness) \
+    X(extreme_weld_tolerance_of_huge_and_tiny_boxes)     \
+    X(extreme_normals_of_tiny_and_huge_triangles)        \
+    X(extreme_from_mesh_refuses_overflowing_extent)      \
+    X(extreme_kdtree_knn_except_bounded_under_ties)      \
+    X(extreme_from_mesh_neighbours_with_ties)            \
+    X(extreme_skin_neighbours_with_ties)                 \
+    X(extreme_skin_refuses_vertices_out_of_range)        \
+    X(extreme_damping_overflow_is_the_infinitely_damped_limit) \
+    X(extreme_plastic_flow_of_a_tiny_rest_stays_finite)  \
+    X(extreme_collider_derived_poses_finite)             \
+    X(extreme_cluster_refuses_overflowing_box)
+
 /* every test, in the order they run: add a line here for each TEST() */
 #define TEST_LIST(X)                             \
     X(world_def_defaults)                        \
@@ -69,7 +88,8 @@
     X(collider_absurd_velocity_recovers)         \
     X(hash_covers_collider_velocity_mass_radius) \
     X(memory_budget_shared_by_worlds)           \
-    X(distance_ids_match_distance_at)
+    X(distance_ids_match_distance_at)            \
+    EXTREME_TESTS(X)
 
 #define DECLARE(name) TEST(name);
 #define ENTRY(name) { #name, test_##name },
