@@ -7,6 +7,7 @@
 #       the output of (b)                       no warning/assert/error line that no test announced
 #   (d) tests/cli/run.sh                        the command line in separate processes
 #       tests/cli/sandbox.sh                    escapes from the file rules, in separate processes
+#       tests/cli/extreme.sh                    extreme input (overflowing builders, rest lengths, KNN ties)
 #   (e) tests/render/run.sh                     wobble run --record, encoders that fail
 #   (f) tests/layers.sh                         the layers of DESIGN §1: no upward call, no circle
 #   (g) tests/cli/firstrun.sh                   what a new user meets: make deps, bench --frames, print
