@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <poll.h>
 #include <signal.h>
 #include <spawn.h>
 #include <stdio.h>
@@ -21,8 +22,11 @@
 #pragma GCC diagnostic pop
 
 /* run argv[0] and collect its standard output (malloc'd, NUL added, *len bytes; what
- * passes max is read and dropped so the program never blocks); *ok: it exited 0 */
-static char *capture(const char *const argv[], size_t max, size_t *len, bool *ok, char *err, size_t n)
+ * passes max is read and dropped so the program never blocks); *ok: it exited 0. The
+ * helper may wait forever (a FIFO, a live stream): `stop` is asked every 100 ms while
+ * it runs, and when it answers true the helper is killed and the call fails. */
+static char *capture(const char *const argv[], size_t max, const wb_media_stop *stop, size_t *len, bool *ok,
+                     char *err, size_t n)
 {
     int pfd[2];
     *ok = false;
@@ -40,7 +44,19 @@ static char *capture(const char *const argv[], size_t max, size_t *len, bool *ok
     }
     size_t got = 0, cap = 4096;
     char *out = malloc(cap + 1), drop[4096];
+    bool stopped = false;
     for (;;) {
+        if (stop && stop->fn) {
+            struct pollfd p = { pfd[0], POLLIN, 0 };
+            int r = poll(&p, 1, 100);
+            if (r < 0 && errno != EINTR) break;
+            if (stop->fn(stop->ud)) {
+                stopped = true;
+                kill(pid, SIGKILL);
+                break;
+            }
+            if (r <= 0) continue;
+        }
         if (out && got == cap && cap < max) {
             size_t c = cap * 2 < max ? cap * 2 : max;
             char *q = realloc(out, c + 1);
@@ -56,6 +72,11 @@ static char *capture(const char *const argv[], size_t max, size_t *len, bool *ok
     close(pfd[0]);
     int status = 0;
     while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
+    if (stopped) {
+        free(out);
+        snprintf(err, n, "%s was stopped: a budget of the script ran out", argv[0]);
+        return NULL;
+    }
     if (!out) {
         snprintf(err, n, "out of memory reading what %s wrote", argv[0]);
         return NULL;
@@ -78,7 +99,7 @@ static void ff_input(char *in, size_t n, const char *path)
     snprintf(in, n, "file:%s%s", path[0] == '/' ? "" : "./", path);
 }
 
-bool wb_media_probe(const char *path, wb_media_info *info, char *err, size_t n)
+bool wb_media_probe(const char *path, wb_media_info *info, const wb_media_stop *stop, char *err, size_t n)
 {
     memset(info, 0, sizeof *info);
     const char *e = strrchr(path, '.');
@@ -105,7 +126,7 @@ bool wb_media_probe(const char *path, wb_media_info *info, char *err, size_t n)
                            "default=noprint_wrappers=1", in, NULL };
     size_t len;
     bool ok;
-    char *out = capture(argv, 65536, &len, &ok, err, n);
+    char *out = capture(argv, 65536, stop, &len, &ok, err, n);
     if (!out) return false;
     char *save = NULL;
     for (char *line = strtok_r(out, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
@@ -128,7 +149,8 @@ bool wb_media_probe(const char *path, wb_media_info *info, char *err, size_t n)
     return true;
 }
 
-uint8_t *wb_media_read_frame(const char *path, int64_t index, int *w, int *h, char *err, size_t n)
+uint8_t *wb_media_read_frame(const char *path, int64_t index, const wb_media_stop *stop, int *w, int *h, char *err,
+                             size_t n)
 {
     if (access(path, R_OK) != 0) {
         snprintf(err, n, "cannot read %s: %s", path, strerror(errno));
@@ -143,7 +165,7 @@ uint8_t *wb_media_read_frame(const char *path, int64_t index, int *w, int *h, ch
                            "-frames:v", "1", "-f", "image2pipe", "-c:v", "png", "pipe:1", NULL };
     size_t len;
     bool ok;
-    char *out = capture(argv, (size_t)1 << 30, &len, &ok, err, n);
+    char *out = capture(argv, (size_t)1 << 30, stop, &len, &ok, err, n);
     if (!out) return NULL;
     int comp;
     uint8_t *px = ok && len ? stbi_load_from_memory((const unsigned char *)out, (int)len, w, h, &comp, 3) : NULL;
