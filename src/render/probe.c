@@ -12,6 +12,7 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "render.h"
@@ -70,8 +71,20 @@ static char *capture(const char *const argv[], size_t max, const wb_media_stop *
         if (keep) got += (size_t)k;
     }
     close(pfd[0]);
+    /* a helper may close its output and still not end: the same question while it runs */
     int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
+    for (;;) {
+        bool ask = stop && stop->fn && !stopped;
+        pid_t k = waitpid(pid, &status, ask ? WNOHANG : 0);
+        if (k == pid || (k < 0 && errno != EINTR)) break;
+        if (k == 0 && stop->fn(stop->ud)) {
+            stopped = true;
+            kill(pid, SIGKILL);
+        } else if (k == 0) {
+            struct timespec ts = { 0, 10000000 };
+            nanosleep(&ts, NULL);
+        }
+    }
     if (stopped) {
         free(out);
         snprintf(err, n, "%s was stopped: a budget of the script ran out", argv[0]);
