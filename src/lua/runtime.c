@@ -26,14 +26,17 @@
 
 #define HOOK_COUNT (1 << 20)          /* instructions between two budget checks */
 #define MEM_SLACK ((size_t)64 << 20)  /* granted past the memory limit so the error can be reported */
-#define GRACE_MIN 2.0                 /* the watchdog's grace: 2 s or 10% of the limit, the longer */
+#define GRACE_MIN 5.0                 /* the watchdog's grace: 5 s or 10% of the limit, the longer */
 #define GRACE_PART 0.1
+#define REARM_SIGNAL SIGURG           /* ignored by default: one arriving after close does nothing */
 
 /* The watchdog: a thread that sleeps until the deadline of --time-limit, raises
  * `expired` (the budget checks read it) and, when the script has not come back to a
  * budget check a grace period later (a __gc finalizer, which Lua runs without hooks;
  * one long C call such as a backtracking string.find; a blocking read), ends the
- * process itself: children killed, `words` on stdout, `msg` on stderr, exit code 3. */
+ * process itself: children killed, `words` on stdout, `msg` on stderr, exit code 3.
+ * The grace leaves room for checks that do come, only late: a step polls once per
+ * substep, and one substep of a heavy scene under sanitizers takes seconds. */
 typedef struct watchdog {
     pthread_t th;
     int on;                           /* the thread runs */
@@ -44,6 +47,9 @@ typedef struct watchdog {
     double resumed;                   /* the last end of a pause: the grace counts from it */
     double deadline, grace;
     atomic_int expired;               /* the deadline passed */
+    pthread_t main;                   /* the thread running the script: REARM_SIGNAL goes to it */
+    int rearm;                        /* this runtime owns REARM_SIGNAL's handler (one runtime at a time) */
+    struct sigaction old_sa;          /* the handler before ours */
     char msg[PATH_MAX + 512];         /* made in advance: the thread only writes it */
     char words[2048];                 /* wb_rt_set_last_words */
 } watchdog;
@@ -240,6 +246,22 @@ static _Noreturn void end_process(watchdog *wd) {
     _exit(3);  /* DESIGN §4: a budget was exceeded */
 }
 
+/* The state whose hook the deadline re-arms. At the deadline the watchdog signals the
+ * script's thread, whose handler sets the count hook to 1 instruction: a loop whose
+ * every few instructions call a slow C function (string.rep of megabytes) would
+ * otherwise reach the next check only after 2^20 of them. Lua allows lua_sethook in a
+ * signal handler (ldebug.c) but not from another thread; the handler runs on the
+ * script's thread, so wb_rt_close clearing the pointer first is enough. */
+static lua_State *_Atomic rearm_state;
+
+static void rearm(int sig) {
+    (void)sig;
+    int e = errno;
+    lua_State *L = atomic_load(&rearm_state);
+    if (L) lua_sethook(L, rt_hook, LUA_MASKCOUNT, 1);
+    errno = e;
+}
+
 static struct timespec monotonic_at(double t) {
     struct timespec ts;
     ts.tv_sec = (time_t)t;
@@ -258,6 +280,7 @@ static void *watchdog_main(void *arg) {
             if (t >= wd->deadline) {
                 /* the hook, the step's interrupt and the probes read this */
                 atomic_store(&wd->expired, 1);
+                if (wd->rearm) pthread_kill(wd->main, REARM_SIGNAL);
                 continue;
             }
             wake = wd->deadline;
@@ -279,7 +302,7 @@ static void *watchdog_main(void *arg) {
 
 /* only with a time budget; without a thread (it could not start) the hook and the
  * clock hold the budget wherever they run */
-static void watchdog_start(rt_state *rt) {
+static void watchdog_start(rt_state *rt, lua_State *L) {
     watchdog *wd = &rt->wd;
     double limit = rt->pub.time_budget;
     if (limit <= 0) return;
@@ -300,6 +323,18 @@ static void watchdog_start(rt_state *rt) {
         pthread_cond_destroy(&wd->cv);
         return;
     }
+    /* the re-arm signal, when no other runtime has it (SA_RESTART: reads go on) */
+    lua_State *none = NULL;
+    wd->main = pthread_self();
+    if (atomic_compare_exchange_strong(&rearm_state, &none, L)) {
+        struct sigaction sa;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = rearm;
+        sa.sa_flags = SA_RESTART;
+        sigemptyset(&sa.sa_mask);
+        if (sigaction(REARM_SIGNAL, &sa, &wd->old_sa) == 0) wd->rearm = 1;
+        else atomic_store(&rearm_state, NULL);
+    }
     /* signals (SIGINT, SIGPIPE of the script's writes) stay the main thread's */
     sigset_t all, old;
     sigfillset(&all);
@@ -309,6 +344,11 @@ static void watchdog_start(rt_state *rt) {
     if (e) {
         pthread_mutex_destroy(&wd->mu);
         pthread_cond_destroy(&wd->cv);
+        if (wd->rearm) {
+            atomic_store(&rearm_state, NULL);
+            sigaction(REARM_SIGNAL, &wd->old_sa, NULL);
+            wd->rearm = 0;
+        }
         return;
     }
     wd->on = 1;
@@ -324,6 +364,8 @@ static void watchdog_stop(rt_state *rt) {
     pthread_join(wd->th, NULL);
     pthread_mutex_destroy(&wd->mu);
     pthread_cond_destroy(&wd->cv);
+    if (wd->rearm) sigaction(REARM_SIGNAL, &wd->old_sa, NULL);  /* rearm_state is NULL by now */
+    wd->rearm = 0;
     wd->on = 0;
 }
 
@@ -502,7 +544,7 @@ lua_State *wb_rt_open(const wb_runtime *cfg) {
         return NULL;
     }
     lua_sethook(L, rt_hook, LUA_MASKCOUNT, HOOK_COUNT);
-    watchdog_start(rt);
+    watchdog_start(rt, L);
     return L;
 }
 
@@ -510,6 +552,8 @@ int wb_rt_close(lua_State *L) {
     if (!L) return 0;
     rt_state *rt = rt_from(L);
     int before = rt && time_over(rt);
+    /* no re-arm from here on: the state goes (finalizers run without hooks anyway) */
+    if (rt && rt->wd.rearm) atomic_store(&rearm_state, NULL);
     /* finalizers may allocate past a spent memory budget, but the time budget stays:
      * Lua runs them without hooks, and the watchdog ends one that never returns */
     if (rt) rt->pub.memory_budget = rt->pub.memory.limit = 0;

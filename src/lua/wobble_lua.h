@@ -57,7 +57,7 @@ int wb_rt_close(lua_State *L);                /* lua_close (finalizers run under
 int wb_rt_budget_hit(lua_State *L);           /* 1 once a budget error was raised: exit code 3 */
 int wb_rt_msgh(lua_State *L);                 /* lua_pcall message handler: message (any value) + traceback */
 void wb_rt_add_frame_hook(lua_State *L, int index); /* wb_rt_after_frame calls the function at index(w) */
-/* --time-limit's watchdog: a thread that, a grace period past the limit (2 s or 10% of
+/* --time-limit's watchdog: a thread that, a grace period past the limit (5 s or 10% of
  * the limit, the longer), ends a script that never came back to a budget check (a __gc
  * finalizer, one long C call): children killed, the last words on stdout, a message
  * naming cfg->script on stderr, exit code 3. Paused, it waits (the caller's own
