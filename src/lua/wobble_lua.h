@@ -60,9 +60,10 @@ void wb_rt_add_frame_hook(lua_State *L, int index); /* wb_rt_after_frame calls t
 /* --time-limit's watchdog: a thread that, a grace period past the limit (5 s or 10% of
  * the limit, the longer), ends a script that never came back to a budget check (a __gc
  * finalizer, one long C call): children killed, the last words on stdout, a message
- * naming cfg->script on stderr, exit code 3. Paused, it waits (the caller's own
- * cleanup, bounded by its own timeouts, such as finishing a recording); the grace
- * counts again from the end of the pause. */
+ * naming cfg->script on stderr, exit code 3. At the limit itself it signals the opening
+ * thread (SIGURG, handled while the state is open) to check every instruction. Paused,
+ * it waits (the caller's own cleanup, bounded by its own timeouts, such as finishing a
+ * recording); the grace counts again from the end of the pause. */
 void wb_rt_pause_watchdog(lua_State *L, int paused);
 void wb_rt_set_last_words(lua_State *L, const char *text);  /* stdout text for that end (TAP); NULL: none */
 const char *wb_rt_lib_dir(void);              /* the folder holding wobble/test.lua, or NULL */
