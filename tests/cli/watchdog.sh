@@ -95,6 +95,14 @@ run run $F/slow_calls.lua --time-limit 2
 check "slow C calls between hook checks stop at the script's line (${secs} s)" 3 \
     err "$F/slow_calls.lua:5: $LIMIT" !err "grace period"
 
+# a read of standard input that never ends: a FIFO held open (fd 3) and never written
+mkfifo "$TMP/stdin.fifo"
+exec 3<>"$TMP/stdin.fifo"
+run run $F/stdin_read.lua --time-limit 2 <"$TMP/stdin.fifo"
+exec 3>&-
+check "io.read of a pipe that never ends: exit 3 (${secs} s)" 3 err "$F/stdin_read.lua: $LIMIT" \
+    !out "should not get here"
+
 # ---- helpers that wait forever: a FIFO no one writes to, under the output folder
 mkdir -p "$TMP/out-fifo"
 mkfifo "$TMP/out-fifo/live.fifo"
@@ -112,8 +120,8 @@ code=$?
 check "no ffmpeg left behind${stray:+ (pids$stray)}" 0
 
 # ---- the encoder of --record (a process group of its own) dies with the run
-run run $F/record_hang.lua --record "$TMP/rec/v.mp4" --out "$TMP/out" --time-limit 4
-check "stuck while recording: exit 3 (${secs} s)" 3 err "$F/record_hang.lua: time limit of 4 s exceeded" !out "should not get here"
+run run $F/record_hang.lua --record "$TMP/rec/v.mp4" --out "$TMP/out" --time-limit 3
+check "stuck while recording: exit 3 (${secs} s)" 3 err "$F/record_hang.lua: time limit of 3 s exceeded" !out "should not get here"
 
 # an encoder that takes no frame and never ends, even at the end of its input: only
 # the kill of its process group ends it
@@ -121,9 +129,9 @@ mkdir -p "$TMP/fakebin"
 printf '#!/bin/sh\nwhile :; do sleep 1; done\n' >"$TMP/fakebin/stuck-encoder"
 chmod +x "$TMP/fakebin/stuck-encoder"
 export WOBBLE_FFMPEG="$TMP/fakebin/stuck-encoder"
-run run $F/record_hang.lua --record "$TMP/rec2/v.mp4" --out "$TMP/out" --time-limit 4
+run run $F/record_hang.lua --record "$TMP/rec2/v.mp4" --out "$TMP/out" --time-limit 3
 unset WOBBLE_FFMPEG
-check "stuck while a stuck encoder records: exit 3 (${secs} s)" 3 err "$F/record_hang.lua: time limit of 4 s exceeded"
+check "stuck while a stuck encoder records: exit 3 (${secs} s)" 3 err "$F/record_hang.lua: time limit of 3 s exceeded"
 stray=$(left "$TMP/fakebin/stuck-encoder")
 code=$?
 check "the stuck encoder is killed with its process group${stray:+ (pids$stray)}" 0
