@@ -328,6 +328,7 @@ static lua_State *open_state(const opts *o, const char *script, int harness, con
     else if (slash == dir) dir[1] = 0;
     else *slash = 0;
     cfg.scene_dir = dir;
+    cfg.script = script;  /* named by the watchdog when it ends the run */
     lua_State *L = wb_rt_open(&cfg);
     *err = NULL;
     if (!L) return *err = "cannot start the Lua runtime", NULL;
@@ -347,17 +348,17 @@ static lua_State *open_state(const opts *o, const char *script, int harness, con
 
 typedef struct tap { int n, passed, failed, code; } tap;
 
-static void yaml_string(const char *s, size_t n) {
-    putchar('"');
+static void yaml_string(FILE *f, const char *s, size_t n) {
+    fputc('"', f);
     for (size_t i = 0; i < n; i++) {
         unsigned char c = (unsigned char)s[i];
-        if (c == '"' || c == '\\') printf("\\%c", c);
-        else if (c == '\n') printf("\\n");
-        else if (c == '\t') printf("\\t");
-        else if (c < 0x20) printf("\\x%02x", c);
-        else putchar(c);
+        if (c == '"' || c == '\\') fprintf(f, "\\%c", c);
+        else if (c == '\n') fprintf(f, "\\n");
+        else if (c == '\t') fprintf(f, "\\t");
+        else if (c < 0x20) fprintf(f, "\\x%02x", c);
+        else fputc(c, f);
     }
-    putchar('"');
+    fputc('"', f);
 }
 
 /* frames of the harness itself and of the C error function tell the reader nothing */
@@ -388,40 +389,62 @@ static void print_error(const char *msg) {
     }
 }
 
-static void tap_result(tap *t, int code, const char *file, const char *name, const char *err) {
-    t->n++;
-    if (code == EXIT_PASS) t->passed++;
-    else t->failed++;
-    if (code > t->code) t->code = code;
-    printf("%sok %d - %s: ", code == EXIT_PASS ? "" : "not ", t->n, file);
+/* the TAP line of test n and, for a failure, its YAML block */
+static void tap_line(FILE *f, int n, int code, const char *file, const char *name, const char *err) {
+    fprintf(f, "%sok %d - %s: ", code == EXIT_PASS ? "" : "not ", n, file);
     for (const char *s = name; *s; s++) {  /* '#' starts a TAP directive */
-        if (*s == '#') putchar('\\');
-        putchar(*s == '\n' ? ' ' : *s);
+        if (*s == '#') fputc('\\', f);
+        fputc(*s == '\n' ? ' ' : *s, f);
     }
-    putchar('\n');
+    fputc('\n', f);
     if (err) {
         const char *tb = strstr(err, "\nstack traceback:\n");
-        printf("  ---\n  message: ");
-        yaml_string(err, tb ? (size_t)(tb - err) : strlen(err));
-        putchar('\n');
+        fprintf(f, "  ---\n  message: ");
+        yaml_string(f, err, tb ? (size_t)(tb - err) : strlen(err));
+        fputc('\n', f);
         if (tb) {
             int header = 0;
             for (const char *s = tb + 18; *s;) {
                 const char *e = strchr(s, '\n');
                 size_t n = e ? (size_t)(e - s) : strlen(s);
                 if (!noise(s, n)) {
-                    if (!header) printf("  traceback: |-\n");
+                    if (!header) fprintf(f, "  traceback: |-\n");
                     header = 1;
                     while (n && *s == '\t') s++, n--;
-                    printf("    %.*s\n", (int)n, s);
+                    fprintf(f, "    %.*s\n", (int)n, s);
                 }
                 s += n + (e != NULL);
                 if (!e) break;
             }
         }
-        printf("  ...\n");
+        fprintf(f, "  ...\n");
     }
+}
+
+static void tap_result(tap *t, int code, const char *file, const char *name, const char *err) {
+    t->n++;
+    if (code == EXIT_PASS) t->passed++;
+    else t->failed++;
+    if (code > t->code) t->code = code;
+    tap_line(stdout, t->n, code, file, name, err);
     fflush(stdout);
+}
+
+/* What the watchdog prints on stdout should it end the process while `what` runs (a
+ * finalizer or a C call that never returns past --time-limit): that test failed and
+ * the summary, so the TAP stream ends as it does for any other budget. */
+static void tap_last_words(lua_State *L, const tap *t, const char *file, const char *what) {
+    double limit = wb_rt_get(L)->time_budget;
+    char *buf = NULL, msg[PATH_MAX + 256];
+    size_t len = 0;
+    FILE *f;
+    if (limit <= 0 || !(f = open_memstream(&buf, &len))) return;
+    snprintf(msg, sizeof msg, "%s: time limit of %g s exceeded (--time-limit SECONDS); ended by the watchdog", file,
+             limit);
+    tap_line(f, t->n + 1, EXIT_BUDGET, file, what, msg);
+    fprintf(f, "1..%d\n%d passed, %d failed\n", t->n + 1, t->passed, t->failed + 1);
+    if (fclose(f) == 0) wb_rt_set_last_words(L, buf);
+    free(buf);
 }
 
 /* how many cases the chunk registered with wobble.test */
@@ -456,6 +479,7 @@ static int run_cases(lua_State *L, const char *file, tap *t) {
         lua_setfield(L, m, "_first_failure");
         lua_pushboolean(L, 1);
         lua_setfield(L, m, "_running");
+        tap_last_words(L, t, file, name);
         lua_getfield(L, -2, "fn");
         int status = pcall_top(L);
         lua_pushboolean(L, 0);
@@ -480,6 +504,7 @@ static int run_cases(lua_State *L, const char *file, tap *t) {
         lua_settop(L, cases);
         if (wb_rt_budget_hit(L)) break;  /* every further instruction would fail too */
     }
+    wb_rt_set_last_words(L, NULL);
     lua_settop(L, top);
     return n;
 }
@@ -538,6 +563,18 @@ static void list_free(list *l) {
     free(l->v);
 }
 
+/* the finalizers run under the time budget: past it, they fail the file */
+static void close_test_state(lua_State *L, tap *t, const char *path) {
+    double limit = wb_rt_get(L)->time_budget;
+    tap_last_words(L, t, path, "closing the file (finalizers)");
+    if (wb_rt_close(L)) {
+        char msg[PATH_MAX + 128];
+        snprintf(msg, sizeof msg, "%s: time limit of %g s exceeded (--time-limit SECONDS) while the finalizers (__gc) ran",
+                 path, limit);
+        tap_result(t, EXIT_BUDGET, path, "closing the file (finalizers)", msg);
+    }
+}
+
 static void test_file(const char *path, const opts *o, tap *t) {
     const char *err;
     lua_State *L = open_state(o, path, 1, &err);
@@ -545,13 +582,14 @@ static void test_file(const char *path, const opts *o, tap *t) {
         tap_result(t, EXIT_SCRIPT, path, "loading the file", err);
         return;
     }
+    tap_last_words(L, t, path, "loading the file");
     int status = run_file(L, path);
     const char *caught;
     if (status != LUA_OK) {
         const char *msg;
         int code = failure(L, status, path, &msg);
         tap_result(t, code, path, "loading the file", msg);
-        wb_rt_close(L);
+        close_test_state(L, t, path);
         return;
     }
     if ((caught = caught_failure(L))) {  /* an expectation at the top of the file */
@@ -562,7 +600,7 @@ static void test_file(const char *path, const opts *o, tap *t) {
         tap_result(t, EXIT_FAILED, path, "no test cases",
                    "the file defines no test cases: call test(name, function() ... end)");
     }
-    wb_rt_close(L);
+    close_test_state(L, t, path);
 }
 
 static int cmd_test(const opts *o) {
@@ -645,11 +683,17 @@ static int run_scene(const opts *o, const char *path) {
             code = EXIT_BUDGET;
         }
     }
+    wb_rt_pause_watchdog(L, 1);  /* finishing the file has the encoder's own timeouts */
     if (o->record && !wbl_record_end(L, rerr, sizeof rerr)) {
         fprintf(stderr, "wobble: --record: %s\n", rerr);
         if (code == EXIT_PASS) code = EXIT_SCRIPT;
     }
-    wb_rt_close(L);
+    wb_rt_pause_watchdog(L, 0);
+    if (wb_rt_close(L) && code < EXIT_BUDGET) {  /* finalizers ran past the limit */
+        fprintf(stderr, "%s: time limit of %g s exceeded (--time-limit SECONDS) while the finalizers (__gc) ran at the end\n",
+                path, o->rt.time_budget);
+        code = EXIT_BUDGET;
+    }
     return code;
 }
 

@@ -414,7 +414,10 @@ static int l_probe(lua_State *L)
     char buf[PATH_MAX], err[PATH_MAX + 128];
     const char *path = script_path(L, 1, 0, buf, sizeof buf);
     wb_media_info mi;
-    if (!wb_media_probe(path, &mi, err, sizeof err)) {
+    wb_media_stop stop;
+    wb_rt_interrupt(L, &stop.fn, &stop.ud);   /* ffprobe may wait forever (a FIFO): the budgets end it */
+    if (!wb_media_probe(path, &mi, &stop, err, sizeof err)) {
+        wb_rt_check_budgets(L);
         luaL_pushfail(L);
         lua_pushstring(L, err);
         return 2;
@@ -463,8 +466,11 @@ static int l_read_frame(lua_State *L)
     lua_Integer index = luaL_optinteger(L, 2, 0);
     luaL_argcheck(L, index >= 0, 2, "frame index must be >= 0");
     int w, h;
-    uint8_t *px = wb_media_read_frame(path, (int64_t)index, &w, &h, err, sizeof err);
+    wb_media_stop stop;
+    wb_rt_interrupt(L, &stop.fn, &stop.ud);
+    uint8_t *px = wb_media_read_frame(path, (int64_t)index, &stop, &w, &h, err, sizeof err);
     if (!px) {
+        wb_rt_check_budgets(L);
         luaL_pushfail(L);
         lua_pushstring(L, err);
         return 2;

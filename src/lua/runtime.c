@@ -1,14 +1,21 @@
 /* runtime.c: what runs around a scene script. The sandbox of DESIGN §4 (no
  * process control, no bytecode, no debug library, file access through path rules),
- * the budgets (memory through the allocator, wall time through a count hook and
- * after every frame) and the discovery of the Lua library folder. */
+ * the budgets (memory through the allocator, wall time through a count hook, after
+ * every frame and a watchdog thread for what hooks never see) and the discovery of
+ * the Lua library folder. */
 #include "wobble_lua.h"
 #include "sandbox.h"
 
 #include <lualib.h>
 
+#include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
+#include <poll.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdatomic.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,6 +26,33 @@
 
 #define HOOK_COUNT (1 << 20)          /* instructions between two budget checks */
 #define MEM_SLACK ((size_t)64 << 20)  /* granted past the memory limit so the error can be reported */
+#define GRACE_MIN 5.0                 /* the watchdog's grace: 5 s or 10% of the limit, the longer */
+#define GRACE_PART 0.1
+#define REARM_SIGNAL SIGURG           /* ignored by default: one arriving after close does nothing */
+
+/* The watchdog: a thread that sleeps until the deadline of --time-limit, raises
+ * `expired` (the budget checks read it) and, when the script has not come back to a
+ * budget check a grace period later (a __gc finalizer, which Lua runs without hooks;
+ * one long C call such as a backtracking string.find; a blocking read), ends the
+ * process itself: children killed, `words` on stdout, `msg` on stderr, exit code 3.
+ * The grace leaves room for checks that do come, only late: a step polls once per
+ * substep, and one substep of a heavy scene under sanitizers takes seconds. */
+typedef struct watchdog {
+    pthread_t th;
+    int on;                           /* the thread runs */
+    pthread_mutex_t mu;               /* guards what follows but `expired` */
+    pthread_cond_t cv;                /* CLOCK_MONOTONIC; wakes the thread for stop and pause */
+    int stop;                         /* wb_rt_close: the thread ends */
+    int paused;                       /* the command line's own cleanup runs (wb_rt_pause_watchdog) */
+    double resumed;                   /* the last end of a pause: the grace counts from it */
+    double deadline, grace;
+    atomic_int expired;               /* the deadline passed */
+    pthread_t main;                   /* the thread running the script: REARM_SIGNAL goes to it */
+    int rearm;                        /* this runtime owns REARM_SIGNAL's handler (one runtime at a time) */
+    struct sigaction old_sa;          /* the handler before ours */
+    char msg[PATH_MAX + 512];         /* made in advance: the thread only writes it */
+    char words[2048];                 /* wb_rt_set_last_words */
+} watchdog;
 
 typedef struct rt_state {
     wb_runtime pub;                   /* first: what wb_rt_get hands out */
@@ -28,6 +62,7 @@ typedef struct rt_state {
     int budget_hit;                   /* a budget error was raised; it is raised again at every step */
     double t0;                        /* wall clock at wb_rt_open */
     char budget_msg[256];
+    watchdog wd;
 } rt_state;
 
 static const char frame_hooks_key = 0;  /* registry: array of frame hooks */
@@ -45,7 +80,7 @@ static rt_state *rt_from(lua_State *L) {
 wb_runtime *wb_rt_get(lua_State *L) {
     /* a state opened without the runtime (embedding, `require "wobble"` from lua) gets
      * permissive defaults so the binding never has to test for NULL */
-    static wb_runtime plain = { ".", "out", NULL, 1, 0, 0, -1, 0, 0, { 0, 0 }, NULL };
+    static wb_runtime plain = { ".", "out", NULL, 1, 0, 0, -1, 0, 0, { 0, 0 }, NULL, NULL };
     rt_state *rt = rt_from(L);
     return rt ? &rt->pub : &plain;
 }
@@ -107,12 +142,18 @@ int wb_rt_budget_error(lua_State *L, const char *fmt, ...) {
     return lua_error(L);
 }
 
+/* the watchdog's flag, or the clock when no watchdog runs (it could not start) */
+static int time_over(const rt_state *rt) {
+    if (rt->pub.time_budget <= 0) return 0;
+    return atomic_load_explicit(&rt->wd.expired, memory_order_relaxed) || now() - rt->t0 > rt->pub.time_budget;
+}
+
 static void check_budgets(lua_State *L, rt_state *rt) {
     if (rt->budget_hit) wb_rt_budget_error(L, "%s", rt->budget_msg);
     if (rt->mem_over)
         wb_rt_budget_error(L, "memory limit of %.0f MB exceeded (--memory-limit MB)",
                            rt->pub.memory_budget / 1048576.0);
-    if (rt->pub.time_budget > 0 && now() - rt->t0 > rt->pub.time_budget)
+    if (time_over(rt))
         wb_rt_budget_error(L, "time limit of %g s exceeded (--time-limit SECONDS)", rt->pub.time_budget);
 }
 
@@ -124,7 +165,7 @@ void wb_rt_check_budgets(lua_State *L) {
 /* called from inside a step, outside Lua: reads the clock and flags only */
 static int rt_interrupt(void *ud) {
     const rt_state *rt = ud;
-    return rt->budget_hit || rt->mem_over || (rt->pub.time_budget > 0 && now() - rt->t0 > rt->pub.time_budget);
+    return rt->budget_hit || rt->mem_over || time_over(rt);
 }
 
 void wb_rt_interrupt(lua_State *L, int (**fn)(void *), void **ud) {
@@ -142,6 +183,208 @@ static void rt_hook(lua_State *L, lua_Debug *ar) {
 int wb_rt_budget_hit(lua_State *L) {
     rt_state *rt = rt_from(L);
     return rt && (rt->budget_hit || rt->mem_over);
+}
+
+/* ---- the watchdog -------------------------------------------------------------------- */
+
+/* write everything unless the reader stops taking it: a full pipe must not keep the
+ * process alive past its budget */
+static void say(int fd, const char *s) {
+    size_t n = strlen(s);
+    while (n) {
+        struct pollfd p = { fd, POLLOUT, 0 };
+        if (poll(&p, 1, 1000) <= 0) return;
+        ssize_t k = write(fd, s, n);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) return;
+        s += k;
+        n -= (size_t)k;
+    }
+}
+
+/* SIGKILL every child of this process (the encoder with its process group, ffprobe,
+ * what an --unsafe script started), found in /proc: a zombie keeps its pid until we
+ * reap it, so no pid read here can belong to a stranger yet */
+static void kill_children(void) {
+    const long me = (long)getpid();
+    DIR *d = opendir("/proc");
+    if (!d) return;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        char *end, p[64], buf[512];
+        long pid = strtol(e->d_name, &end, 10);
+        if (*end || pid <= 0) continue;
+        snprintf(p, sizeof p, "/proc/%ld/stat", pid);
+        int fd = open(p, O_RDONLY | O_CLOEXEC);
+        if (fd < 0) continue;
+        ssize_t k = read(fd, buf, sizeof buf - 1);
+        close(fd);
+        if (k <= 0) continue;
+        buf[k] = 0;
+        /* "pid (comm) state ppid pgrp ...": comm may hold anything but the last ')' */
+        char *rp = strrchr(buf, ')'), state;
+        long ppid, pgrp;
+        if (!rp || sscanf(rp + 1, " %c %ld %ld", &state, &ppid, &pgrp) != 3 || ppid != me) continue;
+        if (pgrp == pid) kill(-(pid_t)pid, SIGKILL);  /* a group leader: whatever it started too */
+        kill((pid_t)pid, SIGKILL);
+    }
+    closedir(d);
+}
+
+/* the grace period is over: the script cannot be stopped from inside, so end it */
+static _Noreturn void end_process(watchdog *wd) {
+    kill_children();
+    /* what the script printed and stdio still holds, unless the main thread is inside
+     * a write (its lock taken) */
+    struct pollfd p = { STDOUT_FILENO, POLLOUT, 0 };
+    if (poll(&p, 1, 1000) > 0 && ftrylockfile(stdout) == 0) {
+        fflush_unlocked(stdout);
+        funlockfile(stdout);
+    }
+    say(STDOUT_FILENO, wd->words);
+    say(STDERR_FILENO, wd->msg);
+    _exit(3);  /* DESIGN §4: a budget was exceeded */
+}
+
+/* The state whose hook the deadline re-arms. At the deadline the watchdog signals the
+ * script's thread, whose handler sets the count hook to 1 instruction: a loop whose
+ * every few instructions call a slow C function (string.rep of megabytes) would
+ * otherwise reach the next check only after 2^20 of them. Lua allows lua_sethook in a
+ * signal handler (ldebug.c) but not from another thread; the handler runs on the
+ * script's thread, so wb_rt_close clearing the pointer first is enough. */
+static lua_State *_Atomic rearm_state;
+
+static void rearm(int sig) {
+    (void)sig;
+    int e = errno;
+    lua_State *L = atomic_load(&rearm_state);
+    if (L) lua_sethook(L, rt_hook, LUA_MASKCOUNT, 1);
+    errno = e;
+}
+
+static struct timespec monotonic_at(double t) {
+    struct timespec ts;
+    ts.tv_sec = (time_t)t;
+    ts.tv_nsec = (long)((t - (double)ts.tv_sec) * 1e9);
+    if (ts.tv_nsec >= 1000000000) ts.tv_sec++, ts.tv_nsec -= 1000000000;
+    if (ts.tv_nsec < 0) ts.tv_nsec = 0;
+    return ts;
+}
+
+static void *watchdog_main(void *arg) {
+    watchdog *wd = arg;
+    pthread_mutex_lock(&wd->mu);
+    while (!wd->stop) {
+        double t = now(), wake = -1;  /* -1: until woken */
+        if (!atomic_load(&wd->expired)) {
+            if (t >= wd->deadline) {
+                /* the hook, the step's interrupt and the probes read this */
+                atomic_store(&wd->expired, 1);
+                if (wd->rearm) pthread_kill(wd->main, REARM_SIGNAL);
+                continue;
+            }
+            wake = wd->deadline;
+        } else if (!wd->paused) {
+            double end = (wd->resumed > wd->deadline ? wd->resumed : wd->deadline) + wd->grace;
+            if (t >= end) end_process(wd);
+            wake = end;
+        }
+        if (wake < 0) {
+            pthread_cond_wait(&wd->cv, &wd->mu);
+        } else {
+            struct timespec ts = monotonic_at(wake);
+            pthread_cond_timedwait(&wd->cv, &wd->mu, &ts);
+        }
+    }
+    pthread_mutex_unlock(&wd->mu);
+    return NULL;
+}
+
+/* only with a time budget; without a thread (it could not start) the hook and the
+ * clock hold the budget wherever they run */
+static void watchdog_start(rt_state *rt, lua_State *L) {
+    watchdog *wd = &rt->wd;
+    double limit = rt->pub.time_budget;
+    if (limit <= 0) return;
+    wd->deadline = rt->t0 + limit;
+    wd->grace = limit * GRACE_PART > GRACE_MIN ? limit * GRACE_PART : GRACE_MIN;
+    snprintf(wd->msg, sizeof wd->msg,
+             "%s: time limit of %g s exceeded (--time-limit SECONDS); the script did not come back to a budget "
+             "check within the grace period of %g s (a __gc finalizer, one long C call such as a backtracking "
+             "string pattern, or a read that never ends), so wobble ended it\n",
+             rt->pub.script ? rt->pub.script : "wobble", limit, wd->grace);
+    pthread_condattr_t ca;
+    if (pthread_condattr_init(&ca) != 0) return;
+    int e = pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+    if (!e) e = pthread_cond_init(&wd->cv, &ca);
+    pthread_condattr_destroy(&ca);
+    if (e) return;
+    if (pthread_mutex_init(&wd->mu, NULL) != 0) {
+        pthread_cond_destroy(&wd->cv);
+        return;
+    }
+    /* the re-arm signal, when no other runtime has it (SA_RESTART: reads go on) */
+    lua_State *none = NULL;
+    wd->main = pthread_self();
+    if (atomic_compare_exchange_strong(&rearm_state, &none, L)) {
+        struct sigaction sa;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = rearm;
+        sa.sa_flags = SA_RESTART;
+        sigemptyset(&sa.sa_mask);
+        if (sigaction(REARM_SIGNAL, &sa, &wd->old_sa) == 0) wd->rearm = 1;
+        else atomic_store(&rearm_state, NULL);
+    }
+    /* signals (SIGINT, SIGPIPE of the script's writes) stay the main thread's */
+    sigset_t all, old;
+    sigfillset(&all);
+    pthread_sigmask(SIG_SETMASK, &all, &old);
+    e = pthread_create(&wd->th, NULL, watchdog_main, wd);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    if (e) {
+        pthread_mutex_destroy(&wd->mu);
+        pthread_cond_destroy(&wd->cv);
+        if (wd->rearm) {
+            atomic_store(&rearm_state, NULL);
+            sigaction(REARM_SIGNAL, &wd->old_sa, NULL);
+            wd->rearm = 0;
+        }
+        return;
+    }
+    wd->on = 1;
+}
+
+static void watchdog_stop(rt_state *rt) {
+    watchdog *wd = &rt->wd;
+    if (!wd->on) return;
+    pthread_mutex_lock(&wd->mu);
+    wd->stop = 1;
+    pthread_cond_signal(&wd->cv);
+    pthread_mutex_unlock(&wd->mu);
+    pthread_join(wd->th, NULL);
+    pthread_mutex_destroy(&wd->mu);
+    pthread_cond_destroy(&wd->cv);
+    if (wd->rearm) sigaction(REARM_SIGNAL, &wd->old_sa, NULL);  /* rearm_state is NULL by now */
+    wd->rearm = 0;
+    wd->on = 0;
+}
+
+void wb_rt_pause_watchdog(lua_State *L, int paused) {
+    rt_state *rt = rt_from(L);
+    if (!rt || !rt->wd.on) return;
+    pthread_mutex_lock(&rt->wd.mu);
+    rt->wd.paused = paused;
+    if (!paused) rt->wd.resumed = now();
+    pthread_cond_signal(&rt->wd.cv);
+    pthread_mutex_unlock(&rt->wd.mu);
+}
+
+void wb_rt_set_last_words(lua_State *L, const char *text) {
+    rt_state *rt = rt_from(L);
+    if (!rt || !rt->wd.on) return;
+    pthread_mutex_lock(&rt->wd.mu);
+    snprintf(rt->wd.words, sizeof rt->wd.words, "%s", text ? text : "");
+    pthread_mutex_unlock(&rt->wd.mu);
 }
 
 void wb_rt_add_frame_hook(lua_State *L, int index) {
@@ -301,16 +544,24 @@ lua_State *wb_rt_open(const wb_runtime *cfg) {
         return NULL;
     }
     lua_sethook(L, rt_hook, LUA_MASKCOUNT, HOOK_COUNT);
+    watchdog_start(rt, L);
     return L;
 }
 
-void wb_rt_close(lua_State *L) {
-    if (!L) return;
+int wb_rt_close(lua_State *L) {
+    if (!L) return 0;
     rt_state *rt = rt_from(L);
-    lua_sethook(L, NULL, 0, 0);          /* finalizers must run, budget or not */
+    int before = rt && time_over(rt);
+    /* no re-arm from here on: the state goes (finalizers run without hooks anyway) */
+    if (rt && rt->wd.rearm) atomic_store(&rearm_state, NULL);
+    /* finalizers may allocate past a spent memory budget, but the time budget stays:
+     * Lua runs them without hooks, and the watchdog ends one that never returns */
     if (rt) rt->pub.memory_budget = rt->pub.memory.limit = 0;
     lua_close(L);
+    int late = rt && !before && time_over(rt);
+    if (rt) watchdog_stop(rt);
     free(rt);
+    return late;
 }
 
 /* ---- where the library and the project are ---------------------------------------------- */

@@ -27,6 +27,7 @@ typedef struct wb_runtime {
     wb_memory memory;          /* that budget's account: worlds are charged to it (wb_world_def.memory) */
     lua_CFunction open_module; /* opens the `wobble` table (luaopen_wobble): given by the caller, so the
                                   runtime, which the binding uses, does not depend on the binding */
+    const char *script;        /* the script's path as given, named when the watchdog ends the run; may be NULL */
 } wb_runtime;
 
 wb_runtime *wb_rt_get(lua_State *L);   /* the runtime of this state (never NULL after wb_rt_open) */
@@ -51,10 +52,20 @@ void wb_rt_after_frame(lua_State *L, int world_index);
 lua_State *wb_rt_open(const wb_runtime *cfg); /* standard libraries, sandbox unless cfg->unsafe, budgets,
                                                  `wobble` global + package.loaded, wobble.args = {};
                                                  NULL (message on stderr) on failure */
-void wb_rt_close(lua_State *L);               /* lua_close + free the runtime */
+int wb_rt_close(lua_State *L);                /* lua_close (finalizers run under the time budget) + free
+                                                 the runtime; 1 when the time limit ran out while it closed */
 int wb_rt_budget_hit(lua_State *L);           /* 1 once a budget error was raised: exit code 3 */
 int wb_rt_msgh(lua_State *L);                 /* lua_pcall message handler: message (any value) + traceback */
 void wb_rt_add_frame_hook(lua_State *L, int index); /* wb_rt_after_frame calls the function at index(w) */
+/* --time-limit's watchdog: a thread that, a grace period past the limit (5 s or 10% of
+ * the limit, the longer), ends a script that never came back to a budget check (a __gc
+ * finalizer, one long C call): children killed, the last words on stdout, a message
+ * naming cfg->script on stderr, exit code 3. At the limit itself it signals the opening
+ * thread (SIGURG, handled while the state is open) to check every instruction. Paused,
+ * it waits (the caller's own cleanup, bounded by its own timeouts, such as finishing a
+ * recording); the grace counts again from the end of the pause. */
+void wb_rt_pause_watchdog(lua_State *L, int paused);
+void wb_rt_set_last_words(lua_State *L, const char *text);  /* stdout text for that end (TAP); NULL: none */
 const char *wb_rt_lib_dir(void);              /* the folder holding wobble/test.lua, or NULL */
 const char *wb_rt_project_root(void);         /* the source tree (tests/bench, assets), or NULL */
 

@@ -4,13 +4,16 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <poll.h>
 #include <signal.h>
 #include <spawn.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "render.h"
@@ -21,8 +24,11 @@
 #pragma GCC diagnostic pop
 
 /* run argv[0] and collect its standard output (malloc'd, NUL added, *len bytes; what
- * passes max is read and dropped so the program never blocks); *ok: it exited 0 */
-static char *capture(const char *const argv[], size_t max, size_t *len, bool *ok, char *err, size_t n)
+ * passes max is read and dropped so the program never blocks); *ok: it exited 0. The
+ * helper may wait forever (a FIFO, a live stream): `stop` is asked every 100 ms while
+ * it runs, and when it answers true the helper is killed and the call fails. */
+static char *capture(const char *const argv[], size_t max, const wb_media_stop *stop, size_t *len, bool *ok,
+                     char *err, size_t n)
 {
     int pfd[2];
     *ok = false;
@@ -40,7 +46,19 @@ static char *capture(const char *const argv[], size_t max, size_t *len, bool *ok
     }
     size_t got = 0, cap = 4096;
     char *out = malloc(cap + 1), drop[4096];
+    bool stopped = false;
     for (;;) {
+        if (stop && stop->fn) {
+            struct pollfd p = { pfd[0], POLLIN, 0 };
+            int r = poll(&p, 1, 100);
+            if (r < 0 && errno != EINTR) break;
+            if (stop->fn(stop->ud)) {
+                stopped = true;
+                kill(pid, SIGKILL);
+                break;
+            }
+            if (r <= 0) continue;
+        }
         if (out && got == cap && cap < max) {
             size_t c = cap * 2 < max ? cap * 2 : max;
             char *q = realloc(out, c + 1);
@@ -54,8 +72,25 @@ static char *capture(const char *const argv[], size_t max, size_t *len, bool *ok
         if (keep) got += (size_t)k;
     }
     close(pfd[0]);
+    /* a helper may close its output and still not end: the same question while it runs */
     int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
+    for (;;) {
+        bool ask = stop && stop->fn && !stopped;
+        pid_t k = waitpid(pid, &status, ask ? WNOHANG : 0);
+        if (k == pid || (k < 0 && errno != EINTR)) break;
+        if (k == 0 && stop->fn(stop->ud)) {
+            stopped = true;
+            kill(pid, SIGKILL);
+        } else if (k == 0) {
+            struct timespec ts = { 0, 10000000 };
+            nanosleep(&ts, NULL);
+        }
+    }
+    if (stopped) {
+        free(out);
+        snprintf(err, n, "%s was stopped: a budget of the script ran out", argv[0]);
+        return NULL;
+    }
     if (!out) {
         snprintf(err, n, "out of memory reading what %s wrote", argv[0]);
         return NULL;
@@ -87,18 +122,28 @@ static void ff_input(char *in, size_t n, const char *path)
 static const char *demuxer_of(const char *path, char *err, size_t n)
 {
     unsigned char b[16] = { 0 };
-    FILE *f = fopen(path, "rb");
-    if (!f) {
+    /* O_NONBLOCK: opening a FIFO must not wait for a writer; only a regular file is a
+     * media file (a FIFO or a device would keep ffmpeg waiting on a live stream) */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    struct stat st;
+    if (fd < 0 || fstat(fd, &st) != 0) {
         snprintf(err, n, "cannot read %s: %s", path, strerror(errno));
+        if (fd >= 0) close(fd);
         return NULL;
     }
-    size_t got = fread(b, 1, sizeof b, f);
-    int bad = got < sizeof b && ferror(f) ? errno : 0;  /* a folder: EISDIR */
-    fclose(f);
+    if (!S_ISREG(st.st_mode)) {
+        close(fd);
+        snprintf(err, n, "cannot read %s: %s", path, S_ISDIR(st.st_mode) ? strerror(EISDIR) : "not a regular file");
+        return NULL;
+    }
+    ssize_t r = read(fd, b, sizeof b);
+    int bad = r < 0 ? errno : 0;
+    close(fd);
     if (bad) {
         snprintf(err, n, "cannot read %s: %s", path, strerror(bad));
         return NULL;
     }
+    size_t got = (size_t)r;
     static const char *const boxes[] = { "ftyp", "moov", "mdat", "free", "skip", "wide" };  /* ISO BMFF */
     if (got >= 8 && !memcmp(b, "\x89PNG\r\n\x1a\n", 8)) return "png_pipe";   /* one image, no name pattern */
     if (got >= 6 && (!memcmp(b, "GIF87a", 6) || !memcmp(b, "GIF89a", 6))) return "gif";
@@ -130,7 +175,7 @@ static int input_args(const char **argv, int a, const char *fmt, const char *in)
     return a;
 }
 
-bool wb_media_probe(const char *path, wb_media_info *info, char *err, size_t n)
+bool wb_media_probe(const char *path, wb_media_info *info, const wb_media_stop *stop, char *err, size_t n)
 {
     memset(info, 0, sizeof *info);
     const char *e = strrchr(path, '.');
@@ -158,7 +203,7 @@ bool wb_media_probe(const char *path, wb_media_info *info, char *err, size_t n)
     for (size_t k = 0; k < sizeof tail / sizeof *tail; k++) argv[a++] = tail[k];
     size_t len;
     bool ok;
-    char *out = capture(argv, 65536, &len, &ok, err, n);
+    char *out = capture(argv, 65536, stop, &len, &ok, err, n);
     if (!out) return false;
     char *save = NULL;
     for (char *line = strtok_r(out, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
@@ -181,7 +226,8 @@ bool wb_media_probe(const char *path, wb_media_info *info, char *err, size_t n)
     return true;
 }
 
-uint8_t *wb_media_read_frame(const char *path, int64_t index, int *w, int *h, char *err, size_t n)
+uint8_t *wb_media_read_frame(const char *path, int64_t index, const wb_media_stop *stop, int *w, int *h, char *err,
+                             size_t n)
 {
     const char *fmt = demuxer_of(path, err, n);
     if (!fmt) return NULL;
@@ -197,7 +243,7 @@ uint8_t *wb_media_read_frame(const char *path, int64_t index, int *w, int *h, ch
     for (size_t k = 0; k < sizeof tail / sizeof *tail; k++) argv[a++] = tail[k];
     size_t len;
     bool ok;
-    char *out = capture(argv, (size_t)1 << 30, &len, &ok, err, n);
+    char *out = capture(argv, (size_t)1 << 30, stop, &len, &ok, err, n);
     if (!out) return NULL;
     int comp;
     uint8_t *px = ok && len ? stbi_load_from_memory((const unsigned char *)out, (int)len, w, h, &comp, 3) : NULL;

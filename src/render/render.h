@@ -122,10 +122,15 @@ typedef struct wb_media_info {
     double duration;
     char codec[32], pix_fmt[32];
 } wb_media_info;
-bool wb_media_probe(const char *path, wb_media_info *info, char *err, size_t n);
+/* `stop` (may be NULL) is asked while ffprobe / ffmpeg runs, which can be forever (a
+ * FIFO, a live stream): when fn(ud) answers true the helper is killed and the call
+ * fails (the Lua side passes the script's budgets, wb_rt_interrupt) */
+typedef struct wb_media_stop { int (*fn)(void *ud); void *ud; } wb_media_stop;
+bool wb_media_probe(const char *path, wb_media_info *info, const wb_media_stop *stop, char *err, size_t n);
 /* frame `index` (0 first) of a video decoded by ffmpeg: RGB8, top row first (malloc'd,
  * free()), NULL with a message. For tests that compare a file with what was drawn. */
-uint8_t *wb_media_read_frame(const char *path, int64_t index, int *w, int *h, char *err, size_t n);
+uint8_t *wb_media_read_frame(const char *path, int64_t index, const wb_media_stop *stop, int *w, int *h, char *err,
+                             size_t n);
 
 /* start prog (found through PATH) with argv, its stdin, stdout and stderr the
  * descriptors fds[0..2] (-1: /dev/null) and no other descriptor of ours; SIGPIPE
