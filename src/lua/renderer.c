@@ -34,14 +34,10 @@ static bool over_budget(const wb_memory *m, size_t bytes)
 }
 
 /* charge `bytes` more to the budget (*slot keeps what this use holds); raises a budget
- * error naming `what` when the budget would be passed */
-static void charge(lua_State *L, wbl_renderer *u, size_t *slot, size_t bytes, const char *what)
+ * error naming `what` when the budget would be passed, even after a collection */
+static void charge(lua_State *L, size_t *slot, size_t bytes, const char *what)
 {
-    wb_memory *m = u->mem;
-    if (over_budget(m, bytes))
-        wb_rt_budget_error(L, "%s needs about %.0f MB, over the memory budget of %.0f MB (--memory-limit MB)", what,
-                           bytes / 1048576.0, m->limit / 1048576.0);
-    m->used += bytes;
+    wbl_charge(L, bytes, what);
     *slot += bytes;
 }
 
@@ -101,9 +97,18 @@ static int l_renderer(lua_State *L)
     luaL_setmetatable(L, WBL_RENDERER);
     char err[512], what[64];
     snprintf(what, sizeof what, "a %dx%d renderer", w, h);
-    charge(L, u, &u->charged, wb_renderer_bytes(be, w, h, samples), what);
+    charge(L, &u->charged, wb_renderer_bytes(be, w, h, samples), what);
     u->r = wb_renderer_create(be, w, h, samples, err, sizeof err);
-    if (!u->r) return luaL_error(L, "wobble.renderer: %s", err);
+    if (!u->r) {
+        release(u, &u->charged);
+        return luaL_error(L, "wobble.renderer: %s", err);
+    }
+    /* the context may grant fewer samples than asked (llvmpipe: 4 at most) */
+    const size_t real = wb_renderer_bytes(be, w, h, wb_renderer_samples(u->r));
+    if (real < u->charged) {
+        u->mem->used -= u->charged - real;
+        u->charged = real;
+    }
     return 1;
 }
 
@@ -280,7 +285,7 @@ static int r_record(lua_State *L)
     wb_media kind = wb_media_of(given, path, err, sizeof err);   /* the name decides, not where it leads */
     int w, h;
     wb_renderer_size(u->r, &w, &h);
-    charge(L, u, &u->rec_charged, wb_recorder_bytes(w, h), "recording");
+    charge(L, &u->rec_charged, wb_recorder_bytes(w, h), "recording");
     u->rec = wb_recorder_open(path, kind, w, h, err, sizeof err);
     if (!u->rec) {
         release(u, &u->rec_charged);
