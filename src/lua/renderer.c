@@ -440,22 +440,42 @@ static int l_probe(lua_State *L)
     return 1;
 }
 
+static int push_pixels(lua_State *L)
+{
+    lua_pushlstring(L, (const char *)lua_touserdata(L, 1), (size_t)lua_tointeger(L, 2));
+    return 1;
+}
+
 /* wobble.read_png(path) -> width, height, RGB string; or nil, message */
 static int l_read_png(lua_State *L)
 {
-    char buf[PATH_MAX], err[PATH_MAX + 128];
+    char buf[PATH_MAX], err[PATH_MAX + 128], what[96];
     const char *path = script_path(L, 1, 0, buf, sizeof buf);
-    int w, h;
+    int w = 0, h = 0;
+    /* the header first: a 30 kB file can claim 16000 x 16000 pixels (2 GB decoded).
+     * The decoder's peak is charged while it runs, then the pixels while Lua copies
+     * them into a string (the string is the Lua heap's own) */
+    const size_t dec = wb_image_png_bytes(path, &w, &h), rgb = dec ? (size_t)w * (size_t)h * 3 : 0;
+    snprintf(what, sizeof what, "read_png: a %dx%d image", w, h);
+    if (dec) wbl_charge(L, dec + rgb, what);
     uint8_t *px = wb_image_read_png(path, &w, &h, err, sizeof err);
+    wbl_release(L, dec);
     if (!px) {
+        wbl_release(L, rgb);
         luaL_pushfail(L);
         lua_pushstring(L, err);
         return 2;
     }
     lua_pushinteger(L, w);
     lua_pushinteger(L, h);
-    lua_pushlstring(L, (const char *)px, (size_t)w * h * 3);
+    /* protected, so that a refused string cannot leak the pixels */
+    lua_pushcfunction(L, push_pixels);
+    lua_pushlightuserdata(L, px);
+    lua_pushinteger(L, (lua_Integer)w * h * 3);
+    const int st = lua_pcall(L, 2, 1, 0);
     free(px);
+    wbl_release(L, rgb);
+    if (st != LUA_OK) return lua_error(L);
     return 3;
 }
 
