@@ -74,6 +74,7 @@ done
 part "scenario and validation tests" "$BUILD/wobble" test --out "$TMP/out-tests" $lua_dirs
 part "example scenes (scripts/*.lua, 5 frames)" examples
 part "command line (tests/cli/run.sh)" sh tests/cli/run.sh "$BUILD"
+part "memory budgets (tests/cli/memory.sh)" sh tests/cli/memory.sh "$BUILD"
 part "recording from the command line (tests/render/run.sh)" sh tests/render/run.sh "$BUILD"
 part "layers (tests/layers.sh)" sh tests/layers.sh "$BUILD"
 
