@@ -185,7 +185,10 @@ static int l_load_mesh(lua_State *L)
      * other budgets (the time limit): either is a budget error, not a file's failure */
     const wb_memory *mem = &wb_rt_get(L)->memory;
     wbio_budget b = { 0, NULL, NULL, false };
-    if (mem->limit) b.max_bytes = mem->used < mem->limit ? mem->limit - mem->used : 1;
+    if (mem->limit) {
+        lua_gc(L, LUA_GCCOLLECT);   /* what unreachable meshes hold is left to the import */
+        b.max_bytes = mem->used < mem->limit ? mem->limit - mem->used : 1;
+    }
     wb_rt_interrupt(L, &b.interrupt, &b.interrupt_ud);
     wb_mesh **slot = wbl_push_mesh_slot(L);
     *slot = wbio_load_mesh_within(path, name, &o, &b, wbl_allow, L, err, sizeof err);
