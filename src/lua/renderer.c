@@ -26,6 +26,7 @@ typedef struct wbl_renderer {
     /* the buffers live outside the Lua heap: charged to the runtime's memory budget */
     wb_memory *mem;
     size_t charged, rec_charged;
+    size_t draw_charged;  /* what drawing takes: the layers and GL's buffers, kept between frames */
 } wbl_renderer;
 
 static bool over_budget(const wb_memory *m, size_t bytes)
@@ -206,9 +207,15 @@ static bool draw_frame(lua_State *L, wbl_renderer *u, int world_index, const wb_
     int top = lua_gettop(L), nsk = 0;
     wb_world *w = wbl_checkworld(L, world_index);
     wb_draw_skin *sk = o->skins ? world_skins(L, world_index, &nsk) : NULL;
+    /* a world of a million links takes hundreds of MB to draw: charged before drawing,
+     * then what the renderer holds after (its buffers grow by doubling and stay) */
+    size_t want = wb_renderer_draw_bytes(u->r, w, sk, nsk);
+    if (want > u->draw_charged) charge(L, &u->draw_charged, want - u->draw_charged, "drawing this world");
     bool ok = wb_renderer_draw(u->r, w, o, sk, nsk, err, n);
     lua_settop(L, top);
     if (!ok) return false;
+    size_t held = wb_renderer_draw_held(u->r);
+    if (held > u->draw_charged) charge(L, &u->draw_charged, held - u->draw_charged, "drawing this world");
     u->draws++;
     if (u->rec) {
         if (!u->fps_set && !wb_recorder_started(u->rec)) wb_recorder_set_fps(u->rec, 1.0 / wb_world_get_def(w).dt);
@@ -382,7 +389,10 @@ static void destroy(wbl_renderer *u)
 {
     wb_renderer_destroy(u->r);
     u->r = NULL;
-    if (u->mem) release(u, &u->charged);
+    if (u->mem) {
+        release(u, &u->charged);
+        release(u, &u->draw_charged);
+    }
 }
 
 /* __gc, __close and r:close(): a recording is finished; at collection its failure can

@@ -103,6 +103,36 @@ size_t wb_renderer_bytes(const wb_backend *be, int width, int height, int sample
     return px * (3 + 4 + 8 + 8 * (size_t)(samples > 1 ? samples : 1)) + 4 * shadow * shadow + GL_CONTEXT_BYTES;
 }
 
+/* the layers (CPU) and the GL buffers they are copied to, which llvmpipe keeps in
+ * memory of its own: grown by doubling, never shrunk */
+size_t wb_renderer_draw_held(const wb_renderer *r)
+{
+    const wb_layers *l = &r->layers;
+    size_t b = l->inst_cap * sizeof *l->inst + l->seg_cap * sizeof *l->seg + l->sv_cap * sizeof *l->sv +
+               l->si_cap * sizeof *l->si + l->pair_cap * sizeof *l->pairs + (l->pair_cap / 2 + 1) * sizeof *l->strain +
+               l->vstrain_cap * sizeof *l->vstrain + l->flag_cap;
+    if (r->gl_ready) b += r->gl.inst_cap + r->gl.surf_cap + r->gl.surf_idx_cap + r->gl.seg_cap;
+    return b;
+}
+
+size_t wb_renderer_draw_bytes(const wb_renderer *r, const wb_world *w, const wb_draw_skin *sk, int nsk)
+{
+    if (!r->be->gl) return 0;
+    size_t np = (size_t)wb_particle_count(w), nc = (size_t)wb_collider_count(w);
+    size_t nd = (size_t)wb_world_distance_pairs(w, NULL, NULL), nv = np, nt = 0;
+    for (int32_t s = 0; s < wb_surface_count(w); s++) {
+        int32_t k;
+        wb_surface_triangles(w, s, &k);
+        nt += (size_t)k;
+    }
+    for (int i = 0; i < nsk; i++) nv += (size_t)sk[i].nv, nt += (size_t)sk[i].nt;
+    /* what wb_layers_build fills (instances, links, surface vertices and indices, each
+     * twice: the layers and the GL buffers), its per-pair and per-particle arrays and
+     * its scratch (a normal accumulator, an owner per particle) */
+    return 2 * ((np + 3 * nc) * sizeof(wb_inst) + nd * sizeof(wb_seg) + nv * WB_SV * sizeof(float) + 3 * nt * sizeof(GLuint)) +
+           nd * (2 * sizeof(int32_t) + sizeof(wb_real)) + np * (3 * sizeof(float) + 1 + 3 * sizeof(double) + 2);
+}
+
 void wb_renderer_destroy(wb_renderer *r)
 {
     if (!r) return;

@@ -76,6 +76,10 @@ typedef struct wb_draw_skin {
 } wb_draw_skin;
 bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, const wb_draw_skin *skins,
                       int nskins, char *err, size_t n);
+/* for a memory budget: about how many bytes drawing w takes (what it draws, on the CPU
+ * and in GL's buffers), before drawing; and what the renderer holds for that after */
+size_t wb_renderer_draw_bytes(const wb_renderer *r, const wb_world *w, const wb_draw_skin *skins, int nskins);
+size_t wb_renderer_draw_held(const wb_renderer *r);
 const uint8_t *wb_renderer_pixels(const wb_renderer *r);  /* the last frame, RGB */
 /* world point -> pixel coordinates of the last frame (x right, y down, pixel (i,j)
  * covers [i,i+1) x [j,j+1)); false when behind the camera or nothing drawn yet */
