@@ -57,12 +57,27 @@ typedef struct wbio_mesh_opts {
     double timeout;        /* seconds for the import (a child process); 0: $WOBBLE_IMPORT_TIMEOUT or 60 */
 } wbio_mesh_opts;
 
+/* the budgets an import runs under (wbio_load_mesh_within) */
+typedef struct wbio_budget {
+    /* memory the import may take: the child's address space past what it starts with
+     * (RLIMIT_AS) and the arrays it sends back; 0: no budget, half the machine's memory */
+    size_t max_bytes;
+    int (*interrupt)(void *ud); /* polled while the child works; true stops it (a spent budget) */
+    void *interrupt_ud;
+    bool stopped;          /* out: max_bytes or interrupt is what stopped the import */
+} wbio_budget;
+
 /* any format assimp reads, triangulated, node transforms applied, all meshes of the file
  * merged, welded, normals recomputed. NULL with a message on a missing, empty or corrupt file.
  * assimp runs in a forked child: a file that crashes or hangs it is "the importer failed
- * (crashed|timed out ...)", never the caller's crash */
+ * (crashed|timed out ...)", never the caller's crash; one that needs more memory than
+ * the budget is "the importer ran out of memory (...)" with b->stopped set (without a
+ * budget, half of the machine's memory is the child's limit). The child dies with the
+ * caller (PR_SET_PDEATHSIG) */
+wb_mesh *wbio_load_mesh_within(const char *path, const char *shown, const wbio_mesh_opts *o, wbio_budget *b,
+                               wbio_allow_fn allow, void *ud, char *err, size_t errn);
 wb_mesh *wbio_load_mesh(const char *path, const char *shown, const wbio_mesh_opts *o,
-                        wbio_allow_fn allow, void *ud, char *err, size_t errn);
+                        wbio_allow_fn allow, void *ud, char *err, size_t errn);   /* no budget */
 /* by extension: .obj and .ply written here (vertex order kept, as Blender's Mesh Cache
  * needs), .stl .gltf .glb .fbx .dae through assimp's exporter. v overrides m->v when given
  * (a deformed pose of the same mesh) */

@@ -19,6 +19,8 @@
 #include <strings.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -91,7 +93,8 @@ static void f_close(struct aiFileIO *io, struct aiFile *f)
  * import runs in a child process that sends the bare arrays back over a pipe; the parent
  * waits with a wall-clock limit and turns a crash, an abort or a hang into an error. */
 typedef struct import_head {
-    int32_t ok;            /* 1: nv, nt and the arrays follow; 0: a message of len bytes */
+    int32_t ok;            /* 1: nv, nt and the arrays follow; 0: a message of len bytes; 2: the
+                              same, the child ran out of the memory it was given */
     int32_t len;
     int64_t nv, nt;
 } import_head;
@@ -122,7 +125,9 @@ static int write_all(int fd, const void *buf, size_t n)
 
 static void child_fail(int fd, const char *why)
 {
-    import_head h = { 0, (int32_t)strlen(why), 0, 0 };
+    /* assimp turns a refused allocation into the message of std::bad_alloc */
+    const int oom = strstr(why, "bad_alloc") || strstr(why, "out of memory");
+    import_head h = { oom ? 2 : 0, (int32_t)strlen(why), 0, 0 };
     if (write_all(fd, &h, sizeof h) == 0) write_all(fd, why, (size_t)h.len);
 }
 
@@ -189,13 +194,16 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* read n bytes before the deadline: 0, -1 end of file or error, -2 time is up */
-static int read_all(int fd, void *buf, size_t n, double deadline)
+/* read n bytes before the deadline: 0, -1 end of file or error, -2 time is up, -6 the
+ * caller's interrupt said stop (polled ten times a second) */
+static int read_all(int fd, void *buf, size_t n, double deadline, const wbio_budget *o)
 {
     char *p = buf;
     while (n > 0) {
         double left = deadline - now_s();
         if (left <= 0) return -2;
+        if (o->interrupt && o->interrupt(o->interrupt_ud)) return -6;
+        if (o->interrupt && left > 0.1) left = 0.1;
         struct pollfd pf = { fd, POLLIN, 0 };
         int r = poll(&pf, 1, left > 1e6 ? 1000000000 : (int)(left * 1000) + 1);
         if (r < 0 && errno == EINTR) continue;
@@ -217,15 +225,48 @@ static double import_timeout(const wbio_mesh_opts *o)
     return t && atof(t) > 0 ? atof(t) : 60;
 }
 
+/* the memory an import may take: the caller's budget, else half of this machine's */
+static size_t import_bytes(const wbio_budget *o)
+{
+    if (o->max_bytes) return o->max_bytes;
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    return pages > 0 && page > 0 ? (size_t)pages / 2 * (size_t)page : (size_t)1 << 32;
+}
+
+/* in the child, before assimp runs: a header that promises a billion vertices must meet
+ * a refused allocation (std::bad_alloc, reported) rather than grow the machine into its
+ * OOM killer. The address space it starts with is the parent's (libraries, heaps, the
+ * renderers' threads), so the limit is that plus what it may take; CPU time is capped as
+ * well, in case the parent's clock is not watching any more */
+static void limit_child(size_t bytes, double timeout)
+{
+    unsigned long size = 0;
+    FILE *f = fopen("/proc/self/statm", "r");
+    if (f) {
+        if (fscanf(f, "%lu", &size) != 1) size = 0;
+        fclose(f);
+    }
+    const long page = sysconf(_SC_PAGESIZE);
+    const double as = (double)size * (double)(page > 0 ? page : 4096) + (double)bytes;
+    if (size && as < (double)RLIM_INFINITY) {
+        struct rlimit rl = { (rlim_t)as, (rlim_t)as };
+        setrlimit(RLIMIT_AS, &rl);
+    }
+    struct rlimit cpu = { (rlim_t)timeout + 2, (rlim_t)timeout + 3 };
+    setrlimit(RLIMIT_CPU, &cpu);
+}
+
 /* run the import in a child; arrays (malloc'd) or a message in why */
-static int import_isolated(const char *path, const wbio_mesh_opts *o, wbio_allow_fn allow, void *ud,
-                           wb_real **v, int64_t *nv, int32_t **tri, int64_t *nt, char *why, size_t whyn)
+static int import_isolated(const char *path, const wbio_mesh_opts *mo, wbio_budget *o, wbio_allow_fn allow,
+                           void *ud, wb_real **v, int64_t *nv, int32_t **tri, int64_t *nt, char *why, size_t whyn)
 {
     *v = NULL;
     *tri = NULL;
+    const size_t budget = import_bytes(o);
     int fds[2];
     if (pipe(fds) != 0) { snprintf(why, whyn, "cannot start the importer: %s", strerror(errno)); return -1; }
     fflush(NULL);   /* the child must not write the parent's buffered output a second time */
+    const pid_t parent = getpid();
     pid_t pid = fork();
     if (pid < 0) {
         snprintf(why, whyn, "cannot start the importer: %s", strerror(errno));
@@ -234,36 +275,44 @@ static int import_isolated(const char *path, const wbio_mesh_opts *o, wbio_allow
         return -1;
     }
     if (pid == 0) {
+        /* killed with the parent: an import never outlives the run that asked for it
+         * (checked again after, in case the parent died before the request) */
+        prctl(PR_SET_PDEATHSIG, SIGKILL);
+        if (getppid() != parent) _exit(1);
         close(fds[0]);
         signal(SIGPIPE, SIG_DFL);
+        limit_child(budget, import_timeout(mo));
         child_import(fds[1], path, allow, ud);
         _exit(0);   /* no atexit handlers: they belong to the parent (Lua, the renderer) */
     }
     close(fds[1]);
-    const double deadline = now_s() + import_timeout(o);
+    const double deadline = now_s() + import_timeout(mo);
     import_head h;
-    int r = read_all(fds[0], &h, sizeof h, deadline);
+    int r = read_all(fds[0], &h, sizeof h, deadline, o);
     if (r == 0 && h.ok == 1) {
+        /* the arrays on their way, then the mesh made of them (wbio_load_mesh) */
+        const double need = (double)h.nv * (3 * sizeof **v + 6 * sizeof(wb_real)) + (double)h.nt * 6 * sizeof **tri;
         if (h.nv < 1 || h.nt < 1 || h.nv > WB_MAX_PARTICLES || h.nt > WB_MAX_CONSTRAINTS) r = -1;
+        else if (need > (double)budget) r = -5;
         else {
             *v = malloc(sizeof **v * 3 * (size_t)h.nv);
             *tri = malloc(sizeof **tri * 3 * (size_t)h.nt);
             if (!*v || !*tri) r = -3;
-            else if ((r = read_all(fds[0], *v, sizeof **v * 3 * (size_t)h.nv, deadline)) == 0)
-                r = read_all(fds[0], *tri, sizeof **tri * 3 * (size_t)h.nt, deadline);
+            else if ((r = read_all(fds[0], *v, sizeof **v * 3 * (size_t)h.nv, deadline, o)) == 0)
+                r = read_all(fds[0], *tri, sizeof **tri * 3 * (size_t)h.nt, deadline, o);
         }
         *nv = h.nv;
         *nt = h.nt;
     } else if (r == 0) {
         char msg[512];
         size_t len = h.len < 0 ? 0 : (size_t)h.len < sizeof msg - 1 ? (size_t)h.len : sizeof msg - 1;
-        if ((r = read_all(fds[0], msg, len, deadline)) == 0) {
+        if ((r = read_all(fds[0], msg, len, deadline, o)) == 0) {
             msg[len] = 0;
             snprintf(why, whyn, "%s", msg);
-            r = -4;
+            r = h.ok == 2 ? -5 : -4;
         }
     }
-    if (r == -2 || r == -3) kill(pid, SIGKILL);
+    if (r != 0 && r != -4) kill(pid, SIGKILL);   /* still running, or on its way out */
     close(fds[0]);
     int status = 0;
     while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
@@ -272,8 +321,13 @@ static int import_isolated(const char *path, const wbio_mesh_opts *o, wbio_allow
     free(*tri);
     *v = NULL;
     *tri = NULL;
-    if (r == -2) snprintf(why, whyn, "the importer failed (timed out after %g s)", import_timeout(o));
+    if (r == -6 || (r == -5 && o->max_bytes)) o->stopped = true;
+    if (r == -1 && WIFSIGNALED(status) && WTERMSIG(status) == SIGXCPU) r = -2;
+    if (r == -2) snprintf(why, whyn, "the importer failed (timed out after %g s)", import_timeout(mo));
     else if (r == -3) snprintf(why, whyn, "out of memory");
+    else if (r == -5) snprintf(why, whyn, "the importer ran out of memory (%.0f MB allowed%s)", budget / 1048576.0,
+                               o->max_bytes ? "" : ", half of this machine's");
+    else if (r == -6) snprintf(why, whyn, "the import was stopped (a budget is spent)");
     else if (r == -1) snprintf(why, whyn, "the importer failed (crashed%s%s)",
                                WIFSIGNALED(status) ? ": " : "", WIFSIGNALED(status) ? strsignal(WTERMSIG(status)) : "");
     return -1;
@@ -301,6 +355,13 @@ static int ply_header_cut(const char *path)
 wb_mesh *wbio_load_mesh(const char *path, const char *shown, const wbio_mesh_opts *o,
                         wbio_allow_fn allow, void *ud, char *err, size_t errn)
 {
+    wbio_budget none = { 0, NULL, NULL, false };
+    return wbio_load_mesh_within(path, shown, o, &none, allow, ud, err, errn);
+}
+
+wb_mesh *wbio_load_mesh_within(const char *path, const char *shown, const wbio_mesh_opts *o, wbio_budget *b,
+                               wbio_allow_fn allow, void *ud, char *err, size_t errn)
+{
     struct stat st;
     if (stat(path, &st) != 0) { snprintf(err, errn, "%s: %s", shown, strerror(errno)); return NULL; }
     if (S_ISDIR(st.st_mode)) { snprintf(err, errn, "%s: is a folder, not a file", shown); return NULL; }
@@ -314,7 +375,7 @@ wb_mesh *wbio_load_mesh(const char *path, const char *shown, const wbio_mesh_opt
     int32_t *tri;
     int64_t nv, nt;
     char why[512];
-    if (import_isolated(path, o, allow, ud, &v, &nv, &tri, &nt, why, sizeof why) != 0) {
+    if (import_isolated(path, o, b, allow, ud, &v, &nv, &tri, &nt, why, sizeof why) != 0) {
         snprintf(err, errn, "%s: %s", shown, why);
         return NULL;
     }

@@ -12,14 +12,66 @@
 #include "mesh.h"
 #include "sandbox.h"
 
-typedef struct wbl_mesh { wb_mesh *m; } wbl_mesh;
+typedef struct wbl_mesh {
+    wb_mesh *m;
+    size_t charged;   /* bytes charged to the memory budget for m (0: none) */
+} wbl_mesh;
 
+/* ---- the memory budget: meshes, skins and renderers live outside the Lua heap ----------------- */
+static bool fits(const wb_memory *m, size_t bytes)
+{
+    return !m->limit || (bytes <= m->limit && m->used <= m->limit - bytes);
+}
+
+void wbl_charge(lua_State *L, size_t bytes, const char *what)
+{
+    wb_memory *m = &wb_rt_get(L)->memory;
+    /* Lua's collector only sees the small userdata: what it would free out there is
+     * invisible to it, so collect before refusing (as Lua does for its own heap) */
+    if (!fits(m, bytes)) lua_gc(L, LUA_GCCOLLECT);
+    if (!fits(m, bytes))
+        wb_rt_budget_error(L, "%s needs about %.0f MB, over the memory budget of %.0f MB (%.0f MB of it left; "
+                              "--memory-limit MB)", what, bytes / 1048576.0, m->limit / 1048576.0,
+                           (m->used < m->limit ? m->limit - m->used : 0) / 1048576.0);
+    m->used += bytes;
+}
+
+void wbl_release(lua_State *L, size_t bytes)
+{
+    wb_memory *m = &wb_rt_get(L)->memory;
+    m->used -= bytes < m->used ? bytes : m->used;
+}
+
+size_t wbl_mesh_bytes(int64_t nv, int64_t nt)
+{
+    /* positions and normals (nv x 3 each), triangles (nt x 3), as wb_mesh_create allocates */
+    return sizeof(wb_mesh) + (size_t)(nv > 0 ? nv : 1) * 6 * sizeof(wb_real) + (size_t)(nt > 0 ? nt : 1) * 3 * sizeof(int32_t);
+}
+
+/* ---- handles ---------------------------------------------------------------------------------- */
 wb_mesh **wbl_push_mesh_slot(lua_State *L)
 {
     wbl_mesh *u = (wbl_mesh *)lua_newuserdatauv(L, sizeof *u, 0);
     u->m = NULL;
+    u->charged = 0;
     luaL_setmetatable(L, WBL_MESH);
     return &u->m;
+}
+
+/* charge the mesh userdata on top for a mesh of that size (before or after it is made) */
+static void charge_top(lua_State *L, int64_t nv, int64_t nt, const char *what)
+{
+    wbl_mesh *u = (wbl_mesh *)lua_touserdata(L, -1);
+    const size_t bytes = wbl_mesh_bytes(nv, nt);
+    wbl_charge(L, bytes, what);
+    u->charged += bytes;
+}
+
+wb_mesh **wbl_push_mesh_charged(lua_State *L, int64_t nv, int64_t nt, const char *what)
+{
+    wb_mesh **slot = wbl_push_mesh_slot(L);
+    charge_top(L, nv, nt, what);
+    return slot;
 }
 
 wb_mesh *wbl_checkmesh(lua_State *L, int arg)
@@ -100,7 +152,7 @@ static int l_mesh(lua_State *L)
     else if (!lua_isnil(L, -1) && wbl_optreal(L, 1, "weld", &weld) && weld < 0)
         return wbl_fielderror(L, 1, "weld", "tolerance must be >= 0");
     lua_pop(L, 1);
-    wb_mesh **slot = wbl_push_mesh_slot(L);
+    wb_mesh **slot = wbl_push_mesh_charged(L, nv, nt, "wobble.mesh");
     wb_status st;
     *slot = wb_mesh_create(v, (int32_t)nv, tri, (int32_t)nt, &st);
     if (!*slot) return wbl_status_error(L, 1, st, "mesh");
@@ -129,13 +181,28 @@ static int l_load_mesh(lua_State *L)
     }
     char path[4096], err[1024];
     wbl_path(L, name, 0, path, sizeof path);
+    /* the import may take what is left of the memory budget, and stops with the run's
+     * other budgets (the time limit): either is a budget error, not a file's failure */
+    const wb_memory *mem = &wb_rt_get(L)->memory;
+    wbio_budget b = { 0, NULL, NULL, false };
+    if (mem->limit) {
+        lua_gc(L, LUA_GCCOLLECT);   /* what unreachable meshes hold is left to the import */
+        b.max_bytes = mem->used < mem->limit ? mem->limit - mem->used : 1;
+    }
+    wb_rt_interrupt(L, &b.interrupt, &b.interrupt_ud);
     wb_mesh **slot = wbl_push_mesh_slot(L);
-    *slot = wbio_load_mesh(path, name, &o, wbl_allow, L, err, sizeof err);
+    *slot = wbio_load_mesh_within(path, name, &o, &b, wbl_allow, L, err, sizeof err);
+    if (b.stopped) {
+        wb_rt_check_budgets(L);   /* the time limit: its own message */
+        return wb_rt_budget_error(L, "load_mesh: %s: memory limit of %.0f MB exceeded (--memory-limit MB)", err,
+                                  mem->limit / 1048576.0);
+    }
     if (!*slot) {
         luaL_pushfail(L);
         lua_pushstring(L, err);
         return 2;
     }
+    charge_top(L, (*slot)->nv, (*slot)->nt, name);
     return 1;
 }
 
@@ -211,7 +278,7 @@ static int m_transform(lua_State *L)
 static int m_copy(lua_State *L)
 {
     const wb_mesh *m = wbl_checkmesh(L, 1);
-    wb_mesh **slot = wbl_push_mesh_slot(L);
+    wb_mesh **slot = wbl_push_mesh_charged(L, m->nv, m->nt, "m:copy()");
     *slot = wb_mesh_copy(m);
     if (!*slot) return wb_rt_budget_error(L, "out of memory copying a mesh");
     return 1;
@@ -245,6 +312,8 @@ static int m_close(lua_State *L)
     wbl_mesh *u = (wbl_mesh *)luaL_checkudata(L, 1, WBL_MESH);
     wb_mesh_destroy(u->m);
     u->m = NULL;
+    wbl_release(L, u->charged);
+    u->charged = 0;
     return 0;
 }
 

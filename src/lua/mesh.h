@@ -15,11 +15,24 @@ void wbl_open_mesh(lua_State *L);   /* wobble.mesh{...}, wobble.load_mesh, w:fro
 void wbl_open_skin(lua_State *L);   /* w:skin, w:skins, the skin methods */
 void wbl_open_io(lua_State *L);     /* wobble.load, w:load_particles, w:save, exports */
 
+/* ---- memory held outside the Lua heap (mesh.c) ----------------------------------------- */
+/* charge `bytes` to the runtime's memory budget (wb_runtime.memory, the account of the Lua
+ * heap and the worlds); past its limit, collect garbage once (the finalizers of unreachable
+ * meshes, skins and renderers give back what they hold) and try again, then raise a budget
+ * error: "<what> needs about N MB, over the memory budget of M MB (--memory-limit MB)" */
+void wbl_charge(lua_State *L, size_t bytes, const char *what);
+void wbl_release(lua_State *L, size_t bytes);     /* give a charge back */
+size_t wbl_mesh_bytes(int64_t nv, int64_t nt);    /* what a wb_mesh of that size holds */
+
 /* ---- meshes (mesh.c) ----------------------------------------------------------------- */
 wb_mesh *wbl_checkmesh(lua_State *L, int arg);    /* raises when closed */
 /* push a mesh userdata and return where to store the mesh it will own: allocate the
- * userdata before the mesh, so a Lua memory error cannot leak it */
+ * userdata before the mesh, so a Lua memory error cannot leak it. Not charged: see
+ * wbl_push_mesh_charged */
 wb_mesh **wbl_push_mesh_slot(lua_State *L);
+/* the same, with a mesh of nv vertices and nt triangles charged to the memory budget
+ * first (given back when the mesh is closed or collected); raises a budget error */
+wb_mesh **wbl_push_mesh_charged(lua_State *L, int64_t nv, int64_t nt, const char *what);
 
 /* ---- skins (skin.c) ------------------------------------------------------------------- */
 /* the skin at idx and its world (NULL when not a skin or either is closed); vertices read

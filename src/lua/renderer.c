@@ -26,6 +26,7 @@ typedef struct wbl_renderer {
     /* the buffers live outside the Lua heap: charged to the runtime's memory budget */
     wb_memory *mem;
     size_t charged, rec_charged;
+    size_t draw_charged;  /* what drawing takes: the layers and GL's buffers, kept between frames */
 } wbl_renderer;
 
 static bool over_budget(const wb_memory *m, size_t bytes)
@@ -34,14 +35,10 @@ static bool over_budget(const wb_memory *m, size_t bytes)
 }
 
 /* charge `bytes` more to the budget (*slot keeps what this use holds); raises a budget
- * error naming `what` when the budget would be passed */
-static void charge(lua_State *L, wbl_renderer *u, size_t *slot, size_t bytes, const char *what)
+ * error naming `what` when the budget would be passed, even after a collection */
+static void charge(lua_State *L, size_t *slot, size_t bytes, const char *what)
 {
-    wb_memory *m = u->mem;
-    if (over_budget(m, bytes))
-        wb_rt_budget_error(L, "%s needs about %.0f MB, over the memory budget of %.0f MB (--memory-limit MB)", what,
-                           bytes / 1048576.0, m->limit / 1048576.0);
-    m->used += bytes;
+    wbl_charge(L, bytes, what);
     *slot += bytes;
 }
 
@@ -101,9 +98,18 @@ static int l_renderer(lua_State *L)
     luaL_setmetatable(L, WBL_RENDERER);
     char err[512], what[64];
     snprintf(what, sizeof what, "a %dx%d renderer", w, h);
-    charge(L, u, &u->charged, wb_renderer_bytes(be, w, h, samples), what);
+    charge(L, &u->charged, wb_renderer_bytes(be, w, h, samples), what);
     u->r = wb_renderer_create(be, w, h, samples, err, sizeof err);
-    if (!u->r) return luaL_error(L, "wobble.renderer: %s", err);
+    if (!u->r) {
+        release(u, &u->charged);
+        return luaL_error(L, "wobble.renderer: %s", err);
+    }
+    /* the context may grant fewer samples than asked (llvmpipe: 4 at most) */
+    const size_t real = wb_renderer_bytes(be, w, h, wb_renderer_samples(u->r));
+    if (real < u->charged) {
+        u->mem->used -= u->charged - real;
+        u->charged = real;
+    }
     return 1;
 }
 
@@ -201,9 +207,15 @@ static bool draw_frame(lua_State *L, wbl_renderer *u, int world_index, const wb_
     int top = lua_gettop(L), nsk = 0;
     wb_world *w = wbl_checkworld(L, world_index);
     wb_draw_skin *sk = o->skins ? world_skins(L, world_index, &nsk) : NULL;
+    /* a world of a million links takes hundreds of MB to draw: charged before drawing,
+     * then what the renderer holds after (its buffers grow by doubling and stay) */
+    size_t want = wb_renderer_draw_bytes(u->r, w, sk, nsk);
+    if (want > u->draw_charged) charge(L, &u->draw_charged, want - u->draw_charged, "drawing this world");
     bool ok = wb_renderer_draw(u->r, w, o, sk, nsk, err, n);
     lua_settop(L, top);
     if (!ok) return false;
+    size_t held = wb_renderer_draw_held(u->r);
+    if (held > u->draw_charged) charge(L, &u->draw_charged, held - u->draw_charged, "drawing this world");
     u->draws++;
     if (u->rec) {
         if (!u->fps_set && !wb_recorder_started(u->rec)) wb_recorder_set_fps(u->rec, 1.0 / wb_world_get_def(w).dt);
@@ -280,7 +292,7 @@ static int r_record(lua_State *L)
     wb_media kind = wb_media_of(given, path, err, sizeof err);   /* the name decides, not where it leads */
     int w, h;
     wb_renderer_size(u->r, &w, &h);
-    charge(L, u, &u->rec_charged, wb_recorder_bytes(w, h), "recording");
+    charge(L, &u->rec_charged, wb_recorder_bytes(w, h), "recording");
     u->rec = wb_recorder_open(path, kind, w, h, err, sizeof err);
     if (!u->rec) {
         release(u, &u->rec_charged);
@@ -377,7 +389,10 @@ static void destroy(wbl_renderer *u)
 {
     wb_renderer_destroy(u->r);
     u->r = NULL;
-    if (u->mem) release(u, &u->charged);
+    if (u->mem) {
+        release(u, &u->charged);
+        release(u, &u->draw_charged);
+    }
 }
 
 /* __gc, __close and r:close(): a recording is finished; at collection its failure can
@@ -438,22 +453,42 @@ static int l_probe(lua_State *L)
     return 1;
 }
 
+static int push_pixels(lua_State *L)
+{
+    lua_pushlstring(L, (const char *)lua_touserdata(L, 1), (size_t)lua_tointeger(L, 2));
+    return 1;
+}
+
 /* wobble.read_png(path) -> width, height, RGB string; or nil, message */
 static int l_read_png(lua_State *L)
 {
-    char buf[PATH_MAX], err[PATH_MAX + 128];
+    char buf[PATH_MAX], err[PATH_MAX + 128], what[96];
     const char *path = script_path(L, 1, 0, buf, sizeof buf);
-    int w, h;
+    int w = 0, h = 0;
+    /* the header first: a 30 kB file can claim 16000 x 16000 pixels (2 GB decoded).
+     * The decoder's peak is charged while it runs, then the pixels while Lua copies
+     * them into a string (the string is the Lua heap's own) */
+    const size_t dec = wb_image_png_bytes(path, &w, &h), rgb = dec ? (size_t)w * (size_t)h * 3 : 0;
+    snprintf(what, sizeof what, "read_png: a %dx%d image", w, h);
+    if (dec) wbl_charge(L, dec + rgb, what);
     uint8_t *px = wb_image_read_png(path, &w, &h, err, sizeof err);
+    wbl_release(L, dec);
     if (!px) {
+        wbl_release(L, rgb);
         luaL_pushfail(L);
         lua_pushstring(L, err);
         return 2;
     }
     lua_pushinteger(L, w);
     lua_pushinteger(L, h);
-    lua_pushlstring(L, (const char *)px, (size_t)w * h * 3);
+    /* protected, so that a refused string cannot leak the pixels */
+    lua_pushcfunction(L, push_pixels);
+    lua_pushlightuserdata(L, px);
+    lua_pushinteger(L, (lua_Integer)w * h * 3);
+    const int st = lua_pcall(L, 2, 1, 0);
     free(px);
+    wbl_release(L, rgb);
+    if (st != LUA_OK) return lua_error(L);
     return 3;
 }
 

@@ -182,7 +182,9 @@ static void rt_hook(lua_State *L, lua_Debug *ar) {
 
 int wb_rt_budget_hit(lua_State *L) {
     rt_state *rt = rt_from(L);
-    return rt && (rt->budget_hit || rt->mem_over);
+    /* mem_refused too: lauxlib's buffers (string.rep, table.concat) ask the allocator
+     * once, without the collection and second try, so one refusal is the budget's no */
+    return rt && (rt->budget_hit || rt->mem_over || rt->mem_refused);
 }
 
 /* ---- the watchdog -------------------------------------------------------------------- */

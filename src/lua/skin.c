@@ -12,7 +12,21 @@
 #include "mesh.h"
 #include "sandbox.h"
 
-typedef struct wbl_skin { wb_skin *s; } wbl_skin; /* user value 1: the world */
+typedef struct wbl_skin {   /* user value 1: the world */
+    wb_skin *s;
+    size_t charged;            /* bytes charged to the memory budget for s */
+} wbl_skin;
+
+/* what wb_skin_create allocates for a mesh of nv vertices and nt triangles over n bones:
+ * a copy of the mesh; influences and weights (nv x k); deformed vertices and normals; per
+ * bone its particle, bind and current positions, up to 32 neighbours, a flag, a quaternion
+ * and a matrix */
+static size_t skin_bytes(const wb_mesh *m, int32_t n, const wb_skin_def *d)
+{
+    const size_t nv = (size_t)(m->nv > 0 ? m->nv : 1);
+    return 256 + wbl_mesh_bytes(m->nv, m->nt) + nv * (size_t)d->bones * (sizeof(int32_t) + sizeof(wb_real)) +
+           nv * 6 * sizeof(wb_real) + (size_t)n * (2 * sizeof(int32_t) + 32 * sizeof(int32_t) + 1 + 19 * sizeof(wb_real));
+}
 
 static const char skins_key = 0; /* registry: {[world] = {skin, ...}}, weak keys */
 static const char hook_key = 0;  /* registry: the frame hook is installed */
@@ -121,9 +135,13 @@ void wbl_new_skin(lua_State *L, int world_index, const wb_mesh *m, const int32_t
     /* the handle first: a Lua memory error cannot leak the skin */
     wbl_skin *u = (wbl_skin *)lua_newuserdatauv(L, sizeof *u, 1);
     u->s = NULL;
+    u->charged = 0;
     luaL_setmetatable(L, WBL_SKIN);
     lua_pushvalue(L, world_index);
     lua_setiuservalue(L, -2, 1);
+    const size_t bytes = skin_bytes(m, n, def);
+    wbl_charge(L, bytes, "skin");
+    u->charged = bytes;
     push_list(L, world_index, 1);
     wb_status st;
     u->s = wb_skin_create(w, m, ids, n, def, &st);
@@ -214,7 +232,7 @@ static int s_mesh(lua_State *L)
 {
     wb_world *w;
     wb_skin *s = wbl_checkskin(L, 1, &w);
-    wb_mesh **slot = wbl_push_mesh_slot(L);
+    wb_mesh **slot = wbl_push_mesh_charged(L, wb_skin_rest(s)->nv, wb_skin_rest(s)->nt, "s:mesh()");
     wb_mesh *m = wb_mesh_copy(wb_skin_rest(s));
     if (!m) return wb_rt_budget_error(L, "out of memory copying a mesh");
     *slot = m;
@@ -339,6 +357,8 @@ static int s_world(lua_State *L)
 static int s_close(lua_State *L)
 {
     wbl_skin *u = (wbl_skin *)luaL_checkudata(L, 1, WBL_SKIN);
+    wbl_release(L, u->charged);   /* also when creation failed after the charge */
+    u->charged = 0;
     if (!u->s) return 0;
     wb_skin_destroy(u->s);
     u->s = NULL;

@@ -132,6 +132,20 @@ bool wb_image_write_png(const char *path, const uint8_t *rgb, int w, int h, char
     return ok;
 }
 
+size_t wb_image_png_bytes(const char *path, int *w, int *h)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0;
+    int comp = 0;
+    const int ok = stbi_info_from_file(f, w, h, &comp), wide = ok && stbi_is_16_bit_from_file(f);
+    fclose(f);
+    if (!ok || *w < 1 || *h < 1) return 0;
+    /* stb holds the inflated rows and the image at the file's depth together, then that
+     * image and its RGB8 conversion: at most twice the file's bytes per pixel plus 3 */
+    const size_t px = (size_t)*w * (size_t)*h, depth = (size_t)comp * (wide ? 2 : 1);
+    return px * (2 * depth + 3) + (size_t)*h;
+}
+
 uint8_t *wb_image_read_png(const char *path, int *w, int *h, char *err, size_t n)
 {
     FILE *f = fopen(path, "rb");

@@ -18,15 +18,44 @@
 
 enum { S_KE, S_PE, S_TOTAL, S_STRAIN, S_ERROR, S_COUNT };
 
+/* samples kept at most: a long run keeps every stride-th frame, the stride doubling
+ * each time the samples fill up (pairs merged), so a plot's memory is bounded (0.8 MB)
+ * however long the run, and still many times the chart's width in points */
+#define MAX_SAMPLES 16384
+
 struct wb_plot {
     double *t, *v[S_COUNT];
     size_t n, cap;
+    size_t stride;         /* frames per sample kept */
+    size_t pending;        /* frames seen since the last sample kept */
+    double peak[S_COUNT];  /* strain and error: the largest over those frames */
     int32_t *pairs;
     wb_real *strain;
     size_t pcap;
 };
 
-wb_plot *wb_plot_create(void) { return calloc(1, sizeof(wb_plot)); }
+wb_plot *wb_plot_create(void)
+{
+    wb_plot *p = calloc(1, sizeof(wb_plot));
+    if (p) p->stride = 1;
+    return p;
+}
+
+/* halve the samples: each pair becomes its later sample (time, energies), with the
+ * pair's largest strain and error, so a spike between two kept frames still shows */
+static void merge_pairs(wb_plot *p)
+{
+    size_t k = 0;
+    for (size_t i = 1; i < p->n; i += 2, k++) {
+        p->t[k] = p->t[i];
+        for (int s = 0; s < S_COUNT; s++) {
+            double a = p->v[s][i - 1], b = p->v[s][i];
+            p->v[s][k] = (s == S_STRAIN || s == S_ERROR) && a > b ? a : b;
+        }
+    }
+    p->n = k;
+    p->stride *= 2;
+}
 
 void wb_plot_destroy(wb_plot *p)
 {
@@ -50,6 +79,7 @@ static bool grow_to(double **a, size_t cap)
 
 bool wb_plot_sample(wb_plot *p, const wb_world *w)
 {
+    if (p->n == MAX_SAMPLES) merge_pairs(p);
     if (p->n == p->cap) {
         size_t cap = p->cap ? 2 * p->cap : 1024;
         if (!grow_to(&p->t, cap)) return false;
@@ -77,6 +107,11 @@ bool wb_plot_sample(wb_plot *p, const wb_world *w)
         double s = p->strain[i], e = 1 + s != 0 ? d * s / (1 + s) : 0;
         sum += e * e;
     }
+    const double strain = 100 * wb_world_max_strain(w), error = nd ? 1000 * sqrt(sum / nd) : 0;   /* %, mm */
+    if (p->pending == 0 || strain > p->peak[S_STRAIN]) p->peak[S_STRAIN] = strain;
+    if (p->pending == 0 || error > p->peak[S_ERROR]) p->peak[S_ERROR] = error;
+    if (++p->pending < p->stride) return true;
+    p->pending = 0;
     wb_real ke, pe;
     wb_world_energy(w, &ke, &pe);
     size_t k = p->n++;
@@ -84,8 +119,8 @@ bool wb_plot_sample(wb_plot *p, const wb_world *w)
     p->v[S_KE][k] = ke;
     p->v[S_PE][k] = pe;
     p->v[S_TOTAL][k] = ke + pe;
-    p->v[S_STRAIN][k] = 100 * wb_world_max_strain(w);
-    p->v[S_ERROR][k] = nd ? 1000 * sqrt(sum / nd) : 0;   /* mm */
+    p->v[S_STRAIN][k] = p->peak[S_STRAIN];
+    p->v[S_ERROR][k] = p->peak[S_ERROR];
     return true;
 }
 

@@ -76,6 +76,10 @@ typedef struct wb_draw_skin {
 } wb_draw_skin;
 bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, const wb_draw_skin *skins,
                       int nskins, char *err, size_t n);
+/* for a memory budget: about how many bytes drawing w takes (what it draws, on the CPU
+ * and in GL's buffers), before drawing; and what the renderer holds for that after */
+size_t wb_renderer_draw_bytes(const wb_renderer *r, const wb_world *w, const wb_draw_skin *skins, int nskins);
+size_t wb_renderer_draw_held(const wb_renderer *r);
 const uint8_t *wb_renderer_pixels(const wb_renderer *r);  /* the last frame, RGB */
 /* world point -> pixel coordinates of the last frame (x right, y down, pixel (i,j)
  * covers [i,i+1) x [j,j+1)); false when behind the camera or nothing drawn yet */
@@ -87,6 +91,10 @@ void wb_renderer_get_camera(const wb_renderer *r, double eye[3], double target[3
 bool wb_image_write_png(const char *path, const uint8_t *rgb, int w, int h, char *err, size_t n);
 /* RGB8 pixels of a PNG (malloc'd, free()), NULL with a message */
 uint8_t *wb_image_read_png(const char *path, int *w, int *h, char *err, size_t n);
+/* from the PNG's header alone: its size and about how many bytes wb_image_read_png takes
+ * at its peak (its result included), so a small file claiming a huge image can be refused
+ * before it is decoded; 0 when the header cannot be read */
+size_t wb_image_png_bytes(const char *path, int *w, int *h);
 
 /* ---- recording ---------------------------------------------------------------------- */
 typedef enum wb_media { WB_MEDIA_NONE = 0, WB_MEDIA_MP4, WB_MEDIA_GIF, WB_MEDIA_FOLDER } wb_media;
