@@ -6,6 +6,7 @@
 #   (d) tests/cli/run.sh                        the command line in separate processes
 #   (e) tests/render/run.sh                     wobble run --record, encoders that fail
 #   (f) tests/layers.sh                         the layers of DESIGN §1: no upward call, no circle
+#   (g) tests/fuzz/replay.sh                    the fuzz corpus and past crashes, once each
 # Each part prints its output and ends with "N passed, N failed"; a part that crashes
 # or prints no such line counts as a failure, never as zero tests. The last line is
 # the sum, "N passed, N failed"; the exit status is 1 when anything failed.
@@ -76,6 +77,7 @@ part "example scenes (scripts/*.lua, 5 frames)" examples
 part "command line (tests/cli/run.sh)" sh tests/cli/run.sh "$BUILD"
 part "recording from the command line (tests/render/run.sh)" sh tests/render/run.sh "$BUILD"
 part "layers (tests/layers.sh)" sh tests/layers.sh "$BUILD"
+part "fuzz corpus replay (tests/fuzz/replay.sh)" sh tests/fuzz/replay.sh "$BUILD"
 
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]

@@ -599,12 +599,9 @@ static int json_depth(const char *text, const char *end)
     return depth;
 }
 
-int wbio_read_config(const char *path, const char *shown, wbio_config *cfg, char *err, size_t errn)
+/* the parse of a whole text (text[len] is a NUL the reader put there); frees text */
+static int parse_text(char *text, size_t len, const char *shown, wbio_config *cfg, char *err, size_t errn)
 {
-    memset(cfg, 0, sizeof *cfg);
-    size_t len = 0;
-    char *text = read_text(path, shown, &len, err, errn);
-    if (!text) return -1;
     scan s = { text, text, 0, 0, NULL, NULL, 0 };
     rd r = { shown, text, NULL, err, errn };
     int rc = -1, line, col;
@@ -641,6 +638,28 @@ int wbio_read_config(const char *path, const char *shown, wbio_config *cfg, char
     free(text);
     if (rc) wbio_config_free(cfg);
     return rc;
+}
+
+int wbio_read_config(const char *path, const char *shown, wbio_config *cfg, char *err, size_t errn)
+{
+    memset(cfg, 0, sizeof *cfg);
+    size_t len = 0;
+    char *text = read_text(path, shown, &len, err, errn);
+    return text ? parse_text(text, len, shown, cfg, err, errn) : -1;
+}
+
+int wbio_parse_config(const char *data, size_t len, const char *shown, wbio_config *cfg, char *err, size_t errn)
+{
+    memset(cfg, 0, sizeof *cfg);
+    /* a copy ending in the NUL that cJSON's parser and the position scanner stop at */
+    char *text = len < (size_t)MAX_FILE ? malloc(len + 1) : NULL;
+    if (!text) {
+        snprintf(err, errn, "%s: %s", shown, len < (size_t)MAX_FILE ? "out of memory" : "too large (2 GiB at most)");
+        return -1;
+    }
+    memcpy(text, data, len);
+    text[len] = '\0';
+    return parse_text(text, len, shown, cfg, err, errn);
 }
 
 void wbio_config_free(wbio_config *cfg)
