@@ -75,13 +75,25 @@ wb_mesh *wb_mesh_copy(const wb_mesh *src)
 void wb_mesh_compute_normals(wb_mesh *m)
 {
     if (m->nv) memset(m->n, 0, sizeof *m->n * 3 * (size_t)m->nv);
+    /* the cross products of a mesh past ~1e150 overflow (NaN normals), of one below ~1e-150
+     * underflow (zero normals): such a mesh is measured scaled by a power of two, which is
+     * exact; an ordinary one is not scaled at all */
+    wb_real big = 0, s = 1;
+    for (int32_t i = 0; i < 3 * m->nv; i++) big = fmax(big, fabs(m->v[i]));
+    if (big > 1e100 || (big > 0 && big < 1e-100)) {
+        int e;
+        frexp(big, &e);
+        s = ldexp(1, -e);
+    }
     /* the unnormalised face normal is twice the area times the unit normal: summing it
      * weights each face by its area, so many thin slivers do not outvote one big face */
     for (int32_t i = 0; i < m->nt; i++) {
         const int32_t *t = &m->tri[3 * i];
         wb_real e1[3], e2[3], c[3];
-        v3_sub(e1, &m->v[3 * t[1]], &m->v[3 * t[0]]);
-        v3_sub(e2, &m->v[3 * t[2]], &m->v[3 * t[0]]);
+        for (int k = 0; k < 3; k++) {
+            e1[k] = m->v[3 * t[1] + k] * s - m->v[3 * t[0] + k] * s;
+            e2[k] = m->v[3 * t[2] + k] * s - m->v[3 * t[0] + k] * s;
+        }
         v3_cross(c, e1, e2);
         for (int k = 0; k < 3; k++) v3_add(&m->n[3 * t[k]], &m->n[3 * t[k]], c);
     }
@@ -110,7 +122,12 @@ wb_real wb_mesh_weld_tolerance(const wb_mesh *m)
     wb_real mn[3], mx[3];
     if (!wb_mesh_bounds(m, mn, mx)) return 0;
     const wb_real d[3] = { mx[0] - mn[0], mx[1] - mn[1], mx[2] - mn[2] };
-    return 1e-6 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    const wb_real t = 1e-6 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (isfinite(t) && (t > 0 || (d[0] == 0 && d[1] == 0 && d[2] == 0))) return t;
+    /* the extent or its square is past the largest double (or its square below the
+     * smallest): 1e-6 of the extent, measured without overflow, is not */
+    const wb_real e[3] = { 1e-6 * mx[0] - 1e-6 * mn[0], 1e-6 * mx[1] - 1e-6 * mn[1], 1e-6 * mx[2] - 1e-6 * mn[2] };
+    return v3_len_safe(e);
 }
 
 void wb_mesh_transform(wb_mesh *m, wb_real scale, const wb_real offset[3])
@@ -329,6 +346,16 @@ int32_t wb_mesh_cluster(const wb_mesh *m, int32_t target, int32_t *cluster)
     if (!wb_mesh_bounds(m, mn, mx)) return 0;
     v3_sub(d, mx, mn);
     const wb_real diag = v3_len(d);
+    if (!isfinite(diag)) {
+        /* an extent past the largest double: cluster a copy a quarter the size (a power of
+         * two, so the cells come out the same) rather than divide infinities */
+        wb_mesh *q = wb_mesh_copy(m);
+        if (!q) return WB_ERR_NOMEM;
+        for (int32_t i = 0; i < 3 * q->nv; i++) q->v[i] = ldexp(q->v[i], -2);
+        const int32_t n = wb_mesh_cluster(q, target, cluster);
+        wb_mesh_destroy(q);
+        return n;
+    }
     if (diag == 0 || target >= m->nv) {
         /* a single point is one cluster; a target past the vertex count keeps every vertex */
         for (int32_t i = 0; i < m->nv; i++) cluster[i] = diag == 0 ? 0 : i;

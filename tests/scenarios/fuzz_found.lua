@@ -22,3 +22,23 @@ test("a surface with no triangles loads (it read as 'out of memory')", function(
   expect.eq(w:save("fuzz_found/again.json"), true)
   expect.eq(assert(wobble.load("fuzz_found/again.json")):hash(), w:hash())
 end)
+
+-- a mesh of huge coordinates had an infinite weld tolerance (the diagonal squared
+-- overflows), so weld = true and w:from_mesh refused it; normals were NaN past ~1e150
+-- (overflowing cross products) and zero below ~1e-150 (underflowing ones)
+test("a mesh of huge or tiny coordinates welds, keeps unit normals and makes a body", function()
+  for _, s in ipairs{ 1e300, 1e-300 } do
+    local V = { {-s, -s, -s}, {s, -s, -s}, {s, s, -s}, {-s, s, -s}, {0, 0, s}, {s, s, -s} }
+    local T = { {1, 3, 2}, {1, 4, 3}, {1, 2, 5}, {2, 6, 5}, {3, 4, 5}, {4, 1, 5} }
+    local m = wobble.mesh{ vertices = V, triangles = T, weld = true }
+    expect.eq(m:vertex_count(), 5, s)   -- the repeated corner merged
+    for i = 1, 5 do
+      local x, y, z = m:normal(i)
+      expect.near(math.sqrt(x * x + y * y + z * z), 1, 1e-12, s .. " normal " .. i)
+    end
+    local w = wobble.world{}
+    local b = w:from_mesh(m)
+    expect.eq(b.count, 5, s)
+    expect.eq(w:stats().distances, 9, s)
+  end
+end)
