@@ -13,6 +13,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -385,6 +386,11 @@ wb_mesh *wbio_mesh_from_memory(const void *data, size_t n, const char *hint, con
                                const char *shown, char *err, size_t errn)
 {
     guard g = { NULL, NULL, "" };
+    /* assimp asserts (aborts) on an empty buffer; its length is an unsigned int */
+    if (n == 0 || n > UINT_MAX) {
+        snprintf(err, errn, "%s: %s", shown, n ? "too large" : "empty file");
+        return NULL;
+    }
     const struct aiScene *sc = aiImportFileFromMemory(data, (unsigned)n, import_flags, hint);
     if (!sc) {
         snprintf(err, errn, "%s: %s", shown, import_error(&g));

@@ -65,26 +65,18 @@ static void check_mesh(const wb_mesh *m)
     }
 }
 
-static int cmp_pos(const void *a, const void *b)
-{
-    const wb_real *x = a, *y = b;
-    for (int k = 0; k < 3; k++)
-        if (x[k] != y[k]) return x[k] < y[k] ? -1 : 1;
-    return 0;
-}
-
-/* particles [first, first+n) at distinct positions? The k-d tree's callers have a known
- * problem with ties at distance 0 (another engineer's fix): the harness steers clear */
+/* particles [first, first+n) pairwise apart (squared distance > 0)? The k-d tree's callers
+ * have a known problem with ties at distance 0 (another engineer's fix), coincident or
+ * so close that the square underflows: the harness steers clear */
 static int distinct(const wb_world *w, int32_t first, int32_t n)
 {
-    wb_real *x = malloc(sizeof *x * 3 * (size_t)(n > 0 ? n : 1));
-    CHECK(x);
-    memcpy(x, wb_particle_positions(w) + 3 * (size_t)first, sizeof *x * 3 * (size_t)n);
-    qsort(x, (size_t)n, sizeof *x * 3, cmp_pos);
-    int ok = 1;
-    for (int32_t i = 1; i < n && ok; i++) ok = cmp_pos(&x[3 * i], &x[3 * (i - 1)]) != 0;
-    free(x);
-    return ok;
+    const wb_real *x = wb_particle_positions(w) + 3 * (size_t)first;
+    for (int32_t i = 0; i < n; i++)
+        for (int32_t j = i + 1; j < n; j++) {
+            const wb_real d[3] = { x[3 * i] - x[3 * j], x[3 * i + 1] - x[3 * j + 1], x[3 * i + 2] - x[3 * j + 2] };
+            if (!(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > 0)) return 0;
+        }
+    return 1;
 }
 
 static void check_world(const wb_world *w)
@@ -158,10 +150,11 @@ static void use_mesh(const wb_mesh *m, uint8_t flags, const uint8_t h[8])
     if (isfinite(c->v[0])) check_mesh(c); /* a huge mesh may overflow when scaled */
     wb_mesh_destroy(c);
 
-    /* an extent past the largest double: from_mesh.c's cluster centroids and rest lengths
-     * overflow (known, another engineer's fix); the mesh-level code above is what we test */
+    /* coordinates near the largest double: from_mesh.c's cluster centroids (sums) and rest
+     * lengths overflow (known, another engineer's fix); the mesh-level code above is what
+     * we test there */
     for (int k = 0; k < 3; k++)
-        if (!isfinite(mx[k] - mn[k])) return;
+        if (fmax(fabs(mn[k]), fabs(mx[k])) > 1e305) return;
 
     /* w:from_mesh: first without k-nearest links, to see the particles it makes */
     wb_world_def wd = wb_world_default_def();
