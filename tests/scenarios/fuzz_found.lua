@@ -40,5 +40,13 @@ test("a mesh of huge or tiny coordinates welds, keeps unit normals and makes a b
     local b = w:from_mesh(m)
     expect.eq(b.count, 5, s)
     expect.eq(w:stats().distances, 9, s)
+    -- clustering measures the extent too (a diagonal whose square overflowed was infinite,
+    -- one whose square underflowed 0: one cluster): a strip of 12 vertices clusters to 3
+    -- particles, as it does at scale 1
+    local V, T = {}, {}
+    for i = 0, 5 do V[#V + 1] = {i * s, 0, 0}; V[#V + 1] = {i * s, s, 0} end
+    for i = 0, 4 do T[#T + 1] = {2 * i + 1, 2 * i + 3, 2 * i + 2}; T[#T + 1] = {2 * i + 2, 2 * i + 3, 2 * i + 4} end
+    local strip = wobble.mesh{ vertices = V, triangles = T }
+    expect.eq(wobble.world{}:from_mesh(strip, { target = 3 }).count, 3, s)
   end
 end)
