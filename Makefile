@@ -143,8 +143,8 @@ fuzz: check-deps
 	  mkdir -p $(FUZZ_BUILD)/corpus/$$t; \
 	  dict=; [ -f tests/fuzz/$$t.dict ] && dict=-dict=tests/fuzz/$$t.dict; \
 	  echo "== fuzz_$$t for $(FUZZ_TIME) s"; \
-	  leaks=; [ $$t = mesh_obj ] && leaks=-detect_leaks=0; \
-	  $(FUZZ_BUILD)/fuzz_$$t $$leaks -max_total_time=$(FUZZ_TIME) -timeout=10 -rss_limit_mb=2048 -max_len=4096 \
+	  leaks=1; [ $$t = mesh_obj ] && leaks=0; \
+	  ASAN_OPTIONS=detect_leaks=$$leaks $(FUZZ_BUILD)/fuzz_$$t -detect_leaks=$$leaks -max_total_time=$(FUZZ_TIME) -timeout=10 -rss_limit_mb=2048 -max_len=4096 \
 	    -print_final_stats=1 -artifact_prefix=$(FUZZ_BUILD)/crash-$$t- $$dict \
 	    $(FUZZ_BUILD)/corpus/$$t tests/fuzz/corpus/$$t tests/fuzz/regress/$$t || exit 1; \
 	done
