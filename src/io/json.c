@@ -38,7 +38,12 @@ static int read_defaults(rd *r, const cJSON *it, defaults *d)
     d->link = wb_distance_default_def();
     if (!it) return 0;
     if (jv_get_object(r, it, &p, keys, f)) return -1;
-    return jv_opt_nonneg(r, f[0], &p, "mass", &d->mass) || jv_opt_nonneg(r, f[1], &p, "radius", &d->radius) ||
+    if (jv_opt_nonneg(r, f[0], &p, "mass", &d->mass)) return -1;
+    if (d->mass > 0 && !isfinite(1 / d->mass)) {
+        kp mp = { &p, "mass", 0 };
+        return jv_fail(r, f[0], 0, &mp, "%g is too small (its inverse overflows)", (double)d->mass);
+    }
+    return jv_opt_nonneg(r, f[1], &p, "radius", &d->radius) ||
            jv_opt_nonneg(r, f[2], &p, "compliance", &d->link.compliance) || jv_opt_nonneg(r, f[3], &p, "damping", &d->link.damping) ||
            jv_opt_nonneg(r, f[4], &p, "yield", &d->link.yield) || jv_opt_nonneg(r, f[5], &p, "creep", &d->link.creep) ||
            jv_opt_nonneg(r, f[6], &p, "break_strain", &d->link.break_strain) ? -1 : 0;
@@ -197,8 +202,14 @@ static int read_particles(rd *r, const sections *s, const defaults *d, wb_image 
             jv_opt_nonneg(r, f[2], &p, "mass", &mass) || jv_opt_nonneg(r, f[4], &p, "radius", &radius))
             return -1;
         g->inv_mass[i] = mass > 0 ? 1 / mass : 0;
+        /* as wb_particle_add: a mass whose inverse overflows is refused, and so is an
+         * inverse whose mass overflows (w:mass, the energy and w:save would meet infinity) */
+        kp mp = { &p, "mass", 0 }, ip = { &p, "inv_mass", 0 };
+        if (!isfinite(g->inv_mass[i])) return jv_fail(r, f[2] ? f[2] : c, 0, &mp, "%g is too small (its inverse overflows)", (double)mass);
         /* inv_mass (w:save writes it) is exact where 1/mass might not round-trip */
         if (jv_opt_nonneg(r, f[3], &p, "inv_mass", &g->inv_mass[i])) return -1;
+        if (g->inv_mass[i] > 0 && !isfinite(1 / g->inv_mass[i]))
+            return jv_fail(r, f[3], 0, &ip, "%g is too small (its inverse, the mass, overflows)", (double)g->inv_mass[i]);
         if (f[5]) {
             kp q = { &p, "pinned", 0 };
             if (jv_get_bool(r, f[5], &q, &pinned)) return -1;

@@ -50,3 +50,31 @@ test("a mesh of huge or tiny coordinates welds, keeps unit normals and makes a b
     expect.eq(wobble.world{}:from_mesh(strip, { target = 3 }).count, 3, s)
   end
 end)
+
+-- an inv_mass so small that the mass overflows made a world that w:save could not write
+-- ("the state holds a non-finite number"), w:mass() infinite; a mass so small that its
+-- inverse overflows read as "particle mass must be >= 0" with no position
+test("a mass or inv_mass whose inverse overflows is refused with its key", function()
+  local function bad(name, text, expected)
+    local path = write("fuzz_found/" .. name, text)
+    local w = wobble.world{}
+    local b, err = w:load_particles(path)
+    expect.eq(b, nil, name)
+    expect.truthy(type(err) == "string" and err:find(path .. expected, 1, true), tostring(err))
+    expect.eq(w:particle_count(), 0)
+    local v, err2 = wobble.load(path)
+    expect.eq(v, nil, name)
+    expect.truthy(type(err2) == "string" and err2:find(path .. expected, 1, true), tostring(err2))
+  end
+  local head = '{"format": "wobble-particles", "version": 1,\n'
+  bad("inv_mass.json", head .. ' "particles": [{"position": [0, 0, 0], "inv_mass": 41e-320}]}',
+      ":2:52: particles[0].inv_mass: 4.1e-319 is too small (its inverse, the mass, overflows)")
+  bad("mass.json", head .. ' "particles": [{"position": [0, 0, 0], "mass": 1e-320}]}',
+      ":2:48: particles[0].mass: ")
+  bad("default_mass.json", head .. ' "defaults": {"mass": 1e-320}, "particles": []}',
+      ":2:23: defaults.mass: ")
+  -- the smallest inverse that still has a finite mass loads, and saves
+  local w = assert(wobble.load(write("fuzz_found/inv_mass_ok.json",
+    head .. ' "particles": [{"position": [0, 0, 0], "inv_mass": 1e-300}]}')))
+  expect.eq(w:save("fuzz_found/inv_mass_ok_again.json"), true)
+end)
