@@ -29,7 +29,7 @@ CORE_OBJ := $(CORE_SRC:src/%.c=$(BUILD)/obj/%.o)
 APP_OBJ  := $(APP_SRC:src/%.c=$(BUILD)/obj/%.o)
 UNIT_SRC := $(wildcard tests/unit/*.c)
 
-.PHONY: all build deps check-deps test asan bench demo install clean mutate
+.PHONY: all build deps check-deps test asan bench demo install clean mutate fuzz fuzz-build
 all: check-deps
 	@$(MAKE) --no-print-directory build
 
@@ -112,4 +112,53 @@ install: all
 
 # build folders only: out/ holds the user's videos and results
 clean:
-	rm -rf build build-asan build-bench $(BUILD)
+	rm -rf build build-asan build-bench build-fuzz $(BUILD)
+
+# ---- fuzzing (README, "Fuzzing"): `make fuzz` runs each libFuzzer target FUZZ_TIME
+# seconds; FUZZ_PKGS are installed by it alone, never by `make test`
+FUZZ_PKGS    := clang libclang-rt-14-dev libomp-14-dev
+FUZZ_TIME    ?= 60
+FUZZ_CC      ?= clang
+FUZZ_BUILD   := build-fuzz
+FUZZ_TARGETS := json mesh mesh_obj
+FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined
+FUZZ_CFLAGS  := -std=c11 -O1 -g -fno-omit-frame-pointer -fopenmp -fno-math-errno -D_GNU_SOURCE -Isrc -Wall -Wextra
+FUZZ_SRC     := $(CORE_SRC) $(wildcard src/io/*.c)
+FUZZ_OBJ     := $(FUZZ_SRC:src/%.c=$(FUZZ_BUILD)/obj/%.o)
+# the same targets under gcc, run once per file of the corpus by tests/fuzz/replay.sh
+FUZZ_REPLAY  := $(FUZZ_TARGETS:%=$(BUILD)/fuzz_%_replay)
+IO_OBJ        = $(filter $(BUILD)/obj/io/%,$(APP_OBJ))
+fuzz_def      = $(if $(filter mesh_obj,$(1)),-DFUZZ_FORMAT='"obj"')
+fuzz_src      = tests/fuzz/fuzz_$(if $(filter mesh_obj,$(1)),mesh,$(1)).c
+build: $(FUZZ_REPLAY)
+
+$(BUILD)/fuzz_%_replay: tests/fuzz/fuzz_json.c tests/fuzz/fuzz_mesh.c tests/fuzz/replay.c $(IO_OBJ) $(BUILD)/libwobble.a
+	$(CC) $(CFLAGS) $(PC_CFLAGS) $(call fuzz_def,$*) -o $@ $(call fuzz_src,$*) tests/fuzz/replay.c \
+	  $(IO_OBJ) $(BUILD)/libwobble.a $(LDFLAGS) $(PC_LIBS) -lm
+
+$(FUZZ_BUILD)/obj/%.o: src/%.c $(HEADERS)
+	@mkdir -p $(dir $@)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link $(FUZZ_SAN) $(PC_CFLAGS) -c $< -o $@
+
+$(FUZZ_BUILD)/fuzz_%: tests/fuzz/fuzz_json.c tests/fuzz/fuzz_mesh.c $(FUZZ_OBJ)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $(FUZZ_SAN) $(PC_CFLAGS) $(call fuzz_def,$*) -o $@ \
+	  $(call fuzz_src,$*) $(FUZZ_OBJ) $(PC_LIBS) -lm
+
+fuzz-build: $(FUZZ_TARGETS:%=$(FUZZ_BUILD)/fuzz_%)
+
+# new inputs go to build-fuzz/corpus/T (the seeds in tests/fuzz/corpus/T stay as they
+# are), crashes to build-fuzz/crash-T-*: add those to tests/fuzz/regress/T once fixed.
+# fuzz_mesh_obj ignores leaks: assimp leaks on its own error paths, and the suppression
+# (tests/fuzz/lsan.supp, used by the replay) needs full malloc stacks, too slow here
+fuzz: check-deps
+	@$(MAKE) --no-print-directory check-deps PKGS="$(FUZZ_PKGS)"
+	@$(MAKE) --no-print-directory fuzz-build
+	@for t in $(FUZZ_TARGETS); do \
+	  mkdir -p $(FUZZ_BUILD)/corpus/$$t; \
+	  dict=; [ -f tests/fuzz/$$t.dict ] && dict=-dict=tests/fuzz/$$t.dict; \
+	  echo "== fuzz_$$t for $(FUZZ_TIME) s"; \
+	  leaks=1; [ $$t = mesh_obj ] && leaks=0; \
+	  ASAN_OPTIONS=detect_leaks=$$leaks $(FUZZ_BUILD)/fuzz_$$t -detect_leaks=$$leaks -max_total_time=$(FUZZ_TIME) -timeout=10 -rss_limit_mb=2048 -max_len=4096 \
+	    -print_final_stats=1 -artifact_prefix=$(FUZZ_BUILD)/crash-$$t- $$dict \
+	    $(FUZZ_BUILD)/corpus/$$t tests/fuzz/corpus/$$t tests/fuzz/regress/$$t || exit 1; \
+	done

@@ -13,6 +13,7 @@
 #   (f) tests/layers.sh                         the layers of DESIGN §1: no upward call, no circle
 #   (g) tests/cli/firstrun.sh                   what a new user meets: make deps, bench --frames, print
 #   (h) tests/cli/watchdog.sh                   --time-limit in finalizers, C calls, helper programs
+#   (i) tests/fuzz/replay.sh                    the fuzz corpus and past crashes, once each
 # Each part prints its output and ends with "N passed, N failed"; a part that crashes
 # or prints no such line counts as a failure, never as zero tests. The last line is
 # the sum, "N passed, N failed"; the exit status is 1 when anything failed.
@@ -124,6 +125,7 @@ part "recording from the command line (tests/render/run.sh)" sh tests/render/run
 part "layers (tests/layers.sh)" sh tests/layers.sh "$BUILD"
 part "first run (tests/cli/firstrun.sh)" sh tests/cli/firstrun.sh "$BUILD"
 part "--time-limit watchdog (tests/cli/watchdog.sh)" sh tests/cli/watchdog.sh "$BUILD"
+part "fuzz corpus replay (tests/fuzz/replay.sh)" sh tests/fuzz/replay.sh "$BUILD"
 
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]

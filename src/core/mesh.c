@@ -364,12 +364,20 @@ int32_t wb_mesh_cluster(const wb_mesh *m, int32_t target, int32_t *cluster)
     wb_real mn[3], mx[3], d[3];
     if (!wb_mesh_bounds(m, mn, mx)) return 0;
     v3_sub(d, mx, mn);
-    const wb_real diag = v3_len(d);
-    if (!isfinite(diag)) {
-        /* cells are anchored at the minimum: offsets from it would overflow too */
-        wb__set_error("the mesh is too large to cluster (its bounding box's diagonal overflows)");
-        return WB_ERR_ARG;
+    if (!isfinite(d[0]) || !isfinite(d[1]) || !isfinite(d[2])) {
+        /* an extent past the largest double: cluster a copy a quarter the size (a power of
+         * two, so the cells come out the same; its extent is finite) rather than divide
+         * infinities */
+        wb_mesh *q = wb_mesh_copy(m);
+        if (!q) return WB_ERR_NOMEM;
+        for (int32_t i = 0; i < 3 * q->nv; i++) q->v[i] = ldexp(q->v[i], -2);
+        const int32_t n = wb_mesh_cluster(q, target, cluster);
+        wb_mesh_destroy(q);
+        return n;
     }
+    wb_real diag = v3_len(d);
+    /* its square overflows or underflows, not it */
+    if (!isfinite(diag) || (diag == 0 && (d[0] != 0 || d[1] != 0 || d[2] != 0))) diag = v3_len_safe(d);
     if (diag == 0 || target >= m->nv) {
         /* a single point is one cluster; a target past the vertex count keeps every vertex */
         for (int32_t i = 0; i < m->nv; i++) cluster[i] = diag == 0 ? 0 : i;
@@ -377,7 +385,7 @@ int32_t wb_mesh_cluster(const wb_mesh *m, int32_t target, int32_t *cluster)
     }
     /* the occupied-cell count falls (roughly monotonically) as cells grow: bisect on
      * log h and keep the size whose count is closest to the target */
-    wb_real lo = log(diag * 1e-7), hi = log(diag * 1.01), best_h = diag;
+    wb_real lo = log(diag * 1e-7), hi = isfinite(diag * 1.01) ? log(diag * 1.01) : log(diag) + log(1.01), best_h = diag;
     int32_t best = -1;
     for (int it = 0; it < 48; it++) {
         const wb_real mid = (lo + hi) / 2, h = exp(mid);

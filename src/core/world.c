@@ -434,7 +434,8 @@ wb_status wb__surface_reserve(wb_world *w, int32_t ntri)
     int32_t *st = wb__grow(m->surf_start, &m->cap_surf, m->nsurf + 2, sizeof *st);
     if (!st) return WB_ERR_NOMEM;
     m->surf_start = st;
-    int32_t *t = wb__grow(m->tri, &m->cap_tri, 3 * (m->ntri + ntri), sizeof *t);
+    /* at least one slot: a surface may be empty, and a NULL array would read as no memory */
+    int32_t *t = wb__grow(m->tri, &m->cap_tri, 3 * (m->ntri + ntri) + 1, sizeof *t);
     if (!t) return WB_ERR_NOMEM;
     m->tri = t;
     return WB_OK;

@@ -44,6 +44,8 @@ typedef struct wbio_config {
 
 /* read and check the whole file; on error nothing is allocated (cfg zeroed) */
 int wbio_read_config(const char *path, const char *shown, wbio_config *cfg, char *err, size_t errn);
+/* the same from a text in memory (len bytes, no NUL needed): what a file would give */
+int wbio_parse_config(const char *data, size_t len, const char *shown, wbio_config *cfg, char *err, size_t errn);
 void wbio_config_free(wbio_config *cfg);
 /* the full state (a superset of the config format) so that wobble.load restores it exactly;
  * written to a temporary file and renamed, so a failure leaves no half file */
@@ -78,6 +80,15 @@ wb_mesh *wbio_load_mesh_within(const char *path, const char *shown, const wbio_m
                                wbio_allow_fn allow, void *ud, char *err, size_t errn);
 wb_mesh *wbio_load_mesh(const char *path, const char *shown, const wbio_mesh_opts *o,
                         wbio_allow_fn allow, void *ud, char *err, size_t errn);   /* no budget */
+/* what wbio_load_mesh does with the importer's arrays, whatever their values: v (nv x 3,
+ * scaled in place) and tri (nt x 3) checked, made a mesh, welded; NULL with a message */
+wb_mesh *wbio_mesh_from_arrays(wb_real *v, int64_t nv, const int32_t *tri, int64_t nt, const wbio_mesh_opts *o,
+                               const char *shown, char *err, size_t errn);
+/* a file's bytes through assimp in this process, no child and no timeout (assimp may crash
+ * or hang on damaged input): for trusted data and for fuzzing our side of the import.
+ * hint: the format's extension ("obj", "ply", ...) */
+wb_mesh *wbio_mesh_from_memory(const void *data, size_t n, const char *hint, const wbio_mesh_opts *o,
+                               const char *shown, char *err, size_t errn);
 /* by extension: .obj and .ply written here (vertex order kept, as Blender's Mesh Cache
  * needs), .stl .gltf .glb .fbx .dae through assimp's exporter. v overrides m->v when given
  * (a deformed pose of the same mesh) */

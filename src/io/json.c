@@ -38,7 +38,12 @@ static int read_defaults(rd *r, const cJSON *it, defaults *d)
     d->link = wb_distance_default_def();
     if (!it) return 0;
     if (jv_get_object(r, it, &p, keys, f)) return -1;
-    return jv_opt_nonneg(r, f[0], &p, "mass", &d->mass) || jv_opt_nonneg(r, f[1], &p, "radius", &d->radius) ||
+    if (jv_opt_nonneg(r, f[0], &p, "mass", &d->mass)) return -1;
+    if (d->mass > 0 && !isfinite(1 / d->mass)) {
+        kp mp = { &p, "mass", 0 };
+        return jv_fail(r, f[0], 0, &mp, "%g is too small (its inverse overflows)", (double)d->mass);
+    }
+    return jv_opt_nonneg(r, f[1], &p, "radius", &d->radius) ||
            jv_opt_nonneg(r, f[2], &p, "compliance", &d->link.compliance) || jv_opt_nonneg(r, f[3], &p, "damping", &d->link.damping) ||
            jv_opt_nonneg(r, f[4], &p, "yield", &d->link.yield) || jv_opt_nonneg(r, f[5], &p, "creep", &d->link.creep) ||
            jv_opt_nonneg(r, f[6], &p, "break_strain", &d->link.break_strain) ? -1 : 0;
@@ -197,8 +202,14 @@ static int read_particles(rd *r, const sections *s, const defaults *d, wb_image 
             jv_opt_nonneg(r, f[2], &p, "mass", &mass) || jv_opt_nonneg(r, f[4], &p, "radius", &radius))
             return -1;
         g->inv_mass[i] = mass > 0 ? 1 / mass : 0;
+        /* as wb_particle_add: a mass whose inverse overflows is refused, and so is an
+         * inverse whose mass overflows (w:mass, the energy and w:save would meet infinity) */
+        kp mp = { &p, "mass", 0 }, ip = { &p, "inv_mass", 0 };
+        if (!isfinite(g->inv_mass[i])) return jv_fail(r, f[2] ? f[2] : c, 0, &mp, "%g is too small (its inverse overflows)", (double)mass);
         /* inv_mass (w:save writes it) is exact where 1/mass might not round-trip */
         if (jv_opt_nonneg(r, f[3], &p, "inv_mass", &g->inv_mass[i])) return -1;
+        if (g->inv_mass[i] > 0 && !isfinite(1 / g->inv_mass[i]))
+            return jv_fail(r, f[3], 0, &ip, "%g is too small (its inverse, the mass, overflows)", (double)g->inv_mass[i]);
         if (f[5]) {
             kp q = { &p, "pinned", 0 };
             if (jv_get_bool(r, f[5], &q, &pinned)) return -1;
@@ -607,12 +618,9 @@ static int json_depth(const char *text, const char *end)
     return depth;
 }
 
-int wbio_read_config(const char *path, const char *shown, wbio_config *cfg, char *err, size_t errn)
+/* the parse of a whole text (text[len] is a NUL the reader put there); frees text */
+static int parse_text(char *text, size_t len, const char *shown, wbio_config *cfg, char *err, size_t errn)
 {
-    memset(cfg, 0, sizeof *cfg);
-    size_t len = 0;
-    char *text = read_text(path, shown, &len, err, errn);
-    if (!text) return -1;
     scan s = { text, text, 0, 0, NULL, NULL, 0 };
     rd r = { shown, text, NULL, err, errn };
     int rc = -1, line, col;
@@ -649,6 +657,28 @@ int wbio_read_config(const char *path, const char *shown, wbio_config *cfg, char
     free(text);
     if (rc) wbio_config_free(cfg);
     return rc;
+}
+
+int wbio_read_config(const char *path, const char *shown, wbio_config *cfg, char *err, size_t errn)
+{
+    memset(cfg, 0, sizeof *cfg);
+    size_t len = 0;
+    char *text = read_text(path, shown, &len, err, errn);
+    return text ? parse_text(text, len, shown, cfg, err, errn) : -1;
+}
+
+int wbio_parse_config(const char *data, size_t len, const char *shown, wbio_config *cfg, char *err, size_t errn)
+{
+    memset(cfg, 0, sizeof *cfg);
+    /* a copy ending in the NUL that cJSON's parser and the position scanner stop at */
+    char *text = len < (size_t)MAX_FILE ? malloc(len + 1) : NULL;
+    if (!text) {
+        snprintf(err, errn, "%s: %s", shown, len < (size_t)MAX_FILE ? "out of memory" : "too large (2 GiB at most)");
+        return -1;
+    }
+    memcpy(text, data, len);
+    text[len] = '\0';
+    return parse_text(text, len, shown, cfg, err, errn);
 }
 
 void wbio_config_free(wbio_config *cfg)

@@ -13,6 +13,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -131,38 +132,28 @@ static void child_fail(int fd, const char *why)
     if (write_all(fd, &h, sizeof h) == 0) write_all(fd, why, (size_t)h.len);
 }
 
-/* the child's whole work: import, flatten every triangle mesh into one pair of arrays */
-static void child_import(int fd, const char *path, wbio_allow_fn allow, void *ud)
+/* every triangle mesh of the scene flattened into one pair of arrays (malloc'd), or a
+ * message in why */
+static int flatten_scene(const struct aiScene *sc, wb_real **v_out, int64_t *nv_out, int32_t **tri_out,
+                         int64_t *nt_out, char *why, size_t whyn)
 {
-    guard g = { allow, ud, "" };
-    struct aiFileIO io = { f_open, f_close, (aiUserData)&g };
-    const unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType |
-                           aiProcess_ValidateDataStructure;
-    const struct aiScene *sc = aiImportFileEx(path, flags, &io);
-    if (!sc) {
-        const char *why = g.refused[0] ? g.refused : aiGetErrorString();
-        /* assimp's validator words a file without meshes as a broken scene */
-        if (!g.refused[0] && why && strstr(why, "mNumMeshes is 0")) why = "no triangles in this file";
-        child_fail(fd, why && *why ? why : "cannot read this file");
-        return;
-    }
     int64_t nv, nt;
     count_scene(sc, &nv, &nt);
     if ((sc->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || nt == 0) {
-        child_fail(fd, "no triangles in this file");
-        return;
+        snprintf(why, whyn, "no triangles in this file");
+        return -1;
     }
     if (nv > WB_MAX_PARTICLES || nt > WB_MAX_CONSTRAINTS) {
-        char why[128];
-        snprintf(why, sizeof why, "too large (%lld vertices, %lld triangles)", (long long)nv, (long long)nt);
-        child_fail(fd, why);
-        return;
+        snprintf(why, whyn, "too large (%lld vertices, %lld triangles)", (long long)nv, (long long)nt);
+        return -1;
     }
-    wb_real *v = malloc(sizeof *v * 3 * (size_t)nv);
+    wb_real *v = malloc(sizeof *v * 3 * (size_t)(nv > 0 ? nv : 1));
     int32_t *tri = malloc(sizeof *tri * 3 * (size_t)nt);
     if (!v || !tri) {
-        child_fail(fd, "out of memory");
-        return;
+        free(v);
+        free(tri);
+        snprintf(why, whyn, "out of memory");
+        return -1;
     }
     int32_t base = 0, t = 0;
     for (unsigned i = 0; i < sc->mNumMeshes; i++) {
@@ -181,9 +172,46 @@ static void child_import(int fd, const char *path, wbio_allow_fn allow, void *ud
         }
         base += (int32_t)m->mNumVertices;
     }
-    import_head h = { 1, 0, nv, t };
+    *v_out = v;
+    *tri_out = tri;
+    *nv_out = nv;
+    *nt_out = t;
+    return 0;
+}
+
+static const unsigned import_flags = aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType |
+                                     aiProcess_ValidateDataStructure;
+
+/* assimp's message for a failed import */
+static const char *import_error(const guard *g)
+{
+    const char *why = g->refused[0] ? g->refused : aiGetErrorString();
+    /* assimp's validator words a file without meshes as a broken scene */
+    if (!g->refused[0] && why && strstr(why, "mNumMeshes is 0")) why = "no triangles in this file";
+    return why && *why ? why : "cannot read this file";
+}
+
+/* the child's whole work: import, flatten every triangle mesh into one pair of arrays */
+static void child_import(int fd, const char *path, wbio_allow_fn allow, void *ud)
+{
+    guard g = { allow, ud, "" };
+    struct aiFileIO io = { f_open, f_close, (aiUserData)&g };
+    const struct aiScene *sc = aiImportFileEx(path, import_flags, &io);
+    if (!sc) {
+        child_fail(fd, import_error(&g));
+        return;
+    }
+    wb_real *v;
+    int32_t *tri;
+    int64_t nv, nt;
+    char why[128];
+    if (flatten_scene(sc, &v, &nv, &tri, &nt, why, sizeof why)) {
+        child_fail(fd, why);
+        return;
+    }
+    import_head h = { 1, 0, nv, nt };
     if (write_all(fd, &h, sizeof h) == 0 && write_all(fd, v, sizeof *v * 3 * (size_t)nv) == 0)
-        write_all(fd, tri, sizeof *tri * 3 * (size_t)t);
+        write_all(fd, tri, sizeof *tri * 3 * (size_t)nt);
     /* no aiReleaseImport or free: the process ends now */
 }
 
@@ -379,11 +407,22 @@ wb_mesh *wbio_load_mesh_within(const char *path, const char *shown, const wbio_m
         snprintf(err, errn, "%s: %s", shown, why);
         return NULL;
     }
+    wb_mesh *mesh = wbio_mesh_from_arrays(v, nv, tri, nt, o, shown, err, errn);
+    free(v);
+    free(tri);
+    return mesh;
+}
+
+wb_mesh *wbio_mesh_from_arrays(wb_real *v, int64_t nv, const int32_t *tri, int64_t nt, const wbio_mesh_opts *o,
+                               const char *shown, char *err, size_t errn)
+{
+    if (nv < 0 || nt < 0 || nv > WB_MAX_PARTICLES || nt > WB_MAX_CONSTRAINTS) {
+        snprintf(err, errn, "%s: too large (%lld vertices, %lld triangles)", shown, (long long)nv, (long long)nt);
+        return NULL;
+    }
     for (int64_t i = 0; i < 3 * nv; i++) v[i] *= o->scale;
     wb_status status = WB_ERR_NOMEM;
     wb_mesh *mesh = wb_mesh_create(v, (int32_t)nv, tri, (int32_t)nt, &status);
-    free(v);
-    free(tri);
     if (mesh && o->weld) {
         /* files repeat a vertex per face it touches (an STL cube has 36): merge by position */
         status = wb_mesh_weld(mesh, o->tol < 0 ? wb_mesh_weld_tolerance(mesh) : o->tol, NULL);
@@ -401,6 +440,35 @@ wb_mesh *wbio_load_mesh_within(const char *path, const char *shown, const wbio_m
         wb_mesh_destroy(mesh);
         return NULL;
     }
+    return mesh;
+}
+
+wb_mesh *wbio_mesh_from_memory(const void *data, size_t n, const char *hint, const wbio_mesh_opts *o,
+                               const char *shown, char *err, size_t errn)
+{
+    guard g = { NULL, NULL, "" };
+    /* assimp asserts (aborts) on an empty buffer; its length is an unsigned int */
+    if (n == 0 || n > UINT_MAX) {
+        snprintf(err, errn, "%s: %s", shown, n ? "too large" : "empty file");
+        return NULL;
+    }
+    const struct aiScene *sc = aiImportFileFromMemory(data, (unsigned)n, import_flags, hint);
+    if (!sc) {
+        snprintf(err, errn, "%s: %s", shown, import_error(&g));
+        return NULL;
+    }
+    wb_real *v;
+    int32_t *tri;
+    int64_t nv, nt;
+    char why[128];
+    wb_mesh *mesh = NULL;
+    if (flatten_scene(sc, &v, &nv, &tri, &nt, why, sizeof why)) snprintf(err, errn, "%s: %s", shown, why);
+    else {
+        mesh = wbio_mesh_from_arrays(v, nv, tri, nt, o, shown, err, errn);
+        free(v);
+        free(tri);
+    }
+    aiReleaseImport(sc);
     return mesh;
 }
 
