@@ -140,8 +140,8 @@ wb_real wb_mesh_weld_tolerance(const wb_mesh *m)
     /* the diagonal squared underflows (a 1e-200 m mesh) or overflows (1e200 m): its length
      * without squaring; when the box itself overflows (1e308 - -1e308), from halves */
     if (isfinite(d[0]) && isfinite(d[1]) && isfinite(d[2])) return 1e-6 * v3_len_safe(d);
-    const wb_real h[3] = { mx[0] / 2 - mn[0] / 2, mx[1] / 2 - mn[1] / 2, mx[2] / 2 - mn[2] / 2 };
-    return 2e-6 * v3_len_safe(h);
+    const wb_real e[3] = { 1e-6 * mx[0] - 1e-6 * mn[0], 1e-6 * mx[1] - 1e-6 * mn[1], 1e-6 * mx[2] - 1e-6 * mn[2] };
+    return v3_len_safe(e);   /* 1e-6 of the extent first: the extent's length itself may overflow */
 }
 
 void wb_mesh_transform(wb_mesh *m, wb_real scale, const wb_real offset[3])

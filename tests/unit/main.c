@@ -29,7 +29,7 @@
     X(extreme_damping_overflow_is_the_infinitely_damped_limit) \
     X(extreme_plastic_flow_of_a_tiny_rest_stays_finite)  \
     X(extreme_collider_derived_poses_finite)             \
-    X(extreme_cluster_refuses_overflowing_box)
+    X(extreme_cluster_of_an_overflowing_box)
 
 /* every test, in the order they run: add a line here for each TEST() */
 #define TEST_LIST(X)                             \
