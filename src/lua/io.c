@@ -82,7 +82,7 @@ static void make_skins(lua_State *L, int world_index, int meshes, const wbio_con
 static int w_load_particles(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
-    const char *name = luaL_checkstring(L, 2);
+    const char *name = wbl_checkfilename(L, 2);
     char path[PATH_MAX], err[1024];
     lua_settop(L, 2);
     wbl_path(L, name, 0, path, sizeof path);
@@ -141,7 +141,7 @@ static int w_load_particles(lua_State *L)
 /* wobble.load(path) -> world, exactly as w:save wrote it (or a new world holding a config) */
 static int l_load(lua_State *L)
 {
-    const char *name = luaL_checkstring(L, 1);
+    const char *name = wbl_checkfilename(L, 1);
     char path[PATH_MAX], err[1024];
     lua_settop(L, 1);
     wbl_path(L, name, 0, path, sizeof path);
@@ -202,7 +202,7 @@ static int w_distances(lua_State *L)
 static int w_save(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
-    const char *name = luaL_checkstring(L, 2);
+    const char *name = wbl_checkfilename(L, 2);
     char path[PATH_MAX], err[1024];
     wbl_path(L, name, 1, path, sizeof path);
     if (wbio_write_snapshot(w, path, name, err, sizeof err)) return fail_with(L, err);
@@ -363,7 +363,7 @@ static void read_pc2_opts(lua_State *L, int arg, int *every, int *rest_fmt, int 
 static int w_record_pc2(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
-    const char *name = luaL_checkstring(L, 2);
+    const char *name = wbl_checkfilename(L, 2);
     int every, fmt;
     read_pc2_opts(L, 3, &every, &fmt, 1);
     lua_settop(L, 3);
@@ -411,7 +411,7 @@ static int s_record_pc2(lua_State *L)
 {
     wb_world *w;
     wb_skin *s = wbl_checkskin(L, 1, &w);
-    const char *name = luaL_checkstring(L, 2);
+    const char *name = wbl_checkfilename(L, 2);
     int every, fmt;
     read_pc2_opts(L, 3, &every, &fmt, 0);
     lua_settop(L, 3);
@@ -426,7 +426,7 @@ static const char *const vtk_keys[] = { "every", NULL };
 static int w_record_vtk(lua_State *L)
 {
     wbl_checkworld(L, 1);
-    const char *name = luaL_checkstring(L, 2);
+    const char *name = wbl_checkfilename(L, 2);
     int every = 1;
     if (wbl_checkopts(L, 3, vtk_keys, true)) wbl_optint(L, 3, "every", 1, INT32_MAX, &every);
     lua_settop(L, 3);
@@ -458,7 +458,7 @@ static int w_record_vtk(lua_State *L)
 static int w_save_vtp(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
-    const char *name = luaL_checkstring(L, 2);
+    const char *name = wbl_checkfilename(L, 2);
     char path[PATH_MAX];
     wbl_path(L, name, 1, path, sizeof path);
     FILE *f = fopen(path, "w");

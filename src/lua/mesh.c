@@ -166,7 +166,7 @@ static const char *const load_keys[] = { "scale", "weld", "timeout", NULL };
 
 static int l_load_mesh(lua_State *L)
 {
-    const char *name = luaL_checkstring(L, 1);
+    const char *name = wbl_checkfilename(L, 1);
     wbio_mesh_opts o = { 1, true, -1, 0 };
     if (wbl_checkopts(L, 2, load_keys, true)) {
         if (wbl_optreal(L, 2, "scale", &o.scale) && !(o.scale > 0)) return wbl_fielderror(L, 2, "scale", "must be > 0");
@@ -288,7 +288,7 @@ static int m_copy(lua_State *L)
 static int save_as(lua_State *L, const char *ext)
 {
     const wb_mesh *m = wbl_checkmesh(L, 1);
-    const char *name = luaL_checkstring(L, 2);
+    const char *name = wbl_checkfilename(L, 2);
     char path[4096], err[1024];
     if (ext) {
         const char *dot = strrchr(name, '.');

@@ -72,7 +72,7 @@ static wbl_renderer *checkrenderer(lua_State *L, int arg)
 /* a script's path, resolved for writing or reading; raises the sandbox's message */
 static const char *script_path(lua_State *L, int arg, int write, char *buf, size_t n)
 {
-    const char *err, *p = wb_sandbox_path(L, luaL_checkstring(L, arg), write, buf, n, &err);
+    const char *err, *p = wb_sandbox_path(L, wbl_checkfilename(L, arg), write, buf, n, &err);
     if (!p) luaL_error(L, "%s", err);
     return p;
 }
@@ -262,7 +262,7 @@ static int r_save_png(lua_State *L)
 {
     wbl_renderer *u = checkrenderer(L, 1);
     char buf[PATH_MAX], err[PATH_MAX + 128];
-    const char *given = luaL_checkstring(L, 2), *e = strrchr(given, '.');
+    const char *given = wbl_checkfilename(L, 2), *e = strrchr(given, '.');
     if (!e || strchr(e, '/') || strcasecmp(e, ".png") != 0)   /* a PNG by any other name surprises */
         return luaL_argerror(L, 2, lua_pushfstring(L, "a .png file name expected, got '%s'", given));
     const char *path = script_path(L, 2, 1, buf, sizeof buf);
@@ -280,7 +280,7 @@ static int r_record(lua_State *L)
 {
     wbl_renderer *u = checkrenderer(L, 1);
     char buf[PATH_MAX], err[PATH_MAX + 256];
-    luaL_checkstring(L, 2);
+    wbl_checkfilename(L, 2);
     wbl_checkopts(L, 3, record_keys, true);
     wb_real fps = 0;
     bool has_fps = !lua_isnoneornil(L, 3) && wbl_optreal(L, 3, "fps", &fps);

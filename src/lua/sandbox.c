@@ -169,7 +169,7 @@ static const char *display(const wb_sandbox *sb, const char *path) {
 /* A file name must be a string. The io library would turn a number into a name itself,
  * after a check that only looked at strings (io.output(4242) made ./4242 anywhere), and
  * a zero byte would cut the name the rules see short of the name the caller meant. */
-static const char *name_arg(lua_State *L, int arg) {
+const char *wbl_checkfilename(lua_State *L, int arg) {
     size_t len;
     if (lua_type(L, arg) != LUA_TSTRING) luaL_typeerror(L, arg, "file name (a string)");
     const char *s = lua_tolstring(L, arg, &len);
@@ -180,7 +180,7 @@ static const char *name_arg(lua_State *L, int arg) {
 /* replace the path argument at arg by its resolved form, or raise the rule's message */
 static void check_arg(lua_State *L, int arg, int write) {
     char buf[PATH_MAX];
-    const char *err, *p = wb_sandbox_path(L, name_arg(L, arg), write, buf, sizeof buf, &err);
+    const char *err, *p = wb_sandbox_path(L, wbl_checkfilename(L, arg), write, buf, sizeof buf, &err);
     if (!p) luaL_error(L, "%s", err);
     lua_pushstring(L, p);
     lua_replace(L, arg);

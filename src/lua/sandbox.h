@@ -30,6 +30,9 @@ void wb_sandbox_open(lua_State *L, wb_sandbox *sb);
  * relative path is taken inside it; parent folders are created). Returns buf, or NULL
  * with *err set to a message naming the path. A state without a sandbox: no rules. */
 const char *wb_sandbox_path(lua_State *L, const char *path, int write, char *buf, size_t n, const char **err);
+/* the file name at arg: a string without a zero byte, else an argument error. A number
+ * is refused, not converted (as Lua's own functions would): a name is a string */
+const char *wbl_checkfilename(lua_State *L, int arg);
 /* the same, raising the message as a Lua error */
 const char *wbl_path(lua_State *L, const char *path, int write, char *buf, size_t n);
 /* wbio_allow_fn over the sandbox, ud = the lua_State: never raises (assimp calls it) */

@@ -247,7 +247,7 @@ static int save_as(lua_State *L, const char *ext)
 {
     wb_world *w;
     wb_skin *s = wbl_checkskin(L, 1, &w);
-    const char *name = luaL_checkstring(L, 2), *dot = strrchr(name, '.');
+    const char *name = wbl_checkfilename(L, 2), *dot = strrchr(name, '.');
     char path[4096], err[1024];
     if (ext && (!dot || strcmp(dot, ext))) return luaL_argerror(L, 2, lua_pushfstring(L, "a %s file name expected", ext));
     wbl_path(L, name, 1, path, sizeof path);

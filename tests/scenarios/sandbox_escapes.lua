@@ -29,6 +29,38 @@ test("a number is not a file name: refused before the io library turns it into o
   expect.eq(io.open("4242"), nil, "nothing called 4242 was made, here or in the output folder")
 end)
 
+test("wobble's own functions take a file name only as a string, without a zero byte", function()
+  local w = wobble.world{}
+  local b = w:rope{ from = {0, 1, 0}, to = {1, 1, 0}, segments = 2 }
+  local m = wobble.mesh{ vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, triangles = {{1, 2, 3}} }
+  local s = w:skin(m, b, { bones = 1, neighbours = 2 })
+  local r = wobble.renderer{ width = 16, height = 16, backend = "null" }
+  r:draw(w)
+  local calls = {
+    { "save", function(x) return w:save(x) end },
+    { "load", function(x) return wobble.load(x) end },
+    { "load_particles", function(x) return w:load_particles(x) end },
+    { "load_mesh", function(x) return wobble.load_mesh(x) end },
+    { "save_obj", function(x) return m:save_obj(x) end },
+    { "save_obj", function(x) return s:save_obj(x) end },
+    { "record_pc2", function(x) return w:record_pc2(x) end },
+    { "record_pc2", function(x) return s:record_pc2(x) end },
+    { "record_vtk", function(x) return w:record_vtk(x) end },
+    { "save_vtp", function(x) return w:save_vtp(x) end },
+    { "save_png", function(x) return r:save_png(x) end },
+    { "record", function(x) return r:record(x) end },
+    { "read_png", function(x) return wobble.read_png(x) end },
+    { "probe", function(x) return wobble.probe(x) end },
+    { "read_frame", function(x) return wobble.read_frame(x) end },
+  }
+  for _, c in ipairs(calls) do
+    local name, f = c[1], c[2]
+    expect.error(function() f(4242) end, "to '" .. name .. "' (file name (a string) expected, got number)")
+    expect.error(function() f("x.json\0.png") end, "to '" .. name .. "' (file name contains a zero byte)")
+  end
+  expect.eq(io.open("4242"), nil, "nothing called 4242 was made in the output folder")
+end)
+
 test("io.read after a refused io.input(4242) still reads the input it had", function()
   local before = io.input()
   expect.error(function() io.input(4242) end, "got number")
