@@ -36,7 +36,6 @@ static int w_distance(lua_State *L)
     int32_t a = wbl_checkparticle(L, w, 2);
     int32_t b = wbl_checkparticle(L, w, 3);
     wb_distance_def d = wb_distance_default_def();
-    if (a == b) return luaL_argerror(L, 3, "a constraint needs two distinct particles");
     if (wbl_checkopts(L, 4, distance_keys, true)) {
         wbl_read_link(L, 4, &d);
         /* nil (absent) means the current distance; an explicit value must be >= 0 */
@@ -50,7 +49,7 @@ static int w_distance(lua_State *L)
     wb_status st = WB_OK;
     *id = wb_distance_add(w, a, b, &d, &st);
     /* the options were checked above: an argument error now is about the particles
-     * (too far apart for a finite squared length) */
+     * (the same particle twice, or too far apart for a finite squared length) */
     if (st != WB_OK) return wbl_status_error(L, st == WB_ERR_ARG ? 3 : 4, st, "distance constraint");
     return 1;
 }

@@ -66,11 +66,13 @@ if ! make -s -C "$T" -j"$JOBS" build >"$TMP/build.log" 2>&1; then
 fi
 
 # run_tests TOKENS...: unit[:NAME,NAME] (the C unit tests, or those named), cli, render,
-# and .lua files or folders for `wobble test`. Prints the first token that failed.
+# a tests/.../NAME.sh script (run as `sh NAME.sh build`), and .lua files or folders for
+# `wobble test`. Prints the first token that failed.
 run_tests() {
     lua=""
     for tok; do
         case $tok in
+        *.sh) ;;
         *.lua | tests/*) lua="$lua $tok" ;;
         esac
     done
@@ -80,6 +82,7 @@ run_tests() {
         unit:*) cmd="build/unit_tests $(echo "${tok#unit:}" | tr ',' ' ')" ;;
         cli) cmd="sh tests/cli/run.sh build" ;;
         render) cmd="sh tests/render/run.sh build" ;;
+        *.sh) cmd="sh $tok build" ;;
         *.lua | tests/*) continue ;;
         *) echo "unknown test '$tok'"; return 0 ;;
         esac
@@ -88,6 +91,7 @@ run_tests() {
     done
     if [ -n "$lua" ]; then
         # shellcheck disable=SC2086
+        rm -rf "$TMP/out"   # what one mutant wrote must not fail the next one's tests
         (cd "$T" && timeout "$TIMEOUT" build/wobble test --out "$TMP/out" $lua) >"$TMP/test.log" 2>&1 ||
             { first=$(grep -m1 '^not ok' "$TMP/test.log" | sed 's/^not ok [0-9]* - //' | cut -c1-70)
               echo "${first:-wobble test (no 'not ok' line: a crash or a hang)}"; return 0; }
