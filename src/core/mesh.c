@@ -138,10 +138,16 @@ wb_real wb_mesh_weld_tolerance(const wb_mesh *m)
     const wb_real dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
     if ((dd >= DBL_MIN && isfinite(dd)) || (d[0] == 0 && d[1] == 0 && d[2] == 0)) return 1e-6 * sqrt(dd);
     /* the diagonal squared underflows (a 1e-200 m mesh) or overflows (1e200 m): its length
-     * without squaring; when the box itself overflows (1e308 - -1e308), from halves */
-    if (isfinite(d[0]) && isfinite(d[1]) && isfinite(d[2])) return 1e-6 * v3_len_safe(d);
+     * without squaring, taking 1e-6 of it after when small (1e-6 first would lose a tiny
+     * one's digits), first when large (a diagonal near the largest double overflows), and
+     * of each corner first when the box itself overflows (1e308 - -1e308) */
+    if (isfinite(d[0]) && isfinite(d[1]) && isfinite(d[2])) {
+        if (dd < 1) return 1e-6 * v3_len_safe(d);
+        const wb_real e[3] = { 1e-6 * d[0], 1e-6 * d[1], 1e-6 * d[2] };
+        return v3_len_safe(e);
+    }
     const wb_real e[3] = { 1e-6 * mx[0] - 1e-6 * mn[0], 1e-6 * mx[1] - 1e-6 * mn[1], 1e-6 * mx[2] - 1e-6 * mn[2] };
-    return v3_len_safe(e);   /* 1e-6 of the extent first: the extent's length itself may overflow */
+    return v3_len_safe(e);
 }
 
 void wb_mesh_transform(wb_mesh *m, wb_real scale, const wb_real offset[3])
