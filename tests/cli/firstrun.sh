@@ -10,33 +10,8 @@ W="$BUILD/wobble"
 F=tests/cli/fixtures
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/wobble-firstrun.XXXXXX") || exit 2
 trap 'rm -rf "$TMP"' EXIT INT TERM
-n=0 passed=0 failed=0
+. tests/cli/lib.sh
 
-# check NAME CODE [STREAM TEXT]...: as in tests/cli/run.sh; STREAM is out or err
-check() {
-    name=$1 want=$2
-    shift 2
-    why=""
-    [ "$code" = "$want" ] || why="exit code $code, expected $want"
-    while [ $# -ge 2 ]; do
-        case $1 in
-        !*) if grep -qF -- "$2" "$TMP/${1#!}"; then why="${why:+$why; }${1#!} has '$2'"; fi ;;
-        *) if ! grep -qF -- "$2" "$TMP/$1"; then why="${why:+$why; }$1 lacks '$2'"; fi ;;
-        esac
-        shift 2
-    done
-    n=$((n + 1))
-    if [ -z "$why" ]; then
-        passed=$((passed + 1))
-        echo "ok $n - $name"
-    else
-        failed=$((failed + 1))
-        echo "not ok $n - $name"
-        echo "  # $why"
-        head -n 15 "$TMP/out" | sed 's/^/  # stdout: /'
-        head -n 15 "$TMP/err" | sed 's/^/  # stderr: /'
-    fi
-}
 
 # ---- make deps with stand-ins: a PATH holding only the tools the rule needs, so no real
 # sudo or apt-get can be reached

@@ -10,7 +10,7 @@ W="$BUILD/wobble"
 F=tests/cli/fixtures
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/wobble-cli.XXXXXX") || exit 2
 trap 'rm -rf "$TMP"' EXIT INT TERM
-n=0 passed=0 failed=0
+. tests/cli/lib.sh
 
 # run ARGS...: run wobble; stdout in $TMP/out, stderr in $TMP/err, exit code in $code
 run() {
@@ -18,33 +18,6 @@ run() {
     code=$?
 }
 
-# check NAME CODE [STREAM TEXT]...: the exit code of the last run is CODE and each
-# STREAM (out, err) contains TEXT; a STREAM written !out / !err must not contain it
-# ("!err ''" : stderr empty)
-check() {
-    name=$1 want=$2
-    shift 2
-    why=""
-    [ "$code" = "$want" ] || why="exit code $code, expected $want"
-    while [ $# -ge 2 ]; do
-        case $1 in
-        !*) if grep -qF -- "$2" "$TMP/${1#!}"; then why="${why:+$why; }${1#!} has '$2'"; fi ;;
-        *) if ! grep -qF -- "$2" "$TMP/$1"; then why="${why:+$why; }$1 lacks '$2'"; fi ;;
-        esac
-        shift 2
-    done
-    n=$((n + 1))
-    if [ -z "$why" ]; then
-        passed=$((passed + 1))
-        echo "ok $n - $name"
-    else
-        failed=$((failed + 1))
-        echo "not ok $n - $name"
-        echo "  # $why"
-        head -n 15 "$TMP/out" | sed 's/^/  # stdout: /'
-        head -n 15 "$TMP/err" | sed 's/^/  # stderr: /'
-    fi
-}
 
 # ---- the command itself
 run --version

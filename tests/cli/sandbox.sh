@@ -12,7 +12,7 @@ TMP=$(mktemp -d "${TMPDIR:-/tmp}/wobble-sandbox.XXXXXX") || exit 2
 trap 'rm -rf "$TMP"' EXIT INT TERM
 S=$TMP/scene WD=$TMP/work RD=$TMP/read
 mkdir -p "$S" "$WD" "$RD" "$TMP/secret"
-n=0 passed=0 failed=0
+. tests/cli/lib.sh
 
 # run DIR ARGS...: wobble in folder DIR; stdout in $TMP/out, stderr in $TMP/err, exit code in $code
 run() {
@@ -22,38 +22,7 @@ run() {
     code=$?
 }
 
-# result NAME WHY: one TAP line; WHY empty means passed
-result() {
-    n=$((n + 1))
-    if [ -z "$2" ]; then
-        passed=$((passed + 1))
-        echo "ok $n - $1"
-    else
-        failed=$((failed + 1))
-        echo "not ok $n - $1"
-        echo "  # $2"
-        head -n 10 "$TMP/out" | sed 's/^/  # stdout: /'
-        head -n 10 "$TMP/err" | sed 's/^/  # stderr: /'
-    fi
-}
 
-# check NAME CODE [STREAM TEXT]...: as in tests/cli/run.sh (!STREAM: must not contain);
-# STREAM "none" names a file that must not exist
-check() {
-    name=$1 want=$2
-    shift 2
-    why=""
-    [ "$code" = "$want" ] || why="exit code $code, expected $want"
-    while [ $# -ge 2 ]; do
-        case $1 in
-        none) if [ -e "$2" ]; then why="${why:+$why; }$2 was created"; fi ;;
-        !*) if grep -qF -- "$2" "$TMP/${1#!}"; then why="${why:+$why; }${1#!} has '$2'"; fi ;;
-        *) if ! grep -qF -- "$2" "$TMP/$1"; then why="${why:+$why; }$1 lacks '$2'"; fi ;;
-        esac
-        shift 2
-    done
-    result "$name" "$why"
-}
 
 # ---- a number as a file name: refused in both modes, nothing made in the current folder
 cat >"$S/number.lua" <<'EOF'

@@ -11,7 +11,8 @@ W="$BUILD/wobble"
 F=tests/cli/fixtures
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/wobble-watchdog.XXXXXX") || exit 2
 trap 'rm -rf "$TMP"' EXIT INT TERM
-n=0 passed=0 failed=0
+. tests/cli/lib.sh
+MAX_SECS=15   # the limit (2 s), the grace (5 s) and room to start
 
 # run ARGS...: wobble under timeout; stdout in $TMP/out, stderr in $TMP/err, exit
 # code in $code (124: timeout killed it), seconds taken in $secs
@@ -39,33 +40,6 @@ left() {
     return 1
 }
 
-# check NAME CODE [STREAM TEXT]...: as tests/cli/run.sh (!STREAM: must not contain),
-# plus: the run took at most 15 s
-check() {
-    name=$1 want=$2
-    shift 2
-    why=""
-    [ "$code" = "$want" ] || why="exit code $code, expected $want"
-    [ "$secs" -le 15 ] || why="${why:+$why; }took $secs s"
-    while [ $# -ge 2 ]; do
-        case $1 in
-        !*) if grep -qF -- "$2" "$TMP/${1#!}"; then why="${why:+$why; }${1#!} has '$2'"; fi ;;
-        *) if ! grep -qF -- "$2" "$TMP/$1"; then why="${why:+$why; }$1 lacks '$2'"; fi ;;
-        esac
-        shift 2
-    done
-    n=$((n + 1))
-    if [ -z "$why" ]; then
-        passed=$((passed + 1))
-        echo "ok $n - $name"
-    else
-        failed=$((failed + 1))
-        echo "not ok $n - $name"
-        echo "  # $why"
-        head -n 15 "$TMP/out" | sed 's/^/  # stdout: /'
-        head -n 15 "$TMP/err" | sed 's/^/  # stderr: /'
-    fi
-}
 
 LIMIT="time limit of 2 s exceeded"
 
