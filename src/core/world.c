@@ -97,6 +97,7 @@ void wb_world_destroy(wb_world *w)
 {
     if (!w) return;
     wb_model *m = &w->m;
+    for (int32_t i = 0; i < m->nc; i++) wb__mesh_release(w, &m->c_shape[i]); /* mesh colliders' copies */
     if (m->def.memory) m->def.memory->used -= m->charged;
     wb_state *s = &w->s;
     wb_cache *k = &w->k;
