@@ -252,3 +252,38 @@ test("mesh collider errors name the key and add nothing", function()
   expect.error(function() w:collider{ shape = "mesh", mesh = closed } end, "mesh is closed")
   expect.eq(#w:colliders(), 0)
 end)
+
+local function write(name, text)
+  local f = assert(io.open(name, "w"))
+  f:write(text)
+  f:close()
+  return name
+end
+
+test("a JSON particle config lists a mesh collider in the world form; bad corners name the key path", function()
+  local w = wobble.world{}
+  local b = assert(w:load_particles(write("collide_mesh/cfg.json", [[
+{"format": "wobble-particles", "version": 1, "particles": [{"position": [0, 2, 0]}],
+ "colliders": [{"shape": "mesh", "vertices": [-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1],
+                "triangles": [0, 2, 1, 0, 3, 2], "center": [0, 0.5, 0], "scale": 2, "friction": 0.3}]}]])))
+  local col = b.colliders[1]
+  expect.eq(col:shape(), "mesh")
+  expect.near(col:distance(0, 2, 0), 1.5, 1e-15)
+  expect.near(col:distance(2.5, 0.5, 0), 0.5, 1e-15)   -- scale 2: the quad reaches x = 2
+  expect.eq(select(1, col:material()), 0.3)
+  -- the same through w:collider gives the same distances
+  local c2 = w:collider{ shape = "mesh", mesh = quad(0), center = {0, 0.5, 0}, scale = 2 }
+  expect.eq(c2:distance(0.3, 1.7, -0.4), col:distance(0.3, 1.7, -0.4))
+  local n = #w:colliders()
+  local ok, err = w:load_particles(write("collide_mesh/bad.json", [[
+{"format": "wobble-particles", "version": 1, "particles": [],
+ "colliders": [{"shape": "mesh", "vertices": [0, 0, 0, 1, 0, 0, 0, 0, 1], "triangles": [0, 1, 3]}]}]]))
+  expect.eq(ok, nil)
+  expect.truthy(err:find("colliders%[1%]%.triangles%[3%]") or err:find("triangles"), err)
+  local ok2, err2 = w:load_particles(write("collide_mesh/bad2.json", [[
+{"format": "wobble-particles", "version": 1, "particles": [],
+ "colliders": [{"shape": "mesh", "vertices": [0, 0, 0, 1, 0, 0, 0, 0, 1], "triangles": [0, 1, 2], "radius": 1}]}]]))
+  expect.eq(ok2, nil)
+  expect.truthy(err2:find("radius"), err2)
+  expect.eq(#w:colliders(), n, "a refused config adds nothing")
+end)
