@@ -117,6 +117,21 @@ TEST(bvh_closed_and_open_and_sign)
     const wb_real tip_in[3] = { 0.999, 0, 0 };
     CHECK_NEAR(wb__colmesh_distance(cm, tip_in, NULL, NULL, NULL), -0.001 / sqrt(3), 1e-12);
     wb__colmesh_free(cm);
+    /* a sharp pyramid (apex (0,10,0)): past the apex, sideways, the closest point is the
+     * apex for all four sides (a tie: the first side, +x, is taken), and the +x face's
+     * normal says "inside" for a point on the -x side; the apex's angle-weighted
+     * pseudo-normal (about +y) signs it right (Bærentzen & Aanæs's case for them) */
+    static const wb_real pyr_v[] = { -1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1, 0, 10, 0 };
+    static const int32_t pyr_t[] = { 1, 4, 2, 0, 3, 4, 2, 4, 3, 0, 4, 1, 0, 1, 2, 0, 2, 3 };
+    cm = wb__colmesh_build(pyr_v, 5, pyr_t, 6, 1);
+    REQUIRE(cm);
+    CHECK(cm->closed);
+    const wb_real side[3] = { -0.5, 10.25, 0 };
+    CHECK_NEAR(wb__colmesh_distance(cm, side, NULL, NULL, NULL), 0.5 * sqrt(1.25), 1e-14);
+    /* and near an edge of the base, outside below it: the edge's pseudo-normal */
+    const wb_real below[3] = { 1.2, -0.01, 0 };
+    CHECK(wb__colmesh_distance(cm, below, NULL, NULL, NULL) > 0);
+    wb__colmesh_free(cm);
     cm = wb__colmesh_build(octa_v, 6, octa_t, 7, 1);
     REQUIRE(cm);
     CHECK(!cm->closed);
