@@ -10,7 +10,7 @@ local w = wobble.world{ substeps = 20 }
 w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.5 }
 local col, top
 if args.mesh == "torus" then
-  -- the torus lies in the xz plane, 1 m across and 0.3 m thick at scale 2
+  -- the torus lies in the xz plane, 2 m across and 0.6 m thick at scale 2: its top at y = 0.9
   col = w:collider{ shape = "mesh", mesh = wobble.load_mesh("../assets/torus.ply"), scale = 2,
                     center = {0, 0.6, 0}, friction = 0.5 }
   w:collider{ shape = "capsule", a = {0, 0, 0}, b = {0, 0.6, 0}, radius = 0.1, friction = 0.5 }
