@@ -46,7 +46,7 @@ typedef enum wb_status {
 typedef enum wb_solver { WB_SOLVER_GAUSS_SEIDEL = 0, WB_SOLVER_JACOBI = 1 } wb_solver;
 
 typedef enum wb_shape {
-    WB_SHAPE_PLANE = 0, WB_SHAPE_SPHERE, WB_SHAPE_BOX, WB_SHAPE_CAPSULE, WB_SHAPE_COUNT
+    WB_SHAPE_PLANE = 0, WB_SHAPE_SPHERE, WB_SHAPE_BOX, WB_SHAPE_CAPSULE, WB_SHAPE_MESH, WB_SHAPE_COUNT
 } wb_shape;
 
 typedef struct wb_world wb_world;
@@ -135,13 +135,17 @@ int32_t wb_distance_ids(const wb_world *w, wb_distance_id *out);
 typedef struct wb_collider_def {
     wb_shape shape;
     wb_real normal[3], offset;    /* plane: points x with n.x = offset, normal need not be unit */
-    wb_real center[3];            /* sphere, box */
+    wb_real center[3];            /* sphere, box, mesh */
     wb_real radius;               /* sphere, capsule */
     wb_real half[3];              /* box half extents */
-    wb_real rotation[4];          /* box: (w,x,y,z), normalised on add */
+    wb_real rotation[4];          /* box, mesh: (w,x,y,z), normalised on add */
     wb_real a[3], b[3];           /* capsule segment */
     wb_real friction;             /* Coulomb coefficient (static = dynamic) */
     wb_real restitution;          /* 0..1 */
+    const struct wb_mesh *mesh;   /* mesh: its triangles, copied (x scale) into the collider's own
+                                   * frame; closed (every edge shared by two triangles): inside
+                                   * is inside, else two-sided. get_def gives NULL: see wb_collider_mesh */
+    wb_real scale;                /* mesh: > 0, default 1 */
 } wb_collider_def;
 
 wb_collider_def wb_collider_default_def(wb_shape shape);      /* a unit-ish shape at the origin */
@@ -162,8 +166,13 @@ void wb_collider_velocity(const wb_world *w, wb_collider_id c, wb_real out[3]);
 void wb_collider_get_def(const wb_world *w, wb_collider_id c, wb_collider_def *out); /* shape + current pose */
 int32_t wb_collider_count(const wb_world *w);
 wb_collider_id wb_collider_at(const wb_world *w, int32_t i);
-/* signed distance from p to the collider surface at its current pose (negative inside) */
+/* signed distance from p to the collider surface at its current pose (negative inside;
+ * an open mesh is two-sided: >= 0) */
 wb_real wb_collider_distance(const wb_world *w, wb_collider_id c, const wb_real p[3]);
+/* a mesh collider's triangles in its own frame (scale applied; world = pose applied):
+ * returns the vertex count, 0 for other shapes; pointers valid until it is removed */
+int32_t wb_collider_mesh(const wb_world *w, wb_collider_id c, const wb_real **v, const int32_t **tri, int32_t *nt);
+bool wb_collider_mesh_closed(const wb_world *w, wb_collider_id c);
 
 /* ---- builders: particles are contiguous [first, first+count) --------------------------- */
 typedef struct wb_body { int32_t first, count; } wb_body;

@@ -1,5 +1,5 @@
-/* collide.c: kinematic colliders (plane, sphere, oriented box, capsule) and their
- * projection, friction and restitution.
+/* collide.c: kinematic colliders (plane, sphere, oriented box, capsule, triangle mesh)
+ * and their projection, friction and restitution.
  *
  * A collider sweeps from its pose at the end of the last step to the pose the script
  * set, substep by substep, so a fast collider pushes particles instead of passing
@@ -10,6 +10,7 @@
 #include <stdlib.h>
 
 #include "core.h"
+#include "bvh.h"
 
 /* ---- quaternions ------------------------------------------------------------------- */
 void q_normalize(wb_real q[4])
@@ -88,6 +89,7 @@ wb_collider_def wb_collider_default_def(wb_shape shape)
     d.rotation[0] = 1;
     v3_set(d.a, 0, -0.5, 0);
     v3_set(d.b, 0, 0.5, 0);
+    d.scale = 1;
     return d;
 }
 
@@ -124,10 +126,43 @@ const char *wb_collider_def_check(const wb_collider_def *d)
         }
         if (!(d->radius > 0) || !isfinite(d->radius)) return "radius must be > 0";
         break;
+    case WB_SHAPE_MESH:
+        if (!d->mesh) return "mesh is missing";
+        if (d->mesh->nt <= 0) return "mesh is empty (no triangles)";
+        if (!(d->scale > 0) || !isfinite(d->scale)) return "scale must be > 0";
+        if (!fin3(d->center)) return "center must be finite";
+        if (!fin3(&d->rotation[1]) || !isfinite(d->rotation[0])) return "rotation must be finite";
+        if (!(fmax(fabs(d->rotation[0]), v3_len_safe(&d->rotation[1])) > 1e-12)) return "rotation must not be zero";
+        for (int64_t i = 0; i < 3 * (int64_t)d->mesh->nv; i++)
+            if (!isfinite(d->mesh->v[i] * d->scale)) return "mesh vertices x scale must be finite";
+        for (int64_t i = 0; i < 3 * (int64_t)d->mesh->nt; i++)
+            if (d->mesh->tri[i] < 0 || d->mesh->tri[i] >= d->mesh->nv) return "mesh corner out of range";
+        break;
     default:
         break;
     }
     return NULL;
+}
+
+/* a mesh collider's copy against the world's memory budget: 0 when it would pass the limit */
+int wb__mesh_charge(wb_world *w, const wb_colmesh *cm)
+{
+    wb_memory *mem = w->m.def.memory;
+    if (!mem) return 1;
+    if (mem->limit > 0 && (double)mem->used + (double)cm->bytes > (double)mem->limit) return 0;
+    mem->used += cm->bytes;
+    w->m.charged_mesh += cm->bytes;
+    return 1;
+}
+
+void wb__mesh_release(wb_world *w, wb_cshape *s)
+{
+    if (!s->mesh) return;
+    wb_memory *mem = w->m.def.memory;
+    if (mem) mem->used -= s->mesh->bytes;
+    w->m.charged_mesh -= s->mesh->bytes;
+    wb__colmesh_free(s->mesh);
+    s->mesh = NULL;
 }
 
 wb_collider_id wb_collider_add(wb_world *w, const wb_collider_def *def, wb_status *status)
@@ -138,20 +173,28 @@ wb_collider_id wb_collider_add(wb_world *w, const wb_collider_def *def, wb_statu
     const char *err = wb_collider_def_check(def);
     if (err) { wb__set_error("%s", err); *status = WB_ERR_ARG; return none; }
     wb_model *m = &w->m;
+    /* the mesh's copy first: when it fails nothing has changed */
+    wb_colmesh *cm = NULL;
+    if (def->shape == WB_SHAPE_MESH) {
+        cm = wb__colmesh_build(def->mesh->v, def->mesh->nv, def->mesh->tri, def->mesh->nt, def->scale);
+        if (!cm) { *status = WB_ERR_NOMEM; return none; }
+        if (!wb__mesh_charge(w, cm)) { wb__colmesh_free(cm); *status = WB_ERR_NOMEM; return none; }
+    }
     int32_t slot = -1;
     for (int32_t i = 0; i < m->nc; i++)
         if (!(m->c_gen[i] & 1u)) { slot = i; break; }
     if (slot < 0) {
-        if (m->nc >= WB_MAX_COLLIDERS) { *status = WB_ERR_LIMIT; return none; }
+        wb_cshape tmp = { .mesh = cm };
+        if (m->nc >= WB_MAX_COLLIDERS) { wb__mesh_release(w, &tmp); *status = WB_ERR_LIMIT; return none; }
         int32_t cap = m->cap_c, cap2 = m->cap_c, cap3 = m->cap_c;
         wb_cshape *sh = wb__grow(m->c_shape, &cap, m->nc + 1, sizeof *sh);
-        if (!sh) { *status = WB_ERR_NOMEM; return none; }
+        if (!sh) { wb__mesh_release(w, &tmp); *status = WB_ERR_NOMEM; return none; }
         m->c_shape = sh;
         uint32_t *gen = wb__grow(m->c_gen, &cap2, m->nc + 1, sizeof *gen);
-        if (!gen) { *status = WB_ERR_NOMEM; return none; }
+        if (!gen) { wb__mesh_release(w, &tmp); *status = WB_ERR_NOMEM; return none; }
         m->c_gen = gen;
         wb_collider_pose *po = wb__grow(w->s.c_pose, &cap3, m->nc + 1, sizeof *po);
-        if (!po) { *status = WB_ERR_NOMEM; return none; }
+        if (!po) { wb__mesh_release(w, &tmp); *status = WB_ERR_NOMEM; return none; }
         w->s.c_pose = po;
         m->cap_c = cap;
         slot = m->nc++;
@@ -175,6 +218,12 @@ wb_collider_id wb_collider_add(wb_world *w, const wb_collider_def *def, wb_statu
     case WB_SHAPE_SPHERE:
         s->radius = def->radius;
         v3_copy(p->p, def->center);
+        break;
+    case WB_SHAPE_MESH:
+        s->mesh = cm;
+        v3_copy(p->p, def->center);
+        memcpy(p->q, def->rotation, sizeof p->q);
+        q_normalize(p->q);
         break;
     case WB_SHAPE_BOX:
         v3_copy(s->half, def->half);
@@ -211,7 +260,28 @@ bool wb_collider_valid(const wb_world *w, wb_collider_id c)
 
 #define CSLOT(w, c) (assert(wb_collider_valid((w), (c))), (int32_t)(c).index - 1)
 
-void wb_collider_remove(wb_world *w, wb_collider_id c) { w->m.c_gen[CSLOT(w, c)]++; }
+void wb_collider_remove(wb_world *w, wb_collider_id c)
+{
+    const int32_t i = CSLOT(w, c);
+    wb__mesh_release(w, &w->m.c_shape[i]);
+    w->m.c_gen[i]++;
+}
+
+int32_t wb_collider_mesh(const wb_world *w, wb_collider_id c, const wb_real **v, const int32_t **tri, int32_t *nt)
+{
+    const wb_colmesh *cm = w->m.c_shape[CSLOT(w, c)].mesh;
+    if (!cm) { *v = NULL; *tri = NULL; *nt = 0; return 0; }
+    *v = cm->v;
+    *tri = cm->tri;
+    *nt = cm->nt;
+    return cm->nv;
+}
+
+bool wb_collider_mesh_closed(const wb_world *w, wb_collider_id c)
+{
+    const wb_colmesh *cm = w->m.c_shape[CSLOT(w, c)].mesh;
+    return cm && cm->closed;
+}
 wb_shape wb_collider_shape(const wb_world *w, wb_collider_id c) { return w->m.c_shape[CSLOT(w, c)].shape; }
 
 void wb_collider_set_position(wb_world *w, wb_collider_id c, const wb_real p[3]) { v3_copy(w->s.c_pose[CSLOT(w, c)].p, p); }
@@ -319,6 +389,9 @@ wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real
         }
         break;
     }
+    case WB_SHAPE_MESH:
+        dist = wb__colmesh_distance(s->mesh, l, nl, NULL, NULL);
+        break;
     default:
         v3_set(nl, 0, 1, 0);
         dist = INFINITY;
@@ -363,6 +436,60 @@ typedef struct contact {
     wb_real vc[3];         /* collider surface velocity at the contact */
     wb_real vn_pre;        /* normal velocity relative to the surface before the solve */
 } contact;
+
+/* A mesh's contact: depth and the world normal out of it. A closed mesh pushes out of
+ * its nearest surface (a particle inside goes out, not deeper). An open mesh has two
+ * sides: the particle stays on the side it was on at the substep's start (x_prev in the
+ * collider's start pose), so one that crossed the sheet within the substep goes back
+ * rather than out the far side. */
+static wb_real mesh_depth(const sub_pose *sp, const wb_real x[3], const wb_real xprev[3], wb_real r, wb_real n[3])
+{
+    const wb_colmesh *cm = sp->s->mesh;
+    wb_real u[3], l[3], nl[3], c[3], pn[3];
+    v3_sub(u, x, sp->p1);
+    q_rotate_inv(sp->q1, u, l);
+    /* far from the tree's box: no contact, and no query */
+    const wb_bvh_node *root = &cm->nodes[0];
+    wb_real lp[3], mv = 0;
+    if (!cm->closed) {
+        v3_sub(u, xprev, sp->p0);
+        q_rotate_inv(sp->q0, u, lp);
+        v3_sub(u, l, lp);
+        mv = v3_len(u);
+    }
+    const wb_real reach = r + mv;
+    for (int k = 0; k < 3; k++)
+        if (l[k] < root->lo[k] - reach || l[k] > root->hi[k] + reach) return 0;
+    wb_real depth;
+    if (cm->closed) {
+        depth = r - wb__colmesh_distance(cm, l, nl, c, pn);
+    } else {
+        int32_t t;
+        int region;
+        const wb_real d2 = wb__colmesh_closest_within(cm, l, reach * reach, c, &t, &region);
+        if (t < 0) return 0;
+        wb__colmesh_pseudo_normal(cm, t, region, pn);
+        const wb_real lpn = v3_len(pn), d = sqrt(d2);
+        wb_real a[3], b[3];
+        v3_sub(a, l, c);
+        v3_sub(b, lp, c);
+        const wb_real s_now = v3_dot(a, pn), s_prev = v3_dot(b, pn);
+        if (lpn > 0 && s_prev != 0 && (s_now * s_prev < 0 || !(d > 1e-12 * (1 + v3_len(c))))) {
+            /* crossed (or on the sheet): back to the side it came from */
+            v3_scale(nl, pn, (s_prev > 0 ? 1 : -1) / lpn);
+            depth = r - v3_dot(a, nl);
+        } else if (d > 0) {
+            v3_scale(nl, a, 1 / d);
+            depth = r - d;
+        } else {
+            if (lpn > 0) v3_scale(nl, pn, 1 / lpn);
+            else v3_set(nl, 0, 1, 0);
+            depth = r;
+        }
+    }
+    q_rotate(sp->q1, nl, n);
+    return depth;
+}
 
 /* more simultaneous contacts than this on one particle keep their position
  * correction but lose their velocity pass (friction, restitution) */
@@ -467,6 +594,8 @@ void wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1)
             if (sp->s->shape == WB_SHAPE_PLANE) {
                 depth = rad[i] + sp->off - v3_dot(sp->n, xi);
                 v3_copy(n, sp->n);
+            } else if (sp->s->shape == WB_SHAPE_MESH) {
+                depth = mesh_depth(sp, xi, pi, rad[i], n);
             } else {
                 depth = rad[i] - wb__shape_distance(sp->s, sp->p1, sp->q1, xi, n);
             }

@@ -52,6 +52,7 @@ typedef struct wb_cshape {
     wb_real half[3];       /* box */
     wb_real a[3], b[3];    /* capsule segment in the collider frame */
     wb_real friction, restitution;
+    struct wb_colmesh *mesh; /* mesh: owned triangles and tree (bvh.h); NULL otherwise */
 } wb_cshape;
 
 typedef struct wb_model {
@@ -80,6 +81,7 @@ typedef struct wb_model {
 
     int topology_dirty;    /* colour batches must be rebuilt */
     size_t charged;        /* bytes charged to def.memory */
+    size_t charged_mesh;   /* bytes of mesh colliders' copies, charged to def.memory too */
 
     /* surfaces: triangles over particles, concatenated */
     int32_t nsurf, cap_surf;
@@ -149,6 +151,9 @@ void wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1);
 void wb__collider_pose_at(const wb_collider_pose *cp, wb_real t, wb_real p[3], wb_real q[4]);
 wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real q[4],
                            const wb_real x[3], wb_real n[3]);
+/* collide.c: a mesh collider's copy charged to / given back to the memory budget (and freed) */
+int wb__mesh_charge(wb_world *w, const struct wb_colmesh *cm);
+void wb__mesh_release(wb_world *w, wb_cshape *s);
 wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra); /* world.c */
 wb_status wb__surface_reserve(wb_world *w, int32_t ntri);
 void *wb__grow(void *ptr, int32_t *cap, int32_t need, size_t elem); /* world.c: realloc helper */

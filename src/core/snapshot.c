@@ -9,6 +9,7 @@
 #include <stdlib.h>
 
 #include "core.h"
+#include "bvh.h"
 #include "snapshot.h"
 
 static int fin3(const wb_real *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
@@ -61,6 +62,10 @@ wb_status wb_image_alloc(wb_image *g, int32_t np, int32_t nd, int32_t nfree, int
 
 void wb_image_free(wb_image *g)
 {
+    for (int32_t i = 0; g->c && i < g->nc; i++) {
+        free(g->c[i].mv);
+        free(g->c[i].mt);
+    }
     void *p[] = { g->x, g->v, g->inv_mass, g->radius, g->pinned, g->d_ij, g->d_alpha, g->d_beta, g->d_yield,
                   g->d_creep, g->d_break, g->d_rest, g->d_broken, g->d_gen, g->d_free, g->c, g->c_gen,
                   g->surf_start, g->tri };
@@ -114,6 +119,19 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
         v3_copy(c->v, cp->v);
         v3_copy(c->om, cp->om);
         g->c_gen[i] = m->c_gen[i];
+        if (cs->mesh && (m->c_gen[i] & 1u)) {
+            const wb_colmesh *cm = cs->mesh;
+            c->mv = malloc(3 * (size_t)(cm->nv > 0 ? cm->nv : 1) * sizeof *c->mv);
+            c->mt = malloc(3 * (size_t)cm->nt * sizeof *c->mt);
+            if (!c->mv || !c->mt) {
+                wb_image_free(g);
+                return WB_ERR_NOMEM;
+            }
+            c->mnv = cm->nv;
+            c->mnt = cm->nt;
+            memcpy(c->mv, cm->v, 3 * (size_t)cm->nv * sizeof *c->mv);
+            memcpy(c->mt, cm->tri, 3 * (size_t)cm->nt * sizeof *c->mt);
+        }
     }
     if (m->nsurf) memcpy(g->surf_start, m->surf_start, ((size_t)m->nsurf + 1) * sizeof *g->surf_start);
     if (m->ntri) memcpy(g->tri, m->tri, 3 * (size_t)m->ntri * sizeof *g->tri);
@@ -144,6 +162,13 @@ static const char *check_collider(const wb_image_collider *c)
         if (!isfinite(v3_dot(ab, ab))) return "capsule ends are too far apart (|b - a| squared overflows)";
     }
     if (c->shape == WB_SHAPE_PLANE && !(v3_len(c->n) > 1e-12)) return "plane normal must not be zero";
+    if (c->shape == WB_SHAPE_MESH) {
+        if (!c->mv || !c->mt || c->mnt <= 0 || c->mnv <= 0) return "mesh collider has no triangles";
+        for (int64_t i = 0; i < 3 * (int64_t)c->mnv; i++)
+            if (!isfinite(c->mv[i])) return "mesh collider vertices must be finite";
+        for (int64_t i = 0; i < 3 * (int64_t)c->mnt; i++)
+            if (c->mt[i] < 0 || c->mt[i] >= c->mnv) return "mesh collider corner out of range";
+    }
     return NULL;
 }
 
@@ -219,11 +244,33 @@ static wb_status grow_colliders(wb_world *w, int32_t need)
     return WB_OK;
 }
 
-static void put_collider(wb_world *w, int32_t slot, const wb_image_collider *c)
+/* the mesh colliders' copies of the image's live colliders, built and charged before
+ * anything changes (all or nothing); cms[i] is NULL for other shapes */
+static wb_status build_meshes(wb_world *w, const wb_image *g, wb_colmesh **cms)
+{
+    for (int32_t i = 0; i < g->nc; i++) {
+        const wb_image_collider *c = &g->c[i];
+        cms[i] = NULL;
+        if (!(g->c_gen[i] & 1u) || c->shape != WB_SHAPE_MESH) continue;
+        cms[i] = wb__colmesh_build(c->mv, c->mnv, c->mt, c->mnt, 1);
+        if (!cms[i] || !wb__mesh_charge(w, cms[i])) {
+            wb__colmesh_free(cms[i]);
+            for (int32_t j = 0; j < i; j++) {
+                wb_cshape tmp = { .mesh = cms[j] };
+                wb__mesh_release(w, &tmp);
+            }
+            return WB_ERR_NOMEM;
+        }
+    }
+    return WB_OK;
+}
+
+static void put_collider(wb_world *w, int32_t slot, const wb_image_collider *c, wb_colmesh *cm)
 {
     wb_cshape *cs = &w->m.c_shape[slot];
     wb_collider_pose *cp = &w->s.c_pose[slot];
     memset(cs, 0, sizeof *cs);
+    cs->mesh = cm;
     cs->shape = c->shape;
     v3_copy(cs->n, c->n);
     cs->radius = c->radius;
@@ -275,10 +322,13 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
         return NULL;
     }
     wb_world *w = wb_world_create(&g->def);
-    wb_status st = w ? wb__reserve(w, g->np, g->nd) : WB_ERR_NOMEM;
+    wb_colmesh **cms = calloc((size_t)(g->nc > 0 ? g->nc : 1), sizeof *cms);
+    wb_status st = w && cms ? wb__reserve(w, g->np, g->nd) : WB_ERR_NOMEM;
     if (st == WB_OK) st = grow_colliders(w, g->nc);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
+    if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
+        free(cms);
         wb_world_destroy(w);
         *status = st;
         return NULL;
@@ -317,9 +367,10 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     if (g->nfree) memcpy(m->d_free, g->d_free, (size_t)g->nfree * sizeof *m->d_free);
     m->nc = g->nc;
     for (int32_t i = 0; i < g->nc; i++) {
-        put_collider(w, i, &g->c[i]);
+        put_collider(w, i, &g->c[i], cms[i]);
         m->c_gen[i] = g->c_gen[i];
     }
+    free(cms);
     put_surfaces(w, g, 0);
     s->time = g->time;
     s->frame = g->frame;
@@ -356,10 +407,16 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     const int32_t new_c = live_c > dead_c ? live_c - dead_c : 0;
     if ((int64_t)m->nc + new_c > WB_MAX_COLLIDERS || (int64_t)m->ntri + g->ntri > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     /* everything reserved first: after this nothing can fail */
+    wb_colmesh **cms = calloc((size_t)(g->nc > 0 ? g->nc : 1), sizeof *cms);
+    if (!cms) return WB_ERR_NOMEM;
     wb_status st = wb__reserve(w, g->np, live_d);
     if (st == WB_OK) st = grow_colliders(w, m->nc + new_c);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
-    if (st != WB_OK) return st;
+    if (st == WB_OK) st = build_meshes(w, g, cms);
+    if (st != WB_OK) {
+        free(cms);
+        return st;
+    }
 
     const int32_t first = m->np;
     for (int32_t i = 0; i < g->np; i++) {
@@ -387,9 +444,10 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
             slot = m->nc++;
             m->c_gen[slot] = 0;
         }
-        put_collider(w, slot, &g->c[i]);
+        put_collider(w, slot, &g->c[i], cms[i]);
         m->c_gen[slot]++;
     }
+    free(cms);
     put_surfaces(w, g, first);
     m->topology_dirty = 1;
     out->first = first;
@@ -414,7 +472,11 @@ wb_status wb_image_collider_from_def(const wb_collider_def *d, wb_image_collider
     if (st == WB_OK) {
         wb_image g;
         st = wb_image_of(w, &g);
-        if (st == WB_OK) *out = g.c[id.index - 1];
+        if (st == WB_OK) {
+            *out = g.c[id.index - 1];
+            g.c[id.index - 1].mv = NULL; /* the mesh's arrays go to out */
+            g.c[id.index - 1].mt = NULL;
+        }
         wb_image_free(&g);
     }
     wb_world_destroy(w);

@@ -18,6 +18,9 @@ typedef struct wb_image_collider {
     wb_real p[3], q[4];    /* pose now */
     wb_real p0[3], q0[4];  /* pose at the end of the last step: start of the next sweep */
     wb_real v[3], om[3];   /* velocities the script set */
+    int32_t mnv, mnt;      /* mesh: vertex and triangle counts */
+    wb_real *mv;           /* mesh: (mnv x 3) vertices in the collider frame (malloc'd, the image owns it) */
+    int32_t *mt;           /* mesh: (mnt x 3) corners (malloc'd, the image owns it) */
 } wb_image_collider;
 
 typedef struct wb_image {
@@ -54,7 +57,7 @@ typedef struct wb_image {
 
 /* allocate the arrays for these counts (zeroed; generations 1, i.e. live); WB_ERR_NOMEM */
 wb_status wb_image_alloc(wb_image *img, int32_t np, int32_t nd, int32_t nfree, int32_t nc, int32_t nsurf, int32_t ntri);
-void wb_image_free(wb_image *img);                     /* and zero it; fine on a zeroed image */
+void wb_image_free(wb_image *img);                     /* and zero it (mesh colliders' arrays too); fine on a zeroed image */
 wb_status wb_image_of(const wb_world *w, wb_image *img); /* a full copy of the world */
 /* NULL, or what is inconsistent (an index out of range, a free list that does not match
  * the dead slots, a non-finite value, ...): a reader's last line of defence */

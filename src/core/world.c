@@ -6,6 +6,7 @@
 #include <stdlib.h>
 
 #include "core.h"
+#include "bvh.h"
 
 static _Thread_local char wb_err[256];
 
@@ -97,7 +98,8 @@ void wb_world_destroy(wb_world *w)
 {
     if (!w) return;
     wb_model *m = &w->m;
-    if (m->def.memory) m->def.memory->used -= m->charged;
+    for (int32_t i = 0; i < m->nc; i++) wb__colmesh_free(m->c_shape[i].mesh); /* mesh colliders' copies */
+    if (m->def.memory) m->def.memory->used -= m->charged + m->charged_mesh;
     wb_state *s = &w->s;
     wb_cache *k = &w->k;
     void *ptrs[] = { m->inv_mass, m->w, m->radius, m->pinned, m->d_ij, m->d_alpha, m->d_beta,

@@ -285,7 +285,40 @@ static int read_constraints(rd *r, const sections *s, const defaults *d, wb_imag
     return 0;
 }
 
-static const char *const shape_names[] = { "plane", "sphere", "box", "capsule", NULL };
+static const char *const shape_names[] = { "plane", "sphere", "box", "capsule", "mesh", NULL };
+
+/* a mesh collider's "vertices" (flat x,y,z, ...) and "triangles" (flat, 0-based corners) */
+static int read_mesh_arrays(rd *r, const cJSON *it, const kp *p, const cJSON *fv, const cJSON *ft, wb_image_collider *c)
+{
+    if (!fv) return jv_missing(r, it, p, "vertices");
+    if (!ft) return jv_missing(r, it, p, "triangles");
+    kp vp = { p, "vertices", 0 }, tp = { p, "triangles", 0 };
+    int32_t nv3, nt3;
+    if (jv_get_array(r, fv, &vp, 3ll * WB_MAX_PARTICLES, &nv3) || jv_get_array(r, ft, &tp, 3ll * WB_MAX_CONSTRAINTS, &nt3))
+        return -1;
+    if (nv3 % 3) return jv_fail(r, fv, 0, &vp, "%d numbers is not a whole number of vertices", nv3);
+    if (nt3 % 3) return jv_fail(r, ft, 0, &tp, "%d corners is not a whole number of triangles", nt3);
+    if (nt3 == 0) return jv_fail(r, ft, 0, &tp, "a mesh collider needs at least one triangle");
+    c->mv = malloc((size_t)(nv3 > 0 ? nv3 : 1) * sizeof *c->mv);
+    c->mt = malloc((size_t)nt3 * sizeof *c->mt);
+    if (!c->mv || !c->mt) return jv_fail(r, it, 0, p, "out of memory");
+    c->mnv = nv3 / 3;
+    c->mnt = nt3 / 3;
+    int32_t k = 0;
+    for (const cJSON *e = fv->child; e; e = e->next, k++) {
+        kp q = { &vp, NULL, k };
+        if (jv_get_real(r, e, &q, &c->mv[k])) return -1;
+    }
+    k = 0;
+    for (const cJSON *e = ft->child; e; e = e->next, k++) {
+        kp q = { &tp, NULL, k };
+        int64_t v;
+        if (c->mnv == 0) return jv_fail(r, e, 0, &q, "there are no vertices");
+        if (jv_get_int(r, e, &q, 0, c->mnv - 1, &v)) return -1;
+        c->mt[k] = (int32_t)v;
+    }
+    return 0;
+}
 
 /* a rotation as given, normalised only when it is not already unit (a snapshot's rotations
  * are, and must come back bit for bit) */
@@ -323,11 +356,12 @@ static int read_pose(rd *r, const cJSON *it, const kp *up, wb_image_collider *c)
 static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider *c)
 {
     static const char *const keys[] = { "shape", "normal", "offset", "center", "radius", "half", "rotation", "a", "b",
-                                        "friction", "restitution", "pose", NULL };
+                                        "friction", "restitution", "pose", "vertices", "triangles", "scale", NULL };
     /* which keys each shape takes, world form / own-frame form (pose) */
-    static const char *const world_keys[WB_SHAPE_COUNT] = { "normal offset", "center radius", "center half rotation", "a b radius" };
-    static const char *const local_keys[WB_SHAPE_COUNT] = { "normal", "radius", "half", "a b radius" };
-    const cJSON *f[13];
+    static const char *const world_keys[WB_SHAPE_COUNT] = { "normal offset", "center radius", "center half rotation", "a b radius",
+                                                            "center rotation vertices triangles scale" };
+    static const char *const local_keys[WB_SHAPE_COUNT] = { "normal", "radius", "half", "a b radius", "vertices triangles" };
+    const cJSON *f[16];
     if (jv_get_object(r, it, p, keys, f)) return -1;
     if (!f[0]) return jv_missing(r, it, p, "shape");
     kp sp = { p, "shape", 0 };
@@ -335,11 +369,11 @@ static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider 
     if (jv_get_string(r, f[0], &sp, &name)) return -1;
     int shape = 0;
     while (shape_names[shape] && strcmp(name, shape_names[shape])) shape++;
-    if (!shape_names[shape]) return jv_fail(r, f[0], 0, &sp, "unknown shape '%s' (expected plane, sphere, box or capsule)", name);
+    if (!shape_names[shape]) return jv_fail(r, f[0], 0, &sp, "unknown shape '%s' (expected plane, sphere, box, capsule or mesh)", name);
     const int local = f[11] != NULL;
     const char *allowed = (local ? local_keys : world_keys)[shape];
-    for (int i = 1; i <= 8; i++) {
-        if (!f[i]) continue;
+    for (int i = 1; i <= 14; i++) {
+        if (!f[i] || (i >= 9 && i <= 11)) continue;
         const char *k = keys[i], *hit = strstr(allowed, k);
         const size_t kl = strlen(k);
         /* a whole word of the list */
@@ -360,13 +394,37 @@ static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider 
         kp q = { p, "rotation", 0 };
         if (get_quat(r, f[6], &q, d.rotation)) return -1;
     }
+    if (shape == WB_SHAPE_MESH) {
+        kp sc = { p, "scale", 0 };
+        if (f[14] && jv_get_real(r, f[14], &sc, &d.scale)) return -1;
+        if (read_mesh_arrays(r, it, p, f[12], f[13], c)) return -1;
+    }
+    if (!local && shape == WB_SHAPE_MESH) {
+        /* the arrays just read are the mesh the def copies (scaled) into the collider */
+        wb_mesh mesh = { c->mnv, c->mnt, c->mv, NULL, c->mt };
+        d.mesh = &mesh;
+        wb_image_collider tmp;
+        wb_status st = wb_image_collider_from_def(&d, &tmp);
+        if (st == WB_ERR_NOMEM) return jv_fail(r, it, 0, p, "out of memory");
+        if (st != WB_OK) return jv_fail(r, it, 0, p, "%s", wb_last_error());
+        free(c->mv);
+        free(c->mt);
+        *c = tmp;
+        return 0;
+    }
     if (!local) {
         wb_status st = wb_image_collider_from_def(&d, c);
         if (st == WB_ERR_NOMEM) return jv_fail(r, it, 0, p, "out of memory");
         return st != WB_OK ? jv_fail(r, it, 0, p, "%s", wb_last_error()) : 0;
     }
     /* own frame: the values are the collider's internals, as w:save wrote them */
+    wb_real *mv = c->mv;
+    int32_t *mt = c->mt, mnv = c->mnv, mnt = c->mnt;
     memset(c, 0, sizeof *c);
+    c->mv = mv; /* a mesh's arrays, read above */
+    c->mt = mt;
+    c->mnv = mnv;
+    c->mnt = mnt;
     c->shape = (wb_shape)shape;
     c->friction = d.friction;
     c->restitution = d.restitution;

@@ -129,7 +129,7 @@ static void write_constraints(out *o, const wb_image *g)
 
 static void write_colliders(out *o, const wb_image *g)
 {
-    static const char *const names[] = { "plane", "sphere", "box", "capsule" };
+    static const char *const names[] = { "plane", "sphere", "box", "capsule", "mesh" };
     FILE *f = o->f;
     int first = 1;
     fputs("  \"colliders\": [", f);
@@ -143,6 +143,14 @@ static void write_colliders(out *o, const wb_image *g)
         case WB_SHAPE_PLANE: fputs("\"normal\": ", f); vec(o, c->n, 3); break;
         case WB_SHAPE_SPHERE: fputs("\"radius\": ", f); num(o, c->radius); break;
         case WB_SHAPE_BOX: fputs("\"half\": ", f); vec(o, c->half, 3); break;
+        case WB_SHAPE_MESH:
+            /* its own copy, in its own frame with the scale applied: exact */
+            fputs("\"vertices\": ", f);
+            vec(o, c->mv, 3 * c->mnv);
+            fputs(",\n     \"triangles\": [", f);
+            for (int64_t k = 0; k < 3 * (int64_t)c->mnt; k++) fprintf(f, "%s%d", k ? ", " : "", (int)c->mt[k]);
+            fputc(']', f);
+            break;
         default:
             fputs("\"a\": ", f); vec(o, c->a, 3);
             fputs(", \"b\": ", f); vec(o, c->b, 3);

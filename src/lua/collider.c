@@ -1,10 +1,11 @@
 /* collider.c: kinematic colliders: w:collider{shape = ...} and the collider
  * handle (id + generation, the world's userdata as its user value). */
+#include "mesh.h"
 #include "util.h"
 
 typedef struct wbl_collider { wb_collider_id id; } wbl_collider;
 
-static const char *const shape_names[] = { "plane", "sphere", "box", "capsule", NULL };
+static const char *const shape_names[] = { "plane", "sphere", "box", "capsule", "mesh", NULL };
 
 /* the keys each shape accepts: a key of another shape is an error, not ignored */
 static const char *const shape_keys[WB_SHAPE_COUNT][8] = {
@@ -12,6 +13,7 @@ static const char *const shape_keys[WB_SHAPE_COUNT][8] = {
     [WB_SHAPE_SPHERE] = { "shape", "center", "radius", "friction", "restitution", NULL },
     [WB_SHAPE_BOX] = { "shape", "center", "half", "rotation", "friction", "restitution", NULL },
     [WB_SHAPE_CAPSULE] = { "shape", "a", "b", "radius", "friction", "restitution", NULL },
+    [WB_SHAPE_MESH] = { "shape", "mesh", "center", "rotation", "scale", "friction", "restitution", NULL },
 };
 
 wb_collider_id *wbl_push_collider(lua_State *L, int world_index, wb_collider_id id)
@@ -39,7 +41,7 @@ static int w_collider(lua_State *L)
     wb_world *w = wbl_checkworld(L, 1);
     luaL_checktype(L, 2, LUA_TTABLE);
     int shape = wbl_optenum(L, 2, "shape", "shape", shape_names);
-    if (shape < 0) return wbl_fielderror(L, 2, "shape", "missing (plane, sphere, box or capsule)");
+    if (shape < 0) return wbl_fielderror(L, 2, "shape", "missing (plane, sphere, box, capsule or mesh)");
     wbl_checkopts(L, 2, shape_keys[shape], false);
     wb_collider_def d = wb_collider_default_def((wb_shape)shape);
     wbl_optvec(L, 2, "normal", 3, d.normal);
@@ -52,6 +54,16 @@ static int w_collider(lua_State *L)
     wbl_optvec(L, 2, "b", 3, d.b);
     wbl_optreal(L, 2, "friction", &d.friction);
     wbl_optreal(L, 2, "restitution", &d.restitution);
+    if (shape == WB_SHAPE_MESH) {
+        wbl_optreal(L, 2, "scale", &d.scale);
+        lua_getfield(L, 2, "mesh");
+        if (lua_isnil(L, -1)) return wbl_fielderror(L, 2, "mesh", "missing (a mesh from wobble.load_mesh or wobble.mesh)");
+        if (!luaL_testudata(L, -1, WBL_MESH))
+            return wbl_fielderror(L, 2, "mesh", "mesh expected, got %s", luaL_typename(L, -1));
+        d.mesh = wbl_checkmesh(L, -1);
+        if (d.mesh->nt <= 0) return wbl_fielderror(L, 2, "mesh", "is empty (no triangles)");
+        lua_pop(L, 1); /* the table at 2 still holds the mesh: it lives through the add */
+    }
     const char *err = wb_collider_def_check(&d);
     if (err) return luaL_argerror(L, 2, err);
     wb_collider_id none = { 0, 0 };

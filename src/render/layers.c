@@ -223,8 +223,58 @@ static void put_vertex(float *v, const double p[3], const double n[3], const flo
     v[9] = surface_shine;
 }
 
-/* vertices: the particles, then every skin's; indices: the surfaces' triangles (those
- * not wholly under a drawn skin), then the skins'. Smooth normals: area-weighted. */
+/* the mesh colliders' triangles (when colliders are drawn) */
+static size_t mesh_collider_triangles(const wb_world *w, const wb_draw_opts *o)
+{
+    size_t n = 0;
+    for (int32_t i = 0; o->colliders && i < wb_collider_count(w); i++) {
+        const wb_real *v;
+        const int32_t *t;
+        int32_t nt = 0;
+        wb_collider_mesh(w, wb_collider_at(w, i), &v, &t, &nt);
+        n += (size_t)nt;
+    }
+    return n;
+}
+
+/* a mesh collider's triangles at its pose, three vertices each with the face's normal:
+ * flat shading shows the facets the particles actually collide with */
+static size_t put_mesh_colliders(wb_layers *l, const wb_world *w, const wb_draw_opts *o, size_t base, size_t *k)
+{
+    float col[3];
+    wb_lin3(col_collider, col);
+    for (int32_t i = 0; o->colliders && i < wb_collider_count(w); i++) {
+        const wb_collider_id id = wb_collider_at(w, i);
+        const wb_real *v;
+        const int32_t *t;
+        int32_t nt = 0;
+        wb_collider_mesh(w, id, &v, &t, &nt);
+        if (nt == 0) continue;
+        wb_collider_def d;
+        wb_collider_get_def(w, id, &d);
+        double m[9];
+        quat_mat(d.rotation, m);
+        for (int32_t j = 0; j < nt; j++) {
+            double p[3][3], e1[3], e2[3], fn[3];
+            for (int c = 0; c < 3; c++) {
+                const wb_real *q = &v[3 * t[3 * j + c]];
+                for (int r = 0; r < 3; r++) p[c][r] = d.center[r] + m[r * 3] * q[0] + m[r * 3 + 1] * q[1] + m[r * 3 + 2] * q[2];
+            }
+            for (int r = 0; r < 3; r++) e1[r] = p[1][r] - p[0][r], e2[r] = p[2][r] - p[0][r];
+            cross3(e1, e2, fn);
+            norm3(fn);
+            for (int c = 0; c < 3; c++) {
+                put_vertex(l->sv + WB_SV * base, p[c], fn, col);
+                l->si[(*k)++] = (GLuint)base++;
+            }
+        }
+    }
+    return base;
+}
+
+/* vertices: the particles, then every skin's, then the mesh colliders'; indices: the
+ * surfaces' triangles (those not wholly under a drawn skin), then the skins', then the
+ * mesh colliders'. Smooth normals: area-weighted. */
 static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *o, const wb_draw_skin *sk, int nsk)
 {
     int32_t np = wb_particle_count(w), ns = o->surfaces ? wb_surface_count(w) : 0;
@@ -236,6 +286,9 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
         total += 3 * (size_t)nt;
     }
     for (int i = 0; i < nsk; i++) total += 3 * (size_t)sk[i].nt, nv += (size_t)sk[i].nv;
+    const size_t nmesh = mesh_collider_triangles(w, o);
+    total += 3 * nmesh;
+    nv += 3 * nmesh;
     if (!grow(&l->sv, &l->sv_cap, WB_SV * nv + WB_SV, sizeof *l->sv) || !grow(&l->si, &l->si_cap, total + 1, sizeof *l->si))
         return false;
     double *acc = calloc((size_t)np * 3 + 3, sizeof *acc);
@@ -287,6 +340,7 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
         for (int32_t t = 0; t < 3 * sk[i].nt; t++) l->si[k++] = (GLuint)(base + (size_t)sk[i].tri[t]);
         base += (size_t)sk[i].nv;
     }
+    put_mesh_colliders(l, w, o, base, &k);
     l->nv = nv;
     l->nidx = k;
     return true;
@@ -307,7 +361,7 @@ bool wb_layers_build(wb_layers *l, const wb_world *w, const wb_draw_opts *o, con
     l->npairs = 0;
     if (o->constraints && !load_pairs(l, w)) return false;
     l->nv = l->nidx = l->nseg = 0;
-    l->surfaces = (o->surfaces && wb_surface_count(w) > 0 && np > 0) || nsk > 0;
+    l->surfaces = (o->surfaces && wb_surface_count(w) > 0 && np > 0) || nsk > 0 || mesh_collider_triangles(w, o) > 0;
     if (l->surfaces && !build_surfaces(l, w, o, sk, nsk)) return false;
     if (!build_instances(l, w, o, unit)) return false;
     if (o->constraints && !build_segments(l, w, o)) return false;

@@ -255,6 +255,18 @@ static box scene_box(const wb_world *w)
             double a[3] = { d.a[0], d.a[1], d.a[2] }, e[3] = { d.b[0], d.b[1], d.b[2] };
             box_add(&b, a, d.radius);
             box_add(&b, e, d.radius);
+        } else if (d.shape == WB_SHAPE_MESH) {
+            const wb_real *v;
+            const int32_t *t;
+            int32_t nt = 0, nv = wb_collider_mesh(w, wb_collider_at(w, i), &v, &t, &nt);
+            double m[9];
+            quat_mat(d.rotation, m);
+            for (int32_t k = 0; k < nv; k++) {
+                const wb_real *q = &v[3 * k];
+                double p[3];
+                for (int r = 0; r < 3; r++) p[r] = c[r] + m[r * 3] * q[0] + m[r * 3 + 1] * q[1] + m[r * 3 + 2] * q[2];
+                box_add(&b, p, 0);
+            }
         }
     }
     if (!b.any) {

@@ -102,7 +102,7 @@ end)
 
 test("unknown enum strings list the valid values", function()
   local w = world_with(0)
-  expect.error(function() w:collider{ shape = "cone" } end, "unknown shape 'cone' %(expected plane, sphere, box or capsule%)")
+  expect.error(function() w:collider{ shape = "cone" } end, "unknown shape 'cone' %(expected plane, sphere, box, capsule or mesh%)")
   expect.error(function() wobble.world{ solver = "sor" } end, "unknown solver 'sor' %(expected gauss")
   expect.error(function() w:collider{} end, "field 'shape': missing")
   expect.eq(w:stats().colliders, 0)

@@ -121,7 +121,7 @@ test("constraints: type, particles, options", function()
 end)
 
 test("colliders: shapes and their keys", function()
-  bad(TWO .. ' "colliders": [{"shape": "cone"}]}', "colliders[0].shape: unknown shape 'cone' (expected plane, sphere, box or capsule)")
+  bad(TWO .. ' "colliders": [{"shape": "cone"}]}', "colliders[0].shape: unknown shape 'cone' (expected plane, sphere, box, capsule or mesh)")
   local t = TWO .. ' "colliders": [{"shape": "sphere", "normal": [0,1,0]}]}'
   bad_at(t, '"normal"', "colliders[0].normal: a sphere takes center radius (and friction, restitution, pose), not 'normal'")
   bad(TWO .. ' "colliders": [{"shape": "sphere", "radius": -1}]}', "colliders[0]: radius must be > 0")

@@ -89,6 +89,10 @@
     X(hash_covers_collider_velocity_mass_radius) \
     X(memory_budget_shared_by_worlds)           \
     X(distance_ids_match_distance_at)            \
+    X(bvh_point_triangle_projection)             \
+    X(bvh_closest_matches_brute_force)           \
+    X(bvh_closed_and_open_and_sign)              \
+    X(bvh_mesh_collider_memory_charged)          \
     EXTREME_TESTS(X)
 
 #define DECLARE(name) TEST(name);
