@@ -97,6 +97,21 @@ test("load_particles: the config's parts are bodies of their own", function()
   expect.eq(#logo.parts, 6)
 end)
 
+test("load_particles of a snapshot: its bodies stay apart, in new groups", function()
+  local w = wobble.world{}
+  local a = w:lattice{ res = {2, 2, 2} }
+  local b = w:lattice{ min = {2, 0, 0}, max = {3, 1, 1}, res = {2, 2, 2} }
+  expect.eq(w:save("contacts_api/two.json"), true)
+  local v = wobble.world{}
+  v:particle{ pos = {9, 9, 9} }
+  local c = v:cloth{ res = {2, 2} }
+  local both = assert(v:load_particles("contacts_api/two.json"))
+  local ga, gb = v:group(both.particles[1]), v:group(both.particles[9])
+  expect.truthy(ga ~= gb and ga > c.group and gb > c.group, "two new groups")
+  expect.eq(both.group, ga - a.group)
+  expect.eq(gb - ga, b.group - a.group)
+end)
+
 test("snapshots keep groups, self-collision, friction and the contacts switch exactly", function()
   for _, contacts in ipairs{ true, false } do
     local w = wobble.world{ contacts = contacts }

@@ -153,6 +153,40 @@ TEST(contact_self_collision_skips_rest_neighbours)
         CHECK(j - i >= 2);
     }
     wb_world_destroy(w);
+
+    /* a thinner rope (r = 0.04: as built, neighbours 0.1 apart are outside 2 r) with a
+     * link squeezed to 0.05: still never a candidate, being linked */
+    w = wb_world_create(&d);
+    REQUIRE(w);
+    r.radius = 0.04;
+    REQUIRE(wb_rope(w, &r, &b) == WB_OK);
+    wb_group_set_self_collide(w, b.group, true);
+    wb_real p1[3];
+    wb_particle_position(w, b.first, p1);
+    p1[0] += 0.05;
+    wb_particle_set_position(w, b.first + 1, p1);
+    wb_world_step(w);
+    for (int32_t k = 0; k < w->k.pc.n; k++) {
+        const int32_t i = w->k.pc.ij[2 * k], j = w->k.pc.ij[2 * k + 1];
+        CHECK(j - i >= 2);
+    }
+    wb_world_destroy(w);
+
+    /* a fat rope (r = 0.12, next-but-one 0.2 apart, not linked, inside 2 r as built):
+     * self-colliding and straight, it has no contact and does not move */
+    w = wb_world_create(&d);
+    REQUIRE(w);
+    r.radius = 0.12;
+    REQUIRE(wb_rope(w, &r, &b) == WB_OK);
+    wb_group_set_self_collide(w, b.group, true);
+    const uint64_t h0 = wb_world_hash(w);
+    wb_world_step(w);
+    CHECK_EQ(wb_world_stats(w).particle_contacts, 0);
+    wb_real q[3];
+    wb_particle_position(w, b.first + 2, q);
+    CHECK_NEAR(q[0], 0.2, 1e-12);
+    CHECK(wb_world_hash(w) != h0); /* (time moved on) */
+    wb_world_destroy(w);
 }
 
 TEST(contact_clone_keeps_groups)

@@ -47,6 +47,24 @@ test("head-on: no overlap, momentum exact, perfectly inelastic", function()
   expect.near(dist(w, a, b), 0.25, 1e-12, "in touch")
 end)
 
+test("head-on, one substep per frame: inelastic in the substep they meet", function()
+  -- the velocity pass removes the approach speed at once (without it the pair would
+  -- overlap again in the next substep and be stopped only then)
+  local w = wobble.world{ gravity = {0, 0, 0}, substeps = 1 }
+  local a = w:particle{ pos = {-1, 0, 0}, vel = {3, 0, 0}, mass = 1, radius = 0.1 }
+  local b = w:particle{ pos = {1, 0, 0}, vel = {-1, 0, 0}, mass = 2.5, radius = 0.15 }
+  local met
+  w:run{ frames = 60, on_frame = function(w, f)
+    if not met and dist(w, a, b) < 0.25 + 1e-9 then
+      met = f
+      expect.near((w:velocity(a)), 0.5 / 3.5, 1e-12, "a, frame " .. f)
+      expect.near((w:velocity(b)), 0.5 / 3.5, 1e-12, "b, frame " .. f)
+      expect.gt(w:stats().particle_contacts, 0)
+    end
+  end }
+  expect.truthy(met, "they met")
+end)
+
 test("contacts = false: the same pair passes through (so the test above tests something)", function()
   local w, a, b = head_on(false)
   w:run{ frames = 60 }
