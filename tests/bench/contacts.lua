@@ -1,13 +1,13 @@
 -- contacts.lua: the contact benchmark of issue 8. 27 soft blocks (4x4x4 lattices, 64
 -- particles and 279 links each) dropped in a 3x3x3 heap into a box (a floor and four
 -- walls) pile up and push each other: 1728 particles, 10 substeps x 2 iterations,
--- 300 frames, single thread.
+-- 300 frames, single thread (--set contacts=0: the same scene without contacts, for the ratio).
 -- Figures: ms per frame (the whole step), particle contacts in the last substep (mean
 -- over the frames), the broad phase's ms per frame and its share of the step.
 -- Run: make bench   (or build/wobble bench [--json]; --set frames=N for a quick look)
 local args = wobble.args
 local frames = args.frames or 300
-local w = wobble.world{ substeps = 10, iterations = 2, threads = args.threads or 1 }
+local w = wobble.world{ substeps = 10, iterations = 2, threads = args.threads or 1, contacts = args.contacts ~= 0 }
 w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.5 }
 for _, n in ipairs{ {1, 0, 0}, {-1, 0, 0}, {0, 0, 1}, {0, 0, -1} } do
   w:collider{ shape = "plane", normal = n, offset = -1.1, friction = 0.2 }
