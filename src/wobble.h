@@ -34,6 +34,7 @@ typedef double wb_real; /* the reference thesis names 32-bit floats as its weakn
 #define WB_MAX_SUBSTEPS 10000
 #define WB_MAX_ITERATIONS 10000
 #define WB_MAX_THREADS 256
+#define WB_MAX_GROUP (1 << 30)  /* contact groups are 0..WB_MAX_GROUP */
 
 typedef enum wb_status {
     WB_OK = 0,
@@ -70,6 +71,7 @@ typedef struct wb_world_def {
     wb_solver solver;     /* default Gauss-Seidel */
     wb_real relaxation;   /* Jacobi over-relaxation factor omega, default 1 */
     int threads;          /* default 1; results are bit-identical for any value */
+    bool contacts;        /* particle-particle contacts, default true */
     wb_memory *memory;    /* budget the world's arrays are charged to; NULL = none (not copied by set_def) */
 } wb_world_def;
 
@@ -175,7 +177,7 @@ int32_t wb_collider_mesh(const wb_world *w, wb_collider_id c, const wb_real **v,
 bool wb_collider_mesh_closed(const wb_world *w, wb_collider_id c);
 
 /* ---- builders: particles are contiguous [first, first+count) --------------------------- */
-typedef struct wb_body { int32_t first, count; } wb_body;
+typedef struct wb_body { int32_t first, count, group; } wb_body; /* group: its contact group */
 
 typedef struct wb_cloth_def {
     wb_real origin[3];    /* corner; the cloth spans +x by size[0] and +z by size[1] */
@@ -209,6 +211,28 @@ wb_status wb_cloth(wb_world *w, const wb_cloth_def *def, wb_body *out);     /* W
 wb_status wb_rope(wb_world *w, const wb_rope_def *def, wb_body *out);
 wb_status wb_lattice(wb_world *w, const wb_lattice_def *def, wb_body *out);
 
+/* ---- contacts between particles (contact.c) ------------------------------------------- */
+/* Every particle has a group: 0 = loose (collides with every particle), > 0 = a body.
+ * Pairs of different groups collide when both have `collide`; pairs inside one body only
+ * when it self-collides, and then never when joined by a constraint or closer than
+ * r_i + r_j where they were created. Contact distance r_i + r_j, friction the mean of
+ * the two particles'. wb_world_def.contacts = false turns them all off. Builders give
+ * each body a new group (collide on, self-collision off, friction 0). */
+int32_t wb_group_new(const wb_world *w);                      /* 1 + the largest group in use */
+int32_t wb_particle_group(const wb_world *w, int32_t p);
+void wb_particle_set_group(wb_world *w, int32_t p, int32_t group); /* group >= 0 */
+wb_real wb_particle_friction(const wb_world *w, int32_t p);
+void wb_particle_set_friction(wb_world *w, int32_t p, wb_real mu); /* mu >= 0, finite */
+bool wb_particle_collides(const wb_world *w, int32_t p);
+/* the particles [b.first, b.first + b.count) into group b.group with these settings */
+void wb_body_set_contacts(wb_world *w, wb_body b, bool collide, bool self_collide, wb_real friction);
+void wb_group_set_self_collide(wb_world *w, int32_t group, bool on); /* every particle of the group */
+bool wb_group_self_collide(const wb_world *w, int32_t group);  /* some particle of it self-collides */
+void wb_particle_set_radius(wb_world *w, int32_t p, wb_real r); /* r >= 0, finite */
+/* the mean over the body's particles of their shortest constraint (0 when none): the
+ * spacing a default contact radius is taken from */
+wb_real wb_body_spacing(const wb_world *w, wb_body b);
+
 /* ---- surfaces: triangles over particles, for drawing and export ------------------------ */
 /* builders register theirs (the cloth's sheet, the lattice's hull); returns the surface
  * index or a negative wb_status; tri is (ntri x 3) particle ids */
@@ -231,6 +255,8 @@ typedef struct wb_stats {
     int32_t particles, distances, broken, colliders;
     int32_t colours;          /* batches of the last colouring */
     int32_t contacts;         /* collider contacts in the last substep */
+    int32_t particle_contacts; /* particle pairs overlapping or in touch in the last substep */
+    double broad_ms;          /* broad phase of the last step */
     int64_t projections;      /* constraint projections in the last step */
     double step_ms;           /* wall time of the last step */
     double solve_ms;          /* of which constraint projection */

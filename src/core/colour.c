@@ -22,6 +22,7 @@ wb_status wb__colour(wb_world *w)
     wb_model *m = &w->m;
     wb_cache *k = &w->k;
     if (!m->topology_dirty) return WB_OK;
+    k->pc.keys_dirty = 1; /* the constraint pairs that self-collision skips */
 
     int32_t ns = 0;
     for (int32_t s = 0; s < m->nd; s++)

@@ -63,6 +63,11 @@ typedef struct wb_model {
     wb_real *w;            /* (np) what the solver uses: 0 while pinned */
     wb_real *radius;       /* (np) */
     uint8_t *pinned;       /* (np) */
+    /* contacts (contact.c) */
+    int32_t *group;        /* (np) body: 0 = loose (collides with every particle) */
+    uint8_t *cflags;       /* (np) WB_CF_* */
+    wb_real *cfric;        /* (np) contact friction (Coulomb, static = dynamic) */
+    wb_real *x0;           /* (np x 3) where it was created: rest neighbours never collide */
 
     /* distance constraints by slot; a slot is live while d_gen is odd */
     int32_t nd, cap_d, nd_live;
@@ -108,6 +113,39 @@ typedef struct wb_state {
     char last_warning[160];
 } wb_state;
 
+#define WB_CF_COLLIDE 1u     /* collides with other bodies and loose particles */
+#define WB_CF_SELF 2u        /* collides with its own body (group > 0) */
+
+/* ---- particle contacts: per-frame scratch (contact.c) -------------------------------- */
+typedef struct wb_contacts {
+    int32_t n, cap;        /* candidate pairs of this frame */
+    int32_t *ij;           /* (n x 2) i < j, in the broad phase's fixed order */
+    int32_t nact, cap_act; /* contacts of the current substep */
+    int32_t *act;          /* (nact) candidate index */
+    wb_real *act_nd;       /* (nact x 4) normal (i -> j) and depth */
+    int32_t cap_nd;
+    wb_real *reach;        /* (np) broad-phase reach, < 0 = not a candidate */
+    int32_t cap_reach;
+    int32_t *cell_start, *cell_ids; /* spatial hash: counting sort of particles by cell */
+    int32_t cap_cells, cap_ids;
+    int32_t *stamp;        /* (cells) the last particle that visited a bucket */
+    int32_t cap_stamp;
+    uint64_t *keys;        /* sorted (a << 32 | b) of live constraints: neighbours at rest */
+    int32_t nkeys, cap_keys;
+    int keys_dirty;        /* set when the topology changes */
+    int32_t scanned_np;    /* particles when `possible` was worked out */
+    int scan_dirty;        /* groups or flags changed since */
+    int possible;          /* some pair could collide */
+    int32_t last;          /* contacts in the last substep */
+    double broad_ms;       /* broad phase of the last step */
+} wb_contacts;
+
+/* every pair i < j with |x_i - x_j| < reach_i + reach_j (particles with reach < 0 left
+ * out), each once, in an order fixed by the input alone; keep(ud, i, j) filters them.
+ * A spatial hash (counting sort, linear in n). Appends to c->ij; -1 when out of memory */
+int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, int32_t n,
+                       int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
+
 /* ---- solver cache: packed colour batches and per-step scratch ------------------------ */
 typedef struct wb_cache {
     int32_t ns;            /* packed constraints (live and not broken) */
@@ -134,6 +172,7 @@ typedef struct wb_cache {
     int (*interrupt)(void *);
     void *interrupt_ud;
     int32_t last_contacts;
+    wb_contacts pc;        /* particle-particle contacts (contact.c) */
     int64_t projections;
     double step_ms, solve_ms;
 } wb_cache;
@@ -154,6 +193,11 @@ wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real
 /* collide.c: a mesh collider's copy charged to / given back to the memory budget (and freed) */
 int wb__mesh_charge(wb_world *w, const struct wb_colmesh *cm);
 void wb__mesh_release(wb_world *w, wb_cshape *s);
+/* contact.c: broad phase once per frame, projection per substep, velocity pass after
+ * the velocities are updated */
+void wb__contacts_begin(wb_world *w);
+void wb__contacts_project(wb_world *w, wb_real h);
+void wb__contacts_velocity(wb_world *w, wb_real h);
 wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra); /* world.c */
 wb_status wb__surface_reserve(wb_world *w, int32_t ntri);
 void *wb__grow(void *ptr, int32_t *cap, int32_t need, size_t elem); /* world.c: realloc helper */

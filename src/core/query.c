@@ -105,6 +105,10 @@ uint64_t wb_world_hash(const wb_world *w)
     h = fnv(h, m->pinned, (size_t)m->np);
     h = fnv(h, m->inv_mass, sizeof(wb_real) * (size_t)m->np);
     h = fnv(h, m->radius, sizeof(wb_real) * (size_t)m->np);
+    h = fnv(h, m->group, sizeof(int32_t) * (size_t)m->np);
+    h = fnv(h, m->cflags, (size_t)m->np);
+    h = fnv(h, m->cfric, sizeof(wb_real) * (size_t)m->np);
+    h = fnv(h, m->x0, sizeof(wb_real) * 3 * (size_t)m->np);
     for (int32_t i = 0; i < m->nd; i++) {
         if (!(m->d_gen[i] & 1u)) continue;
         h = fnv(h, &s->d_rest[i], sizeof s->d_rest[i]);
@@ -130,6 +134,8 @@ wb_stats wb_world_stats(const wb_world *w)
     st.colliders = wb_collider_count(w);
     st.colours = w->k.ncolours;
     st.contacts = w->k.last_contacts;
+    st.particle_contacts = w->k.pc.last;
+    st.broad_ms = w->k.pc.broad_ms;
     st.projections = w->k.projections;
     st.step_ms = w->k.step_ms;
     st.solve_ms = w->k.solve_ms;

@@ -32,6 +32,10 @@ wb_status wb_image_alloc(wb_image *g, int32_t np, int32_t nd, int32_t nfree, int
     g->inv_mass = zalloc(np, sizeof *g->inv_mass);
     g->radius = zalloc(np, sizeof *g->radius);
     g->pinned = zalloc(np, 1);
+    g->group = zalloc(np, sizeof *g->group);
+    g->cflags = zalloc(np, 1);
+    g->cfric = zalloc(np, sizeof *g->cfric);
+    g->x0 = zalloc(3 * (int64_t)np, sizeof *g->x0);
     g->d_ij = zalloc(2 * (int64_t)nd, sizeof *g->d_ij);
     g->d_alpha = zalloc(nd, sizeof(wb_real));
     g->d_beta = zalloc(nd, sizeof(wb_real));
@@ -48,11 +52,12 @@ wb_status wb_image_alloc(wb_image *g, int32_t np, int32_t nd, int32_t nfree, int
     g->tri = zalloc(3 * (int64_t)ntri, sizeof *g->tri);
     if (!g->x || !g->v || !g->inv_mass || !g->radius || !g->pinned || !g->d_ij || !g->d_alpha || !g->d_beta ||
         !g->d_yield || !g->d_creep || !g->d_break || !g->d_rest || !g->d_broken || !g->d_gen || !g->d_free ||
-        !g->c || !g->c_gen || !g->surf_start || !g->tri) {
+        !g->c || !g->c_gen || !g->surf_start || !g->tri || !g->group || !g->cflags || !g->cfric || !g->x0) {
         wb_image_free(g);
         return WB_ERR_NOMEM;
     }
     for (int32_t i = 0; i < nd; i++) g->d_gen[i] = 1;
+    memset(g->cflags, WB_CF_COLLIDE, (size_t)np);
     for (int32_t i = 0; i < nc; i++) {
         g->c_gen[i] = 1;
         g->c[i].q[0] = g->c[i].q0[0] = 1;
@@ -68,7 +73,7 @@ void wb_image_free(wb_image *g)
     }
     void *p[] = { g->x, g->v, g->inv_mass, g->radius, g->pinned, g->d_ij, g->d_alpha, g->d_beta, g->d_yield,
                   g->d_creep, g->d_break, g->d_rest, g->d_broken, g->d_gen, g->d_free, g->c, g->c_gen,
-                  g->surf_start, g->tri };
+                  g->surf_start, g->tri, g->group, g->cflags, g->cfric, g->x0 };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     memset(g, 0, sizeof *g);
 }
@@ -87,6 +92,10 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
         memcpy(g->inv_mass, m->inv_mass, np * sizeof *g->inv_mass);
         memcpy(g->radius, m->radius, np * sizeof *g->radius);
         memcpy(g->pinned, m->pinned, np);
+        memcpy(g->group, m->group, np * sizeof *g->group);
+        memcpy(g->cflags, m->cflags, np);
+        memcpy(g->cfric, m->cfric, np * sizeof *g->cfric);
+        memcpy(g->x0, m->x0, 3 * np * sizeof *g->x0);
     }
     if (nd) {
         memcpy(g->d_ij, m->d_ij, 2 * nd * sizeof *g->d_ij);
@@ -184,6 +193,10 @@ const char *wb_image_check(const wb_image *g)
         if (!fin3(&g->x[3 * i]) || !fin3(&g->v[3 * i])) return "particle position and velocity must be finite";
         if (!(g->inv_mass[i] >= 0) || !isfinite(g->inv_mass[i])) return "particle mass must be >= 0";
         if (!(g->radius[i] >= 0) || !isfinite(g->radius[i])) return "particle radius must be >= 0";
+        if (g->group[i] < 0 || g->group[i] > WB_MAX_GROUP) return "particle group must be in 0..2^30";
+        if (g->cflags[i] > (WB_CF_COLLIDE | WB_CF_SELF)) return "particle contact flags out of range";
+        if (!(g->cfric[i] >= 0) || !isfinite(g->cfric[i])) return "particle friction must be >= 0";
+        if (!fin3(&g->x0[3 * i])) return "particle rest position must be finite";
     }
     int32_t dead = 0;
     for (int32_t i = 0; i < g->nd; i++) {
@@ -344,6 +357,10 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
         memcpy(m->inv_mass, g->inv_mass, np * sizeof *m->inv_mass);
         memcpy(m->radius, g->radius, np * sizeof *m->radius);
         memcpy(m->pinned, g->pinned, np);
+        memcpy(m->group, g->group, np * sizeof *m->group);
+        memcpy(m->cflags, g->cflags, np);
+        memcpy(m->cfric, g->cfric, np * sizeof *m->cfric);
+        memcpy(m->x0, g->x0, 3 * np * sizeof *m->x0);
     }
     for (size_t i = 0; i < np; i++) m->w[i] = g->pinned[i] ? 0 : g->inv_mass[i];
     m->nd = g->nd;
@@ -406,6 +423,13 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     for (int32_t i = 0; i < m->nc; i++) dead_c += !(m->c_gen[i] & 1u);
     const int32_t new_c = live_c > dead_c ? live_c - dead_c : 0;
     if ((int64_t)m->nc + new_c > WB_MAX_COLLIDERS || (int64_t)m->ntri + g->ntri > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    /* the image's groups become new ones: its loose particles (a plain config has no
+     * groups) the body's group, its group k the group body + k */
+    const int32_t group = wb_group_new(w);
+    int32_t gmax = 0;
+    for (int32_t i = 0; i < g->np; i++)
+        if (g->group[i] > gmax) gmax = g->group[i];
+    if ((int64_t)group + gmax > WB_MAX_GROUP) return WB_ERR_LIMIT;
     /* everything reserved first: after this nothing can fail */
     wb_colmesh **cms = calloc((size_t)(g->nc > 0 ? g->nc : 1), sizeof *cms);
     if (!cms) return WB_ERR_NOMEM;
@@ -427,7 +451,12 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
         m->pinned[first + i] = g->pinned[i];
         m->w[first + i] = g->pinned[i] ? 0 : g->inv_mass[i];
         memcpy(&w->s.v[3 * (first + i)], &g->v[3 * i], 3 * sizeof(wb_real));
+        m->group[first + i] = group + g->group[i];
+        m->cflags[first + i] = g->cflags[i];
+        m->cfric[first + i] = g->cfric[i];
+        memcpy(&m->x0[3 * (first + i)], &g->x0[3 * i], 3 * sizeof(wb_real));
     }
+    w->k.pc.scan_dirty = 1;
     for (int32_t i = 0; i < g->nd; i++) {
         if (!(g->d_gen[i] & 1u)) continue;
         wb_distance_def d = { g->d_alpha[i], g->d_beta[i], g->d_rest[i], g->d_yield[i], g->d_creep[i], g->d_break[i] };
@@ -452,6 +481,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     m->topology_dirty = 1;
     out->first = first;
     out->count = g->np;
+    out->group = group;
     return WB_OK;
 }
 

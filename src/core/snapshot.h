@@ -31,6 +31,10 @@ typedef struct wb_image {
     wb_real *inv_mass;     /* (np) as created; 0 = immovable */
     wb_real *radius;       /* (np) */
     uint8_t *pinned;       /* (np) */
+    int32_t *group;        /* (np) contact group, 0 = loose */
+    uint8_t *cflags;       /* (np) bit 0: collide, bit 1: self-collide */
+    wb_real *cfric;        /* (np) contact friction */
+    wb_real *x0;           /* (np x 3) where created (the self-collision rest rule) */
 
     /* distance constraints by slot: a slot is live while its generation is odd */
     int32_t nd;
@@ -55,7 +59,8 @@ typedef struct wb_image {
     char last_warning[160];
 } wb_image;
 
-/* allocate the arrays for these counts (zeroed; generations 1, i.e. live); WB_ERR_NOMEM */
+/* allocate the arrays for these counts (zeroed; generations 1, i.e. live; particles collide);
+ * WB_ERR_NOMEM */
 wb_status wb_image_alloc(wb_image *img, int32_t np, int32_t nd, int32_t nfree, int32_t nc, int32_t nsurf, int32_t ntri);
 void wb_image_free(wb_image *img);                     /* and zero it (mesh colliders' arrays too); fine on a zeroed image */
 wb_status wb_image_of(const wb_world *w, wb_image *img); /* a full copy of the world */

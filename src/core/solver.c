@@ -287,6 +287,7 @@ wb_status wb_world_step(wb_world *w)
         q_integrate(cp->q, cp->om, dt, cp->q);
     }
 
+    wb__contacts_begin(w);
     double solve = 0;
     for (int sub = 0; sub < d->substeps; sub++) {
         if (k->interrupt && k->interrupt(k->interrupt_ud)) {
@@ -301,7 +302,9 @@ wb_status wb_world_step(wb_world *w)
         if (k->ns > 0) memset(k->s_lambda, 0, sizeof(wb_real) * (size_t)k->ns);
         solve_constraints(w, h);
         solve += now_ms() - t0;
+        wb__contacts_project(w, h);
         wb__collide_and_update(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
+        wb__contacts_velocity(w, h);
     }
 
     /* a frame gone non-finite is undone before it can bend or break anything */

@@ -59,6 +59,7 @@ wb_world_def wb_world_default_def(void)
     d.solver = WB_SOLVER_GAUSS_SEIDEL;
     d.relaxation = 1;
     d.threads = 1;
+    d.contacts = true;
     return d;
 }
 
@@ -107,7 +108,8 @@ void wb_world_destroy(wb_world *w)
                      s->x, s->x_prev, s->v, s->d_rest, s->d_broken, s->c_pose,
                      k->colour_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda, k->s_jac,
                      k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->c_sub, k->c_save,
-                     k->breaks };
+                     k->breaks, m->group, m->cflags, m->cfric, m->x0, k->pc.ij, k->pc.act, k->pc.act_nd,
+                     k->pc.reach, k->pc.cell_start, k->pc.cell_ids, k->pc.keys, k->pc.stamp };
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
     free(w);
 }
@@ -136,7 +138,7 @@ int64_t wb_world_frame(const wb_world *w) { return w->s.frame; }
 /* ---- particles ------------------------------------------------------------------- */
 /* bytes per particle and per constraint over all the arrays that grow with them
  * (model, state and solver cache), for the memory limit */
-#define PARTICLE_BYTES (21 * sizeof(wb_real) + 5 + 8)
+#define PARTICLE_BYTES (25 * sizeof(wb_real) + 5 + 8 + 5)
 #define CONSTRAINT_BYTES (10 * sizeof(wb_real) + 33)
 
 /* charge the arrays at capacities (cap_p, cap_d) to the budget; 0 when it would pass
@@ -172,6 +174,8 @@ static wb_status grow_particles(wb_world *w, int32_t need)
         { (void **)&w->s.v, 3 * sizeof(wb_real) }, { (void **)&w->k.dx, 3 * sizeof(wb_real) },
         { (void **)&w->k.x_save, 3 * sizeof(wb_real) }, { (void **)&w->k.v_save, 3 * sizeof(wb_real) },
         { (void **)&w->k.ncount, sizeof(int32_t) },
+        { (void **)&m->group, sizeof(int32_t) }, { (void **)&m->cflags, 1 },
+        { (void **)&m->cfric, sizeof(wb_real) }, { (void **)&m->x0, 3 * sizeof(wb_real) },
     };
     for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
         void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
@@ -197,6 +201,10 @@ int32_t wb_particle_add(wb_world *w, const wb_real pos[3], const wb_real vel[3],
     m->w[i] = m->inv_mass[i];
     m->radius[i] = radius;
     m->pinned[i] = 0;
+    m->group[i] = 0;
+    m->cflags[i] = WB_CF_COLLIDE;
+    m->cfric[i] = 0;
+    v3_copy(&m->x0[3 * i], pos);
     v3_copy(&w->s.x[3 * i], pos);
     v3_copy(&w->s.x_prev[3 * i], pos);
     if (vel && mass > 0) v3_copy(&w->s.v[3 * i], vel);

@@ -54,8 +54,9 @@ static const char *const solver_names[] = { "gauss-seidel", "jacobi" };
 /* the "world" settings of a snapshot */
 static int read_world(rd *r, const cJSON *it, const kp *up, wb_world_def *d)
 {
-    static const char *const keys[] = { "gravity", "dt", "substeps", "iterations", "damping", "solver", "relaxation", "threads", NULL };
-    const cJSON *f[9];
+    static const char *const keys[] = { "gravity", "dt", "substeps", "iterations", "damping", "solver", "relaxation", "threads",
+                                        "contacts", NULL };
+    const cJSON *f[10];
     kp p = { up, "world", 0 };
     int64_t i;
     if (jv_get_object(r, it, &p, keys, f)) return -1;
@@ -73,6 +74,10 @@ static int read_world(rd *r, const cJSON *it, const kp *up, wb_world_def *d)
     }
     if (jv_opt_real(r, f[6], &p, "relaxation", &d->relaxation)) return -1;
     if (f[7]) { if (jv_opt_int(r, f[7], &p, "threads", 1, WB_MAX_THREADS, &i)) return -1; d->threads = (int)i; }
+    if (f[8]) {
+        kp q = { &p, "contacts", 0 };
+        if (jv_get_bool(r, f[8], &q, &d->contacts)) return -1;
+    }
     const char *e = wb_world_def_check(d);
     return e ? jv_fail(r, it, 0, &p, "%s", e) : 0;
 }
@@ -188,11 +193,12 @@ static int read_snapshot(rd *r, const sections *s, wb_image *g)
 
 static int read_particles(rd *r, const sections *s, const defaults *d, wb_image *g)
 {
-    static const char *const keys[] = { "position", "velocity", "mass", "inv_mass", "radius", "pinned", NULL };
+    static const char *const keys[] = { "position", "velocity", "mass", "inv_mass", "radius", "pinned",
+                                        "group", "friction", "collide", "self_collide", "created_at", NULL };
     kp top = { NULL, "particles", 0 };
     int32_t i = 0;
     for (const cJSON *c = s->particles->child; c; c = c->next, i++) {
-        const cJSON *f[7];
+        const cJSON *f[12];
         kp p = { &top, NULL, i };
         wb_real mass = d->mass, radius = d->radius;
         bool pinned = false;
@@ -214,6 +220,24 @@ static int read_particles(rd *r, const sections *s, const defaults *d, wb_image 
             kp q = { &p, "pinned", 0 };
             if (jv_get_bool(r, f[5], &q, &pinned)) return -1;
         }
+        /* contacts: group 0 (the body's own when loaded into a world), collide, no friction,
+         * created where it is (w:save writes all of them for the exact restore) */
+        int64_t group = 0;
+        bool collide = true, self = false;
+        memcpy(&g->x0[3 * i], &g->x[3 * i], 3 * sizeof(wb_real));
+        if (jv_opt_int(r, f[6], &p, "group", 0, WB_MAX_GROUP, &group) || jv_opt_nonneg(r, f[7], &p, "friction", &g->cfric[i]) ||
+            jv_opt_vec(r, f[10], &p, "created_at", 3, &g->x0[3 * i]))
+            return -1;
+        if (f[8]) {
+            kp q = { &p, "collide", 0 };
+            if (jv_get_bool(r, f[8], &q, &collide)) return -1;
+        }
+        if (f[9]) {
+            kp q = { &p, "self_collide", 0 };
+            if (jv_get_bool(r, f[9], &q, &self)) return -1;
+        }
+        g->group[i] = (int32_t)group;
+        g->cflags[i] = (uint8_t)((collide ? 1 : 0) | (self ? 2 : 0));
         g->radius[i] = radius;
         g->pinned[i] = pinned;
         if (g->inv_mass[i] == 0 || pinned) g->v[3 * i] = g->v[3 * i + 1] = g->v[3 * i + 2] = 0;

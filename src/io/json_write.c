@@ -67,7 +67,7 @@ static void write_snapshot(out *o, const wb_image *g)
     num(o, d->damping);
     fprintf(f, ", \"solver\": \"%s\", \"relaxation\": ", d->solver == WB_SOLVER_JACOBI ? "jacobi" : "gauss-seidel");
     num(o, d->relaxation);
-    fprintf(f, ", \"threads\": %d},\n    \"time\": ", d->threads);
+    fprintf(f, ", \"threads\": %d, \"contacts\": %s},\n    \"time\": ", d->threads, d->contacts ? "true" : "false");
     num(o, g->time);
     fprintf(f, ", \"frame\": %lld, \"warnings\": %lld, \"last_warning\": ", (long long)g->frame, (long long)g->warnings);
     str(f, g->last_warning);
@@ -96,7 +96,12 @@ static void write_particles(out *o, const wb_image *g)
         num(o, g->inv_mass[i]);
         fputs(", \"radius\": ", f);
         num(o, g->radius[i]);
-        fprintf(f, ", \"pinned\": %s}", g->pinned[i] ? "true" : "false");
+        fprintf(f, ", \"pinned\": %s, \"group\": %d, \"friction\": ", g->pinned[i] ? "true" : "false", g->group[i]);
+        num(o, g->cfric[i]);
+        fprintf(f, ", \"collide\": %s, \"self_collide\": %s, \"created_at\": ", (g->cflags[i] & 1) ? "true" : "false",
+                (g->cflags[i] & 2) ? "true" : "false");
+        vec(o, &g->x0[3 * i], 3);
+        fputc('}', f);
     }
     fputs(g->np ? "\n  ],\n" : "],\n", f);
 }

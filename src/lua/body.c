@@ -3,6 +3,8 @@
  * constraint_count = m } with methods pin_where, pin_all and unpin_all.
  * Bodies are plain tables (scripts may add fields); the methods come from a
  * shared metatable. */
+#include <math.h>
+
 #include "util.h"
 
 /* ---- the body table -------------------------------------------------------------- */
@@ -30,7 +32,34 @@ void wbl_body_end(lua_State *L, int world_index, wb_body b, int32_t constraints)
     lua_setfield(L, -2, "constraint_count");
     lua_pushvalue(L, world_index);
     lua_setfield(L, -2, "world");
+    if (b.group > 0) {
+        lua_pushinteger(L, b.group);
+        lua_setfield(L, -2, "group");
+    }
     luaL_setmetatable(L, WBL_BODY);
+}
+
+void wbl_read_contact_opts(lua_State *L, int arg, wbl_contact_opts *o)
+{
+    o->collide = true;
+    o->self_collide = false;
+    o->friction = 0;
+    if (lua_type(L, arg) != LUA_TTABLE) return;
+    wbl_optbool(L, arg, "collide", &o->collide);
+    wbl_optbool(L, arg, "self_collide", &o->self_collide);
+    if (wbl_optreal(L, arg, "friction", &o->friction) && !(o->friction >= 0 && isfinite(o->friction)))
+        wbl_fielderror(L, arg, "friction", "must be a finite number >= 0");
+}
+
+void wbl_apply_contact_opts(wb_world *w, wb_body b, const wbl_contact_opts *o)
+{
+    wb_body_set_contacts(w, b, o->collide, o->self_collide, o->friction);
+}
+
+void wbl_default_radius(wb_world *w, wb_body b)
+{
+    const wb_real r = wb_body_spacing(w, b) / 2;
+    for (int32_t i = 0; i < b.count; i++) wb_particle_set_radius(w, b.first + i, r);
 }
 
 void wbl_push_body(lua_State *L, int world_index, wb_body b, int32_t constraints)
@@ -126,14 +155,21 @@ static int body_tostring(lua_State *L)
         int32_t nd0_ = wb_distance_count(w);                                        \
         wb_status st_ = call(w, &d, &b_);                                           \
         if (st_ != WB_OK) return wbl_status_error(L, 2, st_, what);                 \
+        if (auto_radius) wbl_default_radius(w, b_);                                 \
+        wbl_apply_contact_opts(w, b_, &co);                                         \
         wbl_body_end(L, 1, b_, wb_distance_count(w) - nd0_);                        \
         return 1;                                                                   \
     } while (0)
 
-static void read_mass_radius(lua_State *L, wb_real *mass, wb_real *radius)
+/* returns whether the radius is the default (half the spacing, set after building) */
+static bool read_mass_radius(lua_State *L, wb_real *mass, wb_real *radius)
 {
     if (wbl_optreal(L, 2, "mass", mass) && *mass <= 0) wbl_fielderror(L, 2, "mass", "must be > 0");
-    if (wbl_optreal(L, 2, "radius", radius) && *radius < 0) wbl_fielderror(L, 2, "radius", "must be >= 0");
+    if (wbl_optreal(L, 2, "radius", radius)) {
+        if (*radius < 0) wbl_fielderror(L, 2, "radius", "must be >= 0");
+        return false;
+    }
+    return true;
 }
 
 static void check_link(lua_State *L, const wb_distance_def *d)
@@ -144,7 +180,7 @@ static void check_link(lua_State *L, const wb_distance_def *d)
 
 static const char *const cloth_keys[] = {
     "origin", "size", "res", "mass", "radius", "shear", "bend",
-    "compliance", "damping", "yield", "creep", "break_strain", NULL
+    "compliance", "damping", "yield", "creep", "break_strain", "collide", "self_collide", "friction", NULL
 };
 
 static int w_cloth(lua_State *L)
@@ -156,7 +192,9 @@ static int w_cloth(lua_State *L)
     if (wbl_optvec(L, 2, "size", 2, d.size) && !(d.size[0] > 0 && d.size[1] > 0))
         return wbl_fielderror(L, 2, "size", "both sizes must be > 0");
     wbl_optivec(L, 2, "res", 2, 2, WB_MAX_PARTICLES, d.res);
-    read_mass_radius(L, &d.mass, &d.radius);
+    const bool auto_radius = read_mass_radius(L, &d.mass, &d.radius);
+    wbl_contact_opts co;
+    wbl_read_contact_opts(L, 2, &co);
     wbl_optbool(L, 2, "shear", &d.shear);
     wbl_read_link(L, 2, &d.link);
     /* bend: nil/false = none, true = as stiff as the links, a number = its compliance */
@@ -175,7 +213,7 @@ static int w_cloth(lua_State *L)
 
 static const char *const rope_keys[] = {
     "from", "to", "segments", "mass", "radius",
-    "compliance", "damping", "yield", "creep", "break_strain", NULL
+    "compliance", "damping", "yield", "creep", "break_strain", "collide", "self_collide", "friction", NULL
 };
 
 static int w_rope(lua_State *L)
@@ -186,7 +224,9 @@ static int w_rope(lua_State *L)
     wbl_optvec(L, 2, "from", 3, d.from);
     wbl_optvec(L, 2, "to", 3, d.to);
     wbl_optint(L, 2, "segments", 1, WB_MAX_PARTICLES - 1, &d.segments);
-    read_mass_radius(L, &d.mass, &d.radius);
+    const bool auto_radius = read_mass_radius(L, &d.mass, &d.radius);
+    wbl_contact_opts co;
+    wbl_read_contact_opts(L, 2, &co);
     wbl_read_link(L, 2, &d.link);
     check_link(L, &d.link);
     BUILD(L, w, wb_rope, "rope", (int64_t)d.segments + 1);
@@ -194,7 +234,7 @@ static int w_rope(lua_State *L)
 
 static const char *const lattice_keys[] = {
     "min", "max", "res", "mass", "radius", "tets",
-    "compliance", "damping", "yield", "creep", "break_strain", NULL
+    "compliance", "damping", "yield", "creep", "break_strain", "collide", "self_collide", "friction", NULL
 };
 
 static int w_lattice(lua_State *L)
@@ -207,7 +247,9 @@ static int w_lattice(lua_State *L)
     if (!(d.min[0] < d.max[0] && d.min[1] < d.max[1] && d.min[2] < d.max[2]))
         return luaL_argerror(L, 2, "min must be below max on every axis");
     wbl_optivec(L, 2, "res", 3, 2, WB_MAX_PARTICLES, d.res);
-    read_mass_radius(L, &d.mass, &d.radius);
+    const bool auto_radius = read_mass_radius(L, &d.mass, &d.radius);
+    wbl_contact_opts co;
+    wbl_read_contact_opts(L, 2, &co);
     bool tets = false;
     if (wbl_optbool(L, 2, "tets", &tets) && tets)
         return wbl_fielderror(L, 2, "tets", "not supported yet: tets needs the volume constraint");

@@ -84,6 +84,11 @@ static int w_load_particles(lua_State *L)
     wb_world *w = wbl_checkworld(L, 1);
     const char *name = wbl_checkfilename(L, 2);
     char path[PATH_MAX], err[1024];
+    /* contact options for the whole body; without them the file's own settings stay */
+    static const char *const keys[] = { "collide", "self_collide", "friction", NULL };
+    const bool given = wbl_checkopts(L, 3, keys, true);
+    wbl_contact_opts co;
+    wbl_read_contact_opts(L, 3, &co);
     lua_settop(L, 2);
     wbl_path(L, name, 0, path, sizeof path);
     wbio_config *c = push_config(L); /* 3 */
@@ -108,6 +113,13 @@ static int w_load_particles(lua_State *L)
     wb_status st = wb_world_append_image(w, &c->img, &b);
     if (st == WB_ERR_ARG) return fail_with(L, lua_pushfstring(L, "%s: %s", name, wb_last_error()));
     if (st != WB_OK) return wbl_status_error(L, 2, st, "load_particles");
+    if (given) wbl_apply_contact_opts(w, b, &co);
+    /* each part is a body of its own: its own group, so the parts (the logo's letters)
+     * push each other; the particles of no part stay in the body's group */
+    for (int32_t i = 0; i < c->nparts; i++) {
+        const int32_t g = wb_group_new(w);
+        for (int32_t k = 0; k < c->parts[i].count; k++) wb_particle_set_group(w, b.first + c->parts[i].first + k, g);
+    }
     wbl_body_end(L, 1, b, live); /* 6: the body */
     /* body.colliders: the colliders the config made, in slot order (= the config's order:
      * free slots are reused lowest first, then new ones appended) */
@@ -122,7 +134,8 @@ static int w_load_particles(lua_State *L)
     /* body.parts: an array of part bodies, also indexed by name */
     lua_createtable(L, c->nparts, c->nparts);
     for (int32_t i = 0; i < c->nparts; i++) {
-        wb_body pb = { b.first + c->parts[i].first, c->parts[i].count };
+        const int32_t p0 = b.first + c->parts[i].first;
+        wb_body pb = { p0, c->parts[i].count, c->parts[i].count > 0 ? wb_particle_group(w, p0) : 0 };
         wbl_push_body(L, 1, pb, 0);
         lua_pushstring(L, c->parts[i].name);
         lua_setfield(L, -2, "name");

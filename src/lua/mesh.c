@@ -328,7 +328,7 @@ static int m_tostring(lua_State *L)
 /* ---- w:from_mesh(m, {...}) --------------------------------------------------------------------- */
 static const char *const from_mesh_keys[] = {
     "mass", "radius", "target", "neighbours", "surface",
-    "compliance", "damping", "yield", "creep", "break_strain", NULL
+    "compliance", "damping", "yield", "creep", "break_strain", "collide", "self_collide", "friction", NULL
 };
 
 static int w_from_mesh(lua_State *L)
@@ -336,9 +336,15 @@ static int w_from_mesh(lua_State *L)
     wb_world *w = wbl_checkworld(L, 1);
     const wb_mesh *m = wbl_checkmesh(L, 2);
     wb_from_mesh_def d = wb_from_mesh_default_def();
+    bool auto_radius = true; /* half the spacing, set after building */
+    wbl_contact_opts co;
+    wbl_read_contact_opts(L, 3, &co);
     if (wbl_checkopts(L, 3, from_mesh_keys, true)) {
         if (wbl_optreal(L, 3, "mass", &d.mass) && !(d.mass > 0)) return wbl_fielderror(L, 3, "mass", "must be > 0");
-        if (wbl_optreal(L, 3, "radius", &d.radius) && d.radius < 0) return wbl_fielderror(L, 3, "radius", "must be >= 0");
+        if (wbl_optreal(L, 3, "radius", &d.radius)) {
+            if (d.radius < 0) return wbl_fielderror(L, 3, "radius", "must be >= 0");
+            auto_radius = false;
+        }
         wbl_optint(L, 3, "target", 1, WB_MAX_PARTICLES, &d.target);
         wbl_optint(L, 3, "neighbours", 0, 32, &d.neighbours);
         wbl_optbool(L, 3, "surface", &d.surface);
@@ -352,6 +358,8 @@ static int w_from_mesh(lua_State *L)
     wb_body b;
     wb_status st = wb_from_mesh(w, m, &d, &b);
     if (st != WB_OK) return wbl_status_error(L, st == WB_ERR_ARG ? 2 : 3, st, "from_mesh");
+    if (auto_radius) wbl_default_radius(w, b);
+    wbl_apply_contact_opts(w, b, &co);
     wbl_body_end(L, 1, b, wb_distance_count(w) - nd0);
     return 1;
 }

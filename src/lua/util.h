@@ -90,5 +90,13 @@ wb_collider_id *wbl_push_collider(lua_State *L, int world_index, wb_collider_id 
 void wbl_push_body(lua_State *L, int world_index, wb_body b, int32_t constraints);
 void wbl_body_begin(lua_State *L, int64_t count);
 void wbl_body_end(lua_State *L, int world_index, wb_body b, int32_t constraints);
+/* a builder's contact options (collide = true, self_collide = false, friction = 0) from
+ * the options table at arg, and their application to the body it made */
+typedef struct wbl_contact_opts { bool collide, self_collide; wb_real friction; } wbl_contact_opts;
+void wbl_read_contact_opts(lua_State *L, int arg, wbl_contact_opts *o);
+void wbl_apply_contact_opts(wb_world *w, wb_body b, const wbl_contact_opts *o);
+/* the builders' default radius: half the spacing of the body's particles, so that
+ * neighbouring particles' contact spheres touch and other bodies cannot pass between */
+void wbl_default_radius(wb_world *w, wb_body b);
 
 #endif

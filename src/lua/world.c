@@ -15,7 +15,7 @@ static const char *const solver_names[] = { "gauss-seidel", "jacobi", NULL };
 
 /* ---- settings --------------------------------------------------------------------- */
 static const char *const world_keys[] = {
-    "gravity", "dt", "substeps", "iterations", "damping", "solver", "relaxation", "threads", NULL
+    "gravity", "dt", "substeps", "iterations", "damping", "solver", "relaxation", "threads", "contacts", NULL
 };
 
 /* read the settings table at arg over *d; the core's check gives the ranges */
@@ -30,6 +30,7 @@ static void read_world_def(lua_State *L, int arg, wb_world_def *d)
     if (s >= 0) d->solver = (wb_solver)s;
     wbl_optreal(L, arg, "relaxation", &d->relaxation);
     wbl_optint(L, arg, "threads", INT32_MIN, INT32_MAX, &d->threads);
+    wbl_optbool(L, arg, "contacts", &d->contacts);
 }
 
 /* check *d and apply it: errors blame argument `arg` */
@@ -133,7 +134,7 @@ static int w_solver(lua_State *L)
 }
 
 /* ---- particles ---------------------------------------------------------------------- */
-static const char *const particle_keys[] = { "pos", "vel", "mass", "radius", NULL };
+static const char *const particle_keys[] = { "pos", "vel", "mass", "radius", "group", "friction", NULL };
 
 static int w_particle(lua_State *L)
 {
@@ -144,8 +145,16 @@ static int w_particle(lua_State *L)
     wbl_optvec(L, 2, "vel", 3, vel);
     if (wbl_optreal(L, 2, "mass", &mass) && mass < 0) return wbl_fielderror(L, 2, "mass", "must be >= 0");
     if (wbl_optreal(L, 2, "radius", &radius) && radius < 0) return wbl_fielderror(L, 2, "radius", "must be >= 0");
+    /* group 0: loose, collides with every particle; a group > 0 joins that body */
+    lua_Integer group = 0;
+    wbl_optinteger(L, 2, "group", 0, WB_MAX_GROUP, &group);
+    wb_real mu = 0;
+    if (wbl_optreal(L, 2, "friction", &mu) && !(mu >= 0 && isfinite(mu)))
+        return wbl_fielderror(L, 2, "friction", "must be a finite number >= 0");
     int32_t id = wb_particle_add(w, pos, vel, mass, radius);
     if (id < 0) return wbl_status_error(L, 2, (wb_status)id, "particle");
+    wb_particle_set_group(w, id, (int32_t)group);
+    wb_particle_set_friction(w, id, mu);
     lua_pushinteger(L, (lua_Integer)id + 1);
     return 1;
 }
@@ -395,6 +404,25 @@ static int w_max_strain(lua_State *L)
     return 1;
 }
 
+/* w:group(p) -> its contact group (0 = loose) */
+static int w_group(lua_State *L)
+{
+    wb_world *w = toworld(L);
+    lua_pushinteger(L, wb_particle_group(w, wbl_checkparticle(L, w, 2)));
+    return 1;
+}
+
+/* w:set_self_collide(group, bool): whether a body collides with itself */
+static int w_set_self_collide(lua_State *L)
+{
+    wb_world *w = toworld(L);
+    lua_Integer g = wbl_checkint(L, 2);
+    if (g < 1 || g > WB_MAX_GROUP) return luaL_argerror(L, 2, "group must be a body's group (>= 1)");
+    luaL_checktype(L, 3, LUA_TBOOLEAN);
+    wb_group_set_self_collide(w, (int32_t)g, lua_toboolean(L, 3));
+    return 0;
+}
+
 static int w_stats(lua_State *L)
 {
     wb_world *w = toworld(L);
@@ -409,6 +437,8 @@ static int w_stats(lua_State *L)
     SETI("colliders", s.colliders);
     SETI("colours", s.colours);
     SETI("contacts", s.contacts);
+    SETI("particle_contacts", s.particle_contacts);
+    SETN("broad_ms", s.broad_ms);
     SETI("projections", s.projections);
     SETN("step_ms", s.step_ms);
     SETN("solve_ms", s.solve_ms);
@@ -475,6 +505,8 @@ static const luaL_Reg world_methods[] = {
     { "set_velocity", w_set_velocity },
     { "mass", w_mass },
     { "radius", w_radius },
+    { "group", w_group },
+    { "set_self_collide", w_set_self_collide },
     { "pin", w_pin },
     { "unpin", w_unpin },
     { "pinned", w_pinned },

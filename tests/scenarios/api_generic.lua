@@ -34,14 +34,15 @@ end
 
 local link_nums = { "compliance", "damping", "yield", "creep", "break_strain" }
 -- the link options every builder takes, valid values
-local function link(t) t.compliance, t.damping, t.yield, t.creep, t.break_strain = 0, 0, 0.1, 1, 1 return t end
+local function link(t) t.compliance, t.damping, t.yield, t.creep, t.break_strain = 0, 0, 0.1, 1, 1
+  t.collide, t.self_collide, t.friction = true, false, 0 return t end
 local function plus(t, extra) local r = {} for _, v in ipairs(t) do r[#r + 1] = v end
   for _, v in ipairs(extra) do r[#r + 1] = v end return r end
 
 local CASES = {
   -- ---- wobble.*
   ["wobble.world"] = { opts = { gravity = {0, -9.81, 0}, dt = 1 / 60, substeps = 2, iterations = 1, damping = 0,
-                                relaxation = 1, threads = 1 },
+                                relaxation = 1, threads = 1, contacts = true },
                        nums = { "gravity", "dt", "substeps", "iterations", "damping", "relaxation", "threads" },
                        call = function(_, o) return wobble.world(o) end },
   ["wobble.renderer"] = { opts = { width = 8, height = 8, samples = 1, backend = "null" },
@@ -61,23 +62,23 @@ local CASES = {
   ["wobble.clock"] = { none = "no arguments" },
 
   -- ---- world: options
-  ["world:particle"] = { opts = { pos = {0, 0, 0}, vel = {0, 0, 0}, mass = 1, radius = 0.02 },
-                         nums = { "pos", "vel", "mass", "radius" },
+  ["world:particle"] = { opts = { pos = {0, 0, 0}, vel = {0, 0, 0}, mass = 1, radius = 0.02, group = 0, friction = 0 },
+                         nums = { "pos", "vel", "mass", "radius", "group", "friction" },
                          call = function(f, o) return f.w:particle(o) end },
   ["world:distance"] = { opts = { compliance = 0, rest = 1, damping = 0, yield = 0.1, creep = 1, break_strain = 1 },
                          opts_arg = 3, nums = plus(link_nums, { "rest" }),
                          call = function(f, o) return f.w:distance(f.p, f.q, o) end },
   ["world:cloth"] = { opts = link{ origin = {0, 0, 0}, size = {1, 1}, res = {2, 2}, mass = 1, radius = 0.02, bend = 0 },
-                      nums = plus(link_nums, { "origin", "size", "res", "mass", "radius", "bend" }),
+                      nums = plus(link_nums, { "origin", "size", "res", "mass", "radius", "bend", "friction" }),
                       call = function(f, o) return f.w:cloth(o) end },
   ["world:rope"] = { opts = link{ from = {0, 0, 0}, to = {1, 0, 0}, segments = 2, mass = 1, radius = 0.02 },
-                     nums = plus(link_nums, { "from", "to", "segments", "mass", "radius" }),
+                     nums = plus(link_nums, { "from", "to", "segments", "mass", "radius", "friction" }),
                      call = function(f, o) return f.w:rope(o) end },
   ["world:lattice"] = { opts = link{ min = {0, 0, 0}, max = {1, 1, 1}, res = {2, 2, 2}, mass = 1, radius = 0.02 },
-                        nums = plus(link_nums, { "min", "max", "res", "mass", "radius" }),
+                        nums = plus(link_nums, { "min", "max", "res", "mass", "radius", "friction" }),
                         call = function(f, o) return f.w:lattice(o) end },
   ["world:from_mesh"] = { opts = link{ mass = 1, radius = 0.02, target = 4, neighbours = 3 }, opts_arg = 2,
-                          nums = plus(link_nums, { "mass", "radius", "target", "neighbours" }),
+                          nums = plus(link_nums, { "mass", "radius", "target", "neighbours", "friction" }),
                           call = function(f, o) return f.w:from_mesh(f.m, o) end },
   ["world:skin"] = { opts = { bones = 2, neighbours = 4, iterations = 2 }, opts_arg = 3,
                      nums = { "bones", "neighbours", "iterations" },
@@ -114,6 +115,8 @@ local CASES = {
   ["world:velocity"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.w:velocity(...) end },
   ["world:mass"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.w:mass(...) end },
   ["world:radius"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.w:radius(...) end },
+  ["world:group"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.w:group(...) end },
+  ["world:set_self_collide"] = { args = { 1, true }, nums = { 1 }, call = function(f, ...) return f.w:set_self_collide(...) end },
   ["world:set_dt"] = { args = { 0.01 }, nums = { 1 }, call = function(f, ...) return f.w:set_dt(...) end },
   ["world:set_substeps"] = { args = { 2 }, nums = { 1 }, call = function(f, ...) return f.w:set_substeps(...) end },
   ["world:set_iterations"] = { args = { 2 }, nums = { 1 }, call = function(f, ...) return f.w:set_iterations(...) end },

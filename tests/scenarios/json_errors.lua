@@ -84,7 +84,7 @@ test("unknown, miscased and repeated keys are pointed at", function()
   bad_at(t, '"version"', "version: duplicate key 'version' (first at line 1, column 32)", 40)
   bad(HEAD .. ' "particles": [{"position": [0,0,0], "position": [1,1,1]}]}', "particles[0].position: duplicate key 'position'")
   local t = HEAD .. ' "particles": [{"position": [0,0,0], "colour": 1}]}'
-  bad_at(t, '"colour"', "particles[0].colour: unknown key 'colour' (expected one of: position, velocity, mass, inv_mass, radius, pinned)")
+  bad_at(t, '"colour"', "particles[0].colour: unknown key 'colour' (expected one of: position, velocity, mass, inv_mass, radius, pinned, group, friction, collide, self_collide, created_at)")
 end)
 
 test("particles: types, shapes and ranges", function()

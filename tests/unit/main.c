@@ -31,6 +31,14 @@
     X(extreme_collider_derived_poses_finite)             \
     X(extreme_cluster_of_an_overflowing_box)
 
+/* test_contact.c: the particle-particle broad phase and contact rules */
+#define CONTACT_TESTS(X)                                 \
+    X(contact_broadphase_matches_brute_force)            \
+    X(contact_broadphase_huge_and_clustered_input)       \
+    X(contact_builders_get_own_groups)                   \
+    X(contact_self_collision_skips_rest_neighbours)      \
+    X(contact_clone_keeps_groups)
+
 /* every test, in the order they run: add a line here for each TEST() */
 #define TEST_LIST(X)                             \
     X(world_def_defaults)                        \
@@ -93,6 +101,7 @@
     X(bvh_closest_matches_brute_force)           \
     X(bvh_closed_and_open_and_sign)              \
     X(bvh_mesh_collider_memory_charged)          \
+    CONTACT_TESTS(X)                             \
     EXTREME_TESTS(X)
 
 #define DECLARE(name) TEST(name);

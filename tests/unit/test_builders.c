@@ -57,7 +57,7 @@ TEST(builder_cloth_counts)
         d.mass = 4;
         d.shear = cases[k].shear;
         d.bend = cases[k].bend;
-        wb_body body = { -1, -1 };
+        wb_body body = { -1, -1, -1 };
         CHECK_EQ(wb_cloth(w, &d, &body), WB_OK);
         CHECK_EQ(body.first, 0);
         CHECK_EQ(body.count, 20);
@@ -240,7 +240,7 @@ TEST(builder_failure_changes_nothing)
     wb_world_step(w);
     const int32_t np = wb_particle_count(w), nd = wb_distance_count(w);
     const uint64_t h = wb_world_hash(w);
-    wb_body untouched = { 12345, 678 };
+    wb_body untouched = { 12345, 678, 9 };
 
     wb_cloth_def c = wb_cloth_default_def();
     c.res[0] = 1;
