@@ -217,6 +217,39 @@ static bool build_segments(wb_layers *l, const wb_world *w, const wb_draw_opts *
 }
 
 /* ---- surfaces ------------------------------------------------------------------------------ */
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* +1 or -1 when a surface is closed (every edge on exactly two triangles), the sign of
+ * its enclosed volume: its triangles wind outward or inward; 0 when it is open (a
+ * sheet has no outside) or memory runs short */
+static int closed_sign(const wb_real *x, const int32_t *t, int32_t nt)
+{
+    if (nt < 4) return 0;
+    uint64_t *e = malloc(3 * (size_t)nt * sizeof *e);
+    if (!e) return 0;
+    for (int32_t i = 0; i < nt; i++)
+        for (int j = 0; j < 3; j++) {
+            uint32_t a = (uint32_t)t[3 * i + j], b = (uint32_t)t[3 * i + (j + 1) % 3];
+            e[3 * i + j] = a < b ? (uint64_t)a << 32 | b : (uint64_t)b << 32 | a;
+        }
+    qsort(e, 3 * (size_t)nt, sizeof *e, cmp_u64);
+    bool closed = true;
+    for (size_t i = 0; closed && i < 3 * (size_t)nt; i += 2)
+        closed = i + 1 < 3 * (size_t)nt && e[i + 1] == e[i] && (i + 2 >= 3 * (size_t)nt || e[i + 2] != e[i]);
+    free(e);
+    if (!closed) return 0;
+    double vol = 0;   /* six times the signed volume: the triple products about the origin */
+    for (int32_t i = 0; i < nt; i++) {
+        const wb_real *a = x + 3 * t[3 * i], *b = x + 3 * t[3 * i + 1], *c = x + 3 * t[3 * i + 2];
+        vol += a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+    }
+    return vol > 0 ? 1 : vol < 0 ? -1 : 0;
+}
+
 static void put_vertex(float *v, const double p[3], const double n[3], const float col[3])
 {
     for (int c = 0; c < 3; c++) v[c] = (float)p[c], v[3 + c] = (float)n[c], v[6 + c] = col[c];
@@ -274,7 +307,10 @@ static size_t put_mesh_colliders(wb_layers *l, const wb_world *w, const wb_draw_
 
 /* vertices: the particles, then every skin's, then the mesh colliders'; indices: the
  * surfaces' triangles (those not wholly under a drawn skin), then the skins', then the
- * mesh colliders'. Smooth normals: area-weighted. */
+ * mesh colliders'. Smooth normals: area-weighted. A closed surface's vertices sit out
+ * along their normals by their particle's contact radius, where its sphere ends: bodies
+ * that touch (or rest on a collider, also at the radius) look touching, not a spacing
+ * apart; an open one (a cloth) stays through the centres. */
 static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *o, const wb_draw_skin *sk, int nsk)
 {
     int32_t np = wb_particle_count(w), ns = o->surfaces ? wb_surface_count(w) : 0;
@@ -293,8 +329,9 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
         return false;
     double *acc = calloc((size_t)np * 3 + 3, sizeof *acc);
     int16_t *owner = malloc(((size_t)np + 1) * sizeof *owner);   /* the first surface a particle is on */
-    if (!acc || !owner) {
-        free(acc), free(owner);
+    signed char *out = calloc((size_t)np + 1, 1);   /* per particle: +-1 on a closed surface */
+    if (!acc || !owner || !out) {
+        free(acc), free(owner), free(out);
         return false;
     }
     memset(owner, 0xff, ((size_t)np + 1) * sizeof *owner);
@@ -302,6 +339,8 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
     for (int32_t s = 0; s < ns; s++) {
         int32_t nt = 0;
         const int32_t *t = wb_surface_triangles(w, s, &nt);
+        const int sign = closed_sign(x, t, nt);
+        for (int32_t i = 0; sign && i < 3 * nt; i++) out[t[i]] = (signed char)sign;
         for (int32_t i = 0; i < nt; i++) {
             const int32_t *v = t + 3 * i;
             if (l->flags[v[0]] & l->flags[v[1]] & l->flags[v[2]] & F_HIDDEN) continue;
@@ -324,10 +363,13 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
         if (o->constraints) strain_colour(l->vstrain[i], o->strain_scale, cloth, col);
         else wb_lin3(col_surface[owner[i] < 0 ? 0 : owner[i]], col);
         norm3(acc + 3 * i);
+        const double off = out[i] * (double)wb_particle_radius(w, i);
+        for (int c = 0; c < 3; c++) p[c] += off * acc[3 * i + c];
         put_vertex(l->sv + WB_SV * i, p, acc + 3 * i, col);
     }
     free(acc);
     free(owner);
+    free(out);
     size_t base = (size_t)np;   /* skins: their own (deformed) vertices and normals */
     float skin[3];
     wb_lin3(col_skin, skin);
