@@ -1,8 +1,8 @@
 -- contact_stack.lua: three soft blocks dropped onto each other come to rest as a stack
 -- (particle-particle contacts, issue 8): each block is a body of its own (its own
 -- contact group), so they push instead of passing through. A particle's contact radius
--- is half its body's spacing by default, so the drawn hulls (through the particle
--- centres) rest about one spacing apart. Friction between the blocks keeps the stack from
+-- is half its body's spacing by default; the renderer draws each block's hull out by that
+-- radius, so the blocks are seen touching. Friction between the blocks keeps the stack from
 -- sliding off the bumps of the particles; try --set friction=0, or --set contacts=0 to
 -- watch them sink into each other.
 -- Run: build/wobble run scripts/contact_stack.lua [--record out/stack.mp4]
