@@ -232,6 +232,15 @@ void wb_particle_set_radius(wb_world *w, int32_t p, wb_real r); /* r >= 0, finit
 /* the mean over the body's particles of their shortest constraint (0 when none): the
  * spacing a default contact radius is taken from */
 wb_real wb_body_spacing(const wb_world *w, wb_body b);
+/* the particle-particle contacts that corrected positions in the last substep of the last
+ * step, in projection order (pairs merely in touch, with nothing to correct, are in
+ * stats.particle_contacts but not here). force = the normal correction's multiplier over
+ * h^2: lambda = depth / (w_a + w_b), force = lambda / h^2 in newtons, h the substep, as
+ * wb_distance_force (friction not included); normal: unit, from a towards b; depth: the
+ * overlap the substep corrected (m). Valid until the world changes */
+typedef struct wb_contact { int32_t a, b; wb_real force, normal[3], depth; } wb_contact;
+int32_t wb_world_contact_count(const wb_world *w);
+wb_contact wb_world_contact_at(const wb_world *w, int32_t i);     /* 0 <= i < count */
 
 /* ---- surfaces: triangles over particles, for drawing and export ------------------------ */
 /* builders register theirs (the cloth's sheet, the lattice's hull); returns the surface

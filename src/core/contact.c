@@ -303,7 +303,6 @@ void wb__contacts_begin(wb_world *w)
  * slip of this substep when it is within the friction cone (mu x depth). */
 void wb__contacts_project(wb_world *w, wb_real h)
 {
-    (void)h;
     wb_contacts *c = &w->k.pc;
     c->nact = 0;
     if (c->n == 0) { c->last = 0; return; }
@@ -314,7 +313,7 @@ void wb__contacts_project(wb_world *w, wb_real h)
     int32_t *act = wb__grow(c->act, &c->cap_act, c->n, sizeof *act);
     if (!act) goto nomem;
     c->act = act;
-    wb_real *nds = wb__grow(c->act_nd, &c->cap_nd, 4 * c->n, sizeof *nds);
+    wb_real *nds = wb__grow(c->act_nd, &c->cap_nd, 5 * c->n, sizeof *nds);
     if (!nds) goto nomem;
     c->act_nd = nds;
     for (int32_t k = 0; k < c->n; k++) {
@@ -356,10 +355,12 @@ void wb__contacts_project(wb_world *w, wb_real h)
                 if (wj > 0) v3_madd(xj, slip, f * wj / wsum);
             }
         }
-        /* normal and depth, kept for the velocity pass */
+        /* normal and depth, kept for the velocity pass; the normal force for the readout
+         * (XPBD multiplier of a zero-compliance contact, depth / (w_i + w_j), over h^2) */
         act[c->nact] = k;
-        v3_copy(&nds[4 * c->nact], n);
-        nds[4 * c->nact + 3] = depth;
+        v3_copy(&nds[5 * c->nact], n);
+        nds[5 * c->nact + 3] = depth;
+        nds[5 * c->nact + 4] = depth / wsum / (h * h);
         c->nact++;
     }
     c->last = c->nact + touching;
@@ -381,7 +382,7 @@ void wb__contacts_velocity(wb_world *w, wb_real h)
         const int32_t k = c->act[a], i = c->ij[2 * k], j = c->ij[2 * k + 1];
         const wb_real wi = m->w[i], wj = m->w[j], wsum = wi + wj;
         if (wsum == 0) continue;
-        const wb_real *n = &c->act_nd[4 * a];
+        const wb_real *n = &c->act_nd[5 * a];
         wb_real *vi = &v[3 * i], *vj = &v[3 * j], u[3];
         v3_sub(u, vj, vi);
         const wb_real un = v3_dot(u, n);
@@ -390,4 +391,22 @@ void wb__contacts_velocity(wb_world *w, wb_real h)
         if (wi > 0) v3_madd(vi, n, un * wi / wsum);
         if (wj > 0) v3_madd(vj, n, -un * wj / wsum);
     }
+}
+
+/* ---- readout of the last substep's contacts ------------------------------------------------ */
+int32_t wb_world_contact_count(const wb_world *w) { return w->k.pc.nact; }
+
+wb_contact wb_world_contact_at(const wb_world *w, int32_t i)
+{
+    const wb_contacts *c = &w->k.pc;
+    wb_contact out = { -1, -1, 0, { 0, 0, 0 }, 0 };
+    if (i < 0 || i >= c->nact) return out;
+    const int32_t k = c->act[i];
+    const wb_real *nd = &c->act_nd[5 * i];
+    out.a = c->ij[2 * k];
+    out.b = c->ij[2 * k + 1];
+    v3_copy(out.normal, nd);
+    out.depth = nd[3];
+    out.force = nd[4];
+    return out;
 }

@@ -454,6 +454,36 @@ static int w_stats(lua_State *L)
     return 1;
 }
 
+/* w:contacts() -> { {a =, b =, force =, normal = {x, y, z}}, ... }: the particle-particle
+ * contacts that corrected positions in the last substep (wobble.h: wb_world_contact_at);
+ * particle ids from 1 */
+static int w_contacts(lua_State *L)
+{
+    wb_world *w = toworld(L);
+    const int32_t n = wb_world_contact_count(w);
+    lua_createtable(L, n, 0);
+    for (int32_t i = 0; i < n; i++) {
+        const wb_contact c = wb_world_contact_at(w, i);
+        lua_createtable(L, 0, 5);
+        lua_pushinteger(L, (lua_Integer)c.a + 1);
+        lua_setfield(L, -2, "a");
+        lua_pushinteger(L, (lua_Integer)c.b + 1);
+        lua_setfield(L, -2, "b");
+        lua_pushnumber(L, (lua_Number)c.force);
+        lua_setfield(L, -2, "force");
+        lua_pushnumber(L, (lua_Number)c.depth);
+        lua_setfield(L, -2, "depth");
+        lua_createtable(L, 3, 0);
+        for (int k = 0; k < 3; k++) {
+            lua_pushnumber(L, (lua_Number)c.normal[k]);
+            lua_rawseti(L, -2, k + 1);
+        }
+        lua_setfield(L, -2, "normal");
+        lua_rawseti(L, -2, i + 1);
+    }
+    return 1;
+}
+
 static int w_hash(lua_State *L)
 {
     char buf[17];
@@ -520,6 +550,7 @@ static const luaL_Reg world_methods[] = {
     { "bounds", w_bounds },
     { "max_strain", w_max_strain },
     { "stats", w_stats },
+    { "contacts", w_contacts },
     { "hash", w_hash },
     { "warnings", w_warnings },
     { "gravity", w_gravity },

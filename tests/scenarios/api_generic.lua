@@ -129,7 +129,7 @@ local CASES = {
   ["world:save_vtp"] = { none = "a path" },
   ["world:close"] = { none = "no arguments" },
 }
-for _, name in ipairs{ "angular_momentum", "bounds", "breaks", "closed", "colliders", "damping", "distances", "dt",
+for _, name in ipairs{ "angular_momentum", "bounds", "breaks", "closed", "colliders", "contacts", "damping", "distances", "dt",
                        "energy", "frame", "gravity", "hash", "iterations", "max_strain", "momentum", "particle_count",
                        "relaxation", "skins", "solver", "stats", "step", "substeps", "threads", "time", "warnings" } do
   CASES["world:" .. name] = { none = "a getter or step: no arguments" }
