@@ -192,11 +192,7 @@ wb_status wb_cloth(wb_world *w, const wb_cloth_def *d, wb_body *out)
         free(tri);
     }
 #undef ID
-    out->group = wb_group_new(w); /* before the new particles join it */
-    out->first = first;
-    out->count = (int32_t)np;
-    wb_body_set_contacts(w, *out, true, false, 0);
-    return WB_OK;
+    return wb__body_finish(w, first, (int32_t)np, out);
 }
 
 wb_status wb_rope(wb_world *w, const wb_rope_def *d, wb_body *out)
@@ -217,11 +213,7 @@ wb_status wb_rope(wb_world *w, const wb_rope_def *d, wb_body *out)
         wb_particle_add(w, p, NULL, d->mass / n, d->radius);
     }
     for (int i = 0; i + 1 < n; i++) link(w, first + i, first + i + 1, &d->link);
-    out->group = wb_group_new(w); /* before the new particles join it */
-    out->first = first;
-    out->count = n;
-    wb_body_set_contacts(w, *out, true, false, 0);
-    return WB_OK;
+    return wb__body_finish(w, first, n, out);
 }
 
 wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
@@ -299,9 +291,5 @@ wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
         free(tri);
     }
 #undef ID
-    out->group = wb_group_new(w); /* before the new particles join it */
-    out->first = first;
-    out->count = (int32_t)np;
-    wb_body_set_contacts(w, *out, true, false, 0);
-    return WB_OK;
+    return wb__body_finish(w, first, (int32_t)np, out);
 }

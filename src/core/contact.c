@@ -57,6 +57,15 @@ void wb_body_set_contacts(wb_world *w, wb_body b, bool collide, bool self_collid
     w->k.pc.scan_dirty = 1;
 }
 
+wb_status wb__body_finish(wb_world *w, int32_t first, int32_t count, wb_body *out)
+{
+    out->group = wb_group_new(w); /* before the new particles join it */
+    out->first = first;
+    out->count = count;
+    wb_body_set_contacts(w, *out, true, false, 0);
+    return WB_OK;
+}
+
 void wb_group_set_self_collide(wb_world *w, int32_t group, bool on)
 {
     for (int32_t i = 0; i < w->m.np; i++) {

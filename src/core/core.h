@@ -196,6 +196,9 @@ void wb__mesh_release(wb_world *w, wb_cshape *s);
 /* contact.c: broad phase once per frame, projection per substep, velocity pass after
  * the velocities are updated */
 void wb__contacts_begin(wb_world *w);
+/* a builder's particles first..first+count as a body: a new contact group of its own,
+ * colliding with others, not with itself, no contact friction (the binding sets those) */
+wb_status wb__body_finish(wb_world *w, int32_t first, int32_t count, wb_body *out);
 void wb__contacts_project(wb_world *w, wb_real h);
 void wb__contacts_velocity(wb_world *w, wb_real h);
 wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra); /* world.c */

@@ -260,9 +260,5 @@ wb_status wb_from_mesh(wb_world *w, const wb_mesh *m, const wb_from_mesh_def *d,
         wb_surface_add(w, p.tri, p.ntri);
     }
     plan_free(&p);
-    out->group = wb_group_new(w);
-    out->first = first;
-    out->count = p.np;
-    wb_body_set_contacts(w, *out, true, false, 0);
-    return WB_OK;
+    return wb__body_finish(w, first, p.np, out);
 }
