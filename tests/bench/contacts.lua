@@ -35,16 +35,7 @@ local r = {
   broad_share = broad_ms / step_ms,
 }
 if args.json then
-  local keys = {}
-  for k in pairs(r) do keys[#keys + 1] = k end
-  table.sort(keys)
-  local parts = {}
-  for _, k in ipairs(keys) do
-    local v = r[k]
-    parts[#parts + 1] = string.format("%q: %s", k, type(v) == "string" and string.format("%q", v)
-      or (math.type(v) == "integer" and tostring(v) or string.format("%.6g", v)))
-  end
-  print("{" .. table.concat(parts, ", ") .. "}")
+  print(require("wobble.bench").json(r))
 else
   print(string.format("%-10s %9s %11s %8s %6s %10s %10s %12s %8s", "scene", "particles", "constraints",
     "substeps", "iters", "ms/frame", "contacts", "broad ms/fr", "broad %"))

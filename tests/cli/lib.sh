@@ -2,6 +2,7 @@
 # The sourcing script sets TMP (a scratch folder; the last run's stdout and stderr in
 # $TMP/out and $TMP/err) and counts in n, passed and failed, and ends with
 #   echo "$passed passed, $failed failed"
+# OUT_FILE / ERR_FILE, when set, are where a failed run's output is shown from instead.
 # MAX_SECS, when set, is the longest a run may take ($secs, set by the script's runner).
 
 n=0 passed=0 failed=0
@@ -17,8 +18,8 @@ result() {
         failed=$((failed + 1))
         echo "not ok $n - $1"
         echo "  # $2"
-        head -n 15 "$TMP/out" 2>/dev/null | sed 's/^/  # stdout: /'
-        head -n 15 "$TMP/err" 2>/dev/null | sed 's/^/  # stderr: /'
+        head -n 15 "${OUT_FILE:-$TMP/out}" 2>/dev/null | sed 's/^/  # stdout: /'
+        head -n 15 "${ERR_FILE:-$TMP/err}" 2>/dev/null | sed 's/^/  # stderr: /'
     fi
 }
 

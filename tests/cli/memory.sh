@@ -16,7 +16,8 @@ LIMIT=200
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/wobble-memory.XXXXXX") || exit 2
 trap 'rm -rf "$TMP"' EXIT INT TERM
 mkdir -p "$TMP/out"
-n=0 passed=0 failed=0
+. tests/cli/lib.sh
+OUT_FILE=$TMP/stdout ERR_FILE=$TMP/stderr   # what result shows of a failed run
 SAN=0
 if ldd "$W" 2>/dev/null | grep -q 'libasan\|libubsan'; then SAN=1; fi
 
@@ -68,22 +69,9 @@ check() {
         esac
         shift 2
     done
-    result "$name ($((peak / 1024)) MB peak, $secs s)"
+    result "$name ($((peak / 1024)) MB peak, $secs s)" "$why"
 }
 
-result() {
-    n=$((n + 1))
-    if [ -z "$why" ]; then
-        passed=$((passed + 1))
-        echo "ok $n - $1"
-    else
-        failed=$((failed + 1))
-        echo "not ok $n - $1"
-        echo "  # $why"
-        head -n 10 "$TMP/stdout" 2>/dev/null | sed 's/^/  # stdout: /'
-        head -n 10 "$TMP/stderr" 2>/dev/null | sed 's/^/  # stderr: /'
-    fi
-}
 
 # ---- the assimp child: a billion vertices promised in 200 bytes. The shell's own limit
 # is a safety net for this machine should the child's limit ever be lost (it is far above
@@ -130,7 +118,7 @@ if [ -n "$child" ] && kill -0 "$child" 2>/dev/null; then
 fi
 : >"$TMP/stdout"
 : >"$TMP/stderr"
-result "the import's child dies with its parent (kill -9)"
+result "the import's child dies with its parent (kill -9)" "$why"
 
 # ---- a PNG of 30 kB that decodes to 16000 x 16000
 png="$TMP/out/bomb.png"
@@ -173,7 +161,7 @@ why=""
 [ "$code" = 0 ] || why="exit code $code, expected 0"
 [ "$peak" -le $((100 * 1024 * 3 / 2)) ] || why="${why:+$why; }peak RSS $((peak / 1024)) MB, over 1.5 x 100 MB"
 grep -q "made and closed 25 renderers" "$TMP/stdout" || why="${why:+$why; }stdout lacks 'made and closed 25 renderers'"
-result "25 renderers made and closed under --memory-limit 100 ($((peak / 1024)) MB peak)"
+result "25 renderers made and closed under --memory-limit 100 ($((peak / 1024)) MB peak)" "$why"
 
 # ---- one refusal by the budget, not retried by Lua (lauxlib's buffers): still exit 3
 run string_rep.lua
@@ -189,7 +177,7 @@ why=""
 [ "$code" = 0 ] || why="exit code $code, expected 0"
 [ -s "$TMP/out/long.png" ] || why="${why:+$why; }no plot written"
 [ "$peak" -le $((short + 16384)) ] || why="${why:+$why; }peak RSS $((peak / 1024)) MB, $(((peak - short) / 1024)) MB over 1000 frames'"
-result "w:run{plot} over 1,000,000 frames: $(((peak - short) / 1024)) MB more than over 1000"
+result "w:run{plot} over 1,000,000 frames: $(((peak - short) / 1024)) MB more than over 1000" "$why"
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
