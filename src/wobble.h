@@ -113,6 +113,7 @@ typedef struct wb_distance_def {
     wb_real yield;        /* plastic yield strain; 0 = elastic */
     wb_real creep;        /* plastic flow rate, 1/s, when past yield */
     wb_real break_strain; /* tensile strain that breaks it; 0 = unbreakable */
+    wb_real break_force;  /* N: breaks when the force of a frame's last substep passes it; 0 = never */
 } wb_distance_def;
 
 wb_distance_def wb_distance_default_def(void);                /* rigid, rest = current, elastic, unbreakable */
@@ -132,6 +133,29 @@ wb_distance_id wb_distance_at(const wb_world *w, int32_t i);
 /* every live constraint's handle in slot order, at once (out holds wb_distance_count):
  * wb_distance_at is a scan, so a loop over it is quadratic */
 int32_t wb_distance_ids(const wb_world *w, wb_distance_id *out);
+
+/* ---- bending constraints (XPBD, bend.c) ------------------------------------------------- */
+/* the dihedral angle between triangles (p1, p2, p3) and (p2, p1, p4) across the hinge
+ * p1-p2, 0 when they lie flat, +-pi folded over (Müller et al. 2007, appendix A) */
+typedef struct wb_bend_id { uint32_t index; uint32_t gen; } wb_bend_id;
+typedef struct wb_bend_def {
+    wb_real compliance;   /* alpha, rad/(N m) (inverse angular stiffness); 0 = rigid */
+    wb_real damping;      /* beta, as a distance's; acts when compliance > 0 */
+    wb_real rest;         /* rest angle, rad in [-pi, pi]; NAN = the angle at creation */
+} wb_bend_def;
+
+wb_bend_def wb_bend_default_def(void);                        /* rigid, undamped, rest = current */
+const char *wb_bend_def_check(const wb_bend_def *def);        /* NULL or what is wrong */
+/* four distinct particles whose triangles are not degenerate; index 0 / gen 0 and
+ * *status set on failure. Bends are never removed */
+wb_bend_id wb_bend_add(wb_world *w, const int32_t p[4], const wb_bend_def *def, wb_status *status);
+bool wb_bend_valid(const wb_world *w, wb_bend_id b);
+wb_real wb_bend_angle(const wb_world *w, wb_bend_id b);       /* rad now (NAN while degenerate) */
+wb_real wb_bend_rest(const wb_world *w, wb_bend_id b);        /* rad */
+wb_real wb_bend_force(const wb_world *w, wb_bend_id b);       /* N m, |lambda|/h^2 of the last substep */
+void wb_bend_particles(const wb_world *w, wb_bend_id b, int32_t p[4]);
+int32_t wb_bend_count(const wb_world *w);
+wb_bend_id wb_bend_at(const wb_world *w, int32_t i);          /* 0 <= i < count, creation order */
 
 /* ---- colliders (kinematic: the script moves them) -------------------------------- */
 typedef struct wb_collider_def {

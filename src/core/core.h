@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "wobble.h"
+#include "bend.h"
 
 /* ---- small vector helpers ---------------------------------------------------------- */
 static inline void v3_set(wb_real *o, wb_real x, wb_real y, wb_real z) { o[0] = x; o[1] = y; o[2] = z; }
@@ -75,6 +76,7 @@ typedef struct wb_model {
     wb_real *d_alpha;      /* (nd) compliance */
     wb_real *d_beta;       /* (nd) damping */
     wb_real *d_yield, *d_creep, *d_break; /* (nd) plasticity and breaking */
+    wb_real *d_bforce;     /* (nd) force that breaks it, N; 0 = none */
     uint32_t *d_gen;       /* (nd) generation: odd = live */
     int32_t *d_free;       /* free slots (stack) */
     int32_t nfree;
@@ -181,10 +183,28 @@ struct wb_world {
     wb_model m;
     wb_state s;
     wb_cache k;
+    wb_bends bend;         /* bending constraints (bend.c): model, state and cache */
 };
 
 /* internal entry points */
-wb_status wb__colour(wb_world *w);                 /* colour.c: rebuild batches if dirty */
+wb_status wb__colour(wb_world *w);                 /* distance.c: rebuild the distance batches if dirty */
+/* colour.c: greedy colouring of n constraints of k particles each (constraint i joins
+ * idx[k i .. k i + k - 1]); those live() refuses get WB_NO_COLOUR, the others a colour
+ * in [0, WB_MAX_COLOURS] (WB_MAX_COLOURS: the serial overflow batch), counted in count.
+ * 0 when out of memory */
+#define WB_NO_COLOUR 255
+int wb__colour_greedy(const wb_real *inv_mass, int32_t np, const int32_t *idx, int k, int32_t n,
+                      int (*live)(const void *ud, int32_t i), const void *ud, uint8_t *colour,
+                      int32_t count[WB_MAX_COLOURS + 1]);
+/* batch ranges from the counts: colour_start (ncolours + 1), the first serial batch, and
+ * start[c] the first packed index of colour c; returns the packed total */
+int32_t wb__colour_ranges(const int32_t count[WB_MAX_COLOURS + 1], int32_t *colour_start, int32_t *ncolours,
+                          int32_t *serial_start, int32_t start[WB_MAX_COLOURS + 1]);
+void wb__bend_free(wb_world *w);                   /* bend.c: its arrays, and its memory charge back */
+wb_status wb__bend_reserve(wb_world *w, int64_t extra); /* bend.c: after it, extra bends add without failing */
+/* bend.c: the dihedral angle of the bend over particles p[0..3] at positions x; *ok = 0
+ * when a triangle is degenerate */
+wb_real wb__bend_angle_of(const wb_real *x, const int32_t *p, int *ok);
 /* collide.c: collisions, then v = (x - x_prev)/h, friction and restitution */
 void wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1);
 void wb__collider_pose_at(const wb_collider_pose *cp, wb_real t, wb_real p[3], wb_real q[4]);

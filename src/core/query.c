@@ -1,5 +1,5 @@
 /* query.c: read-only measures of a world: energy, momenta, bounds, strain, hash, stats. */
-#include "core.h"
+#include "ctype.h"
 
 static wb_real mass_of(const wb_world *w, int32_t i) { return w->m.w[i] > 0 ? 1 / w->m.w[i] : 0; }
 
@@ -23,12 +23,9 @@ void wb_world_energy(const wb_world *w, wb_real *kinetic, wb_real *potential)
         ke += (wb_real)0.5 * m * v3_dot(&w->s.v[3 * i], &w->s.v[3 * i]);
         pe -= m * v3_dot(g, &w->s.x[3 * i]);
     }
-    /* elastic: U = C^2 / (2 alpha) for compliant constraints (alpha = 1/k) */
-    for (int32_t s = 0; s < w->m.nd; s++) {
-        if (!live(w, s) || w->m.d_alpha[s] <= 0) continue;
-        wb_real c = slot_length(w, s) - w->s.d_rest[s];
-        pe += c * c / (2 * w->m.d_alpha[s]);
-    }
+    /* elastic: each constraint type's, U = C^2 / (2 alpha) for compliant ones */
+    for (int t = 0; t < wb__nctypes; t++)
+        if (wb__ctypes[t]->energy) pe += wb__ctypes[t]->energy(w);
     *kinetic = ke;
     *potential = pe;
 }

@@ -42,6 +42,7 @@ wb_status wb_image_alloc(wb_image *g, int32_t np, int32_t nd, int32_t nfree, int
     g->d_yield = zalloc(nd, sizeof(wb_real));
     g->d_creep = zalloc(nd, sizeof(wb_real));
     g->d_break = zalloc(nd, sizeof(wb_real));
+    g->d_bforce = zalloc(nd, sizeof(wb_real));
     g->d_rest = zalloc(nd, sizeof(wb_real));
     g->d_broken = zalloc(nd, 1);
     g->d_gen = zalloc(nd, sizeof *g->d_gen);
@@ -51,7 +52,7 @@ wb_status wb_image_alloc(wb_image *g, int32_t np, int32_t nd, int32_t nfree, int
     g->surf_start = zalloc((int64_t)nsurf + 1, sizeof *g->surf_start);
     g->tri = zalloc(3 * (int64_t)ntri, sizeof *g->tri);
     if (!g->x || !g->v || !g->inv_mass || !g->radius || !g->pinned || !g->d_ij || !g->d_alpha || !g->d_beta ||
-        !g->d_yield || !g->d_creep || !g->d_break || !g->d_rest || !g->d_broken || !g->d_gen || !g->d_free ||
+        !g->d_yield || !g->d_creep || !g->d_break || !g->d_bforce || !g->d_rest || !g->d_broken || !g->d_gen || !g->d_free ||
         !g->c || !g->c_gen || !g->surf_start || !g->tri || !g->group || !g->cflags || !g->cfric || !g->x0) {
         wb_image_free(g);
         return WB_ERR_NOMEM;
@@ -65,6 +66,21 @@ wb_status wb_image_alloc(wb_image *g, int32_t np, int32_t nd, int32_t nfree, int
     return WB_OK;
 }
 
+wb_status wb_image_alloc_bends(wb_image *g, int32_t nb)
+{
+    free(g->b_ij); free(g->b_alpha); free(g->b_beta); free(g->b_rest);
+    g->nb = nb;
+    g->b_ij = zalloc(4 * (int64_t)nb, sizeof *g->b_ij);
+    g->b_alpha = zalloc(nb, sizeof(wb_real));
+    g->b_beta = zalloc(nb, sizeof(wb_real));
+    g->b_rest = zalloc(nb, sizeof(wb_real));
+    if (!g->b_ij || !g->b_alpha || !g->b_beta || !g->b_rest) {
+        wb_image_free(g);
+        return WB_ERR_NOMEM;
+    }
+    return WB_OK;
+}
+
 void wb_image_free(wb_image *g)
 {
     for (int32_t i = 0; g->c && i < g->nc; i++) {
@@ -73,7 +89,8 @@ void wb_image_free(wb_image *g)
     }
     void *p[] = { g->x, g->v, g->inv_mass, g->radius, g->pinned, g->d_ij, g->d_alpha, g->d_beta, g->d_yield,
                   g->d_creep, g->d_break, g->d_rest, g->d_broken, g->d_gen, g->d_free, g->c, g->c_gen,
-                  g->surf_start, g->tri, g->group, g->cflags, g->cfric, g->x0 };
+                  g->surf_start, g->tri, g->group, g->cflags, g->cfric, g->x0, g->d_bforce,
+                  g->b_ij, g->b_alpha, g->b_beta, g->b_rest };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     memset(g, 0, sizeof *g);
 }
@@ -104,11 +121,20 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
         memcpy(g->d_yield, m->d_yield, nd * sizeof(wb_real));
         memcpy(g->d_creep, m->d_creep, nd * sizeof(wb_real));
         memcpy(g->d_break, m->d_break, nd * sizeof(wb_real));
+        memcpy(g->d_bforce, m->d_bforce, nd * sizeof(wb_real));
         memcpy(g->d_rest, s->d_rest, nd * sizeof(wb_real));
         memcpy(g->d_broken, s->d_broken, nd);
         memcpy(g->d_gen, m->d_gen, nd * sizeof *g->d_gen);
     }
     if (m->nfree) memcpy(g->d_free, m->d_free, (size_t)m->nfree * sizeof *g->d_free);
+    const wb_bends *bd = &w->bend;
+    if (bd->n > 0) {
+        if ((st = wb_image_alloc_bends(g, bd->n)) != WB_OK) return st;
+        memcpy(g->b_ij, bd->ij, 4 * (size_t)bd->n * sizeof *g->b_ij);
+        memcpy(g->b_alpha, bd->alpha, (size_t)bd->n * sizeof(wb_real));
+        memcpy(g->b_beta, bd->beta, (size_t)bd->n * sizeof(wb_real));
+        memcpy(g->b_rest, bd->rest, (size_t)bd->n * sizeof(wb_real));
+    }
     for (int32_t i = 0; i < m->nc; i++) {
         const wb_cshape *cs = &m->c_shape[i];
         const wb_collider_pose *cp = &s->c_pose[i];
@@ -204,12 +230,25 @@ const char *wb_image_check(const wb_image *g)
         const int32_t a = g->d_ij[2 * i], b = g->d_ij[2 * i + 1];
         if (a < 0 || b < 0 || a >= g->np || b >= g->np) return "constraint particle out of range";
         if (a == b) return "a constraint needs two distinct particles";
-        wb_distance_def d = { g->d_alpha[i], g->d_beta[i], g->d_rest[i], g->d_yield[i], g->d_creep[i], g->d_break[i] };
+        wb_distance_def d = { g->d_alpha[i], g->d_beta[i], g->d_rest[i], g->d_yield[i], g->d_creep[i], g->d_break[i],
+                              g->d_bforce[i] };
         if ((e = wb_distance_def_check(&d))) return e;
         if (!(g->d_rest[i] >= 0)) return "rest length must be >= 0";
         wb_real dx[3];
         v3_sub(dx, &g->x[3 * b], &g->x[3 * a]);
         if (!isfinite(v3_dot(dx, dx))) return "constraint particles are too far apart (their distance squared overflows)";
+    }
+    if (g->nb < 0 || g->nb > WB_MAX_CONSTRAINTS) return "too many bends";
+    for (int32_t i = 0; i < g->nb; i++) {
+        const int32_t *p = &g->b_ij[4 * i];
+        for (int a = 0; a < 4; a++) {
+            if (p[a] < 0 || p[a] >= g->np) return "bend particle out of range";
+            for (int b = 0; b < a; b++)
+                if (p[a] == p[b]) return "a bend needs four distinct particles";
+        }
+        wb_bend_def bd = { g->b_alpha[i], g->b_beta[i], g->b_rest[i] };
+        if (isnan(g->b_rest[i])) return "bend rest must be an angle in [-pi, pi] (radians)";
+        if ((e = wb_bend_def_check(&bd))) return e;
     }
     /* the free list is exactly the dead slots, each once (a mark per slot: linear) */
     if (g->nfree != dead) return "the free constraint slots do not match the dead ones";
@@ -337,6 +376,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     wb_world *w = wb_world_create(&g->def);
     wb_colmesh **cms = calloc((size_t)(g->nc > 0 ? g->nc : 1), sizeof *cms);
     wb_status st = w && cms ? wb__reserve(w, g->np, g->nd) : WB_ERR_NOMEM;
+    if (st == WB_OK) st = wb__bend_reserve(w, g->nb);
     if (st == WB_OK) st = grow_colliders(w, g->nc);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
     if (st == WB_OK) st = build_meshes(w, g, cms);
@@ -372,6 +412,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
         memcpy(m->d_yield, g->d_yield, nd * sizeof(wb_real));
         memcpy(m->d_creep, g->d_creep, nd * sizeof(wb_real));
         memcpy(m->d_break, g->d_break, nd * sizeof(wb_real));
+        memcpy(m->d_bforce, g->d_bforce, nd * sizeof(wb_real));
         memcpy(s->d_rest, g->d_rest, nd * sizeof(wb_real));
         memcpy(s->d_broken, g->d_broken, nd);
         memcpy(m->d_gen, g->d_gen, nd * sizeof *m->d_gen);
@@ -382,6 +423,15 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     }
     m->nfree = g->nfree;
     if (g->nfree) memcpy(m->d_free, g->d_free, (size_t)g->nfree * sizeof *m->d_free);
+    wb_bends *bd = &w->bend;
+    bd->n = g->nb;
+    if (g->nb > 0) {
+        memcpy(bd->ij, g->b_ij, 4 * (size_t)g->nb * sizeof *bd->ij);
+        memcpy(bd->alpha, g->b_alpha, (size_t)g->nb * sizeof(wb_real));
+        memcpy(bd->beta, g->b_beta, (size_t)g->nb * sizeof(wb_real));
+        memcpy(bd->rest, g->b_rest, (size_t)g->nb * sizeof(wb_real));
+        bd->dirty = 1;
+    }
     m->nc = g->nc;
     for (int32_t i = 0; i < g->nc; i++) {
         put_collider(w, i, &g->c[i], cms[i]);
@@ -434,6 +484,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     wb_colmesh **cms = calloc((size_t)(g->nc > 0 ? g->nc : 1), sizeof *cms);
     if (!cms) return WB_ERR_NOMEM;
     wb_status st = wb__reserve(w, g->np, live_d);
+    if (st == WB_OK) st = wb__bend_reserve(w, g->nb);
     if (st == WB_OK) st = grow_colliders(w, m->nc + new_c);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
     if (st == WB_OK) st = build_meshes(w, g, cms);
@@ -459,9 +510,16 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     w->k.pc.scan_dirty = 1;
     for (int32_t i = 0; i < g->nd; i++) {
         if (!(g->d_gen[i] & 1u)) continue;
-        wb_distance_def d = { g->d_alpha[i], g->d_beta[i], g->d_rest[i], g->d_yield[i], g->d_creep[i], g->d_break[i] };
+        wb_distance_def d = { g->d_alpha[i], g->d_beta[i], g->d_rest[i], g->d_yield[i], g->d_creep[i], g->d_break[i],
+                              g->d_bforce[i] };
         wb_distance_id id = wb_distance_add(w, first + g->d_ij[2 * i], first + g->d_ij[2 * i + 1], &d, NULL);
         w->s.d_broken[id.index - 1] = g->d_broken[i];
+    }
+    for (int32_t i = 0; i < g->nb; i++) {
+        const int32_t p[4] = { first + g->b_ij[4 * i], first + g->b_ij[4 * i + 1], first + g->b_ij[4 * i + 2],
+                               first + g->b_ij[4 * i + 3] };
+        wb_bend_def bd = { g->b_alpha[i], g->b_beta[i], g->b_rest[i] };
+        wb_bend_add(w, p, &bd, NULL); /* checked and reserved: cannot fail */
     }
     int32_t scan = 0; /* dead slots are taken lowest first: the scan never goes back */
     for (int32_t i = 0; i < g->nc; i++) {

@@ -40,10 +40,16 @@ typedef struct wb_image {
     int32_t nd;
     int32_t *d_ij;         /* (nd x 2) */
     wb_real *d_alpha, *d_beta, *d_yield, *d_creep, *d_break, *d_rest; /* (nd) */
+    wb_real *d_bforce;     /* (nd) break_force, N (0 = none) */
     uint8_t *d_broken;     /* (nd) */
     uint32_t *d_gen;       /* (nd) */
     int32_t nfree;
     int32_t *d_free;       /* (nfree) free slots, in stack order */
+
+    /* bending constraints in creation order (wb_image_alloc_bends) */
+    int32_t nb;
+    int32_t *b_ij;         /* (nb x 4) hinge p1 p2, wings p3 p4 */
+    wb_real *b_alpha, *b_beta, *b_rest; /* (nb) compliance, damping, rest angle */
 
     int32_t nc;
     wb_image_collider *c;  /* (nc) by slot */
@@ -62,6 +68,8 @@ typedef struct wb_image {
 /* allocate the arrays for these counts (zeroed; generations 1, i.e. live; particles collide);
  * WB_ERR_NOMEM */
 wb_status wb_image_alloc(wb_image *img, int32_t np, int32_t nd, int32_t nfree, int32_t nc, int32_t nsurf, int32_t ntri);
+/* the bend arrays for nb bends (zeroed), after wb_image_alloc; WB_ERR_NOMEM */
+wb_status wb_image_alloc_bends(wb_image *img, int32_t nb);
 void wb_image_free(wb_image *img);                     /* and zero it (mesh colliders' arrays too); fine on a zeroed image */
 wb_status wb_image_of(const wb_world *w, wb_image *img); /* a full copy of the world */
 /* NULL, or what is inconsistent (an index out of range, a free list that does not match

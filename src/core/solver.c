@@ -3,11 +3,12 @@
  * Per frame, `substeps` times: predict, project the constraints `iterations` times
  * (XPBD, Gauss-Seidel over colour batches or Jacobi), project collisions, update
  * velocities, then friction and restitution at velocity level. Plastic flow, breaking
- * and the finiteness check run once per frame. */
+ * and the finiteness check run once per frame. The constraints are projected type by
+ * type from the table wb__ctypes (ctype.h): each type is a file of its own. */
 #include <stdio.h>
 #include <time.h>
 
-#include "core.h"
+#include "ctype.h"
 
 static double now_ms(void)
 {
@@ -16,130 +17,21 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
-/* Project the distance constraints [b, e) of the packed arrays (XPBD, Macklin et al.
- * 2016 eq. 18 with the damping of eq. 26). Gauss-Seidel updates positions in place;
- * Jacobi (out = dx) accumulates corrections computed from the same positions, each
- * scaled by omega / max(n_a, n_b) (k->s_jac) for both its ends, so that a pair's
- * corrections stay equal and opposite (momentum) and lambda is the multiplier
- * actually applied (force readback). Particles with w = 0 are never written, not
- * even with 0: -0.0 would turn +0.0, and immovable particles may be shared inside
- * a batch. The caller guarantees that no two constraints in [b, e) write the same
- * movable particle when it runs the range in parallel. `damped` and `jacobi` are
- * compile-time constants at each call. (A branch-free `omp simd` version with
- * AVX-512 gathers and scatters measured slower than this scalar loop.) */
-static inline __attribute__((always_inline)) void
-project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
-              wb_real *out, int32_t b, int32_t e, wb_real h, wb_real inv_h2, wb_real omega,
-              const int damped, const int jacobi)
-{
-    const int32_t *restrict sa = k->s_a, *restrict sb = k->s_b;
-    const wb_real *restrict rest = k->s_rest, *restrict alpha = k->s_alpha, *restrict beta = k->s_beta;
-    const wb_real *restrict jac = k->s_jac;
-    wb_real *restrict lambda = k->s_lambda;
-    for (int32_t i = b; i < e; i++) {
-        const int32_t ia = sa[i], ic = sb[i];
-        const wb_real wa = wv[ia], wc = wv[ic], wsum = wa + wc;
-        const wb_real *xa = &x[3 * ia], *xc = &x[3 * ic];
-        const wb_real d0 = xc[0] - xa[0], d1 = xc[1] - xa[1], d2 = xc[2] - xa[2];
-        const wb_real len2 = d0 * d0 + d1 * d1 + d2 * d2;
-        /* immovable pair, or coincident particles: nothing to push along */
-        if (wsum == 0 || len2 < (wb_real)1e-24) continue;
-        const wb_real at = alpha[i] * inv_h2;
-        /* compliance/h^2 overflowed: the limit is a constraint with no stiffness (it would
-         * otherwise give inf * 0 = NaN below and undo the frame) */
-        if (isinf(at)) continue;
-        const wb_real len = sqrt(len2);
-        wb_real num = rest[i] - len - at * lambda[i];
-        wb_real den = wsum + at;
-        if (damped) {
-            /* gamma = alpha~ beta~ / h with beta~ = h^2 beta */
-            const wb_real gamma = at * beta[i] * h;
-            const wb_real *pa = &xp[3 * ia], *pc = &xp[3 * ic];
-            const wb_real rel = ((xc[0] - pc[0]) - (xa[0] - pa[0])) * d0 + ((xc[1] - pc[1]) - (xa[1] - pa[1])) * d1 +
-                                ((xc[2] - pc[2]) - (xa[2] - pa[2])) * d2;
-            if (isinf(gamma)) {
-                /* alpha~ beta h overflowed: the limit gamma -> inf of num/den, a correction
-                 * that removes the relative velocity along d (inf * 0 would be NaN) */
-                num = -rel / len;
-                den = wsum;
-            } else {
-                num -= gamma * rel / len;
-                den += gamma * wsum;
-            }
-        }
-        /* s = dlambda / len, so the correction is s * d without normalising d */
-        wb_real s = num / (den * len);
-        if (jacobi) s *= omega * jac[i];
-        lambda[i] += s * len;
-        if (wa > 0) {
-            wb_real *oa = &out[3 * ia];
-            const wb_real f = wa * s;
-            oa[0] -= f * d0; oa[1] -= f * d1; oa[2] -= f * d2;
-        }
-        if (wc > 0) {
-            wb_real *oc = &out[3 * ic];
-            const wb_real f = wc * s;
-            oc[0] += f * d0; oc[1] += f * d1; oc[2] += f * d2;
-        }
-    }
-}
+/* the constraint types the step walks, in projection order (ctype.h; DESIGN.md §2):
+ * adding a type adds its line here. TYPE TABLE: volume, shape and pressure join here. */
+const wb_ctype *const wb__ctypes[] = {
+    &wb__distance_type,
+    &wb__bend_type,
+};
+const int wb__nctypes = (int)(sizeof wb__ctypes / sizeof wb__ctypes[0]);
 
-static void project_distances(const wb_world *w, wb_real *dx, int32_t b, int32_t e, wb_real h, wb_real inv_h2)
-{
-    const wb_cache *k = &w->k;
-    const wb_real *wv = w->m.w, *xp = w->s.x_prev, omega = w->m.def.relaxation;
-    wb_real *x = w->s.x;
-    if (dx) {
-        if (k->any_damping) project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1);
-        else project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1);
-    } else {
-        if (k->any_damping) project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0);
-        else project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0);
-    }
-}
-
-/* one pass over every batch; batches before serial_start are conflict-free */
-static void project_batches(wb_world *w, wb_real *dx, wb_real h, wb_real inv_h2)
-{
-    wb_cache *k = &w->k;
-    const int threads = w->m.def.threads;
-    for (int32_t c = 0; c < k->ncolours; c++) {
-        const int32_t b = k->colour_start[c], e = k->colour_start[c + 1];
-        if (c >= k->serial_start || threads == 1 || e - b < 512) {
-            project_distances(w, dx, b, e, h, inv_h2);
-            continue;
-        }
-        /* split the batch into contiguous chunks, one per thread: disjoint writes */
-        #pragma omp parallel for num_threads(threads) schedule(static)
-        for (int t = 0; t < threads; t++) {
-            const int32_t n = e - b;
-            const int32_t lo = b + (int32_t)((int64_t)n * t / threads), hi = b + (int32_t)((int64_t)n * (t + 1) / threads);
-            project_distances(w, dx, lo, hi, h, inv_h2);
-        }
-    }
-}
-
+/* one pass of every type, `iterations` times: the types run one after the other (Gauss-
+ * Seidel between types; inside one, as the type projects: batches or Jacobi) */
 static void solve_constraints(wb_world *w, wb_real h)
 {
-    wb_cache *k = &w->k;
-    const wb_world_def *d = &w->m.def;
-    const wb_real inv_h2 = 1 / (h * h);
-    const int32_t np = w->m.np;
-    for (int it = 0; it < d->iterations; it++) {
-        if (d->solver == WB_SOLVER_GAUSS_SEIDEL) {
-            project_batches(w, NULL, h, inv_h2);
-            continue;
-        }
-        /* Jacobi: every correction from the same positions, scaled per constraint
-         * (see project_range), then applied at once */
-        if (np == 0) break;
-        memset(k->dx, 0, sizeof(wb_real) * 3 * (size_t)np);
-        project_batches(w, k->dx, h, inv_h2);
-        const wb_real *wv = w->m.w;
-        for (int32_t i = 0; i < np; i++)
-            if (wv[i] > 0) v3_add(&w->s.x[3 * i], &w->s.x[3 * i], &k->dx[3 * i]);
-    }
-    k->projections += (int64_t)k->ns * d->iterations;
+    const int iterations = w->m.def.iterations;
+    for (int it = 0; it < iterations; it++)
+        for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->project(w, h);
 }
 
 static void predict(wb_world *w, wb_real h)
@@ -160,42 +52,6 @@ static void predict(wb_world *w, wb_real h)
 }
 
 
-/* plastic flow and breaking, once per frame on the frame's final lengths */
-static void plasticity_and_breaking(wb_world *w)
-{
-    wb_model *m = &w->m;
-    wb_cache *k = &w->k;
-    const wb_real dt = m->def.dt;
-    for (int32_t i = 0; i < k->ns; i++) {
-        const int32_t s = k->s_slot[i];
-        if (m->d_break[s] <= 0 && m->d_yield[s] <= 0) continue;
-        wb_real d[3];
-        v3_sub(d, &w->s.x[3 * k->s_b[i]], &w->s.x[3 * k->s_a[i]]);
-        const wb_real len = v3_len(d), rest = k->s_rest[i];
-        if (rest <= 0) continue;
-        const wb_real strain = (len - rest) / rest;
-        if (m->d_break[s] > 0 && strain > m->d_break[s]) {
-            w->s.d_broken[s] = 1;
-            m->topology_dirty = 1;
-            wb_distance_id id = { (uint32_t)s + 1, m->d_gen[s] };
-            wb_distance_id *q = wb__grow(k->breaks, &k->cap_breaks, k->nbreaks + 1, sizeof *q);
-            if (q) { k->breaks = q; k->breaks[k->nbreaks++] = id; }
-            continue;
-        }
-        const wb_real a = fabs(strain), y = m->d_yield[s];
-        if (y > 0 && a > y) {
-            /* flow towards the current length by the part of the strain past yield */
-            const wb_real rate = m->d_creep[s] * dt < 1 ? m->d_creep[s] * dt : 1;
-            /* the part past yield, (a - y)/a; a rest so small that the strain overflows
-             * (inf/inf = NaN would poison the rest for good) flows as if a were huge: 1 */
-            const wb_real past = isinf(a) ? 1 : (a - y) / a;
-            const wb_real r = rest + rate * (len - rest) * past;
-            k->s_rest[i] = r;
-            w->s.d_rest[s] = r;
-        }
-    }
-}
-
 /* put the particles back as they were at the frame's start; the multipliers of the
  * abandoned frame mean nothing (and may be NaN): force() reads 0 until the next step */
 static void undo_particles(wb_world *w)
@@ -206,7 +62,7 @@ static void undo_particles(wb_world *w)
         memcpy(w->s.x_prev, w->k.x_save, sizeof(wb_real) * n);
         memcpy(w->s.v, w->k.v_save, sizeof(wb_real) * n);
     }
-    if (w->k.ns > 0) memset(w->k.s_lambda, 0, sizeof(wb_real) * (size_t)w->k.ns);
+    for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->substep_begin(w);
 }
 
 /* the colliders' poses at the frame's start, before their velocities move them */
@@ -264,7 +120,9 @@ wb_status wb_world_step(wb_world *w)
 {
     const double t_begin = now_ms();
     wb_cache *k = &w->k;
-    if (wb__colour(w) != WB_OK || !save_colliders(w)) {
+    wb_status prep = WB_OK;
+    for (int t = 0; t < wb__nctypes && prep == WB_OK; t++) prep = wb__ctypes[t]->prepare(w);
+    if (prep != WB_OK || !save_colliders(w)) {
         wb__warn(w, "frame %lld: out of memory preparing the step; frame skipped", (long long)w->s.frame + 1);
         return WB_ERR_NOMEM;
     }
@@ -299,7 +157,8 @@ wb_status wb_world_step(wb_world *w)
         }
         predict(w, h);
         double t0 = now_ms();
-        if (k->ns > 0) memset(k->s_lambda, 0, sizeof(wb_real) * (size_t)k->ns);
+        /* TYPE HOOK: the constraint types, walked from the table (wb__ctypes) */
+        for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->substep_begin(w);
         solve_constraints(w, h);
         solve += now_ms() - t0;
         wb__contacts_project(w, h);
@@ -308,7 +167,9 @@ wb_status wb_world_step(wb_world *w)
     }
 
     /* a frame gone non-finite is undone before it can bend or break anything */
-    if (check_finite(w)) plasticity_and_breaking(w);
+    if (check_finite(w))
+        for (int t = 0; t < wb__nctypes; t++)
+            if (wb__ctypes[t]->frame_end) wb__ctypes[t]->frame_end(w);
     for (int32_t c = 0; c < w->m.nc; c++) {
         wb_collider_pose *cp = &w->s.c_pose[c];
         v3_copy(cp->p0, cp->p);

@@ -100,11 +100,12 @@ void wb_world_destroy(wb_world *w)
     if (!w) return;
     wb_model *m = &w->m;
     for (int32_t i = 0; i < m->nc; i++) wb__colmesh_free(m->c_shape[i].mesh); /* mesh colliders' copies */
+    wb__bend_free(w);
     if (m->def.memory) m->def.memory->used -= m->charged + m->charged_mesh;
     wb_state *s = &w->s;
     wb_cache *k = &w->k;
     void *ptrs[] = { m->inv_mass, m->w, m->radius, m->pinned, m->d_ij, m->d_alpha, m->d_beta,
-                     m->d_yield, m->d_creep, m->d_break, m->d_gen, m->d_free, m->c_shape, m->c_gen, m->surf_start, m->tri,
+                     m->d_yield, m->d_creep, m->d_break, m->d_bforce, m->d_gen, m->d_free, m->c_shape, m->c_gen, m->surf_start, m->tri,
                      s->x, s->x_prev, s->v, s->d_rest, s->d_broken, s->c_pose,
                      k->colour_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda, k->s_jac,
                      k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->c_sub, k->c_save,
@@ -139,7 +140,7 @@ int64_t wb_world_frame(const wb_world *w) { return w->s.frame; }
 /* bytes per particle and per constraint over all the arrays that grow with them
  * (model, state and solver cache), for the memory limit */
 #define PARTICLE_BYTES (25 * sizeof(wb_real) + 5 + 8 + 5)
-#define CONSTRAINT_BYTES (10 * sizeof(wb_real) + 33)
+#define CONSTRAINT_BYTES (11 * sizeof(wb_real) + 33)
 
 /* charge the arrays at capacities (cap_p, cap_d) to the budget; 0 when it would pass
  * the limit (nothing charged then) */
@@ -258,7 +259,7 @@ void wb_particle_unpin(wb_world *w, int32_t p)
 /* ---- distance constraints --------------------------------------------------------- */
 wb_distance_def wb_distance_default_def(void)
 {
-    wb_distance_def d = { 0, 0, -1, 0, 0, 0 };
+    wb_distance_def d = { 0, 0, -1, 0, 0, 0, 0 };
     return d;
 }
 
@@ -271,6 +272,7 @@ const char *wb_distance_def_check(const wb_distance_def *d)
     if (!(d->yield >= 0) || !isfinite(d->yield)) return "yield must be >= 0";
     if (!(d->creep >= 0) || !isfinite(d->creep)) return "creep must be >= 0";
     if (!(d->break_strain >= 0) || !isfinite(d->break_strain)) return "break_strain must be >= 0";
+    if (!(d->break_force >= 0) || !isfinite(d->break_force)) return "break_force must be >= 0";
     return NULL;
 }
 
@@ -291,6 +293,7 @@ static wb_status grow_distances(wb_world *w, int32_t need)
         { (void **)&m->d_ij, 2 * sizeof(int32_t) }, { (void **)&m->d_alpha, sizeof(wb_real) },
         { (void **)&m->d_beta, sizeof(wb_real) }, { (void **)&m->d_yield, sizeof(wb_real) },
         { (void **)&m->d_creep, sizeof(wb_real) }, { (void **)&m->d_break, sizeof(wb_real) },
+        { (void **)&m->d_bforce, sizeof(wb_real) },
         { (void **)&m->d_gen, sizeof(uint32_t) }, { (void **)&m->d_free, sizeof(int32_t) },
         { (void **)&w->s.d_rest, sizeof(wb_real) }, { (void **)&w->s.d_broken, 1 },
         { (void **)&w->k.slot_pack, sizeof(int32_t) },
@@ -353,6 +356,7 @@ wb_distance_id wb_distance_add(wb_world *w, int32_t a, int32_t b, const wb_dista
     m->d_yield[slot] = def->yield;
     m->d_creep[slot] = def->creep;
     m->d_break[slot] = def->break_strain;
+    m->d_bforce[slot] = def->break_force;
     m->d_gen[slot]++; /* even -> odd: live */
     w->s.d_rest[slot] = rest;
     w->s.d_broken[slot] = 0;

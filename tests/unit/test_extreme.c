@@ -136,7 +136,7 @@ TEST(extreme_dt_that_cannot_step_refused)
     const wb_real p[3] = { 0, 1, 0 }, q[3] = { 0, 2, 0 };
     wb_particle_add(w, p, NULL, 1, 0);
     wb_particle_add(w, q, NULL, 1, 0);
-    wb_distance_add(w, 0, 1, &(wb_distance_def){ 0, 0, -1, 0, 0, 0 }, NULL);
+    wb_distance_add(w, 0, 1, &(wb_distance_def){ 0, 0, -1, 0, 0, 0, 0 }, NULL);
     for (int i = 0; i < 3; i++) wb_world_step(w);
     CHECK_EQ(wb_world_warnings(w), 0);
     wb_world_destroy(w);

@@ -1,0 +1,28 @@
+/* bend.h: the bending constraints' arrays (bend.c), one member of struct wb_world. */
+#ifndef WB_BEND_H
+#define WB_BEND_H
+
+#include "wobble.h"
+
+#define WB_MAX_COLOURS 64  /* one bit each in a per-particle mask; the rest go to a serial batch */
+
+typedef struct wb_bends {
+    /* model: what a step does not change */
+    int32_t n, cap;        /* constraints (never removed: the slot is the handle) */
+    int32_t *ij;           /* (n x 4) p1 p2 = the hinge edge, p3 p4 = the wings */
+    wb_real *alpha;        /* (n) compliance, rad/(N m) */
+    wb_real *beta;         /* (n) damping (as a distance's, Macklin et al. 2016 eq. 26) */
+    wb_real *rest;         /* (n) rest dihedral angle, rad in (-pi, pi] */
+    size_t charged;        /* bytes charged to def.memory */
+    /* cache: packed by colour, rebuilt when dirty */
+    int dirty;
+    int32_t ncolours, serial_start;
+    int32_t colour_start[WB_MAX_COLOURS + 2];
+    int32_t *s_ij;         /* (n x 4) packed particles */
+    int32_t *s_slot;       /* (n) slot of each packed entry */
+    int32_t *pack;         /* (n) packed index of each slot */
+    wb_real *lambda;       /* (n) multipliers of the current substep, by packed index */
+    int32_t cap_s;
+} wb_bends;
+
+#endif
