@@ -156,6 +156,8 @@ wb_real wb_bend_force(const wb_world *w, wb_bend_id b);       /* N m, |lambda|/h
 void wb_bend_particles(const wb_world *w, wb_bend_id b, int32_t p[4]);
 int32_t wb_bend_count(const wb_world *w);
 wb_bend_id wb_bend_at(const wb_world *w, int32_t i);          /* 0 <= i < count, creation order */
+/* the dihedral angle a bend over these positions has (rad); false when degenerate */
+bool wb_dihedral_angle(const wb_real x1[3], const wb_real x2[3], const wb_real x3[3], const wb_real x4[3], wb_real *theta);
 
 /* ---- colliders (kinematic: the script moves them) -------------------------------- */
 typedef struct wb_collider_def {
@@ -210,7 +212,8 @@ typedef struct wb_cloth_def {
     wb_real mass;         /* total, spread evenly */
     wb_real radius;
     bool shear;           /* one diagonal per cell, alternating */
-    wb_real bend;         /* < 0: none; else compliance of skip-one bending links */
+    wb_real bend;         /* < 0: none; else compliance (rad/(N m)) of a dihedral bend per interior edge */
+    wb_real bend_links;   /* < 0: none; else compliance of skip-one bending links (distance) */
     wb_distance_def link; /* options of every constraint made */
 } wb_cloth_def;
 

@@ -141,6 +141,11 @@ const char *wb_bend_def_check(const wb_bend_def *d)
     return NULL;
 }
 
+bool wb_dihedral_angle(const wb_real x1[3], const wb_real x2[3], const wb_real x3[3], const wb_real x4[3], wb_real *theta)
+{
+    return dihedral(x1, x2, x3, x4, theta, NULL) != 0;
+}
+
 wb_real wb__bend_angle_of(const wb_real *x, const int32_t *p, int *ok)
 {
     wb_real th = 0;
@@ -333,3 +338,44 @@ const wb_ctype wb__bend_type = {
     .frame_end = NULL,
     .energy = bend_energy,
 };
+
+/* ---- hinges of a triangle list ----------------------------------------------------------------- */
+typedef struct hedge { int32_t lo, hi, u, v, opp, t; } hedge;
+
+static int cmp_hedge(const void *pa, const void *pb)
+{
+    const hedge *a = pa, *b = pb;
+    if (a->lo != b->lo) return a->lo < b->lo ? -1 : 1;
+    if (a->hi != b->hi) return a->hi < b->hi ? -1 : 1;
+    return a->t < b->t ? -1 : a->t > b->t; /* (lo, hi, t) is unique: a total order, so any qsort agrees */
+}
+
+int32_t wb__bend_hinges(const int32_t *tri, int32_t ntri, int32_t *out)
+{
+    hedge *e = malloc(sizeof *e * 3 * (size_t)(ntri > 0 ? ntri : 1));
+    if (!e) return -1;
+    for (int32_t t = 0; t < ntri; t++)
+        for (int k = 0; k < 3; k++) {
+            const int32_t u = tri[3 * t + k], v = tri[3 * t + (k + 1) % 3], o = tri[3 * t + (k + 2) % 3];
+            hedge h = { u < v ? u : v, u < v ? v : u, u, v, o, t };
+            e[3 * t + k] = h;
+        }
+    qsort(e, 3 * (size_t)ntri, sizeof *e, cmp_hedge);
+    int32_t n = 0;
+    for (int32_t i = 0; i < 3 * ntri;) {
+        int32_t j = i + 1;
+        while (j < 3 * ntri && e[j].lo == e[i].lo && e[j].hi == e[i].hi) j++;
+        /* exactly two triangles: an interior edge (a border has one, a non-manifold edge more) */
+        if (j - i == 2 && e[i].opp != e[i + 1].opp) {
+            /* hinge in the first triangle's winding: (p1, p2, p3) and (p2, p1, p4) */
+            out[4 * n] = e[i].u;
+            out[4 * n + 1] = e[i].v;
+            out[4 * n + 2] = e[i].opp;
+            out[4 * n + 3] = e[i + 1].opp;
+            n++;
+        }
+        i = j;
+    }
+    free(e);
+    return n;
+}

@@ -15,6 +15,7 @@ wb_cloth_def wb_cloth_default_def(void)
     d.radius = 0.02;
     d.shear = true;
     d.bend = -1;
+    d.bend_links = -1;
     d.link = wb_distance_default_def();
     return d;
 }
@@ -142,22 +143,48 @@ wb_status wb_cloth(wb_world *w, const wb_cloth_def *d, wb_body *out)
     if (!fin(d->origin[0]) || !fin(d->origin[1]) || !fin(d->origin[2])) return bad("origin must be finite");
     if (!(d->size[0] > 0 && d->size[1] > 0) || !fin(d->size[0]) || !fin(d->size[1])) return bad("size must be > 0");
     if (!(d->bend < 0 || fin(d->bend))) return bad("bend must be a finite compliance >= 0");
+    if (!(d->bend_links < 0 || fin(d->bend_links))) return bad("bend_links must be a finite compliance >= 0");
     const int64_t np = (int64_t)nx * nz;
     int64_t nd = (int64_t)(nx - 1) * nz + (int64_t)nx * (nz - 1);
     if (d->shear) nd += (int64_t)(nx - 1) * (nz - 1);
-    if (d->bend >= 0) nd += (int64_t)(nx - 2 > 0 ? nx - 2 : 0) * nz + (int64_t)nx * (nz - 2 > 0 ? nz - 2 : 0);
+    if (d->bend_links >= 0) nd += (int64_t)(nx - 2 > 0 ? nx - 2 : 0) * nz + (int64_t)nx * (nz - 2 > 0 ? nz - 2 : 0);
     const int64_t ntri = 2 * (int64_t)(nx - 1) * (nz - 1);
     if ((st = check_derived(cloth_pos, d, np, "origin/size", d->mass)) != WB_OK) return st;
-    if ((st = wb__reserve(w, np, nd)) != WB_OK || (st = wb__surface_reserve(w, (int32_t)ntri)) != WB_OK) return st;
-
     const int32_t first = w->m.np;
+    /* the sheet, split along the shear diagonals so shading follows the links; its
+     * interior edges are the hinges of the dihedral bends */
+    int32_t *tri = malloc(sizeof *tri * 3 * (size_t)ntri), *hinge = NULL, nb = 0;
+#define ID(i, j) (first + (i) + (j) * nx)
+    if (tri) {
+        int32_t *t = tri;
+        for (int j = 0; j + 1 < nz; j++)
+            for (int i = 0; i + 1 < nx; i++) {
+                const int32_t a = ID(i, j), b = ID(i + 1, j), c = ID(i + 1, j + 1), e = ID(i, j + 1);
+                if ((i + j) % 2 == 0) { t[0] = a; t[1] = e; t[2] = c; t[3] = a; t[4] = c; t[5] = b; }
+                else { t[0] = a; t[1] = e; t[2] = b; t[3] = b; t[4] = e; t[5] = c; }
+                t += 6;
+            }
+    }
+    if (d->bend >= 0) {
+        hinge = tri ? malloc(sizeof *hinge * 4 * (size_t)(3 * ntri / 2 + 1)) : NULL;
+        nb = hinge ? wb__bend_hinges(tri, (int32_t)ntri, hinge) : -1;
+        if (nb < 0) st = WB_ERR_NOMEM;
+    }
+    if (st == WB_OK) st = wb__reserve(w, np, nd);
+    if (st == WB_OK) st = wb__surface_reserve(w, (int32_t)ntri);
+    if (st == WB_OK) st = wb__bend_reserve(w, nb);
+    if (st != WB_OK) {
+        free(tri);
+        free(hinge);
+        return st;
+    }
+
     const wb_real m = d->mass / (wb_real)np;
     for (int64_t i = 0; i < np; i++) {
         wb_real p[3];
         cloth_pos(d, i, p);
         wb_particle_add(w, p, NULL, m, d->radius);
     }
-#define ID(i, j) (first + (i) + (j) * nx)
     for (int j = 0; j < nz; j++)
         for (int i = 0; i < nx; i++) {
             if (i + 1 < nx) link(w, ID(i, j), ID(i + 1, j), &d->link);
@@ -168,29 +195,22 @@ wb_status wb_cloth(wb_world *w, const wb_cloth_def *d, wb_body *out)
                 else link(w, ID(i + 1, j), ID(i, j + 1), &d->link);
             }
         }
-    if (d->bend >= 0) {
+    if (d->bend_links >= 0) {
         wb_distance_def bl = d->link;
-        bl.compliance = d->bend;
+        bl.compliance = d->bend_links;
         for (int j = 0; j < nz; j++)
             for (int i = 0; i < nx; i++) {
                 if (i + 2 < nx) link(w, ID(i, j), ID(i + 2, j), &bl);
                 if (j + 2 < nz) link(w, ID(i, j), ID(i, j + 2), &bl);
             }
     }
-    /* the sheet, split along the shear diagonals so shading follows the links */
-    int32_t *tri = malloc(sizeof *tri * 3 * (size_t)ntri);
-    if (tri) {
-        int32_t *t = tri;
-        for (int j = 0; j + 1 < nz; j++)
-            for (int i = 0; i + 1 < nx; i++) {
-                const int32_t a = ID(i, j), b = ID(i + 1, j), c = ID(i + 1, j + 1), e = ID(i, j + 1);
-                if ((i + j) % 2 == 0) { t[0] = a; t[1] = e; t[2] = c; t[3] = a; t[4] = c; t[5] = b; }
-                else { t[0] = a; t[1] = e; t[2] = b; t[3] = b; t[4] = e; t[5] = c; }
-                t += 6;
-            }
-        wb_surface_add(w, tri, (int32_t)ntri);
-        free(tri);
-    }
+    /* one bend per interior edge, rest = flat as built */
+    wb_bend_def bd = wb_bend_default_def();
+    bd.compliance = d->bend;
+    for (int32_t i = 0; i < nb; i++) wb_bend_add(w, &hinge[4 * i], &bd, NULL);
+    if (tri) wb_surface_add(w, tri, (int32_t)ntri);
+    free(tri);
+    free(hinge);
 #undef ID
     return wb__body_finish(w, first, (int32_t)np, out);
 }

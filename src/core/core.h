@@ -205,6 +205,9 @@ wb_status wb__bend_reserve(wb_world *w, int64_t extra); /* bend.c: after it, ext
 /* bend.c: the dihedral angle of the bend over particles p[0..3] at positions x; *ok = 0
  * when a triangle is degenerate */
 wb_real wb__bend_angle_of(const wb_real *x, const int32_t *p, int *ok);
+/* bend.c: the interior edges of a triangle list (each shared by exactly two triangles), as
+ * hinges p1 p2 p3 p4 into out (room for 3 ntri / 2 x 4), in edge order; -1 when out of memory */
+int32_t wb__bend_hinges(const int32_t *tri, int32_t ntri, int32_t *out);
 /* collide.c: collisions, then v = (x - x_prev)/h, friction and restitution */
 void wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1);
 void wb__collider_pose_at(const wb_collider_pose *cp, wb_real t, wb_real p[3], wb_real q[4]);

@@ -102,6 +102,7 @@ typedef struct sections {      /* the top-level values, checked for type */
     const cJSON *particles, *constraints, *colliders, *surfaces, *parts, *skins, *snapshot;
     const cJSON *world, *dgen, *dfree, *cgen, *clock[4];
     int32_t np, ncons, ncol, nsurf, ntri, nparts, nskins, nd, nfree, nc;
+    int32_t nbend;             /* "constraints" entries of type "bend" (ncons counts the others) */
 } sections;
 
 /* the snapshot section's shape (its values are read once the image exists) */
@@ -245,23 +246,66 @@ static int read_particles(rd *r, const sections *s, const defaults *d, wb_image 
     return 0;
 }
 
+/* {"type": "bend", "particles": [p1, p2, p3, p4], "rest": angle, "compliance": 0, "damping": 0}:
+ * the i-th bend; rest defaults to the angle the particles make */
+static int read_bend(rd *r, const cJSON *c, const kp *p, wb_image *g, int32_t i)
+{
+    static const char *const keys[] = { "type", "particles", "rest", "compliance", "damping", NULL };
+    const cJSON *f[6];
+    if (jv_get_object(r, c, p, keys, f)) return -1;
+    if (!f[1]) return jv_missing(r, c, p, "particles");
+    kp pp = { p, "particles", 0 }, rp = { p, "rest", 0 };
+    int32_t n;
+    if (jv_get_array(r, f[1], &pp, 16, &n)) return -1;
+    if (n != 4) return jv_fail(r, f[1], 0, &pp, "a bend joins 4 particles (hinge p1 p2, wings p3 p4), got %d", n);
+    int32_t *q = &g->b_ij[4 * i];
+    int k = 0;
+    for (const cJSON *e = f[1]->child; e; e = e->next, k++) {
+        kp ep = { &pp, NULL, k };
+        int64_t v;
+        if (g->np == 0) return jv_fail(r, e, 0, &ep, "there are no particles");
+        if (jv_get_int(r, e, &ep, 0, g->np - 1, &v)) return -1;
+        q[k] = (int32_t)v;
+        for (int j = 0; j < k; j++)
+            if (q[j] == q[k]) return jv_fail(r, f[1], 0, &pp, "a bend needs four distinct particles");
+    }
+    wb_bend_def d = wb_bend_default_def();
+    if (jv_opt_nonneg(r, f[3], p, "compliance", &d.compliance) || jv_opt_nonneg(r, f[4], p, "damping", &d.damping)) return -1;
+    if (f[2]) {
+        if (!cJSON_IsNumber(f[2])) return jv_fail(r, f[2], 0, &rp, "number expected, got %s", jv_type_name(f[2]));
+        d.rest = (wb_real)f[2]->valuedouble;
+        if (!(fabs(d.rest) <= 3.14159265358979323846)) return jv_fail(r, f[2], 0, &rp, "must be an angle in [-pi, pi] (radians)");
+    } else if (!wb_dihedral_angle(&g->x[3 * q[0]], &g->x[3 * q[1]], &g->x[3 * q[2]], &g->x[3 * q[3]], &d.rest)) {
+        return jv_fail(r, f[1], 0, &pp, "the two triangles are degenerate (a wing on the hinge line): no angle to keep");
+    }
+    g->b_alpha[i] = d.compliance;
+    g->b_beta[i] = d.damping;
+    g->b_rest[i] = d.rest;
+    return 0;
+}
+
 static int read_constraints(rd *r, const sections *s, const defaults *d, wb_image *g)
 {
     static const char *const keys[] = { "type", "particles", "rest", "compliance", "damping", "yield", "creep",
-                                        "break_strain", "broken", NULL };
+                                        "break_strain", "broken", "break_force", NULL };
     kp top = { NULL, "constraints", 0 };
-    int32_t i = 0, slot = -1;
+    int32_t i = 0, slot = -1, nb = 0;
     if (!s->constraints) return 0;
     for (const cJSON *c = s->constraints->child; c; c = c->next, i++) {
-        const cJSON *f[10];
+        const cJSON *f[11];
         kp p = { &top, NULL, i };
+        const cJSON *t = cJSON_IsObject(c) ? cJSON_GetObjectItemCaseSensitive(c, "type") : NULL;
+        if (cJSON_IsString(t) && strcmp(t->valuestring, "bend") == 0) {
+            if (read_bend(r, c, &p, g, nb++)) return -1;
+            continue;
+        }
         if (jv_get_object(r, c, &p, keys, f)) return -1;
         if (!f[0]) return jv_missing(r, c, &p, "type");
         if (!f[1]) return jv_missing(r, c, &p, "particles");
         kp tp = { &p, "type", 0 }, pp = { &p, "particles", 0 };
         const char *type = "";
         if (jv_get_string(r, f[0], &tp, &type)) return -1;
-        if (strcmp(type, "distance") != 0) return jv_fail(r, f[0], 0, &tp, "unknown constraint type '%s' (expected distance)", type);
+        if (strcmp(type, "distance") != 0) return jv_fail(r, f[0], 0, &tp, "unknown constraint type '%s' (expected distance or bend)", type);
         int32_t n;
         if (jv_get_array(r, f[1], &pp, 16, &n)) return -1;
         if (n != 2) return jv_fail(r, f[1], 0, &pp, "a distance constraint joins 2 particles, got %d", n);
@@ -282,7 +326,8 @@ static int read_constraints(rd *r, const sections *s, const defaults *d, wb_imag
         bool broken = false;
         if (jv_opt_nonneg(r, f[2], &p, "rest", &l.rest) || jv_opt_nonneg(r, f[3], &p, "compliance", &l.compliance) ||
             jv_opt_nonneg(r, f[4], &p, "damping", &l.damping) || jv_opt_nonneg(r, f[5], &p, "yield", &l.yield) ||
-            jv_opt_nonneg(r, f[6], &p, "creep", &l.creep) || jv_opt_nonneg(r, f[7], &p, "break_strain", &l.break_strain))
+            jv_opt_nonneg(r, f[6], &p, "creep", &l.creep) || jv_opt_nonneg(r, f[7], &p, "break_strain", &l.break_strain) ||
+            jv_opt_nonneg(r, f[9], &p, "break_force", &l.break_force))
             return -1;
         /* the solver squares lengths (wb_distance_add's rule): the particles' distance and
          * the rest must have finite squares */
@@ -303,6 +348,7 @@ static int read_constraints(rd *r, const sections *s, const defaults *d, wb_imag
         g->d_yield[slot] = l.yield;
         g->d_creep[slot] = l.creep;
         g->d_break[slot] = l.break_strain;
+        g->d_bforce[slot] = l.break_force;
         g->d_rest[slot] = l.rest;
         g->d_broken[slot] = broken;
     }
@@ -632,9 +678,16 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
         *arrays[i].dst = it;
         if (it && jv_get_array(r, it, &ap, arrays[i].max, arrays[i].n)) return -1;
     }
+    /* bends have no slots: the distance slot tables count the other entries */
+    for (const cJSON *c = s.constraints ? s.constraints->child : NULL; c; c = c->next) {
+        const cJSON *t = cJSON_IsObject(c) ? cJSON_GetObjectItemCaseSensitive(c, "type") : NULL;
+        if (cJSON_IsString(t) && strcmp(t->valuestring, "bend") == 0) s.nbend++;
+    }
+    s.ncons -= s.nbend;
     s.snapshot = f[10];
     if (scan_snapshot(r, &s) || read_surfaces(r, &s, NULL, &s.ntri)) return -1;
     if (wb_image_alloc(&cfg->img, s.np, s.nd, s.nfree, s.nc, s.nsurf, s.ntri) != WB_OK ||
+        (s.nbend > 0 && wb_image_alloc_bends(&cfg->img, s.nbend) != WB_OK) ||
         !(cfg->parts = calloc((size_t)s.nparts + 1, sizeof *cfg->parts)) ||
         !(cfg->skins = calloc((size_t)s.nskins + 1, sizeof *cfg->skins)))
         return jv_fail(r, NULL, 0, NULL, "out of memory");

@@ -127,7 +127,23 @@ static void write_constraints(out *o, const wb_image *g)
         num(o, g->d_creep[i]);
         fputs(", \"break_strain\": ", f);
         num(o, g->d_break[i]);
+        if (g->d_bforce[i] > 0) { /* only when set: configs without it read as before */
+            fputs(", \"break_force\": ", f);
+            num(o, g->d_bforce[i]);
+        }
         fprintf(f, ", \"broken\": %s}", g->d_broken[i] ? "true" : "false");
+    }
+    for (int32_t i = 0; i < g->nb; i++) {
+        const int32_t *p = &g->b_ij[4 * i];
+        fprintf(f, "%s    {\"type\": \"bend\", \"particles\": [%d, %d, %d, %d], \"rest\": ", first ? "\n" : ",\n", p[0],
+                p[1], p[2], p[3]);
+        first = 0;
+        num(o, g->b_rest[i]);
+        fputs(", \"compliance\": ", f);
+        num(o, g->b_alpha[i]);
+        fputs(", \"damping\": ", f);
+        num(o, g->b_beta[i]);
+        fputc('}', f);
     }
     fputs(first ? "],\n" : "\n  ],\n", f);
 }

@@ -179,8 +179,8 @@ static void check_link(lua_State *L, const wb_distance_def *d)
 }
 
 static const char *const cloth_keys[] = {
-    "origin", "size", "res", "mass", "radius", "shear", "bend",
-    "compliance", "damping", "yield", "creep", "break_strain", "collide", "self_collide", "friction", NULL
+    "origin", "size", "res", "mass", "radius", "shear", "bend", "bend_links",
+    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
 };
 
 static int w_cloth(lua_State *L)
@@ -197,11 +197,19 @@ static int w_cloth(lua_State *L)
     wbl_read_contact_opts(L, 2, &co);
     wbl_optbool(L, 2, "shear", &d.shear);
     wbl_read_link(L, 2, &d.link);
-    /* bend: nil/false = none, true = as stiff as the links, a number = its compliance */
+    /* bend (dihedral, per interior edge): nil/false = none, true = rigid (0), a number =
+     * its compliance in rad/(N m) */
     lua_getfield(L, 2, "bend");
-    if (lua_isboolean(L, -1)) d.bend = lua_toboolean(L, -1) ? d.link.compliance : -1;
+    if (lua_isboolean(L, -1)) d.bend = lua_toboolean(L, -1) ? 0 : -1;
     else if (!lua_isnil(L, -1) && wbl_optreal(L, 2, "bend", &d.bend) && d.bend < 0)
         return wbl_fielderror(L, 2, "bend", "compliance must be >= 0");
+    lua_pop(L, 1);
+    /* bend_links (skip-one distance links): nil/false = none, true = as stiff as the
+     * links, a number = their compliance */
+    lua_getfield(L, 2, "bend_links");
+    if (lua_isboolean(L, -1)) d.bend_links = lua_toboolean(L, -1) ? d.link.compliance : -1;
+    else if (!lua_isnil(L, -1) && wbl_optreal(L, 2, "bend_links", &d.bend_links) && d.bend_links < 0)
+        return wbl_fielderror(L, 2, "bend_links", "compliance must be >= 0");
     lua_pop(L, 1);
     check_link(L, &d.link);
     /* refuse absurd sizes before the core allocates anything */
@@ -213,7 +221,7 @@ static int w_cloth(lua_State *L)
 
 static const char *const rope_keys[] = {
     "from", "to", "segments", "mass", "radius",
-    "compliance", "damping", "yield", "creep", "break_strain", "collide", "self_collide", "friction", NULL
+    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
 };
 
 static int w_rope(lua_State *L)
@@ -234,7 +242,7 @@ static int w_rope(lua_State *L)
 
 static const char *const lattice_keys[] = {
     "min", "max", "res", "mass", "radius", "tets",
-    "compliance", "damping", "yield", "creep", "break_strain", "collide", "self_collide", "friction", NULL
+    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
 };
 
 static int w_lattice(lua_State *L)

@@ -27,7 +27,7 @@ static wb_world *checkdistance(lua_State *L, int arg, wb_distance_id *id)
 }
 
 static const char *const distance_keys[] = {
-    "compliance", "rest", "damping", "yield", "creep", "break_strain", NULL
+    "compliance", "rest", "damping", "yield", "creep", "break_strain", "break_force", NULL
 };
 
 static int w_distance(lua_State *L)

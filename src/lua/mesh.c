@@ -328,7 +328,7 @@ static int m_tostring(lua_State *L)
 /* ---- w:from_mesh(m, {...}) --------------------------------------------------------------------- */
 static const char *const from_mesh_keys[] = {
     "mass", "radius", "target", "neighbours", "surface",
-    "compliance", "damping", "yield", "creep", "break_strain", "collide", "self_collide", "friction", NULL
+    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
 };
 
 static int w_from_mesh(lua_State *L)

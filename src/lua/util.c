@@ -302,7 +302,7 @@ int wbl_optenum(lua_State *L, int arg, const char *key, const char *what, const 
 }
 
 /* ---- constraint options -------------------------------------------------------------- */
-const char *const wbl_link_keys[] = { "compliance", "damping", "yield", "creep", "break_strain", NULL };
+const char *const wbl_link_keys[] = { "compliance", "damping", "yield", "creep", "break_strain", "break_force", NULL };
 
 void wbl_read_link(lua_State *L, int arg, wb_distance_def *d)
 {
@@ -311,6 +311,7 @@ void wbl_read_link(lua_State *L, int arg, wb_distance_def *d)
     wbl_optreal(L, arg, "yield", &d->yield);
     wbl_optreal(L, arg, "creep", &d->creep);
     wbl_optreal(L, arg, "break_strain", &d->break_strain);
+    wbl_optreal(L, arg, "break_force", &d->break_force);
 }
 
 int wbl_status_error(lua_State *L, int arg, wb_status st, const char *what)

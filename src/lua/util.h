@@ -26,6 +26,7 @@ typedef struct wbl_world {
 /* ---- registration (one per binding file; luaopen_wobble calls them in order) ---- */
 void wbl_open_world(lua_State *L);     /* world.c: must run first */
 void wbl_open_distance(lua_State *L);  /* distance.c */
+void wbl_open_bend(lua_State *L);      /* bend.c */
 void wbl_open_collider(lua_State *L);  /* collider.c */
 void wbl_open_body(lua_State *L);      /* body.c: builders + body metatable */
 int wbl_world_new(lua_State *L);       /* wobble.world{...} */

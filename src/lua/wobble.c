@@ -15,6 +15,7 @@ int luaopen_wobble(lua_State *L)
     /* the world first: the other files add their methods to its method table */
     wbl_open_world(L);
     wbl_open_distance(L);
+    wbl_open_bend(L);
     wbl_open_collider(L);
     wbl_open_body(L);
 
