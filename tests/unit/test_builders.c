@@ -56,7 +56,7 @@ TEST(builder_cloth_counts)
         d.origin[0] = 1; d.origin[1] = 2; d.origin[2] = 3;
         d.mass = 4;
         d.shear = cases[k].shear;
-        d.bend = cases[k].bend;
+        d.bend_links = cases[k].bend;
         wb_body body = { -1, -1, -1 };
         CHECK_EQ(wb_cloth(w, &d, &body), WB_OK);
         CHECK_EQ(body.first, 0);
@@ -94,13 +94,13 @@ TEST(builder_cloth_counts)
     REQUIRE(w);
     wb_cloth_def d = wb_cloth_default_def();
     d.res[0] = d.res[1] = 2;
-    d.bend = 0;
+    d.bend_links = 0;
     wb_body body;
     CHECK_EQ(wb_cloth(w, &d, &body), WB_OK);
     CHECK_EQ(wb_particle_count(w), 4);
     CHECK_EQ(wb_distance_count(w), 5);
     /* a second body starts after the first */
-    d.res[0] = 3; d.res[1] = 3; d.shear = false; d.bend = -1;
+    d.res[0] = 3; d.res[1] = 3; d.shear = false; d.bend_links = -1;
     CHECK_EQ(wb_cloth(w, &d, &body), WB_OK);
     CHECK_EQ(body.first, 4);
     CHECK_EQ(body.count, 9);

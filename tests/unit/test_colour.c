@@ -70,7 +70,7 @@ TEST(colour_batches_valid)
     /* a cloth with shear and bend, a lattice, and a rope with a pinned end */
     wb_cloth_def cd = wb_cloth_default_def();
     cd.res[0] = 17; cd.res[1] = 13;
-    cd.bend = 1e-4;
+    cd.bend_links = 1e-4;
     wb_body cloth, lat, rope;
     REQUIRE(wb_cloth(w, &cd, &cloth) == WB_OK);
     wb_lattice_def ld = wb_lattice_default_def();

@@ -63,7 +63,7 @@ static wb_world *cloth_on_sphere(int threads, wb_solver solver)
     c.origin[0] = -1; c.origin[1] = 1; c.origin[2] = -1;
     c.size[0] = c.size[1] = 2;
     c.res[0] = c.res[1] = 48;
-    c.bend = 1e-3;
+    c.bend_links = 1e-3;
     c.link.compliance = 1e-6;
     c.link.damping = 0.1;
     wb_body body;
