@@ -28,14 +28,24 @@ test("cloth without shear, with bending", function()
   expect.eq(distances(w), 17)
   -- bending links skip one particle: (3-2)*4 along x + 3*(4-2) along z = 4 + 6
   local w2 = wobble.world{}
-  local b = w2:cloth{ res = {3, 4}, shear = false, bend = 1e-4 }
+  local b = w2:cloth{ res = {3, 4}, shear = false, bend_links = 1e-4 }
   expect.eq(b.constraint_count, 27)
   local w3 = wobble.world{}
-  w3:cloth{ res = {3, 4}, bend = true }
+  w3:cloth{ res = {3, 4}, bend_links = true }
   expect.eq(distances(w3), 33)
   local w4 = wobble.world{}
-  w4:cloth{ res = {3, 4}, bend = false }
+  w4:cloth{ res = {3, 4}, bend_links = false }
   expect.eq(distances(w4), 23)
+  -- bend = dihedral bends, one per interior edge of the sheet's triangles: of the
+  -- 2*4 + 3*3 + 6 = 23 edges, 2*2 + 2*3 = 10 lie on the border; no extra links
+  local w5 = wobble.world{}
+  w5:cloth{ res = {3, 4}, bend = 1e-4 }
+  expect.eq(distances(w5), 23)
+  expect.eq(#w5:bends(), 13)
+  for _, bd in ipairs(w5:bends()) do expect.eq(bd:rest(), 0, "built flat") end
+  local w6 = wobble.world{}
+  w6:cloth{ res = {3, 4}, bend = false }
+  expect.eq(#w6:bends(), 0)
 end)
 
 test("cloth mass is the total, spread evenly", function()

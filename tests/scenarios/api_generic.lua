@@ -22,6 +22,9 @@ local function fixture()
   f.p = f.w:particle{ pos = {0, 0, 0} }
   f.q = f.w:particle{ pos = {1, 0, 0} }
   f.c = f.w:distance(f.p, f.q)
+  f.r3 = f.w:particle{ pos = {0.5, 0, 1} }
+  f.r4 = f.w:particle{ pos = {0.5, 0.5, -1} }
+  f.bend = f.w:bend(f.p, f.q, f.r3, f.r4)
   f.col = f.w:collider{ shape = "sphere", center = {0, -3, 0}, radius = 0.5 }
   f.body = f.w:lattice{ min = {-1, 1, -1}, max = {1, 3, 1}, res = {2, 2, 2} }
   f.m = wobble.mesh{ vertices = {{-0.5, 1.5, -0.5}, {0.5, 1.5, -0.5}, {0, 2.5, 0.5}, {0, 1.5, 0.5}},
@@ -32,9 +35,9 @@ local function fixture()
   return f
 end
 
-local link_nums = { "compliance", "damping", "yield", "creep", "break_strain" }
+local link_nums = { "compliance", "damping", "yield", "creep", "break_strain", "break_force" }
 -- the link options every builder takes, valid values
-local function link(t) t.compliance, t.damping, t.yield, t.creep, t.break_strain = 0, 0, 0.1, 1, 1
+local function link(t) t.compliance, t.damping, t.yield, t.creep, t.break_strain, t.break_force = 0, 0, 0.1, 1, 1, 1e3
   t.collide, t.self_collide, t.friction = true, false, 0 return t end
 local function plus(t, extra) local r = {} for _, v in ipairs(t) do r[#r + 1] = v end
   for _, v in ipairs(extra) do r[#r + 1] = v end return r end
@@ -65,11 +68,16 @@ local CASES = {
   ["world:particle"] = { opts = { pos = {0, 0, 0}, vel = {0, 0, 0}, mass = 1, radius = 0.02, group = 0, friction = 0 },
                          nums = { "pos", "vel", "mass", "radius", "group", "friction" },
                          call = function(f, o) return f.w:particle(o) end },
-  ["world:distance"] = { opts = { compliance = 0, rest = 1, damping = 0, yield = 0.1, creep = 1, break_strain = 1 },
+  ["world:distance"] = { opts = { compliance = 0, rest = 1, damping = 0, yield = 0.1, creep = 1, break_strain = 1,
+                                  break_force = 1e3 },
                          opts_arg = 3, nums = plus(link_nums, { "rest" }),
                          call = function(f, o) return f.w:distance(f.p, f.q, o) end },
-  ["world:cloth"] = { opts = link{ origin = {0, 0, 0}, size = {1, 1}, res = {2, 2}, mass = 1, radius = 0.02, bend = 0 },
-                      nums = plus(link_nums, { "origin", "size", "res", "mass", "radius", "bend", "friction" }),
+  ["world:bend"] = { opts = { compliance = 0, damping = 0, rest = 0.5 }, opts_arg = 5,
+                     nums = { "compliance", "damping", "rest" },
+                     call = function(f, o) return f.w:bend(f.p, f.q, f.r3, f.r4, o) end },
+  ["world:cloth"] = { opts = link{ origin = {0, 0, 0}, size = {1, 1}, res = {2, 2}, mass = 1, radius = 0.02, bend = 0,
+                                  bend_links = 0 },
+                      nums = plus(link_nums, { "origin", "size", "res", "mass", "radius", "bend", "bend_links", "friction" }),
                       call = function(f, o) return f.w:cloth(o) end },
   ["world:rope"] = { opts = link{ from = {0, 0, 0}, to = {1, 0, 0}, segments = 2, mass = 1, radius = 0.02 },
                      nums = plus(link_nums, { "from", "to", "segments", "mass", "radius", "friction" }),
@@ -129,7 +137,7 @@ local CASES = {
   ["world:save_vtp"] = { none = "a path" },
   ["world:close"] = { none = "no arguments" },
 }
-for _, name in ipairs{ "angular_momentum", "bounds", "breaks", "closed", "colliders", "contacts", "damping", "distances", "dt",
+for _, name in ipairs{ "angular_momentum", "bends", "bounds", "breaks", "closed", "colliders", "contacts", "damping", "distances", "dt",
                        "energy", "frame", "gravity", "hash", "iterations", "max_strain", "momentum", "particle_count",
                        "relaxation", "skins", "solver", "stats", "step", "substeps", "threads", "time", "warnings" } do
   CASES["world:" .. name] = { none = "a getter or step: no arguments" }
@@ -151,6 +159,9 @@ for _, name in ipairs{ "material", "position", "remove", "rotation", "shape", "v
 end
 for _, name in ipairs{ "broken", "force", "length", "particles", "remove", "rest", "strain", "valid", "world" } do
   CASES["distance:" .. name] = { none = "a getter or remove: no arguments" }
+end
+for _, name in ipairs{ "angle", "force", "particles", "rest", "valid", "world" } do
+  CASES["bend:" .. name] = { none = "a getter: no arguments" }
 end
 CASES["body:pin_where"] = { none = "a predicate function" }
 CASES["body:pin_all"] = { none = "no arguments" }
@@ -214,6 +225,7 @@ local function api()
   end
   methods_of("world", f.w, names)
   methods_of("distance", f.c, names)
+  methods_of("bend", f.bend, names)
   methods_of("collider", f.col, names)
   methods_of("body", f.body, names)
   methods_of("mesh", f.m, names)

@@ -113,8 +113,9 @@ test("constraints: type, particles, options", function()
   bad(TWO .. ' "constraints": [{"type": "distance", "particles": [1, 1]}]}', "constraints[0].particles: a constraint needs two distinct particles")
   bad(TWO .. ' "constraints": [{"type": "distance", "particles": [0, 1.5]}]}', "constraints[0].particles[1]: integer expected, got 1.5")
   bad(TWO .. ' "constraints": [{"type": "distance", "particles": [0, 1, 1]}]}', "a distance constraint joins 2 particles, got 3")
-  t = TWO .. ' "constraints": [{"type": "bend", "particles": [0, 1]}]}'
-  bad_at(t, '"bend"', "constraints[0].type: unknown constraint type 'bend' (expected distance)")
+  t = TWO .. ' "constraints": [{"type": "spring", "particles": [0, 1]}]}'
+  bad_at(t, '"spring"', "constraints[0].type: unknown constraint type 'spring' (expected distance or bend)")
+  bad(TWO .. ' "constraints": [{"type": "bend", "particles": [0, 1]}]}', "constraints[0].particles: a bend joins 4 particles (hinge p1 p2, wings p3 p4), got 2")
   bad(TWO .. ' "constraints": [{"particles": [0, 1]}]}', "constraints[0]: missing key 'type'")
   bad(TWO .. ' "constraints": [{"type": "distance", "particles": [0, 1], "compliance": -1}]}', "constraints[0].compliance: must be >= 0")
   bad(TWO .. ' "constraints": [{"type": "distance", "particles": [0, 1], "Compliance": 1}]}', "keys are case-sensitive: 'compliance'")

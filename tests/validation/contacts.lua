@@ -193,7 +193,7 @@ local function crumple(self_collide)
   w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.5 }
   local n = 16
   local cloth = w:cloth{ origin = {-0.5, 0, -0.5}, size = {1, 1}, res = {n, n}, mass = 0.2, compliance = 1e-6,
-                         bend = 1e-2, self_collide = self_collide, friction = 0.2 }
+                         bend_links = 1e-2, self_collide = self_collide, friction = 0.2 }
   for _, p in ipairs(cloth.particles) do
     local x, _, z = w:position(p)
     local y = z + 0.55

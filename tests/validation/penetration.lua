@@ -100,7 +100,7 @@ test("sphere: a cloth draped over it, particles raining on it", function()
   local w = wobble.world{ iterations = 2 }
   local def = { shape = "sphere", center = { 0, 0, 0 }, radius = 0.5, friction = 0.2 }
   local col = w:collider(def)
-  w:cloth{ origin = { -0.7, 0.6, -0.7 }, size = { 1.4, 1.4 }, res = { 24, 24 }, radius = 0.015, bend = 1e-4 }
+  w:cloth{ origin = { -0.7, 0.6, -0.7 }, size = { 1.4, 1.4 }, res = { 24, 24 }, radius = 0.015, bend_links = 1e-4 }
   rain(w, -0.4, 0.4, 1.0, -0.4, 0.4, 6)
   local worst, contacts = watch(w, col, "sphere", def, 120, { 0, 0, 0 })
   expect.ge(worst, -eps, "min over frames of distance - radius")
