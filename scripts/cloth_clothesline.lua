@@ -14,7 +14,7 @@ w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.6 }
 
 -- start horizontal, level with the line, so the fall swings it down into place
 local cloth = w:cloth{ origin = {-0.75, 2, 0}, size = {1.5, 1.5}, res = {res, res},
-                       mass = 0.3, compliance = 2e-6, bend = 30 }
+                       mass = 0.3, compliance = 2e-6, bend = 100 }
 -- the pegs: the two corners on the line (z = 0) and the middle of that edge
 local pegged = cloth:pin_where(function(x, y, z)
   return z < 1e-6 and (math.abs(x + 0.75) < 1e-6 or math.abs(x - 0.75) < 1e-6 or math.abs(x) < 0.76 / (res - 1))

@@ -23,7 +23,7 @@ else
   top = 1.2
 end
 local cloth = w:cloth{ origin = {-1.1, top + 0.3, -1.1}, size = {2.2, 2.2}, res = {36, 36},
-                       compliance = 1e-6, shear = true }
+                       compliance = 1e-6, bend = 100 }
 
 -- the cloth's centre: the particle nearest the middle of the sheet
 local centre, best = nil, math.huge

@@ -7,7 +7,7 @@ local args = wobble.args
 local w = wobble.world{ substeps = 20 }
 w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.5 }
 w:collider{ shape = "sphere", center = {0, 0.5, 0}, radius = 0.4, friction = args.friction or 0.5 }
-local cloth = w:cloth{ origin = {-1, 1.2, -1}, size = {2, 2}, res = {30, 30}, compliance = 1e-6, shear = true }
+local cloth = w:cloth{ origin = {-1, 1.2, -1}, size = {2, 2}, res = {30, 30}, compliance = 1e-6, bend = 100 }
 cloth:pin_where(function(x, y, z) return z < -0.99 end)
 
 -- the cloth's centre: the particle nearest the middle of the sheet
