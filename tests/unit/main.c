@@ -55,6 +55,10 @@
     X(builder_failure_changes_nothing)           \
     X(colour_batches_valid)                      \
     X(colour_broken_constraints_unpacked)        \
+    X(bend_batches_valid)                        \
+    X(bend_threads_identical)                    \
+    X(bend_conserves_momentum)                   \
+    X(bend_hinges_and_refusals)                  \
     X(collider_distance_plane)                   \
     X(collider_distance_sphere)                  \
     X(collider_distance_box_rotated)             \
