@@ -117,15 +117,6 @@ wb_status wb__bend_reserve(wb_world *w, int64_t extra)
     return grow(w, w->bend.n + (int32_t)extra);
 }
 
-void wb__bend_free(wb_world *w)
-{
-    wb_bends *b = &w->bend;
-    if (w->m.def.memory) w->m.def.memory->used -= b->charged;
-    void *p[] = { b->ij, b->alpha, b->beta, b->rest, b->s_ij, b->s_slot, b->pack, b->lambda };
-    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
-    memset(b, 0, sizeof *b);
-}
-
 /* ---- the C API -------------------------------------------------------------------------------- */
 wb_bend_def wb_bend_default_def(void)
 {

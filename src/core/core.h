@@ -200,7 +200,6 @@ int wb__colour_greedy(const wb_real *inv_mass, int32_t np, const int32_t *idx, i
  * start[c] the first packed index of colour c; returns the packed total */
 int32_t wb__colour_ranges(const int32_t count[WB_MAX_COLOURS + 1], int32_t *colour_start, int32_t *ncolours,
                           int32_t *serial_start, int32_t start[WB_MAX_COLOURS + 1]);
-void wb__bend_free(wb_world *w);                   /* bend.c: its arrays, and its memory charge back */
 wb_status wb__bend_reserve(wb_world *w, int64_t extra); /* bend.c: after it, extra bends add without failing */
 /* bend.c: the dihedral angle of the bend over particles p[0..3] at positions x; *ok = 0
  * when a triangle is degenerate */

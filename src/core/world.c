@@ -100,7 +100,11 @@ void wb_world_destroy(wb_world *w)
     if (!w) return;
     wb_model *m = &w->m;
     for (int32_t i = 0; i < m->nc; i++) wb__colmesh_free(m->c_shape[i].mesh); /* mesh colliders' copies */
-    wb__bend_free(w);
+    /* the bends' arrays (bend.c owns their use; freed here so that no circle joins the files) */
+    wb_bends *bd = &w->bend;
+    if (m->def.memory) m->def.memory->used -= bd->charged;
+    void *bp[] = { bd->ij, bd->alpha, bd->beta, bd->rest, bd->s_ij, bd->s_slot, bd->pack, bd->lambda };
+    for (size_t i = 0; i < sizeof bp / sizeof bp[0]; i++) free(bp[i]);
     if (m->def.memory) m->def.memory->used -= m->charged + m->charged_mesh;
     wb_state *s = &w->s;
     wb_cache *k = &w->k;

@@ -30,8 +30,9 @@ typedef struct defaults {
 
 static int read_defaults(rd *r, const cJSON *it, defaults *d)
 {
-    static const char *const keys[] = { "mass", "radius", "compliance", "damping", "yield", "creep", "break_strain", NULL };
-    const cJSON *f[8];
+    static const char *const keys[] = { "mass", "radius", "compliance", "damping", "yield", "creep", "break_strain",
+                                        "break_force", NULL };
+    const cJSON *f[9];
     kp p = { NULL, "defaults", 0 };
     d->mass = 1;
     d->radius = 0.02;
@@ -46,7 +47,8 @@ static int read_defaults(rd *r, const cJSON *it, defaults *d)
     return jv_opt_nonneg(r, f[1], &p, "radius", &d->radius) ||
            jv_opt_nonneg(r, f[2], &p, "compliance", &d->link.compliance) || jv_opt_nonneg(r, f[3], &p, "damping", &d->link.damping) ||
            jv_opt_nonneg(r, f[4], &p, "yield", &d->link.yield) || jv_opt_nonneg(r, f[5], &p, "creep", &d->link.creep) ||
-           jv_opt_nonneg(r, f[6], &p, "break_strain", &d->link.break_strain) ? -1 : 0;
+           jv_opt_nonneg(r, f[6], &p, "break_strain", &d->link.break_strain) ||
+           jv_opt_nonneg(r, f[7], &p, "break_force", &d->link.break_force) ? -1 : 0;
 }
 
 static const char *const solver_names[] = { "gauss-seidel", "jacobi" };

@@ -14,7 +14,7 @@ w:collider{ shape = "capsule", a = {-1.5, 2.02, 0}, b = {1.5, 2.02, 0}, radius =
 w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.6 }
 local res = 30
 local cloth = w:cloth{ origin = {-0.75, 2, 0}, size = {1.5, 1.5}, res = {res, res},
-                       mass = 0.3, compliance = 2e-6, bend = 1e-3 }
+                       mass = 0.3, compliance = 2e-6, bend_links = 1e-3 }
 cloth:pin_where(function(x, y, z)
   return z < 1e-6 and (math.abs(x + 0.75) < 1e-6 or math.abs(x - 0.75) < 1e-6 or math.abs(x) < 0.76 / (res - 1))
 end)
