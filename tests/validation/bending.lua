@@ -212,3 +212,22 @@ test("JSON particle config: bend entries (rest measured when absent) and break_f
   local w2 = wobble.load("bend_config_out.json")
   expect.eq(w2:hash(), w:hash())
 end)
+
+test("w:energy(): a bend bent by C stores C^2 / (2 alpha)", function()
+  -- immovable particles and no gravity: the potential is the bend's alone
+  local w = wobble.world{ gravity = {0, 0, 0} }
+  local p = {}
+  for i, x in ipairs{ {0, 0, 0}, {1, 0, 0}, {0.5, 0, 1}, {0.5, 0, -1} } do p[i] = w:particle{ pos = x, mass = 0 } end
+  local b = w:bend(p[1], p[2], p[3], p[4], { compliance = 0.5 })
+  expect.eq(select(2, w:energy()), 0, "at rest: none")
+  local phi = 0.3 -- the wing p4 turned by phi about the hinge (the x axis)
+  w:set_position(p[4], 0.5, math.sin(phi), -math.cos(phi))
+  expect.near(math.abs(b:angle()), phi, 1e-12)
+  expect.near(select(2, w:energy()), phi * phi / (2 * 0.5), 1e-12, "C^2 / (2 alpha)")
+  -- a rigid bend (compliance 0) stores none: its potential is not defined
+  local w2 = wobble.world{ gravity = {0, 0, 0} }
+  local q = {}
+  for i, x in ipairs{ {0, 0, 0}, {1, 0, 0}, {0.5, 0, 1}, {0.5, 0.3, -1} } do q[i] = w2:particle{ pos = x, mass = 0 } end
+  w2:bend(q[1], q[2], q[3], q[4], { compliance = 0, rest = 0 })
+  expect.eq(select(2, w2:energy()), 0)
+end)
