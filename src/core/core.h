@@ -181,6 +181,7 @@ struct wb_world {
     wb_model m;
     wb_state s;
     wb_cache k;
+    struct wb_volumes *vol; /* volume constraints (volume.h), NULL until the first */
 };
 
 /* internal entry points */

@@ -1,5 +1,6 @@
 /* query.c: read-only measures of a world: energy, momenta, bounds, strain, hash, stats. */
 #include "core.h"
+#include "ctype.h"
 
 static wb_real mass_of(const wb_world *w, int32_t i) { return w->m.w[i] > 0 ? 1 / w->m.w[i] : 0; }
 
@@ -29,6 +30,7 @@ void wb_world_energy(const wb_world *w, wb_real *kinetic, wb_real *potential)
         wb_real c = slot_length(w, s) - w->s.d_rest[s];
         pe += c * c / (2 * w->m.d_alpha[s]);
     }
+    pe += wb__volume_type.energy(w); /* TYPE HOOK: the table's energies once `types` lands */
     *kinetic = ke;
     *potential = pe;
 }

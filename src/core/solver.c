@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "core.h"
+#include "ctype.h"
 
 static double now_ms(void)
 {
@@ -264,7 +265,7 @@ wb_status wb_world_step(wb_world *w)
 {
     const double t_begin = now_ms();
     wb_cache *k = &w->k;
-    if (wb__colour(w) != WB_OK || !save_colliders(w)) {
+    if (wb__colour(w) != WB_OK || wb__volume_type.prepare(w) != WB_OK || !save_colliders(w)) {
         wb__warn(w, "frame %lld: out of memory preparing the step; frame skipped", (long long)w->s.frame + 1);
         return WB_ERR_NOMEM;
     }
@@ -301,6 +302,9 @@ wb_status wb_world_step(wb_world *w)
         double t0 = now_ms();
         if (k->ns > 0) memset(k->s_lambda, 0, sizeof(wb_real) * (size_t)k->ns);
         solve_constraints(w, h);
+        /* TYPE HOOK: walked from the type table once `types` lands */
+        wb__volume_type.substep_begin(w);
+        for (int it = 0; it < d->iterations; it++) wb__volume_type.project(w, h);
         solve += now_ms() - t0;
         wb__contacts_project(w, h);
         wb__collide_and_update(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
