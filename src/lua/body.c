@@ -233,7 +233,7 @@ static int w_rope(lua_State *L)
 }
 
 static const char *const lattice_keys[] = {
-    "min", "max", "res", "mass", "radius", "tets",
+    "min", "max", "res", "mass", "radius", "tets", "volume_compliance",
     "compliance", "damping", "yield", "creep", "break_strain", "collide", "self_collide", "friction", NULL
 };
 
@@ -250,9 +250,11 @@ static int w_lattice(lua_State *L)
     const bool auto_radius = read_mass_radius(L, &d.mass, &d.radius);
     wbl_contact_opts co;
     wbl_read_contact_opts(L, 2, &co);
-    bool tets = false;
-    if (wbl_optbool(L, 2, "tets", &tets) && tets)
-        return wbl_fielderror(L, 2, "tets", "not supported yet: tets needs the volume constraint");
+    /* tets: 6 per cell, each with a volume constraint of compliance volume_compliance
+     * (m^3/Pa, default 0: incompressible; `compliance` stays the links' own, in m/N) */
+    wbl_optbool(L, 2, "tets", &d.tets);
+    if (wbl_optreal(L, 2, "volume_compliance", &d.volume_compliance) && d.volume_compliance < 0)
+        return wbl_fielderror(L, 2, "volume_compliance", "must be >= 0");
     wbl_read_link(L, 2, &d.link);
     check_link(L, &d.link);
     if ((int64_t)d.res[0] * d.res[1] * d.res[2] > WB_MAX_PARTICLES)

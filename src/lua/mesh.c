@@ -327,12 +327,18 @@ static int m_tostring(lua_State *L)
 
 /* ---- w:from_mesh(m, {...}) --------------------------------------------------------------------- */
 static const char *const from_mesh_keys[] = {
-    "mass", "radius", "target", "neighbours", "surface",
+    "mass", "radius", "target", "neighbours", "surface", "tets",
     "compliance", "damping", "yield", "creep", "break_strain", "collide", "self_collide", "friction", NULL
 };
 
 static int w_from_mesh(lua_State *L)
 {
+    /* tets = true: filled with tetrahedra by tetgen, options of their own (lua/volume.c) */
+    if (lua_type(L, 3) == LUA_TTABLE && lua_getfield(L, 3, "tets") != LUA_TNIL) {
+        const bool tets = lua_toboolean(L, -1);
+        lua_pop(L, 1);
+        if (tets) return wbl_from_mesh_tets(L);
+    }
     wb_world *w = wbl_checkworld(L, 1);
     const wb_mesh *m = wbl_checkmesh(L, 2);
     wb_from_mesh_def d = wb_from_mesh_default_def();

@@ -28,6 +28,8 @@ void wbl_open_world(lua_State *L);     /* world.c: must run first */
 void wbl_open_distance(lua_State *L);  /* distance.c */
 void wbl_open_collider(lua_State *L);  /* collider.c */
 void wbl_open_body(lua_State *L);      /* body.c: builders + body metatable */
+void wbl_open_volume(lua_State *L);    /* volume.c: volume constraints, tet bodies */
+int wbl_from_mesh_tets(lua_State *L);  /* volume.c: w:from_mesh(m, {tets = true, ...}) */
 int wbl_world_new(lua_State *L);       /* wobble.world{...} */
 /* add methods to the world's method table (used by the per-type files) */
 void wbl_add_world_methods(lua_State *L, const luaL_Reg *l);
