@@ -301,7 +301,8 @@ static int run_child(const char *dir, const char *const argv[], size_t bytes, do
     return 1;
 }
 
-/* the most telling line of tetgen's log: one that names the trouble, else the last */
+/* the most telling line of tetgen's log: one it marks "!!" (a finding), else one that
+ * names the trouble, else the last */
 static void log_reason(const char *dir, char *out, size_t n)
 {
     char p[PATH_MAX];
@@ -310,16 +311,18 @@ static void log_reason(const char *dir, char *out, size_t n)
     FILE *f = fopen(p, "r");
     if (!f) return;
     char line[512], last[512] = "";
-    int found = 0;
+    int found = 0; /* 2: a "!!" line, 1: a line with a telling word */
     while (fgets(line, sizeof line, f)) {
         line[strcspn(line, "\r\n")] = 0;
+        const int marked = line[0] == '!';
         char *s = line;
         while (*s == ' ' || *s == '!') s++;
         if (!*s) continue;
-        if (!found && (strstr(s, "rror") || strstr(s, "ntersect") || strstr(s, "nvalid") || strstr(s, "memory") ||
-                       strstr(s, "bad_alloc"))) {
+        const int telling = strstr(s, "rror") || strstr(s, "nvalid") || strstr(s, "memory") || strstr(s, "bad_alloc") ||
+                            (strstr(s, "ntersect") && !strstr(s, "Detecting"));
+        if ((marked && found < 2) || (telling && found < 1)) {
             snprintf(out, n, "%s", s);
-            found = 1;
+            found = marked ? 2 : 1;
         }
         snprintf(last, sizeof last, "%s", s);
     }
