@@ -256,7 +256,8 @@ static int write_poly(const char *path, const wb_mesh *m)
 
 /* run argv in dir with stdout and stderr to dir/log; 0 exited 0, else what happened:
  * 1 failed (exit status or signal in *status), -2 timed out, -6 interrupted, -1 not started */
-static int run_child(const char *dir, const char *const argv[], size_t bytes, double timeout, wbio_budget *b, int *status)
+static int run_child(const char *dir, const char *const argv[], size_t bytes, double timeout, wbio_budget *b, int *status,
+                     double *peak)
 {
     char log[PATH_MAX];
     snprintf(log, sizeof log, "%s/log", dir);
@@ -282,8 +283,10 @@ static int run_child(const char *dir, const char *const argv[], size_t bytes, do
     }
     const double deadline = now_s() + timeout;
     int r = 1;
+    struct rusage ru;
+    memset(&ru, 0, sizeof ru);
     for (;;) {
-        pid_t k = waitpid(pid, status, WNOHANG);
+        pid_t k = wait4(pid, status, WNOHANG, &ru);
         if (k == pid) break;
         if (k < 0 && errno != EINTR) { r = -1; break; }
         if (now_s() > deadline) { r = -2; break; }
@@ -296,6 +299,7 @@ static int run_child(const char *dir, const char *const argv[], size_t bytes, do
         while (waitpid(pid, status, 0) < 0 && errno == EINTR) {}
         return r;
     }
+    *peak = (double)ru.ru_maxrss * 1024; /* bytes it touched at most */
     if (WIFEXITED(*status) && WEXITSTATUS(*status) == 0) return 0;
     if (WIFSIGNALED(*status) && WTERMSIG(*status) == SIGXCPU) return -2;
     return 1;
@@ -382,7 +386,8 @@ int wbio_tetgen(const wb_mesh *m, const wbio_tetgen_opts *o, wbio_budget *b, wbi
     const size_t bytes = tetgen_bytes(b);
     const double timeout = o->timeout > 0 ? o->timeout : 60;
     int status = 0;
-    int r = run_child(dir, have_stdbuf ? argv_sb : argv_pl, bytes, timeout, b, &status);
+    double peak = 0;
+    int r = run_child(dir, have_stdbuf ? argv_sb : argv_pl, bytes, timeout, b, &status, &peak);
     char why[512];
     if (r == 0) {
         char node[PATH_MAX + 16], ele[PATH_MAX + 16];
@@ -405,7 +410,10 @@ int wbio_tetgen(const wb_mesh *m, const wbio_tetgen_opts *o, wbio_budget *b, wbi
     if (r == -2) snprintf(err, errn, "tetgen timed out after %g s (raise timeout, or max_volume)", timeout);
     else if (r == -6) { snprintf(err, errn, "tetgen was stopped (a budget is spent)"); b->stopped = true; }
     else if (r == -1) snprintf(err, errn, "cannot start tetgen: %s", strerror(errno));
-    else if (strstr(why, "memory") || strstr(why, "bad_alloc")) {
+    else if (strstr(why, "memory") || strstr(why, "bad_alloc") ||
+             (WIFSIGNALED(status) && WTERMSIG(status) == SIGABRT && peak > 0.5 * (double)bytes)) {
+        /* this tetgen aborts without a word when an allocation fails: a failure after it
+         * touched half of what it may take is taken for that */
         snprintf(err, errn, "tetgen ran out of memory (%.0f MB allowed%s)", bytes / 1048576.0,
                  b->max_bytes ? "" : ", half of this machine's");
         if (b->max_bytes) b->stopped = true;
@@ -416,8 +424,9 @@ int wbio_tetgen(const wb_mesh *m, const wbio_tetgen_opts *o, wbio_budget *b, wbi
         const char *const *ad = have_stdbuf ? argv_d : (const char *const[]){ tetgen, "-dNEF", "in.poly", NULL };
         char why_d[512] = "";
         int st2 = 0;
-        if (run_child(dir, ad, bytes, timeout, b, &st2) >= 0) log_reason(dir, why_d, sizeof why_d);
-        if (strstr(why_d, "ntersect"))
+        double peak2 = 0;
+        if (run_child(dir, ad, bytes, timeout, b, &st2, &peak2) >= 0) log_reason(dir, why_d, sizeof why_d);
+        if (strstr(why_d, "ntersect") && !strstr(why_d, "No faces"))
             snprintf(err, errn, "the mesh intersects itself (tetgen: %s); tets need a closed surface that does not "
                      "cross itself", why_d);
         else {

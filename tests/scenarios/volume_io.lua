@@ -193,3 +193,23 @@ test(".node/.ele round trip, and load_tets makes the same solid", function()
   expect.truthy(err:find("missing.node", 1, true), err)
   expect.error(function() w2:load_tets("/etc/passwd") end, "passwd")
 end)
+
+test("from_mesh's tets options refuse unknown keys and non-finite numbers, changing nothing", function()
+  local w = wobble.world{}
+  local m = wobble.mesh{ vertices = PTS, triangles = FACES }
+  expect.error(function() w:from_mesh(m, { tets = true, no_such_key = 1 }) end, "unknown key 'no_such_key'")
+  for _, key in ipairs{ "max_volume", "quality", "timeout", "mass", "radius", "volume_compliance", "compliance" } do
+    for _, bad in ipairs{ 0 / 0, 1 / 0, -1 / 0 } do
+      expect.error(function() w:from_mesh(m, { tets = true, [key] = bad }) end, key)
+    end
+  end
+  expect.error(function() w:from_mesh(m, { tets = true, max_volume = 0 }) end, "max_volume")
+  expect.eq(w:particle_count(), 0, "nothing made")
+  -- the valid call works, with every option
+  local b = w:from_mesh(m, { tets = true, max_volume = 0.1, quality = 2, keep_surface = true, timeout = 30, mass = 2,
+                             radius = 0.01, volume_compliance = 1e-6, compliance = 1e-4, damping = 0, collide = true })
+  expect.eq(w:mass(b.first) > 0, true)
+  local total = 0
+  for i = b.first, b.first + b.count - 1 do total = total + w:mass(i) end
+  expect.near(total, 2, 1e-12, "mass lumped by volume adds up")
+end)
