@@ -78,19 +78,6 @@ wb_status wb__volume_reserve(wb_world *w, int64_t extra)
     return WB_OK;
 }
 
-void wb__volume_free(wb_world *w)
-{
-    wb_volumes *v = w->vol;
-    if (!v) return;
-    if (w->m.def.memory) w->m.def.memory->used -= v->charged;
-    free(v->ijkl);
-    free(v->alpha);
-    free(v->rest);
-    free(v->lambda);
-    free(v);
-    w->vol = NULL;
-}
-
 /* append one constraint after wb__volume_reserve (cannot fail) */
 void wb__volume_put(wb_world *w, const int32_t p[4], wb_real alpha, wb_real rest)
 {

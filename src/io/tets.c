@@ -112,6 +112,9 @@ static int read_node(const char *path, const char *shown, wbio_tets *t, int *bas
     if (k >= 2 && h[1] != 3) FAIL("%s:%d: dimension must be 3", shown, r.line);
     const int nattr = k >= 3 && integral(h[2], 0, 1000) ? (int)h[2] : 0;
     const int marker = k >= 4 && h[3] != 0;
+    /* a point takes a line of at least 8 bytes: a count the file cannot hold is refused
+     * before anything is allocated for it */
+    if (h[0] > (double)strlen(r.p) / 8 + 1) FAIL("%s: %.0f points announced, the file is too short for them", shown, h[0]);
     t->nv = (int32_t)h[0];
     t->v = malloc(sizeof *t->v * 3 * (size_t)t->nv);
     if (!t->v) FAIL("%s: out of memory", shown);
@@ -149,6 +152,7 @@ static int read_ele(const char *path, const char *shown, wbio_tets *t, int base,
     if (k < 1 || !integral(h[0], 1, WB_MAX_CONSTRAINTS / 6))
         FAIL("%s:%d: the tet count must be an integer in 1..%d", shown, r.line, WB_MAX_CONSTRAINTS / 6);
     if (k >= 2 && h[1] != 4 && h[1] != 10) FAIL("%s:%d: nodes per tet must be 4 (or 10: the first 4 are used)", shown, r.line);
+    if (h[0] > (double)strlen(r.p) / 10 + 1) FAIL("%s: %.0f tets announced, the file is too short for them", shown, h[0]);
     t->nt = (int32_t)h[0];
     t->tet = malloc(sizeof *t->tet * 4 * (size_t)t->nt);
     if (!t->tet) FAIL("%s: out of memory", shown);

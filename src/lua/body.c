@@ -260,7 +260,20 @@ static int w_lattice(lua_State *L)
     if ((int64_t)d.res[0] * d.res[1] * d.res[2] > WB_MAX_PARTICLES)
         return wbl_fielderror(L, 2, "res", "%d x %d x %d particles is too many (limit %d)", d.res[0], d.res[1],
                               d.res[2], (int)WB_MAX_PARTICLES);
-    BUILD(L, w, wb_lattice, "lattice", (int64_t)d.res[0] * d.res[1] * d.res[2]);
+    /* BUILD, plus body.tet_count as the other tet bodies have it */
+    wb_body b;
+    wbl_body_begin(L, (int64_t)d.res[0] * d.res[1] * d.res[2]);
+    const int32_t nd0 = wb_distance_count(w), nv0 = wb_volume_count(w);
+    wb_status st = wb_lattice(w, &d, &b);
+    if (st != WB_OK) return wbl_status_error(L, 2, st, "lattice");
+    if (auto_radius) wbl_default_radius(w, b);
+    wbl_apply_contact_opts(w, b, &co);
+    wbl_body_end(L, 1, b, wb_distance_count(w) - nd0);
+    if (d.tets) {
+        lua_pushinteger(L, wb_volume_count(w) - nv0);
+        lua_setfield(L, -2, "tet_count");
+    }
+    return 1;
 }
 
 static const luaL_Reg body_methods[] = {

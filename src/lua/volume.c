@@ -2,7 +2,7 @@
  *   w:volume(p1, p2, p3, p4, {compliance, rest}) -> index    w:volume_count()
  *   w:volume_info(i) -> volume, rest, pressure               w:total_volume() -> volume, rest
  *   w:load_tets(path, {...}) -> body (tetgen's .node/.ele)   w:save_tets(path [, body])
- * and the tets branch of w:from_mesh (tetgen run on the mesh, src/io/tets.c).
+ * and the helpers of the tets branch of w:from_mesh (lua/mesh.c: tetgen run on the mesh).
  * Volume constraints are plain indices (1-based): they are never removed. */
 #include <limits.h>
 #include <math.h>
@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "io/io.h"
-#include "mesh.h"
+#include "util.h"
 #include "sandbox.h"
 
 static const char *const volume_keys[] = { "compliance", "rest", NULL };
@@ -71,7 +71,7 @@ static int w_total_volume(lua_State *L)
 #define WBL_TETS "wobble.tets (scratch)"
 
 /* tetgen's arrays owned by a userdata, so a Lua error on the way cannot leak them */
-static wbio_tets *push_tets(lua_State *L)
+wbio_tets *wbl_push_tets(lua_State *L)
 {
     wbio_tets *t = (wbio_tets *)lua_newuserdatauv(L, sizeof *t, 0);
     memset(t, 0, sizeof *t);
@@ -86,7 +86,7 @@ static int tets_gc(lua_State *L)
 }
 
 /* the options of a tet body (both builders), at arg; returns whether the radius is the default */
-static bool read_tet_body(lua_State *L, int arg, wb_tet_body_def *d)
+bool wbl_read_tet_body(lua_State *L, int arg, wb_tet_body_def *d)
 {
     bool auto_radius = true;
     if (lua_type(L, arg) != LUA_TTABLE) return auto_radius;
@@ -104,7 +104,7 @@ static bool read_tet_body(lua_State *L, int arg, wb_tet_body_def *d)
 }
 
 /* build the body of t on the world at 1 and push it (with .tet_count); raises */
-static int push_tet_body(lua_State *L, wb_world *w, const wbio_tets *t, const int32_t *tri, int32_t ntri,
+int wbl_push_tet_body(lua_State *L, wb_world *w, const wbio_tets *t, const int32_t *tri, int32_t ntri,
                          const wb_tet_body_def *d, bool auto_radius, const wbl_contact_opts *co, const char *what)
 {
     const int32_t nd0 = wb_distance_count(w), nv0 = wb_volume_count(w);
@@ -147,13 +147,13 @@ static int w_load_tets(lua_State *L)
     const char *name = wbl_checkfilename(L, 2);
     wbl_checkopts(L, 3, load_tets_keys, true);
     wb_tet_body_def d = wb_tet_body_default_def();
-    const bool auto_radius = read_tet_body(L, 3, &d);
+    const bool auto_radius = wbl_read_tet_body(L, 3, &d);
     wbl_contact_opts co;
     wbl_read_contact_opts(L, 3, &co);
     char node[PATH_MAX], ele[PATH_MAX], node_shown[PATH_MAX], ele_shown[PATH_MAX], err[1024];
     tet_paths(L, name, 0, node, ele, node_shown, ele_shown);
     lua_settop(L, 3);
-    wbio_tets *t = push_tets(L);
+    wbio_tets *t = wbl_push_tets(L);
     if (wbio_read_tets(node, node_shown, ele, ele_shown, t, err, sizeof err)) {
         luaL_pushfail(L);
         lua_pushstring(L, err);
@@ -218,71 +218,6 @@ static int w_save_tets(lua_State *L)
     }
     lua_pushboolean(L, 1);
     return 1;
-}
-
-/* ---- w:from_mesh(m, {tets = true, ...}) --------------------------------------------------------- */
-static const char *const from_mesh_tets_keys[] = {
-    "tets", "max_volume", "quality", "keep_surface", "timeout", "mass", "radius", "volume_compliance",
-    "compliance", "damping", "yield", "creep", "break_strain", "collide", "self_collide", "friction", NULL
-};
-
-int wbl_from_mesh_tets(lua_State *L)
-{
-    wb_world *w = wbl_checkworld(L, 1);
-    const wb_mesh *m = wbl_checkmesh(L, 2);
-    wbl_checkopts(L, 3, from_mesh_tets_keys, false);
-    wb_tet_body_def d = wb_tet_body_default_def();
-    const bool auto_radius = read_tet_body(L, 3, &d);
-    wbl_contact_opts co;
-    wbl_read_contact_opts(L, 3, &co);
-    wbio_tetgen_opts o = { 0, 2, true, 0 };
-    wb_real x;
-    if (wbl_optreal(L, 3, "max_volume", &x)) {
-        if (!(x > 0)) return wbl_fielderror(L, 3, "max_volume", "must be > 0 (m^3)");
-        o.max_volume = x;
-    }
-    /* quality: tetgen's radius-edge ratio bound (-q), default 2; false: none */
-    lua_getfield(L, 3, "quality");
-    if (lua_isboolean(L, -1)) {
-        if (lua_toboolean(L, -1)) return wbl_fielderror(L, 3, "quality", "a ratio (>= 1.1) or false expected");
-        o.quality = 0;
-    } else if (wbl_optreal(L, 3, "quality", &x)) {
-        if (!(x >= 1.1 && x <= 100)) return wbl_fielderror(L, 3, "quality", "radius-edge ratio must be in 1.1..100");
-        o.quality = x;
-    }
-    lua_pop(L, 1);
-    wbl_optbool(L, 3, "keep_surface", &o.keep_surface);
-    if (wbl_optreal(L, 3, "timeout", &x)) {
-        if (!(x > 0)) return wbl_fielderror(L, 3, "timeout", "must be > 0");
-        o.timeout = x;
-    }
-    lua_settop(L, 3);
-    /* tetgen may take what is left of the memory budget, and stops with the run's time limit */
-    const wb_memory *mem = &wb_rt_get(L)->memory;
-    wbio_budget b = { 0, NULL, NULL, false };
-    if (mem->limit) {
-        lua_gc(L, LUA_GCCOLLECT);
-        b.max_bytes = mem->used < mem->limit ? mem->limit - mem->used : 1;
-    }
-    wb_rt_interrupt(L, &b.interrupt, &b.interrupt_ud);
-    wbio_tets *t = push_tets(L); /* 4 */
-    char err[1024];
-    if (wbio_tetgen(m, &o, &b, t, err, sizeof err)) {
-        if (b.stopped) {
-            wb_rt_check_budgets(L);
-            return wb_rt_budget_error(L, "from_mesh: %s: memory limit of %.0f MB exceeded (--memory-limit MB)", err,
-                                      mem->limit / 1048576.0);
-        }
-        return luaL_argerror(L, 2, err);
-    }
-    /* with the surface kept, the mesh's vertices are tetgen's first nodes: its triangles are
-     * the body's surface, as they were; else the tets' boundary (tetgen split it) */
-    int keep = o.keep_surface && t->nv >= m->nv;
-    for (int64_t i = 0; keep && i < 3 * (int64_t)m->nv; i++) {
-        const wb_real a = t->v[i], c = m->v[i];
-        keep = fabs(a - c) <= 1e-9 * (1 + fabs(c));
-    }
-    return push_tet_body(L, w, t, keep ? m->tri : NULL, keep ? m->nt : 0, &d, auto_radius, &co, "from_mesh");
 }
 
 static const luaL_Reg world_methods[] = {
