@@ -132,3 +132,40 @@ test("w:volume refuses bad particles and options, changing nothing", function()
   expect.eq(w:volume_count(), 0)
   expect.error(function() w:lattice{ tets = true, volume_compliance = -1 } end, "volume_compliance")
 end)
+
+test("tets step bit-identically for any thread count, with either solver", function()
+  local function run(threads, solver)
+    local w = wobble.world{ substeps = 8, threads = threads, solver = solver }
+    w:collider{ shape = "plane", normal = { 0, 1, 0 }, offset = 0 }
+    w:lattice{ min = { -0.5, 0.2, -0.5 }, max = { 0.5, 1.2, 0.5 }, res = { 9, 9, 9 }, compliance = 1e-3,
+               tets = true, volume_compliance = 1e-8 }
+    for _ = 1, 30 do w:step() end
+    return w:hash()
+  end
+  for _, solver in ipairs{ "gauss-seidel", "jacobi" } do
+    local h1 = run(1, solver)
+    expect.eq(run(4, solver), h1, solver .. ": 4 threads = 1 thread")
+  end
+end)
+
+-- Pressure readback: a tet on an immovable base triangle (area A, normal +z), its apex of
+-- mass m under gravity -z. The apex's gradient is A/3 along +z, so at rest the constraint
+-- holds it with a pressure p = m g / (A/3) and, being compliant, gives way by
+-- C = V - V0 = -alpha p (XPBD: exact at rest for any substeps, as for distance links).
+-- World drag (5/s) settles it (exp(-50) of the start after 10 s; drag vanishes at rest).
+test("a compliant tet under a weight: pressure 3 m g / A and volume V0 - alpha p", function()
+  local m, g, alpha = 2, 9.81, 1e-3
+  for _, sub in ipairs{ 5, 20 } do
+    local w = wobble.world{ gravity = { 0, 0, -g }, substeps = sub, damping = 5 }
+    local a = w:particle{ pos = { 0, 0, 0 }, mass = 0 }
+    local b = w:particle{ pos = { 1, 0, 0 }, mass = 0 }
+    local c = w:particle{ pos = { 0, 1, 0 }, mass = 0 }
+    local d = w:particle{ pos = { 0.2, 0.2, 1 }, mass = m }
+    local id = w:volume(a, b, c, d, { compliance = alpha })
+    w:run{ seconds = 10 }
+    local v, rest, p = w:volume_info(id)
+    local p_expected = m * g / (0.5 / 3)
+    expect.near(p, p_expected, 1e-6 * p_expected, sub .. " substeps: pressure")
+    expect.near(v, rest - alpha * p_expected, 1e-9, sub .. " substeps: volume")
+  end
+end)
