@@ -5,6 +5,7 @@
 # more than the budgets below allow):
 #   - without tetgen on $PATH: exit 2 and a message naming the Debian package;
 #   - past --memory-limit: exit 3 (a budget), the message naming tetgen and the limit;
+#   - past --time-limit: exit 3 (tetgen is stopped when the run's time is up);
 #   - past its timeout: exit 2, "tetgen timed out";
 #   - each leaves nothing in $TMPDIR (its private folder removed) and no tetgen running.
 # Last line: "N passed, N failed"; exit status 1 when a check failed.
@@ -43,6 +44,9 @@ if command -v tetgen >/dev/null 2>&1; then
     check "past --memory-limit: exit 3 naming tetgen and the limit" 3 err "tetgen ran out of memory" \
         err "memory limit of 150 MB"
     result "past --memory-limit: nothing left behind" "$(left)"
+    run "$W" run "$F" --time-limit 2
+    check "past --time-limit: exit 3, the time limit named" 3 err "time limit of 2 s exceeded"
+    result "past --time-limit: nothing left behind" "$(left)"
     run "$W" run "$F" --set timeout=0.5
     check "past its timeout: exit 2" 2 err "tetgen timed out after 0.5 s"
     result "past its timeout: nothing left behind" "$(left)"
