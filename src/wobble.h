@@ -229,6 +229,8 @@ typedef struct wb_lattice_def {
     int res[3];           /* particles per axis (>= 2) */
     wb_real mass, radius;
     wb_distance_def link; /* edges, face and body diagonals of every cell */
+    bool tets;            /* also 6 tetrahedra per cell, each with a volume constraint */
+    wb_real volume_compliance; /* theirs (m^3/Pa), default 0: incompressible */
 } wb_lattice_def;
 
 wb_cloth_def wb_cloth_default_def(void);
@@ -409,5 +411,46 @@ wb_real wb_mesh_weld_tolerance(const wb_mesh *m);
 /* ---- snapshots (snapshot.c) --------------------------------------------------------------- */
 /* an exact copy: same hash, and the two step bit-identically; NULL when out of memory */
 wb_world *wb_world_clone(const wb_world *w);
+
+
+/* ==== volume constraints and tetrahedral solids (issue 9: volume.c, tets.c) ================ */
+/* A volume constraint keeps the signed volume of the tetrahedron p0 p1 p2 p3,
+ * V = (p1-p0) . ((p2-p0) x (p3-p0)) / 6, at its rest value (XPBD, gradients of V, mass
+ * weighted): a tet pushed inside out is pushed back to the sign it was made with.
+ * Compliance alpha in m^3/Pa (C = V - V0 = alpha * p, p the pressure); 0 = incompressible.
+ * Constraints are numbered 0.. in the order made and are not removed. */
+typedef struct wb_volume_def {
+    wb_real compliance;   /* m^3/Pa; 0 = incompressible */
+    bool has_rest;        /* false: the current signed volume */
+    wb_real rest;         /* the signed rest volume, when has_rest */
+} wb_volume_def;
+
+wb_volume_def wb_volume_default_def(void);                    /* incompressible, rest = current */
+const char *wb_volume_def_check(const wb_volume_def *def);    /* NULL or what is wrong */
+/* returns the constraint's index, or a negative wb_status (WB_ERR_ARG: see wb_last_error) */
+int32_t wb_volume_add(wb_world *w, const int32_t p[4], const wb_volume_def *def);
+int32_t wb_volume_count(const wb_world *w);
+void wb_volume_particles(const wb_world *w, int32_t i, int32_t p[4]);
+wb_real wb_volume_rest(const wb_world *w, int32_t i);          /* signed, m^3 */
+wb_real wb_volume_current(const wb_world *w, int32_t i);       /* signed, m^3 */
+wb_real wb_volume_compliance(const wb_world *w, int32_t i);
+wb_real wb_volume_pressure(const wb_world *w, int32_t i);      /* Pa, lambda/h^2 of the last substep; > 0 compressed */
+/* sums over every volume constraint of the current and rest signed volumes */
+void wb_world_volume_total(const wb_world *w, wb_real *current, wb_real *rest);
+wb_real wb_tet_signed_volume(const wb_real *a, const wb_real *b, const wb_real *c, const wb_real *d);
+
+/* a tetrahedral solid: a particle per node (mass lumped by tet volume), a volume constraint
+ * per tet (turned positive: two corners swapped when given inside out), a distance link per
+ * tet edge, and a surface: tri when given (ntri > 0), else the tets' boundary faces */
+typedef struct wb_tet_body_def {
+    wb_real mass, radius; /* total mass, particle radius */
+    wb_distance_def link; /* every edge link (rest = current length) */
+    wb_real volume_compliance; /* every tet's volume constraint */
+} wb_tet_body_def;
+wb_tet_body_def wb_tet_body_default_def(void);                 /* mass 1, radius 0.02, rigid */
+wb_status wb_tet_body(wb_world *w, const wb_real *v, int32_t nv, const int32_t *tet, int32_t nt,
+                      const int32_t *tri, int32_t ntri, const wb_tet_body_def *def, wb_body *out);
+/* edges of m used by other than two triangles (0 for a closed mesh); the first in *a, *b */
+int32_t wb_mesh_open_edges(const wb_mesh *m, int32_t *a, int32_t *b);
 
 #endif

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 
 #include "core.h"
+#include "volume.h"
 
 wb_cloth_def wb_cloth_default_def(void)
 {
@@ -255,7 +256,12 @@ wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
                        4 * cells;
     const int64_t ntri = 4 * ((int64_t)(nx - 1) * (ny - 1) + (int64_t)(ny - 1) * (nz - 1) + (int64_t)(nz - 1) * (nx - 1));
     if ((st = check_derived(lattice_pos, d, np, "min/max", d->mass)) != WB_OK) return st;
-    if ((st = wb__reserve(w, np, nd)) != WB_OK || (st = wb__surface_reserve(w, (int32_t)ntri)) != WB_OK) return st;
+    if (d->tets && !(d->volume_compliance >= 0 && isfinite(d->volume_compliance)))
+        return bad("volume_compliance must be >= 0");
+    if (d->tets && 6 * cells > WB_MAX_CONSTRAINTS) return bad("res is too large for tets");
+    if ((st = wb__reserve(w, np, nd)) != WB_OK || (st = wb__surface_reserve(w, (int32_t)ntri)) != WB_OK ||
+        (d->tets && (st = wb__volume_reserve(w, 6 * cells)) != WB_OK))
+        return st;
     const int32_t first = w->m.np;
     const wb_real m = d->mass / (wb_real)np;
     for (int64_t i = 0; i < np; i++) {
@@ -282,6 +288,8 @@ wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
                     link(w, ID(i + 1, j, k), ID(i, j + 1, k + 1), &d->link);
                     link(w, ID(i, j + 1, k), ID(i + 1, j, k + 1), &d->link);
                     link(w, ID(i, j, k + 1), ID(i + 1, j + 1, k), &d->link);
+                    if (d->tets) wb__kuhn_tets(w, ID(i, j, k), ID(i + 1, j, k) - ID(i, j, k), ID(i, j + 1, k) - ID(i, j, k),
+                                               ID(i, j, k + 1) - ID(i, j, k), d->volume_compliance);
                 }
             }
     /* the hull: each of the six faces as a grid of quads, wound outwards */

@@ -184,6 +184,7 @@ struct wb_world {
     wb_state s;
     wb_cache k;
     wb_bends bend;         /* bending constraints (bend.c): model, state and cache */
+    struct wb_volumes *vol; /* volume constraints (volume.h), NULL until the first */
 };
 
 /* internal entry points */

@@ -11,6 +11,7 @@
 #include "core.h"
 #include "bvh.h"
 #include "snapshot.h"
+#include "volume.h"
 
 static int fin3(const wb_real *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
 
@@ -81,8 +82,30 @@ wb_status wb_image_alloc_bends(wb_image *g, int32_t nb)
     return WB_OK;
 }
 
+wb_status wb_image_alloc_volumes(wb_image *g, int32_t n)
+{
+    free(g->vol_ijkl);
+    free(g->vol_alpha);
+    free(g->vol_rest);
+    g->nvol = n;
+    g->vol_ijkl = zalloc(4 * (int64_t)n, sizeof *g->vol_ijkl);
+    g->vol_alpha = zalloc(n, sizeof *g->vol_alpha);
+    g->vol_rest = zalloc(n, sizeof *g->vol_rest);
+    if (g->vol_ijkl && g->vol_alpha && g->vol_rest) return WB_OK;
+    free(g->vol_ijkl);
+    free(g->vol_alpha);
+    free(g->vol_rest);
+    g->vol_ijkl = NULL;
+    g->vol_alpha = g->vol_rest = NULL;
+    g->nvol = 0;
+    return WB_ERR_NOMEM;
+}
+
 void wb_image_free(wb_image *g)
 {
+    free(g->vol_ijkl);
+    free(g->vol_alpha);
+    free(g->vol_rest);
     for (int32_t i = 0; g->c && i < g->nc; i++) {
         free(g->c[i].mv);
         free(g->c[i].mt);
@@ -174,6 +197,16 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
     g->frame = s->frame;
     g->warnings = s->warnings;
     memcpy(g->last_warning, s->last_warning, sizeof g->last_warning);
+    const int32_t nvol = wb_volume_count(w);
+    if (wb_image_alloc_volumes(g, nvol) != WB_OK) {
+        wb_image_free(g);
+        return WB_ERR_NOMEM;
+    }
+    if (nvol) {
+        memcpy(g->vol_ijkl, w->vol->ijkl, 4 * (size_t)nvol * sizeof *g->vol_ijkl);
+        memcpy(g->vol_alpha, w->vol->alpha, (size_t)nvol * sizeof *g->vol_alpha);
+        memcpy(g->vol_rest, w->vol->rest, (size_t)nvol * sizeof *g->vol_rest);
+    }
     return WB_OK;
 }
 
@@ -273,7 +306,28 @@ const char *wb_image_check(const wb_image *g)
     for (int64_t i = 0; i < 3 * (int64_t)g->ntri; i++)
         if (g->tri[i] < 0 || g->tri[i] >= g->np) return "surface corner out of range";
     if (!(g->time >= 0) || !isfinite(g->time) || g->frame < 0 || g->warnings < 0) return "time, frame and warnings must be finite and >= 0";
+    if (g->nvol < 0 || g->nvol > WB_MAX_CONSTRAINTS) return "too many volume constraints";
+    for (int32_t i = 0; i < g->nvol; i++) {
+        const int32_t *p = &g->vol_ijkl[4 * i];
+        for (int k = 0; k < 4; k++) {
+            if (p[k] < 0 || p[k] >= g->np) return "volume constraint particle out of range";
+            for (int j = 0; j < k; j++)
+                if (p[j] == p[k]) return "a volume constraint needs four distinct particles";
+        }
+        const wb_volume_def d = { g->vol_alpha[i], true, g->vol_rest[i] };
+        if ((e = wb_volume_def_check(&d))) return e;
+    }
     return NULL;
+}
+
+/* the image's volume constraints after w's, particles shifted by `shift` (reserved) */
+static void put_volumes(wb_world *w, const wb_image *g, int32_t shift)
+{
+    for (int32_t i = 0; i < g->nvol; i++) {
+        int32_t p[4];
+        for (int k = 0; k < 4; k++) p[k] = g->vol_ijkl[4 * i + k] + shift;
+        wb__volume_put(w, p, g->vol_alpha[i], g->vol_rest[i]);
+    }
 }
 
 /* ---- exact restore ----------------------------------------------------------------------- */
@@ -379,6 +433,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     if (st == WB_OK) st = wb__bend_reserve(w, g->nb);
     if (st == WB_OK) st = grow_colliders(w, g->nc);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
+    if (st == WB_OK && g->nvol > 0) st = wb__volume_reserve(w, g->nvol);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
@@ -439,6 +494,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     }
     free(cms);
     put_surfaces(w, g, 0);
+    put_volumes(w, g, 0);
     s->time = g->time;
     s->frame = g->frame;
     s->warnings = g->warnings;
@@ -487,6 +543,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     if (st == WB_OK) st = wb__bend_reserve(w, g->nb);
     if (st == WB_OK) st = grow_colliders(w, m->nc + new_c);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
+    if (st == WB_OK && g->nvol > 0) st = wb__volume_reserve(w, g->nvol);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
@@ -536,6 +593,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     }
     free(cms);
     put_surfaces(w, g, first);
+    put_volumes(w, g, first);
     m->topology_dirty = 1;
     out->first = first;
     out->count = g->np;

@@ -63,6 +63,11 @@ typedef struct wb_image {
     double time;
     int64_t frame, warnings;
     char last_warning[160];
+
+    /* volume constraints (volume.c), in creation order: allocated by wb_image_alloc_volumes */
+    int32_t nvol;
+    int32_t *vol_ijkl;     /* (nvol x 4) */
+    wb_real *vol_alpha, *vol_rest; /* (nvol) compliance, signed rest volume */
 } wb_image;
 
 /* allocate the arrays for these counts (zeroed; generations 1, i.e. live; particles collide);
@@ -70,6 +75,8 @@ typedef struct wb_image {
 wb_status wb_image_alloc(wb_image *img, int32_t np, int32_t nd, int32_t nfree, int32_t nc, int32_t nsurf, int32_t ntri);
 /* the bend arrays for nb bends (zeroed), after wb_image_alloc; WB_ERR_NOMEM */
 wb_status wb_image_alloc_bends(wb_image *img, int32_t nb);
+/* the volume constraints' arrays for n of them (zeroed); WB_ERR_NOMEM */
+wb_status wb_image_alloc_volumes(wb_image *img, int32_t n);
 void wb_image_free(wb_image *img);                     /* and zero it (mesh colliders' arrays too); fine on a zeroed image */
 wb_status wb_image_of(const wb_world *w, wb_image *img); /* a full copy of the world */
 /* NULL, or what is inconsistent (an index out of range, a free list that does not match

@@ -22,6 +22,7 @@ static double now_ms(void)
 const wb_ctype *const wb__ctypes[] = {
     &wb__distance_type,
     &wb__bend_type,
+    &wb__volume_type,
 };
 const int wb__nctypes = (int)(sizeof wb__ctypes / sizeof wb__ctypes[0]);
 

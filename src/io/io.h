@@ -121,4 +121,30 @@ int wbio_vtk_close(wbio_vtk *v, char *err, size_t errn);     /* NULL is fine; fr
 int32_t wbio_vtk_frames(const wbio_vtk *v);
 int wbio_write_vtp(FILE *f, const wb_world *w);               /* one frame */
 
+
+/* ---- tet meshes (tets.c): tetgen's .node/.ele, and the tetgen program ------------------------ */
+typedef struct wbio_tets {
+    int32_t nv, nt;
+    wb_real *v;            /* (nv x 3) nodes */
+    int32_t *tet;          /* (nt x 4) 0-based node ids */
+} wbio_tets;
+void wbio_tets_free(wbio_tets *t);                    /* and zero it; fine on a zeroed one */
+/* a .node and an .ele file (indices from 0 or 1, as the .node's first point says; extra
+ * attributes and markers ignored; 10-node tets keep their corners) */
+int wbio_read_tets(const char *node_path, const char *node_shown, const char *ele_path, const char *ele_shown,
+                   wbio_tets *out, char *err, size_t errn);
+int wbio_write_tets(const char *node_path, const char *node_shown, const char *ele_path, const char *ele_shown,
+                    const wb_real *v, int32_t nv, const int32_t *tet, int32_t nt, char *err, size_t errn);
+typedef struct wbio_tetgen_opts {
+    double max_volume;     /* tetgen -a: largest tet volume, m^3; 0 = none */
+    double quality;        /* tetgen -q: largest radius-edge ratio; 0 = none */
+    bool keep_surface;     /* tetgen -Y: the mesh's triangles stay the surface (nodes 0..nv-1 are its vertices) */
+    double timeout;        /* seconds; 0 = 60 */
+} wbio_tetgen_opts;
+/* fill the closed mesh m with tets by running the tetgen program in a private temporary
+ * folder (removed after), under b's memory (the child's address space) and interrupt.
+ * Refuses an open mesh before running anything; an input that intersects itself is named
+ * as such; without tetgen installed, the message names the Debian package */
+int wbio_tetgen(const wb_mesh *m, const wbio_tetgen_opts *o, wbio_budget *b, wbio_tets *out, char *err, size_t errn);
+
 #endif

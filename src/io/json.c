@@ -357,6 +357,44 @@ static int read_constraints(rd *r, const sections *s, const defaults *d, wb_imag
     return 0;
 }
 
+/* "volumes": [ {"particles": [a, b, c, d], "rest": V, "compliance": alpha}, ... ]: volume
+ * constraints (the tet's signed volume kept at rest, default the particles' current one) */
+static int read_volumes(rd *r, const cJSON *arr, const defaults *d, wb_image *g)
+{
+    static const char *const keys[] = { "particles", "rest", "compliance", NULL };
+    kp top = { NULL, "volumes", 0 };
+    int32_t i = 0;
+    (void)d;
+    if (!arr) return 0;
+    for (const cJSON *c = arr->child; c; c = c->next, i++) {
+        const cJSON *f[4];
+        kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "particles");
+        int32_t n;
+        if (jv_get_array(r, f[0], &pp, 16, &n)) return -1;
+        if (n != 4) return jv_fail(r, f[0], 0, &pp, "a volume constraint joins 4 particles, got %d", n);
+        int32_t *ijkl = &g->vol_ijkl[4 * i];
+        int k = 0;
+        for (const cJSON *e = f[0]->child; e; e = e->next, k++) {
+            kp q = { &pp, NULL, k };
+            int64_t v;
+            if (g->np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
+            if (jv_get_int(r, e, &q, 0, g->np - 1, &v)) return -1;
+            ijkl[k] = (int32_t)v;
+            for (int j = 0; j < k; j++)
+                if (ijkl[j] == ijkl[k]) return jv_fail(r, f[0], 0, &pp, "a volume constraint needs four distinct particles");
+        }
+        const wb_real *x = g->x;
+        g->vol_rest[i] = wb_tet_signed_volume(&x[3 * ijkl[0]], &x[3 * ijkl[1]], &x[3 * ijkl[2]], &x[3 * ijkl[3]]);
+        g->vol_alpha[i] = 0;
+        if (jv_opt_real(r, f[1], &p, "rest", &g->vol_rest[i]) || jv_opt_nonneg(r, f[2], &p, "compliance", &g->vol_alpha[i]))
+            return -1;
+        if (!isfinite(g->vol_rest[i])) return jv_fail(r, f[0], 0, &pp, "the particles are too far apart (their volume overflows)");
+    }
+    return 0;
+}
+
 static const char *const shape_names[] = { "plane", "sphere", "box", "capsule", "mesh", NULL };
 
 /* a mesh collider's "vertices" (flat x,y,z, ...) and "triangles" (flat, 0-based corners) */
@@ -645,8 +683,8 @@ static int read_skins(rd *r, const sections *s, wbio_config *cfg)
 static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
 {
     static const char *const keys[] = { "format", "version", "description", "defaults", "particles", "constraints",
-                                        "colliders", "surfaces", "parts", "skins", "snapshot", NULL };
-    const cJSON *f[12];
+                                        "colliders", "surfaces", "parts", "skins", "snapshot", "volumes", NULL };
+    const cJSON *f[13];
     sections s;
     defaults d;
     memset(&s, 0, sizeof s);
@@ -687,17 +725,22 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
     }
     s.ncons -= s.nbend;
     s.snapshot = f[10];
+    int32_t nvol = 0;
+    kp volp = { NULL, "volumes", 0 };
+    if (f[11] && jv_get_array(r, f[11], &volp, WB_MAX_CONSTRAINTS, &nvol)) return -1;
     if (scan_snapshot(r, &s) || read_surfaces(r, &s, NULL, &s.ntri)) return -1;
     if (wb_image_alloc(&cfg->img, s.np, s.nd, s.nfree, s.nc, s.nsurf, s.ntri) != WB_OK ||
         (s.nbend > 0 && wb_image_alloc_bends(&cfg->img, s.nbend) != WB_OK) ||
         !(cfg->parts = calloc((size_t)s.nparts + 1, sizeof *cfg->parts)) ||
-        !(cfg->skins = calloc((size_t)s.nskins + 1, sizeof *cfg->skins)))
+        !(cfg->skins = calloc((size_t)s.nskins + 1, sizeof *cfg->skins)) ||
+        wb_image_alloc_volumes(&cfg->img, nvol) != WB_OK)
         return jv_fail(r, NULL, 0, NULL, "out of memory");
     cfg->snapshot = s.snapshot != NULL;
     /* the snapshot first: its slot tables say where the constraints and colliders go */
     if ((s.snapshot && read_snapshot(r, &s, &cfg->img)) || read_particles(r, &s, &d, &cfg->img) ||
         read_constraints(r, &s, &d, &cfg->img) || read_colliders(r, &s, &cfg->img) ||
-        read_surfaces(r, &s, &cfg->img, &s.ntri) || read_parts(r, &s, cfg) || read_skins(r, &s, cfg))
+        read_surfaces(r, &s, &cfg->img, &s.ntri) || read_parts(r, &s, cfg) || read_skins(r, &s, cfg) ||
+        read_volumes(r, f[11], &d, &cfg->img))
         return -1;
     /* every value was checked where it was read: this is the last line of defence */
     const char *e = wb_image_check(&cfg->img);

@@ -148,6 +148,23 @@ static void write_constraints(out *o, const wb_image *g)
     fputs(first ? "],\n" : "\n  ],\n", f);
 }
 
+/* "volumes" (only when there are any: a config without stays as it was) */
+static void write_volumes(out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    if (g->nvol == 0) return;
+    fputs("  \"volumes\": [", f);
+    for (int32_t i = 0; i < g->nvol; i++) {
+        const int32_t *p = &g->vol_ijkl[4 * i];
+        fprintf(f, "%s    {\"particles\": [%d, %d, %d, %d], \"rest\": ", i ? ",\n" : "\n", p[0], p[1], p[2], p[3]);
+        num(o, g->vol_rest[i]);
+        fputs(", \"compliance\": ", f);
+        num(o, g->vol_alpha[i]);
+        fputc('}', f);
+    }
+    fputs("\n  ],\n", f);
+}
+
 static void write_colliders(out *o, const wb_image *g)
 {
     static const char *const names[] = { "plane", "sphere", "box", "capsule", "mesh" };
@@ -238,6 +255,7 @@ int wbio_write_snapshot(const wb_world *w, const char *path, const char *shown, 
     write_snapshot(&o, &g);
     write_particles(&o, &g);
     write_constraints(&o, &g);
+    write_volumes(&o, &g);
     write_colliders(&o, &g);
     write_surfaces(&o, &g);
     fputs("}\n", o.f);

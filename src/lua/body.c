@@ -241,7 +241,7 @@ static int w_rope(lua_State *L)
 }
 
 static const char *const lattice_keys[] = {
-    "min", "max", "res", "mass", "radius", "tets",
+    "min", "max", "res", "mass", "radius", "tets", "volume_compliance",
     "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
 };
 
@@ -258,15 +258,30 @@ static int w_lattice(lua_State *L)
     const bool auto_radius = read_mass_radius(L, &d.mass, &d.radius);
     wbl_contact_opts co;
     wbl_read_contact_opts(L, 2, &co);
-    bool tets = false;
-    if (wbl_optbool(L, 2, "tets", &tets) && tets)
-        return wbl_fielderror(L, 2, "tets", "not supported yet: tets needs the volume constraint");
+    /* tets: 6 per cell, each with a volume constraint of compliance volume_compliance
+     * (m^3/Pa, default 0: incompressible; `compliance` stays the links' own, in m/N) */
+    wbl_optbool(L, 2, "tets", &d.tets);
+    if (wbl_optreal(L, 2, "volume_compliance", &d.volume_compliance) && d.volume_compliance < 0)
+        return wbl_fielderror(L, 2, "volume_compliance", "must be >= 0");
     wbl_read_link(L, 2, &d.link);
     check_link(L, &d.link);
     if ((int64_t)d.res[0] * d.res[1] * d.res[2] > WB_MAX_PARTICLES)
         return wbl_fielderror(L, 2, "res", "%d x %d x %d particles is too many (limit %d)", d.res[0], d.res[1],
                               d.res[2], (int)WB_MAX_PARTICLES);
-    BUILD(L, w, wb_lattice, "lattice", (int64_t)d.res[0] * d.res[1] * d.res[2]);
+    /* BUILD, plus body.tet_count as the other tet bodies have it */
+    wb_body b;
+    wbl_body_begin(L, (int64_t)d.res[0] * d.res[1] * d.res[2]);
+    const int32_t nd0 = wb_distance_count(w), nv0 = wb_volume_count(w);
+    wb_status st = wb_lattice(w, &d, &b);
+    if (st != WB_OK) return wbl_status_error(L, 2, st, "lattice");
+    if (auto_radius) wbl_default_radius(w, b);
+    wbl_apply_contact_opts(w, b, &co);
+    wbl_body_end(L, 1, b, wb_distance_count(w) - nd0);
+    if (d.tets) {
+        lua_pushinteger(L, wb_volume_count(w) - nv0);
+        lua_setfield(L, -2, "tet_count");
+    }
+    return 1;
 }
 
 static const luaL_Reg body_methods[] = {

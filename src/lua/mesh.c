@@ -325,14 +325,85 @@ static int m_tostring(lua_State *L)
     return 1;
 }
 
+/* ---- w:from_mesh(m, {tets = true, ...}): filled with tets by tetgen (io/tets.c), lua/volume.c builds */
+static const char *const from_mesh_tets_keys[] = {
+    "tets", "max_volume", "quality", "keep_surface", "timeout", "mass", "radius", "volume_compliance",
+    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
+};
+
+static int from_mesh_tets(lua_State *L)
+{
+    wb_world *w = wbl_checkworld(L, 1);
+    const wb_mesh *m = wbl_checkmesh(L, 2);
+    wbl_checkopts(L, 3, from_mesh_tets_keys, false);
+    wb_tet_body_def d = wb_tet_body_default_def();
+    const bool auto_radius = wbl_read_tet_body(L, 3, &d);
+    wbl_contact_opts co;
+    wbl_read_contact_opts(L, 3, &co);
+    wbio_tetgen_opts o = { 0, 2, true, 0 };
+    wb_real x;
+    if (wbl_optreal(L, 3, "max_volume", &x)) {
+        if (!(x > 0)) return wbl_fielderror(L, 3, "max_volume", "must be > 0 (m^3)");
+        o.max_volume = x;
+    }
+    /* quality: tetgen's radius-edge ratio bound (-q), default 2; false: none */
+    lua_getfield(L, 3, "quality");
+    if (lua_isboolean(L, -1)) {
+        if (lua_toboolean(L, -1)) return wbl_fielderror(L, 3, "quality", "a ratio (>= 1.1) or false expected");
+        o.quality = 0;
+    } else if (wbl_optreal(L, 3, "quality", &x)) {
+        if (!(x >= 1.1 && x <= 100)) return wbl_fielderror(L, 3, "quality", "radius-edge ratio must be in 1.1..100");
+        o.quality = x;
+    }
+    lua_pop(L, 1);
+    wbl_optbool(L, 3, "keep_surface", &o.keep_surface);
+    if (wbl_optreal(L, 3, "timeout", &x)) {
+        if (!(x > 0)) return wbl_fielderror(L, 3, "timeout", "must be > 0");
+        o.timeout = x;
+    }
+    lua_settop(L, 3);
+    /* tetgen may take what is left of the memory budget, and stops with the run's time limit */
+    const wb_memory *mem = &wb_rt_get(L)->memory;
+    wbio_budget b = { 0, NULL, NULL, false };
+    if (mem->limit) {
+        lua_gc(L, LUA_GCCOLLECT);
+        b.max_bytes = mem->used < mem->limit ? mem->limit - mem->used : 1;
+    }
+    wb_rt_interrupt(L, &b.interrupt, &b.interrupt_ud);
+    wbio_tets *t = wbl_push_tets(L); /* 4 */
+    char err[1024];
+    if (wbio_tetgen(m, &o, &b, t, err, sizeof err)) {
+        if (b.stopped) {
+            wb_rt_check_budgets(L);
+            return wb_rt_budget_error(L, "from_mesh: %s: memory limit of %.0f MB exceeded (--memory-limit MB)", err,
+                                      mem->limit / 1048576.0);
+        }
+        return luaL_argerror(L, 2, err);
+    }
+    /* with the surface kept, the mesh's vertices are tetgen's first nodes: its triangles are
+     * the body's surface, as they were; else the tets' boundary (tetgen split it) */
+    int keep = o.keep_surface && t->nv >= m->nv;
+    for (int64_t i = 0; keep && i < 3 * (int64_t)m->nv; i++) {
+        const wb_real a = t->v[i], c = m->v[i];
+        keep = fabs(a - c) <= 1e-9 * (1 + fabs(c));
+    }
+    return wbl_push_tet_body(L, w, t, keep ? m->tri : NULL, keep ? m->nt : 0, &d, auto_radius, &co, "from_mesh");
+}
+
 /* ---- w:from_mesh(m, {...}) --------------------------------------------------------------------- */
 static const char *const from_mesh_keys[] = {
-    "mass", "radius", "target", "neighbours", "surface",
+    "mass", "radius", "target", "neighbours", "surface", "tets",
     "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
 };
 
 static int w_from_mesh(lua_State *L)
 {
+    /* tets = true: filled with tetrahedra by tetgen, options of their own (lua/volume.c) */
+    if (lua_type(L, 3) == LUA_TTABLE && lua_getfield(L, 3, "tets") != LUA_TNIL) {
+        const bool tets = lua_toboolean(L, -1);
+        lua_pop(L, 1);
+        if (tets) return from_mesh_tets(L);
+    }
     wb_world *w = wbl_checkworld(L, 1);
     const wb_mesh *m = wbl_checkmesh(L, 2);
     wb_from_mesh_def d = wb_from_mesh_default_def();

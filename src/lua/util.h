@@ -29,6 +29,7 @@ void wbl_open_distance(lua_State *L);  /* distance.c */
 void wbl_open_bend(lua_State *L);      /* bend.c */
 void wbl_open_collider(lua_State *L);  /* collider.c */
 void wbl_open_body(lua_State *L);      /* body.c: builders + body metatable */
+void wbl_open_volume(lua_State *L);    /* volume.c: volume constraints, tet bodies */
 int wbl_world_new(lua_State *L);       /* wobble.world{...} */
 /* add methods to the world's method table (used by the per-type files) */
 void wbl_add_world_methods(lua_State *L, const luaL_Reg *l);
@@ -91,6 +92,15 @@ wb_collider_id *wbl_push_collider(lua_State *L, int world_index, wb_collider_id 
 void wbl_push_body(lua_State *L, int world_index, wb_body b, int32_t constraints);
 void wbl_body_begin(lua_State *L, int64_t count);
 void wbl_body_end(lua_State *L, int world_index, wb_body b, int32_t constraints);
+/* tet bodies (volume.c), for w:load_tets and w:from_mesh{tets = true} (mesh.c): tetgen's
+ * arrays owned by a scratch userdata pushed on the stack; a tet body's options at arg
+ * (returns whether the radius is the default); the body built and pushed (raises) */
+struct wbio_tets;
+struct wbl_contact_opts;
+struct wbio_tets *wbl_push_tets(lua_State *L);
+bool wbl_read_tet_body(lua_State *L, int arg, wb_tet_body_def *d);
+int wbl_push_tet_body(lua_State *L, wb_world *w, const struct wbio_tets *t, const int32_t *tri, int32_t ntri,
+                      const wb_tet_body_def *d, bool auto_radius, const struct wbl_contact_opts *co, const char *what);
 /* a builder's contact options (collide = true, self_collide = false, friction = 0) from
  * the options table at arg, and their application to the body it made */
 typedef struct wbl_contact_opts { bool collide, self_collide; wb_real friction; } wbl_contact_opts;

@@ -18,6 +18,7 @@ int luaopen_wobble(lua_State *L)
     wbl_open_bend(L);
     wbl_open_collider(L);
     wbl_open_body(L);
+    wbl_open_volume(L);
 
     luaL_newlib(L, wobble_funcs);
     wbl_open_mesh(L);       /* wobble.mesh, wobble.load_mesh; w:from_mesh */

@@ -27,6 +27,7 @@ local function fixture()
   f.bend = f.w:bend(f.p, f.q, f.r3, f.r4)
   f.col = f.w:collider{ shape = "sphere", center = {0, -3, 0}, radius = 0.5 }
   f.body = f.w:lattice{ min = {-1, 1, -1}, max = {1, 3, 1}, res = {2, 2, 2} }
+  f.vol = f.w:volume(f.body.first, f.body.first + 1, f.body.first + 2, f.body.first + 4)
   f.m = wobble.mesh{ vertices = {{-0.5, 1.5, -0.5}, {0.5, 1.5, -0.5}, {0, 2.5, 0.5}, {0, 1.5, 0.5}},
                      triangles = {{1, 3, 2}, {1, 2, 4}, {1, 4, 3}, {2, 3, 4}} }
   f.skin = f.w:skin(f.m, f.body)
@@ -82,8 +83,9 @@ local CASES = {
   ["world:rope"] = { opts = link{ from = {0, 0, 0}, to = {1, 0, 0}, segments = 2, mass = 1, radius = 0.02 },
                      nums = plus(link_nums, { "from", "to", "segments", "mass", "radius", "friction" }),
                      call = function(f, o) return f.w:rope(o) end },
-  ["world:lattice"] = { opts = link{ min = {0, 0, 0}, max = {1, 1, 1}, res = {2, 2, 2}, mass = 1, radius = 0.02 },
-                        nums = plus(link_nums, { "min", "max", "res", "mass", "radius", "friction" }),
+  ["world:lattice"] = { opts = link{ min = {0, 0, 0}, max = {1, 1, 1}, res = {2, 2, 2}, mass = 1, radius = 0.02,
+                                     tets = true, volume_compliance = 0 },
+                        nums = plus(link_nums, { "min", "max", "res", "mass", "radius", "friction", "volume_compliance" }),
                         call = function(f, o) return f.w:lattice(o) end },
   ["world:from_mesh"] = { opts = link{ mass = 1, radius = 0.02, target = 4, neighbours = 3 }, opts_arg = 2,
                           nums = plus(link_nums, { "mass", "radius", "target", "neighbours", "friction" }),
@@ -136,6 +138,18 @@ local CASES = {
   ["world:save"] = { none = "a path" },
   ["world:save_vtp"] = { none = "a path" },
   ["world:close"] = { none = "no arguments" },
+  -- volume constraints and tet solids (lua/volume.c); from_mesh's tets options: volume_io.lua
+  ["world:volume"] = { opts = { compliance = 0, rest = 0.5 }, opts_arg = 5, nums = { "compliance", "rest" },
+                       call = function(f, o) local b = f.body.first
+                         return f.w:volume(b, b + 1, b + 2, b + 4, o) end },
+  ["world:volume_info"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.w:volume_info(...) end },
+  ["world:load_tets"] = { opts = link{ mass = 1, radius = 0.02, volume_compliance = 0 }, opts_arg = 2,
+                          nums = plus(link_nums, { "mass", "radius", "volume_compliance", "friction" }),
+                          call = function(f, o) assert(f.w:save_tets("api_generic/tets", f.body))
+                            return f.w:load_tets("api_generic/tets", o) end },
+  ["world:save_tets"] = { none = "a path and a body" },
+  ["world:volume_count"] = { none = "a getter: no arguments" },
+  ["world:total_volume"] = { none = "a getter: no arguments" },
 }
 for _, name in ipairs{ "angular_momentum", "bends", "bounds", "breaks", "closed", "colliders", "contacts", "damping", "distances", "dt",
                        "energy", "frame", "gravity", "hash", "iterations", "max_strain", "momentum", "particle_count",

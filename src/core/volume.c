@@ -1,0 +1,220 @@
+/* volume.c: volume constraints (DESIGN.md §2, one file per constraint type).
+ *
+ * C = V - V0 with V the signed volume of the tetrahedron (p0 p1 p2 p3),
+ * V = (p1-p0) . ((p2-p0) x (p3-p0)) / 6, projected with XPBD (Macklin et al. 2016):
+ * dlambda = (-C - alpha~ lambda) / (sum_k w_k |grad_k V|^2 + alpha~), dx_k = w_k grad_k V dlambda.
+ * The gradients are those of the signed volume, so a tet pushed inside out is driven
+ * back through zero to the sign it was made with, and a flat tet still has gradients
+ * (its faces' area normals) to be pushed apart along. The corrections are mass-weighted:
+ * sum_k m_k dx_k = dlambda sum_k grad_k V = 0, momentum is conserved.
+ *
+ * Model: the corners, compliance and signed rest volume (a step changes none of them).
+ * Cache: the multipliers of the current substep (force readback). The pass is serial in
+ * creation order (deterministic for any thread count; colouring them is left for later). */
+#include <assert.h>
+#include <stdlib.h>
+
+#include "core.h"
+#include "ctype.h"
+#include "volume.h"
+
+
+#define VOLUME_BYTES (4 * sizeof(int32_t) + 3 * sizeof(wb_real))
+
+wb_real wb_tet_signed_volume(const wb_real *a, const wb_real *b, const wb_real *c, const wb_real *d)
+{
+    wb_real e1[3], e2[3], e3[3], n[3];
+    v3_sub(e1, b, a);
+    v3_sub(e2, c, a);
+    v3_sub(e3, d, a);
+    v3_cross(n, e2, e3);
+    return v3_dot(e1, n) / 6;
+}
+
+wb_volume_def wb_volume_default_def(void)
+{
+    wb_volume_def d = { 0, false, 0 };
+    return d;
+}
+
+const char *wb_volume_def_check(const wb_volume_def *d)
+{
+    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return "compliance must be >= 0";
+    if (d->has_rest && !isfinite(d->rest)) return "rest must be finite";
+    return NULL;
+}
+
+/* room for `extra` more constraints, charged to the memory budget (all or nothing) */
+wb_status wb__volume_reserve(wb_world *w, int64_t extra)
+{
+    wb_volumes *v = w->vol;
+    if (!v) {
+        v = calloc(1, sizeof *v);
+        if (!v) return WB_ERR_NOMEM;
+        w->vol = v;
+    }
+    const int64_t need = v->n + extra;
+    if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    if (need <= v->cap) return WB_OK;
+    int64_t cap = v->cap ? v->cap : 64;
+    while (cap < need) cap *= 2;
+    if (cap > WB_MAX_CONSTRAINTS) cap = WB_MAX_CONSTRAINTS;
+    wb_memory *mem = w->m.def.memory;
+    const size_t want = (size_t)cap * VOLUME_BYTES;
+    if (mem && mem->limit > 0 && (double)mem->used - (double)v->charged + (double)want > (double)mem->limit)
+        return WB_ERR_NOMEM;
+    struct { void **p; size_t elem; } arr[] = {
+        { (void **)&v->ijkl, 4 * sizeof(int32_t) }, { (void **)&v->alpha, sizeof(wb_real) },
+        { (void **)&v->rest, sizeof(wb_real) }, { (void **)&v->lambda, sizeof(wb_real) },
+    };
+    for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
+        void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
+        if (!q) return WB_ERR_NOMEM; /* arrays already grown are merely larger */
+        *arr[i].p = q;
+    }
+    if (mem) mem->used = mem->used - v->charged + want;
+    v->charged = want;
+    v->cap = (int32_t)cap;
+    return WB_OK;
+}
+
+/* append one constraint after wb__volume_reserve (cannot fail) */
+void wb__volume_put(wb_world *w, const int32_t p[4], wb_real alpha, wb_real rest)
+{
+    wb_volumes *v = w->vol;
+    assert(v && v->n < v->cap); /* contract: reserved first */
+    const int32_t i = v->n++;
+    memcpy(&v->ijkl[4 * i], p, 4 * sizeof *p);
+    v->alpha[i] = alpha;
+    v->rest[i] = rest;
+    v->lambda[i] = 0;
+}
+
+int32_t wb_volume_add(wb_world *w, const int32_t p[4], const wb_volume_def *def)
+{
+    const char *err = wb_volume_def_check(def);
+    for (int k = 0; k < 4 && !err; k++) {
+        if (p[k] < 0 || p[k] >= w->m.np) err = "particle out of range";
+        for (int j = 0; j < k && !err; j++)
+            if (p[j] == p[k]) err = "a volume constraint needs four distinct particles";
+    }
+    const wb_real *x = w->s.x;
+    const wb_real rest = def->has_rest ? def->rest
+                       : err ? 0 : wb_tet_signed_volume(&x[3 * p[0]], &x[3 * p[1]], &x[3 * p[2]], &x[3 * p[3]]);
+    if (!err && !isfinite(rest)) err = "the particles are too far apart (their volume overflows)";
+    if (err) {
+        wb__set_error("%s", err);
+        return WB_ERR_ARG;
+    }
+    wb_status st = wb__volume_reserve(w, 1);
+    if (st != WB_OK) return st;
+    wb__volume_put(w, p, def->compliance, rest);
+    return w->vol->n - 1;
+}
+
+int32_t wb_volume_count(const wb_world *w) { return w->vol ? w->vol->n : 0; }
+
+#define CHECK_V(w, i) ((w)->vol && (i) >= 0 && (i) < (w)->vol->n)
+
+void wb_volume_particles(const wb_world *w, int32_t i, int32_t p[4])
+{
+    if (!CHECK_V(w, i)) return;
+    memcpy(p, &w->vol->ijkl[4 * i], 4 * sizeof *p);
+}
+
+wb_real wb_volume_rest(const wb_world *w, int32_t i) { return CHECK_V(w, i) ? w->vol->rest[i] : 0; }
+wb_real wb_volume_compliance(const wb_world *w, int32_t i) { return CHECK_V(w, i) ? w->vol->alpha[i] : 0; }
+
+static wb_real current(const wb_world *w, int32_t i)
+{
+    const int32_t *p = &w->vol->ijkl[4 * i];
+    const wb_real *x = w->s.x;
+    return wb_tet_signed_volume(&x[3 * p[0]], &x[3 * p[1]], &x[3 * p[2]], &x[3 * p[3]]);
+}
+
+wb_real wb_volume_current(const wb_world *w, int32_t i) { return CHECK_V(w, i) ? current(w, i) : 0; }
+
+wb_real wb_volume_pressure(const wb_world *w, int32_t i)
+{
+    if (!CHECK_V(w, i)) return 0;
+    const wb_real h = w->k.h_last;
+    return h > 0 ? w->vol->lambda[i] / (h * h) : 0;
+}
+
+void wb_world_volume_total(const wb_world *w, wb_real *cur, wb_real *rest)
+{
+    wb_real c = 0, r = 0;
+    for (int32_t i = 0; i < wb_volume_count(w); i++) {
+        c += current(w, i);
+        r += w->vol->rest[i];
+    }
+    if (cur) *cur = c;
+    if (rest) *rest = r;
+}
+
+/* ---- the type ---------------------------------------------------------------------- */
+static int32_t vol_count(const wb_world *w) { return wb_volume_count(w); }
+
+static wb_status vol_prepare(wb_world *w)
+{
+    (void)w; /* nothing to pack: the arrays are the projection's order */
+    return WB_OK;
+}
+
+static void vol_substep_begin(wb_world *w)
+{
+    if (w->vol && w->vol->n > 0) memset(w->vol->lambda, 0, sizeof(wb_real) * (size_t)w->vol->n);
+}
+
+static void vol_project(wb_world *w, wb_real h)
+{
+    wb_volumes *v = w->vol;
+    if (!v) return;
+    const wb_real inv_h2 = 1 / (h * h);
+    const wb_real *wv = w->m.w;
+    wb_real *x = w->s.x;
+    for (int32_t i = 0; i < v->n; i++) {
+        const int32_t *p = &v->ijkl[4 * i];
+        const wb_real wk[4] = { wv[p[0]], wv[p[1]], wv[p[2]], wv[p[3]] };
+        if (wk[0] + wk[1] + wk[2] + wk[3] == 0) continue;
+        const wb_real *x0 = &x[3 * p[0]], *x1 = &x[3 * p[1]], *x2 = &x[3 * p[2]], *x3 = &x[3 * p[3]];
+        wb_real e1[3], e2[3], e3[3], g[4][3];
+        v3_sub(e1, x1, x0);
+        v3_sub(e2, x2, x0);
+        v3_sub(e3, x3, x0);
+        /* grad_1 V = e2 x e3 / 6, grad_2 = e3 x e1 / 6, grad_3 = e1 x e2 / 6, grad_0 = -sum */
+        v3_cross(g[1], e2, e3);
+        v3_cross(g[2], e3, e1);
+        v3_cross(g[3], e1, e2);
+        for (int k = 1; k < 4; k++) v3_scale(g[k], g[k], (wb_real)1 / 6);
+        for (int c = 0; c < 3; c++) g[0][c] = -(g[1][c] + g[2][c] + g[3][c]);
+        const wb_real vol = v3_dot(e1, g[1]);
+        const wb_real at = v->alpha[i] * inv_h2;
+        if (isinf(at)) continue; /* compliance/h^2 overflowed: no stiffness */
+        wb_real den = at;
+        for (int k = 0; k < 4; k++) den += wk[k] * v3_dot(g[k], g[k]);
+        /* all four on a line (or on a point): no direction changes the volume */
+        if (!(den > (wb_real)1e-300) || !isfinite(den)) continue;
+        const wb_real dl = (v->rest[i] - vol - at * v->lambda[i]) / den;
+        v->lambda[i] += dl;
+        for (int k = 0; k < 4; k++)
+            if (wk[k] > 0) v3_madd(&x[3 * p[k]], g[k], wk[k] * dl);
+    }
+}
+
+/* U = C^2 / (2 alpha) for compliant constraints; incompressible ones store none */
+static wb_real vol_energy(const wb_world *w)
+{
+    wb_real e = 0;
+    for (int32_t i = 0; i < wb_volume_count(w); i++) {
+        const wb_real a = w->vol->alpha[i];
+        if (a <= 0) continue;
+        const wb_real c = current(w, i) - w->vol->rest[i];
+        e += c * c / (2 * a);
+    }
+    return e;
+}
+
+const wb_ctype wb__volume_type = {
+    "volume", vol_count, vol_prepare, vol_substep_begin, vol_project, NULL, vol_energy,
+};

@@ -1,0 +1,41 @@
+/* volume.h: the volume constraints' arrays (volume.c), for the core files that copy them
+ * (snapshot.c) and the builders that make them (builders.c, tets.c). */
+#ifndef WB_VOLUME_H
+#define WB_VOLUME_H
+
+#include <stdlib.h>
+
+#include "core.h"
+
+/* w->vol: NULL until the first one is made */
+typedef struct wb_volumes {
+    int32_t n, cap;
+    int32_t *ijkl;         /* (n x 4) model: corners */
+    wb_real *alpha;        /* (n) model: compliance, m^3/Pa */
+    wb_real *rest;         /* (n) model: signed rest volume, m^3 */
+    wb_real *lambda;       /* (n) cache: multipliers of the current substep */
+    size_t charged;        /* bytes charged to def.memory */
+} wb_volumes;
+
+/* room for `extra` more, charged to the memory budget; after it wb__volume_put cannot fail */
+wb_status wb__volume_reserve(wb_world *w, int64_t extra);
+void wb__volume_put(wb_world *w, const int32_t p[4], wb_real alpha, wb_real rest);
+/* tets.c: a lattice cell's 6 tets (Kuhn), corner c at base + (c&1) sx + (c&2) sy + (c&4) sz */
+void wb__kuhn_tets(wb_world *w, int32_t base, int32_t sx, int32_t sy, int32_t sz, wb_real alpha);
+
+/* world.c's destroy: the arrays freed and the budget given back (inline, so that world.c
+ * and volume.c do not call each other) */
+static inline void wb__volume_free(wb_world *w)
+{
+    wb_volumes *v = w->vol;
+    if (!v) return;
+    if (w->m.def.memory) w->m.def.memory->used -= v->charged;
+    free(v->ijkl);
+    free(v->alpha);
+    free(v->rest);
+    free(v->lambda);
+    free(v);
+    w->vol = NULL;
+}
+
+#endif

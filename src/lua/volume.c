@@ -1,0 +1,240 @@
+/* volume.c: volume constraints and tetrahedral solids from scripts:
+ *   w:volume(p1, p2, p3, p4, {compliance, rest}) -> index    w:volume_count()
+ *   w:volume_info(i) -> volume, rest, pressure               w:total_volume() -> volume, rest
+ *   w:load_tets(path, {...}) -> body (tetgen's .node/.ele)   w:save_tets(path [, body])
+ * and the helpers of the tets branch of w:from_mesh (lua/mesh.c: tetgen run on the mesh).
+ * Volume constraints are plain indices (1-based): they are never removed. */
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/io.h"
+#include "util.h"
+#include "sandbox.h"
+
+static const char *const volume_keys[] = { "compliance", "rest", NULL };
+
+static int w_volume(lua_State *L)
+{
+    wb_world *w = wbl_checkworld(L, 1);
+    int32_t p[4];
+    for (int k = 0; k < 4; k++) p[k] = wbl_checkparticle(L, w, 2 + k);
+    wb_volume_def d = wb_volume_default_def();
+    if (wbl_checkopts(L, 6, volume_keys, true)) {
+        if (wbl_optreal(L, 6, "compliance", &d.compliance) && d.compliance < 0)
+            return wbl_fielderror(L, 6, "compliance", "must be >= 0");
+        d.has_rest = wbl_optreal(L, 6, "rest", &d.rest);
+    }
+    const int32_t i = wb_volume_add(w, p, &d);
+    /* the options were checked: an argument error is about the particles (one twice) */
+    if (i < 0) return wbl_status_error(L, i == WB_ERR_ARG ? 5 : 6, (wb_status)i, "volume constraint");
+    lua_pushinteger(L, (lua_Integer)i + 1);
+    return 1;
+}
+
+static int w_volume_count(lua_State *L)
+{
+    lua_pushinteger(L, wb_volume_count(wbl_checkworld(L, 1)));
+    return 1;
+}
+
+static int32_t checkvolume(lua_State *L, const wb_world *w, int arg)
+{
+    const lua_Integer i = wbl_checkint(L, arg);
+    if (i < 1 || i > wb_volume_count(w))
+        luaL_argerror(L, arg, lua_pushfstring(L, "volume constraint %I out of range (1..%d)", i, (int)wb_volume_count(w)));
+    return (int32_t)(i - 1);
+}
+
+/* w:volume_info(i) -> current signed volume, rest volume (m^3), pressure (Pa, > 0 compressed) */
+static int w_volume_info(lua_State *L)
+{
+    wb_world *w = wbl_checkworld(L, 1);
+    const int32_t i = checkvolume(L, w, 2);
+    lua_pushnumber(L, wb_volume_current(w, i));
+    lua_pushnumber(L, wb_volume_rest(w, i));
+    lua_pushnumber(L, wb_volume_pressure(w, i));
+    return 3;
+}
+
+static int w_total_volume(lua_State *L)
+{
+    wb_real cur, rest;
+    wb_world_volume_total(wbl_checkworld(L, 1), &cur, &rest);
+    lua_pushnumber(L, cur);
+    lua_pushnumber(L, rest);
+    return 2;
+}
+
+/* ---- tet bodies ------------------------------------------------------------------------------- */
+#define WBL_TETS "wobble.tets (scratch)"
+
+/* tetgen's arrays owned by a userdata, so a Lua error on the way cannot leak them */
+wbio_tets *wbl_push_tets(lua_State *L)
+{
+    wbio_tets *t = (wbio_tets *)lua_newuserdatauv(L, sizeof *t, 0);
+    memset(t, 0, sizeof *t);
+    luaL_setmetatable(L, WBL_TETS);
+    return t;
+}
+
+static int tets_gc(lua_State *L)
+{
+    wbio_tets_free((wbio_tets *)luaL_checkudata(L, 1, WBL_TETS));
+    return 0;
+}
+
+/* the options of a tet body (both builders), at arg; returns whether the radius is the default */
+bool wbl_read_tet_body(lua_State *L, int arg, wb_tet_body_def *d)
+{
+    bool auto_radius = true;
+    if (lua_type(L, arg) != LUA_TTABLE) return auto_radius;
+    if (wbl_optreal(L, arg, "mass", &d->mass) && !(d->mass > 0)) wbl_fielderror(L, arg, "mass", "must be > 0");
+    if (wbl_optreal(L, arg, "radius", &d->radius)) {
+        if (d->radius < 0) wbl_fielderror(L, arg, "radius", "must be >= 0");
+        auto_radius = false;
+    }
+    if (wbl_optreal(L, arg, "volume_compliance", &d->volume_compliance) && d->volume_compliance < 0)
+        wbl_fielderror(L, arg, "volume_compliance", "must be >= 0");
+    wbl_read_link(L, arg, &d->link);
+    const char *e = wb_distance_def_check(&d->link);
+    if (e) luaL_argerror(L, arg, e);
+    return auto_radius;
+}
+
+/* build the body of t on the world at 1 and push it (with .tet_count); raises */
+int wbl_push_tet_body(lua_State *L, wb_world *w, const wbio_tets *t, const int32_t *tri, int32_t ntri,
+                         const wb_tet_body_def *d, bool auto_radius, const wbl_contact_opts *co, const char *what)
+{
+    const int32_t nd0 = wb_distance_count(w), nv0 = wb_volume_count(w);
+    wbl_body_begin(L, t->nv);
+    wb_body b;
+    wb_status st = wb_tet_body(w, t->v, t->nv, t->tet, t->nt, tri, ntri, d, &b);
+    if (st == WB_ERR_ARG) return luaL_error(L, "%s: %s", what, wb_last_error());
+    if (st != WB_OK) return wbl_status_error(L, 2, st, what);
+    if (auto_radius) wbl_default_radius(w, b);
+    wbl_apply_contact_opts(w, b, co);
+    wbl_body_end(L, 1, b, wb_distance_count(w) - nd0);
+    lua_pushinteger(L, wb_volume_count(w) - nv0);
+    lua_setfield(L, -2, "tet_count");
+    return 1;
+}
+
+/* "solid", "solid.node" or "solid.ele" -> the two paths through the sandbox */
+static void tet_paths(lua_State *L, const char *name, int write, char *node, char *ele, char *node_shown,
+                      char *ele_shown)
+{
+    size_t n = strlen(name);
+    if (n > 5 && (strcmp(name + n - 5, ".node") == 0)) n -= 5;
+    else if (n > 4 && strcmp(name + n - 4, ".ele") == 0) n -= 4;
+    if (n == 0 || n > PATH_MAX - 8) luaL_argerror(L, 2, "a file name expected");
+    snprintf(node_shown, PATH_MAX, "%.*s.node", (int)n, name);
+    snprintf(ele_shown, PATH_MAX, "%.*s.ele", (int)n, name);
+    wbl_path(L, node_shown, write, node, PATH_MAX);
+    wbl_path(L, ele_shown, write, ele, PATH_MAX);
+}
+
+static const char *const load_tets_keys[] = {
+    "mass", "radius", "volume_compliance",
+    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
+};
+
+/* w:load_tets(path, {...}) -> body, or nil and "file:line: reason" */
+static int w_load_tets(lua_State *L)
+{
+    wb_world *w = wbl_checkworld(L, 1);
+    const char *name = wbl_checkfilename(L, 2);
+    wbl_checkopts(L, 3, load_tets_keys, true);
+    wb_tet_body_def d = wb_tet_body_default_def();
+    const bool auto_radius = wbl_read_tet_body(L, 3, &d);
+    wbl_contact_opts co;
+    wbl_read_contact_opts(L, 3, &co);
+    char node[PATH_MAX], ele[PATH_MAX], node_shown[PATH_MAX], ele_shown[PATH_MAX], err[1024];
+    tet_paths(L, name, 0, node, ele, node_shown, ele_shown);
+    lua_settop(L, 3);
+    wbio_tets *t = wbl_push_tets(L);
+    if (wbio_read_tets(node, node_shown, ele, ele_shown, t, err, sizeof err)) {
+        luaL_pushfail(L);
+        lua_pushstring(L, err);
+        return 2;
+    }
+    /* a file's tets that the core refuses (flat ones): an expected failure as well */
+    const int32_t nd0 = wb_distance_count(w), nv0 = wb_volume_count(w);
+    wbl_body_begin(L, t->nv);
+    wb_body b;
+    wb_status st = wb_tet_body(w, t->v, t->nv, t->tet, t->nt, NULL, 0, &d, &b);
+    if (st == WB_ERR_ARG) {
+        luaL_pushfail(L);
+        lua_pushfstring(L, "%s: %s", ele_shown, wb_last_error());
+        return 2;
+    }
+    if (st != WB_OK) return wbl_status_error(L, 2, st, "load_tets");
+    if (auto_radius) wbl_default_radius(w, b);
+    wbl_apply_contact_opts(w, b, &co);
+    wbl_body_end(L, 1, b, wb_distance_count(w) - nd0);
+    lua_pushinteger(L, wb_volume_count(w) - nv0);
+    lua_setfield(L, -2, "tet_count");
+    return 1;
+}
+
+/* w:save_tets(path [, body]) -> true, or nil and a message: the volume constraints' tets
+ * (of the body's particles only, renumbered, when a body is given) and their particles */
+static int w_save_tets(lua_State *L)
+{
+    wb_world *w = wbl_checkworld(L, 1);
+    const char *name = wbl_checkfilename(L, 2);
+    int32_t first = 0, count = wb_particle_count(w);
+    if (!lua_isnoneornil(L, 3)) {
+        luaL_checktype(L, 3, LUA_TTABLE);
+        lua_getfield(L, 3, "first");
+        lua_getfield(L, 3, "count");
+        if (!lua_isinteger(L, -2) || !lua_isinteger(L, -1)) return luaL_argerror(L, 3, "body expected (first, count)");
+        first = (int32_t)lua_tointeger(L, -2) - 1;
+        count = (int32_t)lua_tointeger(L, -1);
+        if (first < 0 || count < 0 || (int64_t)first + count > wb_particle_count(w))
+            return luaL_argerror(L, 3, "body's particles out of range");
+        lua_pop(L, 2);
+    }
+    char node[PATH_MAX], ele[PATH_MAX], node_shown[PATH_MAX], ele_shown[PATH_MAX], err[1024];
+    tet_paths(L, name, 1, node, ele, node_shown, ele_shown);
+    const int32_t nvol = wb_volume_count(w);
+    int32_t *tet = (int32_t *)lua_newuserdatauv(L, sizeof *tet * 4 * (size_t)(nvol > 0 ? nvol : 1), 0);
+    int32_t nt = 0;
+    for (int32_t i = 0; i < nvol; i++) {
+        int32_t p[4], in = 1;
+        wb_volume_particles(w, i, p);
+        for (int k = 0; k < 4; k++) in &= p[k] >= first && p[k] < first + count;
+        if (!in) continue;
+        for (int k = 0; k < 4; k++) tet[4 * nt + k] = p[k] - first;
+        nt++;
+    }
+    if (nt == 0) return luaL_error(L, "save_tets: no volume constraints %s", lua_isnoneornil(L, 3) ? "in the world" : "in the body");
+    const wb_real *x = wb_particle_positions(w) + 3 * (size_t)first;
+    if (wbio_write_tets(node, node_shown, ele, ele_shown, x, count, tet, nt, err, sizeof err)) {
+        luaL_pushfail(L);
+        lua_pushstring(L, err);
+        return 2;
+    }
+    lua_pushboolean(L, 1);
+    return 1;
+}
+
+static const luaL_Reg world_methods[] = {
+    { "volume", w_volume },
+    { "volume_count", w_volume_count },
+    { "volume_info", w_volume_info },
+    { "total_volume", w_total_volume },
+    { "load_tets", w_load_tets },
+    { "save_tets", w_save_tets },
+    { NULL, NULL }
+};
+
+void wbl_open_volume(lua_State *L)
+{
+    luaL_newmetatable(L, WBL_TETS);
+    lua_pushcfunction(L, tets_gc);
+    lua_setfield(L, -2, "__gc");
+    lua_pop(L, 1);
+    wbl_add_world_methods(L, world_methods);
+}
