@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "wobble.h"
+#include "shape_match.h"
 
 /* ---- small vector helpers ---------------------------------------------------------- */
 static inline void v3_set(wb_real *o, wb_real x, wb_real y, wb_real z) { o[0] = x; o[1] = y; o[2] = z; }
@@ -181,6 +182,8 @@ struct wb_world {
     wb_model m;
     wb_state s;
     wb_cache k;
+    wb_smatch sm;          /* shape-matching clusters (shape_match.c) */
+    wb_pressures pr;       /* pressure constraints (pressure.c) */
 };
 
 /* internal entry points */

@@ -1,5 +1,6 @@
 /* query.c: read-only measures of a world: energy, momenta, bounds, strain, hash, stats. */
 #include "core.h"
+#include "ctype.h"
 
 static wb_real mass_of(const wb_world *w, int32_t i) { return w->m.w[i] > 0 ? 1 / w->m.w[i] : 0; }
 
@@ -29,6 +30,8 @@ void wb_world_energy(const wb_world *w, wb_real *kinetic, wb_real *potential)
         wb_real c = slot_length(w, s) - w->s.d_rest[s];
         pe += c * c / (2 * w->m.d_alpha[s]);
     }
+    /* TYPE HOOK: the types' elastic energy, walked from the table once `types` lands */
+    pe += wb__shape_type.energy(w) + wb__pressure_type.energy(w);
     *kinetic = ke;
     *potential = pe;
 }
@@ -117,6 +120,26 @@ uint64_t wb_world_hash(const wb_world *w)
     for (int32_t c = 0; c < m->nc; c++) {
         if (!(m->c_gen[c] & 1u)) continue;
         h = fnv(h, &s->c_pose[c], sizeof s->c_pose[c]); /* pose, sweep start, velocities */
+    }
+    /* shape matching and pressure: their parameters and state (rest shapes, rotations) */
+    const wb_smatch *sm = &w->sm;
+    if (sm->n > 0) { /* (worlds without any hash as they always did) */
+        h = fnv(h, &sm->n, sizeof sm->n);
+        h = fnv(h, sm->start, sizeof(int32_t) * ((size_t)sm->n + 1));
+        h = fnv(h, sm->ids, sizeof(int32_t) * (size_t)sm->nids);
+        h = fnv(h, sm->stiff, sizeof(wb_real) * (size_t)sm->n);
+        h = fnv(h, sm->yield, sizeof(wb_real) * (size_t)sm->n);
+        h = fnv(h, sm->creep, sizeof(wb_real) * (size_t)sm->n);
+        h = fnv(h, sm->rest, sizeof(wb_real) * 3 * (size_t)sm->nids);
+        h = fnv(h, sm->q, sizeof(wb_real) * 4 * (size_t)sm->n);
+    }
+    const wb_pressures *pr = &w->pr;
+    if (pr->n > 0) {
+        h = fnv(h, &pr->n, sizeof pr->n);
+        h = fnv(h, pr->surface, sizeof(int32_t) * (size_t)pr->n);
+        h = fnv(h, pr->pressure, sizeof(wb_real) * (size_t)pr->n);
+        h = fnv(h, pr->alpha, sizeof(wb_real) * (size_t)pr->n);
+        h = fnv(h, pr->v0, sizeof(wb_real) * (size_t)pr->n);
     }
     h = fnv(h, &s->time, sizeof s->time);
     h = fnv(h, &s->frame, sizeof s->frame);

@@ -75,6 +75,8 @@ void wb_image_free(wb_image *g)
                   g->d_creep, g->d_break, g->d_rest, g->d_broken, g->d_gen, g->d_free, g->c, g->c_gen,
                   g->surf_start, g->tri, g->group, g->cflags, g->cfric, g->x0 };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    wb__smatch_image_free(g);
+    wb__pressure_image_free(g);
     memset(g, 0, sizeof *g);
 }
 
@@ -148,6 +150,10 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
     g->frame = s->frame;
     g->warnings = s->warnings;
     memcpy(g->last_warning, s->last_warning, sizeof g->last_warning);
+    if ((st = wb__smatch_image_of(w, g)) != WB_OK || (st = wb__pressure_image_of(w, g)) != WB_OK) {
+        wb_image_free(g);
+        return st;
+    }
     return WB_OK;
 }
 
@@ -234,6 +240,7 @@ const char *wb_image_check(const wb_image *g)
     for (int64_t i = 0; i < 3 * (int64_t)g->ntri; i++)
         if (g->tri[i] < 0 || g->tri[i] >= g->np) return "surface corner out of range";
     if (!(g->time >= 0) || !isfinite(g->time) || g->frame < 0 || g->warnings < 0) return "time, frame and warnings must be finite and >= 0";
+    if ((e = wb__smatch_image_check(g)) || (e = wb__pressure_image_check(g))) return e;
     return NULL;
 }
 
@@ -339,6 +346,8 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     wb_status st = w && cms ? wb__reserve(w, g->np, g->nd) : WB_ERR_NOMEM;
     if (st == WB_OK) st = grow_colliders(w, g->nc);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
+    if (st == WB_OK) st = wb__smatch_reserve(w, g);
+    if (st == WB_OK) st = wb__pressure_reserve(w, g);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
@@ -389,6 +398,8 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     }
     free(cms);
     put_surfaces(w, g, 0);
+    wb__smatch_put(w, g, 0);
+    wb__pressure_put(w, g, 0);
     s->time = g->time;
     s->frame = g->frame;
     s->warnings = g->warnings;
@@ -436,11 +447,14 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     wb_status st = wb__reserve(w, g->np, live_d);
     if (st == WB_OK) st = grow_colliders(w, m->nc + new_c);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
+    if (st == WB_OK) st = wb__smatch_reserve(w, g);
+    if (st == WB_OK) st = wb__pressure_reserve(w, g);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
         return st;
     }
+    const int32_t first_surface = m->nsurf;
 
     const int32_t first = m->np;
     for (int32_t i = 0; i < g->np; i++) {
@@ -478,6 +492,8 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     }
     free(cms);
     put_surfaces(w, g, first);
+    wb__smatch_put(w, g, first);
+    wb__pressure_put(w, g, first_surface);
     m->topology_dirty = 1;
     out->first = first;
     out->count = g->np;

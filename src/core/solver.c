@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "core.h"
+#include "ctype.h"
 
 static double now_ms(void)
 {
@@ -264,7 +265,9 @@ wb_status wb_world_step(wb_world *w)
 {
     const double t_begin = now_ms();
     wb_cache *k = &w->k;
-    if (wb__colour(w) != WB_OK || !save_colliders(w)) {
+    /* TYPE HOOK: prepare, walked from the type table once `types` lands */
+    if (wb__colour(w) != WB_OK || !save_colliders(w) || wb__shape_type.prepare(w) != WB_OK ||
+        wb__pressure_type.prepare(w) != WB_OK) {
         wb__warn(w, "frame %lld: out of memory preparing the step; frame skipped", (long long)w->s.frame + 1);
         return WB_ERR_NOMEM;
     }
@@ -301,6 +304,13 @@ wb_status wb_world_step(wb_world *w)
         double t0 = now_ms();
         if (k->ns > 0) memset(k->s_lambda, 0, sizeof(wb_real) * (size_t)k->ns);
         solve_constraints(w, h);
+        /* TYPE HOOK: walked from the type table once `types` lands */
+        wb__shape_type.substep_begin(w);
+        wb__pressure_type.substep_begin(w);
+        for (int it = 0; it < d->iterations; it++) {
+            wb__shape_type.project(w, h);
+            wb__pressure_type.project(w, h);
+        }
         solve += now_ms() - t0;
         wb__contacts_project(w, h);
         wb__collide_and_update(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
@@ -308,7 +318,10 @@ wb_status wb_world_step(wb_world *w)
     }
 
     /* a frame gone non-finite is undone before it can bend or break anything */
-    if (check_finite(w)) plasticity_and_breaking(w);
+    if (check_finite(w)) {
+        plasticity_and_breaking(w);
+        wb__shape_type.frame_end(w); /* TYPE HOOK: frame_end */
+    }
     for (int32_t c = 0; c < w->m.nc; c++) {
         wb_collider_pose *cp = &w->s.c_pose[c];
         v3_copy(cp->p0, cp->p);

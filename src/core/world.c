@@ -98,6 +98,8 @@ wb_world *wb_world_create(const wb_world_def *def)
 void wb_world_destroy(wb_world *w)
 {
     if (!w) return;
+    wb__smatch_free(w);
+    wb__pressures_free(w);
     wb_model *m = &w->m;
     for (int32_t i = 0; i < m->nc; i++) wb__colmesh_free(m->c_shape[i].mesh); /* mesh colliders' copies */
     if (m->def.memory) m->def.memory->used -= m->charged + m->charged_mesh;

@@ -597,8 +597,9 @@ static int read_skins(rd *r, const sections *s, wbio_config *cfg)
 static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
 {
     static const char *const keys[] = { "format", "version", "description", "defaults", "particles", "constraints",
-                                        "colliders", "surfaces", "parts", "skins", "snapshot", NULL };
-    const cJSON *f[12];
+                                        "colliders", "surfaces", "parts", "skins", "snapshot", "shape_matches",
+                                        "pressures", NULL };
+    const cJSON *f[14];
     sections s;
     defaults d;
     memset(&s, 0, sizeof s);
@@ -642,7 +643,8 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
     /* the snapshot first: its slot tables say where the constraints and colliders go */
     if ((s.snapshot && read_snapshot(r, &s, &cfg->img)) || read_particles(r, &s, &d, &cfg->img) ||
         read_constraints(r, &s, &d, &cfg->img) || read_colliders(r, &s, &cfg->img) ||
-        read_surfaces(r, &s, &cfg->img, &s.ntri) || read_parts(r, &s, cfg) || read_skins(r, &s, cfg))
+        read_surfaces(r, &s, &cfg->img, &s.ntri) || read_parts(r, &s, cfg) || read_skins(r, &s, cfg) ||
+        jm_read_shape_matches(r, f[11], &cfg->img) || jm_read_pressures(r, f[12], &cfg->img))
         return -1;
     /* every value was checked where it was read: this is the last line of defence */
     const char *e = wb_image_check(&cfg->img);
