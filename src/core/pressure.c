@@ -28,15 +28,6 @@
 #define BYTES_V (sizeof(int32_t))
 #define BYTES_T (3 * sizeof(int32_t))
 
-void wb__pressures_free(wb_world *w)
-{
-    wb_pressures *p = &w->pr;
-    if (w->m.def.memory) w->m.def.memory->used -= p->charged;
-    void *a[] = { p->surface, p->pressure, p->alpha, p->v0, p->vstart, p->tstart, p->verts, p->tri, p->lambda, p->grad };
-    for (size_t i = 0; i < sizeof a / sizeof a[0]; i++) free(a[i]);
-    memset(p, 0, sizeof *p);
-}
-
 static int32_t grown(int32_t cap, int64_t need)
 {
     int64_t c = cap ? cap : 16;

@@ -56,15 +56,6 @@ int wb__material_charge(wb_world *w, size_t *charged, size_t want)
     return 1;
 }
 
-void wb__smatch_free(wb_world *w)
-{
-    wb_smatch *sm = &w->sm;
-    if (w->m.def.memory) w->m.def.memory->used -= sm->charged;
-    void *p[] = { sm->start, sm->stiff, sm->yield, sm->creep, sm->ids, sm->rest, sm->q, sm->qk, sm->lambda };
-    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
-    memset(sm, 0, sizeof *sm);
-}
-
 static int32_t grown(int32_t cap, int64_t need)
 {
     int64_t c = cap ? cap : 16;

@@ -42,10 +42,8 @@ typedef struct wb_pressures {
     size_t charged;
 } wb_pressures;
 
+/* (world.c's wb_world_destroy frees both structs' arrays and gives their charge back) */
 struct wb_world;
-/* world.c's wb_world_destroy: free the arrays, give the budget back */
-void wb__smatch_free(struct wb_world *w);
-void wb__pressures_free(struct wb_world *w);
 /* charge `want` bytes in place of *charged to the world's budget; 0 (nothing charged)
  * when it would pass the limit */
 int wb__material_charge(struct wb_world *w, size_t *charged, size_t want);
