@@ -452,5 +452,52 @@ wb_status wb_tet_body(wb_world *w, const wb_real *v, int32_t nv, const int32_t *
                       const int32_t *tri, int32_t ntri, const wb_tet_body_def *def, wb_body *out);
 /* edges of m used by other than two triangles (0 for a closed mesh); the first in *a, *b */
 int32_t wb_mesh_open_edges(const wb_mesh *m, int32_t *a, int32_t *b);
+/* ---- shape matching (shape_match.c) ---------------------------------------------------------
+ * Müller et al. 2005: a cluster's particles are pulled towards goal positions, their rest
+ * shape turned by the rotation that best fits the current shape (Müller et al. 2016's
+ * extraction) about the current mass centre; mass-weighted, so momentum is kept. */
+typedef struct wb_shape_match_def {
+    wb_real stiffness;    /* [0, 1], default 1 (rigid): the fraction of a particle's distance
+                           * to its goal removed per 1/60 s; a spring of the same strength at
+                           * any dt and substeps (see shape_match.c) */
+    wb_real yield;        /* shape strain past which the rest shape flows; 0 = elastic */
+    wb_real creep;        /* plastic flow rate, 1/s, past yield */
+} wb_shape_match_def;
+
+wb_shape_match_def wb_shape_match_default_def(void);          /* rigid, elastic */
+const char *wb_shape_match_def_check(const wb_shape_match_def *def); /* NULL or what is wrong */
+/* a cluster of n >= 2 distinct particles, some with mass, their rest shape as they are now;
+ * returns its index (clusters are never removed) or a negative wb_status */
+int32_t wb_shape_match_add(wb_world *w, const int32_t *ids, int32_t n, const wb_shape_match_def *def);
+int32_t wb_shape_match_count(const wb_world *w);
+wb_shape_match_def wb_shape_match_get_def(const wb_world *w, int32_t s);
+int32_t wb_shape_match_size(const wb_world *w, int32_t s);    /* particles in it */
+int32_t wb_shape_match_particle(const wb_world *w, int32_t s, int32_t i); /* its i-th particle */
+/* sqrt(sum m |x - goal|^2 / sum m |rest|^2) now: the strain that `yield` is compared with */
+wb_real wb_shape_match_strain(const wb_world *w, int32_t s);
+/* its i-th particle's rest position about the rest mass centre (plastic flow moves it) */
+void wb_shape_match_rest(const wb_world *w, int32_t s, int32_t i, wb_real out[3]);
+
+/* ---- pressure (pressure.c): a closed surface keeps pressure x its rest volume ------------- */
+typedef struct wb_pressure_def {
+    wb_real pressure;     /* target volume / rest volume, > 0, default 1 */
+    wb_real compliance;   /* XPBD compliance of C = V - pressure V0, m^6/J (U = C^2 / 2 alpha); 0 = hard */
+} wb_pressure_def;
+
+wb_pressure_def wb_pressure_default_def(void);
+const char *wb_pressure_def_check(const wb_pressure_def *def);
+/* the first surface whose corners all lie in the body's particles; -1 when none */
+int32_t wb_body_surface(const wb_world *w, wb_body b);
+/* over surface s, which must be closed (every edge shared by exactly two triangles,
+ * consistently oriented) and enclose a positive volume (outward facing); its rest
+ * volume is the one now. Returns its index or a negative wb_status (WB_ERR_ARG: see
+ * wb_last_error) */
+int32_t wb_pressure_add(wb_world *w, int32_t surface, const wb_pressure_def *def);
+int32_t wb_pressure_count(const wb_world *w);
+wb_pressure_def wb_pressure_get_def(const wb_world *w, int32_t i);
+void wb_pressure_set(wb_world *w, int32_t i, wb_real pressure); /* pressure > 0, finite */
+wb_real wb_pressure_volume(const wb_world *w, int32_t i);      /* enclosed now, m^3 */
+wb_real wb_pressure_rest_volume(const wb_world *w, int32_t i); /* V0, m^3 */
+int32_t wb_pressure_surface(const wb_world *w, int32_t i);
 
 #endif

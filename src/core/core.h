@@ -13,6 +13,7 @@
 
 #include "wobble.h"
 #include "bend.h"
+#include "shape_match.h"
 
 /* ---- small vector helpers ---------------------------------------------------------- */
 static inline void v3_set(wb_real *o, wb_real x, wb_real y, wb_real z) { o[0] = x; o[1] = y; o[2] = z; }
@@ -185,6 +186,8 @@ struct wb_world {
     wb_cache k;
     wb_bends bend;         /* bending constraints (bend.c): model, state and cache */
     struct wb_volumes *vol; /* volume constraints (volume.h), NULL until the first */
+    wb_smatch sm;          /* shape-matching clusters (shape_match.c) */
+    wb_pressures pr;       /* pressure constraints (pressure.c) */
 };
 
 /* internal entry points */

@@ -115,6 +115,26 @@ uint64_t wb_world_hash(const wb_world *w)
         if (!(m->c_gen[c] & 1u)) continue;
         h = fnv(h, &s->c_pose[c], sizeof s->c_pose[c]); /* pose, sweep start, velocities */
     }
+    /* shape matching and pressure: their parameters and state (rest shapes, rotations) */
+    const wb_smatch *sm = &w->sm;
+    if (sm->n > 0) { /* (worlds without any hash as they always did) */
+        h = fnv(h, &sm->n, sizeof sm->n);
+        h = fnv(h, sm->start, sizeof(int32_t) * ((size_t)sm->n + 1));
+        h = fnv(h, sm->ids, sizeof(int32_t) * (size_t)sm->nids);
+        h = fnv(h, sm->stiff, sizeof(wb_real) * (size_t)sm->n);
+        h = fnv(h, sm->yield, sizeof(wb_real) * (size_t)sm->n);
+        h = fnv(h, sm->creep, sizeof(wb_real) * (size_t)sm->n);
+        h = fnv(h, sm->rest, sizeof(wb_real) * 3 * (size_t)sm->nids);
+        h = fnv(h, sm->q, sizeof(wb_real) * 4 * (size_t)sm->n);
+    }
+    const wb_pressures *pr = &w->pr;
+    if (pr->n > 0) {
+        h = fnv(h, &pr->n, sizeof pr->n);
+        h = fnv(h, pr->surface, sizeof(int32_t) * (size_t)pr->n);
+        h = fnv(h, pr->pressure, sizeof(wb_real) * (size_t)pr->n);
+        h = fnv(h, pr->alpha, sizeof(wb_real) * (size_t)pr->n);
+        h = fnv(h, pr->v0, sizeof(wb_real) * (size_t)pr->n);
+    }
     h = fnv(h, &s->time, sizeof s->time);
     h = fnv(h, &s->frame, sizeof s->frame);
     return h;

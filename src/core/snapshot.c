@@ -115,6 +115,8 @@ void wb_image_free(wb_image *g)
                   g->surf_start, g->tri, g->group, g->cflags, g->cfric, g->x0, g->d_bforce,
                   g->b_ij, g->b_alpha, g->b_beta, g->b_rest };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    wb__smatch_image_free(g);
+    wb__pressure_image_free(g);
     memset(g, 0, sizeof *g);
 }
 
@@ -206,6 +208,10 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
         memcpy(g->vol_ijkl, w->vol->ijkl, 4 * (size_t)nvol * sizeof *g->vol_ijkl);
         memcpy(g->vol_alpha, w->vol->alpha, (size_t)nvol * sizeof *g->vol_alpha);
         memcpy(g->vol_rest, w->vol->rest, (size_t)nvol * sizeof *g->vol_rest);
+    }
+    if ((st = wb__smatch_image_of(w, g)) != WB_OK || (st = wb__pressure_image_of(w, g)) != WB_OK) {
+        wb_image_free(g);
+        return st;
     }
     return WB_OK;
 }
@@ -317,6 +323,7 @@ const char *wb_image_check(const wb_image *g)
         const wb_volume_def d = { g->vol_alpha[i], true, g->vol_rest[i] };
         if ((e = wb_volume_def_check(&d))) return e;
     }
+    if ((e = wb__smatch_image_check(g)) || (e = wb__pressure_image_check(g))) return e;
     return NULL;
 }
 
@@ -434,6 +441,8 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     if (st == WB_OK) st = grow_colliders(w, g->nc);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
     if (st == WB_OK && g->nvol > 0) st = wb__volume_reserve(w, g->nvol);
+    if (st == WB_OK) st = wb__smatch_reserve(w, g);
+    if (st == WB_OK) st = wb__pressure_reserve(w, g);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
@@ -495,6 +504,8 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     free(cms);
     put_surfaces(w, g, 0);
     put_volumes(w, g, 0);
+    wb__smatch_put(w, g, 0);
+    wb__pressure_put(w, g, 0);
     s->time = g->time;
     s->frame = g->frame;
     s->warnings = g->warnings;
@@ -544,11 +555,14 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     if (st == WB_OK) st = grow_colliders(w, m->nc + new_c);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
     if (st == WB_OK && g->nvol > 0) st = wb__volume_reserve(w, g->nvol);
+    if (st == WB_OK) st = wb__smatch_reserve(w, g);
+    if (st == WB_OK) st = wb__pressure_reserve(w, g);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
         return st;
     }
+    const int32_t first_surface = m->nsurf;
 
     const int32_t first = m->np;
     for (int32_t i = 0; i < g->np; i++) {
@@ -594,6 +608,8 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     free(cms);
     put_surfaces(w, g, first);
     put_volumes(w, g, first);
+    wb__smatch_put(w, g, first);
+    wb__pressure_put(w, g, first_surface);
     m->topology_dirty = 1;
     out->first = first;
     out->count = g->np;

@@ -23,6 +23,23 @@ typedef struct wb_image_collider {
     int32_t *mt;           /* mesh: (mnt x 3) corners (malloc'd, the image owns it) */
 } wb_image_collider;
 
+/* shape-matching clusters (shape_match.c): model and state by cluster */
+typedef struct wb_image_smatch {
+    int32_t n, nids;
+    int32_t *start;        /* (n + 1) ranges into ids */
+    int32_t *ids;          /* (nids) particles */
+    wb_real *stiff, *yield, *creep; /* (n) */
+    wb_real *rest;         /* (nids x 3) rest shape about its mass centre */
+    wb_real *q;            /* (n x 4) rotation at the end of the last frame */
+} wb_image_smatch;
+
+/* pressure constraints (pressure.c): each over one of the image's surfaces */
+typedef struct wb_image_pressure {
+    int32_t n;
+    int32_t *surface;      /* (n) */
+    wb_real *pressure, *alpha, *v0; /* (n) factor, compliance, rest volume */
+} wb_image_pressure;
+
 typedef struct wb_image {
     wb_world_def def;
 
@@ -68,6 +85,8 @@ typedef struct wb_image {
     int32_t nvol;
     int32_t *vol_ijkl;     /* (nvol x 4) */
     wb_real *vol_alpha, *vol_rest; /* (nvol) compliance, signed rest volume */
+    wb_image_smatch sm;    /* empty unless wb_image_alloc_smatch */
+    wb_image_pressure pr;  /* empty unless wb_image_alloc_pressure */
 } wb_image;
 
 /* allocate the arrays for these counts (zeroed; generations 1, i.e. live; particles collide);
@@ -77,6 +96,9 @@ wb_status wb_image_alloc(wb_image *img, int32_t np, int32_t nd, int32_t nfree, i
 wb_status wb_image_alloc_bends(wb_image *img, int32_t nb);
 /* the volume constraints' arrays for n of them (zeroed); WB_ERR_NOMEM */
 wb_status wb_image_alloc_volumes(wb_image *img, int32_t n);
+/* the materials' sections (after wb_image_alloc; zeroed, rotations identity); WB_ERR_NOMEM */
+wb_status wb_image_alloc_smatch(wb_image *img, int32_t n, int32_t nids);
+wb_status wb_image_alloc_pressure(wb_image *img, int32_t n);
 void wb_image_free(wb_image *img);                     /* and zero it (mesh colliders' arrays too); fine on a zeroed image */
 wb_status wb_image_of(const wb_world *w, wb_image *img); /* a full copy of the world */
 /* NULL, or what is inconsistent (an index out of range, a free list that does not match
@@ -89,5 +111,21 @@ wb_world *wb_world_from_image(const wb_image *img, wb_status *status);
 wb_status wb_world_append_image(wb_world *w, const wb_image *img, wb_body *out);
 /* the collider w:collider{...} would make from a world-frame def, in its own frame + pose */
 wb_status wb_image_collider_from_def(const wb_collider_def *d, wb_image_collider *out);
+
+/* core-internal: each material type's part of the functions above (shape_match.c,
+ * pressure.c). _of copies the world's; _check is the image's last line of defence (its
+ * particle ids and surfaces already checked); _reserve makes room in w for the image's
+ * (adding nothing); _put then adds them, particle ids shifted by pshift and surface
+ * indices by sshift, and cannot fail */
+void wb__smatch_image_free(wb_image *g);
+wb_status wb__smatch_image_of(const wb_world *w, wb_image *g);
+const char *wb__smatch_image_check(const wb_image *g);
+wb_status wb__smatch_reserve(wb_world *w, const wb_image *g);
+void wb__smatch_put(wb_world *w, const wb_image *g, int32_t pshift);
+void wb__pressure_image_free(wb_image *g);
+wb_status wb__pressure_image_of(const wb_world *w, wb_image *g);
+const char *wb__pressure_image_check(const wb_image *g);
+wb_status wb__pressure_reserve(wb_world *w, const wb_image *g);
+void wb__pressure_put(wb_world *w, const wb_image *g, int32_t sshift);
 
 #endif

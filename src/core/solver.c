@@ -23,6 +23,8 @@ const wb_ctype *const wb__ctypes[] = {
     &wb__distance_type,
     &wb__bend_type,
     &wb__volume_type,
+    &wb__shape_type,
+    &wb__pressure_type,
 };
 const int wb__nctypes = (int)(sizeof wb__ctypes / sizeof wb__ctypes[0]);
 
@@ -161,6 +163,13 @@ wb_status wb_world_step(wb_world *w)
         /* TYPE HOOK: the constraint types, walked from the table (wb__ctypes) */
         for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->substep_begin(w);
         solve_constraints(w, h);
+        /* TYPE HOOK: walked from the type table once `types` lands */
+        wb__shape_type.substep_begin(w);
+        wb__pressure_type.substep_begin(w);
+        for (int it = 0; it < d->iterations; it++) {
+            wb__shape_type.project(w, h);
+            wb__pressure_type.project(w, h);
+        }
         solve += now_ms() - t0;
         wb__contacts_project(w, h);
         wb__collide_and_update(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);

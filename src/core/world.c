@@ -107,7 +107,7 @@ void wb_world_destroy(wb_world *w)
     if (m->def.memory) m->def.memory->used -= bd->charged;
     void *bp[] = { bd->ij, bd->alpha, bd->beta, bd->rest, bd->s_ij, bd->s_slot, bd->pack, bd->lambda };
     for (size_t i = 0; i < sizeof bp / sizeof bp[0]; i++) free(bp[i]);
-    if (m->def.memory) m->def.memory->used -= m->charged + m->charged_mesh;
+    if (m->def.memory) m->def.memory->used -= m->charged + m->charged_mesh + w->sm.charged + w->pr.charged;
     wb_state *s = &w->s;
     wb_cache *k = &w->k;
     void *ptrs[] = { m->inv_mass, m->w, m->radius, m->pinned, m->d_ij, m->d_alpha, m->d_beta,
@@ -116,7 +116,12 @@ void wb_world_destroy(wb_world *w)
                      k->colour_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda, k->s_jac,
                      k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->c_sub, k->c_save,
                      k->breaks, m->group, m->cflags, m->cfric, m->x0, k->pc.ij, k->pc.act, k->pc.act_nd,
-                     k->pc.reach, k->pc.cell_start, k->pc.cell_ids, k->pc.keys, k->pc.stamp };
+                     k->pc.reach, k->pc.cell_start, k->pc.cell_ids, k->pc.keys, k->pc.stamp,
+                     /* shape matching and pressure (freed here: a call into their files
+                      * would close a circle, as they call this one) */
+                     w->sm.start, w->sm.stiff, w->sm.yield, w->sm.creep, w->sm.ids, w->sm.rest, w->sm.q,
+                     w->sm.qk, w->sm.lambda, w->pr.surface, w->pr.pressure, w->pr.alpha, w->pr.v0, w->pr.vstart,
+                     w->pr.tstart, w->pr.verts, w->pr.tri, w->pr.lambda, w->pr.grad };
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
     free(w);
 }

@@ -683,8 +683,9 @@ static int read_skins(rd *r, const sections *s, wbio_config *cfg)
 static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
 {
     static const char *const keys[] = { "format", "version", "description", "defaults", "particles", "constraints",
-                                        "colliders", "surfaces", "parts", "skins", "snapshot", "volumes", NULL };
-    const cJSON *f[13];
+                                        "colliders", "surfaces", "parts", "skins", "snapshot", "volumes",
+                                        "shape_matches", "pressures", NULL };
+    const cJSON *f[15];
     sections s;
     defaults d;
     memset(&s, 0, sizeof s);
@@ -740,7 +741,8 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
     if ((s.snapshot && read_snapshot(r, &s, &cfg->img)) || read_particles(r, &s, &d, &cfg->img) ||
         read_constraints(r, &s, &d, &cfg->img) || read_colliders(r, &s, &cfg->img) ||
         read_surfaces(r, &s, &cfg->img, &s.ntri) || read_parts(r, &s, cfg) || read_skins(r, &s, cfg) ||
-        read_volumes(r, f[11], &d, &cfg->img))
+        read_volumes(r, f[11], &d, &cfg->img) || jm_read_shape_matches(r, f[12], &cfg->img) ||
+        jm_read_pressures(r, f[13], &cfg->img))
         return -1;
     /* every value was checked where it was read: this is the last line of defence */
     const char *e = wb_image_check(&cfg->img);

@@ -63,4 +63,9 @@ int jv_opt_nonneg(rd *r, const cJSON *f, const kp *up, const char *key, wb_real 
 int jv_opt_int(rd *r, const cJSON *f, const kp *up, const char *key, int64_t lo, int64_t hi, int64_t *out);
 int jv_opt_vec(rd *r, const cJSON *f, const kp *up, const char *key, int n, wb_real *out);
 
+/* json_material.c: the "shape_matches" and "pressures" sections (arr may be NULL) into
+ * the image, after its particles and surfaces */
+int jm_read_shape_matches(rd *r, const cJSON *arr, wb_image *g);
+int jm_read_pressures(rd *r, const cJSON *arr, wb_image *g);
+
 #endif

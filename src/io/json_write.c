@@ -165,6 +165,40 @@ static void write_volumes(out *o, const wb_image *g)
     fputs("\n  ],\n", f);
 }
 
+/* shape-matching clusters and pressures (json_material.c reads them): only when present */
+static void write_materials(out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    const wb_image_smatch *s = &g->sm;
+    for (int32_t k = 0; k < s->n; k++) {
+        const int32_t a = s->start[k], b = s->start[k + 1];
+        fputs(k ? ",\n    {\"particles\": " : "  \"shape_matches\": [\n    {\"particles\": ", f);
+        ints(f, "      ", NULL, &s->ids[a], b - a);
+        fputs(", \"stiffness\": ", f);
+        num(o, s->stiff[k]);
+        fputs(", \"yield\": ", f);
+        num(o, s->yield[k]);
+        fputs(", \"creep\": ", f);
+        num(o, s->creep[k]);
+        fputs(",\n     \"rest\": ", f);
+        vec(o, &s->rest[3 * (int64_t)a], 3 * (b - a));
+        fputs(", \"rotation\": ", f);
+        vec(o, &s->q[4 * k], 4);
+        fputc('}', f);
+    }
+    if (s->n) fputs("\n  ],\n", f);
+    for (int32_t k = 0; k < g->pr.n; k++) {
+        fprintf(f, "%s    {\"surface\": %d, \"pressure\": ", k ? ",\n" : "  \"pressures\": [\n", g->pr.surface[k]);
+        num(o, g->pr.pressure[k]);
+        fputs(", \"compliance\": ", f);
+        num(o, g->pr.alpha[k]);
+        fputs(", \"rest_volume\": ", f);
+        num(o, g->pr.v0[k]);
+        fputc('}', f);
+    }
+    if (g->pr.n) fputs("\n  ],\n", f);
+}
+
 static void write_colliders(out *o, const wb_image *g)
 {
     static const char *const names[] = { "plane", "sphere", "box", "capsule", "mesh" };
@@ -256,6 +290,7 @@ int wbio_write_snapshot(const wb_world *w, const char *path, const char *shown, 
     write_particles(&o, &g);
     write_constraints(&o, &g);
     write_volumes(&o, &g);
+    write_materials(&o, &g);
     write_colliders(&o, &g);
     write_surfaces(&o, &g);
     fputs("}\n", o.f);

@@ -19,6 +19,8 @@ int luaopen_wobble(lua_State *L)
     wbl_open_collider(L);
     wbl_open_body(L);
     wbl_open_volume(L);
+    wbl_open_shape_match(L);
+    wbl_open_pressure(L);
 
     luaL_newlib(L, wobble_funcs);
     wbl_open_mesh(L);       /* wobble.mesh, wobble.load_mesh; w:from_mesh */

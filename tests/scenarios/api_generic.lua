@@ -31,6 +31,8 @@ local function fixture()
   f.m = wobble.mesh{ vertices = {{-0.5, 1.5, -0.5}, {0.5, 1.5, -0.5}, {0, 2.5, 0.5}, {0, 1.5, 0.5}},
                      triangles = {{1, 3, 2}, {1, 2, 4}, {1, 4, 3}, {2, 3, 4}} }
   f.skin = f.w:skin(f.m, f.body)
+  f.sm = f.w:shape_match(f.body, { stiffness = 0.5 })
+  f.pr = f.w:pressure(f.body)
   f.r = wobble.renderer{ width = 8, height = 8, backend = "null" }
   f.rec = f.w:record_vtk("api_generic/rec")
   return f
@@ -93,6 +95,11 @@ local CASES = {
   ["world:skin"] = { opts = { bones = 2, neighbours = 4, iterations = 2 }, opts_arg = 3,
                      nums = { "bones", "neighbours", "iterations" },
                      call = function(f, o) return f.w:skin(f.m, f.body, o) end },
+  ["world:shape_match"] = { opts = { stiffness = 0.5, yield = 0.1, creep = 1 }, opts_arg = 2,
+                            nums = { "stiffness", "yield", "creep" },
+                            call = function(f, o) return f.w:shape_match(f.body, o) end },
+  ["world:pressure"] = { opts = { pressure = 1.5, compliance = 0 }, opts_arg = 2, nums = { "pressure", "compliance" },
+                         call = function(f, o) return f.w:pressure(f.body, o) end },
   ["world:run"] = { opts = { frames = 1, seconds = 0.1 }, nums = { "frames", "seconds" },
                     call = function(f, o) return f.w:run(o) end },
   ["world:record_pc2"] = { opts = { particles = {1, 2}, every = 1 }, opts_arg = 2, nums = { "particles", "every" },
@@ -177,6 +184,14 @@ end
 for _, name in ipairs{ "angle", "force", "particles", "rest", "valid", "world" } do
   CASES["bend:" .. name] = { none = "a getter: no arguments" }
 end
+CASES["shape_match:rest"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.sm:rest(...) end }
+for _, name in ipairs{ "particles", "stiffness", "strain", "world" } do
+  CASES["shape_match:" .. name] = { none = "a getter: no arguments" }
+end
+CASES["pressure:set_pressure"] = { args = { 1.5 }, nums = { 1 }, call = function(f, ...) return f.pr:set_pressure(...) end }
+for _, name in ipairs{ "pressure", "rest_volume", "volume", "world" } do
+  CASES["pressure:" .. name] = { none = "a getter: no arguments" }
+end
 CASES["body:pin_where"] = { none = "a predicate function" }
 CASES["body:pin_all"] = { none = "no arguments" }
 CASES["body:unpin_all"] = { none = "no arguments" }
@@ -241,6 +256,8 @@ local function api()
   methods_of("distance", f.c, names)
   methods_of("bend", f.bend, names)
   methods_of("collider", f.col, names)
+  methods_of("shape_match", f.sm, names)
+  methods_of("pressure", f.pr, names)
   methods_of("body", f.body, names)
   methods_of("mesh", f.m, names)
   methods_of("skin", f.skin, names)

@@ -1,0 +1,127 @@
+/* json_material.c: the "shape_matches" and "pressures" sections of a particle config
+ * (README, "Particle configs"):
+ *
+ *   "shape_matches": [ {"particles": [0, 1, 2, ...], "stiffness": 1, "yield": 0, "creep": 1,
+ *                       "rest": [x,y,z, ...], "rotation": [w,x,y,z]}, ... ]
+ *   "pressures": [ {"surface": 0, "pressure": 1, "compliance": 0, "rest_volume": 0.5}, ... ]
+ *
+ * "rest" (the rest shape about its mass centre) defaults to the particles' positions
+ * about their mass centre, "rest_volume" to the surface's volume at load; w:save writes
+ * both and the rotation (the fit's warm start) for the exact restore. As w:shape_match,
+ * a cluster given a yield but no creep flows at 1/s. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "json.h"
+
+int jm_read_shape_matches(rd *r, const cJSON *arr, wb_image *g)
+{
+    static const char *const keys[] = { "particles", "stiffness", "yield", "creep", "rest", "rotation", NULL };
+    kp top = { NULL, "shape_matches", 0 };
+    int32_t n = 0, i = 0;
+    int64_t nids = 0;
+    if (!arr) return 0;
+    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
+    /* first pass: the shape of every entry and the total of particles */
+    for (const cJSON *c = arr->child; c; c = c->next, i++) {
+        const cJSON *f[7];
+        kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
+        int32_t k;
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "particles");
+        if (jv_get_array(r, f[0], &pp, WB_MAX_PARTICLES, &k)) return -1;
+        if (k < 2) return jv_fail(r, f[0], 0, &pp, "a cluster needs at least 2 particles, got %d", k);
+        nids += k;
+        if (nids > WB_MAX_CONSTRAINTS) return jv_fail(r, f[0], 0, &pp, "too many particles in clusters");
+    }
+    if (wb_image_alloc_smatch(g, n, (int32_t)nids) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
+    wb_image_smatch *s = &g->sm;
+    int32_t at = 0;
+    i = 0;
+    for (const cJSON *c = arr->child; c; c = c->next, i++) {
+        const cJSON *f[7];
+        kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
+        jv_get_object(r, c, &p, keys, f); /* checked above */
+        const int32_t first = at;
+        int32_t k = 0;
+        for (const cJSON *e = f[0]->child; e; e = e->next, k++) {
+            kp q = { &pp, NULL, k };
+            int64_t v;
+            if (g->np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
+            if (jv_get_int(r, e, &q, 0, g->np - 1, &v)) return -1;
+            s->ids[at++] = (int32_t)v;
+        }
+        s->start[i + 1] = at;
+        wb_real st = 1, y = 0, cr = 0;
+        if (jv_opt_nonneg(r, f[1], &p, "stiffness", &st) || jv_opt_nonneg(r, f[2], &p, "yield", &y) ||
+            jv_opt_nonneg(r, f[3], &p, "creep", &cr) || jv_opt_vec(r, f[5], &p, "rotation", 4, &s->q[4 * i]))
+            return -1;
+        if (st > 1) {
+            kp q = { &p, "stiffness", 0 };
+            return jv_fail(r, f[1], 0, &q, "must be in [0, 1]");
+        }
+        if (!f[3] && y > 0) cr = 1;
+        s->stiff[i] = st;
+        s->yield[i] = y;
+        s->creep[i] = cr;
+        if (f[4]) {
+            kp q = { &p, "rest", 0 };
+            int32_t m;
+            if (jv_get_array(r, f[4], &q, 3ll * WB_MAX_PARTICLES, &m)) return -1;
+            if (m != 3 * k) return jv_fail(r, f[4], 0, &q, "%d numbers expected (x, y, z of each particle), got %d", 3 * k, m);
+            int32_t j = 0;
+            for (const cJSON *e = f[4]->child; e; e = e->next, j++) {
+                kp ej = { &q, NULL, j };
+                if (jv_get_real(r, e, &ej, &s->rest[3 * (int64_t)first + j])) return -1;
+            }
+        } else {
+            /* the positions about their mass centre, as w:shape_match takes them */
+            wb_real cm[3] = { 0, 0, 0 }, M = 0;
+            for (int32_t j = first; j < at; j++) {
+                const wb_real im = g->inv_mass[s->ids[j]];
+                if (im <= 0) continue;
+                for (int a = 0; a < 3; a++) cm[a] += g->x[3 * s->ids[j] + a] * (1 / im);
+                M += 1 / im;
+            }
+            if (!(M > 0)) return jv_fail(r, f[0], 0, &pp, "a cluster needs a particle with mass (all are immovable)");
+            for (int a = 0; a < 3; a++) cm[a] *= 1 / M;
+            for (int32_t j = first; j < at; j++)
+                for (int a = 0; a < 3; a++) s->rest[3 * j + a] = g->x[3 * s->ids[j] + a] - cm[a];
+        }
+    }
+    return 0;
+}
+
+int jm_read_pressures(rd *r, const cJSON *arr, wb_image *g)
+{
+    static const char *const keys[] = { "surface", "pressure", "compliance", "rest_volume", NULL };
+    kp top = { NULL, "pressures", 0 };
+    int32_t n = 0, i = 0;
+    if (!arr) return 0;
+    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
+    if (wb_image_alloc_pressure(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
+    for (const cJSON *c = arr->child; c; c = c->next, i++) {
+        const cJSON *f[5];
+        kp p = { &top, NULL, i };
+        int64_t s;
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "surface");
+        if (g->nsurf == 0) {
+            kp q = { &p, "surface", 0 };
+            return jv_fail(r, f[0], 0, &q, "there are no surfaces");
+        }
+        wb_real pr = 1, a = 0, v0 = -1;
+        if (jv_opt_int(r, f[0], &p, "surface", 0, g->nsurf - 1, &s) || jv_opt_real(r, f[1], &p, "pressure", &pr) ||
+            jv_opt_nonneg(r, f[2], &p, "compliance", &a) || jv_opt_real(r, f[3], &p, "rest_volume", &v0))
+            return -1;
+        kp pq = { &p, "pressure", 0 }, vq = { &p, "rest_volume", 0 };
+        if (!(pr > 0)) return jv_fail(r, f[1], 0, &pq, "must be > 0");
+        if (f[3] && !(v0 > 0)) return jv_fail(r, f[3], 0, &vq, "must be > 0");
+        g->pr.surface[i] = (int32_t)s;
+        g->pr.pressure[i] = pr;
+        g->pr.alpha[i] = a;
+        g->pr.v0[i] = v0; /* < 0: the volume at load */
+    }
+    return 0;
+}
