@@ -18,7 +18,7 @@ static double now_ms(void)
 }
 
 /* the constraint types the step walks, in projection order (ctype.h; DESIGN.md §2):
- * adding a type adds its line here. TYPE TABLE: volume, shape and pressure join here. */
+ * adding a type adds its line here. */
 const wb_ctype *const wb__ctypes[] = {
     &wb__distance_type,
     &wb__bend_type,
@@ -163,13 +163,6 @@ wb_status wb_world_step(wb_world *w)
         /* TYPE HOOK: the constraint types, walked from the table (wb__ctypes) */
         for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->substep_begin(w);
         solve_constraints(w, h);
-        /* TYPE HOOK: walked from the type table once `types` lands */
-        wb__shape_type.substep_begin(w);
-        wb__pressure_type.substep_begin(w);
-        for (int it = 0; it < d->iterations; it++) {
-            wb__shape_type.project(w, h);
-            wb__pressure_type.project(w, h);
-        }
         solve += now_ms() - t0;
         wb__contacts_project(w, h);
         wb__collide_and_update(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
