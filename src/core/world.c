@@ -111,6 +111,7 @@ void wb_world_destroy(wb_world *w)
                      k->breaks, m->group, m->cflags, m->cfric, m->x0, k->pc.ij, k->pc.act, k->pc.act_nd,
                      k->pc.reach, k->pc.cell_start, k->pc.cell_ids, k->pc.keys, k->pc.stamp };
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
+    wb__tricontacts_free(&k->tc);
     free(w);
 }
 
