@@ -354,10 +354,12 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
             s_now = v3_dot(d, n);
         }
         const wb_real r = rad[p], dist = sqrt(d2);
-        /* crossed the plane within reach of the triangle: it went through this substep
-         * (the relative motion bounds how far off the triangle it could have crossed) */
+        /* crossed the plane over the triangle's face, within reach of it: it went through
+         * this substep (the relative motion bounds how far off it could have crossed).
+         * Beside an edge or a corner the plane's extension means nothing: a point in a
+         * valley between two triangles is below each one's extension and still outside */
         int crossed = 0;
-        if (s_prev != 0 && s_now * s_prev < 0) {
+        if (s_prev != 0 && s_now * s_prev < 0 && b[0] > 0 && b[1] > 0 && b[2] > 0) {
             wb_real rel[3];
             v3_sub(rel, xs, &xp[3 * p]);
             for (int i = 0; i < 3; i++) v3_madd(rel, &x[3 * v[i]], -b[i]), v3_madd(rel, &xp[3 * v[i]], b[i]);
