@@ -149,17 +149,20 @@ int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, i
 /* ---- particle-triangle contacts: per-frame scratch (tricontact.c) ------------------- */
 typedef struct wb_tricontacts {
     int32_t n, cap;        /* candidates of this frame */
-    int32_t *pt;           /* (n x 2) point, triangle; triangle order, then the hash's order */
+    int32_t *pt;           /* (n x 2) point, triangle; point order, then triangle order */
     int32_t nact, cap_act; /* contacts that corrected positions in the current substep */
     int32_t *act;          /* (nact) candidate index */
     wb_real *act_d;        /* (nact x 8) barycentrics, normal (triangle -> point), depth, force */
     int32_t cap_d;
     wb_real *reach;        /* (np) a point's broad-phase reach, < 0 = not a point */
     int32_t cap_reach;
-    wb_real *tbox;         /* (ntri x 7) a triangle's box and how far its corners may move */
+    wb_real *tbox;         /* (ntri x 10) a triangle's box, how far its corners may move, its normal */
     int32_t cap_tbox;
-    int32_t *cell_start, *cell_ids, *stamp; /* spatial hash of the points */
+    int32_t *cell_start, *cell_ids, *stamp; /* spatial hash of the triangles */
     int32_t cap_cells, cap_ids, cap_stamp;
+    int32_t *tgroup;       /* (ntri) the group none of whose points may touch it, or -1 */
+    int32_t *tstamp;       /* (ntri) the last point that met it in the broad phase */
+    int32_t cap_tgroup, cap_tstamp;
     int32_t last;          /* contacts in the last substep (corrected or in touch) */
     double broad_ms;       /* its broad phase in the last step */
 } wb_tricontacts;

@@ -126,18 +126,23 @@ static int pair_allowed(const wb_model *m, int32_t p, int32_t v)
     return (m->cflags[p] & m->cflags[v] & WB_CF_SELF) != 0;
 }
 
-static int may_touch_tri(const wb_model *m, int32_t p, const int32_t *v)
+/* the rules without geometry: not its own corner, and each corner allowed; *same: some
+ * corner is of the point's own body (the rest rule then applies) */
+static int rules_allow(const wb_model *m, int32_t p, const int32_t *v, int *same)
 {
     if (p == v[0] || p == v[1] || p == v[2]) return 0;
-    const wb_real *wv = m->w;
-    if (wv[p] == 0 && wv[v[0]] == 0 && wv[v[1]] == 0 && wv[v[2]] == 0) return 0;
-    int same = 0;
+    *same = 0;
     for (int k = 0; k < 3; k++) {
         if (!pair_allowed(m, p, v[k])) return 0;
-        same |= m->group[p] != 0 && m->group[p] == m->group[v[k]];
+        *same |= m->group[p] != 0 && m->group[p] == m->group[v[k]];
     }
-    if (!same) return 1;
-    /* one body: not a point that lay within its radius of the triangle at rest */
+    const wb_real *wv = m->w;
+    return wv[p] != 0 || wv[v[0]] != 0 || wv[v[1]] != 0 || wv[v[2]] != 0;
+}
+
+/* one body: not a point that lay within its radius of the triangle at rest */
+static int rest_apart(const wb_model *m, int32_t p, const int32_t *v)
+{
     wb_real bary[3], q[3];
     const wb_real d2 = wb__tri_closest(&m->x0[3 * p], &m->x0[3 * v[0]], &m->x0[3 * v[1]], &m->x0[3 * v[2]], bary, q);
     return !(d2 < m->radius[p] * m->radius[p]);
@@ -166,7 +171,9 @@ static wb_real box_dist2(const wb_real p[3], const wb_real lo[3], const wb_real 
     return s;
 }
 
-/* point p against triangle t (its box and motion in tb): appended when its reach sphere
+#define TB 10 /* per triangle: box lo, hi; how far its corners may move; unit normal */
+
+/* point p against triangle t (its box, motion and normal in tb): appended when its reach sphere
  * comes within the triangle's motion of the triangle and the rules let them touch */
 static int consider(wb_world *w, const wb_real *tb, int32_t t, int32_t p)
 {
@@ -174,19 +181,59 @@ static int consider(wb_world *w, const wb_real *tb, int32_t t, int32_t p)
     const wb_model *m = &w->m;
     const wb_real *x = w->s.x, rp = c->reach[p], reach = rp + tb[6];
     if (rp < 0) return 0;
+    /* the box first: it reads the triangle's own record only */
     wb_real lo[3], hi[3];
     for (int k = 0; k < 3; k++) lo[k] = tb[k] - tb[6], hi[k] = tb[3 + k] + tb[6];
     if (!(box_dist2(&x[3 * p], lo, hi) < rp * rp)) return 0;
     const int32_t *v = &m->tri[3 * t];
+    int same;
+    if (!rules_allow(m, p, v, &same)) return 0;
+    wb_real d[3];
+    v3_sub(d, &x[3 * p], &x[3 * v[0]]);
+    if (!(fabs(v3_dot(d, tb + 7)) < reach)) return 0;
     wb_real bary[3], q[3];
     if (!(wb__tri_closest(&x[3 * p], &x[3 * v[0]], &x[3 * v[1]], &x[3 * v[2]], bary, q) < reach * reach)) return 0;
-    if (!may_touch_tri(m, p, v)) return 0;
+    if (same && !rest_apart(m, p, v)) return 0;
     int32_t *pt = wb__grow(c->pt, &c->cap, 2 * (c->n + 1), sizeof *pt);
     if (!pt) return -1;
     c->pt = pt;
     pt[2 * c->n] = p;
     pt[2 * c->n + 1] = t;
     c->n++;
+    return 0;
+}
+
+/* the cells of box [lo - g, hi + g] */
+static double cell_range(const wb_real *lo, const wb_real *hi, wb_real g, wb_real inv, int64_t c0[3], int64_t c1[3])
+{
+    double n = 1;
+    for (int k = 0; k < 3; k++) {
+        c0[k] = cell_of(lo[k] - g, inv);
+        c1[k] = cell_of(hi[k] + g, inv);
+        n *= (double)(c1[k] - c0[k] + 1);
+    }
+    return n;
+}
+
+/* point p against the triangles of bucket bk not yet seen by it (tstamp) */
+static int visit(wb_world *w, uint32_t bk, int32_t p)
+{
+    wb_tricontacts *c = &w->k.tc;
+    const wb_real *xp = &w->s.x[3 * p], rp = c->reach[p];
+    const int32_t gp = w->m.group[p];
+    for (int32_t s = c->cell_start[bk]; s < c->cell_start[bk + 1]; s++) {
+        const int32_t t = c->cell_ids[s];
+        if (c->tstamp[t] == p) continue;
+        c->tstamp[t] = p;
+        /* a body's own hull is near all of its particles: the cheapest test first; then
+         * the slabs of the grown box, which reject most of the rest */
+        if (c->tgroup[t] == gp) continue;
+        const wb_real *tb = &c->tbox[TB * t], gr = tb[6] + rp;
+        if (xp[0] < tb[0] - gr || xp[0] > tb[3] + gr || xp[1] < tb[1] - gr || xp[1] > tb[4] + gr ||
+            xp[2] < tb[2] - gr || xp[2] > tb[5] + gr)
+            continue;
+        if (consider(w, tb, t, p) < 0) return -1;
+    }
     return 0;
 }
 
@@ -198,28 +245,38 @@ static int broadphase(wb_world *w)
     wb_real *reach = wb__grow(c->reach, &c->cap_reach, m->np, sizeof *reach);
     if (!reach) return -1;
     c->reach = reach;
-    wb_real *tbox = wb__grow(c->tbox, &c->cap_tbox, 7 * m->ntri, sizeof *tbox);
+    wb_real *tbox = wb__grow(c->tbox, &c->cap_tbox, TB * m->ntri, sizeof *tbox);
     if (!tbox) return -1;
     c->tbox = tbox;
+    int32_t *tg = wb__grow(c->tgroup, &c->cap_tgroup, m->ntri, sizeof *tg);
+    if (!tg) return -1;
+    c->tgroup = tg;
+    int32_t *ts = wb__grow(c->tstamp, &c->cap_tstamp, m->ntri, sizeof *ts);
+    if (!ts) return -1;
+    c->tstamp = ts;
     /* how far a particle may get this frame (velocity and gravity over dt); points add
      * their radius and a quarter of it for what the constraints move them, as contact.c */
     const wb_real dt = m->def.dt, g = v3_len(m->def.gravity) * dt * dt;
-    wb_real rmax = 0;
+    wb_real rsum = 0;
     int32_t na = 0;
     for (int32_t i = 0; i < m->np; i++) {
         const wb_real mv = v3_len_safe(&v[3 * i]) * dt + g + m->radius[i] / 4;
         reach[i] = (m->cflags[i] & (WB_CF_COLLIDE | WB_CF_SELF)) ? m->radius[i] + mv : -1;
         if (!isfinite(reach[i])) reach[i] = -1;
-        if (reach[i] >= 0) { na++; if (reach[i] > rmax) rmax = reach[i]; }
+        if (reach[i] >= 0) { na++; rsum += reach[i]; }
     }
-    /* triangles: box and motion (-1: left out); the cell is the larger of the widest
-     * reach and the mean triangle size, so a triangle visits a few cells */
+    /* triangles: box, motion (-1: left out), normal; and the group no point of which may
+     * touch it (its corners' body when it does not self-collide; else -1) */
     wb_real ext = 0;
     int32_t nt = 0;
     for (int32_t t = 0; t < m->ntri; t++) {
         const int32_t *tv = &m->tri[3 * t];
-        wb_real *tb = &tbox[7 * t];
+        wb_real *tb = &tbox[TB * t];
         tb[6] = -1;
+        ts[t] = -1;
+        const int32_t g0 = m->group[tv[0]];
+        tg[t] = g0 > 0 && m->group[tv[1]] == g0 && m->group[tv[2]] == g0 &&
+                        !(m->cflags[tv[0]] & m->cflags[tv[1]] & m->cflags[tv[2]] & WB_CF_SELF) ? g0 : -1;
         if (!((m->cflags[tv[0]] | m->cflags[tv[1]] | m->cflags[tv[2]]) & (WB_CF_COLLIDE | WB_CF_SELF))) continue;
         wb_real mv = 0;
         for (int k = 0; k < 3; k++) {
@@ -231,64 +288,102 @@ static int broadphase(wb_world *w)
             const wb_real mk = v3_len_safe(&v[3 * tv[k]]) * dt + g + m->radius[tv[k]] / 4;
             if (mk > mv) mv = mk;
         }
-        const wb_real e = fmax(tb[3] - tb[0], fmax(tb[4] - tb[1], tb[5] - tb[2]));
-        if (!isfinite(mv) || !isfinite(e)) continue;
+        const wb_real e = fmax(tb[3] - tb[0], fmax(tb[4] - tb[1], tb[5] - tb[2])) + 2 * mv;
+        if (!isfinite(e)) continue;
         tb[6] = mv;
+        /* the unit normal (0 when degenerate): a point farther than its reach from the
+         * plane is farther from the triangle */
+        wb_real e1[3], e2[3];
+        v3_sub(e1, &x[3 * tv[1]], &x[3 * tv[0]]);
+        v3_sub(e2, &x[3 * tv[2]], &x[3 * tv[0]]);
+        v3_cross(tb + 7, e1, e2);
+        const wb_real ln = v3_len(tb + 7);
+        if (ln > 0 && isfinite(ln)) v3_scale(tb + 7, tb + 7, 1 / ln);
+        else v3_set(tb + 7, 0, 0, 0);
         ext += e;
         nt++;
     }
     if (na == 0 || nt == 0) return 0;
-    const wb_real cell = fmax(2 * rmax, ext / nt);
+    /* a grid of triangles: each in the buckets of the cells its box grown by its motion
+     * covers; a point visits the cells its reach covers. The cell: the mean grown
+     * triangle, or the mean reach diameter when that is larger, so either visits a few
+     * cells; a triangle or a point that would visit many goes by brute force instead */
+    const wb_real cell = fmax(ext / nt, 2 * rsum / na);
     if (!(cell > 0) || !isfinite(cell)) return 0;
     const wb_real inv = 1 / cell;
     uint32_t size = 16;
-    while (size < 2 * (uint32_t)na && size < (1u << 30)) size *= 2;
+    while (size < 8 * (uint32_t)nt && size < (1u << 30)) size *= 2;
     const uint32_t mask = size - 1;
     int32_t *cs = wb__grow(c->cell_start, &c->cap_cells, (int32_t)size + 1, sizeof *cs);
     if (!cs) return -1;
     c->cell_start = cs;
-    int32_t *ids = wb__grow(c->cell_ids, &c->cap_ids, na, sizeof *ids);
-    if (!ids) return -1;
-    c->cell_ids = ids;
     int32_t *stamp = wb__grow(c->stamp, &c->cap_stamp, (int32_t)size, sizeof *stamp);
     if (!stamp) return -1;
     c->stamp = stamp;
-    for (uint32_t b = 0; b < size; b++) stamp[b] = -1;
-    /* counting sort of the points by bucket, index order inside a bucket */
     memset(cs, 0, sizeof *cs * (size + 1));
-    for (int32_t i = 0; i < m->np; i++)
-        if (reach[i] >= 0) cs[cell_hash(cell_of(x[3 * i], inv), cell_of(x[3 * i + 1], inv), cell_of(x[3 * i + 2], inv), mask) + 1]++;
-    for (uint32_t b = 0; b < size; b++) cs[b + 1] += cs[b];
-    for (int32_t i = 0; i < m->np; i++)
-        if (reach[i] >= 0) ids[cs[cell_hash(cell_of(x[3 * i], inv), cell_of(x[3 * i + 1], inv), cell_of(x[3 * i + 2], inv), mask)]++] = i;
-    for (uint32_t b = size; b > 0; b--) cs[b] = cs[b - 1];
-    cs[0] = 0;
-    for (int32_t t = 0; t < m->ntri; t++) {
-        const wb_real *tb = &tbox[7 * t];
-        if (tb[6] < 0) continue;
-        int64_t c0[3], c1[3];
-        double ncell = 1;
-        for (int k = 0; k < 3; k++) {
-            c0[k] = cell_of(tb[k] - tb[6] - rmax, inv);
-            c1[k] = cell_of(tb[3 + k] + tb[6] + rmax, inv);
-            ncell *= (double)(c1[k] - c0[k] + 1);
+    /* two passes over the triangles' cells: count, then fill (a counting sort, triangles
+     * in index order inside a bucket); the big ones go by brute force after */
+    int64_t entries = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        for (uint32_t bk = 0; bk < size; bk++) stamp[bk] = -1;
+        for (int32_t t = 0; t < m->ntri; t++) {
+            const wb_real *tb = &tbox[TB * t];
+            if (tb[6] < 0) continue;
+            int64_t c0[3], c1[3];
+            if (cell_range(tb, tb + 3, tb[6], inv, c0, c1) > 64) continue;
+            for (int64_t cz = c0[2]; cz <= c1[2]; cz++)
+                for (int64_t cy = c0[1]; cy <= c1[1]; cy++)
+                    for (int64_t cx = c0[0]; cx <= c1[0]; cx++) {
+                        /* each bucket once per triangle: two cells may hash to one */
+                        const uint32_t bk = cell_hash(cx, cy, cz, mask);
+                        if (stamp[bk] == t) continue;
+                        stamp[bk] = t;
+                        if (pass == 0) cs[bk + 1]++, entries++;
+                        else c->cell_ids[cs[bk]++] = t;
+                    }
         }
-        if (ncell > 2.0 * na + 27) {
-            /* a triangle far bigger than the rest: every point, cheaper than its cells */
-            for (int32_t p = 0; p < m->np; p++)
-                if (consider(w, tb, t, p) < 0) return -1;
+        if (pass == 0) {
+            if (entries > INT32_MAX / 2) return -1;
+            int32_t *ids = wb__grow(c->cell_ids, &c->cap_ids, (int32_t)entries + 1, sizeof *ids);
+            if (!ids) return -1;
+            c->cell_ids = ids;
+            for (uint32_t bk = 0; bk < size; bk++) cs[bk + 1] += cs[bk];
+        }
+    }
+    for (uint32_t bk = size; bk > 0; bk--) cs[bk] = cs[bk - 1]; /* back to starts */
+    cs[0] = 0;
+    /* the points in index order; the buckets each once per point (stamp), a triangle each
+     * once per point (tstamp) */
+    for (uint32_t bk = 0; bk < size; bk++) stamp[bk] = -1;
+    for (int32_t p = 0; p < m->np; p++) {
+        if (reach[p] < 0) continue;
+        int64_t c0[3], c1[3];
+        const wb_real *xp = &x[3 * p];
+        if (cell_range(xp, xp, reach[p], inv, c0, c1) > 64) {
+            for (int32_t t = 0; t < m->ntri; t++)
+                if (tbox[TB * t + 6] >= 0 && tg[t] != m->group[p] && consider(w, &tbox[TB * t], t, p) < 0) return -1;
             continue;
         }
         for (int64_t cz = c0[2]; cz <= c1[2]; cz++)
             for (int64_t cy = c0[1]; cy <= c1[1]; cy++)
                 for (int64_t cx = c0[0]; cx <= c1[0]; cx++) {
-                    /* each bucket once per triangle: two cells may hash to one */
                     const uint32_t bk = cell_hash(cx, cy, cz, mask);
-                    if (stamp[bk] == t) continue;
-                    stamp[bk] = t;
-                    for (int32_t s = cs[bk]; s < cs[bk + 1]; s++)
-                        if (consider(w, tb, t, ids[s]) < 0) return -1;
+                    if (stamp[bk] == p) continue;
+                    stamp[bk] = p;
+                    if (visit(w, bk, p) < 0) return -1;
                 }
+    }
+    /* the big triangles against every point (after the grid: their pairs come last) */
+    for (int32_t t = 0; t < m->ntri; t++) {
+        const wb_real *tb = &tbox[TB * t];
+        int64_t c0[3], c1[3];
+        if (tb[6] < 0 || !(cell_range(tb, tb + 3, tb[6], inv, c0, c1) > 64)) continue;
+        for (int32_t p = 0; p < m->np; p++) {
+            int64_t d0[3], d1[3];
+            /* a brute-force point has met every triangle already */
+            if (reach[p] < 0 || tg[t] == m->group[p] || cell_range(&x[3 * p], &x[3 * p], reach[p], inv, d0, d1) > 64) continue;
+            if (consider(w, tb, t, p) < 0) return -1;
+        }
     }
     return 0;
 }
@@ -333,11 +428,8 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
         wb_real *xs = &x[3 * p];
         const wb_real *xa = &x[3 * v[0]], *xb = &x[3 * v[1]], *xc = &x[3 * v[2]];
         wb_real b[3], q[3], d[3], n[3], e1[3], e2[3];
-        const wb_real d2 = wb__tri_closest(xs, xa, xb, xc, b, q);
-        const wb_real wp = wv[p], W = wp + b[0] * b[0] * wv[v[0]] + b[1] * b[1] * wv[v[1]] + b[2] * b[2] * wv[v[2]];
-        if (W == 0) continue;
-        v3_sub(d, xs, q);
-        /* the side at the substep's start: the plane of the triangle then */
+        const wb_real r = rad[p];
+        /* the side now and at the substep's start (the plane of the triangle then) */
         v3_sub(e1, xb, xa);
         v3_sub(e2, xc, xa);
         v3_cross(n, e1, e2);
@@ -351,9 +443,16 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
             v3_cross(np, f1, f2);
             v3_sub(dp, &xp[3 * p], &xp[3 * v[0]]);
             s_prev = v3_dot(dp, np);
+            v3_sub(d, xs, xa);
             s_now = v3_dot(d, n);
+            /* on its side and farther than r from the plane: from the triangle too */
+            if (s_now * s_prev >= 0 && fabs(s_now) > r * (1 + (wb_real)1e-9)) continue;
         }
-        const wb_real r = rad[p], dist = sqrt(d2);
+        const wb_real d2 = wb__tri_closest(xs, xa, xb, xc, b, q);
+        const wb_real wp = wv[p], W = wp + b[0] * b[0] * wv[v[0]] + b[1] * b[1] * wv[v[1]] + b[2] * b[2] * wv[v[2]];
+        if (W == 0) continue;
+        v3_sub(d, xs, q);
+        const wb_real dist = sqrt(d2);
         /* crossed the plane over the triangle's face, within reach of it: it went through
          * this substep (the relative motion bounds how far off it could have crossed).
          * Beside an edge or a corner the plane's extension means nothing: a point in a
@@ -446,7 +545,8 @@ void wb__tricontacts_velocity(wb_world *w, wb_real h)
 
 void wb__tricontacts_free(wb_tricontacts *t)
 {
-    void *ptrs[] = { t->pt, t->act, t->act_d, t->reach, t->tbox, t->cell_start, t->cell_ids, t->stamp };
+    void *ptrs[] = { t->pt, t->act, t->act_d, t->reach, t->tbox, t->cell_start, t->cell_ids, t->stamp, t->tgroup,
+                     t->tstamp };
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
     memset(t, 0, sizeof *t);
 }
