@@ -171,11 +171,10 @@ typedef struct wb_tricontacts {
  * point out; returns the squared distance (a degenerate triangle: its nearest edge) */
 wb_real wb__tri_closest(const wb_real p[3], const wb_real a[3], const wb_real b[3], const wb_real c[3],
                         wb_real bary[3], wb_real out[3]);
-/* tricontact.c: the step's three passes, as contact.c's; free: the scratch */
+/* tricontact.c: the step's three passes, as contact.c's (world.c frees the scratch) */
 void wb__tricontacts_begin(wb_world *w);
 void wb__tricontacts_project(wb_world *w, wb_real h);
 void wb__tricontacts_velocity(wb_world *w, wb_real h);
-void wb__tricontacts_free(wb_tricontacts *t);
 
 /* ---- solver cache: packed colour batches and per-step scratch ------------------------ */
 typedef struct wb_cache {

@@ -543,14 +543,6 @@ void wb__tricontacts_velocity(wb_world *w, wb_real h)
     }
 }
 
-void wb__tricontacts_free(wb_tricontacts *t)
-{
-    void *ptrs[] = { t->pt, t->act, t->act_d, t->reach, t->tbox, t->cell_start, t->cell_ids, t->stamp, t->tgroup,
-                     t->tstamp };
-    for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
-    memset(t, 0, sizeof *t);
-}
-
 /* ---- readout -------------------------------------------------------------------------------------------- */
 int32_t wb_world_tri_contact_count(const wb_world *w) { return w->k.tc.nact; }
 
