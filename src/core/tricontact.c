@@ -30,12 +30,11 @@
  * were created (wb_model.x0). A triangle whose particles are all immovable still stops
  * others.
  *
- * Broad phase, once per frame: the points go into a spatial hash; every triangle visits
- * the cells of its box grown by how far its corners may move this frame and by the
- * largest point reach, and keeps the points whose reach sphere comes within that motion
- * of the triangle. The candidates are projected serially in that order (triangle order,
- * then the hash's), which depends on the positions alone: bit-identical for any thread
- * count. */
+ * Broad phase, once per frame: the triangles go into a hashed grid, each into the cells
+ * of its box grown by how far its corners may move this frame; every point visits the
+ * cells its reach (radius and motion) covers and keeps the triangles it comes within
+ * that motion of. The candidates are projected serially in that order (point order, then
+ * the grid's), which depends on the positions alone: bit-identical for any thread count. */
 #include <stdlib.h>
 #include <time.h>
 
