@@ -270,6 +270,17 @@ wb_real wb_body_spacing(const wb_world *w, wb_body b);
 typedef struct wb_contact { int32_t a, b; wb_real force, normal[3], depth; } wb_contact;
 int32_t wb_world_contact_count(const wb_world *w);
 wb_contact wb_world_contact_at(const wb_world *w, int32_t i);     /* 0 <= i < count */
+/* particle-triangle contacts (tricontact.c): a particle keeps its radius from the
+ * triangles of the registered surfaces it may touch (the pair rules above between it and
+ * each corner; never its own triangles, nor, in one body, a triangle it lay within its
+ * radius of where created). Those that corrected positions in the last substep, in
+ * projection order: p the particle, tri the corners, bary the barycentrics of the
+ * closest point; normal unit from p towards the triangle (the triangle is pushed along
+ * it, p against it, as wb_contact's a -> b); depth and force as wb_contact's, with
+ * lambda = depth / (w_p + sum bary_i^2 w_i). Counted in stats.particle_contacts */
+typedef struct wb_tri_contact { int32_t p, tri[3]; wb_real bary[3], force, normal[3], depth; } wb_tri_contact;
+int32_t wb_world_tri_contact_count(const wb_world *w);
+wb_tri_contact wb_world_tri_contact_at(const wb_world *w, int32_t i); /* 0 <= i < count */
 
 /* ---- surfaces: triangles over particles, for drawing and export ------------------------ */
 /* builders register theirs (the cloth's sheet, the lattice's hull); returns the surface
@@ -293,7 +304,8 @@ typedef struct wb_stats {
     int32_t particles, distances, broken, colliders;
     int32_t colours;          /* batches of the last colouring */
     int32_t contacts;         /* collider contacts in the last substep */
-    int32_t particle_contacts; /* particle pairs overlapping or in touch in the last substep */
+    int32_t particle_contacts; /* particle pairs and particle-triangle pairs overlapping or in touch
+                                  in the last substep */
     double broad_ms;          /* broad phase of the last step */
     int64_t projections;      /* constraint projections in the last step */
     double step_ms;           /* wall time of the last step */

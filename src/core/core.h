@@ -149,6 +149,36 @@ typedef struct wb_contacts {
 int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, int32_t n,
                        int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
 
+/* ---- particle-triangle contacts: per-frame scratch (tricontact.c) ------------------- */
+typedef struct wb_tricontacts {
+    int32_t n, cap;        /* candidates of this frame */
+    int32_t *pt;           /* (n x 2) point, triangle; point order, then triangle order */
+    int32_t nact, cap_act; /* contacts that corrected positions in the current substep */
+    int32_t *act;          /* (nact) candidate index */
+    wb_real *act_d;        /* (nact x 8) barycentrics, normal (triangle -> point), depth, force */
+    int32_t cap_d;
+    wb_real *reach;        /* (np) a point's broad-phase reach, < 0 = not a point */
+    int32_t cap_reach;
+    wb_real *tbox;         /* (ntri x 10) a triangle's box, how far its corners may move, its normal */
+    int32_t cap_tbox;
+    int32_t *cell_start, *cell_ids, *stamp; /* spatial hash of the triangles */
+    int32_t cap_cells, cap_ids, cap_stamp;
+    int32_t *tgroup;       /* (ntri) the group none of whose points may touch it, or -1 */
+    int32_t *tstamp;       /* (ntri) the last point that met it in the broad phase */
+    int32_t cap_tgroup, cap_tstamp;
+    int32_t last;          /* contacts in the last substep (corrected or in touch) */
+    double broad_ms;       /* its broad phase in the last step */
+} wb_tricontacts;
+
+/* the closest point of triangle (a, b, c) to p as barycentrics bary (summing to 1) and the
+ * point out; returns the squared distance (a degenerate triangle: its nearest edge) */
+wb_real wb__tri_closest(const wb_real p[3], const wb_real a[3], const wb_real b[3], const wb_real c[3],
+                        wb_real bary[3], wb_real out[3]);
+/* tricontact.c: the step's three passes, as contact.c's (world.c frees the scratch) */
+void wb__tricontacts_begin(wb_world *w);
+void wb__tricontacts_project(wb_world *w, wb_real h);
+void wb__tricontacts_velocity(wb_world *w, wb_real h);
+
 /* ---- solver cache: packed colour batches and per-step scratch ------------------------ */
 typedef struct wb_cache {
     int32_t ns;            /* packed constraints (live and not broken) */
@@ -176,6 +206,7 @@ typedef struct wb_cache {
     void *interrupt_ud;
     int32_t last_contacts;
     wb_contacts pc;        /* particle-particle contacts (contact.c) */
+    wb_tricontacts tc;     /* particle-triangle contacts (tricontact.c) */
     int64_t projections;
     double step_ms, solve_ms;
 } wb_cache;

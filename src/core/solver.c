@@ -149,6 +149,7 @@ wb_status wb_world_step(wb_world *w)
     }
 
     wb__contacts_begin(w);
+    wb__tricontacts_begin(w);
     double solve = 0;
     for (int sub = 0; sub < d->substeps; sub++) {
         if (k->interrupt && k->interrupt(k->interrupt_ud)) {
@@ -165,8 +166,10 @@ wb_status wb_world_step(wb_world *w)
         solve_constraints(w, h);
         solve += now_ms() - t0;
         wb__contacts_project(w, h);
+        wb__tricontacts_project(w, h);
         wb__collide_and_update(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
         wb__contacts_velocity(w, h);
+        wb__tricontacts_velocity(w, h);
     }
 
     /* a frame gone non-finite is undone before it can bend or break anything */

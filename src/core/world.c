@@ -121,7 +121,9 @@ void wb_world_destroy(wb_world *w)
                       * would close a circle, as they call this one) */
                      w->sm.start, w->sm.stiff, w->sm.yield, w->sm.creep, w->sm.ids, w->sm.rest, w->sm.q,
                      w->sm.qk, w->sm.lambda, w->pr.surface, w->pr.pressure, w->pr.alpha, w->pr.v0, w->pr.vstart,
-                     w->pr.tstart, w->pr.verts, w->pr.tri, w->pr.lambda, w->pr.grad };
+                     w->pr.tstart, w->pr.verts, w->pr.tri, w->pr.lambda, w->pr.grad,
+                     k->tc.pt, k->tc.act, k->tc.act_d, k->tc.reach, k->tc.tbox, k->tc.cell_start, k->tc.cell_ids,
+                     k->tc.stamp, k->tc.tgroup, k->tc.tstamp };
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
     free(w);
 }

@@ -454,8 +454,9 @@ static int w_stats(lua_State *L)
     return 1;
 }
 
-/* w:contacts() -> { {a =, b =, force =, normal = {x, y, z}}, ... }: the particle-particle
- * contacts that corrected positions in the last substep (wobble.h: wb_world_contact_at);
+/* w:contacts() -> { {a =, b =, force =, normal = {x, y, z}, kind =}, ... }: the particle-particle
+ * contacts (kind "particle"), then the particle-triangle ones (kind "triangle"), that
+ * corrected positions in the last substep (wobble.h: wb_world_contact_at, wb_world_tri_contact_at);
  * particle ids from 1 */
 static int w_contacts(lua_State *L)
 {
@@ -479,7 +480,37 @@ static int w_contacts(lua_State *L)
             lua_rawseti(L, -2, k + 1);
         }
         lua_setfield(L, -2, "normal");
+        lua_pushliteral(L, "particle");
+        lua_setfield(L, -2, "kind");
         lua_rawseti(L, -2, i + 1);
+    }
+    /* then the particle-triangle contacts: a = the particle, b = the triangle's first
+     * corner, kind = "triangle", triangle = its corners, bary = the closest point's weights */
+    const int32_t nt = wb_world_tri_contact_count(w);
+    for (int32_t i = 0; i < nt; i++) {
+        const wb_tri_contact c = wb_world_tri_contact_at(w, i);
+        lua_createtable(L, 0, 8);
+        lua_pushinteger(L, (lua_Integer)c.p + 1);
+        lua_setfield(L, -2, "a");
+        lua_pushinteger(L, (lua_Integer)c.tri[0] + 1);
+        lua_setfield(L, -2, "b");
+        lua_pushnumber(L, (lua_Number)c.force);
+        lua_setfield(L, -2, "force");
+        lua_pushnumber(L, (lua_Number)c.depth);
+        lua_setfield(L, -2, "depth");
+        lua_pushliteral(L, "triangle");
+        lua_setfield(L, -2, "kind");
+        const char *const vec[3] = { "normal", "triangle", "bary" };
+        for (int f = 0; f < 3; f++) {
+            lua_createtable(L, 3, 0);
+            for (int k = 0; k < 3; k++) {
+                if (f == 1) lua_pushinteger(L, (lua_Integer)c.tri[k] + 1);
+                else lua_pushnumber(L, (lua_Number)(f == 0 ? c.normal[k] : c.bary[k]));
+                lua_rawseti(L, -2, k + 1);
+            }
+            lua_setfield(L, -2, vec[f]);
+        }
+        lua_rawseti(L, -2, n + i + 1);
     }
     return 1;
 }

@@ -39,6 +39,13 @@
     X(contact_self_collision_skips_rest_neighbours)      \
     X(contact_clone_keeps_groups)
 
+/* test_tricontact.c: particle-triangle contacts */
+#define TRICONTACT_TESTS(X)                              \
+    X(tricontact_closest_point_regions)                  \
+    X(tricontact_closest_matches_bvh)                    \
+    X(tricontact_projection_conserves_momentum)          \
+    X(tricontact_who_may_touch)
+
 /* every test, in the order they run: add a line here for each TEST() */
 #define TEST_LIST(X)                             \
     X(world_def_defaults)                        \
@@ -106,6 +113,7 @@
     X(bvh_closed_and_open_and_sign)              \
     X(bvh_mesh_collider_memory_charged)          \
     CONTACT_TESTS(X)                             \
+    TRICONTACT_TESTS(X)                          \
     EXTREME_TESTS(X)
 
 #define DECLARE(name) TEST(name);

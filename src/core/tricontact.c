@@ -1,0 +1,564 @@
+/* tricontact.c: particle-triangle contacts (DESIGN.md §2, issue 8).
+ *
+ * The surfaces builders register (a cloth's sheet, a lattice's hull, from_mesh's surface,
+ * a JSON config's surfaces) are collision geometry: a particle keeps its radius r_p away
+ * from every triangle it may touch, so a small particle cannot slip between the coarse
+ * particles of another body. The triangle itself has no thickness: its particles'
+ * spheres are already handled by the particle-particle contacts (contact.c), and these
+ * contacts close the gaps between them. That keeps a cloth's sheet, which is drawn
+ * through its particles' centres, where a particle resting on it is seen to rest, and a
+ * self-colliding cloth with the default radius (half its spacing) free of contacts
+ * between particles two spacings apart in its own plane, which an interpolated thickness
+ * would make touch at rest.
+ *
+ * Each substep a candidate (point p, triangle abc) with the closest point q = sum b_i x_i
+ * is the inequality C = (x_p - q) . n - r_p >= 0, projected with XPBD at compliance 0:
+ * gradients n for p and -b_i n for the corners, generalized inverse mass
+ * W = w_p + sum b_i^2 w_i, so p moves w_p depth / W and corner i moves -b_i w_i depth / W
+ * along n: the corrections' momentum sums to (1 - sum b_i) depth / W = 0. Coulomb
+ * friction at position level as contact.c's (the relative slip of p against q undone up
+ * to mu depth, mu the mean of p's and the triangle's barycentric friction), and after the
+ * velocity update the approach speed along n is removed the same way.
+ *
+ * A surface is two-sided: n points to the side the point was on at the substep's start
+ * (x_prev), as collide.c does for an open mesh collider, so a point the substep carried
+ * through the sheet goes back rather than out the far side.
+ *
+ * Who may touch: a point and each corner of the triangle must be allowed to touch by
+ * contact.c's rules (different groups: both collide; one body: both self-collide), never
+ * a triangle's own corner, nor (one body) a point within r_p of the triangle where they
+ * were created (wb_model.x0). A triangle whose particles are all immovable still stops
+ * others.
+ *
+ * Broad phase, once per frame: the triangles go into a hashed grid, each into the cells
+ * of its box grown by how far its corners may move this frame; every point visits the
+ * cells its reach (radius and motion) covers and keeps the triangles it comes within
+ * that motion of. The candidates are projected serially in that order (point order, then
+ * the grid's), which depends on the positions alone: bit-identical for any thread count. */
+#include <stdlib.h>
+#include <time.h>
+
+#include "core.h"
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+/* ---- closest point, as barycentrics ---------------------------------------------------------- */
+/* on segment a + t (b - a): t in [0, 1] */
+static wb_real seg_t(const wb_real p[3], const wb_real a[3], const wb_real b[3])
+{
+    wb_real ab[3], ap[3];
+    v3_sub(ab, b, a);
+    v3_sub(ap, p, a);
+    const wb_real ll = v3_dot(ab, ab);
+    return ll > 0 ? clampr(v3_dot(ap, ab) / ll, 0, 1) : 0;
+}
+
+static wb_real finish(const wb_real p[3], const wb_real a[3], const wb_real b[3], const wb_real c[3],
+                      wb_real u, wb_real v, wb_real t, wb_real bary[3], wb_real out[3])
+{
+    bary[0] = u; bary[1] = v; bary[2] = t;
+    for (int k = 0; k < 3; k++) out[k] = u * a[k] + v * b[k] + t * c[k];
+    wb_real d[3];
+    v3_sub(d, p, out);
+    return v3_dot(d, d);
+}
+
+/* Ericson, Real-Time Collision Detection 5.1.5: the Voronoi region of p decides the face,
+ * an edge or a corner; the same tests as bvh.c's, keeping the weights */
+wb_real wb__tri_closest(const wb_real p[3], const wb_real a[3], const wb_real b[3], const wb_real c[3],
+                        wb_real bary[3], wb_real out[3])
+{
+    wb_real ab[3], ac[3], ap[3], bp[3], cp[3];
+    v3_sub(ab, b, a);
+    v3_sub(ac, c, a);
+    v3_sub(ap, p, a);
+    const wb_real d1 = v3_dot(ab, ap), d2 = v3_dot(ac, ap);
+    if (d1 <= 0 && d2 <= 0) return finish(p, a, b, c, 1, 0, 0, bary, out);
+    v3_sub(bp, p, b);
+    const wb_real d3 = v3_dot(ab, bp), d4 = v3_dot(ac, bp);
+    if (d3 >= 0 && d4 <= d3) return finish(p, a, b, c, 0, 1, 0, bary, out);
+    const wb_real vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+        const wb_real t = d1 / (d1 - d3);
+        return finish(p, a, b, c, 1 - t, t, 0, bary, out);
+    }
+    v3_sub(cp, p, c);
+    const wb_real d5 = v3_dot(ab, cp), d6 = v3_dot(ac, cp);
+    if (d6 >= 0 && d5 <= d6) return finish(p, a, b, c, 0, 0, 1, bary, out);
+    const wb_real vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+        const wb_real t = d2 / (d2 - d6);
+        return finish(p, a, b, c, 1 - t, 0, t, bary, out);
+    }
+    const wb_real va = d3 * d6 - d5 * d4;
+    if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+        const wb_real t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return finish(p, a, b, c, 0, 1 - t, t, bary, out);
+    }
+    const wb_real sum = va + vb + vc;
+    if (!(sum > 0)) {
+        /* degenerate (collinear corners): the nearest of the three edges */
+        wb_real bb[3], o[3], best, e;
+        wb_real t = seg_t(p, a, b);
+        best = finish(p, a, b, c, 1 - t, t, 0, bary, out);
+        t = seg_t(p, b, c);
+        if ((e = finish(p, a, b, c, 0, 1 - t, t, bb, o)) < best) { best = e; v3_copy(bary, bb); v3_copy(out, o); }
+        t = seg_t(p, c, a);
+        if ((e = finish(p, a, b, c, t, 0, 1 - t, bb, o)) < best) { best = e; v3_copy(bary, bb); v3_copy(out, o); }
+        return best;
+    }
+    const wb_real v = vb / sum, t = vc / sum;
+    return finish(p, a, b, c, 1 - v - t, v, t, bary, out);
+}
+
+/* ---- who may touch ------------------------------------------------------------------------------ */
+/* contact.c's pair rule without its rest-neighbour part (applied per triangle below) */
+static int pair_allowed(const wb_model *m, int32_t p, int32_t v)
+{
+    const int32_t gp = m->group[p], gv = m->group[v];
+    if (gp != gv || gp == 0) return (m->cflags[p] & m->cflags[v] & WB_CF_COLLIDE) != 0;
+    return (m->cflags[p] & m->cflags[v] & WB_CF_SELF) != 0;
+}
+
+/* the rules without geometry: not its own corner, and each corner allowed; *same: some
+ * corner is of the point's own body (the rest rule then applies) */
+static int rules_allow(const wb_model *m, int32_t p, const int32_t *v, int *same)
+{
+    if (p == v[0] || p == v[1] || p == v[2]) return 0;
+    *same = 0;
+    for (int k = 0; k < 3; k++) {
+        if (!pair_allowed(m, p, v[k])) return 0;
+        *same |= m->group[p] != 0 && m->group[p] == m->group[v[k]];
+    }
+    const wb_real *wv = m->w;
+    return wv[p] != 0 || wv[v[0]] != 0 || wv[v[1]] != 0 || wv[v[2]] != 0;
+}
+
+/* one body: not a point that lay within its radius of the triangle at rest */
+static int rest_apart(const wb_model *m, int32_t p, const int32_t *v)
+{
+    wb_real bary[3], q[3];
+    const wb_real d2 = wb__tri_closest(&m->x0[3 * p], &m->x0[3 * v[0]], &m->x0[3 * v[1]], &m->x0[3 * v[2]], bary, q);
+    return !(d2 < m->radius[p] * m->radius[p]);
+}
+
+/* ---- broad phase ------------------------------------------------------------------------------------ */
+static uint32_t cell_hash(int64_t x, int64_t y, int64_t z, uint32_t mask)
+{
+    return (uint32_t)(((uint64_t)x * 73856093u) ^ ((uint64_t)y * 19349663u) ^ ((uint64_t)z * 83492791u)) & mask;
+}
+
+/* clamped as contact.c's: the cast stays defined for huge positions */
+static int64_t cell_of(wb_real x, wb_real inv)
+{
+    const wb_real c = floor(x * inv);
+    return c > 1e15 ? (int64_t)1e15 : c < -1e15 ? -(int64_t)1e15 : (int64_t)c;
+}
+
+static wb_real box_dist2(const wb_real p[3], const wb_real lo[3], const wb_real hi[3])
+{
+    wb_real s = 0;
+    for (int k = 0; k < 3; k++) {
+        const wb_real d = p[k] < lo[k] ? lo[k] - p[k] : p[k] > hi[k] ? p[k] - hi[k] : 0;
+        s += d * d;
+    }
+    return s;
+}
+
+#define TB 10 /* per triangle: box lo, hi; how far its corners may move; unit normal */
+
+/* point p against triangle t (its box, motion and normal in tb): appended when its reach sphere
+ * comes within the triangle's motion of the triangle and the rules let them touch */
+static int consider(wb_world *w, const wb_real *tb, int32_t t, int32_t p)
+{
+    wb_tricontacts *c = &w->k.tc;
+    const wb_model *m = &w->m;
+    const wb_real *x = w->s.x, rp = c->reach[p], reach = rp + tb[6];
+    if (rp < 0) return 0;
+    /* the box first: it reads the triangle's own record only */
+    wb_real lo[3], hi[3];
+    for (int k = 0; k < 3; k++) lo[k] = tb[k] - tb[6], hi[k] = tb[3 + k] + tb[6];
+    if (!(box_dist2(&x[3 * p], lo, hi) < rp * rp)) return 0;
+    const int32_t *v = &m->tri[3 * t];
+    int same;
+    if (!rules_allow(m, p, v, &same)) return 0;
+    wb_real d[3];
+    v3_sub(d, &x[3 * p], &x[3 * v[0]]);
+    if (!(fabs(v3_dot(d, tb + 7)) < reach)) return 0;
+    wb_real bary[3], q[3];
+    if (!(wb__tri_closest(&x[3 * p], &x[3 * v[0]], &x[3 * v[1]], &x[3 * v[2]], bary, q) < reach * reach)) return 0;
+    if (same && !rest_apart(m, p, v)) return 0;
+    int32_t *pt = wb__grow(c->pt, &c->cap, 2 * (c->n + 1), sizeof *pt);
+    if (!pt) return -1;
+    c->pt = pt;
+    pt[2 * c->n] = p;
+    pt[2 * c->n + 1] = t;
+    c->n++;
+    return 0;
+}
+
+/* the cells of box [lo - g, hi + g] */
+static double cell_range(const wb_real *lo, const wb_real *hi, wb_real g, wb_real inv, int64_t c0[3], int64_t c1[3])
+{
+    double n = 1;
+    for (int k = 0; k < 3; k++) {
+        c0[k] = cell_of(lo[k] - g, inv);
+        c1[k] = cell_of(hi[k] + g, inv);
+        n *= (double)(c1[k] - c0[k] + 1);
+    }
+    return n;
+}
+
+/* point p against the triangles of bucket bk not yet seen by it (tstamp) */
+static int visit(wb_world *w, uint32_t bk, int32_t p)
+{
+    wb_tricontacts *c = &w->k.tc;
+    const wb_real *xp = &w->s.x[3 * p], rp = c->reach[p];
+    const int32_t gp = w->m.group[p];
+    for (int32_t s = c->cell_start[bk]; s < c->cell_start[bk + 1]; s++) {
+        const int32_t t = c->cell_ids[s];
+        if (c->tstamp[t] == p) continue;
+        c->tstamp[t] = p;
+        /* a body's own hull is near all of its particles: the cheapest test first; then
+         * the slabs of the grown box, which reject most of the rest */
+        if (c->tgroup[t] == gp) continue;
+        const wb_real *tb = &c->tbox[TB * t], gr = tb[6] + rp;
+        if (xp[0] < tb[0] - gr || xp[0] > tb[3] + gr || xp[1] < tb[1] - gr || xp[1] > tb[4] + gr ||
+            xp[2] < tb[2] - gr || xp[2] > tb[5] + gr)
+            continue;
+        if (consider(w, tb, t, p) < 0) return -1;
+    }
+    return 0;
+}
+
+static int broadphase(wb_world *w)
+{
+    wb_model *m = &w->m;
+    wb_tricontacts *c = &w->k.tc;
+    const wb_real *x = w->s.x, *v = w->s.v;
+    wb_real *reach = wb__grow(c->reach, &c->cap_reach, m->np, sizeof *reach);
+    if (!reach) return -1;
+    c->reach = reach;
+    wb_real *tbox = wb__grow(c->tbox, &c->cap_tbox, TB * m->ntri, sizeof *tbox);
+    if (!tbox) return -1;
+    c->tbox = tbox;
+    int32_t *tg = wb__grow(c->tgroup, &c->cap_tgroup, m->ntri, sizeof *tg);
+    if (!tg) return -1;
+    c->tgroup = tg;
+    int32_t *ts = wb__grow(c->tstamp, &c->cap_tstamp, m->ntri, sizeof *ts);
+    if (!ts) return -1;
+    c->tstamp = ts;
+    /* how far a particle may get this frame (velocity and gravity over dt); points add
+     * their radius and a quarter of it for what the constraints move them, as contact.c */
+    const wb_real dt = m->def.dt, g = v3_len(m->def.gravity) * dt * dt;
+    wb_real rsum = 0;
+    int32_t na = 0;
+    for (int32_t i = 0; i < m->np; i++) {
+        const wb_real mv = v3_len_safe(&v[3 * i]) * dt + g + m->radius[i] / 4;
+        reach[i] = (m->cflags[i] & (WB_CF_COLLIDE | WB_CF_SELF)) ? m->radius[i] + mv : -1;
+        if (!isfinite(reach[i])) reach[i] = -1;
+        if (reach[i] >= 0) { na++; rsum += reach[i]; }
+    }
+    /* triangles: box, motion (-1: left out), normal; and the group no point of which may
+     * touch it (its corners' body when it does not self-collide; else -1) */
+    wb_real ext = 0;
+    int32_t nt = 0;
+    for (int32_t t = 0; t < m->ntri; t++) {
+        const int32_t *tv = &m->tri[3 * t];
+        wb_real *tb = &tbox[TB * t];
+        tb[6] = -1;
+        ts[t] = -1;
+        const int32_t g0 = m->group[tv[0]];
+        tg[t] = g0 > 0 && m->group[tv[1]] == g0 && m->group[tv[2]] == g0 &&
+                        !(m->cflags[tv[0]] & m->cflags[tv[1]] & m->cflags[tv[2]] & WB_CF_SELF) ? g0 : -1;
+        if (!((m->cflags[tv[0]] | m->cflags[tv[1]] | m->cflags[tv[2]]) & (WB_CF_COLLIDE | WB_CF_SELF))) continue;
+        wb_real mv = 0;
+        for (int k = 0; k < 3; k++) {
+            const wb_real *p = &x[3 * tv[k]];
+            for (int a = 0; a < 3; a++) {
+                if (k == 0 || p[a] < tb[a]) tb[a] = p[a];
+                if (k == 0 || p[a] > tb[3 + a]) tb[3 + a] = p[a];
+            }
+            const wb_real mk = v3_len_safe(&v[3 * tv[k]]) * dt + g + m->radius[tv[k]] / 4;
+            if (mk > mv) mv = mk;
+        }
+        const wb_real e = fmax(tb[3] - tb[0], fmax(tb[4] - tb[1], tb[5] - tb[2])) + 2 * mv;
+        if (!isfinite(e)) continue;
+        tb[6] = mv;
+        /* the unit normal (0 when degenerate): a point farther than its reach from the
+         * plane is farther from the triangle */
+        wb_real e1[3], e2[3];
+        v3_sub(e1, &x[3 * tv[1]], &x[3 * tv[0]]);
+        v3_sub(e2, &x[3 * tv[2]], &x[3 * tv[0]]);
+        v3_cross(tb + 7, e1, e2);
+        const wb_real ln = v3_len(tb + 7);
+        if (ln > 0 && isfinite(ln)) v3_scale(tb + 7, tb + 7, 1 / ln);
+        else v3_set(tb + 7, 0, 0, 0);
+        ext += e;
+        nt++;
+    }
+    if (na == 0 || nt == 0) return 0;
+    /* a grid of triangles: each in the buckets of the cells its box grown by its motion
+     * covers; a point visits the cells its reach covers. The cell: the mean grown
+     * triangle, or the mean reach diameter when that is larger, so either visits a few
+     * cells; a triangle or a point that would visit many goes by brute force instead */
+    const wb_real cell = fmax(ext / nt, 2 * rsum / na);
+    if (!(cell > 0) || !isfinite(cell)) return 0;
+    const wb_real inv = 1 / cell;
+    uint32_t size = 16;
+    while (size < 8 * (uint32_t)nt && size < (1u << 30)) size *= 2;
+    const uint32_t mask = size - 1;
+    int32_t *cs = wb__grow(c->cell_start, &c->cap_cells, (int32_t)size + 1, sizeof *cs);
+    if (!cs) return -1;
+    c->cell_start = cs;
+    int32_t *stamp = wb__grow(c->stamp, &c->cap_stamp, (int32_t)size, sizeof *stamp);
+    if (!stamp) return -1;
+    c->stamp = stamp;
+    memset(cs, 0, sizeof *cs * (size + 1));
+    /* two passes over the triangles' cells: count, then fill (a counting sort, triangles
+     * in index order inside a bucket); the big ones go by brute force after */
+    int64_t entries = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        for (uint32_t bk = 0; bk < size; bk++) stamp[bk] = -1;
+        for (int32_t t = 0; t < m->ntri; t++) {
+            const wb_real *tb = &tbox[TB * t];
+            if (tb[6] < 0) continue;
+            int64_t c0[3], c1[3];
+            if (cell_range(tb, tb + 3, tb[6], inv, c0, c1) > 64) continue;
+            for (int64_t cz = c0[2]; cz <= c1[2]; cz++)
+                for (int64_t cy = c0[1]; cy <= c1[1]; cy++)
+                    for (int64_t cx = c0[0]; cx <= c1[0]; cx++) {
+                        /* each bucket once per triangle: two cells may hash to one */
+                        const uint32_t bk = cell_hash(cx, cy, cz, mask);
+                        if (stamp[bk] == t) continue;
+                        stamp[bk] = t;
+                        if (pass == 0) cs[bk + 1]++, entries++;
+                        else c->cell_ids[cs[bk]++] = t;
+                    }
+        }
+        if (pass == 0) {
+            if (entries > INT32_MAX / 2) return -1;
+            int32_t *ids = wb__grow(c->cell_ids, &c->cap_ids, (int32_t)entries + 1, sizeof *ids);
+            if (!ids) return -1;
+            c->cell_ids = ids;
+            for (uint32_t bk = 0; bk < size; bk++) cs[bk + 1] += cs[bk];
+        }
+    }
+    for (uint32_t bk = size; bk > 0; bk--) cs[bk] = cs[bk - 1]; /* back to starts */
+    cs[0] = 0;
+    /* the points in index order; the buckets each once per point (stamp), a triangle each
+     * once per point (tstamp) */
+    for (uint32_t bk = 0; bk < size; bk++) stamp[bk] = -1;
+    for (int32_t p = 0; p < m->np; p++) {
+        if (reach[p] < 0) continue;
+        int64_t c0[3], c1[3];
+        const wb_real *xp = &x[3 * p];
+        if (cell_range(xp, xp, reach[p], inv, c0, c1) > 64) {
+            for (int32_t t = 0; t < m->ntri; t++)
+                if (tbox[TB * t + 6] >= 0 && tg[t] != m->group[p] && consider(w, &tbox[TB * t], t, p) < 0) return -1;
+            continue;
+        }
+        for (int64_t cz = c0[2]; cz <= c1[2]; cz++)
+            for (int64_t cy = c0[1]; cy <= c1[1]; cy++)
+                for (int64_t cx = c0[0]; cx <= c1[0]; cx++) {
+                    const uint32_t bk = cell_hash(cx, cy, cz, mask);
+                    if (stamp[bk] == p) continue;
+                    stamp[bk] = p;
+                    if (visit(w, bk, p) < 0) return -1;
+                }
+    }
+    /* the big triangles against every point (after the grid: their pairs come last) */
+    for (int32_t t = 0; t < m->ntri; t++) {
+        const wb_real *tb = &tbox[TB * t];
+        int64_t c0[3], c1[3];
+        if (tb[6] < 0 || !(cell_range(tb, tb + 3, tb[6], inv, c0, c1) > 64)) continue;
+        for (int32_t p = 0; p < m->np; p++) {
+            int64_t d0[3], d1[3];
+            /* a brute-force point has met every triangle already */
+            if (reach[p] < 0 || tg[t] == m->group[p] || cell_range(&x[3 * p], &x[3 * p], reach[p], inv, d0, d1) > 64) continue;
+            if (consider(w, tb, t, p) < 0) return -1;
+        }
+    }
+    return 0;
+}
+
+void wb__tricontacts_begin(wb_world *w)
+{
+    const wb_model *m = &w->m;
+    wb_tricontacts *c = &w->k.tc;
+    c->n = 0;
+    c->nact = 0;
+    c->last = 0;
+    c->broad_ms = 0;
+    /* contact.c's scan of this frame: no pair of particles may touch, so no point a
+     * triangle either (its corners' rules are the pairs'); one body costs nothing */
+    if (!m->def.contacts || m->ntri == 0 || m->np < 4 || !w->k.pc.possible) return;
+    const double t0 = now_ms();
+    if (broadphase(w) < 0) {
+        c->n = 0;
+        wb__warn(w, "out of memory in the triangle contact broad phase; triangle contacts skipped");
+    }
+    c->broad_ms = now_ms() - t0;
+}
+
+/* ---- projection -------------------------------------------------------------------------------------- */
+void wb__tricontacts_project(wb_world *w, wb_real h)
+{
+    wb_tricontacts *c = &w->k.tc;
+    c->nact = 0;
+    if (c->n == 0) { c->last = 0; return; }
+    const wb_model *m = &w->m;
+    wb_real *x = w->s.x;
+    const wb_real *xp = w->s.x_prev, *wv = m->w, *rad = m->radius, *cf = m->cfric;
+    int32_t *act = wb__grow(c->act, &c->cap_act, c->n, sizeof *act);
+    if (!act) goto nomem;
+    c->act = act;
+    wb_real *ad = wb__grow(c->act_d, &c->cap_d, 8 * c->n, sizeof *ad);
+    if (!ad) goto nomem;
+    c->act_d = ad;
+    int32_t touching = 0;
+    for (int32_t k = 0; k < c->n; k++) {
+        const int32_t p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
+        wb_real *xs = &x[3 * p];
+        const wb_real *xa = &x[3 * v[0]], *xb = &x[3 * v[1]], *xc = &x[3 * v[2]];
+        wb_real b[3], q[3], d[3], n[3], e1[3], e2[3];
+        const wb_real r = rad[p];
+        /* the side now and at the substep's start (the plane of the triangle then) */
+        v3_sub(e1, xb, xa);
+        v3_sub(e2, xc, xa);
+        v3_cross(n, e1, e2);
+        const wb_real ln = v3_len(n);
+        wb_real s_prev = 0, s_now = 0;
+        if (ln > 0) {
+            wb_real f1[3], f2[3], np[3], dp[3];
+            v3_scale(n, n, 1 / ln);
+            v3_sub(f1, &xp[3 * v[1]], &xp[3 * v[0]]);
+            v3_sub(f2, &xp[3 * v[2]], &xp[3 * v[0]]);
+            v3_cross(np, f1, f2);
+            v3_sub(dp, &xp[3 * p], &xp[3 * v[0]]);
+            s_prev = v3_dot(dp, np);
+            v3_sub(d, xs, xa);
+            s_now = v3_dot(d, n);
+            /* on its side and farther than r from the plane: from the triangle too */
+            if (s_now * s_prev >= 0 && fabs(s_now) > r * (1 + (wb_real)1e-9)) continue;
+        }
+        const wb_real d2 = wb__tri_closest(xs, xa, xb, xc, b, q);
+        const wb_real wp = wv[p], W = wp + b[0] * b[0] * wv[v[0]] + b[1] * b[1] * wv[v[1]] + b[2] * b[2] * wv[v[2]];
+        if (W == 0) continue;
+        v3_sub(d, xs, q);
+        const wb_real dist = sqrt(d2);
+        /* crossed the plane over the triangle's face, within reach of it: it went through
+         * this substep (the relative motion bounds how far off it could have crossed).
+         * Beside an edge or a corner the plane's extension means nothing: a point in a
+         * valley between two triangles is below each one's extension and still outside */
+        int crossed = 0;
+        if (s_prev != 0 && s_now * s_prev < 0 && b[0] > 0 && b[1] > 0 && b[2] > 0) {
+            wb_real rel[3];
+            v3_sub(rel, xs, &xp[3 * p]);
+            for (int i = 0; i < 3; i++) v3_madd(rel, &x[3 * v[i]], -b[i]), v3_madd(rel, &xp[3 * v[i]], b[i]);
+            crossed = dist < r + v3_len(rel);
+        }
+        wb_real nn[3], depth;
+        if (crossed) {
+            v3_scale(nn, n, s_prev > 0 ? 1 : -1);
+            depth = r - v3_dot(d, nn);
+        } else if (!(d2 < r * r)) {
+            /* in touch (left at r by the last substep, to round-off): counted, nothing to do */
+            const wb_real rt = r * (1 + (wb_real)1e-9);
+            if (d2 <= rt * rt) touching++;
+            continue;
+        } else if (dist > r * (wb_real)1e-9 || ln == 0) {
+            if (!(dist > 0)) continue; /* on a degenerate triangle: no direction */
+            v3_scale(nn, d, 1 / dist);
+            depth = r - dist;
+        } else {
+            /* on the sheet: back to the side it came from */
+            const wb_real side = s_prev < 0 || (s_prev == 0 && s_now < 0) ? -1 : 1;
+            v3_scale(nn, n, side);
+            depth = r - side * s_now;
+        }
+        if (!(depth > 0)) continue;
+        const wb_real s = depth / W;
+        if (wp > 0) v3_madd(xs, nn, wp * s);
+        for (int i = 0; i < 3; i++)
+            if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&x[3 * v[i]], nn, -b[i] * wv[v[i]] * s);
+        /* friction at position level, as contact.c: the slip of p against the triangle's
+         * point q this substep undone up to mu x depth */
+        const wb_real mu = (cf[p] + b[0] * cf[v[0]] + b[1] * cf[v[1]] + b[2] * cf[v[2]]) / 2;
+        if (mu > 0) {
+            wb_real slip[3];
+            v3_sub(slip, xs, &xp[3 * p]);
+            for (int i = 0; i < 3; i++) v3_madd(slip, &x[3 * v[i]], -b[i]), v3_madd(slip, &xp[3 * v[i]], b[i]);
+            v3_madd(slip, nn, -v3_dot(slip, nn));
+            const wb_real sl = v3_len(slip), cap = mu * depth;
+            if (sl > 0) {
+                const wb_real f = (sl < cap ? 1 : cap / sl) / W;
+                if (wp > 0) v3_madd(xs, slip, -f * wp);
+                for (int i = 0; i < 3; i++)
+                    if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&x[3 * v[i]], slip, f * b[i] * wv[v[i]]);
+            }
+        }
+        wb_real *o = &ad[8 * c->nact];
+        v3_copy(o, b);
+        v3_copy(o + 3, nn);
+        o[6] = depth;
+        o[7] = s / (h * h); /* the multiplier over h^2: newtons */
+        act[c->nact++] = k;
+    }
+    c->last = c->nact + touching;
+    return;
+nomem:
+    c->last = 0;
+    wb__warn(w, "out of memory in triangle contacts; skipped this substep");
+}
+
+/* after v = (x - x_prev)/h: no approach speed of p towards the triangle's point left */
+void wb__tricontacts_velocity(wb_world *w, wb_real h)
+{
+    (void)h;
+    wb_tricontacts *c = &w->k.tc;
+    const wb_model *m = &w->m;
+    wb_real *vel = w->s.v;
+    const wb_real *wv = m->w;
+    for (int32_t a = 0; a < c->nact; a++) {
+        const int32_t k = c->act[a], p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
+        const wb_real *b = &c->act_d[8 * a], *nn = b + 3;
+        const wb_real W = wv[p] + b[0] * b[0] * wv[v[0]] + b[1] * b[1] * wv[v[1]] + b[2] * b[2] * wv[v[2]];
+        if (W == 0) continue;
+        wb_real u[3];
+        v3_copy(u, &vel[3 * p]);
+        for (int i = 0; i < 3; i++) v3_madd(u, &vel[3 * v[i]], -b[i]);
+        const wb_real un = v3_dot(u, nn);
+        if (!(un < 0)) continue;
+        const wb_real s = un / W;
+        if (wv[p] > 0) v3_madd(&vel[3 * p], nn, -s * wv[p]);
+        for (int i = 0; i < 3; i++)
+            if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&vel[3 * v[i]], nn, s * b[i] * wv[v[i]]);
+    }
+}
+
+/* ---- readout -------------------------------------------------------------------------------------------- */
+int32_t wb_world_tri_contact_count(const wb_world *w) { return w->k.tc.nact; }
+
+wb_tri_contact wb_world_tri_contact_at(const wb_world *w, int32_t i)
+{
+    const wb_tricontacts *c = &w->k.tc;
+    wb_tri_contact out;
+    memset(&out, 0, sizeof out);
+    out.p = out.tri[0] = out.tri[1] = out.tri[2] = -1;
+    if (i < 0 || i >= c->nact) return out;
+    const int32_t k = c->act[i];
+    const wb_real *d = &c->act_d[8 * i];
+    out.p = c->pt[2 * k];
+    memcpy(out.tri, &w->m.tri[3 * c->pt[2 * k + 1]], sizeof out.tri);
+    v3_copy(out.bary, d);
+    v3_scale(out.normal, d + 3, -1); /* point -> triangle, as wb_contact's a -> b */
+    out.depth = d[6];
+    out.force = d[7];
+    return out;
+}
