@@ -126,10 +126,9 @@ typedef struct wb_contacts {
     int32_t cap_nd;
     wb_real *reach;        /* (np) broad-phase reach, < 0 = not a candidate */
     int32_t cap_reach;
-    int32_t *cell_start, *cell_ids; /* spatial hash: counting sort of particles by cell */
-    int32_t cap_cells, cap_ids;
-    int32_t *stamp;        /* (cells) the last particle that visited a bucket */
-    int32_t cap_stamp;
+    int32_t *skip;         /* (np) broad-phase skip key: a body without self-collision, else 0 */
+    int32_t cap_skip;
+    struct wb_broad *bp;   /* broad-phase scratch (broadphase.c) */
     uint64_t *keys;        /* sorted (a << 32 | b) of live constraints: neighbours at rest */
     int32_t nkeys, cap_keys;
     int keys_dirty;        /* set when the topology changes */
@@ -140,11 +139,15 @@ typedef struct wb_contacts {
     double broad_ms;       /* broad phase of the last step */
 } wb_contacts;
 
-/* every pair i < j with |x_i - x_j| < reach_i + reach_j (particles with reach < 0 left
- * out), each once, in an order fixed by the input alone; keep(ud, i, j) filters them.
- * A spatial hash (counting sort, linear in n). Appends to c->ij; -1 when out of memory */
-int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, int32_t n,
-                       int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
+/* broadphase.c: every pair i < j with |x_i - x_j| < reach_i + reach_j (particles with
+ * reach < 0 or a non-finite position left out; pairs with one nonzero skip key too,
+ * skip may be NULL), each once, in an order fixed by the input alone (the same for any
+ * thread count); keep(ud, i, j) filters them (NULL: all; called from several threads
+ * at once). A sorted grid, linear in n. Appends to c->ij; -1 when out of memory */
+typedef struct wb_broad wb_broad;
+int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
+                       int32_t n, int threads, int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
+void wb__broadphase_free(wb_contacts *c); /* the scratch above; the rest is the world's */
 
 /* ---- solver cache: packed colour batches and per-step scratch ------------------------ */
 typedef struct wb_cache {
