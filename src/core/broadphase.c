@@ -43,12 +43,14 @@ static double now_ms(void)
 #define PAR_MIN 1024
 /* body culling only with at most this many runs (its cost is quadratic in them) */
 #define RUNS_MAX 256
+/* a run's overlaps tested one by one up to this many */
+#define BOXES_MAX 16
 
 typedef struct run {
     int32_t first, last;   /* candidate list range [first, last) */
     int32_t key;           /* skip key; 0 = the catch-all run of keyless particles */
     wb_real lo[3], hi[3];  /* swept box */
-    wb_real clo[3], chi[3]; /* hull of its overlaps with other runs (empty: lo > hi) */
+    int32_t box0, nbox;    /* its overlaps with other runs: boxes[box0..], -1: covers it */
 } run;
 
 typedef struct pairbuf { int32_t *ij; int32_t n, cap; int fail; } pairbuf;
@@ -61,13 +63,17 @@ struct wb_broad {
     int32_t *id; int32_t cap_id;       /* sorted: particle */
     int32_t *key; int32_t cap_key;     /* sorted: skip key */
     run *runs; int32_t cap_runs;
+    wb_real *boxes; int32_t cap_boxes; /* (lo, hi) of runs' overlaps */
     pairbuf *out; int nout;            /* one per thread */
+    int32_t *first; int32_t cap_first; /* (n + 1) sorting the pairs by i */
 };
 
 typedef struct grid {
     wb_real o[3], inv;
     int64_t nc[3];                     /* cells per axis */
     int wrap;                          /* coordinates wrap around (a sparse, huge volume) */
+    wb_real big;                       /* reach past which a particle is big */
+    wb_real rn;                        /* the largest reach up to big */
 } grid;
 
 static int grow(void **p, int32_t *cap, int64_t need, size_t elem)
@@ -86,7 +92,7 @@ void wb__broadphase_free(wb_contacts *c)
     c->cap_skip = 0;
     wb_broad *b = c->bp;
     if (!b) return;
-    free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key); free(b->runs);
+    free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key); free(b->runs); free(b->boxes); free(b->first);
     for (int t = 0; t < b->nout; t++) free(b->out[t].ij);
     free(b->out);
     free(b);
@@ -98,7 +104,8 @@ void wb__broadphase_free(wb_contacts *c)
  * against more of them); monotone in v, so a search range never misses a cell */
 static inline int64_t cell_of(wb_real v, wb_real o, wb_real inv)
 {
-    const wb_real c = floor((v - o) * inv);
+    const wb_real c = (v - o) * inv;
+    /* truncation is floor for c > 0 (and no libm call without SSE4.1) */
     return c > 0 ? (c < 1e15 ? (int64_t)c : (int64_t)1e15) : 0;
 }
 
@@ -121,49 +128,72 @@ static inline int box_overlap(const wb_real *alo, const wb_real *ahi, const wb_r
 }
 
 /* pass 1: runs of consecutive candidates with one nonzero key, every keyless candidate
- * in one catch-all run; keeps in b->cand the candidates that can touch another run.
+ * in one catch-all run; keeps in b->cand the candidates whose box overlaps one of their
+ * run's overlaps with the runs of other keys (a pair closer than reach_i + reach_j has
+ * overlapping boxes, both inside their runs' boxes, so inside the runs' overlap).
  * Returns the survivors, or -1 when out of memory */
 static int32_t cull(wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t na)
 {
     if (!skip) return na;
-    int32_t nr = 0, keyless = -1;
-    run *r = NULL;
+    int32_t nr = 0, keyless = -1, last = -1;
     for (int32_t k = 0; k < na; k++) {
         const int32_t i = b->cand[k], key = skip[i];
-        run *cur;
-        if (key == 0 && keyless >= 0) cur = &b->runs[keyless];
-        else if (key != 0 && r && r->key == key && r->last == k) cur = r;
+        int32_t cur;
+        if (key == 0 && keyless >= 0) cur = keyless;
+        else if (key != 0 && last >= 0 && b->runs[last].key == key && b->runs[last].last == k) cur = last;
         else {
             if (nr == RUNS_MAX) return na; /* too fragmented to pay off: no culling */
             if (!grow((void **)&b->runs, &b->cap_runs, nr + 1, sizeof *b->runs)) return -1;
-            cur = &b->runs[nr];
-            cur->first = k;
-            cur->key = key;
-            for (int a = 0; a < 3; a++) { cur->lo[a] = INFINITY; cur->hi[a] = -INFINITY; }
-            if (key == 0) keyless = nr;
-            nr++;
+            cur = nr++;
+            run *R = &b->runs[cur];
+            R->first = k;
+            R->key = key;
+            for (int a = 0; a < 3; a++) { R->lo[a] = INFINITY; R->hi[a] = -INFINITY; }
+            if (key == 0) keyless = cur;
         }
-        if (key != 0) { r = cur; cur->last = k + 1; }
+        run *R = &b->runs[cur];
+        if (key != 0) { last = cur; R->last = k + 1; }
+        const wb_real e = reach[i], *p = &x[3 * i];
         for (int a = 0; a < 3; a++) {
-            const wb_real v = x[3 * i + a], e = reach[i];
-            if (v - e < cur->lo[a]) cur->lo[a] = v - e;
-            if (v + e > cur->hi[a]) cur->hi[a] = v + e;
+            if (p[a] - e < R->lo[a]) R->lo[a] = p[a] - e;
+            if (p[a] + e > R->hi[a]) R->hi[a] = p[a] + e;
         }
     }
-    /* each keyed run: the hull of its overlaps with the runs of other keys */
+    /* each keyed run: its overlaps with the runs of other keys, as boxes (past BOXES_MAX
+     * of them the last box grows to the hull of the rest) */
+    int32_t nb = 0, culls = 0;
     for (int32_t s = 0; s < nr; s++) {
         run *A = &b->runs[s];
-        for (int a = 0; a < 3; a++) { A->clo[a] = INFINITY; A->chi[a] = -INFINITY; }
+        A->box0 = nb;
+        A->nbox = 0;
         if (A->key == 0) continue;
         for (int32_t t = 0; t < nr; t++) {
             const run *B = &b->runs[t];
             if (B->key == A->key || !box_overlap(A->lo, A->hi, B->lo, B->hi)) continue;
-            for (int a = 0; a < 3; a++) {
-                A->clo[a] = fmin(A->clo[a], fmax(A->lo[a], B->lo[a]));
-                A->chi[a] = fmax(A->chi[a], fmin(A->hi[a], B->hi[a]));
+            if (A->nbox == BOXES_MAX) nb--, A->nbox--; /* reopen the last box */
+            else {
+                if (!grow((void **)&b->boxes, &b->cap_boxes, 6 * ((int64_t)nb + 1), sizeof *b->boxes)) return -1;
+                for (int a = 0; a < 3; a++) { b->boxes[6 * nb + a] = INFINITY; b->boxes[6 * nb + 3 + a] = -INFINITY; }
             }
+            wb_real *bx = &b->boxes[6 * nb];
+            for (int a = 0; a < 3; a++) {
+                const wb_real lo = A->lo[a] > B->lo[a] ? A->lo[a] : B->lo[a];
+                const wb_real hi = A->hi[a] < B->hi[a] ? A->hi[a] : B->hi[a];
+                if (lo < bx[a]) bx[a] = lo;
+                if (hi > bx[3 + a]) bx[3 + a] = hi;
+            }
+            nb++;
+            A->nbox++;
         }
+        /* a box that covers the whole run culls nothing: test none */
+        for (int32_t q = A->box0; q < A->box0 + A->nbox; q++) {
+            const wb_real *bx = &b->boxes[6 * q];
+            if (bx[0] <= A->lo[0] && bx[1] <= A->lo[1] && bx[2] <= A->lo[2] &&
+                bx[3] >= A->hi[0] && bx[4] >= A->hi[1] && bx[5] >= A->hi[2]) { A->nbox = -1; break; }
+        }
+        if (A->nbox >= 0) culls = 1;
     }
+    if (!culls) return na;
     /* survivors, in candidate order (the list's order stays the input's) */
     int32_t m = 0, s = 0;
     for (int32_t k = 0; k < na; k++) {
@@ -171,11 +201,16 @@ static int32_t cull(wb_broad *b, const wb_real *x, const wb_real *reach, const i
         if (skip[i] == 0) { b->cand[m++] = i; continue; }
         while (!(b->runs[s].key != 0 && k >= b->runs[s].first && k < b->runs[s].last)) s++;
         const run *A = &b->runs[s];
-        if (!(A->clo[0] <= A->chi[0])) continue; /* touches nothing */
+        if (A->nbox < 0) { b->cand[m++] = i; continue; }
         const wb_real e = reach[i], *p = &x[3 * i];
-        if (p[0] + e >= A->clo[0] && p[0] - e <= A->chi[0] && p[1] + e >= A->clo[1] &&
-            p[1] - e <= A->chi[1] && p[2] + e >= A->clo[2] && p[2] - e <= A->chi[2])
-            b->cand[m++] = i;
+        for (int32_t q = A->box0; q < A->box0 + A->nbox; q++) {
+            const wb_real *bx = &b->boxes[6 * q];
+            if (p[0] + e >= bx[0] && p[0] - e <= bx[3] && p[1] + e >= bx[1] && p[1] - e <= bx[4] &&
+                p[2] + e >= bx[2] && p[2] - e <= bx[5]) {
+                b->cand[m++] = i;
+                break;
+            }
+        }
     }
     return m;
 }
@@ -208,37 +243,71 @@ static inline int axis_ranges(const grid *g, int a, wb_real v, wb_real e, int64_
     return 2;
 }
 
-/* pass 3 over the sorted positions [lo, hi) */
+/* one candidate pair: not of one skip key, within reach, kept */
+
+/* the sorted positions [q0, q1) that s pairs with. big: s is big, partners of a smaller
+ * reach (ties: a higher index); else partners that are not big. The distance test
+ * first: it fails for most (a branch that predicts well), the skip key after */
+static inline void try_range(const wb_broad *b, const grid *g, int32_t s, int32_t q0, int32_t q1, int big,
+                             pairbuf *o, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
+{
+    const wb_real *P = b->p, *p = &P[4 * s], rs = p[3], T = g->big;
+    const int32_t *key = b->key, *id = b->id, ks = key[s], i = id[s];
+    for (int32_t t = q0; t < q1; t++) {
+        const wb_real *q = &P[4 * t], rt = q[3];
+        const wb_real d0 = q[0] - p[0], d1 = q[1] - p[1], d2 = q[2] - p[2], r = rs + rt;
+        if (d0 * d0 + d1 * d1 + d2 * d2 >= r * r) continue;
+        if (ks != 0 && key[t] == ks) continue;
+        if (big ? rt > rs || (rt == rs && id[t] <= i) : rt > T) continue;
+        const int32_t j = id[t];
+        if (keep && !keep(ud, i < j ? i : j, i < j ? j : i)) continue;
+        push(o, i, j);
+    }
+}
+
+/* pass 3 over the sorted positions [lo, hi). A pair of two ordinary particles (reach
+ * up to g->big) is found from the one earlier in the sorted array, which searches
+ * reach + g->rn (rows wholly before it are skipped); a pair with a big particle from
+ * the one with the larger reach (ties: the lower index), which searches twice its
+ * reach over the whole neighbourhood */
 static void scan(const wb_broad *b, const grid *g, int32_t lo, int32_t hi, pairbuf *o,
                  int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
 {
-    const int32_t *start = b->start, *id = b->id, *key = b->key;
-    const wb_real *P = b->p;
+    const int32_t *start = b->start;
+    const wb_real *P = b->p, T = g->big;
     const int64_t nx = g->nc[0], ny = g->nc[1];
     for (int32_t s = lo; s < hi; s++) {
-        const wb_real *p = &P[4 * s], rs = p[3], e = 2 * rs;
-        const int32_t i = id[s], ki = key[s];
+        const wb_real *p = &P[4 * s], rs = p[3];
+        const int big = rs > T;
+        const wb_real e = big ? 2 * rs : rs + g->rn;
         int64_t rx[4], ry[4], rz[4];
         const int kx = axis_ranges(g, 0, p[0], e, rx), ky = axis_ranges(g, 1, p[1], e, ry),
                   kz = axis_ranges(g, 2, p[2], e, rz);
+        if (!g->wrap && !big) {
+            /* rows wholly before s in the sorted order hold no partner of it: from its
+             * own row on (its own from s + 1) */
+            const int64_t y0 = cell_of(p[1], g->o[1], g->inv), z0 = cell_of(p[2], g->o[2], g->inv);
+            for (int64_t z = z0; z <= rz[1]; z++)
+                for (int64_t y = z == z0 ? y0 : ry[0]; y <= ry[1]; y++) {
+                    const int64_t row = nx * (y + ny * z);
+                    const int32_t q0 = y == y0 && z == z0 ? s + 1 : start[row + rx[0]], q1 = start[row + rx[1] + 1];
+                    if (q0 < q1) try_range(b, g, s, q0, q1, 0, o, keep, ud);
+                }
+            continue;
+        }
         for (int az = 0; az < kz; az++)
             for (int64_t z = rz[2 * az]; z <= rz[2 * az + 1]; z++)
                 for (int ay = 0; ay < ky; ay++)
                     for (int64_t y = ry[2 * ay]; y <= ry[2 * ay + 1]; y++) {
                         const int64_t row = nx * (y + ny * z);
                         for (int ax = 0; ax < kx; ax++) {
-                            const int32_t q0 = start[row + rx[2 * ax]], q1 = start[row + rx[2 * ax + 1] + 1];
-                            for (int32_t t = q0; t < q1; t++) {
-                                const wb_real *q = &P[4 * t], rt = q[3];
-                                const int32_t j = id[t];
-                                /* from the larger reach, ties from the lower index */
-                                if (rt > rs || (rt == rs && j <= i)) continue;
-                                if (ki != 0 && key[t] == ki) continue;
-                                const wb_real d0 = q[0] - p[0], d1 = q[1] - p[1], d2 = q[2] - p[2], r = rs + rt;
-                                if (d0 * d0 + d1 * d1 + d2 * d2 >= r * r) continue;
-                                if (keep && !keep(ud, i < j ? i : j, i < j ? j : i)) continue;
-                                push(o, i, j);
+                                    int32_t q0 = start[row + rx[2 * ax]];
+                            const int32_t q1 = start[row + rx[2 * ax + 1] + 1];
+                            if (!big) {
+                                if (q1 <= s + 1) continue;
+                                if (q0 < s + 1) q0 = s + 1;
                             }
+                            try_range(b, g, s, q0, q1, big, o, keep, ud);
                         }
                     }
     }
@@ -253,6 +322,14 @@ static int cmp_real(const void *a, const void *b)
 /* pass 2: the grid's origin, cell size and shape */
 static void make_grid(grid *g, const wb_broad *b, const wb_real *x, const wb_real *reach, int32_t m)
 {
+    /* the typical reach: the median of up to 31 reaches sampled evenly over the list */
+    wb_real sample[31];
+    const int ns = m < 31 ? (int)m : 31;
+    for (int k = 0; k < ns; k++) sample[k] = reach[b->cand[(int64_t)m * k / ns]];
+    qsort(sample, (size_t)ns, sizeof *sample, cmp_real);
+    const wb_real typical = sample[ns / 2];
+    g->big = 2 * typical;
+    g->rn = 0;
     wb_real lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY }, rmax = 0;
     for (int32_t k = 0; k < m; k++) {
         const int32_t i = b->cand[k];
@@ -261,13 +338,9 @@ static void make_grid(grid *g, const wb_broad *b, const wb_real *x, const wb_rea
             if (x[3 * i + a] > hi[a]) hi[a] = x[3 * i + a];
         }
         if (reach[i] > rmax) rmax = reach[i];
+        if (reach[i] > g->rn && !(reach[i] > g->big)) g->rn = reach[i];
     }
-    /* the typical reach: the median of up to 31 reaches sampled evenly over the list */
-    wb_real sample[31];
-    const int ns = m < 31 ? (int)m : 31;
-    for (int k = 0; k < ns; k++) sample[k] = reach[b->cand[(int64_t)m * k / ns]];
-    qsort(sample, (size_t)ns, sizeof *sample, cmp_real);
-    wb_real cs = 2 * sample[ns / 2];
+    wb_real cs = typical;
     if (!(cs > 0)) cs = 2 * rmax;
     if (!(cs > 1e-300)) cs = 1e-300;
     /* at most ~2 cells per particle: cells grown by 2^(1/3) until the box fits, past
@@ -375,11 +448,32 @@ int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, c
         if (b->out[t].fail) return -1;
         total += b->out[t].n;
     }
-    if (!grow((void **)&c->ij, &c->cap, 2 * total, sizeof *c->ij)) return -1;
-    for (int t = 0; t < nt; t++) {
-        memcpy(&c->ij[2 * c->n], b->out[t].ij, sizeof *c->ij * 2 * (size_t)b->out[t].n);
-        c->n += b->out[t].n;
+    if (!grow((void **)&c->ij, &c->cap, 2 * total, sizeof *c->ij) ||
+        !grow((void **)&b->first, &b->cap_first, (int64_t)n + 1, sizeof *b->first))
+        return -1;
+    /* in (i, j) order: a counting sort by i, then j sorted in each i's handful. The list
+     * is then the set of pairs alone, whatever the grid, the ranges or the threads */
+    int32_t *first = b->first, *ij = &c->ij[2 * c->n];
+    memset(first, 0, sizeof *first * ((size_t)n + 1));
+    for (int t = 0; t < nt; t++)
+        for (int32_t k = 0; k < b->out[t].n; k++) first[b->out[t].ij[2 * k] + 1]++;
+    for (int32_t i = 0; i < n; i++) first[i + 1] += first[i];
+    for (int t = 0; t < nt; t++)
+        for (int32_t k = 0; k < b->out[t].n; k++) {
+            const int32_t at = first[b->out[t].ij[2 * k]]++;
+            ij[2 * at] = b->out[t].ij[2 * k];
+            ij[2 * at + 1] = b->out[t].ij[2 * k + 1];
+        }
+    for (int32_t i = 0, at = 0; i < n; i++) { /* first[i] is now the end of i's pairs */
+        for (int32_t k = at + 1; k < first[i]; k++) {
+            const int32_t j = ij[2 * k + 1];
+            int32_t q = k;
+            for (; q > at && ij[2 * q - 1] > j; q--) ij[2 * q + 1] = ij[2 * q - 1];
+            ij[2 * q + 1] = j;
+        }
+        at = first[i];
     }
+    c->n = (int32_t)total;
     return c->n;
 }
 
