@@ -46,27 +46,14 @@ static double now_ms(void)
 /* a run's overlaps tested one by one up to this many */
 #define BOXES_MAX 16
 
-typedef struct run {
+typedef struct wb_broad_run {
     int32_t first, last;   /* candidate list range [first, last) */
     int32_t key;           /* skip key; 0 = the catch-all run of keyless particles */
     wb_real lo[3], hi[3];  /* swept box */
     int32_t box0, nbox;    /* its overlaps with other runs: boxes[box0..], -1: covers it */
 } run;
 
-typedef struct pairbuf { int32_t *ij; int32_t n, cap; int fail; } pairbuf;
-
-struct wb_broad {
-    int32_t *cand; int32_t cap_cand;   /* candidates in index order, then the survivors */
-    int32_t *cell; int32_t cap_cell;   /* cell of each survivor */
-    int32_t *start; int32_t cap_start; /* (cells + 1) counting-sort offsets */
-    wb_real *p; int32_t cap_p;         /* sorted: x, y, z, reach */
-    int32_t *id; int32_t cap_id;       /* sorted: particle */
-    int32_t *key; int32_t cap_key;     /* sorted: skip key */
-    run *runs; int32_t cap_runs;
-    wb_real *boxes; int32_t cap_boxes; /* (lo, hi) of runs' overlaps */
-    pairbuf *out; int nout;            /* one per thread */
-    int32_t *first; int32_t cap_first; /* (n + 1) sorting the pairs by i */
-};
+typedef wb_pairbuf pairbuf;
 
 typedef struct grid {
     wb_real o[3], inv;
@@ -83,20 +70,6 @@ static int grow(void **p, int32_t *cap, int64_t need, size_t elem)
     if (!q) return 0;
     *p = q;
     return 1;
-}
-
-void wb__broadphase_free(wb_contacts *c)
-{
-    free(c->skip);
-    c->skip = NULL;
-    c->cap_skip = 0;
-    wb_broad *b = c->bp;
-    if (!b) return;
-    free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key); free(b->runs); free(b->boxes); free(b->first);
-    for (int t = 0; t < b->nout; t++) free(b->out[t].ij);
-    free(b->out);
-    free(b);
-    c->bp = NULL;
 }
 
 /* cell coordinate, clamped to [0, 1e15] so that the cast stays defined for huge or

@@ -9,6 +9,7 @@
 #define WB_CORE_H
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "wobble.h"
@@ -147,7 +148,35 @@ typedef struct wb_contacts {
 typedef struct wb_broad wb_broad;
 int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
                        int32_t n, int threads, int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
-void wb__broadphase_free(wb_contacts *c); /* the scratch above; the rest is the world's */
+/* its scratch, kept from frame to frame (defined here so that the world frees it
+ * without calling back into broadphase.c) */
+typedef struct wb_pairbuf { int32_t *ij; int32_t n, cap; int fail; } wb_pairbuf;
+struct wb_broad {
+    int32_t *cand; int32_t cap_cand;   /* candidates in index order, then the survivors */
+    int32_t *cell; int32_t cap_cell;   /* cell of each survivor */
+    int32_t *start; int32_t cap_start; /* (cells + 1) counting-sort offsets */
+    wb_real *p; int32_t cap_p;         /* sorted: x, y, z, reach */
+    int32_t *id; int32_t cap_id;       /* sorted: particle */
+    int32_t *key; int32_t cap_key;     /* sorted: skip key */
+    struct wb_broad_run *runs; int32_t cap_runs;
+    wb_real *boxes; int32_t cap_boxes; /* (lo, hi) of runs' overlaps */
+    wb_pairbuf *out; int nout;         /* one per thread */
+    int32_t *first; int32_t cap_first; /* (n + 1) sorting the pairs by i */
+};
+static inline void wb__broadphase_free(wb_contacts *c)
+{
+    wb_broad *b = c->bp;
+    free(c->skip);
+    c->skip = NULL;
+    c->cap_skip = 0;
+    if (!b) return;
+    free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key);
+    free(b->runs); free(b->boxes); free(b->first);
+    for (int t = 0; t < b->nout; t++) free(b->out[t].ij);
+    free(b->out);
+    free(b);
+    c->bp = NULL;
+}
 
 /* ---- solver cache: packed colour batches and per-step scratch ------------------------ */
 typedef struct wb_cache {
