@@ -178,8 +178,8 @@ static int32_t cull(wb_broad *b, const wb_real *x, const wb_real *reach, const i
         const wb_real e = reach[i], *p = &x[3 * i];
         for (int32_t q = A->box0; q < A->box0 + A->nbox; q++) {
             const wb_real *bx = &b->boxes[6 * q];
-            if (p[0] + e >= bx[0] && p[0] - e <= bx[3] && p[1] + e >= bx[1] && p[1] - e <= bx[4] &&
-                p[2] + e >= bx[2] && p[2] - e <= bx[5]) {
+            if ((p[0] + e >= bx[0]) & (p[0] - e <= bx[3]) & (p[1] + e >= bx[1]) & (p[1] - e <= bx[4]) &
+                (p[2] + e >= bx[2]) & (p[2] - e <= bx[5])) {
                 b->cand[m++] = i;
                 break;
             }
