@@ -10,22 +10,26 @@
  *  1. Body culling. Particles of one body that does not collide with itself share a
  *     nonzero skip key. A body's swept box is the union of its particles' boxes
  *     (x +- reach); a particle can only touch another body if its own box overlaps that
- *     body's box, hence the hull of the body's overlaps with every other box. Particles
- *     outside it (deep inside a body, or every particle of a body that touches nothing)
- *     never enter the grid.
+ *     body's box, so it is kept only if its box meets one of its body's overlaps with
+ *     the other bodies' boxes. The others (deep inside a body, or every particle of a
+ *     body that touches nothing) never enter the grid.
  *  2. A sorted grid: the rest are counting-sorted by cell, row-major (x fastest), so the
- *     cells of one x-row are one contiguous range of the sorted array. The cell is about
- *     the typical reach diameter (twice a median of sampled reaches), grown until the
- *     grid has at most ~2 cells per particle; one fast particle does not enlarge the
- *     cells of all the others. Past that (particles spread over an enormous volume) the
- *     cell coordinates wrap around the grid, which only costs extra distance tests.
- *  3. Each pair is found from the particle with the larger reach (ties: the lower
- *     index), which searches the cells within twice its reach: reach_i + reach_j <=
- *     2 reach_i. Pairs of one skip key are dropped before the distance test.
+ *     cells of one x-row are one contiguous range of the sorted array. The cell is the
+ *     typical reach (a median of sampled reaches), grown until the grid has at most ~2
+ *     cells per particle; one fast particle does not enlarge the cells of all the
+ *     others. Past that (particles spread over an enormous volume) the cell coordinates
+ *     wrap around the grid, which only costs extra distance tests.
+ *  3. The search. A particle whose reach is at most twice the typical one (ordinary)
+ *     finds its pairs with the ordinary particles after it in the sorted array, within
+ *     its reach + the largest ordinary reach (rows wholly before it are skipped: half
+ *     the neighbourhood). A big (fast) one finds its pairs with every particle of a
+ *     smaller reach (ties: the higher index) within twice its reach, since reach_i +
+ *     reach_j <= 2 reach_i. Each pair is found once. Pairs of one skip key are dropped
+ *     after the distance test, before the group rules (keep).
  *
- * Determinism: the grid and the scan order depend on the input alone; threads take
- * contiguous ranges of the sorted array, each with its own pair buffer, and the buffers
- * are concatenated in range order, so the list is the same for any thread count. */
+ * Determinism: threads take contiguous ranges of the sorted array, each with its own
+ * pair buffer; the pairs are then counting-sorted into (i, j) order, so the list is the
+ * set of pairs alone, the same for any thread count, cell size or search order. */
 #include <stdlib.h>
 #include <time.h>
 

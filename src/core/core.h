@@ -142,8 +142,8 @@ typedef struct wb_contacts {
 
 /* broadphase.c: every pair i < j with |x_i - x_j| < reach_i + reach_j (particles with
  * reach < 0 or a non-finite position left out; pairs with one nonzero skip key too,
- * skip may be NULL), each once, in an order fixed by the input alone (the same for any
- * thread count); keep(ud, i, j) filters them (NULL: all; called from several threads
+ * skip may be NULL), each once, in (i, j) order (so the same for any thread count);
+ * keep(ud, i, j) filters them (NULL: all; called from several threads
  * at once). A sorted grid, linear in n. Appends to c->ij; -1 when out of memory */
 typedef struct wb_broad wb_broad;
 int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
