@@ -8,7 +8,10 @@
 -- Run: build/wobble run scripts/contact_pile.lua [--record out/pile/]
 local args = wobble.args
 local w = wobble.world{ substeps = 20, iterations = 2, contacts = args.contacts ~= 0 }
-local half, wall = 0.45, 0.3 -- the box's inner half-width and its walls' height (m)
+-- the box's inner half-width and its walls' height (m): the walls stand higher than the
+-- third ball up (~0.45 m), which otherwise can roll out over them (1 mm moved in a ball's
+-- drop point decides it)
+local half, wall = 0.45, 0.5
 w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.5 }
 -- four walls, thin boxes whose inner faces are at |x|, |z| = half
 local t = 0.02

@@ -1,6 +1,6 @@
 /* contact.c: particle-particle contacts (DESIGN.md §2, issue 8).
  *
- * Once per frame a broad phase (a spatial hash rebuilt from the frame's swept bounds
+ * Once per frame a broad phase (broadphase.c: a sorted grid over the frame's swept bounds
  * plus a margin, Macklin et al. 2019 "Small steps" §4) lists the candidate pairs; every
  * substep they are projected as inequality constraints |x_i - x_j| >= r_i + r_j (XPBD
  * with compliance 0, mass-weighted so momentum is conserved), with Coulomb friction
@@ -10,20 +10,12 @@
  * self-collides, and then not when joined by a constraint or closer than r_i + r_j
  * where they were created (Müller's Ten Minute Physics rule).
  *
- * Determinism: the candidate list depends on the positions alone (its order is the
- * particle order and the hash's bucket order), and the pairs are projected in a
+ * Determinism: the candidate list depends on the positions alone (broadphase.c, for
+ * any thread count), and the pairs are projected in a
  * serial pass in that order, so the result is the same for any thread count. */
 #include <stdlib.h>
-#include <time.h>
 
 #include "core.h"
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
 
 /* ---- groups and settings ---------------------------------------------------------------- */
 int32_t wb_group_new(const wb_world *w)
@@ -109,204 +101,7 @@ wb_real wb_body_spacing(const wb_world *w, wb_body b)
     return n > 0 ? sum / n : 0;
 }
 
-/* ---- broad phase ---------------------------------------------------------------------------- */
-static uint32_t cell_hash(int64_t x, int64_t y, int64_t z, uint32_t mask)
-{
-    /* Teschner et al. 2003's primes; unsigned arithmetic wraps without undefined behaviour */
-    return (uint32_t)(((uint64_t)x * 73856093u) ^ ((uint64_t)y * 19349663u) ^ ((uint64_t)z * 83492791u)) & mask;
-}
-
-/* cell coordinate, clamped so that the cast stays defined for huge or tiny positions
- * (particles past 1e15 cells from the origin share the last cell: still found, merely
- * tested against more neighbours) */
-static int64_t cell_of(wb_real x, wb_real inv)
-{
-    const wb_real c = floor(x * inv);
-    return c > 1e15 ? (int64_t)1e15 : c < -1e15 ? -(int64_t)1e15 : (int64_t)c;
-}
-
-int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, int32_t n,
-                       int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
-{
-    /* the cell is the largest reach diameter: a pair within reach_i + reach_j lies in
-     * neighbouring cells (at most one apart on every axis) */
-    wb_real rmax = 0;
-    int32_t na = 0;
-    for (int32_t i = 0; i < n; i++)
-        if (reach[i] >= 0) { na++; if (reach[i] > rmax) rmax = reach[i]; }
-    if (na < 2 || !(rmax > 0) || !isfinite(rmax)) return c->n;
-    const wb_real inv = 1 / (2 * rmax);
-    uint32_t size = 16;
-    while (size < 2 * (uint32_t)na && size < (1u << 30)) size *= 2;
-    const uint32_t mask = size - 1;
-    int32_t *cs = wb__grow(c->cell_start, &c->cap_cells, (int32_t)size + 1, sizeof *cs);
-    if (!cs) return -1;
-    c->cell_start = cs;
-    int32_t *ids = wb__grow(c->cell_ids, &c->cap_ids, na, sizeof *ids);
-    if (!ids) return -1;
-    c->cell_ids = ids;
-    int32_t *stamp = wb__grow(c->stamp, &c->cap_stamp, (int32_t)size, sizeof *stamp);
-    if (!stamp) return -1;
-    c->stamp = stamp;
-    for (uint32_t b = 0; b < size; b++) stamp[b] = -1;
-    /* counting sort by bucket; particles stay in index order inside a bucket */
-    memset(cs, 0, sizeof *cs * (size + 1));
-    for (int32_t i = 0; i < n; i++) {
-        if (reach[i] < 0) continue;
-        const wb_real *p = &x[3 * i];
-        cs[cell_hash(cell_of(p[0], inv), cell_of(p[1], inv), cell_of(p[2], inv), mask) + 1]++;
-    }
-    for (uint32_t b = 0; b < size; b++) cs[b + 1] += cs[b];
-    for (int32_t i = 0; i < n; i++) {
-        if (reach[i] < 0) continue;
-        const wb_real *p = &x[3 * i];
-        ids[cs[cell_hash(cell_of(p[0], inv), cell_of(p[1], inv), cell_of(p[2], inv), mask)]++] = i;
-    }
-    for (uint32_t b = size; b > 0; b--) cs[b] = cs[b - 1]; /* back to starts */
-    cs[0] = 0;
-    for (int32_t i = 0; i < n; i++) {
-        if (reach[i] < 0) continue;
-        const wb_real *p = &x[3 * i];
-        const int64_t cx = cell_of(p[0], inv), cy = cell_of(p[1], inv), cz = cell_of(p[2], inv);
-        /* the 27 neighbour cells' buckets, each once: two cells hashing to one bucket
-         * must not report its particles twice (a stamp per bucket: the last particle
-         * that visited it) */
-        for (int dz = -1; dz <= 1; dz++)
-            for (int dy = -1; dy <= 1; dy++)
-                for (int dx = -1; dx <= 1; dx++) {
-                    const uint32_t bk = cell_hash(cx + dx, cy + dy, cz + dz, mask);
-                    if (stamp[bk] == i) continue;
-                    stamp[bk] = i;
-                    for (int32_t s = cs[bk]; s < cs[bk + 1]; s++) {
-                        const int32_t j = ids[s];
-                        if (j <= i) continue;
-                        const wb_real *q = &x[3 * j];
-                        const wb_real d0 = q[0] - p[0], d1 = q[1] - p[1], d2 = q[2] - p[2], r = reach[i] + reach[j];
-                        if (d0 * d0 + d1 * d1 + d2 * d2 >= r * r) continue;
-                        if (keep && !keep(ud, i, j)) continue;
-                        int32_t *ij = wb__grow(c->ij, &c->cap, 2 * (c->n + 1), sizeof *ij);
-                        if (!ij) return -1;
-                        c->ij = ij;
-                        ij[2 * c->n] = i;
-                        ij[2 * c->n + 1] = j;
-                        c->n++;
-                    }
-                }
-    }
-    return c->n;
-}
-
-/* ---- which pairs may touch -------------------------------------------------------------------- */
-static int cmp_u64(const void *a, const void *b)
-{
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return x < y ? -1 : x > y;
-}
-
-static uint64_t pair_key(int32_t a, int32_t b)
-{
-    return a < b ? (uint64_t)(uint32_t)a << 32 | (uint32_t)b : (uint64_t)(uint32_t)b << 32 | (uint32_t)a;
-}
-
-/* the live constraints' pairs, sorted, for the self-collision rule */
-static int build_keys(wb_world *w)
-{
-    wb_contacts *c = &w->k.pc;
-    const wb_model *m = &w->m;
-    uint64_t *k = wb__grow(c->keys, &c->cap_keys, m->nd_live > 0 ? m->nd_live : 1, sizeof *k);
-    if (!k) return 0;
-    c->keys = k;
-    c->nkeys = 0;
-    for (int32_t s = 0; s < m->nd; s++)
-        if (m->d_gen[s] & 1u) k[c->nkeys++] = pair_key(m->d_ij[2 * s], m->d_ij[2 * s + 1]);
-    qsort(k, (size_t)c->nkeys, sizeof *k, cmp_u64);
-    c->keys_dirty = 0;
-    return 1;
-}
-
-static int joined(const wb_contacts *c, int32_t i, int32_t j)
-{
-    const uint64_t key = pair_key(i, j);
-    int32_t lo = 0, hi = c->nkeys;
-    while (lo < hi) {
-        const int32_t mid = lo + (hi - lo) / 2;
-        if (c->keys[mid] < key) lo = mid + 1;
-        else hi = mid;
-    }
-    return lo < c->nkeys && c->keys[lo] == key;
-}
-
-static int may_touch(void *ud, int32_t i, int32_t j)
-{
-    const wb_world *w = ud;
-    const wb_model *m = &w->m;
-    if (m->w[i] == 0 && m->w[j] == 0) return 0;
-    const int32_t gi = m->group[i], gj = m->group[j];
-    if (gi != gj || gi == 0) return (m->cflags[i] & m->cflags[j] & WB_CF_COLLIDE) != 0;
-    /* one body: only when it self-collides, and never between rest neighbours */
-    if (!(m->cflags[i] & m->cflags[j] & WB_CF_SELF)) return 0;
-    wb_real d[3];
-    v3_sub(d, &m->x0[3 * j], &m->x0[3 * i]);
-    const wb_real r = m->radius[i] + m->radius[j];
-    if (v3_dot(d, d) < r * r) return 0;
-    return !joined(&w->k.pc, i, j);
-}
-
-/* whether any pair could collide at all: one body without self-collision costs nothing */
-static int any_possible(const wb_model *m)
-{
-    int32_t loose = 0, g1 = -1;
-    int groups = 0;
-    for (int32_t i = 0; i < m->np; i++) {
-        const uint8_t f = m->cflags[i];
-        if (f & WB_CF_SELF) return 1;
-        if (!(f & WB_CF_COLLIDE)) continue;
-        if (m->group[i] == 0) loose++;
-        else if (g1 < 0) { g1 = m->group[i]; groups = 1; }
-        else if (m->group[i] != g1) groups = 2;
-        if (loose >= 2 || groups >= 2 || (loose >= 1 && groups >= 1)) return 1;
-    }
-    return 0;
-}
-
 /* ---- the step ---------------------------------------------------------------------------------- */
-void wb__contacts_begin(wb_world *w)
-{
-    wb_model *m = &w->m;
-    wb_contacts *c = &w->k.pc;
-    c->n = 0;
-    c->nact = 0;
-    c->last = 0;
-    c->broad_ms = 0;
-    if (!m->def.contacts || m->np < 2) return;
-    if (c->scan_dirty || c->scanned_np != m->np) {
-        c->possible = any_possible(m);
-        c->scanned_np = m->np;
-        c->scan_dirty = 0;
-    }
-    if (!c->possible) return;
-    const double t0 = now_ms();
-    if (c->keys_dirty || c->nkeys == 0) {
-        if (!build_keys(w)) { wb__warn(w, "out of memory in the contact broad phase; contacts skipped"); return; }
-    }
-    wb_real *reach = wb__grow(c->reach, &c->cap_reach, m->np, sizeof *reach);
-    if (!reach) { wb__warn(w, "out of memory in the contact broad phase; contacts skipped"); return; }
-    c->reach = reach;
-    /* swept bounds: how far a particle can get this frame (its velocity and gravity over
-     * dt), plus a quarter of its radius for what the constraints move it */
-    const wb_real dt = m->def.dt, g = v3_len(m->def.gravity) * dt * dt;
-    for (int32_t i = 0; i < m->np; i++) {
-        const int in = m->group[i] == 0 || (m->cflags[i] & (WB_CF_COLLIDE | WB_CF_SELF));
-        reach[i] = in ? m->radius[i] * (wb_real)1.25 + v3_len_safe(&w->s.v[3 * i]) * dt + g : -1;
-        if (!isfinite(reach[i])) reach[i] = -1;
-    }
-    if (wb__broadphase(c, w->s.x, reach, m->np, may_touch, w) < 0) {
-        c->n = 0;
-        wb__warn(w, "out of memory in the contact broad phase; contacts skipped");
-    }
-    c->broad_ms = now_ms() - t0;
-}
-
 /* Project every candidate once, in list order (Gauss-Seidel): push the pair apart along
  * their line by the overlap, split by inverse mass, then undo their relative tangential
  * slip of this substep when it is within the friction cone (mu x depth). */

@@ -9,6 +9,7 @@
 #define WB_CORE_H
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "wobble.h"
@@ -129,10 +130,9 @@ typedef struct wb_contacts {
     int32_t cap_nd;
     wb_real *reach;        /* (np) broad-phase reach, < 0 = not a candidate */
     int32_t cap_reach;
-    int32_t *cell_start, *cell_ids; /* spatial hash: counting sort of particles by cell */
-    int32_t cap_cells, cap_ids;
-    int32_t *stamp;        /* (cells) the last particle that visited a bucket */
-    int32_t cap_stamp;
+    int32_t *skip;         /* (np) broad-phase skip key: a body without self-collision, else 0 */
+    int32_t cap_skip;
+    struct wb_broad *bp;   /* broad-phase scratch (broadphase.c) */
     uint64_t *keys;        /* sorted (a << 32 | b) of live constraints: neighbours at rest */
     int32_t nkeys, cap_keys;
     int keys_dirty;        /* set when the topology changes */
@@ -143,11 +143,43 @@ typedef struct wb_contacts {
     double broad_ms;       /* broad phase of the last step */
 } wb_contacts;
 
-/* every pair i < j with |x_i - x_j| < reach_i + reach_j (particles with reach < 0 left
- * out), each once, in an order fixed by the input alone; keep(ud, i, j) filters them.
- * A spatial hash (counting sort, linear in n). Appends to c->ij; -1 when out of memory */
-int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, int32_t n,
-                       int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
+/* broadphase.c: every pair i < j with |x_i - x_j| < reach_i + reach_j (particles with
+ * reach < 0 or a non-finite position left out; pairs with one nonzero skip key too,
+ * skip may be NULL), each once, in (i, j) order (so the same for any thread count);
+ * keep(ud, i, j) filters them (NULL: all; called from several threads
+ * at once). A sorted grid, linear in n. Appends to c->ij; -1 when out of memory */
+typedef struct wb_broad wb_broad;
+int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
+                       int32_t n, int threads, int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
+/* its scratch, kept from frame to frame (defined here so that the world frees it
+ * without calling back into broadphase.c) */
+typedef struct wb_pairbuf { int32_t *ij; int32_t n, cap; int fail; } wb_pairbuf;
+struct wb_broad {
+    int32_t *cand; int32_t cap_cand;   /* candidates in index order, then the survivors */
+    int32_t *cell; int32_t cap_cell;   /* cell of each survivor */
+    int32_t *start; int32_t cap_start; /* (cells + 1) counting-sort offsets */
+    wb_real *p; int32_t cap_p;         /* sorted: x, y, z, reach */
+    int32_t *id; int32_t cap_id;       /* sorted: particle */
+    int32_t *key; int32_t cap_key;     /* sorted: skip key */
+    struct wb_broad_run *runs; int32_t cap_runs;
+    wb_real *boxes; int32_t cap_boxes; /* (lo, hi) of runs' overlaps */
+    wb_pairbuf *out; int nout;         /* one per thread */
+    int32_t *first; int32_t cap_first; /* (n + 1) sorting the pairs by i */
+};
+static inline void wb__broadphase_free(wb_contacts *c)
+{
+    wb_broad *b = c->bp;
+    free(c->skip);
+    c->skip = NULL;
+    c->cap_skip = 0;
+    if (!b) return;
+    free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key);
+    free(b->runs); free(b->boxes); free(b->first);
+    for (int t = 0; t < b->nout; t++) free(b->out[t].ij);
+    free(b->out);
+    free(b);
+    c->bp = NULL;
+}
 
 /* ---- particle-triangle contacts: per-frame scratch (tricontact.c) ------------------- */
 typedef struct wb_tricontacts {

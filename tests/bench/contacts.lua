@@ -3,7 +3,9 @@
 -- walls) pile up and push each other: 1728 particles, 10 substeps x 2 iterations,
 -- 300 frames, single thread (--set contacts=0: the same scene without contacts, for the ratio).
 -- Figures: ms per frame (the whole step), particle contacts in the last substep (mean
--- over the frames), the broad phase's ms per frame and its share of the step.
+-- over the frames), the broad phase's ms per frame and its share of the step, and the
+-- broad phase as a multiple of one distance-constraint sweep (one iteration over every
+-- link, the solver's projection time / (substeps x iterations)): the aim is below 1.
 -- Run: make bench   (or build/wobble bench [--json]; --set frames=N for a quick look)
 local args = wobble.args
 local frames = args.frames or 300
@@ -19,11 +21,12 @@ for k = 0, 26 do
              compliance = 1e-5, damping = 0.01, friction = 0.4 }
 end
 
-local step_ms, broad_ms, contacts = 0, 0, 0
+local step_ms, broad_ms, solve_ms, contacts = 0, 0, 0, 0
 for _ = 1, frames do
   w:step()
   local s = w:stats()
   step_ms, broad_ms, contacts = step_ms + s.step_ms, broad_ms + s.broad_ms, contacts + s.particle_contacts
+  solve_ms = solve_ms + s.solve_ms
 end
 local s = w:stats()
 local r = {
@@ -33,12 +36,15 @@ local r = {
   contacts_per_frame = contacts / frames,
   broad_ms_per_frame = broad_ms / frames,
   broad_share = broad_ms / step_ms,
+  sweep_ms = solve_ms / (frames * s.substeps * s.iterations),
 }
+r.broad_sweeps = r.broad_ms_per_frame / r.sweep_ms
 if args.json then
   print(require("wobble.bench").json(r))
 else
-  print(string.format("%-10s %9s %11s %8s %6s %10s %10s %12s %8s", "scene", "particles", "constraints",
-    "substeps", "iters", "ms/frame", "contacts", "broad ms/fr", "broad %"))
-  print(string.format("%-10s %9d %11d %8d %6d %10.3f %10.1f %12.3f %8.1f", r.scene, r.particles, r.constraints,
-    r.substeps, r.iterations, r.ms_per_frame, r.contacts_per_frame, r.broad_ms_per_frame, 100 * r.broad_share))
+  print(string.format("%-10s %9s %11s %8s %6s %10s %10s %12s %8s %12s", "scene", "particles", "constraints",
+    "substeps", "iters", "ms/frame", "contacts", "broad ms/fr", "broad %", "broad/sweep"))
+  print(string.format("%-10s %9d %11d %8d %6d %10.3f %10.1f %12.3f %8.1f %12.2f", r.scene, r.particles,
+    r.constraints, r.substeps, r.iterations, r.ms_per_frame, r.contacts_per_frame, r.broad_ms_per_frame,
+    100 * r.broad_share, r.broad_sweeps))
 end

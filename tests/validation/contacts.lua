@@ -254,3 +254,30 @@ test("determinism with contacts: the same hash with 1 and 2 threads", function()
   expect.gt(n1, 0, "the pile is in contact")
   expect.eq(h1, h2)
 end)
+
+test("determinism with contacts, a pile big enough for the parallel broad phase: 1 and 2 threads", function()
+  -- 27 blocks (1728 particles, past the 1024 from which the broad phase runs on every
+  -- thread) in a heap, squeezed by four walls so that they keep touching
+  local function heap(threads)
+    local w = wobble.world{ threads = threads, substeps = 3 }
+    w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.4 }
+    for _, n in ipairs{ {1, 0, 0}, {-1, 0, 0}, {0, 0, 1}, {0, 0, -1} } do
+      w:collider{ shape = "plane", normal = n, offset = -0.8, friction = 0.2 }
+    end
+    for k = 0, 26 do
+      local i, j, l = k % 3, (k // 3) % 3, k // 9
+      local x, y, z = -0.8 + 0.55 * i + 0.02 * l, 0.1 + 0.55 * l, -0.8 + 0.55 * j
+      w:lattice{ min = {x, y, z}, max = {x + 0.5, y + 0.5, z + 0.5}, res = {4, 4, 4}, compliance = 1e-5,
+                 friction = 0.3 }
+    end
+    local contacts = 0
+    for _ = 1, 12 do
+      w:step()
+      contacts = contacts + w:stats().particle_contacts
+    end
+    return w:hash(), contacts
+  end
+  local h1, n1 = heap(1)
+  expect.gt(n1, 200, "the heap is in contact")
+  expect.eq(heap(2), h1)
+end)

@@ -1,0 +1,578 @@
+/* broadphase.c: the candidate pairs of particle-particle contacts, once per frame
+ * (DESIGN.md §2, issue 8; Macklin et al. 2019 "Small steps" §4: swept bounds plus a
+ * margin, then every substep projects the same list).
+ *
+ * wb__contacts_begin works out each particle's reach (its radius with a margin, plus how
+ * far its velocity and gravity carry it in a frame) and asks wb__broadphase for every
+ * pair closer than reach_i + reach_j that may touch (contact.c's group rules).
+ *
+ * wb__broadphase, in three passes, each linear in the particles:
+ *  1. Body culling. Particles of one body that does not collide with itself share a
+ *     nonzero skip key. A body's swept box is the union of its particles' boxes
+ *     (x +- reach); a particle can only touch another body if its own box overlaps that
+ *     body's box, so it is kept only if its box meets one of its body's overlaps with
+ *     the other bodies' boxes. The others (deep inside a body, or every particle of a
+ *     body that touches nothing) never enter the grid.
+ *  2. A sorted grid: the rest are counting-sorted by cell, row-major (x fastest), so the
+ *     cells of one x-row are one contiguous range of the sorted array. The cell is the
+ *     typical reach (a median of sampled reaches), grown until the grid has at most ~2
+ *     cells per particle; one fast particle does not enlarge the cells of all the
+ *     others. Past that (particles spread over an enormous volume) the cell coordinates
+ *     wrap around the grid, which only costs extra distance tests.
+ *  3. The search. A particle whose reach is at most twice the typical one (ordinary)
+ *     finds its pairs with the ordinary particles after it in the sorted array, within
+ *     its reach + the largest ordinary reach (rows wholly before it are skipped: half
+ *     the neighbourhood). A big (fast) one finds its pairs with every particle of a
+ *     smaller reach (ties: the higher index) within twice its reach, since reach_i +
+ *     reach_j <= 2 reach_i. Each pair is found once. Pairs of one skip key are dropped
+ *     after the distance test, before the group rules (keep).
+ *
+ * Determinism: threads take contiguous ranges of the sorted array, each with its own
+ * pair buffer; the pairs are then counting-sorted into (i, j) order, so the list is the
+ * set of pairs alone, the same for any thread count, cell size or search order. */
+#include <stdlib.h>
+#include <time.h>
+
+#include "core.h"
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+/* below this many particles in the grid the scan stays on one thread (a parallel
+ * region costs more than it saves) */
+#define PAR_MIN 1024
+/* body culling only with at most this many runs (its cost is quadratic in them) */
+#define RUNS_MAX 256
+/* a run's overlaps tested one by one up to this many */
+#define BOXES_MAX 16
+
+typedef struct wb_broad_run {
+    int32_t first, last;   /* candidate list range [first, last) */
+    int32_t key;           /* skip key; 0 = the catch-all run of keyless particles */
+    wb_real lo[3], hi[3];  /* swept box */
+    int32_t box0, nbox;    /* its overlaps with other runs: boxes[box0..], -1: covers it */
+} run;
+
+typedef wb_pairbuf pairbuf;
+
+typedef struct grid {
+    wb_real o[3], inv;
+    int64_t nc[3];                     /* cells per axis */
+    int wrap;                          /* coordinates wrap around (a sparse, huge volume) */
+    wb_real big;                       /* reach past which a particle is big */
+    wb_real rn;                        /* the largest reach up to big */
+} grid;
+
+static int grow(void **p, int32_t *cap, int64_t need, size_t elem)
+{
+    if (need > INT32_MAX / 2) return 0;
+    void *q = wb__grow(*p, cap, (int32_t)(need > 0 ? need : 1), elem);
+    if (!q) return 0;
+    *p = q;
+    return 1;
+}
+
+/* cell coordinate, clamped to [0, 1e15] so that the cast stays defined for huge or
+ * infinite offsets (far particles share the last cell: still found, merely tested
+ * against more of them); monotone in v, so a search range never misses a cell */
+static inline int64_t cell_of(wb_real v, wb_real o, wb_real inv)
+{
+    const wb_real c = (v - o) * inv;
+    /* truncation is floor for c > 0 (and no libm call without SSE4.1) */
+    return c > 0 ? (c < 1e15 ? (int64_t)c : (int64_t)1e15) : 0;
+}
+
+static inline int64_t wrap_to(int64_t c, int64_t n) { return c % n; }
+
+static inline int32_t cell_index(const grid *g, const wb_real *x)
+{
+    int64_t c[3];
+    for (int a = 0; a < 3; a++) {
+        c[a] = cell_of(x[a], g->o[a], g->inv);
+        if (g->wrap) c[a] = wrap_to(c[a], g->nc[a]);
+    }
+    return (int32_t)(c[0] + g->nc[0] * (c[1] + g->nc[1] * c[2]));
+}
+
+static inline int box_overlap(const wb_real *alo, const wb_real *ahi, const wb_real *blo, const wb_real *bhi)
+{
+    return alo[0] <= bhi[0] && blo[0] <= ahi[0] && alo[1] <= bhi[1] && blo[1] <= ahi[1] &&
+           alo[2] <= bhi[2] && blo[2] <= ahi[2];
+}
+
+/* pass 1: runs of consecutive candidates with one nonzero key, every keyless candidate
+ * in one catch-all run; keeps in b->cand the candidates whose box overlaps one of their
+ * run's overlaps with the runs of other keys (a pair closer than reach_i + reach_j has
+ * overlapping boxes, both inside their runs' boxes, so inside the runs' overlap).
+ * Returns the survivors, or -1 when out of memory */
+static int32_t cull(wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t na)
+{
+    if (!skip) return na;
+    int32_t nr = 0, keyless = -1, last = -1;
+    for (int32_t k = 0; k < na; k++) {
+        const int32_t i = b->cand[k], key = skip[i];
+        int32_t cur;
+        if (key == 0 && keyless >= 0) cur = keyless;
+        else if (key != 0 && last >= 0 && b->runs[last].key == key && b->runs[last].last == k) cur = last;
+        else {
+            if (nr == RUNS_MAX) return na; /* too fragmented to pay off: no culling */
+            if (!grow((void **)&b->runs, &b->cap_runs, nr + 1, sizeof *b->runs)) return -1;
+            cur = nr++;
+            run *R = &b->runs[cur];
+            R->first = k;
+            R->key = key;
+            for (int a = 0; a < 3; a++) { R->lo[a] = INFINITY; R->hi[a] = -INFINITY; }
+            if (key == 0) keyless = cur;
+        }
+        run *R = &b->runs[cur];
+        if (key != 0) { last = cur; R->last = k + 1; }
+        const wb_real e = reach[i], *p = &x[3 * i];
+        for (int a = 0; a < 3; a++) {
+            if (p[a] - e < R->lo[a]) R->lo[a] = p[a] - e;
+            if (p[a] + e > R->hi[a]) R->hi[a] = p[a] + e;
+        }
+    }
+    /* each keyed run: its overlaps with the runs of other keys, as boxes (past BOXES_MAX
+     * of them the last box grows to the hull of the rest) */
+    int32_t nb = 0, culls = 0;
+    for (int32_t s = 0; s < nr; s++) {
+        run *A = &b->runs[s];
+        A->box0 = nb;
+        A->nbox = 0;
+        if (A->key == 0) continue;
+        for (int32_t t = 0; t < nr; t++) {
+            const run *B = &b->runs[t];
+            if (B->key == A->key || !box_overlap(A->lo, A->hi, B->lo, B->hi)) continue;
+            if (A->nbox == BOXES_MAX) nb--, A->nbox--; /* reopen the last box */
+            else {
+                if (!grow((void **)&b->boxes, &b->cap_boxes, 6 * ((int64_t)nb + 1), sizeof *b->boxes)) return -1;
+                for (int a = 0; a < 3; a++) { b->boxes[6 * nb + a] = INFINITY; b->boxes[6 * nb + 3 + a] = -INFINITY; }
+            }
+            wb_real *bx = &b->boxes[6 * nb];
+            for (int a = 0; a < 3; a++) {
+                const wb_real lo = A->lo[a] > B->lo[a] ? A->lo[a] : B->lo[a];
+                const wb_real hi = A->hi[a] < B->hi[a] ? A->hi[a] : B->hi[a];
+                if (lo < bx[a]) bx[a] = lo;
+                if (hi > bx[3 + a]) bx[3 + a] = hi;
+            }
+            nb++;
+            A->nbox++;
+        }
+        /* a box that covers the whole run culls nothing: test none */
+        for (int32_t q = A->box0; q < A->box0 + A->nbox; q++) {
+            const wb_real *bx = &b->boxes[6 * q];
+            if (bx[0] <= A->lo[0] && bx[1] <= A->lo[1] && bx[2] <= A->lo[2] &&
+                bx[3] >= A->hi[0] && bx[4] >= A->hi[1] && bx[5] >= A->hi[2]) { A->nbox = -1; break; }
+        }
+        if (A->nbox >= 0) culls = 1;
+    }
+    if (!culls) return na;
+    /* survivors, in candidate order (the list's order stays the input's) */
+    int32_t m = 0, s = 0;
+    for (int32_t k = 0; k < na; k++) {
+        const int32_t i = b->cand[k];
+        if (skip[i] == 0) { b->cand[m++] = i; continue; }
+        while (!(b->runs[s].key != 0 && k >= b->runs[s].first && k < b->runs[s].last)) s++;
+        const run *A = &b->runs[s];
+        if (A->nbox < 0) { b->cand[m++] = i; continue; }
+        const wb_real e = reach[i], *p = &x[3 * i];
+        for (int32_t q = A->box0; q < A->box0 + A->nbox; q++) {
+            const wb_real *bx = &b->boxes[6 * q];
+            if ((p[0] + e >= bx[0]) & (p[0] - e <= bx[3]) & (p[1] + e >= bx[1]) & (p[1] - e <= bx[4]) &
+                (p[2] + e >= bx[2]) & (p[2] - e <= bx[5])) {
+                b->cand[m++] = i;
+                break;
+            }
+        }
+    }
+    return m;
+}
+
+static void push(pairbuf *o, int32_t i, int32_t j)
+{
+    if (2 * (o->n + 1) > o->cap && !grow((void **)&o->ij, &o->cap, 2 * ((int64_t)o->n + 1), sizeof *o->ij)) {
+        o->fail = 1;
+        return;
+    }
+    o->ij[2 * o->n] = i < j ? i : j;
+    o->ij[2 * o->n + 1] = i < j ? j : i;
+    o->n++;
+}
+
+/* an axis's search range [c - 2 reach, c + 2 reach] as at most two runs of grid cells */
+static inline int axis_ranges(const grid *g, int a, wb_real v, wb_real e, int64_t r[4])
+{
+    int64_t lo = cell_of(v - e, g->o[a], g->inv), hi = cell_of(v + e, g->o[a], g->inv);
+    const int64_t n = g->nc[a];
+    if (!g->wrap) {
+        r[0] = lo; r[1] = hi < n - 1 ? hi : n - 1;
+        return 1;
+    }
+    if (hi - lo + 1 >= n) { r[0] = 0; r[1] = n - 1; return 1; }
+    lo = wrap_to(lo, n);
+    hi = wrap_to(hi, n);
+    if (lo <= hi) { r[0] = lo; r[1] = hi; return 1; }
+    r[0] = lo; r[1] = n - 1; r[2] = 0; r[3] = hi;
+    return 2;
+}
+
+/* one candidate pair: not of one skip key, within reach, kept */
+
+/* the sorted positions [q0, q1) that s pairs with. big: s is big, partners of a smaller
+ * reach (ties: a higher index); else partners that are not big. The distance test
+ * first: it fails for most (a branch that predicts well), the skip key after */
+static inline void try_range(const wb_broad *b, const grid *g, int32_t s, int32_t q0, int32_t q1, int big,
+                             pairbuf *o, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
+{
+    const wb_real *P = b->p, *p = &P[4 * s], rs = p[3], T = g->big;
+    const int32_t *key = b->key, *id = b->id, ks = key[s], i = id[s];
+    for (int32_t t = q0; t < q1; t++) {
+        const wb_real *q = &P[4 * t], rt = q[3];
+        const wb_real d0 = q[0] - p[0], d1 = q[1] - p[1], d2 = q[2] - p[2], r = rs + rt;
+        if (d0 * d0 + d1 * d1 + d2 * d2 >= r * r) continue;
+        if (ks != 0 && key[t] == ks) continue;
+        if (big ? rt > rs || (rt == rs && id[t] <= i) : rt > T) continue;
+        const int32_t j = id[t];
+        if (keep && !keep(ud, i < j ? i : j, i < j ? j : i)) continue;
+        push(o, i, j);
+    }
+}
+
+/* pass 3 over the sorted positions [lo, hi). A pair of two ordinary particles (reach
+ * up to g->big) is found from the one earlier in the sorted array, which searches
+ * reach + g->rn (rows wholly before it are skipped); a pair with a big particle from
+ * the one with the larger reach (ties: the lower index), which searches twice its
+ * reach over the whole neighbourhood */
+static void scan(const wb_broad *b, const grid *g, int32_t lo, int32_t hi, pairbuf *o,
+                 int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
+{
+    const int32_t *start = b->start;
+    const wb_real *P = b->p, T = g->big;
+    const int64_t nx = g->nc[0], ny = g->nc[1];
+    for (int32_t s = lo; s < hi; s++) {
+        const wb_real *p = &P[4 * s], rs = p[3];
+        const int big = rs > T;
+        const wb_real e = big ? 2 * rs : rs + g->rn;
+        int64_t rx[4], ry[4], rz[4];
+        const int kx = axis_ranges(g, 0, p[0], e, rx), ky = axis_ranges(g, 1, p[1], e, ry),
+                  kz = axis_ranges(g, 2, p[2], e, rz);
+        if (!g->wrap && !big) {
+            /* rows wholly before s in the sorted order hold no partner of it: from its
+             * own row on (its own from s + 1) */
+            const int64_t y0 = cell_of(p[1], g->o[1], g->inv), z0 = cell_of(p[2], g->o[2], g->inv);
+            for (int64_t z = z0; z <= rz[1]; z++)
+                for (int64_t y = z == z0 ? y0 : ry[0]; y <= ry[1]; y++) {
+                    const int64_t row = nx * (y + ny * z);
+                    const int32_t q0 = y == y0 && z == z0 ? s + 1 : start[row + rx[0]], q1 = start[row + rx[1] + 1];
+                    if (q0 < q1) try_range(b, g, s, q0, q1, 0, o, keep, ud);
+                }
+            continue;
+        }
+        for (int az = 0; az < kz; az++)
+            for (int64_t z = rz[2 * az]; z <= rz[2 * az + 1]; z++)
+                for (int ay = 0; ay < ky; ay++)
+                    for (int64_t y = ry[2 * ay]; y <= ry[2 * ay + 1]; y++) {
+                        const int64_t row = nx * (y + ny * z);
+                        for (int ax = 0; ax < kx; ax++) {
+                                    int32_t q0 = start[row + rx[2 * ax]];
+                            const int32_t q1 = start[row + rx[2 * ax + 1] + 1];
+                            if (!big) {
+                                if (q1 <= s + 1) continue;
+                                if (q0 < s + 1) q0 = s + 1;
+                            }
+                            try_range(b, g, s, q0, q1, big, o, keep, ud);
+                        }
+                    }
+    }
+}
+
+static int cmp_real(const void *a, const void *b)
+{
+    const wb_real x = *(const wb_real *)a, y = *(const wb_real *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* pass 2: the grid's origin, cell size and shape */
+static void make_grid(grid *g, const wb_broad *b, const wb_real *x, const wb_real *reach, int32_t m)
+{
+    /* the typical reach: the median of up to 31 reaches sampled evenly over the list */
+    wb_real sample[31];
+    const int ns = m < 31 ? (int)m : 31;
+    for (int k = 0; k < ns; k++) sample[k] = reach[b->cand[(int64_t)m * k / ns]];
+    qsort(sample, (size_t)ns, sizeof *sample, cmp_real);
+    const wb_real typical = sample[ns / 2];
+    g->big = 2 * typical;
+    g->rn = 0;
+    wb_real lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY }, rmax = 0;
+    for (int32_t k = 0; k < m; k++) {
+        const int32_t i = b->cand[k];
+        for (int a = 0; a < 3; a++) {
+            if (x[3 * i + a] < lo[a]) lo[a] = x[3 * i + a];
+            if (x[3 * i + a] > hi[a]) hi[a] = x[3 * i + a];
+        }
+        if (reach[i] > rmax) rmax = reach[i];
+        if (reach[i] > g->rn && !(reach[i] > g->big)) g->rn = reach[i];
+    }
+    wb_real cs = typical;
+    if (!(cs > 0)) cs = 2 * rmax;
+    if (!(cs > 1e-300)) cs = 1e-300;
+    /* at most ~2 cells per particle: cells grown by 2^(1/3) until the box fits, past
+     * 2^20 times the reach the coordinates wrap instead */
+    const double budget = 2.0 * m + 64;
+    double dims[3];
+    wb_real inv = 1 / cs;
+    for (int grow_step = 0;; grow_step++) {
+        double prod = 1;
+        inv = 1 / cs;
+        for (int a = 0; a < 3; a++) {
+            /* as cell_of computes it: the last particle's cell is inside */
+            dims[a] = floor((hi[a] - lo[a]) * inv) + 1;
+            if (!(dims[a] < 1e15)) dims[a] = 1e15;
+            prod *= dims[a];
+        }
+        g->wrap = prod > budget;
+        if (!g->wrap || grow_step == 60) break;
+        cs *= 1.2599210498948732;
+    }
+    if (g->wrap) {
+        /* the budget shared out from the thinnest axis up */
+        int order[3] = { 0, 1, 2 };
+        for (int a = 0; a < 2; a++)
+            for (int c = a + 1; c < 3; c++)
+                if (dims[order[c]] < dims[order[a]]) { int t = order[a]; order[a] = order[c]; order[c] = t; }
+        double left = budget;
+        for (int k = 0; k < 3; k++) {
+            const int a = order[k];
+            double cap = floor(pow(left, 1.0 / (3 - k)) + 1e-9);
+            if (cap < 1) cap = 1;
+            if (dims[a] > cap) dims[a] = cap;
+            left /= dims[a];
+        }
+    }
+    for (int a = 0; a < 3; a++) { g->o[a] = lo[a]; g->nc[a] = (int64_t)dims[a]; }
+    g->inv = inv;
+}
+
+int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
+                       int32_t n, int threads, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
+{
+    if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
+    wb_broad *b = c->bp;
+    if (!grow((void **)&b->cand, &b->cap_cand, n, sizeof *b->cand)) return -1;
+    int32_t na = 0;
+    for (int32_t i = 0; i < n; i++) {
+        const wb_real *p = &x[3 * i];
+        if (reach[i] >= 0 && isfinite(reach[i]) && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])) b->cand[na++] = i;
+    }
+    if (na < 2) return c->n;
+    const int32_t m = cull(b, x, reach, skip, na);
+    if (m < 0) return -1;
+    if (m < 2) return c->n;
+
+    grid g;
+    make_grid(&g, b, x, reach, m);
+    const int64_t ncell = g.nc[0] * g.nc[1] * g.nc[2];
+    if (!grow((void **)&b->start, &b->cap_start, ncell + 1, sizeof *b->start) ||
+        !grow((void **)&b->cell, &b->cap_cell, m, sizeof *b->cell) ||
+        !grow((void **)&b->p, &b->cap_p, 4 * (int64_t)m, sizeof *b->p) ||
+        !grow((void **)&b->id, &b->cap_id, m, sizeof *b->id) ||
+        !grow((void **)&b->key, &b->cap_key, m, sizeof *b->key))
+        return -1;
+    /* counting sort by cell: stable, so a cell's particles stay in index order */
+    int32_t *start = b->start;
+    memset(start, 0, sizeof *start * (size_t)(ncell + 1));
+    for (int32_t k = 0; k < m; k++) {
+        const int32_t cl = cell_index(&g, &x[3 * b->cand[k]]);
+        b->cell[k] = cl;
+        start[cl + 1]++;
+    }
+    for (int64_t q = 0; q < ncell; q++) start[q + 1] += start[q];
+    for (int32_t k = 0; k < m; k++) {
+        const int32_t i = b->cand[k], s = start[b->cell[k]]++;
+        wb_real *p = &b->p[4 * s];
+        v3_copy(p, &x[3 * i]);
+        p[3] = reach[i];
+        b->id[s] = i;
+        b->key[s] = skip ? skip[i] : 0;
+    }
+    for (int64_t q = ncell; q > 0; q--) start[q] = start[q - 1]; /* back to starts */
+    start[0] = 0;
+
+    /* pass 3: contiguous ranges of the sorted array, one pair buffer each */
+    int nt = threads > 1 && m >= PAR_MIN ? threads : 1;
+    if (nt > b->nout) {
+        pairbuf *o = realloc(b->out, sizeof *o * (size_t)nt);
+        if (!o) return -1;
+        memset(o + b->nout, 0, sizeof *o * (size_t)(nt - b->nout));
+        b->out = o;
+        b->nout = nt;
+    }
+    for (int t = 0; t < nt; t++) { b->out[t].n = 0; b->out[t].fail = 0; }
+    if (nt == 1) scan(b, &g, 0, m, &b->out[0], keep, ud);
+    else {
+        #pragma omp parallel for num_threads(nt) schedule(static)
+        for (int t = 0; t < nt; t++) {
+            const int32_t lo = (int32_t)((int64_t)m * t / nt), hi = (int32_t)((int64_t)m * (t + 1) / nt);
+            scan(b, &g, lo, hi, &b->out[t], keep, ud);
+        }
+    }
+    int64_t total = c->n;
+    for (int t = 0; t < nt; t++) {
+        if (b->out[t].fail) return -1;
+        total += b->out[t].n;
+    }
+    if (!grow((void **)&c->ij, &c->cap, 2 * total, sizeof *c->ij) ||
+        !grow((void **)&b->first, &b->cap_first, (int64_t)n + 1, sizeof *b->first))
+        return -1;
+    /* in (i, j) order: a counting sort by i, then j sorted in each i's handful. The list
+     * is then the set of pairs alone, whatever the grid, the ranges or the threads */
+    int32_t *first = b->first, *ij = &c->ij[2 * c->n];
+    memset(first, 0, sizeof *first * ((size_t)n + 1));
+    for (int t = 0; t < nt; t++)
+        for (int32_t k = 0; k < b->out[t].n; k++) first[b->out[t].ij[2 * k] + 1]++;
+    for (int32_t i = 0; i < n; i++) first[i + 1] += first[i];
+    for (int t = 0; t < nt; t++)
+        for (int32_t k = 0; k < b->out[t].n; k++) {
+            const int32_t at = first[b->out[t].ij[2 * k]]++;
+            ij[2 * at] = b->out[t].ij[2 * k];
+            ij[2 * at + 1] = b->out[t].ij[2 * k + 1];
+        }
+    for (int32_t i = 0, at = 0; i < n; i++) { /* first[i] is now the end of i's pairs */
+        for (int32_t k = at + 1; k < first[i]; k++) {
+            const int32_t j = ij[2 * k + 1];
+            int32_t q = k;
+            for (; q > at && ij[2 * q - 1] > j; q--) ij[2 * q + 1] = ij[2 * q - 1];
+            ij[2 * q + 1] = j;
+        }
+        at = first[i];
+    }
+    c->n = (int32_t)total;
+    return c->n;
+}
+
+/* ---- which pairs may touch -------------------------------------------------------------------- */
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+static uint64_t pair_key(int32_t a, int32_t b)
+{
+    return a < b ? (uint64_t)(uint32_t)a << 32 | (uint32_t)b : (uint64_t)(uint32_t)b << 32 | (uint32_t)a;
+}
+
+/* the live constraints' pairs, sorted, for the self-collision rule */
+static int build_keys(wb_world *w)
+{
+    wb_contacts *c = &w->k.pc;
+    const wb_model *m = &w->m;
+    uint64_t *k = wb__grow(c->keys, &c->cap_keys, m->nd_live > 0 ? m->nd_live : 1, sizeof *k);
+    if (!k) return 0;
+    c->keys = k;
+    c->nkeys = 0;
+    for (int32_t s = 0; s < m->nd; s++)
+        if (m->d_gen[s] & 1u) k[c->nkeys++] = pair_key(m->d_ij[2 * s], m->d_ij[2 * s + 1]);
+    qsort(k, (size_t)c->nkeys, sizeof *k, cmp_u64);
+    c->keys_dirty = 0;
+    return 1;
+}
+
+static int joined(const wb_contacts *c, int32_t i, int32_t j)
+{
+    const uint64_t key = pair_key(i, j);
+    int32_t lo = 0, hi = c->nkeys;
+    while (lo < hi) {
+        const int32_t mid = lo + (hi - lo) / 2;
+        if (c->keys[mid] < key) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < c->nkeys && c->keys[lo] == key;
+}
+
+static int may_touch(void *ud, int32_t i, int32_t j)
+{
+    const wb_world *w = ud;
+    const wb_model *m = &w->m;
+    if (m->w[i] == 0 && m->w[j] == 0) return 0;
+    const int32_t gi = m->group[i], gj = m->group[j];
+    if (gi != gj || gi == 0) return (m->cflags[i] & m->cflags[j] & WB_CF_COLLIDE) != 0;
+    /* one body: only when it self-collides, and never between rest neighbours */
+    if (!(m->cflags[i] & m->cflags[j] & WB_CF_SELF)) return 0;
+    wb_real d[3];
+    v3_sub(d, &m->x0[3 * j], &m->x0[3 * i]);
+    const wb_real r = m->radius[i] + m->radius[j];
+    if (v3_dot(d, d) < r * r) return 0;
+    return !joined(&w->k.pc, i, j);
+}
+
+/* whether any pair could collide at all: one body without self-collision costs nothing */
+static int any_possible(const wb_model *m)
+{
+    int32_t loose = 0, g1 = -1;
+    int groups = 0;
+    for (int32_t i = 0; i < m->np; i++) {
+        const uint8_t f = m->cflags[i];
+        if (f & WB_CF_SELF) return 1;
+        if (!(f & WB_CF_COLLIDE)) continue;
+        if (m->group[i] == 0) loose++;
+        else if (g1 < 0) { g1 = m->group[i]; groups = 1; }
+        else if (m->group[i] != g1) groups = 2;
+        if (loose >= 2 || groups >= 2 || (loose >= 1 && groups >= 1)) return 1;
+    }
+    return 0;
+}
+
+/* ---- the step ---------------------------------------------------------------------------------- */
+void wb__contacts_begin(wb_world *w)
+{
+    wb_model *m = &w->m;
+    wb_contacts *c = &w->k.pc;
+    c->n = 0;
+    c->nact = 0;
+    c->last = 0;
+    c->broad_ms = 0;
+    if (!m->def.contacts || m->np < 2) return;
+    if (c->scan_dirty || c->scanned_np != m->np) {
+        c->possible = any_possible(m);
+        c->scanned_np = m->np;
+        c->scan_dirty = 0;
+    }
+    if (!c->possible) return;
+    const double t0 = now_ms();
+    if (c->keys_dirty || c->nkeys == 0) {
+        if (!build_keys(w)) { wb__warn(w, "out of memory in the contact broad phase; contacts skipped"); return; }
+    }
+    wb_real *reach = wb__grow(c->reach, &c->cap_reach, m->np, sizeof *reach);
+    if (!reach) { wb__warn(w, "out of memory in the contact broad phase; contacts skipped"); return; }
+    c->reach = reach;
+    /* swept bounds: how far a particle can get this frame (its velocity and gravity over
+     * dt), plus a quarter of its radius for what the constraints move it */
+    int32_t *skip = wb__grow(c->skip, &c->cap_skip, m->np, sizeof *skip);
+    if (!skip) { wb__warn(w, "out of memory in the contact broad phase; contacts skipped"); return; }
+    c->skip = skip;
+    const wb_real dt = m->def.dt, g = v3_len(m->def.gravity) * dt * dt;
+    const wb_real *v = w->s.v;
+    for (int32_t i = 0; i < m->np; i++) {
+        const uint8_t f = m->cflags[i];
+        const int32_t gi = m->group[i];
+        /* may_touch's rules: other bodies need `collide`, its own body `self_collide` */
+        if (!((f & WB_CF_COLLIDE) || (gi > 0 && (f & WB_CF_SELF)))) { reach[i] = -1; continue; }
+        const wb_real vv = v3_dot(&v[3 * i], &v[3 * i]);
+        const wb_real sp = vv < 1e300 ? sqrt(vv) : v3_len_safe(&v[3 * i]);
+        reach[i] = m->radius[i] * (wb_real)1.25 + sp * dt + g;
+        if (!isfinite(reach[i])) reach[i] = -1;
+        /* a body that does not collide with itself: its pairs are left out before the
+         * distance test, and its inside is culled by its bounds */
+        skip[i] = gi > 0 && !(f & WB_CF_SELF) ? gi : 0;
+    }
+    if (wb__broadphase(c, w->s.x, reach, skip, m->np, m->def.threads, may_touch, w) < 0) {
+        c->n = 0;
+        wb__warn(w, "out of memory in the contact broad phase; contacts skipped");
+    }
+    c->broad_ms = now_ms() - t0;
+}
