@@ -60,6 +60,7 @@ wb_world_def wb_world_default_def(void)
     d.relaxation = 1;
     d.threads = 1;
     d.contacts = true;
+    d.max_depenetration = 0.25;
     return d;
 }
 
@@ -83,6 +84,7 @@ const char *wb_world_def_check(const wb_world_def *d)
     if (d->solver != WB_SOLVER_GAUSS_SEIDEL && d->solver != WB_SOLVER_JACOBI) return "unknown solver";
     if (!(d->relaxation > 0 && d->relaxation < 2)) return "relaxation must be in (0, 2)";
     if (d->threads < 1 || d->threads > WB_MAX_THREADS) return "threads must be in 1..256";
+    if (!(d->max_depenetration >= 0) || !isfinite(d->max_depenetration)) return "max_depenetration must be finite and >= 0 (m/s)";
     return NULL;
 }
 
