@@ -326,6 +326,13 @@ void wb__contacts_project(wb_world *w, wb_real h)
     wb_real *nds = wb__grow(c->act_nd, &c->cap_nd, 6 * c->n, sizeof *nds);
     if (!nds) goto nomem;
     c->act_nd = nds;
+    wb_real *left = wb__grow(c->left, &c->cap_left, c->n, sizeof *left);
+    if (!left) goto nomem;
+    c->left = left;
+    if (c->left_frame != w->s.frame + 1) { /* a new candidate list */
+        for (int32_t k = 0; k < c->n; k++) left[k] = INFINITY;
+        c->left_frame = w->s.frame + 1;
+    }
     for (int32_t k = 0; k < c->n; k++) {
         const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];
         const wb_real wi = wv[i], wj = wv[j], wsum = wi + wj;
@@ -339,22 +346,26 @@ void wb__contacts_project(wb_world *w, wb_real h)
              * for the count, with nothing to correct */
             const wb_real rt = r * (1 + (wb_real)1e-9);
             if (d2 <= rt * rt) touching++;
+            left[k] = 0;
             continue;
         }
         wb_real n[3];
         const wb_real len = sqrt(d2);
         if (len > r * (wb_real)1e-9) v3_scale(n, d, 1 / len);
         else v3_set(n, 0, 1, 0); /* coincident: any direction separates them */
-        /* d0: the overlap the pair started the substep with (at x_prev). Zero for a
-         * pair that meets in this substep and, to what the links and colliders moved
-         * since, for one that rests in touch (the last substep left it at r_i + r_j);
-         * deep only where bodies were made inside each other or squeezed together.
-         * That overlap goes at no more than max_depenetration x h per substep; what
-         * this substep's motion added goes in full (see wb__contacts_velocity) */
+        /* d0: the overlap the pair started the substep with (at x_prev). Most of it is
+         * what the contact pass left to the links and colliders after it, or what later
+         * pairs of the pass pushed back (Gauss-Seidel): repaired in full, as every
+         * substep must, or a heap's layers sink into each other. What is older, the
+         * overlap this pair was itself left with last substep (bodies made inside each
+         * other, a deep squeeze; before a frame's first substep all of d0 counts), goes
+         * at no more than max_depenetration x h per substep, so that a body is not
+         * squashed in one substep. Neither becomes speed (wb__contacts_velocity) */
         wb_real depth = r - len, dp[3];
         v3_sub(dp, &xp[3 * j], &xp[3 * i]);
-        const wb_real d0 = r - v3_len(dp), keep = d0 - vmax * h;
+        const wb_real d0 = r - v3_len(dp), old = d0 < left[k] ? d0 : left[k], keep = old - vmax * h;
         if (keep > 0) depth = depth > keep ? depth - keep : 0;
+        left[k] = r - len - depth;
         if (!(depth > 0)) { touching++; continue; }
         const wb_real err = !(d0 > 0) ? 0 : d0 < depth ? d0 : depth; /* of it, old overlap */
         if (wi > 0) v3_madd(xi, n, -depth * wi / wsum);

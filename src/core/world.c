@@ -111,7 +111,7 @@ void wb_world_destroy(wb_world *w)
                      k->colour_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda, k->s_jac,
                      k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->c_sub, k->c_save,
                      k->breaks, m->group, m->cflags, m->cfric, m->x0, k->pc.ij, k->pc.act, k->pc.act_nd,
-                     k->pc.reach, k->pc.cell_start, k->pc.cell_ids, k->pc.keys, k->pc.stamp };
+                     k->pc.left, k->pc.reach, k->pc.cell_start, k->pc.cell_ids, k->pc.keys, k->pc.stamp };
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
     free(w);
 }
