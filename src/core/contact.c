@@ -7,9 +7,10 @@
  * at position level (static inside the cone, as the collider contacts do in collide.c,
  * and kinetic outside it); after the velocity update a velocity pass removes the
  * approach speed (no restitution) and any speed the repair of an old overlap made (bodies
- * made inside each other push apart at max_depenetration, never fly apart). Inside one body, pairs never collide unless it
- * self-collides, and then not when joined by a constraint or closer than r_i + r_j
- * where they were created (Müller's Ten Minute Physics rule).
+ * made inside each other push apart at max_depenetration, never fly apart). Inside one
+ * body, pairs never collide unless it self-collides, and then not when joined by a
+ * constraint or closer than r_i + r_j where they were created (Müller's Ten Minute
+ * Physics rule).
  *
  * Determinism: the candidate list depends on the positions alone (its order is the
  * particle order and the hash's bucket order), and the pairs are projected in a
@@ -329,10 +330,12 @@ void wb__contacts_project(wb_world *w, wb_real h)
     wb_real *left = wb__grow(c->left, &c->cap_left, c->n, sizeof *left);
     if (!left) goto nomem;
     c->left = left;
-    if (c->left_frame != w->s.frame + 1) { /* a new candidate list */
+    /* a new candidate list (wb__contacts_begin clears c->last; so does a substep with no
+     * contact, whose pairs were left with nothing): what each pair was left with is not
+     * known, and all of its overlap counts as old. Worked out from the state alone, so
+     * a step interrupted and run again gives the same result */
+    if (c->last == 0)
         for (int32_t k = 0; k < c->n; k++) left[k] = INFINITY;
-        c->left_frame = w->s.frame + 1;
-    }
     for (int32_t k = 0; k < c->n; k++) {
         const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];
         const wb_real wi = wv[i], wj = wv[j], wsum = wi + wj;
@@ -387,8 +390,8 @@ void wb__contacts_project(wb_world *w, wb_real h)
                 if (wj > 0) v3_madd(xj, slip, f * wj / wsum);
             }
         }
-        /* normal, depth and old overlap, kept for the velocity pass; the normal force for the readout
-         * (XPBD multiplier of a zero-compliance contact, depth / (w_i + w_j), over h^2) */
+        /* normal, depth and old overlap, kept for the velocity pass; the normal force for
+         * the readout (XPBD multiplier of a zero-compliance contact, depth / (w_i + w_j), over h^2) */
         act[c->nact] = k;
         v3_copy(&nds[6 * c->nact], n);
         nds[6 * c->nact + 3] = depth;

@@ -125,9 +125,8 @@ typedef struct wb_contacts {
     wb_real *act_nd;       /* (nact x 6) normal (i -> j), depth, normal force, the overlap it started with */
     int32_t cap_nd;
     wb_real *left;         /* (n) overlap a candidate was left with by its last projection;
-                              INFINITY before the frame's first (contact.c: old overlap) */
+                              INFINITY when not known (contact.c: old overlap) */
     int32_t cap_left;
-    int64_t left_frame;    /* frame + 1 that `left` belongs to (0: none) */
     wb_real *reach;        /* (np) broad-phase reach, < 0 = not a candidate */
     int32_t cap_reach;
     int32_t *cell_start, *cell_ids; /* spatial hash: counting sort of particles by cell */
