@@ -72,6 +72,8 @@ typedef struct wb_world_def {
     wb_real relaxation;   /* Jacobi over-relaxation factor omega, default 1 */
     int threads;          /* default 1; results are bit-identical for any value */
     bool contacts;        /* particle-particle contacts, default true */
+    wb_real max_depenetration; /* m/s: how fast contacts push out an overlap a pair already had
+                                  (bodies made inside each other), default 0.25; >= 0 */
     wb_memory *memory;    /* budget the world's arrays are charged to; NULL = none (not copied by set_def) */
 } wb_world_def;
 

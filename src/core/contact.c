@@ -6,9 +6,11 @@
  * with compliance 0, mass-weighted so momentum is conserved), with Coulomb friction
  * at position level (static inside the cone, as the collider contacts do in collide.c,
  * and kinetic outside it); after the velocity update a velocity pass removes the
- * approach speed (no restitution). Inside one body, pairs never collide unless it
- * self-collides, and then not when joined by a constraint or closer than r_i + r_j
- * where they were created (Müller's Ten Minute Physics rule).
+ * approach speed (no restitution) and any speed the repair of an old overlap made (bodies
+ * made inside each other push apart at max_depenetration, never fly apart). Inside one
+ * body, pairs never collide unless it self-collides, and then not when joined by a
+ * constraint or closer than r_i + r_j where they were created (Müller's Ten Minute
+ * Physics rule).
  *
  * Determinism: the candidate list depends on the positions alone (broadphase.c, for
  * any thread count), and the pairs are projected in a
@@ -113,13 +115,22 @@ void wb__contacts_project(wb_world *w, wb_real h)
     int32_t touching = 0;
     const wb_model *m = &w->m;
     wb_real *x = w->s.x;
-    const wb_real *xp = w->s.x_prev, *wv = m->w, *rad = m->radius;
+    const wb_real *xp = w->s.x_prev, *wv = m->w, *rad = m->radius, vmax = m->def.max_depenetration;
     int32_t *act = wb__grow(c->act, &c->cap_act, c->n, sizeof *act);
     if (!act) goto nomem;
     c->act = act;
-    wb_real *nds = wb__grow(c->act_nd, &c->cap_nd, 5 * c->n, sizeof *nds);
+    wb_real *nds = wb__grow(c->act_nd, &c->cap_nd, 6 * c->n, sizeof *nds);
     if (!nds) goto nomem;
     c->act_nd = nds;
+    wb_real *left = wb__grow(c->left, &c->cap_left, c->n, sizeof *left);
+    if (!left) goto nomem;
+    c->left = left;
+    /* a new candidate list (wb__contacts_begin clears c->last; so does a substep with no
+     * contact, whose pairs were left with nothing): what each pair was left with is not
+     * known, and all of its overlap counts as old. Worked out from the state alone, so
+     * a step interrupted and run again gives the same result */
+    if (c->last == 0)
+        for (int32_t k = 0; k < c->n; k++) left[k] = INFINITY;
     for (int32_t k = 0; k < c->n; k++) {
         const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];
         const wb_real wi = wv[i], wj = wv[j], wsum = wi + wj;
@@ -133,13 +144,28 @@ void wb__contacts_project(wb_world *w, wb_real h)
              * for the count, with nothing to correct */
             const wb_real rt = r * (1 + (wb_real)1e-9);
             if (d2 <= rt * rt) touching++;
+            left[k] = 0;
             continue;
         }
         wb_real n[3];
         const wb_real len = sqrt(d2);
         if (len > r * (wb_real)1e-9) v3_scale(n, d, 1 / len);
         else v3_set(n, 0, 1, 0); /* coincident: any direction separates them */
-        const wb_real depth = r - len;
+        /* d0: the overlap the pair started the substep with (at x_prev). Most of it is
+         * what the contact pass left to the links and colliders after it, or what later
+         * pairs of the pass pushed back (Gauss-Seidel): repaired in full, as every
+         * substep must, or a heap's layers sink into each other. What is older, the
+         * overlap this pair was itself left with last substep (bodies made inside each
+         * other, a deep squeeze; before a frame's first substep all of d0 counts), goes
+         * at no more than max_depenetration x h per substep, so that a body is not
+         * squashed in one substep. Neither becomes speed (wb__contacts_velocity) */
+        wb_real depth = r - len, dp[3];
+        v3_sub(dp, &xp[3 * j], &xp[3 * i]);
+        const wb_real d0 = r - v3_len(dp), old = d0 < left[k] ? d0 : left[k], keep = old - vmax * h;
+        if (keep > 0) depth = depth > keep ? depth - keep : 0;
+        left[k] = r - len - depth;
+        if (!(depth > 0)) { touching++; continue; }
+        const wb_real err = !(d0 > 0) ? 0 : d0 < depth ? d0 : depth; /* of it, old overlap */
         if (wi > 0) v3_madd(xi, n, -depth * wi / wsum);
         if (wj > 0) v3_madd(xj, n, depth * wj / wsum);
         /* friction at position level (Macklin et al. 2014, "Unified particle physics", §6.1):
@@ -159,12 +185,13 @@ void wb__contacts_project(wb_world *w, wb_real h)
                 if (wj > 0) v3_madd(xj, slip, f * wj / wsum);
             }
         }
-        /* normal and depth, kept for the velocity pass; the normal force for the readout
-         * (XPBD multiplier of a zero-compliance contact, depth / (w_i + w_j), over h^2) */
+        /* normal, depth and old overlap, kept for the velocity pass; the normal force for
+         * the readout (XPBD multiplier of a zero-compliance contact, depth / (w_i + w_j), over h^2) */
         act[c->nact] = k;
-        v3_copy(&nds[5 * c->nact], n);
-        nds[5 * c->nact + 3] = depth;
-        nds[5 * c->nact + 4] = depth / wsum / (h * h);
+        v3_copy(&nds[6 * c->nact], n);
+        nds[6 * c->nact + 3] = depth;
+        nds[6 * c->nact + 4] = depth / wsum / (h * h);
+        nds[6 * c->nact + 5] = err;
         c->nact++;
     }
     c->last = c->nact + touching;
@@ -175,18 +202,37 @@ nomem:
 }
 
 /* after v = (x - x_prev)/h: no approach speed left (perfectly inelastic; friction was
- * applied at position level, so the tangential velocity is already what it implies) */
+ * applied at position level, so the tangential velocity is already what it implies),
+ * and no speed made out of old overlap.
+ *
+ * A correction of depth adds depth / h to the pair's separating speed. The part that
+ * takes back this substep's approach is the collision; the part that removed overlap
+ * the pair already had (err, from the projection) is the repair of a position error
+ * (bodies made inside each other, a ball squeezed into a pile): kept as speed it
+ * would fling them apart at up to depth / h (2 cm at h = 1/600 s: 12 m/s). So it is
+ * taken out of the velocity again, both particles along n split by inverse mass
+ * (momentum exact), and the pair leaves with what the rest of the step gave it (what
+ * Bullet's split impulse does for rigid bodies). Pushing that overlap out slowly (at
+ * most max_depenetration x h per substep, in the projection) keeps a body from being
+ * squashed in one substep, which its links would then turn into the same speed. */
 void wb__contacts_velocity(wb_world *w, wb_real h)
 {
-    (void)h;
     wb_contacts *c = &w->k.pc;
     const wb_model *m = &w->m;
     wb_real *v = w->s.v;
     for (int32_t a = 0; a < c->nact; a++) {
         const int32_t k = c->act[a], i = c->ij[2 * k], j = c->ij[2 * k + 1];
+        const wb_real wi = m->w[i], wj = m->w[j], wsum = wi + wj, e = c->act_nd[6 * a + 5] / h;
+        if (!(e > 0) || wsum == 0) continue;
+        const wb_real *n = &c->act_nd[6 * a];
+        if (wi > 0) v3_madd(&v[3 * i], n, e * wi / wsum);
+        if (wj > 0) v3_madd(&v[3 * j], n, -e * wj / wsum);
+    }
+    for (int32_t a = 0; a < c->nact; a++) {
+        const int32_t k = c->act[a], i = c->ij[2 * k], j = c->ij[2 * k + 1];
         const wb_real wi = m->w[i], wj = m->w[j], wsum = wi + wj;
         if (wsum == 0) continue;
-        const wb_real *n = &c->act_nd[5 * a];
+        const wb_real *n = &c->act_nd[6 * a];
         wb_real *vi = &v[3 * i], *vj = &v[3 * j], u[3];
         v3_sub(u, vj, vi);
         const wb_real un = v3_dot(u, n);
@@ -206,7 +252,7 @@ wb_contact wb_world_contact_at(const wb_world *w, int32_t i)
     wb_contact out = { -1, -1, 0, { 0, 0, 0 }, 0 };
     if (i < 0 || i >= c->nact) return out;
     const int32_t k = c->act[i];
-    const wb_real *nd = &c->act_nd[5 * i];
+    const wb_real *nd = &c->act_nd[6 * i];
     out.a = c->ij[2 * k];
     out.b = c->ij[2 * k + 1];
     v3_copy(out.normal, nd);

@@ -126,8 +126,11 @@ typedef struct wb_contacts {
     int32_t *ij;           /* (n x 2) i < j, in the broad phase's fixed order */
     int32_t nact, cap_act; /* contacts of the current substep */
     int32_t *act;          /* (nact) candidate index */
-    wb_real *act_nd;       /* (nact x 5) normal (i -> j), depth, normal force */
+    wb_real *act_nd;       /* (nact x 6) normal (i -> j), depth, normal force, the overlap it started with */
     int32_t cap_nd;
+    wb_real *left;         /* (n) overlap a candidate was left with by its last projection;
+                              INFINITY when not known (contact.c: old overlap) */
+    int32_t cap_left;
     wb_real *reach;        /* (np) broad-phase reach, < 0 = not a candidate */
     int32_t cap_reach;
     int32_t *skip;         /* (np) broad-phase skip key: a body without self-collision, else 0 */

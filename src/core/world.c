@@ -61,6 +61,7 @@ wb_world_def wb_world_default_def(void)
     d.relaxation = 1;
     d.threads = 1;
     d.contacts = true;
+    d.max_depenetration = 0.25;
     return d;
 }
 
@@ -84,6 +85,7 @@ const char *wb_world_def_check(const wb_world_def *d)
     if (d->solver != WB_SOLVER_GAUSS_SEIDEL && d->solver != WB_SOLVER_JACOBI) return "unknown solver";
     if (!(d->relaxation > 0 && d->relaxation < 2)) return "relaxation must be in (0, 2)";
     if (d->threads < 1 || d->threads > WB_MAX_THREADS) return "threads must be in 1..256";
+    if (!(d->max_depenetration >= 0) || !isfinite(d->max_depenetration)) return "max_depenetration must be finite and >= 0 (m/s)";
     return NULL;
 }
 
@@ -117,7 +119,7 @@ void wb_world_destroy(wb_world *w)
                      k->colour_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda, k->s_jac,
                      k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->c_sub, k->c_save,
                      k->breaks, m->group, m->cflags, m->cfric, m->x0, k->pc.ij, k->pc.act, k->pc.act_nd,
-                     k->pc.reach, k->pc.keys,
+                     k->pc.left, k->pc.reach, k->pc.keys,
                      /* shape matching and pressure (freed here: a call into their files
                       * would close a circle, as they call this one) */
                      w->sm.start, w->sm.stiff, w->sm.yield, w->sm.creep, w->sm.ids, w->sm.rest, w->sm.q,

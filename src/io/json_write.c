@@ -67,7 +67,9 @@ static void write_snapshot(out *o, const wb_image *g)
     num(o, d->damping);
     fprintf(f, ", \"solver\": \"%s\", \"relaxation\": ", d->solver == WB_SOLVER_JACOBI ? "jacobi" : "gauss-seidel");
     num(o, d->relaxation);
-    fprintf(f, ", \"threads\": %d, \"contacts\": %s},\n    \"time\": ", d->threads, d->contacts ? "true" : "false");
+    fprintf(f, ", \"threads\": %d, \"contacts\": %s, \"max_depenetration\": ", d->threads, d->contacts ? "true" : "false");
+    num(o, d->max_depenetration);
+    fputs("},\n    \"time\": ", f);
     num(o, g->time);
     fprintf(f, ", \"frame\": %lld, \"warnings\": %lld, \"last_warning\": ", (long long)g->frame, (long long)g->warnings);
     str(f, g->last_warning);

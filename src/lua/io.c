@@ -6,6 +6,7 @@
  * (with line, column and key path for JSON), and the world is left as it was. */
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -84,11 +85,15 @@ static int w_load_particles(lua_State *L)
     wb_world *w = wbl_checkworld(L, 1);
     const char *name = wbl_checkfilename(L, 2);
     char path[PATH_MAX], err[1024];
-    /* contact options for the whole body; without them the file's own settings stay */
-    static const char *const keys[] = { "collide", "self_collide", "friction", NULL };
+    /* contact options for the whole body; without them the file's own settings stay
+     * (radius: every particle's contact radius, e.g. a file made before contacts) */
+    static const char *const keys[] = { "collide", "self_collide", "friction", "radius", NULL };
     const bool given = wbl_checkopts(L, 3, keys, true);
     wbl_contact_opts co;
     wbl_read_contact_opts(L, 3, &co);
+    wb_real radius = -1;
+    if (given && wbl_optreal(L, 3, "radius", &radius) && !(radius >= 0 && isfinite(radius)))
+        return wbl_fielderror(L, 3, "radius", "must be finite and >= 0");
     lua_settop(L, 2);
     wbl_path(L, name, 0, path, sizeof path);
     wbio_config *c = push_config(L); /* 3 */
@@ -114,6 +119,7 @@ static int w_load_particles(lua_State *L)
     if (st == WB_ERR_ARG) return fail_with(L, lua_pushfstring(L, "%s: %s", name, wb_last_error()));
     if (st != WB_OK) return wbl_status_error(L, 2, st, "load_particles");
     if (given) wbl_apply_contact_opts(w, b, &co);
+    for (int32_t i = 0; radius >= 0 && i < b.count; i++) wb_particle_set_radius(w, b.first + i, radius);
     /* each part is a body of its own: its own group, so the parts (the logo's letters)
      * push each other; the particles of no part stay in the body's group */
     for (int32_t i = 0; i < c->nparts; i++) {

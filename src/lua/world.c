@@ -15,7 +15,8 @@ static const char *const solver_names[] = { "gauss-seidel", "jacobi", NULL };
 
 /* ---- settings --------------------------------------------------------------------- */
 static const char *const world_keys[] = {
-    "gravity", "dt", "substeps", "iterations", "damping", "solver", "relaxation", "threads", "contacts", NULL
+    "gravity", "dt", "substeps", "iterations", "damping", "solver", "relaxation", "threads", "contacts",
+    "max_depenetration", NULL
 };
 
 /* read the settings table at arg over *d; the core's check gives the ranges */
@@ -31,6 +32,7 @@ static void read_world_def(lua_State *L, int arg, wb_world_def *d)
     wbl_optreal(L, arg, "relaxation", &d->relaxation);
     wbl_optint(L, arg, "threads", INT32_MIN, INT32_MAX, &d->threads);
     wbl_optbool(L, arg, "contacts", &d->contacts);
+    wbl_optreal(L, arg, "max_depenetration", &d->max_depenetration);
 }
 
 /* check *d and apply it: errors blame argument `arg` */

@@ -254,17 +254,16 @@ TEST(contact_self_collision_skips_rest_neighbours)
     wb_group_set_self_collide(w, b.group, true);
     wb_particle_set_position(w, b.first + 10, p0);
     wb_world_step(w);
-    /* the pair put together is a candidate (whether it is still in touch in the last
-     * substep depends on how the rope, jerked by the first step, flails) */
-    int together = 0;
-    for (int32_t k = 0; k < w->k.pc.n; k++)
-        together += w->k.pc.ij[2 * k] == b.first && w->k.pc.ij[2 * k + 1] == b.first + 10;
-    CHECK_EQ(together, 1);
-    /* the pairs listed: never two linked neighbours */
+    /* the pair 0-10 is a candidate (its stretched link yanks particle 10 away within
+     * the step, faster than an old overlap is pushed out, so the contact count of the
+     * last substep says nothing); the pairs listed: never two linked neighbours */
+    int found = 0;
     for (int32_t k = 0; k < w->k.pc.n; k++) {
         const int32_t i = w->k.pc.ij[2 * k], j = w->k.pc.ij[2 * k + 1];
         CHECK(j - i >= 2);
+        if (i == b.first && j == b.first + 10) found = 1;
     }
+    CHECK(found);
     wb_world_destroy(w);
 
     /* a thinner rope (r = 0.04: as built, neighbours 0.1 apart are outside 2 r) with a
