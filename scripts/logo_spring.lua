@@ -23,8 +23,8 @@ local press = w:collider{ shape = "box", center = {0, 1.1, 0}, half = {1.3, 0.2,
 for _, part in ipairs(logo.parts) do
   if shape then
     w:shape_match(part.particles, { stiffness = args.stiffness or 0.95,
-                                                  yield = plastic and (args.yield or 0.1) or nil,
-                                                  creep = plastic and (args.creep or 1.5) or nil })
+                                    yield = plastic and (args.yield or 0.1) or nil,
+                                    creep = plastic and (args.creep or 1.5) or nil })
   end
 end
 
