@@ -304,12 +304,14 @@ uint64_t wb_world_hash(const wb_world *w);                          /* FNV-1a of
 
 typedef struct wb_stats {
     int32_t particles, distances, broken, colliders;
+    int32_t bends, volumes, shape_matches, pressures;   /* constraints of the other types */
     int32_t colours;          /* batches of the last colouring */
     int32_t contacts;         /* collider contacts in the last substep */
     int32_t particle_contacts; /* particle pairs and particle-triangle pairs overlapping or in touch
                                   in the last substep */
     double broad_ms;          /* broad phase of the last step */
-    int64_t projections;      /* constraint projections in the last step */
+    int64_t projections;      /* constraint projections in the last step, every type's (a
+                                 shape-matching cluster or a pressure body counts one) */
     double step_ms;           /* wall time of the last step */
     double solve_ms;          /* of which constraint projection */
     int64_t warnings;         /* numerical trouble detected so far */

@@ -207,6 +207,7 @@ static void pr_project(wb_world *w, wb_real h)
     wb_pressures *p = &w->pr;
     const wb_real *wv = w->m.w;
     wb_real *x = w->s.x, *g = p->grad;
+    w->k.projections += p->n;
     for (int32_t k = 0; k < p->n; k++) {
         const int32_t *v = &p->verts[p->vstart[k]], nv = p->vstart[k + 1] - p->vstart[k];
         const wb_real C = volume6(w, k, g) / 6 - p->pressure[k] * p->v0[k];

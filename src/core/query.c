@@ -149,6 +149,10 @@ wb_stats wb_world_stats(const wb_world *w)
     for (int32_t s = 0; s < w->m.nd; s++)
         if ((w->m.d_gen[s] & 1u) && w->s.d_broken[s]) st.broken++;
     st.colliders = wb_collider_count(w);
+    st.bends = wb_bend_count(w);
+    st.volumes = wb_volume_count(w);
+    st.shape_matches = wb_shape_match_count(w);
+    st.pressures = wb_pressure_count(w);
     st.colours = w->k.ncolours;
     st.contacts = w->k.last_contacts;
     st.particle_contacts = w->k.pc.last + w->k.tc.last;

@@ -166,6 +166,7 @@ static void sm_project(wb_world *w, wb_real h)
     wb_smatch *sm = &w->sm;
     const wb_real *wv = w->m.w, *im = w->m.inv_mass;
     wb_real *x = w->s.x;
+    w->k.projections += sm->n;   /* a cluster is one projection */
     for (int32_t k = 0; k < sm->n; k++) {
         const wb_real s = sm->stiff[k];
         if (s <= 0) continue;

@@ -173,6 +173,7 @@ static void vol_project(wb_world *w, wb_real h)
     const wb_real inv_h2 = 1 / (h * h);
     const wb_real *wv = w->m.w;
     wb_real *x = w->s.x;
+    w->k.projections += v->n;
     for (int32_t i = 0; i < v->n; i++) {
         const int32_t *p = &v->ijkl[4 * i];
         const wb_real wk[4] = { wv[p[0]], wv[p[1]], wv[p[2]], wv[p[3]] };

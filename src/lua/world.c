@@ -430,13 +430,17 @@ static int w_stats(lua_State *L)
     wb_world *w = toworld(L);
     wb_stats s = wb_world_stats(w);
     wb_world_def d = wb_world_get_def(w);
-    lua_createtable(L, 0, 16);
+    lua_createtable(L, 0, 20);
 #define SETI(name, v) (lua_pushinteger(L, (lua_Integer)(v)), lua_setfield(L, -2, name))
 #define SETN(name, v) (lua_pushnumber(L, (lua_Number)(v)), lua_setfield(L, -2, name))
     SETI("particles", s.particles);
     SETI("distances", s.distances);
     SETI("broken", s.broken);
     SETI("colliders", s.colliders);
+    SETI("bends", s.bends);
+    SETI("volumes", s.volumes);
+    SETI("shape_matches", s.shape_matches);
+    SETI("pressures", s.pressures);
     SETI("colours", s.colours);
     SETI("contacts", s.contacts);
     SETI("particle_contacts", s.particle_contacts);

@@ -52,6 +52,8 @@ typedef struct wb_layers {
     size_t pair_cap;
     float *vstrain;                                 /* per particle: the strain its surface shows */
     size_t vstrain_cap;
+    float *mstrain;                                 /* per particle: its materials' strain (F_MATERIAL) */
+    size_t mstrain_cap;
     uint8_t *flags;                                 /* per particle: on a surface, under a skin */
     size_t flag_cap;
 } wb_layers;

@@ -3,7 +3,10 @@
  * (position, smooth normal, colour) and triangles, and the links as coloured
  * segments. Strain colours follow the reference thesis's Figure 12: grey at rest, red
  * stretched (links also blue compressed); with the links drawn, surfaces take the
- * colour of their stretch, so a dense cloth shows it rather than a fence of lines. */
+ * colour of their stretch, so a dense cloth shows it rather than a fence of lines.
+ * The other materials tint their particles and surfaces the same way (red expanded,
+ * blue compressed): a tet's volumetric strain, a shape-matching cluster's, a pressure
+ * body's volume against its target. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,7 +29,9 @@ static const float col_surface[][3] = {
 static const float col_skin[3] = { 0.86f, 0.76f, 0.62f };
 static const float surface_shine = 0.12f;
 
-enum { F_SURFACE = 1, F_HIDDEN = 2 };   /* per particle: on a drawn surface; covered by a drawn skin */
+/* per particle: on a drawn surface; covered by a drawn skin; in a volume, shape-matching
+ * or pressure constraint (l->mstrain holds its strain) */
+enum { F_SURFACE = 1, F_HIDDEN = 2, F_MATERIAL = 4 };
 
 void wb_lin3(const float s[3], float o[3])
 {
@@ -56,8 +61,19 @@ void wb_layers_free(wb_layers *l)
     free(l->pairs);
     free(l->strain);
     free(l->vstrain);
+    free(l->mstrain);
     free(l->flags);
     memset(l, 0, sizeof *l);
+}
+
+/* a particle sphere's colour (sRGB: inst_set linearises): grey at rest, red expanded,
+ * blue compressed, fully at +-scale */
+static void strain_colour_srgb(double strain, double scale, float out[3])
+{
+    double t = strain / scale;
+    t = t > 1 ? 1 : t < -1 ? -1 : t;
+    const float *to = t >= 0 ? col_tension : col_compress;
+    for (int c = 0; c < 3; c++) out[c] = (float)(col_rest[c] + (to[c] - col_rest[c]) * fabs(t));
 }
 
 /* ---- instances -------------------------------------------------------------------------- */
@@ -117,7 +133,12 @@ static bool build_instances(wb_layers *l, const wb_world *w, const wb_draw_opts 
         if (!isfinite(p[0] + p[1] + p[2])) continue;
         if (rad <= 0) rad = 0.004 * unit;   /* a point still shows */
         if (pin && o->pins) inst_sphere(&l->inst[k++], p, fmax(1.6 * rad, 0.006 * unit), col_pin, 0.5f);
-        else if (o->particles && !l->flags[i]) inst_sphere(&l->inst[k++], p, rad, col_particle, 0.5f);
+        else if (o->particles && !(l->flags[i] & (F_SURFACE | F_HIDDEN))) {
+            float col[3];
+            if (o->materials && (l->flags[i] & F_MATERIAL)) strain_colour_srgb(l->mstrain[i], o->strain_scale, col);
+            else memcpy(col, col_particle, sizeof col);
+            inst_sphere(&l->inst[k++], p, rad, col, 0.5f);
+        }
     }
     l->count[WB_G_LO] = k;
     for (int g = WB_G_HI; g < WB_G_COUNT; g++) {
@@ -191,6 +212,71 @@ static bool load_pairs(wb_layers *l, const wb_world *w)
         v[b] += peak[a], count[b]++;
     }
     for (int32_t i = 0; i < np; i++) v[i] /= count[i];
+    return true;
+}
+
+/* a material's strain e at particle i: where several apply, the largest in magnitude */
+static void put_material(wb_layers *l, int32_t i, double e)
+{
+    if (!isfinite(e)) return;
+    if (!(l->flags[i] & F_MATERIAL) || fabs(e) > fabs(l->mstrain[i])) l->mstrain[i] = (float)e;
+    l->flags[i] |= F_MATERIAL;
+}
+
+/* per particle, the strain of the materials it belongs to (l->mstrain[0..np), flag
+ * F_MATERIAL; the rest is scratch): the volumetric strain (V - V0) / V0 averaged over
+ * its tets; a shape-matching cluster's strain (wb_shape_match_strain), negative when the
+ * cluster drew in (its spread about the centre of mass below the rest shape's); a
+ * pressure body's V / (pressure V0) - 1 on its surface */
+static bool load_materials(wb_layers *l, const wb_world *w)
+{
+    const int32_t np = wb_particle_count(w), nv = wb_volume_count(w);
+    if (!grow(&l->mstrain, &l->mstrain_cap, 3 * (size_t)np + 1, sizeof *l->mstrain)) return false;
+    float *sum = l->mstrain + np, *count = l->mstrain + 2 * (size_t)np;
+    memset(l->mstrain, 0, 3 * (size_t)np * sizeof *l->mstrain);
+    for (int32_t i = 0; i < nv; i++) {
+        const double v0 = wb_volume_rest(w, i);
+        if (v0 == 0) continue;
+        const double e = (wb_volume_current(w, i) - v0) / v0;
+        if (!isfinite(e)) continue;
+        int32_t p[4];
+        wb_volume_particles(w, i, p);
+        for (int k = 0; k < 4; k++) sum[p[k]] += (float)e, count[p[k]]++;
+    }
+    for (int32_t i = 0; nv > 0 && i < np; i++)
+        if (count[i] > 0) put_material(l, i, sum[i] / count[i]);
+    const wb_real *x = wb_particle_positions(w);
+    for (int32_t s = 0; s < wb_shape_match_count(w); s++) {
+        const int32_t n = wb_shape_match_size(w, s);
+        double c[3] = { 0, 0, 0 }, m = 0, now = 0, rest = 0;
+        for (int32_t i = 0; i < n; i++) {
+            const int32_t p = wb_shape_match_particle(w, s, i);
+            const double mi = wb_particle_mass(w, p);
+            for (int k = 0; k < 3; k++) c[k] += mi * x[3 * p + k];
+            m += mi;
+        }
+        if (!(m > 0)) continue;
+        for (int i = 0; i < n; i++) {
+            const int32_t p = wb_shape_match_particle(w, s, i);
+            const double mi = wb_particle_mass(w, p);
+            wb_real r[3];
+            wb_shape_match_rest(w, s, i, r);
+            for (int k = 0; k < 3; k++) {
+                const double d = x[3 * p + k] - c[k] / m;
+                now += mi * d * d, rest += mi * (double)r[k] * r[k];
+            }
+        }
+        const double e = (now < rest ? -1 : 1) * (double)wb_shape_match_strain(w, s);
+        for (int32_t i = 0; i < n; i++) put_material(l, wb_shape_match_particle(w, s, i), e);
+    }
+    for (int32_t i = 0; i < wb_pressure_count(w); i++) {
+        const double target = wb_pressure_get_def(w, i).pressure * wb_pressure_rest_volume(w, i);
+        if (!(target > 0)) continue;
+        const double e = wb_pressure_volume(w, i) / target - 1;
+        int32_t nt = 0;
+        const int32_t *t = wb_surface_triangles(w, wb_pressure_surface(w, i), &nt);
+        for (int32_t k = 0; k < 3 * nt; k++) put_material(l, t[k], e);
+    }
     return true;
 }
 
@@ -360,7 +446,12 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
     for (int32_t i = 0; i < np; i++) {
         double p[3] = { x[3 * i], x[3 * i + 1], x[3 * i + 2] };
         float col[3];
-        if (o->constraints) strain_colour(l->vstrain[i], o->strain_scale, cloth, col);
+        if (o->materials && (l->flags[i] & F_MATERIAL)) {
+            /* the material's strain, or its links' stretch where that is larger */
+            double e = l->mstrain[i];
+            if (o->constraints && fabs(l->vstrain[i]) > fabs(e)) e = l->vstrain[i];
+            strain_colour(e, o->strain_scale, cloth, col);
+        } else if (o->constraints) strain_colour(l->vstrain[i], o->strain_scale, cloth, col);
         else wb_lin3(col_surface[owner[i] < 0 ? 0 : owner[i]], col);
         norm3(acc + 3 * i);
         const double off = out[i] * (double)wb_particle_radius(w, i);
@@ -402,6 +493,7 @@ bool wb_layers_build(wb_layers *l, const wb_world *w, const wb_draw_opts *o, con
         }
     l->npairs = 0;
     if (o->constraints && !load_pairs(l, w)) return false;
+    if (o->materials && !load_materials(l, w)) return false;
     l->nv = l->nidx = l->nseg = 0;
     l->surfaces = (o->surfaces && wb_surface_count(w) > 0 && np > 0) || nsk > 0 || mesh_collider_triangles(w, o) > 0;
     if (l->surfaces && !build_surfaces(l, w, o, sk, nsk)) return false;

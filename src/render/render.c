@@ -43,7 +43,7 @@ static const double box_shrink = 0.03;
 
 wb_draw_opts wb_draw_default_opts(void)
 {
-    wb_draw_opts o = { true, true, true, true, true, true, true, false, 0.02, 1.5 };
+    wb_draw_opts o = { true, true, true, true, true, true, true, false, 0.02, 1.5, true };
     return o;
 }
 
@@ -130,7 +130,7 @@ size_t wb_renderer_draw_bytes(const wb_renderer *r, const wb_world *w, const wb_
      * twice: the layers and the GL buffers), its per-pair and per-particle arrays and
      * its scratch (a normal accumulator, an owner per particle) */
     return 2 * ((np + 3 * nc) * sizeof(wb_inst) + nd * sizeof(wb_seg) + nv * WB_SV * sizeof(float) + 3 * nt * sizeof(GLuint)) +
-           nd * (2 * sizeof(int32_t) + sizeof(wb_real)) + np * (3 * sizeof(float) + 1 + 3 * sizeof(double) + 2);
+           nd * (2 * sizeof(int32_t) + sizeof(wb_real)) + np * (6 * sizeof(float) + 1 + 3 * sizeof(double) + 2);
 }
 
 void wb_renderer_destroy(wb_renderer *r)

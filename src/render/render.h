@@ -47,6 +47,8 @@ typedef struct wb_draw_opts {
     bool cage;             /* also the particles, links and surfaces a drawn skin covers */
     double strain_scale;   /* |strain| drawn fully red (tension) / blue (compression) */
     double line_width;     /* pixels at 720 rows; scaled with the height */
+    bool materials;        /* tint the particles and surfaces of volume, shape-matching and
+                              pressure bodies by their strain (layers.c) */
 } wb_draw_opts;
 
 /* every layer on but the cage, strain_scale 0.02, line_width 1.5 */

@@ -203,6 +203,13 @@ code=$?
 check "README: the first scene was found" 0
 
 # ---- make: deps, clean, install (the Makefile's own rules, with stand-ins for apt)
+# ---- scripts/logo_spring.lua's other claims (make test checks the elastic one): plastic
+# letters keep a dent; without shape matching the letters stay flat, so its check fails
+run test scripts/logo_spring.lua --set plastic=1 --quiet
+check "logo_spring --set plastic=1: the letters keep a dent" 0 out "plastic letters keep a dent"
+run test scripts/logo_spring.lua --set shape=0 --quiet
+check "logo_spring --set shape=0: links alone do not spring back" 1 out "not ok 2"
+
 if command -v make >/dev/null 2>&1; then
     # these makes are a user's, typed in a shell: under `make -jN test` the outer make's
     # MAKEFLAGS name a jobserver whose pipes it does not hand to this script, and the

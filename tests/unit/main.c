@@ -104,6 +104,8 @@
     X(step_interrupt_leaves_world_unchanged)     \
     X(force_reads_the_step_that_made_it)         \
     X(force_zero_after_an_undone_frame)          \
+    X(types_multipliers_cleared_by_an_undone_frame) \
+    X(types_counted_in_stats)                    \
     X(collider_huge_inputs_normalised)           \
     X(collider_absurd_velocity_recovers)         \
     X(hash_covers_collider_velocity_mass_radius) \
