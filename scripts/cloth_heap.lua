@@ -3,12 +3,15 @@
 -- lower edge just above the floor, rippled and swirling a little; let go, its lower part
 -- buckles on the floor and the rest falls onto it in folds. It is one body built with
 -- self_collide = true: its particles collide with each other except for the rest
--- neighbours (linked, or closer than r_i + r_j as built). Soft in bending (bend = 10) so
--- it folds tightly; air drag (world damping 0.5 /s) lets it settle in a few seconds.
+-- neighbours (linked, or closer than r_i + r_j as built). Soft in bending (skip-one
+-- bend_links of compliance 10 m/N) so it folds tightly; air drag (world damping 0.5 /s)
+-- lets it settle in a few seconds. (Written when w:cloth's `bend` meant those links; the
+-- dihedral `bend = 10` rad/(N m) is far stiffer: springy folds that never came to rest.)
 -- Try --set self_collide=0 or --set contacts=0 to watch the folds pass through each other.
 -- Run: build/wobble run scripts/cloth_heap.lua [--record out/heap/]
 --      build/wobble test scripts/cloth_heap.lua   (runs it and checks the heap)
--- Options: --set seconds=4, --set bend=10, --set res=16 (particles across; 40 down)
+-- Options: --set seconds=4, --set bend_links=10, --set bend=1000 (dihedral bends too),
+--          --set res=16 (particles across; 40 down)
 local args = wobble.args
 local w = wobble.world{ substeps = 20, iterations = 2, damping = args.damping or 0.5, contacts = args.contacts ~= 0 }
 w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.8 }
@@ -16,7 +19,8 @@ local width, size = args.width or 0.8, args.height or 2 -- m
 local nx = args.res or 16
 local n = math.floor(nx * size / width + 0.5)
 local cloth = w:cloth{ origin = {-width / 2, 0, 0}, size = {width, size}, res = {nx, n}, mass = 0.3, compliance = 1e-6,
-                       bend = args.bend or 10, self_collide = args.self_collide ~= 0, friction = args.friction or 0.8 }
+                       bend_links = args.bend_links or 10, bend = args.bend,
+                       self_collide = args.self_collide ~= 0, friction = args.friction or 0.8 }
 -- hang the sheet straight down in the x-y plane, its lower edge a little above the
 -- floor, rippled so that it buckles as it lands, with a slow swirl; let go, it falls
 -- onto its own lower part in folds

@@ -190,8 +190,10 @@ typedef struct wb_tricontacts {
     int32_t *pt;           /* (n x 2) point, triangle; point order, then triangle order */
     int32_t nact, cap_act; /* contacts that corrected positions in the current substep */
     int32_t *act;          /* (nact) candidate index */
-    wb_real *act_d;        /* (nact x 8) barycentrics, normal (triangle -> point), depth, force */
+    wb_real *act_d;        /* (nact x 9) barycentrics, normal (triangle -> point), depth, force, old overlap */
     int32_t cap_d;
+    wb_real *left;         /* (n) overlap each candidate was left with last substep (contact.c's) */
+    int32_t cap_left;
     wb_real *reach;        /* (np) a point's broad-phase reach, < 0 = not a point */
     int32_t cap_reach;
     wb_real *tbox;         /* (ntri x 10) a triangle's box, how far its corners may move, its normal */

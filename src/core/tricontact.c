@@ -18,7 +18,9 @@
  * along n: the corrections' momentum sums to (1 - sum b_i) depth / W = 0. Coulomb
  * friction at position level as contact.c's (the relative slip of p against q undone up
  * to mu depth, mu the mean of p's and the triangle's barycentric friction), and after the
- * velocity update the approach speed along n is removed the same way.
+ * velocity update the approach speed along n is removed the same way. Old overlap (made
+ * inside, a deep squeeze) follows contact.c's rule: pushed out at max_depenetration at
+ * most, and the speed of that repair taken back, so it never flings a particle off.
  *
  * A surface is two-sided: n points to the side the point was on at the substep's start
  * (x_prev), as collide.c does for an open mesh collider, so a point the substep carried
@@ -414,20 +416,29 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
     if (c->n == 0) { c->last = 0; return; }
     const wb_model *m = &w->m;
     wb_real *x = w->s.x;
-    const wb_real *xp = w->s.x_prev, *wv = m->w, *rad = m->radius, *cf = m->cfric;
+    const wb_real *xp = w->s.x_prev, *wv = m->w, *rad = m->radius, *cf = m->cfric, vmax = m->def.max_depenetration;
     int32_t *act = wb__grow(c->act, &c->cap_act, c->n, sizeof *act);
     if (!act) goto nomem;
     c->act = act;
-    wb_real *ad = wb__grow(c->act_d, &c->cap_d, 8 * c->n, sizeof *ad);
+    wb_real *ad = wb__grow(c->act_d, &c->cap_d, 9 * c->n, sizeof *ad);
     if (!ad) goto nomem;
     c->act_d = ad;
+    wb_real *left = wb__grow(c->left, &c->cap_left, c->n, sizeof *left);
+    if (!left) goto nomem;
+    c->left = left;
+    /* contact.c's rule for old overlap: on a new candidate list (begin clears c->last) or
+     * after a substep without contacts, what each candidate was left with is not known and
+     * all of its overlap counts as old */
+    if (c->last == 0)
+        for (int32_t k = 0; k < c->n; k++) left[k] = INFINITY;
     int32_t touching = 0;
     for (int32_t k = 0; k < c->n; k++) {
         const int32_t p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
         wb_real *xs = &x[3 * p];
         const wb_real *xa = &x[3 * v[0]], *xb = &x[3 * v[1]], *xc = &x[3 * v[2]];
         wb_real b[3], q[3], d[3], n[3], e1[3], e2[3];
-        const wb_real r = rad[p];
+        const wb_real r = rad[p], was = left[k];
+        left[k] = 0; /* what it is left with: none unless corrected below */
         /* the side now and at the substep's start (the plane of the triangle then) */
         v3_sub(e1, xb, xa);
         v3_sub(e2, xc, xa);
@@ -483,6 +494,20 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
             depth = r - side * s_now;
         }
         if (!(depth > 0)) continue;
+        /* d0: the overlap at the substep's start (x_prev, the triangle then). As in
+         * contact.c (wb__contacts_project): what this candidate was itself left with last
+         * substep (made overlapping, a deep squeeze; before a frame's first substep all of
+         * d0) goes out at no more than max_depenetration x h per substep; the rest (what the
+         * links, colliders and later contacts pushed back) in full. Neither becomes speed
+         * (wb__tricontacts_velocity), or a particle made 1.5 cm inside a sheet would leave
+         * at 9 m/s while a pair made as deep leaves at max_depenetration */
+        wb_real bp[3], qp[3];
+        const wb_real d0 = r - sqrt(wb__tri_closest(&xp[3 * p], &xp[3 * v[0]], &xp[3 * v[1]], &xp[3 * v[2]], bp, qp));
+        const wb_real full = depth, old = d0 < was ? d0 : was, keep = old - vmax * h;
+        if (keep > 0) depth = depth > keep ? depth - keep : 0;
+        left[k] = full - depth;
+        if (!(depth > 0)) { touching++; continue; }
+        const wb_real err = !(d0 > 0) ? 0 : d0 < depth ? d0 : depth; /* of it, old overlap */
         const wb_real s = depth / W;
         if (wp > 0) v3_madd(xs, nn, wp * s);
         for (int i = 0; i < 3; i++)
@@ -503,11 +528,12 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
                     if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&x[3 * v[i]], slip, f * b[i] * wv[v[i]]);
             }
         }
-        wb_real *o = &ad[8 * c->nact];
+        wb_real *o = &ad[9 * c->nact];
         v3_copy(o, b);
         v3_copy(o + 3, nn);
         o[6] = depth;
         o[7] = s / (h * h); /* the multiplier over h^2: newtons */
+        o[8] = err;
         act[c->nact++] = k;
     }
     c->last = c->nact + touching;
@@ -517,17 +543,28 @@ nomem:
     wb__warn(w, "out of memory in triangle contacts; skipped this substep");
 }
 
-/* after v = (x - x_prev)/h: no approach speed of p towards the triangle's point left */
+/* after v = (x - x_prev)/h: no speed made out of old overlap (the err part of the
+ * correction, taken back along n with the correction's weights, as contact.c), then no
+ * approach speed of p towards the triangle's point left */
 void wb__tricontacts_velocity(wb_world *w, wb_real h)
 {
-    (void)h;
     wb_tricontacts *c = &w->k.tc;
     const wb_model *m = &w->m;
     wb_real *vel = w->s.v;
     const wb_real *wv = m->w;
     for (int32_t a = 0; a < c->nact; a++) {
         const int32_t k = c->act[a], p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
-        const wb_real *b = &c->act_d[8 * a], *nn = b + 3;
+        const wb_real *b = &c->act_d[9 * a], *nn = b + 3;
+        const wb_real W = wv[p] + b[0] * b[0] * wv[v[0]] + b[1] * b[1] * wv[v[1]] + b[2] * b[2] * wv[v[2]];
+        const wb_real e = b[8] / h;
+        if (!(e > 0) || W == 0) continue;
+        if (wv[p] > 0) v3_madd(&vel[3 * p], nn, -e * wv[p] / W);
+        for (int i = 0; i < 3; i++)
+            if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&vel[3 * v[i]], nn, e * b[i] * wv[v[i]] / W);
+    }
+    for (int32_t a = 0; a < c->nact; a++) {
+        const int32_t k = c->act[a], p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
+        const wb_real *b = &c->act_d[9 * a], *nn = b + 3;
         const wb_real W = wv[p] + b[0] * b[0] * wv[v[0]] + b[1] * b[1] * wv[v[1]] + b[2] * b[2] * wv[v[2]];
         if (W == 0) continue;
         wb_real u[3];
@@ -553,7 +590,7 @@ wb_tri_contact wb_world_tri_contact_at(const wb_world *w, int32_t i)
     out.p = out.tri[0] = out.tri[1] = out.tri[2] = -1;
     if (i < 0 || i >= c->nact) return out;
     const int32_t k = c->act[i];
-    const wb_real *d = &c->act_d[8 * i];
+    const wb_real *d = &c->act_d[9 * i];
     out.p = c->pt[2 * k];
     memcpy(out.tri, &w->m.tri[3 * c->pt[2 * k + 1]], sizeof out.tri);
     v3_copy(out.bary, d);
