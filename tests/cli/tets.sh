@@ -24,9 +24,12 @@ run() {
     code=$?
     secs=$(($(date +%s) - t0))
 }
-left() { # what the run left behind: temporary folders, tetgen processes of ours
+left() { # what the run left behind: temporary folders, tetgen processes of ours (those
+    # working in a folder under our $TMPDIR: other runs on the machine are not ours)
     ls -A "$TMP/tmp"
-    pgrep -f "tetgen.*in.poly" >/dev/null 2>&1 && echo "a tetgen process"
+    for p in $(pgrep -f "tetgen.*in.poly" 2>/dev/null); do
+        case "$(readlink "/proc/$p/cwd" 2>/dev/null)" in "$TMP"/tmp/*) echo "a tetgen process"; break ;; esac
+    done
 }
 
 if ! command -v tetgen >/dev/null 2>&1; then
