@@ -3,7 +3,7 @@
  * Macklin & Müller 2021, "A constraint-based formulation of stable Neo-Hookean materials":
  * with F = Ds Dm^-1 (Ds = [x1-x0, x2-x0, x3-x0], Dm the same at rest) the energy
  *   Psi = mu/2 (tr(F^T F) - 3) + lam/2 (det F - a)^2,   a = 1 + mu/lam,
- * is split into two XPBD constraints per tet, projected one after the other:
+ * is split into two XPBD constraints per tet, solved together (a 2x2 system, below):
  *   deviatoric  C_D = sqrt(tr(F^T F)),   compliance 1/(mu V0),
  *   hydrostatic C_H = det F - a,         compliance 1/(lam V0).
  * At F = I their forces cancel (mu F against lam (1 - a) cof F = -mu I), so the rest shape
@@ -218,25 +218,29 @@ static void tet_substep_begin(wb_world *w)
     if (w->neo && w->neo->n > 0) memset(w->neo->lambda, 0, 2 * sizeof(wb_real) * (size_t)w->neo->n);
 }
 
-/* one XPBD update of the constraint with value c and gradient dC/dF = G (row-major) */
-static void solve(wb_real *x, const int32_t *p, const wb_real wk[4], const wb_real *dminv, const wb_real G[9],
-                  wb_real c, wb_real at, wb_real *lambda)
+/* dC/dx_k of a constraint with dC/dF = G (row-major): column k-1 of G Dm^-T for k = 1..3,
+ * minus their sum for k = 0 */
+static void grads(const wb_real *dminv, const wb_real G[9], wb_real g[4][3])
 {
-    /* dC/dx_k = column k-1 of G Dm^-T (k = 1..3), dC/dx_0 = -their sum */
-    wb_real g[4][3];
     for (int k = 0; k < 3; k++)
         for (int r = 0; r < 3; r++)
             g[k + 1][r] = G[3 * r] * dminv[3 * k] + G[3 * r + 1] * dminv[3 * k + 1] + G[3 * r + 2] * dminv[3 * k + 2];
     for (int r = 0; r < 3; r++) g[0][r] = -(g[1][r] + g[2][r] + g[3][r]);
-    wb_real den = at;
-    for (int k = 0; k < 4; k++) den += wk[k] * v3_dot(g[k], g[k]);
-    if (!(den > (wb_real)1e-300) || !isfinite(den)) return;
-    const wb_real dl = (-c - at * *lambda) / den;
-    *lambda += dl;
-    for (int k = 0; k < 4; k++)
-        if (wk[k] > 0) v3_madd(&x[3 * p[k]], g[k], wk[k] * dl);
 }
 
+static wb_real wdot(const wb_real wk[4], wb_real a[4][3], wb_real b[4][3])
+{
+    wb_real s = 0;
+    for (int k = 0; k < 4; k++) s += wk[k] * v3_dot(a[k], b[k]);
+    return s;
+}
+
+/* Both constraints of a tet in one 2x2 XPBD solve (the linearised system of the pair), not
+ * one after the other: at rest their gradients are parallel and their values large (C_D =
+ * sqrt 3, C_H = -mu/lam), balanced only through the compliances; projected in turn, each
+ * under-converged pass leaves a bias that squeezes the solid (measured: a hanging bar
+ * shortened instead of stretched). Solved together, the rest shape is a fixed point of a
+ * single iteration at any stiffness, and the error is that of the linearisation. */
 static void tet_project(wb_world *w, wb_real h)
 {
     wb_neos *v = w->neo;
@@ -249,16 +253,16 @@ static void tet_project(wb_world *w, wb_real h)
         const wb_real wk[4] = { wv[p[0]], wv[p[1]], wv[p[2]], wv[p[3]] };
         if (wk[0] + wk[1] + wk[2] + wk[3] == 0) continue;
         const wb_real *dm = &v->dminv[9 * i];
-        wb_real F[9], G[9];
-        /* deviatoric: dC_D/dF = F / C_D; a tet crushed to a point has no direction */
+        wb_real F[9], G[9], gd[4][3], gh[4][3];
         deformation(v, x, i, F);
         wb_real ic = 0;
         for (int k = 0; k < 9; k++) ic += F[k] * F[k];
         const wb_real cd = sqrt(ic);
-        if (cd > (wb_real)1e-12) {
+        /* deviatoric: dC_D/dF = F / C_D; a tet crushed to a point has no direction */
+        const bool dev = cd > (wb_real)1e-12;
+        if (dev) {
             for (int k = 0; k < 9; k++) G[k] = F[k] / cd;
-            solve(x, p, wk, dm, G, cd, inv_h2 / (v->mu[i] * v->v0[i]), &v->lambda[2 * i]);
-            deformation(v, x, i, F);
+            grads(dm, G, gd);
         }
         /* hydrostatic: dJ/dF = cof F, its columns f1 x f2, f2 x f0, f0 x f1 */
         const wb_real f0[3] = { F[0], F[3], F[6] }, f1[3] = { F[1], F[4], F[7] }, f2[3] = { F[2], F[5], F[8] };
@@ -267,8 +271,28 @@ static void tet_project(wb_world *w, wb_real h)
         v3_cross(c1, f2, f0);
         v3_cross(c2, f0, f1);
         for (int r = 0; r < 3; r++) { G[3 * r] = c0[r]; G[3 * r + 1] = c1[r]; G[3 * r + 2] = c2[r]; }
+        grads(dm, G, gh);
         const wb_real ch = v3_dot(f0, c0) - (1 + v->mu[i] / v->lam[i]);
-        solve(x, p, wk, dm, G, ch, inv_h2 / (v->lam[i] * v->v0[i]), &v->lambda[2 * i + 1]);
+        const wb_real ad = inv_h2 / (v->mu[i] * v->v0[i]), ah = inv_h2 / (v->lam[i] * v->v0[i]);
+        wb_real *ld = &v->lambda[2 * i], *lh = &v->lambda[2 * i + 1];
+        const wb_real rh = -ch - ah * *lh;
+        const wb_real a22 = wdot(wk, gh, gh) + ah;
+        wb_real dd = 0, dh;
+        if (dev) {
+            const wb_real a11 = wdot(wk, gd, gd) + ad, a12 = wdot(wk, gd, gh), rd = -cd - ad * *ld;
+            const wb_real det = a11 * a22 - a12 * a12; /* > 0: the compliances are > 0 */
+            if (!(det > 0) || !isfinite(det)) continue;
+            dd = (rd * a22 - a12 * rh) / det;
+            dh = (a11 * rh - a12 * rd) / det;
+        } else {
+            if (!(a22 > 0) || !isfinite(a22)) continue;
+            dh = rh / a22;
+        }
+        *ld += dd;
+        *lh += dh;
+        for (int k = 0; k < 4; k++)
+            if (wk[k] > 0)
+                for (int r = 0; r < 3; r++) x[3 * p[k] + r] += wk[k] * ((dev ? gd[k][r] * dd : 0) + gh[k][r] * dh);
     }
 }
 
