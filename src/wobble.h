@@ -468,6 +468,9 @@ wb_real wb_tet_energy(const wb_world *w, int32_t i);           /* J, 0 at rest *
 wb_real wb_tet_rest_volume(const wb_world *w, int32_t i);      /* m^3, > 0 */
 wb_real wb_tet_volume_ratio(const wb_world *w, int32_t i);     /* det F: < 0 inverted */
 void wb_tet_material(const wb_world *w, int32_t i, wb_real *young, wb_real *poisson);
+/* the rest state of a tet (a b c d): Dm^-1 (row-major) and |volume|; false when flat */
+bool wb_tet_rest_shape(const wb_real *a, const wb_real *b, const wb_real *c, const wb_real *d, wb_real dminv[9],
+                       wb_real *volume);
 wb_real wb_tet_signed_volume(const wb_real *a, const wb_real *b, const wb_real *c, const wb_real *d);
 
 /* a tetrahedral solid: a particle per node (mass lumped by tet volume), a volume constraint

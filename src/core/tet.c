@@ -22,6 +22,7 @@
 
 #include "core.h"
 #include "ctype.h"
+#include "snapshot.h"
 #include "tet.h"
 
 #define TET_BYTES (4 * sizeof(int32_t) + 16 * sizeof(wb_real))
@@ -120,6 +121,16 @@ static bool rest_of(const wb_real *x, const int32_t p[4], wb_real inv[9], wb_rea
     return true;
 }
 
+bool wb_tet_rest_shape(const wb_real *a, const wb_real *b, const wb_real *c, const wb_real *d, wb_real dminv[9],
+                       wb_real *volume)
+{
+    const wb_real x[12] = { a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], d[0], d[1], d[2] };
+    const int32_t p[4] = { 0, 1, 2, 3 };
+    const bool ok = rest_of(x, p, dminv, volume);
+    *volume = fabs(*volume);
+    return ok;
+}
+
 bool wb__tet_put_current(wb_world *w, const int32_t p[4], wb_real young, wb_real poisson)
 {
     wb_real inv[9], vol;
@@ -202,6 +213,73 @@ void wb_tet_material(const wb_world *w, int32_t i, wb_real *young, wb_real *pois
     if (!CHECK_T(w, i)) return;
     if (young) *young = w->neo->young[i];
     if (poisson) *poisson = w->neo->poisson[i];
+}
+
+/* ---- snapshots (snapshot.h): the model as it is, so a restored world has the same future */
+wb_status wb_image_alloc_tets(wb_image *g, int32_t n)
+{
+    void **a[] = { (void **)&g->tet_ijkl, (void **)&g->tet_dminv, (void **)&g->tet_v0, (void **)&g->tet_young,
+                   (void **)&g->tet_poisson };
+    const size_t el[] = { 4 * sizeof(int32_t), 9 * sizeof(wb_real), sizeof(wb_real), sizeof(wb_real), sizeof(wb_real) };
+    bool ok = true;
+    for (int k = 0; k < 5; k++) {
+        free(*a[k]);
+        *a[k] = calloc(n > 0 ? (size_t)n : 1, el[k]);
+        ok = ok && *a[k];
+    }
+    g->ntet = n;
+    if (ok) return WB_OK;
+    for (int k = 0; k < 5; k++) { free(*a[k]); *a[k] = NULL; }
+    g->ntet = 0;
+    return WB_ERR_NOMEM;
+}
+
+wb_status wb__tet_image_of(const wb_world *w, wb_image *g)
+{
+    const int32_t n = wb_tet_count(w);
+    if (wb_image_alloc_tets(g, n) != WB_OK) return WB_ERR_NOMEM;
+    if (n == 0) return WB_OK;
+    const wb_neos *v = w->neo;
+    memcpy(g->tet_ijkl, v->ijkl, 4 * sizeof(int32_t) * (size_t)n);
+    memcpy(g->tet_dminv, v->dminv, 9 * sizeof(wb_real) * (size_t)n);
+    memcpy(g->tet_v0, v->v0, sizeof(wb_real) * (size_t)n);
+    memcpy(g->tet_young, v->young, sizeof(wb_real) * (size_t)n);
+    memcpy(g->tet_poisson, v->poisson, sizeof(wb_real) * (size_t)n);
+    return WB_OK;
+}
+
+const char *wb__tet_image_check(const wb_image *g)
+{
+    if (g->ntet < 0 || g->ntet > WB_MAX_CONSTRAINTS) return "too many tets";
+    for (int32_t i = 0; i < g->ntet; i++) {
+        const int32_t *p = &g->tet_ijkl[4 * i];
+        for (int k = 0; k < 4; k++) {
+            if (p[k] < 0 || p[k] >= g->np) return "tet particle out of range";
+            for (int j = 0; j < k; j++)
+                if (p[j] == p[k]) return "a tet needs four distinct particles";
+        }
+        const wb_tet_def d = { g->tet_young[i], g->tet_poisson[i] };
+        const char *e = wb_tet_def_check(&d);
+        if (e) return e;
+        if (!(g->tet_v0[i] > 0) || !isfinite(g->tet_v0[i])) return "a tet's rest volume must be > 0";
+        for (int k = 0; k < 9; k++)
+            if (!isfinite(g->tet_dminv[9 * i + k])) return "a tet's rest shape must be finite";
+    }
+    return NULL;
+}
+
+wb_status wb__tet_image_reserve(wb_world *w, const wb_image *g)
+{
+    return g->ntet > 0 ? wb__tet_reserve(w, g->ntet) : WB_OK;
+}
+
+void wb__tet_image_put(wb_world *w, const wb_image *g, int32_t shift)
+{
+    for (int32_t i = 0; i < g->ntet; i++) {
+        int32_t p[4];
+        for (int k = 0; k < 4; k++) p[k] = g->tet_ijkl[4 * i + k] + shift;
+        wb__tet_put(w, p, &g->tet_dminv[9 * i], g->tet_v0[i], g->tet_young[i], g->tet_poisson[i]);
+    }
 }
 
 /* ---- the type ---------------------------------------------------------------------- */
