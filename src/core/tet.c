@@ -357,8 +357,20 @@ static void tet_project(wb_world *w, wb_real h)
         const wb_real a22 = wdot(wk, gh, gh) + ah;
         wb_real dd = 0, dh;
         if (dev) {
-            const wb_real a11 = wdot(wk, gd, gd) + ad, a12 = wdot(wk, gd, gh), rd = -cd - ad * *ld;
-            const wb_real det = a11 * a22 - a12 * a12; /* > 0: the compliances are > 0 */
+            const wb_real k22 = a22 - ah, k12 = wdot(wk, gd, gh), k11 = wdot(wk, gd, gd), rd = -cd - ad * *ld;
+            /* det = k11 k22 - k12^2 + ad k22 + ah k11 + ad ah; the gradients are nearly
+             * parallel near rest, so k11 k22 - k12^2 (>= 0) is not formed by subtraction
+             * (it cancels to noise on stiff or sliver tets) but as k22 |gd - (k12/k22) gh|^2 */
+            wb_real gram = 0;
+            if (k22 > 0) {
+                const wb_real c = k12 / k22;
+                wb_real o[4][3];
+                for (int k = 0; k < 4; k++)
+                    for (int r = 0; r < 3; r++) o[k][r] = gd[k][r] - c * gh[k][r];
+                gram = k22 * wdot(wk, o, o);
+            }
+            const wb_real a11 = k11 + ad, a12 = k12;
+            const wb_real det = gram + ad * k22 + ah * k11 + ad * ah;
             if (!(det > 0) || !isfinite(det)) continue;
             dd = (rd * a22 - a12 * rh) / det;
             dh = (a11 * rh - a12 * rd) / det;
