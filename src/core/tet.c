@@ -15,6 +15,11 @@
  * log term); small strains then follow Hooke's law with the given Young's modulus and
  * Poisson's ratio (tests/validation/neo_hookean.lua measures both).
  *
+ * Limit: the substep must stay below about the time a wave (sqrt(E / density)) takes to
+ * cross the smallest tet: past it the linearised 2x2 step overshoots (a tet stiff against
+ * its corners' masses is asked for C_D -> 0, a collapse, that only the compliance stops).
+ * A light body of sliver tets explodes; more substeps, not iterations, is the cure.
+ *
  * Model: corners, Dm^-1, V0, E, nu (mu and lam derived). Cache: the multipliers of the
  * substep. The pass is serial in creation order: deterministic for any thread count. */
 #include <assert.h>
