@@ -70,18 +70,6 @@ static int w_total_volume(lua_State *L)
 }
 
 /* ---- Neo-Hookean tets ------------------------------------------------------------------------ */
-/* young (Pa, > 0) and poisson ([0, 0.5)) of the options at arg, when given; raises */
-void wbl_read_neo(lua_State *L, int arg, wb_real *young, wb_real *poisson)
-{
-    if (lua_type(L, arg) != LUA_TTABLE) return;
-    const bool has_young = wbl_optreal(L, arg, "young", young);
-    if (has_young && !(*young > 0)) wbl_fielderror(L, arg, "young", "must be > 0 (Pa)");
-    if (wbl_optreal(L, arg, "poisson", poisson)) {
-        if (!(*poisson >= 0 && *poisson < 0.5)) wbl_fielderror(L, arg, "poisson", "must be in [0, 0.5)");
-        if (!has_young) wbl_fielderror(L, arg, "poisson", "needs young");
-    }
-}
-
 static const char *const tet_keys[] = { "young", "poisson", NULL };
 
 /* w:tet(p1, p2, p3, p4, {young = 1e5, poisson = 0.3}) -> index: rest shape = the current one */
