@@ -233,6 +233,8 @@ typedef struct wb_lattice_def {
     wb_distance_def link; /* edges, face and body diagonals of every cell */
     bool tets;            /* also 6 tetrahedra per cell, each with a volume constraint */
     wb_real volume_compliance; /* theirs (m^3/Pa), default 0: incompressible */
+    wb_real young, poisson; /* young > 0 (Pa, needs tets): Neo-Hookean tets (tet.c) instead of
+                             * volume constraints and no links; default 0 (off), 0.3 */
 } wb_lattice_def;
 
 wb_cloth_def wb_cloth_default_def(void);
@@ -453,6 +455,26 @@ wb_real wb_volume_compliance(const wb_world *w, int32_t i);
 wb_real wb_volume_pressure(const wb_world *w, int32_t i);      /* Pa, lambda/h^2 of the last substep; > 0 compressed */
 /* sums over every volume constraint of the current and rest signed volumes */
 void wb_world_volume_total(const wb_world *w, wb_real *current, wb_real *rest);
+/* ==== Neo-Hookean tetrahedra (tet.c; Macklin & Müller 2021) ===============================
+ * Two XPBD constraints per tet (deviatoric, hydrostatic), rest shape = the particles' shape
+ * when made; recovers from inversion. */
+typedef struct wb_tet_def {
+    wb_real young;        /* Young's modulus, Pa (> 0), default 1e5 */
+    wb_real poisson;      /* Poisson's ratio in [0, 0.5), default 0.3 */
+} wb_tet_def;
+wb_tet_def wb_tet_default_def(void);
+const char *wb_tet_def_check(const wb_tet_def *def);          /* NULL or what is wrong */
+/* index, or WB_ERR_ARG (see wb_last_error: a particle twice, a flat tet) */
+int32_t wb_tet_add(wb_world *w, const int32_t p[4], const wb_tet_def *def);
+int32_t wb_tet_count(const wb_world *w);
+void wb_tet_particles(const wb_world *w, int32_t i, int32_t p[4]);
+wb_real wb_tet_energy(const wb_world *w, int32_t i);           /* J, 0 at rest */
+wb_real wb_tet_rest_volume(const wb_world *w, int32_t i);      /* m^3, > 0 */
+wb_real wb_tet_volume_ratio(const wb_world *w, int32_t i);     /* det F: < 0 inverted */
+void wb_tet_material(const wb_world *w, int32_t i, wb_real *young, wb_real *poisson);
+/* the rest state of a tet (a b c d): Dm^-1 (row-major) and |volume|; false when flat */
+bool wb_tet_rest_shape(const wb_real *a, const wb_real *b, const wb_real *c, const wb_real *d, wb_real dminv[9],
+                       wb_real *volume);
 wb_real wb_tet_signed_volume(const wb_real *a, const wb_real *b, const wb_real *c, const wb_real *d);
 
 /* a tetrahedral solid: a particle per node (mass lumped by tet volume), a volume constraint
@@ -462,6 +484,7 @@ typedef struct wb_tet_body_def {
     wb_real mass, radius; /* total mass, particle radius */
     wb_distance_def link; /* every edge link (rest = current length) */
     wb_real volume_compliance; /* every tet's volume constraint */
+    wb_real young, poisson; /* young > 0 (Pa): Neo-Hookean tets instead, no links; default 0, 0.3 */
 } wb_tet_body_def;
 wb_tet_body_def wb_tet_body_default_def(void);                 /* mass 1, radius 0.02, rigid */
 wb_status wb_tet_body(wb_world *w, const wb_real *v, int32_t nv, const int32_t *tet, int32_t nt,

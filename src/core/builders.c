@@ -5,6 +5,7 @@
 
 #include "core.h"
 #include "volume.h"
+#include "tet.h"
 
 wb_cloth_def wb_cloth_default_def(void)
 {
@@ -42,6 +43,7 @@ wb_lattice_def wb_lattice_default_def(void)
     d.mass = 1;
     d.radius = 0.02;
     d.link = wb_distance_default_def();
+    d.poisson = 0.3;
     return d;
 }
 
@@ -259,8 +261,16 @@ wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
     if (d->tets && !(d->volume_compliance >= 0 && isfinite(d->volume_compliance)))
         return bad("volume_compliance must be >= 0");
     if (d->tets && 6 * cells > WB_MAX_CONSTRAINTS) return bad("res is too large for tets");
-    if ((st = wb__reserve(w, np, nd)) != WB_OK || (st = wb__surface_reserve(w, (int32_t)ntri)) != WB_OK ||
-        (d->tets && (st = wb__volume_reserve(w, 6 * cells)) != WB_OK))
+    /* young: Neo-Hookean tets and no links (E means E: links would add their stiffness) */
+    const bool neo = d->young != 0;
+    if (neo && !d->tets) return bad("young needs tets = true");
+    if (neo) {
+        const wb_tet_def td = { d->young, d->poisson };
+        const char *e = wb_tet_def_check(&td);
+        if (e) return bad(e);
+    }
+    if ((st = wb__reserve(w, np, neo ? 0 : nd)) != WB_OK || (st = wb__surface_reserve(w, (int32_t)ntri)) != WB_OK ||
+        (d->tets && (st = neo ? wb__tet_reserve(w, 6 * cells) : wb__volume_reserve(w, 6 * cells)) != WB_OK))
         return st;
     const int32_t first = w->m.np;
     const wb_real m = d->mass / (wb_real)np;
@@ -277,6 +287,11 @@ wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
             for (int i = 0; i < nx; i++) {
                 const int a = ID(i, j, k);
                 const int ex = i + 1 < nx, ey = j + 1 < ny, ez = k + 1 < nz;
+                if (neo) {
+                    if (ex && ey && ez)
+                        wb__kuhn_tets(w, a, ID(i + 1, j, k) - a, ID(i, j + 1, k) - a, ID(i, j, k + 1) - a, 0, d->young, d->poisson);
+                    continue;
+                }
                 if (ex) link(w, a, ID(i + 1, j, k), &d->link);
                 if (ey) link(w, a, ID(i, j + 1, k), &d->link);
                 if (ez) link(w, a, ID(i, j, k + 1), &d->link);
@@ -289,7 +304,7 @@ wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
                     link(w, ID(i, j + 1, k), ID(i + 1, j, k + 1), &d->link);
                     link(w, ID(i, j, k + 1), ID(i + 1, j + 1, k), &d->link);
                     if (d->tets) wb__kuhn_tets(w, ID(i, j, k), ID(i + 1, j, k) - ID(i, j, k), ID(i, j + 1, k) - ID(i, j, k),
-                                               ID(i, j, k + 1) - ID(i, j, k), d->volume_compliance);
+                                               ID(i, j, k + 1) - ID(i, j, k), d->volume_compliance, 0, 0);
                 }
             }
     /* the hull: each of the six faces as a grid of quads, wound outwards */

@@ -254,6 +254,7 @@ struct wb_world {
     wb_cache k;
     wb_bends bend;         /* bending constraints (bend.c): model, state and cache */
     struct wb_volumes *vol; /* volume constraints (volume.h), NULL until the first */
+    struct wb_neos *neo;    /* Neo-Hookean tets (tet.h), NULL until the first */
     wb_smatch sm;          /* shape-matching clusters (shape_match.c) */
     wb_pressures pr;       /* pressure constraints (pressure.c) */
 };

@@ -17,7 +17,7 @@ typedef struct wb_ctype {
 } wb_ctype;
 
 extern const wb_ctype wb__distance_type, wb__bend_type, wb__volume_type,
-                      wb__shape_type, wb__pressure_type;
+                      wb__shape_type, wb__pressure_type, wb__tet_type;
 
 /* the table the step walks (solver.c), in projection order, and its length */
 extern const wb_ctype *const wb__ctypes[];

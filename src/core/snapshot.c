@@ -103,6 +103,11 @@ wb_status wb_image_alloc_volumes(wb_image *g, int32_t n)
 
 void wb_image_free(wb_image *g)
 {
+    free(g->tet_ijkl);
+    free(g->tet_dminv);
+    free(g->tet_v0);
+    free(g->tet_young);
+    free(g->tet_poisson);
     free(g->vol_ijkl);
     free(g->vol_alpha);
     free(g->vol_rest);
@@ -209,7 +214,8 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
         memcpy(g->vol_alpha, w->vol->alpha, (size_t)nvol * sizeof *g->vol_alpha);
         memcpy(g->vol_rest, w->vol->rest, (size_t)nvol * sizeof *g->vol_rest);
     }
-    if ((st = wb__smatch_image_of(w, g)) != WB_OK || (st = wb__pressure_image_of(w, g)) != WB_OK) {
+    if ((st = wb__tet_image_of(w, g)) != WB_OK || (st = wb__smatch_image_of(w, g)) != WB_OK ||
+        (st = wb__pressure_image_of(w, g)) != WB_OK) {
         wb_image_free(g);
         return st;
     }
@@ -323,7 +329,7 @@ const char *wb_image_check(const wb_image *g)
         const wb_volume_def d = { g->vol_alpha[i], true, g->vol_rest[i] };
         if ((e = wb_volume_def_check(&d))) return e;
     }
-    if ((e = wb__smatch_image_check(g)) || (e = wb__pressure_image_check(g))) return e;
+    if ((e = wb__tet_image_check(g)) || (e = wb__smatch_image_check(g)) || (e = wb__pressure_image_check(g))) return e;
     return NULL;
 }
 
@@ -441,6 +447,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     if (st == WB_OK) st = grow_colliders(w, g->nc);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
     if (st == WB_OK && g->nvol > 0) st = wb__volume_reserve(w, g->nvol);
+    if (st == WB_OK) st = wb__tet_image_reserve(w, g);
     if (st == WB_OK) st = wb__smatch_reserve(w, g);
     if (st == WB_OK) st = wb__pressure_reserve(w, g);
     if (st == WB_OK) st = build_meshes(w, g, cms);
@@ -504,6 +511,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     free(cms);
     put_surfaces(w, g, 0);
     put_volumes(w, g, 0);
+    wb__tet_image_put(w, g, 0);
     wb__smatch_put(w, g, 0);
     wb__pressure_put(w, g, 0);
     s->time = g->time;
@@ -555,6 +563,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     if (st == WB_OK) st = grow_colliders(w, m->nc + new_c);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
     if (st == WB_OK && g->nvol > 0) st = wb__volume_reserve(w, g->nvol);
+    if (st == WB_OK) st = wb__tet_image_reserve(w, g);
     if (st == WB_OK) st = wb__smatch_reserve(w, g);
     if (st == WB_OK) st = wb__pressure_reserve(w, g);
     if (st == WB_OK) st = build_meshes(w, g, cms);
@@ -608,6 +617,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     free(cms);
     put_surfaces(w, g, first);
     put_volumes(w, g, first);
+    wb__tet_image_put(w, g, first);
     wb__smatch_put(w, g, first);
     wb__pressure_put(w, g, first_surface);
     m->topology_dirty = 1;

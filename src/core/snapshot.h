@@ -85,6 +85,11 @@ typedef struct wb_image {
     int32_t nvol;
     int32_t *vol_ijkl;     /* (nvol x 4) */
     wb_real *vol_alpha, *vol_rest; /* (nvol) compliance, signed rest volume */
+    /* Neo-Hookean tets (tet.c), in creation order: allocated by wb_image_alloc_tets */
+    int32_t ntet;
+    int32_t *tet_ijkl;     /* (ntet x 4) */
+    wb_real *tet_dminv;    /* (ntet x 9) rest edge matrix inverse, row-major */
+    wb_real *tet_v0, *tet_young, *tet_poisson; /* (ntet) rest volume (> 0), E, nu */
     wb_image_smatch sm;    /* empty unless wb_image_alloc_smatch */
     wb_image_pressure pr;  /* empty unless wb_image_alloc_pressure */
 } wb_image;
@@ -96,6 +101,14 @@ wb_status wb_image_alloc(wb_image *img, int32_t np, int32_t nd, int32_t nfree, i
 wb_status wb_image_alloc_bends(wb_image *img, int32_t nb);
 /* the volume constraints' arrays for n of them (zeroed); WB_ERR_NOMEM */
 wb_status wb_image_alloc_volumes(wb_image *img, int32_t n);
+/* the Neo-Hookean tets' arrays for n of them (zeroed; tet.c); WB_ERR_NOMEM */
+wb_status wb_image_alloc_tets(wb_image *img, int32_t n);
+/* tet.c: copy w's tets into the image, check an image's, and add them after w's (reserved
+ * by wb__tet_image_reserve), particles shifted by `shift` */
+wb_status wb__tet_image_of(const wb_world *w, wb_image *img);
+const char *wb__tet_image_check(const wb_image *img);
+wb_status wb__tet_image_reserve(wb_world *w, const wb_image *img);
+void wb__tet_image_put(wb_world *w, const wb_image *img, int32_t shift);
 /* the materials' sections (after wb_image_alloc; zeroed, rotations identity); WB_ERR_NOMEM */
 wb_status wb_image_alloc_smatch(wb_image *img, int32_t n, int32_t nids);
 wb_status wb_image_alloc_pressure(wb_image *img, int32_t n);

@@ -23,6 +23,7 @@ const wb_ctype *const wb__ctypes[] = {
     &wb__distance_type,
     &wb__bend_type,
     &wb__volume_type,
+    &wb__tet_type,
     &wb__shape_type,
     &wb__pressure_type,
 };

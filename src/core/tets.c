@@ -5,6 +5,7 @@
 
 #include "core.h"
 #include "volume.h"
+#include "tet.h"
 
 /* ---- the lattice's cells --------------------------------------------------------------- */
 /* Kuhn's split of a cell into the 6 tets around its main diagonal 0 -> 7 (corner c at
@@ -13,7 +14,8 @@
  * (from its lowest to its highest corner) on both sides: the tets of neighbouring cells
  * meet face to face. Each is turned positive (two corners swapped) whatever the axes'
  * handedness, so all of them keep the same sign. Space reserved by the caller. */
-void wb__kuhn_tets(wb_world *w, int32_t base, int32_t sx, int32_t sy, int32_t sz, wb_real alpha)
+void wb__kuhn_tets(wb_world *w, int32_t base, int32_t sx, int32_t sy, int32_t sz, wb_real alpha,
+                   wb_real young, wb_real poisson)
 {
     static const int perm[6][3] = { { 1, 2, 4 }, { 1, 4, 2 }, { 2, 1, 4 }, { 2, 4, 1 }, { 4, 1, 2 }, { 4, 2, 1 } };
     const wb_real *x = w->s.x;
@@ -26,7 +28,8 @@ void wb__kuhn_tets(wb_world *w, int32_t base, int32_t sx, int32_t sy, int32_t sz
             int32_t s = p[2]; p[2] = p[3]; p[3] = s;
             v = -v;
         }
-        wb__volume_put(w, p, alpha, v);
+        if (young > 0) wb__tet_put_current(w, p, young, poisson); /* a lattice cell is never flat */
+        else wb__volume_put(w, p, alpha, v);
     }
 }
 
@@ -76,6 +79,7 @@ wb_tet_body_def wb_tet_body_default_def(void)
     d.radius = 0.02;
     d.link = wb_distance_default_def();
     d.volume_compliance = 0;
+    d.poisson = 0.3;
     return d;
 }
 
@@ -141,6 +145,11 @@ wb_status wb_tet_body(wb_world *w, const wb_real *v, int32_t nv, const int32_t *
     if (!(d->mass > 0) || !isfinite(d->mass)) return bad("mass must be > 0", 0, 0);
     if (!(d->radius >= 0) || !isfinite(d->radius)) return bad("radius must be >= 0", 0, 0);
     if (!(d->volume_compliance >= 0) || !isfinite(d->volume_compliance)) return bad("volume_compliance must be >= 0", 0, 0);
+    const bool neo = d->young != 0;
+    if (neo) {
+        const wb_tet_def td = { d->young, d->poisson };
+        if ((e = wb_tet_def_check(&td))) { wb__set_error("%s", e); return WB_ERR_ARG; }
+    }
     if (nv < 4 || nt < 1) return bad("a tet mesh needs at least 4 nodes and 1 tet (got %lld nodes, %lld tets)", nv, nt);
     if (nv > WB_MAX_PARTICLES || nt > WB_MAX_CONSTRAINTS / 6 || ntri < 0 || ntri > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     for (int64_t i = 0; i < 3 * (int64_t)nv; i++)
@@ -197,9 +206,11 @@ wb_status wb_tet_body(wb_world *w, const wb_real *v, int32_t nv, const int32_t *
         }
     }
     /* everything reserved first: after this nothing can fail */
+    /* Neo-Hookean: the tets alone make the solid (links would stiffen it past E) */
+    if (neo) ne = 0;
     if (st == WB_OK) st = wb__reserve(w, nv, ne);
     if (st == WB_OK) st = wb__surface_reserve(w, ntri);
-    if (st == WB_OK) st = wb__volume_reserve(w, nt);
+    if (st == WB_OK) st = neo ? wb__tet_reserve(w, nt) : wb__volume_reserve(w, nt);
     if (st == WB_OK) {
         const int32_t first = w->m.np;
         for (int32_t i = 0; i < nv; i++) {
@@ -214,7 +225,8 @@ wb_status wb_tet_body(wb_world *w, const wb_real *v, int32_t nv, const int32_t *
         for (int32_t t = 0; t < nt; t++) {
             int32_t p[4];
             for (int k = 0; k < 4; k++) p[k] = first + tet[4 * t + k];
-            wb__volume_put(w, p, d->volume_compliance, vol[t]);
+            if (neo) wb__tet_put_current(w, p, d->young, d->poisson); /* not flat: checked above */
+            else wb__volume_put(w, p, d->volume_compliance, vol[t]);
         }
         for (int64_t i = 0; i < 3 * (int64_t)ntri; i++) tri[i] += first;
         wb_surface_add(w, tri, ntri);

@@ -20,8 +20,10 @@ typedef struct wb_volumes {
 /* room for `extra` more, charged to the memory budget; after it wb__volume_put cannot fail */
 wb_status wb__volume_reserve(wb_world *w, int64_t extra);
 void wb__volume_put(wb_world *w, const int32_t p[4], wb_real alpha, wb_real rest);
-/* tets.c: a lattice cell's 6 tets (Kuhn), corner c at base + (c&1) sx + (c&2) sy + (c&4) sz */
-void wb__kuhn_tets(wb_world *w, int32_t base, int32_t sx, int32_t sy, int32_t sz, wb_real alpha);
+/* tets.c: a lattice cell's 6 tets (Kuhn), corner c at base + (c&1) sx + (c&2) sy + (c&4) sz:
+ * volume constraints of compliance alpha, or Neo-Hookean tets (tet.h) when young > 0 */
+void wb__kuhn_tets(wb_world *w, int32_t base, int32_t sx, int32_t sy, int32_t sz, wb_real alpha,
+                   wb_real young, wb_real poisson);
 
 /* world.c's destroy: the arrays freed and the budget given back (inline, so that world.c
  * and volume.c do not call each other) */

@@ -67,5 +67,6 @@ int jv_opt_vec(rd *r, const cJSON *f, const kp *up, const char *key, int n, wb_r
  * the image, after its particles and surfaces */
 int jm_read_shape_matches(rd *r, const cJSON *arr, wb_image *g);
 int jm_read_pressures(rd *r, const cJSON *arr, wb_image *g);
+int jm_read_tets(rd *r, const cJSON *arr, wb_image *g);
 
 #endif

@@ -125,3 +125,59 @@ int jm_read_pressures(rd *r, const cJSON *arr, wb_image *g)
     }
     return 0;
 }
+
+/* "tets": [ {"particles": [a, b, c, d], "young": E, "poisson": nu, "rest_inverse": [9],
+ * "rest_volume": V0}, ... ]: Neo-Hookean tets (core/tet.c). young is required, poisson
+ * 0.3 by default; the rest state (Dm^-1 row-major and V0 > 0, both or neither; w:save
+ * writes them so a reload has the same future) is the particles' shape by default. */
+int jm_read_tets(rd *r, const cJSON *arr, wb_image *g)
+{
+    static const char *const keys[] = { "particles", "young", "poisson", "rest_inverse", "rest_volume", NULL };
+    kp top = { NULL, "tets", 0 };
+    int32_t n = 0, i = 0;
+    if (!arr) return 0;
+    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
+    if (wb_image_alloc_tets(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
+    for (const cJSON *c = arr->child; c; c = c->next, i++) {
+        const cJSON *f[5];
+        kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "particles");
+        if (!f[1]) return jv_missing(r, c, &p, "young");
+        int32_t m;
+        if (jv_get_array(r, f[0], &pp, 16, &m)) return -1;
+        if (m != 4) return jv_fail(r, f[0], 0, &pp, "a tet joins 4 particles, got %d", m);
+        int32_t *q4 = &g->tet_ijkl[4 * i];
+        int k = 0;
+        for (const cJSON *e = f[0]->child; e; e = e->next, k++) {
+            kp q = { &pp, NULL, k };
+            int64_t v;
+            if (g->np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
+            if (jv_get_int(r, e, &q, 0, g->np - 1, &v)) return -1;
+            q4[k] = (int32_t)v;
+            for (int j = 0; j < k; j++)
+                if (q4[j] == q4[k]) return jv_fail(r, f[0], 0, &pp, "a tet needs four distinct particles");
+        }
+        wb_real y = 0, nu = 0.3;
+        if (jv_opt_real(r, f[1], &p, "young", &y) || jv_opt_real(r, f[2], &p, "poisson", &nu)) return -1;
+        kp yq = { &p, "young", 0 }, nq = { &p, "poisson", 0 };
+        if (!(y > 0) || !isfinite(y)) return jv_fail(r, f[1], 0, &yq, "must be > 0 (Pa)");
+        if (!(nu >= 0 && nu < 0.5)) return jv_fail(r, f[2], 0, &nq, "must be in [0, 0.5)");
+        g->tet_young[i] = y;
+        g->tet_poisson[i] = nu;
+        if (!f[3] != !f[4]) return jv_fail(r, c, 0, &p, "rest_inverse and rest_volume go together");
+        if (f[3]) {
+            kp vq = { &p, "rest_volume", 0 };
+            if (jv_opt_vec(r, f[3], &p, "rest_inverse", 9, &g->tet_dminv[9 * i]) ||
+                jv_opt_real(r, f[4], &p, "rest_volume", &g->tet_v0[i]))
+                return -1;
+            if (!(g->tet_v0[i] > 0) || !isfinite(g->tet_v0[i])) return jv_fail(r, f[4], 0, &vq, "must be > 0");
+        } else {
+            const wb_real *x = g->x;
+            if (!wb_tet_rest_shape(&x[3 * q4[0]], &x[3 * q4[1]], &x[3 * q4[2]], &x[3 * q4[3]], &g->tet_dminv[9 * i],
+                                   &g->tet_v0[i]))
+                return jv_fail(r, f[0], 0, &pp, "the four particles lie in a plane (a flat tet has no rest shape)");
+        }
+    }
+    return 0;
+}

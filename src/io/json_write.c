@@ -167,6 +167,27 @@ static void write_volumes(out *o, const wb_image *g)
     fputs("\n  ],\n", f);
 }
 
+/* "tets": Neo-Hookean tets with their rest state (json_material.c reads them) */
+static void write_tets(out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    if (g->ntet == 0) return;
+    fputs("  \"tets\": [", f);
+    for (int32_t i = 0; i < g->ntet; i++) {
+        const int32_t *p = &g->tet_ijkl[4 * i];
+        fprintf(f, "%s    {\"particles\": [%d, %d, %d, %d], \"young\": ", i ? ",\n" : "\n", p[0], p[1], p[2], p[3]);
+        num(o, g->tet_young[i]);
+        fputs(", \"poisson\": ", f);
+        num(o, g->tet_poisson[i]);
+        fputs(", \"rest_volume\": ", f);
+        num(o, g->tet_v0[i]);
+        fputs(", \"rest_inverse\": ", f);
+        vec(o, &g->tet_dminv[9 * i], 9);
+        fputc('}', f);
+    }
+    fputs("\n  ],\n", f);
+}
+
 /* shape-matching clusters and pressures (json_material.c reads them): only when present */
 static void write_materials(out *o, const wb_image *g)
 {
@@ -292,6 +313,7 @@ int wbio_write_snapshot(const wb_world *w, const char *path, const char *shown, 
     write_particles(&o, &g);
     write_constraints(&o, &g);
     write_volumes(&o, &g);
+    write_tets(&o, &g);
     write_materials(&o, &g);
     write_colliders(&o, &g);
     write_surfaces(&o, &g);

@@ -241,7 +241,7 @@ static int w_rope(lua_State *L)
 }
 
 static const char *const lattice_keys[] = {
-    "min", "max", "res", "mass", "radius", "tets", "volume_compliance",
+    "min", "max", "res", "mass", "radius", "tets", "volume_compliance", "young", "poisson",
     "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
 };
 
@@ -263,6 +263,9 @@ static int w_lattice(lua_State *L)
     wbl_optbool(L, 2, "tets", &d.tets);
     if (wbl_optreal(L, 2, "volume_compliance", &d.volume_compliance) && d.volume_compliance < 0)
         return wbl_fielderror(L, 2, "volume_compliance", "must be >= 0");
+    /* young (Pa): Neo-Hookean tets (lua/volume.c's w:tet) and no links, so that E means E */
+    wbl_read_neo(L, 2, &d.young, &d.poisson);
+    if (d.young > 0 && !d.tets) return wbl_fielderror(L, 2, "young", "needs tets = true");
     wbl_read_link(L, 2, &d.link);
     check_link(L, &d.link);
     if ((int64_t)d.res[0] * d.res[1] * d.res[2] > WB_MAX_PARTICLES)
@@ -271,14 +274,14 @@ static int w_lattice(lua_State *L)
     /* BUILD, plus body.tet_count as the other tet bodies have it */
     wb_body b;
     wbl_body_begin(L, (int64_t)d.res[0] * d.res[1] * d.res[2]);
-    const int32_t nd0 = wb_distance_count(w), nv0 = wb_volume_count(w);
+    const int32_t nd0 = wb_distance_count(w), nv0 = wb_volume_count(w) + wb_tet_count(w);
     wb_status st = wb_lattice(w, &d, &b);
     if (st != WB_OK) return wbl_status_error(L, 2, st, "lattice");
     if (auto_radius) wbl_default_radius(w, b);
     wbl_apply_contact_opts(w, b, &co);
     wbl_body_end(L, 1, b, wb_distance_count(w) - nd0);
     if (d.tets) {
-        lua_pushinteger(L, wb_volume_count(w) - nv0);
+        lua_pushinteger(L, wb_volume_count(w) + wb_tet_count(w) - nv0);
         lua_setfield(L, -2, "tet_count");
     }
     return 1;

@@ -327,7 +327,7 @@ static int m_tostring(lua_State *L)
 
 /* ---- w:from_mesh(m, {tets = true, ...}): filled with tets by tetgen (io/tets.c), lua/volume.c builds */
 static const char *const from_mesh_tets_keys[] = {
-    "tets", "max_volume", "quality", "keep_surface", "timeout", "mass", "radius", "volume_compliance",
+    "tets", "max_volume", "quality", "keep_surface", "timeout", "mass", "radius", "volume_compliance", "young", "poisson",
     "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
 };
 

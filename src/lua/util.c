@@ -389,3 +389,16 @@ void wbl_after_frame(lua_State *L, int world_index)
     }
     wb_rt_after_frame(L, world_index);
 }
+
+/* young (Pa, > 0) and poisson ([0, 0.5)) of a tet solid's options at arg, when given (the
+ * lattice in body.c, the tet bodies in volume.c: here so that neither calls the other); raises */
+void wbl_read_neo(lua_State *L, int arg, wb_real *young, wb_real *poisson)
+{
+    if (lua_type(L, arg) != LUA_TTABLE) return;
+    const bool has_young = wbl_optreal(L, arg, "young", young);
+    if (has_young && !(*young > 0)) wbl_fielderror(L, arg, "young", "must be > 0 (Pa)");
+    if (wbl_optreal(L, arg, "poisson", poisson)) {
+        if (!(*poisson >= 0 && *poisson < 0.5)) wbl_fielderror(L, arg, "poisson", "must be in [0, 0.5)");
+        if (!has_young) wbl_fielderror(L, arg, "poisson", "needs young");
+    }
+}

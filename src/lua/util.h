@@ -103,6 +103,8 @@ struct wbio_tets;
 struct wbl_contact_opts;
 struct wbio_tets *wbl_push_tets(lua_State *L);
 bool wbl_read_tet_body(lua_State *L, int arg, wb_tet_body_def *d);
+/* young and poisson of a tet solid's options (util.c); raises */
+void wbl_read_neo(lua_State *L, int arg, wb_real *young, wb_real *poisson);
 int wbl_push_tet_body(lua_State *L, wb_world *w, const struct wbio_tets *t, const int32_t *tri, int32_t ntri,
                       const wb_tet_body_def *d, bool auto_radius, const struct wbl_contact_opts *co, const char *what);
 /* a builder's contact options (collide = true, self_collide = false, friction = 0) from

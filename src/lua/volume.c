@@ -2,6 +2,8 @@
  *   w:volume(p1, p2, p3, p4, {compliance, rest}) -> index    w:volume_count()
  *   w:volume_info(i) -> volume, rest, pressure               w:total_volume() -> volume, rest
  *   w:load_tets(path, {...}) -> body (tetgen's .node/.ele)   w:save_tets(path [, body])
+ *   w:tet(p1, p2, p3, p4, {young, poisson}) -> index (Neo-Hookean, core/tet.c)
+ *   w:tet_count()   w:tet_info(i) -> det F, energy, rest volume
  * and the helpers of the tets branch of w:from_mesh (lua/mesh.c: tetgen run on the mesh).
  * Volume constraints are plain indices (1-based): they are never removed. */
 #include <limits.h>
@@ -67,6 +69,47 @@ static int w_total_volume(lua_State *L)
     return 2;
 }
 
+/* ---- Neo-Hookean tets ------------------------------------------------------------------------ */
+static const char *const tet_keys[] = { "young", "poisson", NULL };
+
+/* w:tet(p1, p2, p3, p4, {young = 1e5, poisson = 0.3}) -> index: rest shape = the current one */
+static int w_tet(lua_State *L)
+{
+    wb_world *w = wbl_checkworld(L, 1);
+    int32_t p[4];
+    for (int k = 0; k < 4; k++) p[k] = wbl_checkparticle(L, w, 2 + k);
+    wb_tet_def d = wb_tet_default_def();
+    if (wbl_checkopts(L, 6, tet_keys, true)) {
+        if (wbl_optreal(L, 6, "young", &d.young) && !(d.young > 0)) return wbl_fielderror(L, 6, "young", "must be > 0 (Pa)");
+        if (wbl_optreal(L, 6, "poisson", &d.poisson) && !(d.poisson >= 0 && d.poisson < 0.5))
+            return wbl_fielderror(L, 6, "poisson", "must be in [0, 0.5)");
+    }
+    const int32_t i = wb_tet_add(w, p, &d);
+    if (i == WB_ERR_ARG) return luaL_argerror(L, 5, wb_last_error());
+    if (i < 0) return wbl_status_error(L, 6, (wb_status)i, "tet");
+    lua_pushinteger(L, (lua_Integer)i + 1);
+    return 1;
+}
+
+static int w_tet_count(lua_State *L)
+{
+    lua_pushinteger(L, wb_tet_count(wbl_checkworld(L, 1)));
+    return 1;
+}
+
+/* w:tet_info(i) -> det F (current / rest volume, < 0 inverted), energy (J), rest volume (m^3) */
+static int w_tet_info(lua_State *L)
+{
+    wb_world *w = wbl_checkworld(L, 1);
+    const lua_Integer i = wbl_checkint(L, 2);
+    if (i < 1 || i > wb_tet_count(w))
+        return luaL_argerror(L, 2, lua_pushfstring(L, "tet %I out of range (1..%d)", i, (int)wb_tet_count(w)));
+    lua_pushnumber(L, wb_tet_volume_ratio(w, (int32_t)i - 1));
+    lua_pushnumber(L, wb_tet_energy(w, (int32_t)i - 1));
+    lua_pushnumber(L, wb_tet_rest_volume(w, (int32_t)i - 1));
+    return 3;
+}
+
 /* ---- tet bodies ------------------------------------------------------------------------------- */
 #define WBL_TETS "wobble.tets (scratch)"
 
@@ -97,6 +140,7 @@ bool wbl_read_tet_body(lua_State *L, int arg, wb_tet_body_def *d)
     }
     if (wbl_optreal(L, arg, "volume_compliance", &d->volume_compliance) && d->volume_compliance < 0)
         wbl_fielderror(L, arg, "volume_compliance", "must be >= 0");
+    wbl_read_neo(L, arg, &d->young, &d->poisson);
     wbl_read_link(L, arg, &d->link);
     const char *e = wb_distance_def_check(&d->link);
     if (e) luaL_argerror(L, arg, e);
@@ -107,7 +151,7 @@ bool wbl_read_tet_body(lua_State *L, int arg, wb_tet_body_def *d)
 int wbl_push_tet_body(lua_State *L, wb_world *w, const wbio_tets *t, const int32_t *tri, int32_t ntri,
                          const wb_tet_body_def *d, bool auto_radius, const wbl_contact_opts *co, const char *what)
 {
-    const int32_t nd0 = wb_distance_count(w), nv0 = wb_volume_count(w);
+    const int32_t nd0 = wb_distance_count(w), nv0 = wb_volume_count(w) + wb_tet_count(w);
     wbl_body_begin(L, t->nv);
     wb_body b;
     wb_status st = wb_tet_body(w, t->v, t->nv, t->tet, t->nt, tri, ntri, d, &b);
@@ -116,7 +160,7 @@ int wbl_push_tet_body(lua_State *L, wb_world *w, const wbio_tets *t, const int32
     if (auto_radius) wbl_default_radius(w, b);
     wbl_apply_contact_opts(w, b, co);
     wbl_body_end(L, 1, b, wb_distance_count(w) - nd0);
-    lua_pushinteger(L, wb_volume_count(w) - nv0);
+    lua_pushinteger(L, wb_volume_count(w) + wb_tet_count(w) - nv0);
     lua_setfield(L, -2, "tet_count");
     return 1;
 }
@@ -136,7 +180,7 @@ static void tet_paths(lua_State *L, const char *name, int write, char *node, cha
 }
 
 static const char *const load_tets_keys[] = {
-    "mass", "radius", "volume_compliance",
+    "mass", "radius", "volume_compliance", "young", "poisson",
     "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
 };
 
@@ -227,6 +271,9 @@ static const luaL_Reg world_methods[] = {
     { "total_volume", w_total_volume },
     { "load_tets", w_load_tets },
     { "save_tets", w_save_tets },
+    { "tet", w_tet },
+    { "tet_count", w_tet_count },
+    { "tet_info", w_tet_info },
     { NULL, NULL }
 };
 

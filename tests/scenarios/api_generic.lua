@@ -86,8 +86,9 @@ local CASES = {
                      nums = plus(link_nums, { "from", "to", "segments", "mass", "radius", "friction" }),
                      call = function(f, o) return f.w:rope(o) end },
   ["world:lattice"] = { opts = link{ min = {0, 0, 0}, max = {1, 1, 1}, res = {2, 2, 2}, mass = 1, radius = 0.02,
-                                     tets = true, volume_compliance = 0 },
-                        nums = plus(link_nums, { "min", "max", "res", "mass", "radius", "friction", "volume_compliance" }),
+                                     tets = true, volume_compliance = 0, young = 1e5, poisson = 0.3 },
+                        nums = plus(link_nums, { "min", "max", "res", "mass", "radius", "friction", "volume_compliance",
+                                                 "young", "poisson" }),
                         call = function(f, o) return f.w:lattice(o) end },
   ["world:from_mesh"] = { opts = link{ mass = 1, radius = 0.02, target = 4, neighbours = 3 }, opts_arg = 2,
                           nums = plus(link_nums, { "mass", "radius", "target", "neighbours", "friction" }),
@@ -157,6 +158,15 @@ local CASES = {
   ["world:save_tets"] = { none = "a path and a body" },
   ["world:volume_count"] = { none = "a getter: no arguments" },
   ["world:total_volume"] = { none = "a getter: no arguments" },
+  -- Neo-Hookean tets (lua/volume.c, core/tet.c); young/poisson on lattice: neo_hookean.lua
+  ["world:tet"] = { opts = { young = 1e5, poisson = 0.3 }, opts_arg = 5, nums = { "young", "poisson" },
+                    call = function(f, o) local b = f.body.first
+                      return f.w:tet(b, b + 1, b + 2, b + 4, o) end },
+  ["world:tet_info"] = { args = { 1 }, nums = { 1 },
+                         call = function(f, ...) local b = f.body.first
+                           if f.w:tet_count() == 0 then f.w:tet(b, b + 1, b + 2, b + 4) end
+                           return f.w:tet_info(...) end },
+  ["world:tet_count"] = { none = "a getter: no arguments" },
 }
 for _, name in ipairs{ "angular_momentum", "bends", "bounds", "breaks", "closed", "colliders", "contacts", "damping", "distances", "dt",
                        "energy", "frame", "gravity", "hash", "iterations", "max_strain", "momentum", "particle_count",

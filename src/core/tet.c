@@ -1,0 +1,403 @@
+/* tet.c: Neo-Hookean tetrahedra (DESIGN.md §2, one file per constraint type).
+ *
+ * Macklin & Müller 2021, "A constraint-based formulation of stable Neo-Hookean materials":
+ * with F = Ds Dm^-1 (Ds = [x1-x0, x2-x0, x3-x0], Dm the same at rest) the energy
+ *   Psi = mu/2 (tr(F^T F) - 3) + lam/2 (det F - a)^2,   a = 1 + mu/lam,
+ * is split into two XPBD constraints per tet, solved together (a 2x2 system, below):
+ *   deviatoric  C_D = sqrt(tr(F^T F)),   compliance 1/(mu V0),
+ *   hydrostatic C_H = det F - a,         compliance 1/(lam V0).
+ * At F = I their forces cancel (mu F against lam (1 - a) cof F = -mu I), so the rest shape
+ * is stress free. det F is signed: an inverted tet has C_H < -a and its gradient (the
+ * cofactor) pushes it back through flat to the positive side; a flat one still has one.
+ *
+ * E means E: linearised about F = I this energy is mu |eps|^2 + (lam - mu)/2 tr(eps)^2, so
+ * lam is the Lamé lambda of (E, nu) plus mu (the paper's remapping for the form without its
+ * log term); small strains then follow Hooke's law with the given Young's modulus and
+ * Poisson's ratio (tests/validation/neo_hookean.lua measures both).
+ *
+ * Limit: the substep must stay below about the time a wave (sqrt(E / density)) takes to
+ * cross the smallest tet: past it the linearised 2x2 step overshoots (a tet stiff against
+ * its corners' masses is asked for C_D -> 0, a collapse, that only the compliance stops).
+ * A light body of sliver tets explodes; more substeps, not iterations, is the cure.
+ *
+ * Model: corners, Dm^-1, V0, E, nu (mu and lam derived). Cache: the multipliers of the
+ * substep. The pass is serial in creation order: deterministic for any thread count. */
+#include <assert.h>
+#include <stdlib.h>
+
+#include "core.h"
+#include "ctype.h"
+#include "snapshot.h"
+#include "tet.h"
+
+#define TET_BYTES (4 * sizeof(int32_t) + 16 * sizeof(wb_real))
+
+wb_tet_def wb_tet_default_def(void)
+{
+    wb_tet_def d = { 1e5, 0.3 };
+    return d;
+}
+
+const char *wb_tet_def_check(const wb_tet_def *d)
+{
+    if (!(d->young > 0) || !isfinite(d->young)) return "young must be > 0 (Pa)";
+    if (!(d->poisson >= 0 && d->poisson < 0.5)) return "poisson must be in [0, 0.5)";
+    return NULL;
+}
+
+static void lame(wb_real young, wb_real poisson, wb_real *mu, wb_real *lam)
+{
+    *mu = young / (2 * (1 + poisson));
+    *lam = young * poisson / ((1 + poisson) * (1 - 2 * poisson)) + *mu;
+}
+
+wb_status wb__tet_reserve(wb_world *w, int64_t extra)
+{
+    wb_neos *v = w->neo;
+    if (!v) {
+        v = calloc(1, sizeof *v);
+        if (!v) return WB_ERR_NOMEM;
+        w->neo = v;
+    }
+    const int64_t need = v->n + extra;
+    if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    if (need <= v->cap) return WB_OK;
+    int64_t cap = v->cap ? v->cap : 64;
+    while (cap < need) cap *= 2;
+    if (cap > WB_MAX_CONSTRAINTS) cap = WB_MAX_CONSTRAINTS;
+    wb_memory *mem = w->m.def.memory;
+    const size_t want = (size_t)cap * TET_BYTES;
+    if (mem && mem->limit > 0 && (double)mem->used - (double)v->charged + (double)want > (double)mem->limit)
+        return WB_ERR_NOMEM;
+    struct { void **p; size_t elem; } arr[] = {
+        { (void **)&v->ijkl, 4 * sizeof(int32_t) }, { (void **)&v->dminv, 9 * sizeof(wb_real) },
+        { (void **)&v->v0, sizeof(wb_real) }, { (void **)&v->young, sizeof(wb_real) },
+        { (void **)&v->poisson, sizeof(wb_real) }, { (void **)&v->mu, sizeof(wb_real) },
+        { (void **)&v->lam, sizeof(wb_real) }, { (void **)&v->lambda, 2 * sizeof(wb_real) },
+    };
+    for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
+        void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
+        if (!q) return WB_ERR_NOMEM; /* arrays already grown are merely larger */
+        *arr[i].p = q;
+    }
+    if (mem) mem->used = mem->used - v->charged + want;
+    v->charged = want;
+    v->cap = (int32_t)cap;
+    return WB_OK;
+}
+
+void wb__tet_put(wb_world *w, const int32_t p[4], const wb_real dminv[9], wb_real v0, wb_real young, wb_real poisson)
+{
+    wb_neos *v = w->neo;
+    assert(v && v->n < v->cap); /* contract: reserved first */
+    const int32_t i = v->n++;
+    memcpy(&v->ijkl[4 * i], p, 4 * sizeof *p);
+    memcpy(&v->dminv[9 * i], dminv, 9 * sizeof *dminv);
+    v->v0[i] = v0;
+    v->young[i] = young;
+    v->poisson[i] = poisson;
+    lame(young, poisson, &v->mu[i], &v->lam[i]);
+    v->lambda[2 * i] = v->lambda[2 * i + 1] = 0;
+}
+
+/* Dm^-1 (row-major) and the signed volume of the tet at x; false when flat */
+static bool rest_of(const wb_real *x, const int32_t p[4], wb_real inv[9], wb_real *vol)
+{
+    const wb_real *x0 = &x[3 * p[0]];
+    wb_real m[9]; /* columns: the edges from corner 0 */
+    for (int k = 0; k < 3; k++)
+        for (int r = 0; r < 3; r++) m[3 * r + k] = x[3 * p[k + 1] + r] - x0[r];
+    const wb_real det = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
+                        m[2] * (m[3] * m[7] - m[4] * m[6]);
+    *vol = det / 6;
+    if (!(fabs(det) > 0) || !isfinite(det)) return false;
+    const wb_real id = 1 / det;
+    inv[0] = (m[4] * m[8] - m[5] * m[7]) * id;
+    inv[1] = (m[2] * m[7] - m[1] * m[8]) * id;
+    inv[2] = (m[1] * m[5] - m[2] * m[4]) * id;
+    inv[3] = (m[5] * m[6] - m[3] * m[8]) * id;
+    inv[4] = (m[0] * m[8] - m[2] * m[6]) * id;
+    inv[5] = (m[2] * m[3] - m[0] * m[5]) * id;
+    inv[6] = (m[3] * m[7] - m[4] * m[6]) * id;
+    inv[7] = (m[1] * m[6] - m[0] * m[7]) * id;
+    inv[8] = (m[0] * m[4] - m[1] * m[3]) * id;
+    for (int k = 0; k < 9; k++)
+        if (!isfinite(inv[k])) return false;
+    return true;
+}
+
+bool wb_tet_rest_shape(const wb_real *a, const wb_real *b, const wb_real *c, const wb_real *d, wb_real dminv[9],
+                       wb_real *volume)
+{
+    const wb_real x[12] = { a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], d[0], d[1], d[2] };
+    const int32_t p[4] = { 0, 1, 2, 3 };
+    const bool ok = rest_of(x, p, dminv, volume);
+    *volume = fabs(*volume);
+    return ok;
+}
+
+bool wb__tet_put_current(wb_world *w, const int32_t p[4], wb_real young, wb_real poisson)
+{
+    wb_real inv[9], vol;
+    if (!rest_of(w->s.x, p, inv, &vol)) return false;
+    /* a negative rest volume is its own rest: Dm^-1 carries the sign, F = I at rest */
+    wb__tet_put(w, p, inv, fabs(vol), young, poisson);
+    return true;
+}
+
+int32_t wb_tet_add(wb_world *w, const int32_t p[4], const wb_tet_def *def)
+{
+    const char *err = wb_tet_def_check(def);
+    for (int k = 0; k < 4 && !err; k++) {
+        if (p[k] < 0 || p[k] >= w->m.np) err = "particle out of range";
+        for (int j = 0; j < k && !err; j++)
+            if (p[j] == p[k]) err = "a tet needs four distinct particles";
+    }
+    wb_real inv[9], vol;
+    if (!err && !rest_of(w->s.x, p, inv, &vol)) err = "the four particles lie in a plane (a flat tet has no rest shape)";
+    if (err) {
+        wb__set_error("%s", err);
+        return WB_ERR_ARG;
+    }
+    wb_status st = wb__tet_reserve(w, 1);
+    if (st != WB_OK) return st;
+    wb__tet_put(w, p, inv, fabs(vol), def->young, def->poisson);
+    return w->neo->n - 1;
+}
+
+int32_t wb_tet_count(const wb_world *w) { return w->neo ? w->neo->n : 0; }
+
+#define CHECK_T(w, i) ((w)->neo && (i) >= 0 && (i) < (w)->neo->n)
+
+void wb_tet_particles(const wb_world *w, int32_t i, int32_t p[4])
+{
+    if (CHECK_T(w, i)) memcpy(p, &w->neo->ijkl[4 * i], 4 * sizeof *p);
+}
+
+/* F = Ds Dm^-1 of tet i (row-major) */
+static void deformation(const wb_neos *v, const wb_real *x, int32_t i, wb_real F[9])
+{
+    const int32_t *p = &v->ijkl[4 * i];
+    const wb_real *d = &v->dminv[9 * i], *x0 = &x[3 * p[0]];
+    wb_real e[3][3];
+    for (int k = 0; k < 3; k++) v3_sub(e[k], &x[3 * p[k + 1]], x0);
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) F[3 * r + c] = e[0][r] * d[c] + e[1][r] * d[3 + c] + e[2][r] * d[6 + c];
+}
+
+static wb_real det3(const wb_real F[9])
+{
+    return F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) + F[2] * (F[3] * F[7] - F[4] * F[6]);
+}
+
+/* the energy of tet i less its rest value (so a body at rest stores none), J */
+static wb_real energy_of(const wb_neos *v, const wb_real *x, int32_t i)
+{
+    wb_real F[9];
+    deformation(v, x, i, F);
+    wb_real ic = 0;
+    for (int k = 0; k < 9; k++) ic += F[k] * F[k];
+    const wb_real mu = v->mu[i], lam = v->lam[i], a = 1 + mu / lam, c = det3(F) - a;
+    return v->v0[i] * (mu / 2 * (ic - 3) + lam / 2 * c * c - mu * mu / (2 * lam));
+}
+
+wb_real wb_tet_energy(const wb_world *w, int32_t i) { return CHECK_T(w, i) ? energy_of(w->neo, w->s.x, i) : 0; }
+wb_real wb_tet_rest_volume(const wb_world *w, int32_t i) { return CHECK_T(w, i) ? w->neo->v0[i] : 0; }
+
+/* signed current volume over the signed rest one, det F */
+wb_real wb_tet_volume_ratio(const wb_world *w, int32_t i)
+{
+    if (!CHECK_T(w, i)) return 0;
+    wb_real F[9];
+    deformation(w->neo, w->s.x, i, F);
+    return det3(F);
+}
+
+void wb_tet_material(const wb_world *w, int32_t i, wb_real *young, wb_real *poisson)
+{
+    if (!CHECK_T(w, i)) return;
+    if (young) *young = w->neo->young[i];
+    if (poisson) *poisson = w->neo->poisson[i];
+}
+
+/* ---- snapshots (snapshot.h): the model as it is, so a restored world has the same future */
+wb_status wb_image_alloc_tets(wb_image *g, int32_t n)
+{
+    void **a[] = { (void **)&g->tet_ijkl, (void **)&g->tet_dminv, (void **)&g->tet_v0, (void **)&g->tet_young,
+                   (void **)&g->tet_poisson };
+    const size_t el[] = { 4 * sizeof(int32_t), 9 * sizeof(wb_real), sizeof(wb_real), sizeof(wb_real), sizeof(wb_real) };
+    bool ok = true;
+    for (int k = 0; k < 5; k++) {
+        free(*a[k]);
+        *a[k] = calloc(n > 0 ? (size_t)n : 1, el[k]);
+        ok = ok && *a[k];
+    }
+    g->ntet = n;
+    if (ok) return WB_OK;
+    for (int k = 0; k < 5; k++) { free(*a[k]); *a[k] = NULL; }
+    g->ntet = 0;
+    return WB_ERR_NOMEM;
+}
+
+wb_status wb__tet_image_of(const wb_world *w, wb_image *g)
+{
+    const int32_t n = wb_tet_count(w);
+    if (wb_image_alloc_tets(g, n) != WB_OK) return WB_ERR_NOMEM;
+    if (n == 0) return WB_OK;
+    const wb_neos *v = w->neo;
+    memcpy(g->tet_ijkl, v->ijkl, 4 * sizeof(int32_t) * (size_t)n);
+    memcpy(g->tet_dminv, v->dminv, 9 * sizeof(wb_real) * (size_t)n);
+    memcpy(g->tet_v0, v->v0, sizeof(wb_real) * (size_t)n);
+    memcpy(g->tet_young, v->young, sizeof(wb_real) * (size_t)n);
+    memcpy(g->tet_poisson, v->poisson, sizeof(wb_real) * (size_t)n);
+    return WB_OK;
+}
+
+const char *wb__tet_image_check(const wb_image *g)
+{
+    if (g->ntet < 0 || g->ntet > WB_MAX_CONSTRAINTS) return "too many tets";
+    for (int32_t i = 0; i < g->ntet; i++) {
+        const int32_t *p = &g->tet_ijkl[4 * i];
+        for (int k = 0; k < 4; k++) {
+            if (p[k] < 0 || p[k] >= g->np) return "tet particle out of range";
+            for (int j = 0; j < k; j++)
+                if (p[j] == p[k]) return "a tet needs four distinct particles";
+        }
+        const wb_tet_def d = { g->tet_young[i], g->tet_poisson[i] };
+        const char *e = wb_tet_def_check(&d);
+        if (e) return e;
+        if (!(g->tet_v0[i] > 0) || !isfinite(g->tet_v0[i])) return "a tet's rest volume must be > 0";
+        for (int k = 0; k < 9; k++)
+            if (!isfinite(g->tet_dminv[9 * i + k])) return "a tet's rest shape must be finite";
+    }
+    return NULL;
+}
+
+wb_status wb__tet_image_reserve(wb_world *w, const wb_image *g)
+{
+    return g->ntet > 0 ? wb__tet_reserve(w, g->ntet) : WB_OK;
+}
+
+void wb__tet_image_put(wb_world *w, const wb_image *g, int32_t shift)
+{
+    for (int32_t i = 0; i < g->ntet; i++) {
+        int32_t p[4];
+        for (int k = 0; k < 4; k++) p[k] = g->tet_ijkl[4 * i + k] + shift;
+        wb__tet_put(w, p, &g->tet_dminv[9 * i], g->tet_v0[i], g->tet_young[i], g->tet_poisson[i]);
+    }
+}
+
+/* ---- the type ---------------------------------------------------------------------- */
+static int32_t tet_count(const wb_world *w) { return wb_tet_count(w); }
+
+static wb_status tet_prepare(wb_world *w)
+{
+    (void)w; /* nothing to pack: the arrays are the projection's order */
+    return WB_OK;
+}
+
+static void tet_substep_begin(wb_world *w)
+{
+    if (w->neo && w->neo->n > 0) memset(w->neo->lambda, 0, 2 * sizeof(wb_real) * (size_t)w->neo->n);
+}
+
+/* dC/dx_k of a constraint with dC/dF = G (row-major): column k-1 of G Dm^-T for k = 1..3,
+ * minus their sum for k = 0 */
+static void grads(const wb_real *dminv, const wb_real G[9], wb_real g[4][3])
+{
+    for (int k = 0; k < 3; k++)
+        for (int r = 0; r < 3; r++)
+            g[k + 1][r] = G[3 * r] * dminv[3 * k] + G[3 * r + 1] * dminv[3 * k + 1] + G[3 * r + 2] * dminv[3 * k + 2];
+    for (int r = 0; r < 3; r++) g[0][r] = -(g[1][r] + g[2][r] + g[3][r]);
+}
+
+static wb_real wdot(const wb_real wk[4], wb_real a[4][3], wb_real b[4][3])
+{
+    wb_real s = 0;
+    for (int k = 0; k < 4; k++) s += wk[k] * v3_dot(a[k], b[k]);
+    return s;
+}
+
+/* Both constraints of a tet in one 2x2 XPBD solve (the linearised system of the pair), not
+ * one after the other: at rest their gradients are parallel and their values large (C_D =
+ * sqrt 3, C_H = -mu/lam), balanced only through the compliances; projected in turn, each
+ * under-converged pass leaves a bias that squeezes the solid (measured: a hanging bar
+ * shortened instead of stretched). Solved together, the rest shape is a fixed point of a
+ * single iteration at any stiffness, and the error is that of the linearisation. */
+static void tet_project(wb_world *w, wb_real h)
+{
+    wb_neos *v = w->neo;
+    if (!v) return;
+    const wb_real inv_h2 = 1 / (h * h);
+    const wb_real *wv = w->m.w;
+    wb_real *x = w->s.x;
+    for (int32_t i = 0; i < v->n; i++) {
+        const int32_t *p = &v->ijkl[4 * i];
+        const wb_real wk[4] = { wv[p[0]], wv[p[1]], wv[p[2]], wv[p[3]] };
+        if (wk[0] + wk[1] + wk[2] + wk[3] == 0) continue;
+        const wb_real *dm = &v->dminv[9 * i];
+        wb_real F[9], G[9], gd[4][3], gh[4][3];
+        deformation(v, x, i, F);
+        wb_real ic = 0;
+        for (int k = 0; k < 9; k++) ic += F[k] * F[k];
+        const wb_real cd = sqrt(ic);
+        /* deviatoric: dC_D/dF = F / C_D; a tet crushed to a point has no direction */
+        const bool dev = cd > (wb_real)1e-12;
+        if (dev) {
+            for (int k = 0; k < 9; k++) G[k] = F[k] / cd;
+            grads(dm, G, gd);
+        }
+        /* hydrostatic: dJ/dF = cof F, its columns f1 x f2, f2 x f0, f0 x f1 */
+        const wb_real f0[3] = { F[0], F[3], F[6] }, f1[3] = { F[1], F[4], F[7] }, f2[3] = { F[2], F[5], F[8] };
+        wb_real c0[3], c1[3], c2[3];
+        v3_cross(c0, f1, f2);
+        v3_cross(c1, f2, f0);
+        v3_cross(c2, f0, f1);
+        for (int r = 0; r < 3; r++) { G[3 * r] = c0[r]; G[3 * r + 1] = c1[r]; G[3 * r + 2] = c2[r]; }
+        grads(dm, G, gh);
+        const wb_real ch = v3_dot(f0, c0) - (1 + v->mu[i] / v->lam[i]);
+        const wb_real ad = inv_h2 / (v->mu[i] * v->v0[i]), ah = inv_h2 / (v->lam[i] * v->v0[i]);
+        wb_real *ld = &v->lambda[2 * i], *lh = &v->lambda[2 * i + 1];
+        const wb_real rh = -ch - ah * *lh;
+        const wb_real a22 = wdot(wk, gh, gh) + ah;
+        wb_real dd = 0, dh;
+        if (dev) {
+            const wb_real k22 = a22 - ah, k12 = wdot(wk, gd, gh), k11 = wdot(wk, gd, gd), rd = -cd - ad * *ld;
+            /* det = k11 k22 - k12^2 + ad k22 + ah k11 + ad ah; the gradients are nearly
+             * parallel near rest, so k11 k22 - k12^2 (>= 0) is not formed by subtraction
+             * (it cancels to noise on stiff or sliver tets) but as k22 |gd - (k12/k22) gh|^2 */
+            wb_real gram = 0;
+            if (k22 > 0) {
+                const wb_real c = k12 / k22;
+                wb_real o[4][3];
+                for (int k = 0; k < 4; k++)
+                    for (int r = 0; r < 3; r++) o[k][r] = gd[k][r] - c * gh[k][r];
+                gram = k22 * wdot(wk, o, o);
+            }
+            const wb_real a11 = k11 + ad, a12 = k12;
+            const wb_real det = gram + ad * k22 + ah * k11 + ad * ah;
+            if (!(det > 0) || !isfinite(det)) continue;
+            dd = (rd * a22 - a12 * rh) / det;
+            dh = (a11 * rh - a12 * rd) / det;
+        } else {
+            if (!(a22 > 0) || !isfinite(a22)) continue;
+            dh = rh / a22;
+        }
+        *ld += dd;
+        *lh += dh;
+        for (int k = 0; k < 4; k++)
+            if (wk[k] > 0)
+                for (int r = 0; r < 3; r++) x[3 * p[k] + r] += wk[k] * ((dev ? gd[k][r] * dd : 0) + gh[k][r] * dh);
+    }
+}
+
+static wb_real tet_energy(const wb_world *w)
+{
+    wb_real e = 0;
+    for (int32_t i = 0; i < wb_tet_count(w); i++) e += energy_of(w->neo, w->s.x, i);
+    return e;
+}
+
+const wb_ctype wb__tet_type = {
+    "tet", tet_count, tet_prepare, tet_substep_begin, tet_project, NULL, tet_energy,
+};

@@ -1,0 +1,41 @@
+/* tet.h: the Neo-Hookean tetrahedra's arrays (tet.c), for the core files that copy them
+ * (snapshot.c, query.c) and the builders that make them (builders.c, tets.c). */
+#ifndef WB_TET_H
+#define WB_TET_H
+
+#include <stdlib.h>
+
+#include "core.h"
+
+/* w->neo: NULL until the first one is made */
+typedef struct wb_neos {
+    int32_t n, cap;
+    int32_t *ijkl;         /* (n x 4) model: corners */
+    wb_real *dminv;        /* (n x 9) model: rest edge matrix inverse, row-major */
+    wb_real *v0;           /* (n) model: rest volume, m^3 (> 0) */
+    wb_real *young, *poisson; /* (n) model: as given */
+    wb_real *mu, *lam;     /* (n) derived: Lamé parameters of the constraint form */
+    wb_real *lambda;       /* (n x 2) cache: deviatoric, hydrostatic multipliers of the substep */
+    size_t charged;        /* bytes charged to def.memory */
+} wb_neos;
+
+/* room for `extra` more, charged to the memory budget; after it wb__tet_put cannot fail */
+wb_status wb__tet_reserve(wb_world *w, int64_t extra);
+/* append one with its rest state (dminv row-major, v0 > 0) */
+void wb__tet_put(wb_world *w, const int32_t p[4], const wb_real dminv[9], wb_real v0, wb_real young, wb_real poisson);
+/* append one at rest in its current shape; false (nothing added) when it is flat */
+bool wb__tet_put_current(wb_world *w, const int32_t p[4], wb_real young, wb_real poisson);
+
+/* world.c's destroy (inline so that world.c and tet.c do not call each other) */
+static inline void wb__tet_free(wb_world *w)
+{
+    wb_neos *v = w->neo;
+    if (!v) return;
+    if (w->m.def.memory) w->m.def.memory->used -= v->charged;
+    void *a[] = { v->ijkl, v->dminv, v->v0, v->young, v->poisson, v->mu, v->lam, v->lambda };
+    for (size_t i = 0; i < sizeof a / sizeof a[0]; i++) free(a[i]);
+    free(v);
+    w->neo = NULL;
+}
+
+#endif
