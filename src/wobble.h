@@ -306,7 +306,7 @@ uint64_t wb_world_hash(const wb_world *w);                          /* FNV-1a of
 
 typedef struct wb_stats {
     int32_t particles, distances, broken, colliders;
-    int32_t bends, volumes, shape_matches, pressures;   /* constraints of the other types */
+    int32_t bends, volumes, tets, shape_matches, pressures;   /* constraints of the other types */
     int32_t colours;          /* batches of the last colouring */
     int32_t contacts;         /* collider contacts in the last substep */
     int32_t particle_contacts; /* particle pairs and particle-triangle pairs overlapping or in touch

@@ -151,6 +151,7 @@ wb_stats wb_world_stats(const wb_world *w)
     st.colliders = wb_collider_count(w);
     st.bends = wb_bend_count(w);
     st.volumes = wb_volume_count(w);
+    st.tets = wb_tet_count(w);
     st.shape_matches = wb_shape_match_count(w);
     st.pressures = wb_pressure_count(w);
     st.colours = w->k.ncolours;

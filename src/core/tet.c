@@ -389,6 +389,7 @@ static void tet_project(wb_world *w, wb_real h)
             if (wk[k] > 0)
                 for (int r = 0; r < 3; r++) x[3 * p[k] + r] += wk[k] * ((dev ? gd[k][r] * dd : 0) + gh[k][r] * dh);
     }
+    w->k.projections += v->n; /* a tet (both of its constraints) is one projection */
 }
 
 static wb_real tet_energy(const wb_world *w)

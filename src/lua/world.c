@@ -439,6 +439,7 @@ static int w_stats(lua_State *L)
     SETI("colliders", s.colliders);
     SETI("bends", s.bends);
     SETI("volumes", s.volumes);
+    SETI("tets", s.tets);
     SETI("shape_matches", s.shape_matches);
     SETI("pressures", s.pressures);
     SETI("colours", s.colours);

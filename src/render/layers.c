@@ -225,7 +225,7 @@ static void put_material(wb_layers *l, int32_t i, double e)
 
 /* per particle, the strain of the materials it belongs to (l->mstrain[0..np), flag
  * F_MATERIAL; the rest is scratch): the volumetric strain (V - V0) / V0 averaged over
- * its tets; a shape-matching cluster's strain (wb_shape_match_strain), negative when the
+ * its tets (volume constraints and Neo-Hookean tets); a shape-matching cluster's strain (wb_shape_match_strain), negative when the
  * cluster drew in (its spread about the centre of mass below the rest shape's); a
  * pressure body's V / (pressure V0) - 1 on its surface */
 static bool load_materials(wb_layers *l, const wb_world *w)
@@ -243,7 +243,16 @@ static bool load_materials(wb_layers *l, const wb_world *w)
         wb_volume_particles(w, i, p);
         for (int k = 0; k < 4; k++) sum[p[k]] += (float)e, count[p[k]]++;
     }
-    for (int32_t i = 0; nv > 0 && i < np; i++)
+    /* Neo-Hookean tets the same way: det F - 1 is their (V - V0) / V0 */
+    const int32_t nt = wb_tet_count(w);
+    for (int32_t i = 0; i < nt; i++) {
+        const double e = wb_tet_volume_ratio(w, i) - 1;
+        if (!isfinite(e)) continue;
+        int32_t p[4];
+        wb_tet_particles(w, i, p);
+        for (int k = 0; k < 4; k++) sum[p[k]] += (float)e, count[p[k]]++;
+    }
+    for (int32_t i = 0; nv + nt > 0 && i < np; i++)
         if (count[i] > 0) put_material(l, i, sum[i] / count[i]);
     const wb_real *x = wb_particle_positions(w);
     for (int32_t s = 0; s < wb_shape_match_count(w); s++) {

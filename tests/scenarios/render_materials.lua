@@ -25,9 +25,28 @@ end
 
 local front = { 0, 1, 0.5 }   -- the middle of a unit block's front face (centre {0, 1, 0})
 
-local function block(w, tets)
-  return w:lattice{ min = {-0.5, 0.5, -0.5}, max = {0.5, 1.5, 0.5}, res = {3, 3, 3}, tets = tets }
+local function block(w, tets, young)
+  return w:lattice{ min = {-0.5, 0.5, -0.5}, max = {0.5, 1.5, 0.5}, res = {3, 3, 3}, tets = tets, young = young }
 end
+
+test("a Neo-Hookean block shows det F - 1 like a volume block: blue squashed, red swollen", function()
+  local w = wobble.world{ gravity = {0, 0, 0} }
+  local b = block(w, true, 1e5)
+  expect.eq(w:stats().tets, w:tet_count()); expect.gt(w:tet_count(), 0); expect.eq(w:stats().volumes, 0)
+  r:camera{ eye = {0, 1, 4}, target = {0, 1, 0} }
+  scale(w, b.particles, {0, 1, 0}, {1, 1, 0.9})
+  r:draw(w, { grid = false })
+  local sr, sg, sb = at{ 0, 1, 0.45 }
+  expect.gt(sb, sr + 60, "squashed: blue " .. rgb(sr, sg, sb))
+  scale(w, b.particles, {0, 1, 0}, {1, 1, 1.1 / 0.9})
+  r:draw(w, { grid = false })
+  local er, eg, eb = at{ 0, 1, 0.55 }
+  expect.gt(er, eb + 60, "swollen: red " .. rgb(er, eg, eb))
+  -- a step projects every tet once per substep (no links: young makes none)
+  local d = w:stats().distances
+  w:step()
+  expect.eq(w:stats().projections, 10 * (d + w:tet_count()))
+end)
 
 test("a tet block's hull shows its volumetric strain: grey at rest, blue squashed, red swollen", function()
   local w = wobble.world{ gravity = {0, 0, 0} }
