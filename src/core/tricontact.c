@@ -394,6 +394,7 @@ void wb__tricontacts_begin(wb_world *w)
     c->n = 0;
     c->nact = 0;
     c->last = 0;
+    c->fresh = 1;
     c->broad_ms = 0;
     /* contact.c's scan of this frame: no pair of particles may touch, so no point a
      * triangle either (its corners' rules are the pairs'); one body costs nothing */
@@ -413,14 +414,28 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
     c->nact = 0;
     if (c->n == 0) { c->last = 0; return; }
     const wb_model *m = &w->m;
-    wb_real *x = w->s.x;
-    const wb_real *xp = w->s.x_prev, *wv = m->w, *rad = m->radius, *cf = m->cfric;
+    wb_real *x = w->s.x, *xp = w->s.x_prev;
+    const wb_real *wv = m->w, *rad = m->radius, *cf = m->cfric;
     int32_t *act = wb__grow(c->act, &c->cap_act, c->n, sizeof *act);
     if (!act) goto nomem;
     c->act = act;
-    wb_real *ad = wb__grow(c->act_d, &c->cap_d, 8 * c->n, sizeof *ad);
+    wb_real *ad = wb__grow(c->act_d, &c->cap_d, 9 * c->n, sizeof *ad);
     if (!ad) goto nomem;
     c->act_d = ad;
+    wb_real *left = wb__grow(c->left, &c->cap_left, c->n, sizeof *left);
+    if (!left) goto nomem;
+    c->left = left;
+    /* a new candidate list: all the overlap it has now counts as old (contact.c) */
+    const wb_real step = m->def.max_depenetration * h;
+    if (c->fresh) {
+        for (int32_t k = 0; k < c->n; k++) {
+            const int32_t p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
+            wb_real b[3], q[3];
+            const wb_real d0 = rad[p] - sqrt(wb__tri_closest(&xp[3 * p], &xp[3 * v[0]], &xp[3 * v[1]], &xp[3 * v[2]], b, q));
+            left[k] = d0 > step ? d0 : 0;
+        }
+        c->fresh = 0;
+    }
     int32_t touching = 0;
     for (int32_t k = 0; k < c->n; k++) {
         const int32_t p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
@@ -428,6 +443,9 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
         const wb_real *xa = &x[3 * v[0]], *xb = &x[3 * v[1]], *xc = &x[3 * v[2]];
         wb_real b[3], q[3], d[3], n[3], e1[3], e2[3];
         const wb_real r = rad[p];
+        /* what it was left with, until it is found overlapping again */
+        wb_real lk = left[k];
+        left[k] = 0;
         /* the side now and at the substep's start (the plane of the triangle then) */
         v3_sub(e1, xb, xa);
         v3_sub(e2, xc, xa);
@@ -483,10 +501,19 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
             depth = r - side * s_now;
         }
         if (!(depth > 0)) continue;
-        const wb_real s = depth / W;
-        if (wp > 0) v3_madd(xs, nn, wp * s);
+        /* the overlap it started the substep with: the same distance at x_prev (on the
+         * side it was on then). Old overlap goes out slowly, and its repair (err) moves
+         * x_prev too, so it adds no speed (contact.c explains why) */
+        wb_real bp[3], qp[3], slow, err;
+        const wb_real dp2 = wb__tri_closest(&xp[3 * p], &xp[3 * v[0]], &xp[3 * v[1]], &xp[3 * v[2]], bp, qp);
+        depth = wb__contact_depth(depth, r - sqrt(dp2), &lk, step, &slow, &err);
+        left[k] = lk;
+        if (!(depth > 0)) { touching++; continue; }
+        const wb_real s = depth / W, se = slow / W;
+        if (wp > 0) v3_madd(xs, nn, wp * s), v3_madd(&xp[3 * p], nn, wp * se);
         for (int i = 0; i < 3; i++)
-            if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&x[3 * v[i]], nn, -b[i] * wv[v[i]] * s);
+            if (wv[v[i]] > 0 && b[i] != 0)
+                v3_madd(&x[3 * v[i]], nn, -b[i] * wv[v[i]] * s), v3_madd(&xp[3 * v[i]], nn, -b[i] * wv[v[i]] * se);
         /* friction at position level, as contact.c: the slip of p against the triangle's
          * point q this substep undone up to mu x depth */
         const wb_real mu = (cf[p] + b[0] * cf[v[0]] + b[1] * cf[v[1]] + b[2] * cf[v[2]]) / 2;
@@ -503,11 +530,12 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
                     if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&x[3 * v[i]], slip, f * b[i] * wv[v[i]]);
             }
         }
-        wb_real *o = &ad[8 * c->nact];
+        wb_real *o = &ad[9 * c->nact];
         v3_copy(o, b);
         v3_copy(o + 3, nn);
         o[6] = depth;
         o[7] = s / (h * h); /* the multiplier over h^2: newtons */
+        o[8] = err;
         act[c->nact++] = k;
     }
     c->last = c->nact + touching;
@@ -517,17 +545,27 @@ nomem:
     wb__warn(w, "out of memory in triangle contacts; skipped this substep");
 }
 
-/* after v = (x - x_prev)/h: no approach speed of p towards the triangle's point left */
+/* after v = (x - x_prev)/h: no speed made out of old overlap (contact.c), then no
+ * approach speed of p towards the triangle's point left */
 void wb__tricontacts_velocity(wb_world *w, wb_real h)
 {
-    (void)h;
     wb_tricontacts *c = &w->k.tc;
     const wb_model *m = &w->m;
     wb_real *vel = w->s.v;
     const wb_real *wv = m->w;
     for (int32_t a = 0; a < c->nact; a++) {
         const int32_t k = c->act[a], p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
-        const wb_real *b = &c->act_d[8 * a], *nn = b + 3;
+        const wb_real *b = &c->act_d[9 * a], *nn = b + 3;
+        const wb_real W = wv[p] + b[0] * b[0] * wv[v[0]] + b[1] * b[1] * wv[v[1]] + b[2] * b[2] * wv[v[2]];
+        if (!(b[8] > 0) || W == 0) continue;
+        const wb_real s = b[8] / W / h; /* the projection's push of err, as speed */
+        if (wv[p] > 0) v3_madd(&vel[3 * p], nn, -s * wv[p]);
+        for (int i = 0; i < 3; i++)
+            if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&vel[3 * v[i]], nn, s * b[i] * wv[v[i]]);
+    }
+    for (int32_t a = 0; a < c->nact; a++) {
+        const int32_t k = c->act[a], p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
+        const wb_real *b = &c->act_d[9 * a], *nn = b + 3;
         const wb_real W = wv[p] + b[0] * b[0] * wv[v[0]] + b[1] * b[1] * wv[v[1]] + b[2] * b[2] * wv[v[2]];
         if (W == 0) continue;
         wb_real u[3];
@@ -553,7 +591,7 @@ wb_tri_contact wb_world_tri_contact_at(const wb_world *w, int32_t i)
     out.p = out.tri[0] = out.tri[1] = out.tri[2] = -1;
     if (i < 0 || i >= c->nact) return out;
     const int32_t k = c->act[i];
-    const wb_real *d = &c->act_d[8 * i];
+    const wb_real *d = &c->act_d[9 * i];
     out.p = c->pt[2 * k];
     memcpy(out.tri, &w->m.tri[3 * c->pt[2 * k + 1]], sizeof out.tri);
     v3_copy(out.bary, d);

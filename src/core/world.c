@@ -126,7 +126,7 @@ void wb_world_destroy(wb_world *w)
                      w->sm.qk, w->sm.lambda, w->pr.surface, w->pr.pressure, w->pr.alpha, w->pr.v0, w->pr.vstart,
                      w->pr.tstart, w->pr.verts, w->pr.tri, w->pr.lambda, w->pr.grad,
                      k->tc.pt, k->tc.act, k->tc.act_d, k->tc.reach, k->tc.tbox, k->tc.cell_start, k->tc.cell_ids,
-                     k->tc.stamp, k->tc.tgroup, k->tc.tstamp };
+                     k->tc.stamp, k->tc.tgroup, k->tc.tstamp, k->tc.left };
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
     free(w);
 }
