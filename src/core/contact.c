@@ -110,20 +110,22 @@ wb_real wb_body_spacing(const wb_world *w, wb_body b)
  *
  * Old overlap. A correction of depth adds depth / h to the pair's separating speed
  * (v = (x - x_prev) / h). The part that takes back this substep's approach (what the
- * prediction and the links did since x_prev) is the collision. The part that removes
- * overlap the pair already had at x_prev (d0: bodies made inside each other, a ball
- * squeezed into a pile, what later pairs or the colliders pushed back after this pair's
- * last projection) is the repair of a position error: kept as speed it would fling them
- * apart at up to depth / h (2 cm at h = 1/600 s: 12 m/s). So that part (err) moves x_prev
- * with x (Macklin et al. 2014, "Unified particle physics", §4.2, pre-stabilization): it
- * changes where the pair is, not how fast it goes, and a pair later in the pass that it
- * pushes into overlap sees that overlap at x_prev too, as old, not as an approach (a row
- * of particles made inside each other would otherwise leave at the sum of their pushes).
- * Of d0, what the pair was itself left with by its last projection (deep, persistent
- * overlap; before a frame's first substep all of d0) goes at no more than
- * max_depenetration x h per substep, so that a body is not squashed in one substep;
- * the rest of d0, and overlap made since, in full, or a heap's layers sink into each
- * other (wb__contact_depth). */
+ * prediction and the links did since x_prev, including the links pulling a pushed
+ * particle back) is the collision and stays speed. The part that removes overlap the
+ * pair already had at x_prev (d0) is the repair of a position error: kept as speed it
+ * would fling them apart at up to depth / h (2 cm at h = 1/600 s: 12 m/s). Of d0:
+ *  - what the pair keeps from substep to substep (bodies made inside each other, a deep
+ *    squeeze) goes at no more than max_depenetration x h per substep, counting what
+ *    other contacts pushed out of it (a particle inside another body touches several of
+ *    its particles and triangles: each pushing at full rate sent interleaved blocks off
+ *    at metres per second). Its push moves x_prev with x (Macklin et al. 2014, "Unified
+ *    particle physics", §4.2, pre-stabilization): a position change, not a speed, which
+ *    a pair later in the pass that it pushes into overlap also sees as old;
+ *  - the rest (what later pairs or the colliders pushed back after this pair's last
+ *    projection: a heap's layers) goes in full, or the heap sinks, and its speed is taken
+ *    out in the velocity pass (err). Not through x_prev: a settled stack would then rest
+ *    on position corrections alone and keep a velocity (-g h / 3 in a stack of three).
+ * wb__contact_depth (core.h) works the parts out; tricontact.c uses it too. */
 void wb__contacts_project(wb_world *w, wb_real h)
 {
     wb_contacts *c = &w->k.pc;
@@ -142,9 +144,11 @@ void wb__contacts_project(wb_world *w, wb_real h)
     wb_real *left = wb__grow(c->left, &c->cap_left, c->n, sizeof *left);
     if (!left) goto nomem;
     c->left = left;
-    /* a new candidate list (each frame): what each pair was left with is not known, and
-     * all of the overlap it has now counts as old. Worked out from the state alone, so a
-     * step interrupted and run again gives the same result */
+    /* a new candidate list (each frame): what each pair was left with is not known; the
+     * overlap it has now counts as kept, unless one step would take it all anyway (a
+     * resting contact's g h^2: then its repair is taken out of the speed as within a
+     * frame, and a settled stack stays exactly at rest). Worked out from the state
+     * alone, so a step interrupted and run again gives the same result */
     if (c->fresh) {
         for (int32_t k = 0; k < c->n; k++) {
             const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];
@@ -214,8 +218,9 @@ nomem:
     wb__warn(w, "out of memory in contacts; contacts skipped this substep");
 }
 
-/* after v = (x - x_prev)/h: no approach speed left (perfectly inelastic; friction was
- * applied at position level, so the tangential velocity is already what it implies) */
+/* after v = (x - x_prev)/h: no speed made out of old overlap pushed back in full (err,
+ * above), then no approach speed left (perfectly inelastic; friction was applied at
+ * position level, so the tangential velocity is already what it implies) */
 void wb__contacts_velocity(wb_world *w, wb_real h)
 {
     wb_contacts *c = &w->k.pc;

@@ -123,13 +123,15 @@ typedef struct wb_state {
 /* ---- particle contacts: per-frame scratch (contact.c) -------------------------------- */
 /* How much of a contact's overlap ov to correct this substep (contact.c explains why).
  * d0: the overlap it started the substep with (at x_prev, which earlier contacts of the
- * pass have moved); *left: what the pair was left with by the last substep (at a frame's
- * start, its overlap then), updated. Overlap the pair keeps from substep to substep goes
- * at no more than `step` (max_depenetration x h) per substep, whatever pushes it out (so a
- * particle with several such contacts is not pushed out by each at full speed); what
- * was added to it since it was left (other pairs, the colliders, the prediction, the
- * links) in full. Returns the correction; *err: how much of it repairs d0, a position
- * error whose push must not become speed (the caller moves x_prev with x by that much). */
+ * pass may have moved); *left: what the pair was left with by the last substep (at a
+ * frame's start, its overlap then if deeper than one step, else 0), updated. Overlap the
+ * pair keeps from substep to substep goes at no more than `step` (max_depenetration x h)
+ * per substep, whatever pushes it out, so a particle with several such contacts is not
+ * pushed out by each at full speed; *slow: what of it goes this substep (the caller moves
+ * x_prev with x by it). What was added since it was left: at x_prev (other pairs, the
+ * colliders after this pair's projection) in full, *fast (the caller takes its speed out
+ * in the velocity pass); since x_prev (the prediction, the links) in full, as a collision.
+ * Returns the correction. */
 static inline wb_real wb__contact_depth(wb_real ov, wb_real d0, wb_real *left, wb_real step, wb_real *slow,
                                        wb_real *fast)
 {

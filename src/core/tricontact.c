@@ -18,7 +18,10 @@
  * along n: the corrections' momentum sums to (1 - sum b_i) depth / W = 0. Coulomb
  * friction at position level as contact.c's (the relative slip of p against q undone up
  * to mu depth, mu the mean of p's and the triangle's barycentric friction), and after the
- * velocity update the approach speed along n is removed the same way.
+ * velocity update the approach speed along n is removed the same way. Overlap a point
+ * already had goes out as contact.c's does (wb__contact_depth): at max_depenetration
+ * and without becoming speed; before, all of it went in one substep, as speed, and
+ * bodies made inside each other's hulls flew apart at metres per second.
  *
  * A surface is two-sided: n points to the side the point was on at the substep's start
  * (x_prev), as collide.c does for an open mesh collider, so a point the substep carried
@@ -425,7 +428,7 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
     wb_real *left = wb__grow(c->left, &c->cap_left, c->n, sizeof *left);
     if (!left) goto nomem;
     c->left = left;
-    /* a new candidate list: all the overlap it has now counts as old (contact.c) */
+    /* a new candidate list: the overlap it has now counts as kept, as in contact.c */
     const wb_real step = m->def.max_depenetration * h;
     if (c->fresh) {
         for (int32_t k = 0; k < c->n; k++) {
@@ -502,8 +505,8 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
         }
         if (!(depth > 0)) continue;
         /* the overlap it started the substep with: the same distance at x_prev (on the
-         * side it was on then). Old overlap goes out slowly, and its repair (err) moves
-         * x_prev too, so it adds no speed (contact.c explains why) */
+         * side it was on then). Kept overlap goes out slowly, its push moving x_prev too;
+         * the rest in full, its speed taken out in the velocity pass (contact.c) */
         wb_real bp[3], qp[3], slow, err;
         const wb_real dp2 = wb__tri_closest(&xp[3 * p], &xp[3 * v[0]], &xp[3 * v[1]], &xp[3 * v[2]], bp, qp);
         depth = wb__contact_depth(depth, r - sqrt(dp2), &lk, step, &slow, &err);
