@@ -74,12 +74,15 @@ TEST(tricontact_closest_matches_bvh)
 }
 
 /* a triangle of three unequal masses in z = 0 and a point 0.01 above it moving down at
- * 3 m/s, radius 0.05, no gravity: one step of one substep */
+ * 3 m/s, radius 0.05, no gravity: one step of one substep. The point is made inside its
+ * contact distance, overlap that would go out at max_depenetration (0.25 m/s, 4 mm in
+ * this substep); lifted here, so that the whole overlap is one projection's */
 static wb_world *scene(wb_real mu, int32_t *pt)
 {
     wb_world_def d = wb_world_default_def();
     d.gravity[1] = 0;
     d.substeps = 1;
+    d.max_depenetration = 1e3;
     wb_world *w = wb_world_create(&d);
     const wb_real x[4][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 }, { 0.2, 0.3, 0.01 } };
     const wb_real v[4][3] = { { 0, 0, 0.5 }, { 0.1, 0, 0 }, { 0, 0, 0 }, { 0.4, -0.2, -3 } };
