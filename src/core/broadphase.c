@@ -535,6 +535,7 @@ void wb__contacts_begin(wb_world *w)
     c->n = 0;
     c->nact = 0;
     c->last = 0;
+    c->fresh = 1;
     c->broad_ms = 0;
     if (!m->def.contacts || m->np < 2) return;
     if (c->scan_dirty || c->scanned_np != m->np) {

@@ -106,7 +106,26 @@ wb_real wb_body_spacing(const wb_world *w, wb_body b)
 /* ---- the step ---------------------------------------------------------------------------------- */
 /* Project every candidate once, in list order (Gauss-Seidel): push the pair apart along
  * their line by the overlap, split by inverse mass, then undo their relative tangential
- * slip of this substep when it is within the friction cone (mu x depth). */
+ * slip of this substep when it is within the friction cone (mu x depth).
+ *
+ * Old overlap. A correction of depth adds depth / h to the pair's separating speed
+ * (v = (x - x_prev) / h). The part that takes back this substep's approach (what the
+ * prediction and the links did since x_prev, including the links pulling a pushed
+ * particle back) is the collision and stays speed. The part that removes overlap the
+ * pair already had at x_prev (d0) is the repair of a position error: kept as speed it
+ * would fling them apart at up to depth / h (2 cm at h = 1/600 s: 12 m/s). Of d0:
+ *  - what the pair keeps from substep to substep (bodies made inside each other, a deep
+ *    squeeze) goes at no more than max_depenetration x h per substep, counting what
+ *    other contacts pushed out of it (a particle inside another body touches several of
+ *    its particles and triangles: each pushing at full rate sent interleaved blocks off
+ *    at metres per second). Its push moves x_prev with x (Macklin et al. 2014, "Unified
+ *    particle physics", §4.2, pre-stabilization): a position change, not a speed, which
+ *    a pair later in the pass that it pushes into overlap also sees as old;
+ *  - the rest (what later pairs or the colliders pushed back after this pair's last
+ *    projection: a heap's layers) goes in full, or the heap sinks, and its speed is taken
+ *    out in the velocity pass (err). Not through x_prev: a settled stack would then rest
+ *    on position corrections alone and keep a velocity (-g h / 3 in a stack of three).
+ * wb__contact_depth (core.h) works the parts out; tricontact.c uses it too. */
 void wb__contacts_project(wb_world *w, wb_real h)
 {
     wb_contacts *c = &w->k.pc;
@@ -114,8 +133,8 @@ void wb__contacts_project(wb_world *w, wb_real h)
     if (c->n == 0) { c->last = 0; return; }
     int32_t touching = 0;
     const wb_model *m = &w->m;
-    wb_real *x = w->s.x;
-    const wb_real *xp = w->s.x_prev, *wv = m->w, *rad = m->radius, vmax = m->def.max_depenetration;
+    wb_real *x = w->s.x, *xp = w->s.x_prev;
+    const wb_real *wv = m->w, *rad = m->radius, vmax = m->def.max_depenetration;
     int32_t *act = wb__grow(c->act, &c->cap_act, c->n, sizeof *act);
     if (!act) goto nomem;
     c->act = act;
@@ -125,17 +144,26 @@ void wb__contacts_project(wb_world *w, wb_real h)
     wb_real *left = wb__grow(c->left, &c->cap_left, c->n, sizeof *left);
     if (!left) goto nomem;
     c->left = left;
-    /* a new candidate list (wb__contacts_begin clears c->last; so does a substep with no
-     * contact, whose pairs were left with nothing): what each pair was left with is not
-     * known, and all of its overlap counts as old. Worked out from the state alone, so
-     * a step interrupted and run again gives the same result */
-    if (c->last == 0)
-        for (int32_t k = 0; k < c->n; k++) left[k] = INFINITY;
+    /* a new candidate list (each frame): what each pair was left with is not known; the
+     * overlap it has now counts as kept, unless one step would take it all anyway (a
+     * resting contact's g h^2: then its repair is taken out of the speed as within a
+     * frame, and a settled stack stays exactly at rest). Worked out from the state
+     * alone, so a step interrupted and run again gives the same result */
+    if (c->fresh) {
+        for (int32_t k = 0; k < c->n; k++) {
+            const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];
+            wb_real d[3];
+            v3_sub(d, &xp[3 * j], &xp[3 * i]);
+            const wb_real d0 = rad[i] + rad[j] - v3_len(d);
+            left[k] = d0 > vmax * h ? d0 : 0;
+        }
+        c->fresh = 0;
+    }
     for (int32_t k = 0; k < c->n; k++) {
         const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];
         const wb_real wi = wv[i], wj = wv[j], wsum = wi + wj;
         if (wsum == 0) continue;
-        wb_real *xi = &x[3 * i], *xj = &x[3 * j];
+        wb_real *xi = &x[3 * i], *xj = &x[3 * j], *pi = &xp[3 * i], *pj = &xp[3 * j];
         wb_real d[3];
         v3_sub(d, xj, xi);
         const wb_real r = rad[i] + rad[j], d2 = v3_dot(d, d);
@@ -151,23 +179,12 @@ void wb__contacts_project(wb_world *w, wb_real h)
         const wb_real len = sqrt(d2);
         if (len > r * (wb_real)1e-9) v3_scale(n, d, 1 / len);
         else v3_set(n, 0, 1, 0); /* coincident: any direction separates them */
-        /* d0: the overlap the pair started the substep with (at x_prev). Most of it is
-         * what the contact pass left to the links and colliders after it, or what later
-         * pairs of the pass pushed back (Gauss-Seidel): repaired in full, as every
-         * substep must, or a heap's layers sink into each other. What is older, the
-         * overlap this pair was itself left with last substep (bodies made inside each
-         * other, a deep squeeze; before a frame's first substep all of d0 counts), goes
-         * at no more than max_depenetration x h per substep, so that a body is not
-         * squashed in one substep. Neither becomes speed (wb__contacts_velocity) */
-        wb_real depth = r - len, dp[3];
-        v3_sub(dp, &xp[3 * j], &xp[3 * i]);
-        const wb_real d0 = r - v3_len(dp), old = d0 < left[k] ? d0 : left[k], keep = old - vmax * h;
-        if (keep > 0) depth = depth > keep ? depth - keep : 0;
-        left[k] = r - len - depth;
+        wb_real dp[3], slow, err;
+        v3_sub(dp, pj, pi);
+        const wb_real depth = wb__contact_depth(r - len, r - v3_len(dp), &left[k], vmax * h, &slow, &err);
         if (!(depth > 0)) { touching++; continue; }
-        const wb_real err = !(d0 > 0) ? 0 : d0 < depth ? d0 : depth; /* of it, old overlap */
-        if (wi > 0) v3_madd(xi, n, -depth * wi / wsum);
-        if (wj > 0) v3_madd(xj, n, depth * wj / wsum);
+        if (wi > 0) v3_madd(xi, n, -depth * wi / wsum), v3_madd(pi, n, -slow * wi / wsum);
+        if (wj > 0) v3_madd(xj, n, depth * wj / wsum), v3_madd(pj, n, slow * wj / wsum);
         /* friction at position level (Macklin et al. 2014, "Unified particle physics", §6.1):
          * the relative tangential slip of the substep is undone up to mu x depth, all of it
          * inside the cone (static), mu x depth of it outside (kinetic). Bounded per contact
@@ -176,7 +193,7 @@ void wb__contacts_project(wb_world *w, wb_real h)
         const wb_real mu = (m->cfric[i] + m->cfric[j]) / 2;
         if (mu > 0) {
             wb_real slip[3];
-            for (int a = 0; a < 3; a++) slip[a] = (xi[a] - xp[3 * i + a]) - (xj[a] - xp[3 * j + a]);
+            for (int a = 0; a < 3; a++) slip[a] = (xi[a] - pi[a]) - (xj[a] - pj[a]);
             v3_madd(slip, n, -v3_dot(slip, n));
             const wb_real sl = v3_len(slip), cap = mu * depth;
             if (sl > 0) {
@@ -185,8 +202,8 @@ void wb__contacts_project(wb_world *w, wb_real h)
                 if (wj > 0) v3_madd(xj, slip, f * wj / wsum);
             }
         }
-        /* normal, depth and old overlap, kept for the velocity pass; the normal force for
-         * the readout (XPBD multiplier of a zero-compliance contact, depth / (w_i + w_j), over h^2) */
+        /* normal and depth, kept for the velocity pass; the normal force for the readout
+         * (XPBD multiplier of a zero-compliance contact, depth / (w_i + w_j), over h^2) */
         act[c->nact] = k;
         v3_copy(&nds[6 * c->nact], n);
         nds[6 * c->nact + 3] = depth;
@@ -201,20 +218,9 @@ nomem:
     wb__warn(w, "out of memory in contacts; contacts skipped this substep");
 }
 
-/* after v = (x - x_prev)/h: no approach speed left (perfectly inelastic; friction was
- * applied at position level, so the tangential velocity is already what it implies),
- * and no speed made out of old overlap.
- *
- * A correction of depth adds depth / h to the pair's separating speed. The part that
- * takes back this substep's approach is the collision; the part that removed overlap
- * the pair already had (err, from the projection) is the repair of a position error
- * (bodies made inside each other, a ball squeezed into a pile): kept as speed it
- * would fling them apart at up to depth / h (2 cm at h = 1/600 s: 12 m/s). So it is
- * taken out of the velocity again, both particles along n split by inverse mass
- * (momentum exact), and the pair leaves with what the rest of the step gave it (what
- * Bullet's split impulse does for rigid bodies). Pushing that overlap out slowly (at
- * most max_depenetration x h per substep, in the projection) keeps a body from being
- * squashed in one substep, which its links would then turn into the same speed. */
+/* after v = (x - x_prev)/h: no speed made out of old overlap pushed back in full (err,
+ * above), then no approach speed left (perfectly inelastic; friction was applied at
+ * position level, so the tangential velocity is already what it implies) */
 void wb__contacts_velocity(wb_world *w, wb_real h)
 {
     wb_contacts *c = &w->k.pc;

@@ -121,12 +121,37 @@ typedef struct wb_state {
 #define WB_CF_SELF 2u        /* collides with its own body (group > 0) */
 
 /* ---- particle contacts: per-frame scratch (contact.c) -------------------------------- */
+/* How much of a contact's overlap ov to correct this substep (contact.c explains why).
+ * d0: the overlap it started the substep with (at x_prev, which earlier contacts of the
+ * pass may have moved); *left: what the pair was left with by the last substep (at a
+ * frame's start, its overlap then if deeper than one step, else 0), updated. Overlap the
+ * pair keeps from substep to substep goes at no more than `step` (max_depenetration x h)
+ * per substep, whatever pushes it out, so a particle with several such contacts is not
+ * pushed out by each at full speed; *slow: what of it goes this substep (the caller moves
+ * x_prev with x by it). What was added since it was left: at x_prev (other pairs, the
+ * colliders after this pair's projection) in full, *fast (the caller takes its speed out
+ * in the velocity pass); since x_prev (the prediction, the links) in full, as a collision.
+ * Returns the correction. */
+static inline wb_real wb__contact_depth(wb_real ov, wb_real d0, wb_real *left, wb_real step, wb_real *slow,
+                                       wb_real *fast)
+{
+    /* only what is still there is old (a pair that moved apart since has less) */
+    d0 = !(d0 > 0) ? 0 : d0 < ov ? d0 : ov;
+    const wb_real kept = d0 < *left ? d0 : *left;
+    wb_real keep = *left - step;
+    keep = !(keep > 0) ? 0 : keep < d0 ? keep : d0;
+    *left = keep;
+    *slow = kept - keep;
+    *fast = d0 - kept;
+    return ov - keep;
+}
+
 typedef struct wb_contacts {
     int32_t n, cap;        /* candidate pairs of this frame */
     int32_t *ij;           /* (n x 2) i < j, in the broad phase's fixed order */
     int32_t nact, cap_act; /* contacts of the current substep */
     int32_t *act;          /* (nact) candidate index */
-    wb_real *act_nd;       /* (nact x 6) normal (i -> j), depth, normal force, the overlap it started with */
+    wb_real *act_nd;       /* (nact x 5) normal (i -> j), depth, normal force */
     int32_t cap_nd;
     wb_real *left;         /* (n) overlap a candidate was left with by its last projection;
                               INFINITY when not known (contact.c: old overlap) */
@@ -143,6 +168,7 @@ typedef struct wb_contacts {
     int scan_dirty;        /* groups or flags changed since */
     int possible;          /* some pair could collide */
     int32_t last;          /* contacts in the last substep */
+    int fresh;             /* a new candidate list: `left` not known yet */
     double broad_ms;       /* broad phase of the last step */
 } wb_contacts;
 
@@ -192,7 +218,7 @@ typedef struct wb_tricontacts {
     int32_t *act;          /* (nact) candidate index */
     wb_real *act_d;        /* (nact x 9) barycentrics, normal (triangle -> point), depth, force, old overlap */
     int32_t cap_d;
-    wb_real *left;         /* (n) overlap each candidate was left with last substep (contact.c's) */
+    wb_real *left;         /* (n) overlap a candidate was left with (wb__contact_depth) */
     int32_t cap_left;
     wb_real *reach;        /* (np) a point's broad-phase reach, < 0 = not a point */
     int32_t cap_reach;
@@ -204,6 +230,7 @@ typedef struct wb_tricontacts {
     int32_t *tstamp;       /* (ntri) the last point that met it in the broad phase */
     int32_t cap_tgroup, cap_tstamp;
     int32_t last;          /* contacts in the last substep (corrected or in touch) */
+    int fresh;             /* a new candidate list: `left` not known yet */
     double broad_ms;       /* its broad phase in the last step */
 } wb_tricontacts;
 

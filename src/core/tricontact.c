@@ -18,9 +18,10 @@
  * along n: the corrections' momentum sums to (1 - sum b_i) depth / W = 0. Coulomb
  * friction at position level as contact.c's (the relative slip of p against q undone up
  * to mu depth, mu the mean of p's and the triangle's barycentric friction), and after the
- * velocity update the approach speed along n is removed the same way. Old overlap (made
- * inside, a deep squeeze) follows contact.c's rule: pushed out at max_depenetration at
- * most, and the speed of that repair taken back, so it never flings a particle off.
+ * velocity update the approach speed along n is removed the same way. Overlap a point
+ * already had goes out as contact.c's does (wb__contact_depth): at max_depenetration
+ * and without becoming speed; before, all of it went in one substep, as speed, and
+ * bodies made inside each other's hulls flew apart at metres per second.
  *
  * A surface is two-sided: n points to the side the point was on at the substep's start
  * (x_prev), as collide.c does for an open mesh collider, so a point the substep carried
@@ -396,6 +397,7 @@ void wb__tricontacts_begin(wb_world *w)
     c->n = 0;
     c->nact = 0;
     c->last = 0;
+    c->fresh = 1;
     c->broad_ms = 0;
     /* contact.c's scan of this frame: no pair of particles may touch, so no point a
      * triangle either (its corners' rules are the pairs'); one body costs nothing */
@@ -415,8 +417,8 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
     c->nact = 0;
     if (c->n == 0) { c->last = 0; return; }
     const wb_model *m = &w->m;
-    wb_real *x = w->s.x;
-    const wb_real *xp = w->s.x_prev, *wv = m->w, *rad = m->radius, *cf = m->cfric, vmax = m->def.max_depenetration;
+    wb_real *x = w->s.x, *xp = w->s.x_prev;
+    const wb_real *wv = m->w, *rad = m->radius, *cf = m->cfric;
     int32_t *act = wb__grow(c->act, &c->cap_act, c->n, sizeof *act);
     if (!act) goto nomem;
     c->act = act;
@@ -426,19 +428,27 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
     wb_real *left = wb__grow(c->left, &c->cap_left, c->n, sizeof *left);
     if (!left) goto nomem;
     c->left = left;
-    /* contact.c's rule for old overlap: on a new candidate list (begin clears c->last) or
-     * after a substep without contacts, what each candidate was left with is not known and
-     * all of its overlap counts as old */
-    if (c->last == 0)
-        for (int32_t k = 0; k < c->n; k++) left[k] = INFINITY;
+    /* a new candidate list: the overlap it has now counts as kept, as in contact.c */
+    const wb_real step = m->def.max_depenetration * h;
+    if (c->fresh) {
+        for (int32_t k = 0; k < c->n; k++) {
+            const int32_t p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
+            wb_real b[3], q[3];
+            const wb_real d0 = rad[p] - sqrt(wb__tri_closest(&xp[3 * p], &xp[3 * v[0]], &xp[3 * v[1]], &xp[3 * v[2]], b, q));
+            left[k] = d0 > step ? d0 : 0;
+        }
+        c->fresh = 0;
+    }
     int32_t touching = 0;
     for (int32_t k = 0; k < c->n; k++) {
         const int32_t p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
         wb_real *xs = &x[3 * p];
         const wb_real *xa = &x[3 * v[0]], *xb = &x[3 * v[1]], *xc = &x[3 * v[2]];
         wb_real b[3], q[3], d[3], n[3], e1[3], e2[3];
-        const wb_real r = rad[p], was = left[k];
-        left[k] = 0; /* what it is left with: none unless corrected below */
+        const wb_real r = rad[p];
+        /* what it was left with, until it is found overlapping again */
+        wb_real lk = left[k];
+        left[k] = 0;
         /* the side now and at the substep's start (the plane of the triangle then) */
         v3_sub(e1, xb, xa);
         v3_sub(e2, xc, xa);
@@ -494,24 +504,19 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
             depth = r - side * s_now;
         }
         if (!(depth > 0)) continue;
-        /* d0: the overlap at the substep's start (x_prev, the triangle then). As in
-         * contact.c (wb__contacts_project): what this candidate was itself left with last
-         * substep (made overlapping, a deep squeeze; before a frame's first substep all of
-         * d0) goes out at no more than max_depenetration x h per substep; the rest (what the
-         * links, colliders and later contacts pushed back) in full. Neither becomes speed
-         * (wb__tricontacts_velocity), or a particle made 1.5 cm inside a sheet would leave
-         * at 9 m/s while a pair made as deep leaves at max_depenetration */
-        wb_real bp[3], qp[3];
-        const wb_real d0 = r - sqrt(wb__tri_closest(&xp[3 * p], &xp[3 * v[0]], &xp[3 * v[1]], &xp[3 * v[2]], bp, qp));
-        const wb_real full = depth, old = d0 < was ? d0 : was, keep = old - vmax * h;
-        if (keep > 0) depth = depth > keep ? depth - keep : 0;
-        left[k] = full - depth;
+        /* the overlap it started the substep with: the same distance at x_prev (on the
+         * side it was on then). Kept overlap goes out slowly, its push moving x_prev too;
+         * the rest in full, its speed taken out in the velocity pass (contact.c) */
+        wb_real bp[3], qp[3], slow, err;
+        const wb_real dp2 = wb__tri_closest(&xp[3 * p], &xp[3 * v[0]], &xp[3 * v[1]], &xp[3 * v[2]], bp, qp);
+        depth = wb__contact_depth(depth, r - sqrt(dp2), &lk, step, &slow, &err);
+        left[k] = lk;
         if (!(depth > 0)) { touching++; continue; }
-        const wb_real err = !(d0 > 0) ? 0 : d0 < depth ? d0 : depth; /* of it, old overlap */
-        const wb_real s = depth / W;
-        if (wp > 0) v3_madd(xs, nn, wp * s);
+        const wb_real s = depth / W, se = slow / W;
+        if (wp > 0) v3_madd(xs, nn, wp * s), v3_madd(&xp[3 * p], nn, wp * se);
         for (int i = 0; i < 3; i++)
-            if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&x[3 * v[i]], nn, -b[i] * wv[v[i]] * s);
+            if (wv[v[i]] > 0 && b[i] != 0)
+                v3_madd(&x[3 * v[i]], nn, -b[i] * wv[v[i]] * s), v3_madd(&xp[3 * v[i]], nn, -b[i] * wv[v[i]] * se);
         /* friction at position level, as contact.c: the slip of p against the triangle's
          * point q this substep undone up to mu x depth */
         const wb_real mu = (cf[p] + b[0] * cf[v[0]] + b[1] * cf[v[1]] + b[2] * cf[v[2]]) / 2;
@@ -543,8 +548,7 @@ nomem:
     wb__warn(w, "out of memory in triangle contacts; skipped this substep");
 }
 
-/* after v = (x - x_prev)/h: no speed made out of old overlap (the err part of the
- * correction, taken back along n with the correction's weights, as contact.c), then no
+/* after v = (x - x_prev)/h: no speed made out of old overlap (contact.c), then no
  * approach speed of p towards the triangle's point left */
 void wb__tricontacts_velocity(wb_world *w, wb_real h)
 {
@@ -556,11 +560,11 @@ void wb__tricontacts_velocity(wb_world *w, wb_real h)
         const int32_t k = c->act[a], p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
         const wb_real *b = &c->act_d[9 * a], *nn = b + 3;
         const wb_real W = wv[p] + b[0] * b[0] * wv[v[0]] + b[1] * b[1] * wv[v[1]] + b[2] * b[2] * wv[v[2]];
-        const wb_real e = b[8] / h;
-        if (!(e > 0) || W == 0) continue;
-        if (wv[p] > 0) v3_madd(&vel[3 * p], nn, -e * wv[p] / W);
+        if (!(b[8] > 0) || W == 0) continue;
+        const wb_real s = b[8] / W / h; /* the projection's push of err, as speed */
+        if (wv[p] > 0) v3_madd(&vel[3 * p], nn, -s * wv[p]);
         for (int i = 0; i < 3; i++)
-            if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&vel[3 * v[i]], nn, e * b[i] * wv[v[i]] / W);
+            if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&vel[3 * v[i]], nn, s * b[i] * wv[v[i]]);
     }
     for (int32_t a = 0; a < c->nact; a++) {
         const int32_t k = c->act[a], p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];

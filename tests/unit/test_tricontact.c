@@ -74,9 +74,9 @@ TEST(tricontact_closest_matches_bvh)
 }
 
 /* a triangle of three unequal masses in z = 0 and a point 0.01 above it moving down at
- * 3 m/s, radius 0.05, no gravity: one step of one substep. The point is made 0.04 inside
- * its radius: old overlap, which max_depenetration would push out at 0.25 m/s; set high
- * so that these checks see the whole correction in the one substep */
+ * 3 m/s, radius 0.05, no gravity: one step of one substep. The point is made inside its
+ * contact distance, overlap that would go out at max_depenetration (0.25 m/s, 4 mm in
+ * this substep); lifted here, so that the whole overlap is one projection's */
 static wb_world *scene(wb_real mu, int32_t *pt)
 {
     wb_world_def d = wb_world_default_def();
