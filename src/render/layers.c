@@ -291,7 +291,7 @@ static bool load_materials(wb_layers *l, const wb_world *w, double scale)
         double d = a - r;
         if (!isfinite(d)) continue;
         d = fabs(remainder(d, 2 * M_PI));
-        const bool flatter = a * r > 0 && fabs(a) < fabs(r);
+        const bool flatter = a * r >= 0 && fabs(a) < fabs(r);
         const double e = (flatter ? -1 : 1) * scale * d / (M_PI / 4);
         int32_t p[4];
         wb_bend_particles(w, b, p);
