@@ -471,6 +471,8 @@ void wb_tet_particles(const wb_world *w, int32_t i, int32_t p[4]);
 wb_real wb_tet_energy(const wb_world *w, int32_t i);           /* J, 0 at rest */
 wb_real wb_tet_rest_volume(const wb_world *w, int32_t i);      /* m^3, > 0 */
 wb_real wb_tet_volume_ratio(const wb_world *w, int32_t i);     /* det F: < 0 inverted */
+/* det F - 1, or where larger the shape change (shear too; > 0, von Mises equivalent strain) */
+wb_real wb_tet_strain(const wb_world *w, int32_t i);
 void wb_tet_material(const wb_world *w, int32_t i, wb_real *young, wb_real *poisson);
 /* the rest state of a tet (a b c d): Dm^-1 (row-major) and |volume|; false when flat */
 bool wb_tet_rest_shape(const wb_real *a, const wb_real *b, const wb_real *c, const wb_real *d, wb_real dminv[9],

@@ -23,6 +23,7 @@
  * Model: corners, Dm^-1, V0, E, nu (mu and lam derived). Cache: the multipliers of the
  * substep. The pass is serial in creation order: deterministic for any thread count. */
 #include <assert.h>
+#include <math.h>
 #include <stdlib.h>
 
 #include "core.h"
@@ -211,6 +212,35 @@ wb_real wb_tet_volume_ratio(const wb_world *w, int32_t i)
     wb_real F[9];
     deformation(w->neo, w->s.x, i, F);
     return det3(F);
+}
+
+/* the volume change det F - 1, or the shape change where that is larger: the von Mises
+ * equivalent of the isochoric Green strain (C' = C / J^(2/3), E = (C' - I)/2,
+ * sqrt(2/3 dev E : dev E)), which equals the strain of a volume-keeping uniaxial stretch
+ * and is about k/sqrt(3) in a shear of k: pure shear leaves det F at 1 and the volume
+ * measure alone blind to it. The shape change has no sign (> 0). */
+wb_real wb_tet_strain(const wb_world *w, int32_t i)
+{
+    if (!CHECK_T(w, i)) return 0;
+    wb_real F[9];
+    deformation(w->neo, w->s.x, i, F);
+    const double J = det3(F), vol = J - 1;
+    if (!(fabs(J) > 1e-9)) return (wb_real)vol;   /* flat: no isochoric part */
+    const double iso = 1 / cbrt(J * J);
+    double E[9], tr = 0, dd = 0;
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) {
+            double cc = 0;   /* (F^T F)_rc */
+            for (int k = 0; k < 3; k++) cc += (double)F[3 * k + r] * F[3 * k + c];
+            E[3 * r + c] = 0.5 * (iso * cc - (r == c));
+        }
+    for (int k = 0; k < 3; k++) tr += E[4 * k];
+    for (int k = 0; k < 9; k++) {
+        const double d = E[k] - (k % 4 == 0 ? tr / 3 : 0);
+        dd += d * d;
+    }
+    const double eq = sqrt(2.0 / 3.0 * dd);
+    return (wb_real)(fabs(vol) >= eq ? vol : eq);
 }
 
 void wb_tet_material(const wb_world *w, int32_t i, wb_real *young, wb_real *poisson)

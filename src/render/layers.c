@@ -6,7 +6,7 @@
  * colour of their stretch, so a dense cloth shows it rather than a fence of lines.
  * The other materials tint their particles and surfaces the same way (red expanded,
  * blue compressed): a tet's volumetric strain, a shape-matching cluster's, a pressure
- * body's volume against its target. */
+ * body's volume against its target, a bend's angle against its rest. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -227,8 +227,9 @@ static void put_material(wb_layers *l, int32_t i, double e)
  * F_MATERIAL; the rest is scratch): the volumetric strain (V - V0) / V0 averaged over
  * its tets (volume constraints and Neo-Hookean tets); a shape-matching cluster's strain (wb_shape_match_strain), negative when the
  * cluster drew in (its spread about the centre of mass below the rest shape's); a
- * pressure body's V / (pressure V0) - 1 on its surface */
-static bool load_materials(wb_layers *l, const wb_world *w)
+ * pressure body's V / (pressure V0) - 1 on its surface; a bend's angle off its rest
+ * (below) */
+static bool load_materials(wb_layers *l, const wb_world *w, double scale)
 {
     const int32_t np = wb_particle_count(w), nv = wb_volume_count(w);
     if (!grow(&l->mstrain, &l->mstrain_cap, 3 * (size_t)np + 1, sizeof *l->mstrain)) return false;
@@ -243,10 +244,11 @@ static bool load_materials(wb_layers *l, const wb_world *w)
         wb_volume_particles(w, i, p);
         for (int k = 0; k < 4; k++) sum[p[k]] += (float)e, count[p[k]]++;
     }
-    /* Neo-Hookean tets the same way: det F - 1 is their (V - V0) / V0 */
+    /* Neo-Hookean tets the same way, by det F - 1 (their (V - V0) / V0) or, where larger,
+     * their shape change (wb_tet_strain: a shear keeps the volume) */
     const int32_t nt = wb_tet_count(w);
     for (int32_t i = 0; i < nt; i++) {
-        const double e = wb_tet_volume_ratio(w, i) - 1;
+        const double e = wb_tet_strain(w, i);
         if (!isfinite(e)) continue;
         int32_t p[4];
         wb_tet_particles(w, i, p);
@@ -277,6 +279,23 @@ static bool load_materials(wb_layers *l, const wb_world *w)
         }
         const double e = (now < rest ? -1 : 1) * (double)wb_shape_match_strain(w, s);
         for (int32_t i = 0; i < n; i++) put_material(l, wb_shape_match_particle(w, s, i), e);
+    }
+    /* bends at their hinge's two particles: |angle - rest| / (pi/4) of strain_scale (a
+     * bend pi/4 off its rest is as full a colour as a link strain_scale off its); red
+     * when bent further than its rest (further from flat, or through to the other side),
+     * blue when opened out flatter. The angle's sign follows the wings' order, so only
+     * its size against the rest's says which way */
+    for (int32_t i = 0; i < wb_bend_count(w); i++) {
+        const wb_bend_id b = wb_bend_at(w, i);
+        const double a = wb_bend_angle(w, b), r = wb_bend_rest(w, b);
+        double d = a - r;
+        if (!isfinite(d)) continue;
+        d = fabs(remainder(d, 2 * M_PI));
+        const bool flatter = a * r >= 0 && fabs(a) < fabs(r);
+        const double e = (flatter ? -1 : 1) * scale * d / (M_PI / 4);
+        int32_t p[4];
+        wb_bend_particles(w, b, p);
+        put_material(l, p[0], e), put_material(l, p[1], e);
     }
     for (int32_t i = 0; i < wb_pressure_count(w); i++) {
         const double target = wb_pressure_get_def(w, i).pressure * wb_pressure_rest_volume(w, i);
@@ -502,7 +521,7 @@ bool wb_layers_build(wb_layers *l, const wb_world *w, const wb_draw_opts *o, con
         }
     l->npairs = 0;
     if (o->constraints && !load_pairs(l, w)) return false;
-    if (o->materials && !load_materials(l, w)) return false;
+    if (o->materials && !load_materials(l, w, o->strain_scale)) return false;
     l->nv = l->nidx = l->nseg = 0;
     l->surfaces = (o->surfaces && wb_surface_count(w) > 0 && np > 0) || nsk > 0 || mesh_collider_triangles(w, o) > 0;
     if (l->surfaces && !build_surfaces(l, w, o, sk, nsk)) return false;

@@ -117,7 +117,8 @@
     X(bvh_mesh_collider_memory_charged)          \
     CONTACT_TESTS(X)                             \
     TRICONTACT_TESTS(X)                          \
-    EXTREME_TESTS(X)
+    EXTREME_TESTS(X)                             \
+    X(tet_strain_volume_shape_and_shear)
 
 #define DECLARE(name) TEST(name);
 #define ENTRY(name) { #name, test_##name },
