@@ -23,6 +23,7 @@
  * Model: corners, Dm^-1, V0, E, nu (mu and lam derived). Cache: the multipliers of the
  * substep. The pass is serial in creation order: deterministic for any thread count. */
 #include <assert.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "core.h"
@@ -290,9 +291,38 @@ void wb__tet_image_put(wb_world *w, const wb_image *g, int32_t shift)
 /* ---- the type ---------------------------------------------------------------------- */
 static int32_t tet_count(const wb_world *w) { return wb_tet_count(w); }
 
+/* the longest h/t over the tets, t the time a wave sqrt(E/density) takes to cross the tet:
+ * t^-2 = E V0 sum_k w_k |dx_k at rest|^2 (E V0 / (m L^2) = (E/density) / L^2), the ratio of
+ * the deviatoric stiffness to the corners' mass over h^2 (k11 / ad of tet_project at rest);
+ * *at is the tet (-1 when none moves) */
+static wb_real wave_ratio(const wb_world *w, wb_real h, int32_t *at)
+{
+    const wb_neos *v = w->neo;
+    const wb_real *wv = w->m.w;
+    wb_real worst = 0;
+    *at = -1;
+    for (int32_t i = 0; v && i < v->n; i++) {
+        const int32_t *p = &v->ijkl[4 * i];
+        const wb_real *d = &v->dminv[9 * i];
+        wb_real s = 0;
+        for (int r = 0; r < 3; r++) { /* corner 0's gradient is minus the sum of the rows */
+            const wb_real g0 = d[r] + d[3 + r] + d[6 + r];
+            s += wv[p[0]] * g0 * g0 + wv[p[1]] * d[r] * d[r] + wv[p[2]] * d[3 + r] * d[3 + r] +
+                 wv[p[3]] * d[6 + r] * d[6 + r];
+        }
+        const wb_real q = h * h * v->young[i] * v->v0[i] * s;
+        if (q > worst) { worst = q; *at = i; }
+    }
+    return sqrt(worst);
+}
+
 static wb_status tet_prepare(wb_world *w)
 {
-    (void)w; /* nothing to pack: the arrays are the projection's order */
+    /* nothing to pack: the arrays are the projection's order */
+    if (!w->neo || w->neo->n == 0) return WB_OK;
+    int32_t at;
+    const wb_real h = w->m.def.dt / w->m.def.substeps, r = wave_ratio(w, h, &at);
+    fprintf(stderr, "RATIO %g\n", r);
     return WB_OK;
 }
 
