@@ -342,11 +342,9 @@ static wb_status tet_prepare(wb_world *w)
         const wb_real m = corner_mass(w, at);
         const double need = ceil(w->m.def.substeps * r / WAVE_LIMIT);
         v->advised = need < 1e9 ? (int32_t)need : 1000000000;
-        wb__warn(w, "Neo-Hookean tets: substep h = %.3g s is %.1f times longer than a wave needs to cross "
-                    "the smallest tet (tet %d: E = %.3g Pa, corners %.3g kg, rest volume %.3g m^3; stable up to about %.0f); "
-                    "raise substeps to about %.0f or lower young, or the solid collapses",
-                 h, r, at + 1, v->young[at], m, v->v0[at], (double)WAVE_LIMIT,
-                 need);
+        wb__warn(w, "Neo-Hookean tets: substep %.3g s is %.1f times a wave's time across tet %d (E %.3g Pa, "
+                    "%.3g kg; ok to 2): raise substeps to about %d or lower young",
+                 h, r, at + 1, v->young[at], m, (int)v->advised);
         v->warned_h = h;
         v->warned_n = v->n;
     }
