@@ -18,12 +18,17 @@
  * Limit: the substep must stay below about the time a wave (sqrt(E / density)) takes to
  * cross the smallest tet: past it the linearised 2x2 step overshoots (a tet stiff against
  * its corners' masses is asked for C_D -> 0, a collapse, that only the compliance stops).
- * A light body of sliver tets explodes; more substeps, not iterations, is the cure.
+ * A light body of sliver tets explodes; more substeps, not iterations, is the cure. It is
+ * not silent: prepare warns once when h exceeds WAVE_LIMIT crossing times (with the substeps
+ * that would do), and a frame ending with over 1% of the tets inverted warns once. (A clamp
+ * on each projection's correction was tried: it slows the collapse, does not stop it at
+ * E = 1e9, and would cap how fast a squashed solid may spring back; so none.)
  *
  * Model: corners, Dm^-1, V0, E, nu (mu and lam derived). Cache: the multipliers of the
  * substep. The pass is serial in creation order: deterministic for any thread count. */
 #include <assert.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "core.h"
@@ -320,10 +325,85 @@ void wb__tet_image_put(wb_world *w, const wb_image *g, int32_t shift)
 /* ---- the type ---------------------------------------------------------------------- */
 static int32_t tet_count(const wb_world *w) { return wb_tet_count(w); }
 
+#define WAVE_LIMIT ((wb_real)2)
+
+/* the corners' mass of tet i (0 for a pinned corner) */
+static wb_real corner_mass(const wb_world *w, int32_t i)
+{
+    wb_real m = 0;
+    for (int k = 0; k < 4; k++) {
+        const wb_real wk = w->m.w[w->neo->ijkl[4 * i + k]];
+        if (wk > 0) m += 1 / wk;
+    }
+    return m;
+}
+
+/* the longest h/t over the tets, t the time a wave sqrt(E/density) takes to cross the tet:
+ * t^-2 = E V0 sum_k w_k |dx_k at rest|^2 (E V0 / (m L^2) = (E/density) / L^2), the ratio of
+ * the deviatoric stiffness to the corners' mass over h^2 (k11 / ad of tet_project at rest);
+ * *at is the tet (-1 when none moves) */
+static wb_real wave_ratio(const wb_world *w, wb_real h, int32_t *at)
+{
+    const wb_neos *v = w->neo;
+    const wb_real *wv = w->m.w;
+    wb_real worst = 0;
+    *at = -1;
+    for (int32_t i = 0; v && i < v->n; i++) {
+        const int32_t *p = &v->ijkl[4 * i];
+        const wb_real *d = &v->dminv[9 * i];
+        wb_real s = 0;
+        for (int r = 0; r < 3; r++) { /* corner 0's gradient is minus the sum of the rows */
+            const wb_real g0 = d[r] + d[3 + r] + d[6 + r];
+            s += wv[p[0]] * g0 * g0 + wv[p[1]] * d[r] * d[r] + wv[p[2]] * d[3 + r] * d[3 + r] +
+                 wv[p[3]] * d[6 + r] * d[6 + r];
+        }
+        const wb_real q = h * h * v->young[i] * v->v0[i] * s;
+        if (q > worst) { worst = q; *at = i; }
+    }
+    return sqrt(worst);
+}
+
 static wb_status tet_prepare(wb_world *w)
 {
-    (void)w; /* nothing to pack: the arrays are the projection's order */
+    /* nothing to pack: the arrays are the projection's order */
+    if (!w->neo || w->neo->n == 0) return WB_OK;
+    int32_t at;
+    const wb_real h = w->m.def.dt / w->m.def.substeps, r = wave_ratio(w, h, &at);
+    /* stable up to about 2 (a hanging lattice bar: whole at 2.3, collapsed at 3.2); once per
+     * substep length and tet count, not per step */
+    wb_neos *v = w->neo;
+    if (r > WAVE_LIMIT && (h != v->warned_h || v->n != v->warned_n)) {
+        const wb_real m = corner_mass(w, at);
+        const double need = ceil(w->m.def.substeps * r / WAVE_LIMIT);
+        v->advised = need < 1e9 ? (int32_t)need : 1000000000;
+        wb__warn(w, "Neo-Hookean tets: substep %.3g s is %.1f times a wave's time across tet %d (E %.3g Pa, "
+                    "%.3g kg; ok to 2): raise substeps to about %d or lower young",
+                 h, r, at + 1, v->young[at], m, (int)v->advised);
+        v->warned_h = h;
+        v->warned_n = v->n;
+    }
     return WB_OK;
+}
+
+/* a frame ending with many tets inside out is a solid that collapsed (too long a substep,
+ * a crushing contact): said once per world, as it costs only a determinant per tet a frame */
+static void tet_frame_end(wb_world *w)
+{
+    wb_neos *v = w->neo;
+    if (!v || v->n == 0 || v->inverted_warned) return;
+    int32_t bad = 0;
+    for (int32_t i = 0; i < v->n; i++) {
+        wb_real F[9];
+        deformation(v, w->s.x, i, F);
+        bad += !(det3(F) > 0);
+    }
+    if ((int64_t)bad * 100 <= v->n) return; /* a few: a contact may pinch a tet flat */
+    v->inverted_warned = 1;
+    /* the CLI shows the last warning: repeat the advice of the substep one */
+    char advice[64] = "";
+    if (v->advised > 0) snprintf(advice, sizeof advice, " to about %d", (int)v->advised);
+    wb__warn(w, "frame %lld: %d of %d Neo-Hookean tets are inverted (det F <= 0); the solid has "
+                "collapsed: raise substeps%s or lower young", (long long)w->s.frame + 1, bad, v->n, advice);
 }
 
 static void tet_substep_begin(wb_world *w)
@@ -430,5 +510,5 @@ static wb_real tet_energy(const wb_world *w)
 }
 
 const wb_ctype wb__tet_type = {
-    "tet", tet_count, tet_prepare, tet_substep_begin, tet_project, NULL, tet_energy,
+    "tet", tet_count, tet_prepare, tet_substep_begin, tet_project, tet_frame_end, tet_energy,
 };

@@ -17,6 +17,10 @@ typedef struct wb_neos {
     wb_real *mu, *lam;     /* (n) derived: Lamé parameters of the constraint form */
     wb_real *lambda;       /* (n x 2) cache: deviatoric, hydrostatic multipliers of the substep */
     size_t charged;        /* bytes charged to def.memory */
+    wb_real warned_h;      /* the substep last warned about as too long (0: none), tet.c */
+    int32_t warned_n;      /* ... and the tet count then */
+    int32_t advised;       /* the substeps then advised (0: none) */
+    int inverted_warned;   /* the inverted-tets warning was given */
 } wb_neos;
 
 /* room for `extra` more, charged to the memory budget; after it wb__tet_put cannot fail */
