@@ -1,0 +1,40 @@
+-- materials_attack.lua: hostile input to the materials API (bends, volumes, Neo-Hookean
+-- tets, shape matching, pressure) that once got through; each case must be refused
+-- cleanly or, where accepted, leave a finite state.
+
+local function read(path)
+  local f = assert(io.open(path, "rb")); local s = f:read("a"); f:close(); return s
+end
+local function write(path, s)
+  local f = assert(io.open(path, "wb")); f:write(s); f:close()
+end
+
+local function tet_snapshot()
+  local w = wobble.world{}
+  local p = { w:particle{ pos = { 0, 0, 0 } }, w:particle{ pos = { 1, 0, 0 } },
+              w:particle{ pos = { 0, 1, 0 } }, w:particle{ pos = { 0, 0, 1 } } }
+  w:tet(p[1], p[2], p[3], p[4], { young = 1e3 })
+  assert(w:save("materials_attack/tet.json"))
+  return read("materials_attack/tet.json")
+end
+
+-- A snapshot's tet keeps Dm^-1 and V0 (= 1 / (6 |det Dm^-1|)); a hand-edited file whose
+-- pair is singular or overflows made det F and w:energy() NaN after loading.
+test("a tet's rest_inverse must be a finite, invertible match of its rest_volume", function()
+  local s = tet_snapshot()
+  local inv = s:match('"rest_inverse": (%b[])')
+  assert(inv, "the snapshot writes rest_inverse")
+  for name, bad in pairs{ zero = "[0, 0, 0, 0, 0, 0, 0, 0, 0]",
+                          huge = "[1e308, 1e308, 1e308, 1e308, 1e308, 1e308, 1e308, 1e308, 1e308]",
+                          scaled = "[2, 0, 0, 0, 2, 0, 0, 0, 2]" } do
+    write("materials_attack/bad.json", (s:gsub('"rest_inverse": %b[]', '"rest_inverse": ' .. bad)))
+    local w, err = wobble.load("materials_attack/bad.json")
+    expect.eq(w, nil, name .. " is refused")
+    expect.truthy(tostring(err):find("rest", 1, true), name .. ": " .. tostring(err))
+  end
+  -- the written pair itself still loads, with a finite energy
+  local w = assert(wobble.load("materials_attack/tet.json"))
+  local j, e = w:tet_info(1)
+  expect.eq(j, 1)
+  expect.truthy(e == e and w:energy() == w:energy(), "finite energy")
+end)
