@@ -38,3 +38,16 @@ test("a tet's rest_inverse must be a finite, invertible match of its rest_volume
   expect.eq(j, 1)
   expect.truthy(e == e and w:energy() == w:energy(), "finite energy")
 end)
+
+-- tets = 0 (or "no") is true in Lua: from_mesh took it as tets = true and ran tetgen
+test("from_mesh's tets must be a boolean", function()
+  local m = wobble.mesh{ vertices = { {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1} },
+                         triangles = { {1, 3, 2}, {1, 2, 4}, {1, 4, 3}, {2, 3, 4} } }
+  local w = wobble.world{}
+  local h = w:hash()
+  expect.error(function() w:from_mesh(m, { tets = 0 }) end,
+               "bad argument #2 to 'from_mesh' %(field 'tets': boolean expected, got number%)")
+  expect.error(function() w:from_mesh(m, { tets = "no" }) end, "field 'tets': boolean expected, got string")
+  expect.eq(w:hash(), h, "nothing added")
+  expect.eq(w:particle_count(), 0)
+end)
