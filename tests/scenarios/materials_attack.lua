@@ -51,3 +51,22 @@ test("from_mesh's tets must be a boolean", function()
   expect.eq(w:hash(), h, "nothing added")
   expect.eq(w:particle_count(), 0)
 end)
+
+-- A Neo-Hookean tet body (young: w:tet elements, no volume constraints) could not be
+-- written by w:save_tets ("no volume constraints"), and w:load_tets(.., {young}) gave it
+-- tet_count = 0. The error of an empty world also said "in the body" for no body.
+test("save_tets / load_tets carry Neo-Hookean tet bodies", function()
+  local w = wobble.world{}
+  local b = w:lattice{ min = {0, 0, 0}, max = {1, 1, 1}, res = {2, 2, 2}, tets = true, young = 1e5 }
+  expect.eq(w:volume_count(), 0); expect.eq(b.tet_count, 6)
+  expect.eq(w:save_tets("materials_attack/neo"), true)
+  expect.eq(w:save_tets("materials_attack/neo_body", b), true)
+  local v = wobble.world{}
+  local c = assert(v:load_tets("materials_attack/neo", { young = 1e5 }))
+  expect.eq(v:tet_count(), 6)
+  expect.eq(c.tet_count, 6, "the body counts its Neo-Hookean tets")
+  local u = wobble.world{}
+  local d = assert(u:load_tets("materials_attack/neo_body"))
+  expect.eq(d.tet_count, 6); expect.eq(u:volume_count(), 6)
+  expect.error(function() wobble.world{}:save_tets("materials_attack/none") end, "no tets .* in the world")
+end)
