@@ -302,8 +302,14 @@ const char *wb__tet_image_check(const wb_image *g)
         const char *e = wb_tet_def_check(&d);
         if (e) return e;
         if (!(g->tet_v0[i] > 0) || !isfinite(g->tet_v0[i])) return "a tet's rest volume must be > 0";
+        const wb_real *dm = &g->tet_dminv[9 * i];
         for (int k = 0; k < 9; k++)
-            if (!isfinite(g->tet_dminv[9 * i + k])) return "a tet's rest shape must be finite";
+            if (!isfinite(dm[k]) || fabs(dm[k]) > 1e150) return "a tet's rest shape must be finite";
+        /* Dm^-1 and V0 describe one rest tet (V0 = 1 / (6 |det Dm^-1|)); a singular or
+         * mismatched pair from a hand-edited file would make F and the energy NaN */
+        const wb_real det = det3(dm);
+        if (!(fabs(6 * g->tet_v0[i] * det - 1) <= 1e-6) && !(fabs(6 * g->tet_v0[i] * det + 1) <= 1e-6))
+            return "a tet's rest_inverse and rest_volume disagree (V0 = 1 / (6 |det|))";
     }
     return NULL;
 }

@@ -400,6 +400,8 @@ static int w_from_mesh(lua_State *L)
 {
     /* tets = true: filled with tetrahedra by tetgen, options of their own (lua/volume.c) */
     if (lua_type(L, 3) == LUA_TTABLE && lua_getfield(L, 3, "tets") != LUA_TNIL) {
+        /* a boolean only: tets = 0 is true in Lua and would silently fill the mesh */
+        if (!lua_isboolean(L, -1)) return wbl_fielderror(L, 3, "tets", "boolean expected, got %s", luaL_typename(L, -1));
         const bool tets = lua_toboolean(L, -1);
         lua_pop(L, 1);
         if (tets) return from_mesh_tets(L);

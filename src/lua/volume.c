@@ -204,7 +204,8 @@ static int w_load_tets(lua_State *L)
         return 2;
     }
     /* a file's tets that the core refuses (flat ones): an expected failure as well */
-    const int32_t nd0 = wb_distance_count(w), nv0 = wb_volume_count(w);
+    /* tet_count: volume constraints, or Neo-Hookean tets with young */
+    const int32_t nd0 = wb_distance_count(w), nv0 = wb_volume_count(w) + wb_tet_count(w);
     wbl_body_begin(L, t->nv);
     wb_body b;
     wb_status st = wb_tet_body(w, t->v, t->nv, t->tet, t->nt, NULL, 0, &d, &b);
@@ -217,19 +218,20 @@ static int w_load_tets(lua_State *L)
     if (auto_radius) wbl_default_radius(w, b);
     wbl_apply_contact_opts(w, b, &co);
     wbl_body_end(L, 1, b, wb_distance_count(w) - nd0);
-    lua_pushinteger(L, wb_volume_count(w) - nv0);
+    lua_pushinteger(L, wb_volume_count(w) + wb_tet_count(w) - nv0);
     lua_setfield(L, -2, "tet_count");
     return 1;
 }
 
-/* w:save_tets(path [, body]) -> true, or nil and a message: the volume constraints' tets
+/* w:save_tets(path [, body]) -> true, or nil and a message: the tets (volume constraints and w:tet)
  * (of the body's particles only, renumbered, when a body is given) and their particles */
 static int w_save_tets(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
     const char *name = wbl_checkfilename(L, 2);
+    const bool whole = lua_isnoneornil(L, 3); /* now: index 3 is taken by what is pushed below */
     int32_t first = 0, count = wb_particle_count(w);
-    if (!lua_isnoneornil(L, 3)) {
+    if (!whole) {
         luaL_checktype(L, 3, LUA_TTABLE);
         lua_getfield(L, 3, "first");
         lua_getfield(L, 3, "count");
@@ -242,18 +244,20 @@ static int w_save_tets(lua_State *L)
     }
     char node[PATH_MAX], ele[PATH_MAX], node_shown[PATH_MAX], ele_shown[PATH_MAX], err[1024];
     tet_paths(L, name, 1, node, ele, node_shown, ele_shown);
-    const int32_t nvol = wb_volume_count(w);
-    int32_t *tet = (int32_t *)lua_newuserdatauv(L, sizeof *tet * 4 * (size_t)(nvol > 0 ? nvol : 1), 0);
+    /* the volume constraints, then the Neo-Hookean tets (a body made with young has only those) */
+    const int32_t nvol = wb_volume_count(w), nneo = wb_tet_count(w), nall = nvol + nneo;
+    int32_t *tet = (int32_t *)lua_newuserdatauv(L, sizeof *tet * 4 * (size_t)(nall > 0 ? nall : 1), 0);
     int32_t nt = 0;
-    for (int32_t i = 0; i < nvol; i++) {
+    for (int32_t i = 0; i < nall; i++) {
         int32_t p[4], in = 1;
-        wb_volume_particles(w, i, p);
+        if (i < nvol) wb_volume_particles(w, i, p);
+        else wb_tet_particles(w, i - nvol, p);
         for (int k = 0; k < 4; k++) in &= p[k] >= first && p[k] < first + count;
         if (!in) continue;
         for (int k = 0; k < 4; k++) tet[4 * nt + k] = p[k] - first;
         nt++;
     }
-    if (nt == 0) return luaL_error(L, "save_tets: no volume constraints %s", lua_isnoneornil(L, 3) ? "in the world" : "in the body");
+    if (nt == 0) return luaL_error(L, "save_tets: no tets (volume constraints or w:tet) %s", whole ? "in the world" : "in the body");
     const wb_real *x = wb_particle_positions(w) + 3 * (size_t)first;
     if (wbio_write_tets(node, node_shown, ele, ele_shown, x, count, tet, nt, err, sizeof err)) {
         luaL_pushfail(L);
