@@ -46,7 +46,8 @@ wb_tet_def wb_tet_default_def(void)
 
 const char *wb_tet_def_check(const wb_tet_def *d)
 {
-    if (!(d->young > 0) || !isfinite(d->young)) return "young must be > 0 (Pa)";
+    /* the bound: 100x diamond's modulus; far past it mu V0 and the energy overflow */
+    if (!(d->young > 0) || !(d->young <= 1e14)) return "young must be in (0, 1e14] (Pa)";
     if (!(d->poisson >= 0 && d->poisson < 0.5)) return "poisson must be in [0, 0.5)";
     return NULL;
 }

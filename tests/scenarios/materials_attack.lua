@@ -70,3 +70,23 @@ test("save_tets / load_tets carry Neo-Hookean tet bodies", function()
   expect.eq(d.tet_count, 6); expect.eq(u:volume_count(), 6)
   expect.error(function() wobble.world{}:save_tets("materials_attack/none") end, "no tets .* in the world")
 end)
+
+-- young = 1e300 was accepted and made a tet's energy -inf and w:energy() inf: refused
+-- now past 1e14 Pa (100x diamond's modulus), from Lua and from a config alike, naming it.
+test("young past 1e14 Pa is refused, the world unchanged", function()
+  local w = wobble.world{}
+  local p = { w:particle{ pos = { 0, 0, 0 } }, w:particle{ pos = { 1, 0, 0 } },
+              w:particle{ pos = { 0, 1, 0 } }, w:particle{ pos = { 0, 0, 1 } } }
+  local h = w:hash()
+  expect.error(function() w:tet(p[1], p[2], p[3], p[4], { young = 1e300 }) end, "young")
+  expect.error(function() w:lattice{ min = {0, 0, 0}, max = {1, 1, 1}, res = {2, 2, 2}, tets = true, young = 1e15 } end, "young")
+  expect.eq(w:hash(), h)
+  expect.eq(w:tet_count(), 0)
+  w:tet(p[1], p[2], p[3], p[4], { young = 1e14 })
+  local s, n = tet_snapshot():gsub('"young": [^,}]+', '"young": 1e300')
+  expect.eq(n, 1, "the snapshot names young once")
+  write("materials_attack/young.json", s)
+  local w2, e2 = wobble.load("materials_attack/young.json")
+  expect.eq(w2, nil)
+  expect.truthy(tostring(e2):find("young", 1, true), "the error names young: " .. tostring(e2))
+end)
