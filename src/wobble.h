@@ -317,6 +317,7 @@ typedef struct wb_stats {
     double step_ms;           /* wall time of the last step */
     double solve_ms;          /* of which constraint projection */
     int64_t warnings;         /* numerical trouble detected so far */
+    int32_t attachments, grabs; /* live ones (attach.c, grab.c) */
 } wb_stats;
 wb_stats wb_world_stats(const wb_world *w);
 
@@ -540,5 +541,37 @@ void wb_pressure_set(wb_world *w, int32_t i, wb_real pressure); /* pressure > 0,
 wb_real wb_pressure_volume(const wb_world *w, int32_t i);      /* enclosed now, m^3 */
 wb_real wb_pressure_rest_volume(const wb_world *w, int32_t i); /* V0, m^3 */
 int32_t wb_pressure_surface(const wb_world *w, int32_t i);
+
+/* ---- attachments and grabs (attach.c, grab.c; issue 10) ---------------------------------- */
+/* XPBD constraints C = x_p - target (a vector, zero rest length): compliance alpha in m/N
+ * (0 = exactly there at the end of every substep; else a spring of stiffness 1/alpha,
+ * F = -C/alpha, U = |C|^2 / (2 alpha)). force() is the force on the particle, lambda/h^2
+ * of the last substep, pointing to the target; it returns |F|. */
+typedef struct wb_attach_id { uint32_t index; uint32_t gen; } wb_attach_id;
+typedef struct wb_grab_id { uint32_t index; uint32_t gen; } wb_grab_id;
+
+/* particle p kept where it is now in collider c's frame: it rides the collider as the
+ * collider moves and turns, and no longer collides with it */
+wb_attach_id wb_attach_collider(wb_world *w, int32_t p, wb_collider_id c, wb_real compliance, wb_status *status);
+bool wb_attach_valid(const wb_world *w, wb_attach_id a);          /* live, its collider too */
+void wb_attach_remove(wb_world *w, wb_attach_id a);
+wb_real wb_attach_force(const wb_world *w, wb_attach_id a, wb_real f[3]); /* f may be NULL */
+int32_t wb_attach_particle(const wb_world *w, wb_attach_id a);
+void wb_attach_point(const wb_world *w, wb_attach_id a, wb_real out[3]); /* its target now, world */
+wb_real wb_attach_compliance(const wb_world *w, wb_attach_id a);
+int32_t wb_attach_count(const wb_world *w);                        /* live ones */
+wb_attach_id wb_attach_at(const wb_world *w, int32_t i);           /* i-th live, slot order */
+
+/* particle p pulled to target; the pose moved between steps is swept to over the next step */
+wb_grab_id wb_grab_add(wb_world *w, int32_t p, const wb_real target[3], wb_real compliance, wb_status *status);
+bool wb_grab_valid(const wb_world *w, wb_grab_id g);
+void wb_grab_release(wb_world *w, wb_grab_id g);
+void wb_grab_move(wb_world *w, wb_grab_id g, const wb_real target[3]); /* finite */
+void wb_grab_target(const wb_world *w, wb_grab_id g, wb_real out[3]);
+wb_real wb_grab_force(const wb_world *w, wb_grab_id g, wb_real f[3]);   /* f may be NULL */
+int32_t wb_grab_particle(const wb_world *w, wb_grab_id g);
+wb_real wb_grab_compliance(const wb_world *w, wb_grab_id g);
+int32_t wb_grab_count(const wb_world *w);
+wb_grab_id wb_grab_at(const wb_world *w, int32_t i);
 
 #endif

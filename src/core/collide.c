@@ -11,6 +11,7 @@
 
 #include "core.h"
 #include "bvh.h"
+#include "attach.h"
 
 /* ---- quaternions ------------------------------------------------------------------- */
 void q_normalize(wb_real q[4])
@@ -581,6 +582,7 @@ void wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1)
     const int32_t np = m->np;
     const int threads = m->def.threads;
     int64_t ncontacts = 0;
+    const wb_attaches *att = w->att && w->att->skip_np > 0 ? w->att : NULL; /* attached: no contact */
     #pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : ncontacts) if (threads > 1 && np >= 4096)
     for (int32_t i = 0; i < np; i++) {
         wb_real *xi = &x[3 * i], *vi = &v[3 * i];
@@ -590,6 +592,7 @@ void wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1)
         int nct = 0;
         for (int32_t c = 0; c < nlive; c++) {
             const sub_pose *sp = &cs[c];
+            if (att && wb__attach_skip(att, i, sp->slot)) continue;
             wb_real n[3], depth;
             if (sp->s->shape == WB_SHAPE_PLANE) {
                 depth = rad[i] + sp->off - v3_dot(sp->n, xi);

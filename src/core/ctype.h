@@ -18,6 +18,7 @@ typedef struct wb_ctype {
 
 extern const wb_ctype wb__distance_type, wb__bend_type, wb__volume_type,
                       wb__shape_type, wb__pressure_type, wb__tet_type;
+extern const wb_ctype wb__attach_type, wb__grab_type; /* attach.c, grab.c (issue 10) */
 
 /* the table the step walks (solver.c), in projection order, and its length */
 extern const wb_ctype *const wb__ctypes[];

@@ -1,5 +1,7 @@
 /* query.c: read-only measures of a world: energy, momenta, bounds, strain, hash, stats. */
 #include "ctype.h"
+#include "attach.h"
+#include "grab.h"
 
 static wb_real mass_of(const wb_world *w, int32_t i) { return w->m.w[i] > 0 ? 1 / w->m.w[i] : 0; }
 
@@ -135,6 +137,24 @@ uint64_t wb_world_hash(const wb_world *w)
         h = fnv(h, pr->alpha, sizeof(wb_real) * (size_t)pr->n);
         h = fnv(h, pr->v0, sizeof(wb_real) * (size_t)pr->n);
     }
+    /* attachments and grabs: the live ones in slot order (a snapshot keeps that order) */
+    const wb_attaches *at = w->att;
+    for (int32_t i = 0; at && i < at->n; i++) {
+        if (!(at->gen[i] & 1u)) continue;
+        h = fnv(h, &at->p[i], sizeof at->p[i]);
+        h = fnv(h, &at->kind[i], 1);
+        h = fnv(h, &at->tindex[i], sizeof at->tindex[i]);
+        h = fnv(h, &at->local[3 * i], 3 * sizeof(wb_real));
+        h = fnv(h, &at->alpha[i], sizeof(wb_real));
+    }
+    const wb_grabs *gr = w->grab;
+    for (int32_t i = 0; gr && i < gr->n; i++) {
+        if (!(gr->gen[i] & 1u)) continue;
+        h = fnv(h, &gr->p[i], sizeof gr->p[i]);
+        h = fnv(h, &gr->target[3 * i], 3 * sizeof(wb_real));
+        h = fnv(h, &gr->from[3 * i], 3 * sizeof(wb_real));
+        h = fnv(h, &gr->alpha[i], sizeof(wb_real));
+    }
     h = fnv(h, &s->time, sizeof s->time);
     h = fnv(h, &s->frame, sizeof s->frame);
     return h;
@@ -162,5 +182,7 @@ wb_stats wb_world_stats(const wb_world *w)
     st.step_ms = w->k.step_ms;
     st.solve_ms = w->k.solve_ms;
     st.warnings = w->s.warnings;
+    st.attachments = wb_attach_count(w);
+    st.grabs = wb_grab_count(w);
     return st;
 }

@@ -26,6 +26,8 @@ const wb_ctype *const wb__ctypes[] = {
     &wb__tet_type,
     &wb__shape_type,
     &wb__pressure_type,
+    &wb__attach_type,
+    &wb__grab_type,
 };
 const int wb__nctypes = (int)(sizeof wb__ctypes / sizeof wb__ctypes[0]);
 

@@ -1,0 +1,303 @@
+/* attach.c: attachments (DESIGN.md §2, one file per constraint type; issue 10 part 3).
+ *
+ * A particle is kept at a point fixed in a target's frame: the point `local` is stored
+ * in that frame when it is made, and every substep the target is where the target is
+ * at that substep (a kinematic collider sweeps from its last pose to the one the script
+ * set, wb__collider_pose_at, exactly as the particles' collider contacts see it). So a
+ * turning drum carries a rope's end round and winds the rope on.
+ *
+ * XPBD with a vector constraint C = x - t (zero rest length; the target has no inverse
+ * mass): dlambda = (-C - alpha~ lambda) / (w + alpha~), x += w dlambda, alpha~ = alpha/h^2.
+ * A vector multiplier has no direction to lose when C = 0. Force on the particle:
+ * lambda / h^2. Energy: |C|^2 / (2 alpha) for compliant ones.
+ *
+ * Model: particle, target {kind, slot, gen}, local point, compliance. Cache: multipliers
+ * and the substep counter. The pass is serial in slot order: deterministic for any thread
+ * count (attachments are few; colouring them is not worth it). */
+#include <assert.h>
+
+#include "attach.h"
+#include "ctype.h"
+#include "shape_match.h"
+
+#define ATTACH_BYTES (2 * sizeof(int32_t) + 1 + 2 * sizeof(uint32_t) + 7 * sizeof(wb_real))
+
+static int live(const wb_attaches *a, int32_t s) { return (a->gen[s] & 1u) != 0; }
+
+/* the target still exists (a removed collider leaves its attachments inert) */
+static int target_live(const wb_world *w, const wb_attaches *a, int32_t s)
+{
+    if (a->kind[s] != WB_TARGET_COLLIDER) return 0; /* rigid bodies: wired at the merge */
+    const int32_t c = a->tindex[s];
+    return c >= 0 && c < w->m.nc && w->m.c_gen[c] == a->tgen[s];
+}
+
+/* the target's pose at fraction f of the current step (f >= 1: the pose now) */
+static void target_pose(const wb_world *w, const wb_attaches *a, int32_t s, wb_real f, wb_real p[3], wb_real q[4])
+{
+    wb__collider_pose_at(&w->s.c_pose[a->tindex[s]], f, p, q);
+}
+
+static void point_at(const wb_world *w, const wb_attaches *a, int32_t s, wb_real f, wb_real out[3])
+{
+    wb_real p[3], q[4];
+    target_pose(w, a, s, f, p, q);
+    q_rotate(q, &a->local[3 * s], out);
+    v3_add(out, out, p);
+}
+
+wb_status wb__attach_reserve(wb_world *w, int64_t extra)
+{
+    wb_attaches *a = w->att;
+    if (!a) {
+        a = calloc(1, sizeof *a);
+        if (!a) return WB_ERR_NOMEM;
+        w->att = a;
+    }
+    const int64_t need = a->n + extra;
+    if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    if (need <= a->cap) return WB_OK;
+    int64_t cap = a->cap ? 2 * (int64_t)a->cap : 16;
+    while (cap < need) cap *= 2;
+    if (cap > WB_MAX_CONSTRAINTS) cap = WB_MAX_CONSTRAINTS;
+    if (!wb__material_charge(w, &a->charged, (size_t)cap * ATTACH_BYTES)) return WB_ERR_NOMEM;
+    struct { void **p; size_t elem; } arr[] = {
+        { (void **)&a->p, sizeof(int32_t) }, { (void **)&a->kind, 1 }, { (void **)&a->tindex, sizeof(int32_t) },
+        { (void **)&a->tgen, sizeof(uint32_t) }, { (void **)&a->local, 3 * sizeof(wb_real) },
+        { (void **)&a->alpha, sizeof(wb_real) }, { (void **)&a->gen, sizeof(uint32_t) },
+        { (void **)&a->lambda, 3 * sizeof(wb_real) },
+    };
+    for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
+        void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
+        if (!q) return WB_ERR_NOMEM; /* arrays already grown are merely larger */
+        *arr[i].p = q;
+    }
+    a->cap = (int32_t)cap;
+    return WB_OK;
+}
+
+static void fill(wb_attaches *a, int32_t s, int32_t p, int kind, int32_t tindex, uint32_t tgen,
+                 const wb_real local[3], wb_real alpha)
+{
+    a->p[s] = p;
+    a->kind[s] = (uint8_t)kind;
+    a->tindex[s] = tindex;
+    a->tgen[s] = tgen;
+    v3_copy(&a->local[3 * s], local);
+    a->alpha[s] = alpha;
+    v3_set(&a->lambda[3 * s], 0, 0, 0);
+    a->nlive++;
+    a->dirty = 1;
+}
+
+/* a new live slot after the last one (snapshots restore the live slots in order) */
+void wb__attach_put(wb_world *w, int32_t p, int kind, int32_t tindex, uint32_t tgen, const wb_real local[3],
+                    wb_real alpha)
+{
+    wb_attaches *a = w->att;
+    assert(a && a->n < a->cap); /* contract: reserved first */
+    const int32_t s = a->n++;
+    fill(a, s, p, kind, tindex, tgen, local, alpha);
+    a->gen[s] = 1;
+}
+
+wb_attach_id wb_attach_collider(wb_world *w, int32_t p, wb_collider_id c, wb_real compliance, wb_status *status)
+{
+    wb_attach_id none = { 0, 0 };
+    wb_status dummy;
+    if (!status) status = &dummy;
+    const char *err = !(compliance >= 0) || !isfinite(compliance) ? "compliance must be >= 0"
+                    : p < 0 || p >= w->m.np ? "particle out of range"
+                    : !wb_collider_valid(w, c) ? "collider removed" : NULL;
+    if (err) {
+        wb__set_error("%s", err);
+        *status = WB_ERR_ARG;
+        return none;
+    }
+    /* the point where the particle is now, in the collider's frame at its pose now */
+    const int32_t slot_c = (int32_t)c.index - 1;
+    const wb_collider_pose *cp = &w->s.c_pose[slot_c];
+    wb_real r[3], local[3];
+    v3_sub(r, &w->s.x[3 * p], cp->p);
+    q_rotate_inv(cp->q, r, local);
+    if (!isfinite(local[0]) || !isfinite(local[1]) || !isfinite(local[2])) {
+        wb__set_error("the particle is too far from the collider (its offset overflows)");
+        *status = WB_ERR_ARG;
+        return none;
+    }
+    /* the lowest dead slot, else a new one */
+    wb_attaches *a = w->att;
+    int32_t s = -1;
+    for (int32_t i = 0; a && i < a->n && s < 0; i++)
+        if (!live(a, i)) s = i;
+    if (s < 0) {
+        wb_status st = wb__attach_reserve(w, 1);
+        if (st != WB_OK) { *status = st; return none; }
+        wb__attach_put(w, p, WB_TARGET_COLLIDER, slot_c, c.gen, local, compliance);
+        a = w->att;
+        s = a->n - 1;
+    } else {
+        fill(a, s, p, WB_TARGET_COLLIDER, slot_c, c.gen, local, compliance);
+        a->gen[s]++; /* even -> odd: live, old handles of the slot stay stale */
+    }
+    *status = WB_OK;
+    wb_attach_id id = { (uint32_t)s + 1, a->gen[s] };
+    return id;
+}
+
+static int32_t slot_of(const wb_world *w, wb_attach_id id)
+{
+    const wb_attaches *a = w->att;
+    if (!a || id.index == 0 || id.index > (uint32_t)a->n) return -1;
+    const int32_t s = (int32_t)id.index - 1;
+    return live(a, s) && a->gen[s] == id.gen ? s : -1;
+}
+
+bool wb_attach_valid(const wb_world *w, wb_attach_id id)
+{
+    const int32_t s = slot_of(w, id);
+    return s >= 0 && target_live(w, w->att, s);
+}
+
+#define SLOT(w, id) (assert(slot_of((w), (id)) >= 0), (int32_t)(id).index - 1)
+
+void wb_attach_remove(wb_world *w, wb_attach_id id)
+{
+    const int32_t s = SLOT(w, id);
+    w->att->gen[s]++;
+    w->att->nlive--;
+    w->att->dirty = 1;
+}
+
+wb_real wb_attach_force(const wb_world *w, wb_attach_id id, wb_real f[3])
+{
+    const int32_t s = SLOT(w, id);
+    const wb_real h = w->k.h_last;
+    wb_real out[3] = { 0, 0, 0 };
+    if (h > 0) v3_scale(out, &w->att->lambda[3 * s], 1 / (h * h));
+    if (f) v3_copy(f, out);
+    return v3_len(out);
+}
+
+int32_t wb_attach_particle(const wb_world *w, wb_attach_id id) { return w->att->p[SLOT(w, id)]; }
+wb_real wb_attach_compliance(const wb_world *w, wb_attach_id id) { return w->att->alpha[SLOT(w, id)]; }
+
+void wb_attach_point(const wb_world *w, wb_attach_id id, wb_real out[3])
+{
+    const int32_t s = SLOT(w, id);
+    if (target_live(w, w->att, s)) point_at(w, w->att, s, 1, out);
+    else v3_copy(out, &w->s.x[3 * w->att->p[s]]);
+}
+
+int32_t wb_attach_count(const wb_world *w)
+{
+    const wb_attaches *a = w->att;
+    int32_t n = 0;
+    for (int32_t s = 0; a && s < a->n; s++) n += live(a, s) && target_live(w, a, s);
+    return n;
+}
+
+wb_attach_id wb_attach_at(const wb_world *w, int32_t i)
+{
+    const wb_attaches *a = w->att;
+    for (int32_t s = 0; a && s < a->n; s++) {
+        if (!live(a, s) || !target_live(w, a, s)) continue;
+        if (i-- == 0) { wb_attach_id id = { (uint32_t)s + 1, a->gen[s] }; return id; }
+    }
+    wb_attach_id none = { 0, 0 };
+    return none;
+}
+
+/* ---- the type ---------------------------------------------------------------------- */
+static int32_t att_count(const wb_world *w) { return wb_attach_count(w); }
+
+/* once per step: attachments whose collider was removed die; the particle -> collider
+ * skip table is rebuilt when anything changed */
+static wb_status att_prepare(wb_world *w)
+{
+    wb_attaches *a = w->att;
+    if (!a) return WB_OK;
+    a->sub = 0;
+    for (int32_t s = 0; s < a->n; s++)
+        if (live(a, s) && !target_live(w, a, s)) {
+            a->gen[s]++;
+            a->nlive--;
+            a->dirty = 1;
+        }
+    const int32_t np = w->m.np;
+    if (a->nlive == 0) a->skip_np = 0; /* nothing to skip: collide.c does not look */
+    if (a->nlive == 0 || (!a->dirty && a->skip_np == np)) return WB_OK;
+    int32_t *st = wb__grow(a->skip_start, &a->cap_start, np + 1, sizeof *st);
+    if (!st) return WB_ERR_NOMEM;
+    a->skip_start = st;
+    int32_t *col = wb__grow(a->skip_col, &a->cap_col, a->nlive > 0 ? a->nlive : 1, sizeof *col);
+    if (!col) return WB_ERR_NOMEM;
+    a->skip_col = col;
+    /* counting sort by particle, slot order inside one */
+    memset(st, 0, sizeof *st * ((size_t)np + 1));
+    for (int32_t s = 0; s < a->n; s++)
+        if (live(a, s) && a->kind[s] == WB_TARGET_COLLIDER && a->p[s] < np) st[a->p[s] + 1]++;
+    for (int32_t i = 0; i < np; i++) st[i + 1] += st[i];
+    for (int32_t s = 0; s < a->n; s++)
+        if (live(a, s) && a->kind[s] == WB_TARGET_COLLIDER && a->p[s] < np) col[st[a->p[s]]++] = a->tindex[s];
+    for (int32_t i = np; i > 0; i--) st[i] = st[i - 1];
+    st[0] = 0;
+    a->skip_np = np;
+    a->dirty = 0;
+    return WB_OK;
+}
+
+static void att_substep_begin(wb_world *w)
+{
+    wb_attaches *a = w->att;
+    if (!a) return;
+    a->sub++;
+    if (a->n > 0) memset(a->lambda, 0, sizeof(wb_real) * 3 * (size_t)a->n);
+}
+
+static void att_project(wb_world *w, wb_real h)
+{
+    wb_attaches *a = w->att;
+    if (!a || a->nlive == 0) return;
+    /* the target at this substep's end, as the collider contacts place the collider */
+    const wb_real f = (wb_real)a->sub / w->m.def.substeps;
+    const wb_real inv_h2 = 1 / (h * h);
+    const wb_real *wv = w->m.w;
+    wb_real *x = w->s.x;
+    w->k.projections += a->nlive;
+    for (int32_t s = 0; s < a->n; s++) {
+        if (!live(a, s) || !target_live(w, a, s)) continue;
+        const int32_t p = a->p[s];
+        const wb_real wp = wv[p];
+        if (wp == 0) continue; /* pinned or immovable: never written */
+        const wb_real at = a->alpha[s] * inv_h2;
+        if (isinf(at)) continue;
+        wb_real t[3];
+        point_at(w, a, s, f, t);
+        wb_real *xp = &x[3 * p], *l = &a->lambda[3 * s];
+        const wb_real inv = 1 / (wp + at);
+        for (int k = 0; k < 3; k++) {
+            const wb_real dl = (t[k] - xp[k] - at * l[k]) * inv;
+            l[k] += dl;
+            xp[k] += wp * dl;
+        }
+    }
+}
+
+static wb_real att_energy(const wb_world *w)
+{
+    const wb_attaches *a = w->att;
+    wb_real e = 0;
+    for (int32_t s = 0; a && s < a->n; s++) {
+        if (!live(a, s) || !target_live(w, a, s) || !(a->alpha[s] > 0)) continue;
+        wb_real t[3], c[3];
+        point_at(w, a, s, 1, t);
+        v3_sub(c, &w->s.x[3 * a->p[s]], t);
+        e += v3_dot(c, c) / (2 * a->alpha[s]);
+    }
+    return e;
+}
+
+const wb_ctype wb__attach_type = {
+    "attach", att_count, att_prepare, att_substep_begin, att_project, NULL, att_energy,
+};

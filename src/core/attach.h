@@ -1,0 +1,65 @@
+/* attach.h: attachments (attach.c): a particle kept at a point fixed in a target's frame.
+ *
+ * The target is a tagged union {kind, index, gen} (RIGID.md): this session only
+ * kinematic colliders; rigid bodies (issue 10, `rigid`) add the kind and apply the
+ * correction to the body too. Slots live while gen is odd, like colliders'. */
+#ifndef WB_ATTACH_H
+#define WB_ATTACH_H
+
+#include <stdlib.h>
+
+#include "core.h"
+
+enum { WB_TARGET_COLLIDER = 0, WB_TARGET_RIGID = 1 };
+
+/* w->att: NULL until the first attachment */
+typedef struct wb_attaches {
+    int32_t n, cap, nlive;  /* slots, capacity, live ones */
+    /* model */
+    int32_t *p;             /* (n) particle */
+    uint8_t *kind;          /* (n) WB_TARGET_* */
+    int32_t *tindex;        /* (n) target slot (0-based) */
+    uint32_t *tgen;         /* (n) target generation when attached */
+    wb_real *local;         /* (n x 3) the point in the target's frame */
+    wb_real *alpha;         /* (n) compliance, m/N */
+    uint32_t *gen;          /* (n) odd = live */
+    /* cache */
+    wb_real *lambda;        /* (n x 3) multipliers of the current substep (vector: C = x - target) */
+    int32_t sub;            /* substeps begun in this step: the target's pose is the one at sub/substeps */
+    size_t charged;         /* bytes charged to def.memory */
+    /* particle -> colliders it is attached to (CSR, rebuilt by prepare when dirty): the
+     * particle-collider contact of such a pair is skipped (collide.c) */
+    int dirty;
+    int32_t skip_np;        /* particles when it was built; 0 = no skips */
+    int32_t *skip_start;    /* (skip_np + 1) */
+    int32_t *skip_col;      /* collider slots */
+    int32_t cap_start, cap_col;
+} wb_attaches;
+
+/* collide.c: is particle i attached to collider slot c (no contact between them)? */
+static inline int wb__attach_skip(const wb_attaches *a, int32_t i, int32_t c)
+{
+    if (i >= a->skip_np) return 0;
+    for (int32_t k = a->skip_start[i]; k < a->skip_start[i + 1]; k++)
+        if (a->skip_col[k] == c) return 1;
+    return 0;
+}
+
+/* world.c's destroy: arrays freed, budget given back (inline: no call between the files) */
+static inline void wb__attach_free(wb_world *w)
+{
+    wb_attaches *a = w->att;
+    if (!a) return;
+    if (w->m.def.memory) w->m.def.memory->used -= a->charged;
+    void *p[] = { a->p, a->kind, a->tindex, a->tgen, a->local, a->alpha, a->gen, a->lambda,
+                  a->skip_start, a->skip_col };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    free(a);
+    w->att = NULL;
+}
+
+/* snapshot.c: room for `extra` more (charged), then put one (cannot fail after reserving) */
+wb_status wb__attach_reserve(wb_world *w, int64_t extra);
+void wb__attach_put(wb_world *w, int32_t p, int kind, int32_t tindex, uint32_t tgen, const wb_real local[3],
+                    wb_real alpha);
+#endif

@@ -1,0 +1,228 @@
+/* grab.c: grabs (DESIGN.md §2, one file per constraint type; issue 10 part 4).
+ *
+ * The scripted form of dragging a particle with the mouse: particle p is pulled to a
+ * target point the script moves. XPBD with the vector constraint C = x - t, as
+ * attach.c: dlambda = (-C - alpha~ lambda) / (w + alpha~), x += w dlambda. Compliance 0
+ * puts the particle exactly on the target at the end of every substep; a compliant grab
+ * is a zero-length spring of stiffness 1/alpha (F = -C/alpha, U = |C|^2 / (2 alpha)).
+ *
+ * A target moved between steps is swept to over the next step (from the last step's
+ * target, linearly, substep by substep, as kinematic colliders move), so a jump of the
+ * mouse gives the particle the speed of the move over the frame, not over one substep.
+ *
+ * Model: particle, compliance. State: target and sweep start. Cache: multipliers and the
+ * substep counter. Serial pass in slot order: deterministic for any thread count. */
+#include <assert.h>
+
+#include "ctype.h"
+#include "grab.h"
+#include "shape_match.h"
+
+#define GRAB_BYTES (sizeof(int32_t) + sizeof(uint32_t) + 10 * sizeof(wb_real))
+
+static int live(const wb_grabs *g, int32_t s) { return (g->gen[s] & 1u) != 0; }
+
+wb_status wb__grab_reserve(wb_world *w, int64_t extra)
+{
+    wb_grabs *g = w->grab;
+    if (!g) {
+        g = calloc(1, sizeof *g);
+        if (!g) return WB_ERR_NOMEM;
+        w->grab = g;
+    }
+    const int64_t need = g->n + extra;
+    if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    if (need <= g->cap) return WB_OK;
+    int64_t cap = g->cap ? 2 * (int64_t)g->cap : 16;
+    while (cap < need) cap *= 2;
+    if (cap > WB_MAX_CONSTRAINTS) cap = WB_MAX_CONSTRAINTS;
+    if (!wb__material_charge(w, &g->charged, (size_t)cap * GRAB_BYTES)) return WB_ERR_NOMEM;
+    struct { void **p; size_t elem; } arr[] = {
+        { (void **)&g->p, sizeof(int32_t) }, { (void **)&g->alpha, sizeof(wb_real) },
+        { (void **)&g->gen, sizeof(uint32_t) }, { (void **)&g->target, 3 * sizeof(wb_real) },
+        { (void **)&g->from, 3 * sizeof(wb_real) }, { (void **)&g->lambda, 3 * sizeof(wb_real) },
+    };
+    for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
+        void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
+        if (!q) return WB_ERR_NOMEM; /* arrays already grown are merely larger */
+        *arr[i].p = q;
+    }
+    g->cap = (int32_t)cap;
+    return WB_OK;
+}
+
+static void fill(wb_grabs *g, int32_t s, int32_t p, const wb_real target[3], const wb_real from[3], wb_real alpha)
+{
+    g->p[s] = p;
+    g->alpha[s] = alpha;
+    v3_copy(&g->target[3 * s], target);
+    v3_copy(&g->from[3 * s], from);
+    v3_set(&g->lambda[3 * s], 0, 0, 0);
+    g->nlive++;
+}
+
+/* a new live slot after the last one (snapshots restore the live slots in order) */
+void wb__grab_put(wb_world *w, int32_t p, const wb_real target[3], const wb_real from[3], wb_real alpha)
+{
+    wb_grabs *g = w->grab;
+    assert(g && g->n < g->cap); /* contract: reserved first */
+    const int32_t s = g->n++;
+    fill(g, s, p, target, from, alpha);
+    g->gen[s] = 1;
+}
+
+static int fin3(const wb_real *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
+wb_grab_id wb_grab_add(wb_world *w, int32_t p, const wb_real target[3], wb_real compliance, wb_status *status)
+{
+    wb_grab_id none = { 0, 0 };
+    wb_status dummy;
+    if (!status) status = &dummy;
+    const char *err = !(compliance >= 0) || !isfinite(compliance) ? "compliance must be >= 0"
+                    : p < 0 || p >= w->m.np ? "particle out of range"
+                    : !fin3(target) ? "target must be finite" : NULL;
+    if (err) {
+        wb__set_error("%s", err);
+        *status = WB_ERR_ARG;
+        return none;
+    }
+    wb_grabs *g = w->grab;
+    int32_t s = -1;
+    for (int32_t i = 0; g && i < g->n && s < 0; i++)
+        if (!live(g, i)) s = i;
+    /* a new grab starts at its target: it pulls from the first substep on */
+    if (s < 0) {
+        wb_status st = wb__grab_reserve(w, 1);
+        if (st != WB_OK) { *status = st; return none; }
+        wb__grab_put(w, p, target, target, compliance);
+        g = w->grab;
+        s = g->n - 1;
+    } else {
+        fill(g, s, p, target, target, compliance);
+        g->gen[s]++; /* even -> odd: live, old handles of the slot stay stale */
+    }
+    *status = WB_OK;
+    wb_grab_id id = { (uint32_t)s + 1, g->gen[s] };
+    return id;
+}
+
+bool wb_grab_valid(const wb_world *w, wb_grab_id id)
+{
+    const wb_grabs *g = w->grab;
+    if (!g || id.index == 0 || id.index > (uint32_t)g->n) return false;
+    const int32_t s = (int32_t)id.index - 1;
+    return live(g, s) && g->gen[s] == id.gen;
+}
+
+#define SLOT(w, id) (assert(wb_grab_valid((w), (id))), (int32_t)(id).index - 1)
+
+void wb_grab_release(wb_world *w, wb_grab_id id)
+{
+    const int32_t s = SLOT(w, id);
+    w->grab->gen[s]++;
+    w->grab->nlive--;
+}
+
+void wb_grab_move(wb_world *w, wb_grab_id id, const wb_real target[3])
+{
+    assert(fin3(target));
+    v3_copy(&w->grab->target[3 * SLOT(w, id)], target);
+}
+
+void wb_grab_target(const wb_world *w, wb_grab_id id, wb_real out[3]) { v3_copy(out, &w->grab->target[3 * SLOT(w, id)]); }
+int32_t wb_grab_particle(const wb_world *w, wb_grab_id id) { return w->grab->p[SLOT(w, id)]; }
+wb_real wb_grab_compliance(const wb_world *w, wb_grab_id id) { return w->grab->alpha[SLOT(w, id)]; }
+
+wb_real wb_grab_force(const wb_world *w, wb_grab_id id, wb_real f[3])
+{
+    const int32_t s = SLOT(w, id);
+    const wb_real h = w->k.h_last;
+    wb_real out[3] = { 0, 0, 0 };
+    if (h > 0) v3_scale(out, &w->grab->lambda[3 * s], 1 / (h * h));
+    if (f) v3_copy(f, out);
+    return v3_len(out);
+}
+
+int32_t wb_grab_count(const wb_world *w) { return w->grab ? w->grab->nlive : 0; }
+
+wb_grab_id wb_grab_at(const wb_world *w, int32_t i)
+{
+    const wb_grabs *g = w->grab;
+    for (int32_t s = 0; g && s < g->n; s++) {
+        if (!live(g, s)) continue;
+        if (i-- == 0) { wb_grab_id id = { (uint32_t)s + 1, g->gen[s] }; return id; }
+    }
+    wb_grab_id none = { 0, 0 };
+    return none;
+}
+
+/* ---- the type ---------------------------------------------------------------------- */
+static int32_t grab_count(const wb_world *w) { return wb_grab_count(w); }
+
+static wb_status grab_prepare(wb_world *w)
+{
+    if (w->grab) w->grab->sub = 0;
+    return WB_OK;
+}
+
+static void grab_substep_begin(wb_world *w)
+{
+    wb_grabs *g = w->grab;
+    if (!g) return;
+    g->sub++;
+    if (g->n > 0) memset(g->lambda, 0, sizeof(wb_real) * 3 * (size_t)g->n);
+}
+
+static void grab_project(wb_world *w, wb_real h)
+{
+    wb_grabs *g = w->grab;
+    if (!g || g->nlive == 0) return;
+    const int32_t n_sub = w->m.def.substeps;
+    const wb_real f = (wb_real)g->sub / n_sub;
+    const wb_real inv_h2 = 1 / (h * h);
+    const wb_real *wv = w->m.w;
+    wb_real *x = w->s.x;
+    w->k.projections += g->nlive;
+    for (int32_t s = 0; s < g->n; s++) {
+        if (!live(g, s)) continue;
+        const int32_t p = g->p[s];
+        const wb_real wp = wv[p];
+        if (wp == 0) continue; /* pinned or immovable: never written */
+        const wb_real at = g->alpha[s] * inv_h2;
+        if (isinf(at)) continue;
+        const wb_real *t1 = &g->target[3 * s], *t0 = &g->from[3 * s];
+        wb_real *xp = &x[3 * p], *l = &g->lambda[3 * s];
+        const wb_real inv = 1 / (wp + at);
+        for (int k = 0; k < 3; k++) {
+            /* the last substep reaches the target exactly, not t0 + (t1 - t0) rounded */
+            const wb_real t = g->sub >= n_sub ? t1[k] : t0[k] + (t1[k] - t0[k]) * f;
+            const wb_real dl = (t - xp[k] - at * l[k]) * inv;
+            l[k] += dl;
+            xp[k] += wp * dl;
+        }
+    }
+}
+
+/* the sweep of the next step starts where this one ended */
+static void grab_frame_end(wb_world *w)
+{
+    wb_grabs *g = w->grab;
+    if (g && g->n > 0) memcpy(g->from, g->target, sizeof(wb_real) * 3 * (size_t)g->n);
+}
+
+static wb_real grab_energy(const wb_world *w)
+{
+    const wb_grabs *g = w->grab;
+    wb_real e = 0;
+    for (int32_t s = 0; g && s < g->n; s++) {
+        if (!live(g, s) || !(g->alpha[s] > 0)) continue;
+        wb_real c[3];
+        v3_sub(c, &w->s.x[3 * g->p[s]], &g->target[3 * s]);
+        e += v3_dot(c, c) / (2 * g->alpha[s]);
+    }
+    return e;
+}
+
+const wb_ctype wb__grab_type = {
+    "grab", grab_count, grab_prepare, grab_substep_begin, grab_project, grab_frame_end, grab_energy,
+};
