@@ -442,6 +442,8 @@ static int w_stats(lua_State *L)
     SETI("tets", s.tets);
     SETI("shape_matches", s.shape_matches);
     SETI("pressures", s.pressures);
+    SETI("attachments", s.attachments);
+    SETI("grabs", s.grabs);
     SETI("colours", s.colours);
     SETI("contacts", s.contacts);
     SETI("particle_contacts", s.particle_contacts);

@@ -35,6 +35,8 @@ local function fixture()
   f.pr = f.w:pressure(f.body)
   f.r = wobble.renderer{ width = 8, height = 8, backend = "null" }
   f.rec = f.w:record_vtk("api_generic/rec")
+  f.att = f.w:attach(f.p, f.col)
+  f.grab = f.w:grab(f.q, {1, 0, 0})
   return f
 end
 
@@ -202,6 +204,19 @@ CASES["pressure:set_pressure"] = { args = { 1.5 }, nums = { 1 }, call = function
 for _, name in ipairs{ "pressure", "rest_volume", "volume", "world" } do
   CASES["pressure:" .. name] = { none = "a getter: no arguments" }
 end
+CASES["world:attach"] = { opts = { compliance = 0 }, opts_arg = 3, nums = { "compliance" },
+                          call = function(f, o) return f.w:attach(f.r3, f.col, o) end }
+CASES["world:grab"] = { opts = { compliance = 0 }, opts_arg = 3, nums = { "compliance" },
+                        call = function(f, o) return f.w:grab(f.r3, {0, 1, 0}, o) end }
+CASES["world:attachments"] = { none = "a getter: no arguments" }
+CASES["world:grabs"] = { none = "a getter: no arguments" }
+for _, name in ipairs{ "force", "particle", "point", "remove", "valid" } do
+  CASES["attach:" .. name] = { none = "a getter or remove: no arguments" }
+end
+CASES["grab:move"] = { args = { 0, 1, 0 }, nums = { 1, 2, 3 }, call = function(f, ...) return f.grab:move(...) end }
+for _, name in ipairs{ "force", "particle", "release", "target", "valid" } do
+  CASES["grab:" .. name] = { none = "a getter or release: no arguments" }
+end
 CASES["body:pin_where"] = { none = "a predicate function" }
 CASES["body:pin_all"] = { none = "no arguments" }
 CASES["body:unpin_all"] = { none = "no arguments" }
@@ -268,6 +283,8 @@ local function api()
   methods_of("collider", f.col, names)
   methods_of("shape_match", f.sm, names)
   methods_of("pressure", f.pr, names)
+  methods_of("attach", f.att, names)
+  methods_of("grab", f.grab, names)
   methods_of("body", f.body, names)
   methods_of("mesh", f.m, names)
   methods_of("skin", f.skin, names)
