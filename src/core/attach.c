@@ -19,6 +19,7 @@
 #include "attach.h"
 #include "ctype.h"
 #include "shape_match.h"
+#include "snapshot.h"
 
 #define ATTACH_BYTES (2 * sizeof(int32_t) + 1 + 2 * sizeof(uint32_t) + 7 * sizeof(wb_real))
 
@@ -206,6 +207,79 @@ wb_attach_id wb_attach_at(const wb_world *w, int32_t i)
     }
     wb_attach_id none = { 0, 0 };
     return none;
+}
+
+/* ---- images (snapshot.h) ------------------------------------------------------------- */
+static void *zalloc(int64_t n, size_t elem) { return calloc((size_t)(n > 0 ? n : 1), elem); }
+
+void wb__attach_image_free(wb_image *g)
+{
+    wb_image_attach *a = &g->att;
+    free(a->p); free(a->kind); free(a->target); free(a->local); free(a->alpha);
+    memset(a, 0, sizeof *a);
+}
+
+wb_status wb_image_alloc_attach(wb_image *g, int32_t n)
+{
+    wb__attach_image_free(g);
+    wb_image_attach *a = &g->att;
+    a->n = n;
+    a->p = zalloc(n, sizeof *a->p);
+    a->kind = zalloc(n, sizeof *a->kind);
+    a->target = zalloc(n, sizeof *a->target);
+    a->local = zalloc(3 * (int64_t)n, sizeof *a->local);
+    a->alpha = zalloc(n, sizeof *a->alpha);
+    if (a->p && a->kind && a->target && a->local && a->alpha) return WB_OK;
+    wb__attach_image_free(g);
+    return WB_ERR_NOMEM;
+}
+
+wb_status wb__attach_image_of(const wb_world *w, wb_image *g)
+{
+    wb_status st = wb_image_alloc_attach(g, wb_attach_count(w));
+    if (st != WB_OK) return st;
+    const wb_attaches *a = w->att;
+    int32_t k = 0;
+    for (int32_t s = 0; a && s < a->n; s++) {
+        if (!live(a, s) || !target_live(w, a, s)) continue;
+        g->att.p[k] = a->p[s];
+        g->att.kind[k] = a->kind[s];
+        g->att.target[k] = a->tindex[s];
+        v3_copy(&g->att.local[3 * k], &a->local[3 * s]);
+        g->att.alpha[k] = a->alpha[s];
+        k++;
+    }
+    return WB_OK;
+}
+
+const char *wb__attach_image_check(const wb_image *g)
+{
+    const wb_image_attach *a = &g->att;
+    if (a->n < 0 || a->n > WB_MAX_CONSTRAINTS) return "too many attachments";
+    for (int32_t k = 0; k < a->n; k++) {
+        if (a->p[k] < 0 || a->p[k] >= g->np) return "attachment particle out of range";
+        if (a->kind[k] != WB_TARGET_COLLIDER) return "attachment target kind unknown (0 = collider)";
+        const int32_t c = a->target[k];
+        if (c < 0 || c >= g->nc || !(g->c_gen[c] & 1u)) return "attachment collider out of range";
+        if (!isfinite(a->local[3 * k]) || !isfinite(a->local[3 * k + 1]) || !isfinite(a->local[3 * k + 2]))
+            return "attachment point must be finite";
+        if (!(a->alpha[k] >= 0) || !isfinite(a->alpha[k])) return "attachment compliance must be >= 0";
+    }
+    return NULL;
+}
+
+wb_status wb__attach_image_reserve(wb_world *w, const wb_image *g)
+{
+    return g->att.n > 0 ? wb__attach_reserve(w, g->att.n) : WB_OK;
+}
+
+void wb__attach_image_put(wb_world *w, const wb_image *g, int32_t pshift, const int32_t *cmap)
+{
+    const wb_image_attach *a = &g->att;
+    for (int32_t k = 0; k < a->n; k++) {
+        const int32_t c = cmap ? cmap[a->target[k]] : a->target[k];
+        wb__attach_put(w, a->p[k] + pshift, a->kind[k], c, w->m.c_gen[c], &a->local[3 * k], a->alpha[k]);
+    }
 }
 
 /* ---- the type ---------------------------------------------------------------------- */

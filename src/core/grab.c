@@ -17,6 +17,7 @@
 #include "ctype.h"
 #include "grab.h"
 #include "shape_match.h"
+#include "snapshot.h"
 
 #define GRAB_BYTES (sizeof(int32_t) + sizeof(uint32_t) + 10 * sizeof(wb_real))
 
@@ -154,6 +155,71 @@ wb_grab_id wb_grab_at(const wb_world *w, int32_t i)
     }
     wb_grab_id none = { 0, 0 };
     return none;
+}
+
+/* ---- images (snapshot.h) ------------------------------------------------------------- */
+static void *zalloc(int64_t n, size_t elem) { return calloc((size_t)(n > 0 ? n : 1), elem); }
+
+void wb__grab_image_free(wb_image *g)
+{
+    wb_image_grab *a = &g->grab;
+    free(a->p); free(a->target); free(a->from); free(a->alpha);
+    memset(a, 0, sizeof *a);
+}
+
+wb_status wb_image_alloc_grab(wb_image *g, int32_t n)
+{
+    wb__grab_image_free(g);
+    wb_image_grab *a = &g->grab;
+    a->n = n;
+    a->p = zalloc(n, sizeof *a->p);
+    a->target = zalloc(3 * (int64_t)n, sizeof *a->target);
+    a->from = zalloc(3 * (int64_t)n, sizeof *a->from);
+    a->alpha = zalloc(n, sizeof *a->alpha);
+    if (a->p && a->target && a->from && a->alpha) return WB_OK;
+    wb__grab_image_free(g);
+    return WB_ERR_NOMEM;
+}
+
+wb_status wb__grab_image_of(const wb_world *w, wb_image *img)
+{
+    wb_status st = wb_image_alloc_grab(img, wb_grab_count(w));
+    if (st != WB_OK) return st;
+    const wb_grabs *g = w->grab;
+    int32_t k = 0;
+    for (int32_t s = 0; g && s < g->n; s++) {
+        if (!live(g, s)) continue;
+        img->grab.p[k] = g->p[s];
+        v3_copy(&img->grab.target[3 * k], &g->target[3 * s]);
+        v3_copy(&img->grab.from[3 * k], &g->from[3 * s]);
+        img->grab.alpha[k] = g->alpha[s];
+        k++;
+    }
+    return WB_OK;
+}
+
+const char *wb__grab_image_check(const wb_image *img)
+{
+    const wb_image_grab *g = &img->grab;
+    if (g->n < 0 || g->n > WB_MAX_CONSTRAINTS) return "too many grabs";
+    for (int32_t k = 0; k < g->n; k++) {
+        if (g->p[k] < 0 || g->p[k] >= img->np) return "grab particle out of range";
+        if (!fin3(&g->target[3 * k]) || !fin3(&g->from[3 * k])) return "grab target must be finite";
+        if (!(g->alpha[k] >= 0) || !isfinite(g->alpha[k])) return "grab compliance must be >= 0";
+    }
+    return NULL;
+}
+
+wb_status wb__grab_image_reserve(wb_world *w, const wb_image *img)
+{
+    return img->grab.n > 0 ? wb__grab_reserve(w, img->grab.n) : WB_OK;
+}
+
+void wb__grab_image_put(wb_world *w, const wb_image *img, int32_t pshift)
+{
+    const wb_image_grab *g = &img->grab;
+    for (int32_t k = 0; k < g->n; k++)
+        wb__grab_put(w, g->p[k] + pshift, &g->target[3 * k], &g->from[3 * k], g->alpha[k]);
 }
 
 /* ---- the type ---------------------------------------------------------------------- */

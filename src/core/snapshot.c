@@ -122,6 +122,8 @@ void wb_image_free(wb_image *g)
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     wb__smatch_image_free(g);
     wb__pressure_image_free(g);
+    wb__attach_image_free(g);
+    wb__grab_image_free(g);
     memset(g, 0, sizeof *g);
 }
 
@@ -215,7 +217,8 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
         memcpy(g->vol_rest, w->vol->rest, (size_t)nvol * sizeof *g->vol_rest);
     }
     if ((st = wb__tet_image_of(w, g)) != WB_OK || (st = wb__smatch_image_of(w, g)) != WB_OK ||
-        (st = wb__pressure_image_of(w, g)) != WB_OK) {
+        (st = wb__pressure_image_of(w, g)) != WB_OK || (st = wb__attach_image_of(w, g)) != WB_OK ||
+        (st = wb__grab_image_of(w, g)) != WB_OK) {
         wb_image_free(g);
         return st;
     }
@@ -329,7 +332,9 @@ const char *wb_image_check(const wb_image *g)
         const wb_volume_def d = { g->vol_alpha[i], true, g->vol_rest[i] };
         if ((e = wb_volume_def_check(&d))) return e;
     }
-    if ((e = wb__tet_image_check(g)) || (e = wb__smatch_image_check(g)) || (e = wb__pressure_image_check(g))) return e;
+    if ((e = wb__tet_image_check(g)) || (e = wb__smatch_image_check(g)) || (e = wb__pressure_image_check(g)) ||
+        (e = wb__attach_image_check(g)) || (e = wb__grab_image_check(g)))
+        return e;
     return NULL;
 }
 
@@ -450,6 +455,8 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     if (st == WB_OK) st = wb__tet_image_reserve(w, g);
     if (st == WB_OK) st = wb__smatch_reserve(w, g);
     if (st == WB_OK) st = wb__pressure_reserve(w, g);
+    if (st == WB_OK) st = wb__attach_image_reserve(w, g);
+    if (st == WB_OK) st = wb__grab_image_reserve(w, g);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
@@ -514,6 +521,8 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     wb__tet_image_put(w, g, 0);
     wb__smatch_put(w, g, 0);
     wb__pressure_put(w, g, 0);
+    wb__attach_image_put(w, g, 0, NULL);
+    wb__grab_image_put(w, g, 0);
     s->time = g->time;
     s->frame = g->frame;
     s->warnings = g->warnings;
@@ -557,7 +566,8 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     if ((int64_t)group + gmax > WB_MAX_GROUP) return WB_ERR_LIMIT;
     /* everything reserved first: after this nothing can fail */
     wb_colmesh **cms = calloc((size_t)(g->nc > 0 ? g->nc : 1), sizeof *cms);
-    if (!cms) return WB_ERR_NOMEM;
+    int32_t *cmap = calloc((size_t)(g->nc > 0 ? g->nc : 1), sizeof *cmap); /* image slot -> w's */
+    if (!cms || !cmap) { free(cms); free(cmap); return WB_ERR_NOMEM; }
     wb_status st = wb__reserve(w, g->np, live_d);
     if (st == WB_OK) st = wb__bend_reserve(w, g->nb);
     if (st == WB_OK) st = grow_colliders(w, m->nc + new_c);
@@ -566,9 +576,12 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     if (st == WB_OK) st = wb__tet_image_reserve(w, g);
     if (st == WB_OK) st = wb__smatch_reserve(w, g);
     if (st == WB_OK) st = wb__pressure_reserve(w, g);
+    if (st == WB_OK) st = wb__attach_image_reserve(w, g);
+    if (st == WB_OK) st = wb__grab_image_reserve(w, g);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
+        free(cmap);
         return st;
     }
     const int32_t first_surface = m->nsurf;
@@ -613,6 +626,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
         }
         put_collider(w, slot, &g->c[i], cms[i]);
         m->c_gen[slot]++;
+        cmap[i] = slot;
     }
     free(cms);
     put_surfaces(w, g, first);
@@ -620,6 +634,9 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     wb__tet_image_put(w, g, first);
     wb__smatch_put(w, g, first);
     wb__pressure_put(w, g, first_surface);
+    wb__attach_image_put(w, g, first, cmap);
+    wb__grab_image_put(w, g, first);
+    free(cmap);
     m->topology_dirty = 1;
     out->first = first;
     out->count = g->np;

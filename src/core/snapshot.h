@@ -40,6 +40,22 @@ typedef struct wb_image_pressure {
     wb_real *pressure, *alpha, *v0; /* (n) factor, compliance, rest volume */
 } wb_image_pressure;
 
+/* attachments (attach.c) and grabs (grab.c): the live ones, in slot order */
+typedef struct wb_image_attach {
+    int32_t n;
+    int32_t *p;            /* (n) particle */
+    int32_t *kind;         /* (n) target kind: 0 = collider */
+    int32_t *target;       /* (n) the target's slot (a live collider slot of the image) */
+    wb_real *local;        /* (n x 3) the point in the target's frame */
+    wb_real *alpha;        /* (n) compliance, m/N */
+} wb_image_attach;
+typedef struct wb_image_grab {
+    int32_t n;
+    int32_t *p;            /* (n) particle */
+    wb_real *target, *from; /* (n x 3) target now, and where the next step's sweep starts */
+    wb_real *alpha;        /* (n) compliance, m/N */
+} wb_image_grab;
+
 typedef struct wb_image {
     wb_world_def def;
 
@@ -92,6 +108,8 @@ typedef struct wb_image {
     wb_real *tet_v0, *tet_young, *tet_poisson; /* (ntet) rest volume (> 0), E, nu */
     wb_image_smatch sm;    /* empty unless wb_image_alloc_smatch */
     wb_image_pressure pr;  /* empty unless wb_image_alloc_pressure */
+    wb_image_attach att;   /* empty unless wb_image_alloc_attach */
+    wb_image_grab grab;    /* empty unless wb_image_alloc_grab */
 } wb_image;
 
 /* allocate the arrays for these counts (zeroed; generations 1, i.e. live; particles collide);
@@ -140,5 +158,19 @@ wb_status wb__pressure_image_of(const wb_world *w, wb_image *g);
 const char *wb__pressure_image_check(const wb_image *g);
 wb_status wb__pressure_reserve(wb_world *w, const wb_image *g);
 void wb__pressure_put(wb_world *w, const wb_image *g, int32_t sshift);
+/* attach.c and grab.c, the same way; cmap maps the image's collider slots to w's (NULL:
+ * the same slots) */
+wb_status wb_image_alloc_attach(wb_image *g, int32_t n);
+wb_status wb_image_alloc_grab(wb_image *g, int32_t n);
+void wb__attach_image_free(wb_image *g);
+wb_status wb__attach_image_of(const wb_world *w, wb_image *g);
+const char *wb__attach_image_check(const wb_image *g);
+wb_status wb__attach_image_reserve(wb_world *w, const wb_image *g);
+void wb__attach_image_put(wb_world *w, const wb_image *g, int32_t pshift, const int32_t *cmap);
+void wb__grab_image_free(wb_image *g);
+wb_status wb__grab_image_of(const wb_world *w, wb_image *g);
+const char *wb__grab_image_check(const wb_image *g);
+wb_status wb__grab_image_reserve(wb_world *w, const wb_image *g);
+void wb__grab_image_put(wb_world *w, const wb_image *g, int32_t pshift);
 
 #endif

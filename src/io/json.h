@@ -68,5 +68,8 @@ int jv_opt_vec(rd *r, const cJSON *f, const kp *up, const char *key, int n, wb_r
 int jm_read_shape_matches(rd *r, const cJSON *arr, wb_image *g);
 int jm_read_pressures(rd *r, const cJSON *arr, wb_image *g);
 int jm_read_tets(rd *r, const cJSON *arr, wb_image *g);
+/* json_attach.c: the "attachments" and "grabs" sections, after particles and colliders */
+int ja_read_attachments(rd *r, const cJSON *arr, wb_image *g);
+int ja_read_grabs(rd *r, const cJSON *arr, wb_image *g);
 
 #endif

@@ -222,6 +222,36 @@ static void write_materials(out *o, const wb_image *g)
     if (g->pr.n) fputs("\n  ],\n", f);
 }
 
+/* "attachments" and "grabs" (json_attach.c reads them): only when present. An
+ * attachment names its collider by its place among the written (live) colliders */
+static void write_attach(out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    const wb_image_attach *a = &g->att;
+    for (int32_t k = 0; k < a->n; k++) {
+        int32_t rank = 0;
+        for (int32_t s = 0; s < a->target[k]; s++) rank += (int32_t)(g->c_gen[s] & 1u);
+        fprintf(f, "%s    {\"particle\": %d, \"collider\": %d, \"point\": ", k ? ",\n" : "  \"attachments\": [\n",
+                a->p[k], rank);
+        vec(o, &a->local[3 * k], 3);
+        fputs(", \"compliance\": ", f);
+        num(o, a->alpha[k]);
+        fputc('}', f);
+    }
+    if (a->n) fputs("\n  ],\n", f);
+    const wb_image_grab *gr = &g->grab;
+    for (int32_t k = 0; k < gr->n; k++) {
+        fprintf(f, "%s    {\"particle\": %d, \"target\": ", k ? ",\n" : "  \"grabs\": [\n", gr->p[k]);
+        vec(o, &gr->target[3 * k], 3);
+        fputs(", \"from\": ", f);
+        vec(o, &gr->from[3 * k], 3);
+        fputs(", \"compliance\": ", f);
+        num(o, gr->alpha[k]);
+        fputc('}', f);
+    }
+    if (gr->n) fputs("\n  ],\n", f);
+}
+
 static void write_colliders(out *o, const wb_image *g)
 {
     static const char *const names[] = { "plane", "sphere", "box", "capsule", "mesh" };
@@ -315,6 +345,7 @@ int wbio_write_snapshot(const wb_world *w, const char *path, const char *shown, 
     write_volumes(&o, &g);
     write_tets(&o, &g);
     write_materials(&o, &g);
+    write_attach(&o, &g);
     write_colliders(&o, &g);
     write_surfaces(&o, &g);
     fputs("}\n", o.f);

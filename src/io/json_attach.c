@@ -1,0 +1,116 @@
+/* json_attach.c: the "attachments" and "grabs" sections of a particle config (README,
+ * "Attachments and grabs"):
+ *
+ *   "attachments": [ {"particle": 3, "collider": 0, "point": [x,y,z], "compliance": 0}, ... ]
+ *   "grabs": [ {"particle": 7, "target": [x,y,z], "from": [x,y,z], "compliance": 0}, ... ]
+ *
+ * "collider" counts the file's "colliders" entries from 0. "point" (in the collider's
+ * frame) defaults to where the particle is, as w:attach does; "from" (where the next
+ * step's sweep of the target starts) defaults to the target. w:save writes both. */
+#include <math.h>
+#include <string.h>
+
+#include "json.h"
+
+/* v in the frame of a pose with rotation q (w, x, y, z), unit: q* v q */
+static void rotate_inv(const wb_real q[4], const wb_real v[3], wb_real out[3])
+{
+    const wb_real u[3] = { -q[1], -q[2], -q[3] }, s = q[0];
+    /* v + 2 u x (u x v + s v) */
+    const wb_real t[3] = { u[1] * v[2] - u[2] * v[1] + s * v[0], u[2] * v[0] - u[0] * v[2] + s * v[1],
+                           u[0] * v[1] - u[1] * v[0] + s * v[2] };
+    out[0] = v[0] + 2 * (u[1] * t[2] - u[2] * t[1]);
+    out[1] = v[1] + 2 * (u[2] * t[0] - u[0] * t[2]);
+    out[2] = v[2] + 2 * (u[0] * t[1] - u[1] * t[0]);
+}
+
+int ja_read_attachments(rd *r, const cJSON *arr, wb_image *g)
+{
+    static const char *const keys[] = { "particle", "collider", "point", "compliance", NULL };
+    kp top = { NULL, "attachments", 0 };
+    int32_t n = 0, i = 0, ncol = 0;
+    if (!arr) return 0;
+    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
+    if (wb_image_alloc_attach(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
+    for (int32_t c = 0; c < g->nc; c++) ncol += (int32_t)(g->c_gen[c] & 1u);
+    for (const cJSON *c = arr->child; c; c = c->next, i++) {
+        const cJSON *f[4];
+        kp p = { &top, NULL, i };
+        int64_t pid, cid;
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "particle");
+        if (!f[1]) return jv_missing(r, c, &p, "collider");
+        if (g->np == 0) {
+            kp q = { &p, "particle", 0 };
+            return jv_fail(r, f[0], 0, &q, "there are no particles");
+        }
+        if (ncol == 0) {
+            kp q = { &p, "collider", 0 };
+            return jv_fail(r, f[1], 0, &q, "there are no colliders");
+        }
+        wb_real a = 0;
+        if (jv_opt_int(r, f[0], &p, "particle", 0, g->np - 1, &pid) ||
+            jv_opt_int(r, f[1], &p, "collider", 0, ncol - 1, &cid) || jv_opt_nonneg(r, f[3], &p, "compliance", &a))
+            return -1;
+        /* the cid-th live collider slot */
+        int32_t slot = -1;
+        for (int32_t s = 0; s < g->nc && slot < 0; s++)
+            if ((g->c_gen[s] & 1u) && cid-- == 0) slot = s;
+        wb_real *local = &g->att.local[3 * i];
+        if (f[2]) {
+            if (jv_opt_vec(r, f[2], &p, "point", 3, local)) return -1;
+        } else {
+            const wb_image_collider *col = &g->c[slot];
+            const wb_real *x = &g->x[3 * pid];
+            const wb_real d[3] = { x[0] - col->p[0], x[1] - col->p[1], x[2] - col->p[2] };
+            wb_real q[4];
+            const wb_real qn = sqrt(col->q[0] * col->q[0] + col->q[1] * col->q[1] + col->q[2] * col->q[2] +
+                                    col->q[3] * col->q[3]);
+            for (int k = 0; k < 4; k++) q[k] = col->q[k] / qn;
+            rotate_inv(q, d, local);
+            if (!isfinite(local[0]) || !isfinite(local[1]) || !isfinite(local[2])) {
+                kp q2 = { &p, "particle", 0 };
+                return jv_fail(r, f[0], 0, &q2, "the particle is too far from the collider");
+            }
+        }
+        g->att.p[i] = (int32_t)pid;
+        g->att.kind[i] = 0;
+        g->att.target[i] = slot;
+        g->att.alpha[i] = a;
+    }
+    return 0;
+}
+
+int ja_read_grabs(rd *r, const cJSON *arr, wb_image *g)
+{
+    static const char *const keys[] = { "particle", "target", "from", "compliance", NULL };
+    kp top = { NULL, "grabs", 0 };
+    int32_t n = 0, i = 0;
+    if (!arr) return 0;
+    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
+    if (wb_image_alloc_grab(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
+    for (const cJSON *c = arr->child; c; c = c->next, i++) {
+        const cJSON *f[4];
+        kp p = { &top, NULL, i };
+        int64_t pid;
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "particle");
+        if (!f[1]) return jv_missing(r, c, &p, "target");
+        if (g->np == 0) {
+            kp q = { &p, "particle", 0 };
+            return jv_fail(r, f[0], 0, &q, "there are no particles");
+        }
+        wb_real a = 0, *t = &g->grab.target[3 * i], *fr = &g->grab.from[3 * i];
+        if (jv_opt_int(r, f[0], &p, "particle", 0, g->np - 1, &pid) || jv_opt_vec(r, f[1], &p, "target", 3, t) ||
+            jv_opt_nonneg(r, f[3], &p, "compliance", &a))
+            return -1;
+        if (f[2]) {
+            if (jv_opt_vec(r, f[2], &p, "from", 3, fr)) return -1;
+        } else {
+            memcpy(fr, t, 3 * sizeof *fr);
+        }
+        g->grab.p[i] = (int32_t)pid;
+        g->grab.alpha[i] = a;
+    }
+    return 0;
+}
