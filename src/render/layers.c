@@ -17,6 +17,8 @@
 /* colours, sRGB */
 static const float col_particle[3] = { 0.22f, 0.47f, 0.80f };
 static const float col_pin[3] = { 0.98f, 0.68f, 0.08f };
+static const float col_attach[3] = { 0.16f, 0.70f, 0.30f };  /* attached to a collider */
+static const float col_grab[3] = { 0.85f, 0.15f, 0.75f };    /* grabbed, its target and line */
 static const float col_collider[3] = { 0.55f, 0.58f, 0.64f };
 static const float col_rest[3] = { 0.40f, 0.40f, 0.42f };
 static const float col_tension[3] = { 0.92f, 0.08f, 0.06f };
@@ -122,7 +124,8 @@ static void inst_cylinder(wb_inst *in, const double a[3], const double b[3], dou
 static bool build_instances(wb_layers *l, const wb_world *w, const wb_draw_opts *o, double unit)
 {
     int32_t np = wb_particle_count(w), nc = wb_collider_count(w);
-    size_t need = (size_t)np + 3 * (size_t)nc;
+    const int32_t na = wb_attach_count(w), ng = wb_grab_count(w);
+    size_t need = (size_t)np + 3 * (size_t)nc + (size_t)na + 2 * (size_t)ng;
     if (!grow(&l->inst, &l->inst_cap, need + 1, sizeof *l->inst)) return false;
     const wb_real *x = wb_particle_positions(w);
     size_t k = 0;
@@ -139,6 +142,25 @@ static bool build_instances(wb_layers *l, const wb_world *w, const wb_draw_opts 
             else memcpy(col, col_particle, sizeof col);
             inst_sphere(&l->inst[k++], p, rad, col, 0.5f);
         }
+    }
+    /* attached particles and grabbed ones are marked as pins are (with the pins), a
+     * grab's target as a small sphere of its colour */
+    for (int32_t i = 0; o->pins && i < na; i++) {
+        const int32_t pi = wb_attach_particle(w, wb_attach_at(w, i));
+        const double p[3] = { x[3 * pi], x[3 * pi + 1], x[3 * pi + 2] };
+        if (isfinite(p[0] + p[1] + p[2]))
+            inst_sphere(&l->inst[k++], p, fmax(1.6 * wb_particle_radius(w, pi), 0.006 * unit), col_attach, 0.5f);
+    }
+    for (int32_t i = 0; o->pins && i < ng; i++) {
+        const wb_grab_id gid = wb_grab_at(w, i);
+        const int32_t pi = wb_grab_particle(w, gid);
+        const double p[3] = { x[3 * pi], x[3 * pi + 1], x[3 * pi + 2] };
+        wb_real t[3];
+        wb_grab_target(w, gid, t);
+        const double tp[3] = { t[0], t[1], t[2] };
+        const double rad = fmax(1.6 * wb_particle_radius(w, pi), 0.006 * unit);
+        if (isfinite(p[0] + p[1] + p[2])) inst_sphere(&l->inst[k++], p, rad, col_grab, 0.5f);
+        inst_sphere(&l->inst[k++], tp, 0.5 * rad, col_grab, 0.5f);
     }
     l->count[WB_G_LO] = k;
     for (int g = WB_G_HI; g < WB_G_COUNT; g++) {
@@ -327,6 +349,27 @@ static bool build_segments(wb_layers *l, const wb_world *w, const wb_draw_opts *
         s->c[3] = 1;
     }
     l->nseg = k;
+    return true;
+}
+
+/* a line from each grabbed particle to its target (after the links) */
+static bool build_grab_lines(wb_layers *l, const wb_world *w)
+{
+    const int32_t ng = wb_grab_count(w);
+    if (ng == 0) return true;
+    if (!grow(&l->seg, &l->seg_cap, l->nseg + (size_t)ng, sizeof *l->seg)) return false;
+    const wb_real *x = wb_particle_positions(w);
+    float col[3];
+    wb_lin3(col_grab, col);
+    for (int32_t i = 0; i < ng; i++) {
+        const wb_grab_id gid = wb_grab_at(w, i);
+        const int32_t p = wb_grab_particle(w, gid);
+        wb_real t[3];
+        wb_grab_target(w, gid, t);
+        wb_seg *s = &l->seg[l->nseg++];
+        for (int c = 0; c < 3; c++) s->a[c] = (float)x[3 * p + c], s->b[c] = (float)t[c], s->c[c] = col[c];
+        s->c[3] = 1;
+    }
     return true;
 }
 
@@ -527,5 +570,6 @@ bool wb_layers_build(wb_layers *l, const wb_world *w, const wb_draw_opts *o, con
     if (l->surfaces && !build_surfaces(l, w, o, sk, nsk)) return false;
     if (!build_instances(l, w, o, unit)) return false;
     if (o->constraints && !build_segments(l, w, o)) return false;
+    if (o->pins && !build_grab_lines(l, w)) return false;
     return true;
 }
