@@ -118,7 +118,10 @@
     CONTACT_TESTS(X)                             \
     TRICONTACT_TESTS(X)                          \
     EXTREME_TESTS(X)                             \
-    X(tet_strain_volume_shape_and_shear)
+    X(tet_strain_volume_shape_and_shear)         \
+    X(attach_grab_forces_cleared_by_an_undone_frame) \
+    X(attach_grab_clone_same_future)             \
+    X(attach_grab_ids_and_memory)
 
 #define DECLARE(name) TEST(name);
 #define ENTRY(name) { #name, test_##name },

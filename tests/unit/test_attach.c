@@ -1,0 +1,114 @@
+/* test_attach.c: the C API of attachments and grabs (attach.c, grab.c): an undone frame
+ * leaves no multiplier behind, a clone keeps them (same hash, same future), the memory
+ * budget is charged and given back, ids go stale on removal, release and reuse. */
+#include <math.h>
+#include <string.h>
+
+#include "test.h"
+#include "wobble.h"
+
+static int polls;
+static int stop_after_2(void *ud)
+{
+    (void)ud;
+    return ++polls > 2;
+}
+
+TEST(attach_grab_forces_cleared_by_an_undone_frame)
+{
+    wb_world_def d = wb_world_default_def();
+    wb_world *w = wb_world_create(&d);
+    REQUIRE(w);
+    wb_collider_def cd = wb_collider_default_def(WB_SHAPE_SPHERE);
+    wb_status st;
+    wb_collider_id c = wb_collider_add(w, &cd, &st);
+    const wb_real x0[3] = { 0, 2, 0 }, x1[3] = { 1, 2, 0 };
+    const int32_t p = wb_particle_add(w, x0, NULL, 1, 0), q = wb_particle_add(w, x1, NULL, 1, 0);
+    wb_attach_id a = wb_attach_collider(w, p, c, 0, &st);
+    REQUIRE(st == WB_OK);
+    wb_grab_id g = wb_grab_add(w, q, x1, 0, &st);
+    REQUIRE(st == WB_OK);
+    REQUIRE(wb_world_step(w) == WB_OK);
+    wb_real f[3];
+    CHECK_NEAR(wb_attach_force(w, a, f), 9.81, 1e-9);
+    CHECK_NEAR(f[1], 9.81, 1e-9); /* up: towards the point the particle is pulled to */
+    CHECK_NEAR(wb_grab_force(w, g, NULL), 9.81, 1e-9);
+    polls = 0;
+    wb_world_set_interrupt(w, stop_after_2, NULL);
+    CHECK_EQ(wb_world_step(w), WB_ERR_INTERRUPTED);
+    CHECK(wb_attach_force(w, a, NULL) == 0);
+    CHECK(wb_grab_force(w, g, NULL) == 0);
+    wb_world_destroy(w);
+}
+
+TEST(attach_grab_clone_same_future)
+{
+    wb_world_def d = wb_world_default_def();
+    wb_world *w = wb_world_create(&d);
+    REQUIRE(w);
+    wb_collider_def cd = wb_collider_default_def(WB_SHAPE_BOX);
+    wb_status st;
+    wb_collider_id c = wb_collider_add(w, &cd, &st);
+    const wb_real om[3] = { 0, 0, 3 }, x0[3] = { 0.6, 0, 0 }, x1[3] = { 2, 0, 0 }, t[3] = { 2, 1, 0 };
+    wb_collider_set_angular_velocity(w, c, om);
+    const int32_t p = wb_particle_add(w, x0, NULL, 1, 0.05), q = wb_particle_add(w, x1, NULL, 1, 0);
+    wb_attach_collider(w, p, c, 1e-4, &st);
+    wb_grab_id g = wb_grab_add(w, q, x1, 1e-3, &st);
+    for (int i = 0; i < 5; i++) wb_world_step(w);
+    wb_grab_move(w, g, t);
+    wb_world *v = wb_world_clone(w);
+    REQUIRE(v);
+    CHECK(wb_world_hash(v) == wb_world_hash(w));
+    CHECK_EQ(wb_attach_count(v), 1);
+    CHECK_EQ(wb_grab_count(v), 1);
+    for (int i = 0; i < 10; i++) {
+        wb_world_step(w);
+        wb_world_step(v);
+    }
+    CHECK(wb_world_hash(v) == wb_world_hash(w));
+    wb_world_destroy(v);
+    wb_world_destroy(w);
+}
+
+TEST(attach_grab_ids_and_memory)
+{
+    wb_memory mem = { 0, 0 };
+    wb_world_def d = wb_world_default_def();
+    d.memory = &mem;
+    wb_world *w = wb_world_create(&d);
+    REQUIRE(w);
+    wb_collider_def cd = wb_collider_default_def(WB_SHAPE_SPHERE);
+    wb_status st;
+    wb_collider_id c = wb_collider_add(w, &cd, &st);
+    const wb_real x0[3] = { 0, 2, 0 }, bad[3] = { 0, NAN, 0 };
+    const int32_t p = wb_particle_add(w, x0, NULL, 1, 0);
+    const size_t before = mem.used;
+    wb_attach_id a = wb_attach_collider(w, p, c, 0, &st);
+    CHECK(mem.used > before); /* charged */
+    /* refused: nothing changes */
+    wb_attach_collider(w, p, c, -1, &st);
+    CHECK_EQ(st, WB_ERR_ARG);
+    wb_attach_collider(w, 7, c, 0, &st);
+    CHECK_EQ(st, WB_ERR_ARG);
+    wb_grab_add(w, p, bad, 0, &st);
+    CHECK_EQ(st, WB_ERR_ARG);
+    CHECK_EQ(wb_attach_count(w), 1);
+    CHECK_EQ(wb_grab_count(w), 0);
+    /* removal and slot reuse: the old id stays stale */
+    wb_attach_remove(w, a);
+    CHECK(!wb_attach_valid(w, a));
+    wb_attach_id b = wb_attach_collider(w, p, c, 0, &st);
+    CHECK(b.index == a.index && b.gen != a.gen);
+    CHECK(!wb_attach_valid(w, a));
+    CHECK(wb_attach_valid(w, b));
+    /* the collider removed: its attachment is no longer valid, nor counted */
+    wb_collider_remove(w, c);
+    CHECK(!wb_attach_valid(w, b));
+    CHECK_EQ(wb_attach_count(w), 0);
+    CHECK(wb_world_step(w) == WB_OK);
+    wb_grab_id g = wb_grab_add(w, p, x0, 0, &st);
+    wb_grab_release(w, g);
+    CHECK(!wb_grab_valid(w, g));
+    wb_world_destroy(w);
+    CHECK_EQ(mem.used, (size_t)0); /* given back */
+}
