@@ -346,9 +346,10 @@ static void att_project(wb_world *w, wb_real h)
         if (wp == 0) continue; /* pinned or immovable: never written */
         const wb_real at = a->alpha[s] * inv_h2;
         if (isinf(at)) continue;
-        /* a rigid target (after the merge): the point from the body's pose, the
-         * generalized inverse mass wb__rigid_w added per direction to wp, and
-         * wb__rigid_apply(-dl) at the point, so the body is pulled back (RIGID.md) */
+        /* a rigid target (after the merge, RIGID.md): the point from the body's pose,
+         * then the scalar form along n = C/|C| (Müller et al. 2020, 3.3.1) with
+         * w = wp + wb__rigid_w(point, n), and wb__rigid_apply(-dlambda n) at the point,
+         * so the body is pulled back */
         wb_real t[3];
         point_at(w, a, s, f, t);
         wb_real *xp = &x[3 * p], *l = &a->lambda[3 * s];
