@@ -7,7 +7,7 @@ local tets = wobble.args.tets ~= 0
 local w = wobble.world{ substeps = 20 }
 w:collider{ shape = "plane", normal = { 0, 1, 0 }, offset = 0, friction = 0.8 }
 local jelly = w:lattice{ min = { -0.3, 0.01, -0.3 }, max = { 0.3, 0.61, 0.3 }, res = { 6, 6, 6 }, mass = 2,
-                         radius = 0.01, compliance = 2e-2, damping = 0.05, tets = tets, volume_compliance = 0 }
+                         radius = 0.01, compliance = 2e-2, damping = 0.05, tets = tets, volume_compliance = tets and 0 or nil }
 local press = w:collider{ shape = "box", center = { 0, 1.0, 0 }, half = { 0.8, 0.1, 0.8 } }
 local v0 = w:total_volume()
 local low, kept = math.huge, 1

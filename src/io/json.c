@@ -720,10 +720,17 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
         *arrays[i].dst = it;
         if (it && jv_get_array(r, it, &ap, arrays[i].max, arrays[i].n)) return -1;
     }
-    /* bends have no slots: the distance slot tables count the other entries */
-    for (const cJSON *c = s.constraints ? s.constraints->child : NULL; c; c = c->next) {
+    /* bends have no slots: the distance slot tables count the other entries. A type
+     * neither counts is named here, before a slot count that would miss it blames the
+     * slot tables instead */
+    int64_t ci = 0;
+    for (const cJSON *c = s.constraints ? s.constraints->child : NULL; c; c = c->next, ci++) {
         const cJSON *t = cJSON_IsObject(c) ? cJSON_GetObjectItemCaseSensitive(c, "type") : NULL;
         if (cJSON_IsString(t) && strcmp(t->valuestring, "bend") == 0) s.nbend++;
+        else if (cJSON_IsString(t) && strcmp(t->valuestring, "distance") != 0) {
+            kp top = { NULL, "constraints", 0 }, p = { &top, NULL, ci }, tp = { &p, "type", 0 };
+            return jv_fail(r, t, 0, &tp, "unknown constraint type '%s' (expected distance or bend)", t->valuestring);
+        }
     }
     s.ncons -= s.nbend;
     s.snapshot = f[10];

@@ -266,6 +266,10 @@ static int w_lattice(lua_State *L)
     /* young (Pa): Neo-Hookean tets (lua/volume.c's w:tet) and no links, so that E means E */
     wbl_read_neo(L, 2, &d.young, &d.poisson);
     if (d.young > 0 && !d.tets) return wbl_fielderror(L, 2, "young", "needs tets = true");
+    /* the compliance of the tets' volume constraints: meaningless without tets */
+    const int has_vc = lua_getfield(L, 2, "volume_compliance") != LUA_TNIL;
+    lua_pop(L, 1);
+    if (has_vc && !d.tets) return wbl_fielderror(L, 2, "volume_compliance", "needs tets = true");
     wbl_read_link(L, 2, &d.link);
     check_link(L, &d.link);
     if ((int64_t)d.res[0] * d.res[1] * d.res[2] > WB_MAX_PARTICLES)

@@ -408,6 +408,14 @@ static int w_from_mesh(lua_State *L)
     }
     wb_world *w = wbl_checkworld(L, 1);
     const wb_mesh *m = wbl_checkmesh(L, 2);
+    /* the tet options mean nothing for a body of links: say what they need, not just "unknown" */
+    static const char *const tet_only[] = { "volume_compliance", "max_volume", "quality", "keep_surface", "timeout",
+                                            "young", "poisson", NULL };
+    for (int i = 0; tet_only[i] && lua_type(L, 3) == LUA_TTABLE; i++) {
+        const int given = lua_getfield(L, 3, tet_only[i]) != LUA_TNIL;
+        lua_pop(L, 1);
+        if (given) return wbl_fielderror(L, 3, tet_only[i], "needs tets = true");
+    }
     wb_from_mesh_def d = wb_from_mesh_default_def();
     bool auto_radius = true; /* half the spacing, set after building */
     wbl_contact_opts co;

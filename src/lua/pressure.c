@@ -39,6 +39,12 @@ static int w_pressure(lua_State *L)
         if (wbl_optreal(L, 3, "compliance", &d.compliance) && !(d.compliance >= 0))
             return wbl_fielderror(L, 3, "compliance", "must be >= 0");
     }
+    /* a body names its world: another world's body has a range that means other particles here */
+    if (lua_getfield(L, 2, "world") != LUA_TNIL) {
+        const wbl_world *bw = (const wbl_world *)luaL_testudata(L, -1, WBL_WORLD);
+        if (bw && bw->w != w) return luaL_argerror(L, 2, "the body belongs to another world");
+    }
+    lua_pop(L, 1);
     const lua_Integer first = body_field(L, 2, "first"), count = body_field(L, 2, "count");
     if (first < 1 || count < 0 || first - 1 + count > wb_particle_count(w))
         return luaL_argerror(L, 2, "body expected (its particles are not in this world)");

@@ -109,6 +109,12 @@ int32_t *wbl_checkids(lua_State *L, int arg, const wb_world *w, int32_t *n)
     arg = lua_absindex(L, arg);
     if (!lua_istable(L, arg)) luaL_typeerror(L, arg, "body or table of particle ids");
     int t = arg;
+    /* a body names its world: another world's body has ids that mean other particles here */
+    if (lua_getfield(L, arg, "world") != LUA_TNIL) {
+        const wbl_world *bw = (const wbl_world *)luaL_testudata(L, -1, WBL_WORLD);
+        if (bw && bw->w != w) luaL_argerror(L, arg, "the body belongs to another world");
+    }
+    lua_pop(L, 1);
     if (lua_getfield(L, arg, "particles") == LUA_TTABLE) t = lua_gettop(L);
     else lua_pop(L, 1);
     const size_t len = lua_rawlen(L, t);

@@ -206,7 +206,7 @@ test("from_mesh's tets options refuse unknown keys and non-finite numbers, chang
   expect.error(function() w:from_mesh(m, { tets = true, max_volume = 0 }) end, "max_volume")
   expect.eq(w:particle_count(), 0, "nothing made")
   -- the valid call works, with every option
-  local b = w:from_mesh(m, { tets = true, max_volume = 0.1, quality = 2, keep_surface = true, timeout = 30, mass = 2,
+  local b = w:from_mesh(m, { tets = true, max_volume = 0.2, quality = 2, keep_surface = true, timeout = 30, mass = 2,
                              radius = 0.01, volume_compliance = 1e-6, compliance = 1e-4, damping = 0, collide = true })
   expect.eq(w:mass(b.first) > 0, true)
   local total = 0
