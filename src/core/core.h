@@ -284,6 +284,7 @@ struct wb_world {
     struct wb_neos *neo;    /* Neo-Hookean tets (tet.h), NULL until the first */
     wb_smatch sm;          /* shape-matching clusters (shape_match.c) */
     wb_pressures pr;       /* pressure constraints (pressure.c) */
+    struct wb_rigids *rb;  /* rigid bodies (rigid.h), NULL until the first */
 };
 
 /* internal entry points */

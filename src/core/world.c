@@ -9,6 +9,7 @@
 #include "bvh.h"
 #include "volume.h"
 #include "tet.h"
+#include "rigid.h"
 
 static _Thread_local char wb_err[256];
 
@@ -104,6 +105,7 @@ void wb_world_destroy(wb_world *w)
     if (!w) return;
     wb__volume_free(w);
     wb__tet_free(w);
+    wb__rigids_free(w, w->rb);
     wb_model *m = &w->m;
     for (int32_t i = 0; i < m->nc; i++) wb__colmesh_free(m->c_shape[i].mesh); /* mesh colliders' copies */
     /* the bends' arrays (bend.c owns their use; freed here so that no circle joins the files) */
