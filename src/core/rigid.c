@@ -297,6 +297,8 @@ wb_real wb_rigid_distance(const wb_world *w, wb_rigid_id r, const wb_real p[3])
     return wb__shape_distance(&w->rb->shape[i], &w->rb->x[3 * i], &w->rb->q[4 * i], p, n);
 }
 
+static void turn(wb_real q[4], const wb_real t[3]);
+
 /* ---- the helpers of RIGID.md ---------------------------------------------------------------- */
 wb_real wb__rigid_w(const wb_world *w, int32_t r, const wb_real x[3], const wb_real n[3])
 {
@@ -318,15 +320,7 @@ void wb__rigid_apply(wb_world *w, int32_t r, const wb_real x[3], const wb_real d
     v3_cross(t, d, dp);
     inv_inertia_world(rb, r, t, t);
     v3_madd(p, dp, rb->inv_mass[r]);
-    /* q += 0.5 [t, 0] q: the linearised rotation of the paper's eq. 8 */
-    const wb_real dq[4] = {
-        (-t[0] * q[1] - t[1] * q[2] - t[2] * q[3]) / 2,
-        (t[0] * q[0] + t[1] * q[3] - t[2] * q[2]) / 2,
-        (-t[0] * q[3] + t[1] * q[0] + t[2] * q[1]) / 2,
-        (t[0] * q[2] - t[1] * q[1] + t[2] * q[0]) / 2,
-    };
-    for (int i = 0; i < 4; i++) q[i] += dq[i];
-    q_normalize(q);
+    turn(q, t);
 }
 
 void wb__rigid_to_world(const wb_world *w, int32_t r, const wb_real local[3], wb_real out[3])
@@ -469,54 +463,114 @@ static void push(wb_world *w, const side *A, const side *B, const wb_real xa[3],
     }
 }
 
+/* a side's offset of world point x from its centre (a collider: none needed) */
+static void side_arm(const wb_rigids *rb, const side *s, const wb_real x[3], wb_real out[3])
+{
+    if (s->r >= 0) v3_sub(out, x, &rb->x[3 * s->r]);
+    else v3_set(out, 0, 0, 0);
+}
+
+/* rotate a body by the small angle vector th: q += 0.5 [th, 0] q (the paper's eq. 8) */
+static void turn(wb_real q[4], const wb_real t[3])
+{
+    const wb_real dq[4] = {
+        (-t[0] * q[1] - t[1] * q[2] - t[2] * q[3]) / 2,
+        (t[0] * q[0] + t[1] * q[3] - t[2] * q[2]) / 2,
+        (-t[0] * q[3] + t[1] * q[0] + t[2] * q[1]) / 2,
+        (t[0] * q[2] - t[1] * q[1] + t[2] * q[0]) / 2,
+    };
+    for (int i = 0; i < 4; i++) q[i] += dq[i];
+    q_normalize(q);
+}
+
+/* The manifold's normal corrections are solved together: point after point (Gauss-Seidel
+ * over the points, each moving the body before the next) tilts a box resting on four
+ * corners a little differently every substep, and the tilts, not commuting, pump a spin
+ * about the normal that nothing frictionless takes out again. Instead the multipliers
+ * solve K lambda = depth, lambda >= 0 (K: the points' coupling through the two bodies'
+ * generalized inverse masses at this pose) by projected Gauss-Seidel on the small system,
+ * and the bodies move once: a symmetric contact gives a symmetric push. */
 static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_cshape *sa, const wb_cshape *sb,
                            const wb_manifold *m, wb_real h)
 {
     wb_rigids *rb = w->rb;
     const wb_real mu = fmax(sa->friction, sb->friction), e = fmax(sa->restitution, sb->restitution);
     const wb_real *n = m->normal;
-    wb_real la[WB_MANIFOLD_MAX][3], lb[WB_MANIFOLD_MAX][3];
-    /* the points in the sides' frames first: each correction moves the bodies */
-    for (int k = 0; k < m->n && k < WB_MANIFOLD_MAX; k++) {
+    const int np = m->n < WB_MANIFOLD_MAX ? m->n : WB_MANIFOLD_MAX;
+    wb_real la[WB_MANIFOLD_MAX][3], lb[WB_MANIFOLD_MAX][3], d[WB_MANIFOLD_MAX], vn_pre[WB_MANIFOLD_MAX];
+    wb_real vcs[WB_MANIFOLD_MAX][3], ja[WB_MANIFOLD_MAX][3], jb[WB_MANIFOLD_MAX][3], lam[WB_MANIFOLD_MAX];
+    int any = 0;
+    for (int k = 0; k < np; k++) {
+        wb_real pa[3], pa0[3], pb[3], pb0[3], d3[3], va[3], vb[3], rel[3], ra[3], rr[3];
         side_local(rb, A, m->pt[k].pa, la[k]);
         side_local(rb, B, m->pt[k].pb, lb[k]);
-    }
-    for (int k = 0; k < m->n && k < WB_MANIFOLD_MAX; k++) {
-        wb_real pa[3], pa0[3], pb[3], pb0[3], d3[3];
         side_points(rb, A, la[k], pa, pa0);
         side_points(rb, B, lb[k], pb, pb0);
         v3_sub(d3, pa, pb);
-        const wb_real depth = v3_dot(d3, n);
-        if (!(depth > 0)) continue;
-        /* before the correction: the velocities the bodies came in with */
-        wb_real vc[3], va[3], vb[3], rel[3];
-        v3_sub(vc, pa, pa0);
-        v3_scale(vc, vc, 1 / h);
-        side_velocity(rb, A, pa, vc, va);
-        side_velocity(rb, B, pb, vc, vb);
+        d[k] = v3_dot(d3, n);
+        any |= d[k] > 0;
+        /* the velocities the bodies came in with */
+        v3_sub(vcs[k], pa, pa0);
+        v3_scale(vcs[k], vcs[k], 1 / h);
+        side_velocity(rb, A, pa, vcs[k], va);
+        side_velocity(rb, B, pb, vcs[k], vb);
         v3_sub(rel, vb, va);
-        const wb_real vn_pre = v3_dot(rel, n);
-        const wb_real wsum = side_w(w, A, pa, n) + side_w(w, B, pb, n);
-        if (!(wsum > 0)) continue;
-        const wb_real lambda = depth / wsum;
-        wb_real dp[3];
-        v3_scale(dp, n, lambda);
-        push(w, A, B, pa, pb, dp);
+        vn_pre[k] = v3_dot(rel, n);
+        /* I^-1 (r x n) of each side, body frame rotated to the world */
+        side_arm(rb, A, pa, ra);
+        side_arm(rb, B, pb, rr);
+        v3_cross(ja[k], ra, n);
+        v3_cross(jb[k], rr, n);
+        lam[k] = 0;
+    }
+    if (!any) return;
+    wb_real ia[WB_MANIFOLD_MAX][3], ib[WB_MANIFOLD_MAX][3], K[WB_MANIFOLD_MAX][WB_MANIFOLD_MAX];
+    const wb_real wa = A->r >= 0 ? rb->inv_mass[A->r] : 0, wbm = B->r >= 0 ? rb->inv_mass[B->r] : 0;
+    for (int k = 0; k < np; k++) {
+        if (A->r >= 0) inv_inertia_world(rb, A->r, ja[k], ia[k]); else v3_set(ia[k], 0, 0, 0);
+        if (B->r >= 0) inv_inertia_world(rb, B->r, jb[k], ib[k]); else v3_set(ib[k], 0, 0, 0);
+    }
+    for (int i = 0; i < np; i++)
+        for (int j = 0; j < np; j++) K[i][j] = wa + wbm + v3_dot(ja[i], ia[j]) + v3_dot(jb[i], ib[j]);
+    for (int it = 0; it < 8 * np; it++) {
+        wb_real change = 0;
+        for (int i = 0; i < np; i++) {
+            if (!(K[i][i] > 0)) continue;
+            wb_real r = d[i];
+            for (int j = 0; j < np; j++) r -= K[i][j] * lam[j];
+            wb_real nl = lam[i] + r / K[i][i];
+            if (!(nl > 0)) nl = 0;
+            change = fmax(change, fabs(nl - lam[i]) * K[i][i]);
+            lam[i] = nl;
+        }
+        if (!(change > 1e-15 * fabs(d[0]) + 1e-300)) break;
+    }
+    /* move each body once by the sum of its points' impulses */
+    wb_real lsum = 0, ta[3] = { 0, 0, 0 }, tb[3] = { 0, 0, 0 };
+    for (int k = 0; k < np; k++) {
+        lsum += lam[k];
+        v3_madd(ta, ia[k], -lam[k]);
+        v3_madd(tb, ib[k], lam[k]);
+    }
+    if (B->r >= 0) { v3_madd(&rb->x[3 * B->r], n, lsum * wbm); turn(&rb->q[4 * B->r], tb); }
+    if (A->r >= 0) { v3_madd(&rb->x[3 * A->r], n, -lsum * wa); turn(&rb->q[4 * A->r], ta); }
+    for (int k = 0; k < np; k++) {
+        if (!(lam[k] > 0) && !(d[k] > 0)) continue;
         /* static friction (§3.5): undo the tangential slip of the two points over the
          * substep when the impulse needed stays inside the friction cone */
         if (mu > 0) {
-            wb_real slip[3];
+            wb_real slip[3], pa[3], pa0[3], pb[3], pb0[3];
             side_points(rb, A, la[k], pa, pa0);
             side_points(rb, B, lb[k], pb, pb0);
             for (int c = 0; c < 3; c++) slip[c] = (pb[c] - pb0[c]) - (pa[c] - pa0[c]);
             v3_madd(slip, n, -v3_dot(slip, n));
             const wb_real len = v3_len(slip);
             if (len > 0) {
-                wb_real t[3];
+                wb_real t[3], dp[3];
                 v3_scale(t, slip, 1 / len);
                 const wb_real wt = side_w(w, A, pa, t) + side_w(w, B, pb, t);
                 const wb_real lt = wt > 0 ? len / wt : INFINITY;
-                if (lt < mu * lambda) {
+                if (lt < mu * lam[k]) {
                     v3_scale(dp, t, -lt);
                     push(w, A, B, pa, pb, dp);
                 }
@@ -531,11 +585,11 @@ static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_c
         ct->b = B->r;
         v3_copy(ct->ra, la[k]);
         v3_copy(ct->rb, lb[k]);
-        if (A->r < 0) side_points(rb, A, la[k], ct->ra, pa0); /* a collider: the world point */
+        if (A->r < 0) { wb_real pa0[3]; side_points(rb, A, la[k], ct->ra, pa0); } /* a collider: the world point */
         v3_copy(ct->n, n);
-        ct->lambda = lambda;
-        ct->vn_pre = vn_pre;
-        v3_copy(ct->vc, vc);
+        ct->lambda = lam[k];
+        ct->vn_pre = vn_pre[k];
+        v3_copy(ct->vc, vcs[k]);
         ct->mu = mu;
         ct->e = e;
     }
