@@ -34,6 +34,7 @@ typedef struct wb_rigids {
     /* cache */
     wb_real *x_prev, *q_prev; /* (n x 3), (n x 4) pose at the substep's start */
     wb_real *save;         /* (n x 13) the frame's start: x, q, v, om (undo) */
+    uint8_t *moved;        /* (n) a correction moved it this substep: its velocities come from the poses */
     wb_rcontact *ct;       /* contacts of the current substep */
     int32_t nct, cap_ct;
     size_t charged;        /* bytes charged to def.memory */
@@ -73,7 +74,7 @@ static inline void wb__rigids_free(wb_world *w, wb_rigids *rb)
     if (!rb) return;
     if (w->m.def.memory) w->m.def.memory->used -= rb->charged;
     void *p[] = { rb->shape, rb->inv_mass, rb->inertia, rb->inv_inertia, rb->bound, rb->gen, rb->x, rb->q,
-                  rb->v, rb->om, rb->x_prev, rb->q_prev, rb->save, rb->ct };
+                  rb->v, rb->om, rb->x_prev, rb->q_prev, rb->save, rb->ct, rb->moved };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     free(rb);
 }
