@@ -566,6 +566,7 @@ static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_c
     }
     if (B->r >= 0) { v3_madd(&rb->x[3 * B->r], n, lsum * wbm); turn(&rb->q[4 * B->r], tb); rb->moved[B->r] = 1; }
     if (A->r >= 0) { v3_madd(&rb->x[3 * A->r], n, -lsum * wa); turn(&rb->q[4 * A->r], ta); rb->moved[A->r] = 1; }
+    const int32_t first = rb->nct;
     for (int k = 0; k < np; k++) {
         if (!(lam[k] > 0) && !(d[k] > 0)) continue;
         /* static friction (§3.5): undo the tangential slip of the two points over the
@@ -593,6 +594,7 @@ static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_c
         if (!ct) { wb__warn(w, "out of memory in rigid contacts; friction and restitution skipped"); continue; }
         rb->ct = ct;
         ct = &ct[rb->nct++];
+        ct->first = first;
         ct->a = A->r;
         ct->b = B->r;
         v3_copy(ct->ra, la[k]);
@@ -706,51 +708,104 @@ void wb__rigids_solve(wb_world *w, wb_real h, wb_real f0, wb_real f1)
     }
 }
 
-/* dynamic friction and restitution (§3.6) on the velocities the poses gave */
+/* a contact's world points and its sides */
+static void contact_points(const wb_world *w, const wb_rcontact *ct, side *A, side *B, wb_real pa[3], wb_real pb[3])
+{
+    const side a = { ct->a, NULL, NULL, NULL, NULL }, b = { ct->b, NULL, NULL, NULL, NULL };
+    *A = a;
+    *B = b;
+    if (ct->a >= 0) wb__rigid_to_world(w, ct->a, ct->ra, pa);
+    else v3_copy(pa, ct->ra);
+    wb__rigid_to_world(w, ct->b, ct->rb, pb);
+}
+
+static wb_real normal_velocity(const wb_rigids *rb, const wb_rcontact *ct, const side *A, const side *B,
+                               const wb_real pa[3], const wb_real pb[3], wb_real rel[3])
+{
+    wb_real va[3], vb[3];
+    side_velocity(rb, A, pa, ct->vc, va);
+    side_velocity(rb, B, pb, ct->vc, vb);
+    v3_sub(rel, vb, va);
+    return v3_dot(rel, ct->n);
+}
+
+static void impulse(wb_rigids *rb, const wb_rcontact *ct, const wb_real pa[3], const wb_real pb[3], const wb_real p[3])
+{
+    if (ct->b >= 0) apply_velocity_impulse(rb, ct->b, pb, p);
+    if (ct->a >= 0) {
+        const wb_real m[3] = { -p[0], -p[1], -p[2] };
+        apply_velocity_impulse(rb, ct->a, pa, m);
+    }
+}
+
+/* Dynamic friction and restitution (§3.6) on the velocities the poses gave, a manifold
+ * at a time: friction (|tangential impulse| <= mu x the point's normal impulse
+ * lambda / h), then the normal velocities of all its points together (as the
+ * positions: point by point, a box sliding with friction, pitched by it, kept an upward
+ * velocity every substep and pressed the ground 3% too lightly). The target normal
+ * velocity is -e times the one the point came in with, none below 2 |g| h so that
+ * resting contact does not jitter. */
 void wb__rigids_velocity(wb_world *w, wb_real h)
 {
     wb_rigids *rb = w->rb;
     if (!rb) return;
     const wb_real g = v3_len(w->m.def.gravity);
-    for (int32_t k = 0; k < rb->nct; k++) {
-        const wb_rcontact *ct = &rb->ct[k];
-        const side A = { ct->a, NULL, NULL, NULL, NULL }, B = { ct->b, NULL, NULL, NULL, NULL };
-        wb_real pa[3], pb[3], va[3], vb[3], rel[3], vt[3], p[3];
-        if (ct->a >= 0) wb__rigid_to_world(w, ct->a, ct->ra, pa);
-        else v3_copy(pa, ct->ra);
-        wb__rigid_to_world(w, ct->b, ct->rb, pb);
-        side_velocity(rb, &A, pa, ct->vc, va);
-        side_velocity(rb, &B, pb, ct->vc, vb);
-        v3_sub(rel, vb, va);
-        const wb_real vn = v3_dot(rel, ct->n);
-        v3_copy(vt, rel);
-        v3_madd(vt, ct->n, -vn);
-        const wb_real vtl = v3_len(vt);
-        if (ct->mu > 0 && vtl > 0) {
-            /* |tangential impulse| <= mu x normal impulse (lambda / h) */
+    for (int32_t k0 = 0, k1; k0 < rb->nct; k0 = k1) {
+        for (k1 = k0 + 1; k1 < rb->nct && rb->ct[k1].first == k0; k1++) {}
+        const int np = k1 - k0;
+        side A = { -1, NULL, NULL, NULL, NULL }, B = A;
+        wb_real pa[WB_MANIFOLD_MAX][3], pb[WB_MANIFOLD_MAX][3], rel[3], p[3];
+        /* friction impulses all from the same velocities, then applied (point by point,
+         * the corners of a sliding box each met a slightly different velocity and it
+         * veered); each stops no more than its share 1/np of its point's slip */
+        wb_real pt[WB_MANIFOLD_MAX][3];
+        for (int k = 0; k < np; k++) {
+            const wb_rcontact *ct = &rb->ct[k0 + k];
+            contact_points(w, ct, &A, &B, pa[k], pb[k]);
+            v3_set(pt[k], 0, 0, 0);
+            if (!(ct->mu > 0)) continue;
+            const wb_real vn = normal_velocity(rb, ct, &A, &B, pa[k], pb[k], rel);
+            v3_madd(rel, ct->n, -vn);
+            const wb_real vtl = v3_len(rel);
+            if (!(vtl > 0)) continue;
             wb_real t[3];
-            v3_scale(t, vt, 1 / vtl);
-            const wb_real wt = side_w(w, &A, pa, t) + side_w(w, &B, pb, t);
-            if (wt > 0) {
-                const wb_real jt = fmin(ct->mu * ct->lambda / h, vtl / wt);
-                v3_scale(p, t, -jt);
-                if (ct->b >= 0) apply_velocity_impulse(rb, ct->b, pb, p);
-                if (ct->a >= 0) { v3_scale(p, p, -1); apply_velocity_impulse(rb, ct->a, pa, p); }
-                side_velocity(rb, &A, pa, ct->vc, va);
-                side_velocity(rb, &B, pb, ct->vc, vb);
-                v3_sub(rel, vb, va);
-            }
+            v3_scale(t, rel, 1 / vtl);
+            const wb_real wt = side_w(w, &A, pa[k], t) + side_w(w, &B, pb[k], t);
+            if (!(wt > 0)) continue;
+            v3_scale(pt[k], t, -fmin(ct->mu * ct->lambda / h, vtl / (wt * np)));
         }
-        /* restitution: the normal velocity becomes -e times the one it came in with; none
-         * below 2 |g| h, so that resting contact does not jitter */
-        const wb_real vn2 = v3_dot(rel, ct->n);
-        const wb_real e = fabs(ct->vn_pre) > 2 * g * h ? ct->e : 0;
-        const wb_real dvn = fmax(-e * ct->vn_pre, 0) - vn2;
-        const wb_real wn = side_w(w, &A, pa, ct->n) + side_w(w, &B, pb, ct->n);
-        if (wn > 0 && dvn != 0) {
-            v3_scale(p, ct->n, dvn / wn);
-            if (ct->b >= 0) apply_velocity_impulse(rb, ct->b, pb, p);
-            if (ct->a >= 0) { v3_scale(p, p, -1); apply_velocity_impulse(rb, ct->a, pa, p); }
+        for (int k = 0; k < np; k++) impulse(rb, &rb->ct[k0 + k], pa[k], pb[k], pt[k]);
+        /* K dl = target - vn, by Gauss-Seidel on the small system (K as in solve_manifold) */
+        const wb_real *n = rb->ct[k0].n;
+        wb_real ja[WB_MANIFOLD_MAX][3], jb[WB_MANIFOLD_MAX][3], ia[WB_MANIFOLD_MAX][3], ib[WB_MANIFOLD_MAX][3];
+        wb_real K[WB_MANIFOLD_MAX][WB_MANIFOLD_MAX], b[WB_MANIFOLD_MAX], dl[WB_MANIFOLD_MAX];
+        const wb_real wa = A.r >= 0 ? rb->inv_mass[A.r] : 0, wbm = rb->inv_mass[B.r];
+        for (int k = 0; k < np; k++) {
+            const wb_rcontact *ct = &rb->ct[k0 + k];
+            wb_real r[3];
+            side_arm(rb, &A, pa[k], r);
+            v3_cross(ja[k], r, n);
+            side_arm(rb, &B, pb[k], r);
+            v3_cross(jb[k], r, n);
+            if (A.r >= 0) inv_inertia_world(rb, A.r, ja[k], ia[k]); else v3_set(ia[k], 0, 0, 0);
+            inv_inertia_world(rb, B.r, jb[k], ib[k]);
+            const wb_real vn = normal_velocity(rb, ct, &A, &B, pa[k], pb[k], rel);
+            const wb_real e = fabs(ct->vn_pre) > 2 * g * h ? ct->e : 0;
+            b[k] = fmax(-e * ct->vn_pre, 0) - vn;
+            dl[k] = 0;
+        }
+        for (int i = 0; i < np; i++)
+            for (int j = 0; j < np; j++) K[i][j] = wa + wbm + v3_dot(ja[i], ia[j]) + v3_dot(jb[i], ib[j]);
+        for (int it = 0; it < 8 * np; it++)
+            for (int i = 0; i < np; i++) {
+                if (!(K[i][i] > 0)) continue;
+                wb_real r = b[i];
+                for (int j = 0; j < np; j++) r -= K[i][j] * dl[j];
+                dl[i] += r / K[i][i];
+            }
+        for (int k = 0; k < np; k++) {
+            v3_scale(p, n, dl[k]);
+            impulse(rb, &rb->ct[k0 + k], pa[k], pb[k], p);
         }
     }
 }

@@ -11,7 +11,8 @@
 #include "narrow.h"
 
 typedef struct wb_rcontact {
-    int32_t a, b;          /* bodies; a < 0: a kinematic collider (slot -1 - a) */
+    int32_t first;         /* the first contact of its manifold (they are contiguous) */
+    int32_t a, b;          /* bodies; a < 0: a kinematic collider */
     wb_real ra[3], rb[3];  /* contact points in A's and B's body frame (a collider: world offset) */
     wb_real n[3];          /* unit, A -> B */
     wb_real lambda;        /* normal positional impulse of the substep, N s^2 */
