@@ -566,29 +566,42 @@ static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_c
     }
     if (B->r >= 0) { v3_madd(&rb->x[3 * B->r], n, lsum * wbm); turn(&rb->q[4 * B->r], tb); rb->moved[B->r] = 1; }
     if (A->r >= 0) { v3_madd(&rb->x[3 * A->r], n, -lsum * wa); turn(&rb->q[4 * A->r], ta); rb->moved[A->r] = 1; }
+    /* static friction (§3.5): undo the tangential slip of the two bodies over the substep
+     * when the impulse needed stays inside the friction cone, mu x the normal impulse. One
+     * correction for the manifold, at the centre of its normal impulses: corner by corner
+     * each correction turned the box about the normal and left the next corner slipping,
+     * and a box on a slope crept down at 1 mm/s */
+    if (mu > 0 && lsum > 0) {
+        wb_real c[3] = { 0, 0, 0 }, lca[3], lcb[3], pa[3], pa0[3], pb[3], pb0[3], slip[3];
+        for (int k = 0; k < np; k++) {
+            v3_madd(c, m->pt[k].pa, lam[k] / (2 * lsum));
+            v3_madd(c, m->pt[k].pb, lam[k] / (2 * lsum));
+        }
+        /* c as it was before this solve moved the bodies: its local points in each */
+        wb_real ca[3], cb[3];
+        v3_copy(ca, c);
+        v3_copy(cb, c);
+        side_local(rb, A, ca, lca);
+        side_local(rb, B, cb, lcb);
+        side_points(rb, A, lca, pa, pa0);
+        side_points(rb, B, lcb, pb, pb0);
+        for (int i = 0; i < 3; i++) slip[i] = (pb[i] - pb0[i]) - (pa[i] - pa0[i]);
+        v3_madd(slip, n, -v3_dot(slip, n));
+        const wb_real len = v3_len(slip);
+        if (len > 0) {
+            wb_real t[3], dp[3];
+            v3_scale(t, slip, 1 / len);
+            const wb_real wt = side_w(w, A, pa, t) + side_w(w, B, pb, t);
+            const wb_real lt = wt > 0 ? len / wt : INFINITY;
+            if (lt < mu * lsum) {
+                v3_scale(dp, t, -lt);
+                push(w, A, B, pa, pb, dp);
+            }
+        }
+    }
     const int32_t first = rb->nct;
     for (int k = 0; k < np; k++) {
         if (!(lam[k] > 0) && !(d[k] > 0)) continue;
-        /* static friction (§3.5): undo the tangential slip of the two points over the
-         * substep when the impulse needed stays inside the friction cone */
-        if (mu > 0) {
-            wb_real slip[3], pa[3], pa0[3], pb[3], pb0[3];
-            side_points(rb, A, la[k], pa, pa0);
-            side_points(rb, B, lb[k], pb, pb0);
-            for (int c = 0; c < 3; c++) slip[c] = (pb[c] - pb0[c]) - (pa[c] - pa0[c]);
-            v3_madd(slip, n, -v3_dot(slip, n));
-            const wb_real len = v3_len(slip);
-            if (len > 0) {
-                wb_real t[3], dp[3];
-                v3_scale(t, slip, 1 / len);
-                const wb_real wt = side_w(w, A, pa, t) + side_w(w, B, pb, t);
-                const wb_real lt = wt > 0 ? len / wt : INFINITY;
-                if (lt < mu * lam[k]) {
-                    v3_scale(dp, t, -lt);
-                    push(w, A, B, pa, pb, dp);
-                }
-            }
-        }
         /* kept for the velocity pass */
         wb_rcontact *ct = wb__grow(rb->ct, &rb->cap_ct, rb->nct + 1, sizeof *ct);
         if (!ct) { wb__warn(w, "out of memory in rigid contacts; friction and restitution skipped"); continue; }
