@@ -31,7 +31,7 @@ void wb_world_energy(const wb_world *w, wb_real *kinetic, wb_real *potential)
     const wb_rigids *rb = w->rb;
     for (int32_t r = 0; rb && r < rb->n; r++) {
         if (!(rb->gen[r] & 1u)) continue;
-        const wb_real m = 1 / rb->inv_mass[r], *v = &rb->v[3 * r];
+        const wb_real m = rb->mass[r], *v = &rb->v[3 * r];
         wb_real ob[3], L[3];
         q_rotate_inv(&rb->q[4 * r], &rb->om[3 * r], ob);
         const wb_real *I = &rb->inertia[9 * r];
@@ -49,7 +49,7 @@ void wb_world_momentum(const wb_world *w, wb_real out[3])
     for (int32_t i = 0; i < w->m.np; i++) v3_madd(out, &w->s.v[3 * i], mass_of(w, i));
     const wb_rigids *rb = w->rb;
     for (int32_t r = 0; rb && r < rb->n; r++)
-        if (rb->gen[r] & 1u) v3_madd(out, &rb->v[3 * r], 1 / rb->inv_mass[r]);
+        if (rb->gen[r] & 1u) v3_madd(out, &rb->v[3 * r], rb->mass[r]);
 }
 
 void wb_world_angular_momentum(const wb_world *w, wb_real out[3])
@@ -67,7 +67,7 @@ void wb_world_angular_momentum(const wb_world *w, wb_real out[3])
         wb_real l[3], ob[3], L[3];
         const wb_real *I = &rb->inertia[9 * r];
         v3_cross(l, &rb->x[3 * r], &rb->v[3 * r]);
-        v3_madd(out, l, 1 / rb->inv_mass[r]);
+        v3_madd(out, l, rb->mass[r]);
         q_rotate_inv(&rb->q[4 * r], &rb->om[3 * r], ob);
         for (int c = 0; c < 3; c++) L[c] = I[3 * c] * ob[0] + I[3 * c + 1] * ob[1] + I[3 * c + 2] * ob[2];
         q_rotate(&rb->q[4 * r], L, l);
@@ -178,7 +178,7 @@ uint64_t wb_world_hash(const wb_world *w)
         h = fnv(h, sh->b, sizeof sh->b);
         h = fnv(h, &sh->friction, sizeof sh->friction);
         h = fnv(h, &sh->restitution, sizeof sh->restitution);
-        h = fnv(h, &rb->inv_mass[r], sizeof(wb_real));
+        h = fnv(h, &rb->mass[r], sizeof(wb_real));
         h = fnv(h, &rb->x[3 * r], 3 * sizeof(wb_real));
         h = fnv(h, &rb->q[4 * r], 4 * sizeof(wb_real));
         h = fnv(h, &rb->v[3 * r], 3 * sizeof(wb_real));

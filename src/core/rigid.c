@@ -10,7 +10,7 @@
 #include "rigid.h"
 
 /* bytes per slot over the model, state and cache arrays, for the memory budget */
-#define SLOT_BYTES (sizeof(wb_cshape) + sizeof(uint32_t) + (1 + 9 + 9 + 1 + 13 + 7 + 13) * sizeof(wb_real) + 1)
+#define SLOT_BYTES (sizeof(wb_cshape) + sizeof(uint32_t) + (2 + 9 + 9 + 1 + 13 + 7 + 13) * sizeof(wb_real) + 1)
 
 static int fin3(const wb_real *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
 
@@ -115,6 +115,32 @@ const char *wb_rigid_def_check(const wb_rigid_def *d)
     return NULL;
 }
 
+int wb__rigid_set_slot(wb_world *w, int32_t r, const wb_cshape *s, wb_real mass, const wb_real x[3],
+                       const wb_real q[4], const wb_real v[3], const wb_real om[3])
+{
+    wb_rigids *rb = w->rb;
+    wb_real I[9], Ii[9];
+    wb__rigid_inertia(s, mass, I);
+    if (!m3_inverse(I, Ii)) return 0;
+    rb->shape[r] = *s;
+    rb->shape[r].mesh = NULL;
+    rb->mass[r] = mass;
+    rb->inv_mass[r] = 1 / mass;
+    memcpy(&rb->inertia[9 * r], I, sizeof I);
+    memcpy(&rb->inv_inertia[9 * r], Ii, sizeof Ii);
+    rb->bound[r] = s->shape == WB_SHAPE_BOX ? v3_len(s->half)
+                 : s->shape == WB_SHAPE_SPHERE ? s->radius
+                 : fmax(v3_len(s->a), v3_len(s->b)) + s->radius;
+    v3_copy(&rb->x[3 * r], x);
+    memcpy(&rb->q[4 * r], q, 4 * sizeof(wb_real));
+    v3_copy(&rb->v[3 * r], v);
+    v3_copy(&rb->om[3 * r], om);
+    v3_copy(&rb->x_prev[3 * r], x);
+    memcpy(&rb->q_prev[4 * r], q, 4 * sizeof(wb_real));
+    rb->moved[r] = 0;
+    return 1;
+}
+
 /* every per-slot array grows together; 0 on failure, nothing lost */
 static int grow(wb_world *w, wb_rigids *rb, int32_t need)
 {
@@ -130,11 +156,17 @@ static int grow(wb_world *w, wb_rigids *rb, int32_t need)
         if (!np_) return 0;                                                \
         rb->ptr = np_;                                                     \
     } while (0)
-    G(shape, 1); G(inv_mass, 1); G(inertia, 9); G(inv_inertia, 9); G(bound, 1); G(gen, 1);
+    G(shape, 1); G(mass, 1); G(inv_mass, 1); G(inertia, 9); G(inv_inertia, 9); G(bound, 1); G(gen, 1);
     G(x, 3); G(q, 4); G(v, 3); G(om, 3); G(x_prev, 3); G(q_prev, 4); G(save, 13); G(moved, 1);
 #undef G
     rb->cap = c;
     return 1;
+}
+
+int wb__rigids_reserve(wb_world *w, int32_t need)
+{
+    if (!w->rb && !(w->rb = calloc(1, sizeof *w->rb))) return 0;
+    return grow(w, w->rb, need);
 }
 
 wb_rigid_id wb_rigid_add(wb_world *w, const wb_rigid_def *def, wb_status *status)
@@ -158,41 +190,31 @@ wb_rigid_id wb_rigid_add(wb_world *w, const wb_rigid_def *def, wb_status *status
         slot = rb->n++;
         rb->gen[slot] = 0;
     }
-    wb_cshape *s = &rb->shape[slot];
-    memset(s, 0, sizeof *s);
-    s->shape = def->shape;
-    s->friction = def->friction;
-    s->restitution = def->restitution;
-    s->radius = def->radius;
-    wb_real *x = &rb->x[3 * slot], *q = &rb->q[4 * slot];
-    memcpy(q, def->rotation, 4 * sizeof(wb_real));
+    wb_cshape s;
+    memset(&s, 0, sizeof s);
+    s.shape = def->shape;
+    s.friction = def->friction;
+    s.restitution = def->restitution;
+    if (def->shape != WB_SHAPE_BOX) s.radius = def->radius;
+    wb_real x[3], q[4];
+    memcpy(q, def->rotation, sizeof q);
     q_normalize(q);
     v3_copy(x, def->pos);
-    if (def->shape == WB_SHAPE_BOX) v3_copy(s->half, def->half);
+    if (def->shape == WB_SHAPE_BOX) v3_copy(s.half, def->half);
     if (def->shape == WB_SHAPE_CAPSULE) {
         /* the segment about its midpoint, the centre of mass */
         wb_real c[3] = { def->a[0] / 2 + def->b[0] / 2, def->a[1] / 2 + def->b[1] / 2, def->a[2] / 2 + def->b[2] / 2 }, cw[3];
-        v3_sub(s->a, def->a, c);
-        v3_sub(s->b, def->b, c);
+        v3_sub(s.a, def->a, c);
+        v3_sub(s.b, def->b, c);
         q_rotate(q, c, cw);
         v3_add(x, x, cw);
     }
-    rb->inv_mass[slot] = 1 / def->mass;
-    wb__rigid_inertia(s, def->mass, &rb->inertia[9 * slot]);
-    if (!m3_inverse(&rb->inertia[9 * slot], &rb->inv_inertia[9 * slot])) {
+    if (!wb__rigid_set_slot(w, slot, &s, def->mass, x, q, def->vel, def->angular_velocity)) {
         wb__set_error("the inertia tensor is singular (shape too small for its mass)");
         *status = WB_ERR_ARG;
         if (slot == rb->n - 1 && rb->gen[slot] == 0) rb->n--;
         return none;
     }
-    rb->bound[slot] = def->shape == WB_SHAPE_BOX ? v3_len(s->half)
-                    : def->shape == WB_SHAPE_SPHERE ? s->radius
-                    : fmax(v3_len(s->a), v3_len(s->b)) + s->radius;
-    v3_copy(&rb->v[3 * slot], def->vel);
-    v3_copy(&rb->om[3 * slot], def->angular_velocity);
-    v3_copy(&rb->x_prev[3 * slot], x);
-    memcpy(&rb->q_prev[4 * slot], q, 4 * sizeof(wb_real));
-    rb->moved[slot] = 0;
     rb->gen[slot]++;
     *status = WB_OK;
     wb_rigid_id id = { (uint32_t)slot + 1, rb->gen[slot] };
@@ -240,7 +262,7 @@ void wb_rigid_get_def(const wb_world *w, wb_rigid_id r, wb_rigid_def *out)
     v3_copy(out->half, s->half);
     v3_copy(out->a, s->a);
     v3_copy(out->b, s->b);
-    out->mass = 1 / rb->inv_mass[i];
+    out->mass = rb->mass[i];
     out->friction = s->friction;
     out->restitution = s->restitution;
     v3_copy(out->pos, &rb->x[3 * i]);
@@ -253,7 +275,7 @@ void wb_rigid_position(const wb_world *w, wb_rigid_id r, wb_real out[3]) { v3_co
 void wb_rigid_rotation(const wb_world *w, wb_rigid_id r, wb_real out[4]) { memcpy(out, &w->rb->q[4 * RSLOT(w, r)], 4 * sizeof(wb_real)); }
 void wb_rigid_velocity(const wb_world *w, wb_rigid_id r, wb_real out[3]) { v3_copy(out, &w->rb->v[3 * RSLOT(w, r)]); }
 void wb_rigid_angular_velocity(const wb_world *w, wb_rigid_id r, wb_real out[3]) { v3_copy(out, &w->rb->om[3 * RSLOT(w, r)]); }
-wb_real wb_rigid_mass(const wb_world *w, wb_rigid_id r) { return 1 / w->rb->inv_mass[RSLOT(w, r)]; }
+wb_real wb_rigid_mass(const wb_world *w, wb_rigid_id r) { return w->rb->mass[RSLOT(w, r)]; }
 void wb_rigid_set_position(wb_world *w, wb_rigid_id r, const wb_real p[3]) { assert(fin3(p)); v3_copy(&w->rb->x[3 * RSLOT(w, r)], p); }
 void wb_rigid_set_velocity(wb_world *w, wb_rigid_id r, const wb_real v[3]) { assert(fin3(v)); v3_copy(&w->rb->v[3 * RSLOT(w, r)], v); }
 void wb_rigid_set_angular_velocity(wb_world *w, wb_rigid_id r, const wb_real om[3]) { assert(fin3(om)); v3_copy(&w->rb->om[3 * RSLOT(w, r)], om); }

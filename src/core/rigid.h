@@ -25,7 +25,8 @@ typedef struct wb_rigids {
     int32_t n, cap;        /* slots */
     /* model */
     wb_cshape *shape;      /* (n) shape, friction, restitution */
-    wb_real *inv_mass;     /* (n) */
+    wb_real *mass;         /* (n) kg, as given */
+    wb_real *inv_mass;     /* (n) 1 / mass */
     wb_real *inertia;      /* (n x 9) body-frame inertia tensor (row-major) */
     wb_real *inv_inertia;  /* (n x 9) its inverse */
     wb_real *bound;        /* (n) bounding radius about the centre */
@@ -66,6 +67,13 @@ void wb__rigid_contact_collider(wb_world *w, int32_t c, const wb_real p0[3], con
                                 const wb_real p1[3], const wb_real q1[4], int32_t r,
                                 const wb_manifold *m, wb_real h);
 
+/* room for `need` slots (charged to the budget); put slot `r` (< need) as given, raw:
+ * shape (the capsule about its centre), mass, pose, velocities; 0 when the inertia is
+ * singular (nothing changed). The snapshot (rigid_image.c) restores bodies through these */
+int wb__rigids_reserve(wb_world *w, int32_t need);
+int wb__rigid_set_slot(wb_world *w, int32_t r, const wb_cshape *s, wb_real mass, const wb_real x[3],
+                       const wb_real q[4], const wb_real v[3], const wb_real om[3]);
+
 /* body-frame inertia tensor (row-major 3 x 3) of a shape of mass m about its centre */
 void wb__rigid_inertia(const wb_cshape *s, wb_real m, wb_real I[9]);
 
@@ -74,7 +82,7 @@ static inline void wb__rigids_free(wb_world *w, wb_rigids *rb)
 {
     if (!rb) return;
     if (w->m.def.memory) w->m.def.memory->used -= rb->charged;
-    void *p[] = { rb->shape, rb->inv_mass, rb->inertia, rb->inv_inertia, rb->bound, rb->gen, rb->x, rb->q,
+    void *p[] = { rb->shape, rb->mass, rb->inv_mass, rb->inertia, rb->inv_inertia, rb->bound, rb->gen, rb->x, rb->q,
                   rb->v, rb->om, rb->x_prev, rb->q_prev, rb->save, rb->ct, rb->moved };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     free(rb);

@@ -122,6 +122,7 @@ void wb_image_free(wb_image *g)
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     wb__smatch_image_free(g);
     wb__pressure_image_free(g);
+    wb__rigid_image_free(g);
     memset(g, 0, sizeof *g);
 }
 
@@ -215,7 +216,7 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
         memcpy(g->vol_rest, w->vol->rest, (size_t)nvol * sizeof *g->vol_rest);
     }
     if ((st = wb__tet_image_of(w, g)) != WB_OK || (st = wb__smatch_image_of(w, g)) != WB_OK ||
-        (st = wb__pressure_image_of(w, g)) != WB_OK) {
+        (st = wb__pressure_image_of(w, g)) != WB_OK || (st = wb__rigid_image_of(w, g)) != WB_OK) {
         wb_image_free(g);
         return st;
     }
@@ -329,7 +330,9 @@ const char *wb_image_check(const wb_image *g)
         const wb_volume_def d = { g->vol_alpha[i], true, g->vol_rest[i] };
         if ((e = wb_volume_def_check(&d))) return e;
     }
-    if ((e = wb__tet_image_check(g)) || (e = wb__smatch_image_check(g)) || (e = wb__pressure_image_check(g))) return e;
+    if ((e = wb__tet_image_check(g)) || (e = wb__smatch_image_check(g)) || (e = wb__pressure_image_check(g)) ||
+        (e = wb__rigid_image_check(g)))
+        return e;
     return NULL;
 }
 
@@ -450,6 +453,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     if (st == WB_OK) st = wb__tet_image_reserve(w, g);
     if (st == WB_OK) st = wb__smatch_reserve(w, g);
     if (st == WB_OK) st = wb__pressure_reserve(w, g);
+    if (st == WB_OK) st = wb__rigid_reserve(w, g, 1);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
@@ -514,6 +518,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     wb__tet_image_put(w, g, 0);
     wb__smatch_put(w, g, 0);
     wb__pressure_put(w, g, 0);
+    wb__rigid_put(w, g, 1);
     s->time = g->time;
     s->frame = g->frame;
     s->warnings = g->warnings;
@@ -566,6 +571,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     if (st == WB_OK) st = wb__tet_image_reserve(w, g);
     if (st == WB_OK) st = wb__smatch_reserve(w, g);
     if (st == WB_OK) st = wb__pressure_reserve(w, g);
+    if (st == WB_OK) st = wb__rigid_reserve(w, g, 0);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
@@ -620,6 +626,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     wb__tet_image_put(w, g, first);
     wb__smatch_put(w, g, first);
     wb__pressure_put(w, g, first_surface);
+    wb__rigid_put(w, g, 0);
     m->topology_dirty = 1;
     out->first = first;
     out->count = g->np;

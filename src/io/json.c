@@ -685,8 +685,8 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
 {
     static const char *const keys[] = { "format", "version", "description", "defaults", "particles", "constraints",
                                         "colliders", "surfaces", "parts", "skins", "snapshot", "volumes",
-                                        "shape_matches", "pressures", "tets", NULL };
-    const cJSON *f[16];
+                                        "shape_matches", "pressures", "tets", "rigids", NULL };
+    const cJSON *f[17];
     sections s;
     defaults d;
     memset(&s, 0, sizeof s);
@@ -743,7 +743,8 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
         read_constraints(r, &s, &d, &cfg->img) || read_colliders(r, &s, &cfg->img) ||
         read_surfaces(r, &s, &cfg->img, &s.ntri) || read_parts(r, &s, cfg) || read_skins(r, &s, cfg) ||
         read_volumes(r, f[11], &d, &cfg->img) || jm_read_shape_matches(r, f[12], &cfg->img) ||
-        jm_read_pressures(r, f[13], &cfg->img) || jm_read_tets(r, f[14], &cfg->img))
+        jm_read_pressures(r, f[13], &cfg->img) || jm_read_tets(r, f[14], &cfg->img) ||
+        jr_read_rigids(r, f[15], &cfg->img))
         return -1;
     /* every value was checked where it was read: this is the last line of defence */
     const char *e = wb_image_check(&cfg->img);

@@ -68,5 +68,7 @@ int jv_opt_vec(rd *r, const cJSON *f, const kp *up, const char *key, int n, wb_r
 int jm_read_shape_matches(rd *r, const cJSON *arr, wb_image *g);
 int jm_read_pressures(rd *r, const cJSON *arr, wb_image *g);
 int jm_read_tets(rd *r, const cJSON *arr, wb_image *g);
+/* json_rigid.c: the "rigids" section (arr may be NULL) into the image */
+int jr_read_rigids(rd *r, const cJSON *arr, wb_image *g);
 
 #endif
