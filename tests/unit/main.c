@@ -31,6 +31,14 @@
     X(extreme_collider_derived_poses_finite)             \
     X(extreme_cluster_of_an_overflowing_box)
 
+/* test_rigid.c: rigid bodies */
+#define RIGID_TESTS(X)                                   \
+    X(rigid_helpers_match_their_formulas)                \
+    X(rigid_inertia_of_the_shapes)                       \
+    X(rigid_slots_handles_and_budget)                    \
+    X(rigid_nonfinite_frame_undone)                      \
+    X(rigid_clone_same_hash_and_future)
+
 /* test_contact.c: the particle-particle broad phase and contact rules */
 #define CONTACT_TESTS(X)                                 \
     X(contact_broadphase_matches_brute_force)            \
@@ -118,6 +126,7 @@
     CONTACT_TESTS(X)                             \
     TRICONTACT_TESTS(X)                          \
     EXTREME_TESTS(X)                             \
+    RIGID_TESTS(X)                               \
     X(tet_strain_volume_shape_and_shear)
 
 #define DECLARE(name) TEST(name);
