@@ -15,7 +15,7 @@ local bodies = {
            vel = {0, 0, 0.5}, angular_velocity = {0, 4, 0}, restitution = e },
   w:rigid{ shape = "box", half = {0.5, 0.05, 0.25}, mass = 1, pos = {2, 1.0, 0.3}, vel = {0, 2, 0},
            angular_velocity = {0, 0, 6}, restitution = e },
-  w:rigid{ shape = "sphere", radius = 0.25, pos = {0.3, 2.5, 1.2}, vel = {0.5, 0, 0}, restitution = 0.8 },
+  w:rigid{ shape = "sphere", radius = 0.25, pos = {0.3, 2.5, 1.2}, vel = {0, 0, 0.4}, restitution = 0.8 },
   w:rigid{ shape = "sphere", radius = 0.15, mass = 0.3, pos = {-1.5, 3, 2}, restitution = e },
   w:rigid{ shape = "capsule", a = {-0.35, 0, 0}, b = {0.35, 0, 0}, radius = 0.12, pos = {2, 1.8, -2},
            rotation = {0.9, 0, 0.3, 0.3}, angular_velocity = {1, 2, 0}, restitution = e },
