@@ -37,7 +37,8 @@
     X(rigid_inertia_of_the_shapes)                       \
     X(rigid_slots_handles_and_budget)                    \
     X(rigid_nonfinite_frame_undone)                      \
-    X(rigid_clone_same_hash_and_future)
+    X(rigid_clone_same_hash_and_future)                  \
+    X(rigid_pair_manifold_pushes_apart_by_inverse_mass)
 
 /* test_contact.c: the particle-particle broad phase and contact rules */
 #define CONTACT_TESTS(X)                                 \

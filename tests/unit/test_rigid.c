@@ -191,3 +191,40 @@ TEST(rigid_clone_same_hash_and_future)
     wb_world_destroy(c);
     wb_world_destroy(w);
 }
+
+TEST(rigid_pair_manifold_pushes_apart_by_inverse_mass)
+{
+    /* two spheres overlapping 0.1 along x, masses 1 and 3: the manifold's correction
+     * moves them apart by 3/4 and 1/4 of it (no turn: the arms are along the normal),
+     * sum m dx = 0 exactly as the impulses are opposite; the contact is kept for the
+     * velocity pass */
+    wb_world *w = world(0);
+    REQUIRE(w);
+    wb_rigid_def d = wb_rigid_default_def(WB_SHAPE_SPHERE);
+    d.radius = 0.5;
+    wb_rigid_id a = wb_rigid_add(w, &d, NULL);
+    v3_set(d.pos, 0.9, 0, 0);
+    d.mass = 3;
+    wb_rigid_id b = wb_rigid_add(w, &d, NULL);
+    wb_manifold m;
+    memset(&m, 0, sizeof m);
+    m.n = 1;
+    v3_set(m.normal, 1, 0, 0);
+    v3_set(m.pt[0].pa, 0.5, 0, 0);
+    v3_set(m.pt[0].pb, 0.4, 0, 0);
+    m.pt[0].depth = 0.1;
+    w->rb->nct = 0;
+    wb__rigid_contact_rigid(w, (int32_t)a.index - 1, (int32_t)b.index - 1, &m, 1.0 / 600);
+    wb_real xa[3], xb[3], q[4];
+    wb_rigid_position(w, a, xa);
+    wb_rigid_position(w, b, xb);
+    CHECK_NEAR(xa[0], -0.075, 1e-15);
+    CHECK_NEAR(xb[0], 0.925, 1e-15);
+    CHECK_NEAR(1 * xa[0] + 3 * (xb[0] - 0.9), 0, 1e-15);
+    CHECK_NEAR(xb[0] - xa[0], 1.0, 1e-15);   /* touching */
+    wb_rigid_rotation(w, a, q);
+    CHECK_NEAR(q[0], 1, 0);
+    CHECK_EQ(w->rb->nct, 1);
+    CHECK_NEAR(w->rb->ct[0].lambda, 0.1 / (1 + 1.0 / 3), 1e-15);
+    wb_world_destroy(w);
+}
