@@ -574,4 +574,44 @@ wb_real wb_grab_compliance(const wb_world *w, wb_grab_id g);
 int32_t wb_grab_count(const wb_world *w);
 wb_grab_id wb_grab_at(const wb_world *w, int32_t i);
 
+/* ---- rigid bodies (rigid.c, issue 10): XPBD rigid bodies (Müller et al. 2020) --------- */
+#define WB_MAX_RIGIDS (1 << 20)
+typedef struct wb_rigid_id { uint32_t index; uint32_t gen; } wb_rigid_id; /* odd gen = live */
+typedef struct wb_rigid_def {
+    wb_shape shape;               /* WB_SHAPE_SPHERE, WB_SHAPE_BOX or WB_SHAPE_CAPSULE */
+    wb_real radius;               /* sphere, capsule */
+    wb_real half[3];              /* box half extents */
+    wb_real a[3], b[3];           /* capsule segment in the body frame (its midpoint is the
+                                   * centre of mass: a and b are taken about it) */
+    wb_real mass;                 /* kg, > 0 */
+    wb_real pos[3];               /* centre of mass */
+    wb_real rotation[4];          /* (w,x,y,z), normalised on add */
+    wb_real vel[3], angular_velocity[3]; /* m/s, rad/s (world frame) */
+    wb_real friction;             /* Coulomb, static = dynamic; a contact takes the larger of two */
+    wb_real restitution;          /* 0..1; a contact takes the larger of two */
+} wb_rigid_def;
+
+wb_rigid_def wb_rigid_default_def(wb_shape shape);           /* unit-ish, mass 1, at the origin */
+const char *wb_rigid_def_check(const wb_rigid_def *def);     /* NULL or what is wrong */
+wb_rigid_id wb_rigid_add(wb_world *w, const wb_rigid_def *def, wb_status *status);
+bool wb_rigid_valid(const wb_world *w, wb_rigid_id r);
+void wb_rigid_remove(wb_world *w, wb_rigid_id r);
+int32_t wb_rigid_count(const wb_world *w);                   /* live bodies */
+wb_rigid_id wb_rigid_at(const wb_world *w, int32_t i);       /* 0 <= i < count, slot order */
+void wb_rigid_get_def(const wb_world *w, wb_rigid_id r, wb_rigid_def *out); /* shape + state now */
+void wb_rigid_position(const wb_world *w, wb_rigid_id r, wb_real out[3]);
+void wb_rigid_rotation(const wb_world *w, wb_rigid_id r, wb_real out[4]);
+void wb_rigid_velocity(const wb_world *w, wb_rigid_id r, wb_real out[3]);
+void wb_rigid_angular_velocity(const wb_world *w, wb_rigid_id r, wb_real out[3]);
+wb_real wb_rigid_mass(const wb_world *w, wb_rigid_id r);
+/* setters take finite values (asserted; the binding checks) */
+void wb_rigid_set_position(wb_world *w, wb_rigid_id r, const wb_real p[3]);
+void wb_rigid_set_rotation(wb_world *w, wb_rigid_id r, const wb_real q[4]); /* normalised; not zero */
+void wb_rigid_set_velocity(wb_world *w, wb_rigid_id r, const wb_real v[3]);
+void wb_rigid_set_angular_velocity(wb_world *w, wb_rigid_id r, const wb_real om[3]);
+/* an impulse J (N s) at world point `at` (NULL: the centre): v += J/m, om += I^-1 (r x J) */
+void wb_rigid_apply_impulse(wb_world *w, wb_rigid_id r, const wb_real J[3], const wb_real at[3]);
+/* its surface's signed distance from p (negative inside) */
+wb_real wb_rigid_distance(const wb_world *w, wb_rigid_id r, const wb_real p[3]);
+
 #endif

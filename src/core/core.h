@@ -286,6 +286,7 @@ struct wb_world {
     wb_pressures pr;       /* pressure constraints (pressure.c) */
     struct wb_attaches *att; /* attachments (attach.h), NULL until the first */
     struct wb_grabs *grab;  /* grabs (grab.h), NULL until the first */
+    struct wb_rigids *rb;  /* rigid bodies (rigid.h), NULL until the first */
 };
 
 /* internal entry points */

@@ -2,6 +2,7 @@
 #include "ctype.h"
 #include "attach.h"
 #include "grab.h"
+#include "rigid.h"
 
 static wb_real mass_of(const wb_world *w, int32_t i) { return w->m.w[i] > 0 ? 1 / w->m.w[i] : 0; }
 
@@ -28,6 +29,18 @@ void wb_world_energy(const wb_world *w, wb_real *kinetic, wb_real *potential)
     /* elastic: each constraint type's, U = C^2 / (2 alpha) for compliant ones */
     for (int t = 0; t < wb__nctypes; t++)
         if (wb__ctypes[t]->energy) pe += wb__ctypes[t]->energy(w);
+    /* rigid bodies: translation and rotation (om . I om / 2 in the body frame), weight */
+    const wb_rigids *rb = w->rb;
+    for (int32_t r = 0; rb && r < rb->n; r++) {
+        if (!(rb->gen[r] & 1u)) continue;
+        const wb_real m = rb->mass[r], *v = &rb->v[3 * r];
+        wb_real ob[3], L[3];
+        q_rotate_inv(&rb->q[4 * r], &rb->om[3 * r], ob);
+        const wb_real *I = &rb->inertia[9 * r];
+        for (int c = 0; c < 3; c++) L[c] = I[3 * c] * ob[0] + I[3 * c + 1] * ob[1] + I[3 * c + 2] * ob[2];
+        ke += (wb_real)0.5 * (m * v3_dot(v, v) + v3_dot(ob, L));
+        pe -= m * v3_dot(g, &rb->x[3 * r]);
+    }
     *kinetic = ke;
     *potential = pe;
 }
@@ -36,6 +49,9 @@ void wb_world_momentum(const wb_world *w, wb_real out[3])
 {
     v3_set(out, 0, 0, 0);
     for (int32_t i = 0; i < w->m.np; i++) v3_madd(out, &w->s.v[3 * i], mass_of(w, i));
+    const wb_rigids *rb = w->rb;
+    for (int32_t r = 0; rb && r < rb->n; r++)
+        if (rb->gen[r] & 1u) v3_madd(out, &rb->v[3 * r], rb->mass[r]);
 }
 
 void wb_world_angular_momentum(const wb_world *w, wb_real out[3])
@@ -45,6 +61,19 @@ void wb_world_angular_momentum(const wb_world *w, wb_real out[3])
         wb_real l[3];
         v3_cross(l, &w->s.x[3 * i], &w->s.v[3 * i]);
         v3_madd(out, l, mass_of(w, i));
+    }
+    /* rigid bodies: x x m v + R I R^T om */
+    const wb_rigids *rb = w->rb;
+    for (int32_t r = 0; rb && r < rb->n; r++) {
+        if (!(rb->gen[r] & 1u)) continue;
+        wb_real l[3], ob[3], L[3];
+        const wb_real *I = &rb->inertia[9 * r];
+        v3_cross(l, &rb->x[3 * r], &rb->v[3 * r]);
+        v3_madd(out, l, rb->mass[r]);
+        q_rotate_inv(&rb->q[4 * r], &rb->om[3 * r], ob);
+        for (int c = 0; c < 3; c++) L[c] = I[3 * c] * ob[0] + I[3 * c + 1] * ob[1] + I[3 * c + 2] * ob[2];
+        q_rotate(&rb->q[4 * r], L, l);
+        v3_add(out, out, l);
     }
 }
 
@@ -154,6 +183,25 @@ uint64_t wb_world_hash(const wb_world *w)
         h = fnv(h, &gr->target[3 * i], 3 * sizeof(wb_real));
         h = fnv(h, &gr->from[3 * i], 3 * sizeof(wb_real));
         h = fnv(h, &gr->alpha[i], sizeof(wb_real));
+    const wb_rigids *rb = w->rb;
+    for (int32_t r = 0; rb && r < rb->n; r++) { /* (worlds without any hash as they always did) */
+        if (!(rb->gen[r] & 1u)) continue;
+        const wb_cshape *sh = &rb->shape[r];
+        const int32_t shape = (int32_t)sh->shape;
+        h = fnv(h, &r, sizeof r);
+        h = fnv(h, &rb->gen[r], sizeof rb->gen[r]);
+        h = fnv(h, &shape, sizeof shape);
+        h = fnv(h, &sh->radius, sizeof sh->radius);
+        h = fnv(h, sh->half, sizeof sh->half);
+        h = fnv(h, sh->a, sizeof sh->a);
+        h = fnv(h, sh->b, sizeof sh->b);
+        h = fnv(h, &sh->friction, sizeof sh->friction);
+        h = fnv(h, &sh->restitution, sizeof sh->restitution);
+        h = fnv(h, &rb->mass[r], sizeof(wb_real));
+        h = fnv(h, &rb->x[3 * r], 3 * sizeof(wb_real));
+        h = fnv(h, &rb->q[4 * r], 4 * sizeof(wb_real));
+        h = fnv(h, &rb->v[3 * r], 3 * sizeof(wb_real));
+        h = fnv(h, &rb->om[3 * r], 3 * sizeof(wb_real));
     }
     h = fnv(h, &s->time, sizeof s->time);
     h = fnv(h, &s->frame, sizeof s->frame);

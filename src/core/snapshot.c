@@ -124,6 +124,7 @@ void wb_image_free(wb_image *g)
     wb__pressure_image_free(g);
     wb__attach_image_free(g);
     wb__grab_image_free(g);
+    wb__rigid_image_free(g);
     memset(g, 0, sizeof *g);
 }
 
@@ -219,6 +220,7 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
     if ((st = wb__tet_image_of(w, g)) != WB_OK || (st = wb__smatch_image_of(w, g)) != WB_OK ||
         (st = wb__pressure_image_of(w, g)) != WB_OK || (st = wb__attach_image_of(w, g)) != WB_OK ||
         (st = wb__grab_image_of(w, g)) != WB_OK) {
+        (st = wb__pressure_image_of(w, g)) != WB_OK || (st = wb__rigid_image_of(w, g)) != WB_OK) {
         wb_image_free(g);
         return st;
     }
@@ -334,6 +336,7 @@ const char *wb_image_check(const wb_image *g)
     }
     if ((e = wb__tet_image_check(g)) || (e = wb__smatch_image_check(g)) || (e = wb__pressure_image_check(g)) ||
         (e = wb__attach_image_check(g)) || (e = wb__grab_image_check(g)))
+        (e = wb__rigid_image_check(g)))
         return e;
     return NULL;
 }
@@ -457,6 +460,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     if (st == WB_OK) st = wb__pressure_reserve(w, g);
     if (st == WB_OK) st = wb__attach_image_reserve(w, g);
     if (st == WB_OK) st = wb__grab_image_reserve(w, g);
+    if (st == WB_OK) st = wb__rigid_reserve(w, g, 1);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
@@ -523,6 +527,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     wb__pressure_put(w, g, 0);
     wb__attach_image_put(w, g, 0, NULL);
     wb__grab_image_put(w, g, 0);
+    wb__rigid_put(w, g, 1);
     s->time = g->time;
     s->frame = g->frame;
     s->warnings = g->warnings;
@@ -578,6 +583,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     if (st == WB_OK) st = wb__pressure_reserve(w, g);
     if (st == WB_OK) st = wb__attach_image_reserve(w, g);
     if (st == WB_OK) st = wb__grab_image_reserve(w, g);
+    if (st == WB_OK) st = wb__rigid_reserve(w, g, 0);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
@@ -637,6 +643,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     wb__attach_image_put(w, g, first, cmap);
     wb__grab_image_put(w, g, first);
     free(cmap);
+    wb__rigid_put(w, g, 0);
     m->topology_dirty = 1;
     out->first = first;
     out->count = g->np;

@@ -55,6 +55,14 @@ typedef struct wb_image_grab {
     wb_real *target, *from; /* (n x 3) target now, and where the next step's sweep starts */
     wb_real *alpha;        /* (n) compliance, m/N */
 } wb_image_grab;
+/* a rigid body (rigid.c): its shape in its own frame, mass, pose and velocities, raw (a
+ * capsule's a and b about its centre of mass, the rotation unit) */
+typedef struct wb_image_rigid {
+    wb_shape shape;
+    wb_real radius, half[3], a[3], b[3];
+    wb_real friction, restitution, mass;
+    wb_real x[3], q[4], v[3], om[3];
+} wb_image_rigid;
 
 typedef struct wb_image {
     wb_world_def def;
@@ -110,6 +118,9 @@ typedef struct wb_image {
     wb_image_pressure pr;  /* empty unless wb_image_alloc_pressure */
     wb_image_attach att;   /* empty unless wb_image_alloc_attach */
     wb_image_grab grab;    /* empty unless wb_image_alloc_grab */
+    int32_t nrb;           /* rigid bodies by slot: empty unless wb_image_alloc_rigids */
+    wb_image_rigid *rb;    /* (nrb) */
+    uint32_t *rb_gen;      /* (nrb) odd = live */
 } wb_image;
 
 /* allocate the arrays for these counts (zeroed; generations 1, i.e. live; particles collide);
@@ -172,5 +183,17 @@ wb_status wb__grab_image_of(const wb_world *w, wb_image *g);
 const char *wb__grab_image_check(const wb_image *g);
 wb_status wb__grab_image_reserve(wb_world *w, const wb_image *g);
 void wb__grab_image_put(wb_world *w, const wb_image *g, int32_t pshift);
+
+/* rigid bodies (rigid_image.c): n slots, zeroed, generations 1 (live); WB_ERR_NOMEM */
+wb_status wb_image_alloc_rigids(wb_image *img, int32_t n);
+/* the body w:rigid{...} would make from a def (checked by wb_rigid_def_check): WB_ERR_ARG */
+wb_status wb_image_rigid_from_def(const wb_rigid_def *d, wb_image_rigid *out);
+void wb__rigid_image_free(wb_image *g);
+wb_status wb__rigid_image_of(const wb_world *w, wb_image *g);
+const char *wb__rigid_image_check(const wb_image *g);
+/* room for the image's bodies in w: exact (a new world: the image's slots as they are)
+ * or appended (its live bodies into free or new slots) */
+wb_status wb__rigid_reserve(wb_world *w, const wb_image *g, int exact);
+void wb__rigid_put(wb_world *w, const wb_image *g, int exact);
 
 #endif

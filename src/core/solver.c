@@ -9,6 +9,7 @@
 #include <time.h>
 
 #include "ctype.h"
+#include "rigid.h"
 
 static double now_ms(void)
 {
@@ -69,6 +70,7 @@ static void undo_particles(wb_world *w)
         memcpy(w->s.v, w->k.v_save, sizeof(wb_real) * n);
     }
     for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->substep_begin(w);
+    wb__rigids_undo(w);
 }
 
 /* the colliders' poses at the frame's start, before their velocities move them */
@@ -110,6 +112,13 @@ static int check_finite(wb_world *w)
         v3_set(cp->v, 0, 0, 0);
         v3_set(cp->om, 0, 0, 0);
     }
+    const int32_t bad = wb__rigids_finite(w);
+    if (bad >= 0) {
+        wb__warn(w, "frame %lld: rigid body %d became non-finite; its frame was undone (reduce dt, "
+                    "raise substeps)", (long long)w->s.frame + 1, bad + 1);
+        undo_particles(w);
+        return 0;
+    }
     const int32_t n = 3 * w->m.np;
     const wb_real *x = w->s.x, *v = w->s.v;
     for (int32_t i = 0; i < n; i++) {
@@ -139,6 +148,7 @@ wb_status wb_world_step(wb_world *w)
         memcpy(k->x_save, w->s.x, sizeof(wb_real) * 3 * (size_t)np);
         memcpy(k->v_save, w->s.v, sizeof(wb_real) * 3 * (size_t)np);
     }
+    wb__rigids_save(w);
     k->nbreaks = 0;
     k->projections = 0;
     k->h_last = h;
@@ -163,6 +173,7 @@ wb_status wb_world_step(wb_world *w)
             return WB_ERR_INTERRUPTED;
         }
         predict(w, h);
+        wb__rigids_predict(w, h);
         double t0 = now_ms();
         /* TYPE HOOK: the constraint types, walked from the table (wb__ctypes) */
         for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->substep_begin(w);
@@ -170,9 +181,12 @@ wb_status wb_world_step(wb_world *w)
         solve += now_ms() - t0;
         wb__contacts_project(w, h);
         wb__tricontacts_project(w, h);
+        wb__rigids_solve(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
         wb__collide_and_update(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
+        wb__rigids_update(w, h);
         wb__contacts_velocity(w, h);
         wb__tricontacts_velocity(w, h);
+        wb__rigids_velocity(w, h);
     }
 
     /* a frame gone non-finite is undone before it can bend or break anything */

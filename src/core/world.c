@@ -11,6 +11,7 @@
 #include "tet.h"
 #include "attach.h"
 #include "grab.h"
+#include "rigid.h"
 
 static _Thread_local char wb_err[256];
 
@@ -108,6 +109,7 @@ void wb_world_destroy(wb_world *w)
     wb__tet_free(w);
     wb__attach_free(w);
     wb__grab_free(w);
+    wb__rigids_free(w, w->rb);
     wb_model *m = &w->m;
     for (int32_t i = 0; i < m->nc; i++) wb__colmesh_free(m->c_shape[i].mesh); /* mesh colliders' copies */
     /* the bends' arrays (bend.c owns their use; freed here so that no circle joins the files) */

@@ -71,5 +71,7 @@ int jm_read_tets(rd *r, const cJSON *arr, wb_image *g);
 /* json_attach.c: the "attachments" and "grabs" sections, after particles and colliders */
 int ja_read_attachments(rd *r, const cJSON *arr, wb_image *g);
 int ja_read_grabs(rd *r, const cJSON *arr, wb_image *g);
+/* json_rigid.c: the "rigids" section (arr may be NULL) into the image */
+int jr_read_rigids(rd *r, const cJSON *arr, wb_image *g);
 
 #endif

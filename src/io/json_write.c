@@ -303,6 +303,34 @@ static void write_colliders(out *o, const wb_image *g)
     fputs(first ? "],\n" : "\n  ],\n", f);
 }
 
+/* rigid bodies by slot, raw, with their generations (json_rigid.c reads them) */
+static void write_rigids(out *o, const wb_image *g)
+{
+    static const char *const names[] = { "plane", "sphere", "box", "capsule", "mesh" };
+    FILE *f = o->f;
+    for (int32_t i = 0; i < g->nrb; i++) {
+        const wb_image_rigid *b = &g->rb[i];
+        fputs(i ? ",\n    {" : "  \"rigids\": [\n    {", f);
+        if (!(g->rb_gen[i] & 1u)) { fprintf(f, "\"generation\": %u}", (unsigned)g->rb_gen[i]); continue; }
+        fprintf(f, "\"shape\": \"%s\", ", names[b->shape]);
+        if (b->shape == WB_SHAPE_BOX) { fputs("\"half\": ", f); vec(o, b->half, 3); }
+        else { fputs("\"radius\": ", f); num(o, b->radius); }
+        if (b->shape == WB_SHAPE_CAPSULE) {
+            fputs(", \"a\": ", f); vec(o, b->a, 3);
+            fputs(", \"b\": ", f); vec(o, b->b, 3);
+        }
+        fputs(", \"mass\": ", f); num(o, b->mass);
+        fputs(", \"friction\": ", f); num(o, b->friction);
+        fputs(", \"restitution\": ", f); num(o, b->restitution);
+        fputs(",\n     \"pos\": ", f); vec(o, b->x, 3);
+        fputs(", \"rotation\": ", f); vec(o, b->q, 4);
+        fputs(", \"vel\": ", f); vec(o, b->v, 3);
+        fputs(", \"angular_velocity\": ", f); vec(o, b->om, 3);
+        fprintf(f, ", \"generation\": %u}", (unsigned)g->rb_gen[i]);
+    }
+    if (g->nrb) fputs("\n  ],\n", f);
+}
+
 static void write_surfaces(out *o, const wb_image *g)
 {
     FILE *f = o->f;
@@ -346,6 +374,7 @@ int wbio_write_snapshot(const wb_world *w, const char *path, const char *shown, 
     write_tets(&o, &g);
     write_materials(&o, &g);
     write_attach(&o, &g);
+    write_rigids(&o, &g);
     write_colliders(&o, &g);
     write_surfaces(&o, &g);
     fputs("}\n", o.f);

@@ -166,7 +166,7 @@ static int r_get_camera(lua_State *L)
 
 /* ---- drawing and recording ---------------------------------------------------------------- */
 static const char *const draw_keys[] = { "particles", "constraints", "colliders", "surfaces", "skins", "pins",
-                                         "grid", "cage", "strain_scale", "line_width", "materials", NULL };
+                                         "grid", "cage", "strain_scale", "line_width", "materials", "rigids", NULL };
 
 /* finish the recording; raises with the encoder's message when it failed */
 static void stop_recording(lua_State *L, wbl_renderer *u)
@@ -240,6 +240,7 @@ static int r_draw(lua_State *L)
         wbl_optbool(L, 3, "grid", &o.grid);
         wbl_optbool(L, 3, "cage", &o.cage);
         wbl_optbool(L, 3, "materials", &o.materials);
+        wbl_optbool(L, 3, "rigids", &o.rigids);
         wb_real v;
         if (wbl_optreal(L, 3, "strain_scale", &v)) {
             if (!(v > 0)) return wbl_fielderror(L, 3, "strain_scale", "must be > 0");

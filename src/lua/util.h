@@ -18,6 +18,7 @@
 #define WBL_BODY "wobble.body"
 #define WBL_SHAPE_MATCH "wobble.shape_match"
 #define WBL_PRESSURE "wobble.pressure"
+#define WBL_RIGID "wobble.rigid"
 
 /* the world userdata: w is NULL once closed, so __gc/__close can run twice */
 typedef struct wbl_world {
@@ -35,6 +36,7 @@ void wbl_open_volume(lua_State *L);    /* volume.c: volume constraints, tet bodi
 void wbl_open_shape_match(lua_State *L); /* shape_match.c: w:shape_match and its handle */
 void wbl_open_pressure(lua_State *L);  /* pressure.c: w:pressure and its handle */
 void wbl_open_attach(lua_State *L);    /* attach.c: w:attach, w:grab and their handles */
+void wbl_open_rigid(lua_State *L);     /* rigid.c: w:rigid and its handle */
 int wbl_world_new(lua_State *L);       /* wobble.world{...} */
 /* add methods to the world's method table (used by the per-type files) */
 void wbl_add_world_methods(lua_State *L, const luaL_Reg *l);

@@ -20,6 +20,7 @@ static const float col_pin[3] = { 0.98f, 0.68f, 0.08f };
 static const float col_attach[3] = { 0.16f, 0.70f, 0.30f };  /* attached to a collider */
 static const float col_grab[3] = { 0.85f, 0.15f, 0.75f };    /* grabbed, its target and line */
 static const float col_collider[3] = { 0.55f, 0.58f, 0.64f };
+static const float col_rigid[3] = { 0.86f, 0.50f, 0.20f };  /* rigid bodies: a warm orange */
 static const float col_rest[3] = { 0.40f, 0.40f, 0.42f };
 static const float col_tension[3] = { 0.92f, 0.08f, 0.06f };
 static const float col_compress[3] = { 0.12f, 0.32f, 0.92f };
@@ -123,9 +124,9 @@ static void inst_cylinder(wb_inst *in, const double a[3], const double b[3], dou
  * sphere per cloth vertex hides the cloth), those under a skin by the skin. */
 static bool build_instances(wb_layers *l, const wb_world *w, const wb_draw_opts *o, double unit)
 {
-    int32_t np = wb_particle_count(w), nc = wb_collider_count(w);
+    int32_t np = wb_particle_count(w), nc = wb_collider_count(w), nr = o->rigids ? wb_rigid_count(w) : 0;
     const int32_t na = wb_attach_count(w), ng = wb_grab_count(w);
-    size_t need = (size_t)np + 3 * (size_t)nc + (size_t)na + 2 * (size_t)ng;
+    size_t need = (size_t)np + 3 * (size_t)nc + 3 * (size_t)nr + (size_t)na + 2 * (size_t)ng;
     if (!grow(&l->inst, &l->inst_cap, need + 1, sizeof *l->inst)) return false;
     const wb_real *x = wb_particle_positions(w);
     size_t k = 0;
@@ -183,6 +184,31 @@ static bool build_instances(wb_layers *l, const wb_world *w, const wb_draw_opts 
                 for (int cc = 0; cc < 3; cc++)
                     for (int rr = 0; rr < 3; rr++) cols[cc][rr] = m[rr * 3 + cc] * d.half[cc];
                 inst_set(&l->inst[k++], c, cols, col_collider, 0.35f);
+            }
+        }
+        /* rigid bodies: the same solids at their poses (a capsule's ends are body-frame) */
+        for (int32_t i = 0; i < nr; i++) {
+            wb_rigid_def d;
+            wb_rigid_get_def(w, wb_rigid_at(w, i), &d);
+            double c[3] = { d.pos[0], d.pos[1], d.pos[2] }, m[9], cols[3][3];
+            if (!isfinite(c[0] + c[1] + c[2])) continue;
+            quat_mat(d.rotation, m);
+            double a[3], b[3];
+            for (int rr = 0; rr < 3; rr++) {
+                a[rr] = c[rr] + m[rr * 3] * d.a[0] + m[rr * 3 + 1] * d.a[1] + m[rr * 3 + 2] * d.a[2];
+                b[rr] = c[rr] + m[rr * 3] * d.b[0] + m[rr * 3 + 1] * d.b[1] + m[rr * 3 + 2] * d.b[2];
+            }
+            if (g == WB_G_HI && d.shape == WB_SHAPE_SPHERE) {
+                inst_sphere(&l->inst[k++], c, d.radius, col_rigid, 0.45f);
+            } else if (g == WB_G_HI && d.shape == WB_SHAPE_CAPSULE) {
+                inst_sphere(&l->inst[k++], a, d.radius, col_rigid, 0.45f);
+                inst_sphere(&l->inst[k++], b, d.radius, col_rigid, 0.45f);
+            } else if (g == WB_G_CYL && d.shape == WB_SHAPE_CAPSULE) {
+                inst_cylinder(&l->inst[k++], a, b, d.radius, col_rigid);
+            } else if (g == WB_G_BOX && d.shape == WB_SHAPE_BOX) {
+                for (int cc = 0; cc < 3; cc++)
+                    for (int rr = 0; rr < 3; rr++) cols[cc][rr] = m[rr * 3 + cc] * d.half[cc];
+                inst_set(&l->inst[k++], c, cols, col_rigid, 0.45f);
             }
         }
         l->count[g] = k - l->first[g];

@@ -43,7 +43,7 @@ static const double box_shrink = 0.03;
 
 wb_draw_opts wb_draw_default_opts(void)
 {
-    wb_draw_opts o = { true, true, true, true, true, true, true, false, 0.02, 1.5, true };
+    wb_draw_opts o = { true, true, true, true, true, true, true, false, 0.02, 1.5, true, true };
     return o;
 }
 
@@ -118,7 +118,7 @@ size_t wb_renderer_draw_held(const wb_renderer *r)
 size_t wb_renderer_draw_bytes(const wb_renderer *r, const wb_world *w, const wb_draw_skin *sk, int nsk)
 {
     if (!r->be->gl) return 0;
-    size_t np = (size_t)wb_particle_count(w), nc = (size_t)wb_collider_count(w);
+    size_t np = (size_t)wb_particle_count(w), nc = (size_t)wb_collider_count(w) + (size_t)wb_rigid_count(w);
     size_t nd = (size_t)wb_world_distance_pairs(w, NULL, NULL), nv = np, nt = 0;
     for (int32_t s = 0; s < wb_surface_count(w); s++) {
         int32_t k;
@@ -268,6 +268,15 @@ static box scene_box(const wb_world *w)
                 box_add(&b, p, 0);
             }
         }
+    }
+    for (int32_t i = 0; i < wb_rigid_count(w); i++) {
+        wb_rigid_def d;
+        wb_rigid_get_def(w, wb_rigid_at(w, i), &d);
+        double c[3] = { d.pos[0], d.pos[1], d.pos[2] };
+        const double r = d.shape == WB_SHAPE_BOX ? sqrt(d.half[0] * d.half[0] + d.half[1] * d.half[1] + d.half[2] * d.half[2])
+                       : d.shape == WB_SHAPE_SPHERE ? d.radius
+                       : sqrt(d.a[0] * d.a[0] + d.a[1] * d.a[1] + d.a[2] * d.a[2]) + d.radius;
+        if (isfinite(c[0] + c[1] + c[2] + r)) box_add(&b, c, r);
     }
     if (!b.any) {
         double o[3] = { 0, 0, 0 };

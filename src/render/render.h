@@ -49,6 +49,7 @@ typedef struct wb_draw_opts {
     double line_width;     /* pixels at 720 rows; scaled with the height */
     bool materials;        /* tint the particles and surfaces of volume, shape-matching and
                               pressure bodies by their strain (layers.c) */
+    bool rigids;           /* rigid bodies, as shaded solids in their own colour */
 } wb_draw_opts;
 
 /* every layer on but the cage, strain_scale 0.02, line_width 1.5 */

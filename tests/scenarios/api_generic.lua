@@ -37,6 +37,7 @@ local function fixture()
   f.rec = f.w:record_vtk("api_generic/rec")
   f.att = f.w:attach(f.p, f.col)
   f.grab = f.w:grab(f.q, {1, 0, 0})
+  f.rb = f.w:rigid{ shape = "box", half = {0.2, 0.2, 0.2}, pos = {0, 6, 0} }
   return f
 end
 
@@ -120,6 +121,17 @@ local CASES = {
         center = {0, 0, 0}, rotation = {1, 0, 0, 0}, scale = 1, friction = 0, restitution = 0 },
     },
     call = function(f, o) return f.w:collider(o) end },
+  -- rigid bodies: one row per shape
+  ["world:rigid"] = {
+    shapes = {
+      { shape = "sphere", radius = 0.5, mass = 1, pos = {0, 0, 0}, rotation = {1, 0, 0, 0}, vel = {0, 0, 0},
+        angular_velocity = {0, 0, 0}, friction = 0, restitution = 0 },
+      { shape = "box", half = {1, 1, 1}, mass = 1, pos = {0, 0, 0}, rotation = {1, 0, 0, 0}, vel = {0, 0, 0},
+        angular_velocity = {0, 0, 0}, friction = 0, restitution = 0 },
+      { shape = "capsule", a = {0, 0, 0}, b = {1, 0, 0}, radius = 0.5, mass = 1, pos = {0, 0, 0},
+        rotation = {1, 0, 0, 0}, vel = {0, 0, 0}, angular_velocity = {0, 0, 0}, friction = 0, restitution = 0 },
+    },
+    call = function(f, o) return f.w:rigid(o) end },
 
   -- ---- world: positional numbers
   ["world:set_position"] = { args = { 1, 0, 0, 0 }, nums = { 1, 2, 3, 4 },
@@ -172,7 +184,7 @@ local CASES = {
 }
 for _, name in ipairs{ "angular_momentum", "bends", "bounds", "breaks", "closed", "colliders", "contacts", "damping", "distances", "dt",
                        "energy", "frame", "gravity", "hash", "iterations", "max_strain", "momentum", "particle_count",
-                       "relaxation", "skins", "solver", "stats", "step", "substeps", "threads", "time", "warnings" } do
+                       "relaxation", "rigids", "skins", "solver", "stats", "step", "substeps", "threads", "time", "warnings" } do
   CASES["world:" .. name] = { none = "a getter or step: no arguments" }
 end
 
@@ -189,6 +201,21 @@ CASES["collider:distance"] = { args = { 0, 0, 0 }, nums = { 1, 2, 3 },
                                call = function(f, ...) return f.col:distance(...) end }
 for _, name in ipairs{ "material", "position", "remove", "rotation", "shape", "valid", "velocity", "world" } do
   CASES["collider:" .. name] = { none = "a getter or remove: no arguments" }
+end
+CASES["rigid:set_position"] = { args = { 0, 0, 0 }, nums = { 1, 2, 3 },
+                                call = function(f, ...) return f.rb:set_position(...) end }
+CASES["rigid:set_velocity"] = { args = { 0, 0, 0 }, nums = { 1, 2, 3 },
+                                call = function(f, ...) return f.rb:set_velocity(...) end }
+CASES["rigid:set_angular_velocity"] = { args = { 0, 0, 0 }, nums = { 1, 2, 3 },
+                                        call = function(f, ...) return f.rb:set_angular_velocity(...) end }
+CASES["rigid:distance"] = { args = { 0, 0, 0 }, nums = { 1, 2, 3 },
+                            call = function(f, ...) return f.rb:distance(...) end }
+CASES["rigid:set_rotation"] = { args = { 1, 0, 0, 0 }, nums = { 1, 2, 3, 4 },
+                                call = function(f, ...) return f.rb:set_rotation(...) end }
+CASES["rigid:apply_impulse"] = { args = { {1, 0, 0}, {0, 6.2, 0} }, nums = { 1, 2 },
+                                 call = function(f, ...) return f.rb:apply_impulse(...) end }
+for _, name in ipairs{ "angular_velocity", "mass", "position", "remove", "rotation", "shape", "valid", "velocity", "world" } do
+  CASES["rigid:" .. name] = { none = "a getter or remove: no arguments" }
 end
 for _, name in ipairs{ "broken", "force", "length", "particles", "remove", "rest", "strain", "valid", "world" } do
   CASES["distance:" .. name] = { none = "a getter or remove: no arguments" }
@@ -281,6 +308,7 @@ local function api()
   methods_of("distance", f.c, names)
   methods_of("bend", f.bend, names)
   methods_of("collider", f.col, names)
+  methods_of("rigid", f.rb, names)
   methods_of("shape_match", f.sm, names)
   methods_of("pressure", f.pr, names)
   methods_of("attach", f.att, names)

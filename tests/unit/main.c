@@ -31,6 +31,15 @@
     X(extreme_collider_derived_poses_finite)             \
     X(extreme_cluster_of_an_overflowing_box)
 
+/* test_rigid.c: rigid bodies */
+#define RIGID_TESTS(X)                                   \
+    X(rigid_helpers_match_their_formulas)                \
+    X(rigid_inertia_of_the_shapes)                       \
+    X(rigid_slots_handles_and_budget)                    \
+    X(rigid_nonfinite_frame_undone)                      \
+    X(rigid_clone_same_hash_and_future)                  \
+    X(rigid_pair_manifold_pushes_apart_by_inverse_mass)
+
 /* test_contact.c: the particle-particle broad phase and contact rules */
 #define CONTACT_TESTS(X)                                 \
     X(contact_broadphase_matches_brute_force)            \
@@ -121,7 +130,8 @@
     X(tet_strain_volume_shape_and_shear)         \
     X(attach_grab_forces_cleared_by_an_undone_frame) \
     X(attach_grab_clone_same_future)             \
-    X(attach_grab_ids_and_memory)
+    X(attach_grab_ids_and_memory)                \
+    RIGID_TESTS(X)
 
 #define DECLARE(name) TEST(name);
 #define ENTRY(name) { #name, test_##name },

@@ -1,0 +1,90 @@
+/* rigid.h: XPBD rigid bodies (Müller, Macklin, Chentanez, Jeschke, Kim 2020, "Detailed
+ * rigid body simulation with extended position based dynamics"), issue 10.
+ *
+ * Bodies live in slots with generations (odd = live), as colliders do. Model: shape,
+ * inverse mass, body-frame inertia and its inverse. State: pose (centre of mass, unit
+ * quaternion) and velocities (linear, angular in the world frame). Cache: the pose at the
+ * substep's start, the frame's start (undo) and the substep's contacts. */
+#ifndef WB_RIGID_H
+#define WB_RIGID_H
+#include "core.h"
+#include "narrow.h"
+
+typedef struct wb_rcontact {
+    int32_t first;         /* the first contact of its manifold (they are contiguous) */
+    int32_t a, b;          /* bodies; a < 0: a kinematic collider */
+    wb_real ra[3], rb[3];  /* contact points in A's and B's body frame (a collider: world offset) */
+    wb_real n[3];          /* unit, A -> B */
+    wb_real lambda;        /* normal positional impulse of the substep, N s^2 */
+    wb_real vn_pre;        /* normal relative velocity (B - A) before the solve */
+    wb_real vc[3];         /* a collider's surface velocity at the point */
+    wb_real mu, e;
+} wb_rcontact;
+
+typedef struct wb_rigids {
+    int32_t n, cap;        /* slots */
+    /* model */
+    wb_cshape *shape;      /* (n) shape, friction, restitution */
+    wb_real *mass;         /* (n) kg, as given */
+    wb_real *inv_mass;     /* (n) 1 / mass */
+    wb_real *inertia;      /* (n x 9) body-frame inertia tensor (row-major) */
+    wb_real *inv_inertia;  /* (n x 9) its inverse */
+    wb_real *bound;        /* (n) bounding radius about the centre */
+    uint32_t *gen;         /* (n) odd = live */
+    /* state */
+    wb_real *x, *q, *v, *om; /* (n x 3), (n x 4), (n x 3), (n x 3): om in the world frame */
+    /* cache */
+    wb_real *x_prev, *q_prev; /* (n x 3), (n x 4) pose at the substep's start */
+    wb_real *save;         /* (n x 13) the frame's start: x, q, v, om (undo) */
+    uint8_t *moved;        /* (n) a correction moved it this substep: its velocities come from the poses */
+    wb_rcontact *ct;       /* contacts of the current substep */
+    int32_t nct, cap_ct;
+    size_t charged;        /* bytes charged to def.memory */
+} wb_rigids;
+
+/* generalized inverse mass of body r for a positional correction along unit n at world point x
+ * (Müller 2020 eq. 2): 1/m + (r x n)^T I^-1 (r x n), r = x - centre */
+wb_real wb__rigid_w(const wb_world *w, int32_t r, const wb_real x[3], const wb_real n[3]);
+/* apply positional impulse dp (= lambda n, world) at world point x: p += dp/m, q += 0.5 [I^-1 (r x dp), 0] q */
+void wb__rigid_apply(wb_world *w, int32_t r, const wb_real x[3], const wb_real dp[3]);
+/* world point of a body-local point, and body-local of a world point, at the current pose */
+void wb__rigid_to_world(const wb_world *w, int32_t r, const wb_real local[3], wb_real out[3]);
+void wb__rigid_to_local(const wb_world *w, int32_t r, const wb_real world[3], wb_real out[3]);
+
+/* the step's hooks (solver.c), per substep of length h */
+void wb__rigids_predict(wb_world *w, wb_real h);   /* gravity, gyroscopic term, pose */
+void wb__rigids_solve(wb_world *w, wb_real h, wb_real f0, wb_real f1); /* contacts; colliders at f0 -> f1 */
+void wb__rigids_update(wb_world *w, wb_real h);    /* v, om from the poses */
+void wb__rigids_velocity(wb_world *w, wb_real h);  /* dynamic friction, restitution */
+void wb__rigids_save(wb_world *w);                 /* the frame's start, for undo */
+void wb__rigids_undo(wb_world *w);                 /* back to it */
+int wb__rigids_finite(const wb_world *w);          /* -1 when all are finite, else a slot */
+
+/* contact solving given a manifold (narrow.h): two bodies, or collider slot c (A) and
+ * body r (B); the collider's poses at the substep's start and end */
+void wb__rigid_contact_rigid(wb_world *w, int32_t a, int32_t b, const wb_manifold *m, wb_real h);
+void wb__rigid_contact_collider(wb_world *w, int32_t c, const wb_real p0[3], const wb_real q0[4],
+                                const wb_real p1[3], const wb_real q1[4], int32_t r,
+                                const wb_manifold *m, wb_real h);
+
+/* room for `need` slots (charged to the budget); put slot `r` (< need) as given, raw:
+ * shape (the capsule about its centre), mass, pose, velocities; 0 when the inertia is
+ * singular (nothing changed). The snapshot (rigid_image.c) restores bodies through these */
+int wb__rigids_reserve(wb_world *w, int32_t need);
+int wb__rigid_set_slot(wb_world *w, int32_t r, const wb_cshape *s, wb_real mass, const wb_real x[3],
+                       const wb_real q[4], const wb_real v[3], const wb_real om[3]);
+
+/* body-frame inertia tensor (row-major 3 x 3) of a shape of mass m about its centre */
+void wb__rigid_inertia(const wb_cshape *s, wb_real m, wb_real I[9]);
+
+/* freed by world.c (an inline: a call into rigid.c would close a circle) */
+static inline void wb__rigids_free(wb_world *w, wb_rigids *rb)
+{
+    if (!rb) return;
+    if (w->m.def.memory) w->m.def.memory->used -= rb->charged;
+    void *p[] = { rb->shape, rb->mass, rb->inv_mass, rb->inertia, rb->inv_inertia, rb->bound, rb->gen, rb->x, rb->q,
+                  rb->v, rb->om, rb->x_prev, rb->q_prev, rb->save, rb->ct, rb->moved };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    free(rb);
+}
+#endif
