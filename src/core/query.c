@@ -183,6 +183,7 @@ uint64_t wb_world_hash(const wb_world *w)
         h = fnv(h, &gr->target[3 * i], 3 * sizeof(wb_real));
         h = fnv(h, &gr->from[3 * i], 3 * sizeof(wb_real));
         h = fnv(h, &gr->alpha[i], sizeof(wb_real));
+    }
     const wb_rigids *rb = w->rb;
     for (int32_t r = 0; rb && r < rb->n; r++) { /* (worlds without any hash as they always did) */
         if (!(rb->gen[r] & 1u)) continue;

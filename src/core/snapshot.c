@@ -219,8 +219,7 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
     }
     if ((st = wb__tet_image_of(w, g)) != WB_OK || (st = wb__smatch_image_of(w, g)) != WB_OK ||
         (st = wb__pressure_image_of(w, g)) != WB_OK || (st = wb__attach_image_of(w, g)) != WB_OK ||
-        (st = wb__grab_image_of(w, g)) != WB_OK) {
-        (st = wb__pressure_image_of(w, g)) != WB_OK || (st = wb__rigid_image_of(w, g)) != WB_OK) {
+        (st = wb__grab_image_of(w, g)) != WB_OK || (st = wb__rigid_image_of(w, g)) != WB_OK) {
         wb_image_free(g);
         return st;
     }
@@ -335,8 +334,7 @@ const char *wb_image_check(const wb_image *g)
         if ((e = wb_volume_def_check(&d))) return e;
     }
     if ((e = wb__tet_image_check(g)) || (e = wb__smatch_image_check(g)) || (e = wb__pressure_image_check(g)) ||
-        (e = wb__attach_image_check(g)) || (e = wb__grab_image_check(g)))
-        (e = wb__rigid_image_check(g)))
+        (e = wb__attach_image_check(g)) || (e = wb__grab_image_check(g)) || (e = wb__rigid_image_check(g)))
         return e;
     return NULL;
 }
