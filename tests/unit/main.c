@@ -47,6 +47,20 @@
     X(tricontact_projection_conserves_momentum)          \
     X(tricontact_who_may_touch)
 
+/* test_narrow.c: rigid shapes' contact manifolds */
+#define NARROW_TESTS(X)                                  \
+    X(narrow_sphere_sphere)                              \
+    X(narrow_capsules)                                   \
+    X(narrow_box_box_face)                               \
+    X(narrow_box_box_edge)                               \
+    X(narrow_plane)                                      \
+    X(narrow_capsule_box)                                \
+    X(narrow_sphere_box_regions)                         \
+    X(narrow_mesh_icosahedron)                           \
+    X(narrow_mesh_open_sheet)                            \
+    X(narrow_swapped_order)                              \
+    X(narrow_random_consistency)
+
 /* every test, in the order they run: add a line here for each TEST() */
 #define TEST_LIST(X)                             \
     X(world_def_defaults)                        \
@@ -118,6 +132,7 @@
     CONTACT_TESTS(X)                             \
     TRICONTACT_TESTS(X)                          \
     EXTREME_TESTS(X)                             \
+    NARROW_TESTS(X)                              \
     X(tet_strain_volume_shape_and_shear)
 
 #define DECLARE(name) TEST(name);
