@@ -52,6 +52,7 @@
     X(narrow_sphere_sphere)                              \
     X(narrow_capsules)                                   \
     X(narrow_box_box_face)                               \
+    X(narrow_box_box_reduced_and_face_preferred)         \
     X(narrow_box_box_edge)                               \
     X(narrow_plane)                                      \
     X(narrow_capsule_box)                                \

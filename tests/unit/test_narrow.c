@@ -204,6 +204,71 @@ TEST(narrow_box_box_face)
     check_resting(&m, p3, qb, b.half, 1, -0.02, 4);
 }
 
+/* convex hull area of the points' pb seen from above (y), at most 8 points, by gift wrapping */
+static wb_real hull_area_y(const wb_manifold *m)
+{
+    int start = 0, cur, h[WB_MANIFOLD_MAX + 1], nh = 0;
+    for (int i = 1; i < m->n; i++)
+        if (m->pt[i].pb[0] < m->pt[start].pb[0]) start = i;
+    cur = start;
+    do {
+        h[nh++] = cur;
+        int nx = (cur + 1) % m->n;
+        for (int i = 0; i < m->n; i++) {
+            const wb_real *a = m->pt[cur].pb, *b = m->pt[nx].pb, *c = m->pt[i].pb;
+            const wb_real cr = (b[0] - a[0]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[0] - a[0]);
+            if (cr < 0) nx = i;
+        }
+        cur = nx;
+    } while (cur != start && nh <= WB_MANIFOLD_MAX);
+    wb_real ar = 0;
+    for (int i = 0; i < nh; i++) {
+        const wb_real *a = m->pt[h[i]].pb, *b = m->pt[h[(i + 1) % nh]].pb;
+        ar += a[0] * b[2] - a[2] * b[0];
+    }
+    return fabs(ar) / 2;
+}
+
+TEST(narrow_box_box_reduced_and_face_preferred)
+{
+    /* a square on a square turned 45 degrees: the clipped face is an octagon (area 3.31);
+     * four points are kept, the deepest (B tilted a little) among them, spread wide */
+    const wb_cshape a = mk_box(1, 1, 1);
+    const wb_real o[3] = { 0, 0, 0 }, pb[3] = { 0, 1.98, 0 };
+    wb_real qt[4], qy[4], qb[4];
+    q_axis(qy, 0, 1, 0, M_PI / 4);
+    q_axis(qt, 1, 0, 0.3, 0.002);
+    q_mul(qt, qy, qb);
+    wb_manifold m;
+    wb__narrow(&a, o, Q0, &a, pb, qb, 0.05, &m);
+    CHECK_EQ(m.n, 4);
+    CHECK(hull_area_y(&m) > 0.6 * 3.31);
+    wb_real deepest = -INFINITY, kept = -INFINITY;
+    for (int i = 0; i < m.n; i++) kept = fmax(kept, m.pt[i].depth);
+    for (int i = 0; i <= 400; i++) /* B's bottom face over A's top face, finely sampled */
+        for (int j = 0; j <= 400; j++) {
+            const wb_real l[3] = { -1 + i / 200.0, -1, -1 + j / 200.0 };
+            wb_real x[3];
+            to_world(pb, qb, l, x);
+            if (fabs(x[0]) <= 1 && fabs(x[2]) <= 1) deepest = fmax(deepest, 1 - x[1]);
+        }
+    CHECK_NEAR(kept, deepest, 1e-4); /* the grid misses the octagon's corners by < 0.005 x 0.002 */
+    /* a box resting nearly flat on another (tilts up to 0.005 rad, corners 0.01 deep):
+     * always the face manifold of four points, never an edge pair that ties with it */
+    const wb_cshape b = mk_box(0.5, 0.3, 0.4);
+    int faces = 0;
+    for (int it = 0; it < 400; it++) {
+        wb_real q[4], p[3];
+        q_axis(q, sin(it * 1.3), cos(it * 0.7), sin(it * 2.1 + 1), 0.005 * (it % 7) / 6);
+        q_axis(qy, 0, 1, 0, 0.01 * it);
+        q_mul(q, qy, qb);
+        v3_set(p, 0.3 * sin(it * 0.37), 1 + 0.3 - 0.01, 0.3 * cos(it * 0.53));
+        wb__narrow(&a, o, Q0, &b, p, qb, 0.05, &m);
+        faces += m.n == 4;
+    }
+    CHECK_EQ(faces, 400);
+}
+
 TEST(narrow_box_box_edge)
 {
     /* A's top edge along z at y = sqrt 2, B's bottom edge along x at y = sqrt 2 - 0.1 */
@@ -330,9 +395,9 @@ TEST(narrow_sphere_box_regions)
         { 0.3, 2.4, -1, 0.5, 0, 1, 0, 0.3, 2, -1 },             /* face +y */
         { 1.3, 2.4, 0, 0.6, 0.6, 0.8, 0, 1, 2, 0 },             /* edge x, y */
         { 1.2, 2.2, 3.1, 0.4, 2 / 3., 2 / 3., 1 / 3., 1, 2, 3 }, /* corner */
-        { 0.8, 0.1, -0.5, 0.3, 1, 0, 0, 1, 0.1, -0.5 },         /* deep inside: nearest face +x */
+        { 0.1, 1.7, -0.5, 0.3, 0, 1, 0, 0.1, 2, -0.5 },         /* deep inside: nearest face +y */
     };
-    const wb_real depth[4] = { 0.1, 0.1, 0.1, 0.5 };
+    const wb_real depth[4] = { 0.1, 0.1, 0.1, 0.6 };
     for (int c = 0; c < 4; c++) {
         const wb_cshape s = mk_sphere(cases[c][3]);
         wb_real ps[3], n[3], q[3], pb[3];
