@@ -302,11 +302,12 @@ static wb_real box_sd(const wb_real h[3], const wb_real l[3], wb_real nl[3], wb_
         o[i] = l[i] - ql[i];
         out |= o[i] != 0;
     }
-    if (out) {
-        const wb_real d = v3_len(o);
+    const wb_real d = out ? v3_len(o) : 0;
+    if (d > 0) { /* (an outside distance that underflows counts as on the surface) */
         v3_scale(nl, o, 1 / d);
         return d;
     }
+    v3_copy(ql, l);
     int k = 0;
     for (int i = 1; i < 3; i++)
         if (fabs(l[i]) - h[i] > fabs(l[k]) - h[k]) k = i;
@@ -625,6 +626,21 @@ static wb_real mesh_sd(const meshq *M, const wb_real x[3], wb_real reach, wb_rea
     return sg * d;
 }
 
+/* triangle t's box misses [lo, hi] (mesh frame) */
+static int tri_apart(const wb_colmesh *cm, int32_t t, const wb_real lo[3], const wb_real hi[3])
+{
+    for (int k = 0; k < 3; k++) {
+        wb_real a = INFINITY, b = -INFINITY;
+        for (int v = 0; v < 3; v++) {
+            const wb_real x = cm->v[3 * cm->tri[3 * t + v] + k];
+            a = fmin(a, x);
+            b = fmax(b, x);
+        }
+        if (a > hi[k] || b < lo[k]) return 1;
+    }
+    return 0;
+}
+
 /* triangles whose boxes overlap [lo, hi] (mesh frame), at most cap */
 static int mesh_tris(const wb_colmesh *cm, const wb_real lo[3], const wb_real hi[3], int32_t *out, int cap)
 {
@@ -642,17 +658,7 @@ static int mesh_tris(const wb_colmesh *cm, const wb_real lo[3], const wb_real hi
         }
         for (int32_t j = 0; j < nd->count && n < cap; j++) {
             const int32_t t = cm->order[nd->left + j];
-            int sep = 0;
-            for (int k = 0; k < 3; k++) {
-                wb_real a = INFINITY, b = -INFINITY;
-                for (int v = 0; v < 3; v++) {
-                    const wb_real x = cm->v[3 * cm->tri[3 * t + v] + k];
-                    a = fmin(a, x);
-                    b = fmax(b, x);
-                }
-                sep |= a > hi[k] || b < lo[k];
-            }
-            if (!sep) out[n++] = t;
+            if (!tri_apart(cm, t, lo, hi)) out[n++] = t;
         }
     }
     return n;
@@ -833,18 +839,8 @@ static void mesh_box(const meshq *M, const obox *B, wb_real margin, mcands *cs)
                 ehi[j] = fmax(l[k][j], l[k2][j]) + margin;
             }
             for (int i = 0; i < n; i++) {
-                const wb_colmesh *cm = M->cm;
-                int sep = 0;
-                for (int j = 0; j < 3 && !sep; j++) {
-                    wb_real a = INFINITY, b = -INFINITY;
-                    for (int v = 0; v < 3; v++) {
-                        a = fmin(a, cm->v[3 * cm->tri[3 * tris[i] + v] + j]);
-                        b = fmax(b, cm->v[3 * cm->tri[3 * tris[i] + v] + j]);
-                    }
-                    sep = a > ehi[j] || b < elo[j];
-                }
-                if (sep) continue;
-                const wb_real t = seg_tri(l[k], l[k2], cm, tris[i]);
+                if (tri_apart(M->cm, tris[i], elo, ehi)) continue;
+                const wb_real t = seg_tri(l[k], l[k2], M->cm, tris[i]);
                 if (!(t > 0 && t < 1) || !fresh_t(tried, &nt, 8, t)) continue;
                 wb_real e[3];
                 lerp3(e, x[k], x[k2], t);
@@ -945,7 +941,7 @@ int wb__narrow(const wb_cshape *a, const wb_real pa[3], const wb_real qa[4],
         flip(out);
         return out->n;
     }
-    if (!(margin >= 0)) margin = 0;
+    if (isnan(margin)) margin = 0;
     round_s rs;
     obox ba, bb;
     switch (ra * 4 + rb) {

@@ -60,6 +60,7 @@
     X(narrow_mesh_icosahedron)                           \
     X(narrow_mesh_open_sheet)                            \
     X(narrow_swapped_order)                              \
+    X(narrow_degenerate_input)                           \
     X(narrow_random_consistency)
 
 /* every test, in the order they run: add a line here for each TEST() */

@@ -605,6 +605,53 @@ TEST(narrow_swapped_order)
     CHECK(tried >= 12);
 }
 
+/* every value finite, the normal unit, depth consistent */
+static int sane(const wb_manifold *m)
+{
+    int ok = m->n >= 0 && m->n <= WB_MANIFOLD_MAX;
+    if (m->n > 0) ok &= fabs(v3_len(m->normal) - 1) < 1e-12;
+    for (int i = 0; i < m->n; i++) {
+        wb_real d[3];
+        v3_sub(d, m->pt[i].pa, m->pt[i].pb);
+        ok &= isfinite(m->pt[i].depth) && fabs(m->pt[i].depth - v3_dot(d, m->normal)) < 1e-9;
+    }
+    return ok;
+}
+
+TEST(narrow_degenerate_input)
+{
+    const wb_real o[3] = { 0.5, 0.5, 0.5 }, ca[3] = { -1, 0, 0 }, cb[3] = { 1, 0, 0 };
+    const wb_cshape s1 = mk_sphere(0.3), s2 = mk_sphere(0.2), c = mk_capsule(ca, cb, 0.1), b = mk_box(0.2, 0.3, 0.4),
+                    flat = mk_box(0, 0, 0), pl = mk_plane(0, 1, 0);
+    wb_manifold m;
+    /* concentric spheres, coaxial capsules, a box on itself: some direction, full depth */
+    REQUIRE(wb__narrow(&s1, o, Q0, &s2, o, Q0, 0, &m) == 1);
+    CHECK(sane(&m));
+    CHECK_NEAR(m.pt[0].depth, 0.5, 1e-15);
+    const wb_real o2[3] = { 1, 0.5, 0.5 };
+    CHECK(wb__narrow(&c, o, Q0, &c, o2, Q0, 0, &m) >= 1);
+    CHECK(sane(&m));
+    CHECK_NEAR(m.pt[0].depth, 0.2, 1e-15);
+    CHECK(wb__narrow(&b, o, Q0, &b, o, Q0, 0, &m) >= 1);
+    CHECK(sane(&m));
+    /* a box of no size is a point */
+    const wb_real low[3] = { 0, -0.1, 0 };
+    REQUIRE(wb__narrow(&pl, Q0 + 1, Q0, &flat, low, Q0, 0, &m) >= 1);
+    CHECK(sane(&m));
+    CHECK_NEAR(m.pt[0].depth, 0.1, 1e-15);
+    CHECK(wb__narrow(&flat, low, Q0, &b, o, Q0, 0, &m) >= 0 && sane(&m));
+    /* not finite, or too large to square: nothing rather than NaN */
+    const wb_real nan3[3] = { NAN, 0, 0 }, huge[3] = { 1e300, 1e300, -1e300 };
+    const wb_cshape shapes[4] = { s1, c, b, pl };
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 3; j++) {
+            CHECK_EQ(wb__narrow(&shapes[i], nan3, Q0, &shapes[j], o, Q0, 0.1, &m), 0);
+            wb__narrow(&shapes[i], huge, Q0, &shapes[j], huge, Q0, 0.1, &m);
+            CHECK(sane(&m));
+            CHECK(wb__narrow(&shapes[i], o, Q0, &shapes[j], o, Q0, NAN, &m) > 0); /* NaN margin: 0 */
+        }
+}
+
 /* ---- random poses ---------------------------------------------------------------------------- */
 static uint64_t rng = 0x9e3779b97f4a7c15ull;
 static wb_real urand(void)
