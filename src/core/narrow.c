@@ -24,8 +24,15 @@
  *                are left out; a mesh edge crossing a box face between the box's edges
  *                and vertices is not seen). A closed mesh has an inside (signed distance
  *                from the pseudo-normals, bvh.h); an open one has two sides and pushes X
- *                to the side X's centre is on.
- * Every point returned lies on A's surface (pa) and on B's (pb), depth = (pa - pb).n. */
+ *                to the side X's centre is on. At most 4 points, from at most MESH_TRIS
+ *                triangles near X.
+ * Every point returned lies on A's surface (pa) and on B's (pb), depth = (pa - pb).n: a
+ * capsule's point is the one of its cross-section (an end's hemisphere or the rim) farthest
+ * along -n, so where the axis runs through a box (its deepest point a kink of the box's
+ * distance) the depth is that cross-section's, under the nearest face. Boxes within the
+ * margin but not overlapping sideways (edge to edge over a face axis) give none.
+ * One file of some 1000 lines: the pairs share the shapes' helpers, and the contract
+ * (RIGID.md) keeps the narrow phase to narrow.c. */
 #include "core.h"
 #include "bvh.h"
 #include "narrow.h"
