@@ -6,8 +6,11 @@
  *     point where the edges cross), a tilted box on a plane (its lowest corners), a
  *     capsule on a box (two points, clipped where it overhangs), a sphere in a box's face,
  *     edge and corner regions and deep inside it (the nearest face);
+ *   - a face clipped to an octagon is reduced to four points, the deepest kept, spread
+ *     wide; a box resting nearly flat always gives its face, never a tying edge pair;
  *   - the order of the shapes only flips the normal and swaps the points; beyond the
- *     margin nothing comes back;
+ *     margin nothing comes back; coincident, flat, NaN and overflowing input gives
+ *     finite answers or none;
  *   - a closed icosahedron mesh against a sphere, a box and a capsule resting on one face,
  *     and an open ground sheet;
  *   - random poses of every pair: each point lies on both surfaces (the shapes' signed
