@@ -658,52 +658,6 @@ void wb__rigid_contact_collider(wb_world *w, int32_t c, const wb_real p0[3], con
     solve_manifold(w, &A, &B, &w->m.c_shape[c], &w->rb->shape[r], m, h);
 }
 
-/* PLANE SHIM: replaced by wb__narrow at merge */
-static int plane_shim(const wb_cshape *a, const wb_real pa[3], const wb_real qa[4], const wb_cshape *b,
-                      const wb_real pb[3], const wb_real qb[4], wb_real margin, wb_manifold *out)
-{
-    out->n = 0;
-    if (a->shape != WB_SHAPE_PLANE) return 0;
-    wb_real n[3], cand[8][3];
-    int nc = 0;
-    q_rotate(qa, a->n, n);
-    const wb_real off = v3_dot(n, pa);
-    switch (b->shape) {
-    case WB_SHAPE_SPHERE:
-        v3_copy(cand[0], pb);
-        v3_madd(cand[0], n, -b->radius);
-        nc = 1;
-        break;
-    case WB_SHAPE_BOX:
-        for (int i = 0; i < 8; i++) {
-            const wb_real l[3] = { (i & 1 ? 1 : -1) * b->half[0], (i & 2 ? 1 : -1) * b->half[1], (i & 4 ? 1 : -1) * b->half[2] };
-            q_rotate(qb, l, cand[i]);
-            v3_add(cand[i], cand[i], pb);
-        }
-        nc = 8;
-        break;
-    case WB_SHAPE_CAPSULE:
-        q_rotate(qb, b->a, cand[0]);
-        q_rotate(qb, b->b, cand[1]);
-        for (int i = 0; i < 2; i++) { v3_add(cand[i], cand[i], pb); v3_madd(cand[i], n, -b->radius); }
-        nc = 2;
-        break;
-    default:
-        return 0;
-    }
-    v3_copy(out->normal, n);
-    for (int i = 0; i < nc; i++) {
-        const wb_real depth = off - v3_dot(n, cand[i]);
-        if (!(depth > -margin)) continue;
-        wb_manifold_point *p = &out->pt[out->n++];
-        v3_copy(p->pb, cand[i]);
-        v3_copy(p->pa, cand[i]);
-        v3_madd(p->pa, n, depth);
-        p->depth = depth;
-    }
-    return out->n;
-}
-
 void wb__rigids_solve(wb_world *w, wb_real h, wb_real f0, wb_real f1)
 {
     wb_rigids *rb = w->rb;
@@ -720,11 +674,11 @@ void wb__rigids_solve(wb_world *w, wb_real h, wb_real f0, wb_real f1)
             wb__collider_pose_at(&w->s.c_pose[c], f0, p0, q0);
             wb__collider_pose_at(&w->s.c_pose[c], f1, p1, q1);
             wb_manifold mf;
-            if (plane_shim(&m->c_shape[c], p1, q1, &rb->shape[r], &rb->x[3 * r], &rb->q[4 * r], margin, &mf) > 0)
+            if (wb__narrow(&m->c_shape[c], p1, q1, &rb->shape[r], &rb->x[3 * r], &rb->q[4 * r], margin, &mf) > 0)
                 wb__rigid_contact_collider(w, c, p0, q0, p1, q1, r, &mf, h);
         }
     }
-    /* body pairs whose bounding spheres meet (the narrow phase arrives at merge) */
+    /* body pairs whose bounding spheres meet (O(n^2): scenes have tens of bodies, not thousands) */
     for (int32_t a = 0; a < rb->n; a++) {
         if (!live(rb, a)) continue;
         for (int32_t b = a + 1; b < rb->n; b++) {
@@ -736,7 +690,7 @@ void wb__rigids_solve(wb_world *w, wb_real h, wb_real f0, wb_real f1)
             const wb_real reach = rb->bound[a] + rb->bound[b] + margin;
             if (v3_dot(d, d) > reach * reach) continue;
             wb_manifold mf;
-            if (plane_shim(&rb->shape[a], &rb->x[3 * a], &rb->q[4 * a], &rb->shape[b], &rb->x[3 * b], &rb->q[4 * b],
+            if (wb__narrow(&rb->shape[a], &rb->x[3 * a], &rb->q[4 * a], &rb->shape[b], &rb->x[3 * b], &rb->q[4 * b],
                            margin, &mf) > 0)
                 wb__rigid_contact_rigid(w, a, b, &mf, h);
         }

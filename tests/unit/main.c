@@ -56,6 +56,22 @@
     X(tricontact_projection_conserves_momentum)          \
     X(tricontact_who_may_touch)
 
+/* test_narrow.c: rigid shapes' contact manifolds */
+#define NARROW_TESTS(X)                                  \
+    X(narrow_sphere_sphere)                              \
+    X(narrow_capsules)                                   \
+    X(narrow_box_box_face)                               \
+    X(narrow_box_box_reduced_and_face_preferred)         \
+    X(narrow_box_box_edge)                               \
+    X(narrow_plane)                                      \
+    X(narrow_capsule_box)                                \
+    X(narrow_sphere_box_regions)                         \
+    X(narrow_mesh_icosahedron)                           \
+    X(narrow_mesh_open_sheet)                            \
+    X(narrow_swapped_order)                              \
+    X(narrow_degenerate_input)                           \
+    X(narrow_random_consistency)
+
 /* every test, in the order they run: add a line here for each TEST() */
 #define TEST_LIST(X)                             \
     X(world_def_defaults)                        \
@@ -131,7 +147,8 @@
     X(attach_grab_forces_cleared_by_an_undone_frame) \
     X(attach_grab_clone_same_future)             \
     X(attach_grab_ids_and_memory)                \
-    RIGID_TESTS(X)
+    RIGID_TESTS(X)                               \
+    NARROW_TESTS(X)
 
 #define DECLARE(name) TEST(name);
 #define ENTRY(name) { #name, test_##name },
