@@ -246,12 +246,14 @@ test("determinism with contacts: the same hash with 1 and 2 threads", function()
                  compliance = 1e-5, friction = 0.3 }
     end
     for i = 1, 20 do w:particle{ pos = {i * 0.03 - 0.3, 3, 0}, radius = 0.04 } end
-    w:run{ frames = 90 }
-    return w:hash(), w:stats().particle_contacts
+    -- contacts over the run (the last substep alone may have none: the pile scatters)
+    local contacts = 0
+    w:run{ frames = 90, on_frame = function(w) contacts = contacts + w:stats().particle_contacts end }
+    return w:hash(), contacts
   end
   local h1, n1 = pile(1)
   local h2 = pile(2)
-  expect.gt(n1, 0, "the pile is in contact")
+  expect.gt(n1, 100, "the pile is in contact")
   expect.eq(h1, h2)
 end)
 
