@@ -3,11 +3,14 @@
  * Once per frame a broad phase (broadphase.c: a sorted grid over the frame's swept bounds
  * plus a margin, Macklin et al. 2019 "Small steps" §4) lists the candidate pairs; every
  * substep they are projected as inequality constraints |x_i - x_j| >= r_i + r_j (XPBD
- * with compliance 0, mass-weighted so momentum is conserved), with Coulomb friction
- * at position level (static inside the cone, as the collider contacts do in collide.c,
- * and kinetic outside it); after the velocity update a velocity pass removes the
- * approach speed (no restitution) and any speed the repair of an old overlap made (bodies
- * made inside each other push apart at max_depenetration, never fly apart). Inside one
+ * with compliance 0, mass-weighted so momentum is conserved). Coulomb friction as the
+ * collider contacts have it (collide.c): static at position level, checked per particle
+ * over all its pair and triangle contacts of the substep (wb__contacts_friction), and
+ * dynamic at velocity level for pairs that slide, mass-weighted. After the velocity
+ * update a velocity pass removes the approach speed (no restitution), any speed the
+ * repair of an old overlap made (bodies made inside each other push apart at
+ * max_depenetration, never fly apart), and a sliding pair's tangential speed up to
+ * mu x its normal impulse. Inside one
  * body, pairs never collide unless it self-collides, and then not when joined by a
  * constraint or closer than r_i + r_j where they were created (Müller's Ten Minute
  * Physics rule).
@@ -109,8 +112,8 @@ wb_real wb_body_spacing(const wb_world *w, wb_body b)
 
 /* ---- the step ---------------------------------------------------------------------------------- */
 /* Project every candidate once, in list order (Gauss-Seidel): push the pair apart along
- * their line by the overlap, split by inverse mass, then undo their relative tangential
- * slip of this substep when it is within the friction cone (mu x depth).
+ * their line by the overlap, split by inverse mass (friction comes after every pair's and
+ * triangle's normal correction: wb__contacts_friction).
  *
  * Old overlap. A correction of depth adds depth / h to the pair's separating speed
  * (v = (x - x_prev) / h). The part that takes back this substep's approach (what the
@@ -214,7 +217,8 @@ nomem:
  *
  * Sliding: the pair's relative tangential speed at the substep's start is more than one
  * substep of dynamic friction takes away (|u_t| > mu depth / h). Its friction is left to
- * the velocity pass (wb__contacts_velocity): -mu depth / h of it, at most all of it.
+ * the velocity pass (wb__contacts_velocity): -mu (depth - err) / h of it, at most all
+ * of it (err: the old overlap pushed back in full, whose speed that pass takes out).
  *
  * At rest (otherwise): the relative tangential slip of the substep is undone at position
  * level, split by inverse mass, within the friction cone. The cone is checked per
@@ -286,16 +290,18 @@ void wb__contacts_friction(wb_world *w, wb_real h)
 /* after v = (x - x_prev)/h, per pair: no speed made out of old overlap pushed back in
  * full (err, above), then no approach speed left (perfectly inelastic), then a sliding
  * pair's dynamic friction: its relative tangential speed reduced by mu x the normal
- * impulse, mu depth / h (collide.c's rule), at most to zero; each change split by
+ * impulse, mu (depth - err) / h (collide.c's rule), at most to zero; each change split by
  * inverse mass, so momentum is kept exactly.
  *
- * The speed of err taken out is at most the pair's separating speed. When the links or
- * other contacts pushed the pair back together after its projection (a tight fold, a
- * squeezed heap), that speed is already gone; taking it out anyway made an approach
- * speed that this pair's next pass took back along its normal but the contacts between,
- * along other normals, left partly in place: in a settled cloth heap particles that
- * stayed put read 3.4 cm/s (tests/validation/contact_kinetic.lua checks that a resting
- * heap's speeds are its motion). */
+ * The speed of err taken out is at most the pair's separating speed. When the links,
+ * the colliders or other contacts pushed the pair back together after its projection (a
+ * tight fold, a particle wedged against the floor), that speed is already gone; taking it
+ * out anyway made an approach speed that this pair's next pass took back along its normal
+ * but the contacts between, along other normals, left partly in place: a particle wedged
+ * under two others read 5.3 cm/s without moving, one in a settled cloth heap 3.4 cm/s
+ * (tests/validation/contact_kinetic.lua). The dynamic friction's normal impulse is
+ * likewise the speed the contact kept, depth - err: with all of depth, the repair of a
+ * fold the links keep pressing shut made friction that kept a cloth heap moving. */
 void wb__contacts_velocity(wb_world *w, wb_real h)
 {
     wb_contacts *c = &w->k.pc;

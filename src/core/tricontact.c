@@ -16,8 +16,9 @@
  * gradients n for p and -b_i n for the corners, generalized inverse mass
  * W = w_p + sum b_i^2 w_i, so p moves w_p depth / W and corner i moves -b_i w_i depth / W
  * along n: the corrections' momentum sums to (1 - sum b_i) depth / W = 0. Coulomb
- * friction at position level as contact.c's (the relative slip of p against q undone up
- * to mu depth, mu the mean of p's and the triangle's barycentric friction), and after the
+ * friction as contact.c's (mu the mean of p's and the triangle's barycentric friction):
+ * the slip of p against q undone at position level within the per-particle cone when at
+ * rest, dynamic friction at velocity level when sliding, with the same weights; after the
  * velocity update the approach speed along n is removed the same way. Overlap a point
  * already had goes out as contact.c's does (wb__contact_depth): at max_depenetration
  * and without becoming speed; before, all of it went in one substep, as speed, and
@@ -612,7 +613,7 @@ void wb__tricontacts_static(wb_world *w, wb_real *load)
 /* after v = (x - x_prev)/h, as contact.c's pass: no speed made out of old overlap (at most
  * the separating speed there is), then no approach speed of p towards the triangle's
  * point left, then a sliding contact's dynamic friction on their relative tangential
- * speed, mu depth / h at most; each change split with the weights of the normal
+ * speed, mu (depth - err) / h at most; each change split with the weights of the normal
  * correction */
 void wb__tricontacts_velocity(wb_world *w, wb_real h)
 {

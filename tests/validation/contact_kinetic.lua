@@ -4,8 +4,9 @@
 -- The model (src/core/contact.c, tricontact.c): a pair sliding faster than one substep
 -- of friction can stop gets no friction at position level; after v = (x - x_prev)/h the
 -- velocity pass takes mu x (its normal impulse) off the relative tangential speed,
--- mu depth / h, at most all of it, split by inverse mass (barycentric weights for a
--- triangle), as collide.c does for a collider. So:
+-- mu depth / h (depth: its normal correction, here the weight's g h^2), at most all of
+-- it, split by inverse mass (barycentric weights for a triangle), as collide.c does for
+-- a collider. So:
 --  * a particle sliding at v0 on a flat surface loses mu g h per substep and stops after
 --    v0^2 / (2 mu g). Velocity-level friction moves each substep at the speed before
 --    its friction (symplectic Euler): the slide is longer by v0 h / 2 (1.7 mm here, 0.4%)
