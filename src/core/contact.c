@@ -215,8 +215,9 @@ nomem:
  * level (Müller et al. 2020, "Detailed rigid body simulation with extended position
  * based dynamics", §3.5-3.6).
  *
- * Sliding: the pair's relative tangential speed at the substep's start is more than one
- * substep of dynamic friction takes away (|u_t| > mu depth / h). Its friction is left to
+ * Sliding: the pair's relative tangential speed as predicted for the substep (before
+ * the constraints) is more than one substep of dynamic friction takes away
+ * (|u_t| > mu depth / h). Its friction is left to
  * the velocity pass (wb__contacts_velocity): -mu (depth - err) / h of it, at most all
  * of it (err: the old overlap pushed back in full, whose speed that pass takes out).
  *
