@@ -3,11 +3,14 @@
  * Once per frame a broad phase (broadphase.c: a sorted grid over the frame's swept bounds
  * plus a margin, Macklin et al. 2019 "Small steps" §4) lists the candidate pairs; every
  * substep they are projected as inequality constraints |x_i - x_j| >= r_i + r_j (XPBD
- * with compliance 0, mass-weighted so momentum is conserved), with Coulomb friction
- * at position level (static inside the cone, as the collider contacts do in collide.c,
- * and kinetic outside it); after the velocity update a velocity pass removes the
- * approach speed (no restitution) and any speed the repair of an old overlap made (bodies
- * made inside each other push apart at max_depenetration, never fly apart). Inside one
+ * with compliance 0, mass-weighted so momentum is conserved). Coulomb friction as the
+ * collider contacts have it (collide.c): static at position level, checked per particle
+ * over all its pair and triangle contacts of the substep (wb__contacts_friction), and
+ * dynamic at velocity level for pairs that slide, mass-weighted. After the velocity
+ * update a velocity pass removes the approach speed (no restitution), any speed the
+ * repair of an old overlap made (bodies made inside each other push apart at
+ * max_depenetration, never fly apart), and a sliding pair's tangential speed up to
+ * mu x its normal impulse. Inside one
  * body, pairs never collide unless it self-collides, and then not when joined by a
  * constraint or closer than r_i + r_j where they were created (Müller's Ten Minute
  * Physics rule).
@@ -18,6 +21,10 @@
 #include <stdlib.h>
 
 #include "core.h"
+
+/* a contact's record for the velocity pass and the readout (act_nd): normal (i -> j),
+ * depth, normal force, old overlap pushed back in full (err), mu when sliding (else 0) */
+#define ND 7
 
 /* ---- groups and settings ---------------------------------------------------------------- */
 int32_t wb_group_new(const wb_world *w)
@@ -105,8 +112,8 @@ wb_real wb_body_spacing(const wb_world *w, wb_body b)
 
 /* ---- the step ---------------------------------------------------------------------------------- */
 /* Project every candidate once, in list order (Gauss-Seidel): push the pair apart along
- * their line by the overlap, split by inverse mass, then undo their relative tangential
- * slip of this substep when it is within the friction cone (mu x depth).
+ * their line by the overlap, split by inverse mass (friction comes after every pair's and
+ * triangle's normal correction: wb__contacts_friction).
  *
  * Old overlap. A correction of depth adds depth / h to the pair's separating speed
  * (v = (x - x_prev) / h). The part that takes back this substep's approach (what the
@@ -138,7 +145,7 @@ void wb__contacts_project(wb_world *w, wb_real h)
     int32_t *act = wb__grow(c->act, &c->cap_act, c->n, sizeof *act);
     if (!act) goto nomem;
     c->act = act;
-    wb_real *nds = wb__grow(c->act_nd, &c->cap_nd, 6 * c->n, sizeof *nds);
+    wb_real *nds = wb__grow(c->act_nd, &c->cap_nd, ND * c->n, sizeof *nds);
     if (!nds) goto nomem;
     c->act_nd = nds;
     wb_real *left = wb__grow(c->left, &c->cap_left, c->n, sizeof *left);
@@ -185,30 +192,14 @@ void wb__contacts_project(wb_world *w, wb_real h)
         if (!(depth > 0)) { touching++; continue; }
         if (wi > 0) v3_madd(xi, n, -depth * wi / wsum), v3_madd(pi, n, -slow * wi / wsum);
         if (wj > 0) v3_madd(xj, n, depth * wj / wsum), v3_madd(pj, n, slow * wj / wsum);
-        /* friction at position level (Macklin et al. 2014, "Unified particle physics", §6.1):
-         * the relative tangential slip of the substep is undone up to mu x depth, all of it
-         * inside the cone (static), mu x depth of it outside (kinetic). Bounded per contact
-         * by its own depth, so a load split over several contacts gets the same friction
-         * as one contact (a plain all-or-nothing test would fail on each half) */
-        const wb_real mu = (m->cfric[i] + m->cfric[j]) / 2;
-        if (mu > 0) {
-            wb_real slip[3];
-            for (int a = 0; a < 3; a++) slip[a] = (xi[a] - pi[a]) - (xj[a] - pj[a]);
-            v3_madd(slip, n, -v3_dot(slip, n));
-            const wb_real sl = v3_len(slip), cap = mu * depth;
-            if (sl > 0) {
-                const wb_real f = sl < cap ? 1 : cap / sl;
-                if (wi > 0) v3_madd(xi, slip, -f * wi / wsum);
-                if (wj > 0) v3_madd(xj, slip, f * wj / wsum);
-            }
-        }
         /* normal and depth, kept for the velocity pass; the normal force for the readout
          * (XPBD multiplier of a zero-compliance contact, depth / (w_i + w_j), over h^2) */
         act[c->nact] = k;
-        v3_copy(&nds[6 * c->nact], n);
-        nds[6 * c->nact + 3] = depth;
-        nds[6 * c->nact + 4] = depth / wsum / (h * h);
-        nds[6 * c->nact + 5] = err;
+        v3_copy(&nds[ND * c->nact], n);
+        nds[ND * c->nact + 3] = depth;
+        nds[ND * c->nact + 4] = depth / wsum / (h * h);
+        nds[ND * c->nact + 5] = err;
+        nds[ND * c->nact + 6] = 0; /* the friction pass sets it */
         c->nact++;
     }
     c->last = c->nact + touching;
@@ -218,9 +209,100 @@ nomem:
     wb__warn(w, "out of memory in contacts; contacts skipped this substep");
 }
 
-/* after v = (x - x_prev)/h: no speed made out of old overlap pushed back in full (err,
- * above), then no approach speed left (perfectly inelastic; friction was applied at
- * position level, so the tangential velocity is already what it implies) */
+/* Friction (Coulomb, one coefficient mu: the mean of the two particles' `friction`), after
+ * the normal corrections of the substep's pairs and triangle contacts, in two regimes as
+ * for the collider contacts (collide.c): static at position level, dynamic at velocity
+ * level (Müller et al. 2020, "Detailed rigid body simulation with extended position
+ * based dynamics", §3.5-3.6).
+ *
+ * Sliding: the pair's relative tangential speed as predicted for the substep (before
+ * the constraints) is more than one substep of dynamic friction takes away
+ * (|u_t| > mu depth / h). Its friction is left to
+ * the velocity pass (wb__contacts_velocity): -mu (depth - err) / h of it, at most all
+ * of it (err: the old overlap pushed back in full, whose speed that pass takes out).
+ *
+ * At rest (otherwise): the relative tangential slip of the substep is undone at position
+ * level, split by inverse mass, within the friction cone. The cone is checked per
+ * particle, not per contact: a particle's normal load is split over all its contacts (a
+ * block's particle on a slab of many, in a hollow of four), and a contact alone holds
+ * only its share. Each particle has a budget of mu x the sum of its at-rest contacts'
+ * normal impulses (lambda = depth / (w_i + w_j); a triangle's corner b_k of its
+ * contact's), and a contact takes the impulse that undoes its slip, |slip| / (w_i + w_j),
+ * from what is left of both its particles' budgets. The contacts go in list order, each
+ * seeing the slip the ones before it left: the first contact of a particle that sticks
+ * takes its slip away and its other contacts need (nearly) nothing, so what a particle
+ * sticks with is its slip against its partners, bounded by mu x its contacts' normal
+ * corrections (an immovable partner: |slip| <= mu sum(depth), collide.c's test for one
+ * contact). Where the budget is short, it undoes what the budget allows: static friction
+ * at its bound mu N while the pair breaks away, as large as the dynamic friction it meets
+ * once sliding. An all-or-nothing test (undo all or nothing) made a stiff block on a
+ * bumpy slab chatter below the critical angle: its particles' shares of the load differ
+ * by the slab's bumps (+-10%), the ones over the cone slid a whole substep's slip, their
+ * links pulled the others over it, and the block crept down at 0.95 tan^-1 mu.
+ * An immovable particle has no budget to keep. */
+void wb__contacts_friction(wb_world *w, wb_real h)
+{
+    wb_contacts *c = &w->k.pc;
+    if (c->nact == 0 && w->k.tc.nact == 0) return;
+    const wb_model *m = &w->m;
+    wb_real *load = wb__grow(c->load, &c->cap_load, m->np, sizeof *load);
+    if (!load) { wb__warn(w, "out of memory in contact friction; friction skipped this substep"); return; }
+    c->load = load;
+    memset(load, 0, sizeof *load * (size_t)m->np);
+    wb_real *x = w->s.x, *nds = c->act_nd;
+    const wb_real *xp = w->s.x_prev, *v = w->s.v, *wv = m->w, *cf = m->cfric;
+    for (int32_t a = 0; a < c->nact; a++) {
+        const int32_t k = c->act[a], i = c->ij[2 * k], j = c->ij[2 * k + 1];
+        const wb_real mu = (cf[i] + cf[j]) / 2, *n = &nds[ND * a], depth = nds[ND * a + 3];
+        if (!(mu > 0)) continue;
+        wb_real u[3];
+        v3_sub(u, &v[3 * j], &v[3 * i]);
+        v3_madd(u, n, -v3_dot(u, n));
+        if (v3_len(u) * h > mu * depth) {
+            nds[ND * a + 6] = mu; /* sliding: the velocity pass's */
+            continue;
+        }
+        const wb_real l = mu * depth / (wv[i] + wv[j]);
+        load[i] += l;
+        load[j] += l;
+    }
+    wb__tricontacts_load(w, h, load);
+    for (int32_t a = 0; a < c->nact; a++) {
+        const int32_t k = c->act[a], i = c->ij[2 * k], j = c->ij[2 * k + 1];
+        if (!(cf[i] + cf[j] > 0) || nds[ND * a + 6] > 0) continue;
+        const wb_real wi = wv[i], wj = wv[j], wsum = wi + wj, *n = &nds[ND * a];
+        wb_real *xi = &x[3 * i], *xj = &x[3 * j], slip[3];
+        for (int d = 0; d < 3; d++) slip[d] = (xi[d] - xp[3 * i + d]) - (xj[d] - xp[3 * j + d]);
+        v3_madd(slip, n, -v3_dot(slip, n));
+        const wb_real need = v3_len(slip) / wsum;
+        wb_real tau = need;
+        if (wi > 0 && load[i] < tau) tau = load[i];
+        if (wj > 0 && load[j] < tau) tau = load[j];
+        if (!(tau > 0)) continue;
+        load[i] -= tau;
+        load[j] -= tau;
+        const wb_real f = tau / need / wsum;
+        if (wi > 0) v3_madd(xi, slip, -f * wi);
+        if (wj > 0) v3_madd(xj, slip, f * wj);
+    }
+    wb__tricontacts_static(w, load);
+}
+
+/* after v = (x - x_prev)/h, per pair: no speed made out of old overlap pushed back in
+ * full (err, above), then no approach speed left (perfectly inelastic), then a sliding
+ * pair's dynamic friction: its relative tangential speed reduced by mu x the normal
+ * impulse, mu (depth - err) / h (collide.c's rule), at most to zero; each change split by
+ * inverse mass, so momentum is kept exactly.
+ *
+ * The speed of err taken out is at most the pair's separating speed. When the links,
+ * the colliders or other contacts pushed the pair back together after its projection (a
+ * tight fold, a particle wedged against the floor), that speed is already gone; taking it
+ * out anyway made an approach speed that this pair's next pass took back along its normal
+ * but the contacts between, along other normals, left partly in place: a particle wedged
+ * under two others read 5.3 cm/s without moving, one in a settled cloth heap 3.4 cm/s
+ * (tests/validation/contact_kinetic.lua). The dynamic friction's normal impulse is
+ * likewise the speed the contact kept, depth - err: with all of depth, the repair of a
+ * fold the links keep pressing shut made friction that kept a cloth heap moving. */
 void wb__contacts_velocity(wb_world *w, wb_real h)
 {
     wb_contacts *c = &w->k.pc;
@@ -228,24 +310,37 @@ void wb__contacts_velocity(wb_world *w, wb_real h)
     wb_real *v = w->s.v;
     for (int32_t a = 0; a < c->nact; a++) {
         const int32_t k = c->act[a], i = c->ij[2 * k], j = c->ij[2 * k + 1];
-        const wb_real wi = m->w[i], wj = m->w[j], wsum = wi + wj, e = c->act_nd[6 * a + 5] / h;
+        const wb_real wi = m->w[i], wj = m->w[j], wsum = wi + wj, e = c->act_nd[ND * a + 5] / h;
         if (!(e > 0) || wsum == 0) continue;
-        const wb_real *n = &c->act_nd[6 * a];
-        if (wi > 0) v3_madd(&v[3 * i], n, e * wi / wsum);
-        if (wj > 0) v3_madd(&v[3 * j], n, -e * wj / wsum);
+        const wb_real *n = &c->act_nd[ND * a];
+        wb_real u[3];
+        v3_sub(u, &v[3 * j], &v[3 * i]);
+        const wb_real un = v3_dot(u, n), s = e < un ? e : un;
+        if (!(s > 0)) continue;
+        if (wi > 0) v3_madd(&v[3 * i], n, s * wi / wsum);
+        if (wj > 0) v3_madd(&v[3 * j], n, -s * wj / wsum);
     }
     for (int32_t a = 0; a < c->nact; a++) {
         const int32_t k = c->act[a], i = c->ij[2 * k], j = c->ij[2 * k + 1];
         const wb_real wi = m->w[i], wj = m->w[j], wsum = wi + wj;
         if (wsum == 0) continue;
-        const wb_real *n = &c->act_nd[6 * a];
+        const wb_real *n = &c->act_nd[ND * a], mu = c->act_nd[ND * a + 6];
         wb_real *vi = &v[3 * i], *vj = &v[3 * j], u[3];
         v3_sub(u, vj, vi);
         const wb_real un = v3_dot(u, n);
-        if (!(un < 0)) continue;
         /* change u = vj - vi by -un n, split by inverse mass */
-        if (wi > 0) v3_madd(vi, n, un * wi / wsum);
-        if (wj > 0) v3_madd(vj, n, -un * wj / wsum);
+        if (un < 0) {
+            if (wi > 0) v3_madd(vi, n, un * wi / wsum);
+            if (wj > 0) v3_madd(vj, n, -un * wj / wsum);
+        }
+        if (!(mu > 0)) continue;
+        v3_madd(u, n, -un); /* the tangential part, which the normal change left as it was */
+        const wb_real ut = v3_len(u), dv = mu * (c->act_nd[ND * a + 3] - c->act_nd[ND * a + 5]) / h;
+        if (!(ut > 0)) continue;
+        /* change u by -min(dv, ut) u / ut */
+        const wb_real f = (dv < ut ? dv : ut) / ut / wsum;
+        if (wi > 0) v3_madd(vi, u, f * wi);
+        if (wj > 0) v3_madd(vj, u, -f * wj);
     }
 }
 
@@ -258,7 +353,7 @@ wb_contact wb_world_contact_at(const wb_world *w, int32_t i)
     wb_contact out = { -1, -1, 0, { 0, 0, 0 }, 0 };
     if (i < 0 || i >= c->nact) return out;
     const int32_t k = c->act[i];
-    const wb_real *nd = &c->act_nd[6 * i];
+    const wb_real *nd = &c->act_nd[ND * i];
     out.a = c->ij[2 * k];
     out.b = c->ij[2 * k + 1];
     v3_copy(out.normal, nd);

@@ -151,7 +151,7 @@ typedef struct wb_contacts {
     int32_t *ij;           /* (n x 2) i < j, in the broad phase's fixed order */
     int32_t nact, cap_act; /* contacts of the current substep */
     int32_t *act;          /* (nact) candidate index */
-    wb_real *act_nd;       /* (nact x 5) normal (i -> j), depth, normal force */
+    wb_real *act_nd;       /* (nact x 7) normal (i -> j), depth, force, err, mu if sliding */
     int32_t cap_nd;
     wb_real *left;         /* (n) overlap a candidate was left with by its last projection;
                               INFINITY when not known (contact.c: old overlap) */
@@ -170,6 +170,9 @@ typedef struct wb_contacts {
     int32_t last;          /* contacts in the last substep */
     int fresh;             /* a new candidate list: `left` not known yet */
     double broad_ms;       /* broad phase of the last step */
+    wb_real *load;         /* (np) static friction budget of the substep, mu x normal impulse
+                              (contact.c's friction pass; pairs' and triangles' together) */
+    int32_t cap_load;
 } wb_contacts;
 
 /* broadphase.c: every pair i < j with |x_i - x_j| < reach_i + reach_j (particles with
@@ -216,7 +219,8 @@ typedef struct wb_tricontacts {
     int32_t *pt;           /* (n x 2) point, triangle; point order, then triangle order */
     int32_t nact, cap_act; /* contacts that corrected positions in the current substep */
     int32_t *act;          /* (nact) candidate index */
-    wb_real *act_d;        /* (nact x 9) barycentrics, normal (triangle -> point), depth, force, old overlap */
+    wb_real *act_d;        /* (nact x 10) barycentrics, normal (triangle -> point), depth, force, old
+                              overlap, mu if sliding */
     int32_t cap_d;
     wb_real *left;         /* (n) overlap a candidate was left with (wb__contact_depth) */
     int32_t cap_left;
@@ -326,6 +330,12 @@ void wb__contacts_begin(wb_world *w);
 wb_status wb__body_finish(wb_world *w, int32_t first, int32_t count, wb_body *out);
 void wb__contacts_project(wb_world *w, wb_real h);
 void wb__contacts_velocity(wb_world *w, wb_real h);
+/* contact.c: static friction of the substep's pair and triangle contacts, after both
+ * projections (per particle: its contacts' normal corrections bound what it may stick
+ * with); tricontact.c: the triangle contacts' part of it */
+void wb__contacts_friction(wb_world *w, wb_real h);
+void wb__tricontacts_load(wb_world *w, wb_real h, wb_real *load);
+void wb__tricontacts_static(wb_world *w, wb_real *load);
 wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra); /* world.c */
 wb_status wb__surface_reserve(wb_world *w, int32_t ntri);
 void *wb__grow(void *ptr, int32_t *cap, int32_t need, size_t elem); /* world.c: realloc helper */

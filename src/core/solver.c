@@ -1,8 +1,9 @@
 /* solver.c: the step (Macklin et al. 2019, "Small steps in physics simulation").
  *
  * Per frame, `substeps` times: predict, project the constraints `iterations` times
- * (XPBD, Gauss-Seidel over colour batches or Jacobi), project collisions, update
- * velocities, then friction and restitution at velocity level. Plastic flow, breaking
+ * (XPBD, Gauss-Seidel over colour batches or Jacobi), project collisions (static
+ * friction at position level), update velocities, then dynamic friction and restitution
+ * at velocity level. Plastic flow, breaking
  * and the finiteness check run once per frame. The constraints are projected type by
  * type from the table wb__ctypes (ctype.h): each type is a file of its own. */
 #include <stdio.h>
@@ -181,6 +182,7 @@ wb_status wb_world_step(wb_world *w)
         solve += now_ms() - t0;
         wb__contacts_project(w, h);
         wb__tricontacts_project(w, h);
+        wb__contacts_friction(w, h);
         wb__rigids_solve(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
         wb__collide_and_update(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
         wb__rigids_update(w, h);

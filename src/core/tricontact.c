@@ -16,8 +16,9 @@
  * gradients n for p and -b_i n for the corners, generalized inverse mass
  * W = w_p + sum b_i^2 w_i, so p moves w_p depth / W and corner i moves -b_i w_i depth / W
  * along n: the corrections' momentum sums to (1 - sum b_i) depth / W = 0. Coulomb
- * friction at position level as contact.c's (the relative slip of p against q undone up
- * to mu depth, mu the mean of p's and the triangle's barycentric friction), and after the
+ * friction as contact.c's (mu the mean of p's and the triangle's barycentric friction):
+ * the slip of p against q undone at position level within the per-particle cone when at
+ * rest, dynamic friction at velocity level when sliding, with the same weights; after the
  * velocity update the approach speed along n is removed the same way. Overlap a point
  * already had goes out as contact.c's does (wb__contact_depth): at max_depenetration
  * and without becoming speed; before, all of it went in one substep, as speed, and
@@ -42,6 +43,10 @@
 #include <time.h>
 
 #include "core.h"
+
+/* a contact's record for the velocity pass and the readout (act_d): barycentrics, normal
+ * (triangle -> point), depth, force, old overlap pushed back in full, mu when sliding */
+#define TD 10
 
 static double now_ms(void)
 {
@@ -418,11 +423,11 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
     if (c->n == 0) { c->last = 0; return; }
     const wb_model *m = &w->m;
     wb_real *x = w->s.x, *xp = w->s.x_prev;
-    const wb_real *wv = m->w, *rad = m->radius, *cf = m->cfric;
+    const wb_real *wv = m->w, *rad = m->radius;
     int32_t *act = wb__grow(c->act, &c->cap_act, c->n, sizeof *act);
     if (!act) goto nomem;
     c->act = act;
-    wb_real *ad = wb__grow(c->act_d, &c->cap_d, 9 * c->n, sizeof *ad);
+    wb_real *ad = wb__grow(c->act_d, &c->cap_d, TD * c->n, sizeof *ad);
     if (!ad) goto nomem;
     c->act_d = ad;
     wb_real *left = wb__grow(c->left, &c->cap_left, c->n, sizeof *left);
@@ -517,28 +522,13 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
         for (int i = 0; i < 3; i++)
             if (wv[v[i]] > 0 && b[i] != 0)
                 v3_madd(&x[3 * v[i]], nn, -b[i] * wv[v[i]] * s), v3_madd(&xp[3 * v[i]], nn, -b[i] * wv[v[i]] * se);
-        /* friction at position level, as contact.c: the slip of p against the triangle's
-         * point q this substep undone up to mu x depth */
-        const wb_real mu = (cf[p] + b[0] * cf[v[0]] + b[1] * cf[v[1]] + b[2] * cf[v[2]]) / 2;
-        if (mu > 0) {
-            wb_real slip[3];
-            v3_sub(slip, xs, &xp[3 * p]);
-            for (int i = 0; i < 3; i++) v3_madd(slip, &x[3 * v[i]], -b[i]), v3_madd(slip, &xp[3 * v[i]], b[i]);
-            v3_madd(slip, nn, -v3_dot(slip, nn));
-            const wb_real sl = v3_len(slip), cap = mu * depth;
-            if (sl > 0) {
-                const wb_real f = (sl < cap ? 1 : cap / sl) / W;
-                if (wp > 0) v3_madd(xs, slip, -f * wp);
-                for (int i = 0; i < 3; i++)
-                    if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&x[3 * v[i]], slip, f * b[i] * wv[v[i]]);
-            }
-        }
-        wb_real *o = &ad[9 * c->nact];
+        wb_real *o = &ad[TD * c->nact];
         v3_copy(o, b);
         v3_copy(o + 3, nn);
         o[6] = depth;
         o[7] = s / (h * h); /* the multiplier over h^2: newtons */
         o[8] = err;
+        o[9] = 0; /* contact.c's friction pass sets it */
         act[c->nact++] = k;
     }
     c->last = c->nact + touching;
@@ -548,8 +538,83 @@ nomem:
     wb__warn(w, "out of memory in triangle contacts; skipped this substep");
 }
 
-/* after v = (x - x_prev)/h: no speed made out of old overlap (contact.c), then no
- * approach speed of p towards the triangle's point left */
+/* a contact's friction coefficient: the mean of the point's and the triangle's, the
+ * triangle's weighted by b */
+static wb_real tri_mu(const wb_real *cf, int32_t p, const int32_t *v, const wb_real *b)
+{
+    return (cf[p] + b[0] * cf[v[0]] + b[1] * cf[v[1]] + b[2] * cf[v[2]]) / 2;
+}
+
+/* ---- friction (contact.c's pass: the regimes and the budget per particle explained there) -- */
+/* a contact sliding (p's speed relative to the triangle's point q = sum b_i x_i, along it,
+ * more than one substep of dynamic friction takes away) gets mu in its record for the
+ * velocity pass; the others add their normal impulse lambda = depth / W to the particles'
+ * budgets: mu lambda for the point, b_i mu lambda for corner i, the normal correction's
+ * weights */
+void wb__tricontacts_load(wb_world *w, wb_real h, wb_real *load)
+{
+    wb_tricontacts *c = &w->k.tc;
+    const wb_model *m = &w->m;
+    const wb_real *wv = m->w, *vel = w->s.v;
+    for (int32_t a = 0; a < c->nact; a++) {
+        const int32_t k = c->act[a], p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
+        wb_real *b = &c->act_d[TD * a], *nn = b + 3;
+        const wb_real mu = tri_mu(m->cfric, p, v, b);
+        if (!(mu > 0)) continue;
+        wb_real u[3];
+        v3_copy(u, &vel[3 * p]);
+        for (int i = 0; i < 3; i++) v3_madd(u, &vel[3 * v[i]], -b[i]);
+        v3_madd(u, nn, -v3_dot(u, nn));
+        if (v3_len(u) * h > mu * b[6]) {
+            b[9] = mu;
+            continue;
+        }
+        const wb_real W = wv[p] + b[0] * b[0] * wv[v[0]] + b[1] * b[1] * wv[v[1]] + b[2] * b[2] * wv[v[2]];
+        const wb_real l = mu * b[6] / W;
+        load[p] += l;
+        for (int i = 0; i < 3; i++) load[v[i]] += b[i] * l;
+    }
+}
+
+/* an at-rest contact: the slip of p against q this substep, tangential to n, undone with
+ * the impulse |slip| / W (b_i of it for corner i), or the part of it that what is left of
+ * every movable particle's budget allows */
+void wb__tricontacts_static(wb_world *w, wb_real *load)
+{
+    const wb_tricontacts *c = &w->k.tc;
+    const wb_model *m = &w->m;
+    wb_real *x = w->s.x;
+    const wb_real *xp = w->s.x_prev, *wv = m->w;
+    for (int32_t a = 0; a < c->nact; a++) {
+        const int32_t k = c->act[a], p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
+        const wb_real *b = &c->act_d[TD * a], *nn = b + 3;
+        if (!(tri_mu(m->cfric, p, v, b) > 0) || b[9] > 0) continue;
+        const wb_real W = wv[p] + b[0] * b[0] * wv[v[0]] + b[1] * b[1] * wv[v[1]] + b[2] * b[2] * wv[v[2]];
+        wb_real slip[3];
+        v3_sub(slip, &x[3 * p], &xp[3 * p]);
+        for (int i = 0; i < 3; i++) v3_madd(slip, &x[3 * v[i]], -b[i]), v3_madd(slip, &xp[3 * v[i]], b[i]);
+        v3_madd(slip, nn, -v3_dot(slip, nn));
+        const wb_real need = v3_len(slip) / W;
+        wb_real tau = need;
+        if (wv[p] > 0 && load[p] < tau) tau = load[p];
+        for (int i = 0; i < 3; i++)
+            if (wv[v[i]] > 0 && b[i] > 0 && load[v[i]] < b[i] * tau) tau = load[v[i]] / b[i];
+        if (!(tau > 0)) continue;
+        const wb_real f = tau / need / W;
+        load[p] -= tau;
+        if (wv[p] > 0) v3_madd(&x[3 * p], slip, -f * wv[p]);
+        for (int i = 0; i < 3; i++) {
+            load[v[i]] -= b[i] * tau;
+            if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&x[3 * v[i]], slip, f * b[i] * wv[v[i]]);
+        }
+    }
+}
+
+/* after v = (x - x_prev)/h, as contact.c's pass: no speed made out of old overlap (at most
+ * the separating speed there is), then no approach speed of p towards the triangle's
+ * point left, then a sliding contact's dynamic friction on their relative tangential
+ * speed, mu (depth - err) / h at most; each change split with the weights of the normal
+ * correction */
 void wb__tricontacts_velocity(wb_world *w, wb_real h)
 {
     wb_tricontacts *c = &w->k.tc;
@@ -558,28 +623,44 @@ void wb__tricontacts_velocity(wb_world *w, wb_real h)
     const wb_real *wv = m->w;
     for (int32_t a = 0; a < c->nact; a++) {
         const int32_t k = c->act[a], p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
-        const wb_real *b = &c->act_d[9 * a], *nn = b + 3;
+        const wb_real *b = &c->act_d[TD * a], *nn = b + 3;
         const wb_real W = wv[p] + b[0] * b[0] * wv[v[0]] + b[1] * b[1] * wv[v[1]] + b[2] * b[2] * wv[v[2]];
         if (!(b[8] > 0) || W == 0) continue;
-        const wb_real s = b[8] / W / h; /* the projection's push of err, as speed */
+        wb_real u[3];
+        v3_copy(u, &vel[3 * p]);
+        for (int i = 0; i < 3; i++) v3_madd(u, &vel[3 * v[i]], -b[i]);
+        const wb_real un = v3_dot(u, nn), e = b[8] / h; /* the projection's push of err, as speed */
+        const wb_real s = (e < un ? e : un) / W;
+        if (!(s > 0)) continue;
         if (wv[p] > 0) v3_madd(&vel[3 * p], nn, -s * wv[p]);
         for (int i = 0; i < 3; i++)
             if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&vel[3 * v[i]], nn, s * b[i] * wv[v[i]]);
     }
     for (int32_t a = 0; a < c->nact; a++) {
         const int32_t k = c->act[a], p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
-        const wb_real *b = &c->act_d[9 * a], *nn = b + 3;
+        const wb_real *b = &c->act_d[TD * a], *nn = b + 3;
         const wb_real W = wv[p] + b[0] * b[0] * wv[v[0]] + b[1] * b[1] * wv[v[1]] + b[2] * b[2] * wv[v[2]];
         if (W == 0) continue;
         wb_real u[3];
         v3_copy(u, &vel[3 * p]);
         for (int i = 0; i < 3; i++) v3_madd(u, &vel[3 * v[i]], -b[i]);
         const wb_real un = v3_dot(u, nn);
-        if (!(un < 0)) continue;
-        const wb_real s = un / W;
-        if (wv[p] > 0) v3_madd(&vel[3 * p], nn, -s * wv[p]);
+        if (un < 0) {
+            const wb_real s = un / W;
+            if (wv[p] > 0) v3_madd(&vel[3 * p], nn, -s * wv[p]);
+            for (int i = 0; i < 3; i++)
+                if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&vel[3 * v[i]], nn, s * b[i] * wv[v[i]]);
+        }
+        const wb_real mu = b[9];
+        if (!(mu > 0)) continue;
+        v3_madd(u, nn, -un); /* tangential: the normal change left it as it was */
+        const wb_real ut = v3_len(u), dv = mu * (b[6] - b[8]) / h;
+        if (!(ut > 0)) continue;
+        /* change u by -min(dv, ut) u / ut */
+        const wb_real f = (dv < ut ? dv : ut) / ut / W;
+        if (wv[p] > 0) v3_madd(&vel[3 * p], u, -f * wv[p]);
         for (int i = 0; i < 3; i++)
-            if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&vel[3 * v[i]], nn, s * b[i] * wv[v[i]]);
+            if (wv[v[i]] > 0 && b[i] != 0) v3_madd(&vel[3 * v[i]], u, f * b[i] * wv[v[i]]);
     }
 }
 
@@ -594,7 +675,7 @@ wb_tri_contact wb_world_tri_contact_at(const wb_world *w, int32_t i)
     out.p = out.tri[0] = out.tri[1] = out.tri[2] = -1;
     if (i < 0 || i >= c->nact) return out;
     const int32_t k = c->act[i];
-    const wb_real *d = &c->act_d[9 * i];
+    const wb_real *d = &c->act_d[TD * i];
     out.p = c->pt[2 * k];
     memcpy(out.tri, &w->m.tri[3 * c->pt[2 * k + 1]], sizeof out.tri);
     v3_copy(out.bary, d);
