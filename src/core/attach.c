@@ -318,6 +318,12 @@ static wb_status att_prepare(wb_world *w)
     int32_t *col = wb__grow(a->skip_col, &a->cap_col, a->nlive > 0 ? a->nlive : 1, sizeof *col);
     if (!col) return WB_ERR_NOMEM;
     a->skip_col = col;
+    /* charged like the attachments (a million particles make it 4 MB); past the budget
+     * the step fails and the table stays built-but-unused until the world goes */
+    if (!wb__material_charge(w, &a->skip_charged, sizeof(int32_t) * ((size_t)a->cap_start + (size_t)a->cap_col))) {
+        a->skip_np = 0;
+        return WB_ERR_NOMEM;
+    }
     /* counting sort by particle, slot order inside one */
     memset(st, 0, sizeof *st * ((size_t)np + 1));
     for (int32_t s = 0; s < a->n; s++)

@@ -34,6 +34,7 @@ typedef struct wb_attaches {
     int32_t *skip_start;    /* (skip_np + 1) */
     int32_t *skip_col;      /* collider slots */
     int32_t cap_start, cap_col;
+    size_t skip_charged;    /* the skip table's bytes charged to def.memory (4 a particle) */
     int32_t free_hint;      /* no dead slot below it: a new attachment's search starts there */
 } wb_attaches;
 
@@ -60,7 +61,7 @@ static inline void wb__attach_free(wb_world *w)
 {
     wb_attaches *a = w->att;
     if (!a) return;
-    if (w->m.def.memory) w->m.def.memory->used -= a->charged;
+    if (w->m.def.memory) w->m.def.memory->used -= a->charged + a->skip_charged;
     void *p[] = { a->p, a->kind, a->tindex, a->tgen, a->local, a->alpha, a->gen, a->lambda,
                   a->skip_start, a->skip_col };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);

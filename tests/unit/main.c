@@ -121,7 +121,8 @@
     X(tet_strain_volume_shape_and_shear)         \
     X(attach_grab_forces_cleared_by_an_undone_frame) \
     X(attach_grab_clone_same_future)             \
-    X(attach_grab_ids_and_memory)
+    X(attach_grab_ids_and_memory)                \
+    X(attach_skip_table_charged_and_lists)
 
 #define DECLARE(name) TEST(name);
 #define ENTRY(name) { #name, test_##name },
