@@ -561,6 +561,9 @@ void wb_attach_point(const wb_world *w, wb_attach_id a, wb_real out[3]); /* its 
 wb_real wb_attach_compliance(const wb_world *w, wb_attach_id a);
 int32_t wb_attach_count(const wb_world *w);                        /* live ones */
 wb_attach_id wb_attach_at(const wb_world *w, int32_t i);           /* i-th live, slot order */
+/* the live ones in slot order into out (at most cap of them); returns how many there are
+ * (wb_attach_at in a loop is quadratic) */
+int32_t wb_attach_list(const wb_world *w, wb_attach_id *out, int32_t cap);
 
 /* particle p pulled to target; the pose moved between steps is swept to over the next step */
 wb_grab_id wb_grab_add(wb_world *w, int32_t p, const wb_real target[3], wb_real compliance, wb_status *status);
@@ -573,6 +576,7 @@ int32_t wb_grab_particle(const wb_world *w, wb_grab_id g);
 wb_real wb_grab_compliance(const wb_world *w, wb_grab_id g);
 int32_t wb_grab_count(const wb_world *w);
 wb_grab_id wb_grab_at(const wb_world *w, int32_t i);
+int32_t wb_grab_list(const wb_world *w, wb_grab_id *out, int32_t cap); /* as wb_attach_list */
 
 /* ---- rigid bodies (rigid.c, issue 10): XPBD rigid bodies (Müller et al. 2020) --------- */
 #define WB_MAX_RIGIDS (1 << 20)

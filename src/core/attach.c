@@ -26,12 +26,7 @@
 static int live(const wb_attaches *a, int32_t s) { return (a->gen[s] & 1u) != 0; }
 
 /* the target still exists (a removed collider leaves its attachments inert) */
-static int target_live(const wb_world *w, const wb_attaches *a, int32_t s)
-{
-    if (a->kind[s] != WB_TARGET_COLLIDER) return 0; /* rigid bodies: wired at the merge */
-    const int32_t c = a->tindex[s];
-    return c >= 0 && c < w->m.nc && w->m.c_gen[c] == a->tgen[s];
-}
+static int target_live(const wb_world *w, const wb_attaches *a, int32_t s) { return wb__attach_active(w, a, s); }
 
 /* the target's pose at fraction f of the current step (f >= 1: the pose now) */
 static void target_pose(const wb_world *w, const wb_attaches *a, int32_t s, wb_real f, wb_real p[3], wb_real q[4])
@@ -126,11 +121,13 @@ wb_attach_id wb_attach_collider(wb_world *w, int32_t p, wb_collider_id c, wb_rea
         *status = WB_ERR_ARG;
         return none;
     }
-    /* the lowest dead slot, else a new one */
+    /* the lowest dead slot, else a new one (the search starts at the hint: thousands of
+     * attachments made in a row cost no quadratic scan) */
     wb_attaches *a = w->att;
     int32_t s = -1;
-    for (int32_t i = 0; a && i < a->n && s < 0; i++)
+    for (int32_t i = a ? a->free_hint : 0; a && i < a->n && s < 0; i++)
         if (!live(a, i)) s = i;
+    if (a) a->free_hint = s < 0 ? a->n : s + 1;
     if (s < 0) {
         wb_status st = wb__attach_reserve(w, 1);
         if (st != WB_OK) { *status = st; return none; }
@@ -168,6 +165,7 @@ void wb_attach_remove(wb_world *w, wb_attach_id id)
     w->att->gen[s]++;
     w->att->nlive--;
     w->att->dirty = 1;
+    if (s < w->att->free_hint) w->att->free_hint = s;
 }
 
 wb_real wb_attach_force(const wb_world *w, wb_attach_id id, wb_real f[3])
@@ -194,7 +192,7 @@ int32_t wb_attach_count(const wb_world *w)
 {
     const wb_attaches *a = w->att;
     int32_t n = 0;
-    for (int32_t s = 0; a && s < a->n; s++) n += live(a, s) && target_live(w, a, s);
+    for (int32_t s = 0; a && s < a->n; s++) n += target_live(w, a, s);
     return n;
 }
 
@@ -202,11 +200,23 @@ wb_attach_id wb_attach_at(const wb_world *w, int32_t i)
 {
     const wb_attaches *a = w->att;
     for (int32_t s = 0; a && s < a->n; s++) {
-        if (!live(a, s) || !target_live(w, a, s)) continue;
+        if (!target_live(w, a, s)) continue;
         if (i-- == 0) { wb_attach_id id = { (uint32_t)s + 1, a->gen[s] }; return id; }
     }
     wb_attach_id none = { 0, 0 };
     return none;
+}
+
+int32_t wb_attach_list(const wb_world *w, wb_attach_id *out, int32_t cap)
+{
+    const wb_attaches *a = w->att;
+    int32_t k = 0;
+    for (int32_t s = 0; a && s < a->n; s++) {
+        if (!target_live(w, a, s)) continue;
+        if (k < cap) { out[k].index = (uint32_t)s + 1; out[k].gen = a->gen[s]; }
+        k++;
+    }
+    return k;
 }
 
 /* ---- images (snapshot.h) ------------------------------------------------------------- */
@@ -241,7 +251,7 @@ wb_status wb__attach_image_of(const wb_world *w, wb_image *g)
     const wb_attaches *a = w->att;
     int32_t k = 0;
     for (int32_t s = 0; a && s < a->n; s++) {
-        if (!live(a, s) || !target_live(w, a, s)) continue;
+        if (!target_live(w, a, s)) continue;
         g->att.p[k] = a->p[s];
         g->att.kind[k] = a->kind[s];
         g->att.target[k] = a->tindex[s];
@@ -297,6 +307,7 @@ static wb_status att_prepare(wb_world *w)
             a->gen[s]++;
             a->nlive--;
             a->dirty = 1;
+            if (s < a->free_hint) a->free_hint = s;
         }
     const int32_t np = w->m.np;
     if (a->nlive == 0) a->skip_np = 0; /* nothing to skip: collide.c does not look */
@@ -307,6 +318,12 @@ static wb_status att_prepare(wb_world *w)
     int32_t *col = wb__grow(a->skip_col, &a->cap_col, a->nlive > 0 ? a->nlive : 1, sizeof *col);
     if (!col) return WB_ERR_NOMEM;
     a->skip_col = col;
+    /* charged like the attachments (a million particles make it 4 MB); past the budget
+     * the step fails and the table stays built-but-unused until the world goes */
+    if (!wb__material_charge(w, &a->skip_charged, sizeof(int32_t) * ((size_t)a->cap_start + (size_t)a->cap_col))) {
+        a->skip_np = 0;
+        return WB_ERR_NOMEM;
+    }
     /* counting sort by particle, slot order inside one */
     memset(st, 0, sizeof *st * ((size_t)np + 1));
     for (int32_t s = 0; s < a->n; s++)
@@ -340,7 +357,7 @@ static void att_project(wb_world *w, wb_real h)
     wb_real *x = w->s.x;
     w->k.projections += a->nlive;
     for (int32_t s = 0; s < a->n; s++) {
-        if (!live(a, s) || !target_live(w, a, s)) continue;
+        if (!target_live(w, a, s)) continue;
         const int32_t p = a->p[s];
         const wb_real wp = wv[p];
         if (wp == 0) continue; /* pinned or immovable: never written */
@@ -367,7 +384,7 @@ static wb_real att_energy(const wb_world *w)
     const wb_attaches *a = w->att;
     wb_real e = 0;
     for (int32_t s = 0; a && s < a->n; s++) {
-        if (!live(a, s) || !target_live(w, a, s) || !(a->alpha[s] > 0)) continue;
+        if (!target_live(w, a, s) || !(a->alpha[s] > 0)) continue;
         wb_real t[3], c[3];
         point_at(w, a, s, 1, t);
         v3_sub(c, &w->s.x[3 * a->p[s]], t);

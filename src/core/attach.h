@@ -34,7 +34,18 @@ typedef struct wb_attaches {
     int32_t *skip_start;    /* (skip_np + 1) */
     int32_t *skip_col;      /* collider slots */
     int32_t cap_start, cap_col;
+    size_t skip_charged;    /* the skip table's bytes charged to def.memory (4 a particle) */
+    int32_t free_hint;      /* no dead slot below it: a new attachment's search starts there */
 } wb_attaches;
+
+/* slot s is live and its target still exists (a removed collider leaves its attachments
+ * inert until the next step's prepare retires them; the hash and images skip them) */
+static inline int wb__attach_active(const wb_world *w, const wb_attaches *a, int32_t s)
+{
+    if (!(a->gen[s] & 1u) || a->kind[s] != WB_TARGET_COLLIDER) return 0; /* rigid bodies: wired at the merge */
+    const int32_t c = a->tindex[s];
+    return c >= 0 && c < w->m.nc && w->m.c_gen[c] == a->tgen[s];
+}
 
 /* collide.c: is particle i attached to collider slot c (no contact between them)? */
 static inline int wb__attach_skip(const wb_attaches *a, int32_t i, int32_t c)
@@ -50,7 +61,7 @@ static inline void wb__attach_free(wb_world *w)
 {
     wb_attaches *a = w->att;
     if (!a) return;
-    if (w->m.def.memory) w->m.def.memory->used -= a->charged;
+    if (w->m.def.memory) w->m.def.memory->used -= a->charged + a->skip_charged;
     void *p[] = { a->p, a->kind, a->tindex, a->tgen, a->local, a->alpha, a->gen, a->lambda,
                   a->skip_start, a->skip_col };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);

@@ -89,8 +89,9 @@ wb_grab_id wb_grab_add(wb_world *w, int32_t p, const wb_real target[3], wb_real 
     }
     wb_grabs *g = w->grab;
     int32_t s = -1;
-    for (int32_t i = 0; g && i < g->n && s < 0; i++)
+    for (int32_t i = g ? g->free_hint : 0; g && i < g->n && s < 0; i++) /* no dead slot below the hint */
         if (!live(g, i)) s = i;
+    if (g) g->free_hint = s < 0 ? g->n : s + 1;
     /* a new grab starts at its target: it pulls from the first substep on */
     if (s < 0) {
         wb_status st = wb__grab_reserve(w, 1);
@@ -122,6 +123,7 @@ void wb_grab_release(wb_world *w, wb_grab_id id)
     const int32_t s = SLOT(w, id);
     w->grab->gen[s]++;
     w->grab->nlive--;
+    if (s < w->grab->free_hint) w->grab->free_hint = s;
 }
 
 void wb_grab_move(wb_world *w, wb_grab_id id, const wb_real target[3])
@@ -155,6 +157,18 @@ wb_grab_id wb_grab_at(const wb_world *w, int32_t i)
     }
     wb_grab_id none = { 0, 0 };
     return none;
+}
+
+int32_t wb_grab_list(const wb_world *w, wb_grab_id *out, int32_t cap)
+{
+    const wb_grabs *g = w->grab;
+    int32_t k = 0;
+    for (int32_t s = 0; g && s < g->n; s++) {
+        if (!live(g, s)) continue;
+        if (k < cap) { out[k].index = (uint32_t)s + 1; out[k].gen = g->gen[s]; }
+        k++;
+    }
+    return k;
 }
 
 /* ---- images (snapshot.h) ------------------------------------------------------------- */

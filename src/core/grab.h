@@ -20,6 +20,7 @@ typedef struct wb_grabs {
     wb_real *lambda;        /* (n x 3) cache: multipliers of the current substep */
     int32_t sub;            /* substeps begun in this step */
     size_t charged;
+    int32_t free_hint;      /* no dead slot below it: a new grab's search starts there */
 } wb_grabs;
 
 static inline void wb__grab_free(wb_world *w)

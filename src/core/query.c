@@ -166,10 +166,11 @@ uint64_t wb_world_hash(const wb_world *w)
         h = fnv(h, pr->alpha, sizeof(wb_real) * (size_t)pr->n);
         h = fnv(h, pr->v0, sizeof(wb_real) * (size_t)pr->n);
     }
-    /* attachments and grabs: the live ones in slot order (a snapshot keeps that order) */
+    /* attachments and grabs: the live ones in slot order (a snapshot keeps that order;
+     * it drops an attachment whose collider was removed, so the hash does too) */
     const wb_attaches *at = w->att;
     for (int32_t i = 0; at && i < at->n; i++) {
-        if (!(at->gen[i] & 1u)) continue;
+        if (!wb__attach_active(w, at, i)) continue;
         h = fnv(h, &at->p[i], sizeof at->p[i]);
         h = fnv(h, &at->kind[i], 1);
         h = fnv(h, &at->tindex[i], sizeof at->tindex[i]);

@@ -8,6 +8,7 @@
  * frame) defaults to where the particle is, as w:attach does; "from" (where the next
  * step's sweep of the target starts) defaults to the target. w:save writes both. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "json.h"
@@ -24,15 +25,32 @@ static void rotate_inv(const wb_real q[4], const wb_real v[3], wb_real out[3])
     out[2] = v[2] + 2 * (u[0] * t[1] - u[1] * t[0]);
 }
 
+static int read_attach_items(rd *r, const cJSON *arr, const kp *parent, const char *const *keys, wb_image *g,
+                     const int32_t *live, int32_t ncol);
+
 int ja_read_attachments(rd *r, const cJSON *arr, wb_image *g)
 {
     static const char *const keys[] = { "particle", "collider", "point", "compliance", NULL };
     kp top = { NULL, "attachments", 0 };
-    int32_t n = 0, i = 0, ncol = 0;
+    int32_t n = 0, ncol = 0;
     if (!arr) return 0;
     if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
     if (wb_image_alloc_attach(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
-    for (int32_t c = 0; c < g->nc; c++) ncol += (int32_t)(g->c_gen[c] & 1u);
+    /* the live collider slots in order, once (a scan per attachment is na x nc) */
+    int32_t *live = malloc(sizeof *live * (size_t)(g->nc > 0 ? g->nc : 1));
+    if (!live) return jv_fail(r, arr, 0, &top, "out of memory");
+    for (int32_t c = 0; c < g->nc; c++)
+        if (g->c_gen[c] & 1u) live[ncol++] = c;
+    const int rc = read_attach_items(r, arr, &top, keys, g, live, ncol);
+    free(live);
+    return rc;
+}
+
+static int read_attach_items(rd *r, const cJSON *arr, const kp *parent, const char *const *keys, wb_image *g,
+                     const int32_t *live, int32_t ncol)
+{
+    int32_t i = 0;
+    kp top = *parent;
     for (const cJSON *c = arr->child; c; c = c->next, i++) {
         const cJSON *f[4];
         kp p = { &top, NULL, i };
@@ -52,10 +70,7 @@ int ja_read_attachments(rd *r, const cJSON *arr, wb_image *g)
         if (jv_opt_int(r, f[0], &p, "particle", 0, g->np - 1, &pid) ||
             jv_opt_int(r, f[1], &p, "collider", 0, ncol - 1, &cid) || jv_opt_nonneg(r, f[3], &p, "compliance", &a))
             return -1;
-        /* the cid-th live collider slot */
-        int32_t slot = -1;
-        for (int32_t s = 0; s < g->nc && slot < 0; s++)
-            if ((g->c_gen[s] & 1u) && cid-- == 0) slot = s;
+        const int32_t slot = live[cid]; /* the cid-th live collider slot */
         wb_real *local = &g->att.local[3 * i];
         if (f[2]) {
             if (jv_opt_vec(r, f[2], &p, "point", 3, local)) return -1;

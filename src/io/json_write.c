@@ -13,6 +13,7 @@
 typedef struct out {
     FILE *f;
     int bad;               /* a non-finite number was met */
+    int nomem;             /* a scratch table could not be had */
 } out;
 
 static void num(out *o, double x)
@@ -228,17 +229,26 @@ static void write_attach(out *o, const wb_image *g)
 {
     FILE *f = o->f;
     const wb_image_attach *a = &g->att;
+    /* slot -> its place among the live ones, once (a count per attachment is na x nc) */
+    int32_t *rank = a->n ? malloc(sizeof *rank * (size_t)(g->nc > 0 ? g->nc : 1)) : NULL;
+    if (a->n && !rank) {
+        o->nomem = 1;
+        return;
+    }
+    for (int32_t s = 0, r = 0; rank && s < g->nc; s++) {
+        rank[s] = r;
+        r += (int32_t)(g->c_gen[s] & 1u);
+    }
     for (int32_t k = 0; k < a->n; k++) {
-        int32_t rank = 0;
-        for (int32_t s = 0; s < a->target[k]; s++) rank += (int32_t)(g->c_gen[s] & 1u);
         fprintf(f, "%s    {\"particle\": %d, \"collider\": %d, \"point\": ", k ? ",\n" : "  \"attachments\": [\n",
-                a->p[k], rank);
+                a->p[k], rank[a->target[k]]);
         vec(o, &a->local[3 * k], 3);
         fputs(", \"compliance\": ", f);
         num(o, a->alpha[k]);
         fputc('}', f);
     }
     if (a->n) fputs("\n  ],\n", f);
+    free(rank);
     const wb_image_grab *gr = &g->grab;
     for (int32_t k = 0; k < gr->n; k++) {
         fprintf(f, "%s    {\"particle\": %d, \"target\": ", k ? ",\n" : "  \"grabs\": [\n", gr->p[k]);
@@ -358,7 +368,7 @@ int wbio_write_snapshot(const wb_world *w, const char *path, const char *shown, 
         wb_image_free(&g);
         return -1;
     }
-    out o = { fopen(tmp, "wb"), 0 };
+    out o = { fopen(tmp, "wb"), 0, 0 };
     if (!o.f) {
         snprintf(err, errn, "%s: %s", shown, strerror(errno));
         wb_image_free(&g);
@@ -378,7 +388,7 @@ int wbio_write_snapshot(const wb_world *w, const char *path, const char *shown, 
     write_colliders(&o, &g);
     write_surfaces(&o, &g);
     fputs("}\n", o.f);
-    int werr = ferror(o.f) ? errno : 0;
+    int werr = ferror(o.f) ? errno : o.nomem ? ENOMEM : 0;
     if (fclose(o.f) != 0 && !werr) werr = errno ? errno : EIO;
     wb_image_free(&g);
     if (o.bad || werr || rename(tmp, path) != 0) {

@@ -124,9 +124,12 @@ static int w_attachments(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
     const int32_t n = wb_attach_count(w);
+    /* the ids in one pass (a scratch userdata: Lua's budget), not wb_attach_at each */
+    wb_attach_id *ids = (wb_attach_id *)lua_newuserdatauv(L, sizeof *ids * (size_t)(n > 0 ? n : 1), 0);
+    wb_attach_list(w, ids, n);
     lua_createtable(L, n, 0);
     for (int32_t i = 0; i < n; i++) {
-        *push_attach(L, 1) = wb_attach_at(w, i);
+        *push_attach(L, 1) = ids[i];
         lua_rawseti(L, -2, i + 1);
     }
     return 1;
@@ -240,9 +243,11 @@ static int w_grabs(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
     const int32_t n = wb_grab_count(w);
+    wb_grab_id *ids = (wb_grab_id *)lua_newuserdatauv(L, sizeof *ids * (size_t)(n > 0 ? n : 1), 0);
+    wb_grab_list(w, ids, n);
     lua_createtable(L, n, 0);
     for (int32_t i = 0; i < n; i++) {
-        *push_grab(L, 1) = wb_grab_at(w, i);
+        *push_grab(L, 1) = ids[i];
         lua_rawseti(L, -2, i + 1);
     }
     return 1;

@@ -145,15 +145,21 @@ static bool build_instances(wb_layers *l, const wb_world *w, const wb_draw_opts 
         }
     }
     /* attached particles and grabbed ones are marked as pins are (with the pins), a
-     * grab's target as a small sphere of its colour */
+     * grab's target as a small sphere of its colour; the ids listed in one pass each
+     * (wb_attach_at per one is quadratic) */
+    const size_t nid = (size_t)(na > ng ? na : ng);
+    void *ids = o->pins && nid > 0 ? malloc(nid * sizeof(wb_attach_id)) : NULL;
+    if (o->pins && nid > 0 && !ids) return false;
+    if (ids) wb_attach_list(w, ids, na);
     for (int32_t i = 0; o->pins && i < na; i++) {
-        const int32_t pi = wb_attach_particle(w, wb_attach_at(w, i));
+        const int32_t pi = wb_attach_particle(w, ((const wb_attach_id *)ids)[i]);
         const double p[3] = { x[3 * pi], x[3 * pi + 1], x[3 * pi + 2] };
         if (isfinite(p[0] + p[1] + p[2]))
             inst_sphere(&l->inst[k++], p, fmax(1.6 * wb_particle_radius(w, pi), 0.006 * unit), col_attach, 0.5f);
     }
+    if (ids) wb_grab_list(w, ids, ng);
     for (int32_t i = 0; o->pins && i < ng; i++) {
-        const wb_grab_id gid = wb_grab_at(w, i);
+        const wb_grab_id gid = ((const wb_grab_id *)ids)[i];
         const int32_t pi = wb_grab_particle(w, gid);
         const double p[3] = { x[3 * pi], x[3 * pi + 1], x[3 * pi + 2] };
         wb_real t[3];
@@ -163,6 +169,7 @@ static bool build_instances(wb_layers *l, const wb_world *w, const wb_draw_opts 
         if (isfinite(p[0] + p[1] + p[2])) inst_sphere(&l->inst[k++], p, rad, col_grab, 0.5f);
         inst_sphere(&l->inst[k++], tp, 0.5 * rad, col_grab, 0.5f);
     }
+    free(ids);
     l->count[WB_G_LO] = k;
     for (int g = WB_G_HI; g < WB_G_COUNT; g++) {
         l->first[g] = k;
@@ -384,11 +391,14 @@ static bool build_grab_lines(wb_layers *l, const wb_world *w)
     const int32_t ng = wb_grab_count(w);
     if (ng == 0) return true;
     if (!grow(&l->seg, &l->seg_cap, l->nseg + (size_t)ng, sizeof *l->seg)) return false;
+    wb_grab_id *ids = malloc((size_t)ng * sizeof *ids);
+    if (!ids) return false;
+    wb_grab_list(w, ids, ng);
     const wb_real *x = wb_particle_positions(w);
     float col[3];
     wb_lin3(col_grab, col);
     for (int32_t i = 0; i < ng; i++) {
-        const wb_grab_id gid = wb_grab_at(w, i);
+        const wb_grab_id gid = ids[i];
         const int32_t p = wb_grab_particle(w, gid);
         wb_real t[3];
         wb_grab_target(w, gid, t);
@@ -396,6 +406,7 @@ static bool build_grab_lines(wb_layers *l, const wb_world *w)
         for (int c = 0; c < 3; c++) s->a[c] = (float)x[3 * p + c], s->b[c] = (float)t[c], s->c[c] = col[c];
         s->c[3] = 1;
     }
+    free(ids);
     return true;
 }
 

@@ -147,6 +147,7 @@
     X(attach_grab_forces_cleared_by_an_undone_frame) \
     X(attach_grab_clone_same_future)             \
     X(attach_grab_ids_and_memory)                \
+    X(attach_skip_table_charged_and_lists)       \
     RIGID_TESTS(X)                               \
     NARROW_TESTS(X)
 

@@ -112,3 +112,41 @@ TEST(attach_grab_ids_and_memory)
     wb_world_destroy(w);
     CHECK_EQ(mem.used, (size_t)0); /* given back */
 }
+
+/* the attack (tests/scenarios/attach_attack.lua): the particle -> collider skip table the
+ * first step builds (4 bytes a particle) is charged too, and given back; wb_attach_list
+ * and wb_grab_list give the live ids in slot order */
+TEST(attach_skip_table_charged_and_lists)
+{
+    wb_memory mem = { 0, 0 };
+    wb_world_def d = wb_world_default_def();
+    d.memory = &mem;
+    wb_world *w = wb_world_create(&d);
+    REQUIRE(w);
+    wb_collider_def cd = wb_collider_default_def(WB_SHAPE_SPHERE);
+    wb_status st;
+    wb_collider_id c = wb_collider_add(w, &cd, &st);
+    const int32_t n = 20000;
+    for (int32_t i = 0; i < n; i++) {
+        const wb_real x[3] = { (wb_real)(i % 100), 2 + (wb_real)(i / 100), 0 };
+        wb_particle_add(w, x, NULL, 1, 0);
+    }
+    wb_attach_id a[3];
+    for (int k = 0; k < 3; k++) a[k] = wb_attach_collider(w, k, c, 0, &st);
+    const wb_real t[3] = { 0, 0, 0 };
+    wb_grab_id g0 = wb_grab_add(w, 5, t, 0, &st), g1 = wb_grab_add(w, 6, t, 0, &st);
+    const size_t before = mem.used;
+    CHECK(wb_world_step(w) == WB_OK);
+    CHECK(mem.used >= before + sizeof(int32_t) * (size_t)n); /* the table is charged */
+    wb_attach_remove(w, a[1]);
+    wb_grab_release(w, g0);
+    wb_attach_id ids[4];
+    CHECK_EQ(wb_attach_list(w, ids, 4), 2);
+    CHECK(ids[0].index == a[0].index && ids[0].gen == a[0].gen && ids[1].index == a[2].index);
+    CHECK_EQ(wb_attach_list(w, ids, 1), 2); /* the count even when cap is smaller */
+    wb_grab_id gids[2];
+    CHECK_EQ(wb_grab_list(w, gids, 2), 1);
+    CHECK(gids[0].index == g1.index && gids[0].gen == g1.gen);
+    wb_world_destroy(w);
+    CHECK_EQ(mem.used, (size_t)0); /* given back */
+}
