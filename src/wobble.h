@@ -617,5 +617,8 @@ void wb_rigid_set_angular_velocity(wb_world *w, wb_rigid_id r, const wb_real om[
 void wb_rigid_apply_impulse(wb_world *w, wb_rigid_id r, const wb_real J[3], const wb_real at[3]);
 /* its surface's signed distance from p (negative inside) */
 wb_real wb_rigid_distance(const wb_world *w, wb_rigid_id r, const wb_real p[3]);
+/* particle p kept where it is now in body r's frame (attach.c; see wb_attach_collider): the
+ * correction moves the body too, so the particle pulls it back (a ball on a rope) */
+wb_attach_id wb_attach_rigid(wb_world *w, int32_t p, wb_rigid_id r, wb_real compliance, wb_status *status);
 
 #endif

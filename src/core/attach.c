@@ -28,16 +28,16 @@ static int live(const wb_attaches *a, int32_t s) { return (a->gen[s] & 1u) != 0;
 /* the target still exists (a removed collider leaves its attachments inert) */
 static int target_live(const wb_world *w, const wb_attaches *a, int32_t s) { return wb__attach_active(w, a, s); }
 
-/* the target's pose at fraction f of the current step (f >= 1: the pose now) */
-static void target_pose(const wb_world *w, const wb_attaches *a, int32_t s, wb_real f, wb_real p[3], wb_real q[4])
-{
-    wb__collider_pose_at(&w->s.c_pose[a->tindex[s]], f, p, q);
-}
-
+/* the target point: a collider's at fraction f of the current step (f >= 1: the pose
+ * now); a rigid body's at its pose now (the solver moves it) */
 static void point_at(const wb_world *w, const wb_attaches *a, int32_t s, wb_real f, wb_real out[3])
 {
+    if (a->kind[s] == WB_TARGET_RIGID) {
+        wb__rigid_to_world(w, a->tindex[s], &a->local[3 * s], out);
+        return;
+    }
     wb_real p[3], q[4];
-    target_pose(w, a, s, f, p, q);
+    wb__collider_pose_at(&w->s.c_pose[a->tindex[s]], f, p, q);
     q_rotate(q, &a->local[3 * s], out);
     v3_add(out, out, p);
 }
@@ -97,27 +97,14 @@ void wb__attach_put(wb_world *w, int32_t p, int kind, int32_t tindex, uint32_t t
     a->gen[s] = 1;
 }
 
-wb_attach_id wb_attach_collider(wb_world *w, int32_t p, wb_collider_id c, wb_real compliance, wb_status *status)
+/* a new attachment of p to target {kind, slot, gen} at local point `local` */
+static wb_attach_id attach_new(wb_world *w, int32_t p, int kind, int32_t slot, uint32_t gen, const wb_real local[3],
+                               wb_real compliance, wb_status *status)
 {
     wb_attach_id none = { 0, 0 };
-    wb_status dummy;
-    if (!status) status = &dummy;
-    const char *err = !(compliance >= 0) || !isfinite(compliance) ? "compliance must be >= 0"
-                    : p < 0 || p >= w->m.np ? "particle out of range"
-                    : !wb_collider_valid(w, c) ? "collider removed" : NULL;
-    if (err) {
-        wb__set_error("%s", err);
-        *status = WB_ERR_ARG;
-        return none;
-    }
-    /* the point where the particle is now, in the collider's frame at its pose now */
-    const int32_t slot_c = (int32_t)c.index - 1;
-    const wb_collider_pose *cp = &w->s.c_pose[slot_c];
-    wb_real r[3], local[3];
-    v3_sub(r, &w->s.x[3 * p], cp->p);
-    q_rotate_inv(cp->q, r, local);
     if (!isfinite(local[0]) || !isfinite(local[1]) || !isfinite(local[2])) {
-        wb__set_error("the particle is too far from the collider (its offset overflows)");
+        wb__set_error("the particle is too far from the %s (its offset overflows)",
+                      kind == WB_TARGET_RIGID ? "body" : "collider");
         *status = WB_ERR_ARG;
         return none;
     }
@@ -131,16 +118,61 @@ wb_attach_id wb_attach_collider(wb_world *w, int32_t p, wb_collider_id c, wb_rea
     if (s < 0) {
         wb_status st = wb__attach_reserve(w, 1);
         if (st != WB_OK) { *status = st; return none; }
-        wb__attach_put(w, p, WB_TARGET_COLLIDER, slot_c, c.gen, local, compliance);
+        wb__attach_put(w, p, kind, slot, gen, local, compliance);
         a = w->att;
         s = a->n - 1;
     } else {
-        fill(a, s, p, WB_TARGET_COLLIDER, slot_c, c.gen, local, compliance);
+        fill(a, s, p, kind, slot, gen, local, compliance);
         a->gen[s]++; /* even -> odd: live, old handles of the slot stay stale */
     }
     *status = WB_OK;
     wb_attach_id id = { (uint32_t)s + 1, a->gen[s] };
     return id;
+}
+
+static const char *check_new(const wb_world *w, int32_t p, wb_real compliance)
+{
+    return !(compliance >= 0) || !isfinite(compliance) ? "compliance must be >= 0"
+         : p < 0 || p >= w->m.np ? "particle out of range" : NULL;
+}
+
+wb_attach_id wb_attach_collider(wb_world *w, int32_t p, wb_collider_id c, wb_real compliance, wb_status *status)
+{
+    wb_attach_id none = { 0, 0 };
+    wb_status dummy;
+    if (!status) status = &dummy;
+    const char *err = check_new(w, p, compliance);
+    if (!err && !wb_collider_valid(w, c)) err = "collider removed";
+    if (err) {
+        wb__set_error("%s", err);
+        *status = WB_ERR_ARG;
+        return none;
+    }
+    /* the point where the particle is now, in the collider's frame at its pose now */
+    const int32_t slot_c = (int32_t)c.index - 1;
+    const wb_collider_pose *cp = &w->s.c_pose[slot_c];
+    wb_real r[3], local[3];
+    v3_sub(r, &w->s.x[3 * p], cp->p);
+    q_rotate_inv(cp->q, r, local);
+    return attach_new(w, p, WB_TARGET_COLLIDER, slot_c, c.gen, local, compliance, status);
+}
+
+wb_attach_id wb_attach_rigid(wb_world *w, int32_t p, wb_rigid_id r, wb_real compliance, wb_status *status)
+{
+    wb_attach_id none = { 0, 0 };
+    wb_status dummy;
+    if (!status) status = &dummy;
+    const char *err = check_new(w, p, compliance);
+    if (!err && !wb_rigid_valid(w, r)) err = "rigid body removed";
+    if (err) {
+        wb__set_error("%s", err);
+        *status = WB_ERR_ARG;
+        return none;
+    }
+    const int32_t slot_r = (int32_t)r.index - 1;
+    wb_real local[3];
+    wb__rigid_to_local(w, slot_r, &w->s.x[3 * p], local);
+    return attach_new(w, p, WB_TARGET_RIGID, slot_r, r.gen, local, compliance, status);
 }
 
 static int32_t slot_of(const wb_world *w, wb_attach_id id)
@@ -268,9 +300,14 @@ const char *wb__attach_image_check(const wb_image *g)
     if (a->n < 0 || a->n > WB_MAX_CONSTRAINTS) return "too many attachments";
     for (int32_t k = 0; k < a->n; k++) {
         if (a->p[k] < 0 || a->p[k] >= g->np) return "attachment particle out of range";
-        if (a->kind[k] != WB_TARGET_COLLIDER) return "attachment target kind unknown (0 = collider)";
         const int32_t c = a->target[k];
-        if (c < 0 || c >= g->nc || !(g->c_gen[c] & 1u)) return "attachment collider out of range";
+        if (a->kind[k] == WB_TARGET_RIGID) {
+            if (c < 0 || c >= g->nrb || !(g->rb_gen[c] & 1u)) return "attachment rigid body out of range";
+        } else if (a->kind[k] != WB_TARGET_COLLIDER) {
+            return "attachment target kind unknown (0 = collider, 1 = rigid body)";
+        } else if (c < 0 || c >= g->nc || !(g->c_gen[c] & 1u)) {
+            return "attachment collider out of range";
+        }
         if (!isfinite(a->local[3 * k]) || !isfinite(a->local[3 * k + 1]) || !isfinite(a->local[3 * k + 2]))
             return "attachment point must be finite";
         if (!(a->alpha[k] >= 0) || !isfinite(a->alpha[k])) return "attachment compliance must be >= 0";
@@ -283,12 +320,15 @@ wb_status wb__attach_image_reserve(wb_world *w, const wb_image *g)
     return g->att.n > 0 ? wb__attach_reserve(w, g->att.n) : WB_OK;
 }
 
-void wb__attach_image_put(wb_world *w, const wb_image *g, int32_t pshift, const int32_t *cmap)
+void wb__attach_image_put(wb_world *w, const wb_image *g, int32_t pshift, const int32_t *cmap, const int32_t *rmap)
 {
     const wb_image_attach *a = &g->att;
     for (int32_t k = 0; k < a->n; k++) {
-        const int32_t c = cmap ? cmap[a->target[k]] : a->target[k];
-        wb__attach_put(w, a->p[k] + pshift, a->kind[k], c, w->m.c_gen[c], &a->local[3 * k], a->alpha[k]);
+        const int rigid = a->kind[k] == WB_TARGET_RIGID;
+        const int32_t *map = rigid ? rmap : cmap;
+        const int32_t t = map ? map[a->target[k]] : a->target[k];
+        wb__attach_put(w, a->p[k] + pshift, a->kind[k], t, rigid ? w->rb->gen[t] : w->m.c_gen[t], &a->local[3 * k],
+                       a->alpha[k]);
     }
 }
 
@@ -297,6 +337,23 @@ static int32_t att_count(const wb_world *w) { return wb_attach_count(w); }
 
 /* once per step: attachments whose collider was removed die; the particle -> collider
  * skip table is rebuilt when anything changed */
+/* x = A^-1 b for a symmetric positive definite 3 x 3 A (Cramer's rule); 0 when singular */
+static int solve3(const wb_real A[9], const wb_real b[3], wb_real x[3])
+{
+    const wb_real c0[3] = { A[0], A[3], A[6] }, c1[3] = { A[1], A[4], A[7] }, c2[3] = { A[2], A[5], A[8] };
+    wb_real t[3];
+    v3_cross(t, c1, c2);
+    const wb_real det = v3_dot(c0, t);
+    if (!(fabs(det) > 0) || !isfinite(det)) return 0;
+    wb_real u[3];
+    x[0] = v3_dot(b, t) / det;
+    v3_cross(u, b, c2);
+    x[1] = v3_dot(c0, u) / det;
+    v3_cross(u, c1, b);
+    x[2] = v3_dot(c0, u) / det;
+    return 1;
+}
+
 static wb_status att_prepare(wb_world *w)
 {
     wb_attaches *a = w->att;
@@ -327,10 +384,11 @@ static wb_status att_prepare(wb_world *w)
     /* counting sort by particle, slot order inside one */
     memset(st, 0, sizeof *st * ((size_t)np + 1));
     for (int32_t s = 0; s < a->n; s++)
-        if (live(a, s) && a->kind[s] == WB_TARGET_COLLIDER && a->p[s] < np) st[a->p[s] + 1]++;
+        if (live(a, s) && a->p[s] < np) st[a->p[s] + 1]++;
     for (int32_t i = 0; i < np; i++) st[i + 1] += st[i];
     for (int32_t s = 0; s < a->n; s++)
-        if (live(a, s) && a->kind[s] == WB_TARGET_COLLIDER && a->p[s] < np) col[st[a->p[s]]++] = a->tindex[s];
+        if (live(a, s) && a->p[s] < np)
+            col[st[a->p[s]]++] = a->kind[s] == WB_TARGET_RIGID ? -1 - a->tindex[s] : a->tindex[s];
     for (int32_t i = np; i > 0; i--) st[i] = st[i - 1];
     st[0] = 0;
     a->skip_np = np;
@@ -360,16 +418,33 @@ static void att_project(wb_world *w, wb_real h)
         if (!target_live(w, a, s)) continue;
         const int32_t p = a->p[s];
         const wb_real wp = wv[p];
-        if (wp == 0) continue; /* pinned or immovable: never written */
+        /* pinned or immovable: never written (but a body still hangs from it) */
+        if (wp == 0 && a->kind[s] != WB_TARGET_RIGID) continue;
         const wb_real at = a->alpha[s] * inv_h2;
         if (isinf(at)) continue;
-        /* a rigid target (after the merge, RIGID.md): the point from the body's pose,
-         * then the scalar form along n = C/|C| (Müller et al. 2020, 3.3.1) with
-         * w = wp + wb__rigid_w(point, n), and wb__rigid_apply(-dlambda n) at the point,
-         * so the body is pulled back */
         wb_real t[3];
         point_at(w, a, s, f, t);
         wb_real *xp = &x[3 * p], *l = &a->lambda[3 * s];
+        if (a->kind[s] == WB_TARGET_RIGID) {
+            /* the point constraint C = x - t in 3D: (K + alpha~ E) dlambda = -C - alpha~ lambda,
+             * K = wp E + the body's response at the point (Müller et al. 2020's generalized
+             * inverse mass as a matrix). Along C's direction only (the scalar form), each
+             * correction moved the point sideways as well, and a swinging body's attachment
+             * rang from substep to substep with a force 1.7 times its weight */
+            wb_real K[9], rhs[3], dl[3];
+            wb__rigid_point_response(w, a->tindex[s], t, K);
+            for (int k = 0; k < 3; k++) {
+                K[4 * k] += wp + at;
+                rhs[k] = t[k] - xp[k] - at * l[k];
+            }
+            if (!solve3(K, rhs, dl)) continue;
+            v3_add(l, l, dl);
+            if (wp > 0) v3_madd(xp, dl, wp);
+            wb_real dp[3];
+            v3_scale(dp, dl, -1);
+            wb__rigid_apply(w, a->tindex[s], t, dp);
+            continue;
+        }
         const wb_real inv = 1 / (wp + at);
         for (int k = 0; k < 3; k++) {
             const wb_real dl = (t[k] - xp[k] - at * l[k]) * inv;

@@ -1,14 +1,15 @@
 /* attach.h: attachments (attach.c): a particle kept at a point fixed in a target's frame.
  *
- * The target is a tagged union {kind, index, gen} (RIGID.md): this session only
- * kinematic colliders; rigid bodies (issue 10, `rigid`) add the kind and apply the
- * correction to the body too. Slots live while gen is odd, like colliders'. */
+ * The target is a tagged union {kind, index, gen}: a kinematic collider (it carries the
+ * particle) or a rigid body (rigid.h: the correction moves the body too, so the particle
+ * pulls it back). Slots live while gen is odd, like colliders'. */
 #ifndef WB_ATTACH_H
 #define WB_ATTACH_H
 
 #include <stdlib.h>
 
 #include "core.h"
+#include "rigid.h"
 
 enum { WB_TARGET_COLLIDER = 0, WB_TARGET_RIGID = 1 };
 
@@ -42,12 +43,14 @@ typedef struct wb_attaches {
  * inert until the next step's prepare retires them; the hash and images skip them) */
 static inline int wb__attach_active(const wb_world *w, const wb_attaches *a, int32_t s)
 {
-    if (!(a->gen[s] & 1u) || a->kind[s] != WB_TARGET_COLLIDER) return 0; /* rigid bodies: wired at the merge */
-    const int32_t c = a->tindex[s];
-    return c >= 0 && c < w->m.nc && w->m.c_gen[c] == a->tgen[s];
+    if (!(a->gen[s] & 1u)) return 0;
+    const int32_t t = a->tindex[s];
+    if (a->kind[s] == WB_TARGET_RIGID) return w->rb && t >= 0 && t < w->rb->n && w->rb->gen[t] == a->tgen[s];
+    return t >= 0 && t < w->m.nc && w->m.c_gen[t] == a->tgen[s];
 }
 
-/* collide.c: is particle i attached to collider slot c (no contact between them)? */
+/* collide.c: is particle i attached to collider slot c (no contact between them)? The
+ * table holds collider slots c >= 0 and rigid bodies r as -1 - r */
 static inline int wb__attach_skip(const wb_attaches *a, int32_t i, int32_t c)
 {
     if (i >= a->skip_np) return 0;

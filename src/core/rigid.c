@@ -347,6 +347,22 @@ void wb__rigid_apply(wb_world *w, int32_t r, const wb_real x[3], const wb_real d
     rb->moved[r] = 1;
 }
 
+void wb__rigid_point_response(const wb_world *w, int32_t r, const wb_real x[3], wb_real K[9])
+{
+    const wb_rigids *rb = w->rb;
+    wb_real d[3];
+    v3_sub(d, x, &rb->x[3 * r]);
+    for (int k = 0; k < 3; k++) {
+        /* column k: how the point moves for a unit impulse along axis k */
+        wb_real e[3] = { 0, 0, 0 }, t[3], col[3];
+        e[k] = 1;
+        v3_cross(t, d, e);
+        inv_inertia_world(rb, r, t, t);
+        v3_cross(col, t, d);
+        for (int i = 0; i < 3; i++) K[3 * i + k] = col[i] + (i == k ? rb->inv_mass[r] : 0);
+    }
+}
+
 void wb__rigid_to_world(const wb_world *w, int32_t r, const wb_real local[3], wb_real out[3])
 {
     wb_real t[3];

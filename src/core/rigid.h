@@ -47,6 +47,10 @@ typedef struct wb_rigids {
 wb_real wb__rigid_w(const wb_world *w, int32_t r, const wb_real x[3], const wb_real n[3]);
 /* apply positional impulse dp (= lambda n, world) at world point x: p += dp/m, q += 0.5 [I^-1 (r x dp), 0] q */
 void wb__rigid_apply(wb_world *w, int32_t r, const wb_real x[3], const wb_real dp[3]);
+/* K (3 x 3, row-major, symmetric): how world point x of body r moves per unit positional
+ * impulse there, 1/m E - [d]x I^-1 [d]x (d = x - centre): a point constraint in 3D (an
+ * attachment) solves K dlambda = -C at once instead of along C's direction only */
+void wb__rigid_point_response(const wb_world *w, int32_t r, const wb_real x[3], wb_real K[9]);
 /* world point of a body-local point, and body-local of a world point, at the current pose */
 void wb__rigid_to_world(const wb_world *w, int32_t r, const wb_real local[3], wb_real out[3]);
 void wb__rigid_to_local(const wb_world *w, int32_t r, const wb_real world[3], wb_real out[3]);

@@ -148,12 +148,13 @@ static void put_one(wb_world *w, int32_t slot, const wb_image_rigid *o)
     wb__rigid_set_slot(w, slot, &s, o->mass, o->x, o->q, o->v, o->om); /* checked: cannot fail */
 }
 
-void wb__rigid_put(wb_world *w, const wb_image *g, int exact)
+void wb__rigid_put(wb_world *w, const wb_image *g, int exact, int32_t *map)
 {
     if (g->nrb == 0) return;
     wb_rigids *rb = w->rb;
     if (exact) {
         for (int32_t r = 0; r < g->nrb; r++) {
+            if (map) map[r] = r;
             rb->gen[r] = g->rb_gen[r];
             if (g->rb_gen[r] & 1u) put_one(w, r, &g->rb[r]);
             else memset(&rb->shape[r], 0, sizeof rb->shape[r]);
@@ -163,6 +164,7 @@ void wb__rigid_put(wb_world *w, const wb_image *g, int exact)
     }
     int32_t scan = 0;
     for (int32_t r = 0; r < g->nrb; r++) {
+        if (map) map[r] = -1;
         if (!(g->rb_gen[r] & 1u)) continue;
         int32_t slot = -1;
         for (; scan < rb->n && slot < 0; scan++)
@@ -173,5 +175,6 @@ void wb__rigid_put(wb_world *w, const wb_image *g, int exact)
         }
         put_one(w, slot, &g->rb[r]);
         rb->gen[slot]++;
+        if (map) map[r] = slot;
     }
 }

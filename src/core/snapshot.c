@@ -523,9 +523,9 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     wb__tet_image_put(w, g, 0);
     wb__smatch_put(w, g, 0);
     wb__pressure_put(w, g, 0);
-    wb__attach_image_put(w, g, 0, NULL);
+    wb__rigid_put(w, g, 1, NULL);
+    wb__attach_image_put(w, g, 0, NULL, NULL);
     wb__grab_image_put(w, g, 0);
-    wb__rigid_put(w, g, 1);
     s->time = g->time;
     s->frame = g->frame;
     s->warnings = g->warnings;
@@ -570,7 +570,8 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     /* everything reserved first: after this nothing can fail */
     wb_colmesh **cms = calloc((size_t)(g->nc > 0 ? g->nc : 1), sizeof *cms);
     int32_t *cmap = calloc((size_t)(g->nc > 0 ? g->nc : 1), sizeof *cmap); /* image slot -> w's */
-    if (!cms || !cmap) { free(cms); free(cmap); return WB_ERR_NOMEM; }
+    int32_t *rmap = calloc((size_t)(g->nrb > 0 ? g->nrb : 1), sizeof *rmap); /* the same for rigid bodies */
+    if (!cms || !cmap || !rmap) { free(cms); free(cmap); free(rmap); return WB_ERR_NOMEM; }
     wb_status st = wb__reserve(w, g->np, live_d);
     if (st == WB_OK) st = wb__bend_reserve(w, g->nb);
     if (st == WB_OK) st = grow_colliders(w, m->nc + new_c);
@@ -586,6 +587,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     if (st != WB_OK) {
         free(cms);
         free(cmap);
+        free(rmap);
         return st;
     }
     const int32_t first_surface = m->nsurf;
@@ -638,10 +640,12 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     wb__tet_image_put(w, g, first);
     wb__smatch_put(w, g, first);
     wb__pressure_put(w, g, first_surface);
-    wb__attach_image_put(w, g, first, cmap);
+    /* the image's rigid bodies go to free or new slots: the attachments follow them */
+    wb__rigid_put(w, g, 0, rmap);
+    wb__attach_image_put(w, g, first, cmap, rmap);
+    free(rmap);
     wb__grab_image_put(w, g, first);
     free(cmap);
-    wb__rigid_put(w, g, 0);
     m->topology_dirty = 1;
     out->first = first;
     out->count = g->np;

@@ -169,7 +169,7 @@ wb_status wb__pressure_image_of(const wb_world *w, wb_image *g);
 const char *wb__pressure_image_check(const wb_image *g);
 wb_status wb__pressure_reserve(wb_world *w, const wb_image *g);
 void wb__pressure_put(wb_world *w, const wb_image *g, int32_t sshift);
-/* attach.c and grab.c, the same way; cmap maps the image's collider slots to w's (NULL:
+/* attach.c and grab.c, the same way; cmap and rmap map the image's collider and rigid slots to w's (NULL:
  * the same slots) */
 wb_status wb_image_alloc_attach(wb_image *g, int32_t n);
 wb_status wb_image_alloc_grab(wb_image *g, int32_t n);
@@ -177,7 +177,7 @@ void wb__attach_image_free(wb_image *g);
 wb_status wb__attach_image_of(const wb_world *w, wb_image *g);
 const char *wb__attach_image_check(const wb_image *g);
 wb_status wb__attach_image_reserve(wb_world *w, const wb_image *g);
-void wb__attach_image_put(wb_world *w, const wb_image *g, int32_t pshift, const int32_t *cmap);
+void wb__attach_image_put(wb_world *w, const wb_image *g, int32_t pshift, const int32_t *cmap, const int32_t *rmap);
 void wb__grab_image_free(wb_image *g);
 wb_status wb__grab_image_of(const wb_world *w, wb_image *g);
 const char *wb__grab_image_check(const wb_image *g);
@@ -194,6 +194,7 @@ const char *wb__rigid_image_check(const wb_image *g);
 /* room for the image's bodies in w: exact (a new world: the image's slots as they are)
  * or appended (its live bodies into free or new slots) */
 wb_status wb__rigid_reserve(wb_world *w, const wb_image *g, int exact);
-void wb__rigid_put(wb_world *w, const wb_image *g, int exact);
+/* map (nrb, may be NULL): where each image slot went (-1: a dead one) */
+void wb__rigid_put(wb_world *w, const wb_image *g, int exact, int32_t *map);
 
 #endif

@@ -751,8 +751,8 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
         read_surfaces(r, &s, &cfg->img, &s.ntri) || read_parts(r, &s, cfg) || read_skins(r, &s, cfg) ||
         read_volumes(r, f[11], &d, &cfg->img) || jm_read_shape_matches(r, f[12], &cfg->img) ||
         jm_read_pressures(r, f[13], &cfg->img) || jm_read_tets(r, f[14], &cfg->img) ||
-        ja_read_attachments(r, f[15], &cfg->img) || ja_read_grabs(r, f[16], &cfg->img) ||
-        jr_read_rigids(r, f[17], &cfg->img))
+        jr_read_rigids(r, f[17], &cfg->img) || /* before the attachments that name them */
+        ja_read_attachments(r, f[15], &cfg->img) || ja_read_grabs(r, f[16], &cfg->img))
         return -1;
     /* every value was checked where it was read: this is the last line of defence */
     const char *e = wb_image_check(&cfg->img);

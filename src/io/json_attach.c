@@ -52,44 +52,49 @@ static int read_attach_items(rd *r, const cJSON *arr, const kp *parent, const ch
     int32_t i = 0;
     kp top = *parent;
     for (const cJSON *c = arr->child; c; c = c->next, i++) {
-        const cJSON *f[4];
+        const cJSON *f[5];
         kp p = { &top, NULL, i };
         int64_t pid, cid;
         if (jv_get_object(r, c, &p, keys, f)) return -1;
         if (!f[0]) return jv_missing(r, c, &p, "particle");
-        if (!f[1]) return jv_missing(r, c, &p, "collider");
+        const int rigid = f[4] != NULL;
+        const char *tkey = rigid ? "rigid" : "collider";
+        const cJSON *tf = rigid ? f[4] : f[1];
+        kp tq = { &p, tkey, 0 };
+        if (rigid && f[1]) return jv_fail(r, f[4], 0, &tq, "give collider or rigid, not both");
+        if (!tf) return jv_missing(r, c, &p, "collider");
         if (g->np == 0) {
             kp q = { &p, "particle", 0 };
             return jv_fail(r, f[0], 0, &q, "there are no particles");
         }
-        if (ncol == 0) {
-            kp q = { &p, "collider", 0 };
-            return jv_fail(r, f[1], 0, &q, "there are no colliders");
-        }
+        const int32_t ntarget = rigid ? g->nrb : ncol;
+        if (ntarget == 0) return jv_fail(r, tf, 0, &tq, rigid ? "there are no rigid bodies" : "there are no colliders");
         wb_real a = 0;
         if (jv_opt_int(r, f[0], &p, "particle", 0, g->np - 1, &pid) ||
-            jv_opt_int(r, f[1], &p, "collider", 0, ncol - 1, &cid) || jv_opt_nonneg(r, f[3], &p, "compliance", &a))
+            jv_opt_int(r, tf, &p, tkey, 0, ntarget - 1, &cid) || jv_opt_nonneg(r, f[3], &p, "compliance", &a))
             return -1;
-        const int32_t slot = live[cid]; /* the cid-th live collider slot */
+        /* a collider: the cid-th live slot; a rigid body: the cid-th entry of "rigids" */
+        const int32_t slot = rigid ? (int32_t)cid : live[cid];
+        if (rigid && !(g->rb_gen[slot] & 1u)) return jv_fail(r, tf, 0, &tq, "that rigid body was removed");
         wb_real *local = &g->att.local[3 * i];
         if (f[2]) {
             if (jv_opt_vec(r, f[2], &p, "point", 3, local)) return -1;
         } else {
-            const wb_image_collider *col = &g->c[slot];
+            const wb_real *tp = rigid ? g->rb[slot].x : g->c[slot].p, *tqr = rigid ? g->rb[slot].q : g->c[slot].q;
             const wb_real *x = &g->x[3 * pid];
-            const wb_real d[3] = { x[0] - col->p[0], x[1] - col->p[1], x[2] - col->p[2] };
+            const wb_real d[3] = { x[0] - tp[0], x[1] - tp[1], x[2] - tp[2] };
             wb_real q[4];
-            const wb_real qn = sqrt(col->q[0] * col->q[0] + col->q[1] * col->q[1] + col->q[2] * col->q[2] +
-                                    col->q[3] * col->q[3]);
-            for (int k = 0; k < 4; k++) q[k] = col->q[k] / qn;
+            const wb_real qn = sqrt(tqr[0] * tqr[0] + tqr[1] * tqr[1] + tqr[2] * tqr[2] + tqr[3] * tqr[3]);
+            for (int k = 0; k < 4; k++) q[k] = tqr[k] / qn;
             rotate_inv(q, d, local);
             if (!isfinite(local[0]) || !isfinite(local[1]) || !isfinite(local[2])) {
                 kp q2 = { &p, "particle", 0 };
-                return jv_fail(r, f[0], 0, &q2, "the particle is too far from the collider");
+                return jv_fail(r, f[0], 0, &q2, rigid ? "the particle is too far from the body"
+                                                      : "the particle is too far from the collider");
             }
         }
         g->att.p[i] = (int32_t)pid;
-        g->att.kind[i] = 0;
+        g->att.kind[i] = rigid; /* WB_TARGET_COLLIDER = 0, WB_TARGET_RIGID = 1 (attach.h) */
         g->att.target[i] = slot;
         g->att.alpha[i] = a;
     }

@@ -240,8 +240,10 @@ static void write_attach(out *o, const wb_image *g)
         r += (int32_t)(g->c_gen[s] & 1u);
     }
     for (int32_t k = 0; k < a->n; k++) {
-        fprintf(f, "%s    {\"particle\": %d, \"collider\": %d, \"point\": ", k ? ",\n" : "  \"attachments\": [\n",
-                a->p[k], rank[a->target[k]]);
+        /* a rigid body by its slot: w:save writes every slot of "rigids" */
+        const int rigid = a->kind[k] == 1;
+        fprintf(f, "%s    {\"particle\": %d, \"%s\": %d, \"point\": ", k ? ",\n" : "  \"attachments\": [\n",
+                a->p[k], rigid ? "rigid" : "collider", rigid ? a->target[k] : rank[a->target[k]]);
         vec(o, &a->local[3 * k], 3);
         fputs(", \"compliance\": ", f);
         num(o, a->alpha[k]);

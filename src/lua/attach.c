@@ -38,26 +38,32 @@ static wb_world *checkattach(lua_State *L, int arg, wb_attach_id *id)
     wb_world *w;
     wbl_attach *a = (wbl_attach *)wbl_handle(L, arg, WBL_ATTACH, &w);
     if (!w) luaL_error(L, "stale attachment handle (its world was closed)");
-    if (!wb_attach_valid(w, a->id)) luaL_error(L, "attachment was removed (or its collider was)");
+    if (!wb_attach_valid(w, a->id)) luaL_error(L, "attachment was removed (or its collider or body was)");
     *id = a->id;
     return w;
 }
 
-/* w:attach(p, collider [, {compliance = 0}]) -> attachment */
+/* w:attach(p, collider or rigid body [, {compliance = 0}]) -> attachment */
 static int w_attach(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
     const int32_t p = wbl_checkparticle(L, w, 2);
-    if (!luaL_testudata(L, 3, WBL_COLLIDER))
-        return luaL_argerror(L, 3, lua_pushfstring(L, "collider expected, got %s", luaL_typename(L, 3)));
+    const int rigid = luaL_testudata(L, 3, WBL_RIGID) != NULL;
+    if (!rigid && !luaL_testudata(L, 3, WBL_COLLIDER))
+        return luaL_argerror(L, 3, lua_pushfstring(L, "collider or rigid body expected, got %s", luaL_typename(L, 3)));
+    const char *what = rigid ? "rigid body" : "collider";
     wb_world *cw;
-    const wb_collider_id c = *(const wb_collider_id *)wbl_handle(L, 3, WBL_COLLIDER, &cw);
-    if (cw != w) return luaL_argerror(L, 3, "the collider belongs to another world (or its world was closed)");
-    if (!wb_collider_valid(w, c)) return luaL_argerror(L, 3, "the collider was removed");
+    const void *h = wbl_handle(L, 3, rigid ? WBL_RIGID : WBL_COLLIDER, &cw);
+    const wb_collider_id c = rigid ? (wb_collider_id){ 0, 0 } : *(const wb_collider_id *)h;
+    const wb_rigid_id r = rigid ? *(const wb_rigid_id *)h : (wb_rigid_id){ 0, 0 };
+    if (cw != w)
+        return luaL_argerror(L, 3, lua_pushfstring(L, "the %s belongs to another world (or its world was closed)", what));
+    if (rigid ? !wb_rigid_valid(w, r) : !wb_collider_valid(w, c))
+        return luaL_argerror(L, 3, lua_pushfstring(L, "the %s was removed", what));
     const wb_real alpha = read_compliance(L, 4);
     wb_attach_id *id = push_attach(L, 1); /* first: Lua may run out of memory */
     wb_status st = WB_OK;
-    *id = wb_attach_collider(w, p, c, alpha, &st);
+    *id = rigid ? wb_attach_rigid(w, p, r, alpha, &st) : wb_attach_collider(w, p, c, alpha, &st);
     if (st != WB_OK) return wbl_status_error(L, 2, st, "attachment");
     return 1;
 }
