@@ -5,7 +5,7 @@
 
 #include <stdlib.h>
 
-#include "core.h"
+#include "batch.h"
 
 /* w->vol: NULL until the first one is made */
 typedef struct wb_volumes {
@@ -14,6 +14,8 @@ typedef struct wb_volumes {
     wb_real *alpha;        /* (n) model: compliance, m^3/Pa */
     wb_real *rest;         /* (n) model: signed rest volume, m^3 */
     wb_real *lambda;       /* (n) cache: multipliers of the current substep */
+    int32_t *order;        /* (n) cache: slots by colour batch (batch.h) */
+    wb_batches bt;         /* cache: the batches, rebuilt when n changes */
     size_t charged;        /* bytes charged to def.memory */
 } wb_volumes;
 
@@ -36,6 +38,7 @@ static inline void wb__volume_free(wb_world *w)
     free(v->alpha);
     free(v->rest);
     free(v->lambda);
+    free(v->order);
     free(v);
     w->vol = NULL;
 }
