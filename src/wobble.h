@@ -144,6 +144,7 @@ typedef struct wb_bend_def {
     wb_real compliance;   /* alpha, rad/(N m) (inverse angular stiffness); 0 = rigid */
     wb_real damping;      /* beta, as a distance's; acts when compliance > 0 */
     wb_real rest;         /* rest angle, rad in [-pi, pi]; NAN = the angle at creation */
+    wb_real break_torque; /* N m: breaks when the torque of a frame's last substep passes it; 0 = never */
 } wb_bend_def;
 
 wb_bend_def wb_bend_default_def(void);                        /* rigid, undamped, rest = current */
@@ -158,6 +159,9 @@ wb_real wb_bend_force(const wb_world *w, wb_bend_id b);       /* N m, |lambda|/h
 void wb_bend_particles(const wb_world *w, wb_bend_id b, int32_t p[4]);
 int32_t wb_bend_count(const wb_world *w);
 wb_bend_id wb_bend_at(const wb_world *w, int32_t i);          /* 0 <= i < count, creation order */
+bool wb_bend_broken(const wb_world *w, wb_bend_id b);         /* broken by its break_torque (no longer projected) */
+int32_t wb_world_bend_break_count(const wb_world *w);         /* bends broken in the last step */
+wb_bend_id wb_world_bend_break_at(const wb_world *w, int32_t i);
 /* the dihedral angle a bend over these positions has (rad); false when degenerate */
 bool wb_dihedral_angle(const wb_real x1[3], const wb_real x2[3], const wb_real x3[3], const wb_real x4[3], wb_real *theta);
 

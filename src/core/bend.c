@@ -21,7 +21,7 @@
 #define PI_R ((wb_real)3.14159265358979323846)
 
 /* bytes per constraint over the model and cache arrays, for the memory budget */
-#define BEND_BYTES (8 * sizeof(int32_t) + 4 * sizeof(wb_real) + 2 * sizeof(int32_t))
+#define BEND_BYTES (8 * sizeof(int32_t) + 5 * sizeof(wb_real) + 2 * sizeof(int32_t) + 1)
 
 /* ---- geometry ---------------------------------------------------------------------------- */
 /* the dihedral angle across x1-x2 (0 flat, sign: the wings folding towards n1 x n2 . e)
@@ -101,6 +101,7 @@ static wb_status grow(wb_world *w, int32_t need)
         { (void **)&b->beta, sizeof(wb_real) }, { (void **)&b->rest, sizeof(wb_real) },
         { (void **)&b->s_ij, 4 * sizeof(int32_t) }, { (void **)&b->s_slot, sizeof(int32_t) },
         { (void **)&b->pack, sizeof(int32_t) }, { (void **)&b->lambda, sizeof(wb_real) },
+        { (void **)&b->btorque, sizeof(wb_real) }, { (void **)&b->broken, 1 },
     };
     for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
         void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
@@ -120,7 +121,7 @@ wb_status wb__bend_reserve(wb_world *w, int64_t extra)
 /* ---- the C API -------------------------------------------------------------------------------- */
 wb_bend_def wb_bend_default_def(void)
 {
-    wb_bend_def d = { 0, 0, NAN };
+    wb_bend_def d = { 0, 0, NAN, 0 };
     return d;
 }
 
@@ -129,6 +130,7 @@ const char *wb_bend_def_check(const wb_bend_def *d)
     if (!(d->compliance >= 0) || !isfinite(d->compliance)) return "compliance must be >= 0";
     if (!(d->damping >= 0) || !isfinite(d->damping)) return "damping must be >= 0";
     if (!isnan(d->rest) && !(d->rest >= -PI_R && d->rest <= PI_R)) return "rest must be an angle in [-pi, pi] (radians)";
+    if (!(d->break_torque >= 0) || !isfinite(d->break_torque)) return "break_torque must be >= 0 (N m)";
     return NULL;
 }
 
@@ -174,6 +176,8 @@ wb_bend_id wb_bend_add(wb_world *w, const int32_t p[4], const wb_bend_def *def, 
     b->alpha[s] = def->compliance;
     b->beta[s] = def->damping;
     b->rest[s] = rest == -PI_R ? PI_R : rest; /* one name for the folded-over angle */
+    b->btorque[s] = def->break_torque;
+    b->broken[s] = 0;
     b->pack[s] = -1;
     b->dirty = 1;
     *status = WB_OK;
@@ -197,13 +201,20 @@ wb_real wb_bend_rest(const wb_world *w, wb_bend_id c) { return w->bend.rest[BSLO
 wb_real wb_bend_force(const wb_world *w, wb_bend_id c)
 {
     const int32_t s = BSLOT(w, c), i = w->bend.pack[s];
-    if (w->bend.dirty || i < 0) return 0; /* not stepped since it was made */
+    if (w->bend.dirty || i < 0 || w->bend.broken[s]) return 0; /* not stepped since it was made, or broken */
     const wb_real h = w->k.h_last;
     return fabs(w->bend.lambda[i]) / (h * h);
 }
 
 void wb_bend_particles(const wb_world *w, wb_bend_id c, int32_t p[4]) { memcpy(p, &w->bend.ij[4 * BSLOT(w, c)], 4 * sizeof *p); }
 int32_t wb_bend_count(const wb_world *w) { return w->bend.n; }
+bool wb_bend_broken(const wb_world *w, wb_bend_id c) { return w->bend.broken[BSLOT(w, c)] != 0; }
+int32_t wb_world_bend_break_count(const wb_world *w) { return w->bend.nbreaks; }
+wb_bend_id wb_world_bend_break_at(const wb_world *w, int32_t i)
+{
+    assert(i >= 0 && i < w->bend.nbreaks);
+    return w->bend.breaks[i];
+}
 wb_bend_id wb_bend_at(const wb_world *w, int32_t i)
 {
     assert(i >= 0 && i < w->bend.n);
@@ -219,6 +230,7 @@ static int always(const void *ud, int32_t i) { (void)ud; (void)i; return 1; }
 static wb_status bend_prepare(wb_world *w)
 {
     wb_bends *b = &w->bend;
+    b->nbreaks = 0; /* the list reports the step about to run */
     if (!b->dirty) return WB_OK;
     uint8_t *colour = malloc((size_t)(b->n > 0 ? b->n : 1));
     int32_t count[WB_MAX_COLOURS + 1], start[WB_MAX_COLOURS + 1];
@@ -254,6 +266,7 @@ static void project_range(wb_world *w, int32_t lo, int32_t hi, wb_real h, wb_rea
     wb_real *x = w->s.x;
     for (int32_t i = lo; i < hi; i++) {
         const int32_t *p = &b->s_ij[4 * i], s = b->s_slot[i];
+        if (b->broken[s]) continue;
         wb_real g[4][3], th;
         if (!dihedral(&x[3 * p[0]], &x[3 * p[1]], &x[3 * p[2]], &x[3 * p[3]], &th, g)) continue;
         wb_real den = 0;
@@ -311,7 +324,7 @@ static wb_real bend_energy(const wb_world *w)
     wb_real e = 0;
     for (int32_t s = 0; s < b->n; s++) {
         int ok;
-        if (b->alpha[s] <= 0) continue;
+        if (b->alpha[s] <= 0 || b->broken[s]) continue;
         const wb_real th = wb__bend_angle_of(w->s.x, &b->ij[4 * s], &ok);
         if (!ok) continue;
         const wb_real c = wrap(th - b->rest[s]);
@@ -320,13 +333,31 @@ static wb_real bend_energy(const wb_world *w)
     return e;
 }
 
+/* breaking by torque, once per frame on the multiplier of the frame's last substep (the
+ * torque wb_bend_force reads: lambda / h^2 of an angle is N m), as distances break by
+ * force; a broken bend stays (its slot is its handle) and is skipped from then on */
+static void bend_frame_end(wb_world *w)
+{
+    wb_bends *b = &w->bend;
+    if (b->dirty || !(w->k.h_last > 0)) return;
+    const wb_real inv_h2 = 1 / (w->k.h_last * w->k.h_last);
+    for (int32_t i = 0; i < b->n; i++) {
+        const int32_t s = b->s_slot[i];
+        if (!(b->btorque[s] > 0) || b->broken[s] || !(fabs(b->lambda[i]) * inv_h2 > b->btorque[s])) continue;
+        b->broken[s] = 1;
+        wb_bend_id id = { (uint32_t)s + 1, 1 };
+        wb_bend_id *q = wb__grow(b->breaks, &b->cap_breaks, b->nbreaks + 1, sizeof *q);
+        if (q) { b->breaks = q; b->breaks[b->nbreaks++] = id; }
+    }
+}
+
 const wb_ctype wb__bend_type = {
     .name = "bend",
     .count = bend_count,
     .prepare = bend_prepare,
     .substep_begin = bend_substep_begin,
     .project = bend_project,
-    .frame_end = NULL,
+    .frame_end = bend_frame_end,
     .energy = bend_energy,
 };
 

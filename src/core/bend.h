@@ -13,6 +13,11 @@ typedef struct wb_bends {
     wb_real *alpha;        /* (n) compliance, rad/(N m) */
     wb_real *beta;         /* (n) damping (as a distance's, Macklin et al. 2016 eq. 26) */
     wb_real *rest;         /* (n) rest dihedral angle, rad in (-pi, pi] */
+    wb_real *btorque;      /* (n) torque that breaks it, N m; 0 = never */
+    /* state: what a step changes */
+    uint8_t *broken;       /* (n) broken by its torque: no longer projected */
+    wb_bend_id *breaks;    /* broken in the last step (reported after it) */
+    int32_t nbreaks, cap_breaks;
     size_t charged;        /* bytes charged to def.memory */
     /* cache: packed by colour, rebuilt when dirty */
     int dirty;

@@ -7,7 +7,7 @@
  * free colour among WB_MAX_COLOURS go to one last batch projected serially. */
 #include <stdlib.h>
 
-#include "core.h"
+#include "batch.h"
 
 int wb__colour_greedy(const wb_real *inv_mass, int32_t np, const int32_t *idx, int k, int32_t n,
                       int (*live)(const void *ud, int32_t i), const void *ud, uint8_t *colour,
@@ -51,4 +51,40 @@ int32_t wb__colour_ranges(const int32_t count[WB_MAX_COLOURS + 1], int32_t *colo
     colour_start[nc] = pos;
     *ncolours = nc;
     return pos;
+}
+
+/* ---- batches over a permutation (batch.h) ----------------------------------------------- */
+static int all_live(const void *ud, int32_t i) { (void)ud; (void)i; return 1; }
+
+int wb__batches_build(wb_batches *b, const wb_real *inv_mass, int32_t np, const int32_t *idx, int k, int32_t n,
+                      int32_t *order)
+{
+    uint8_t *colour = malloc((size_t)(n > 0 ? n : 1));
+    int32_t count[WB_MAX_COLOURS + 1], start[WB_MAX_COLOURS + 1];
+    if (!colour || !wb__colour_greedy(inv_mass, np, idx, k, n, all_live, NULL, colour, count)) {
+        free(colour);
+        return 0;
+    }
+    wb__colour_ranges(count, b->colour_start, &b->ncolours, &b->serial_start, start);
+    for (int32_t s = 0; s < n; s++) order[start[colour[s]]++] = s;
+    free(colour);
+    b->n = n;
+    return 1;
+}
+
+void wb__batches_run(const wb_batches *b, wb_world *w, int threads, int32_t min_par, wb_range_fn f,
+                     const int32_t *order, wb_real h)
+{
+    for (int32_t c = 0; c < b->ncolours; c++) {
+        const int32_t lo = b->colour_start[c], hi = b->colour_start[c + 1];
+        if (c >= b->serial_start || threads <= 1 || hi - lo < min_par) {
+            f(w, order, lo, hi, h);
+            continue;
+        }
+        #pragma omp parallel for num_threads(threads) schedule(static)
+        for (int t = 0; t < threads; t++) {
+            const int32_t n = hi - lo;
+            f(w, order, lo + (int32_t)((int64_t)n * t / threads), lo + (int32_t)((int64_t)n * (t + 1) / threads), h);
+        }
+    }
 }

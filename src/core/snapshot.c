@@ -69,13 +69,15 @@ wb_status wb_image_alloc(wb_image *g, int32_t np, int32_t nd, int32_t nfree, int
 
 wb_status wb_image_alloc_bends(wb_image *g, int32_t nb)
 {
-    free(g->b_ij); free(g->b_alpha); free(g->b_beta); free(g->b_rest);
+    free(g->b_ij); free(g->b_alpha); free(g->b_beta); free(g->b_rest); free(g->b_btorque); free(g->b_broken);
     g->nb = nb;
     g->b_ij = zalloc(4 * (int64_t)nb, sizeof *g->b_ij);
     g->b_alpha = zalloc(nb, sizeof(wb_real));
     g->b_beta = zalloc(nb, sizeof(wb_real));
     g->b_rest = zalloc(nb, sizeof(wb_real));
-    if (!g->b_ij || !g->b_alpha || !g->b_beta || !g->b_rest) {
+    g->b_btorque = zalloc(nb, sizeof(wb_real));
+    g->b_broken = zalloc(nb, 1);
+    if (!g->b_ij || !g->b_alpha || !g->b_beta || !g->b_rest || !g->b_btorque || !g->b_broken) {
         wb_image_free(g);
         return WB_ERR_NOMEM;
     }
@@ -118,7 +120,7 @@ void wb_image_free(wb_image *g)
     void *p[] = { g->x, g->v, g->inv_mass, g->radius, g->pinned, g->d_ij, g->d_alpha, g->d_beta, g->d_yield,
                   g->d_creep, g->d_break, g->d_rest, g->d_broken, g->d_gen, g->d_free, g->c, g->c_gen,
                   g->surf_start, g->tri, g->group, g->cflags, g->cfric, g->x0, g->d_bforce,
-                  g->b_ij, g->b_alpha, g->b_beta, g->b_rest };
+                  g->b_ij, g->b_alpha, g->b_beta, g->b_rest, g->b_btorque, g->b_broken };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     wb__smatch_image_free(g);
     wb__pressure_image_free(g);
@@ -167,6 +169,8 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
         memcpy(g->b_alpha, bd->alpha, (size_t)bd->n * sizeof(wb_real));
         memcpy(g->b_beta, bd->beta, (size_t)bd->n * sizeof(wb_real));
         memcpy(g->b_rest, bd->rest, (size_t)bd->n * sizeof(wb_real));
+        memcpy(g->b_btorque, bd->btorque, (size_t)bd->n * sizeof(wb_real));
+        memcpy(g->b_broken, bd->broken, (size_t)bd->n);
     }
     for (int32_t i = 0; i < m->nc; i++) {
         const wb_cshape *cs = &m->c_shape[i];
@@ -295,7 +299,7 @@ const char *wb_image_check(const wb_image *g)
             for (int b = 0; b < a; b++)
                 if (p[a] == p[b]) return "a bend needs four distinct particles";
         }
-        wb_bend_def bd = { g->b_alpha[i], g->b_beta[i], g->b_rest[i] };
+        wb_bend_def bd = { g->b_alpha[i], g->b_beta[i], g->b_rest[i], g->b_btorque[i] };
         if (isnan(g->b_rest[i])) return "bend rest must be an angle in [-pi, pi] (radians)";
         if ((e = wb_bend_def_check(&bd))) return e;
     }
@@ -510,6 +514,8 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
         memcpy(bd->alpha, g->b_alpha, (size_t)g->nb * sizeof(wb_real));
         memcpy(bd->beta, g->b_beta, (size_t)g->nb * sizeof(wb_real));
         memcpy(bd->rest, g->b_rest, (size_t)g->nb * sizeof(wb_real));
+        memcpy(bd->btorque, g->b_btorque, (size_t)g->nb * sizeof(wb_real));
+        memcpy(bd->broken, g->b_broken, (size_t)g->nb);
         bd->dirty = 1;
     }
     m->nc = g->nc;
@@ -617,8 +623,9 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     for (int32_t i = 0; i < g->nb; i++) {
         const int32_t p[4] = { first + g->b_ij[4 * i], first + g->b_ij[4 * i + 1], first + g->b_ij[4 * i + 2],
                                first + g->b_ij[4 * i + 3] };
-        wb_bend_def bd = { g->b_alpha[i], g->b_beta[i], g->b_rest[i] };
-        wb_bend_add(w, p, &bd, NULL); /* checked and reserved: cannot fail */
+        wb_bend_def bd = { g->b_alpha[i], g->b_beta[i], g->b_rest[i], g->b_btorque[i] };
+        wb_bend_id id = wb_bend_add(w, p, &bd, NULL); /* checked and reserved: cannot fail */
+        w->bend.broken[id.index - 1] = g->b_broken[i];
     }
     int32_t scan = 0; /* dead slots are taken lowest first: the scan never goes back */
     for (int32_t i = 0; i < g->nc; i++) {

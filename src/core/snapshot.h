@@ -91,6 +91,8 @@ typedef struct wb_image {
     int32_t nb;
     int32_t *b_ij;         /* (nb x 4) hinge p1 p2, wings p3 p4 */
     wb_real *b_alpha, *b_beta, *b_rest; /* (nb) compliance, damping, rest angle */
+    wb_real *b_btorque;    /* (nb) break_torque, N m (0: never) */
+    uint8_t *b_broken;     /* (nb) broken by it */
 
     int32_t nc;
     wb_image_collider *c;  /* (nc) by slot */

@@ -25,7 +25,8 @@
  * E = 1e9, and would cap how fast a squashed solid may spring back; so none.)
  *
  * Model: corners, Dm^-1, V0, E, nu (mu and lam derived). Cache: the multipliers of the
- * substep. The pass is serial in creation order: deterministic for any thread count. */
+ * substep and the colour batches (batch.h, four particles a tet): Gauss-Seidel batch after
+ * batch, each batch in parallel chunks, so the result is the same for any thread count. */
 #include <assert.h>
 #include <math.h>
 #include <stdio.h>
@@ -36,7 +37,10 @@
 #include "snapshot.h"
 #include "tet.h"
 
-#define TET_BYTES (4 * sizeof(int32_t) + 16 * sizeof(wb_real))
+/* a packed tet (tet.h pd): Dm^-1, V0, mu, lam */
+#define PD 12
+
+#define TET_BYTES (9 * sizeof(int32_t) + 28 * sizeof(wb_real))
 
 wb_tet_def wb_tet_default_def(void)
 {
@@ -81,6 +85,8 @@ wb_status wb__tet_reserve(wb_world *w, int64_t extra)
         { (void **)&v->v0, sizeof(wb_real) }, { (void **)&v->young, sizeof(wb_real) },
         { (void **)&v->poisson, sizeof(wb_real) }, { (void **)&v->mu, sizeof(wb_real) },
         { (void **)&v->lam, sizeof(wb_real) }, { (void **)&v->lambda, 2 * sizeof(wb_real) },
+        { (void **)&v->order, sizeof(int32_t) }, { (void **)&v->pk, 4 * sizeof(int32_t) },
+        { (void **)&v->pd, PD * sizeof(wb_real) },
     };
     for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
         void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
@@ -181,15 +187,20 @@ void wb_tet_particles(const wb_world *w, int32_t i, int32_t p[4])
     if (CHECK_T(w, i)) memcpy(p, &w->neo->ijkl[4 * i], 4 * sizeof *p);
 }
 
-/* F = Ds Dm^-1 of tet i (row-major) */
-static void deformation(const wb_neos *v, const wb_real *x, int32_t i, wb_real F[9])
+/* F = Ds Dm^-1 of the tet of corners p and Dm^-1 d (row-major) */
+static void deformation_of(const int32_t *p, const wb_real *d, const wb_real *x, wb_real F[9])
 {
-    const int32_t *p = &v->ijkl[4 * i];
-    const wb_real *d = &v->dminv[9 * i], *x0 = &x[3 * p[0]];
+    const wb_real *x0 = &x[3 * p[0]];
     wb_real e[3][3];
     for (int k = 0; k < 3; k++) v3_sub(e[k], &x[3 * p[k + 1]], x0);
     for (int r = 0; r < 3; r++)
         for (int c = 0; c < 3; c++) F[3 * r + c] = e[0][r] * d[c] + e[1][r] * d[3 + c] + e[2][r] * d[6 + c];
+}
+
+/* F of tet i */
+static void deformation(const wb_neos *v, const wb_real *x, int32_t i, wb_real F[9])
+{
+    deformation_of(&v->ijkl[4 * i], &v->dminv[9 * i], x, F);
 }
 
 static wb_real det3(const wb_real F[9])
@@ -372,8 +383,23 @@ static wb_real wave_ratio(const wb_world *w, wb_real h, int32_t *at)
 
 static wb_status tet_prepare(wb_world *w)
 {
-    /* nothing to pack: the arrays are the projection's order */
     if (!w->neo || w->neo->n == 0) return WB_OK;
+    /* colour batches when tets were added since (they are never removed) */
+    wb_neos *nv = w->neo;
+    if (nv->n != nv->bt.n) {
+        if (!wb__batches_build(&nv->bt, w->m.inv_mass, w->m.np, nv->ijkl, 4, nv->n, nv->order)) return WB_ERR_NOMEM;
+        /* what a projection reads, copied in batch order: a batch streams through memory
+         * (through the order array it jumped across the whole block, 10% slower) */
+        for (int32_t j = 0; j < nv->n; j++) {
+            const int32_t i = nv->order[j];
+            memcpy(&nv->pk[4 * j], &nv->ijkl[4 * i], 4 * sizeof(int32_t));
+            wb_real *d = &nv->pd[PD * j];
+            memcpy(d, &nv->dminv[9 * i], 9 * sizeof(wb_real));
+            d[9] = nv->v0[i];
+            d[10] = nv->mu[i];
+            d[11] = nv->lam[i];
+        }
+    }
     int32_t at;
     const wb_real h = w->m.def.dt / w->m.def.substeps, r = wave_ratio(w, h, &at);
     /* stable up to about 2 (a hanging lattice bar: whole at 2.3, collapsed at 3.2); once per
@@ -441,20 +467,20 @@ static wb_real wdot(const wb_real wk[4], wb_real a[4][3], wb_real b[4][3])
  * under-converged pass leaves a bias that squeezes the solid (measured: a hanging bar
  * shortened instead of stretched). Solved together, the rest shape is a fixed point of a
  * single iteration at any stiffness, and the error is that of the linearisation. */
-static void tet_project(wb_world *w, wb_real h)
+static void project_range(wb_world *w, const int32_t *order, int32_t lo, int32_t hi, wb_real h)
 {
+    (void)order; /* the packed copies are in batch order already */
     wb_neos *v = w->neo;
-    if (!v) return;
     const wb_real inv_h2 = 1 / (h * h);
     const wb_real *wv = w->m.w;
     wb_real *x = w->s.x;
-    for (int32_t i = 0; i < v->n; i++) {
-        const int32_t *p = &v->ijkl[4 * i];
+    for (int32_t j = lo; j < hi; j++) {
+        const int32_t *p = &v->pk[4 * j];
         const wb_real wk[4] = { wv[p[0]], wv[p[1]], wv[p[2]], wv[p[3]] };
         if (wk[0] + wk[1] + wk[2] + wk[3] == 0) continue;
-        const wb_real *dm = &v->dminv[9 * i];
+        const wb_real *dm = &v->pd[PD * j], v0 = dm[9], mu = dm[10], lam = dm[11];
         wb_real F[9], G[9], gd[4][3], gh[4][3];
-        deformation(v, x, i, F);
+        deformation_of(p, dm, x, F);
         wb_real ic = 0;
         for (int k = 0; k < 9; k++) ic += F[k] * F[k];
         const wb_real cd = sqrt(ic);
@@ -472,9 +498,9 @@ static void tet_project(wb_world *w, wb_real h)
         v3_cross(c2, f0, f1);
         for (int r = 0; r < 3; r++) { G[3 * r] = c0[r]; G[3 * r + 1] = c1[r]; G[3 * r + 2] = c2[r]; }
         grads(dm, G, gh);
-        const wb_real ch = v3_dot(f0, c0) - (1 + v->mu[i] / v->lam[i]);
-        const wb_real ad = inv_h2 / (v->mu[i] * v->v0[i]), ah = inv_h2 / (v->lam[i] * v->v0[i]);
-        wb_real *ld = &v->lambda[2 * i], *lh = &v->lambda[2 * i + 1];
+        const wb_real ch = v3_dot(f0, c0) - (1 + mu / lam);
+        const wb_real ad = inv_h2 / (mu * v0), ah = inv_h2 / (lam * v0);
+        wb_real *ld = &v->lambda[2 * j], *lh = &v->lambda[2 * j + 1]; /* by batch position */
         const wb_real rh = -ch - ah * *lh;
         const wb_real a22 = wdot(wk, gh, gh) + ah;
         wb_real dd = 0, dh;
@@ -506,6 +532,15 @@ static void tet_project(wb_world *w, wb_real h)
             if (wk[k] > 0)
                 for (int r = 0; r < 3; r++) x[3 * p[k] + r] += wk[k] * ((dev ? gd[k][r] * dd : 0) + gh[k][r] * dh);
     }
+}
+
+/* batch after batch in colour order, a batch in parallel chunks (a batch shares no
+ * movable particle): the same bits for any thread count */
+static void tet_project(wb_world *w, wb_real h)
+{
+    wb_neos *v = w->neo;
+    if (!v) return;
+    wb__batches_run(&v->bt, w, w->m.def.threads, 64, project_range, v->order, h);
     w->k.projections += v->n; /* a tet (both of its constraints) is one projection */
 }
 

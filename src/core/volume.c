@@ -9,8 +9,9 @@
  * sum_k m_k dx_k = dlambda sum_k grad_k V = 0, momentum is conserved.
  *
  * Model: the corners, compliance and signed rest volume (a step changes none of them).
- * Cache: the multipliers of the current substep (force readback). The pass is serial in
- * creation order (deterministic for any thread count; colouring them is left for later). */
+ * Cache: the multipliers of the current substep (force readback) and the colour batches
+ * (batch.h, four particles a constraint): Gauss-Seidel batch after batch, each batch in
+ * parallel chunks, so the result is the same for any thread count. */
 #include <assert.h>
 #include <stdlib.h>
 
@@ -19,7 +20,7 @@
 #include "volume.h"
 
 
-#define VOLUME_BYTES (4 * sizeof(int32_t) + 3 * sizeof(wb_real))
+#define VOLUME_BYTES (10 * sizeof(int32_t) + 5 * sizeof(wb_real))
 
 wb_real wb_tet_signed_volume(const wb_real *a, const wb_real *b, const wb_real *c, const wb_real *d)
 {
@@ -66,6 +67,8 @@ wb_status wb__volume_reserve(wb_world *w, int64_t extra)
     struct { void **p; size_t elem; } arr[] = {
         { (void **)&v->ijkl, 4 * sizeof(int32_t) }, { (void **)&v->alpha, sizeof(wb_real) },
         { (void **)&v->rest, sizeof(wb_real) }, { (void **)&v->lambda, sizeof(wb_real) },
+        { (void **)&v->order, sizeof(int32_t) }, { (void **)&v->pos, sizeof(int32_t) },
+        { (void **)&v->pk, 4 * sizeof(int32_t) }, { (void **)&v->pa, 2 * sizeof(wb_real) },
     };
     for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
         void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
@@ -138,7 +141,9 @@ wb_real wb_volume_pressure(const wb_world *w, int32_t i)
 {
     if (!CHECK_V(w, i)) return 0;
     const wb_real h = w->k.h_last;
-    return h > 0 ? w->vol->lambda[i] / (h * h) : 0;
+    /* not stepped since it was made: no multiplier yet */
+    if (!(h > 0) || i >= w->vol->bt.n) return 0;
+    return w->vol->lambda[w->vol->pos[i]] / (h * h);
 }
 
 void wb_world_volume_total(const wb_world *w, wb_real *cur, wb_real *rest)
@@ -155,9 +160,20 @@ void wb_world_volume_total(const wb_world *w, wb_real *cur, wb_real *rest)
 /* ---- the type ---------------------------------------------------------------------- */
 static int32_t vol_count(const wb_world *w) { return wb_volume_count(w); }
 
+/* colour batches when constraints were added since (they are never removed) */
 static wb_status vol_prepare(wb_world *w)
 {
-    (void)w; /* nothing to pack: the arrays are the projection's order */
+    wb_volumes *v = w->vol;
+    if (!v || v->n == v->bt.n) return WB_OK;
+    if (!wb__batches_build(&v->bt, w->m.inv_mass, w->m.np, v->ijkl, 4, v->n, v->order)) return WB_ERR_NOMEM;
+    /* what a projection reads, copied in batch order: a batch streams through memory */
+    for (int32_t j = 0; j < v->n; j++) {
+        const int32_t i = v->order[j];
+        memcpy(&v->pk[4 * j], &v->ijkl[4 * i], 4 * sizeof(int32_t));
+        v->pa[2 * j] = v->alpha[i];
+        v->pa[2 * j + 1] = v->rest[i];
+        v->pos[i] = j;
+    }
     return WB_OK;
 }
 
@@ -166,16 +182,16 @@ static void vol_substep_begin(wb_world *w)
     if (w->vol && w->vol->n > 0) memset(w->vol->lambda, 0, sizeof(wb_real) * (size_t)w->vol->n);
 }
 
-static void vol_project(wb_world *w, wb_real h)
+/* the constraints order[lo, hi): one batch's chunk, or the serial tail */
+static void project_range(wb_world *w, const int32_t *order, int32_t lo, int32_t hi, wb_real h)
 {
+    (void)order; /* the packed copies are in batch order already */
     wb_volumes *v = w->vol;
-    if (!v) return;
     const wb_real inv_h2 = 1 / (h * h);
     const wb_real *wv = w->m.w;
     wb_real *x = w->s.x;
-    w->k.projections += v->n;
-    for (int32_t i = 0; i < v->n; i++) {
-        const int32_t *p = &v->ijkl[4 * i];
+    for (int32_t j = lo; j < hi; j++) {
+        const int32_t *p = &v->pk[4 * j];
         const wb_real wk[4] = { wv[p[0]], wv[p[1]], wv[p[2]], wv[p[3]] };
         if (wk[0] + wk[1] + wk[2] + wk[3] == 0) continue;
         const wb_real *x0 = &x[3 * p[0]], *x1 = &x[3 * p[1]], *x2 = &x[3 * p[2]], *x3 = &x[3 * p[3]];
@@ -190,17 +206,27 @@ static void vol_project(wb_world *w, wb_real h)
         for (int k = 1; k < 4; k++) v3_scale(g[k], g[k], (wb_real)1 / 6);
         for (int c = 0; c < 3; c++) g[0][c] = -(g[1][c] + g[2][c] + g[3][c]);
         const wb_real vol = v3_dot(e1, g[1]);
-        const wb_real at = v->alpha[i] * inv_h2;
+        const wb_real at = v->pa[2 * j] * inv_h2;
         if (isinf(at)) continue; /* compliance/h^2 overflowed: no stiffness */
         wb_real den = at;
         for (int k = 0; k < 4; k++) den += wk[k] * v3_dot(g[k], g[k]);
         /* all four on a line (or on a point): no direction changes the volume */
         if (!(den > (wb_real)1e-300) || !isfinite(den)) continue;
-        const wb_real dl = (v->rest[i] - vol - at * v->lambda[i]) / den;
-        v->lambda[i] += dl;
+        const wb_real dl = (v->pa[2 * j + 1] - vol - at * v->lambda[j]) / den;
+        v->lambda[j] += dl;
         for (int k = 0; k < 4; k++)
             if (wk[k] > 0) v3_madd(&x[3 * p[k]], g[k], wk[k] * dl);
     }
+}
+
+/* batch after batch in colour order, a batch in parallel chunks (a batch shares no
+ * movable particle): the same bits for any thread count */
+static void vol_project(wb_world *w, wb_real h)
+{
+    wb_volumes *v = w->vol;
+    if (!v) return;
+    w->k.projections += v->n;
+    wb__batches_run(&v->bt, w, w->m.def.threads, 256, project_range, v->order, h);
 }
 
 /* U = C^2 / (2 alpha) for compliant constraints; incompressible ones store none */

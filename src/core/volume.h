@@ -5,7 +5,7 @@
 
 #include <stdlib.h>
 
-#include "core.h"
+#include "batch.h"
 
 /* w->vol: NULL until the first one is made */
 typedef struct wb_volumes {
@@ -13,7 +13,12 @@ typedef struct wb_volumes {
     int32_t *ijkl;         /* (n x 4) model: corners */
     wb_real *alpha;        /* (n) model: compliance, m^3/Pa */
     wb_real *rest;         /* (n) model: signed rest volume, m^3 */
-    wb_real *lambda;       /* (n) cache: multipliers of the current substep */
+    wb_real *lambda;       /* (n) cache: multipliers of the current substep, by batch position */
+    int32_t *order;        /* (n) cache: slots by colour batch (batch.h) */
+    int32_t *pos;          /* (n) cache: the batch position of each slot (order's inverse) */
+    int32_t *pk;           /* (n x 4) cache: corners in batch order */
+    wb_real *pa;           /* (n x 2) cache: compliance, rest in batch order */
+    wb_batches bt;         /* cache: the batches, rebuilt when n changes */
     size_t charged;        /* bytes charged to def.memory */
 } wb_volumes;
 
@@ -36,6 +41,10 @@ static inline void wb__volume_free(wb_world *w)
     free(v->alpha);
     free(v->rest);
     free(v->lambda);
+    free(v->order);
+    free(v->pos);
+    free(v->pk);
+    free(v->pa);
     free(v);
     w->vol = NULL;
 }

@@ -115,7 +115,8 @@ void wb_world_destroy(wb_world *w)
     /* the bends' arrays (bend.c owns their use; freed here so that no circle joins the files) */
     wb_bends *bd = &w->bend;
     if (m->def.memory) m->def.memory->used -= bd->charged;
-    void *bp[] = { bd->ij, bd->alpha, bd->beta, bd->rest, bd->s_ij, bd->s_slot, bd->pack, bd->lambda };
+    void *bp[] = { bd->ij, bd->alpha, bd->beta, bd->rest, bd->s_ij, bd->s_slot, bd->pack, bd->lambda, bd->btorque,
+                   bd->broken, bd->breaks };
     for (size_t i = 0; i < sizeof bp / sizeof bp[0]; i++) free(bp[i]);
     if (m->def.memory) m->def.memory->used -= m->charged + m->charged_mesh + w->sm.charged + w->pr.charged;
     wb_state *s = &w->s;

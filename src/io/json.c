@@ -253,8 +253,8 @@ static int read_particles(rd *r, const sections *s, const defaults *d, wb_image 
  * the i-th bend; rest defaults to the angle the particles make */
 static int read_bend(rd *r, const cJSON *c, const kp *p, wb_image *g, int32_t i)
 {
-    static const char *const keys[] = { "type", "particles", "rest", "compliance", "damping", NULL };
-    const cJSON *f[6];
+    static const char *const keys[] = { "type", "particles", "rest", "compliance", "damping", "break_torque", "broken", NULL };
+    const cJSON *f[8];
     if (jv_get_object(r, c, p, keys, f)) return -1;
     if (!f[1]) return jv_missing(r, c, p, "particles");
     kp pp = { p, "particles", 0 }, rp = { p, "rest", 0 };
@@ -273,7 +273,14 @@ static int read_bend(rd *r, const cJSON *c, const kp *p, wb_image *g, int32_t i)
             if (q[j] == q[k]) return jv_fail(r, f[1], 0, &pp, "a bend needs four distinct particles");
     }
     wb_bend_def d = wb_bend_default_def();
-    if (jv_opt_nonneg(r, f[3], p, "compliance", &d.compliance) || jv_opt_nonneg(r, f[4], p, "damping", &d.damping)) return -1;
+    if (jv_opt_nonneg(r, f[3], p, "compliance", &d.compliance) || jv_opt_nonneg(r, f[4], p, "damping", &d.damping) ||
+        jv_opt_nonneg(r, f[5], p, "break_torque", &d.break_torque))
+        return -1;
+    bool broken = false;
+    if (f[6]) {
+        kp q = { p, "broken", 0 };
+        if (jv_get_bool(r, f[6], &q, &broken)) return -1;
+    }
     if (f[2]) {
         if (!cJSON_IsNumber(f[2])) return jv_fail(r, f[2], 0, &rp, "number expected, got %s", jv_type_name(f[2]));
         d.rest = (wb_real)f[2]->valuedouble;
@@ -284,6 +291,8 @@ static int read_bend(rd *r, const cJSON *c, const kp *p, wb_image *g, int32_t i)
     g->b_alpha[i] = d.compliance;
     g->b_beta[i] = d.damping;
     g->b_rest[i] = d.rest;
+    g->b_btorque[i] = d.break_torque;
+    g->b_broken[i] = broken;
     return 0;
 }
 

@@ -146,6 +146,11 @@ static void write_constraints(out *o, const wb_image *g)
         num(o, g->b_alpha[i]);
         fputs(", \"damping\": ", f);
         num(o, g->b_beta[i]);
+        if (g->b_btorque[i] > 0) { /* only when set: configs without it read as before */
+            fputs(", \"break_torque\": ", f);
+            num(o, g->b_btorque[i]);
+        }
+        if (g->b_broken[i]) fputs(", \"broken\": true", f);
         fputc('}', f);
     }
     fputs(first ? "],\n" : "\n  ],\n", f);

@@ -28,9 +28,9 @@ static wb_world *checkbend(lua_State *L, int arg, wb_bend_id *id)
     return w;
 }
 
-static const char *const bend_keys[] = { "compliance", "damping", "rest", NULL };
+static const char *const bend_keys[] = { "compliance", "damping", "rest", "break_torque", NULL };
 
-/* w:bend(p1, p2, p3, p4 [, {compliance = 0, damping = 0, rest = current angle}]) */
+/* w:bend(p1, p2, p3, p4 [, {compliance = 0, damping = 0, rest = current angle, break_torque}]) */
 static int w_bend(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
@@ -44,6 +44,8 @@ static int w_bend(lua_State *L)
             return wbl_fielderror(L, 6, "damping", "must be >= 0");
         if (wbl_optreal(L, 6, "rest", &d.rest) && !(fabs(d.rest) <= 3.14159265358979323846))
             return wbl_fielderror(L, 6, "rest", "must be an angle in [-pi, pi] (radians)");
+        if (wbl_optreal(L, 6, "break_torque", &d.break_torque) && !(d.break_torque >= 0 && isfinite(d.break_torque)))
+            return wbl_fielderror(L, 6, "break_torque", "must be >= 0 (N m; 0: never breaks)");
     }
     for (int i = 0; i < 4; i++)
         for (int j = 0; j < i; j++)
@@ -75,6 +77,27 @@ static int b_force(lua_State *L)
     wb_bend_id id;
     wb_world *w = checkbend(L, 1, &id);
     lua_pushnumber(L, wb_bend_force(w, id));
+    return 1;
+}
+
+static int b_broken(lua_State *L)
+{
+    wb_bend_id id;
+    wb_world *w = checkbend(L, 1, &id);
+    lua_pushboolean(L, wb_bend_broken(w, id));
+    return 1;
+}
+
+/* w:bend_breaks() -> the bends broken (by break_torque) during the last step, as handles */
+static int w_bend_breaks(lua_State *L)
+{
+    wb_world *w = wbl_checkworld(L, 1);
+    const int32_t n = wb_world_bend_break_count(w);
+    lua_createtable(L, n, 0);
+    for (int32_t i = 0; i < n; i++) {
+        push_bend(L, 1, wb_world_bend_break_at(w, i));
+        lua_rawseti(L, -2, i + 1);
+    }
     return 1;
 }
 
@@ -140,6 +163,7 @@ static const luaL_Reg bend_methods[] = {
     { "force", b_force },
     { "angle", b_angle },
     { "rest", b_rest },
+    { "broken", b_broken },
     { "particles", b_particles },
     { "valid", b_valid },
     { "world", b_world },
@@ -156,6 +180,7 @@ static const luaL_Reg bend_meta[] = {
 static const luaL_Reg world_methods[] = {
     { "bend", w_bend },
     { "bends", w_bends },
+    { "bend_breaks", w_bend_breaks },
     { NULL, NULL }
 };
 

@@ -3,7 +3,7 @@
 -- ground: 10 substeps x 1 iteration, 120 frames, single thread. Figures: ms per frame (the
 -- whole step: prediction, contacts with the ground, the tets) and ns per tet projection
 -- (the solver's time / (substeps x iterations x tets): both constraints of one tet, the
--- 2x2 solve, serial in creation order).
+-- 2x2 solve; colour batches split across threads with --set threads=N).
 -- Run: make bench   (or build/wobble bench [--json]; --set frames=N for a quick look)
 local args = wobble.args
 local frames = args.frames or 120

@@ -78,8 +78,8 @@ local CASES = {
                                   break_force = 1e3 },
                          opts_arg = 3, nums = plus(link_nums, { "rest" }),
                          call = function(f, o) return f.w:distance(f.p, f.q, o) end },
-  ["world:bend"] = { opts = { compliance = 0, damping = 0, rest = 0.5 }, opts_arg = 5,
-                     nums = { "compliance", "damping", "rest" },
+  ["world:bend"] = { opts = { compliance = 0, damping = 0, rest = 0.5, break_torque = 10 }, opts_arg = 5,
+                     nums = { "compliance", "damping", "rest", "break_torque" },
                      call = function(f, o) return f.w:bend(f.p, f.q, f.r3, f.r4, o) end },
   ["world:cloth"] = { opts = link{ origin = {0, 0, 0}, size = {1, 1}, res = {2, 2}, mass = 1, radius = 0.02, bend = 0,
                                   bend_links = 0 },
@@ -182,7 +182,7 @@ local CASES = {
                            return f.w:tet_info(...) end },
   ["world:tet_count"] = { none = "a getter: no arguments" },
 }
-for _, name in ipairs{ "angular_momentum", "bends", "bounds", "breaks", "closed", "colliders", "contacts", "damping", "distances", "dt",
+for _, name in ipairs{ "angular_momentum", "bend_breaks", "bends", "bounds", "breaks", "closed", "colliders", "contacts", "damping", "distances", "dt",
                        "energy", "frame", "gravity", "hash", "iterations", "max_strain", "momentum", "particle_count",
                        "relaxation", "rigids", "skins", "solver", "stats", "step", "substeps", "threads", "time", "warnings" } do
   CASES["world:" .. name] = { none = "a getter or step: no arguments" }
@@ -220,7 +220,7 @@ end
 for _, name in ipairs{ "broken", "force", "length", "particles", "remove", "rest", "strain", "valid", "world" } do
   CASES["distance:" .. name] = { none = "a getter or remove: no arguments" }
 end
-for _, name in ipairs{ "angle", "force", "particles", "rest", "valid", "world" } do
+for _, name in ipairs{ "angle", "broken", "force", "particles", "rest", "valid", "world" } do
   CASES["bend:" .. name] = { none = "a getter: no arguments" }
 end
 CASES["shape_match:rest"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.sm:rest(...) end }

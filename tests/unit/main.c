@@ -88,6 +88,8 @@
     X(builder_failure_changes_nothing)           \
     X(colour_batches_valid)                      \
     X(colour_broken_constraints_unpacked)        \
+    X(volume_tet_batches_valid)                  \
+    X(volume_tet_threads_identical)              \
     X(bend_batches_valid)                        \
     X(bend_threads_identical)                    \
     X(bend_conserves_momentum)                   \
