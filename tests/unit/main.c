@@ -47,6 +47,12 @@
     X(tricontact_projection_conserves_momentum)          \
     X(tricontact_who_may_touch)
 
+/* test_tribroad.c: the particle-triangle broad phase */
+#define TRIBROAD_TESTS(X)                                \
+    X(tribroad_matches_brute_force_heap)                 \
+    X(tribroad_matches_brute_force_cloth)                \
+    X(tribroad_matches_brute_force_sparse)
+
 /* every test, in the order they run: add a line here for each TEST() */
 #define TEST_LIST(X)                             \
     X(world_def_defaults)                        \
@@ -117,6 +123,7 @@
     X(bvh_mesh_collider_memory_charged)          \
     CONTACT_TESTS(X)                             \
     TRICONTACT_TESTS(X)                          \
+    TRIBROAD_TESTS(X)                            \
     EXTREME_TESTS(X)                             \
     X(tet_strain_volume_shape_and_shear)
 
