@@ -27,9 +27,9 @@
  *     level's largest reach covers (a triangle that would scan more rows than the level
  *     has points scans its points instead); a point of its own key is skipped first,
  *     then the exact test. Threads take contiguous ranges of the kept triangles, each
- *     with its own buffer; the pairs are then counting-sorted by point, stable, and a
- *     thread's pairs come in triangle order: the list is (point, triangle) in
- *     lexicographic order, the set alone, the same for any thread count. */
+ *     with its own buffer; the pairs are then counting-sorted (stable) by point, then by
+ *     triangle: the list is in (triangle, point) order, the set alone, the same for any
+ *     thread count. */
 #include <time.h>
 
 #include "core.h"
@@ -123,6 +123,10 @@ static int candidate(const wb_world *w, const wb_real *tb, int32_t t, int32_t p,
     return !(same && !rest_apart(m, p, v));
 }
 
+/* fmax and fmin (a NaN argument gives the other), without the call into libm */
+static inline wb_real max_(wb_real a, wb_real b) { return b != b ? a : a > b ? a : b; }
+static inline wb_real min_(wb_real a, wb_real b) { return b != b ? a : a < b ? a : b; }
+
 /* ---- pass 1: body culling -------------------------------------------------------------------------- */
 static inline int box_overlap(const wb_real *alo, const wb_real *ahi, const wb_real *blo, const wb_real *bhi)
 {
@@ -151,35 +155,46 @@ static inline void item_box(const struct wb_tribroad *b, const wb_real *x, int32
 static int32_t make_runs(struct wb_tribroad *b, int32_t r0, const int32_t *list, int32_t n, int tris,
                          const wb_world *w, int32_t *rid, wb_real eps)
 {
-    int32_t nr = 0, keyless = -1, last = -1;
-    for (int32_t k = 0; k < n; k++) {
-        const int32_t i = list[k], key = tris ? b->tkey[i] : w->m.group[i];
-        int32_t cur;
-        if (key == 0 && keyless >= 0) cur = keyless;
-        else if (key != 0 && last >= 0 && b->runs[r0 + last].key == key) cur = last;
-        else {
-            if (nr == RUNS_MAX) return -1;
-            if (!grow((void **)&b->runs, &b->cap_runs, r0 + nr + 1, sizeof *b->runs)) return -2;
-            cur = nr++;
-            run *R = &b->runs[r0 + cur];
-            R->key = key;
-            for (int a = 0; a < 3; a++) { R->lo[a] = INFINITY; R->hi[a] = -INFINITY; }
-            if (key == 0) keyless = cur;
+    int32_t nr = 0, keyless = -1, last = -1, cur = -1;
+    wb_real blo[3] = { INFINITY, INFINITY, INFINITY }, bhi[3] = { -INFINITY, -INFINITY, -INFINITY };
+    for (int32_t k = 0; k <= n; k++) {
+        /* the current run's box is gathered in blo, bhi and merged when the run changes */
+        const int32_t i = k < n ? list[k] : -1, key = k == n ? -1 : tris ? b->tkey[i] : w->m.group[i];
+        int32_t next;
+        if (key == 0 && keyless >= 0) next = keyless;
+        else if (key > 0 && last >= 0 && b->runs[r0 + last].key == key) next = last;
+        else next = -1;
+        if (next < 0 || next != cur || k == n) {
+            if (cur >= 0) {
+                run *R = &b->runs[r0 + cur];
+                for (int a = 0; a < 3; a++) R->lo[a] = min_(R->lo[a], blo[a]), R->hi[a] = max_(R->hi[a], bhi[a]);
+            }
+            if (k == n) break;
+            if (next < 0) {
+                if (nr == RUNS_MAX) return -1;
+                if (!grow((void **)&b->runs, &b->cap_runs, r0 + nr + 1, sizeof *b->runs)) return -2;
+                next = nr++;
+                run *R = &b->runs[r0 + next];
+                R->key = key;
+                for (int a = 0; a < 3; a++) { R->lo[a] = INFINITY; R->hi[a] = -INFINITY; }
+                if (key == 0) keyless = next;
+            }
+            cur = next;
+            for (int a = 0; a < 3; a++) blo[a] = INFINITY, bhi[a] = -INFINITY;
         }
         if (key != 0) last = cur;
         rid[k] = r0 + cur;
-        run *R = &b->runs[r0 + cur];
         wb_real lo[3], hi[3];
         item_box(b, w->s.x, i, tris, lo, hi);
         for (int a = 0; a < 3; a++) {
-            if (lo[a] < R->lo[a]) R->lo[a] = lo[a];
-            if (hi[a] > R->hi[a]) R->hi[a] = hi[a];
+            blo[a] = lo[a] < blo[a] ? lo[a] : blo[a];
+            bhi[a] = hi[a] > bhi[a] ? hi[a] : bhi[a];
         }
     }
     for (int32_t r = r0; r < r0 + nr; r++) {
         run *R = &b->runs[r];
         for (int a = 0; a < 3; a++) {
-            const wb_real e = 1e-14 * fmax(fabs(R->lo[a]), fabs(R->hi[a])) + eps;
+            const wb_real e = 1e-14 * max_(fabs(R->lo[a]), fabs(R->hi[a])) + eps;
             R->lo[a] -= e;
             R->hi[a] += e;
         }
@@ -203,7 +218,7 @@ static int overlaps(struct wb_tribroad *b, int32_t ra, int32_t s0, int32_t s1, i
         }
         wb_real *bx = &b->boxes[6 * *nb];
         for (int a = 0; a < 3; a++) {
-            const wb_real lo = fmax(A->lo[a], B->lo[a]), hi = fmin(A->hi[a], B->hi[a]);
+            const wb_real lo = max_(A->lo[a], B->lo[a]), hi = min_(A->hi[a], B->hi[a]);
             if (lo < bx[a]) bx[a] = lo;
             if (hi > bx[3 + a]) bx[3 + a] = hi;
         }
@@ -541,18 +556,22 @@ static int broadphase(wb_world *w)
         if (!((f0 | f1 | f2) & (WB_CF_COLLIDE | WB_CF_SELF))) continue;
         const int32_t g0 = m->group[tv[0]];
         b->tkey[t] = g0 > 0 && m->group[tv[1]] == g0 && m->group[tv[2]] == g0 && !(f0 & f1 & f2 & WB_CF_SELF) ? g0 : 0;
-        /* (a corner not finite makes the box so, and the triangle is left out) */
-        wb_real mv = 0;
-        for (int k = 0; k < 3; k++) {
-            const wb_real *p = &x[3 * tv[k]];
-            for (int a = 0; a < 3; a++) {
-                if (k == 0 || p[a] < tb[a]) tb[a] = p[a];
-                if (k == 0 || p[a] > tb[3 + a]) tb[3 + a] = p[a];
-            }
-            if (mvp[tv[k]] > mv) mv = mvp[tv[k]];
+        /* the corners' box in locals (tb may alias nothing, the compiler cannot know) */
+        const wb_real *p0 = &x[3 * tv[0]], *p1 = &x[3 * tv[1]], *p2 = &x[3 * tv[2]];
+        wb_real lo[3], hi[3];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = p0[a], hi[a] = p0[a];
+            lo[a] = p1[a] < lo[a] ? p1[a] : lo[a];
+            hi[a] = p1[a] > hi[a] ? p1[a] : hi[a];
+            lo[a] = p2[a] < lo[a] ? p2[a] : lo[a];
+            hi[a] = p2[a] > hi[a] ? p2[a] : hi[a];
         }
-        const wb_real e = fmax(tb[3] - tb[0], fmax(tb[4] - tb[1], tb[5] - tb[2])) + 2 * mv;
+        wb_real mv = mvp[tv[0]] > 0 ? mvp[tv[0]] : 0;
+        mv = mvp[tv[1]] > mv ? mvp[tv[1]] : mv;
+        mv = mvp[tv[2]] > mv ? mvp[tv[2]] : mv;
+        const wb_real e = max_(hi[0] - lo[0], max_(hi[1] - lo[1], hi[2] - lo[2])) + 2 * mv;
         if (!isfinite(e)) continue;
+        for (int a = 0; a < 3; a++) tb[a] = lo[a], tb[3 + a] = hi[a];
         tb[6] = mv;
         b->tc[nt++] = t;
     }
@@ -594,11 +613,18 @@ static int broadphase(wb_world *w)
         if (b->out[k].fail) return -1;
         total += b->out[k].n;
     }
+    const int32_t nf = m->np > m->ntri ? m->np : m->ntri;
     if (!grow((void **)&c->pt, &c->cap, 2 * total, sizeof *c->pt) ||
-        !grow((void **)&b->first, &b->cap_first, (int64_t)m->np + 1, sizeof *b->first))
+        !grow((void **)&b->pt2, &b->cap_pt2, 2 * total, sizeof *b->pt2) ||
+        !grow((void **)&b->first, &b->cap_first, (int64_t)nf + 1, sizeof *b->first))
         return -1;
-    /* by point, stable: each point's triangles stay in the scan's (ascending) order */
-    int32_t *first = b->first;
+    /* two stable counting sorts: by point (a thread's pairs of one point come in
+     * ascending triangle order, the threads' ranges ascend), then by triangle: the list in
+     * (triangle, point) order, whatever the threads. The projection is Gauss-Seidel, so
+     * the order is part of the result: with each point's triangles in a row it let the
+     * interleaved blocks of contact_energy.lua topple farther than with each triangle's
+     * points in a row (and, reversed, fly apart) */
+    int32_t *first = b->first, *by_p = b->pt2;
     memset(first, 0, sizeof *first * ((size_t)m->np + 1));
     for (int k = 0; k < nth; k++)
         for (int32_t q = 0; q < b->out[k].n; q++) first[b->out[k].ij[2 * q] + 1]++;
@@ -606,9 +632,17 @@ static int broadphase(wb_world *w)
     for (int k = 0; k < nth; k++)
         for (int32_t q = 0; q < b->out[k].n; q++) {
             const int32_t at = first[b->out[k].ij[2 * q]]++;
-            c->pt[2 * at] = b->out[k].ij[2 * q];
-            c->pt[2 * at + 1] = b->out[k].ij[2 * q + 1];
+            by_p[2 * at] = b->out[k].ij[2 * q];
+            by_p[2 * at + 1] = b->out[k].ij[2 * q + 1];
         }
+    memset(first, 0, sizeof *first * ((size_t)m->ntri + 1));
+    for (int64_t q = 0; q < total; q++) first[by_p[2 * q + 1] + 1]++;
+    for (int32_t t = 0; t < m->ntri; t++) first[t + 1] += first[t];
+    for (int64_t q = 0; q < total; q++) {
+        const int32_t at = first[by_p[2 * q + 1]]++;
+        c->pt[2 * at] = by_p[2 * q];
+        c->pt[2 * at + 1] = by_p[2 * q + 1];
+    }
     c->n = (int32_t)total;
     return 0;
 }

@@ -34,7 +34,7 @@
  * others.
  *
  * Broad phase, once per frame, in tribroad.c (which applies these rules): the candidates
- * in (point, triangle) order, the same for any thread count; they are projected serially
+ * in (triangle, point) order, the same for any thread count; they are projected serially
  * in that order, so the step is bit-identical for any thread count. */
 #include <stdlib.h>
 

@@ -3,7 +3,7 @@
  * Its list must be exactly the (point, triangle) pairs the O(P x T) loop below accepts,
  * written here from the rules alone (tricontact.c's reach and motion, the triangle's box
  * grown by its motion, the plane and the closest point within reach_p + motion, the
- * group rules, the rest rule of one body), in (point, triangle) order, each once, and
+ * group rules, the rest rule of one body), in (triangle, point) order, each once, and
  * the same list for 1, 2 and 3 threads. The scenes: soft blocks jittered into each other
  * (some self-colliding, one not colliding) with loose particles of mixed radii, a few of
  * them fast, among loose triangles; a crumpled self-colliding cloth under another cloth;
@@ -114,13 +114,13 @@ static int32_t check_world(wb_world *w)
     CHECK_EQ(n1, n3);
     CHECK(n1 == n2 && !memcmp(l1, l2, sizeof *l1 * (size_t)(2 * n1)));
     CHECK(n1 == n3 && !memcmp(l1, l3, sizeof *l1 * (size_t)(2 * n1)));
-    /* the brute list in (p, t) order: the broad phase's must be it, element by element */
+    /* the brute list in (t, p) order: the broad phase's must be it, element by element */
     int32_t k = 0, missed = 0, extra = 0;
-    for (int32_t p = 0; p < m->np; p++)
-        for (int32_t t = 0; t < m->ntri; t++) {
+    for (int32_t t = 0; t < m->ntri; t++)
+        for (int32_t p = 0; p < m->np; p++) {
             if (!brute_pair(w, p, t)) continue;
             /* extra pairs of the broad phase before this one */
-            while (k < n1 && (l1[2 * k] < p || (l1[2 * k] == p && l1[2 * k + 1] < t))) extra++, k++;
+            while (k < n1 && (l1[2 * k + 1] < t || (l1[2 * k + 1] == t && l1[2 * k] < p))) extra++, k++;
             if (k < n1 && l1[2 * k] == p && l1[2 * k + 1] == t) k++;
             else missed++;
         }
