@@ -213,7 +213,7 @@ static inline void wb__broadphase_free(wb_contacts *c)
 /* ---- particle-triangle contacts: per-frame scratch (tricontact.c) ------------------- */
 typedef struct wb_tricontacts {
     int32_t n, cap;        /* candidates of this frame */
-    int32_t *pt;           /* (n x 2) point, triangle; triangle order, then point order */
+    int32_t *pt;           /* (n x 2) point, triangle; in the order tribroad.c explains */
     int32_t nact, cap_act; /* contacts that corrected positions in the current substep */
     int32_t *act;          /* (nact) candidate index */
     wb_real *act_d;        /* (nact x 9) barycentrics, normal (triangle -> point), depth, force, old overlap */
@@ -252,15 +252,16 @@ struct wb_tribroad {
     wb_trilevel lv[WB_TRI_LEVELS];
     int nlv;
     wb_pairbuf *out; int nout;           /* (point, triangle) per thread */
-    int32_t *first; int32_t cap_first;   /* (max(np, ntri) + 1) sorting them by point, then triangle */
+    int32_t *first; int32_t cap_first;   /* (np + 1) sorting them by point */
     int32_t *pt2; int32_t cap_pt2;       /* (2 x candidates) the list sorted by point */
+    uint64_t *okey; int32_t cap_okey;    /* (candidates) sort keys of the projection's order */
 };
 static inline void wb__tribroad_free(wb_tricontacts *c)
 {
     struct wb_tribroad *b = c->bp;
     if (!b) return;
     void *p[] = { b->reach, b->mv, b->tbox, b->tkey, b->pc, b->tc, b->prun, b->trun, b->tmp, b->runs, b->boxes,
-                  b->sp, b->sid, b->skey, b->scell, b->start, b->first, b->pt2 };
+                  b->sp, b->sid, b->skey, b->scell, b->start, b->first, b->pt2, b->okey };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     for (int t = 0; t < b->nout; t++) free(b->out[t].ij);
     free(b->out);

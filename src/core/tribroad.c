@@ -27,9 +27,9 @@
  *     level's largest reach covers (a triangle that would scan more rows than the level
  *     has points scans its points instead); a point of its own key is skipped first,
  *     then the exact test. Threads take contiguous ranges of the kept triangles, each
- *     with its own buffer; the pairs are then counting-sorted (stable) by point, then by
- *     triangle: the list is in (triangle, point) order, the set alone, the same for any
- *     thread count. */
+ *     with its own buffer; the pairs are then counting-sorted (stable) by point, and put
+ *     in the projection's order (order_as_grid), a function of the positions: the list
+ *     is the same for any thread count. */
 #include <time.h>
 
 #include "core.h"
@@ -512,6 +512,96 @@ static void tri_scan(const struct wb_tribroad *b, const wb_world *w, int32_t k0,
     }
 }
 
+/* ---- the projection's order ------------------------------------------------------------------- */
+/* The projection is Gauss-Seidel: the order of the list is part of the result, and scenes
+ * tuned with the hashed grid this file replaced are sensitive to it (contact_energy.lua's
+ * interleaved tower toppled past its bound with each point's triangles in index order,
+ * logo_spring.lua's L stayed flattened with the list in triangle order; reversed, the
+ * tower flew apart). So the list keeps that grid's order, which is a function of the
+ * positions: cubic cells of size `cell` from the origin; each point (ascending) met the
+ * triangles of the cells its box covered in (z, y, x) order, a triangle first in the first
+ * cell of its own grown box's cells that the point's cells hold, ties by index; a point
+ * whose box covered more than 64 cells met every triangle in index order; triangles whose
+ * grown box covered more than 64 cells came last, each (ascending) with every other point
+ * in index order. (Two cells that hashed to one bucket could reorder a few; not kept.) */
+static int64_t ocell_of(wb_real x, wb_real inv)
+{
+    const wb_real c = floor(x * inv);
+    return c > 1e15 ? (int64_t)1e15 : c < -1e15 ? -(int64_t)1e15 : (int64_t)c;
+}
+
+static int ocells(const wb_real *lo, const wb_real *hi, wb_real g, wb_real inv, int64_t c0[3])
+{
+    double n = 1;
+    for (int k = 0; k < 3; k++) {
+        c0[k] = ocell_of(lo[k] - g, inv);
+        n *= (double)(ocell_of(hi[k] + g, inv) - c0[k] + 1);
+    }
+    return n > 64;
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* by_p (b->pt2: total pairs by point, each point's in triangle order) into out in that
+ * order; 0 when out of memory */
+static int order_as_grid(struct wb_tribroad *b, const wb_world *w, wb_real cell, int64_t total, int32_t *out)
+{
+    const int32_t *by_p = b->pt2;
+    if (!(cell > 0) || !isfinite(cell)) {
+        memcpy(out, by_p, sizeof *out * (size_t)(2 * total));
+        return 1;
+    }
+    if (!grow((void **)&b->okey, &b->cap_okey, total, sizeof *b->okey)) return 0;
+    const wb_real inv = 1 / cell;
+    int64_t at = 0, nbig = 0;
+    for (int64_t q0 = 0; q0 < total;) {
+        const int32_t p = by_p[2 * q0];
+        int64_t q1 = q0;
+        while (q1 < total && by_p[2 * q1] == p) q1++;
+        int64_t pc[3];
+        const wb_real *xp = &w->s.x[3 * p];
+        if (ocells(xp, xp, b->reach[p], inv, pc)) { /* a big point: index order */
+            memcpy(out + 2 * at, by_p + 2 * q0, sizeof *out * (size_t)(2 * (q1 - q0)));
+            at += q1 - q0;
+            q0 = q1;
+            continue;
+        }
+        int64_t n = 0;
+        for (int64_t q = q0; q < q1; q++) {
+            const int32_t t = by_p[2 * q + 1];
+            const wb_real *tb = &b->tbox[TB * t];
+            int64_t tc[3];
+            if (ocells(tb, tb + 3, tb[6], inv, tc)) { nbig++; continue; } /* after every point */
+            /* the first cell both cover, relative to the point's first (each < 64) */
+            uint64_t key = 0;
+            for (int k = 2; k >= 0; k--) key = key * 64 + (uint64_t)((tc[k] > pc[k] ? tc[k] : pc[k]) - pc[k]);
+            b->okey[n++] = key << 32 | (uint32_t)t;
+        }
+        qsort(b->okey, (size_t)n, sizeof *b->okey, cmp_u64);
+        for (int64_t k = 0; k < n; k++, at++) out[2 * at] = p, out[2 * at + 1] = (int32_t)(b->okey[k] & 0xffffffffu);
+        q0 = q1;
+    }
+    if (nbig == 0) return 1;
+    /* the big triangles' pairs with the other points, by triangle then point */
+    int64_t n = 0;
+    for (int64_t q = 0; q < total; q++) {
+        const int32_t p = by_p[2 * q], t = by_p[2 * q + 1];
+        int64_t c0[3];
+        const wb_real *tb = &b->tbox[TB * t];
+        if (!ocells(tb, tb + 3, tb[6], inv, c0) || ocells(&w->s.x[3 * p], &w->s.x[3 * p], b->reach[p], inv, c0))
+            continue;
+        b->okey[n++] = (uint64_t)(uint32_t)t << 32 | (uint32_t)p;
+    }
+    qsort(b->okey, (size_t)n, sizeof *b->okey, cmp_u64);
+    for (int64_t k = 0; k < n; k++, at++)
+        out[2 * at] = (int32_t)(b->okey[k] & 0xffffffffu), out[2 * at + 1] = (int32_t)(b->okey[k] >> 32);
+    return 1;
+}
+
 /* ---- the frame's list ----------------------------------------------------------------------------- */
 static int broadphase(wb_world *w)
 {
@@ -532,12 +622,13 @@ static int broadphase(wb_world *w)
      * of its radius for what the constraints move it, as contact.c); a point's reach
      * adds its radius */
     const wb_real dt = m->def.dt, g = v3_len(m->def.gravity) * dt * dt;
-    int32_t na = 0;
-    wb_real rmax = 0;
+    int32_t na = 0, nr = 0;
+    wb_real rmax = 0, rsum = 0, ext = 0;
     for (int32_t i = 0; i < m->np; i++) {
         mvp[i] = v3_len_safe(&v[3 * i]) * dt + g + m->radius[i] / 4;
         reach[i] = (m->cflags[i] & (WB_CF_COLLIDE | WB_CF_SELF)) ? m->radius[i] + mvp[i] : -1;
         if (!isfinite(reach[i])) reach[i] = -1;
+        if (reach[i] >= 0) nr++, rsum += reach[i];
         /* a zero reach or a position not finite meets no triangle (the exact test fails) */
         const wb_real *p = &x[3 * i];
         if (reach[i] > 0 && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])) {
@@ -574,8 +665,11 @@ static int broadphase(wb_world *w)
         for (int a = 0; a < 3; a++) tb[a] = lo[a], tb[3 + a] = hi[a];
         tb[6] = mv;
         b->tc[nt++] = t;
+        ext += e;
     }
     if (na == 0 || nt == 0) return 0;
+    /* the cell of the order (see order_as_grid) */
+    const wb_real ocell = max_(ext / nt, 2 * rsum / nr);
     if (cull(b, w, &na, &nt, rmax) < 0) return -1;
     if (na == 0 || nt == 0) return 0;
     /* the kept triangles' unit normals (0 when degenerate): a point farther than its
@@ -613,17 +707,13 @@ static int broadphase(wb_world *w)
         if (b->out[k].fail) return -1;
         total += b->out[k].n;
     }
-    const int32_t nf = m->np > m->ntri ? m->np : m->ntri;
     if (!grow((void **)&c->pt, &c->cap, 2 * total, sizeof *c->pt) ||
         !grow((void **)&b->pt2, &b->cap_pt2, 2 * total, sizeof *b->pt2) ||
-        !grow((void **)&b->first, &b->cap_first, (int64_t)nf + 1, sizeof *b->first))
+        !grow((void **)&b->first, &b->cap_first, (int64_t)m->np + 1, sizeof *b->first))
         return -1;
-    /* two stable counting sorts: by point (a thread's pairs of one point come in
-     * ascending triangle order, the threads' ranges ascend), then by triangle: the list in
-     * (triangle, point) order, whatever the threads. The projection is Gauss-Seidel, so
-     * the order is part of the result: with each point's triangles in a row it let the
-     * interleaved blocks of contact_energy.lua topple farther than with each triangle's
-     * points in a row (and, reversed, fly apart) */
+    /* by point first (stable: a thread's pairs of one point come in ascending triangle
+     * order, the threads' ranges ascend), then in the order of the hashed grid this
+     * replaced (order_as_grid) */
     int32_t *first = b->first, *by_p = b->pt2;
     memset(first, 0, sizeof *first * ((size_t)m->np + 1));
     for (int k = 0; k < nth; k++)
@@ -635,14 +725,7 @@ static int broadphase(wb_world *w)
             by_p[2 * at] = b->out[k].ij[2 * q];
             by_p[2 * at + 1] = b->out[k].ij[2 * q + 1];
         }
-    memset(first, 0, sizeof *first * ((size_t)m->ntri + 1));
-    for (int64_t q = 0; q < total; q++) first[by_p[2 * q + 1] + 1]++;
-    for (int32_t t = 0; t < m->ntri; t++) first[t + 1] += first[t];
-    for (int64_t q = 0; q < total; q++) {
-        const int32_t at = first[by_p[2 * q + 1]]++;
-        c->pt[2 * at] = by_p[2 * q];
-        c->pt[2 * at + 1] = by_p[2 * q + 1];
-    }
+    if (!order_as_grid(b, w, ocell, total, c->pt)) return -1;
     c->n = (int32_t)total;
     return 0;
 }

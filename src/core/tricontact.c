@@ -34,8 +34,8 @@
  * others.
  *
  * Broad phase, once per frame, in tribroad.c (which applies these rules): the candidates
- * in (triangle, point) order, the same for any thread count; they are projected serially
- * in that order, so the step is bit-identical for any thread count. */
+ * in an order that depends on the positions alone; they are projected serially in that
+ * order, so the step is bit-identical for any thread count. */
 #include <stdlib.h>
 
 #include "core.h"

@@ -3,8 +3,8 @@
  * Its list must be exactly the (point, triangle) pairs the O(P x T) loop below accepts,
  * written here from the rules alone (tricontact.c's reach and motion, the triangle's box
  * grown by its motion, the plane and the closest point within reach_p + motion, the
- * group rules, the rest rule of one body), in (triangle, point) order, each once, and
- * the same list for 1, 2 and 3 threads. The scenes: soft blocks jittered into each other
+ * group rules, the rest rule of one body), each once, and the same list, in the same
+ * order, for 1, 2 and 3 threads. The scenes: soft blocks jittered into each other
  * (some self-colliding, one not colliding) with loose particles of mixed radii, a few of
  * them fast, among loose triangles; a crumpled self-colliding cloth under another cloth;
  * bodies far apart with a huge triangle (sparse grids that wrap, a triangle wider than
@@ -89,6 +89,12 @@ static int brute_pair(const wb_world *w, int32_t p, int32_t t)
     return 1;
 }
 
+static int cmp_u64(const void *a, const void *b)
+{
+    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
 /* the broad phase's list for this thread count (a copy, 2 x *n ints) */
 static int32_t *broad_list(wb_world *w, int threads, int32_t *n)
 {
@@ -114,17 +120,23 @@ static int32_t check_world(wb_world *w)
     CHECK_EQ(n1, n3);
     CHECK(n1 == n2 && !memcmp(l1, l2, sizeof *l1 * (size_t)(2 * n1)));
     CHECK(n1 == n3 && !memcmp(l1, l3, sizeof *l1 * (size_t)(2 * n1)));
-    /* the brute list in (t, p) order: the broad phase's must be it, element by element */
+    /* the list sorted by (p, t) against the brute list in that order, element by element */
+    uint64_t *sorted = malloc(sizeof *sorted * (size_t)(n1 + 1));
+    if (!sorted) abort();
+    for (int32_t q = 0; q < n1; q++) sorted[q] = (uint64_t)(uint32_t)l1[2 * q] << 32 | (uint32_t)l1[2 * q + 1];
+    qsort(sorted, (size_t)n1, sizeof *sorted, cmp_u64);
     int32_t k = 0, missed = 0, extra = 0;
-    for (int32_t t = 0; t < m->ntri; t++)
-        for (int32_t p = 0; p < m->np; p++) {
+    for (int32_t p = 0; p < m->np; p++)
+        for (int32_t t = 0; t < m->ntri; t++) {
             if (!brute_pair(w, p, t)) continue;
-            /* extra pairs of the broad phase before this one */
-            while (k < n1 && (l1[2 * k + 1] < t || (l1[2 * k + 1] == t && l1[2 * k] < p))) extra++, k++;
-            if (k < n1 && l1[2 * k] == p && l1[2 * k + 1] == t) k++;
+            const uint64_t want = (uint64_t)(uint32_t)p << 32 | (uint32_t)t;
+            /* extra pairs of the broad phase before this one (twice: the second is extra) */
+            while (k < n1 && sorted[k] < want) extra++, k++;
+            if (k < n1 && sorted[k] == want) k++;
             else missed++;
         }
     extra += n1 - k;
+    free(sorted);
     CHECK_EQ(missed, 0);
     CHECK_EQ(extra, 0); /* a pair twice, out of order or not a candidate */
     free(l1);
