@@ -41,7 +41,8 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
-#define TB 10          /* per triangle: box lo, hi; how far its corners may move; unit normal */
+#define TB 14          /* per triangle: box lo, hi; how far its corners may move; unit normal;
+                          its first cell in the projection's order, whether it is big there */
 #define RUNS_MAX 256   /* body culling only with at most this many runs of either kind */
 #define BOXES_MAX 16   /* a run's overlaps tested one by one up to this many */
 #define PAR_MIN 256    /* below this many kept triangles the scan stays on one thread */
@@ -574,14 +575,23 @@ static int order_as_grid(struct wb_tribroad *b, const wb_world *w, wb_real cell,
         for (int64_t q = q0; q < q1; q++) {
             const int32_t t = by_p[2 * q + 1];
             const wb_real *tb = &b->tbox[TB * t];
-            int64_t tc[3];
-            if (ocells(tb, tb + 3, tb[6], inv, tc)) { nbig++; continue; } /* after every point */
+            if (tb[13] != 0) { nbig++; continue; } /* after every point */
             /* the first cell both cover, relative to the point's first (each < 64) */
             uint64_t key = 0;
-            for (int k = 2; k >= 0; k--) key = key * 64 + (uint64_t)((tc[k] > pc[k] ? tc[k] : pc[k]) - pc[k]);
+            for (int k = 2; k >= 0; k--) {
+                const int64_t tc = (int64_t)tb[10 + k];
+                key = key * 64 + (uint64_t)((tc > pc[k] ? tc : pc[k]) - pc[k]);
+            }
             b->okey[n++] = key << 32 | (uint32_t)t;
         }
-        qsort(b->okey, (size_t)n, sizeof *b->okey, cmp_u64);
+        if (n > 16) qsort(b->okey, (size_t)n, sizeof *b->okey, cmp_u64);
+        else
+            for (int64_t k = 1; k < n; k++) { /* a point's handful */
+                const uint64_t v = b->okey[k];
+                int64_t j = k;
+                for (; j > 0 && b->okey[j - 1] > v; j--) b->okey[j] = b->okey[j - 1];
+                b->okey[j] = v;
+            }
         for (int64_t k = 0; k < n; k++, at++) out[2 * at] = p, out[2 * at + 1] = (int32_t)(b->okey[k] & 0xffffffffu);
         q0 = q1;
     }
@@ -591,9 +601,7 @@ static int order_as_grid(struct wb_tribroad *b, const wb_world *w, wb_real cell,
     for (int64_t q = 0; q < total; q++) {
         const int32_t p = by_p[2 * q], t = by_p[2 * q + 1];
         int64_t c0[3];
-        const wb_real *tb = &b->tbox[TB * t];
-        if (!ocells(tb, tb + 3, tb[6], inv, c0) || ocells(&w->s.x[3 * p], &w->s.x[3 * p], b->reach[p], inv, c0))
-            continue;
+        if (b->tbox[TB * t + 13] == 0 || ocells(&w->s.x[3 * p], &w->s.x[3 * p], b->reach[p], inv, c0)) continue;
         b->okey[n++] = (uint64_t)(uint32_t)t << 32 | (uint32_t)p;
     }
     qsort(b->okey, (size_t)n, sizeof *b->okey, cmp_u64);
@@ -683,6 +691,12 @@ static int broadphase(wb_world *w)
         const wb_real ln = v3_len(n);
         if (ln > 0 && isfinite(ln)) v3_scale(n, n, 1 / ln);
         else v3_set(n, 0, 0, 0);
+        if (ocell > 0 && isfinite(ocell)) {
+            wb_real *tb = &tbox[TB * b->tc[k]];
+            int64_t c0[3];
+            tb[13] = ocells(tb, tb + 3, tb[6], 1 / ocell, c0);
+            for (int a = 0; a < 3; a++) tb[10 + a] = (wb_real)c0[a]; /* |c| <= 1e15: exact */
+        }
     }
     if (make_levels(b, w, na) < 0) return -1;
 
