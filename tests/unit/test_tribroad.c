@@ -9,7 +9,8 @@
  * them fast, among loose triangles; a crumpled self-colliding cloth under another cloth;
  * bodies far apart with a huge triangle (sparse grids that wrap, a triangle wider than
  * the grid). A body culled too eagerly, a search range one cell short, a level of fast
- * points left out, a thread's pairs merged out of order or twice: each fails here. */
+ * points left out, a pair found twice, lists that differ between thread counts: each fails
+ * here. */
 #include <stdlib.h>
 
 #include "core/core.h"
