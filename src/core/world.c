@@ -122,6 +122,7 @@ void wb_world_destroy(wb_world *w)
     wb_state *s = &w->s;
     wb_cache *k = &w->k;
     wb__broadphase_free(&k->pc);
+    wb__tribroad_free(&k->tc);
     void *ptrs[] = { m->inv_mass, m->w, m->radius, m->pinned, m->d_ij, m->d_alpha, m->d_beta,
                      m->d_yield, m->d_creep, m->d_break, m->d_bforce, m->d_gen, m->d_free, m->c_shape, m->c_gen, m->surf_start, m->tri,
                      s->x, s->x_prev, s->v, s->d_rest, s->d_broken, s->c_pose,
@@ -134,8 +135,7 @@ void wb_world_destroy(wb_world *w)
                      w->sm.start, w->sm.stiff, w->sm.yield, w->sm.creep, w->sm.ids, w->sm.rest, w->sm.q,
                      w->sm.qk, w->sm.lambda, w->pr.surface, w->pr.pressure, w->pr.alpha, w->pr.v0, w->pr.vstart,
                      w->pr.tstart, w->pr.verts, w->pr.tri, w->pr.lambda, w->pr.grad,
-                     k->tc.pt, k->tc.act, k->tc.act_d, k->tc.reach, k->tc.tbox, k->tc.cell_start, k->tc.cell_ids,
-                     k->tc.stamp, k->tc.tgroup, k->tc.tstamp, k->tc.left };
+                     k->tc.pt, k->tc.act, k->tc.act_d, k->tc.left };
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
     free(w);
 }

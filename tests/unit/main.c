@@ -56,6 +56,12 @@
     X(tricontact_projection_conserves_momentum)          \
     X(tricontact_who_may_touch)
 
+/* test_tribroad.c: the particle-triangle broad phase */
+#define TRIBROAD_TESTS(X)                                \
+    X(tribroad_matches_brute_force_heap)                 \
+    X(tribroad_matches_brute_force_cloth)                \
+    X(tribroad_matches_brute_force_sparse)
+
 /* test_narrow.c: rigid shapes' contact manifolds */
 #define NARROW_TESTS(X)                                  \
     X(narrow_sphere_sphere)                              \
@@ -144,6 +150,7 @@
     X(bvh_mesh_collider_memory_charged)          \
     CONTACT_TESTS(X)                             \
     TRICONTACT_TESTS(X)                          \
+    TRIBROAD_TESTS(X)                            \
     EXTREME_TESTS(X)                             \
     X(tet_strain_volume_shape_and_shear)         \
     X(attach_grab_forces_cleared_by_an_undone_frame) \
