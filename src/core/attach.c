@@ -432,17 +432,19 @@ static void att_project(wb_world *w, wb_real h)
              * correction moved the point sideways as well, and a swinging body's attachment
              * rang from substep to substep with a force 1.7 times its weight */
             wb_real K[9], rhs[3], dl[3];
-            wb__rigid_point_response(w, a->tindex[s], t, K);
+            wb__rigid_point_response(w, a->tindex[s], xp, K);
             for (int k = 0; k < 3; k++) {
                 K[4 * k] += wp + at;
                 rhs[k] = t[k] - xp[k] - at * l[k];
             }
             if (!solve3(K, rhs, dl)) continue;
             v3_add(l, l, dl);
-            if (wp > 0) v3_madd(xp, dl, wp);
             wb_real dp[3];
             v3_scale(dp, dl, -1);
-            wb__rigid_apply(w, a->tindex[s], t, dp);
+            /* applied to the body at the particle's position, so the pair's impulses are
+             * equal, opposite and on one line: angular momentum kept to round-off */
+            wb__rigid_apply(w, a->tindex[s], xp, dp);
+            if (wp > 0) v3_madd(xp, dl, wp);
             continue;
         }
         const wb_real inv = 1 / (wp + at);

@@ -35,6 +35,7 @@ typedef struct wb_rigids {
     wb_real *x, *q, *v, *om; /* (n x 3), (n x 4), (n x 3), (n x 3): om in the world frame */
     /* cache */
     wb_real *x_prev, *q_prev; /* (n x 3), (n x 4) pose at the substep's start */
+    wb_real *q_pred;       /* (n x 4) rotation after the substep's prediction */
     wb_real *save;         /* (n x 13) the frame's start: x, q, v, om (undo) */
     uint8_t *moved;        /* (n) a correction moved it this substep: its velocities come from the poses */
     wb_rcontact *ct;       /* contacts of the current substep */

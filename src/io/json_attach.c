@@ -30,7 +30,7 @@ static int read_attach_items(rd *r, const cJSON *arr, const kp *parent, const ch
 
 int ja_read_attachments(rd *r, const cJSON *arr, wb_image *g)
 {
-    static const char *const keys[] = { "particle", "collider", "point", "compliance", NULL };
+    static const char *const keys[] = { "particle", "collider", "point", "compliance", "rigid", NULL };
     kp top = { NULL, "attachments", 0 };
     int32_t n = 0, ncol = 0;
     if (!arr) return 0;
