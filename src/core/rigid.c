@@ -487,16 +487,6 @@ static void side_velocity(const wb_rigids *rb, const side *s, const wb_real x[3]
     v3_add(out, out, &rb->v[3 * s->r]);
 }
 
-/* positional impulse dp on B at xb and -dp on A at xa */
-static void push(wb_world *w, const side *A, const side *B, const wb_real xa[3], const wb_real xb[3], const wb_real dp[3])
-{
-    if (B->r >= 0) wb__rigid_apply(w, B->r, xb, dp);
-    if (A->r >= 0) {
-        wb_real m[3] = { -dp[0], -dp[1], -dp[2] };
-        wb__rigid_apply(w, A->r, xa, m);
-    }
-}
-
 /* a side's offset of world point x from its centre (a collider: none needed) */
 static void side_arm(const wb_rigids *rb, const side *s, const wb_real x[3], wb_real out[3])
 {
@@ -517,13 +507,44 @@ static void turn(wb_real q[4], const wb_real t[3])
     q_normalize(q);
 }
 
-/* The manifold's normal corrections are solved together: point after point (Gauss-Seidel
- * over the points, each moving the body before the next) tilts a box resting on four
- * corners a little differently every substep, and the tilts, not commuting, pump a spin
- * about the normal that nothing frictionless takes out again. Instead the multipliers
- * solve K lambda = depth, lambda >= 0 (K: the points' coupling through the two bodies'
- * generalized inverse masses at this pose) by projected Gauss-Seidel on the small system,
- * and the bodies move once: a symmetric contact gives a symmetric push. */
+/* projected Gauss-Seidel on the small system K lam = rhs (m rows): rows with pos[i] kept
+ * >= 0 (normal pushes), the others free (friction) */
+static void small_pgs(int m, const wb_real *K, const wb_real *rhs, const int *pos, wb_real *lam)
+{
+    wb_real scale = 0;
+    for (int i = 0; i < m; i++) { lam[i] = 0; scale = fmax(scale, fabs(rhs[i])); }
+    for (int it = 0; it < 8 * m; it++) {
+        wb_real change = 0;
+        for (int i = 0; i < m; i++) {
+            const wb_real kii = K[i * m + i];
+            if (!(kii > 0)) continue;
+            wb_real r = rhs[i];
+            for (int j = 0; j < m; j++) r -= K[i * m + j] * lam[j];
+            wb_real nl = lam[i] + r / kii;
+            if (pos[i] && !(nl > 0)) nl = 0;
+            change = fmax(change, fabs(nl - lam[i]) * kii);
+            lam[i] = nl;
+        }
+        if (!(change > 1e-15 * scale + 1e-300)) break;
+    }
+}
+
+/* The manifold's corrections are solved together: point after point (Gauss-Seidel over
+ * the points, each moving the body before the next) tilts a box resting on four corners a
+ * little differently every substep, and the tilts, not commuting, pump a spin about the
+ * normal that nothing frictionless takes out again. Instead the multipliers solve
+ * K lambda = c (K: the rows' coupling through the two bodies' generalized inverse masses at
+ * this pose) by projected Gauss-Seidel on the small system, and the bodies move once.
+ * Static friction (§3.5) is in the same system: at every point two tangential rows undo
+ * the point's slip over the substep. Solved after the normal push instead (the paper's
+ * order, here once at the manifold's centre), the friction turned the boxes of a stack
+ * about their centres, the next substep's normal push turned them back and moved the
+ * contact again: a lagged loop that grew round-off 1e4-fold every half second until a
+ * stack of three or more boxes jittered at cm/s. Together, normal and tangential rows see
+ * each other's effect and the bodies stick. The stick holds when the tangential
+ * multipliers stay inside the manifold's friction cone, sum |lambda_t| <= mu sum
+ * lambda_n; otherwise the points slip, only the normal rows are applied and dynamic
+ * friction in the velocity pass acts. */
 static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_cshape *sa, const wb_cshape *sb,
                            const wb_manifold *m, wb_real h)
 {
@@ -531,11 +552,23 @@ static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_c
     const wb_real mu = fmax(sa->friction, sb->friction), e = fmax(sa->restitution, sb->restitution);
     const wb_real *n = m->normal;
     const int np = m->n < WB_MANIFOLD_MAX ? m->n : WB_MANIFOLD_MAX;
+    enum { R = 3 * WB_MANIFOLD_MAX };
     wb_real la[WB_MANIFOLD_MAX][3], lb[WB_MANIFOLD_MAX][3], d[WB_MANIFOLD_MAX], vn_pre[WB_MANIFOLD_MAX];
-    wb_real vcs[WB_MANIFOLD_MAX][3], ja[WB_MANIFOLD_MAX][3], jb[WB_MANIFOLD_MAX][3], lam[WB_MANIFOLD_MAX];
+    wb_real vcs[WB_MANIFOLD_MAX][3], lam[WB_MANIFOLD_MAX];
+    /* rows: per point the normal, then the two tangents t1, t2 */
+    wb_real u[R][3], ja[R][3], jb[R][3], ia[R][3], ib[R][3], rhs[R], K[R * R], sol[R];
+    int pos[R];
+    wb_real t1[3], t2[3];
+    {
+        /* a tangent basis that depends on n only (deterministic) */
+        const wb_real a[3] = { fabs(n[0]) < 0.6 ? 1 : 0, fabs(n[0]) < 0.6 ? 0 : 1, 0 };
+        v3_cross(t1, n, a);
+        v3_scale(t1, t1, 1 / v3_len(t1));
+        v3_cross(t2, n, t1);
+    }
     int any = 0;
     for (int k = 0; k < np; k++) {
-        wb_real pa[3], pa0[3], pb[3], pb0[3], d3[3], va[3], vb[3], rel[3], ra[3], rr[3];
+        wb_real pa[3], pa0[3], pb[3], pb0[3], d3[3], va[3], vb[3], rel[3], ra[3], rr[3], slip[3];
         side_local(rb, A, m->pt[k].pa, la[k]);
         side_local(rb, B, m->pt[k].pb, lb[k]);
         side_points(rb, A, la[k], pa, pa0);
@@ -550,77 +583,74 @@ static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_c
         side_velocity(rb, B, pb, vcs[k], vb);
         v3_sub(rel, vb, va);
         vn_pre[k] = v3_dot(rel, n);
-        /* I^-1 (r x n) of each side, body frame rotated to the world */
+        /* the tangential slip of B over A over the substep so far */
+        for (int i = 0; i < 3; i++) slip[i] = (pb[i] - pb0[i]) - (pa[i] - pa0[i]);
         side_arm(rb, A, pa, ra);
         side_arm(rb, B, pb, rr);
-        v3_cross(ja[k], ra, n);
-        v3_cross(jb[k], rr, n);
-        lam[k] = 0;
+        v3_copy(u[3 * k], n);
+        v3_copy(u[3 * k + 1], t1);
+        v3_copy(u[3 * k + 2], t2);
+        rhs[3 * k] = d[k];
+        rhs[3 * k + 1] = -v3_dot(slip, t1);
+        rhs[3 * k + 2] = -v3_dot(slip, t2);
+        for (int c = 0; c < 3; c++) {
+            const int i = 3 * k + c;
+            pos[i] = c == 0;
+            /* I^-1 (r x u) of each side, body frame rotated to the world */
+            v3_cross(ja[i], ra, u[i]);
+            v3_cross(jb[i], rr, u[i]);
+            if (A->r >= 0) inv_inertia_world(rb, A->r, ja[i], ia[i]); else v3_set(ia[i], 0, 0, 0);
+            if (B->r >= 0) inv_inertia_world(rb, B->r, jb[i], ib[i]); else v3_set(ib[i], 0, 0, 0);
+        }
     }
     if (!any) return;
-    wb_real ia[WB_MANIFOLD_MAX][3], ib[WB_MANIFOLD_MAX][3], K[WB_MANIFOLD_MAX][WB_MANIFOLD_MAX];
     const wb_real wa = A->r >= 0 ? rb->inv_mass[A->r] : 0, wbm = B->r >= 0 ? rb->inv_mass[B->r] : 0;
-    for (int k = 0; k < np; k++) {
-        if (A->r >= 0) inv_inertia_world(rb, A->r, ja[k], ia[k]); else v3_set(ia[k], 0, 0, 0);
-        if (B->r >= 0) inv_inertia_world(rb, B->r, jb[k], ib[k]); else v3_set(ib[k], 0, 0, 0);
-    }
-    for (int i = 0; i < np; i++)
-        for (int j = 0; j < np; j++) K[i][j] = wa + wbm + v3_dot(ja[i], ia[j]) + v3_dot(jb[i], ib[j]);
-    for (int it = 0; it < 8 * np; it++) {
-        wb_real change = 0;
+    /* the normal rows alone first: the push when the points slip */
+    {
+        wb_real Kn[WB_MANIFOLD_MAX * WB_MANIFOLD_MAX], rn[WB_MANIFOLD_MAX];
+        int pn[WB_MANIFOLD_MAX];
         for (int i = 0; i < np; i++) {
-            if (!(K[i][i] > 0)) continue;
-            wb_real r = d[i];
-            for (int j = 0; j < np; j++) r -= K[i][j] * lam[j];
-            wb_real nl = lam[i] + r / K[i][i];
-            if (!(nl > 0)) nl = 0;
-            change = fmax(change, fabs(nl - lam[i]) * K[i][i]);
-            lam[i] = nl;
+            rn[i] = d[i];
+            pn[i] = 1;
+            for (int j = 0; j < np; j++)
+                Kn[i * np + j] = wa + wbm + v3_dot(ja[3 * i], ia[3 * j]) + v3_dot(jb[3 * i], ib[3 * j]);
         }
-        if (!(change > 1e-15 * fabs(d[0]) + 1e-300)) break;
-    }
-    /* move each body once by the sum of its points' impulses */
-    wb_real lsum = 0, ta[3] = { 0, 0, 0 }, tb[3] = { 0, 0, 0 };
-    for (int k = 0; k < np; k++) {
-        lsum += lam[k];
-        v3_madd(ta, ia[k], -lam[k]);
-        v3_madd(tb, ib[k], lam[k]);
-    }
-    if (B->r >= 0) { v3_madd(&rb->x[3 * B->r], n, lsum * wbm); turn(&rb->q[4 * B->r], tb); rb->moved[B->r] = 1; }
-    if (A->r >= 0) { v3_madd(&rb->x[3 * A->r], n, -lsum * wa); turn(&rb->q[4 * A->r], ta); rb->moved[A->r] = 1; }
-    /* static friction (§3.5): undo the tangential slip of the two bodies over the substep
-     * when the impulse needed stays inside the friction cone, mu x the normal impulse. One
-     * correction for the manifold, at the centre of its normal impulses: corner by corner
-     * each correction turned the box about the normal and left the next corner slipping,
-     * and a box on a slope crept down at 1 mm/s */
-    if (mu > 0 && lsum > 0) {
-        wb_real c[3] = { 0, 0, 0 }, lca[3], lcb[3], pa[3], pa0[3], pb[3], pb0[3], slip[3];
+        small_pgs(np, Kn, rn, pn, lam);
         for (int k = 0; k < np; k++) {
-            v3_madd(c, m->pt[k].pa, lam[k] / (2 * lsum));
-            v3_madd(c, m->pt[k].pb, lam[k] / (2 * lsum));
-        }
-        /* c as it was before this solve moved the bodies: its local points in each */
-        wb_real ca[3], cb[3];
-        v3_copy(ca, c);
-        v3_copy(cb, c);
-        side_local(rb, A, ca, lca);
-        side_local(rb, B, cb, lcb);
-        side_points(rb, A, lca, pa, pa0);
-        side_points(rb, B, lcb, pb, pb0);
-        for (int i = 0; i < 3; i++) slip[i] = (pb[i] - pb0[i]) - (pa[i] - pa0[i]);
-        v3_madd(slip, n, -v3_dot(slip, n));
-        const wb_real len = v3_len(slip);
-        if (len > 0) {
-            wb_real t[3], dp[3];
-            v3_scale(t, slip, 1 / len);
-            const wb_real wt = side_w(w, A, pa, t) + side_w(w, B, pb, t);
-            const wb_real lt = wt > 0 ? len / wt : INFINITY;
-            if (lt < mu * lsum) {
-                v3_scale(dp, t, -lt);
-                push(w, A, B, pa, pb, dp);
-            }
+            sol[3 * k] = lam[k];
+            sol[3 * k + 1] = sol[3 * k + 2] = 0;
         }
     }
+    wb_real lsum = 0;
+    for (int k = 0; k < np; k++) lsum += lam[k];
+    int rows = 3 * np;
+    if (mu > 0 && lsum > 0) {
+        wb_real st[R];
+        for (int i = 0; i < rows; i++)
+            for (int j = 0; j < rows; j++)
+                K[i * rows + j] = (wa + wbm) * v3_dot(u[i], u[j]) + v3_dot(ja[i], ia[j]) + v3_dot(jb[i], ib[j]);
+        small_pgs(rows, K, rhs, pos, st);
+        wb_real sn = 0, stt = 0;
+        for (int k = 0; k < np; k++) {
+            sn += st[3 * k];
+            stt += hypot(st[3 * k + 1], st[3 * k + 2]);
+        }
+        if (stt <= mu * sn) {
+            memcpy(sol, st, sizeof(wb_real) * rows);
+            for (int k = 0; k < np; k++) lam[k] = st[3 * k];
+            lsum = sn;
+        }
+    }
+    /* move each body once by the sum of its rows' impulses */
+    wb_real xa[3] = { 0, 0, 0 }, xb[3] = { 0, 0, 0 }, ta[3] = { 0, 0, 0 }, tb[3] = { 0, 0, 0 };
+    for (int i = 0; i < rows; i++) {
+        v3_madd(xb, u[i], sol[i] * wbm);
+        v3_madd(xa, u[i], -sol[i] * wa);
+        v3_madd(ta, ia[i], -sol[i]);
+        v3_madd(tb, ib[i], sol[i]);
+    }
+    if (B->r >= 0) { v3_add(&rb->x[3 * B->r], &rb->x[3 * B->r], xb); turn(&rb->q[4 * B->r], tb); rb->moved[B->r] = 1; }
+    if (A->r >= 0) { v3_add(&rb->x[3 * A->r], &rb->x[3 * A->r], xa); turn(&rb->q[4 * A->r], ta); rb->moved[A->r] = 1; }
     const int32_t first = rb->nct;
     for (int k = 0; k < np; k++) {
         if (!(lam[k] > 0) && !(d[k] > 0)) continue;
