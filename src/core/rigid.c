@@ -487,6 +487,16 @@ static void side_velocity(const wb_rigids *rb, const side *s, const wb_real x[3]
     v3_add(out, out, &rb->v[3 * s->r]);
 }
 
+/* positional impulse dp on B at xb and -dp on A at xa */
+static void push(wb_world *w, const side *A, const side *B, const wb_real xa[3], const wb_real xb[3], const wb_real dp[3])
+{
+    if (B->r >= 0) wb__rigid_apply(w, B->r, xb, dp);
+    if (A->r >= 0) {
+        wb_real m[3] = { -dp[0], -dp[1], -dp[2] };
+        wb__rigid_apply(w, A->r, xa, m);
+    }
+}
+
 /* a side's offset of world point x from its centre (a collider: none needed) */
 static void side_arm(const wb_rigids *rb, const side *s, const wb_real x[3], wb_real out[3])
 {
@@ -507,44 +517,13 @@ static void turn(wb_real q[4], const wb_real t[3])
     q_normalize(q);
 }
 
-/* projected Gauss-Seidel on the small system K lam = rhs (m rows): rows with pos[i] kept
- * >= 0 (normal pushes), the others free (friction) */
-static void small_pgs(int m, const wb_real *K, const wb_real *rhs, const int *pos, wb_real *lam)
-{
-    wb_real scale = 0;
-    for (int i = 0; i < m; i++) { lam[i] = 0; scale = fmax(scale, fabs(rhs[i])); }
-    for (int it = 0; it < 8 * m; it++) {
-        wb_real change = 0;
-        for (int i = 0; i < m; i++) {
-            const wb_real kii = K[i * m + i];
-            if (!(kii > 0)) continue;
-            wb_real r = rhs[i];
-            for (int j = 0; j < m; j++) r -= K[i * m + j] * lam[j];
-            wb_real nl = lam[i] + r / kii;
-            if (pos[i] && !(nl > 0)) nl = 0;
-            change = fmax(change, fabs(nl - lam[i]) * kii);
-            lam[i] = nl;
-        }
-        if (!(change > 1e-15 * scale + 1e-300)) break;
-    }
-}
-
-/* The manifold's corrections are solved together: point after point (Gauss-Seidel over
- * the points, each moving the body before the next) tilts a box resting on four corners a
- * little differently every substep, and the tilts, not commuting, pump a spin about the
- * normal that nothing frictionless takes out again. Instead the multipliers solve
- * K lambda = c (K: the rows' coupling through the two bodies' generalized inverse masses at
- * this pose) by projected Gauss-Seidel on the small system, and the bodies move once.
- * Static friction (§3.5) is in the same system: at every point two tangential rows undo
- * the point's slip over the substep. Solved after the normal push instead (the paper's
- * order, here once at the manifold's centre), the friction turned the boxes of a stack
- * about their centres, the next substep's normal push turned them back and moved the
- * contact again: a lagged loop that grew round-off 1e4-fold every half second until a
- * stack of three or more boxes jittered at cm/s. Together, normal and tangential rows see
- * each other's effect and the bodies stick. The stick holds when the tangential
- * multipliers stay inside the manifold's friction cone, sum |lambda_t| <= mu sum
- * lambda_n; otherwise the points slip, only the normal rows are applied and dynamic
- * friction in the velocity pass acts. */
+/* The manifold's normal corrections are solved together: point after point (Gauss-Seidel
+ * over the points, each moving the body before the next) tilts a box resting on four
+ * corners a little differently every substep, and the tilts, not commuting, pump a spin
+ * about the normal that nothing frictionless takes out again. Instead the multipliers
+ * solve K lambda = depth, lambda >= 0 (K: the points' coupling through the two bodies'
+ * generalized inverse masses at this pose) by projected Gauss-Seidel on the small system,
+ * and the bodies move once: a symmetric contact gives a symmetric push. */
 static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_cshape *sa, const wb_cshape *sb,
                            const wb_manifold *m, wb_real h)
 {
@@ -552,133 +531,96 @@ static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_c
     const wb_real mu = fmax(sa->friction, sb->friction), e = fmax(sa->restitution, sb->restitution);
     const wb_real *n = m->normal;
     const int np = m->n < WB_MANIFOLD_MAX ? m->n : WB_MANIFOLD_MAX;
-    enum { R = WB_MANIFOLD_MAX + 3 };
     wb_real la[WB_MANIFOLD_MAX][3], lb[WB_MANIFOLD_MAX][3], d[WB_MANIFOLD_MAX], vn_pre[WB_MANIFOLD_MAX];
-    wb_real vcs[WB_MANIFOLD_MAX][3], lam[WB_MANIFOLD_MAX];
-    /* rows: the points' normals, then two tangents at the points' centre and the twist
-     * about n; row i moves B by lambda u_i and turns it by lambda I^-1 jb_i, A the reverse */
-    wb_real u[R][3], ja[R][3], jb[R][3], ia[R][3], ib[R][3], rhs[R], K[R * R], sol[R];
-    wb_real pa[WB_MANIFOLD_MAX][3], pb[WB_MANIFOLD_MAX][3];
-    int pos[R];
+    wb_real vcs[WB_MANIFOLD_MAX][3], ja[WB_MANIFOLD_MAX][3], jb[WB_MANIFOLD_MAX][3], lam[WB_MANIFOLD_MAX];
     int any = 0;
     for (int k = 0; k < np; k++) {
-        wb_real pa0[3], pb0[3], d3[3], va[3], vb[3], rel[3], ra[3], rr[3];
+        wb_real pa[3], pa0[3], pb[3], pb0[3], d3[3], va[3], vb[3], rel[3], ra[3], rr[3];
         side_local(rb, A, m->pt[k].pa, la[k]);
         side_local(rb, B, m->pt[k].pb, lb[k]);
-        side_points(rb, A, la[k], pa[k], pa0);
-        side_points(rb, B, lb[k], pb[k], pb0);
-        v3_sub(d3, pa[k], pb[k]);
+        side_points(rb, A, la[k], pa, pa0);
+        side_points(rb, B, lb[k], pb, pb0);
+        v3_sub(d3, pa, pb);
         d[k] = v3_dot(d3, n);
         any |= d[k] > 0;
         /* the velocities the bodies came in with */
-        v3_sub(vcs[k], pa[k], pa0);
+        v3_sub(vcs[k], pa, pa0);
         v3_scale(vcs[k], vcs[k], 1 / h);
-        side_velocity(rb, A, pa[k], vcs[k], va);
-        side_velocity(rb, B, pb[k], vcs[k], vb);
+        side_velocity(rb, A, pa, vcs[k], va);
+        side_velocity(rb, B, pb, vcs[k], vb);
         v3_sub(rel, vb, va);
         vn_pre[k] = v3_dot(rel, n);
-        side_arm(rb, A, pa[k], ra);
-        side_arm(rb, B, pb[k], rr);
-        v3_copy(u[k], n);
+        /* I^-1 (r x n) of each side, body frame rotated to the world */
+        side_arm(rb, A, pa, ra);
+        side_arm(rb, B, pb, rr);
         v3_cross(ja[k], ra, n);
         v3_cross(jb[k], rr, n);
-        rhs[k] = d[k];
-        pos[k] = 1;
         lam[k] = 0;
     }
     if (!any) return;
+    wb_real ia[WB_MANIFOLD_MAX][3], ib[WB_MANIFOLD_MAX][3], K[WB_MANIFOLD_MAX][WB_MANIFOLD_MAX];
     const wb_real wa = A->r >= 0 ? rb->inv_mass[A->r] : 0, wbm = B->r >= 0 ? rb->inv_mass[B->r] : 0;
-    int rows = np;
-    wb_real reach = 0; /* the points' mean distance from their centre: the twist's lever */
-    if (mu > 0) {
-        wb_real c[3] = { 0, 0, 0 }, lca[3], lcb[3], qa[3], qa0[3], qb[3], qb0[3], slip[3], t1[3], t2[3], ra[3], rr[3];
+    for (int k = 0; k < np; k++) {
+        if (A->r >= 0) inv_inertia_world(rb, A->r, ja[k], ia[k]); else v3_set(ia[k], 0, 0, 0);
+        if (B->r >= 0) inv_inertia_world(rb, B->r, jb[k], ib[k]); else v3_set(ib[k], 0, 0, 0);
+    }
+    for (int i = 0; i < np; i++)
+        for (int j = 0; j < np; j++) K[i][j] = wa + wbm + v3_dot(ja[i], ia[j]) + v3_dot(jb[i], ib[j]);
+    for (int it = 0; it < 8 * np; it++) {
+        wb_real change = 0;
+        for (int i = 0; i < np; i++) {
+            if (!(K[i][i] > 0)) continue;
+            wb_real r = d[i];
+            for (int j = 0; j < np; j++) r -= K[i][j] * lam[j];
+            wb_real nl = lam[i] + r / K[i][i];
+            if (!(nl > 0)) nl = 0;
+            change = fmax(change, fabs(nl - lam[i]) * K[i][i]);
+            lam[i] = nl;
+        }
+        if (!(change > 1e-15 * fabs(d[0]) + 1e-300)) break;
+    }
+    /* move each body once by the sum of its points' impulses */
+    wb_real lsum = 0, ta[3] = { 0, 0, 0 }, tb[3] = { 0, 0, 0 };
+    for (int k = 0; k < np; k++) {
+        lsum += lam[k];
+        v3_madd(ta, ia[k], -lam[k]);
+        v3_madd(tb, ib[k], lam[k]);
+    }
+    if (B->r >= 0) { v3_madd(&rb->x[3 * B->r], n, lsum * wbm); turn(&rb->q[4 * B->r], tb); rb->moved[B->r] = 1; }
+    if (A->r >= 0) { v3_madd(&rb->x[3 * A->r], n, -lsum * wa); turn(&rb->q[4 * A->r], ta); rb->moved[A->r] = 1; }
+    /* static friction (§3.5): undo the tangential slip of the two bodies over the substep
+     * when the impulse needed stays inside the friction cone, mu x the normal impulse. One
+     * correction for the manifold, at the centre of its normal impulses: corner by corner
+     * each correction turned the box about the normal and left the next corner slipping,
+     * and a box on a slope crept down at 1 mm/s */
+    if (mu > 0 && lsum > 0 && A->r < 0) {
+        wb_real c[3] = { 0, 0, 0 }, lca[3], lcb[3], pa[3], pa0[3], pb[3], pb0[3], slip[3];
         for (int k = 0; k < np; k++) {
-            v3_madd(c, pa[k], 0.5 / np);
-            v3_madd(c, pb[k], 0.5 / np);
+            v3_madd(c, m->pt[k].pa, lam[k] / (2 * lsum));
+            v3_madd(c, m->pt[k].pb, lam[k] / (2 * lsum));
         }
-        for (int k = 0; k < np; k++) {
-            wb_real dk[3];
-            v3_sub(dk, pb[k], c);
-            v3_madd(dk, n, -v3_dot(dk, n));
-            reach += v3_len(dk) / np;
-        }
-        side_local(rb, A, c, lca);
-        side_local(rb, B, c, lcb);
-        side_points(rb, A, lca, qa, qa0);
-        side_points(rb, B, lcb, qb, qb0);
-        for (int i = 0; i < 3; i++) slip[i] = (qb[i] - qb0[i]) - (qa[i] - qa0[i]);
-        /* a tangent basis that depends on n only (deterministic) */
-        const wb_real ax[3] = { fabs(n[0]) < 0.6 ? 1 : 0, fabs(n[0]) < 0.6 ? 0 : 1, 0 };
-        v3_cross(t1, n, ax);
-        v3_scale(t1, t1, 1 / v3_len(t1));
-        v3_cross(t2, n, t1);
-        side_arm(rb, A, qa, ra);
-        side_arm(rb, B, qb, rr);
-        v3_copy(u[np], t1);
-        v3_copy(u[np + 1], t2);
-        for (int i = np; i < np + 2; i++) {
-            v3_cross(ja[i], ra, u[i]);
-            v3_cross(jb[i], rr, u[i]);
-            rhs[i] = -v3_dot(slip, u[i]);
-            pos[i] = 0;
-        }
-        /* the twist: B's turn about n over the substep less A's (2 vec(q p^-1), small) */
-        wb_real tw = 0;
-        for (int sd = 0; sd < 2; sd++) {
-            const side *S = sd ? B : A;
-            const wb_real *q = S->r >= 0 ? &rb->q[4 * S->r] : S->q1, *p = S->r >= 0 ? &rb->q_prev[4 * S->r] : S->q0;
-            wb_real cr[3], dv[3];
-            v3_cross(cr, &q[1], &p[1]);
-            for (int i = 0; i < 3; i++) dv[i] = p[0] * q[1 + i] - q[0] * p[1 + i] - cr[i];
-            const wb_real dq0 = q[0] * p[0] + v3_dot(&q[1], &p[1]);
-            const wb_real turn_n = 2 * v3_dot(dv, n) * (dq0 < 0 ? -1 : 1);
-            tw += sd ? turn_n : -turn_n;
-        }
-        v3_set(u[np + 2], 0, 0, 0);
-        v3_copy(ja[np + 2], n);
-        v3_copy(jb[np + 2], n);
-        rhs[np + 2] = -tw;
-        pos[np + 2] = 0;
-        rows = np + 3;
-    }
-    for (int i = 0; i < rows; i++) {
-        if (A->r >= 0) inv_inertia_world(rb, A->r, ja[i], ia[i]); else v3_set(ia[i], 0, 0, 0);
-        if (B->r >= 0) inv_inertia_world(rb, B->r, jb[i], ib[i]); else v3_set(ib[i], 0, 0, 0);
-    }
-    for (int i = 0; i < rows; i++)
-        for (int j = 0; j < rows; j++)
-            K[i * rows + j] = (wa + wbm) * v3_dot(u[i], u[j]) + v3_dot(ja[i], ia[j]) + v3_dot(jb[i], ib[j]);
-    /* the normal rows alone first: the push when the points slip */
-    {
-        wb_real Kn[WB_MANIFOLD_MAX * WB_MANIFOLD_MAX];
-        for (int i = 0; i < np; i++)
-            for (int j = 0; j < np; j++) Kn[i * np + j] = K[i * rows + j];
-        small_pgs(np, Kn, rhs, pos, lam);
-        for (int i = 0; i < rows; i++) sol[i] = i < np ? lam[i] : 0;
-    }
-    wb_real lsum = 0;
-    for (int k = 0; k < np; k++) lsum += lam[k];
-    if (rows > np && lsum > 0) {
-        wb_real st[R], sn = 0;
-        small_pgs(rows, K, rhs, pos, st);
-        for (int k = 0; k < np; k++) sn += st[k];
-        /* inside the cone: the tangential impulse and the twist's torque over the lever */
-        if (hypot(st[np], st[np + 1]) <= mu * sn && fabs(st[np + 2]) <= mu * sn * reach) {
-            memcpy(sol, st, sizeof(wb_real) * rows);
-            for (int k = 0; k < np; k++) lam[k] = st[k];
-            lsum = sn;
+        /* c as it was before this solve moved the bodies: its local points in each */
+        wb_real ca[3], cb[3];
+        v3_copy(ca, c);
+        v3_copy(cb, c);
+        side_local(rb, A, ca, lca);
+        side_local(rb, B, cb, lcb);
+        side_points(rb, A, lca, pa, pa0);
+        side_points(rb, B, lcb, pb, pb0);
+        for (int i = 0; i < 3; i++) slip[i] = (pb[i] - pb0[i]) - (pa[i] - pa0[i]);
+        v3_madd(slip, n, -v3_dot(slip, n));
+        const wb_real len = v3_len(slip);
+        if (len > 0) {
+            wb_real t[3], dp[3];
+            v3_scale(t, slip, 1 / len);
+            const wb_real wt = side_w(w, A, pa, t) + side_w(w, B, pb, t);
+            const wb_real lt = wt > 0 ? len / wt : INFINITY;
+            if (lt < mu * lsum) {
+                v3_scale(dp, t, -lt);
+                push(w, A, B, pa, pb, dp);
+            }
         }
     }
-    /* move each body once by the sum of its rows' impulses */
-    wb_real xa[3] = { 0, 0, 0 }, xb[3] = { 0, 0, 0 }, ta[3] = { 0, 0, 0 }, tb[3] = { 0, 0, 0 };
-    for (int i = 0; i < rows; i++) {
-        v3_madd(xb, u[i], sol[i] * wbm);
-        v3_madd(xa, u[i], -sol[i] * wa);
-        v3_madd(ta, ia[i], -sol[i]);
-        v3_madd(tb, ib[i], sol[i]);
-    }
-    if (B->r >= 0) { v3_add(&rb->x[3 * B->r], &rb->x[3 * B->r], xb); turn(&rb->q[4 * B->r], tb); rb->moved[B->r] = 1; }
-    if (A->r >= 0) { v3_add(&rb->x[3 * A->r], &rb->x[3 * A->r], xa); turn(&rb->q[4 * A->r], ta); rb->moved[A->r] = 1; }
     const int32_t first = rb->nct;
     for (int k = 0; k < np; k++) {
         if (!(lam[k] > 0) && !(d[k] > 0)) continue;
