@@ -99,7 +99,12 @@ void wb__rigid_particles_solve(wb_world *w)
         wb_real *xi = &x[3 * i], n[3];
         const wb_real depth = m->radius[i] - wb__shape_distance(s, &rb->x[3 * r], &rb->q[4 * r], xi, n);
         if (!(depth > 0)) continue;
-        const wb_real wp = m->w[i], wsum = wp + wb__rigid_w(w, r, xi, n);
+        /* where the positional impulses act on the body: the particle's offset from the
+         * centre at the substep's start (see the file's head) */
+        wb_real at[3];
+        v3_sub(at, &xp[3 * i], &rb->x_prev[3 * r]);
+        v3_add(at, at, &rb->x[3 * r]);
+        const wb_real wp = m->w[i], wsum = wp + wb__rigid_w(w, r, at, n);
         if (!(wsum > 0)) continue;
         /* the normal velocity they came in with, for restitution */
         wb_real vb[3], rel[3];
@@ -109,7 +114,7 @@ void wb__rigid_particles_solve(wb_world *w)
         const wb_real lam = depth / wsum;
         wb_real dp[3];
         v3_scale(dp, n, -lam);
-        wb__rigid_apply(w, r, xi, dp);
+        wb__rigid_apply(w, r, at, dp);
         v3_madd(xi, n, wp * lam);
         /* static friction (§3.5): undo the relative tangential slip of the substep when the
          * impulse it takes stays inside the cone, mu x lambda */
@@ -127,10 +132,12 @@ void wb__rigid_particles_solve(wb_world *w)
             if (len > 0) {
                 wb_real t[3];
                 v3_scale(t, slip, 1 / len);
-                const wb_real lt = len / (wp + wb__rigid_w(w, r, xi, t));
+                v3_sub(at, &xp[3 * i], &rb->x_prev[3 * r]);
+                v3_add(at, at, &rb->x[3 * r]);
+                const wb_real lt = len / (wp + wb__rigid_w(w, r, at, t));
                 if (lt < mu * lam) {
                     v3_scale(dp, t, lt);
-                    wb__rigid_apply(w, r, xi, dp);
+                    wb__rigid_apply(w, r, at, dp);
                     v3_madd(xi, t, -wp * lt);
                 }
             }
