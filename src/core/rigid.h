@@ -44,6 +44,7 @@ typedef struct wb_rigids {
     int32_t *pc, npc, cap_pc;      /* (npc x 2) particle, body slot */
     wb_real *pc_sph; int32_t cap_sph; /* bodies' swept spheres (scratch) */
     int32_t *pc_slot, cap_slot;    /* their slots (scratch) */
+    int32_t *pc_cnt, cap_cnt;      /* (n) contacts per body in the substep */
     struct wb_rpcontact *pct;
     int32_t npct, cap_pct;
 } wb_rigids;
@@ -53,6 +54,8 @@ typedef struct wb_rpcontact {
     wb_real n[3];          /* unit, out of the body */
     wb_real depth, lambda; /* overlap corrected, positional impulse (N s^2) */
     wb_real vn_pre;        /* normal relative velocity (particle - body) before the solve */
+    wb_real arm[3];        /* where the body takes the impulses: offset from its centre */
+    wb_real dp[3];         /* the body's impulse of the pass (scratch) */
 } wb_rpcontact;
 
 /* generalized inverse mass of body r for a positional correction along unit n at world point x
@@ -106,7 +109,7 @@ static inline void wb__rigids_free(wb_world *w, wb_rigids *rb)
     if (w->m.def.memory) w->m.def.memory->used -= rb->charged;
     void *p[] = { rb->shape, rb->mass, rb->inv_mass, rb->inertia, rb->inv_inertia, rb->bound, rb->gen, rb->x, rb->q,
                   rb->v, rb->om, rb->x_prev, rb->q_prev, rb->save, rb->ct, rb->moved,
-                  rb->pc, rb->pc_sph, rb->pc_slot, rb->pct };
+                  rb->pc, rb->pc_sph, rb->pc_slot, rb->pc_cnt, rb->pct };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     free(rb);
 }

@@ -85,93 +85,110 @@ static void body_velocity(const wb_rigids *rb, int32_t r, const wb_real x[3], wb
     v3_add(out, out, &rb->v[3 * r]);
 }
 
+/* Every contact of a body is worked out against the body's pose at the pass's start and
+ * the body then takes the sum (Jacobi on the body's side, Gauss-Seidel would let the first
+ * corner of a box landing flat tilt it for all the others: a box dropped square on a
+ * block drifted off it); with N contacts each sees the body N times heavier (mass
+ * splitting, Tonge et al. 2012), so that N light particles under a light body do not push
+ * it N times too far. Particles move at once. */
 void wb__rigid_particles_solve(wb_world *w)
 {
     wb_rigids *rb = w->rb;
     if (!rb) return;
     rb->npct = 0;
+    if (rb->npc == 0) return;
     const wb_model *m = &w->m;
     wb_real *x = w->s.x, *xp = w->s.x_prev;
+    int32_t *cnt = wb__grow(rb->pc_cnt, &rb->cap_cnt, rb->n, sizeof *cnt);
+    if (!cnt) goto nomem;
+    rb->pc_cnt = cnt;
+    memset(cnt, 0, sizeof *cnt * (size_t)rb->n);
+    /* the overlaps at the pass's start */
     for (int32_t k = 0; k < rb->npc; k++) {
         const int32_t i = rb->pc[2 * k], r = rb->pc[2 * k + 1];
         if (!live(rb, r)) continue;
-        const wb_cshape *s = &rb->shape[r];
-        wb_real *xi = &x[3 * i], n[3];
-        const wb_real depth = m->radius[i] - wb__shape_distance(s, &rb->x[3 * r], &rb->q[4 * r], xi, n);
+        wb_real n[3];
+        const wb_real depth = m->radius[i] - wb__shape_distance(&rb->shape[r], &rb->x[3 * r], &rb->q[4 * r], &x[3 * i], n);
         if (!(depth > 0)) continue;
-        /* where the positional impulses act on the body: the particle's offset from the
-         * centre at the substep's start (see the file's head) */
-        wb_real at[3];
-        v3_sub(at, &xp[3 * i], &rb->x_prev[3 * r]);
-        v3_add(at, at, &rb->x[3 * r]);
-        const wb_real wp = m->w[i], wsum = wp + wb__rigid_w(w, r, at, n);
-        if (!(wsum > 0)) continue;
-        /* the normal velocity they came in with, for restitution */
-        wb_real vb[3], rel[3];
-        body_velocity(rb, r, xi, vb);
-        v3_sub(rel, &w->s.v[3 * i], vb);
-        const wb_real vn_pre = v3_dot(rel, n);
-        const wb_real lam = depth / wsum;
-        wb_real dp[3];
-        v3_scale(dp, n, -lam);
-        wb__rigid_apply(w, r, at, dp);
-        v3_madd(xi, n, wp * lam);
-        /* static friction (§3.5): undo the relative tangential slip of the substep when the
-         * impulse it takes stays inside the cone, mu x lambda */
-        const wb_real mu = s->friction;
-        if (mu > 0) {
-            wb_real l[3], now[3], prev[3], slip[3];
-            wb__rigid_to_local(w, r, xi, l);
-            q_rotate(&rb->q[4 * r], l, now);
-            v3_add(now, now, &rb->x[3 * r]);
-            q_rotate(&rb->q_prev[4 * r], l, prev);
-            v3_add(prev, prev, &rb->x_prev[3 * r]);
-            for (int c = 0; c < 3; c++) slip[c] = (xi[c] - xp[3 * i + c]) - (now[c] - prev[c]);
-            v3_madd(slip, n, -v3_dot(slip, n));
-            const wb_real len = v3_len(slip);
-            if (len > 0) {
-                wb_real t[3];
-                v3_scale(t, slip, 1 / len);
-                v3_sub(at, &xp[3 * i], &rb->x_prev[3 * r]);
-                v3_add(at, at, &rb->x[3 * r]);
-                const wb_real lt = len / (wp + wb__rigid_w(w, r, at, t));
-                if (lt < mu * lam) {
-                    v3_scale(dp, t, lt);
-                    wb__rigid_apply(w, r, at, dp);
-                    v3_madd(xi, t, -wp * lt);
-                }
-            }
-        }
         wb_rpcontact *ct = wb__grow(rb->pct, &rb->cap_pct, rb->npct + 1, sizeof *ct);
-        if (!ct) { wb__warn(w, "out of memory in particle-rigid contacts; friction and restitution skipped"); continue; }
+        if (!ct) goto nomem;
         rb->pct = ct;
         ct = &ct[rb->npct++];
         ct->i = i;
         ct->r = r;
         v3_copy(ct->n, n);
         ct->depth = depth;
-        ct->lambda = lam;
-        ct->vn_pre = vn_pre;
+        /* where the positional impulses act on the body: the particle's offset from the
+         * centre at the substep's start (see the file's head) */
+        v3_sub(ct->arm, &xp[3 * i], &rb->x_prev[3 * r]);
+        /* the normal velocity they came in with, for restitution */
+        wb_real vb[3], rel[3];
+        body_velocity(rb, r, &x[3 * i], vb);
+        v3_sub(rel, &w->s.v[3 * i], vb);
+        ct->vn_pre = v3_dot(rel, n);
+        cnt[r]++;
     }
+    for (int32_t k = 0; k < rb->npct; k++) {
+        wb_rpcontact *ct = &rb->pct[k];
+        const int32_t i = ct->i, r = ct->r;
+        const wb_real *n = ct->n, mu = rb->shape[r].friction, wp = m->w[i], split = cnt[r];
+        wb_real *xi = &x[3 * i], at[3];
+        v3_add(at, ct->arm, &rb->x[3 * r]);
+        const wb_real wsum = wp + split * wb__rigid_w(w, r, at, n);
+        const wb_real lam = wsum > 0 ? ct->depth / wsum : 0;
+        ct->lambda = lam;
+        v3_scale(ct->dp, n, -lam);
+        v3_madd(xi, n, wp * lam);
+        /* static friction (§3.5): undo the relative tangential slip of the substep when the
+         * impulse it takes stays inside the cone, mu x lambda */
+        if (!(mu > 0) || !(lam > 0)) continue;
+        wb_real l[3], prev[3], slip[3];
+        wb__rigid_to_local(w, r, xi, l);
+        q_rotate(&rb->q_prev[4 * r], l, prev);
+        v3_add(prev, prev, &rb->x_prev[3 * r]);
+        /* (the body's point now is xi itself) */
+        for (int c = 0; c < 3; c++) slip[c] = prev[c] - xp[3 * i + c];
+        v3_madd(slip, n, -v3_dot(slip, n));
+        const wb_real len = v3_len(slip);
+        if (!(len > 0)) continue;
+        wb_real t[3];
+        v3_scale(t, slip, 1 / len);
+        const wb_real lt = len / (wp + split * wb__rigid_w(w, r, at, t));
+        if (lt < mu * lam) {
+            v3_madd(ct->dp, t, lt);
+            v3_madd(xi, t, -wp * lt);
+        }
+    }
+    for (int32_t k = 0; k < rb->npct; k++) {
+        const wb_rpcontact *ct = &rb->pct[k];
+        wb_real at[3];
+        v3_add(at, ct->arm, &rb->x[3 * ct->r]);
+        wb__rigid_apply(w, ct->r, at, ct->dp);
+    }
+    return;
+nomem:
+    rb->npct = 0;
+    wb__warn(w, "out of memory in particle-rigid contacts; they are skipped this substep");
 }
 
-/* Dynamic friction and restitution (§3.6) on the velocities the poses gave, contact by
- * contact: the tangential relative velocity loses at most mu lambda / h, then the normal
- * relative velocity is set to -e times the one it came in with (none below 2 |g| h, so
- * that resting contact does not jitter), which also takes out any speed the push out of
- * an old overlap made */
+/* Dynamic friction and restitution (§3.6) on the velocities the poses gave, split and
+ * summed over a body's contacts as the positions are: the tangential relative velocity
+ * loses at most mu lambda / h, then an approaching normal relative velocity becomes -e
+ * times the one it came in with (none below 2 |g| h, so that resting contact does not
+ * jitter). Impulses act at the particle's centre */
 void wb__rigid_particles_velocity(wb_world *w, wb_real h)
 {
     wb_rigids *rb = w->rb;
-    if (!rb) return;
+    if (!rb || rb->npct == 0) return;
     const wb_model *m = &w->m;
     const wb_real g = v3_len(m->def.gravity);
     for (int32_t k = 0; k < rb->npct; k++) {
-        const wb_rpcontact *ct = &rb->pct[k];
+        wb_rpcontact *ct = &rb->pct[k];
         const int32_t i = ct->i, r = ct->r;
         const wb_cshape *s = &rb->shape[r];
-        const wb_real *xi = &w->s.x[3 * i], *n = ct->n, wp = m->w[i];
-        wb_real *vi = &w->s.v[3 * i], vb[3], u[3], p[3];
+        const wb_real *xi = &w->s.x[3 * i], *n = ct->n, wp = m->w[i], split = rb->pc_cnt[r];
+        wb_real *vi = &w->s.v[3 * i], vb[3], u[3];
+        v3_set(ct->dp, 0, 0, 0);
         body_velocity(rb, r, xi, vb);
         v3_sub(u, vi, vb);
         wb_real un = v3_dot(u, n);
@@ -183,21 +200,22 @@ void wb__rigid_particles_velocity(wb_world *w, wb_real h)
             if (vt > 0) {
                 wb_real t[3];
                 v3_scale(t, ut, 1 / vt);
-                const wb_real wt = wp + wb__rigid_w(w, r, xi, t);
-                const wb_real P = fmin(s->friction * ct->lambda / h, vt / wt);
-                v3_scale(p, t, P);
-                wb__rigid_impulse(w, r, xi, p);
+                const wb_real P = fmin(s->friction * ct->lambda / h, vt / (wp + split * wb__rigid_w(w, r, xi, t)));
+                v3_madd(ct->dp, t, P);
                 v3_madd(vi, t, -wp * P);
-                body_velocity(rb, r, xi, vb);
-                v3_sub(u, vi, vb);
-                un = v3_dot(u, n);
+                v3_madd(u, t, -wp * P - P * wb__rigid_w(w, r, xi, t)); /* (its normal part: none) */
             }
         }
         const wb_real e = fabs(ct->vn_pre) > 2 * g * h ? s->restitution : 0;
-        const wb_real dl = (fmax(-e * ct->vn_pre, 0) - un) / (wp + wb__rigid_w(w, r, xi, n));
-        v3_scale(p, n, -dl);
-        wb__rigid_impulse(w, r, xi, p);
+        const wb_real target = fmax(-e * ct->vn_pre, 0);
+        if (!(un < target)) continue;
+        const wb_real dl = (target - un) / (wp + split * wb__rigid_w(w, r, xi, n));
+        v3_madd(ct->dp, n, -dl);
         v3_madd(vi, n, wp * dl);
+    }
+    for (int32_t k = 0; k < rb->npct; k++) {
+        const wb_rpcontact *ct = &rb->pct[k];
+        wb__rigid_impulse(w, ct->r, &w->s.x[3 * ct->i], ct->dp);
     }
 }
 
