@@ -322,6 +322,8 @@ typedef struct wb_stats {
     double solve_ms;          /* of which constraint projection */
     int64_t warnings;         /* numerical trouble detected so far */
     int32_t attachments, grabs; /* live ones (attach.c, grab.c) */
+    int32_t rigids;           /* live rigid bodies */
+    int32_t rigid_contacts;   /* particle-rigid contacts that corrected positions in the last substep */
 } wb_stats;
 wb_stats wb_world_stats(const wb_world *w);
 
@@ -624,5 +626,15 @@ wb_real wb_rigid_distance(const wb_world *w, wb_rigid_id r, const wb_real p[3]);
 /* particle p kept where it is now in body r's frame (attach.c; see wb_attach_collider): the
  * correction moves the body too, so the particle pulls it back (a ball on a rope) */
 wb_attach_id wb_attach_rigid(wb_world *w, int32_t p, wb_rigid_id r, wb_real compliance, wb_status *status);
+/* particle-rigid contacts that corrected positions in the last substep (rigid_particle.c) */
+typedef struct wb_rigid_contact {
+    int32_t particle;     /* 0-based */
+    wb_rigid_id body;
+    wb_real normal[3];    /* unit, out of the body */
+    wb_real depth;        /* overlap corrected, m */
+    wb_real force;        /* normal force, N (the multiplier over h^2) */
+} wb_rigid_contact;
+int32_t wb_world_rigid_contact_count(const wb_world *w);
+wb_rigid_contact wb_world_rigid_contact_at(const wb_world *w, int32_t i);
 
 #endif

@@ -237,5 +237,7 @@ wb_stats wb_world_stats(const wb_world *w)
     st.warnings = w->s.warnings;
     st.attachments = wb_attach_count(w);
     st.grabs = wb_grab_count(w);
+    st.rigids = wb_rigid_count(w);
+    st.rigid_contacts = wb_world_rigid_contact_count(w);
     return st;
 }

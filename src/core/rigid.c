@@ -307,6 +307,11 @@ static void apply_velocity_impulse(wb_rigids *rb, int32_t r, const wb_real x[3],
     v3_add(&rb->om[3 * r], &rb->om[3 * r], t);
 }
 
+void wb__rigid_impulse(wb_world *w, int32_t r, const wb_real x[3], const wb_real p[3])
+{
+    apply_velocity_impulse(w->rb, r, x, p);
+}
+
 void wb_rigid_apply_impulse(wb_world *w, wb_rigid_id r, const wb_real J[3], const wb_real at[3])
 {
     const int32_t i = RSLOT(w, r);

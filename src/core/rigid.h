@@ -41,7 +41,23 @@ typedef struct wb_rigids {
     wb_rcontact *ct;       /* contacts of the current substep */
     int32_t nct, cap_ct;
     size_t charged;        /* bytes charged to def.memory */
+    /* particle contacts (rigid_particle.c): the frame's candidates, the substep's active ones */
+    int32_t *pc, npc, cap_pc;      /* (npc x 2) particle, body slot */
+    wb_real *pc_sph; int32_t cap_sph; /* bodies' swept spheres (scratch) */
+    int32_t *pc_slot, cap_slot;    /* their slots (scratch) */
+    int32_t *pc_cnt, cap_cnt;      /* (n) contacts per body in the substep */
+    struct wb_rpcontact *pct;
+    int32_t npct, cap_pct;
 } wb_rigids;
+
+typedef struct wb_rpcontact {
+    int32_t i, r;          /* particle, body slot */
+    wb_real n[3];          /* unit, out of the body */
+    wb_real depth, lambda; /* overlap corrected, positional impulse (N s^2) */
+    wb_real vn_pre;        /* normal relative velocity (particle - body) before the solve */
+    wb_real arm[3];        /* where the body takes the impulses: offset from its centre */
+    wb_real dp[3];         /* the body's impulse of the pass (scratch) */
+} wb_rpcontact;
 
 /* generalized inverse mass of body r for a positional correction along unit n at world point x
  * (Müller 2020 eq. 2): 1/m + (r x n)^T I^-1 (r x n), r = x - centre */
@@ -55,6 +71,15 @@ void wb__rigid_point_response(const wb_world *w, int32_t r, const wb_real x[3], 
 /* world point of a body-local point, and body-local of a world point, at the current pose */
 void wb__rigid_to_world(const wb_world *w, int32_t r, const wb_real local[3], wb_real out[3]);
 void wb__rigid_to_local(const wb_world *w, int32_t r, const wb_real world[3], wb_real out[3]);
+
+/* velocity impulse p at world point x on body r (v += p/m, om += I^-1 (r x p)) */
+void wb__rigid_impulse(wb_world *w, int32_t r, const wb_real x[3], const wb_real p[3]);
+
+/* particle-rigid contacts (rigid_particle.c): candidates once per frame, then per substep
+ * the positional solve (after wb__rigids_solve) and the velocity pass (after wb__rigids_velocity) */
+void wb__rigid_particles_begin(wb_world *w);
+void wb__rigid_particles_solve(wb_world *w);
+void wb__rigid_particles_velocity(wb_world *w, wb_real h);
 
 /* the step's hooks (solver.c), per substep of length h */
 void wb__rigids_predict(wb_world *w, wb_real h);   /* gravity, gyroscopic term, pose */
@@ -88,7 +113,8 @@ static inline void wb__rigids_free(wb_world *w, wb_rigids *rb)
     if (!rb) return;
     if (w->m.def.memory) w->m.def.memory->used -= rb->charged;
     void *p[] = { rb->shape, rb->mass, rb->inv_mass, rb->inertia, rb->inv_inertia, rb->bound, rb->gen, rb->x, rb->q,
-                  rb->v, rb->om, rb->x_prev, rb->q_prev, rb->save, rb->ct, rb->moved };
+                  rb->v, rb->om, rb->x_prev, rb->q_prev, rb->save, rb->ct, rb->moved,
+                  rb->pc, rb->pc_sph, rb->pc_slot, rb->pc_cnt, rb->pct };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     free(rb);
 }

@@ -164,6 +164,7 @@ wb_status wb_world_step(wb_world *w)
 
     wb__contacts_begin(w);
     wb__tricontacts_begin(w);
+    wb__rigid_particles_begin(w);
     double solve = 0;
     for (int sub = 0; sub < d->substeps; sub++) {
         if (k->interrupt && k->interrupt(k->interrupt_ud)) {
@@ -184,11 +185,13 @@ wb_status wb_world_step(wb_world *w)
         wb__tricontacts_project(w, h);
         wb__contacts_friction(w, h);
         wb__rigids_solve(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
+        wb__rigid_particles_solve(w);
         wb__collide_and_update(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
         wb__rigids_update(w, h);
         wb__contacts_velocity(w, h);
         wb__tricontacts_velocity(w, h);
         wb__rigids_velocity(w, h);
+        wb__rigid_particles_velocity(w, h);
     }
 
     /* a frame gone non-finite is undone before it can bend or break anything */

@@ -237,9 +237,40 @@ static const luaL_Reg rigid_meta[] = {
     { NULL, NULL }
 };
 
+/* w:rigid_contacts() -> { {particle =, body =, normal = {x, y, z}, depth =, force =}, ... }:
+ * the particle-rigid contacts that corrected positions in the last substep; force in N,
+ * normal out of the body; particle ids from 1 */
+static int w_rigid_contacts(lua_State *L)
+{
+    wb_world *w = wbl_checkworld(L, 1);
+    const int32_t n = wb_world_rigid_contact_count(w);
+    lua_createtable(L, n, 0);
+    for (int32_t i = 0; i < n; i++) {
+        const wb_rigid_contact c = wb_world_rigid_contact_at(w, i);
+        lua_createtable(L, 0, 5);
+        lua_pushinteger(L, (lua_Integer)c.particle + 1);
+        lua_setfield(L, -2, "particle");
+        push_rigid(L, 1, c.body);
+        lua_setfield(L, -2, "body");
+        lua_createtable(L, 3, 0);
+        for (int k = 0; k < 3; k++) {
+            lua_pushnumber(L, c.normal[k]);
+            lua_rawseti(L, -2, k + 1);
+        }
+        lua_setfield(L, -2, "normal");
+        lua_pushnumber(L, c.depth);
+        lua_setfield(L, -2, "depth");
+        lua_pushnumber(L, c.force);
+        lua_setfield(L, -2, "force");
+        lua_rawseti(L, -2, i + 1);
+    }
+    return 1;
+}
+
 static const luaL_Reg world_methods[] = {
     { "rigid", w_rigid },
     { "rigids", w_rigids },
+    { "rigid_contacts", w_rigid_contacts },
     { NULL, NULL }
 };
 

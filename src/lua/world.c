@@ -447,6 +447,8 @@ static int w_stats(lua_State *L)
     SETI("colours", s.colours);
     SETI("contacts", s.contacts);
     SETI("particle_contacts", s.particle_contacts);
+    SETI("rigids", s.rigids);
+    SETI("rigid_contacts", s.rigid_contacts);
     SETN("broad_ms", s.broad_ms);
     SETI("projections", s.projections);
     SETN("step_ms", s.step_ms);

@@ -184,7 +184,7 @@ local CASES = {
 }
 for _, name in ipairs{ "angular_momentum", "bend_breaks", "bends", "bounds", "breaks", "closed", "colliders", "contacts", "damping", "distances", "dt",
                        "energy", "frame", "gravity", "hash", "iterations", "max_strain", "momentum", "particle_count",
-                       "relaxation", "rigids", "skins", "solver", "stats", "step", "substeps", "threads", "time", "warnings" } do
+                       "relaxation", "rigid_contacts", "rigids", "skins", "solver", "stats", "step", "substeps", "threads", "time", "warnings" } do
   CASES["world:" .. name] = { none = "a getter or step: no arguments" }
 end
 
