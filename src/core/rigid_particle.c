@@ -24,6 +24,7 @@
  * reach of 10 bodies' box cost 1.5 ms per frame (measured), against the substeps x
  * iterations x constraints of the step itself; nothing at all without rigid bodies. The list is in particle order,
  * then body order, and projected serially: the same for any thread count. */
+#include "attach.h"
 #include "rigid.h"
 
 static int live(const wb_rigids *rb, int32_t r) { return rb->gen[r] & 1u; }
@@ -59,6 +60,7 @@ void wb__rigid_particles_begin(wb_world *w)
         slot[nb++] = r;
     }
     const wb_real *x = w->s.x, *v = w->s.v;
+    const wb_attaches *att = w->att && w->att->skip_np > 0 ? w->att : NULL;
     for (int32_t i = 0; i < m->np; i++) {
         if (!(m->cflags[i] & WB_CF_COLLIDE)) continue;
         const wb_real reach = m->radius[i] * (wb_real)1.25 + v3_len(&v[3 * i]) * dt + g;
@@ -73,6 +75,7 @@ void wb__rigid_particles_begin(wb_world *w)
             v3_sub(d, &x[3 * i], &sph[4 * b]);
             const wb_real s = reach + sph[4 * b + 3];
             if (!(v3_dot(d, d) < s * s)) continue;
+            if (att && wb__attach_skip(att, i, -1 - slot[b])) continue; /* tied to it: no contact */
             int32_t *pc = wb__grow(rb->pc, &rb->cap_pc, 2 * (rb->npc + 1), sizeof *pc);
             if (!pc) goto nomem;
             rb->pc = pc;

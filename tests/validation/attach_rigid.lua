@@ -149,3 +149,21 @@ test("save and load keep attachments to rigid bodies exactly", function()
   expect.eq(ok, nil)
   expect.truthy(tostring(err):find("attachments[0].rigid", 1, true), "the error names the key: " .. tostring(err))
 end)
+
+test("a particle attached inside a body does not collide with it; other bodies still do", function()
+  local w = wobble.world{ gravity = {0, 0, 0}, substeps = 10 }
+  local b = w:rigid{ shape = "box", half = {0.3, 0.3, 0.3}, mass = 2, pos = {0, 0, 0} }
+  local p = w:particle{ pos = {0.1, 0.05, 0}, mass = 1, radius = 0.05 }
+  w:attach(p, b)
+  for _ = 1, 30 do w:step() end
+  -- with the contact, the particle is pushed out of the box while the attachment holds
+  -- it in: the two fight and the pair moves off; without it nothing moves at all
+  local x, y, z = w:position(p)
+  expect.near(x, 0.1, 1e-12); expect.near(y, 0.05, 1e-12); expect.near(z, 0, 1e-12)
+  local bx, by, bz = b:position()
+  expect.near(bx, 0, 1e-12); expect.near(by, 0, 1e-12); expect.near(bz, 0, 1e-12)
+  -- another body's particle is still pushed out of this one
+  local q = w:particle{ pos = {-0.1, 0, 0}, mass = 1, radius = 0.05 }
+  for _ = 1, 30 do w:step() end
+  expect.ge(b:distance(w:position(q)), 0.05 - 1e-6, "a free particle is pushed out of the box")
+end)
