@@ -121,6 +121,18 @@ const char *wb__rigid_image_check(const wb_image *g)
     return NULL;
 }
 
+int32_t wb_rigid_list(const wb_world *w, wb_rigid_id *out, int32_t cap)
+{
+    int32_t k = 0;
+    for (int32_t r = 0; w->rb && r < w->rb->n && k < cap; r++)
+        if (w->rb->gen[r] & 1u) {
+            out[k].index = (uint32_t)r + 1;
+            out[k].gen = w->rb->gen[r];
+            k++;
+        }
+    return k;
+}
+
 /* the slot an appended body takes: free ones lowest first, then new ones */
 static int32_t free_slots(const wb_world *w)
 {

@@ -219,9 +219,12 @@ static int w_rigids(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
     const int32_t n = wb_rigid_count(w);
-    lua_createtable(L, n, 0);
-    for (int32_t i = 0; i < n; i++) {
-        push_rigid(L, 1, wb_rigid_at(w, i));
+    /* the ids in one pass (Lua's heap, so the budget sees it): wb_rigid_at per body is n^2 */
+    wb_rigid_id *ids = (wb_rigid_id *)lua_newuserdatauv(L, sizeof *ids * (size_t)(n > 0 ? n : 1), 0);
+    const int32_t k = wb_rigid_list(w, ids, n);
+    lua_createtable(L, k, 0);
+    for (int32_t i = 0; i < k; i++) {
+        push_rigid(L, 1, ids[i]);
         lua_rawseti(L, -2, i + 1);
     }
     return 1;

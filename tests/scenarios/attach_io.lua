@@ -127,7 +127,7 @@ test("w:attach and w:grab errors name the argument; nothing changes", function()
   local c = w:collider{ shape = "sphere", center = {0, 0, 0}, radius = 0.1 }
   local p = w:particle{ pos = {0, 1, 0} }
   local h = w:hash()
-  expect.error(function() w:attach(p, "drum") end, "bad argument #2 to 'attach' %(collider expected, got string%)")
+  expect.error(function() w:attach(p, "drum") end, "bad argument #2 to 'attach' %(collider or rigid body expected, got string%)")
   expect.error(function() w:attach(p, {}) end, "bad argument #2 to 'attach'")
   expect.error(function() w:attach(99, c) end, "bad argument #1 to 'attach'")
   expect.error(function() w:attach(p, c, { compliance = -1 }) end, "compliance")

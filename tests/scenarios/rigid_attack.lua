@@ -68,3 +68,13 @@ test("rigids entries as saved: errors name the entry and the key", function()
   bad("capsule", box, [[{"shape": "capsule", "a": [0, 0, 0], "b": [1, 0, 0], "radius": 0.1, "generation": 3}]], "5:",
       "rigids[1]: rigid capsule a and b must be about its centre")
 end)
+
+test("an attachment with neither collider nor rigid names both keys", function()
+  local path = write("rigid_attack/notarget.json", [[{ "format": "wobble-particles", "version": 1,
+  "particles": [ {"position": [0, 2, 0]} ],
+  "rigids": [ {"shape": "sphere", "radius": 0.5} ],
+  "attachments": [ {"particle": 0} ] }]])
+  local ok, err = wobble.load(path)
+  expect.falsy(ok)
+  expect.truthy(err and err:find("attachments[0]: missing key 'collider' (or 'rigid')", 1, true), tostring(err))
+end)
