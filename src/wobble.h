@@ -608,6 +608,9 @@ bool wb_rigid_valid(const wb_world *w, wb_rigid_id r);
 void wb_rigid_remove(wb_world *w, wb_rigid_id r);
 int32_t wb_rigid_count(const wb_world *w);                   /* live bodies */
 wb_rigid_id wb_rigid_at(const wb_world *w, int32_t i);       /* 0 <= i < count, slot order */
+/* the live bodies' ids in slot order, at most cap, in one pass (wb_rigid_at each is n^2);
+ * returns how many were written (rigid_image.c) */
+int32_t wb_rigid_list(const wb_world *w, wb_rigid_id *out, int32_t cap);
 void wb_rigid_get_def(const wb_world *w, wb_rigid_id r, wb_rigid_def *out); /* shape + state now */
 void wb_rigid_position(const wb_world *w, wb_rigid_id r, wb_real out[3]);
 void wb_rigid_rotation(const wb_world *w, wb_rigid_id r, wb_real out[4]);

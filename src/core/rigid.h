@@ -113,7 +113,7 @@ static inline void wb__rigids_free(wb_world *w, wb_rigids *rb)
     if (!rb) return;
     if (w->m.def.memory) w->m.def.memory->used -= rb->charged;
     void *p[] = { rb->shape, rb->mass, rb->inv_mass, rb->inertia, rb->inv_inertia, rb->bound, rb->gen, rb->x, rb->q,
-                  rb->v, rb->om, rb->x_prev, rb->q_prev, rb->save, rb->ct, rb->moved,
+                  rb->v, rb->om, rb->x_prev, rb->q_prev, rb->q_pred, rb->save, rb->ct, rb->moved,
                   rb->pc, rb->pc_sph, rb->pc_slot, rb->pc_cnt, rb->pct };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     free(rb);

@@ -84,35 +84,53 @@ static int fin(const wb_real *v, int n)
     return 1;
 }
 
+const char *wb_image_rigid_check(const wb_image_rigid *o)
+{
+    wb_rigid_def d = wb_rigid_default_def(o->shape);
+    d.radius = o->radius;
+    v3_copy(d.half, o->half);
+    v3_copy(d.a, o->a);
+    v3_copy(d.b, o->b);
+    d.mass = o->mass;
+    d.friction = o->friction;
+    d.restitution = o->restitution;
+    v3_copy(d.pos, o->x);
+    memcpy(d.rotation, o->q, sizeof d.rotation);
+    v3_copy(d.vel, o->v);
+    v3_copy(d.angular_velocity, o->om);
+    const char *e = wb_rigid_def_check(&d);
+    if (e) return e;
+    if (!fin(o->q, 4) || fabs(o->q[0] * o->q[0] + v3_dot(&o->q[1], &o->q[1]) - 1) > 1e-9)
+        return "rigid body rotation must be a unit quaternion";
+    /* the capsule about its centre of mass */
+    if (o->shape == WB_SHAPE_CAPSULE)
+        for (int i = 0; i < 3; i++)
+            if (fabs(o->a[i] + o->b[i]) > 1e-9 * (1 + fabs(o->a[i]) + fabs(o->b[i])))
+                return "rigid capsule a and b must be about its centre (a = -b)";
+    return NULL;
+}
+
 const char *wb__rigid_image_check(const wb_image *g)
 {
     if (g->nrb < 0 || g->nrb > WB_MAX_RIGIDS) return "too many rigid bodies";
     for (int32_t r = 0; r < g->nrb; r++) {
         if (!(g->rb_gen[r] & 1u)) continue;
-        const wb_image_rigid *o = &g->rb[r];
-        wb_rigid_def d = wb_rigid_default_def(o->shape);
-        d.radius = o->radius;
-        v3_copy(d.half, o->half);
-        v3_copy(d.a, o->a);
-        v3_copy(d.b, o->b);
-        d.mass = o->mass;
-        d.friction = o->friction;
-        d.restitution = o->restitution;
-        v3_copy(d.pos, o->x);
-        memcpy(d.rotation, o->q, sizeof d.rotation);
-        v3_copy(d.vel, o->v);
-        v3_copy(d.angular_velocity, o->om);
-        const char *e = wb_rigid_def_check(&d);
+        const char *e = wb_image_rigid_check(&g->rb[r]);
         if (e) return e;
-        if (!fin(o->q, 4) || fabs(o->q[0] * o->q[0] + v3_dot(&o->q[1], &o->q[1]) - 1) > 1e-9)
-            return "rigid body rotation must be a unit quaternion";
-        /* the capsule about its centre of mass */
-        if (o->shape == WB_SHAPE_CAPSULE)
-            for (int i = 0; i < 3; i++)
-                if (fabs(o->a[i] + o->b[i]) > 1e-9 * (1 + fabs(o->a[i]) + fabs(o->b[i])))
-                    return "rigid capsule a and b must be about its centre (a = -b)";
     }
     return NULL;
+}
+
+int32_t wb_rigid_list(const wb_world *w, wb_rigid_id *out, int32_t cap)
+{
+    int32_t k = 0;
+    for (int32_t r = 0; w->rb && r < w->rb->n && k < cap; r++)
+        if (w->rb->gen[r] & 1u) {
+            out[k].index = (uint32_t)r + 1;
+            out[k].gen = w->rb->gen[r];
+            k++;
+        }
+    return k;
 }
 
 /* the slot an appended body takes: free ones lowest first, then new ones */

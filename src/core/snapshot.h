@@ -190,6 +190,8 @@ void wb__grab_image_put(wb_world *w, const wb_image *g, int32_t pshift);
 wb_status wb_image_alloc_rigids(wb_image *img, int32_t n);
 /* the body w:rigid{...} would make from a def (checked by wb_rigid_def_check): WB_ERR_ARG */
 wb_status wb_image_rigid_from_def(const wb_rigid_def *d, wb_image_rigid *out);
+/* a live body as a snapshot holds it (unit rotation, capsule about its centre): NULL or why not */
+const char *wb_image_rigid_check(const wb_image_rigid *o);
 void wb__rigid_image_free(wb_image *g);
 wb_status wb__rigid_image_of(const wb_world *w, wb_image *g);
 const char *wb__rigid_image_check(const wb_image *g);

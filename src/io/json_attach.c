@@ -1,11 +1,11 @@
 /* json_attach.c: the "attachments" and "grabs" sections of a particle config (README,
  * "Attachments and grabs"):
  *
- *   "attachments": [ {"particle": 3, "collider": 0, "point": [x,y,z], "compliance": 0}, ... ]
+ *   "attachments": [ {"particle": 3, "collider": 0 | "rigid": 0, "point": [x,y,z], "compliance": 0}, ... ]
  *   "grabs": [ {"particle": 7, "target": [x,y,z], "from": [x,y,z], "compliance": 0}, ... ]
  *
- * "collider" counts the file's "colliders" entries from 0. "point" (in the collider's
- * frame) defaults to where the particle is, as w:attach does; "from" (where the next
+ * "collider" counts the file's "colliders" entries from 0, "rigid" its "rigids" entries
+ * (removed slots included, as w:save writes them). "point" (in the target's frame) defaults to where the particle is, as w:attach does; "from" (where the next
  * step's sweep of the target starts) defaults to the target. w:save writes both. */
 #include <math.h>
 #include <stdlib.h>
@@ -62,7 +62,7 @@ static int read_attach_items(rd *r, const cJSON *arr, const kp *parent, const ch
         const cJSON *tf = rigid ? f[4] : f[1];
         kp tq = { &p, tkey, 0 };
         if (rigid && f[1]) return jv_fail(r, f[4], 0, &tq, "give collider or rigid, not both");
-        if (!tf) return jv_missing(r, c, &p, "collider");
+        if (!tf) return jv_fail(r, c, 0, &p, "missing key 'collider' (or 'rigid')");
         if (g->np == 0) {
             kp q = { &p, "particle", 0 };
             return jv_fail(r, f[0], 0, &q, "there are no particles");

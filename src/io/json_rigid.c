@@ -31,7 +31,14 @@ int jr_read_rigids(rd *r, const cJSON *arr, wb_image *g)
         int64_t gen = 1;
         if (jv_opt_int(r, f[12], &p, "generation", 1, UINT32_MAX, &gen)) return -1;
         g->rb_gen[i] = (uint32_t)gen;
-        if (!(gen & 1)) continue; /* a removed body's slot */
+        if (!(gen & 1)) { /* a removed body's slot: nothing else, or the file was edited by mistake */
+            for (int k = 0; k < 12; k++)
+                if (f[k]) {
+                    kp q = { &p, keys[k], 0 };
+                    return jv_fail(r, f[k], 1, &q, "a removed body's slot (even generation) has no other key");
+                }
+            continue;
+        }
         if (!f[0]) return jv_missing(r, c, &p, "shape");
         kp sp = { &p, "shape", 0 };
         const char *str;
@@ -77,6 +84,9 @@ int jr_read_rigids(rd *r, const cJSON *arr, wb_image *g)
             memcpy(o->q, d.rotation, sizeof o->q);
             memcpy(o->v, d.vel, sizeof o->v);
             memcpy(o->om, d.angular_velocity, sizeof o->om);
+            /* here, not only in the snapshot's check, so that the error names this entry */
+            const char *raw = wb_image_rigid_check(o);
+            if (raw) return jv_fail(r, c, 0, &p, "%s (an entry with a generation is the body exactly as saved)", raw);
         } else if (wb_image_rigid_from_def(&d, o) != WB_OK) {
             return jv_fail(r, c, 0, &p, "%s", wb_last_error());
         }

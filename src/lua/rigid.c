@@ -1,5 +1,7 @@
 /* rigid.c: rigid bodies (issue 10): w:rigid{shape = ...} and the body handle (id +
  * generation, the world's userdata as its user value), w:rigids(). */
+#include <math.h>
+
 #include "util.h"
 
 typedef struct wbl_rigid { wb_rigid_id id; } wbl_rigid;
@@ -100,7 +102,8 @@ static int rb_set_rotation(lua_State *L)
     wb_world *w = checkrigid(L, 1, &id);
     wb_real q[4];
     wbl_checkreals(L, 2, 4, q);
-    if (q[0] == 0 && q[1] == 0 && q[2] == 0 && q[3] == 0)
+    /* the threshold w:rigid uses (wb_rigid_def_check): a denormal quaternion has no direction */
+    if (!(fmax(fmax(fabs(q[0]), fabs(q[1])), fmax(fabs(q[2]), fabs(q[3]))) > 1e-12))
         return luaL_argerror(L, 2, "rotation must be a non-zero quaternion (w, x, y, z)");
     wb_rigid_set_rotation(w, id, q);
     return 0;
@@ -134,7 +137,20 @@ static int rb_apply_impulse(lua_State *L)
             has_at = true;
         }
     }
+    /* finite J and point can still overflow (J / m, r x J): refuse and change nothing, or
+     * every later frame would be undone for the non-finite body */
+    wb_real v0[3], om0[3], v1[3], om1[3];
+    wb_rigid_velocity(w, id, v0);
+    wb_rigid_angular_velocity(w, id, om0);
     wb_rigid_apply_impulse(w, id, J, has_at ? at : NULL);
+    wb_rigid_velocity(w, id, v1);
+    wb_rigid_angular_velocity(w, id, om1);
+    for (int i = 0; i < 3; i++)
+        if (!isfinite(v1[i]) || !isfinite(om1[i])) {
+            wb_rigid_set_velocity(w, id, v0);
+            wb_rigid_set_angular_velocity(w, id, om0);
+            return luaL_error(L, "apply_impulse: the impulse is too large (the velocity would not be finite)");
+        }
     return 0;
 }
 
@@ -203,9 +219,12 @@ static int w_rigids(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
     const int32_t n = wb_rigid_count(w);
-    lua_createtable(L, n, 0);
-    for (int32_t i = 0; i < n; i++) {
-        push_rigid(L, 1, wb_rigid_at(w, i));
+    /* the ids in one pass (Lua's heap, so the budget sees it): wb_rigid_at per body is n^2 */
+    wb_rigid_id *ids = (wb_rigid_id *)lua_newuserdatauv(L, sizeof *ids * (size_t)(n > 0 ? n : 1), 0);
+    const int32_t k = wb_rigid_list(w, ids, n);
+    lua_createtable(L, k, 0);
+    for (int32_t i = 0; i < k; i++) {
+        push_rigid(L, 1, ids[i]);
         lua_rawseti(L, -2, i + 1);
     }
     return 1;
