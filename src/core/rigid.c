@@ -181,9 +181,12 @@ wb_rigid_id wb_rigid_add(wb_world *w, const wb_rigid_def *def, wb_status *status
         if (!w->rb) { *status = WB_ERR_NOMEM; return none; }
     }
     wb_rigids *rb = w->rb;
+    /* the lowest dead slot, from the hint (no dead slot below it): bodies added in a row
+     * cost no quadratic scan */
     int32_t slot = -1;
-    for (int32_t i = 0; i < rb->n; i++)
+    for (int32_t i = rb->free_hint; i < rb->n; i++)
         if (!(rb->gen[i] & 1u)) { slot = i; break; }
+    rb->free_hint = slot < 0 ? rb->n : slot;
     if (slot < 0) {
         if (rb->n >= WB_MAX_RIGIDS) { *status = WB_ERR_LIMIT; return none; }
         if (!grow(w, rb, rb->n + 1)) { *status = WB_ERR_NOMEM; return none; }
@@ -231,7 +234,12 @@ bool wb_rigid_valid(const wb_world *w, wb_rigid_id r)
 
 #define RSLOT(w, r) (assert(wb_rigid_valid((w), (r))), (int32_t)(r).index - 1)
 
-void wb_rigid_remove(wb_world *w, wb_rigid_id r) { w->rb->gen[RSLOT(w, r)]++; }
+void wb_rigid_remove(wb_world *w, wb_rigid_id r)
+{
+    const int32_t i = RSLOT(w, r);
+    w->rb->gen[i]++;
+    if (i < w->rb->free_hint) w->rb->free_hint = i;
+}
 
 int32_t wb_rigid_count(const wb_world *w)
 {

@@ -48,6 +48,7 @@ typedef struct wb_rigids {
     int32_t *pc_cnt, cap_cnt;      /* (n) contacts per body in the substep */
     struct wb_rpcontact *pct;
     int32_t npct, cap_pct;
+    int32_t free_hint;     /* no dead slot below it (wb_rigid_add's search starts there) */
 } wb_rigids;
 
 typedef struct wb_rpcontact {

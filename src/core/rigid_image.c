@@ -170,6 +170,7 @@ void wb__rigid_put(wb_world *w, const wb_image *g, int exact, int32_t *map)
 {
     if (g->nrb == 0) return;
     wb_rigids *rb = w->rb;
+    rb->free_hint = 0; /* slots change here: search from the start again */
     if (exact) {
         for (int32_t r = 0; r < g->nrb; r++) {
             if (map) map[r] = r;
