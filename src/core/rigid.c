@@ -465,7 +465,7 @@ void wb__rigids_update(wb_world *w, wb_real h)
         /* om: the predicted one (the free rotation's end value, gyroscopic term included)
          * plus the turn the corrections made, dq = q q_pred^-1 as axis x angle / h (the exact
          * inverse of q_integrate). Taking all of om from q q_prev^-1 gives the turn's mean
-         * rate instead of its end value: a tumbling box tied to a particle gained 20 % of
+         * rate instead of its end value: a tumbling box tied to a particle gained 15 % of
          * angular momentum in 2 s */
         wb_real dq[4] = {
             q[0] * p[0] + q[1] * p[1] + q[2] * p[2] + q[3] * p[3],

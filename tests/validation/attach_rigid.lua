@@ -90,7 +90,7 @@ test("a particle and a free body pulling on each other keep momentum, and angula
   expect.lt(dm, 1e-10, "momentum")
   -- the impulses act on one line (the body's at the particle), but velocities come from
   -- poses after a first-order turn (q += 1/2 [theta, 0] q): angular momentum is kept to
-  -- O(h). Measured 0.6 % of |L| at h = 1/600 s and four times less at h/4
+  -- O(h). Measured 0.5 % of |L| at h = 1/600 s and four times less at h/4
   expect.lt(dl, 0.02 * L, "angular momentum within 2 % at 10 substeps")
   local dm4, dl4 = tied(40)
   expect.lt(dm4, 1e-10, "momentum, 40 substeps")
