@@ -5,7 +5,10 @@ PREFIX  ?= /usr/local
 OPT     ?= -O2
 # Debian packages the build and the tests need; `make deps` installs the missing ones
 PKGS    := gcc make libc6-dev pkg-config liblua5.4-dev libcjson-dev libassimp-dev libosmesa6-dev \
-           libstb-dev ffmpeg tetgen
+           libstb-dev ffmpeg tetgen libglfw3-dev xvfb xdotool parallel
+# installed by `make bench` (the Bullet peer) and `make test-cluster` (a one-node Slurm) alone
+BENCH_PKGS   := g++ libbullet-dev
+CLUSTER_PKGS := slurm-wlm munge
 PCMODS  := lua5.4 libcjson assimp osmesa
 # shell code setting `missing` to the packages of PKGS that are not installed ("ii";
 # a removed package whose configuration files remain is not); dpkg-query is quick
