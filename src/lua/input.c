@@ -533,27 +533,31 @@ static void ev_where(const replay *rp, int64_t i, char *buf, size_t n)
 static void apply(lua_State *L, replay *rp, int64_t i, wb_world *w)
 {
     const ev *x = &rp->e.v[i];
-    char where[PATH_MAX + 96];
+    char where[PATH_MAX + 96], msg[PATH_MAX + 512];
     ev_where(rp, i, where, sizeof where);
+    msg[0] = 0;
     if (x->type == EV_GRAB) {
         const int32_t np = wb_particle_count(w);
-        if (x->particle >= np)
-            luaL_error(L, "%s: particle %d out of range (world %d has %d at frame %lld)", where, (int)x->particle + 1,
-                       x->world, (int)np, (long long)x->frame);
         wb_status st = WB_OK;
-        wb_grab_id g = wb_grab_add(w, x->particle, x->target, x->compliance, &st);
-        if (st == WB_ERR_NOMEM) wb_rt_budget_error(L, "%s: out of memory grabbing the particle", where);
-        if (st != WB_OK) luaL_error(L, "%s: the world refuses the grab: %s", where, wb_last_error());
-        rp->grab[x->grab - 1] = g;
-        rp->grab_w[x->grab - 1] = w;
-        return;
+        if (x->particle >= np) {
+            snprintf(msg, sizeof msg, "%s: particle %d out of range (world %d has %d at frame %lld)", where,
+                     (int)x->particle + 1, x->world, (int)np, (long long)x->frame);
+        } else {
+            wb_grab_id g = wb_grab_add(w, x->particle, x->target, x->compliance, &st);
+            if (st == WB_ERR_NOMEM) wb_rt_budget_error(L, "%s: out of memory grabbing the particle", where);
+            if (st != WB_OK) snprintf(msg, sizeof msg, "%s: the world refuses the grab: %s", where, wb_last_error());
+            rp->grab[x->grab - 1] = g;
+            rp->grab_w[x->grab - 1] = w;
+        }
+    } else {
+        const wb_grab_id g = rp->grab[x->grab - 1];
+        if (rp->grab_w[x->grab - 1] != w || !wb_grab_valid(w, g))
+            snprintf(msg, sizeof msg, "%s: grab %lld is no longer in world %d (the scene released it or closed its world)",
+                     where, (long long)x->grab, x->world);
+        else if (x->type == EV_MOVE) wb_grab_move(w, g, x->target);
+        else wb_grab_release(w, g);
     }
-    const wb_grab_id g = rp->grab[x->grab - 1];
-    if (rp->grab_w[x->grab - 1] != w || !wb_grab_valid(w, g))
-        luaL_error(L, "%s: grab %lld is no longer in world %d (the scene released it or closed its world)", where,
-                   (long long)x->grab, x->world);
-    if (x->type == EV_MOVE) wb_grab_move(w, g, x->target);
-    else wb_grab_release(w, g);
+    if (msg[0]) luaL_error(L, "%s", msg); /* (lua_pushfstring knows no %lld) */
 }
 
 /* the frame hook: the events due after this frame of this world, in file order */
@@ -618,9 +622,11 @@ bool wbl_replay_end(lua_State *L, char *err, size_t n)
         else if (rp->seen[k].frame < x->frame)
             snprintf(why, sizeof why, "the scene ended before it: world %d finished frame %lld last", x->world,
                      (long long)rp->seen[k].frame);
+        else if (rp->seen[k].frame == x->frame)
+            snprintf(why, sizeof why, "it failed (the error above)");
         else
-            snprintf(why, sizeof why, "world %d went past that frame (now at %lld) without it: the scene differs from "
-                     "the one recorded, or an event before it failed", x->world, (long long)rp->seen[k].frame);
+            snprintf(why, sizeof why, "world %d went past that frame (it is at frame %lld): the scene differs from the "
+                     "one recorded, or an event before it failed", x->world, (long long)rp->seen[k].frame);
         snprintf(err, n, "%s: %lld event%s not applied, the first events[%lld] (%s after frame %lld of world %d): %s",
                  rp->shown, (long long)left, left == 1 ? " was" : "s were", (long long)rp->next, type_names[x->type],
                  (long long)x->frame, x->world, why);
