@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 /* the folders above a path named on the command line (`--record out/run1/v.mp4`), made
@@ -637,12 +638,28 @@ static int cmd_test(const opts *o) {
 
 /* ---- run and bench ----------------------------------------------------------------------- */
 
-/* run one scene; test cases it registered run afterwards as TAP */
-static int run_scene(const opts *o, const char *path) {
+/* what `wobble run` keeps for OUTDIR/result.json: the figures of the state before it
+ * closes and the first error, without its traceback */
+typedef struct run_report { void *taken; char error[2048]; } run_report;
+
+static void report_error(run_report *rep, const char *msg) {
+    if (!rep || rep->error[0] || !msg) return;
+    const char *tb = strstr(msg, "\nstack traceback:");
+    snprintf(rep->error, sizeof rep->error, "%.*s", (int)(tb ? (size_t)(tb - msg) : strlen(msg)), msg);
+}
+
+static void report_take(run_report *rep, lua_State *L) {
+    if (rep && !rep->taken) rep->taken = wbl_result_take(L);
+}
+
+/* run one scene; test cases it registered run afterwards as TAP; rep (run, not bench)
+ * collects what result.json says */
+static int run_scene(const opts *o, const char *path, run_report *rep) {
     const char *err, *msg;
     lua_State *L = open_state(o, path, 0, &err);
     if (!L) {
         fprintf(stderr, "wobble: %s\n", err);
+        report_error(rep, err);
         return EXIT_SCRIPT;
     }
     char rerr[1024];
@@ -650,11 +667,15 @@ static int run_scene(const opts *o, const char *path) {
      * user's choice, not the sandbox's); the file is finished even after an error */
     if (o->record && make_parents(o->record, rerr, sizeof rerr) != 0) {
         fprintf(stderr, "wobble: --record: %s\n", rerr);
+        report_error(rep, rerr);
+        report_take(rep, L);
         wb_rt_close(L);
         return EXIT_SCRIPT;
     }
     if (o->record && !wbl_record_begin(L, o->record, rerr, sizeof rerr)) {
         fprintf(stderr, "wobble: %s\n", rerr);
+        report_error(rep, rerr);
+        report_take(rep, L);
         wb_rt_close(L);
         return EXIT_SCRIPT;
     }
@@ -662,11 +683,13 @@ static int run_scene(const opts *o, const char *path) {
     if (status != LUA_OK) {
         code = failure(L, status, path, &msg);
         print_error(msg);
+        report_error(rep, msg);
     } else {
         tap t = { 0, 0, 0, 0 };
         const char *caught = caught_failure(L);
         if (caught) {  /* an expectation of the scene itself */
             print_error(caught);
+            report_error(rep, caught);
             t.code = EXIT_FAILED;
             clear_caught(L);
         }
@@ -680,19 +703,51 @@ static int run_scene(const opts *o, const char *path) {
         code = t.code;
         if (wb_rt_budget_hit(L) && code < EXIT_BUDGET) {
             fprintf(stderr, "wobble: %s: a time or memory budget was exceeded\n", path);
+            report_error(rep, "a time or memory budget was exceeded (an error the script caught)");
             code = EXIT_BUDGET;
         }
     }
     wb_rt_pause_watchdog(L, 1);  /* finishing the file has the encoder's own timeouts */
     if (o->record && !wbl_record_end(L, rerr, sizeof rerr)) {
         fprintf(stderr, "wobble: --record: %s\n", rerr);
-        if (code == EXIT_PASS) code = EXIT_SCRIPT;
+        if (code == EXIT_PASS) report_error(rep, rerr), code = EXIT_SCRIPT;
     }
     wb_rt_pause_watchdog(L, 0);
+    report_take(rep, L);
     if (wb_rt_close(L) && code < EXIT_BUDGET) {  /* finalizers ran past the limit */
+        report_error(rep, "time limit exceeded while the finalizers (__gc) ran at the end");
         fprintf(stderr, "%s: time limit of %g s exceeded (--time-limit SECONDS) while the finalizers (__gc) ran at the end\n",
                 path, o->rt.time_budget);
         code = EXIT_BUDGET;
+    }
+    return code;
+}
+
+/* wobble run: the scene, then OUTDIR/result.json (DESIGN §4 collect). The file is
+ * first written saying "running", so a run ended from outside (a signal, the
+ * watchdog past --time-limit, the OOM killer, Slurm) leaves a run that started and
+ * never finished, which collect shows as crashed. */
+static int cmd_run(const opts *o, const char *path) {
+    run_report rep = { 0 };
+    char err[PATH_MAX + 128], dir[PATH_MAX];
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    wbl_run_info info = { o->rt.out_dir, path, o->sets, o->nsets, -1, 0, NULL };
+    snprintf(dir, sizeof dir, "%s/", o->rt.out_dir);  /* make_parents makes the folder itself */
+    if (make_parents(dir, err, sizeof err) == 0) wbl_result_write(NULL, &info, err, sizeof err);
+    int code = run_scene(o, path, &rep);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    if (code != EXIT_PASS && !rep.error[0])
+        report_error(&rep, code == EXIT_FAILED ? "a test case failed (see the TAP output)"
+                           : code == EXIT_BUDGET ? "a time or memory budget was exceeded" : "the run failed");
+    info.exit_code = code;
+    info.wall_time = (double)(t1.tv_sec - t0.tv_sec) + (t1.tv_nsec - t0.tv_nsec) * 1e-9;
+    info.error = rep.error[0] ? rep.error : NULL;
+    if (!rep.taken) rep.taken = wbl_result_take(NULL);
+    /* the output folder cannot be written: the run cannot report, an input error */
+    if (!wbl_result_write(rep.taken, &info, err, sizeof err)) {
+        fprintf(stderr, "wobble: --out: %s\n", err);
+        if (code == EXIT_PASS) code = EXIT_SCRIPT;
     }
     return code;
 }
@@ -745,7 +800,7 @@ static int cmd_bench(opts *o) {
             printf("# %s\n", p);
             fflush(stdout);
         }
-        int c = run_scene(o, p);
+        int c = run_scene(o, p, NULL);
         if (c > code) code = c;
     }
     list_free(&files);
@@ -778,7 +833,7 @@ int main(int argc, char **argv) {
     if (code == EXIT_PASS) {
         if (!strcmp(cmd, "run")) {
             if (o.npos != 1) code = usage_error("%s", o.npos ? "run takes one scene script" : "run needs a scene script");
-            else code = run_scene(&o, o.pos[0]);
+            else code = cmd_run(&o, o.pos[0]);
         } else if (!strcmp(cmd, "test")) {
             code = cmd_test(&o);
         } else if (o.npos) {
