@@ -3,6 +3,7 @@
  * failed, 2 script or input error, 3 a budget was exceeded. */
 #include "lua/wobble_lua.h"
 #include "render/render.h"
+#include "sweep.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -48,6 +49,9 @@ static const char usage_text[] =
     "                                  last line \"N passed, N failed\"\n"
     "  wobble bench [--json]           run the benchmark scenes (tests/bench/*.lua, or\n"
     "                                  share/wobble/bench of an installed wobble)\n"
+    "  wobble sweep SCENE.lua --grid key=a,b,c ... --out DIR   one run per combination: jobs\n"
+    "                                  for GNU parallel and Slurm (wobble sweep --help)\n"
+    "  wobble collect DIR [--csv | --json] [--plot X,Y[,COLOUR] OUT.png]   a sweep's results\n"
     "  wobble --version | --help\n"
     "\n"
     "options of run, test and bench:\n"
@@ -822,10 +826,8 @@ int main(int argc, char **argv) {
         fputs(usage_text, stdout);
         return EXIT_PASS;
     }
-    if (!strcmp(cmd, "sweep") || !strcmp(cmd, "collect")) {
-        fprintf(stderr, "wobble: '%s' is not implemented yet\n", cmd);
-        return EXIT_SCRIPT;
-    }
+    if (!strcmp(cmd, "sweep")) return wb_cmd_sweep(argc, argv);
+    if (!strcmp(cmd, "collect")) return wb_cmd_collect(argc, argv);
     if (strcmp(cmd, "run") && strcmp(cmd, "test") && strcmp(cmd, "bench"))
         return usage_error(cmd[0] == '-' ? "unknown option %s" : "unknown command '%s'", cmd);
     opts o;
