@@ -127,6 +127,7 @@ static int load(const char *dir, table *t) {
         const char *s = cJSON_GetStringValue(cJSON_GetObjectItem(w->res, "status"));
         /* "running": written when the run began, never replaced by its end */
         w->status = !s || !strcmp(s, "running") ? "crashed" : s;
+        if (!strcmp(w->status, "crashed")) cJSON_Delete(w->res), w->res = NULL;  /* its figures are not an end */
         cJSON *res = cJSON_GetObjectItem(w->res, "result"), *e;
         cJSON_ArrayForEach(e, res) {
             int k = 0;
