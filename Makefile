@@ -32,7 +32,7 @@ CORE_OBJ := $(CORE_SRC:src/%.c=$(BUILD)/obj/%.o)
 APP_OBJ  := $(APP_SRC:src/%.c=$(BUILD)/obj/%.o)
 UNIT_SRC := $(wildcard tests/unit/*.c)
 
-.PHONY: all build deps check-deps test asan bench demo install clean mutate fuzz fuzz-build
+.PHONY: all build deps check-deps test asan bench demo install clean mutate fuzz fuzz-build test-cluster
 all: check-deps
 	@$(MAKE) --no-print-directory build
 
@@ -165,3 +165,11 @@ fuzz: check-deps
 	    -print_final_stats=1 -artifact_prefix=$(FUZZ_BUILD)/crash-$$t- $$dict \
 	    $(FUZZ_BUILD)/corpus/$$t tests/fuzz/corpus/$$t tests/fuzz/regress/$$t || exit 1; \
 	done
+
+# ---- a one-node Slurm (README, "Sweeps"): `make test-cluster` starts munged, slurmctld and
+# slurmd in a temporary folder, runs a sweep's job array through sbatch and collects it;
+# CLUSTER_PKGS are installed by it alone, never by `make test`; needs root
+test-cluster: check-deps
+	@$(MAKE) --no-print-directory check-deps PKGS="$(CLUSTER_PKGS)"
+	@$(MAKE) --no-print-directory build
+	@sh tests/cluster/run.sh $(BUILD)
