@@ -173,6 +173,8 @@ static const char *json_text(const cJSON *v, char *buf, size_t n) {
     if (cJSON_IsBool(v)) return cJSON_IsTrue(v) ? "true" : "false";
     if (cJSON_IsNumber(v)) {
         snprintf(buf, n, "%.17g", v->valuedouble);
+        if (v->valuedouble == floor(v->valuedouble) && fabs(v->valuedouble) < 1e15)
+            return snprintf(buf, n, "%.0f", v->valuedouble), buf;  /* frames, exit codes: no exponent */
         /* the shortest text that reads back the same */
         for (int prec = 1; prec <= 17; prec++) {
             char b[64];
