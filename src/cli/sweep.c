@@ -90,7 +90,11 @@ static int add_grid(sweep *s, const char *arg) {
         return sweep_error("--grid '%s': the key must be letters, digits, '_' or '.'%s", arg, "");
     char *key = strndup(arg, kl);
     for (int i = 0; i < s->ng; i++)
-        if (!strcmp(s->g[i].key, key)) return sweep_error("--grid %s: the key '%s' is given twice", arg, key);
+        if (!strcmp(s->g[i].key, key)) {
+            sweep_error("--grid %s: the key '%s' is given twice", arg, key);
+            free(key);
+            return EXIT_SCRIPT;
+        }
     grid *g = &s->g[s->ng++];
     g->key = key;
     g->vals = calloc(strlen(eq) + 1, sizeof *g->vals);
@@ -99,9 +103,9 @@ static int add_grid(sweep *s, const char *arg) {
         size_t n = c ? (size_t)(c - v) : strlen(v);
         if (n == 0) return sweep_error("--grid %s: an empty value (two commas, or one at an end)%s", arg, "");
         char *val = strndup(v, n);
+        g->vals[g->n++] = val;  /* freed with the grid, also after an error */
         if (strchr(val, '\n')) return sweep_error("--grid %s: a value holds a line break%s", arg, "");
         if (overflows(val)) return sweep_error("--grid %s: the number %s is out of range (not finite)", arg, val);
-        g->vals[g->n++] = val;
         if (!c) break;
         v = c + 1;
     }
@@ -143,21 +147,21 @@ static int parse(int argc, char **argv, sweep *s) {
         switch (k) {
         case 0: if (add_grid(s, val)) return EXIT_SCRIPT; break;
         case 1:
-            bad = !parse_number(val, 1, MAX_RUNS) || strchr(val, '.');
+            bad = !parse_number(val, 1, MAX_RUNS) || strpbrk(val, ".eE");
             s->repeat = bad ? 1 : atoi(val);
             break;
         case 2: bad = !*val; s->out = val; break;
         case 3: bad = !parse_number(val, 0, 1e9); s->time_limit = val; break;
         case 4: bad = !parse_number(val, 0, 1e9); s->memory_limit = val; break;
         case 5: bad = !parse_number(val, 0, 1e15) || strpbrk(val, ".eE"); s->frames = val; break;
-        case 6: bad = !parse_number(val, 1, 256) || strchr(val, '.'); s->threads = val; break;
+        case 6: bad = !parse_number(val, 1, 256) || strpbrk(val, ".eE"); s->threads = val; break;
         case 7: {
             const char *e = strchr(val, '=');
             bad = !e || e == val || overflows(e + 1) || strchr(val, '\n');
             s->sets[s->nsets++] = val;
             break;
         }
-        case 8: bad = !parse_number(val, 1, 4096) || strchr(val, '.'); s->jobs = val; break;
+        case 8: bad = !parse_number(val, 1, 4096) || strpbrk(val, ".eE"); s->jobs = val; break;
         }
         if (bad) return sweep_error("%s: '%s' is not a valid value", name, val);
     }
@@ -374,13 +378,32 @@ static int run_parallel(const sweep *s, const char *dir, long count) {
     return failed ? EXIT_FAILED : EXIT_PASS;
 }
 
+static void sweep_free(sweep *s) {
+    for (int j = 0; j < s->ng; j++) {
+        for (int i = 0; i < s->g[j].n; i++) free(s->g[j].vals[i]);
+        free(s->g[j].vals);
+        free((char *)s->g[j].key);
+    }
+    free(s->g);
+    free(s->sets);
+}
+
+static int make_sweep(sweep *s);
+
 int wb_cmd_sweep(int argc, char **argv) {
     sweep s;
     if (argc >= 3 && (!strcmp(argv[2], "--help") || !strcmp(argv[2], "-h"))) {
         fputs(sweep_usage, stdout);
         return EXIT_PASS;
     }
-    if (parse(argc, argv, &s)) return EXIT_SCRIPT;
+    int code = parse(argc, argv, &s);
+    if (code == EXIT_PASS) code = make_sweep(&s);
+    sweep_free(&s);
+    return code;
+}
+
+static int make_sweep(sweep *sp) {
+    sweep s = *sp;
     long count = s.repeat;
     for (int j = 0; j < s.ng; j++) {
         if (count * s.g[j].n > MAX_RUNS) return sweep_error("the grids make more than %s runs%s", "1000000", "");
@@ -400,6 +423,11 @@ int wb_cmd_sweep(int argc, char **argv) {
     }
     exe[k] = 0;
     /* an earlier sweep's results must not mix with this one's */
+    struct stat ost;
+    if (stat(s.out, &ost) == 0 && !S_ISDIR(ost.st_mode)) {
+        fprintf(stderr, "wobble sweep: --out %s is a file, not a folder\n", s.out);
+        return EXIT_SCRIPT;
+    }
     if (!dir_empty(s.out) && !s.force) {
         fprintf(stderr, "wobble sweep: --out %s is not empty (an earlier sweep?): choose another folder, or add "
                         "--force to rewrite its jobs and remove its runs/\n", s.out);

@@ -155,6 +155,10 @@ run sweep $F/sweep_scene.lua --grid n=1 --out "$TMP/afile/sub"
 check "an --out that cannot be made" 2 err "--out $TMP/afile/sub: cannot make the folder"
 run sweep $F/sweep_scene.lua --grid n=1
 check "sweep without --out" 2 err "sweep needs --out DIR"
+run sweep $F/sweep_scene.lua --grid n=1 --out "$TMP/afile"
+check "an --out that is a file" 2 err "--out $TMP/afile is a file, not a folder"
+run sweep $F/sweep_scene.lua --grid n=1 --repeat 1e3 --out "$TMP/e5"
+check "--repeat wants a whole number" 2 err "--repeat: '1e3' is not a valid value" none "$TMP/e5"
 run collect "$S" --plot n,zzz "$TMP/z.png"
 check "--plot on an unknown key names it and lists the keys" 2 err "--plot n,zzz: unknown key 'zzz'" \
     err "grid keys: n g; results: h label odd stable y" none "$TMP/z.png"
