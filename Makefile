@@ -32,7 +32,7 @@ CORE_OBJ := $(CORE_SRC:src/%.c=$(BUILD)/obj/%.o)
 APP_OBJ  := $(APP_SRC:src/%.c=$(BUILD)/obj/%.o)
 UNIT_SRC := $(wildcard tests/unit/*.c)
 
-.PHONY: all build deps check-deps test asan bench demo install clean mutate fuzz fuzz-build
+.PHONY: all build deps check-deps test asan bench demo install clean mutate fuzz fuzz-build test-cluster
 all: check-deps
 	@$(MAKE) --no-print-directory build
 
@@ -173,3 +173,10 @@ build: $(BUILD)/input_driver
 $(BUILD)/input_driver: tests/cli/input_driver.c $(DRIVER_OBJ) $(BUILD)/libwobble.a $(HEADERS)
 	$(CC) $(CFLAGS) $(PC_CFLAGS) -o $@ tests/cli/input_driver.c $(DRIVER_OBJ) $(BUILD)/libwobble.a \
 	  $(LDFLAGS) $(PC_LIBS) -lm
+# ---- a one-node Slurm (README, "Sweeps"): `make test-cluster` starts munged, slurmctld and
+# slurmd in a temporary folder, runs a sweep's job array through sbatch and collects it;
+# CLUSTER_PKGS are installed by it alone, never by `make test`; needs root
+test-cluster: check-deps
+	@$(MAKE) --no-print-directory check-deps PKGS="$(CLUSTER_PKGS)"
+	@$(MAKE) --no-print-directory build
+	@sh tests/cluster/run.sh $(BUILD)

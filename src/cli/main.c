@@ -4,6 +4,7 @@
 #include "lua/input.h"
 #include "lua/wobble_lua.h"
 #include "render/render.h"
+#include "sweep.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -13,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 /* the folders above a path named on the command line (`--record out/run1/v.mp4`), made
@@ -48,6 +50,9 @@ static const char usage_text[] =
     "                                  last line \"N passed, N failed\"\n"
     "  wobble bench [--json]           run the benchmark scenes (tests/bench/*.lua, or\n"
     "                                  share/wobble/bench of an installed wobble)\n"
+    "  wobble sweep SCENE.lua --grid key=a,b,c ... --out DIR   one run per combination: jobs\n"
+    "                                  for GNU parallel and Slurm (wobble sweep --help)\n"
+    "  wobble collect DIR [--csv | --json] [--plot X,Y[,COLOUR] OUT.png]   a sweep's results\n"
     "  wobble --version | --help\n"
     "\n"
     "options of run, test and bench:\n"
@@ -55,7 +60,8 @@ static const char usage_text[] =
     "  --record OUT        (run) draw every frame into OUT: .mp4, .gif or a folder of PNGs\n"
     "  --replay INPUT.json (run) apply the grabs of an input log after their frames; exit\n"
     "                      code 1 when some were not applied (the scene ended or differs)\n"
-    "  --out DIR           output folder, the only place a script writes (default out)\n"
+    "  --out DIR           output folder, the only place a script writes (default out);\n"
+    "                      run writes DIR/result.json there (wobble collect)\n"
     "  --set key=value     wobble.args.key = value (numbers, true/false converted); repeatable\n"
     "  --threads N         default thread count of new worlds, 1 to 256 (default 1)\n"
     "  --unsafe            no sandbox: any path, os.execute, io.popen, C modules, debug\n"
@@ -646,12 +652,28 @@ static int cmd_test(const opts *o) {
 
 /* ---- run and bench ----------------------------------------------------------------------- */
 
-/* run one scene; test cases it registered run afterwards as TAP */
-static int run_scene(const opts *o, const char *path) {
+/* what `wobble run` keeps for OUTDIR/result.json: the figures of the state before it
+ * closes and the first error, without its traceback */
+typedef struct run_report { void *taken; char error[2048]; } run_report;
+
+static void report_error(run_report *rep, const char *msg) {
+    if (!rep || rep->error[0] || !msg) return;
+    const char *tb = strstr(msg, "\nstack traceback:");
+    snprintf(rep->error, sizeof rep->error, "%.*s", (int)(tb ? (size_t)(tb - msg) : strlen(msg)), msg);
+}
+
+static void report_take(run_report *rep, lua_State *L) {
+    if (rep && !rep->taken) rep->taken = wbl_result_take(L);
+}
+
+/* run one scene; test cases it registered run afterwards as TAP; rep (run, not bench)
+ * collects what result.json says */
+static int run_scene(const opts *o, const char *path, run_report *rep) {
     const char *err, *msg;
     lua_State *L = open_state(o, path, 0, &err);
     if (!L) {
         fprintf(stderr, "wobble: %s\n", err);
+        report_error(rep, err);
         return EXIT_SCRIPT;
     }
     char rerr[1024];
@@ -659,6 +681,7 @@ static int run_scene(const opts *o, const char *path) {
      * so that a bad file leaves nothing begun */
     if (o->replay && !wbl_replay_begin(L, o->replay, rerr, sizeof rerr)) {
         fprintf(stderr, "wobble: --replay: %s\n", rerr);
+        report_error(rep, rerr);
         wb_rt_close(L);
         return EXIT_SCRIPT;
     }
@@ -666,11 +689,15 @@ static int run_scene(const opts *o, const char *path) {
      * user's choice, not the sandbox's); the file is finished even after an error */
     if (o->record && make_parents(o->record, rerr, sizeof rerr) != 0) {
         fprintf(stderr, "wobble: --record: %s\n", rerr);
+        report_error(rep, rerr);
+        report_take(rep, L);
         wb_rt_close(L);
         return EXIT_SCRIPT;
     }
     if (o->record && !wbl_record_begin(L, o->record, rerr, sizeof rerr)) {
         fprintf(stderr, "wobble: %s\n", rerr);
+        report_error(rep, rerr);
+        report_take(rep, L);
         wb_rt_close(L);
         return EXIT_SCRIPT;
     }
@@ -678,11 +705,13 @@ static int run_scene(const opts *o, const char *path) {
     if (status != LUA_OK) {
         code = failure(L, status, path, &msg);
         print_error(msg);
+        report_error(rep, msg);
     } else {
         tap t = { 0, 0, 0, 0 };
         const char *caught = caught_failure(L);
         if (caught) {  /* an expectation of the scene itself */
             print_error(caught);
+            report_error(rep, caught);
             t.code = EXIT_FAILED;
             clear_caught(L);
         }
@@ -696,24 +725,57 @@ static int run_scene(const opts *o, const char *path) {
         code = t.code;
         if (wb_rt_budget_hit(L) && code < EXIT_BUDGET) {
             fprintf(stderr, "wobble: %s: a time or memory budget was exceeded\n", path);
+            report_error(rep, "a time or memory budget was exceeded (an error the script caught)");
             code = EXIT_BUDGET;
         }
     }
     /* events left over: the run did not reproduce the recorded one, a failed check */
     if (o->replay && !wbl_replay_end(L, rerr, sizeof rerr)) {
         fprintf(stderr, "wobble: --replay: %s\n", rerr);
+        report_error(rep, rerr);
         if (code == EXIT_PASS) code = EXIT_FAILED;
     }
     wb_rt_pause_watchdog(L, 1);  /* finishing the file has the encoder's own timeouts */
     if (o->record && !wbl_record_end(L, rerr, sizeof rerr)) {
         fprintf(stderr, "wobble: --record: %s\n", rerr);
-        if (code == EXIT_PASS) code = EXIT_SCRIPT;
+        if (code == EXIT_PASS) report_error(rep, rerr), code = EXIT_SCRIPT;
     }
     wb_rt_pause_watchdog(L, 0);
+    report_take(rep, L);
     if (wb_rt_close(L) && code < EXIT_BUDGET) {  /* finalizers ran past the limit */
+        report_error(rep, "time limit exceeded while the finalizers (__gc) ran at the end");
         fprintf(stderr, "%s: time limit of %g s exceeded (--time-limit SECONDS) while the finalizers (__gc) ran at the end\n",
                 path, o->rt.time_budget);
         code = EXIT_BUDGET;
+    }
+    return code;
+}
+
+/* wobble run: the scene, then OUTDIR/result.json (DESIGN §4 collect). The file is
+ * first written saying "running", so a run ended from outside (a signal, the
+ * watchdog past --time-limit, the OOM killer, Slurm) leaves a run that started and
+ * never finished, which collect shows as crashed. */
+static int cmd_run(const opts *o, const char *path) {
+    run_report rep = { 0 };
+    char err[PATH_MAX + 128], dir[PATH_MAX];
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    wbl_run_info info = { o->rt.out_dir, path, o->sets, o->nsets, -1, 0, NULL };
+    snprintf(dir, sizeof dir, "%s/", o->rt.out_dir);  /* make_parents makes the folder itself */
+    if (make_parents(dir, err, sizeof err) == 0) wbl_result_write(NULL, &info, err, sizeof err);
+    int code = run_scene(o, path, &rep);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    if (code != EXIT_PASS && !rep.error[0])
+        report_error(&rep, code == EXIT_FAILED ? "a test case failed (see the TAP output)"
+                           : code == EXIT_BUDGET ? "a time or memory budget was exceeded" : "the run failed");
+    info.exit_code = code;
+    info.wall_time = (double)(t1.tv_sec - t0.tv_sec) + (t1.tv_nsec - t0.tv_nsec) * 1e-9;
+    info.error = rep.error[0] ? rep.error : NULL;
+    if (!rep.taken) rep.taken = wbl_result_take(NULL);
+    /* the output folder cannot be written: the run cannot report, an input error */
+    if (!wbl_result_write(rep.taken, &info, err, sizeof err)) {
+        fprintf(stderr, "wobble: --out: %s\n", err);
+        if (code == EXIT_PASS) code = EXIT_SCRIPT;
     }
     return code;
 }
@@ -766,7 +828,7 @@ static int cmd_bench(opts *o) {
             printf("# %s\n", p);
             fflush(stdout);
         }
-        int c = run_scene(o, p);
+        int c = run_scene(o, p, NULL);
         if (c > code) code = c;
     }
     list_free(&files);
@@ -788,10 +850,8 @@ int main(int argc, char **argv) {
         fputs(usage_text, stdout);
         return EXIT_PASS;
     }
-    if (!strcmp(cmd, "sweep") || !strcmp(cmd, "collect")) {
-        fprintf(stderr, "wobble: '%s' is not implemented yet\n", cmd);
-        return EXIT_SCRIPT;
-    }
+    if (!strcmp(cmd, "sweep")) return wb_cmd_sweep(argc, argv);
+    if (!strcmp(cmd, "collect")) return wb_cmd_collect(argc, argv);
     if (strcmp(cmd, "run") && strcmp(cmd, "test") && strcmp(cmd, "bench"))
         return usage_error(cmd[0] == '-' ? "unknown option %s" : "unknown command '%s'", cmd);
     opts o;
@@ -799,7 +859,7 @@ int main(int argc, char **argv) {
     if (code == EXIT_PASS) {
         if (!strcmp(cmd, "run")) {
             if (o.npos != 1) code = usage_error("%s", o.npos ? "run takes one scene script" : "run needs a scene script");
-            else code = run_scene(&o, o.pos[0]);
+            else code = cmd_run(&o, o.pos[0]);
         } else if (!strcmp(cmd, "test")) {
             code = cmd_test(&o);
         } else if (o.npos) {

@@ -387,6 +387,7 @@ void wbl_after_frame(lua_State *L, int world_index)
         fflush(stderr);
         lua_pop(L, 1);
     }
+    wbl_result_after_frame(L, world_index);
     wb_rt_after_frame(L, world_index);
 }
 

@@ -119,4 +119,9 @@ void wbl_apply_contact_opts(wb_world *w, wb_body b, const wbl_contact_opts *o);
  * neighbouring particles' contact spheres touch and other bodies cannot pass between */
 void wbl_default_radius(wb_world *w, wb_body b);
 
+/* ---- what a run reports (result.c) ---------------------------------------------- */
+void wbl_open_result(lua_State *L);   /* wobble.result, into the module table on top */
+void wbl_result_after_frame(lua_State *L, int world_index);   /* counts the frame, keeps the world */
+void wbl_result_world_closing(lua_State *L, const wbl_world *ud);  /* the last world's figures, kept */
+
 #endif

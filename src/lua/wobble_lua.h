@@ -75,4 +75,20 @@ void wb_progress_update(lua_State *L, int64_t done);
 void wb_progress_end(lua_State *L);
 void wb_progress_note(lua_State *L, const char *note);   /* shown after every bar's label; NULL clears */
 
+/* ---- result.json of a run (result.c; DESIGN §4 collect) --------------------------------- */
+typedef struct wbl_run_info {
+    const char *out_dir;             /* the run's --out folder (exists) */
+    const char *scene;
+    const char *const *sets;         /* the --set key=value strings */
+    int nsets;
+    int exit_code;                   /* -1: the run has started and not ended ("running") */
+    double wall_time;                /* seconds */
+    const char *error;               /* the message of a failed run, or NULL */
+} wbl_run_info;
+/* the run's figures from L (frames, the last world's hash and warnings, the values of
+ * wobble.result): taken before wb_rt_close, even past a spent budget; L may be NULL */
+void *wbl_result_take(lua_State *L);
+/* out_dir/result.json from a taken snapshot (consumed; NULL: none) and info; 0 and err */
+int wbl_result_write(void *taken, const wbl_run_info *info, char *err, size_t n);
+
 #endif

@@ -549,6 +549,7 @@ static int w_warnings(lua_State *L)
 static int w_close(lua_State *L)
 {
     wbl_world *ud = wbl_checkworld_ud(L, 1);
+    wbl_result_world_closing(L, ud);   /* result.json's hash outlives the world */
     wb_world_destroy(ud->w);
     ud->w = NULL;
     return 0;

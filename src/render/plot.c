@@ -308,3 +308,21 @@ uint8_t *wb_plot_render(const wb_plot *pl, int w, int h, const char *title)
     if (!pl->n) wb_text(px, w, h, left + 20, top + 20, "no frames were run", ink, 2);
     return px;
 }
+
+/* ---- the helpers for other charts (render.h) ---------------------------------------------- */
+void wb_chart_rect(uint8_t *rgb, int w, int h, int x0, int y0, int x1, int y1, const uint8_t colour[3])
+{
+    canvas c = { rgb, w, h };
+    rect(&c, x0 < 0 ? 0 : x0, y0 < 0 ? 0 : y0, x1 > w ? w : x1, y1 > h ? h : y1, colour);
+}
+
+void wb_chart_line(uint8_t *rgb, int w, int h, double x0, double y0, double x1, double y1, const uint8_t colour[3])
+{
+    canvas c = { rgb, w, h };
+    line(&c, x0, y0, x1, y1, colour);
+}
+
+void wb_chart_label(char *buf, size_t n, double v, double step)
+{
+    fmt_num(buf, n, v, step);
+}

@@ -165,6 +165,12 @@ double wb_nice_step(double x);
 /* draw text into an RGB image with stb_easy_font (scale 1 = about 6 x 11 pixels) */
 void wb_text(uint8_t *rgb, int w, int h, int x, int y, const char *s, const uint8_t colour[3], int scale);
 int wb_text_width(const char *s, int scale);
+/* the charts' raster helpers, for other charts (wobble collect --plot): a filled
+ * rectangle [x0, x1) x [y0, y1), an anti-aliased 2-pixel line, a tick label for a
+ * value on an axis whose ticks are `step` apart */
+void wb_chart_rect(uint8_t *rgb, int w, int h, int x0, int y0, int x1, int y1, const uint8_t colour[3]);
+void wb_chart_line(uint8_t *rgb, int w, int h, double x0, double y0, double x1, double y1, const uint8_t colour[3]);
+void wb_chart_label(char *buf, size_t n, double v, double step);
 
 /* ---- the Lua side (lua/renderer.c, lua/plot.c) --------------------------------------- */
 typedef struct lua_State lua_State;

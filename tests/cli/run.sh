@@ -33,7 +33,7 @@ check "unknown option" 2 err "unknown option --no-such-option"
 run run $F/args.lua --record out.avi
 check "--record checks the extension (more in tests/render/run.sh)" 2 err "unknown extension '.avi'"
 run sweep x.lua
-check "sweep is not there yet" 2 err "not implemented yet"
+check "sweep without --grid (more in tests/cli/sweep.sh)" 2 err "sweep needs at least one --grid"
 run run
 check "run without a scene" 2 err "run needs a scene script"
 run run $F/missing.lua

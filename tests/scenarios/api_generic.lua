@@ -69,6 +69,7 @@ local CASES = {
   ["wobble.probe"] = { none = "a path" },
   ["wobble.read_png"] = { none = "a path" },
   ["wobble.clock"] = { none = "no arguments" },
+  ["wobble.result"] = { none = "any keys; a NaN is a result to report (tests/cli/sweep.sh)" },
 
   -- ---- world: options
   ["world:particle"] = { opts = { pos = {0, 0, 0}, vel = {0, 0, 0}, mass = 1, radius = 0.02, group = 0, friction = 0 },
