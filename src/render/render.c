@@ -383,23 +383,44 @@ static bool plane_quad(const wb_real nrm[3], double offset, const double c[3], d
     return true;
 }
 
-static void draw_grid(wb_renderer *r, const float quad[12], const double center[3], const double gu[3],
-                      const double gv[3], const double gn[3], double spacing, double ext)
+/* a plane (n.x = offset) through the full-screen triangle; a floor reaches the horizon,
+ * fogged over `fog`; any other plane is a disc of radius ext around center */
+static void draw_grid(wb_renderer *r, const double center[3], const double gu[3], const double gv[3],
+                      const double gn[3], double spacing, double ext, bool floor, double fog)
 {
     GLuint p = r->gl.prog_grid;
-    glBindVertexArray(r->gl.vao_grid);
-    glBindBuffer(GL_ARRAY_BUFFER, r->gl.vbo_grid);
-    glBufferSubData(GL_ARRAY_BUFFER, 0, 12 * sizeof(float), quad);
+    glBindVertexArray(r->gl.vao_empty);
     set_vec(p, "u_center", center[0], center[1], center[2]);
     set_vec(p, "u_gu", gu[0], gu[1], gu[2]);
     set_vec(p, "u_gv", gv[0], gv[1], gv[2]);
     set_vec(p, "u_gn", gn[0], gn[1], gn[2]);
+    glUniform1f(glGetUniformLocation(p, "u_offset"), (float)dot3(gn, center));
     glUniform1f(glGetUniformLocation(p, "u_spacing"), (float)spacing);
     glUniform1f(glGetUniformLocation(p, "u_extent"), (float)ext);
+    glUniform1f(glGetUniformLocation(p, "u_fog"), (float)fog);
+    glUniform1i(glGetUniformLocation(p, "u_floor"), floor);
     float g[3];
     wb_lin3(col_ground, g);
     glUniform3f(glGetUniformLocation(p, "u_base"), g[0], g[1], g[2]);
-    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+/* the camera's axes for the ground's view rays: forward, and right and up scaled to
+ * the frame's edges (a pixel's ray is f + x r + y u, x and y in -1..1) */
+static void camera_rays(const wb_renderer *r, GLuint p)
+{
+    double f[3], s[3], u[3];
+    for (int k = 0; k < 3; k++) f[k] = r->cam_target[k] - r->cam_eye[k];
+    norm3(f);
+    cross3(f, r->cam_up, s);
+    norm3(s);
+    cross3(s, f, u);
+    const double ty = tan(r->cam_fov * M_PI / 360), tx = ty * r->w / r->h;
+    set_vec(p, "u_cf", f[0], f[1], f[2]);
+    set_vec(p, "u_cr", tx * s[0], tx * s[1], tx * s[2]);
+    set_vec(p, "u_cu", ty * u[0], ty * u[1], ty * u[2]);
+    glUniform2f(glGetUniformLocation(p, "u_size"), (float)r->w, (float)r->h);
+    set_mat(p, "u_vp", r->vp);
 }
 
 /* uniforms of the lit programs */
@@ -541,7 +562,10 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     glUniform3f(glGetUniformLocation(g->prog_grid, "u_top"), col_sky_top[0], col_sky_top[1], col_sky_top[2]);
     glUniform3f(glGetUniformLocation(g->prog_grid, "u_bottom"), col_sky_bottom[0], col_sky_bottom[1], col_sky_bottom[2]);
     glUniform1f(glGetUniformLocation(g->prog_grid, "u_height"), (float)r->h);
-    double spacing = wb_nice_step(R / 6), center[3], gu[3], gv[3], gn[3];
+    camera_rays(r, g->prog_grid);
+    /* the fog: the ground around the scene stays clear however far the camera is */
+    const double spacing = wb_nice_step(R / 6), fog = 2 * dc + 3 * ext;
+    double center[3], gu[3], gv[3], gn[3];
     float quad[12];
     int planes = 0;
     int32_t nc = wb_collider_count(w);
@@ -549,16 +573,17 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
         wb_collider_def d;
         wb_collider_get_def(w, wb_collider_at(w, i), &d);
         double h;
-        if (d.shape != WB_SHAPE_PLANE || !(o->colliders || (o->grid && floor_height(&d, &h)))) continue;
+        const bool floor = floor_height(&d, &h);
+        if (d.shape != WB_SHAPE_PLANE || !(o->colliders || (o->grid && floor))) continue;
         if (plane_quad(d.normal, d.offset, c, ext, quad, center, gu, gv, gn)) {
-            draw_grid(r, quad, center, gu, gv, gn, spacing, ext);
+            draw_grid(r, center, gu, gv, gn, spacing, ext, floor, fog);
             planes++;
         }
     }
     if (!planes && o->grid) {
         wb_real up[3] = { 0, 1, 0 };
         if (plane_quad(up, fmin(cur.lo[1], r->view_lo[1]), c, ext, quad, center, gu, gv, gn))
-            draw_grid(r, quad, center, gu, gv, gn, spacing, ext);
+            draw_grid(r, center, gu, gv, gn, spacing, ext, true, fog);
     }
 
     /* solids, then the surfaces pushed back a little so links on them stay visible */
