@@ -56,6 +56,13 @@ typedef struct wb_layers {
     size_t mstrain_cap;
     uint8_t *flags;                                 /* per particle: on a surface, under a skin */
     size_t flag_cap;
+    float *scratch;                                 /* the automatic strain scale's sample */
+    size_t scratch_cap;
+    double scale;                                   /* the strain drawn fully red this frame */
+    bool strain_shown;                              /* any strain colour drawn (the legend) */
+    const wb_world *auto_world;                     /* the automatic scale's easing: the world */
+    int64_t auto_frame;                             /* and frame it was last taken at */
+    double auto_scale;                              /* and the scale it had */
 } wb_layers;
 
 struct wb_draw_opts;

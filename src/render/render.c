@@ -43,7 +43,7 @@ static const double box_shrink = 0.03;
 
 wb_draw_opts wb_draw_default_opts(void)
 {
-    wb_draw_opts o = { true, true, true, true, true, true, true, false, 0.02, 1.5, true, true };
+    wb_draw_opts o = { true, true, true, true, true, true, true, false, 0.02, 1.5, true, true, true, true };
     return o;
 }
 
