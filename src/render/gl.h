@@ -73,6 +73,8 @@ bool wb_layers_build(wb_layers *l, const wb_world *w, const struct wb_draw_opts 
                      int nsk, double unit);
 void wb_layers_free(wb_layers *l);
 void wb_lin3(const float srgb[3], float lin[3]);   /* the shaders' gamma 2 */
+/* a link's strain colour at t = strain / scale (-1 blue, 0 grey, +1 red), sRGB */
+void wb_strain_srgb(double t, float out[3]);
 
 typedef struct wb_gl {
     GLuint prog_mesh, prog_depth, prog_line, prog_grid, prog_bg;

@@ -80,6 +80,11 @@ static void strain_colour_srgb(double strain, double scale, float out[3])
     for (int c = 0; c < 3; c++) out[c] = (float)(col_rest[c] + (to[c] - col_rest[c]) * fabs(t));
 }
 
+void wb_strain_srgb(double t, float out[3])
+{
+    strain_colour_srgb(t, 1, out);
+}
+
 /* ---- instances -------------------------------------------------------------------------- */
 /* model = T(p) * [c0 c1 c2] (columns already scaled), normal matrix = columns / scale^2 */
 static void inst_set(wb_inst *in, const double p[3], const double cols[3][3], const float rgb[3], float shine)

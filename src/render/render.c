@@ -447,6 +447,48 @@ static void background_cpu(wb_renderer *r)
     }
 }
 
+/* the strain colours' legend, bottom left of the frame: "strain" over a bar from blue
+ * (compression) through grey to red (tension) and its numbers, the scale in percent,
+ * on a light panel; only on frames of at least 320 x 200 (on a thumbnail it would
+ * cover the scene) */
+static void draw_legend(wb_renderer *r, double scale)
+{
+    if (r->w < 320 || r->h < 200) return;
+    const int ts = r->h >= 540 ? 2 : 1, pad = 4 * ts, m = 6 * ts, line = 11 * ts, bh = 8 * ts;
+    char lo[32], hi[32];
+    snprintf(hi, sizeof hi, "+%.3g%%", 100 * scale);
+    snprintf(lo, sizeof lo, "-%.3g%%", 100 * scale);
+    const int bw = fmax(80 * ts, wb_text_width(lo, ts) + wb_text_width(hi, ts) + wb_text_width("0", ts) + 12 * ts);
+    const int pw = bw + 2 * pad, ph = 2 * pad + 2 * line + bh + 4 * ts;
+    if (pw + 2 * m > r->w || ph + 2 * m > r->h) return;
+    const int x0 = m, y0 = r->h - m - ph;
+    for (int y = y0; y < y0 + ph; y++)
+        for (int x = x0; x < x0 + pw; x++) {
+            uint8_t *p = r->rgb + 3 * ((size_t)y * r->w + x);
+            for (int k = 0; k < 3; k++) p[k] = (uint8_t)((p[k] + 3 * 242) / 4);
+        }
+    static const uint8_t ink[3] = { 40, 40, 44 };
+    wb_text(r->rgb, r->w, r->h, x0 + pad, y0 + pad, "strain", ink, ts);
+    const int by = y0 + pad + line + 2 * ts;
+    for (int x = 0; x < bw; x++) {
+        float c[3];
+        wb_strain_srgb(2.0 * x / (bw - 1) - 1, c);
+        for (int y = by; y < by + bh; y++) {
+            uint8_t *p = r->rgb + 3 * ((size_t)y * r->w + x0 + pad + x);
+            for (int k = 0; k < 3; k++) p[k] = (uint8_t)lrint(255 * c[k]);
+        }
+    }
+    const int ty = by + bh + 2 * ts;
+    wb_text(r->rgb, r->w, r->h, x0 + pad, ty, lo, ink, ts);
+    wb_text(r->rgb, r->w, r->h, x0 + pad + (bw - wb_text_width("0", ts)) / 2, ty, "0", ink, ts);
+    wb_text(r->rgb, r->w, r->h, x0 + pad + bw - wb_text_width(hi, ts), ty, hi, ink, ts);
+}
+
+double wb_renderer_strain_scale(const wb_renderer *r)
+{
+    return r->drawn && r->layers.strain_shown ? r->layers.scale : 0;
+}
+
 /* what the default camera frames: the union of the current extent and the eased one,
  * so whatever is there now is always in the picture; the box grows at once and only
  * shrinks eased (a video neither shakes nor cuts a falling body off). Another world,
@@ -498,6 +540,7 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     r->drawn = true;
     if (!r->be->gl) {
         background_cpu(r);
+        r->layers.strain_shown = false;
         return true;
     }
     if (!r->be->make_current(r->ctx)) {
@@ -631,5 +674,6 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     const uint8_t *px = r->be->pixels(r->ctx);
     size_t npx = (size_t)r->w * r->h;
     for (size_t i = 0; i < npx; i++) memcpy(r->rgb + 3 * i, px + 4 * i, 3);
+    if (o->legend && l->strain_shown) draw_legend(r, l->scale);
     return true;
 }
