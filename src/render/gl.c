@@ -43,17 +43,33 @@ static const char light_fs[] =
     "uniform sampler2DShadow u_smap;\n"
     "uniform float u_bias;\n"
     "uniform int u_shadows;\n"
-    "float shadow_at(vec3 p, vec3 n) {\n"
+    /* the lookup moves off the surface along its normal by u_bias (a few texels), more
+     * the more the light grazes (slope-scaled: a texel spans more depth there), up to 8
+     * times. The slope is the larger of the smooth normal's and the triangle's own (ng,
+     * on the side seen): near a fold of a two-sided cloth the smooth normal faces the
+     * light while the triangle turns away, and the map sees the fold's other side just
+     * behind it; a fixed offset drew those triangles as stripes of acne */
+    "float shadow_at(vec3 p, vec3 n, vec3 ng) {\n"
     "  if (u_shadows == 0) return 1.0;\n"
-    "  vec4 q = u_lvp * vec4(p + n * u_bias, 1.0);\n"
+    "  float c = clamp(min(dot(n, u_light), dot(ng, u_light)), 0.05, 1.0);\n"
+    "  float k = min(1.0 + 2.0 * sqrt(1.0 - c * c) / c, 8.0);\n"
+    "  vec4 q = u_lvp * vec4(p + n * u_bias * k, 1.0);\n"
     "  vec3 s = q.xyz / q.w * 0.5 + 0.5;\n"
     "  if (any(lessThan(s.xy, vec2(0.0))) || any(greaterThan(s, vec3(1.0)))) return 1.0;\n"
     "  return texture(u_smap, s);\n"  /* one tap: the linear filter is a 2x2 PCF */
     "}\n"
+    /* the triangle's own normal on the side of n (derivatives: in uniform control flow) */
+    "vec3 face_normal(vec3 p, vec3 n) {\n"
+    "  vec3 ng = cross(dFdx(p), dFdy(p));\n"
+    "  float l = length(ng);\n"
+    "  ng = l > 0.0 ? ng / l : n;\n"
+    "  return dot(ng, n) < 0.0 ? -ng : ng;\n"
+    "}\n"
     "vec3 lit(vec3 base, vec3 n, vec3 p, float shine) {\n"
     "  vec3 v = normalize(u_eye - p);\n"
+    "  vec3 ng = face_normal(p, n);\n"
     "  float ndl = dot(n, u_light);\n"
-    "  float sh = ndl > 0.0 ? shadow_at(p, n) : 0.0;\n"
+    "  float sh = ndl > 0.0 ? shadow_at(p, n, ng) : 0.0;\n"
     "  vec3 h = normalize(u_light + v);\n"
     "  float spec = shine * pow(max(dot(n, h), 0.0), 40.0);\n"
     "  vec3 amb = mix(vec3(0.16, 0.14, 0.13), vec3(0.30, 0.34, 0.42), n.y * 0.5 + 0.5);\n"
@@ -66,7 +82,7 @@ static const char light_fs[] =
     /* the ground: diffuse only, its cost is most of the frame's */
     "vec3 lit_matte(vec3 base, vec3 n, vec3 p) {\n"
     "  float ndl = dot(n, u_light);\n"
-    "  float sh = ndl > 0.0 ? shadow_at(p, n) : 0.0;\n"
+    "  float sh = ndl > 0.0 ? shadow_at(p, n, n) : 0.0;\n"
     "  vec3 amb = mix(vec3(0.16, 0.14, 0.13), vec3(0.30, 0.34, 0.42), n.y * 0.5 + 0.5);\n"
     "  return base * (amb + vec3(1.0, 0.96, 0.9) * max(ndl, 0.0) * sh);\n"
     "}\n";

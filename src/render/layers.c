@@ -623,10 +623,12 @@ static bool torn(const uint64_t *broken, size_t nb, const int32_t *v)
     return false;
 }
 
-/* Smooth normals stop at a crease: where two triangles at a particle meet at more than
- * CREASE_DEG, each keeps the normal of its own side (an own vertex per corner there).
- * 55 degrees: above the 45 of a round body cut in eight (a coarse sphere, capsule or a
- * cloth's soft fold stays smooth), well under the 90 of a voxel body's edges (a
+/* Smooth normals stop at a crease of a closed surface (a hull): where two triangles at a
+ * particle meet at more than CREASE_DEG, each keeps the normal of its own side (an own
+ * vertex per corner there). Not on open sheets: a coarse cloth's sharp folds would show
+ * as facets, and a cloth has no edges by design.
+ * 55 degrees: above the 45 of a round body cut in eight (a coarse ball or capsule stays
+ * smooth), well under the 90 of a voxel body's edges (a
  * lattice's hull, the logo's letters), which stay sharp while squashed by a third. */
 #define CREASE_DEG 55.0
 
@@ -660,9 +662,10 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
     /* per drawn triangle: its unit normal, then its area-weighted one */
     double *fn = malloc((nsurf / 3 + 1) * 6 * sizeof *fn);
     int32_t *start = calloc((size_t)np + 2, sizeof *start), *inc = malloc((nsurf + 1) * sizeof *inc);
+    bool *hull = malloc(nsurf / 3 + 1);   /* per drawn triangle: on a closed surface */
     int16_t *owner = malloc(((size_t)np + 1) * sizeof *owner);   /* the first surface a particle is on */
     signed char *out = calloc((size_t)np + 1, 1);   /* per particle: +-1 on a closed surface */
-    bool ok = (broken || !ns) && acc && fn && start && inc && owner && out;
+    bool ok = (broken || !ns) && acc && fn && start && inc && hull && owner && out;
     if (!ok) goto done;
     memset(owner, 0xff, ((size_t)np + 1) * sizeof *owner);
     size_t k = 0;
@@ -679,6 +682,7 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
             for (int c = 0; c < 3; c++) e1[c] = x[3 * v[1] + c] - x[3 * v[0] + c], e2[c] = x[3 * v[2] + c] - x[3 * v[0] + c];
             cross3(e1, e2, f);
             memcpy(f + 3, f, 3 * sizeof *f);
+            hull[k / 3] = sign != 0;
             for (int j = 0; j < 3; j++) {
                 for (int c = 0; c < 3; c++) acc[3 * v[j] + c] += f[c];
                 l->si[k++] = (GLuint)v[j];
@@ -701,7 +705,7 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
     for (size_t c = 0; c < ncorner; c++) {
         const int32_t v = (int32_t)l->si[c];
         const double *f = fn + 6 * (c / 3);
-        for (int32_t q = start[v]; q < start[v + 1]; q++)
+        for (int32_t q = start[v]; hull[c / 3] && q < start[v + 1]; q++)
             if (dot3(f, fn + 6 * inc[q]) < cos_crease) {
                 extra++;
                 break;
@@ -734,6 +738,7 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
     size_t base = (size_t)np;
     for (size_t c = 0; extra && c < ncorner; c++) {
         const int32_t v = (int32_t)l->si[c];
+        if (!hull[c / 3]) continue;
         const double *f = fn + 6 * (c / 3);
         double n[3] = { 0, 0, 0 };
         bool creased = false;
@@ -772,6 +777,7 @@ done:
     free(fn);
     free(start);
     free(inc);
+    free(hull);
     free(owner);
     free(out);
     return ok;
