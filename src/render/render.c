@@ -110,7 +110,8 @@ size_t wb_renderer_draw_held(const wb_renderer *r)
     const wb_layers *l = &r->layers;
     size_t b = l->inst_cap * sizeof *l->inst + l->seg_cap * sizeof *l->seg + l->sv_cap * sizeof *l->sv +
                l->si_cap * sizeof *l->si + l->pair_cap * sizeof *l->pairs + (l->pair_cap / 2 + 1) * sizeof *l->strain +
-               l->vstrain_cap * sizeof *l->vstrain + l->flag_cap;
+               l->vstrain_cap * sizeof *l->vstrain + l->flag_cap + l->scratch_cap * sizeof *l->scratch +
+               l->mstrain_cap * sizeof *l->mstrain;
     if (r->gl_ready) b += r->gl.inst_cap + r->gl.surf_cap + r->gl.surf_idx_cap + r->gl.seg_cap;
     return b;
 }
@@ -125,12 +126,18 @@ size_t wb_renderer_draw_bytes(const wb_renderer *r, const wb_world *w, const wb_
         wb_surface_triangles(w, s, &k);
         nt += (size_t)k;
     }
+    const size_t nst = nt;   /* the surfaces' triangles: a vertex per corner at most (creases) */
+    nv += 3 * nst;
     for (int i = 0; i < nsk; i++) nv += (size_t)sk[i].nv, nt += (size_t)sk[i].nt;
     /* what wb_layers_build fills (instances, links, surface vertices and indices, each
      * twice: the layers and the GL buffers), its per-pair and per-particle arrays and
-     * its scratch (a normal accumulator, an owner per particle) */
+     * its scratch (a normal accumulator, an owner per particle, the automatic strain
+     * scale's sample; per surface triangle two normals, its corners' incidence, a flag;
+     * the broken links) */
     return 2 * ((np + 3 * nc) * sizeof(wb_inst) + nd * sizeof(wb_seg) + nv * WB_SV * sizeof(float) + 3 * nt * sizeof(GLuint)) +
-           nd * (2 * sizeof(int32_t) + sizeof(wb_real)) + np * (6 * sizeof(float) + 1 + 3 * sizeof(double) + 2);
+           nd * (2 * sizeof(int32_t) + sizeof(wb_real) + sizeof(float) + sizeof(uint64_t)) +
+           np * (7 * sizeof(float) + 1 + 3 * sizeof(double) + 2 + sizeof(int32_t)) +
+           nst * (6 * sizeof(double) + 3 * sizeof(int32_t) + 1);
 }
 
 void wb_renderer_destroy(wb_renderer *r)
