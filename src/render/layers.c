@@ -379,14 +379,14 @@ static float select_k(float *v, size_t n, size_t k)
 
 /* the automatic strain scale: the 95th percentile of |strain| over the links and the
  * materials' particles, so the most strained few percent are in full colour and the
- * rest shades (a fixed 2 % turns any loaded body uniformly red); at least 0.1 %, or a
- * body at rest would show its rounding noise in full colour. Eased over frames in log
+ * rest shades (a fixed 2 % turns any loaded body uniformly red); at least 0.5 %, or a
+ * body settling would show its noise (0.1 %, the logo's letters at rest) in full colour. Eased over frames in log
  * scale: a fifth of the way up per frame (a blow shows within a few frames), a
  * twentieth down (a settling body fades over about a second at 60 fps); the same frame
  * drawn again, or another world, takes it as it is. Bends are left out: their colour is
  * a part of the scale (load_bends). */
 #define AUTO_PERCENTILE 0.95
-#define AUTO_MIN 0.001
+#define AUTO_MIN 0.005
 static bool auto_scale(wb_layers *l, const wb_world *w, const wb_draw_opts *o)
 {
     const int32_t np = wb_particle_count(w);

@@ -51,7 +51,7 @@ typedef struct wb_draw_opts {
                               pressure bodies by their strain (layers.c) */
     bool rigids;           /* rigid bodies, as shaded solids in their own colour */
     bool strain_auto;      /* strain_scale chosen per frame (layers.c, wb_strain_auto): the 95th
-                              percentile of |strain|, at least 0.1 %, eased over frames */
+                              percentile of |strain|, at least 0.5 %, eased over frames */
     bool legend;           /* a colour bar with its numbers when strain colours are shown */
 } wb_draw_opts;
 
