@@ -166,7 +166,8 @@ static int r_get_camera(lua_State *L)
 
 /* ---- drawing and recording ---------------------------------------------------------------- */
 static const char *const draw_keys[] = { "particles", "constraints", "colliders", "surfaces", "skins", "pins",
-                                         "grid", "cage", "strain_scale", "line_width", "materials", "rigids", NULL };
+                                         "grid", "cage", "strain_scale", "line_width", "materials", "rigids", "legend",
+                                         NULL };
 
 /* finish the recording; raises with the encoder's message when it failed */
 static void stop_recording(lua_State *L, wbl_renderer *u)
@@ -241,10 +242,23 @@ static int r_draw(lua_State *L)
         wbl_optbool(L, 3, "cage", &o.cage);
         wbl_optbool(L, 3, "materials", &o.materials);
         wbl_optbool(L, 3, "rigids", &o.rigids);
+        wbl_optbool(L, 3, "legend", &o.legend);
         wb_real v;
-        if (wbl_optreal(L, 3, "strain_scale", &v)) {
-            if (!(v > 0)) return wbl_fielderror(L, 3, "strain_scale", "must be > 0");
-            o.strain_scale = v;
+        /* a number > 0, or "auto" (the default) */
+        lua_getfield(L, 3, "strain_scale");
+        const bool is_auto = lua_type(L, -1) == LUA_TSTRING && strcmp(lua_tostring(L, -1), "auto") == 0;
+        lua_pop(L, 1);
+        if (!is_auto) {
+            lua_getfield(L, 3, "strain_scale");
+            const int t = lua_type(L, -1);
+            lua_pop(L, 1);
+            if (t != LUA_TNIL && t != LUA_TNUMBER)
+                return wbl_fielderror(L, 3, "strain_scale", "must be a number > 0 or \"auto\"");
+            if (wbl_optreal(L, 3, "strain_scale", &v)) {
+                if (!(v > 0)) return wbl_fielderror(L, 3, "strain_scale", "must be a number > 0 or \"auto\"");
+                o.strain_scale = v;
+                o.strain_auto = false;
+            }
         }
         if (wbl_optreal(L, 3, "line_width", &v)) {
             if (!(v > 0 && v <= 64)) return wbl_fielderror(L, 3, "line_width", "must be in (0, 64] pixels");
@@ -377,6 +391,16 @@ static int r_project(lua_State *L)
     lua_pushnumber(L, y);
     lua_pushnumber(L, d);
     return 3;
+}
+
+/* r:strain_scale() -> the strain drawn in full colour in the last frame (the given
+ * strain_scale or the automatic one), or nil when it showed no strain colour */
+static int r_strain_scale(lua_State *L)
+{
+    const double s = wb_renderer_strain_scale(checkrenderer(L, 1)->r);
+    if (s > 0) lua_pushnumber(L, s);
+    else lua_pushnil(L);
+    return 1;
 }
 
 static int r_info(lua_State *L)
@@ -642,6 +666,7 @@ static const luaL_Reg renderer_methods[] = {
     { "image", r_image },
     { "project", r_project },
     { "info", r_info },
+    { "strain_scale", r_strain_scale },
     { "close", r_close },
     { NULL, NULL }
 };

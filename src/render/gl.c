@@ -43,17 +43,33 @@ static const char light_fs[] =
     "uniform sampler2DShadow u_smap;\n"
     "uniform float u_bias;\n"
     "uniform int u_shadows;\n"
-    "float shadow_at(vec3 p, vec3 n) {\n"
+    /* the lookup moves off the surface along its normal by u_bias (a few texels), more
+     * the more the light grazes (slope-scaled: a texel spans more depth there), up to 8
+     * times. The slope is the larger of the smooth normal's and the triangle's own (ng,
+     * on the side seen): near a fold of a two-sided cloth the smooth normal faces the
+     * light while the triangle turns away, and the map sees the fold's other side just
+     * behind it; a fixed offset drew those triangles as stripes of acne */
+    "float shadow_at(vec3 p, vec3 n, vec3 ng) {\n"
     "  if (u_shadows == 0) return 1.0;\n"
-    "  vec4 q = u_lvp * vec4(p + n * u_bias, 1.0);\n"
+    "  float c = clamp(min(dot(n, u_light), dot(ng, u_light)), 0.05, 1.0);\n"
+    "  float k = min(1.0 + 2.0 * sqrt(1.0 - c * c) / c, 8.0);\n"
+    "  vec4 q = u_lvp * vec4(p + n * u_bias * k, 1.0);\n"
     "  vec3 s = q.xyz / q.w * 0.5 + 0.5;\n"
     "  if (any(lessThan(s.xy, vec2(0.0))) || any(greaterThan(s, vec3(1.0)))) return 1.0;\n"
     "  return texture(u_smap, s);\n"  /* one tap: the linear filter is a 2x2 PCF */
     "}\n"
+    /* the triangle's own normal on the side of n (derivatives: in uniform control flow) */
+    "vec3 face_normal(vec3 p, vec3 n) {\n"
+    "  vec3 ng = cross(dFdx(p), dFdy(p));\n"
+    "  float l = length(ng);\n"
+    "  ng = l > 0.0 ? ng / l : n;\n"
+    "  return dot(ng, n) < 0.0 ? -ng : ng;\n"
+    "}\n"
     "vec3 lit(vec3 base, vec3 n, vec3 p, float shine) {\n"
     "  vec3 v = normalize(u_eye - p);\n"
+    "  vec3 ng = face_normal(p, n);\n"
     "  float ndl = dot(n, u_light);\n"
-    "  float sh = ndl > 0.0 ? shadow_at(p, n) : 0.0;\n"
+    "  float sh = ndl > 0.0 ? shadow_at(p, n, ng) : 0.0;\n"
     "  vec3 h = normalize(u_light + v);\n"
     "  float spec = shine * pow(max(dot(n, h), 0.0), 40.0);\n"
     "  vec3 amb = mix(vec3(0.16, 0.14, 0.13), vec3(0.30, 0.34, 0.42), n.y * 0.5 + 0.5);\n"
@@ -66,7 +82,7 @@ static const char light_fs[] =
     /* the ground: diffuse only, its cost is most of the frame's */
     "vec3 lit_matte(vec3 base, vec3 n, vec3 p) {\n"
     "  float ndl = dot(n, u_light);\n"
-    "  float sh = ndl > 0.0 ? shadow_at(p, n) : 0.0;\n"
+    "  float sh = ndl > 0.0 ? shadow_at(p, n, n) : 0.0;\n"
     "  vec3 amb = mix(vec3(0.16, 0.14, 0.13), vec3(0.30, 0.34, 0.42), n.y * 0.5 + 0.5);\n"
     "  return base * (amb + vec3(1.0, 0.96, 0.9) * max(ndl, 0.0) * sh);\n"
     "}\n";
@@ -118,22 +134,36 @@ static const char line_fs[] =
     "out vec4 o_col;\n"
     "void main() { o_col = vec4(sqrt(v_col.rgb), 1.0); }\n";
 
+/* the ground: a full-screen triangle; each pixel's view ray meets the plane (grid_fs) */
 static const char grid_vs[] =
     "#version 330 core\n"
-    "layout(location = 0) in vec3 a_pos;\n"
-    "uniform mat4 u_vp;\n"
-    "out vec3 v_pos;\n"
-    "void main() { v_pos = a_pos; gl_Position = u_vp * vec4(a_pos, 1.0); }\n";
+    "void main() {\n"
+    "  vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);\n"
+    "  gl_Position = vec4(p, 0.0, 1.0);\n"
+    "}\n";
 
-/* the ground: anti-aliased minor and major lines (fwidth), fading out at the edge */
+/* the ground where each pixel's view ray meets the plane (n.x = u_offset): a floor
+ * reaches the horizon, fogged with distance into the sky's colour at that row (the sky
+ * is a screen gradient: the far ground meets it without a seam); any other plane is a
+ * disc of radius u_extent fading out, as before. Anti-aliased minor and major lines
+ * (fwidth) that fade where a cell shrinks to a few pixels (they would only shimmer).
+ * The depth is the hit point's, so bodies stand on the ground and beyond the far plane
+ * it is kept just in front of the sky. */
 static const char grid_fs[] =
-    "in vec3 v_pos;\n"
+    "uniform mat4 u_vp;\n"
+    "uniform vec3 u_cf;\n"   /* the camera's forward, right and up, scaled to the frame's edges */
+    "uniform vec3 u_cr;\n"
+    "uniform vec3 u_cu;\n"
+    "uniform vec2 u_size;\n"
     "uniform vec3 u_center;\n"
     "uniform vec3 u_gu;\n"
     "uniform vec3 u_gv;\n"
     "uniform vec3 u_gn;\n"
+    "uniform float u_offset;\n"
     "uniform float u_spacing;\n"
     "uniform float u_extent;\n"
+    "uniform float u_fog;\n"
+    "uniform int u_floor;\n"
     "uniform vec3 u_base;\n"
     "out vec4 o_col;\n"
     "uniform vec3 u_top;\n"
@@ -141,22 +171,33 @@ static const char grid_fs[] =
     "uniform float u_height;\n"
     "float grid(vec2 uv, vec2 fw) {\n"
     "  vec2 g = abs(fract(uv - 0.5) - 0.5) / max(fw, vec2(1e-6));\n"
-    "  return 1.0 - min(min(g.x, g.y), 1.0);\n"
+    "  float fade = 1.0 - smoothstep(0.12, 0.4, max(fw.x, fw.y));\n"
+    "  return (1.0 - min(min(g.x, g.y), 1.0)) * fade;\n"
     "}\n"
     "void main() {\n"
-    "  vec3 d = v_pos - u_center;\n"
-    "  float a = 1.0 - smoothstep(0.45, 1.0, length(d) / u_extent);\n"
-    "  if (a <= 0.0) discard;\n"
+    "  vec2 ndc = gl_FragCoord.xy / u_size * 2.0 - 1.0;\n"
+    "  vec3 dir = u_cf + ndc.x * u_cr + ndc.y * u_cu;\n"
+    "  float den = dot(u_gn, dir);\n"
+    "  float t = abs(den) > 1e-12 ? (u_offset - dot(u_gn, u_eye)) / den : -1.0;\n"
+    "  if (!(t > 0.0)) discard;\n"
+    "  vec3 p = u_eye + t * dir;\n"
+    "  vec4 clip = u_vp * vec4(p, 1.0);\n"
+    "  if (clip.w <= 0.0) discard;\n"
+    "  gl_FragDepth = min(clip.z / clip.w * 0.5 + 0.5, 0.99999);\n"
+    "  vec3 d = p - u_center;\n"
+    "  float a = u_floor != 0 ? exp(-pow(length(p - u_eye) / u_fog, 2.0))\n"
+    "                         : 1.0 - smoothstep(0.45, 1.0, length(d) / u_extent);\n"
+    "  if (a <= 0.002) discard;\n"
     "  vec2 uv = vec2(dot(d, u_gu), dot(d, u_gv)) / u_spacing;\n"
     "  vec3 base = u_base;\n"
     "  vec2 fw = fwidth(uv);\n"
     "  base = mix(base, base * 0.62, grid(uv, fw) * 0.7);\n"
     "  base = mix(base, base * 0.45, grid(uv / 5.0, fw / 5.0));\n"
-    "  vec3 n = dot(u_eye - v_pos, u_gn) >= 0.0 ? u_gn : -u_gn;\n"  /* the side seen */
+    "  vec3 n = dot(u_eye - p, u_gn) >= 0.0 ? u_gn : -u_gn;\n"  /* the side seen */
     /* opaque: faded into the sky's colour here, so the sky is drawn last and only
      * where nothing else is (the cheapest pixels are those never shaded) */
     "  vec3 sky = mix(u_bottom, u_top, clamp(gl_FragCoord.y / u_height, 0.0, 1.0));\n"
-    "  o_col = vec4(mix(sky, to_srgb(lit_matte(base, n, v_pos), 1.0).rgb, a), 1.0);\n"
+    "  o_col = vec4(mix(sky, to_srgb(lit_matte(base, n, p), 1.0).rgb, a), 1.0);\n"
     "}\n";
 
 /* the sky: a vertical gradient over a full-screen triangle */

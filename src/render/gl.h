@@ -56,6 +56,13 @@ typedef struct wb_layers {
     size_t mstrain_cap;
     uint8_t *flags;                                 /* per particle: on a surface, under a skin */
     size_t flag_cap;
+    float *scratch;                                 /* the automatic strain scale's sample */
+    size_t scratch_cap;
+    double scale;                                   /* the strain drawn fully red this frame */
+    bool strain_shown;                              /* any strain colour drawn (the legend) */
+    const wb_world *auto_world;                     /* the automatic scale's easing: the world */
+    int64_t auto_frame;                             /* and frame it was last taken at */
+    double auto_scale;                              /* and the scale it had */
 } wb_layers;
 
 struct wb_draw_opts;
@@ -66,6 +73,8 @@ bool wb_layers_build(wb_layers *l, const wb_world *w, const struct wb_draw_opts 
                      int nsk, double unit);
 void wb_layers_free(wb_layers *l);
 void wb_lin3(const float srgb[3], float lin[3]);   /* the shaders' gamma 2 */
+/* a link's strain colour at t = strain / scale (-1 blue, 0 grey, +1 red), sRGB */
+void wb_strain_srgb(double t, float out[3]);
 
 typedef struct wb_gl {
     GLuint prog_mesh, prog_depth, prog_line, prog_grid, prog_bg;

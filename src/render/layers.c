@@ -34,7 +34,7 @@ static const float surface_shine = 0.12f;
 
 /* per particle: on a drawn surface; covered by a drawn skin; in a volume, shape-matching
  * or pressure constraint (l->mstrain holds its strain) */
-enum { F_SURFACE = 1, F_HIDDEN = 2, F_MATERIAL = 4 };
+enum { F_SURFACE = 1, F_HIDDEN = 2, F_MATERIAL = 4, F_ON_SURFACE = 8 /* on any surface (auto_scale) */ };
 
 void wb_lin3(const float s[3], float o[3])
 {
@@ -66,6 +66,7 @@ void wb_layers_free(wb_layers *l)
     free(l->vstrain);
     free(l->mstrain);
     free(l->flags);
+    free(l->scratch);
     memset(l, 0, sizeof *l);
 }
 
@@ -77,6 +78,11 @@ static void strain_colour_srgb(double strain, double scale, float out[3])
     t = t > 1 ? 1 : t < -1 ? -1 : t;
     const float *to = t >= 0 ? col_tension : col_compress;
     for (int c = 0; c < 3; c++) out[c] = (float)(col_rest[c] + (to[c] - col_rest[c]) * fabs(t));
+}
+
+void wb_strain_srgb(double t, float out[3])
+{
+    strain_colour_srgb(t, 1, out);
 }
 
 /* ---- instances -------------------------------------------------------------------------- */
@@ -139,7 +145,7 @@ static bool build_instances(wb_layers *l, const wb_world *w, const wb_draw_opts 
         if (pin && o->pins) inst_sphere(&l->inst[k++], p, fmax(1.6 * rad, 0.006 * unit), col_pin, 0.5f);
         else if (o->particles && !(l->flags[i] & (F_SURFACE | F_HIDDEN))) {
             float col[3];
-            if (o->materials && (l->flags[i] & F_MATERIAL)) strain_colour_srgb(l->mstrain[i], o->strain_scale, col);
+            if (o->materials && (l->flags[i] & F_MATERIAL)) strain_colour_srgb(l->mstrain[i], l->scale, col);
             else memcpy(col, col_particle, sizeof col);
             inst_sphere(&l->inst[k++], p, rad, col, 0.5f);
         }
@@ -283,8 +289,8 @@ static void put_material(wb_layers *l, int32_t i, double e)
  * its tets (volume constraints and Neo-Hookean tets); a shape-matching cluster's strain (wb_shape_match_strain), negative when the
  * cluster drew in (its spread about the centre of mass below the rest shape's); a
  * pressure body's V / (pressure V0) - 1 on its surface; a bend's angle off its rest
- * (below) */
-static bool load_materials(wb_layers *l, const wb_world *w, double scale)
+ * (load_bends) */
+static bool load_materials(wb_layers *l, const wb_world *w)
 {
     const int32_t np = wb_particle_count(w), nv = wb_volume_count(w);
     if (!grow(&l->mstrain, &l->mstrain_cap, 3 * (size_t)np + 1, sizeof *l->mstrain)) return false;
@@ -335,7 +341,96 @@ static bool load_materials(wb_layers *l, const wb_world *w, double scale)
         const double e = (now < rest ? -1 : 1) * (double)wb_shape_match_strain(w, s);
         for (int32_t i = 0; i < n; i++) put_material(l, wb_shape_match_particle(w, s, i), e);
     }
-    /* bends at their hinge's two particles: |angle - rest| / (pi/4) of strain_scale (a
+    for (int32_t i = 0; i < wb_pressure_count(w); i++) {
+        const double target = wb_pressure_get_def(w, i).pressure * wb_pressure_rest_volume(w, i);
+        if (!(target > 0)) continue;
+        const double e = wb_pressure_volume(w, i) / target - 1;
+        int32_t nt = 0;
+        const int32_t *t = wb_surface_triangles(w, wb_pressure_surface(w, i), &nt);
+        for (int32_t k = 0; k < 3 * nt; k++) put_material(l, t[k], e);
+    }
+    return true;
+}
+
+/* the k-th smallest of v[0..n) in place (quickselect) */
+static float select_k(float *v, size_t n, size_t k)
+{
+    size_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        const float pivot = v[lo + (hi - lo) / 2];
+        size_t i = lo, j = hi;
+        while (i <= j) {
+            while (v[i] < pivot) i++;
+            while (v[j] > pivot) j--;
+            if (i <= j) {
+                const float t = v[i];
+                v[i] = v[j], v[j] = t;
+                i++;
+                if (j == 0) break;
+                j--;
+            }
+        }
+        if (k <= j) hi = j;
+        else if (k >= i) lo = i;
+        else break;
+    }
+    return v[k];
+}
+
+/* the automatic strain scale: the 95th percentile of |strain| over the links and the
+ * materials' particles, so the most strained few percent are in full colour and the
+ * rest shades (a fixed 2 % turns any loaded body uniformly red); at least 0.5 %, or a
+ * body settling would show its noise (0.1 %, the logo's letters at rest) in full colour. Eased over frames in log
+ * scale: a fifth of the way up per frame (a blow shows within a few frames), a
+ * twentieth down (a settling body fades over about a second at 60 fps); the same frame
+ * drawn again, or another world, takes it as it is. Bends are left out: their colour is
+ * a part of the scale (load_bends). */
+#define AUTO_PERCENTILE 0.95
+#define AUTO_MIN 0.005
+static bool auto_scale(wb_layers *l, const wb_world *w, const wb_draw_opts *o)
+{
+    const int32_t np = wb_particle_count(w);
+    const size_t want = (o->constraints ? (size_t)l->npairs : 0) + (o->materials ? (size_t)np : 0) + 1;
+    if (!grow(&l->scratch, &l->scratch_cap, want, sizeof *l->scratch)) return false;
+    /* the strains as shown: a free link's, a surface particle's stretch (vstrain), a
+     * material's */
+    for (int32_t s = 0; o->surfaces && s < wb_surface_count(w); s++) {
+        int32_t nt = 0;
+        const int32_t *t = wb_surface_triangles(w, s, &nt);
+        for (int32_t i = 0; i < 3 * nt; i++) l->flags[t[i]] |= F_ON_SURFACE;
+    }
+    size_t n = 0;
+    for (int32_t i = 0; o->constraints && i < l->npairs; i++)
+        if (isfinite(l->strain[i]) && !((l->flags[l->pairs[2 * i]] | l->flags[l->pairs[2 * i + 1]]) & F_ON_SURFACE))
+            l->scratch[n++] = (float)fabs(l->strain[i]);
+    for (int32_t i = 0; i < np; i++) {
+        float e = 0;
+        if (o->constraints && (l->flags[i] & F_ON_SURFACE)) e = l->vstrain[i];
+        if (o->materials && (l->flags[i] & F_MATERIAL) && fabsf(l->mstrain[i]) > e) e = fabsf(l->mstrain[i]);
+        if ((o->constraints && (l->flags[i] & F_ON_SURFACE)) || (o->materials && (l->flags[i] & F_MATERIAL)))
+            if (isfinite(e)) l->scratch[n++] = e;
+    }
+    double target = AUTO_MIN;
+    if (n > 0) target = fmax(target, select_k(l->scratch, n, (size_t)(AUTO_PERCENTILE * (double)(n - 1))));
+    const int64_t frame = wb_world_frame(w);
+    if (l->auto_world == w && frame > l->auto_frame && l->auto_scale > 0) {
+        /* per frame stepped since the last draw */
+        const double rate = 1 - pow(target > l->auto_scale ? 0.8 : 0.95, (double)(frame - l->auto_frame));
+        l->auto_scale = exp(log(l->auto_scale) + rate * (log(target) - log(l->auto_scale)));
+    } else {
+        l->auto_scale = target;
+    }
+    l->auto_world = w;
+    l->auto_frame = frame;
+    l->scale = l->auto_scale;
+    return true;
+}
+
+/* bends at their hinge's two particles (after the other materials: their colour is a
+ * part of the scale) */
+static void load_bends(wb_layers *l, const wb_world *w, double scale)
+{
+    /* |angle - rest| / (pi/4) of strain_scale (a
      * bend pi/4 off its rest is as full a colour as a link strain_scale off its); red
      * when bent further than its rest (further from flat, or through to the other side),
      * blue when opened out flatter. The angle's sign follows the wings' order, so only
@@ -352,21 +447,12 @@ static bool load_materials(wb_layers *l, const wb_world *w, double scale)
         wb_bend_particles(w, b, p);
         put_material(l, p[0], e), put_material(l, p[1], e);
     }
-    for (int32_t i = 0; i < wb_pressure_count(w); i++) {
-        const double target = wb_pressure_get_def(w, i).pressure * wb_pressure_rest_volume(w, i);
-        if (!(target > 0)) continue;
-        const double e = wb_pressure_volume(w, i) / target - 1;
-        int32_t nt = 0;
-        const int32_t *t = wb_surface_triangles(w, wb_pressure_surface(w, i), &nt);
-        for (int32_t k = 0; k < 3 * nt; k++) put_material(l, t[k], e);
-    }
-    return true;
 }
 
 /* links as segments; those touching a drawn surface are shown by its colour (a dense
  * cloth's links would cover it like a fence; a block's inner links would poke through
  * its hull as dots), those under a skin not at all */
-static bool build_segments(wb_layers *l, const wb_world *w, const wb_draw_opts *o)
+static bool build_segments(wb_layers *l, const wb_world *w)
 {
     if (!grow(&l->seg, &l->seg_cap, (size_t)l->npairs + 1, sizeof *l->seg)) return false;
     const wb_real *x = wb_particle_positions(w);
@@ -378,7 +464,7 @@ static bool build_segments(wb_layers *l, const wb_world *w, const wb_draw_opts *
         if (((l->flags[a] | l->flags[b]) & F_SURFACE) || (l->flags[a] & l->flags[b] & F_HIDDEN)) continue;
         wb_seg *s = &l->seg[k++];
         for (int c = 0; c < 3; c++) s->a[c] = (float)x[3 * a + c], s->b[c] = (float)x[3 * b + c];
-        strain_colour(l->strain[i], o->strain_scale, rest, s->c);
+        strain_colour(l->strain[i], l->scale, rest, s->c);
         s->c[3] = 1;
     }
     l->nseg = k;
@@ -499,12 +585,61 @@ static size_t put_mesh_colliders(wb_layers *l, const wb_world *w, const wb_draw_
     return base;
 }
 
-/* vertices: the particles, then every skin's, then the mesh colliders'; indices: the
- * surfaces' triangles (those not wholly under a drawn skin), then the skins', then the
- * mesh colliders'. Smooth normals: area-weighted. A closed surface's vertices sit out
- * along their normals by their particle's contact radius, where its sphere ends: bodies
- * that touch (or rest on a collider, also at the radius) look touching, not a spacing
- * apart; an open one (a cloth) stays through the centres. */
+/* the particle pairs of the broken links, each as a < b in one uint64, sorted; *n = 0
+ * when none is broken. NULL: out of memory */
+static uint64_t *broken_pairs(const wb_world *w, size_t *n)
+{
+    *n = 0;
+    const int32_t nd = wb_distance_count(w);
+    uint64_t *out = malloc(((size_t)(nd - wb_world_distance_pairs(w, NULL, NULL)) + 1) * sizeof *out);
+    if (!out) return NULL;
+    if (nd == wb_world_distance_pairs(w, NULL, NULL)) return out;
+    wb_distance_id *ids = malloc((size_t)nd * sizeof *ids);
+    if (!ids) {
+        free(out);
+        return NULL;
+    }
+    const int32_t m = wb_distance_ids(w, ids);
+    for (int32_t i = 0; i < m; i++) {
+        if (!wb_distance_broken(w, ids[i])) continue;
+        int32_t a, b;
+        wb_distance_particles(w, ids[i], &a, &b);
+        out[(*n)++] = a < b ? (uint64_t)(uint32_t)a << 32 | (uint32_t)b : (uint64_t)(uint32_t)b << 32 | (uint32_t)a;
+    }
+    free(ids);
+    qsort(out, *n, sizeof *out, cmp_u64);
+    return out;
+}
+
+/* a triangle across a tear: one of its edges is a broken link. Its particles fly apart
+ * with nothing holding them, so it would be drawn as a stretched sliver over the gap. */
+static bool torn(const uint64_t *broken, size_t nb, const int32_t *v)
+{
+    for (int j = 0; nb && j < 3; j++) {
+        uint32_t a = (uint32_t)v[j], b = (uint32_t)v[(j + 1) % 3];
+        uint64_t key = a < b ? (uint64_t)a << 32 | b : (uint64_t)b << 32 | a;
+        if (bsearch(&key, broken, nb, sizeof key, cmp_u64)) return true;
+    }
+    return false;
+}
+
+/* Smooth normals stop at a crease of a closed surface (a hull): where two triangles at a
+ * particle meet at more than CREASE_DEG, each keeps the normal of its own side (an own
+ * vertex per corner there). Not on open sheets: a coarse cloth's sharp folds would show
+ * as facets, and a cloth has no edges by design.
+ * 55 degrees: above the 45 of a round body cut in eight (a coarse ball or capsule stays
+ * smooth), well under the 90 of a voxel body's edges (a
+ * lattice's hull, the logo's letters), which stay sharp while squashed by a third. */
+#define CREASE_DEG 55.0
+
+/* vertices: the particles, then the corners at creases, then every skin's, then the
+ * mesh colliders'; indices: the surfaces' triangles (those not wholly under a drawn
+ * skin nor across a tear), then the skins', then the mesh colliders'. Smooth normals:
+ * area-weighted, split at creases. A closed surface's vertices sit out along their
+ * smooth normals (never the split ones: the hull stays closed) by their particle's
+ * contact radius, where its sphere ends: bodies that touch (or rest on a collider,
+ * also at the radius) look touching, not a spacing apart; an open one (a cloth) stays
+ * through the centres. */
 static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *o, const wb_draw_skin *sk, int nsk)
 {
     int32_t np = wb_particle_count(w), ns = o->surfaces ? wb_surface_count(w) : 0;
@@ -515,19 +650,23 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
         wb_surface_triangles(w, s, &nt);
         total += 3 * (size_t)nt;
     }
+    const size_t nsurf = total;   /* surface corners at most */
     for (int i = 0; i < nsk; i++) total += 3 * (size_t)sk[i].nt, nv += (size_t)sk[i].nv;
     const size_t nmesh = mesh_collider_triangles(w, o);
     total += 3 * nmesh;
     nv += 3 * nmesh;
-    if (!grow(&l->sv, &l->sv_cap, WB_SV * nv + WB_SV, sizeof *l->sv) || !grow(&l->si, &l->si_cap, total + 1, sizeof *l->si))
-        return false;
+    if (!grow(&l->si, &l->si_cap, total + 1, sizeof *l->si)) return false;
+    size_t nb = 0;
+    uint64_t *broken = ns ? broken_pairs(w, &nb) : NULL;
     double *acc = calloc((size_t)np * 3 + 3, sizeof *acc);
+    /* per drawn triangle: its unit normal, then its area-weighted one */
+    double *fn = malloc((nsurf / 3 + 1) * 6 * sizeof *fn);
+    int32_t *start = calloc((size_t)np + 2, sizeof *start), *inc = malloc((nsurf + 1) * sizeof *inc);
+    bool *hull = malloc(nsurf / 3 + 1);   /* per drawn triangle: on a closed surface */
     int16_t *owner = malloc(((size_t)np + 1) * sizeof *owner);   /* the first surface a particle is on */
     signed char *out = calloc((size_t)np + 1, 1);   /* per particle: +-1 on a closed surface */
-    if (!acc || !owner || !out) {
-        free(acc), free(owner), free(out);
-        return false;
-    }
+    bool ok = (broken || !ns) && acc && fn && start && inc && hull && owner && out;
+    if (!ok) goto done;
     memset(owner, 0xff, ((size_t)np + 1) * sizeof *owner);
     size_t k = 0;
     for (int32_t s = 0; s < ns; s++) {
@@ -538,16 +677,44 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
         for (int32_t i = 0; i < nt; i++) {
             const int32_t *v = t + 3 * i;
             if (l->flags[v[0]] & l->flags[v[1]] & l->flags[v[2]] & F_HIDDEN) continue;
-            double e1[3], e2[3], fn[3];
+            if (torn(broken, nb, v)) continue;
+            double e1[3], e2[3], *f = fn + 2 * k;
             for (int c = 0; c < 3; c++) e1[c] = x[3 * v[1] + c] - x[3 * v[0] + c], e2[c] = x[3 * v[2] + c] - x[3 * v[0] + c];
-            cross3(e1, e2, fn);
+            cross3(e1, e2, f);
+            memcpy(f + 3, f, 3 * sizeof *f);
+            hull[k / 3] = sign != 0;
             for (int j = 0; j < 3; j++) {
-                for (int c = 0; c < 3; c++) acc[3 * v[j] + c] += fn[c];
+                for (int c = 0; c < 3; c++) acc[3 * v[j] + c] += f[c];
                 l->si[k++] = (GLuint)v[j];
                 l->flags[v[j]] |= F_SURFACE;
+                start[v[j] + 1]++;
                 if (owner[v[j]] < 0) owner[v[j]] = (int16_t)(s % 4);
             }
+            norm3(f);
         }
+    }
+    const size_t ncorner = k;
+    /* the triangles at each particle: inc[start[i] .. start[i+1]) */
+    for (int32_t i = 0; i < np; i++) start[i + 1] += start[i];
+    for (size_t c = 0; c < ncorner; c++) inc[start[l->si[c]]++] = (int32_t)(c / 3);
+    for (int32_t i = np; i > 0; i--) start[i] = start[i - 1];
+    start[0] = 0;
+    /* a particle is creased when two of its triangles are further apart than the crease */
+    const double cos_crease = cos(CREASE_DEG * M_PI / 180);
+    size_t extra = 0;
+    for (size_t c = 0; c < ncorner; c++) {
+        const int32_t v = (int32_t)l->si[c];
+        const double *f = fn + 6 * (c / 3);
+        for (int32_t q = start[v]; hull[c / 3] && q < start[v + 1]; q++)
+            if (dot3(f, fn + 6 * inc[q]) < cos_crease) {
+                extra++;
+                break;
+            }
+    }
+    nv += extra;
+    if (!grow(&l->sv, &l->sv_cap, WB_SV * nv + WB_SV, sizeof *l->sv)) {
+        ok = false;
+        goto done;
     }
     float cloth[3];
     wb_lin3(col_cloth, cloth);
@@ -558,19 +725,39 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
             /* the material's strain, or its links' stretch where that is larger */
             double e = l->mstrain[i];
             if (o->constraints && fabs(l->vstrain[i]) > fabs(e)) e = l->vstrain[i];
-            strain_colour(e, o->strain_scale, cloth, col);
-        } else if (o->constraints) strain_colour(l->vstrain[i], o->strain_scale, cloth, col);
+            strain_colour(e, l->scale, cloth, col);
+        } else if (o->constraints) strain_colour(l->vstrain[i], l->scale, cloth, col);
         else wb_lin3(col_surface[owner[i] < 0 ? 0 : owner[i]], col);
         norm3(acc + 3 * i);
         const double off = out[i] * (double)wb_particle_radius(w, i);
         for (int c = 0; c < 3; c++) p[c] += off * acc[3 * i + c];
         put_vertex(l->sv + WB_SV * i, p, acc + 3 * i, col);
     }
-    free(acc);
-    free(owner);
-    free(out);
-    size_t base = (size_t)np;   /* skins: their own (deformed) vertices and normals */
-    float skin[3];
+    /* the corners at creases: the particle's vertex with the normal of the triangles on
+     * this corner's side of the crease (area-weighted again) */
+    size_t base = (size_t)np;
+    for (size_t c = 0; extra && c < ncorner; c++) {
+        const int32_t v = (int32_t)l->si[c];
+        if (!hull[c / 3]) continue;
+        const double *f = fn + 6 * (c / 3);
+        double n[3] = { 0, 0, 0 };
+        bool creased = false;
+        for (int32_t q = start[v]; q < start[v + 1]; q++) {
+            const double *g = fn + 6 * inc[q];
+            if (dot3(f, g) < cos_crease) {
+                creased = true;
+                continue;
+            }
+            for (int d = 0; d < 3; d++) n[d] += g[3 + d];
+        }
+        if (!creased) continue;
+        norm3(n);
+        float *dst = l->sv + WB_SV * base;
+        memcpy(dst, l->sv + WB_SV * (size_t)v, WB_SV * sizeof *dst);
+        for (int d = 0; d < 3; d++) dst[3 + d] = (float)n[d];
+        l->si[c] = (GLuint)base++;
+    }
+    float skin[3];   /* skins: their own (deformed) vertices and normals */
     wb_lin3(col_skin, skin);
     for (int i = 0; i < nsk; i++) {
         for (int32_t v = 0; v < sk[i].nv; v++) {
@@ -584,7 +771,16 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
     put_mesh_colliders(l, w, o, base, &k);
     l->nv = nv;
     l->nidx = k;
-    return true;
+done:
+    free(broken);
+    free(acc);
+    free(fn);
+    free(start);
+    free(inc);
+    free(hull);
+    free(owner);
+    free(out);
+    return ok;
 }
 
 bool wb_layers_build(wb_layers *l, const wb_world *w, const wb_draw_opts *o, const wb_draw_skin *sk, int nsk,
@@ -601,12 +797,17 @@ bool wb_layers_build(wb_layers *l, const wb_world *w, const wb_draw_opts *o, con
         }
     l->npairs = 0;
     if (o->constraints && !load_pairs(l, w)) return false;
-    if (o->materials && !load_materials(l, w, o->strain_scale)) return false;
+    if (o->materials && !load_materials(l, w)) return false;
+    l->scale = o->strain_scale;
+    if (o->strain_auto && (o->constraints || o->materials) && !auto_scale(l, w, o)) return false;
+    if (o->materials) load_bends(l, w, l->scale);
     l->nv = l->nidx = l->nseg = 0;
     l->surfaces = (o->surfaces && wb_surface_count(w) > 0 && np > 0) || nsk > 0 || mesh_collider_triangles(w, o) > 0;
     if (l->surfaces && !build_surfaces(l, w, o, sk, nsk)) return false;
     if (!build_instances(l, w, o, unit)) return false;
-    if (o->constraints && !build_segments(l, w, o)) return false;
+    if (o->constraints && !build_segments(l, w)) return false;
     if (o->pins && !build_grab_lines(l, w)) return false;
+    l->strain_shown = o->constraints && l->npairs > 0;
+    for (int32_t i = 0; o->materials && !l->strain_shown && i < np; i++) l->strain_shown = l->flags[i] & F_MATERIAL;
     return true;
 }

@@ -43,7 +43,7 @@ static const double box_shrink = 0.03;
 
 wb_draw_opts wb_draw_default_opts(void)
 {
-    wb_draw_opts o = { true, true, true, true, true, true, true, false, 0.02, 1.5, true, true };
+    wb_draw_opts o = { true, true, true, true, true, true, true, false, 0.02, 1.5, true, true, true, true };
     return o;
 }
 
@@ -110,7 +110,8 @@ size_t wb_renderer_draw_held(const wb_renderer *r)
     const wb_layers *l = &r->layers;
     size_t b = l->inst_cap * sizeof *l->inst + l->seg_cap * sizeof *l->seg + l->sv_cap * sizeof *l->sv +
                l->si_cap * sizeof *l->si + l->pair_cap * sizeof *l->pairs + (l->pair_cap / 2 + 1) * sizeof *l->strain +
-               l->vstrain_cap * sizeof *l->vstrain + l->flag_cap;
+               l->vstrain_cap * sizeof *l->vstrain + l->flag_cap + l->scratch_cap * sizeof *l->scratch +
+               l->mstrain_cap * sizeof *l->mstrain;
     if (r->gl_ready) b += r->gl.inst_cap + r->gl.surf_cap + r->gl.surf_idx_cap + r->gl.seg_cap;
     return b;
 }
@@ -125,12 +126,18 @@ size_t wb_renderer_draw_bytes(const wb_renderer *r, const wb_world *w, const wb_
         wb_surface_triangles(w, s, &k);
         nt += (size_t)k;
     }
+    const size_t nst = nt;   /* the surfaces' triangles: a vertex per corner at most (creases) */
+    nv += 3 * nst;
     for (int i = 0; i < nsk; i++) nv += (size_t)sk[i].nv, nt += (size_t)sk[i].nt;
     /* what wb_layers_build fills (instances, links, surface vertices and indices, each
      * twice: the layers and the GL buffers), its per-pair and per-particle arrays and
-     * its scratch (a normal accumulator, an owner per particle) */
+     * its scratch (a normal accumulator, an owner per particle, the automatic strain
+     * scale's sample; per surface triangle two normals, its corners' incidence, a flag;
+     * the broken links) */
     return 2 * ((np + 3 * nc) * sizeof(wb_inst) + nd * sizeof(wb_seg) + nv * WB_SV * sizeof(float) + 3 * nt * sizeof(GLuint)) +
-           nd * (2 * sizeof(int32_t) + sizeof(wb_real)) + np * (6 * sizeof(float) + 1 + 3 * sizeof(double) + 2);
+           nd * (2 * sizeof(int32_t) + sizeof(wb_real) + sizeof(float) + sizeof(uint64_t)) +
+           np * (7 * sizeof(float) + 1 + 3 * sizeof(double) + 2 + sizeof(int32_t)) +
+           nst * (6 * sizeof(double) + 3 * sizeof(int32_t) + 1);
 }
 
 void wb_renderer_destroy(wb_renderer *r)
@@ -383,23 +390,44 @@ static bool plane_quad(const wb_real nrm[3], double offset, const double c[3], d
     return true;
 }
 
-static void draw_grid(wb_renderer *r, const float quad[12], const double center[3], const double gu[3],
-                      const double gv[3], const double gn[3], double spacing, double ext)
+/* a plane (n.x = offset) through the full-screen triangle; a floor reaches the horizon,
+ * fogged over `fog`; any other plane is a disc of radius ext around center */
+static void draw_grid(wb_renderer *r, const double center[3], const double gu[3], const double gv[3],
+                      const double gn[3], double spacing, double ext, bool floor, double fog)
 {
     GLuint p = r->gl.prog_grid;
-    glBindVertexArray(r->gl.vao_grid);
-    glBindBuffer(GL_ARRAY_BUFFER, r->gl.vbo_grid);
-    glBufferSubData(GL_ARRAY_BUFFER, 0, 12 * sizeof(float), quad);
+    glBindVertexArray(r->gl.vao_empty);
     set_vec(p, "u_center", center[0], center[1], center[2]);
     set_vec(p, "u_gu", gu[0], gu[1], gu[2]);
     set_vec(p, "u_gv", gv[0], gv[1], gv[2]);
     set_vec(p, "u_gn", gn[0], gn[1], gn[2]);
+    glUniform1f(glGetUniformLocation(p, "u_offset"), (float)dot3(gn, center));
     glUniform1f(glGetUniformLocation(p, "u_spacing"), (float)spacing);
     glUniform1f(glGetUniformLocation(p, "u_extent"), (float)ext);
+    glUniform1f(glGetUniformLocation(p, "u_fog"), (float)fog);
+    glUniform1i(glGetUniformLocation(p, "u_floor"), floor);
     float g[3];
     wb_lin3(col_ground, g);
     glUniform3f(glGetUniformLocation(p, "u_base"), g[0], g[1], g[2]);
-    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+/* the camera's axes for the ground's view rays: forward, and right and up scaled to
+ * the frame's edges (a pixel's ray is f + x r + y u, x and y in -1..1) */
+static void camera_rays(const wb_renderer *r, GLuint p)
+{
+    double f[3], s[3], u[3];
+    for (int k = 0; k < 3; k++) f[k] = r->cam_target[k] - r->cam_eye[k];
+    norm3(f);
+    cross3(f, r->cam_up, s);
+    norm3(s);
+    cross3(s, f, u);
+    const double ty = tan(r->cam_fov * M_PI / 360), tx = ty * r->w / r->h;
+    set_vec(p, "u_cf", f[0], f[1], f[2]);
+    set_vec(p, "u_cr", tx * s[0], tx * s[1], tx * s[2]);
+    set_vec(p, "u_cu", ty * u[0], ty * u[1], ty * u[2]);
+    glUniform2f(glGetUniformLocation(p, "u_size"), (float)r->w, (float)r->h);
+    set_mat(p, "u_vp", r->vp);
 }
 
 /* uniforms of the lit programs */
@@ -424,6 +452,48 @@ static void background_cpu(wb_renderer *r)
         for (int k = 0; k < 3; k++) c[k] = (uint8_t)lrint(255 * (col_sky_bottom[k] + (col_sky_top[k] - col_sky_bottom[k]) * t));
         for (int x = 0; x < r->w; x++) memcpy(r->rgb + 3 * ((size_t)y * r->w + x), c, 3);
     }
+}
+
+/* the strain colours' legend, bottom left of the frame: "strain" over a bar from blue
+ * (compression) through grey to red (tension) and its numbers, the scale in percent,
+ * on a light panel; only on frames of at least 320 x 200 (on a thumbnail it would
+ * cover the scene) */
+static void draw_legend(wb_renderer *r, double scale)
+{
+    if (r->w < 320 || r->h < 200) return;
+    const int ts = r->h >= 540 ? 2 : 1, pad = 4 * ts, m = 6 * ts, line = 11 * ts, bh = 8 * ts;
+    char lo[32], hi[32];
+    snprintf(hi, sizeof hi, "+%.3g%%", 100 * scale);
+    snprintf(lo, sizeof lo, "-%.3g%%", 100 * scale);
+    const int bw = fmax(80 * ts, wb_text_width(lo, ts) + wb_text_width(hi, ts) + wb_text_width("0", ts) + 12 * ts);
+    const int pw = bw + 2 * pad, ph = 2 * pad + 2 * line + bh + 4 * ts;
+    if (pw + 2 * m > r->w || ph + 2 * m > r->h) return;
+    const int x0 = m, y0 = r->h - m - ph;
+    for (int y = y0; y < y0 + ph; y++)
+        for (int x = x0; x < x0 + pw; x++) {
+            uint8_t *p = r->rgb + 3 * ((size_t)y * r->w + x);
+            for (int k = 0; k < 3; k++) p[k] = (uint8_t)((p[k] + 3 * 242) / 4);
+        }
+    static const uint8_t ink[3] = { 40, 40, 44 };
+    wb_text(r->rgb, r->w, r->h, x0 + pad, y0 + pad, "strain", ink, ts);
+    const int by = y0 + pad + line + 2 * ts;
+    for (int x = 0; x < bw; x++) {
+        float c[3];
+        wb_strain_srgb(2.0 * x / (bw - 1) - 1, c);
+        for (int y = by; y < by + bh; y++) {
+            uint8_t *p = r->rgb + 3 * ((size_t)y * r->w + x0 + pad + x);
+            for (int k = 0; k < 3; k++) p[k] = (uint8_t)lrint(255 * c[k]);
+        }
+    }
+    const int ty = by + bh + 2 * ts;
+    wb_text(r->rgb, r->w, r->h, x0 + pad, ty, lo, ink, ts);
+    wb_text(r->rgb, r->w, r->h, x0 + pad + (bw - wb_text_width("0", ts)) / 2, ty, "0", ink, ts);
+    wb_text(r->rgb, r->w, r->h, x0 + pad + bw - wb_text_width(hi, ts), ty, hi, ink, ts);
+}
+
+double wb_renderer_strain_scale(const wb_renderer *r)
+{
+    return r->drawn && r->layers.strain_shown ? r->layers.scale : 0;
 }
 
 /* what the default camera frames: the union of the current extent and the eased one,
@@ -477,6 +547,7 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     r->drawn = true;
     if (!r->be->gl) {
         background_cpu(r);
+        r->layers.strain_shown = false;
         return true;
     }
     if (!r->be->make_current(r->ctx)) {
@@ -541,7 +612,10 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     glUniform3f(glGetUniformLocation(g->prog_grid, "u_top"), col_sky_top[0], col_sky_top[1], col_sky_top[2]);
     glUniform3f(glGetUniformLocation(g->prog_grid, "u_bottom"), col_sky_bottom[0], col_sky_bottom[1], col_sky_bottom[2]);
     glUniform1f(glGetUniformLocation(g->prog_grid, "u_height"), (float)r->h);
-    double spacing = wb_nice_step(R / 6), center[3], gu[3], gv[3], gn[3];
+    camera_rays(r, g->prog_grid);
+    /* the fog: the ground around the scene stays clear however far the camera is */
+    const double spacing = wb_nice_step(R / 6), fog = 2 * dc + 3 * ext;
+    double center[3], gu[3], gv[3], gn[3];
     float quad[12];
     int planes = 0;
     int32_t nc = wb_collider_count(w);
@@ -549,16 +623,17 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
         wb_collider_def d;
         wb_collider_get_def(w, wb_collider_at(w, i), &d);
         double h;
-        if (d.shape != WB_SHAPE_PLANE || !(o->colliders || (o->grid && floor_height(&d, &h)))) continue;
+        const bool floor = floor_height(&d, &h);
+        if (d.shape != WB_SHAPE_PLANE || !(o->colliders || (o->grid && floor))) continue;
         if (plane_quad(d.normal, d.offset, c, ext, quad, center, gu, gv, gn)) {
-            draw_grid(r, quad, center, gu, gv, gn, spacing, ext);
+            draw_grid(r, center, gu, gv, gn, spacing, ext, floor, fog);
             planes++;
         }
     }
     if (!planes && o->grid) {
         wb_real up[3] = { 0, 1, 0 };
         if (plane_quad(up, fmin(cur.lo[1], r->view_lo[1]), c, ext, quad, center, gu, gv, gn))
-            draw_grid(r, quad, center, gu, gv, gn, spacing, ext);
+            draw_grid(r, center, gu, gv, gn, spacing, ext, true, fog);
     }
 
     /* solids, then the surfaces pushed back a little so links on them stay visible */
@@ -606,5 +681,6 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     const uint8_t *px = r->be->pixels(r->ctx);
     size_t npx = (size_t)r->w * r->h;
     for (size_t i = 0; i < npx; i++) memcpy(r->rgb + 3 * i, px + 4 * i, 3);
+    if (o->legend && l->strain_shown) draw_legend(r, l->scale);
     return true;
 }

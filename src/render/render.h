@@ -50,9 +50,13 @@ typedef struct wb_draw_opts {
     bool materials;        /* tint the particles and surfaces of volume, shape-matching and
                               pressure bodies by their strain (layers.c) */
     bool rigids;           /* rigid bodies, as shaded solids in their own colour */
+    bool strain_auto;      /* strain_scale chosen per frame (layers.c, wb_strain_auto): the 95th
+                              percentile of |strain|, at least 0.5 %, eased over frames */
+    bool legend;           /* a colour bar with its numbers when strain colours are shown */
 } wb_draw_opts;
 
-/* every layer on but the cage, strain_scale 0.02, line_width 1.5 */
+/* every layer on but the cage, the automatic strain scale (strain_scale 0.02 when it
+ * is switched off), line_width 1.5, the legend */
 wb_draw_opts wb_draw_default_opts(void);
 
 wb_renderer *wb_renderer_create(const wb_backend *be, int width, int height, int samples, char *err, size_t n);
@@ -83,6 +87,9 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
  * and in GL's buffers), before drawing; and what the renderer holds for that after */
 size_t wb_renderer_draw_bytes(const wb_renderer *r, const wb_world *w, const wb_draw_skin *skins, int nskins);
 size_t wb_renderer_draw_held(const wb_renderer *r);
+/* the strain drawn fully red / blue in the last frame (strain_scale, or the automatic
+ * one); 0 when no strain colour was shown */
+double wb_renderer_strain_scale(const wb_renderer *r);
 const uint8_t *wb_renderer_pixels(const wb_renderer *r);  /* the last frame, RGB */
 /* world point -> pixel coordinates of the last frame (x right, y down, pixel (i,j)
  * covers [i,i+1) x [j,j+1)); false when behind the camera or nothing drawn yet */

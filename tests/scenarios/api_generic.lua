@@ -282,7 +282,7 @@ CASES["renderer:record"] = { opts = { fps = 30 }, opts_arg = 2, nums = { "fps" }
                              call = function(f, o) return f.r:record("api_generic/frames/", o) end }
 CASES["renderer:pixel"] = { args = { 0, 0 }, nums = { 1, 2 }, call = function(f, ...) return f.r:pixel(...) end }
 CASES["renderer:project"] = { args = { 0, 0, 0 }, nums = { 1, 2, 3 }, call = function(f, ...) return f.r:project(...) end }
-for _, name in ipairs{ "close", "get_camera", "image", "info", "recording", "size", "stop" } do
+for _, name in ipairs{ "close", "get_camera", "image", "info", "recording", "size", "stop", "strain_scale" } do
   CASES["renderer:" .. name] = { none = "no arguments" }
 end
 CASES["renderer:save_png"] = { none = "a path" }
