@@ -14,6 +14,7 @@
 #   (g) tests/cli/firstrun.sh                   what a new user meets: make deps, bench --frames, print
 #   (h) tests/cli/watchdog.sh                   --time-limit in finalizers, C calls, helper programs
 #   (i) tests/fuzz/replay.sh                    the fuzz corpus and past crashes, once each
+#   (j) tests/cli/bench.sh                      wobble bench --json on a tiny configuration
 # Each part prints its output and ends with "N passed, N failed"; a part that crashes
 # or prints no such line counts as a failure, never as zero tests. The last line is
 # the sum, "N passed, N failed"; the exit status is 1 when anything failed.
@@ -127,6 +128,7 @@ part "first run (tests/cli/firstrun.sh)" sh tests/cli/firstrun.sh "$BUILD"
 part "--time-limit watchdog (tests/cli/watchdog.sh)" sh tests/cli/watchdog.sh "$BUILD"
 part "fuzz corpus replay (tests/fuzz/replay.sh)" sh tests/fuzz/replay.sh "$BUILD"
 part "tetgen under the budgets (tests/cli/tets.sh)" sh tests/cli/tets.sh "$BUILD"
+part "wobble bench --json and the Bullet peer's plumbing (tests/cli/bench.sh)" sh tests/cli/bench.sh "$BUILD"
 
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]

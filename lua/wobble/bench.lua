@@ -97,9 +97,12 @@ function M.bullet(cfg)
     if f then line = f:read("l"); f:close() end
   end
   if not line then
-    if not io.popen then error("bench: --set bullet=PATH runs the Bullet peer as a process: it needs --unsafe", 2) end
     local cmd = string.format("'%s' %s", tostring(exe):gsub("'", "'\\''"), table.concat(argv, " "))
-    local p = io.popen(cmd)
+    local made, p = pcall(io.popen, cmd)
+    if not made or not p then
+      error("bench: --set bullet=PATH runs the Bullet peer as a process of its own: it needs --unsafe ("
+            .. tostring(p) .. ")", 2)
+    end
     line = p:read("a")
     local ok, how, code = p:close()
     if not ok then error(string.format("bench: the Bullet peer failed (%s %s): %s", how, code, cmd), 2) end
@@ -131,6 +134,11 @@ local columns = {
 }
 
 function M.report(r, note)
+  if args.json_file then   -- make bench JSON=FILE: the rows as JSON lines too (--unsafe)
+    local f = assert(io.open(args.json_file, "a"))
+    f:write(M.json(r), "\n")
+    f:close()
+  end
   if args.json then
     print(M.json(r))
     return

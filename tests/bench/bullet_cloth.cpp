@@ -21,7 +21,8 @@
 //   margin is the particle radius.
 // - timing: the stepping loop alone (wall clock, like wobble's w:stats().step_ms), after one
 //   untimed frame; memory: resident memory grown from before the world to the end, per node.
-// Output: one line of JSON.
+// Output: one line of JSON; exit code 3 when the sheet blew up (a node below -0.5 m or
+// above its start + 0.5 m, or not a number), 2 for a bad argument.
 #include <btBulletDynamicsCommon.h>
 #include <BulletSoftBody/btSoftBodyHelpers.h>
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
@@ -138,12 +139,17 @@ int main(int argc, char **argv) {
         if (py > ymax) ymax = py;
     }
     const int nodes = cloth->m_nodes.size(), links = cloth->m_links.size();
+    const bool blew_up = !(ymin > -0.5 && ymax < height + 0.5);  // also NaN
     printf("{\"engine\": \"bullet\", \"particles\": %d, \"links\": %d, \"frames\": %d, \"ticks_per_frame\": %.4f, "
            "\"piterations\": %d, \"ms_per_frame\": %.4f, \"ns_per_projection\": %.3f, \"bytes_per_particle\": %.1f, "
            "\"y_min\": %.4f, \"y_max\": %.4f, \"scalar_bytes\": %d}\n",
            nodes, links, frames, (double)ticks / frames, iterations, secs * 1e3 / frames,
            secs * 1e9 / ((double)ticks * iterations * links), rss1 > rss0 ? (rss1 - rss0) / nodes : 0.0, ymin, ymax,
            (int)sizeof(btScalar));
+    if (blew_up) {  // timing a sheet that blew up compares nothing
+        fprintf(stderr, "bullet_cloth: the sheet blew up (y from %g to %g)\n", ymin, ymax);
+        return 3;
+    }
     world.removeSoftBody(cloth);
     delete cloth;
     world.removeRigidBody(&ground);

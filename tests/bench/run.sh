@@ -1,0 +1,57 @@
+#!/bin/sh
+# tests/bench/run.sh BUILD FLOAT_BUILD [JSON_FILE]: what `make bench` runs once it has built
+# BUILD/wobble (double), FLOAT_BUILD/wobble (WB_FLOAT) and BUILD/bullet_cloth (the Bullet
+# peer). Every scene runs in a process of its own, so that its memory per particle is the
+# growth of a fresh process (memory an earlier scene freed would be reused unseen); the
+# Bullet figures of one scene are measured once (BUILD/bullet-cache) and shared by its
+# 2-thread row and the WB_FLOAT rows. Any scene or peer that fails stops the benchmark
+# (exit 1). JSON_FILE: every row as one JSON object per line, for tracking.
+BUILD=${1:-build-bench}
+FLOAT=${2:-}
+JSON=${3:-}
+cd "$(dirname "$0")/../.." || exit 2
+PEER=$BUILD/bullet_cloth
+CACHE=$BUILD/bullet-cache
+rm -rf "$CACHE" && mkdir -p "$CACHE" || exit 2
+if [ -n "$JSON" ]; then
+    case $JSON in /*) ;; *) JSON=$PWD/$JSON ;; esac
+    mkdir -p "$(dirname "$JSON")" && : >"$JSON" || exit 2
+fi
+SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2 scale32 scale64 scale128 scale256 scale512 contacts sheet tets"
+FLOAT_SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2"
+
+# scene EXE NAME HEADER(1/0): one row (and the header when asked)
+scene() {
+    out=$("$1" bench --unsafe --quiet --out "$BUILD/bench-out" --set scenes="$2" --set header="$3" \
+          --set bullet="$PEER" --set bullet_cache="$CACHE" ${JSON:+--set json_file="$JSON"} 2>&1)
+    rc=$?
+    if [ $rc -ne 0 ] || ! echo "$out" | grep -q "^$2 "; then
+        echo "$out" | grep -v '^# tests/bench/' >&2
+        echo "bench: the scene $2 failed ($1, exit code $rc)" >&2
+        exit 1
+    fi
+    echo "$out" | grep -v '^# tests/bench/'
+}
+
+cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo 2>/dev/null | head -n 1)
+bullet=$(dpkg-query -W -f '${Version}' libbullet-dev 2>/dev/null || pkg-config --modversion bullet)
+echo "wobble bench: $(nproc) CPU ($cpu), load average $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null),"
+echo "Bullet $bullet (btSoftBody, one thread); ratio = Bullet ms / wobble ms (> 1: wobble is faster)"
+echo
+echo "== double precision ($BUILD)"
+first=1
+for s in $SCENES; do
+    scene "$BUILD/wobble" "$s" $first
+    first=0
+done
+if [ -n "$FLOAT" ]; then
+    echo
+    echo "== WB_FLOAT ($FLOAT): the cloth scenes (Bullet's figures as above)"
+    first=1
+    for s in $FLOAT_SCENES; do
+        scene "$FLOAT/wobble" "$s" $first
+        first=0
+    done
+fi
+[ -n "$JSON" ] && echo && echo "JSON lines: $JSON"
+exit 0
