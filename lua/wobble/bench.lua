@@ -131,6 +131,7 @@ local columns = {
   { "ns_per_projection", "%8s", "%8.2f", "ns/proj" }, { "ns_per_projection_solve", "%8s", "%8.2f", "(solve)" },
   { "bytes_per_particle", "%8s", "%8.0f", "B/part" },
   { "bullet_ms_per_frame", "%10s", "%10.3f", "bullet ms" }, { "bullet_ratio", "%7s", "%7.2f", "ratio" },
+  { "bullet_ratio_cpu", "%9s", "%9.2f", "cpu ratio" },
 }
 
 function M.report(r, note)

@@ -16,11 +16,14 @@
 //   wobble substep with iterations = piterations. Bullet's other solvers stay at their
 //   defaults (viterations = diterations = 0). The links are put in random order
 //   (randomizeConstraints, see below): in creation order the sheet blows up.
+// - the sheet: nodes and links alone by default; patch=1 builds it with CreatePatch, whose
+//   faces cost Bullet normals and face updates every step that wobble's step does not do
+//   (measured: about 10 % more CPU time at n = 128).
 // - ground: wobble's plane is a static box here (Bullet's soft-rigid collision works on the
 //   sparse SDF of convex shapes; btStaticPlaneShape is concave); the sheet's collision
 //   margin is the particle radius.
-// - timing: the stepping loop alone (wall clock, like wobble's w:stats().step_ms), after one
-//   untimed frame; memory: resident memory grown from before the world to the end, per node.
+// - timing: the stepping loop alone (wall clock, like wobble's w:stats().step_ms, and the
+//   process's CPU time, steadier on a busy machine), after one untimed frame; memory: resident memory grown from before the world to the end, per node.
 // Output: one line of JSON; exit code 3 when the sheet blew up (a node below -0.5 m or
 // above its start + 0.5 m, or not a number), 2 for a bad argument.
 #include <btBulletDynamicsCommon.h>
@@ -48,15 +51,16 @@ static double rss_bytes() {
     return kb * 1024;
 }
 
-static double now() {
+static double now(clockid_t c = CLOCK_MONOTONIC) {
     timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
+    clock_gettime(c, &t);
     return t.tv_sec + t.tv_nsec * 1e-9;
 }
 
 int main(int argc, char **argv) {
     // key=value arguments, the names of the Lua scene's fields
     int n = 128, frames = 300, substeps = 10, iterations = 1;
+    bool patch = false, ordered = false;
     double size = 2, height = 1, mass = 1, radius = 0.02, dt = 1.0 / 60, gravity = -9.81;
     for (int i = 1; i < argc; i++) {
         const char *eq = strchr(argv[i], '=');
@@ -72,6 +76,8 @@ int main(int argc, char **argv) {
         else if (k == "mass") mass = v;
         else if (k == "radius") radius = v;
         else if (k == "dt") dt = v;
+        else if (k == "patch") patch = v != 0;
+        else if (k == "ordered") ordered = v != 0;
         else { fprintf(stderr, "bullet_cloth: unknown key '%s'\n", k.c_str()); return 2; }
     }
     if (n < 2 || frames < 1 || substeps < 1 || iterations < 1) {
@@ -104,15 +110,39 @@ int main(int argc, char **argv) {
     world.addRigidBody(&ground);
 
     const btScalar h = (btScalar)(size / 2), y = (btScalar)height;
-    btSoftBody *cloth = btSoftBodyHelpers::CreatePatch(info, btVector3(-h, y, -h), btVector3(h, y, -h),
-                                                       btVector3(-h, y, h), btVector3(h, y, h), n, n,
-                                                       1 + 2, true);  // pins: corners 00 and 10
+    btSoftBody *cloth;
+    if (patch) {  // Bullet's helper: the same links, plus faces (normals, aero) every step
+        cloth = btSoftBodyHelpers::CreatePatch(info, btVector3(-h, y, -h), btVector3(h, y, -h), btVector3(-h, y, h),
+                                               btVector3(h, y, h), n, n, 1 + 2, true);  // pins: corners 00 and 10
+    } else {      // nodes and links alone, in CreatePatch's (and wobble's) layout
+        btAlignedObjectArray<btVector3> x;
+        btAlignedObjectArray<btScalar> m;
+        x.resize(n * n);
+        m.resize(n * n);
+        for (int j = 0; j < n; j++)
+            for (int i = 0; i < n; i++) {
+                x[i + j * n] = btVector3(-h + 2 * h * i / (n - 1), y, -h + 2 * h * j / (n - 1));
+                m[i + j * n] = 1;
+            }
+        m[0] = m[n - 1] = 0;  // pins: corners 00 and 10
+        cloth = new btSoftBody(&info, n * n, &x[0], &m[0]);
+        for (int j = 0; j < n; j++)
+            for (int i = 0; i < n; i++) {
+                const int a = i + j * n;
+                if (i + 1 < n) cloth->appendLink(a, a + 1);
+                if (j + 1 < n) cloth->appendLink(a, a + n);
+                if (i + 1 < n && j + 1 < n) {  // one diagonal per cell, alternating
+                    if ((i + j) % 2 == 0) cloth->appendLink(a, a + n + 1);
+                    else cloth->appendLink(a + 1, a + n);
+                }
+            }
+    }
     cloth->m_materials[0]->m_kLST = 1;
     // Bullet's Gauss-Seidel sweeps the links in creation order, row by row from the pinned
     // edge: with piterations = 1 a sheet of 48 x 48 or more then blows up within 20 frames
     // (also without the ground). Bullet's own remedy, used by its cloth demos, is a random
     // order; wobble sweeps its links in colour batches instead.
-    cloth->randomizeConstraints();
+    if (!ordered) cloth->randomizeConstraints();
     cloth->m_cfg.piterations = iterations;
     cloth->m_cfg.kDP = 0;  // no damping: wobble's world damping is 0
     cloth->m_cfg.kDF = 0;  // no friction: wobble's collider friction is 0
@@ -124,12 +154,12 @@ int main(int argc, char **argv) {
     world.stepSimulation(fdt, substeps, h_sub);  // untimed: first-step set-up, as wobble's scene
     info.m_sparsesdf.GarbageCollect();
     ticks = 0;
-    const double t0 = now();
+    const double t0 = now(), c0 = now(CLOCK_PROCESS_CPUTIME_ID);
     for (int f = 0; f < frames; f++) {
         world.stepSimulation(fdt, substeps, h_sub);
         info.m_sparsesdf.GarbageCollect();  // once a frame, as Bullet's soft-body demos do
     }
-    const double secs = now() - t0, rss1 = rss_bytes();
+    const double secs = now() - t0, cpu = now(CLOCK_PROCESS_CPUTIME_ID) - c0, rss1 = rss_bytes();
 
     // sanity: the sheet hangs and lies on the ground, it did not blow up
     double ymin = 1e30, ymax = -1e30;
@@ -141,9 +171,9 @@ int main(int argc, char **argv) {
     const int nodes = cloth->m_nodes.size(), links = cloth->m_links.size();
     const bool blew_up = !(ymin > -0.5 && ymax < height + 0.5);  // also NaN
     printf("{\"engine\": \"bullet\", \"particles\": %d, \"links\": %d, \"frames\": %d, \"ticks_per_frame\": %.4f, "
-           "\"piterations\": %d, \"ms_per_frame\": %.4f, \"ns_per_projection\": %.3f, \"bytes_per_particle\": %.1f, "
+           "\"piterations\": %d, \"ms_per_frame\": %.4f, \"cpu_ms_per_frame\": %.4f, \"ns_per_projection\": %.3f, \"bytes_per_particle\": %.1f, "
            "\"y_min\": %.4f, \"y_max\": %.4f, \"scalar_bytes\": %d}\n",
-           nodes, links, frames, (double)ticks / frames, iterations, secs * 1e3 / frames,
+           nodes, links, frames, (double)ticks / frames, iterations, secs * 1e3 / frames, cpu * 1e3 / frames,
            secs * 1e9 / ((double)ticks * iterations * links), rss1 > rss0 ? (rss1 - rss0) / nodes : 0.0, ymin, ymax,
            (int)sizeof(btScalar));
     if (blew_up) {  // timing a sheet that blew up compares nothing
