@@ -75,7 +75,7 @@ end
 
 -- the Bullet peer: --set bullet=PATH (the program make bench builds) and --unsafe (a
 -- process of its own). cfg: n, frames, substeps, iterations, size, height, mass, radius.
--- With --set bullet_cache=DIR the result is kept in DIR (make bench empties it first), so
+-- With --set bullet_cache=DIR (absolute: a relative path is the --out folder's) the result is kept in DIR (make bench empties it first), so
 -- the 2-thread row and the WB_FLOAT build compare with the same Bullet run. Any failure
 -- of the peer is an error: a benchmark that silently drops its comparison is worse than
 -- none. Returns nil when no peer was asked for.

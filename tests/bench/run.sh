@@ -10,8 +10,9 @@ BUILD=${1:-build-bench}
 FLOAT=${2:-}
 JSON=${3:-}
 cd "$(dirname "$0")/../.." || exit 2
-PEER=$BUILD/bullet_cloth
-CACHE=$BUILD/bullet-cache
+# absolute: a relative path in a scene is the --out folder's
+PEER=$PWD/$BUILD/bullet_cloth
+CACHE=$PWD/$BUILD/bullet-cache
 rm -rf "$CACHE" && mkdir -p "$CACHE" || exit 2
 # the rows as JSON lines: JSON_FILE, else BUILD/bench.json (the goals below read them)
 [ -n "$JSON" ] || JSON=$BUILD/bench.json
@@ -75,7 +76,7 @@ goal "cloth128: Bullet / wobble, 1 thread" "$(fig cloth128 double bullet_ratio)"
 goal "cloth128: Bullet / wobble, 2 threads" "$(fig cloth128_t2 double bullet_ratio)" 18
 goal "cloth32 (3000 frames): Bullet / wobble" "$(fig cloth32 double bullet_ratio)" 4
 goal "cloth128: 2 threads / 1 thread (speed-up)" "$(speedup cloth128 double)" 1.5
-goal "cloth32: 2 threads / 1 thread (>= 0.9: not slower)" "$(speedup cloth32 double)" 0.9
+goal "cloth32: 2 threads / 1 thread (not slower)" "$(speedup cloth32 double)" 0.9
 if [ -n "$FLOAT" ]; then
     goal "cloth128, WB_FLOAT: Bullet / wobble, 1 thread" "$(fig cloth128 float bullet_ratio)" 12
     goal "cloth128, WB_FLOAT: Bullet / wobble, 2 threads" "$(fig cloth128_t2 float bullet_ratio)" 18
