@@ -1,29 +1,31 @@
-// bullet_cloth.cpp: the Bullet peer of wobble's cloth benchmark scenes (tests/bench/cloth.lua).
+// bullet_cloth.cpp: the Bullet peer of wobble's cloth benchmark scenes (tests/bench/cloth128.lua).
 // The same scene in Bullet's btSoftBody (Debian's libbullet-dev), one thread, run as a
 // process of its own by the Lua scene, which prints the ratio. Built by `make bench`:
 //   g++ -O3 -march=native tests/bench/bullet_cloth.cpp $(pkg-config --cflags --libs bullet)
+//   build-bench/bullet_cloth n=128 frames=120 substeps=10 iterations=1 size=2 height=1
 //
 // The scene, as wobble's w:cloth{origin = {-s/2, y, -s/2}, size = {s, s}, res = {n, n}}:
 // an n x n sheet in the x-z plane at height y, total mass m, pinned at corners (0, 0) and
-// (n-1, 0), falling under gravity onto the ground, no friction, no air.
-// - links: btSoftBodyHelpers::CreatePatch with gendiags makes the structural links and one
-//   diagonal per cell, alternating between cells: the links of wobble's cloth with
-//   shear = true (n = 128: 48,641 both), as stiff as Bullet goes (kLST = 1, compliance 0).
-// - work per frame: wobble's substeps x iterations map to Bullet's internal steps x
-//   m_cfg.piterations: one frame of dt is stepSimulation(dt, S, dt/S), S internal steps of
-//   dt/S (the tick count is reported; float time accumulation can shift a step to the next
-//   frame), each predicting, colliding and sweeping every link piterations times, as one
-//   wobble substep with iterations = piterations. Bullet's other solvers stay at their
-//   defaults (viterations = diterations = 0). The links are put in random order
-//   (randomizeConstraints, see below): in creation order the sheet blows up.
+// (n-1, 0), falling under gravity onto the ground, no friction, no air, no damping.
+// - links: the structural links and one diagonal per cell, alternating between cells, as
+//   wobble's cloth with shear = true and CreatePatch with gendiags (n = 128: 48,641 in all
+//   three), as stiff as Bullet goes (kLST = 1; wobble's compliance 0).
 // - the sheet: nodes and links alone by default; patch=1 builds it with CreatePatch, whose
 //   faces cost Bullet normals and face updates every step that wobble's step does not do
 //   (measured: about 10 % more CPU time at n = 128).
+// - work per frame: wobble's substeps x iterations map to Bullet's internal steps x
+//   m_cfg.piterations: one frame of dt is stepSimulation(dt, S, dt/S), S internal steps of
+//   dt/S (the tick count is reported; float time accumulation could shift a step to the
+//   next frame), each predicting, colliding and sweeping every link piterations times, as
+//   one wobble substep with iterations = piterations. Bullet's other solvers stay at their
+//   defaults (viterations = diterations = 0). The links are put in random order
+//   (randomizeConstraints, see below; ordered=1 keeps creation order).
 // - ground: wobble's plane is a static box here (Bullet's soft-rigid collision works on the
 //   sparse SDF of convex shapes; btStaticPlaneShape is concave); the sheet's collision
 //   margin is the particle radius.
-// - timing: the stepping loop alone (wall clock, like wobble's w:stats().step_ms, and the
-//   process's CPU time, steadier on a busy machine), after one untimed frame; memory: resident memory grown from before the world to the end, per node.
+// - timing: the stepping loop alone, after one untimed frame: wall clock (as wobble's
+//   w:stats().step_ms) and the process's CPU time (steadier on a busy machine). Memory:
+//   resident memory grown from before the world to the end, per node.
 // Output: one line of JSON; exit code 3 when the sheet blew up (a node below -0.5 m or
 // above its start + 0.5 m, or not a number), 2 for a bad argument.
 #include <btBulletDynamicsCommon.h>
@@ -35,6 +37,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <string>
 
 static long ticks = 0;
 static void on_tick(btDynamicsWorld *, btScalar) { ticks++; }
