@@ -93,9 +93,21 @@ asan: check-deps
 mutate: check-deps
 	@sh tests/mutate/run.sh $(MUTATIONS)
 
+# the benchmark (README, "Benchmark"; tests/bench/run.sh): the double build, a WB_FLOAT
+# build beside it and the Bullet peer, each scene in a process of its own; BENCH_PKGS are
+# installed by it alone. JSON=FILE: every row as a JSON line too
+BENCH_OPT := -O3 -march=native
 bench: check-deps
-	@$(MAKE) --no-print-directory OPT="-O3 -march=native" BUILD=build-bench build
-	@build-bench/wobble bench
+	@$(MAKE) --no-print-directory check-deps PKGS="$(BENCH_PKGS)"
+	@$(MAKE) --no-print-directory OPT="$(BENCH_OPT)" BUILD=build-bench build build-bench/bullet_cloth
+	@$(MAKE) --no-print-directory OPT="$(BENCH_OPT)" BUILD=build-bench-float EXTRA_CFLAGS=-DWB_FLOAT build-bench-float/wobble
+	@sh tests/bench/run.sh build-bench build-bench-float $(JSON)
+
+# the Bullet peer: Bullet's headers as system headers (they do not pass -Wextra -Werror)
+$(BUILD)/bullet_cloth: tests/bench/bullet_cloth.cpp
+	@mkdir -p $(BUILD)
+	g++ -std=c++11 $(BENCH_OPT) -Wall -Wextra -Werror $(patsubst -I%,-isystem %,$(shell pkg-config --cflags bullet)) \
+	  -o $@ $< $(shell pkg-config --libs bullet)
 
 # the clothesline, 6 s at 1280x720 with every layer, as an H.264 video
 demo: check-deps
@@ -115,7 +127,7 @@ install: all
 
 # build folders only: out/ holds the user's videos and results
 clean:
-	rm -rf build build-asan build-bench build-fuzz $(BUILD)
+	rm -rf build build-asan build-bench build-bench-float build-fuzz $(BUILD)
 
 # ---- fuzzing (README, "Fuzzing"): `make fuzz` runs each libFuzzer target FUZZ_TIME
 # seconds; FUZZ_PKGS are installed by it alone, never by `make test`

@@ -15,6 +15,7 @@
 #   (h) tests/cli/watchdog.sh                   --time-limit in finalizers, C calls, helper programs
 #   (i) tests/fuzz/replay.sh                    the fuzz corpus and past crashes, once each
 #   (j) tests/cli/sweep.sh                      wobble sweep run by GNU parallel, result.json, collect
+#   (k) tests/cli/bench.sh                      wobble bench --json on a tiny configuration
 # Each part prints its output and ends with "N passed, N failed"; a part that crashes
 # or prints no such line counts as a failure, never as zero tests. The last line is
 # the sum, "N passed, N failed"; the exit status is 1 when anything failed.
@@ -130,6 +131,7 @@ part "fuzz corpus replay (tests/fuzz/replay.sh)" sh tests/fuzz/replay.sh "$BUILD
 part "tetgen under the budgets (tests/cli/tets.sh)" sh tests/cli/tets.sh "$BUILD"
 part "--replay of input logs (tests/cli/replay.sh)" sh tests/cli/replay.sh "$BUILD"
 part "sweeps through GNU parallel, result.json, collect (tests/cli/sweep.sh)" sh tests/cli/sweep.sh "$BUILD"
+part "wobble bench --json and the Bullet peer's plumbing (tests/cli/bench.sh)" sh tests/cli/bench.sh "$BUILD"
 
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]

@@ -7,8 +7,12 @@
 -- (particle-particle and particle-triangle) in the last substep (mean over the frames), the
 -- broad phases' ms per frame and their share of the step.
 -- Run: make bench   (or build/wobble bench [--json]; --set frames=N for a quick look)
+local bench = require("wobble.bench")
 local args = wobble.args
-local frames = args.frames or 300
+if not bench.want("sheet") then return end
+local frames = bench.frames(300)
+collectgarbage()
+local rss0 = bench.rss()
 local w = wobble.world{ substeps = 10, iterations = 2, threads = args.threads or 1, contacts = args.contacts ~= 0 }
 local sheet = w:cloth{ origin = {-1, 0, -1}, size = {2, 2}, res = {17, 17}, mass = 2, radius = 0.02,
                        compliance = 1e-6, friction = 0.3 }
@@ -22,11 +26,12 @@ for l = 0, 2 do
   end
 end
 
-local step_ms, broad_ms, contacts = 0, 0, 0
+local step_ms, broad_ms, contacts, solve_ms, projections = 0, 0, 0, 0, 0
 for _ = 1, frames do
   w:step()
   local s = w:stats()
   step_ms, broad_ms, contacts = step_ms + s.step_ms, broad_ms + s.broad_ms, contacts + s.particle_contacts
+  solve_ms, projections = solve_ms + s.solve_ms, projections + s.projections
 end
 local s = w:stats()
 local r = {
@@ -36,12 +41,9 @@ local r = {
   contacts_per_frame = contacts / frames,
   broad_ms_per_frame = broad_ms / frames,
   broad_share = broad_ms / step_ms,
+  ns_per_projection = step_ms * 1e6 / projections,          -- whole step / projections (links, contacts)
+  ns_per_projection_solve = solve_ms * 1e6 / projections,
+  bytes_per_particle = bench.bytes_per(rss0, s.particles),
 }
-if args.json then
-  print(require("wobble.bench").json(r))
-else
-  print(string.format("%-10s %9s %11s %8s %6s %10s %10s %12s %8s", "scene", "particles", "constraints",
-    "substeps", "iters", "ms/frame", "contacts", "broad ms/fr", "broad %"))
-  print(string.format("%-10s %9d %11d %8d %6d %10.3f %10.1f %12.3f %8.1f", r.scene, r.particles, r.constraints,
-    r.substeps, r.iterations, r.ms_per_frame, r.contacts_per_frame, r.broad_ms_per_frame, 100 * r.broad_share))
-end
+bench.report(r, string.format("contacts %.1f, broad %.3f ms/frame (%.1f %%)", r.contacts_per_frame,
+  r.broad_ms_per_frame, 100 * r.broad_share))

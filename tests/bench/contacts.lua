@@ -7,8 +7,12 @@
 -- broad phase as a multiple of one distance-constraint sweep (one iteration over every
 -- link, the solver's projection time / (substeps x iterations)): the aim is below 1.
 -- Run: make bench   (or build/wobble bench [--json]; --set frames=N for a quick look)
+local bench = require("wobble.bench")
 local args = wobble.args
-local frames = args.frames or 300
+if not bench.want("contacts") then return end
+local frames = bench.frames(300)
+collectgarbage()
+local rss0 = bench.rss()
 local w = wobble.world{ substeps = 10, iterations = 2, threads = args.threads or 1, contacts = args.contacts ~= 0 }
 w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.5 }
 for _, n in ipairs{ {1, 0, 0}, {-1, 0, 0}, {0, 0, 1}, {0, 0, -1} } do
@@ -21,12 +25,12 @@ for k = 0, 26 do
              compliance = 1e-5, damping = 0.01, friction = 0.4 }
 end
 
-local step_ms, broad_ms, solve_ms, contacts = 0, 0, 0, 0
+local step_ms, broad_ms, solve_ms, contacts, projections = 0, 0, 0, 0, 0
 for _ = 1, frames do
   w:step()
   local s = w:stats()
   step_ms, broad_ms, contacts = step_ms + s.step_ms, broad_ms + s.broad_ms, contacts + s.particle_contacts
-  solve_ms = solve_ms + s.solve_ms
+  solve_ms, projections = solve_ms + s.solve_ms, projections + s.projections
 end
 local s = w:stats()
 local r = {
@@ -37,14 +41,10 @@ local r = {
   broad_ms_per_frame = broad_ms / frames,
   broad_share = broad_ms / step_ms,
   sweep_ms = solve_ms / (frames * s.substeps * s.iterations),
+  ns_per_projection = step_ms * 1e6 / projections,          -- whole step / projections (links, contacts)
+  ns_per_projection_solve = solve_ms * 1e6 / projections,
+  bytes_per_particle = bench.bytes_per(rss0, s.particles),
 }
 r.broad_sweeps = r.broad_ms_per_frame / r.sweep_ms
-if args.json then
-  print(require("wobble.bench").json(r))
-else
-  print(string.format("%-10s %9s %11s %8s %6s %10s %10s %12s %8s %12s", "scene", "particles", "constraints",
-    "substeps", "iters", "ms/frame", "contacts", "broad ms/fr", "broad %", "broad/sweep"))
-  print(string.format("%-10s %9d %11d %8d %6d %10.3f %10.1f %12.3f %8.1f %12.2f", r.scene, r.particles,
-    r.constraints, r.substeps, r.iterations, r.ms_per_frame, r.contacts_per_frame, r.broad_ms_per_frame,
-    100 * r.broad_share, r.broad_sweeps))
-end
+bench.report(r, string.format("contacts %.1f, broad %.3f ms/frame (%.1f %%, %.2f sweeps)", r.contacts_per_frame,
+  r.broad_ms_per_frame, 100 * r.broad_share, r.broad_sweeps))

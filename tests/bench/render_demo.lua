@@ -6,6 +6,7 @@
 -- wobble.clock() is wall time: os.clock() would add up llvmpipe's threads.
 -- Run: make bench   (or build/wobble bench; --set frames=N for a quick look)
 local args = wobble.args
+if not require("wobble.bench").want("render_demo") then return end
 local frames = args.frames or 120
 local width, height = args.width or 1280, args.height or 720
 

@@ -1,0 +1,86 @@
+#!/bin/sh
+# tests/bench/run.sh BUILD FLOAT_BUILD [JSON_FILE]: what `make bench` runs once it has built
+# BUILD/wobble (double), FLOAT_BUILD/wobble (WB_FLOAT) and BUILD/bullet_cloth (the Bullet
+# peer). Every scene runs in a process of its own, so that its memory per particle is the
+# growth of a fresh process (memory an earlier scene freed would be reused unseen); the
+# Bullet figures of one scene are measured once (BUILD/bullet-cache) and shared by its
+# 2-thread row and the WB_FLOAT rows. Any scene or peer that fails stops the benchmark
+# (exit 1). JSON_FILE: every row as one JSON object per line, for tracking.
+BUILD=${1:-build-bench}
+FLOAT=${2:-}
+JSON=${3:-}
+cd "$(dirname "$0")/../.." || exit 2
+# absolute: a relative path in a scene is the --out folder's
+PEER=$PWD/$BUILD/bullet_cloth
+CACHE=$PWD/$BUILD/bullet-cache
+rm -rf "$CACHE" && mkdir -p "$CACHE" || exit 2
+# the rows as JSON lines: JSON_FILE, else BUILD/bench.json (the goals below read them)
+[ -n "$JSON" ] || JSON=$BUILD/bench.json
+case $JSON in /*) ;; *) JSON=$PWD/$JSON ;; esac
+mkdir -p "$(dirname "$JSON")" && : >"$JSON" || exit 2
+SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2 scale32 scale64 scale128 scale256 scale512 contacts sheet tets"
+FLOAT_SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2"
+
+# scene EXE NAME HEADER(1/0): one row (and the header when asked)
+scene() {
+    out=$("$1" bench --unsafe --quiet --out "$BUILD/bench-out" --set scenes="$2" --set header="$3" \
+          --set bullet="$PEER" --set bullet_cache="$CACHE" --set json_file="$JSON" 2>&1)
+    rc=$?
+    if [ $rc -ne 0 ] || ! echo "$out" | grep -q "^$2 "; then
+        echo "$out" | grep -v '^# tests/bench/' >&2
+        echo "bench: the scene $2 failed ($1, exit code $rc)" >&2
+        exit 1
+    fi
+    echo "$out" | grep -v '^# tests/bench/'
+}
+
+cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo 2>/dev/null | head -n 1)
+bullet=$(dpkg-query -W -f '${Version}' libbullet-dev 2>/dev/null || pkg-config --modversion bullet)
+echo "wobble bench: $(nproc) CPU ($cpu), load average $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null),"
+echo "Bullet $bullet (btSoftBody, one thread); ratio = Bullet ms / wobble ms (> 1: wobble is faster)"
+echo
+echo "== double precision ($BUILD)"
+first=1
+for s in $SCENES; do
+    scene "$BUILD/wobble" "$s" $first
+    first=0
+done
+if [ -n "$FLOAT" ]; then
+    echo
+    echo "== WB_FLOAT ($FLOAT): the cloth scenes (Bullet's figures as above)"
+    first=1
+    for s in $FLOAT_SCENES; do
+        scene "$FLOAT/wobble" "$s" $first
+        first=0
+    done
+fi
+
+# fig SCENE PRECISION KEY: one figure of the JSON rows ("" when missing or null)
+fig() {
+    grep "\"scene\": \"$1\"" "$JSON" | grep "\"precision\": \"$2\"" | head -n 1 |
+        sed -n "s/.*\"$3\": \([-0-9.e+]*\)[,}].*/\1/p"
+}
+# goal LABEL VALUE GOAL: one line of the goals of issue 12 (ratios, larger is better)
+goal() {
+    awk -v l="$1" -v v="$2" -v g="$3" 'BEGIN {
+        if (v == "") { printf "  %-46s %8s   goal %5.2f\n", l, "-", g; exit }
+        printf "  %-46s %8.2f   goal %5.2f  %s\n", l, v, g, (v + 0 >= g ? "met" : "not met") }'
+}
+speedup() {  # wobble 1-thread ms / 2-thread ms of one scene
+    a=$(fig "$1" "$2" ms_per_frame) b=$(fig "$1_t2" "$2" ms_per_frame)
+    [ -n "$a" ] && [ -n "$b" ] && awk -v a="$a" -v b="$b" 'BEGIN { printf "%.4f", a / b }'
+}
+echo
+echo "== the goals of issue 12 (ratios of this run; wall clock)"
+goal "cloth128: Bullet / wobble, 1 thread" "$(fig cloth128 double bullet_ratio)" 12
+goal "cloth128: Bullet / wobble, 2 threads" "$(fig cloth128_t2 double bullet_ratio)" 18
+goal "cloth32 (3000 frames): Bullet / wobble" "$(fig cloth32 double bullet_ratio)" 4
+goal "cloth128: 2 threads / 1 thread (speed-up)" "$(speedup cloth128 double)" 1.5
+goal "cloth32: 2 threads / 1 thread (not slower)" "$(speedup cloth32 double)" 0.9
+if [ -n "$FLOAT" ]; then
+    goal "cloth128, WB_FLOAT: Bullet / wobble, 1 thread" "$(fig cloth128 float bullet_ratio)" 12
+    goal "cloth128, WB_FLOAT: Bullet / wobble, 2 threads" "$(fig cloth128_t2 float bullet_ratio)" 18
+fi
+echo
+echo "JSON lines: $JSON"
+exit 0
