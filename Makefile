@@ -165,3 +165,11 @@ fuzz: check-deps
 	    -print_final_stats=1 -artifact_prefix=$(FUZZ_BUILD)/crash-$$t- $$dict \
 	    $(FUZZ_BUILD)/corpus/$$t tests/fuzz/corpus/$$t tests/fuzz/regress/$$t || exit 1; \
 	done
+
+# tests/cli/replay.sh: the input recorder (src/lua/input.h) has no Lua entry point, so a
+# small program drives it as the viewer does, linked with the app's objects but main.c
+DRIVER_OBJ = $(filter-out $(BUILD)/obj/cli/%,$(APP_OBJ))
+build: $(BUILD)/input_driver
+$(BUILD)/input_driver: tests/cli/input_driver.c $(DRIVER_OBJ) $(BUILD)/libwobble.a $(HEADERS)
+	$(CC) $(CFLAGS) $(PC_CFLAGS) -o $@ tests/cli/input_driver.c $(DRIVER_OBJ) $(BUILD)/libwobble.a \
+	  $(LDFLAGS) $(PC_LIBS) -lm

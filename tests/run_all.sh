@@ -127,6 +127,7 @@ part "first run (tests/cli/firstrun.sh)" sh tests/cli/firstrun.sh "$BUILD"
 part "--time-limit watchdog (tests/cli/watchdog.sh)" sh tests/cli/watchdog.sh "$BUILD"
 part "fuzz corpus replay (tests/fuzz/replay.sh)" sh tests/fuzz/replay.sh "$BUILD"
 part "tetgen under the budgets (tests/cli/tets.sh)" sh tests/cli/tets.sh "$BUILD"
+part "--replay of input logs (tests/cli/replay.sh)" sh tests/cli/replay.sh "$BUILD"
 part "the live viewer under Xvfb (tests/cli/view.sh)" sh tests/cli/view.sh "$BUILD"
 
 echo "$total_pass passed, $total_fail failed"

@@ -1,6 +1,7 @@
 /* main.c: the `wobble` command line (DESIGN §4): run a scene, run scenario tests as
  * TAP 13, run the benchmark scenes. Exit codes: 0 ok, 1 a test or expectation
  * failed, 2 script or input error, 3 a budget was exceeded. */
+#include "lua/input.h"
 #include "lua/wobble_lua.h"
 #include "render/render.h"
 #include "cli/view.h"
@@ -54,6 +55,8 @@ static const char usage_text[] =
     "options of run, test and bench:\n"
     "  --frames N          w:run stops after N frames; bench: each scene runs N frames\n"
     "  --record OUT        (run) draw every frame into OUT: .mp4, .gif or a folder of PNGs\n"
+    "  --replay INPUT.json (run) apply the grabs of an input log after their frames; exit\n"
+    "                      code 1 when some were not applied (the scene ended or differs)\n"
     "  --out DIR           output folder, the only place a script writes (default out)\n"
     "  --set key=value     wobble.args.key = value (numbers, true/false converted); repeatable\n"
     "  --threads N         default thread count of new worlds, 1 to 256 (default 1)\n"
@@ -77,6 +80,7 @@ typedef struct opts {
     wb_runtime rt;
     const char **sets, **pos;  /* --set values, positional arguments */
     const char *record;        /* run --record OUT, or NULL */
+    const char *replay;        /* run --replay INPUT.json, or NULL */
     int nsets, npos;
     int json;                  /* bench --json */
     wb_view_opts view;         /* view's own options (view.h) */
@@ -169,9 +173,11 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
             continue;
         }
         if (strcmp(name, "--frames") && strcmp(name, "--out") && strcmp(name, "--set") && strcmp(name, "--threads") &&
-            strcmp(name, "--time-limit") && strcmp(name, "--memory-limit") && strcmp(name, "--record"))
+            strcmp(name, "--time-limit") && strcmp(name, "--memory-limit") && strcmp(name, "--record") &&
+            strcmp(name, "--replay"))
             return usage_error("unknown option %s", a);
         if (!strcmp(name, "--record") && strcmp(cmd, "run")) return usage_error("%s is an option of run", name);
+        if (!strcmp(name, "--replay") && strcmp(cmd, "run")) return usage_error("%s is an option of run", name);
         if (eq) val = eq + 1;
         else if (i + 1 < argc) val = argv[++i];
         else return usage_error("%s needs a value", name);
@@ -193,6 +199,9 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
         } else if (!strcmp(name, "--record")) {
             if (!*val) return usage_error("%s", "--record expects a file (.mp4, .gif) or a folder");
             o->record = val;
+        } else if (!strcmp(name, "--replay")) {
+            if (!*val) return usage_error("%s", "--replay expects an input log (.json)");
+            o->replay = val;
         } else if (!strcmp(name, "--out")) {
             if (!*val) return usage_error("%s", "--out expects a folder");
             o->rt.out_dir = val;
@@ -675,6 +684,13 @@ static int run_scene(const opts *o, const char *path) {
         return EXIT_SCRIPT;
     }
     char rerr[1024];
+    /* --replay: the logged grabs applied after their frames (a frame hook); read first,
+     * so that a bad file leaves nothing begun */
+    if (o->replay && !wbl_replay_begin(L, o->replay, rerr, sizeof rerr)) {
+        fprintf(stderr, "wobble: --replay: %s\n", rerr);
+        wb_rt_close(L);
+        return EXIT_SCRIPT;
+    }
     /* --record: every frame the scene steps is drawn and encoded (the path is the
      * user's choice, not the sandbox's); the file is finished even after an error */
     if (o->record && make_parents(o->record, rerr, sizeof rerr) != 0) {
@@ -711,6 +727,11 @@ static int run_scene(const opts *o, const char *path) {
             fprintf(stderr, "wobble: %s: a time or memory budget was exceeded\n", path);
             code = EXIT_BUDGET;
         }
+    }
+    /* events left over: the run did not reproduce the recorded one, a failed check */
+    if (o->replay && !wbl_replay_end(L, rerr, sizeof rerr)) {
+        fprintf(stderr, "wobble: --replay: %s\n", rerr);
+        if (code == EXIT_PASS) code = EXIT_FAILED;
     }
     wb_rt_pause_watchdog(L, 1);  /* finishing the file has the encoder's own timeouts */
     if (o->record && !wbl_record_end(L, rerr, sizeof rerr)) {

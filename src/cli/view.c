@@ -44,7 +44,7 @@ typedef struct viewer {
     /* this run of the scene */
     lua_State *L;
     wb_world *world;           /* the world shown: the first that finished a frame */
-    int world_ord, nworlds;
+    int world_ord;
     bool running;              /* inside the script (grabs possible), not after its end */
     int64_t frames_shown;
     bool paused, step_once, quit, restart, reload, dirty;
@@ -69,7 +69,6 @@ typedef struct viewer {
 static viewer V;
 static const char stop_key = 0;     /* the error value that ends a run on purpose */
 static const char world_key = 0;    /* registry: the world shown, kept alive for the end */
-static const char ord_key = 0;      /* registry: world -> its ordinal (input.h) */
 
 static double now(void)
 {
@@ -551,29 +550,6 @@ static void wait_events(double until)
 }
 
 /* ---- the frame hook ------------------------------------------------------------------------------ */
-static int world_ordinal(lua_State *L, int idx)
-{
-    idx = lua_absindex(L, idx);
-    if (lua_rawgetp(L, LUA_REGISTRYINDEX, &ord_key) != LUA_TTABLE) {
-        lua_pop(L, 1);
-        lua_newtable(L);
-        lua_pushvalue(L, -1);
-        lua_rawsetp(L, LUA_REGISTRYINDEX, &ord_key);
-    }
-    lua_pushvalue(L, idx);
-    lua_rawget(L, -2);
-    int ord = (int)lua_tointeger(L, -1);
-    lua_pop(L, 1);
-    if (!ord) {
-        ord = ++V.nworlds;
-        lua_pushvalue(L, idx);
-        lua_pushinteger(L, ord);
-        lua_rawset(L, -3);
-    }
-    lua_pop(L, 1);
-    return ord;
-}
-
 static int stop_run(lua_State *L)
 {
     lua_pushlightuserdata(L, (void *)&stop_key);
@@ -582,7 +558,7 @@ static int stop_run(lua_State *L)
 
 static int view_hook(lua_State *L)
 {
-    int ord = world_ordinal(L, 1);
+    int ord = wbl_input_world(L, 1);   /* every world numbered, as the replay numbers them */
     if (!V.world_ord) {
         V.world_ord = ord;
         lua_pushvalue(L, 1);
@@ -652,7 +628,7 @@ static int run_once(void)
     const wb_view_opts *o = V.o;
     const char *err;
     V.world = NULL;
-    V.world_ord = V.nworlds = 0;
+    V.world_ord = 0;
     V.frames_shown = 0;
     V.restart = V.reload = false;
     V.grabbed = -1;

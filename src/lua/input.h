@@ -40,6 +40,10 @@ void wbl_input_move(wbl_input_log *log, wb_world *w, int world, wb_grab_id g, co
 void wbl_input_release(wbl_input_log *log, wb_world *w, int world, wb_grab_id g);
 int64_t wbl_input_log_events(const wbl_input_log *log);
 bool wbl_input_log_save(const wbl_input_log *log, const char *path, const char *scene, char *err, size_t n);
+/* the ordinal (1-based) of the world at index, as the log names worlds: a world is
+ * numbered the first time this is asked about it, so call it after every frame of every
+ * world (from a frame hook, as the replay does), not only when there is input */
+int wbl_input_world(lua_State *L, int index);
 
 /* ---- replay (`wobble run --replay FILE`) --------------------------------------------- */
 /* read FILE (errors name file:line:col and the key path, exit 2) and register a frame hook
