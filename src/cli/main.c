@@ -66,7 +66,7 @@ static const char usage_text[] =
     "  --memory-limit MB   limit of the Lua heap and all worlds together, default 4096\n"
     "                      (exit code 3)\n"
     "\n"
-    "options of view (and those of run but --record):\n"
+    "options of view (and those of run but --record and --replay):\n"
     "  --watch             restart when the scene or a module it required is saved\n"
     "  --record-input FILE save the grabs (JSON) for `wobble run --replay FILE`\n"
     "  --frames N          also: close the window when the scene ends\n"
