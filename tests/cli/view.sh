@@ -4,8 +4,9 @@
 # xdotool. Proves: no display is a clear error (exit 2); the window opens and shows the
 # scene with its overlay (--screenshot); a drag grabs a particle (the input log has
 # grab, move and release, and the block is lifted); --record-input then `run --replay`
-# ends on the same w:hash(); --watch and R restart the scene, a script error waits for
-# the next save; Esc ends with exit 0. Fixtures: tests/cli/fixtures/view.
+# ends on the same w:hash(); Space pauses and the right arrow steps one frame; --watch
+# and R restart the scene, a script error waits for the next save; Esc ends with exit 0.
+# Fixtures: tests/cli/fixtures/view.
 # Last line: "N passed, N failed"; exit status 1 when a check failed.
 BUILD=${1:-build}
 cd "$(dirname "$0")/../.." || exit 2
@@ -170,6 +171,29 @@ vh=$(grep '^hash' "$TMP/out.view") rh=$(grep '^hash' "$TMP/out") ph=$(grep '^has
 [ -n "$vh" ] && [ "$vh" = "$rh" ] || why="${why:+$why; }view '$vh', replay '$rh'"
 [ "$vh" != "$ph" ] || why="${why:+$why; }the drag changed nothing: $ph without input too"
 result "--record-input, then run --replay: the same w:hash() as the live run" "$why"
+
+# ---- Space pauses (no frame steps), the right arrow steps one frame, Space runs again
+view $F/frames.lua --size 320x240
+why=""
+wait_for "$TMP/out" "frame 5" 1 15 && window || why="the scene did not start"
+xdotool mousemove --window "$wid" 10 10
+xdotool key --window "$wid" space
+sleep 0.5
+c1=$(grep -c '^frame' "$TMP/out")
+sleep 0.5
+c2=$(grep -c '^frame' "$TMP/out")
+[ "$c1" = "$c2" ] || why="${why:+$why; }paused, yet frames went on ($c1, then $c2)"
+xdotool key --window "$wid" Right
+wait_for "$TMP/out" "frame $((c2 + 1))" 1 5 || why="${why:+$why; }the right arrow stepped no frame"
+sleep 0.5
+c3=$(grep -c '^frame' "$TMP/out")
+[ "$c3" = $((c2 + 1)) ] || why="${why:+$why; }the right arrow stepped $((c3 - c2)) frames, not 1"
+xdotool key --window "$wid" space
+wait_for "$TMP/out" "frame $((c3 + 10))" 1 10 || why="${why:+$why; }space did not run it again"
+xdotool key --window "$wid" Escape
+finish 10
+[ "$code" = 0 ] || why="${why:+$why; }Esc: exit code $code"
+result "Space pauses, the right arrow steps one frame, Space runs on" "$why"
 
 # ---- --watch: a saved scene or module restarts; an error waits for the next save
 mkdir -p "$TMP/w"
