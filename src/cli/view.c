@@ -482,10 +482,10 @@ static void compose(void)
         const wb_world *w = V.world;
         wb_stats st = wb_world_stats(w);
         double dt = wb_world_get_def(w).dt;
-        snprintf(line, sizeof line, "frame %lld  t %.2f s  %.2f ms/step  %.0f fps (%.2fx real time)",
+        snprintf(line, sizeof line, "frame %lld  t %.2f s  %.2f ms/step  %.0f fps (%.2fx)",
                  (long long)wb_world_frame(w), wb_world_time(w), st.step_ms, V.fps, V.fps * dt);
         text_line(&y, line, white, &wmax);
-        snprintf(line, sizeof line, "particles %d  contacts %d  particle contacts %d  warnings %lld", (int)st.particles,
+        snprintf(line, sizeof line, "particles %d  contacts %d, particle %d  warnings %lld", (int)st.particles,
                  (int)(st.contacts + st.rigid_contacts), (int)st.particle_contacts, (long long)st.warnings);
         text_line(&y, line, st.warnings ? yellow : white, &wmax);
     }

@@ -54,12 +54,14 @@ bool wb_window_available(char *err, size_t n)
     return false;
 }
 
+static void bind(win *o);
+
 static void win_destroy(void *p)
 {
     win *o = p;
     if (!o) return;
     if (o->win) {
-        glfwMakeContextCurrent(o->win);
+        bind(o);
         if (o->fbo) glDeleteFramebuffers(1, &o->fbo);
         if (o->tex) glDeleteTextures(1, &o->tex);
         glfwMakeContextCurrent(NULL);
@@ -71,10 +73,19 @@ static void win_destroy(void *p)
     free(o);
 }
 
+/* GLX skips a make-current of the context it thinks is current, but a scene's own
+ * OSMesa renderer (wobble.renderer) may have taken the shared dispatch since: release
+ * and bind again, so GL calls reach the window's context for sure */
+static void bind(win *o)
+{
+    glfwMakeContextCurrent(NULL);
+    glfwMakeContextCurrent(o->win);
+}
+
 static bool win_current(void *p)
 {
-    glfwMakeContextCurrent(((win *)p)->win);
-    return true;
+    bind(p);
+    return glfwGetCurrentContext() == ((win *)p)->win;
 }
 
 static void *win_create(int w, int h, char *err, size_t n)
@@ -148,7 +159,7 @@ bool wb_window_blit(const uint8_t *rgb, int x, int y, int w, int h)
 {
     win *o = the_window;
     if (!o || w < 1 || h < 1) return false;
-    glfwMakeContextCurrent(o->win);
+    bind(o);
     if (!o->tex || w > o->tex_w || h > o->tex_h) {
         if (!o->tex) glGenTextures(1, &o->tex), glGenFramebuffers(1, &o->fbo);
         glBindTexture(GL_TEXTURE_2D, o->tex);
@@ -174,7 +185,9 @@ bool wb_window_blit(const uint8_t *rgb, int x, int y, int w, int h)
 
 void wb_window_swap(void)
 {
-    if (the_window) glfwSwapBuffers(the_window->win);
+    if (!the_window) return;
+    bind(the_window);
+    glfwSwapBuffers(the_window->win);
 }
 
 void wb_window_terminate(void)

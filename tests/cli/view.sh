@@ -138,6 +138,19 @@ if [ "$(grep '^hash' "$TMP/out")" = "$(grep '^hash' "$TMP/out.run")" ]; then why
 else why="view: $(grep '^hash' "$TMP/out"), run: $(grep '^hash' "$TMP/out.run")"; fi
 result "untouched, the viewer's run ends on the same hash as wobble run" "$why"
 
+# ---- a scene with its own (OSMesa) renderer: both pictures are drawn (GLX skipped
+# binding the window's context again once OSMesa had taken the dispatch: a crash)
+view $F/own_renderer.lua --size 320x240 --frames 20 --screenshot "$TMP/shot2.png" --out "$TMP/o"
+finish 20
+check "a scene drawing with wobble.renderer in the viewer ends with exit 0" 0 out "hash "
+why=""
+for png in "$TMP/shot2.png" "$TMP/o/own.png"; do
+    "$W" run $F/png_stats.lua --unsafe --set png="$png" >"$TMP/stats" 2>&1
+    blue=$(sed -n 's/^blue //p' "$TMP/stats")
+    [ "${blue:-0}" -ge 20 ] || why="${why:+$why; }$png: only ${blue:-0} blue pixels"
+done
+result "the window and the scene's own renderer both show the rope" "$why"
+
 # ---- a drag lifts the block: grab, moves, release in the log; --replay repeats it
 view $F/grab.lua --size 320x240 --frames 150 --record-input "$TMP/input.json"
 why=""
