@@ -564,7 +564,12 @@ static int view_hook(lua_State *L)
         lua_pushvalue(L, 1);
         lua_rawsetp(L, LUA_REGISTRYINDEX, &world_key);
     }
-    if (ord != V.world_ord) return 0;   /* one world is shown: two would interleave */
+    if (ord != V.world_ord) {
+        /* one world is shown (two would interleave); the window still answers */
+        glfwPollEvents();
+        watch_poll();
+        return stopping() ? stop_run(L) : 0;
+    }
     if (stopping()) return stop_run(L); /* the script caught the marker and stepped on */
     V.world = wbl_checkworld(L, 1);
     if (V.o->frames >= 0 && ++V.frames_shown > V.o->frames) {
@@ -635,6 +640,7 @@ static int run_once(void)
     V.drag = V.drag == 3 ? 0 : V.drag;
     V.last_present = 0;
     V.note[0] = 0;
+    V.error[0] = 0;   /* the last run's error is shown until this one starts */
     lua_State *L = o->open(o->host, &err);
     if (!L) {
         fprintf(stderr, "wobble: %s\n", err);

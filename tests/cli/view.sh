@@ -152,7 +152,7 @@ done
 result "the window and the scene's own renderer both show the rope" "$why"
 
 # ---- a drag lifts the block: grab, moves, release in the log; --replay repeats it
-view $F/grab.lua --size 320x240 --frames 150 --record-input "$TMP/input.json"
+view $F/grab.lua --size 320x240 --frames 240 --record-input "$TMP/input.json"
 why=""
 if window && sleep 1; then
     xdotool mousemove --window "$wid" 160 120 mousedown 1
@@ -175,8 +175,8 @@ top=$(sed -n 's/^top //p' "$TMP/out.view")
 # the block rests with its top at 0.75: lifted by the drag, it ends far higher
 awk -v t="${top:-0}" 'BEGIN { exit !(t > 1.0) }' || why="${why:+$why; }the block's top is at ${top:-?}, not lifted"
 result "a left-drag on the block grabs a particle and lifts it" "$why"
-"$W" run $F/grab.lua --frames 150 >"$TMP/out.plain" 2>&1
-"$W" run $F/grab.lua --frames 150 --replay "$TMP/input.json" >"$TMP/out" 2>"$TMP/err"
+"$W" run $F/grab.lua --frames 240 >"$TMP/out.plain" 2>&1
+"$W" run $F/grab.lua --frames 240 --replay "$TMP/input.json" >"$TMP/out" 2>"$TMP/err"
 code=$?
 why=""
 [ "$code" = 0 ] || why="--replay: exit code $code"
