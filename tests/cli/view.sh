@@ -115,6 +115,16 @@ check "view without a display: exit 2 with a message" 2 err "no display" err "Xv
 code=$?
 check "--watch is an option of view alone" 2 err "--watch is an option of view"
 
+"$W" view >"$TMP/out" 2>"$TMP/err"
+code=$?
+check "view without a scene: exit 2" 2 err "view needs a scene script"
+"$W" view $F/rope.lua --size 10x10 >"$TMP/out" 2>"$TMP/err"
+code=$?
+check "view --size is checked" 2 err "--size expects WIDTHxHEIGHT"
+"$W" view $F/rope.lua --record x.mp4 >"$TMP/out" 2>"$TMP/err"
+code=$?
+check "--record is not an option of view" 2 err "--record is an option of run"
+
 if ! start_x; then
     result "an X server (Xvfb) starts" "no display number answered"
     echo "$passed passed, $failed failed"
