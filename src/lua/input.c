@@ -445,7 +445,8 @@ static char *read_text(const char *path, char *err, size_t n)
         return NULL;
     }
     if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > (1 << 30)) {
-        snprintf(err, n, "%s: %s", path, S_ISDIR(st.st_mode) ? "is a folder, not a file" : "not a regular file of 1 GiB at most");
+        const bool dir = fstat(fileno(f), &st) == 0 && S_ISDIR(st.st_mode);
+        snprintf(err, n, "%s: %s", path, dir ? "is a folder, not a file" : "not a regular file of 1 GiB at most");
         fclose(f);
         return NULL;
     }

@@ -33,7 +33,10 @@ wbl_input_log *wbl_input_log_create(void);          /* NULL when out of memory *
 void wbl_input_log_destroy(wbl_input_log *log);     /* NULL is fine */
 void wbl_input_log_clear(wbl_input_log *log);       /* the scene restarted: drop what was logged */
 /* do it on w and log it (frame = wb_world_frame(w) now, world = that ordinal); false with a
- * message when the world refuses (the particle id is bad, ...) and then nothing is logged */
+ * message when the world refuses (the particle id is bad, ...) and then nothing is logged.
+ * A grab before the world's first frame is refused (no frame to replay it after); a move
+ * or release of a grab that is no longer valid does nothing, and one of a grab the log
+ * did not make (the script's own) is done but not logged. log may be NULL (not logged). */
 bool wbl_input_grab(wbl_input_log *log, wb_world *w, int world, int32_t particle, const wb_real target[3],
                     wb_real compliance, wb_grab_id *out, char *err, size_t n);
 void wbl_input_move(wbl_input_log *log, wb_world *w, int world, wb_grab_id g, const wb_real target[3]);
