@@ -9,7 +9,7 @@ PKGS    := gcc make libc6-dev pkg-config liblua5.4-dev libcjson-dev libassimp-de
 # installed by `make bench` (the Bullet peer) and `make test-cluster` (a one-node Slurm) alone
 BENCH_PKGS   := g++ libbullet-dev
 CLUSTER_PKGS := slurm-wlm munge
-PCMODS  := lua5.4 libcjson assimp osmesa
+PCMODS  := lua5.4 libcjson assimp osmesa glfw3
 # shell code setting `missing` to the packages of PKGS that are not installed ("ii";
 # a removed package whose configuration files remain is not); dpkg-query is quick
 MISSING  = missing=""; for p in $(PKGS); do \

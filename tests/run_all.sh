@@ -132,6 +132,7 @@ part "tetgen under the budgets (tests/cli/tets.sh)" sh tests/cli/tets.sh "$BUILD
 part "--replay of input logs (tests/cli/replay.sh)" sh tests/cli/replay.sh "$BUILD"
 part "sweeps through GNU parallel, result.json, collect (tests/cli/sweep.sh)" sh tests/cli/sweep.sh "$BUILD"
 part "wobble bench --json and the Bullet peer's plumbing (tests/cli/bench.sh)" sh tests/cli/bench.sh "$BUILD"
+part "the live viewer under Xvfb (tests/cli/view.sh)" sh tests/cli/view.sh "$BUILD"
 
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]

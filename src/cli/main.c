@@ -5,6 +5,7 @@
 #include "lua/wobble_lua.h"
 #include "render/render.h"
 #include "sweep.h"
+#include "cli/view.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -48,6 +49,7 @@ static const char usage_text[] =
     "  wobble test [PATH...] [options] run scenario tests (.lua files, folders searched\n"
     "                                  recursively; default tests/); TAP 13 on stdout,\n"
     "                                  last line \"N passed, N failed\"\n"
+    "  wobble view SCENE.lua [options] the scene live in a window (README, \"Live viewer\")\n"
     "  wobble bench [--json]           run the benchmark scenes (tests/bench/*.lua, or\n"
     "                                  share/wobble/bench of an installed wobble)\n"
     "  wobble sweep SCENE.lua --grid key=a,b,c ... --out DIR   one run per combination: jobs\n"
@@ -70,6 +72,13 @@ static const char usage_text[] =
     "  --memory-limit MB   limit of the Lua heap and all worlds together, default 4096\n"
     "                      (exit code 3)\n"
     "\n"
+    "options of view (and those of run but --record and --replay):\n"
+    "  --watch             restart when the scene or a module it required is saved\n"
+    "  --record-input FILE save the grabs (JSON) for `wobble run --replay FILE`\n"
+    "  --frames N          also: close the window when the scene ends\n"
+    "  --size WxH          the window's size in pixels (default 960x540)\n"
+    "  --screenshot FILE   write the window's last picture as PNG when it closes\n"
+    "\n"
     "exit codes: 0 ok, 1 a test or expectation failed, 2 script or input error,\n"
     "            3 time or memory budget exceeded\n";
 
@@ -80,6 +89,7 @@ typedef struct opts {
     const char *replay;        /* run --replay INPUT.json, or NULL */
     int nsets, npos;
     int json;                  /* bench --json */
+    wb_view_opts view;         /* view's own options (view.h) */
 } opts;
 
 static int usage_error(const char *fmt, const char *arg) {
@@ -140,7 +150,26 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
         memcpy(name, a, nl);
         name[nl] = 0;
         int flag = !strcmp(name, "--unsafe") || !strcmp(name, "--quiet") || !strcmp(name, "--json");
-        if (!strcmp(name, "--watch")) return usage_error("%s is not implemented yet", name);
+        if (!strcmp(name, "--watch")) {
+            if (strcmp(cmd, "view")) return usage_error("%s is an option of view", name);
+            if (eq) return usage_error("%s takes no value", name);
+            o->view.watch = true;
+            continue;
+        }
+        if (!strcmp(name, "--record-input") || !strcmp(name, "--screenshot") || !strcmp(name, "--size")) {
+            if (strcmp(cmd, "view")) return usage_error("%s is an option of view", name);
+            if (eq) val = eq + 1;
+            else if (i + 1 < argc) val = argv[++i];
+            else return usage_error("%s needs a value", name);
+            if (!*val) return usage_error("%s needs a value", name);
+            int vw, vh, k = 0;
+            if (!strcmp(name, "--record-input")) o->view.record_input = val;
+            else if (!strcmp(name, "--screenshot")) o->view.screenshot = val;
+            else if (sscanf(val, "%dx%d%n", &vw, &vh, &k) != 2 || val[k] || vw < 16 || vh < 16 || vw > 4096 || vh > 4096)
+                return usage_error("--size expects WIDTHxHEIGHT from 16x16 to 4096x4096, got '%s'", val);
+            else o->view.width = vw, o->view.height = vh;
+            continue;
+        }
         if (flag) {
             if (eq) return usage_error("%s takes no value", name);
             if (!strcmp(name, "--json") && strcmp(cmd, "bench")) return usage_error("unknown option %s", a);
@@ -780,6 +809,28 @@ static int cmd_run(const opts *o, const char *path) {
     return code;
 }
 
+/* ---- view ----------------------------------------------------------------------------------- */
+
+static lua_State *view_open(void *host, const char **err)
+{
+    const opts *o = host;
+    return open_state(o, o->pos[0], 0, err);
+}
+
+static int cmd_view(opts *o)
+{
+    if (o->npos != 1) return usage_error("%s", o->npos ? "view takes one scene script" : "view needs a scene script");
+    wb_view_opts *v = &o->view;
+    v->scene = o->pos[0];
+    v->frames = o->rt.frame_cap;   /* w:run stops there too, as with run */
+    if (!v->width) v->width = 960, v->height = 540;
+    v->open = view_open;
+    v->print_error = print_error;
+    v->host = o;
+    o->rt.quiet = 1;   /* no progress bar under the window */
+    return wb_view_main(v);
+}
+
 /* the benchmark scenes: installed beside the Lua library (share/wobble/bench, so an
  * installed command needs no source tree), else tests/bench of the project */
 static int bench_dir(char dir[PATH_MAX]) {
@@ -852,7 +903,7 @@ int main(int argc, char **argv) {
     }
     if (!strcmp(cmd, "sweep")) return wb_cmd_sweep(argc, argv);
     if (!strcmp(cmd, "collect")) return wb_cmd_collect(argc, argv);
-    if (strcmp(cmd, "run") && strcmp(cmd, "test") && strcmp(cmd, "bench"))
+    if (strcmp(cmd, "run") && strcmp(cmd, "test") && strcmp(cmd, "bench") && strcmp(cmd, "view"))
         return usage_error(cmd[0] == '-' ? "unknown option %s" : "unknown command '%s'", cmd);
     opts o;
     int code = parse_opts(argc, argv, cmd, &o);
@@ -860,6 +911,8 @@ int main(int argc, char **argv) {
         if (!strcmp(cmd, "run")) {
             if (o.npos != 1) code = usage_error("%s", o.npos ? "run takes one scene script" : "run needs a scene script");
             else code = cmd_run(&o, o.pos[0]);
+        } else if (!strcmp(cmd, "view")) {
+            code = cmd_view(&o);
         } else if (!strcmp(cmd, "test")) {
             code = cmd_test(&o);
         } else if (o.npos) {

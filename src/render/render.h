@@ -39,6 +39,17 @@ extern const wb_backend wb_backend_osmesa;
 extern const wb_backend wb_backend_null;
 const wb_backend *wb_backend_find(const char *name);   /* "osmesa", "null"; NULL when unknown */
 
+/* the window of `wobble view` (glfw.c): one per process, made by the backend's create.
+ * wb_window_available starts GLFW: false with a message (no display, ...) */
+extern const wb_backend wb_backend_glfw;
+bool wb_window_available(char *err, size_t n);
+void wb_window_set_title(const char *title);
+void *wb_window_handle(void);   /* the GLFWwindow, NULL when none is open */
+/* an RGB image (top row first) over the back buffer with its top left at pixel (x, y) */
+bool wb_window_blit(const uint8_t *rgb, int x, int y, int w, int h);
+void wb_window_swap(void);      /* present the back buffer */
+void wb_window_terminate(void); /* end GLFW once the window is closed */
+
 /* ---- the renderer ----------------------------------------------------------------- */
 typedef struct wb_renderer wb_renderer;
 

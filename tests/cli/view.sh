@@ -1,0 +1,262 @@
+#!/bin/sh
+# tests/cli/view.sh BUILD_DIR: `wobble view` (issue 11) in a real window: each check
+# starts its own X server (Xvfb, no screen needed) and drives the mouse and keys with
+# xdotool. Proves: no display is a clear error (exit 2); the window opens and shows the
+# scene with its overlay (--screenshot); a drag grabs a particle (the input log has
+# grab, move and release, and the block is lifted); --record-input then `run --replay`
+# ends on the same w:hash(); Space pauses and the right arrow steps one frame; --watch
+# and R restart the scene, a script error waits for the next save; Esc ends with exit 0.
+# Fixtures: tests/cli/fixtures/view.
+# Last line: "N passed, N failed"; exit status 1 when a check failed.
+BUILD=${1:-build}
+cd "$(dirname "$0")/../.." || exit 2
+W="$BUILD/wobble"
+F=tests/cli/fixtures/view
+TMP=$(mktemp -d "${TMPDIR:-/tmp}/wobble-view.XXXXXX") || exit 2
+XPID="" VPID=""
+cleanup() {
+    [ -n "$VPID" ] && kill "$VPID" 2>/dev/null
+    [ -n "$XPID" ] && kill "$XPID" 2>/dev/null
+    rm -rf "$TMP"
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+. tests/cli/lib.sh
+
+for tool in Xvfb xdotool; do
+    if ! command -v $tool >/dev/null 2>&1; then
+        echo "not ok 1 - $tool is installed (make deps installs it)"
+        echo "0 passed, 1 failed"
+        exit 1
+    fi
+done
+
+# start_x: an X server of our own on a free display number (another may be taken by a
+# parallel run: tried until one answers); sets DISPLAY and XPID
+start_x() {
+    for d in $(seq $((100 + $$ % 300)) $((100 + $$ % 300 + 40))); do
+        [ -e "/tmp/.X$d-lock" ] || [ -e "/tmp/.X11-unix/X$d" ] && continue
+        Xvfb ":$d" -screen 0 640x480x24 -nolisten tcp >/dev/null 2>&1 &
+        XPID=$!
+        i=0
+        while [ $i -lt 50 ]; do
+            if DISPLAY=":$d" xdotool getdisplaygeometry >/dev/null 2>&1; then
+                export DISPLAY=":$d"
+                return 0
+            fi
+            kill -0 "$XPID" 2>/dev/null || break
+            sleep 0.1
+            i=$((i + 1))
+        done
+        kill "$XPID" 2>/dev/null
+        wait "$XPID" 2>/dev/null
+        XPID=""
+    done
+    return 1
+}
+
+stop_x() {
+    [ -n "$XPID" ] && kill "$XPID" 2>/dev/null && wait "$XPID" 2>/dev/null
+    XPID=""
+}
+
+# view ARGS...: the viewer in the background (stdout, stderr in $TMP/out, $TMP/err)
+view() {
+    "$W" view "$@" >"$TMP/out" 2>"$TMP/err" &
+    VPID=$!
+}
+
+# finish SECS: wait up to SECS for the viewer to end; its exit code in $code (124: it
+# did not end and was killed)
+finish() {
+    i=0
+    while kill -0 "$VPID" 2>/dev/null && [ $i -lt $(($1 * 10)) ]; do
+        sleep 0.1
+        i=$((i + 1))
+    done
+    if kill -0 "$VPID" 2>/dev/null; then
+        kill "$VPID" 2>/dev/null
+        wait "$VPID" 2>/dev/null
+        code=124
+    else
+        wait "$VPID"
+        code=$?
+    fi
+    VPID=""
+}
+
+# wait_for FILE TEXT COUNT SECS: until FILE has COUNT lines containing TEXT
+wait_for() {
+    i=0
+    while [ "$(grep -cF -- "$2" "$1" 2>/dev/null)" -lt "$3" ] && [ $i -lt $(($4 * 10)) ]; do
+        sleep 0.1
+        i=$((i + 1))
+    done
+    [ "$(grep -cF -- "$2" "$1" 2>/dev/null)" -ge "$3" ]
+}
+
+# the viewer's window id (waits for it to show)
+window() {
+    i=0
+    while [ $i -lt 100 ]; do
+        wid=$(xdotool search --onlyvisible --name "wobble view" 2>/dev/null | head -n 1)
+        [ -n "$wid" ] && return 0
+        sleep 0.1
+        i=$((i + 1))
+    done
+    return 1
+}
+
+# ---- without a display: a clear message, exit 2, no window attempted for long
+(unset DISPLAY WAYLAND_DISPLAY; "$W" view $F/rope.lua >"$TMP/out" 2>"$TMP/err")
+code=$?
+check "view without a display: exit 2 with a message" 2 err "no display" err "Xvfb"
+"$W" run $F/rope.lua --watch >"$TMP/out" 2>"$TMP/err"
+code=$?
+check "--watch is an option of view alone" 2 err "--watch is an option of view"
+
+"$W" view >"$TMP/out" 2>"$TMP/err"
+code=$?
+check "view without a scene: exit 2" 2 err "view needs a scene script"
+"$W" view $F/rope.lua --size 10x10 >"$TMP/out" 2>"$TMP/err"
+code=$?
+check "view --size is checked" 2 err "--size expects WIDTHxHEIGHT"
+"$W" view $F/rope.lua --record x.mp4 >"$TMP/out" 2>"$TMP/err"
+code=$?
+check "--record is not an option of view" 2 err "--record is an option of run"
+
+if ! start_x; then
+    result "an X server (Xvfb) starts" "no display number answered"
+    echo "$passed passed, $failed failed"
+    exit 1
+fi
+
+# ---- the window shows the scene and the overlay; --frames closes it at the scene's end
+view $F/rope.lua --size 320x240 --frames 20 --screenshot "$TMP/shot.png"
+finish 20
+check "view --frames 20 ends by itself with exit 0" 0 out "hash "
+"$W" run $F/png_stats.lua --unsafe --set png="$TMP/shot.png" >"$TMP/stats" 2>&1
+blue=$(sed -n 's/^blue //p' "$TMP/stats")
+white=$(sed -n 's/^white //p' "$TMP/stats")
+why=""
+grep -q "size 320x240" "$TMP/stats" || why="screenshot not 320x240: $(cat "$TMP/stats")"
+[ "${blue:-0}" -ge 100 ] || why="${why:+$why; }only ${blue:-0} blue (particle) pixels"
+[ "${white:-0}" -ge 100 ] || why="${why:+$why; }only ${white:-0} white (overlay text) pixels"
+result "the screenshot shows the rope's particles and the overlay" "$why"
+"$W" run $F/rope.lua --frames 20 >"$TMP/out.run" 2>&1
+if [ "$(grep '^hash' "$TMP/out")" = "$(grep '^hash' "$TMP/out.run")" ]; then why=""
+else why="view: $(grep '^hash' "$TMP/out"), run: $(grep '^hash' "$TMP/out.run")"; fi
+result "untouched, the viewer's run ends on the same hash as wobble run" "$why"
+
+# ---- a scene with its own (OSMesa) renderer: both pictures are drawn (GLX skipped
+# binding the window's context again once OSMesa had taken the dispatch: a crash)
+view $F/own_renderer.lua --size 320x240 --frames 20 --screenshot "$TMP/shot2.png" --out "$TMP/o"
+finish 20
+check "a scene drawing with wobble.renderer in the viewer ends with exit 0" 0 out "hash "
+why=""
+for png in "$TMP/shot2.png" "$TMP/o/own.png"; do
+    "$W" run $F/png_stats.lua --unsafe --set png="$png" >"$TMP/stats" 2>&1
+    blue=$(sed -n 's/^blue //p' "$TMP/stats")
+    [ "${blue:-0}" -ge 20 ] || why="${why:+$why; }$png: only ${blue:-0} blue pixels"
+done
+result "the window and the scene's own renderer both show the rope" "$why"
+
+# ---- a drag lifts the block: grab, moves, release in the log; --replay repeats it
+view $F/grab.lua --size 320x240 --frames 240 --record-input "$TMP/input.json"
+why=""
+if window && wait_for "$TMP/out" "frame 30" 1 20; then
+    xdotool mousemove --window "$wid" 160 120 mousedown 1
+    for dy in 10 20 30 40 50 60 70 80; do
+        xdotool mousemove --window "$wid" 160 $((120 - dy))
+        sleep 0.05
+    done
+    sleep 0.5
+    xdotool mouseup 1
+else
+    why="no window"
+fi
+finish 30
+cp "$TMP/out" "$TMP/out.view"
+check "the drag's run ends with exit 0 and saves the input" 0 out "hash " err "input events to"
+for ev in '"type":	"grab"' '"type":	"move"' '"type":	"release"'; do
+    grep -qF "$ev" "$TMP/input.json" 2>/dev/null || why="${why:+$why; }no $ev event in the log"
+done
+top=$(sed -n 's/^highest //p' "$TMP/out.view")
+# the block rests with its top at 0.75 (`run` without input: highest 0.750); the drag
+# lifts it far higher
+awk -v t="${top:-0}" 'BEGIN { exit !(t > 1.0) }' || why="${why:+$why; }the block's top came to ${top:-?} at most, not lifted"
+result "a left-drag on the block grabs a particle and lifts it" "$why"
+"$W" run $F/grab.lua --frames 240 >"$TMP/out.plain" 2>&1
+"$W" run $F/grab.lua --frames 240 --replay "$TMP/input.json" >"$TMP/out" 2>"$TMP/err"
+code=$?
+why=""
+[ "$code" = 0 ] || why="--replay: exit code $code"
+vh=$(grep '^hash' "$TMP/out.view") rh=$(grep '^hash' "$TMP/out") ph=$(grep '^hash' "$TMP/out.plain")
+[ -n "$vh" ] && [ "$vh" = "$rh" ] || why="${why:+$why; }view '$vh', replay '$rh'"
+[ "$vh" != "$ph" ] || why="${why:+$why; }the drag changed nothing: $ph without input too"
+plain=$(sed -n 's/^highest //p' "$TMP/out.plain")
+awk -v t="${plain:-9}" 'BEGIN { exit !(t < 0.8) }' || why="${why:+$why; }without input the block came to ${plain:-?}"
+result "--record-input, then run --replay: the same w:hash() as the live run" "$why"
+
+# ---- Space pauses (no frame steps), the right arrow steps one frame, Space runs again
+view $F/frames.lua --size 320x240
+why=""
+wait_for "$TMP/out" "frame 5" 1 15 && window || why="the scene did not start"
+xdotool mousemove --window "$wid" 10 10
+xdotool key --window "$wid" space
+# paused: the count stops (a busy machine may take a while to read the key)
+i=0 c1=-1 c2=0
+while [ "$c1" != "$c2" ] && [ $i -lt 10 ]; do
+    c1=$(grep -c '^frame' "$TMP/out")
+    sleep 0.7
+    c2=$(grep -c '^frame' "$TMP/out")
+    i=$((i + 1))
+done
+[ "$c1" = "$c2" ] || why="${why:+$why; }paused, yet frames went on ($c1, then $c2)"
+xdotool key --window "$wid" Right
+wait_for "$TMP/out" "frame $((c2 + 1))" 1 5 || why="${why:+$why; }the right arrow stepped no frame"
+sleep 0.5
+c3=$(grep -c '^frame' "$TMP/out")
+[ "$c3" = $((c2 + 1)) ] || why="${why:+$why; }the right arrow stepped $((c3 - c2)) frames, not 1"
+xdotool key --window "$wid" space
+wait_for "$TMP/out" "frame $((c3 + 10))" 1 10 || why="${why:+$why; }space did not run it again"
+xdotool key --window "$wid" Escape 2>/dev/null   # its release may find the window gone
+finish 10
+[ "$code" = 0 ] || why="${why:+$why; }Esc: exit code $code"
+result "Space pauses, the right arrow steps one frame, Space runs on" "$why"
+
+# ---- --watch: a saved scene or module restarts; an error waits for the next save
+mkdir -p "$TMP/w"
+cp $F/watch.lua $F/view_mod.lua "$TMP/w/"
+view "$TMP/w/watch.lua" --watch --size 320x240
+why=""
+wait_for "$TMP/out" "start 1" 1 15 || why="the scene did not start"
+sleep 0.3
+printf 'return { n = 2 }\n' >"$TMP/w/view_mod.lua"
+wait_for "$TMP/out" "start 2" 1 10 || why="${why:+$why; }saving the module did not restart it"
+sleep 0.3
+touch "$TMP/w/watch.lua"
+wait_for "$TMP/out" "start 2" 2 10 || why="${why:+$why; }touching the scene did not restart it"
+result "--watch restarts the scene when it or a module it required is saved" "$why"
+why=""
+cp "$TMP/w/watch.lua" "$TMP/watch.good"
+printf 'local x = = 1\n' >"$TMP/w/watch.lua"
+wait_for "$TMP/err" "watch.lua:1:" 1 10 || why="the syntax error is not on the terminal"
+sleep 0.5
+kill -0 "$VPID" 2>/dev/null || why="${why:+$why; }the viewer closed on the error"
+cp "$TMP/watch.good" "$TMP/w/watch.lua"
+wait_for "$TMP/out" "start 2" 3 10 || why="${why:+$why; }fixing the file did not run it again"
+result "--watch: a script error is shown and the viewer waits for the next save" "$why"
+why=""
+window || why="no window"
+xdotool mousemove --window "$wid" 10 10
+xdotool key --window "$wid" r
+wait_for "$TMP/out" "start 2" 4 10 || why="R did not restart the scene"
+xdotool key --window "$wid" Escape 2>/dev/null   # its release may find the window gone
+finish 10
+[ "$code" = 0 ] || why="${why:+$why; }Esc: exit code $code"
+result "R restarts the scene; Esc closes the viewer with exit 0" "$why"
+
+stop_x
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
