@@ -1,6 +1,7 @@
 /* test_distance_simd.c: the AVX2 path of the distance projection (distance.c) gives
  * the same bits as the scalar loop: the same cloths stepped once with the vector
- * path and once with the scalar loop forced, every position compared bit for bit.
+ * path and once with the scalar loop forced, every position and multiplier compared
+ * bit for bit.
  * The scenes reach every branch the vector path masks or blends: pinned ends
  * (w = 0), an immovable pair (wsum = 0), coincident particles (len2 tiny), compliance
  * that overflows over h^2 (isinf(at)), damping and infinitely damped links
@@ -55,12 +56,13 @@ static wb_world *scene(int solver, int threads, int damped)
     return w;
 }
 
-/* whether any position differs in its bits */
+/* whether any position or multiplier (the force readback) differs in its bits */
 static int differing(const wb_world *a, const wb_world *b)
 {
     const int32_t n = wb_particle_count(a);
-    if (n != wb_particle_count(b)) return 1;
-    return memcmp(wb_particle_positions(a), wb_particle_positions(b), sizeof(wb_real) * 3 * (size_t)n) != 0;
+    if (n != wb_particle_count(b) || a->k.ns != b->k.ns) return 1;
+    return memcmp(wb_particle_positions(a), wb_particle_positions(b), sizeof(wb_real) * 3 * (size_t)n) != 0 ||
+           memcmp(a->k.s_lambda, b->k.s_lambda, sizeof(wb_real) * (size_t)a->k.ns) != 0;
 }
 
 TEST(distance_simd_bit_identical_to_scalar)
@@ -85,7 +87,7 @@ TEST(distance_simd_bit_identical_to_scalar)
             wb__distance_simd(0);
             CHECK_EQ(wb_world_step(s), WB_OK);
             diff = differing(v, s);
-            if (diff) test_fail(__FILE__, __LINE__, "case %zu: positions differ after frame %d", c, f + 1);
+            if (diff) test_fail(__FILE__, __LINE__, "case %zu: positions or multipliers differ after frame %d", c, f + 1);
         }
         wb_world_destroy(v);
         wb_world_destroy(s);
