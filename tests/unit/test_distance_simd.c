@@ -5,7 +5,8 @@
  * The scenes reach every branch the vector path masks or blends: pinned ends
  * (w = 0), an immovable pair (wsum = 0), coincident particles (len2 tiny), compliance
  * that overflows over h^2 (isinf(at)), damping and infinitely damped links
- * (isinf(gamma)), the undamped and the damped loops, Jacobi with over-relaxation, and 2 threads. */
+ * (isinf(gamma)), the undamped and the damped loops, Jacobi with over-relaxation,
+ * and 2 threads (batches split between them). */
 #include <float.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -47,11 +48,26 @@ static wb_world *scene(int solver, int threads, int damped)
     /* the rare lanes: an immovable pair, an overflowing compliance, an overflowing damping */
     l = wb_distance_default_def();
     { wb_distance_add(w, p0, p1, &l, &st); bad |= st != WB_OK; }
+#ifdef WB_FLOAT
+    l.compliance = 1e37f; /* / h^2 = inf */
+#else
     l.compliance = 1e307; /* / h^2 = inf */
-    for (int32_t i = 0; i + 50 < n; i += 97) { wb_distance_add(w, b.first + i, b.first + i + 50, &l, &st); bad |= st != WB_OK; }
+#endif
+    for (int32_t i = 0; i + 50 < n; i += 97) {
+        wb_distance_add(w, b.first + i, b.first + i + 50, &l, &st);
+        bad |= st != WB_OK;
+    }
     l.compliance = 1e-3;
-    l.damping = DBL_MAX; /* gamma = inf (only in damped scenes: any damping takes the damped loop) */
-    for (int32_t i = 7; damped && i + 45 < n; i += 89) { wb_distance_add(w, b.first + i, b.first + i + 45, &l, &st); bad |= st != WB_OK; }
+#ifdef WB_FLOAT
+    l.damping = FLT_MAX;
+#else
+    l.damping = DBL_MAX;
+#endif
+    /* gamma = inf (only in damped scenes: any damping takes the damped loop) */
+    for (int32_t i = 7; damped && i + 45 < n; i += 89) {
+        wb_distance_add(w, b.first + i, b.first + i + 45, &l, &st);
+        bad |= st != WB_OK;
+    }
     if (bad) { wb_world_destroy(w); return NULL; }
     return w;
 }
@@ -87,7 +103,8 @@ TEST(distance_simd_bit_identical_to_scalar)
             wb__distance_simd(0);
             CHECK_EQ(wb_world_step(s), WB_OK);
             diff = differing(v, s);
-            if (diff) test_fail(__FILE__, __LINE__, "case %zu: positions or multipliers differ after frame %d", c, f + 1);
+            if (diff)
+                test_fail(__FILE__, __LINE__, "case %zu: positions or multipliers differ after frame %d", c, f + 1);
         }
         wb_world_destroy(v);
         wb_world_destroy(s);
