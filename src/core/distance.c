@@ -170,10 +170,12 @@ load4(const wb_real *p, const int32_t i[4], __m256d *X, __m256d *Y, __m256d *Z)
  * every lane doing exactly the scalar operations in the scalar order (no FMA: -std=c11
  * keeps contraction off), so the bits are the scalar loop's. The skipped lanes (the
  * `continue`s) are masked; the isinf(gamma) limit is blended; the writes are scalar.
- * Measured (AMD EPYC VM, 128x128 cloth, CPU time from perf samples, 2 runs): 9.1-9.4 ->
- * 7.5-7.6 ns per projection at -O2, 8.8-9.4 -> 7.3-7.6 at -O3 -march=native. A group at a time (writes right
- * after each group) gained nothing; chunks of 16 or 32 less than 64; prefetching the
- * particles 16 or 64 constraints ahead cost 0.3-0.5 ns. */
+ * Measured (AMD EPYC VM, 128x128 cloth, CPU time from perf samples, 2 runs): 9.1-9.4
+ * -> 7.5-7.6 ns per projection at -O2, 8.8-9.4 -> 7.3-7.6 at -O3 -march=native. A group
+ * at a time (writes right after each group) gained nothing; chunks of 16 or 32 gained
+ * less than 64; prefetching the particles 16 or 64 constraints ahead cost 0.3-0.5 ns;
+ * for Gauss-Seidel, storing the new positions from the vectors instead of updating
+ * them in the scalar writes gained nothing measurable. */
 static inline __attribute__((always_inline, target("avx2"))) void
 project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
                wb_real *out, int32_t b, int32_t e, wb_real h, wb_real inv_h2, wb_real omega,
