@@ -158,7 +158,8 @@
     X(attach_grab_ids_and_memory)                \
     X(attach_skip_table_charged_and_lists)       \
     RIGID_TESTS(X)                               \
-    NARROW_TESTS(X)
+    NARROW_TESTS(X)                              \
+    X(distance_simd_bit_identical_to_scalar)
 
 #define DECLARE(name) TEST(name);
 #define ENTRY(name) { #name, test_##name },
