@@ -549,6 +549,42 @@ static void turn(wb_real q[4], const wb_real t[3])
     q_normalize(q);
 }
 
+/* Static friction at one point (A's local la, B's local lb): the two points' relative
+ * tangential motion over the substep is undone when the impulse needed, |slip| / (w_A +
+ * w_B) along it, is inside the cone lmax (Müller et al. 2020, eq. 9 and §3.5) */
+static void slip_correct(wb_world *w, const side *A, const side *B, const wb_real la[3], const wb_real lb[3],
+                         const wb_real n[3], wb_real lmax)
+{
+    const wb_rigids *rb = w->rb;
+    wb_real pa[3], pa0[3], pb[3], pb0[3], slip[3];
+    side_points(rb, A, la, pa, pa0);
+    side_points(rb, B, lb, pb, pb0);
+    for (int i = 0; i < 3; i++) slip[i] = (pb[i] - pb0[i]) - (pa[i] - pa0[i]);
+    v3_madd(slip, n, -v3_dot(slip, n));
+    const wb_real len = v3_len(slip);
+    if (!(len > 0)) return;
+    wb_real t[3], dp[3];
+    v3_scale(t, slip, 1 / len);
+    const wb_real wt = side_w(w, A, pa, t) + side_w(w, B, pb, t);
+    const wb_real lt = wt > 0 ? len / wt : INFINITY;
+    if (!(lt < lmax)) return;
+    v3_scale(dp, t, -lt);
+    push(w, A, B, pa, pb, dp);
+}
+
+/* body pairs' static friction, after both normal sweeps of the substep: the lower bodies
+ * are back where the contacts below them put them */
+static void static_friction_pairs(wb_world *w)
+{
+    wb_rigids *rb = w->rb;
+    for (int32_t k = 0; k < rb->nfr; k++) {
+        const wb_rfric *f = &rb->fr[k];
+        if (!live(rb, f->a) || !live(rb, f->b)) continue;
+        const side A = { f->a, NULL, NULL, NULL, NULL }, B = { f->b, NULL, NULL, NULL, NULL };
+        slip_correct(w, &A, &B, f->la, f->lb, f->n, f->lmax);
+    }
+}
+
 /* The manifold's normal corrections are solved together: point after point (Gauss-Seidel
  * over the points, each moving the body before the next) tilts a box resting on four
  * corners a little differently every substep, and the tilts, not commuting, pump a spin
@@ -624,37 +660,37 @@ static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_c
      * when the impulse needed stays inside the friction cone, mu x the normal impulse. One
      * correction for the manifold, at the centre of its normal impulses: corner by corner
      * each correction turned the box about the normal and left the next corner slipping,
-     * and a box on a slope crept down at 1 mm/s. Against colliders only: between two
-     * bodies the Gauss-Seidel sweep turns the lower body about its centre under an
-     * off-centre load (the collider below turns it back later), the correction drags the
-     * upper body along with that turn, and, substep after substep, a box set 0.1 m off the
-     * centre of the box below walked off it at 1 cm/s. Body pairs stop slipping by the
-     * velocity pass's friction alone. */
-    if (mu > 0 && lsum > 0 && A->r < 0) {
-        wb_real c[3] = { 0, 0, 0 }, lca[3], lcb[3], pa[3], pa0[3], pb[3], pb0[3], slip[3];
+     * and a box on a slope crept down at 1 mm/s. Against a collider at once; between two
+     * bodies after the substep's normal sweeps (static_friction_pairs): here the sweep has
+     * just turned the lower body about its centre under the upper one's off-centre load
+     * (the contact below turns it back later in the sweep), a correction now would drag the
+     * upper body along with that passing turn, and, substep after substep, a box set 0.1 m
+     * off the centre of the box below walked off it at 1 cm/s. */
+    if (mu > 0 && lsum > 0 && (A->r < 0 || rb->record_fr)) {
+        wb_real c[3] = { 0, 0, 0 }, lca[3], lcb[3];
         for (int k = 0; k < np; k++) {
             v3_madd(c, m->pt[k].pa, lam[k] / (2 * lsum));
             v3_madd(c, m->pt[k].pb, lam[k] / (2 * lsum));
         }
-        /* c as it was before this solve moved the bodies: its local points in each */
-        wb_real ca[3], cb[3];
-        v3_copy(ca, c);
-        v3_copy(cb, c);
-        side_local(rb, A, ca, lca);
-        side_local(rb, B, cb, lcb);
-        side_points(rb, A, lca, pa, pa0);
-        side_points(rb, B, lcb, pb, pb0);
-        for (int i = 0; i < 3; i++) slip[i] = (pb[i] - pb0[i]) - (pa[i] - pa0[i]);
-        v3_madd(slip, n, -v3_dot(slip, n));
-        const wb_real len = v3_len(slip);
-        if (len > 0) {
-            wb_real t[3], dp[3];
-            v3_scale(t, slip, 1 / len);
-            const wb_real wt = side_w(w, A, pa, t) + side_w(w, B, pb, t);
-            const wb_real lt = wt > 0 ? len / wt : INFINITY;
-            if (lt < mu * lsum) {
-                v3_scale(dp, t, -lt);
-                push(w, A, B, pa, pb, dp);
+        /* c's local points in each body (after this solve: the slip is measured from the
+         * substep's start poses to the poses when the correction is made) */
+        side_local(rb, A, c, lca);
+        side_local(rb, B, c, lcb);
+        if (A->r < 0) {
+            slip_correct(w, A, B, lca, lcb, n, mu * lsum);
+        } else {
+            wb_rfric *fr = wb__grow(rb->fr, &rb->cap_fr, rb->nfr + 1, sizeof *fr);
+            if (fr) {
+                rb->fr = fr;
+                fr = &fr[rb->nfr++];
+                fr->a = A->r;
+                fr->b = B->r;
+                v3_copy(fr->la, lca);
+                v3_copy(fr->lb, lcb);
+                v3_copy(fr->n, n);
+                fr->lmax = mu * lsum;
+            } else {
+                wb__warn(w, "out of memory in rigid contacts; static friction skipped");
             }
         }
     }
@@ -745,17 +781,21 @@ void wb__rigids_solve(wb_world *w, wb_real h, wb_real f0, wb_real f1)
     wb_rigids *rb = w->rb;
     if (!rb) return;
     rb->nct = 0;
+    rb->nfr = 0;
     for (int32_t r = 0; r < rb->n; r++)
         if (live(rb, r)) touch_colliders(w, r, h, f0, f1);
+    rb->record_fr = 1;
     for (int32_t a = 0; a < rb->n; a++)
         for (int32_t b = a + 1; live(rb, a) && b < rb->n; b++)
             if (live(rb, b)) touch_pair(w, a, b, h);
+    rb->record_fr = 0;
     const int32_t kept = rb->nct;
     for (int32_t a = rb->n - 1; a >= 0; a--)
         for (int32_t b = rb->n - 1; live(rb, a) && b > a; b--)
             if (live(rb, b)) touch_pair(w, a, b, h);
     for (int32_t r = rb->n - 1; r >= 0; r--)
         if (live(rb, r)) touch_colliders(w, r, h, f0, f1);
+    static_friction_pairs(w);
     rb->nct = kept;
 }
 
