@@ -731,21 +731,47 @@ void wb__rigid_contact_collider(wb_world *w, int32_t c, const wb_real p0[3], con
     solve_manifold(w, &A, &B, &w->m.c_shape[c], &w->rb->shape[r], m, h);
 }
 
-/* body r against the live colliders */
-static void touch_colliders(wb_world *w, int32_t r, wb_real h, wb_real f0, wb_real f1)
+/* the colliders' poses at the substep's start and end, and a bounding radius about the
+ * pose (planes and meshes: -1, always tested), once per substep for all bodies */
+static int collider_poses(wb_world *w, wb_real f0, wb_real f1)
+{
+    wb_rigids *rb = w->rb;
+    const wb_model *m = &w->m;
+    wb_real *cp = wb__grow(rb->cpose, &rb->cap_cpose, 15 * (m->nc > 0 ? m->nc : 1), sizeof *cp);
+    if (!cp) return 0;
+    rb->cpose = cp;
+    for (int32_t c = 0; c < m->nc; c++) {
+        if (!(m->c_gen[c] & 1u)) continue;
+        wb_real *e = &cp[15 * c];
+        wb__collider_pose_at(&w->s.c_pose[c], f0, e, e + 3);
+        wb__collider_pose_at(&w->s.c_pose[c], f1, e + 7, e + 10);
+        const wb_cshape *s = &m->c_shape[c];
+        e[14] = s->shape == WB_SHAPE_SPHERE ? s->radius
+              : s->shape == WB_SHAPE_BOX ? v3_len(s->half)
+              : s->shape == WB_SHAPE_CAPSULE ? fmax(v3_len(s->a), v3_len(s->b)) + s->radius : -1;
+    }
+    return 1;
+}
+
+/* body r against the live colliders. A collider whose bounding sphere is farther from the
+ * body's than the margin has no point within it: skipped without the narrow phase */
+static void touch_colliders(wb_world *w, int32_t r, wb_real h)
 {
     wb_rigids *rb = w->rb;
     const wb_model *m = &w->m;
     /* points that may touch by the substep's end */
     const wb_real margin = h * (v3_len(&rb->v[3 * r]) + v3_len(&rb->om[3 * r]) * rb->bound[r]);
+    const wb_real *xr = &rb->x[3 * r];
     for (int32_t c = 0; c < m->nc; c++) {
         if (!(m->c_gen[c] & 1u)) continue;
-        wb_real p0[3], q0[4], p1[3], q1[4];
-        wb__collider_pose_at(&w->s.c_pose[c], f0, p0, q0);
-        wb__collider_pose_at(&w->s.c_pose[c], f1, p1, q1);
+        const wb_real *e = &rb->cpose[15 * c];
+        if (e[14] >= 0) {
+            const wb_real reach = e[14] + rb->bound[r] + margin, d[3] = { xr[0] - e[7], xr[1] - e[8], xr[2] - e[9] };
+            if (v3_dot(d, d) > reach * reach) continue;
+        }
         wb_manifold mf;
-        if (wb__narrow(&m->c_shape[c], p1, q1, &rb->shape[r], &rb->x[3 * r], &rb->q[4 * r], margin, &mf) > 0)
-            wb__rigid_contact_collider(w, c, p0, q0, p1, q1, r, &mf, h);
+        if (wb__narrow(&m->c_shape[c], e + 7, e + 10, &rb->shape[r], xr, &rb->q[4 * r], margin, &mf) > 0)
+            wb__rigid_contact_collider(w, c, e, e + 3, e + 7, e + 10, r, &mf, h);
     }
 }
 
@@ -765,6 +791,79 @@ static void touch_pair(wb_world *w, int32_t a, int32_t b, wb_real h)
         wb__rigid_contact_rigid(w, a, b, &mf, h);
 }
 
+/* sort keys: a body's low end along the sweep axis (ties by slot); a pair by (a, b) */
+typedef struct wb_rkey { wb_real lo; int32_t r; } wb_rkey;
+static int cmp_lo(const void *pa, const void *pb)
+{
+    const wb_rkey *a = pa, *b = pb;
+    return a->lo < b->lo ? -1 : a->lo > b->lo ? 1 : (a->r > b->r) - (a->r < b->r);
+}
+static int cmp_pair(const void *pa, const void *pb)
+{
+    const int32_t *a = pa, *b = pb;
+    return a[0] != b[0] ? (a[0] > b[0]) - (a[0] < b[0]) : (a[1] > b[1]) - (a[1] < b[1]);
+}
+
+/* The candidate body pairs of the substep by sort and sweep (O(n log n + pairs) instead of
+ * all n^2 pairs), in the order of the all-pairs loop, (a, b) with a < b: the solve is the
+ * same. A body's box: its bounding sphere grown by twice its margin (the pair test's reach
+ * is the two spheres plus the two margins) and 5 % of its bound, so that the corrections
+ * of the sweep, which move the bodies after the boxes are made, leave no pair out that the
+ * exact test (touch_pair) would take. The axis: the one the centres spread most along.
+ * 0 when out of memory (the caller tries all pairs). */
+static int candidate_pairs(wb_world *w, wb_real h)
+{
+    wb_rigids *rb = w->rb;
+    rb->npair = 0;
+    int32_t nb = 0;
+    for (int32_t r = 0; r < rb->n; r++) nb += live(rb, r);
+    wb_real *box = wb__grow(rb->box, &rb->cap_box, 6 * (rb->n > 0 ? rb->n : 1), sizeof *box);
+    if (!box) return 0;
+    rb->box = box;
+    wb_rkey *ord = wb__grow(rb->ord, &rb->cap_ord, nb > 0 ? nb : 1, sizeof *ord);
+    if (!ord) return 0;
+    rb->ord = ord;
+    wb_real mean[3] = { 0, 0, 0 }, var[3] = { 0, 0, 0 };
+    nb = 0;
+    for (int32_t r = 0; r < rb->n; r++) {
+        if (!live(rb, r)) continue;
+        const wb_real *x = &rb->x[3 * r];
+        const wb_real e = rb->bound[r] * (wb_real)1.05 + 2 * h * (v3_len(&rb->v[3 * r]) + v3_len(&rb->om[3 * r]) * rb->bound[r]);
+        for (int c = 0; c < 3; c++) {
+            box[6 * r + c] = x[c] - e;
+            box[6 * r + 3 + c] = x[c] + e;
+            mean[c] += x[c];
+        }
+        ord[nb++].r = r;
+    }
+    if (nb < 2) return 1;
+    for (int c = 0; c < 3; c++) mean[c] /= nb;
+    for (int32_t k = 0; k < nb; k++)
+        for (int c = 0; c < 3; c++) var[c] += (rb->x[3 * ord[k].r + c] - mean[c]) * (rb->x[3 * ord[k].r + c] - mean[c]);
+    const int ax = var[0] >= var[1] && var[0] >= var[2] ? 0 : var[1] >= var[2] ? 1 : 2;
+    for (int32_t k = 0; k < nb; k++) ord[k].lo = box[6 * ord[k].r + ax];
+    qsort(ord, (size_t)nb, sizeof *ord, cmp_lo);
+    for (int32_t i = 0; i < nb; i++) {
+        const int32_t a = ord[i].r;
+        const wb_real *ba = &box[6 * a];
+        for (int32_t k = i + 1; k < nb && ord[k].lo <= ba[3 + ax]; k++) {
+            const int32_t b = ord[k].r;
+            const wb_real *bb = &box[6 * b];
+            int apart = 0;
+            for (int c = 0; c < 3; c++) apart |= bb[c] > ba[3 + c] || ba[c] > bb[3 + c];
+            if (apart) continue;
+            int32_t *pr = wb__grow(rb->pair, &rb->cap_pair, 2 * (rb->npair + 1), sizeof *pr);
+            if (!pr) return 0;
+            rb->pair = pr;
+            pr[2 * rb->npair] = a < b ? a : b;
+            pr[2 * rb->npair + 1] = a < b ? b : a;
+            rb->npair++;
+        }
+    }
+    qsort(rb->pair, (size_t)rb->npair, 2 * sizeof *rb->pair, cmp_pair);
+    return 1;
+}
+
 /* Two Gauss-Seidel sweeps over the manifolds per substep, forward then backward. One
  * forward sweep is a product of projections that do not commute: its eigenvalues are
  * complex, and with the velocities taken from the positions, x' = G (2 x - x_prev), a mode
@@ -774,27 +873,40 @@ static void touch_pair(wb_world *w, int32_t a, int32_t b, wb_real h)
  * is the symmetric product, with real eigenvalues l in [0, 1] and |mu|^2 = l <= 1.
  * (Alternating the direction from substep to substep left a |g| h bounce.) The velocity
  * pass keeps the forward sweep's contacts: their multipliers carry nearly all of the
- * push, and their incoming velocities are the ones restitution needs. O(n^2) pairs:
- * scenes have tens of bodies, not thousands. */
+ * push, and their incoming velocities are the ones restitution needs. The pairs come from
+ * a sort and sweep (candidate_pairs), in the all-pairs order. */
 void wb__rigids_solve(wb_world *w, wb_real h, wb_real f0, wb_real f1)
 {
     wb_rigids *rb = w->rb;
     if (!rb) return;
     rb->nct = 0;
     rb->nfr = 0;
+    if (!collider_poses(w, f0, f1)) {
+        wb__warn(w, "out of memory in rigid contacts; the substep's contacts are skipped");
+        return;
+    }
     for (int32_t r = 0; r < rb->n; r++)
-        if (live(rb, r)) touch_colliders(w, r, h, f0, f1);
+        if (live(rb, r)) touch_colliders(w, r, h);
+    const int sweep = candidate_pairs(w, h);
     rb->record_fr = 1;
-    for (int32_t a = 0; a < rb->n; a++)
-        for (int32_t b = a + 1; live(rb, a) && b < rb->n; b++)
-            if (live(rb, b)) touch_pair(w, a, b, h);
+    if (sweep) {
+        for (int32_t k = 0; k < rb->npair; k++) touch_pair(w, rb->pair[2 * k], rb->pair[2 * k + 1], h);
+    } else {
+        for (int32_t a = 0; a < rb->n; a++)
+            for (int32_t b = a + 1; live(rb, a) && b < rb->n; b++)
+                if (live(rb, b)) touch_pair(w, a, b, h);
+    }
     rb->record_fr = 0;
     const int32_t kept = rb->nct;
-    for (int32_t a = rb->n - 1; a >= 0; a--)
-        for (int32_t b = rb->n - 1; live(rb, a) && b > a; b--)
-            if (live(rb, b)) touch_pair(w, a, b, h);
+    if (sweep) {
+        for (int32_t k = rb->npair - 1; k >= 0; k--) touch_pair(w, rb->pair[2 * k], rb->pair[2 * k + 1], h);
+    } else {
+        for (int32_t a = rb->n - 1; a >= 0; a--)
+            for (int32_t b = rb->n - 1; live(rb, a) && b > a; b--)
+                if (live(rb, b)) touch_pair(w, a, b, h);
+    }
     for (int32_t r = rb->n - 1; r >= 0; r--)
-        if (live(rb, r)) touch_colliders(w, r, h, f0, f1);
+        if (live(rb, r)) touch_colliders(w, r, h);
     static_friction_pairs(w);
     rb->nct = kept;
 }
