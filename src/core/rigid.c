@@ -860,7 +860,7 @@ static int candidate_pairs(wb_world *w, wb_real h)
             rb->npair++;
         }
     }
-    qsort(rb->pair, (size_t)rb->npair, 2 * sizeof *rb->pair, cmp_pair);
+    if (rb->npair > 1) qsort(rb->pair, (size_t)rb->npair, 2 * sizeof *rb->pair, cmp_pair);
     return 1;
 }
 
