@@ -624,6 +624,17 @@ void wb_rigid_set_velocity(wb_world *w, wb_rigid_id r, const wb_real v[3]);
 void wb_rigid_set_angular_velocity(wb_world *w, wb_rigid_id r, const wb_real om[3]);
 /* an impulse J (N s) at world point `at` (NULL: the centre): v += J/m, om += I^-1 (r x J) */
 void wb_rigid_apply_impulse(wb_world *w, wb_rigid_id r, const wb_real J[3], const wb_real at[3]);
+
+/* grabs of rigid bodies (grab.c): the body's point `local` (its frame; NULL = the centre
+ * of mass) pulled to target, two-way through the body's response at the point. The grab's
+ * other functions are wb_grab_*'s; wb_grab_particle gives -1 for one. Removing the body
+ * ends its grabs. */
+wb_grab_id wb_grab_rigid(wb_world *w, wb_rigid_id r, const wb_real local[3], const wb_real target[3],
+                         wb_real compliance, wb_status *status);
+wb_rigid_id wb_grab_body(const wb_world *w, wb_grab_id g);           /* {0, 0}: a particle's grab */
+void wb_grab_local(const wb_world *w, wb_grab_id g, wb_real out[3]);  /* the body point, its frame */
+void wb_grab_point(const wb_world *w, wb_grab_id g, wb_real out[3]);  /* the grabbed point now, world */
+
 /* its surface's signed distance from p (negative inside) */
 wb_real wb_rigid_distance(const wb_world *w, wb_rigid_id r, const wb_real p[3]);
 /* particle p kept where it is now in body r's frame (attach.c; see wb_attach_collider): the

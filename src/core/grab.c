@@ -1,7 +1,10 @@
 /* grab.c: grabs (DESIGN.md §2, one file per constraint type; issue 10 part 4).
  *
  * The scripted form of dragging a particle with the mouse: particle p is pulled to a
- * target point the script moves. XPBD with the vector constraint C = x - t, as
+ * target point the script moves. A rigid body is grabbed at a point fixed in its frame
+ * (`local`): the same constraint with the body's response at that point in place of the
+ * particle's 1/m (wb__rigid_point_response, solved in 3D as attachments to bodies are),
+ * so a box grabbed off its centre swings about the grab point. XPBD with the vector constraint C = x - t, as
  * attach.c: dlambda = (-C - alpha~ lambda) / (w + alpha~), x += w dlambda. Compliance 0
  * puts the particle exactly on the target at the end of every substep; a compliant grab
  * is a zero-length spring of stiffness 1/alpha (F = -C/alpha, U = |C|^2 / (2 alpha)).
@@ -14,12 +17,13 @@
  * substep counter. Serial pass in slot order: deterministic for any thread count. */
 #include <assert.h>
 
+#include "attach.h"
 #include "ctype.h"
 #include "grab.h"
 #include "shape_match.h"
 #include "snapshot.h"
 
-#define GRAB_BYTES (sizeof(int32_t) + sizeof(uint32_t) + 10 * sizeof(wb_real))
+#define GRAB_BYTES (sizeof(int32_t) + 1 + 2 * sizeof(uint32_t) + 13 * sizeof(wb_real))
 
 static int live(const wb_grabs *g, int32_t s) { return (g->gen[s] & 1u) != 0; }
 
@@ -40,6 +44,7 @@ wb_status wb__grab_reserve(wb_world *w, int64_t extra)
     if (!wb__material_charge(w, &g->charged, (size_t)cap * GRAB_BYTES)) return WB_ERR_NOMEM;
     struct { void **p; size_t elem; } arr[] = {
         { (void **)&g->p, sizeof(int32_t) }, { (void **)&g->alpha, sizeof(wb_real) },
+        { (void **)&g->kind, 1 }, { (void **)&g->tgen, sizeof(uint32_t) }, { (void **)&g->local, 3 * sizeof(wb_real) },
         { (void **)&g->gen, sizeof(uint32_t) }, { (void **)&g->target, 3 * sizeof(wb_real) },
         { (void **)&g->from, 3 * sizeof(wb_real) }, { (void **)&g->lambda, 3 * sizeof(wb_real) },
     };
@@ -52,9 +57,14 @@ wb_status wb__grab_reserve(wb_world *w, int64_t extra)
     return WB_OK;
 }
 
-static void fill(wb_grabs *g, int32_t s, int32_t p, const wb_real target[3], const wb_real from[3], wb_real alpha)
+static void fill(const wb_world *w, wb_grabs *g, int32_t s, int32_t p, int kind, const wb_real local[3],
+                 const wb_real target[3], const wb_real from[3], wb_real alpha)
 {
     g->p[s] = p;
+    g->kind[s] = (uint8_t)kind;
+    g->tgen[s] = kind == WB_GRAB_RIGID ? w->rb->gen[p] : 0;
+    if (local) v3_copy(&g->local[3 * s], local);
+    else v3_set(&g->local[3 * s], 0, 0, 0);
     g->alpha[s] = alpha;
     v3_copy(&g->target[3 * s], target);
     v3_copy(&g->from[3 * s], from);
@@ -63,16 +73,43 @@ static void fill(wb_grabs *g, int32_t s, int32_t p, const wb_real target[3], con
 }
 
 /* a new live slot after the last one (snapshots restore the live slots in order) */
-void wb__grab_put(wb_world *w, int32_t p, const wb_real target[3], const wb_real from[3], wb_real alpha)
+void wb__grab_put(wb_world *w, int32_t p, int kind, const wb_real local[3], const wb_real target[3],
+                  const wb_real from[3], wb_real alpha)
 {
     wb_grabs *g = w->grab;
     assert(g && g->n < g->cap); /* contract: reserved first */
     const int32_t s = g->n++;
-    fill(g, s, p, target, from, alpha);
+    fill(w, g, s, p, kind, local, target, from, alpha);
     g->gen[s] = 1;
 }
 
 static int fin3(const wb_real *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
+/* a new grab of particle p, or of body slot p at local point `local` */
+static wb_grab_id grab_new(wb_world *w, int32_t p, int kind, const wb_real local[3], const wb_real target[3],
+                           wb_real compliance, wb_status *status)
+{
+    wb_grab_id none = { 0, 0 };
+    wb_grabs *g = w->grab;
+    int32_t s = -1;
+    for (int32_t i = g ? g->free_hint : 0; g && i < g->n && s < 0; i++) /* no dead slot below the hint */
+        if (!live(g, i)) s = i;
+    if (g) g->free_hint = s < 0 ? g->n : s + 1;
+    /* a new grab starts at its target: it pulls from the first substep on */
+    if (s < 0) {
+        wb_status st = wb__grab_reserve(w, 1);
+        if (st != WB_OK) { *status = st; return none; }
+        wb__grab_put(w, p, kind, local, target, target, compliance);
+        g = w->grab;
+        s = g->n - 1;
+    } else {
+        fill(w, g, s, p, kind, local, target, target, compliance);
+        g->gen[s]++; /* even -> odd: live, old handles of the slot stay stale */
+    }
+    *status = WB_OK;
+    wb_grab_id id = { (uint32_t)s + 1, g->gen[s] };
+    return id;
+}
 
 wb_grab_id wb_grab_add(wb_world *w, int32_t p, const wb_real target[3], wb_real compliance, wb_status *status)
 {
@@ -87,36 +124,52 @@ wb_grab_id wb_grab_add(wb_world *w, int32_t p, const wb_real target[3], wb_real 
         *status = WB_ERR_ARG;
         return none;
     }
-    wb_grabs *g = w->grab;
-    int32_t s = -1;
-    for (int32_t i = g ? g->free_hint : 0; g && i < g->n && s < 0; i++) /* no dead slot below the hint */
-        if (!live(g, i)) s = i;
-    if (g) g->free_hint = s < 0 ? g->n : s + 1;
-    /* a new grab starts at its target: it pulls from the first substep on */
-    if (s < 0) {
-        wb_status st = wb__grab_reserve(w, 1);
-        if (st != WB_OK) { *status = st; return none; }
-        wb__grab_put(w, p, target, target, compliance);
-        g = w->grab;
-        s = g->n - 1;
-    } else {
-        fill(g, s, p, target, target, compliance);
-        g->gen[s]++; /* even -> odd: live, old handles of the slot stay stale */
-    }
-    *status = WB_OK;
-    wb_grab_id id = { (uint32_t)s + 1, g->gen[s] };
-    return id;
+    return grab_new(w, p, WB_GRAB_PARTICLE, NULL, target, compliance, status);
 }
 
-bool wb_grab_valid(const wb_world *w, wb_grab_id id)
+wb_grab_id wb_grab_rigid(wb_world *w, wb_rigid_id r, const wb_real local[3], const wb_real target[3],
+                         wb_real compliance, wb_status *status)
+{
+    wb_grab_id none = { 0, 0 };
+    wb_status dummy;
+    if (!status) status = &dummy;
+    static const wb_real centre[3] = { 0, 0, 0 };
+    if (!local) local = centre;
+    const char *err = !(compliance >= 0) || !isfinite(compliance) ? "compliance must be >= 0"
+                    : !wb_rigid_valid(w, r) ? "rigid body removed"
+                    : !fin3(local) ? "at must be finite"
+                    : !fin3(target) ? "target must be finite" : NULL;
+    if (err) {
+        wb__set_error("%s", err);
+        *status = WB_ERR_ARG;
+        return none;
+    }
+    return grab_new(w, (int32_t)r.index - 1, WB_GRAB_RIGID, local, target, compliance, status);
+}
+
+static int32_t slot_of(const wb_world *w, wb_grab_id id)
 {
     const wb_grabs *g = w->grab;
-    if (!g || id.index == 0 || id.index > (uint32_t)g->n) return false;
+    if (!g || id.index == 0 || id.index > (uint32_t)g->n) return -1;
     const int32_t s = (int32_t)id.index - 1;
-    return live(g, s) && g->gen[s] == id.gen;
+    return live(g, s) && g->gen[s] == id.gen ? s : -1;
 }
 
-#define SLOT(w, id) (assert(wb_grab_valid((w), (id))), (int32_t)(id).index - 1)
+/* live, and its body too (a grab of a removed body is over) */
+bool wb_grab_valid(const wb_world *w, wb_grab_id id)
+{
+    const int32_t s = slot_of(w, id);
+    return s >= 0 && wb__grab_active(w, w->grab, s);
+}
+
+#define SLOT(w, id) (assert(slot_of((w), (id)) >= 0), (int32_t)(id).index - 1)
+
+/* the grabbed point now: the particle, or the body's point */
+static void grabbed_point(const wb_world *w, const wb_grabs *g, int32_t s, wb_real out[3])
+{
+    if (g->kind[s] == WB_GRAB_RIGID) wb__rigid_to_world(w, g->p[s], &g->local[3 * s], out);
+    else v3_copy(out, &w->s.x[3 * g->p[s]]);
+}
 
 void wb_grab_release(wb_world *w, wb_grab_id id)
 {
@@ -133,7 +186,29 @@ void wb_grab_move(wb_world *w, wb_grab_id id, const wb_real target[3])
 }
 
 void wb_grab_target(const wb_world *w, wb_grab_id id, wb_real out[3]) { v3_copy(out, &w->grab->target[3 * SLOT(w, id)]); }
-int32_t wb_grab_particle(const wb_world *w, wb_grab_id id) { return w->grab->p[SLOT(w, id)]; }
+int32_t wb_grab_particle(const wb_world *w, wb_grab_id id)
+{
+    const int32_t s = SLOT(w, id);
+    return w->grab->kind[s] == WB_GRAB_RIGID ? -1 : w->grab->p[s];
+}
+
+wb_rigid_id wb_grab_body(const wb_world *w, wb_grab_id id)
+{
+    const int32_t s = SLOT(w, id);
+    const wb_grabs *g = w->grab;
+    wb_rigid_id r = { 0, 0 };
+    if (g->kind[s] == WB_GRAB_RIGID) { r.index = (uint32_t)g->p[s] + 1; r.gen = g->tgen[s]; }
+    return r;
+}
+
+void wb_grab_local(const wb_world *w, wb_grab_id id, wb_real out[3]) { v3_copy(out, &w->grab->local[3 * SLOT(w, id)]); }
+
+void wb_grab_point(const wb_world *w, wb_grab_id id, wb_real out[3])
+{
+    const int32_t s = SLOT(w, id);
+    if (wb__grab_active(w, w->grab, s)) grabbed_point(w, w->grab, s, out);
+    else v3_copy(out, &w->grab->target[3 * s]);
+}
 wb_real wb_grab_compliance(const wb_world *w, wb_grab_id id) { return w->grab->alpha[SLOT(w, id)]; }
 
 wb_real wb_grab_force(const wb_world *w, wb_grab_id id, wb_real f[3])
@@ -146,13 +221,19 @@ wb_real wb_grab_force(const wb_world *w, wb_grab_id id, wb_real f[3])
     return v3_len(out);
 }
 
-int32_t wb_grab_count(const wb_world *w) { return w->grab ? w->grab->nlive : 0; }
+int32_t wb_grab_count(const wb_world *w)
+{
+    const wb_grabs *g = w->grab;
+    int32_t n = 0;
+    for (int32_t s = 0; g && s < g->n; s++) n += wb__grab_active(w, g, s);
+    return n;
+}
 
 wb_grab_id wb_grab_at(const wb_world *w, int32_t i)
 {
     const wb_grabs *g = w->grab;
     for (int32_t s = 0; g && s < g->n; s++) {
-        if (!live(g, s)) continue;
+        if (!wb__grab_active(w, g, s)) continue;
         if (i-- == 0) { wb_grab_id id = { (uint32_t)s + 1, g->gen[s] }; return id; }
     }
     wb_grab_id none = { 0, 0 };
@@ -164,7 +245,7 @@ int32_t wb_grab_list(const wb_world *w, wb_grab_id *out, int32_t cap)
     const wb_grabs *g = w->grab;
     int32_t k = 0;
     for (int32_t s = 0; g && s < g->n; s++) {
-        if (!live(g, s)) continue;
+        if (!wb__grab_active(w, g, s)) continue;
         if (k < cap) { out[k].index = (uint32_t)s + 1; out[k].gen = g->gen[s]; }
         k++;
     }
@@ -177,7 +258,7 @@ static void *zalloc(int64_t n, size_t elem) { return calloc((size_t)(n > 0 ? n :
 void wb__grab_image_free(wb_image *g)
 {
     wb_image_grab *a = &g->grab;
-    free(a->p); free(a->target); free(a->from); free(a->alpha);
+    free(a->p); free(a->kind); free(a->local); free(a->target); free(a->from); free(a->alpha);
     memset(a, 0, sizeof *a);
 }
 
@@ -187,10 +268,12 @@ wb_status wb_image_alloc_grab(wb_image *g, int32_t n)
     wb_image_grab *a = &g->grab;
     a->n = n;
     a->p = zalloc(n, sizeof *a->p);
+    a->kind = zalloc(n, sizeof *a->kind);
+    a->local = zalloc(3 * (int64_t)n, sizeof *a->local);
     a->target = zalloc(3 * (int64_t)n, sizeof *a->target);
     a->from = zalloc(3 * (int64_t)n, sizeof *a->from);
     a->alpha = zalloc(n, sizeof *a->alpha);
-    if (a->p && a->target && a->from && a->alpha) return WB_OK;
+    if (a->p && a->kind && a->local && a->target && a->from && a->alpha) return WB_OK;
     wb__grab_image_free(g);
     return WB_ERR_NOMEM;
 }
@@ -202,8 +285,10 @@ wb_status wb__grab_image_of(const wb_world *w, wb_image *img)
     const wb_grabs *g = w->grab;
     int32_t k = 0;
     for (int32_t s = 0; g && s < g->n; s++) {
-        if (!live(g, s)) continue;
+        if (!wb__grab_active(w, g, s)) continue;
         img->grab.p[k] = g->p[s];
+        img->grab.kind[k] = g->kind[s];
+        v3_copy(&img->grab.local[3 * k], &g->local[3 * s]);
         v3_copy(&img->grab.target[3 * k], &g->target[3 * s]);
         v3_copy(&img->grab.from[3 * k], &g->from[3 * s]);
         img->grab.alpha[k] = g->alpha[s];
@@ -217,7 +302,15 @@ const char *wb__grab_image_check(const wb_image *img)
     const wb_image_grab *g = &img->grab;
     if (g->n < 0 || g->n > WB_MAX_CONSTRAINTS) return "too many grabs";
     for (int32_t k = 0; k < g->n; k++) {
-        if (g->p[k] < 0 || g->p[k] >= img->np) return "grab particle out of range";
+        if (g->kind[k] == WB_GRAB_RIGID) {
+            const int32_t r = g->p[k];
+            if (r < 0 || r >= img->nrb || !(img->rb_gen[r] & 1u)) return "grab rigid body out of range";
+            if (!fin3(&g->local[3 * k])) return "grab point (at) must be finite";
+        } else if (g->kind[k] != WB_GRAB_PARTICLE) {
+            return "grab kind unknown (0 = particle, 1 = rigid body)";
+        } else if (g->p[k] < 0 || g->p[k] >= img->np) {
+            return "grab particle out of range";
+        }
         if (!fin3(&g->target[3 * k]) || !fin3(&g->from[3 * k])) return "grab target must be finite";
         if (!(g->alpha[k] >= 0) || !isfinite(g->alpha[k])) return "grab compliance must be >= 0";
     }
@@ -229,19 +322,32 @@ wb_status wb__grab_image_reserve(wb_world *w, const wb_image *img)
     return img->grab.n > 0 ? wb__grab_reserve(w, img->grab.n) : WB_OK;
 }
 
-void wb__grab_image_put(wb_world *w, const wb_image *img, int32_t pshift)
+void wb__grab_image_put(wb_world *w, const wb_image *img, int32_t pshift, const int32_t *rmap)
 {
     const wb_image_grab *g = &img->grab;
-    for (int32_t k = 0; k < g->n; k++)
-        wb__grab_put(w, g->p[k] + pshift, &g->target[3 * k], &g->from[3 * k], g->alpha[k]);
+    for (int32_t k = 0; k < g->n; k++) {
+        const int rigid = g->kind[k] == WB_GRAB_RIGID;
+        const int32_t p = rigid ? (rmap ? rmap[g->p[k]] : g->p[k]) : g->p[k] + pshift;
+        wb__grab_put(w, p, rigid ? WB_GRAB_RIGID : WB_GRAB_PARTICLE, rigid ? &g->local[3 * k] : NULL,
+                     &g->target[3 * k], &g->from[3 * k], g->alpha[k]);
+    }
 }
 
 /* ---- the type ---------------------------------------------------------------------- */
 static int32_t grab_count(const wb_world *w) { return wb_grab_count(w); }
 
+/* once per step: grabs of removed bodies end */
 static wb_status grab_prepare(wb_world *w)
 {
-    if (w->grab) w->grab->sub = 0;
+    wb_grabs *g = w->grab;
+    if (!g) return WB_OK;
+    g->sub = 0;
+    for (int32_t s = 0; s < g->n; s++)
+        if (live(g, s) && !wb__grab_active(w, g, s)) {
+            g->gen[s]++;
+            g->nlive--;
+            if (s < g->free_hint) g->free_hint = s;
+        }
     return WB_OK;
 }
 
@@ -251,6 +357,43 @@ static void grab_substep_begin(wb_world *w)
     if (!g) return;
     g->sub++;
     if (g->n > 0) memset(g->lambda, 0, sizeof(wb_real) * 3 * (size_t)g->n);
+}
+
+/* x = A^-1 b for the 3 x 3 A (Cramer's rule); 0 when singular */
+static int solve3(const wb_real A[9], const wb_real b[3], wb_real x[3])
+{
+    const wb_real c0[3] = { A[0], A[3], A[6] }, c1[3] = { A[1], A[4], A[7] }, c2[3] = { A[2], A[5], A[8] };
+    wb_real t[3], u[3];
+    v3_cross(t, c1, c2);
+    const wb_real det = v3_dot(c0, t);
+    if (!(fabs(det) > 0) || !isfinite(det)) return 0;
+    x[0] = v3_dot(b, t) / det;
+    v3_cross(u, b, c2);
+    x[1] = v3_dot(c0, u) / det;
+    v3_cross(u, c1, b);
+    x[2] = v3_dot(c0, u) / det;
+    return 1;
+}
+
+/* a body's point pulled to the target: (K + alpha~ E) dlambda = t - x - alpha~ lambda with
+ * K the body's response at the point (as attach.c's rigid case, the target immovable) */
+static void project_rigid(wb_world *w, wb_grabs *g, int32_t s, wb_real h, wb_real f)
+{
+    const int32_t r = g->p[s];
+    const wb_real at = g->alpha[s] / (h * h);
+    if (isinf(at)) return;
+    const wb_real *t1 = &g->target[3 * s], *t0 = &g->from[3 * s];
+    wb_real x[3], K[9], rhs[3], dl[3], *l = &g->lambda[3 * s];
+    wb__rigid_to_world(w, r, &g->local[3 * s], x);
+    wb__rigid_point_response(w, r, x, K);
+    for (int k = 0; k < 3; k++) {
+        const wb_real t = g->sub >= w->m.def.substeps ? t1[k] : t0[k] + (t1[k] - t0[k]) * f;
+        K[4 * k] += at;
+        rhs[k] = t - x[k] - at * l[k];
+    }
+    if (!solve3(K, rhs, dl)) return;
+    v3_add(l, l, dl);
+    wb__rigid_apply(w, r, x, dl);
 }
 
 static void grab_project(wb_world *w, wb_real h)
@@ -264,7 +407,11 @@ static void grab_project(wb_world *w, wb_real h)
     wb_real *x = w->s.x;
     w->k.projections += g->nlive;
     for (int32_t s = 0; s < g->n; s++) {
-        if (!live(g, s)) continue;
+        if (!wb__grab_active(w, g, s)) continue;
+        if (g->kind[s] == WB_GRAB_RIGID) {
+            project_rigid(w, g, s, h, f);
+            continue;
+        }
         const int32_t p = g->p[s];
         const wb_real wp = wv[p];
         if (wp == 0) continue; /* pinned or immovable: never written */
@@ -295,9 +442,10 @@ static wb_real grab_energy(const wb_world *w)
     const wb_grabs *g = w->grab;
     wb_real e = 0;
     for (int32_t s = 0; g && s < g->n; s++) {
-        if (!live(g, s) || !(g->alpha[s] > 0)) continue;
+        if (!wb__grab_active(w, g, s) || !(g->alpha[s] > 0)) continue;
         wb_real c[3];
-        v3_sub(c, &w->s.x[3 * g->p[s]], &g->target[3 * s]);
+        grabbed_point(w, g, s, c);
+        v3_sub(c, c, &g->target[3 * s]);
         e += v3_dot(c, c) / (2 * g->alpha[s]);
     }
     return e;

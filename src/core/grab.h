@@ -1,16 +1,22 @@
-/* grab.h: grabs (grab.c): a particle pulled to a point the script moves (the mouse drag
- * of a live viewer). Slots live while gen is odd. */
+/* grab.h: grabs (grab.c): a particle, or a point fixed in a rigid body, pulled to a point
+ * the script moves (the mouse drag of a live viewer). Slots live while gen is odd. */
 #ifndef WB_GRAB_H
 #define WB_GRAB_H
 
 #include <stdlib.h>
 
 #include "core.h"
+#include "rigid.h"
+
+enum { WB_GRAB_PARTICLE = 0, WB_GRAB_RIGID = 1 };
 
 /* w->grab: NULL until the first grab */
 typedef struct wb_grabs {
     int32_t n, cap, nlive;  /* slots, capacity, live ones */
-    int32_t *p;             /* (n) model: particle */
+    int32_t *p;             /* (n) model: particle, or the body's slot (kind WB_GRAB_RIGID) */
+    uint8_t *kind;          /* (n) model: WB_GRAB_* */
+    uint32_t *tgen;         /* (n) model: the body's generation when grabbed */
+    wb_real *local;         /* (n x 3) model: the grabbed point in the body's frame */
     wb_real *alpha;         /* (n) model: compliance, m/N */
     uint32_t *gen;          /* (n) odd = live */
     wb_real *target;        /* (n x 3) state: where the script put it */
@@ -28,12 +34,24 @@ static inline void wb__grab_free(wb_world *w)
     wb_grabs *g = w->grab;
     if (!g) return;
     if (w->m.def.memory) w->m.def.memory->used -= g->charged;
-    void *p[] = { g->p, g->alpha, g->gen, g->target, g->from, g->lambda };
+    void *p[] = { g->p, g->kind, g->tgen, g->local, g->alpha, g->gen, g->target, g->from, g->lambda };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     free(g);
     w->grab = NULL;
 }
 
+/* slot s is live and, for a rigid body's grab, the body still is (a removed body leaves
+ * its grabs inert until the next step's prepare retires them; the hash and images skip them) */
+static inline int wb__grab_active(const wb_world *w, const wb_grabs *g, int32_t s)
+{
+    if (!(g->gen[s] & 1u)) return 0;
+    if (g->kind[s] != WB_GRAB_RIGID) return 1;
+    const int32_t r = g->p[s];
+    return w->rb && r >= 0 && r < w->rb->n && w->rb->gen[r] == g->tgen[s];
+}
+
 wb_status wb__grab_reserve(wb_world *w, int64_t extra);
-void wb__grab_put(wb_world *w, int32_t p, const wb_real target[3], const wb_real from[3], wb_real alpha);
+/* kind WB_GRAB_RIGID: p is the body's slot, local the point in its frame (else NULL) */
+void wb__grab_put(wb_world *w, int32_t p, int kind, const wb_real local[3], const wb_real target[3],
+                  const wb_real from[3], wb_real alpha);
 #endif

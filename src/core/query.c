@@ -182,8 +182,12 @@ uint64_t wb_world_hash(const wb_world *w)
     }
     const wb_grabs *gr = w->grab;
     for (int32_t i = 0; gr && i < gr->n; i++) {
-        if (!(gr->gen[i] & 1u)) continue;
+        if (!wb__grab_active(w, gr, i)) continue;
         h = fnv(h, &gr->p[i], sizeof gr->p[i]);
+        if (gr->kind[i] == WB_GRAB_RIGID) { /* (particle grabs hash as they always did) */
+            h = fnv(h, &gr->kind[i], 1);
+            h = fnv(h, &gr->local[3 * i], 3 * sizeof(wb_real));
+        }
         h = fnv(h, &gr->target[3 * i], 3 * sizeof(wb_real));
         h = fnv(h, &gr->from[3 * i], 3 * sizeof(wb_real));
         h = fnv(h, &gr->alpha[i], sizeof(wb_real));

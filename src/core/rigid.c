@@ -549,6 +549,42 @@ static void turn(wb_real q[4], const wb_real t[3])
     q_normalize(q);
 }
 
+/* Static friction at one point (A's local la, B's local lb): the two points' relative
+ * tangential motion over the substep is undone when the impulse needed, |slip| / (w_A +
+ * w_B) along it, is inside the cone lmax (Müller et al. 2020, eq. 9 and §3.5) */
+static void slip_correct(wb_world *w, const side *A, const side *B, const wb_real la[3], const wb_real lb[3],
+                         const wb_real n[3], wb_real lmax)
+{
+    const wb_rigids *rb = w->rb;
+    wb_real pa[3], pa0[3], pb[3], pb0[3], slip[3];
+    side_points(rb, A, la, pa, pa0);
+    side_points(rb, B, lb, pb, pb0);
+    for (int i = 0; i < 3; i++) slip[i] = (pb[i] - pb0[i]) - (pa[i] - pa0[i]);
+    v3_madd(slip, n, -v3_dot(slip, n));
+    const wb_real len = v3_len(slip);
+    if (!(len > 0)) return;
+    wb_real t[3], dp[3];
+    v3_scale(t, slip, 1 / len);
+    const wb_real wt = side_w(w, A, pa, t) + side_w(w, B, pb, t);
+    const wb_real lt = wt > 0 ? len / wt : INFINITY;
+    if (!(lt < lmax)) return;
+    v3_scale(dp, t, -lt);
+    push(w, A, B, pa, pb, dp);
+}
+
+/* body pairs' static friction, after both normal sweeps of the substep: the lower bodies
+ * are back where the contacts below them put them */
+static void static_friction_pairs(wb_world *w)
+{
+    wb_rigids *rb = w->rb;
+    for (int32_t k = 0; k < rb->nfr; k++) {
+        const wb_rfric *f = &rb->fr[k];
+        if (!live(rb, f->a) || !live(rb, f->b)) continue;
+        const side A = { f->a, NULL, NULL, NULL, NULL }, B = { f->b, NULL, NULL, NULL, NULL };
+        slip_correct(w, &A, &B, f->la, f->lb, f->n, f->lmax);
+    }
+}
+
 /* The manifold's normal corrections are solved together: point after point (Gauss-Seidel
  * over the points, each moving the body before the next) tilts a box resting on four
  * corners a little differently every substep, and the tilts, not commuting, pump a spin
@@ -624,37 +660,37 @@ static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_c
      * when the impulse needed stays inside the friction cone, mu x the normal impulse. One
      * correction for the manifold, at the centre of its normal impulses: corner by corner
      * each correction turned the box about the normal and left the next corner slipping,
-     * and a box on a slope crept down at 1 mm/s. Against colliders only: between two
-     * bodies the Gauss-Seidel sweep turns the lower body about its centre under an
-     * off-centre load (the collider below turns it back later), the correction drags the
-     * upper body along with that turn, and, substep after substep, a box set 0.1 m off the
-     * centre of the box below walked off it at 1 cm/s. Body pairs stop slipping by the
-     * velocity pass's friction alone. */
-    if (mu > 0 && lsum > 0 && A->r < 0) {
-        wb_real c[3] = { 0, 0, 0 }, lca[3], lcb[3], pa[3], pa0[3], pb[3], pb0[3], slip[3];
+     * and a box on a slope crept down at 1 mm/s. Against a collider at once; between two
+     * bodies after the substep's normal sweeps (static_friction_pairs): here the sweep has
+     * just turned the lower body about its centre under the upper one's off-centre load
+     * (the contact below turns it back later in the sweep), a correction now would drag the
+     * upper body along with that passing turn, and, substep after substep, a box set 0.1 m
+     * off the centre of the box below walked off it at 1 cm/s. */
+    if (mu > 0 && lsum > 0 && (A->r < 0 || rb->record_fr)) {
+        wb_real c[3] = { 0, 0, 0 }, lca[3], lcb[3];
         for (int k = 0; k < np; k++) {
             v3_madd(c, m->pt[k].pa, lam[k] / (2 * lsum));
             v3_madd(c, m->pt[k].pb, lam[k] / (2 * lsum));
         }
-        /* c as it was before this solve moved the bodies: its local points in each */
-        wb_real ca[3], cb[3];
-        v3_copy(ca, c);
-        v3_copy(cb, c);
-        side_local(rb, A, ca, lca);
-        side_local(rb, B, cb, lcb);
-        side_points(rb, A, lca, pa, pa0);
-        side_points(rb, B, lcb, pb, pb0);
-        for (int i = 0; i < 3; i++) slip[i] = (pb[i] - pb0[i]) - (pa[i] - pa0[i]);
-        v3_madd(slip, n, -v3_dot(slip, n));
-        const wb_real len = v3_len(slip);
-        if (len > 0) {
-            wb_real t[3], dp[3];
-            v3_scale(t, slip, 1 / len);
-            const wb_real wt = side_w(w, A, pa, t) + side_w(w, B, pb, t);
-            const wb_real lt = wt > 0 ? len / wt : INFINITY;
-            if (lt < mu * lsum) {
-                v3_scale(dp, t, -lt);
-                push(w, A, B, pa, pb, dp);
+        /* c's local points in each body (after this solve: the slip is measured from the
+         * substep's start poses to the poses when the correction is made) */
+        side_local(rb, A, c, lca);
+        side_local(rb, B, c, lcb);
+        if (A->r < 0) {
+            slip_correct(w, A, B, lca, lcb, n, mu * lsum);
+        } else {
+            wb_rfric *fr = wb__grow(rb->fr, &rb->cap_fr, rb->nfr + 1, sizeof *fr);
+            if (fr) {
+                rb->fr = fr;
+                fr = &fr[rb->nfr++];
+                fr->a = A->r;
+                fr->b = B->r;
+                v3_copy(fr->la, lca);
+                v3_copy(fr->lb, lcb);
+                v3_copy(fr->n, n);
+                fr->lmax = mu * lsum;
+            } else {
+                wb__warn(w, "out of memory in rigid contacts; static friction skipped");
             }
         }
     }
@@ -695,21 +731,47 @@ void wb__rigid_contact_collider(wb_world *w, int32_t c, const wb_real p0[3], con
     solve_manifold(w, &A, &B, &w->m.c_shape[c], &w->rb->shape[r], m, h);
 }
 
-/* body r against the live colliders */
-static void touch_colliders(wb_world *w, int32_t r, wb_real h, wb_real f0, wb_real f1)
+/* the colliders' poses at the substep's start and end, and a bounding radius about the
+ * pose (planes and meshes: -1, always tested), once per substep for all bodies */
+static int collider_poses(wb_world *w, wb_real f0, wb_real f1)
+{
+    wb_rigids *rb = w->rb;
+    const wb_model *m = &w->m;
+    wb_real *cp = wb__grow(rb->cpose, &rb->cap_cpose, 15 * (m->nc > 0 ? m->nc : 1), sizeof *cp);
+    if (!cp) return 0;
+    rb->cpose = cp;
+    for (int32_t c = 0; c < m->nc; c++) {
+        if (!(m->c_gen[c] & 1u)) continue;
+        wb_real *e = &cp[15 * c];
+        wb__collider_pose_at(&w->s.c_pose[c], f0, e, e + 3);
+        wb__collider_pose_at(&w->s.c_pose[c], f1, e + 7, e + 10);
+        const wb_cshape *s = &m->c_shape[c];
+        e[14] = s->shape == WB_SHAPE_SPHERE ? s->radius
+              : s->shape == WB_SHAPE_BOX ? v3_len(s->half)
+              : s->shape == WB_SHAPE_CAPSULE ? fmax(v3_len(s->a), v3_len(s->b)) + s->radius : -1;
+    }
+    return 1;
+}
+
+/* body r against the live colliders. A collider whose bounding sphere is farther from the
+ * body's than the margin has no point within it: skipped without the narrow phase */
+static void touch_colliders(wb_world *w, int32_t r, wb_real h)
 {
     wb_rigids *rb = w->rb;
     const wb_model *m = &w->m;
     /* points that may touch by the substep's end */
     const wb_real margin = h * (v3_len(&rb->v[3 * r]) + v3_len(&rb->om[3 * r]) * rb->bound[r]);
+    const wb_real *xr = &rb->x[3 * r];
     for (int32_t c = 0; c < m->nc; c++) {
         if (!(m->c_gen[c] & 1u)) continue;
-        wb_real p0[3], q0[4], p1[3], q1[4];
-        wb__collider_pose_at(&w->s.c_pose[c], f0, p0, q0);
-        wb__collider_pose_at(&w->s.c_pose[c], f1, p1, q1);
+        const wb_real *e = &rb->cpose[15 * c];
+        if (e[14] >= 0) {
+            const wb_real reach = e[14] + rb->bound[r] + margin, d[3] = { xr[0] - e[7], xr[1] - e[8], xr[2] - e[9] };
+            if (v3_dot(d, d) > reach * reach) continue;
+        }
         wb_manifold mf;
-        if (wb__narrow(&m->c_shape[c], p1, q1, &rb->shape[r], &rb->x[3 * r], &rb->q[4 * r], margin, &mf) > 0)
-            wb__rigid_contact_collider(w, c, p0, q0, p1, q1, r, &mf, h);
+        if (wb__narrow(&m->c_shape[c], e + 7, e + 10, &rb->shape[r], xr, &rb->q[4 * r], margin, &mf) > 0)
+            wb__rigid_contact_collider(w, c, e, e + 3, e + 7, e + 10, r, &mf, h);
     }
 }
 
@@ -729,6 +791,79 @@ static void touch_pair(wb_world *w, int32_t a, int32_t b, wb_real h)
         wb__rigid_contact_rigid(w, a, b, &mf, h);
 }
 
+/* sort keys: a body's low end along the sweep axis (ties by slot); a pair by (a, b) */
+typedef struct wb_rkey { wb_real lo; int32_t r; } wb_rkey;
+static int cmp_lo(const void *pa, const void *pb)
+{
+    const wb_rkey *a = pa, *b = pb;
+    return a->lo < b->lo ? -1 : a->lo > b->lo ? 1 : (a->r > b->r) - (a->r < b->r);
+}
+static int cmp_pair(const void *pa, const void *pb)
+{
+    const int32_t *a = pa, *b = pb;
+    return a[0] != b[0] ? (a[0] > b[0]) - (a[0] < b[0]) : (a[1] > b[1]) - (a[1] < b[1]);
+}
+
+/* The candidate body pairs of the substep by sort and sweep (O(n log n + pairs) instead of
+ * all n^2 pairs), in the order of the all-pairs loop, (a, b) with a < b: the solve is the
+ * same. A body's box: its bounding sphere grown by twice its margin (the pair test's reach
+ * is the two spheres plus the two margins) and 5 % of its bound, so that the corrections
+ * of the sweep, which move the bodies after the boxes are made, leave no pair out that the
+ * exact test (touch_pair) would take. The axis: the one the centres spread most along.
+ * 0 when out of memory (the caller tries all pairs). */
+static int candidate_pairs(wb_world *w, wb_real h)
+{
+    wb_rigids *rb = w->rb;
+    rb->npair = 0;
+    int32_t nb = 0;
+    for (int32_t r = 0; r < rb->n; r++) nb += live(rb, r);
+    wb_real *box = wb__grow(rb->box, &rb->cap_box, 6 * (rb->n > 0 ? rb->n : 1), sizeof *box);
+    if (!box) return 0;
+    rb->box = box;
+    wb_rkey *ord = wb__grow(rb->ord, &rb->cap_ord, nb > 0 ? nb : 1, sizeof *ord);
+    if (!ord) return 0;
+    rb->ord = ord;
+    wb_real mean[3] = { 0, 0, 0 }, var[3] = { 0, 0, 0 };
+    nb = 0;
+    for (int32_t r = 0; r < rb->n; r++) {
+        if (!live(rb, r)) continue;
+        const wb_real *x = &rb->x[3 * r];
+        const wb_real e = rb->bound[r] * (wb_real)1.05 + 2 * h * (v3_len(&rb->v[3 * r]) + v3_len(&rb->om[3 * r]) * rb->bound[r]);
+        for (int c = 0; c < 3; c++) {
+            box[6 * r + c] = x[c] - e;
+            box[6 * r + 3 + c] = x[c] + e;
+            mean[c] += x[c];
+        }
+        ord[nb++].r = r;
+    }
+    if (nb < 2) return 1;
+    for (int c = 0; c < 3; c++) mean[c] /= nb;
+    for (int32_t k = 0; k < nb; k++)
+        for (int c = 0; c < 3; c++) var[c] += (rb->x[3 * ord[k].r + c] - mean[c]) * (rb->x[3 * ord[k].r + c] - mean[c]);
+    const int ax = var[0] >= var[1] && var[0] >= var[2] ? 0 : var[1] >= var[2] ? 1 : 2;
+    for (int32_t k = 0; k < nb; k++) ord[k].lo = box[6 * ord[k].r + ax];
+    qsort(ord, (size_t)nb, sizeof *ord, cmp_lo);
+    for (int32_t i = 0; i < nb; i++) {
+        const int32_t a = ord[i].r;
+        const wb_real *ba = &box[6 * a];
+        for (int32_t k = i + 1; k < nb && ord[k].lo <= ba[3 + ax]; k++) {
+            const int32_t b = ord[k].r;
+            const wb_real *bb = &box[6 * b];
+            int apart = 0;
+            for (int c = 0; c < 3; c++) apart |= bb[c] > ba[3 + c] || ba[c] > bb[3 + c];
+            if (apart) continue;
+            int32_t *pr = wb__grow(rb->pair, &rb->cap_pair, 2 * (rb->npair + 1), sizeof *pr);
+            if (!pr) return 0;
+            rb->pair = pr;
+            pr[2 * rb->npair] = a < b ? a : b;
+            pr[2 * rb->npair + 1] = a < b ? b : a;
+            rb->npair++;
+        }
+    }
+    if (rb->npair > 1) qsort(rb->pair, (size_t)rb->npair, 2 * sizeof *rb->pair, cmp_pair);
+    return 1;
+}
+
 /* Two Gauss-Seidel sweeps over the manifolds per substep, forward then backward. One
  * forward sweep is a product of projections that do not commute: its eigenvalues are
  * complex, and with the velocities taken from the positions, x' = G (2 x - x_prev), a mode
@@ -738,24 +873,41 @@ static void touch_pair(wb_world *w, int32_t a, int32_t b, wb_real h)
  * is the symmetric product, with real eigenvalues l in [0, 1] and |mu|^2 = l <= 1.
  * (Alternating the direction from substep to substep left a |g| h bounce.) The velocity
  * pass keeps the forward sweep's contacts: their multipliers carry nearly all of the
- * push, and their incoming velocities are the ones restitution needs. O(n^2) pairs:
- * scenes have tens of bodies, not thousands. */
+ * push, and their incoming velocities are the ones restitution needs. The pairs come from
+ * a sort and sweep (candidate_pairs), in the all-pairs order. */
 void wb__rigids_solve(wb_world *w, wb_real h, wb_real f0, wb_real f1)
 {
     wb_rigids *rb = w->rb;
     if (!rb) return;
     rb->nct = 0;
+    rb->nfr = 0;
+    if (!collider_poses(w, f0, f1)) {
+        wb__warn(w, "out of memory in rigid contacts; the substep's contacts are skipped");
+        return;
+    }
     for (int32_t r = 0; r < rb->n; r++)
-        if (live(rb, r)) touch_colliders(w, r, h, f0, f1);
-    for (int32_t a = 0; a < rb->n; a++)
-        for (int32_t b = a + 1; live(rb, a) && b < rb->n; b++)
-            if (live(rb, b)) touch_pair(w, a, b, h);
+        if (live(rb, r)) touch_colliders(w, r, h);
+    const int sweep = candidate_pairs(w, h);
+    rb->record_fr = 1;
+    if (sweep) {
+        for (int32_t k = 0; k < rb->npair; k++) touch_pair(w, rb->pair[2 * k], rb->pair[2 * k + 1], h);
+    } else {
+        for (int32_t a = 0; a < rb->n; a++)
+            for (int32_t b = a + 1; live(rb, a) && b < rb->n; b++)
+                if (live(rb, b)) touch_pair(w, a, b, h);
+    }
+    rb->record_fr = 0;
     const int32_t kept = rb->nct;
-    for (int32_t a = rb->n - 1; a >= 0; a--)
-        for (int32_t b = rb->n - 1; live(rb, a) && b > a; b--)
-            if (live(rb, b)) touch_pair(w, a, b, h);
+    if (sweep) {
+        for (int32_t k = rb->npair - 1; k >= 0; k--) touch_pair(w, rb->pair[2 * k], rb->pair[2 * k + 1], h);
+    } else {
+        for (int32_t a = rb->n - 1; a >= 0; a--)
+            for (int32_t b = rb->n - 1; live(rb, a) && b > a; b--)
+                if (live(rb, b)) touch_pair(w, a, b, h);
+    }
     for (int32_t r = rb->n - 1; r >= 0; r--)
-        if (live(rb, r)) touch_colliders(w, r, h, f0, f1);
+        if (live(rb, r)) touch_colliders(w, r, h);
+    static_friction_pairs(w);
     rb->nct = kept;
 }
 

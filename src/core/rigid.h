@@ -21,6 +21,14 @@ typedef struct wb_rcontact {
     wb_real mu, e;
 } wb_rcontact;
 
+/* a body pair's static friction, applied after the substep's normal sweeps (rigid.c) */
+typedef struct wb_rfric {
+    int32_t a, b;          /* bodies */
+    wb_real la[3], lb[3];  /* the manifold's centre of normal impulses in A's and B's frame */
+    wb_real n[3];          /* unit, A -> B */
+    wb_real lmax;          /* mu x the normal impulse: the friction cone */
+} wb_rfric;
+
 typedef struct wb_rigids {
     int32_t n, cap;        /* slots */
     /* model */
@@ -40,6 +48,15 @@ typedef struct wb_rigids {
     uint8_t *moved;        /* (n) a correction moved it this substep: its velocities come from the poses */
     wb_rcontact *ct;       /* contacts of the current substep */
     int32_t nct, cap_ct;
+    wb_rfric *fr;          /* body pairs' static friction of the current substep */
+    int32_t nfr, cap_fr;
+    int record_fr;         /* the forward sweep records them */
+    /* the substep's broad phase (rigid.c), scratch */
+    wb_real *cpose; int32_t cap_cpose;   /* (nc x 15) colliders' poses at the substep's start and
+                                          * end, and bounding radius (< 0: always tested) */
+    wb_real *box; int32_t cap_box;       /* (live bodies x 6) swept boxes: lo, hi */
+    struct wb_rkey *ord; int32_t cap_ord; /* live bodies, sorted along the sweep axis */
+    int32_t *pair, npair, cap_pair;      /* (npair x 2) candidate body pairs a < b, in (a, b) order */
     size_t charged;        /* bytes charged to def.memory */
     /* particle contacts (rigid_particle.c): the frame's candidates, the substep's active ones */
     int32_t *pc, npc, cap_pc;      /* (npc x 2) particle, body slot */
@@ -114,7 +131,7 @@ static inline void wb__rigids_free(wb_world *w, wb_rigids *rb)
     if (!rb) return;
     if (w->m.def.memory) w->m.def.memory->used -= rb->charged;
     void *p[] = { rb->shape, rb->mass, rb->inv_mass, rb->inertia, rb->inv_inertia, rb->bound, rb->gen, rb->x, rb->q,
-                  rb->v, rb->om, rb->x_prev, rb->q_prev, rb->q_pred, rb->save, rb->ct, rb->moved,
+                  rb->v, rb->om, rb->x_prev, rb->q_prev, rb->q_pred, rb->save, rb->ct, rb->fr, rb->moved, rb->cpose, rb->box, rb->ord, rb->pair,
                   rb->pc, rb->pc_sph, rb->pc_slot, rb->pc_cnt, rb->pct };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     free(rb);

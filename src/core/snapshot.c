@@ -531,7 +531,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     wb__pressure_put(w, g, 0);
     wb__rigid_put(w, g, 1, NULL);
     wb__attach_image_put(w, g, 0, NULL, NULL);
-    wb__grab_image_put(w, g, 0);
+    wb__grab_image_put(w, g, 0, NULL);
     s->time = g->time;
     s->frame = g->frame;
     s->warnings = g->warnings;
@@ -650,8 +650,8 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     /* the image's rigid bodies go to free or new slots: the attachments follow them */
     wb__rigid_put(w, g, 0, rmap);
     wb__attach_image_put(w, g, first, cmap, rmap);
+    wb__grab_image_put(w, g, first, rmap);
     free(rmap);
-    wb__grab_image_put(w, g, first);
     free(cmap);
     m->topology_dirty = 1;
     out->first = first;

@@ -51,7 +51,9 @@ typedef struct wb_image_attach {
 } wb_image_attach;
 typedef struct wb_image_grab {
     int32_t n;
-    int32_t *p;            /* (n) particle */
+    int32_t *p;            /* (n) particle, or the rigid slot (kind 1) */
+    int32_t *kind;         /* (n) 0 = particle, 1 = rigid body */
+    wb_real *local;        /* (n x 3) a body's grabbed point in its frame (kind 1) */
     wb_real *target, *from; /* (n x 3) target now, and where the next step's sweep starts */
     wb_real *alpha;        /* (n) compliance, m/N */
 } wb_image_grab;
@@ -184,7 +186,7 @@ void wb__grab_image_free(wb_image *g);
 wb_status wb__grab_image_of(const wb_world *w, wb_image *g);
 const char *wb__grab_image_check(const wb_image *g);
 wb_status wb__grab_image_reserve(wb_world *w, const wb_image *g);
-void wb__grab_image_put(wb_world *w, const wb_image *g, int32_t pshift);
+void wb__grab_image_put(wb_world *w, const wb_image *g, int32_t pshift, const int32_t *rmap);
 
 /* rigid bodies (rigid_image.c): n slots, zeroed, generations 1 (live); WB_ERR_NOMEM */
 wb_status wb_image_alloc_rigids(wb_image *img, int32_t n);

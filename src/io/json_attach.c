@@ -2,11 +2,13 @@
  * "Attachments and grabs"):
  *
  *   "attachments": [ {"particle": 3, "collider": 0 | "rigid": 0, "point": [x,y,z], "compliance": 0}, ... ]
- *   "grabs": [ {"particle": 7, "target": [x,y,z], "from": [x,y,z], "compliance": 0}, ... ]
+ *   "grabs": [ {"particle": 7 | "rigid": 0, "at": [x,y,z], "target": [x,y,z], "from": [x,y,z],
+ *                "compliance": 0}, ... ]
  *
  * "collider" counts the file's "colliders" entries from 0, "rigid" its "rigids" entries
  * (removed slots included, as w:save writes them). "point" (in the target's frame) defaults to where the particle is, as w:attach does; "from" (where the next
- * step's sweep of the target starts) defaults to the target. w:save writes both. */
+ * step's sweep of the target starts) defaults to the target. w:save writes both. A rigid
+ * body's grab names its body as attachments do; "at" (its frame) defaults to the centre. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -103,25 +105,35 @@ static int read_attach_items(rd *r, const cJSON *arr, const kp *parent, const ch
 
 int ja_read_grabs(rd *r, const cJSON *arr, wb_image *g)
 {
-    static const char *const keys[] = { "particle", "target", "from", "compliance", NULL };
+    static const char *const keys[] = { "particle", "target", "from", "compliance", "rigid", "at", NULL };
     kp top = { NULL, "grabs", 0 };
     int32_t n = 0, i = 0;
     if (!arr) return 0;
     if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
     if (wb_image_alloc_grab(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
     for (const cJSON *c = arr->child; c; c = c->next, i++) {
-        const cJSON *f[4];
+        const cJSON *f[6];
         kp p = { &top, NULL, i };
         int64_t pid;
         if (jv_get_object(r, c, &p, keys, f)) return -1;
-        if (!f[0]) return jv_missing(r, c, &p, "particle");
+        const int rigid = f[4] != NULL;
+        kp rq = { &p, "rigid", 0 }, aq = { &p, "at", 0 };
+        if (rigid && f[0]) return jv_fail(r, f[4], 0, &rq, "give particle or rigid, not both");
+        if (!rigid && f[5]) return jv_fail(r, f[5], 0, &aq, "is for a rigid body's grab (with \"rigid\")");
+        if (!f[0] && !rigid) return jv_fail(r, c, 0, &p, "missing key 'particle' (or 'rigid')");
         if (!f[1]) return jv_missing(r, c, &p, "target");
-        if (g->np == 0) {
+        wb_real *loc = &g->grab.local[3 * i];
+        if (rigid) {
+            if (g->nrb == 0) return jv_fail(r, f[4], 0, &rq, "there are no rigid bodies");
+            if (jv_opt_int(r, f[4], &p, "rigid", 0, g->nrb - 1, &pid)) return -1;
+            if (!(g->rb_gen[pid] & 1u)) return jv_fail(r, f[4], 0, &rq, "that rigid body was removed");
+            if (f[5] && jv_opt_vec(r, f[5], &p, "at", 3, loc)) return -1;
+        } else if (g->np == 0) {
             kp q = { &p, "particle", 0 };
             return jv_fail(r, f[0], 0, &q, "there are no particles");
         }
         wb_real a = 0, *t = &g->grab.target[3 * i], *fr = &g->grab.from[3 * i];
-        if (jv_opt_int(r, f[0], &p, "particle", 0, g->np - 1, &pid) || jv_opt_vec(r, f[1], &p, "target", 3, t) ||
+        if ((!rigid && jv_opt_int(r, f[0], &p, "particle", 0, g->np - 1, &pid)) || jv_opt_vec(r, f[1], &p, "target", 3, t) ||
             jv_opt_nonneg(r, f[3], &p, "compliance", &a))
             return -1;
         if (f[2]) {
@@ -130,6 +142,7 @@ int ja_read_grabs(rd *r, const cJSON *arr, wb_image *g)
             memcpy(fr, t, 3 * sizeof *fr);
         }
         g->grab.p[i] = (int32_t)pid;
+        g->grab.kind[i] = rigid; /* WB_GRAB_PARTICLE = 0, WB_GRAB_RIGID = 1 (grab.h) */
         g->grab.alpha[i] = a;
     }
     return 0;

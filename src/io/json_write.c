@@ -258,7 +258,15 @@ static void write_attach(out *o, const wb_image *g)
     free(rank);
     const wb_image_grab *gr = &g->grab;
     for (int32_t k = 0; k < gr->n; k++) {
-        fprintf(f, "%s    {\"particle\": %d, \"target\": ", k ? ",\n" : "  \"grabs\": [\n", gr->p[k]);
+        /* a rigid body by its slot, as attachments name theirs */
+        const int rigid = gr->kind[k] == 1;
+        fprintf(f, "%s    {\"%s\": %d, ", k ? ",\n" : "  \"grabs\": [\n", rigid ? "rigid" : "particle", gr->p[k]);
+        if (rigid) {
+            fputs("\"at\": ", f);
+            vec(o, &gr->local[3 * k], 3);
+            fputs(", ", f);
+        }
+        fputs("\"target\": ", f);
         vec(o, &gr->target[3 * k], 3);
         fputs(", \"from\": ", f);
         vec(o, &gr->from[3 * k], 3);

@@ -1,4 +1,4 @@
-/* attach.c: w:attach(p, collider [, {compliance}]) and w:grab(p, {x,y,z} [, {compliance}]),
+/* attach.c: w:attach(p, collider [, {compliance}]) and w:grab(p or rb, {x,y,z} [, {compliance, at}]),
  * with their handles (core: attach.c, grab.c). A handle is the core's (index, generation)
  * id plus a reference to the world's userdata (its user value), so the world outlives it;
  * once removed, released or the world closed, its methods raise and valid() is false. */
@@ -11,15 +11,18 @@ typedef struct wbl_attach { wb_attach_id id; } wbl_attach;
 typedef struct wbl_grab { wb_grab_id id; } wbl_grab;
 
 static const char *const keys[] = { "compliance", NULL };
+static const char *const grab_keys[] = { "compliance", "at", NULL };
 
 /* the compliance option at arg (absent: 0) */
-static wb_real read_compliance(lua_State *L, int arg)
+static wb_real read_compliance_keys(lua_State *L, int arg, const char *const *k)
 {
     wb_real a = 0;
-    if (wbl_checkopts(L, arg, keys, true) && wbl_optreal(L, arg, "compliance", &a) && !(a >= 0))
+    if (wbl_checkopts(L, arg, k, true) && wbl_optreal(L, arg, "compliance", &a) && !(a >= 0))
         wbl_fielderror(L, arg, "compliance", "must be >= 0 (m/N)");
     return a;
 }
+
+static wb_real read_compliance(lua_State *L, int arg) { return read_compliance_keys(L, arg, keys); }
 
 /* ---- attachments ------------------------------------------------------------------ */
 static wb_attach_id *push_attach(lua_State *L, int world_index)
@@ -158,19 +161,39 @@ static wb_world *checkgrab(lua_State *L, int arg, wb_grab_id *id)
     wb_world *w;
     wbl_grab *g = (wbl_grab *)wbl_handle(L, arg, WBL_GRAB, &w);
     if (!w) luaL_error(L, "stale grab handle (its world was closed)");
-    if (!wb_grab_valid(w, g->id)) luaL_error(L, "grab was released");
+    if (!wb_grab_valid(w, g->id)) luaL_error(L, "grab was released (or its rigid body removed)");
     *id = g->id;
     return w;
 }
 
-/* w:grab(p, {x,y,z} [, {compliance = 0}]) -> grab */
+/* w:grab(p, {x,y,z} [, {compliance = 0}]) or w:grab(rb, {x,y,z} [, {compliance = 0,
+ * at = {0,0,0}}]) -> grab; `at` is the body's point in its own frame */
 static int w_grab(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
+    if (luaL_testudata(L, 2, WBL_RIGID)) {
+        wb_world *rw;
+        const wb_rigid_id r = *(const wb_rigid_id *)wbl_handle(L, 2, WBL_RIGID, &rw);
+        if (rw != w) return luaL_argerror(L, 2, "the rigid body belongs to another world (or its world was closed)");
+        if (!wb_rigid_valid(w, r)) return luaL_argerror(L, 2, "the rigid body was removed");
+        wb_real t[3], at[3] = { 0, 0, 0 };
+        wbl_checkvec(L, 3, 3, t);
+        const wb_real alpha = read_compliance_keys(L, 4, grab_keys);
+        if (!lua_isnoneornil(L, 4)) wbl_optvec(L, 4, "at", 3, at);
+        wb_grab_id *id = push_grab(L, 1);
+        wb_status st = WB_OK;
+        *id = wb_grab_rigid(w, r, at, t, alpha, &st);
+        if (st != WB_OK) return wbl_status_error(L, 2, st, "grab");
+        return 1;
+    }
+    if (lua_type(L, 2) != LUA_TNUMBER) return luaL_typeerror(L, 2, "particle id or rigid body");
     const int32_t p = wbl_checkparticle(L, w, 2);
     wb_real t[3];
     wbl_checkvec(L, 3, 3, t);
-    const wb_real alpha = read_compliance(L, 4);
+    const wb_real alpha = read_compliance_keys(L, 4, grab_keys);
+    if (lua_istable(L, 4) && lua_getfield(L, 4, "at") != LUA_TNIL)
+        return wbl_fielderror(L, 4, "at", "is for a rigid body's grab (a particle is grabbed where it is)");
+    lua_settop(L, 4);
     wb_grab_id *id = push_grab(L, 1);
     wb_status st = WB_OK;
     *id = wb_grab_add(w, p, t, alpha, &st);
@@ -217,12 +240,41 @@ static int g_target(lua_State *L)
     return 3;
 }
 
+/* g:particle() -> the particle's id, nil for a rigid body's grab */
 static int g_particle(lua_State *L)
 {
     wb_grab_id id;
     wb_world *w = checkgrab(L, 1, &id);
-    lua_pushinteger(L, (lua_Integer)wb_grab_particle(w, id) + 1);
+    const int32_t p = wb_grab_particle(w, id);
+    if (p < 0) lua_pushnil(L);
+    else lua_pushinteger(L, (lua_Integer)p + 1);
     return 1;
+}
+
+/* g:body() -> the rigid body grabbed (a new handle to it), nil for a particle's grab */
+static int g_body(lua_State *L)
+{
+    wb_grab_id id;
+    wb_world *w = checkgrab(L, 1, &id);
+    const wb_rigid_id r = wb_grab_body(w, id);
+    if (r.index == 0) { lua_pushnil(L); return 1; }
+    wb_rigid_id *h = (wb_rigid_id *)lua_newuserdatauv(L, sizeof *h, 1);
+    *h = r;
+    lua_getiuservalue(L, 1, 1); /* the world */
+    lua_setiuservalue(L, -2, 1);
+    luaL_setmetatable(L, WBL_RIGID);
+    return 1;
+}
+
+/* g:point() -> x, y, z: the grabbed point now (the particle, or the body's point) */
+static int g_point(lua_State *L)
+{
+    wb_grab_id id;
+    wb_world *w = checkgrab(L, 1, &id);
+    wb_real x[3];
+    wb_grab_point(w, id, x);
+    wbl_pushreals(L, x, 3);
+    return 3;
 }
 
 static int g_valid(lua_State *L)
@@ -238,6 +290,8 @@ static int g_tostring(lua_State *L)
     wb_world *w;
     wbl_grab *g = (wbl_grab *)wbl_handle(L, 1, WBL_GRAB, &w);
     if (!w || !wb_grab_valid(w, g->id)) lua_pushfstring(L, "wobble.grab: %p (released)", (void *)g);
+    else if (wb_grab_particle(w, g->id) < 0)
+        lua_pushfstring(L, "wobble.grab: %p (rigid body %d)", (void *)g, (int)wb_grab_body(w, g->id).index);
     else lua_pushfstring(L, "wobble.grab: %p (particle %d)", (void *)g, (int)wb_grab_particle(w, g->id) + 1);
     return 1;
 }
@@ -267,7 +321,7 @@ static const luaL_Reg attach_methods[] = {
 static const luaL_Reg attach_meta[] = { { "__index", NULL }, { "__tostring", a_tostring }, { "__eq", a_eq }, { NULL, NULL } };
 static const luaL_Reg grab_methods[] = {
     { "move", g_move }, { "release", g_release }, { "force", g_force }, { "target", g_target },
-    { "particle", g_particle }, { "valid", g_valid }, { NULL, NULL }
+    { "particle", g_particle }, { "body", g_body }, { "point", g_point }, { "valid", g_valid }, { NULL, NULL }
 };
 static const luaL_Reg grab_meta[] = { { "__index", NULL }, { "__tostring", g_tostring }, { "__eq", g_eq }, { NULL, NULL } };
 static const luaL_Reg world_methods[] = {

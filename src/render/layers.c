@@ -166,12 +166,12 @@ static bool build_instances(wb_layers *l, const wb_world *w, const wb_draw_opts 
     if (ids) wb_grab_list(w, ids, ng);
     for (int32_t i = 0; o->pins && i < ng; i++) {
         const wb_grab_id gid = ((const wb_grab_id *)ids)[i];
-        const int32_t pi = wb_grab_particle(w, gid);
-        const double p[3] = { x[3 * pi], x[3 * pi + 1], x[3 * pi + 2] };
-        wb_real t[3];
+        const int32_t pi = wb_grab_particle(w, gid); /* -1: a rigid body's point */
+        wb_real t[3], gp[3];
+        wb_grab_point(w, gid, gp);
         wb_grab_target(w, gid, t);
-        const double tp[3] = { t[0], t[1], t[2] };
-        const double rad = fmax(1.6 * wb_particle_radius(w, pi), 0.006 * unit);
+        const double p[3] = { gp[0], gp[1], gp[2] }, tp[3] = { t[0], t[1], t[2] };
+        const double rad = fmax(pi >= 0 ? 1.6 * wb_particle_radius(w, pi) : 0, 0.006 * unit);
         if (isfinite(p[0] + p[1] + p[2])) inst_sphere(&l->inst[k++], p, rad, col_grab, 0.5f);
         inst_sphere(&l->inst[k++], tp, 0.5 * rad, col_grab, 0.5f);
     }
@@ -480,16 +480,15 @@ static bool build_grab_lines(wb_layers *l, const wb_world *w)
     wb_grab_id *ids = malloc((size_t)ng * sizeof *ids);
     if (!ids) return false;
     wb_grab_list(w, ids, ng);
-    const wb_real *x = wb_particle_positions(w);
     float col[3];
     wb_lin3(col_grab, col);
     for (int32_t i = 0; i < ng; i++) {
         const wb_grab_id gid = ids[i];
-        const int32_t p = wb_grab_particle(w, gid);
-        wb_real t[3];
+        wb_real t[3], p[3]; /* from the grabbed particle or body point */
+        wb_grab_point(w, gid, p);
         wb_grab_target(w, gid, t);
         wb_seg *s = &l->seg[l->nseg++];
-        for (int c = 0; c < 3; c++) s->a[c] = (float)x[3 * p + c], s->b[c] = (float)t[c], s->c[c] = col[c];
+        for (int c = 0; c < 3; c++) s->a[c] = (float)p[c], s->b[c] = (float)t[c], s->c[c] = col[c];
         s->c[3] = 1;
     }
     free(ids);

@@ -234,15 +234,16 @@ for _, name in ipairs{ "pressure", "rest_volume", "volume", "world" } do
 end
 CASES["world:attach"] = { opts = { compliance = 0 }, opts_arg = 3, nums = { "compliance" },
                           call = function(f, o) return f.w:attach(f.r3, f.col, o) end }
-CASES["world:grab"] = { opts = { compliance = 0 }, opts_arg = 3, nums = { "compliance" },
-                        call = function(f, o) return f.w:grab(f.r3, {0, 1, 0}, o) end }
+-- a rigid body's grab: it takes every option (a particle's takes compliance only)
+CASES["world:grab"] = { opts = { compliance = 0, at = {0, 0.1, 0} }, opts_arg = 3, nums = { "compliance", "at" },
+                        call = function(f, o) return f.w:grab(f.rb, {0, 1, 0}, o) end }
 CASES["world:attachments"] = { none = "a getter: no arguments" }
 CASES["world:grabs"] = { none = "a getter: no arguments" }
 for _, name in ipairs{ "force", "particle", "point", "remove", "valid" } do
   CASES["attach:" .. name] = { none = "a getter or remove: no arguments" }
 end
 CASES["grab:move"] = { args = { 0, 1, 0 }, nums = { 1, 2, 3 }, call = function(f, ...) return f.grab:move(...) end }
-for _, name in ipairs{ "force", "particle", "release", "target", "valid" } do
+for _, name in ipairs{ "body", "force", "particle", "point", "release", "target", "valid" } do
   CASES["grab:" .. name] = { none = "a getter or release: no arguments" }
 end
 CASES["body:pin_where"] = { none = "a predicate function" }

@@ -157,6 +157,7 @@
     X(attach_grab_clone_same_future)             \
     X(attach_grab_ids_and_memory)                \
     X(attach_skip_table_charged_and_lists)       \
+    X(attach_grab_rigid_ids)                     \
     RIGID_TESTS(X)                               \
     NARROW_TESTS(X)                              \
     X(distance_simd_bit_identical_to_scalar)

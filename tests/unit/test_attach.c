@@ -150,3 +150,47 @@ TEST(attach_skip_table_charged_and_lists)
     wb_world_destroy(w);
     CHECK_EQ(mem.used, (size_t)0); /* given back */
 }
+
+/* a rigid body's grab: NULL local = its centre; bad arguments refused; the body's removal
+ * ends it (count, list, valid), and the next step retires the slot for reuse */
+TEST(attach_grab_rigid_ids)
+{
+    wb_world_def d = wb_world_default_def();
+    wb_world *w = wb_world_create(&d);
+    REQUIRE(w);
+    wb_status st;
+    wb_rigid_def rd = wb_rigid_default_def(WB_SHAPE_BOX);
+    rd.pos[1] = 1;
+    rd.mass = 2;
+    wb_rigid_id r = wb_rigid_add(w, &rd, &st);
+    REQUIRE(st == WB_OK);
+    const wb_real t[3] = { 0, 1, 0 }, bad[3] = { 0, NAN, 0 };
+    wb_grab_rigid(w, r, bad, t, 0, &st);
+    CHECK_EQ(st, WB_ERR_ARG);
+    wb_grab_rigid(w, r, NULL, t, -1, &st);
+    CHECK_EQ(st, WB_ERR_ARG);
+    CHECK_EQ(wb_grab_count(w), 0);
+    wb_grab_id g = wb_grab_rigid(w, r, NULL, t, 0, &st);
+    REQUIRE(st == WB_OK);
+    CHECK_EQ(wb_grab_particle(w, g), -1);
+    wb_rigid_id b = wb_grab_body(w, g);
+    CHECK(b.index == r.index && b.gen == r.gen);
+    for (int i = 0; i < 10; i++) REQUIRE(wb_world_step(w) == WB_OK);
+    CHECK_NEAR(wb_grab_force(w, g, NULL), 2 * 9.81, 1e-9); /* carries the weight */
+    wb_real x[3];
+    wb_grab_point(w, g, x);
+    CHECK_NEAR(x[1], 1, 1e-12);
+    wb_rigid_remove(w, r);
+    CHECK(!wb_grab_valid(w, g));
+    CHECK_EQ(wb_grab_count(w), 0);
+    wb_grab_id ids[1];
+    CHECK_EQ(wb_grab_list(w, ids, 1), 0);
+    wb_grab_rigid(w, r, NULL, t, 0, &st);
+    CHECK_EQ(st, WB_ERR_ARG);
+    REQUIRE(wb_world_step(w) == WB_OK);
+    const wb_real x0[3] = { 0, 0, 0 };
+    const int32_t p = wb_particle_add(w, x0, NULL, 1, 0);
+    wb_grab_id h = wb_grab_add(w, p, x0, 0, &st);
+    CHECK(st == WB_OK && h.index == g.index && h.gen != g.gen); /* the retired slot, reused */
+    wb_world_destroy(w);
+}
