@@ -553,38 +553,28 @@ static void contact_velocity(wb_real v[3], const contact *ct, wb_real h, wb_real
     }
 }
 
-/* One pass per particle after the constraints: push it out of every collider at the
- * collider's substep-end pose, set v = (x - x_prev) / h, then friction and
- * restitution for the contacts it has. Particles are independent here, so the pass
- * runs in parallel with results identical for any thread count. */
-void wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1)
+typedef struct collide_job {
+    wb_world *w;
+    const sub_pose *cs;
+    int32_t nlive;
+    wb_real h;
+    _Atomic int64_t ncontacts;
+} collide_job;
+
+/* particles [lo, hi) of wb__collide_and_update */
+static void collide_part(void *ctx, int32_t lo, int32_t hi)
 {
-    wb_model *m = &w->m;
-    wb_cache *k = &w->k;
-    int32_t nlive = 0;
-    sub_pose *cs = wb__grow(k->c_sub, &k->cap_c_sub, m->nc > 0 ? m->nc : 1, sizeof *cs);
-    if (!cs) { wb__warn(w, "out of memory in collision"); return; }
-    k->c_sub = cs;
-    for (int32_t c = 0; c < m->nc; c++) {
-        if (!(m->c_gen[c] & 1u)) continue;
-        sub_pose *sp = &cs[nlive++];
-        sp->s = &m->c_shape[c];
-        sp->slot = c;
-        wb__collider_pose_at(&w->s.c_pose[c], f0, sp->p0, sp->q0);
-        wb__collider_pose_at(&w->s.c_pose[c], f1, sp->p1, sp->q1);
-        sp->moving = memcmp(sp->p0, sp->p1, sizeof sp->p0) || memcmp(sp->q0, sp->q1, sizeof sp->q0);
-        q_rotate(sp->q1, sp->s->n, sp->n);
-        sp->off = v3_dot(sp->n, sp->p1);
-    }
-    const wb_real inv_h = 1 / h, g = v3_len(m->def.gravity);
+    collide_job *j = ctx;
+    wb_world *w = j->w;
+    const wb_model *m = &w->m;
+    const sub_pose *cs = j->cs;
+    const int32_t nlive = j->nlive;
+    const wb_real h = j->h, inv_h = 1 / h, g = v3_len(m->def.gravity);
     const wb_real *wv = m->w, *rad = m->radius;
     wb_real *x = w->s.x, *xp = w->s.x_prev, *v = w->s.v;
-    const int32_t np = m->np;
-    const int threads = m->def.threads;
-    int64_t ncontacts = 0;
     const wb_attaches *att = w->att && w->att->skip_np > 0 ? w->att : NULL; /* attached: no contact */
-    #pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : ncontacts) if (threads > 1 && np >= 4096)
-    for (int32_t i = 0; i < np; i++) {
+    int64_t ncontacts = 0;
+    for (int32_t i = lo; i < hi; i++) {
         wb_real *xi = &x[3 * i], *vi = &v[3 * i];
         const wb_real *pi = &xp[3 * i];
         if (wv[i] == 0) { v3_set(vi, 0, 0, 0); continue; } /* pinned and immovable: at rest */
@@ -610,5 +600,34 @@ void wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1)
         for (int c = 0; c < nct && c < MAX_CONTACTS; c++) contact_velocity(vi, &ct[c], h, g);
         ncontacts += nct;
     }
-    k->last_contacts = (int32_t)ncontacts;
+    j->ncontacts += ncontacts; /* a sum of integers: the same in any order */
 }
+
+/* One pass per particle after the constraints: push it out of every collider at the
+ * collider's substep-end pose, set v = (x - x_prev) / h, then friction and
+ * restitution for the contacts it has. Particles are independent here, so the pass
+ * runs in parallel with results identical for any thread count. */
+void wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1)
+{
+    wb_model *m = &w->m;
+    wb_cache *k = &w->k;
+    int32_t nlive = 0;
+    sub_pose *cs = wb__grow(k->c_sub, &k->cap_c_sub, m->nc > 0 ? m->nc : 1, sizeof *cs);
+    if (!cs) { wb__warn(w, "out of memory in collision"); return; }
+    k->c_sub = cs;
+    for (int32_t c = 0; c < m->nc; c++) {
+        if (!(m->c_gen[c] & 1u)) continue;
+        sub_pose *sp = &cs[nlive++];
+        sp->s = &m->c_shape[c];
+        sp->slot = c;
+        wb__collider_pose_at(&w->s.c_pose[c], f0, sp->p0, sp->q0);
+        wb__collider_pose_at(&w->s.c_pose[c], f1, sp->p1, sp->q1);
+        sp->moving = memcmp(sp->p0, sp->p1, sizeof sp->p0) || memcmp(sp->q0, sp->q1, sizeof sp->q0);
+        q_rotate(sp->q1, sp->s->n, sp->n);
+        sp->off = v3_dot(sp->n, sp->p1);
+    }
+    collide_job j = { w, cs, nlive, h, 0 };
+    wb__pool_for(m->np >= 4096 ? wb__world_pool(w) : NULL, m->np, 2048, collide_part, &j);
+    k->last_contacts = (int32_t)j.ncontacts;
+}
+
