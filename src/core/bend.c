@@ -307,11 +307,11 @@ static void bend_project(wb_world *w, wb_real h)
 {
     wb_bends *b = &w->bend;
     const wb_real inv_h2 = 1 / (h * h);
-    wb_pool *pool = b->serial_start > 0 ? wb__world_pool(w) : NULL;
     w->k.projections += b->n;
     for (int32_t c = 0; c < b->ncolours; c++) {
         const int32_t lo = b->colour_start[c], hi = b->colour_start[c + 1];
-        if (c >= b->serial_start || !pool || hi - lo < 256) {
+        wb_pool *pool = c < b->serial_start && hi - lo >= 256 ? wb__world_pool(w) : NULL;
+        if (!pool) {
             project_range(w, lo, hi, h, inv_h2);
             continue;
         }

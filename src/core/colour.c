@@ -89,10 +89,11 @@ static void batch_part(void *ctx, int32_t lo, int32_t hi)
 void wb__batches_run(const wb_batches *b, wb_world *w, int32_t min_par, wb_range_fn f, const int32_t *order,
                      wb_real h)
 {
-    wb_pool *pool = b->serial_start > 0 ? wb__world_pool(w) : NULL;
     for (int32_t c = 0; c < b->ncolours; c++) {
         const int32_t lo = b->colour_start[c], hi = b->colour_start[c + 1];
-        if (c >= b->serial_start || !pool || hi - lo < min_par) {
+        /* (the pool is asked for only here: a small scene never starts a thread) */
+        wb_pool *pool = c < b->serial_start && hi - lo >= min_par ? wb__world_pool(w) : NULL;
+        if (!pool) {
             f(w, order, lo, hi, h);
             continue;
         }

@@ -172,10 +172,11 @@ static void dist_part(void *ctx, int32_t lo, int32_t hi)
 static void project_batches(wb_world *w, wb_real *dx, wb_real h, wb_real inv_h2)
 {
     wb_cache *k = &w->k;
-    wb_pool *pool = k->serial_start > 0 ? wb__world_pool(w) : NULL;
     for (int32_t c = 0; c < k->ncolours; c++) {
         const int32_t b = k->colour_start[c], e = k->colour_start[c + 1];
-        if (c >= k->serial_start || !pool || e - b < 512) {
+        /* (the pool is asked for only here: a small scene never starts a thread) */
+        wb_pool *pool = c < k->serial_start && e - b >= 512 ? wb__world_pool(w) : NULL;
+        if (!pool) {
             project_distances(w, dx, b, e, h, inv_h2);
             continue;
         }

@@ -8,7 +8,7 @@
  * reads a job being rewritten) claims nothing. The caller claims parts the same way and
  * returns when `done` counts them all, so it never waits for a worker that has not
  * started (a busy core), only for parts already running. */
-#include "core/pool.h"
+#include "pool.h"
 
 #include <errno.h>
 #include <limits.h>
