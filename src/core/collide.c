@@ -497,10 +497,9 @@ static wb_real mesh_depth(const sub_pose *sp, const wb_real x[3], const wb_real 
 #define MAX_CONTACTS 16
 
 /* push particle i out along n by depth and apply static friction */
-static void resolve(wb_world *w, int32_t i, const sub_pose *c, const wb_real n[3], wb_real depth, wb_real h,
-                    contact *ct)
+static void resolve(wb_real *restrict xi, const wb_real *restrict pi, const wb_real *restrict vi, const sub_pose *c,
+                    const wb_real n[3], wb_real depth, wb_real h, contact *ct)
 {
-    wb_real *xi = &w->s.x[3 * i];
     v3_madd(xi, n, depth);
     /* the surface point's motion over the substep, carried rigidly by the collider */
     wb_real vc[3] = { 0, 0, 0 };
@@ -516,7 +515,7 @@ static void resolve(wb_world *w, int32_t i, const sub_pose *c, const wb_real n[3
     /* static friction: undo the tangential slip when it is within the friction cone */
     if (c->s->friction > 0) {
         wb_real slip[3];
-        v3_sub(slip, xi, &w->s.x_prev[3 * i]);
+        v3_sub(slip, xi, pi);
         v3_madd(slip, vc, -h);
         v3_madd(slip, n, -v3_dot(slip, n));
         if (v3_len(slip) < c->s->friction * depth) v3_madd(xi, slip, -1);
@@ -527,7 +526,7 @@ static void resolve(wb_world *w, int32_t i, const sub_pose *c, const wb_real n[3
     ct->depth = depth;
     v3_copy(ct->vc, vc);
     wb_real rel[3];
-    v3_sub(rel, &w->s.v[3 * i], vc);
+    v3_sub(rel, vi, vc);
     ct->vn_pre = v3_dot(rel, n);
 }
 
@@ -570,13 +569,16 @@ static void collide_part(void *ctx, int32_t lo, int32_t hi)
     const sub_pose *cs = j->cs;
     const int32_t nlive = j->nlive;
     const wb_real h = j->h, inv_h = 1 / h, g = v3_len(m->def.gravity);
-    const wb_real *wv = m->w, *rad = m->radius;
-    wb_real *x = w->s.x, *xp = w->s.x_prev, *v = w->s.v;
+    /* restrict: the arrays are distinct, so the compiler keeps values in registers
+     * across the stores (the same operations, the same bits) */
+    const wb_real *restrict wv = m->w, *restrict rad = m->radius;
+    wb_real *restrict x = w->s.x, *restrict v = w->s.v;
+    const wb_real *restrict xp = w->s.x_prev;
     const wb_attaches *att = w->att && w->att->skip_np > 0 ? w->att : NULL; /* attached: no contact */
     int64_t ncontacts = 0;
     for (int32_t i = lo; i < hi; i++) {
-        wb_real *xi = &x[3 * i], *vi = &v[3 * i];
-        const wb_real *pi = &xp[3 * i];
+        wb_real *restrict xi = &x[3 * i], *restrict vi = &v[3 * i];
+        const wb_real *restrict pi = &xp[3 * i];
         if (wv[i] == 0) { v3_set(vi, 0, 0, 0); continue; } /* pinned and immovable: at rest */
         contact ct[MAX_CONTACTS];
         int nct = 0;
@@ -593,7 +595,7 @@ static void collide_part(void *ctx, int32_t lo, int32_t hi)
                 depth = rad[i] - wb__shape_distance(sp->s, sp->p1, sp->q1, xi, n);
             }
             if (!(depth > 0)) continue;
-            resolve(w, i, sp, n, depth, h, nct < MAX_CONTACTS ? &ct[nct] : NULL);
+            resolve(xi, pi, vi, sp, n, depth, h, nct < MAX_CONTACTS ? &ct[nct] : NULL);
             nct++;
         }
         for (int c = 0; c < 3; c++) vi[c] = (xi[c] - pi[c]) * inv_h;
