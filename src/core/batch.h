@@ -21,9 +21,9 @@ int wb__batches_build(wb_batches *b, const wb_real *inv_mass, int32_t np, const 
 /* project order[lo, hi) of one batch (or of the serial tail) */
 typedef void (*wb_range_fn)(wb_world *w, const int32_t *order, int32_t lo, int32_t hi, wb_real h);
 
-/* every batch in colour order; a batch of at least min_par constraints is split into one
- * contiguous chunk per thread (conflict-free: the same bits as serially) */
-void wb__batches_run(const wb_batches *b, wb_world *w, int threads, int32_t min_par, wb_range_fn f,
+/* every batch in colour order; a batch of at least min_par constraints is split into
+ * contiguous chunks run by the world's pool (conflict-free: the same bits as serially) */
+void wb__batches_run(const wb_batches *b, wb_world *w, int32_t min_par, wb_range_fn f,
                      const int32_t *order, wb_real h);
 
 #endif

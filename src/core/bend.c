@@ -295,25 +295,29 @@ static void project_range(wb_world *w, int32_t lo, int32_t hi, wb_real h, wb_rea
     }
 }
 
+typedef struct bend_job { wb_world *w; int32_t lo; wb_real h, inv_h2; } bend_job;
+
+static void bend_part(void *ctx, int32_t lo, int32_t hi)
+{
+    const bend_job *j = ctx;
+    project_range(j->w, j->lo + lo, j->lo + hi, j->h, j->inv_h2);
+}
+
 static void bend_project(wb_world *w, wb_real h)
 {
     wb_bends *b = &w->bend;
     const wb_real inv_h2 = 1 / (h * h);
-    const int threads = w->m.def.threads;
     w->k.projections += b->n;
     for (int32_t c = 0; c < b->ncolours; c++) {
         const int32_t lo = b->colour_start[c], hi = b->colour_start[c + 1];
-        if (c >= b->serial_start || threads == 1 || hi - lo < 256) {
+        wb_pool *pool = c < b->serial_start && hi - lo >= 256 ? wb__world_pool(w) : NULL;
+        if (!pool) {
             project_range(w, lo, hi, h, inv_h2);
             continue;
         }
-        /* contiguous chunks, one per thread: a batch shares no movable particle */
-        #pragma omp parallel for num_threads(threads) schedule(static)
-        for (int t = 0; t < threads; t++) {
-            const int32_t n = hi - lo;
-            project_range(w, lo + (int32_t)((int64_t)n * t / threads), lo + (int32_t)((int64_t)n * (t + 1) / threads), h,
-                          inv_h2);
-        }
+        /* contiguous chunks on the pool: a batch shares no movable particle */
+        bend_job j = { w, lo, h, inv_h2 };
+        wb__pool_for(pool, hi - lo, 128, bend_part, &j);
     }
 }
 

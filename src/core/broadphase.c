@@ -357,9 +357,26 @@ static void make_grid(grid *g, const wb_broad *b, const wb_real *x, const wb_rea
     g->inv = inv;
 }
 
-int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
-                       int32_t n, int threads, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
+/* pass 3 on the pool: part t scans its contiguous range into its own buffer */
+typedef struct scan_job {
+    wb_broad *b;
+    const grid *g;
+    int32_t m;
+    int (*keep)(void *ud, int32_t i, int32_t j);
+    void *ud;
+} scan_job;
+
+static void scan_part(void *ctx, int t, int nt)
 {
+    const scan_job *j = ctx;
+    const int32_t lo = (int32_t)((int64_t)j->m * t / nt), hi = (int32_t)((int64_t)j->m * (t + 1) / nt);
+    scan(j->b, j->g, lo, hi, &j->b->out[t], j->keep, j->ud);
+}
+
+int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
+                       int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
+{
+    const int threads = wb__pool_threads(pool);
     if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
     wb_broad *b = c->bp;
     if (!grow((void **)&b->cand, &b->cap_cand, n, sizeof *b->cand)) return -1;
@@ -414,11 +431,8 @@ int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, c
     for (int t = 0; t < nt; t++) { b->out[t].n = 0; b->out[t].fail = 0; }
     if (nt == 1) scan(b, &g, 0, m, &b->out[0], keep, ud);
     else {
-        #pragma omp parallel for num_threads(nt) schedule(static)
-        for (int t = 0; t < nt; t++) {
-            const int32_t lo = (int32_t)((int64_t)m * t / nt), hi = (int32_t)((int64_t)m * (t + 1) / nt);
-            scan(b, &g, lo, hi, &b->out[t], keep, ud);
-        }
+        scan_job j = { b, &g, m, keep, ud };
+        wb__pool_run(pool, scan_part, &j); /* nt parts: nt == the pool's threads */
     }
     int64_t total = c->n;
     for (int t = 0; t < nt; t++) {
@@ -571,7 +585,7 @@ void wb__contacts_begin(wb_world *w)
          * distance test, and its inside is culled by its bounds */
         skip[i] = gi > 0 && !(f & WB_CF_SELF) ? gi : 0;
     }
-    if (wb__broadphase(c, w->s.x, reach, skip, m->np, m->def.threads, may_touch, w) < 0) {
+    if (wb__broadphase(c, w->s.x, reach, skip, m->np, wb__world_pool(w), may_touch, w) < 0) {
         c->n = 0;
         wb__warn(w, "out of memory in the contact broad phase; contacts skipped");
     }

@@ -497,10 +497,9 @@ static wb_real mesh_depth(const sub_pose *sp, const wb_real x[3], const wb_real 
 #define MAX_CONTACTS 16
 
 /* push particle i out along n by depth and apply static friction */
-static void resolve(wb_world *w, int32_t i, const sub_pose *c, const wb_real n[3], wb_real depth, wb_real h,
-                    contact *ct)
+static void resolve(wb_real *restrict xi, const wb_real *restrict pi, const wb_real *restrict vi, const sub_pose *c,
+                    const wb_real n[3], wb_real depth, wb_real h, contact *ct)
 {
-    wb_real *xi = &w->s.x[3 * i];
     v3_madd(xi, n, depth);
     /* the surface point's motion over the substep, carried rigidly by the collider */
     wb_real vc[3] = { 0, 0, 0 };
@@ -516,7 +515,7 @@ static void resolve(wb_world *w, int32_t i, const sub_pose *c, const wb_real n[3
     /* static friction: undo the tangential slip when it is within the friction cone */
     if (c->s->friction > 0) {
         wb_real slip[3];
-        v3_sub(slip, xi, &w->s.x_prev[3 * i]);
+        v3_sub(slip, xi, pi);
         v3_madd(slip, vc, -h);
         v3_madd(slip, n, -v3_dot(slip, n));
         if (v3_len(slip) < c->s->friction * depth) v3_madd(xi, slip, -1);
@@ -527,7 +526,7 @@ static void resolve(wb_world *w, int32_t i, const sub_pose *c, const wb_real n[3
     ct->depth = depth;
     v3_copy(ct->vc, vc);
     wb_real rel[3];
-    v3_sub(rel, &w->s.v[3 * i], vc);
+    v3_sub(rel, vi, vc);
     ct->vn_pre = v3_dot(rel, n);
 }
 
@@ -553,6 +552,59 @@ static void contact_velocity(wb_real v[3], const contact *ct, wb_real h, wb_real
     }
 }
 
+typedef struct collide_job {
+    wb_world *w;
+    const sub_pose *cs;
+    int32_t nlive;
+    wb_real h;
+    _Atomic int64_t ncontacts;
+} collide_job;
+
+/* particles [lo, hi) of wb__collide_and_update */
+static void collide_part(void *ctx, int32_t lo, int32_t hi)
+{
+    collide_job *j = ctx;
+    wb_world *w = j->w;
+    const wb_model *m = &w->m;
+    const sub_pose *cs = j->cs;
+    const int32_t nlive = j->nlive;
+    const wb_real h = j->h, inv_h = 1 / h, g = v3_len(m->def.gravity);
+    /* restrict: the arrays are distinct, so the compiler keeps values in registers
+     * across the stores (the same operations, the same bits) */
+    const wb_real *restrict wv = m->w, *restrict rad = m->radius;
+    wb_real *restrict x = w->s.x, *restrict v = w->s.v;
+    const wb_real *restrict xp = w->s.x_prev;
+    const wb_attaches *att = w->att && w->att->skip_np > 0 ? w->att : NULL; /* attached: no contact */
+    int64_t ncontacts = 0;
+    for (int32_t i = lo; i < hi; i++) {
+        wb_real *restrict xi = &x[3 * i], *restrict vi = &v[3 * i];
+        const wb_real *restrict pi = &xp[3 * i];
+        if (wv[i] == 0) { v3_set(vi, 0, 0, 0); continue; } /* pinned and immovable: at rest */
+        contact ct[MAX_CONTACTS];
+        int nct = 0;
+        for (int32_t c = 0; c < nlive; c++) {
+            const sub_pose *sp = &cs[c];
+            if (att && wb__attach_skip(att, i, sp->slot)) continue;
+            wb_real n[3], depth;
+            if (sp->s->shape == WB_SHAPE_PLANE) {
+                depth = rad[i] + sp->off - v3_dot(sp->n, xi);
+                v3_copy(n, sp->n);
+            } else if (sp->s->shape == WB_SHAPE_MESH) {
+                depth = mesh_depth(sp, xi, pi, rad[i], n);
+            } else {
+                depth = rad[i] - wb__shape_distance(sp->s, sp->p1, sp->q1, xi, n);
+            }
+            if (!(depth > 0)) continue;
+            resolve(xi, pi, vi, sp, n, depth, h, nct < MAX_CONTACTS ? &ct[nct] : NULL);
+            nct++;
+        }
+        for (int c = 0; c < 3; c++) vi[c] = (xi[c] - pi[c]) * inv_h;
+        for (int c = 0; c < nct && c < MAX_CONTACTS; c++) contact_velocity(vi, &ct[c], h, g);
+        ncontacts += nct;
+    }
+    j->ncontacts += ncontacts; /* a sum of integers: the same in any order */
+}
+
 /* One pass per particle after the constraints: push it out of every collider at the
  * collider's substep-end pose, set v = (x - x_prev) / h, then friction and
  * restitution for the contacts it has. Particles are independent here, so the pass
@@ -576,39 +628,8 @@ void wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1)
         q_rotate(sp->q1, sp->s->n, sp->n);
         sp->off = v3_dot(sp->n, sp->p1);
     }
-    const wb_real inv_h = 1 / h, g = v3_len(m->def.gravity);
-    const wb_real *wv = m->w, *rad = m->radius;
-    wb_real *x = w->s.x, *xp = w->s.x_prev, *v = w->s.v;
-    const int32_t np = m->np;
-    const int threads = m->def.threads;
-    int64_t ncontacts = 0;
-    const wb_attaches *att = w->att && w->att->skip_np > 0 ? w->att : NULL; /* attached: no contact */
-    #pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : ncontacts) if (threads > 1 && np >= 4096)
-    for (int32_t i = 0; i < np; i++) {
-        wb_real *xi = &x[3 * i], *vi = &v[3 * i];
-        const wb_real *pi = &xp[3 * i];
-        if (wv[i] == 0) { v3_set(vi, 0, 0, 0); continue; } /* pinned and immovable: at rest */
-        contact ct[MAX_CONTACTS];
-        int nct = 0;
-        for (int32_t c = 0; c < nlive; c++) {
-            const sub_pose *sp = &cs[c];
-            if (att && wb__attach_skip(att, i, sp->slot)) continue;
-            wb_real n[3], depth;
-            if (sp->s->shape == WB_SHAPE_PLANE) {
-                depth = rad[i] + sp->off - v3_dot(sp->n, xi);
-                v3_copy(n, sp->n);
-            } else if (sp->s->shape == WB_SHAPE_MESH) {
-                depth = mesh_depth(sp, xi, pi, rad[i], n);
-            } else {
-                depth = rad[i] - wb__shape_distance(sp->s, sp->p1, sp->q1, xi, n);
-            }
-            if (!(depth > 0)) continue;
-            resolve(w, i, sp, n, depth, h, nct < MAX_CONTACTS ? &ct[nct] : NULL);
-            nct++;
-        }
-        for (int c = 0; c < 3; c++) vi[c] = (xi[c] - pi[c]) * inv_h;
-        for (int c = 0; c < nct && c < MAX_CONTACTS; c++) contact_velocity(vi, &ct[c], h, g);
-        ncontacts += nct;
-    }
-    k->last_contacts = (int32_t)ncontacts;
+    collide_job j = { w, cs, nlive, h, 0 };
+    wb__pool_for(m->np >= 4096 ? wb__world_pool(w) : NULL, m->np, 2048, collide_part, &j);
+    k->last_contacts = (int32_t)j.ncontacts;
 }
+

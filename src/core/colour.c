@@ -72,19 +72,32 @@ int wb__batches_build(wb_batches *b, const wb_real *inv_mass, int32_t np, const 
     return 1;
 }
 
-void wb__batches_run(const wb_batches *b, wb_world *w, int threads, int32_t min_par, wb_range_fn f,
-                     const int32_t *order, wb_real h)
+typedef struct batch_job {
+    wb_world *w;
+    wb_range_fn f;
+    const int32_t *order;
+    int32_t lo;
+    wb_real h;
+} batch_job;
+
+static void batch_part(void *ctx, int32_t lo, int32_t hi)
+{
+    const batch_job *j = ctx;
+    j->f(j->w, j->order, j->lo + lo, j->lo + hi, j->h);
+}
+
+void wb__batches_run(const wb_batches *b, wb_world *w, int32_t min_par, wb_range_fn f, const int32_t *order,
+                     wb_real h)
 {
     for (int32_t c = 0; c < b->ncolours; c++) {
         const int32_t lo = b->colour_start[c], hi = b->colour_start[c + 1];
-        if (c >= b->serial_start || threads <= 1 || hi - lo < min_par) {
+        /* (the pool is asked for only here: a small scene never starts a thread) */
+        wb_pool *pool = c < b->serial_start && hi - lo >= min_par ? wb__world_pool(w) : NULL;
+        if (!pool) {
             f(w, order, lo, hi, h);
             continue;
         }
-        #pragma omp parallel for num_threads(threads) schedule(static)
-        for (int t = 0; t < threads; t++) {
-            const int32_t n = hi - lo;
-            f(w, order, lo + (int32_t)((int64_t)n * t / threads), lo + (int32_t)((int64_t)n * (t + 1) / threads), h);
-        }
+        batch_job j = { w, f, order, lo, h };
+        wb__pool_for(pool, hi - lo, min_par / 2, batch_part, &j);
     }
 }

@@ -15,6 +15,7 @@
 #include "wobble.h"
 #include "bend.h"
 #include "shape_match.h"
+#include "pool.h"
 
 /* ---- small vector helpers ---------------------------------------------------------- */
 static inline void v3_set(wb_real *o, wb_real x, wb_real y, wb_real z) { o[0] = x; o[1] = y; o[2] = z; }
@@ -182,7 +183,7 @@ typedef struct wb_contacts {
  * at once). A sorted grid, linear in n. Appends to c->ij; -1 when out of memory */
 typedef struct wb_broad wb_broad;
 int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
-                       int32_t n, int threads, int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
+                       int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
 /* its scratch, kept from frame to frame (defined here so that the world frees it
  * without calling back into broadphase.c) */
 typedef struct wb_pairbuf { int32_t *ij; int32_t n, cap; int fail; } wb_pairbuf;
@@ -327,6 +328,7 @@ struct wb_world {
     struct wb_attaches *att; /* attachments (attach.h), NULL until the first */
     struct wb_grabs *grab;  /* grabs (grab.h), NULL until the first */
     struct wb_rigids *rb;  /* rigid bodies (rigid.h), NULL until the first */
+    wb_pool *pool;         /* the threads (pool.h), NULL until a step runs with threads > 1 */
 };
 
 /* internal entry points */
@@ -374,6 +376,9 @@ void wb__tricontacts_load(wb_world *w, wb_real h, wb_real *load);
 void wb__tricontacts_static(wb_world *w, wb_real *load);
 wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra); /* world.c */
 wb_status wb__surface_reserve(wb_world *w, int32_t ntri);
+/* world.c: the world's pool for its current thread count (NULL: one thread); created
+ * lazily, the same pool from call to call. A cache: callable on a const world */
+wb_pool *wb__world_pool(const wb_world *w);
 void *wb__grow(void *ptr, int32_t *cap, int32_t need, size_t elem); /* world.c: realloc helper */
 void wb__set_error(const char *fmt, ...);
 void wb__warn(wb_world *w, const char *fmt, ...);

@@ -323,23 +323,28 @@ static void project_distances(const wb_world *w, wb_real *dx, int32_t b, int32_t
 }
 
 /* one pass over every batch; batches before serial_start are conflict-free */
+typedef struct dist_job { wb_world *w; wb_real *dx; int32_t b; wb_real h, inv_h2; } dist_job;
+
+static void dist_part(void *ctx, int32_t lo, int32_t hi)
+{
+    const dist_job *j = ctx;
+    project_distances(j->w, j->dx, j->b + lo, j->b + hi, j->h, j->inv_h2);
+}
+
 static void project_batches(wb_world *w, wb_real *dx, wb_real h, wb_real inv_h2)
 {
     wb_cache *k = &w->k;
-    const int threads = w->m.def.threads;
     for (int32_t c = 0; c < k->ncolours; c++) {
         const int32_t b = k->colour_start[c], e = k->colour_start[c + 1];
-        if (c >= k->serial_start || threads == 1 || e - b < 512) {
+        /* (the pool is asked for only here: a small scene never starts a thread) */
+        wb_pool *pool = c < k->serial_start && e - b >= 512 ? wb__world_pool(w) : NULL;
+        if (!pool) {
             project_distances(w, dx, b, e, h, inv_h2);
             continue;
         }
-        /* split the batch into contiguous chunks, one per thread: disjoint writes */
-        #pragma omp parallel for num_threads(threads) schedule(static)
-        for (int t = 0; t < threads; t++) {
-            const int32_t n = e - b;
-            const int32_t lo = b + (int32_t)((int64_t)n * t / threads), hi = b + (int32_t)((int64_t)n * (t + 1) / threads);
-            project_distances(w, dx, lo, hi, h, inv_h2);
-        }
+        /* split the batch into contiguous chunks on the pool: disjoint writes */
+        dist_job j = { w, dx, b, h, inv_h2 };
+        wb__pool_for(pool, e - b, 256, dist_part, &j);
     }
 }
 

@@ -13,6 +13,7 @@
  * is v itself, and under a rigid motion of all particles it is the same rigid motion. */
 #include <math.h>
 #include <stdlib.h>
+#include <stdatomic.h>
 #include <string.h>
 
 #include "core.h"
@@ -39,7 +40,6 @@ struct wb_skin {
     wb_real *nrm;         /* (nv x 3) their normals */
     uint64_t bones_key;   /* fingerprint of the positions the bones were updated for */
     uint64_t verts_key, normals_key;
-    int threads;
 };
 
 /* ---- rotations ----------------------------------------------------------------------- */
@@ -179,6 +179,34 @@ static uint64_t fingerprint(const wb_skin *s, const wb_world *w)
     return h;
 }
 
+/* every vertex of [lo, hi): its K nearest particles, one more for the weights' radius */
+typedef struct bind_job {
+    wb_skin *s;
+    const wb_kdtree *t;
+    const wb_mesh *m;
+    _Atomic int32_t far; /* the first vertex whose squared distance to a bone overflows */
+} bind_job;
+
+static void bind_part(void *ctx, int32_t lo, int32_t hi)
+{
+    bind_job *bj = ctx;
+    wb_skin *s = bj->s;
+    const int k = s->k;
+    int32_t far = INT32_MAX;
+    for (int32_t v = lo; v < hi; v++) {
+        int32_t id[MAX_BONES + 1];
+        wb_real d2[MAX_BONES + 1];
+        int got = wb_kdtree_knn(bj->t, &bj->m->v[3 * v], k + 1, id, d2);
+        for (int j = 0; j < got; j++)
+            if (!isfinite(d2[j]) && v < far) far = v;
+        vertex_weights(d2, got, k, &s->wt[(size_t)v * k]);
+        for (int j = 0; j < k; j++) s->inf[(size_t)v * k + j] = j < got ? id[j] : 0;
+    }
+    /* the minimum over the parts, whatever their order */
+    int32_t cur = bj->far;
+    while (far < cur && !atomic_compare_exchange_weak(&bj->far, &cur, far)) {}
+}
+
 wb_skin *wb_skin_create(const wb_world *w, const wb_mesh *m, const int32_t *ids, int32_t n,
                         const wb_skin_def *def, wb_status *status)
 {
@@ -201,7 +229,6 @@ wb_skin *wb_skin_create(const wb_world *w, const wb_mesh *m, const int32_t *ids,
     s->k = k;
     s->iterations = def->iterations;
     s->nb = n;
-    s->threads = w->m.def.threads;
     s->rest = wb_mesh_copy(m);
     s->inf = calloc(nvs * (size_t)k, sizeof *s->inf);
     s->wt = calloc(nvs * (size_t)k, sizeof *s->wt);
@@ -231,17 +258,9 @@ wb_skin *wb_skin_create(const wb_world *w, const wb_mesh *m, const int32_t *ids,
     wb_kdtree *t = wb_kdtree_build(s->x0, n);
     if (!t) { wb_skin_destroy(s); return NULL; }
     /* every vertex: its K nearest particles, one more for the weights' radius */
-    int32_t far = nv; /* the first vertex whose squared distance to a bone overflows */
-    #pragma omp parallel for schedule(static) num_threads(s->threads) if (nv > 20000) reduction(min : far)
-    for (int32_t v = 0; v < nv; v++) {
-        int32_t id[MAX_BONES + 1];
-        wb_real d2[MAX_BONES + 1];
-        int got = wb_kdtree_knn(t, &m->v[3 * v], k + 1, id, d2);
-        for (int j = 0; j < got; j++)
-            if (!isfinite(d2[j]) && v < far) far = v;
-        vertex_weights(d2, got, k, &s->wt[(size_t)v * k]);
-        for (int j = 0; j < k; j++) s->inf[(size_t)v * k + j] = j < got ? id[j] : 0;
-    }
+    bind_job bj = { s, t, m, nv };
+    wb__pool_for(nv > 20000 ? wb__world_pool(w) : NULL, nv, 5000, bind_part, &bj);
+    const int32_t far = bj.far;
     if (far < nv) {
         /* weights are d^2 / R^2 (inf / inf = NaN) and offsets v - x0 overflow: refuse */
         wb_kdtree_destroy(t);
@@ -315,14 +334,13 @@ void wb_skin_update_bones(wb_skin *s, const wb_world *w)
     s->bones_key = key;
 }
 
-const wb_real *wb_skin_vertices(wb_skin *s, const wb_world *w)
+/* the blended positions of vertices [lo, hi) */
+static void blend_part(void *ctx, int32_t lo, int32_t hi)
 {
-    wb_skin_update_bones(s, w);
-    if (s->verts_key == s->bones_key) return s->out;
+    wb_skin *s = ctx;
     const int k = s->k;
     const wb_real *v0 = s->rest->v;
-    #pragma omp parallel for schedule(static) num_threads(s->threads) if (s->rest->nv > 20000)
-    for (int32_t v = 0; v < s->rest->nv; v++) {
+    for (int32_t v = lo; v < hi; v++) {
         wb_real o[3] = { 0, 0, 0 };
         for (int j = 0; j < k; j++) {
             const wb_real wj = s->wt[(size_t)v * k + j];
@@ -337,6 +355,13 @@ const wb_real *wb_skin_vertices(wb_skin *s, const wb_world *w)
         }
         v3_copy(&s->out[3 * v], o);
     }
+}
+
+const wb_real *wb_skin_vertices(wb_skin *s, const wb_world *w)
+{
+    wb_skin_update_bones(s, w);
+    if (s->verts_key == s->bones_key) return s->out;
+    wb__pool_for(s->rest->nv > 20000 ? wb__world_pool(w) : NULL, s->rest->nv, 5000, blend_part, s);
     s->verts_key = s->bones_key;
     return s->out;
 }

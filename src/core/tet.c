@@ -540,7 +540,7 @@ static void tet_project(wb_world *w, wb_real h)
 {
     wb_neos *v = w->neo;
     if (!v) return;
-    wb__batches_run(&v->bt, w, w->m.def.threads, 64, project_range, v->order, h);
+    wb__batches_run(&v->bt, w, 64, project_range, v->order, h);
     w->k.projections += v->n; /* a tet (both of its constraints) is one projection */
 }
 

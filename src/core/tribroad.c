@@ -611,6 +611,17 @@ static int order_as_grid(struct wb_tribroad *b, const wb_world *w, wb_real cell,
 }
 
 /* ---- the frame's list ----------------------------------------------------------------------------- */
+/* the scan on the pool: part k takes its contiguous range of the kept triangles into
+ * its own buffer */
+typedef struct tri_job { const struct wb_tribroad *b; const wb_world *w; int32_t nt; } tri_job;
+
+static void tri_part(void *ctx, int k, int nth)
+{
+    const tri_job *j = ctx;
+    tri_scan(j->b, j->w, (int32_t)((int64_t)j->nt * k / nth), (int32_t)((int64_t)j->nt * (k + 1) / nth),
+             &j->b->out[k]);
+}
+
 static int broadphase(wb_world *w)
 {
     wb_model *m = &w->m;
@@ -712,9 +723,8 @@ static int broadphase(wb_world *w)
     for (int k = 0; k < nth; k++) { b->out[k].n = 0; b->out[k].fail = 0; }
     if (nth == 1) tri_scan(b, w, 0, nt, &b->out[0]);
     else {
-        #pragma omp parallel for num_threads(nth) schedule(static)
-        for (int k = 0; k < nth; k++)
-            tri_scan(b, w, (int32_t)((int64_t)nt * k / nth), (int32_t)((int64_t)nt * (k + 1) / nth), &b->out[k]);
+        tri_job j = { b, w, nt };
+        wb__pool_run(wb__world_pool(w), tri_part, &j); /* nth parts: nth == the pool's threads */
     }
     int64_t total = 0;
     for (int k = 0; k < nth; k++) {

@@ -102,6 +102,12 @@ wb_world *wb_world_create(const wb_world_def *def)
     return w;
 }
 
+wb_pool *wb__world_pool(const wb_world *w)
+{
+    wb_world *mw = (wb_world *)w; /* worlds are heap objects: the pool is a mutable cache */
+    return wb__pool_get(&mw->pool, w->m.def.threads);
+}
+
 void wb_world_destroy(wb_world *w)
 {
     if (!w) return;
@@ -110,6 +116,7 @@ void wb_world_destroy(wb_world *w)
     wb__attach_free(w);
     wb__grab_free(w);
     wb__rigids_free(w, w->rb);
+    wb__pool_destroy(w->pool);
     wb_model *m = &w->m;
     for (int32_t i = 0; i < m->nc; i++) wb__colmesh_free(m->c_shape[i].mesh); /* mesh colliders' copies */
     /* the bends' arrays (bend.c owns their use; freed here so that no circle joins the files) */

@@ -78,6 +78,16 @@
     X(narrow_degenerate_input)                           \
     X(narrow_random_consistency)
 
+/* test_pool.c: the thread pool */
+#define POOL_TESTS(X)                                    \
+    X(pool_for_runs_every_index_once)                    \
+    X(pool_run_every_part_once)                          \
+    X(pool_tiny_loops_stay_on_the_caller)                \
+    X(pool_many_successive_jobs)                         \
+    X(pool_destroyed_at_once_or_idle)                    \
+    X(pool_nested_call_runs_inline)                      \
+    X(pool_world_identical_for_1_2_3_threads)
+
 /* every test, in the order they run: add a line here for each TEST() */
 #define TEST_LIST(X)                             \
     X(world_def_defaults)                        \
@@ -160,7 +170,8 @@
     X(attach_grab_rigid_ids)                     \
     RIGID_TESTS(X)                               \
     NARROW_TESTS(X)                              \
-    X(distance_simd_bit_identical_to_scalar)
+    X(distance_simd_bit_identical_to_scalar)     \
+    POOL_TESTS(X)
 
 #define DECLARE(name) TEST(name);
 #define ENTRY(name) { #name, test_##name },

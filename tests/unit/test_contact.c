@@ -27,7 +27,10 @@ static int32_t broad(wb_contacts *c, const wb_real *x, const wb_real *reach, con
                      int threads)
 {
     memset(c, 0, sizeof *c);
-    return wb__broadphase(c, x, reach, skip, n, threads, keep_all, NULL);
+    wb_pool *pool = wb__pool_create(threads);
+    const int32_t r = wb__broadphase(c, x, reach, skip, n, pool, keep_all, NULL);
+    wb__pool_destroy(pool);
+    return r;
 }
 
 static void broad_free(wb_contacts *c)

@@ -1,0 +1,225 @@
+/* pool.c: the persistent thread pool (pool.h).
+ *
+ * Posting a job: the claim word `ticket` (generation << 32 | next part) is first closed
+ * to the new generation, then the job is written, then the ticket opens at part 0 and
+ * `gen` (the word sleeping workers wait on) moves on. A worker reads gen, the job, then
+ * claims a part by a compare-and-swap on the ticket that only succeeds while the ticket
+ * still carries the generation it read: a worker that wakes after its job is over (or
+ * reads a job being rewritten) claims nothing. The caller claims parts the same way and
+ * returns when `done` counts them all, so it never waits for a worker that has not
+ * started (a busy core), only for parts already running. */
+#include "pool.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <time.h>
+#include <unistd.h>
+#include <linux/futex.h>
+#include <sys/syscall.h>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define cpu_relax() _mm_pause()
+#else
+#define cpu_relax() ((void)0)
+#endif
+
+/* how long an idle thread spins before it sleeps: jobs of one substep follow each
+ * other within microseconds; a futex wake-up costs 5-50 us */
+#define SPIN_NS 5000
+#define MAX_PARTS_PER_THREAD 4
+
+struct wb_pool {
+    _Alignas(64) _Atomic uint32_t gen;    /* futex word of the workers */
+    _Atomic int sleepers;                 /* workers in (or entering) futex_wait on gen */
+    _Atomic int stop;
+    _Alignas(64) _Atomic uint64_t ticket; /* gen << 32 | next unclaimed part */
+    _Alignas(64) _Atomic uint32_t done;   /* parts finished; futex word of the caller */
+    _Atomic int caller_sleeps;
+    /* the job, written before gen moves (atomics: a late worker may read while it changes) */
+    _Alignas(64) _Atomic(wb_pool_run_fn) run;
+    _Atomic(wb_pool_for_fn) rfor;
+    void *_Atomic ctx;
+    _Atomic int32_t n, nparts;
+    int threads, in_job;
+    int64_t jobs;
+    pthread_t *th;
+    int nth;                              /* workers started */
+};
+
+static void futex_wait(_Atomic uint32_t *addr, uint32_t val)
+{
+    syscall(SYS_futex, (uint32_t *)addr, FUTEX_WAIT_PRIVATE, val, NULL, NULL, 0);
+}
+
+static void futex_wake(_Atomic uint32_t *addr, int n)
+{
+    syscall(SYS_futex, (uint32_t *)addr, FUTEX_WAKE_PRIVATE, n, NULL, NULL, 0);
+}
+
+static int64_t now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+/* one part of the job posted as generation g */
+static void run_part(wb_pool *p, wb_pool_run_fn run, wb_pool_for_fn rfor, void *ctx, int32_t n, int32_t np, int32_t k)
+{
+    if (run) run(ctx, k, np);
+    else rfor(ctx, (int32_t)((int64_t)n * k / np), (int32_t)((int64_t)n * (k + 1) / np));
+    if (atomic_fetch_add(&p->done, 1) + 1 == (uint32_t)np && atomic_load(&p->caller_sleeps))
+        futex_wake(&p->done, 1);
+}
+
+/* claim and run parts of generation g until none is left */
+static void work(wb_pool *p, uint32_t g)
+{
+    wb_pool_run_fn run = atomic_load_explicit(&p->run, memory_order_relaxed);
+    wb_pool_for_fn rfor = atomic_load_explicit(&p->rfor, memory_order_relaxed);
+    void *ctx = atomic_load_explicit(&p->ctx, memory_order_relaxed);
+    const int32_t n = atomic_load_explicit(&p->n, memory_order_relaxed);
+    const int32_t np = atomic_load_explicit(&p->nparts, memory_order_relaxed);
+    /* any value read above from a newer job implies the ticket closed to it (seqlock) */
+    atomic_thread_fence(memory_order_acquire);
+    uint64_t t = atomic_load(&p->ticket);
+    for (;;) {
+        if ((uint32_t)(t >> 32) != g || (int64_t)(uint32_t)t >= np) return;
+        if (!atomic_compare_exchange_weak(&p->ticket, &t, t + 1)) continue;
+        run_part(p, run, rfor, ctx, n, np, (int32_t)(uint32_t)t);
+        t = atomic_load(&p->ticket);
+    }
+}
+
+static void *worker(void *arg)
+{
+    wb_pool *p = arg;
+    uint32_t seen = 0; /* gen at creation: a thread that starts late still sees every change */
+    for (;;) {
+        uint32_t g = atomic_load(&p->gen);
+        if (g == seen) {
+            const int64_t t0 = now_ns();
+            for (int i = 1; (g = atomic_load(&p->gen)) == seen; i++) {
+                cpu_relax();
+                if ((i & 63) == 0 && now_ns() - t0 > SPIN_NS) {
+                    atomic_fetch_add(&p->sleepers, 1);
+                    while ((g = atomic_load(&p->gen)) == seen) futex_wait(&p->gen, seen);
+                    atomic_fetch_sub(&p->sleepers, 1);
+                    break;
+                }
+            }
+        }
+        seen = g;
+        if (atomic_load(&p->stop)) return NULL;
+        work(p, g);
+    }
+}
+
+wb_pool *wb__pool_create(int threads)
+{
+    if (threads <= 1) return NULL;
+    wb_pool *p = calloc(1, sizeof *p);
+    if (!p) return NULL;
+    p->threads = threads;
+    p->th = calloc((size_t)threads, sizeof *p->th);
+    if (!p->th) { free(p); return NULL; }
+    /* the workers block every signal: the process's handlers run on the caller's thread */
+    sigset_t all, old;
+    sigfillset(&all);
+    pthread_sigmask(SIG_SETMASK, &all, &old);
+    for (int i = 0; i < threads - 1; i++) {
+        if (pthread_create(&p->th[i], NULL, worker, p) != 0) break;
+        p->nth++;
+    }
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    if (p->nth == 0) { wb__pool_destroy(p); return NULL; }
+    return p;
+}
+
+void wb__pool_destroy(wb_pool *p)
+{
+    if (!p) return;
+    atomic_store(&p->stop, 1);
+    atomic_fetch_add(&p->gen, 1);
+    futex_wake(&p->gen, INT_MAX);
+    for (int i = 0; i < p->nth; i++) pthread_join(p->th[i], NULL);
+    free(p->th);
+    free(p);
+}
+
+int wb__pool_threads(const wb_pool *p) { return p ? p->threads : 1; }
+
+int64_t wb__pool_jobs(const wb_pool *p) { return p ? p->jobs : 0; }
+
+wb_pool *wb__pool_get(wb_pool **slot, int threads)
+{
+    if (threads <= 1) return NULL; /* kept for when the count goes up again */
+    if (*slot && (*slot)->threads == threads) return *slot;
+    wb__pool_destroy(*slot);
+    *slot = wb__pool_create(threads);
+    return *slot;
+}
+
+static void post(wb_pool *p, wb_pool_run_fn run, wb_pool_for_fn rfor, void *ctx, int32_t n, int32_t np)
+{
+    const uint32_t g = atomic_load_explicit(&p->gen, memory_order_relaxed) + 1;
+    p->in_job = 1;
+    p->jobs++;
+    /* close the claims to the old job before the job changes (see work) */
+    atomic_store(&p->ticket, (uint64_t)g << 32 | 0xffffffffu);
+    atomic_thread_fence(memory_order_release);
+    atomic_store_explicit(&p->run, run, memory_order_relaxed);
+    atomic_store_explicit(&p->rfor, rfor, memory_order_relaxed);
+    atomic_store_explicit(&p->ctx, ctx, memory_order_relaxed);
+    atomic_store_explicit(&p->n, n, memory_order_relaxed);
+    atomic_store_explicit(&p->nparts, np, memory_order_relaxed);
+    atomic_store(&p->done, 0);
+    atomic_store(&p->ticket, (uint64_t)g << 32);
+    atomic_store(&p->gen, g);
+    if (atomic_load(&p->sleepers) > 0) futex_wake(&p->gen, INT_MAX);
+    work(p, g);
+    /* the parts claimed by workers and still running */
+    uint32_t d = atomic_load(&p->done);
+    if (d != (uint32_t)np) {
+        const int64_t t0 = now_ns();
+        for (int i = 1; (d = atomic_load(&p->done)) != (uint32_t)np; i++) {
+            cpu_relax();
+            if ((i & 63) == 0 && now_ns() - t0 > SPIN_NS) {
+                atomic_store(&p->caller_sleeps, 1);
+                while ((d = atomic_load(&p->done)) != (uint32_t)np) futex_wait(&p->done, d);
+                atomic_store(&p->caller_sleeps, 0);
+                break;
+            }
+        }
+    }
+    p->in_job = 0;
+}
+
+void wb__pool_run(wb_pool *p, wb_pool_run_fn fn, void *ctx)
+{
+    if (!p || p->in_job) {
+        /* inline, the same parts in order: per-part results do not change */
+        const int np = wb__pool_threads(p);
+        for (int k = 0; k < np; k++) fn(ctx, k, np);
+        return;
+    }
+    post(p, fn, NULL, ctx, 0, p->threads);
+}
+
+void wb__pool_for(wb_pool *p, int32_t n, int32_t grain, wb_pool_for_fn fn, void *ctx)
+{
+    if (n <= 0) return;
+    if (grain < 1) grain = 1;
+    int64_t np = n / grain;
+    if (p && np > (int64_t)p->threads * MAX_PARTS_PER_THREAD) np = (int64_t)p->threads * MAX_PARTS_PER_THREAD;
+    if (!p || p->in_job || np < 2) {
+        fn(ctx, 0, n);
+        return;
+    }
+    post(p, NULL, fn, ctx, n, (int32_t)np);
+}
