@@ -125,6 +125,18 @@ check "view --size is checked" 2 err "--size expects WIDTHxHEIGHT"
 code=$?
 check "--record is not an option of view" 2 err "--record is an option of run"
 
+# ---- an output path that cannot be written is an error before the window opens (no
+# display needed: the check comes first), not after minutes of poking
+for opt in --record-input --screenshot; do
+    (unset DISPLAY WAYLAND_DISPLAY; "$W" view $F/rope.lua $opt "$TMP/no/such/out.x" >"$TMP/out" 2>"$TMP/err")
+    code=$?
+    check "view $opt to a folder that does not exist: exit 2 before the window" 2 \
+        err "$opt: cannot write $TMP/no/such/out.x" !err "no display"
+done
+(unset DISPLAY WAYLAND_DISPLAY; "$W" view $F/rope.lua --record-input "$TMP/fresh.json" >"$TMP/out" 2>"$TMP/err")
+code=$?
+check "the check of a writable --record-input leaves no file behind" 2 err "no display" none "$TMP/fresh.json"
+
 if ! start_x; then
     result "an X server (Xvfb) starts" "no display number answered"
     echo "$passed passed, $failed failed"
@@ -256,6 +268,43 @@ xdotool key --window "$wid" Escape 2>/dev/null   # its release may find the wind
 finish 10
 [ "$code" = 0 ] || why="${why:+$why; }Esc: exit code $code"
 result "R restarts the scene; Esc closes the viewer with exit 0" "$why"
+
+# ---- the script closes the world shown and steps another: that one is shown and can be
+# grabbed (the viewer kept a pointer to the freed world: a use after free)
+view $F/closed_world.lua --size 320x240 --frames 240 --record-input "$TMP/input2.json"
+why=""
+if window && wait_for "$TMP/out" "frame 30" 1 20; then
+    xdotool mousemove --window "$wid" 160 120 mousedown 1
+    for dy in 10 20 30 40 50 60; do
+        xdotool mousemove --window "$wid" 160 $((120 - dy))
+        sleep 0.05
+    done
+    sleep 0.3
+    xdotool mouseup 1
+else
+    why="no window"
+fi
+finish 30
+cp "$TMP/out" "$TMP/out.view"
+check "a scene closing its first world ends with exit 0" 0 out "hash "
+grep -qF '"world":	2' "$TMP/input2.json" 2>/dev/null || why="${why:+$why; }no event of world 2 in the log"
+grep -qF '"type":	"grab"' "$TMP/input2.json" 2>/dev/null || why="${why:+$why; }no grab in the log"
+"$W" run $F/closed_world.lua --frames 240 --replay "$TMP/input2.json" >"$TMP/out" 2>"$TMP/err"
+vh=$(grep '^hash' "$TMP/out.view") rh=$(grep '^hash' "$TMP/out")
+[ -n "$vh" ] && [ "$vh" = "$rh" ] || why="${why:+$why; }view '$vh', replay '$rh'"
+result "after the script closes the world shown, the next world is shown and grabbed" "$why"
+
+# ---- --time-limit bounds the script, not the look at its last picture: the viewer
+# waiting for Esc past the limit and the watchdog's grace (5 s) is not ended with exit 3
+view $F/short.lua --size 320x240 --time-limit 1
+why=""
+wait_for "$TMP/out" "ended" 1 15 || why="the scene did not end"
+sleep 8
+kill -0 "$VPID" 2>/dev/null || why="${why:+$why; }the viewer was ended while it waited for Esc"
+window && xdotool key --window "$wid" Escape 2>/dev/null
+finish 10
+[ "$code" = 0 ] || why="${why:+$why; }exit code $code, expected 0"
+result "--time-limit: the wait after the scene's end is not under the budget" "$why"
 
 stop_x
 echo "$passed passed, $failed failed"
