@@ -52,6 +52,7 @@ typedef struct viewer {
     bool running;              /* inside the script (grabs possible), not after its end */
     int64_t frames_shown;
     bool paused, step_once, quit, restart, reload, dirty;
+    int exit_code;             /* os.exit's code (--unsafe), else 0 */
     char error[2048];          /* the script's error (--watch), shown until the next run */
     char note[256];            /* a one-line message (a grab refused, a screenshot written) */
     double last_present, fps;
@@ -617,6 +618,18 @@ static int view_hook(lua_State *L)
     return 0;
 }
 
+/* os.exit (--unsafe): the viewer closes as with Esc, with the code given, so the
+ * input log and the screenshot are still written (a process exit would lose them) */
+static int view_os_exit(lua_State *L)
+{
+    int code = 0;
+    if (lua_isboolean(L, 1)) code = lua_toboolean(L, 1) ? 0 : 1;
+    else if (!lua_isnoneornil(L, 1)) code = (int)(luaL_checkinteger(L, 1) & 0xff);
+    V.exit_code = code;
+    V.quit = true;
+    return stop_run(L);
+}
+
 /* the marker passes unchanged; any other error gets its traceback */
 static int view_msgh(lua_State *L)
 {
@@ -664,6 +677,11 @@ static int run_once(void)
     lua_pushcfunction(L, view_hook);
     wb_rt_add_frame_hook(L, -1);
     lua_pop(L, 1);
+    if (wb_rt_get(L)->unsafe && lua_getglobal(L, "os") == LUA_TTABLE) {
+        lua_pushcfunction(L, view_os_exit);
+        lua_setfield(L, -2, "exit");
+    }
+    lua_settop(L, 0);
     lua_pushcfunction(L, view_msgh);
     V.running = true;
     int status = luaL_loadfilex(L, o->scene, wb_rt_get(L)->unsafe ? NULL : "t");
@@ -691,7 +709,7 @@ static int run_once(void)
         V.error[0] = 0;
         if (o->watch) watch_modules(L);
     }
-    if (V.quit && !code) code = 1 + 0;
+    if (V.quit && !code) code = 1 + V.exit_code;
     /* the window's last picture, before the world it names is gone */
     if (code && o->screenshot) {
         char err[1024];

@@ -294,6 +294,16 @@ vh=$(grep '^hash' "$TMP/out.view") rh=$(grep '^hash' "$TMP/out")
 [ -n "$vh" ] && [ "$vh" = "$rh" ] || why="${why:+$why; }view '$vh', replay '$rh'"
 result "after the script closes the world shown, the next world is shown and grabbed" "$why"
 
+# ---- os.exit (--unsafe) closes the viewer with its code; the input log and the
+# screenshot are still written (the process used to exit on the spot)
+view $F/exit.lua --unsafe --size 320x240 --record-input "$TMP/exit.json" --screenshot "$TMP/exit.png"
+finish 20
+check "os.exit(4) in the viewer: exit code 4, the log is saved" 4 err "input events to"
+why=""
+[ -s "$TMP/exit.json" ] || why="no input log written"
+[ -s "$TMP/exit.png" ] || why="${why:+$why; }no screenshot written"
+result "os.exit in the viewer still writes --record-input and --screenshot" "$why"
+
 # ---- --time-limit bounds the script, not the look at its last picture: the viewer
 # waiting for Esc past the limit and the watchdog's grace (5 s) is not ended with exit 3
 view $F/short.lua --size 320x240 --time-limit 1
