@@ -294,6 +294,45 @@ vh=$(grep '^hash' "$TMP/out.view") rh=$(grep '^hash' "$TMP/out")
 [ -n "$vh" ] && [ "$vh" = "$rh" ] || why="${why:+$why; }view '$vh', replay '$rh'"
 result "after the script closes the world shown, the next world is shown and grabbed" "$why"
 
+# ---- a drag on empty space orbits (nothing logged); a grab made while paused, then R:
+# the log starts again, so the file holds no event of the run before
+view $F/grab.lua --size 320x240 --set frames=100000 --record-input "$TMP/orbit.json"
+why=""
+if window && wait_for "$TMP/out" "frame 30" 1 20; then
+    xdotool mousemove --window "$wid" 5 230 mousedown 1
+    for dx in 20 40 60 80; do
+        xdotool mousemove --window "$wid" $((5 + dx)) 230
+        sleep 0.05
+    done
+    xdotool mouseup 1
+    sleep 0.3
+    xdotool key --window "$wid" Escape 2>/dev/null
+else
+    why="no window"
+fi
+finish 20
+check "a drag on empty space: exit 0 and the log saved" 0 err "recorded 0 input events"
+view $F/grab.lua --size 320x240 --set frames=100000 --record-input "$TMP/restart.json"
+why=""
+if window && wait_for "$TMP/out" "frame 30" 1 20; then
+    xdotool mousemove --window "$wid" 10 10 key --window "$wid" space
+    sleep 1
+    xdotool mousemove --window "$wid" 160 120 mousedown 1
+    for dy in 10 20 30 40; do
+        xdotool mousemove --window "$wid" 160 $((120 - dy))
+        sleep 0.05
+    done
+    xdotool mouseup 1
+    sleep 0.3
+    xdotool key --window "$wid" r
+    wait_for "$TMP/out" "frame 30" 2 20 || why="R did not restart the scene"
+    xdotool key --window "$wid" Escape 2>/dev/null
+else
+    why="no window"
+fi
+finish 20
+check "a grab while paused, then R: the log holds the new run alone" 0 err "recorded 0 input events"
+
 # ---- os.exit (--unsafe) closes the viewer with its code; the input log and the
 # screenshot are still written (the process used to exit on the spot)
 view $F/exit.lua --unsafe --size 320x240 --record-input "$TMP/exit.json" --screenshot "$TMP/exit.png"
