@@ -31,27 +31,27 @@ for tool in Xvfb xdotool; do
     fi
 done
 
-# start_x: an X server of our own on a free display number (another may be taken by a
-# parallel run: tried until one answers); sets DISPLAY and XPID
+# start_x: an X server of our own; Xvfb itself picks a free display number and writes it
+# to fd 3 (-displayfd), so two runs in parallel never share one (choosing the number
+# here raced: the loser's test then ran on the winner's server, gone when it ended);
+# sets DISPLAY and XPID
 start_x() {
-    for d in $(seq $((100 + $$ % 300)) $((100 + $$ % 300 + 40))); do
-        [ -e "/tmp/.X$d-lock" ] || [ -e "/tmp/.X11-unix/X$d" ] && continue
-        Xvfb ":$d" -screen 0 640x480x24 -nolisten tcp >/dev/null 2>&1 &
-        XPID=$!
-        i=0
-        while [ $i -lt 50 ]; do
-            if DISPLAY=":$d" xdotool getdisplaygeometry >/dev/null 2>&1; then
-                export DISPLAY=":$d"
-                return 0
-            fi
-            kill -0 "$XPID" 2>/dev/null || break
-            sleep 0.1
-            i=$((i + 1))
-        done
-        kill "$XPID" 2>/dev/null
-        wait "$XPID" 2>/dev/null
-        XPID=""
+    Xvfb -displayfd 3 -screen 0 640x480x24 -nolisten tcp 3>"$TMP/xdisplay" >/dev/null 2>&1 &
+    XPID=$!
+    i=0
+    while [ $i -lt 100 ]; do
+        d=$(cat "$TMP/xdisplay" 2>/dev/null)
+        if [ -n "$d" ] && DISPLAY=":$d" xdotool getdisplaygeometry >/dev/null 2>&1; then
+            export DISPLAY=":$d"
+            return 0
+        fi
+        kill -0 "$XPID" 2>/dev/null || break
+        sleep 0.1
+        i=$((i + 1))
     done
+    kill "$XPID" 2>/dev/null
+    wait "$XPID" 2>/dev/null
+    XPID=""
     return 1
 }
 
