@@ -8,6 +8,7 @@
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
+#include <errno.h>
 #include <lauxlib.h>
 #include <limits.h>
 #include <math.h>
@@ -16,6 +17,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "cli/view.h"
 #include "lua/input.h"
@@ -43,11 +45,14 @@ typedef struct viewer {
     wbl_input_log *log;
     /* this run of the scene */
     lua_State *L;
-    wb_world *world;           /* the world shown: the first that finished a frame */
+    wbl_world *world;          /* the world shown (its userdata, anchored in the registry so
+                                * a w:close() leaves w NULL, not dangling): the first that
+                                * finished a frame, the next to step once the script closes it */
     int world_ord;
     bool running;              /* inside the script (grabs possible), not after its end */
     int64_t frames_shown;
     bool paused, step_once, quit, restart, reload, dirty;
+    int exit_code;             /* os.exit's code (--unsafe), else 0 */
     char error[2048];          /* the script's error (--watch), shown until the next run */
     char note[256];            /* a one-line message (a grab refused, a screenshot written) */
     double last_present, fps;
@@ -80,6 +85,12 @@ static double now(void)
 static bool stopping(void)
 {
     return V.quit || V.restart || V.reload;
+}
+
+/* the world shown, NULL when none or the script closed it */
+static wb_world *shown(void)
+{
+    return V.world ? V.world->w : NULL;
 }
 
 /* ---- vectors -------------------------------------------------------------------------- */
@@ -215,8 +226,8 @@ static void pos(const wb_world *w, int32_t p, double out[3])
 static int32_t pick(double x, double y, double *hit_t)
 {
     double o[3], d[3], f[3], px;
-    if (!V.world || !pick_ray(x, y, o, d, f, &px)) return -1;
-    const wb_world *w = V.world;
+    const wb_world *w = shown();
+    if (!w || !pick_ray(x, y, o, d, f, &px)) return -1;
     int32_t best = -1, n = wb_particle_count(w);
     double bt = INFINITY;
     for (int32_t i = 0; i < n; i++) {
@@ -259,11 +270,11 @@ static void grab_start(double x, double y)
     }
     double o[3], d[3], f[3], px;
     pick_ray(x, y, o, d, f, &px);
-    pos(V.world, p, V.plane_p);   /* the plane facing the camera through the particle */
+    pos(shown(), p, V.plane_p);   /* the plane facing the camera through the particle */
     for (int k = 0; k < 3; k++) V.plane_n[k] = f[k];
     wb_real target[3] = { V.plane_p[0], V.plane_p[1], V.plane_p[2] };
     char err[256];
-    if (!wbl_input_grab(V.log, V.world, V.world_ord, p, target, 0, &V.grab, err, sizeof err)) {
+    if (!wbl_input_grab(V.log, shown(), V.world_ord, p, target, 0, &V.grab, err, sizeof err)) {
         snprintf(V.note, sizeof V.note, "%s", err);
         V.drag = 0;
         V.dirty = true;
@@ -285,13 +296,14 @@ static void grab_move(double x, double y)
     double t = dot3(q, V.plane_n) / den;
     if (!(t > 0)) return;
     wb_real target[3] = { o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2] };
-    wbl_input_move(V.log, V.world, V.world_ord, V.grab, target);
+    if (!shown()) return;   /* the script closed the world */
+    wbl_input_move(V.log, shown(), V.world_ord, V.grab, target);
     V.dirty = true;
 }
 
 static void grab_end(void)
 {
-    if (V.grabbed >= 0 && V.world) wbl_input_release(V.log, V.world, V.world_ord, V.grab);
+    if (V.grabbed >= 0 && shown()) wbl_input_release(V.log, shown(), V.world_ord, V.grab);
     V.grabbed = -1;
     V.dirty = true;
 }
@@ -306,7 +318,7 @@ static void on_button(GLFWwindow *win, int button, int action, int mods)
     if (action == GLFW_PRESS && V.drag == 0) {
         if (button == GLFW_MOUSE_BUTTON_LEFT) {
             /* a grab needs a running world: after the script's end nothing would step */
-            if (V.running && V.world) grab_start(x, y);
+            if (V.running && shown()) grab_start(x, y);
             else V.drag = 1;
         } else if (button == GLFW_MOUSE_BUTTON_RIGHT || button == GLFW_MOUSE_BUTTON_MIDDLE) {
             V.drag = 2;
@@ -478,8 +490,8 @@ static void compose(void)
         for (size_t i = 0; i < (size_t)V.W * V.H; i++) V.frame[3 * i] = 40, V.frame[3 * i + 1] = 42, V.frame[3 * i + 2] = 48;
     int y = 2, wmax = 0;
     char line[256];
-    if (V.world) {
-        const wb_world *w = V.world;
+    if (shown()) {
+        const wb_world *w = shown();
         wb_stats st = wb_world_stats(w);
         double dt = wb_world_get_def(w).dt;
         snprintf(line, sizeof line, "frame %lld  t %.2f s  %.2f ms/step  %.0f fps (%.2fx)",
@@ -559,8 +571,12 @@ static int stop_run(lua_State *L)
 static int view_hook(lua_State *L)
 {
     int ord = wbl_input_world(L, 1);   /* every world numbered, as the replay numbers them */
-    if (!V.world_ord) {
+    if (!V.world_ord || (ord != V.world_ord && !shown())) {
         V.world_ord = ord;
+        V.world = wbl_checkworld_ud(L, 1);
+        V.frames_shown = 0;   /* --frames N counts the frames of the world shown */
+        if (V.drag == 3) V.drag = 0;   /* a grab of a closed world is gone with it */
+        V.grabbed = -1;
         lua_pushvalue(L, 1);
         lua_rawsetp(L, LUA_REGISTRYINDEX, &world_key);
     }
@@ -571,7 +587,6 @@ static int view_hook(lua_State *L)
         return stopping() ? stop_run(L) : 0;
     }
     if (stopping()) return stop_run(L); /* the script caught the marker and stepped on */
-    V.world = wbl_checkworld(L, 1);
     if (V.o->frames >= 0 && ++V.frames_shown > V.o->frames) {
         V.quit = true;   /* --frames N: a w:step loop past N ends here */
         return stop_run(L);
@@ -579,7 +594,7 @@ static int view_hook(lua_State *L)
     glfwPollEvents();
     draw_world(L, 1);
     /* real time: each frame shown dt after the last, or as soon as drawn when slower */
-    double dt = wb_world_get_def(V.world).dt, due = V.last_present + dt;
+    double dt = wb_world_get_def(shown()).dt, due = V.last_present + dt;
     while (!stopping() && now() < due && V.last_present > 0) wait_events(due);
     double t = now();
     if (V.last_present > 0 && t > V.last_present) {
@@ -603,6 +618,18 @@ static int view_hook(lua_State *L)
     return 0;
 }
 
+/* os.exit (--unsafe): the viewer closes as with Esc, with the code given, so the
+ * input log and the screenshot are still written (a process exit would lose them) */
+static int view_os_exit(lua_State *L)
+{
+    int code = 0;
+    if (lua_isboolean(L, 1)) code = lua_toboolean(L, 1) ? 0 : 1;
+    else if (!lua_isnoneornil(L, 1)) code = (int)(luaL_checkinteger(L, 1) & 0xff);
+    V.exit_code = code;
+    V.quit = true;
+    return stop_run(L);
+}
+
 /* the marker passes unchanged; any other error gets its traceback */
 static int view_msgh(lua_State *L)
 {
@@ -613,18 +640,18 @@ static int view_msgh(lua_State *L)
 /* after the script: the last picture until Esc, R or (--watch) a saved file */
 static void wait_end(lua_State *L)
 {
+    /* the script is over: the time limit bounds it, not the person looking at the end */
+    wb_rt_pause_watchdog(L, 1);
     V.dirty = true;
     while (!stopping()) {
         if (V.dirty) {
-            if (V.world && lua_rawgetp(L, LUA_REGISTRYINDEX, &world_key) == LUA_TUSERDATA) {
-                if (!wbl_checkworld_ud(L, -1)->w) V.world = NULL;   /* the script closed it */
-                else draw_world(L, -1);
-            }
+            if (shown() && lua_rawgetp(L, LUA_REGISTRYINDEX, &world_key) == LUA_TUSERDATA) draw_world(L, -1);
             lua_settop(L, 0);
             present();
         }
         wait_events(now() + 0.1);
     }
+    wb_rt_pause_watchdog(L, 0);   /* the finalizers of wb_rt_close are bounded again */
 }
 
 /* one run of the scene: 0 to go on (restart), else the exit code + 1 */
@@ -650,6 +677,11 @@ static int run_once(void)
     lua_pushcfunction(L, view_hook);
     wb_rt_add_frame_hook(L, -1);
     lua_pop(L, 1);
+    if (wb_rt_get(L)->unsafe && lua_getglobal(L, "os") == LUA_TTABLE) {
+        lua_pushcfunction(L, view_os_exit);
+        lua_setfield(L, -2, "exit");
+    }
+    lua_settop(L, 0);
     lua_pushcfunction(L, view_msgh);
     V.running = true;
     int status = luaL_loadfilex(L, o->scene, wb_rt_get(L)->unsafe ? NULL : "t");
@@ -677,7 +709,7 @@ static int run_once(void)
         V.error[0] = 0;
         if (o->watch) watch_modules(L);
     }
-    if (V.quit && !code) code = 1 + 0;
+    if (V.quit && !code) code = 1 + V.exit_code;
     /* the window's last picture, before the world it names is gone */
     if (code && o->screenshot) {
         char err[1024];
@@ -693,6 +725,21 @@ static int run_once(void)
     return code;
 }
 
+/* can the file be written? Asked before the window opens, so that a bad path is not
+ * found out after minutes of poking; a file made for the test is removed again */
+static bool writable(const char *opt, const char *path)
+{
+    bool existed = access(path, F_OK) == 0;
+    FILE *f = fopen(path, "a");
+    if (!f) {
+        fprintf(stderr, "wobble: %s: cannot write %s: %s\n", opt, path, strerror(errno));
+        return false;
+    }
+    fclose(f);
+    if (!existed) remove(path);
+    return true;
+}
+
 int wb_view_main(const wb_view_opts *o)
 {
     char err[1024];
@@ -701,6 +748,9 @@ int wb_view_main(const wb_view_opts *o)
     V.grabbed = -1;
     V.W = o->width, V.H = o->height;
     V.text_scale = V.H >= 600 ? 2 : 1;
+    if ((o->record_input && !writable("--record-input", o->record_input)) ||
+        (o->screenshot && !writable("--screenshot", o->screenshot)))
+        return 2;
     if (!wb_window_available(err, sizeof err)) {
         fprintf(stderr, "wobble: view: %s\n", err);
         return 2;

@@ -31,27 +31,27 @@ for tool in Xvfb xdotool; do
     fi
 done
 
-# start_x: an X server of our own on a free display number (another may be taken by a
-# parallel run: tried until one answers); sets DISPLAY and XPID
+# start_x: an X server of our own; Xvfb itself picks a free display number and writes it
+# to fd 3 (-displayfd), so two runs in parallel never share one (choosing the number
+# here raced: the loser's test then ran on the winner's server, gone when it ended);
+# sets DISPLAY and XPID
 start_x() {
-    for d in $(seq $((100 + $$ % 300)) $((100 + $$ % 300 + 40))); do
-        [ -e "/tmp/.X$d-lock" ] || [ -e "/tmp/.X11-unix/X$d" ] && continue
-        Xvfb ":$d" -screen 0 640x480x24 -nolisten tcp >/dev/null 2>&1 &
-        XPID=$!
-        i=0
-        while [ $i -lt 50 ]; do
-            if DISPLAY=":$d" xdotool getdisplaygeometry >/dev/null 2>&1; then
-                export DISPLAY=":$d"
-                return 0
-            fi
-            kill -0 "$XPID" 2>/dev/null || break
-            sleep 0.1
-            i=$((i + 1))
-        done
-        kill "$XPID" 2>/dev/null
-        wait "$XPID" 2>/dev/null
-        XPID=""
+    Xvfb -displayfd 3 -screen 0 640x480x24 -nolisten tcp 3>"$TMP/xdisplay" >/dev/null 2>&1 &
+    XPID=$!
+    i=0
+    while [ $i -lt 100 ]; do
+        d=$(cat "$TMP/xdisplay" 2>/dev/null)
+        if [ -n "$d" ] && DISPLAY=":$d" xdotool getdisplaygeometry >/dev/null 2>&1; then
+            export DISPLAY=":$d"
+            return 0
+        fi
+        kill -0 "$XPID" 2>/dev/null || break
+        sleep 0.1
+        i=$((i + 1))
     done
+    kill "$XPID" 2>/dev/null
+    wait "$XPID" 2>/dev/null
+    XPID=""
     return 1
 }
 
@@ -124,6 +124,18 @@ check "view --size is checked" 2 err "--size expects WIDTHxHEIGHT"
 "$W" view $F/rope.lua --record x.mp4 >"$TMP/out" 2>"$TMP/err"
 code=$?
 check "--record is not an option of view" 2 err "--record is an option of run"
+
+# ---- an output path that cannot be written is an error before the window opens (no
+# display needed: the check comes first), not after minutes of poking
+for opt in --record-input --screenshot; do
+    (unset DISPLAY WAYLAND_DISPLAY; "$W" view $F/rope.lua $opt "$TMP/no/such/out.x" >"$TMP/out" 2>"$TMP/err")
+    code=$?
+    check "view $opt to a folder that does not exist: exit 2 before the window" 2 \
+        err "$opt: cannot write $TMP/no/such/out.x" !err "no display"
+done
+(unset DISPLAY WAYLAND_DISPLAY; "$W" view $F/rope.lua --record-input "$TMP/fresh.json" >"$TMP/out" 2>"$TMP/err")
+code=$?
+check "the check of a writable --record-input leaves no file behind" 2 err "no display" none "$TMP/fresh.json"
 
 if ! start_x; then
     result "an X server (Xvfb) starts" "no display number answered"
@@ -256,6 +268,92 @@ xdotool key --window "$wid" Escape 2>/dev/null   # its release may find the wind
 finish 10
 [ "$code" = 0 ] || why="${why:+$why; }Esc: exit code $code"
 result "R restarts the scene; Esc closes the viewer with exit 0" "$why"
+
+# ---- the script closes the world shown and steps another: that one is shown and can be
+# grabbed (the viewer kept a pointer to the freed world: a use after free)
+view $F/closed_world.lua --size 320x240 --frames 240 --record-input "$TMP/input2.json"
+why=""
+if window && wait_for "$TMP/out" "frame 30" 1 20; then
+    xdotool mousemove --window "$wid" 160 120 mousedown 1
+    for dy in 10 20 30 40 50 60; do
+        xdotool mousemove --window "$wid" 160 $((120 - dy))
+        sleep 0.05
+    done
+    sleep 0.3
+    xdotool mouseup 1
+else
+    why="no window"
+fi
+finish 30
+cp "$TMP/out" "$TMP/out.view"
+check "a scene closing its first world ends with exit 0" 0 out "hash "
+grep -qF '"world":	2' "$TMP/input2.json" 2>/dev/null || why="${why:+$why; }no event of world 2 in the log"
+grep -qF '"type":	"grab"' "$TMP/input2.json" 2>/dev/null || why="${why:+$why; }no grab in the log"
+"$W" run $F/closed_world.lua --frames 240 --replay "$TMP/input2.json" >"$TMP/out" 2>"$TMP/err"
+vh=$(grep '^hash' "$TMP/out.view") rh=$(grep '^hash' "$TMP/out")
+[ -n "$vh" ] && [ "$vh" = "$rh" ] || why="${why:+$why; }view '$vh', replay '$rh'"
+result "after the script closes the world shown, the next world is shown and grabbed" "$why"
+
+# ---- a drag on empty space orbits (nothing logged); a grab made while paused, then R:
+# the log starts again, so the file holds no event of the run before
+view $F/grab.lua --size 320x240 --set frames=100000 --record-input "$TMP/orbit.json"
+why=""
+if window && wait_for "$TMP/out" "frame 30" 1 20; then
+    xdotool mousemove --window "$wid" 5 230 mousedown 1
+    for dx in 20 40 60 80; do
+        xdotool mousemove --window "$wid" $((5 + dx)) 230
+        sleep 0.05
+    done
+    xdotool mouseup 1
+    sleep 0.3
+    xdotool key --window "$wid" Escape 2>/dev/null
+else
+    why="no window"
+fi
+finish 20
+check "a drag on empty space: exit 0 and the log saved" 0 err "recorded 0 input events"
+view $F/grab.lua --size 320x240 --set frames=100000 --record-input "$TMP/restart.json"
+why=""
+if window && wait_for "$TMP/out" "frame 30" 1 20; then
+    xdotool mousemove --window "$wid" 10 10 key --window "$wid" space
+    sleep 1
+    xdotool mousemove --window "$wid" 160 120 mousedown 1
+    for dy in 10 20 30 40; do
+        xdotool mousemove --window "$wid" 160 $((120 - dy))
+        sleep 0.05
+    done
+    xdotool mouseup 1
+    sleep 0.3
+    xdotool key --window "$wid" r
+    wait_for "$TMP/out" "frame 30" 2 20 || why="R did not restart the scene"
+    xdotool key --window "$wid" Escape 2>/dev/null
+else
+    why="no window"
+fi
+finish 20
+check "a grab while paused, then R: the log holds the new run alone" 0 err "recorded 0 input events"
+
+# ---- os.exit (--unsafe) closes the viewer with its code; the input log and the
+# screenshot are still written (the process used to exit on the spot)
+view $F/exit.lua --unsafe --size 320x240 --record-input "$TMP/exit.json" --screenshot "$TMP/exit.png"
+finish 20
+check "os.exit(4) in the viewer: exit code 4, the log is saved" 4 err "input events to"
+why=""
+[ -s "$TMP/exit.json" ] || why="no input log written"
+[ -s "$TMP/exit.png" ] || why="${why:+$why; }no screenshot written"
+result "os.exit in the viewer still writes --record-input and --screenshot" "$why"
+
+# ---- --time-limit bounds the script, not the look at its last picture: the viewer
+# waiting for Esc past the limit and the watchdog's grace (5 s) is not ended with exit 3
+view $F/short.lua --size 320x240 --time-limit 1
+why=""
+wait_for "$TMP/out" "ended" 1 15 || why="the scene did not end"
+sleep 8
+kill -0 "$VPID" 2>/dev/null || why="${why:+$why; }the viewer was ended while it waited for Esc"
+window && xdotool key --window "$wid" Escape 2>/dev/null
+finish 10
+[ "$code" = 0 ] || why="${why:+$why; }exit code $code, expected 0"
+result "--time-limit: the wait after the scene's end is not under the budget" "$why"
 
 stop_x
 echo "$passed passed, $failed failed"
