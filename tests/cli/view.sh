@@ -85,10 +85,12 @@ finish() {
     VPID=""
 }
 
-# wait_for FILE TEXT COUNT SECS: until FILE has COUNT lines containing TEXT
+# wait_for FILE TEXT COUNT SECS: until FILE has COUNT lines containing TEXT; the time is
+# tripled, as llvmpipe on a loaded machine can be many times slower (it returns as soon
+# as the text is there, so a quick machine does not wait longer)
 wait_for() {
     i=0
-    while [ "$(grep -cF -- "$2" "$1" 2>/dev/null)" -lt "$3" ] && [ $i -lt $(($4 * 10)) ]; do
+    while [ "$(grep -cF -- "$2" "$1" 2>/dev/null)" -lt "$3" ] && [ $i -lt $(($4 * 30)) ]; do
         sleep 0.1
         i=$((i + 1))
     done
@@ -98,7 +100,7 @@ wait_for() {
 # the viewer's window id (waits for it to show)
 window() {
     i=0
-    while [ $i -lt 100 ]; do
+    while [ $i -lt 300 ]; do
         wid=$(xdotool search --onlyvisible --name "wobble view" 2>/dev/null | head -n 1)
         [ -n "$wid" ] && return 0
         sleep 0.1
