@@ -825,6 +825,7 @@ static int cmd_view(opts *o)
     v->frames = o->rt.frame_cap;   /* w:run stops there too, as with run */
     if (!v->width) v->width = 960, v->height = 540;
     v->open = view_open;
+    o->rt.on_read = wb_view_file_read;   /* --watch: meshes and configs the scene reads too */
     v->print_error = print_error;
     v->host = o;
     o->rt.quiet = 1;   /* no progress bar under the window */

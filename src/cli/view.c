@@ -386,10 +386,23 @@ static void watch_add(const char *path)
     if (!realpath(path, abs)) snprintf(abs, sizeof abs, "%s", path);
     for (int i = 0; i < V.nfiles; i++)
         if (!strcmp(V.files[i].path, abs)) return;
-    if (V.nfiles == MAX_WATCH) return;
+    if (V.nfiles == MAX_WATCH) {
+        static bool told;
+        if (!told) fprintf(stderr, "wobble: --watch follows the first %d files the scene read; %s and later ones are not watched\n",
+                           MAX_WATCH, abs);
+        told = true;
+        return;
+    }
     watched *f = &V.files[V.nfiles++];
     snprintf(f->path, sizeof f->path, "%s", abs);
     stamp(f);
+}
+
+/* every file the scene reads (meshes, configs, dofile, io.open), through the sandbox */
+void wb_view_file_read(void *ud, const char *path)
+{
+    (void)ud;
+    if (V.o && V.o->watch) watch_add(path);
 }
 
 /* the Lua modules the scene required: each name of package.loaded that

@@ -10,7 +10,7 @@
 
 typedef struct wb_view_opts {
     const char *scene;
-    bool watch;                /* --watch: restart when the scene or a module it loaded is saved */
+    bool watch;                /* --watch: restart when the scene or a file it read is saved */
     const char *record_input;  /* --record-input FILE, or NULL */
     const char *screenshot;    /* --screenshot FILE.png: the window's last picture, at the end */
     int width, height;         /* --size WxH */
@@ -24,5 +24,7 @@ typedef struct wb_view_opts {
 /* runs the viewer until Esc, the window is closed, or (--frames) the scene ends;
  * returns the exit code: 0, 2 (no display, a script error without --watch), 3 (budget) */
 int wb_view_main(const wb_view_opts *o);
+/* --watch: a file the scene read (wb_runtime.on_read), watched from now on */
+void wb_view_file_read(void *ud, const char *path);
 
 #endif

@@ -80,7 +80,7 @@ static rt_state *rt_from(lua_State *L) {
 wb_runtime *wb_rt_get(lua_State *L) {
     /* a state opened without the runtime (embedding, `require "wobble"` from lua) gets
      * permissive defaults so the binding never has to test for NULL */
-    static wb_runtime plain = { ".", "out", NULL, 1, 0, 0, -1, 0, 0, { 0, 0 }, NULL, NULL };
+    static wb_runtime plain = { ".", "out", NULL, 1, 0, 0, -1, 0, 0, { 0, 0 }, NULL, NULL, NULL, NULL };
     rt_state *rt = rt_from(L);
     return rt ? &rt->pub : &plain;
 }
@@ -526,6 +526,8 @@ lua_State *wb_rt_open(const wb_runtime *cfg) {
         free(rt);
         return NULL;
     }
+    rt->sb.on_read = cfg->on_read;
+    rt->sb.on_read_ud = cfg->on_read_ud;
     rt->pub.scene_dir = rt->sb.scene;
     rt->pub.out_dir = rt->sb.out;
     rt->pub.lib_dir = rt->sb.lib[0] ? rt->sb.lib : NULL;

@@ -152,6 +152,7 @@ const char *wb_sandbox_path(lua_State *L, const char *path, int write, char *buf
                      show(named, sizeof named, path, c));
             return *err = sb->err, NULL;
         }
+        if (sb->on_read && exists(c)) sb->on_read(sb->on_read_ud, c);
     }
     if (snprintf(buf, n, "%s", c) >= (int)n) return *err = "path too long", NULL;
     return buf;

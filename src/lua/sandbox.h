@@ -15,6 +15,9 @@ typedef struct wb_sandbox {
     char roots[WB_SANDBOX_ROOTS][PATH_MAX];     /* canonical folders a script may read */
     int nroots;
     char err[2 * PATH_MAX + 128];               /* the last refusal's message */
+    /* told of every existing file a read resolves to (wobble view --watch); may be NULL */
+    void (*on_read)(void *ud, const char *path);
+    void *on_read_ud;
 } wb_sandbox;
 
 /* canonical folders from the configuration (relative to the current folder); -1 when a

@@ -28,6 +28,9 @@ typedef struct wb_runtime {
     lua_CFunction open_module; /* opens the `wobble` table (luaopen_wobble): given by the caller, so the
                                   runtime, which the binding uses, does not depend on the binding */
     const char *script;        /* the script's path as given, named when the watchdog ends the run; may be NULL */
+    void (*on_read)(void *ud, const char *path);  /* told of each existing file the script reads
+                                                     (meshes, configs, modules: --watch); may be NULL */
+    void *on_read_ud;
 } wb_runtime;
 
 wb_runtime *wb_rt_get(lua_State *L);   /* the runtime of this state (never NULL after wb_rt_open) */

@@ -242,6 +242,7 @@ result "Space pauses, the right arrow steps one frame, Space runs on" "$why"
 # ---- --watch: a saved scene or module restarts; an error waits for the next save
 mkdir -p "$TMP/w"
 cp $F/watch.lua $F/view_mod.lua "$TMP/w/"
+printf 'one\n' >"$TMP/w/view_data.txt"
 view "$TMP/w/watch.lua" --watch --size 320x240
 why=""
 wait_for "$TMP/out" "start 1" 1 15 || why="the scene did not start"
@@ -253,19 +254,24 @@ touch "$TMP/w/watch.lua"
 wait_for "$TMP/out" "start 2" 2 10 || why="${why:+$why; }touching the scene did not restart it"
 result "--watch restarts the scene when it or a module it required is saved" "$why"
 why=""
+sleep 0.3
+printf 'two\n' >"$TMP/w/view_data.txt"
+wait_for "$TMP/out" "data two" 1 10 || why="saving a data file the scene read did not restart it"
+result "--watch restarts the scene when a file it read (io.open) is saved" "$why"
+why=""
 cp "$TMP/w/watch.lua" "$TMP/watch.good"
 printf 'local x = = 1\n' >"$TMP/w/watch.lua"
 wait_for "$TMP/err" "watch.lua:1:" 1 10 || why="the syntax error is not on the terminal"
 sleep 0.5
 kill -0 "$VPID" 2>/dev/null || why="${why:+$why; }the viewer closed on the error"
 cp "$TMP/watch.good" "$TMP/w/watch.lua"
-wait_for "$TMP/out" "start 2" 3 10 || why="${why:+$why; }fixing the file did not run it again"
+wait_for "$TMP/out" "start 2" 4 10 || why="${why:+$why; }fixing the file did not run it again"
 result "--watch: a script error is shown and the viewer waits for the next save" "$why"
 why=""
 window || why="no window"
 xdotool mousemove --window "$wid" 10 10
 xdotool key --window "$wid" r
-wait_for "$TMP/out" "start 2" 4 10 || why="R did not restart the scene"
+wait_for "$TMP/out" "start 2" 5 10 || why="R did not restart the scene"
 xdotool key --window "$wid" Escape 2>/dev/null   # its release may find the window gone
 finish 10
 [ "$code" = 0 ] || why="${why:+$why; }Esc: exit code $code"
