@@ -130,6 +130,7 @@ part "fuzz corpus replay (tests/fuzz/replay.sh)" sh tests/fuzz/replay.sh "$BUILD
 part "tetgen under the budgets (tests/cli/tets.sh)" sh tests/cli/tets.sh "$BUILD"
 part "--replay of input logs (tests/cli/replay.sh)" sh tests/cli/replay.sh "$BUILD"
 part "sweeps through GNU parallel, result.json, collect (tests/cli/sweep.sh)" sh tests/cli/sweep.sh "$BUILD"
+part "hostile input to sweep, collect, --replay (tests/cli/attack_sweep.sh)" sh tests/cli/attack_sweep.sh "$BUILD"
 
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]

@@ -422,6 +422,17 @@ static int make_sweep(sweep *sp) {
         return EXIT_SCRIPT;
     }
     exe[k] = 0;
+    /* every job line is one line of shell (parallel, sed -n Np) and sweep.slurm quotes
+     * nothing in its comments: a line break in a path would start a command of its own */
+    char cwd[PATH_MAX];
+    if (s.out[0] == '/' || !getcwd(cwd, sizeof cwd)) cwd[0] = 0;  /* a relative --out is under it */
+    const char *broken = strpbrk(scene, "\n\r") ? scene : strpbrk(exe, "\n\r") ? exe
+                       : strpbrk(s.out, "\n\r") ? s.out : strpbrk(cwd, "\n\r") ? cwd : NULL;
+    if (broken) {
+        fprintf(stderr, "wobble sweep: the path '%s' holds a line break: rename it (job lines are one line of "
+                        "shell each)\n", broken);
+        return EXIT_SCRIPT;
+    }
     /* an earlier sweep's results must not mix with this one's */
     struct stat ost;
     if (stat(s.out, &ost) == 0 && !S_ISDIR(ost.st_mode)) {
@@ -431,6 +442,16 @@ static int make_sweep(sweep *sp) {
     if (!dir_empty(s.out) && !s.force) {
         fprintf(stderr, "wobble sweep: --out %s is not empty (an earlier sweep?): choose another folder, or add "
                         "--force to rewrite its jobs and remove its runs/\n", s.out);
+        return EXIT_SCRIPT;
+    }
+    /* --force removes runs/ and slurm/: only an earlier sweep's, never those of a folder
+     * of the user's (the scene's own, a home) that happens to have them */
+    char mark[PATH_MAX + 16];
+    if (!dir_empty(s.out) && s.force &&
+        (snprintf(mark, sizeof mark, "%s/sweep.json", s.out) >= (int)sizeof mark || stat(mark, &st) != 0 ||
+         !S_ISREG(st.st_mode))) {
+        fprintf(stderr, "wobble sweep: --force: --out %s is not an earlier sweep's folder (no sweep.json): its "
+                        "runs/ would be removed; choose another folder\n", s.out);
         return EXIT_SCRIPT;
     }
     if (make_dirs(s.out) != 0 || !realpath(s.out, dir)) {

@@ -1,0 +1,42 @@
+#!/bin/sh
+# tests/cli/attack_sweep.sh BUILD_DIR: hostile input to wobble sweep, wobble collect and
+# wobble run --replay: paths that would break a job line open, --force over a folder
+# that is not a sweep, garbage sweep.json / result.json, odd replay files. Each must be
+# refused with exit 2 and a message naming the culprit (or read safely), and must change
+# nothing. Last line: "N passed, N failed".
+BUILD=${1:-build}
+cd "$(dirname "$0")/../.." || exit 2
+W="$(pwd)/$BUILD/wobble"
+F=tests/cli/fixtures
+TMP=$(mktemp -d "${TMPDIR:-/tmp}/wobble-attack.XXXXXX") || exit 2
+trap 'rm -rf "$TMP"' EXIT INT TERM
+. tests/cli/lib.sh
+
+run() {
+    "$W" "$@" >"$TMP/out" 2>"$TMP/err"
+    code=$?
+}
+
+# a scene whose path holds a line break: jobs.txt and sweep.slurm would run its second
+# line as a command of its own
+NL='
+'
+D="$TMP/d${NL}touch PWNED${NL}"
+mkdir -p "$D" && cp $F/sweep_scene.lua "$D/s.lua"
+run sweep "$D/s.lua" --grid g=1 --out "$TMP/o1"
+check "a scene path with a line break is refused" 2 err "holds a line break" none "$TMP/o1"
+run sweep $F/sweep_scene.lua --grid g=1 --out "$TMP/o2${NL}x"
+check "an --out with a line break is refused" 2 err "holds a line break" none "$TMP/o2${NL}x"
+( cd "$D" && "$W" sweep s.lua --grid g=1 --out o3 >"$TMP/out" 2>"$TMP/err" ); code=$?
+check "a relative --out under a folder with a line break is refused" 2 err "holds a line break" none "$D/o3"
+
+# --force removes runs/: never in a folder that is not an earlier sweep's
+mkdir -p "$TMP/proj/runs" && echo precious >"$TMP/proj/runs/data.txt" && cp $F/sweep_scene.lua "$TMP/proj/s.lua"
+run sweep "$TMP/proj/s.lua" --grid g=1 --out "$TMP/proj" --force
+check "--force on a folder without sweep.json is refused, its runs/ kept" 2 err "not an earlier sweep's folder" \
+    none "$TMP/proj/jobs.txt"
+[ -f "$TMP/proj/runs/data.txt" ] && why="" || why="runs/data.txt was removed"
+result "--force on the scene's own folder removes nothing" "$why"
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
