@@ -38,5 +38,30 @@ check "--force on a folder without sweep.json is refused, its runs/ kept" 2 err 
 [ -f "$TMP/proj/runs/data.txt" ] && why="" || why="runs/data.txt was removed"
 result "--force on the scene's own folder removes nothing" "$why"
 
+# collect on damaged files: a garbage sweep.json is named (exit 2), never followed into
+# a crash; a result.json of the wrong shape is a run whose end is unknown (crashed)
+C=$TMP/c
+mkdir -p "$C/runs/0001" "$C/runs/0002" "$C/runs/0003"
+printf '{"status":"ok","result":[1,2]}' >"$C/runs/0001/result.json"
+printf '{"status":"ok","result":{"a":{"x":1}}}' >"$C/runs/0002/result.json"
+printf '{"status":"ok","resu' >"$C/runs/0003/result.json"
+printf '%s' '{"grid":[{"key":"g","values":["1"]}],"runs":[{"run":"0001","set":{"g":"1"}},{"run":"0002","set":{"g":"1"}},{"run":"0003","set":{"g":"1"}}]}' >"$C/sweep.json"
+run collect "$C"
+check "collect: result.json of the wrong shape or cut short is crashed" 0 out "0001,crashed,,1" out "0002,crashed,,1" \
+    out "0003,crashed,,1"
+bad_sweep() {  # NAME REASON JSON
+    printf '%s' "$3" >"$C/sweep.json"
+    run collect "$C"
+    check "collect: $1" 2 err "sweep.json is not a sweep description" err "$2" !out "run,"
+}
+bad_sweep "a grid entry without a key" "grid[1].key: expected a string" '{"grid":[{}],"runs":[{"run":"0001"}]}'
+bad_sweep "a grid key twice" "grid[2].key: 'g' twice" '{"grid":[{"key":"g"},{"key":"g"}],"runs":[]}'
+bad_sweep "a run that is not an object" "runs[1].run" '{"grid":[],"runs":[1]}'
+bad_sweep "a run named as a path" "runs[1].run: expected the run's number" '{"grid":[],"runs":[{"run":"../../x"}]}'
+bad_sweep "a set value that is not a string" "runs[1].set.g: expected a string" \
+    '{"grid":[{"key":"g"}],"runs":[{"run":"0001","set":{"g":1}}]}'
+bad_sweep "repeat out of range" "repeat: expected a number from 1" '{"grid":[],"runs":[],"repeat":1e300}'
+bad_sweep "cut short" "not JSON, or cut short" '{"grid":'
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
