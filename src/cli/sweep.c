@@ -183,13 +183,26 @@ static int parse(int argc, char **argv, sweep *s) {
 
 /* ---- files ----------------------------------------------------------------------------- */
 
-/* 'text' for sh, ' written '\'' */
-static void quote(FILE *f, const char *s) {
-    fputc('\'', f);
+/* text for sh inside '...' (quote): ' written '\'' */
+static void escaped(FILE *f, const char *s) {
     for (; *s; s++) {
         if (*s == '\'') fputs("'\\''", f);
         else fputc(*s, f);
     }
+}
+
+static void quote(FILE *f, const char *s) {
+    fputc('\'', f);
+    escaped(f, s);
+    fputc('\'', f);
+}
+
+/* 'key=value', of any length (a fixed buffer cut long values short, unlike sweep.json's) */
+static void quote_kv(FILE *f, const char *k, const char *v) {
+    fputc('\'', f);
+    escaped(f, k);
+    fputc('=', f);
+    escaped(f, v);
     fputc('\'', f);
 }
 
@@ -247,12 +260,7 @@ static void job_line(FILE *f, const sweep *s, const char *exe, const char *scene
     fputs(" --out ", f);
     quote(f, run);
     for (int i = 0; i < s->nsets; i++) fputs(" --set ", f), quote(f, s->sets[i]);
-    for (int j = 0; j < s->ng; j++) {
-        char kv[4096];
-        snprintf(kv, sizeof kv, "%s=%s", s->g[j].key, value_at(s, r, j));
-        fputs(" --set ", f);
-        quote(f, kv);
-    }
+    for (int j = 0; j < s->ng; j++) fputs(" --set ", f), quote_kv(f, s->g[j].key, value_at(s, r, j));
     if (s->repeat > 1) fprintf(f, " --set repeat=%ld", r % s->repeat + 1);
     fputs(" --quiet", f);
     if (s->time_limit) fputs(" --time-limit ", f), quote(f, s->time_limit);

@@ -17,6 +17,15 @@ run() {
     code=$?
 }
 
+# has NAME FILE TEXT...: FILE contains every TEXT (fixed strings)
+has() {
+    name=$1 file=$2
+    shift 2
+    why=""
+    for t in "$@"; do grep -qF -- "$t" "$file" 2>/dev/null || why="${why:+$why; }$file lacks '$t'"; done
+    result "$name" "$why"
+}
+
 # a scene whose path holds a line break: jobs.txt and sweep.slurm would run its second
 # line as a command of its own
 NL='
@@ -62,6 +71,15 @@ bad_sweep "a set value that is not a string" "runs[1].set.g: expected a string" 
     '{"grid":[{"key":"g"}],"runs":[{"run":"0001","set":{"g":1}}]}'
 bad_sweep "repeat out of range" "repeat: expected a number from 1" '{"grid":[],"runs":[],"repeat":1e300}'
 bad_sweep "cut short" "not JSON, or cut short" '{"grid":'
+
+# a grid value longer than a job line's old 4 KiB buffer reaches the run whole
+long=$(awk 'BEGIN { for (i = 0; i < 5000; i++) printf "x"; printf "'"'"'end" }')
+cat >"$TMP/echo.lua" <<'LUA'
+wobble.result{ len = #wobble.args.v, tail = wobble.args.v:sub(-4) }
+LUA
+run sweep "$TMP/echo.lua" --grid "v=$long" --out "$TMP/lv"
+sh -c "$(sed -n 1p "$TMP/lv/jobs.txt")" >/dev/null 2>&1
+has "a 5004-byte grid value is passed whole" "$TMP/lv/runs/0001/result.json" '"len":	5004' "\"tail\":	\"'end\""
 
 # --replay of a long log: each event's line:col was counted from the file's start
 # (quadratic: 10^5 events took many minutes); now it is read in seconds. The frames are
