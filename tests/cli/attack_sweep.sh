@@ -81,6 +81,19 @@ run sweep "$TMP/echo.lua" --grid "v=$long" --out "$TMP/lv"
 sh -c "$(sed -n 1p "$TMP/lv/jobs.txt")" >/dev/null 2>&1
 has "a 5004-byte grid value is passed whole" "$TMP/lv/runs/0001/result.json" '"len":	5004' "\"tail\":	\"'end\""
 
+# wobble.result: a NUL byte would cut a value short in result.json; a key's __tostring
+# is never called for the message (it may fail and hide the real error)
+cat >"$TMP/res.lua" <<'LUA'
+if wobble.args.mode == "nul" then wobble.result{ s = "a\0b" } end
+if wobble.args.mode == "key" then wobble.result{ [setmetatable({}, { __tostring = function() return {} end })] = 1 } end
+LUA
+run run "$TMP/res.lua" --set mode=nul --out "$TMP/rn"
+check "wobble.result: a string with a NUL byte is refused, naming the field" 2 err "res.lua:1:" \
+    err "field 's': a string holds a NUL byte"
+run run "$TMP/res.lua" --set mode=key --out "$TMP/rk"
+check "wobble.result: a table key is named without its __tostring" 2 err "res.lua:2:" \
+    err "keys must be strings (names of results), got table key"
+
 # --replay of a long log: each event's line:col was counted from the file's start
 # (quadratic: 10^5 events took many minutes); now it is read in seconds. The frames are
 # past the scene's end, so the run reports the events it did not apply (exit 1).
