@@ -175,6 +175,10 @@ static int parse(int argc, char **argv, sweep *s) {
                 return sweep_error("--set %s: '%s' is a --grid key too", s->sets[i], s->g[j].key);
         }
     if (s->repeat > 1)
+        for (int i = 0; i < s->nsets; i++)
+            if (!strncmp(s->sets[i], "repeat=", 7))
+                return sweep_error("--set %s: with --repeat, 'repeat' is the run's own key%s", s->sets[i], "");
+    if (s->repeat > 1)
         for (int j = 0; j < s->ng; j++)
             if (!strcmp(s->g[j].key, "repeat")) return sweep_error("--grid repeat=...: with --repeat, 'repeat' is the "
                                                                    "run's own key%s%s", "", "");

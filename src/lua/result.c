@@ -181,10 +181,11 @@ int wbl_result_write(void *taken, const wbl_run_info *info, char *err, size_t n)
     if ((sets = cJSON_AddObjectToObject(o, "set")))
         for (int i = 0; i < info->nsets; i++) {
             const char *kv = info->sets[i], *e = strchr(kv, '=');
-            char key[256];
-            snprintf(key, sizeof key, "%.*s", (int)(e - kv), kv);
+            char *key = strndup(kv, (size_t)(e - kv));  /* any length: a fixed buffer cut long keys */
+            if (!key) continue;
             cJSON_DeleteItemFromObjectCaseSensitive(sets, key);  /* the later --set wins, as in wobble.args */
             cJSON_AddItemToObject(sets, key, set_value(e + 1));
+            free(key);
         }
     cJSON_AddStringToObject(o, "status", status_name(info->exit_code));
     if (info->exit_code >= 0) cJSON_AddNumberToObject(o, "exit", info->exit_code);

@@ -94,6 +94,13 @@ run run "$TMP/res.lua" --set mode=key --out "$TMP/rk"
 check "wobble.result: a table key is named without its __tostring" 2 err "res.lua:2:" \
     err "keys must be strings (names of results), got table key"
 
+# result.json: a --set key of any length is kept whole (a 256-byte buffer cut it)
+k=$(awk 'BEGIN { for (i = 0; i < 300; i++) printf "k" }')
+run run "$TMP/echo.lua" --set v=1 --set "$k=1" --out "$TMP/lk"
+has "result.json keeps a 300-byte --set key whole" "$TMP/lk/result.json" "\"$k\":	1"
+run sweep "$TMP/echo.lua" --grid v=1 --repeat 2 --set repeat=5 --out "$TMP/rr"
+check "sweep: --set repeat=... with --repeat is refused" 2 err "--set repeat=5: with --repeat" none "$TMP/rr"
+
 # --replay of a long log: each event's line:col was counted from the file's start
 # (quadratic: 10^5 events took many minutes); now it is read in seconds. The frames are
 # past the scene's end, so the run reports the events it did not apply (exit 1).
