@@ -377,9 +377,11 @@ static int read_event(rd *r, const cJSON *it, const kp *p, int64_t i, fgrab **fg
         if (!f[4]) return jv_missing(r, it, p, "target");
         if (jv_opt_vec(r, f[4], p, "target", 3, x->target) || jv_opt_nonneg(r, f[5], p, "compliance", &x->compliance))
             return -1;
-        fgrab *n = realloc(*fg, (size_t)(*nfg + 1) * sizeof *n);
-        if (!n) return jv_fail(r, it, 0, p, "out of memory");
-        *fg = n;
+        if ((*nfg & (*nfg - 1)) == 0) {  /* doubled at each power of two: one more each time copies n^2 */
+            fgrab *n = realloc(*fg, (size_t)(*nfg ? 2 * *nfg : 1) * sizeof *n);
+            if (!n) return jv_fail(r, it, 0, p, "out of memory");
+            *fg = n;
+        }
         (*fg)[(*nfg)++] = (fgrab){ x->world, -1 };
         x->grab = *nfg; /* a grab event's own ordinal */
     } else {
