@@ -133,6 +133,7 @@ part "--replay of input logs (tests/cli/replay.sh)" sh tests/cli/replay.sh "$BUI
 part "sweeps through GNU parallel, result.json, collect (tests/cli/sweep.sh)" sh tests/cli/sweep.sh "$BUILD"
 part "wobble bench --json and the Bullet peer's plumbing (tests/cli/bench.sh)" sh tests/cli/bench.sh "$BUILD"
 part "the live viewer under Xvfb (tests/cli/view.sh)" sh tests/cli/view.sh "$BUILD"
+part "hostile input to sweep, collect, --replay (tests/cli/attack_sweep.sh)" sh tests/cli/attack_sweep.sh "$BUILD"
 
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" -eq 0 ]

@@ -85,6 +85,50 @@ static int cmp_str(const void *a, const void *b) {
     return strcmp(*(const char *const *)a, *(const char *const *)b);
 }
 
+/* sweep.json as wobble sweep writes it; a hand-edited or damaged one is named, not
+ * followed (a NULL key or a run named ../.. must not reach strcmp or a path) */
+static int bad_sweep(const cJSON *sw, char *why, size_t n) {
+    const cJSON *grid = cJSON_GetObjectItem(sw, "grid"), *runs = cJSON_GetObjectItem(sw, "runs"), *e, *v;
+    const cJSON *rep = cJSON_GetObjectItem(sw, "repeat");
+    int i = 0;
+    if (!cJSON_IsArray(grid) || !cJSON_IsArray(runs)) return snprintf(why, n, "no grid and runs arrays"), 1;
+    if (rep && (!cJSON_IsNumber(rep) || !(rep->valuedouble >= 1 && rep->valuedouble <= 1e6)))
+        return snprintf(why, n, "repeat: expected a number from 1 to 1000000"), 1;
+    cJSON_ArrayForEach(e, grid) {
+        const char *k = cJSON_GetStringValue(cJSON_GetObjectItem(e, "key"));
+        if (!k || !*k) return snprintf(why, n, "grid[%d].key: expected a string", i + 1), 1;
+        for (const cJSON *g = grid->child; g != e; g = g->next)  /* unique: a key is a column */
+            if (!strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(g, "key")), k))
+                return snprintf(why, n, "grid[%d].key: '%s' twice", i + 1, k), 1;
+        i++;
+    }
+    i = 0;
+    cJSON_ArrayForEach(e, runs) {
+        const char *r = cJSON_GetStringValue(cJSON_GetObjectItem(e, "run"));
+        const cJSON *set = cJSON_GetObjectItem(e, "set"), *rp = cJSON_GetObjectItem(e, "repeat");
+        i++;
+        if (!r || !*r || strlen(r) > 20 || strspn(r, "0123456789") != strlen(r))
+            return snprintf(why, n, "runs[%d].run: expected the run's number (digits)", i), 1;
+        if (set && !cJSON_IsObject(set)) return snprintf(why, n, "runs[%d].set: expected an object", i), 1;
+        cJSON_ArrayForEach(v, set) if (!cJSON_IsString(v))
+            return snprintf(why, n, "runs[%d].set.%s: expected a string", i, v->string), 1;
+        if (rp && (!cJSON_IsNumber(rp) || !(rp->valuedouble >= 1 && rp->valuedouble <= 1e6)))
+            return snprintf(why, n, "runs[%d].repeat: expected a number from 1 to 1000000", i), 1;
+    }
+    return 0;
+}
+
+/* result.json as wobble run writes it: else the run's end is unknown (crashed) */
+static int good_result(const cJSON *res) {
+    const cJSON *r = cJSON_GetObjectItem(res, "result"), *nf = cJSON_GetObjectItem(res, "non_finite"), *e;
+    if (!cJSON_IsObject(res) || !cJSON_IsString(cJSON_GetObjectItem(res, "status"))) return 0;
+    if (r && !cJSON_IsNull(r) && !cJSON_IsObject(r)) return 0;
+    if (nf && !cJSON_IsNull(nf) && !cJSON_IsArray(nf)) return 0;
+    const cJSON *values = cJSON_IsObject(r) ? r : NULL;
+    cJSON_ArrayForEach(e, values) if (!e->string || cJSON_IsObject(e) || cJSON_IsArray(e)) return 0;
+    return 1;
+}
+
 static int load(const char *dir, table *t) {
     char p[PATH_MAX + 64];
     memset(t, 0, sizeof *t);
@@ -98,8 +142,11 @@ static int load(const char *dir, table *t) {
     t->sweep = cJSON_Parse(text);
     free(text);
     cJSON *grid = cJSON_GetObjectItem(t->sweep, "grid"), *runs = cJSON_GetObjectItem(t->sweep, "runs");
-    if (!cJSON_IsArray(grid) || !cJSON_IsArray(runs))
-        return collect_error("%s is not a sweep description (wobble sweep writes it)", p, "");
+    char why[256];
+    if (!t->sweep) return collect_error("%s is not a sweep description (wobble sweep writes it): %s", p,
+                                        "not JSON, or cut short");
+    if (bad_sweep(t->sweep, why, sizeof why))
+        return collect_error("%s is not a sweep description (wobble sweep writes it): %s", p, why);
     t->repeat = cJSON_GetObjectItem(t->sweep, "repeat") ? (int)cJSON_GetObjectItem(t->sweep, "repeat")->valuedouble : 1;
     t->ng = cJSON_GetArraySize(grid);
     t->gkeys = calloc((size_t)t->ng + 1, sizeof *t->gkeys);
@@ -126,7 +173,7 @@ static int load(const char *dir, table *t) {
         free(text);
         const char *s = cJSON_GetStringValue(cJSON_GetObjectItem(w->res, "status"));
         /* "running": written when the run began, never replaced by its end */
-        w->status = !s || !strcmp(s, "running") ? "crashed" : s;
+        w->status = !s || !strcmp(s, "running") || !good_result(w->res) ? "crashed" : s;
         if (!strcmp(w->status, "crashed")) cJSON_Delete(w->res), w->res = NULL;  /* its figures are not an end */
         cJSON *res = cJSON_GetObjectItem(w->res, "result"), *e;
         cJSON_ArrayForEach(e, res) {

@@ -175,6 +175,10 @@ static int parse(int argc, char **argv, sweep *s) {
                 return sweep_error("--set %s: '%s' is a --grid key too", s->sets[i], s->g[j].key);
         }
     if (s->repeat > 1)
+        for (int i = 0; i < s->nsets; i++)
+            if (!strncmp(s->sets[i], "repeat=", 7))
+                return sweep_error("--set %s: with --repeat, 'repeat' is the run's own key%s", s->sets[i], "");
+    if (s->repeat > 1)
         for (int j = 0; j < s->ng; j++)
             if (!strcmp(s->g[j].key, "repeat")) return sweep_error("--grid repeat=...: with --repeat, 'repeat' is the "
                                                                    "run's own key%s%s", "", "");
@@ -183,13 +187,26 @@ static int parse(int argc, char **argv, sweep *s) {
 
 /* ---- files ----------------------------------------------------------------------------- */
 
-/* 'text' for sh, ' written '\'' */
-static void quote(FILE *f, const char *s) {
-    fputc('\'', f);
+/* text for sh inside '...' (quote): ' written '\'' */
+static void escaped(FILE *f, const char *s) {
     for (; *s; s++) {
         if (*s == '\'') fputs("'\\''", f);
         else fputc(*s, f);
     }
+}
+
+static void quote(FILE *f, const char *s) {
+    fputc('\'', f);
+    escaped(f, s);
+    fputc('\'', f);
+}
+
+/* 'key=value', of any length (a fixed buffer cut long values short, unlike sweep.json's) */
+static void quote_kv(FILE *f, const char *k, const char *v) {
+    fputc('\'', f);
+    escaped(f, k);
+    fputc('=', f);
+    escaped(f, v);
     fputc('\'', f);
 }
 
@@ -247,12 +264,7 @@ static void job_line(FILE *f, const sweep *s, const char *exe, const char *scene
     fputs(" --out ", f);
     quote(f, run);
     for (int i = 0; i < s->nsets; i++) fputs(" --set ", f), quote(f, s->sets[i]);
-    for (int j = 0; j < s->ng; j++) {
-        char kv[4096];
-        snprintf(kv, sizeof kv, "%s=%s", s->g[j].key, value_at(s, r, j));
-        fputs(" --set ", f);
-        quote(f, kv);
-    }
+    for (int j = 0; j < s->ng; j++) fputs(" --set ", f), quote_kv(f, s->g[j].key, value_at(s, r, j));
     if (s->repeat > 1) fprintf(f, " --set repeat=%ld", r % s->repeat + 1);
     fputs(" --quiet", f);
     if (s->time_limit) fputs(" --time-limit ", f), quote(f, s->time_limit);
@@ -422,6 +434,17 @@ static int make_sweep(sweep *sp) {
         return EXIT_SCRIPT;
     }
     exe[k] = 0;
+    /* every job line is one line of shell (parallel, sed -n Np) and sweep.slurm quotes
+     * nothing in its comments: a line break in a path would start a command of its own */
+    char cwd[PATH_MAX];
+    if (s.out[0] == '/' || !getcwd(cwd, sizeof cwd)) cwd[0] = 0;  /* a relative --out is under it */
+    const char *broken = strpbrk(scene, "\n\r") ? scene : strpbrk(exe, "\n\r") ? exe
+                       : strpbrk(s.out, "\n\r") ? s.out : strpbrk(cwd, "\n\r") ? cwd : NULL;
+    if (broken) {
+        fprintf(stderr, "wobble sweep: the path '%s' holds a line break: rename it (job lines are one line of "
+                        "shell each)\n", broken);
+        return EXIT_SCRIPT;
+    }
     /* an earlier sweep's results must not mix with this one's */
     struct stat ost;
     if (stat(s.out, &ost) == 0 && !S_ISDIR(ost.st_mode)) {
@@ -431,6 +454,16 @@ static int make_sweep(sweep *sp) {
     if (!dir_empty(s.out) && !s.force) {
         fprintf(stderr, "wobble sweep: --out %s is not empty (an earlier sweep?): choose another folder, or add "
                         "--force to rewrite its jobs and remove its runs/\n", s.out);
+        return EXIT_SCRIPT;
+    }
+    /* --force removes runs/ and slurm/: only an earlier sweep's, never those of a folder
+     * of the user's (the scene's own, a home) that happens to have them */
+    char mark[PATH_MAX + 16];
+    if (!dir_empty(s.out) && s.force &&
+        (snprintf(mark, sizeof mark, "%s/sweep.json", s.out) >= (int)sizeof mark || stat(mark, &st) != 0 ||
+         !S_ISREG(st.st_mode))) {
+        fprintf(stderr, "wobble sweep: --force: --out %s is not an earlier sweep's folder (no sweep.json): its "
+                        "runs/ would be removed; choose another folder\n", s.out);
         return EXIT_SCRIPT;
     }
     if (make_dirs(s.out) != 0 || !realpath(s.out, dir)) {

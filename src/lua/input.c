@@ -303,12 +303,24 @@ typedef struct replay {
     char *shown;          /* the file's name as given */
 } replay;
 
-/* line and column of a cJSON item (0, 0 when positions are unknown) */
-static void item_pos(const rd *r, const cJSON *it, int *line, int *col)
+/* where the last item_pos was: the events come in file order, so each position is
+ * counted on from the previous one (from the start each time, 10^5 events took minutes) */
+typedef struct lc { int32_t off; int line, col; } lc;
+
+/* line and column of a cJSON item (0, 0 when positions are unknown), as jv_line_col */
+static void item_pos(const rd *r, const cJSON *it, lc *cur, int *line, int *col)
 {
     *line = *col = 0;
-    if (it && r->pos && it->valueint >= 0 && it->valueint < r->pos->n)
-        jv_line_col(r->text, r->pos->voff[it->valueint], line, col);
+    if (!it || !r->pos || it->valueint < 0 || it->valueint >= r->pos->n) return;
+    const int32_t off = r->pos->voff[it->valueint];
+    if (off < cur->off) *cur = (lc){ 0, 1, 1 };
+    for (int32_t i = cur->off; i < off && r->text[i]; i++) {
+        if (r->text[i] == '\n') cur->line++, cur->col = 1;
+        else cur->col++;
+    }
+    cur->off = off;
+    *line = cur->line;
+    *col = cur->col;
 }
 
 static const char *const ev_keys[3][7] = {
@@ -319,7 +331,7 @@ static const char *const ev_keys[3][7] = {
 
 /* events[i] into x; grabs and worlds as read so far */
 static int read_event(rd *r, const cJSON *it, const kp *p, int64_t i, fgrab **fg, int64_t *nfg,
-                      fworld **fw, int64_t *nfw, ev *x)
+                      fworld **fw, int64_t *nfw, lc *cur, ev *x)
 {
     if (!cJSON_IsObject(it)) return jv_fail(r, it, 0, p, "object expected, got %s", jv_type_name(it));
     const cJSON *t = cJSON_GetObjectItemCaseSensitive(it, "type");
@@ -361,20 +373,22 @@ static int read_event(rd *r, const cJSON *it, const kp *p, int64_t i, fgrab **fg
         if (!f[3]) return jv_missing(r, it, p, "particle");
         if (jv_get_int(r, f[3], &pp, 1, WB_MAX_PARTICLES, &v)) return -1;
         x->particle = (int32_t)(v - 1);
-        item_pos(r, f[3], &x->line, &x->col);
+        item_pos(r, f[3], cur, &x->line, &x->col);
         if (!f[4]) return jv_missing(r, it, p, "target");
         if (jv_opt_vec(r, f[4], p, "target", 3, x->target) || jv_opt_nonneg(r, f[5], p, "compliance", &x->compliance))
             return -1;
-        fgrab *n = realloc(*fg, (size_t)(*nfg + 1) * sizeof *n);
-        if (!n) return jv_fail(r, it, 0, p, "out of memory");
-        *fg = n;
+        if ((*nfg & (*nfg - 1)) == 0) {  /* doubled at each power of two: one more each time copies n^2 */
+            fgrab *n = realloc(*fg, (size_t)(*nfg ? 2 * *nfg : 1) * sizeof *n);
+            if (!n) return jv_fail(r, it, 0, p, "out of memory");
+            *fg = n;
+        }
         (*fg)[(*nfg)++] = (fgrab){ x->world, -1 };
         x->grab = *nfg; /* a grab event's own ordinal */
     } else {
         kp gp = { p, "grab", 0 };
         if (!f[3]) return jv_missing(r, it, p, "grab");
         if (jv_get_int(r, f[3], &gp, 1, INT64_MAX / 2, &x->grab)) return -1;
-        item_pos(r, f[3], &x->line, &x->col);
+        item_pos(r, f[3], cur, &x->line, &x->col);
         if (x->grab > *nfg)
             return jv_fail(r, f[3], 0, &gp, "grab %lld does not exist (%lld grab event%s before this one)",
                            (long long)x->grab, (long long)*nfg, *nfg == 1 ? "" : "s");
@@ -419,10 +433,11 @@ static int read_root(rd *r, const cJSON *root, replay *rp)
     fworld *fw = NULL;
     int64_t nfg = 0, nfw = 0, i = 0;
     int rc = 0;
+    lc cur = { 0, 1, 1 };
     for (const cJSON *c = f[3]->child; c && !rc; c = c->next, i++) {
         kp p = { &ep, NULL, i };
         ev x;
-        rc = read_event(r, c, &p, i, &fg, &nfg, &fw, &nfw, &x);
+        rc = read_event(r, c, &p, i, &fg, &nfg, &fw, &nfw, &cur, &x);
         if (!rc && !evs_push(&rp->e, &x)) rc = jv_fail(r, c, 0, &p, "out of memory");
     }
     free(fg);

@@ -64,15 +64,24 @@ static int l_result(lua_State *L) {
     lua_pushnil(L);
     while (lua_next(L, 1)) {
         if (lua_type(L, -2) != LUA_TSTRING) {
-            luaL_tolstring(L, -2, NULL);
-            return luaL_argerror(L, 1, lua_pushfstring(L, "keys must be strings (names of results), got %s key %s",
-                                                       luaL_typename(L, -3), lua_tostring(L, -1)));
+            /* a number key shown as is; never a key's __tostring (it may fail or lie) */
+            const char *tn = luaL_typename(L, -2), *ks = "";
+            if (lua_type(L, -2) == LUA_TNUMBER) lua_pushvalue(L, -2), ks = lua_pushfstring(L, " %s", lua_tostring(L, -1));
+            return luaL_argerror(L, 1, lua_pushfstring(L, "keys must be strings (names of results), got %s key%s",
+                                                       tn, ks));
         }
         int t = lua_type(L, -1);
         if (t != LUA_TNUMBER && t != LUA_TSTRING && t != LUA_TBOOLEAN)
             /* the words of wbl_fielderror, which util.c (calling this file) holds */
             return luaL_argerror(L, 1, lua_pushfstring(L, "field '%s': expected a number, string or boolean, got %s",
                                                        lua_tostring(L, -2), luaL_typename(L, -1)));
+        /* result.json holds C strings: a NUL byte would cut the key or value short */
+        size_t kl, vl = 0;
+        const char *k = lua_tolstring(L, -2, &kl);
+        if (t == LUA_TSTRING) lua_tolstring(L, -1, &vl);
+        if (strlen(k) != kl || (t == LUA_TSTRING && strlen(lua_tostring(L, -1)) != vl))
+            return luaL_argerror(L, 1, lua_pushfstring(L, "field '%s': a %s holds a NUL byte (\\0)", k,
+                                                       strlen(k) != kl ? "key" : "string"));
         lua_pop(L, 1);
     }
     if (lua_rawgetp(L, LUA_REGISTRYINDEX, &values_key) != LUA_TTABLE) {
@@ -172,10 +181,11 @@ int wbl_result_write(void *taken, const wbl_run_info *info, char *err, size_t n)
     if ((sets = cJSON_AddObjectToObject(o, "set")))
         for (int i = 0; i < info->nsets; i++) {
             const char *kv = info->sets[i], *e = strchr(kv, '=');
-            char key[256];
-            snprintf(key, sizeof key, "%.*s", (int)(e - kv), kv);
+            char *key = strndup(kv, (size_t)(e - kv));  /* any length: a fixed buffer cut long keys */
+            if (!key) continue;
             cJSON_DeleteItemFromObjectCaseSensitive(sets, key);  /* the later --set wins, as in wobble.args */
             cJSON_AddItemToObject(sets, key, set_value(e + 1));
+            free(key);
         }
     cJSON_AddStringToObject(o, "status", status_name(info->exit_code));
     if (info->exit_code >= 0) cJSON_AddNumberToObject(o, "exit", info->exit_code);
