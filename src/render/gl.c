@@ -469,13 +469,13 @@ bool wb_gl_init(wb_gl *g, int w, int h, int *samples, char *err, size_t n)
         snprintf(err, n, "out of memory building meshes");
         return false;
     }
-    GLuint bufs[7];
-    glGenBuffers(7, bufs);
+    GLuint bufs[6];
+    glGenBuffers(6, bufs);
     g->vbo_mesh = bufs[0], g->ebo_mesh = bufs[1], g->vbo_inst = bufs[2], g->vbo_surf = bufs[3];
-    g->ebo_surf = bufs[4], g->vbo_seg = bufs[5], g->vbo_grid = bufs[6];
-    GLuint vaos[5];
-    glGenVertexArrays(5, vaos);
-    g->vao_mesh = vaos[0], g->vao_surf = vaos[1], g->vao_line = vaos[2], g->vao_grid = vaos[3], g->vao_empty = vaos[4];
+    g->ebo_surf = bufs[4], g->vbo_seg = bufs[5];
+    GLuint vaos[4];
+    glGenVertexArrays(4, vaos);
+    g->vao_mesh = vaos[0], g->vao_surf = vaos[1], g->vao_line = vaos[2], g->vao_empty = vaos[3];
 
     glBindVertexArray(g->vao_mesh);
     glBindBuffer(GL_ARRAY_BUFFER, g->vbo_mesh);
@@ -512,12 +512,6 @@ bool wb_gl_init(wb_gl *g, int w, int h, int *samples, char *err, size_t n)
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(wb_seg), (const void *)offsetof(wb_seg, a));
     glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(wb_seg), (const void *)offsetof(wb_seg, b));
     glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, sizeof(wb_seg), (const void *)offsetof(wb_seg, c));
-
-    glBindVertexArray(g->vao_grid);
-    glBindBuffer(GL_ARRAY_BUFFER, g->vbo_grid);
-    glBufferData(GL_ARRAY_BUFFER, 12 * sizeof(float), NULL, GL_STREAM_DRAW);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), (const void *)0);
     glBindVertexArray(0);
 
     if (!targets(g, w, h, samples, err, n)) return false;
@@ -534,10 +528,10 @@ void wb_gl_free(wb_gl *g)
     GLuint progs[] = { g->prog_mesh, g->prog_depth, g->prog_line, g->prog_grid, g->prog_bg };
     for (size_t k = 0; k < sizeof progs / sizeof *progs; k++)
         if (progs[k]) glDeleteProgram(progs[k]);
-    GLuint bufs[] = { g->vbo_mesh, g->ebo_mesh, g->vbo_inst, g->vbo_surf, g->ebo_surf, g->vbo_seg, g->vbo_grid };
-    glDeleteBuffers(7, bufs);
-    GLuint vaos[] = { g->vao_mesh, g->vao_surf, g->vao_line, g->vao_grid, g->vao_empty };
-    glDeleteVertexArrays(5, vaos);
+    GLuint bufs[] = { g->vbo_mesh, g->ebo_mesh, g->vbo_inst, g->vbo_surf, g->ebo_surf, g->vbo_seg };
+    glDeleteBuffers(6, bufs);
+    GLuint vaos[] = { g->vao_mesh, g->vao_surf, g->vao_line, g->vao_empty };
+    glDeleteVertexArrays(4, vaos);
     GLuint fbos[] = { g->fbo_ms, g->fbo_shadow };
     glDeleteFramebuffers(2, fbos);
     GLuint rbs[] = { g->rb_color, g->rb_depth };

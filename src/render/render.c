@@ -363,10 +363,10 @@ static void draw_surfaces(wb_renderer *r)
     glDrawElements(GL_TRIANGLES, (GLsizei)r->layers.nidx, GL_UNSIGNED_INT, (const void *)0);
 }
 
-/* a plane as a square of half size ext around the point nearest c; returns false
- * when the normal is degenerate */
-static bool plane_quad(const wb_real nrm[3], double offset, const double c[3], double ext, float quad[12],
-                       double center[3], double gu[3], double gv[3], double gn[3])
+/* a plane's frame: the point nearest c, the grid's axes gu and gv and the unit normal gn;
+ * returns false when the normal is degenerate */
+static bool plane_frame(const wb_real nrm[3], double offset, const double c[3],
+                        double center[3], double gu[3], double gv[3], double gn[3])
 {
     double n[3] = { nrm[0], nrm[1], nrm[2] };
     double l = norm3(n);
@@ -384,9 +384,6 @@ static bool plane_quad(const wb_real nrm[3], double offset, const double c[3], d
         norm3(gu);
         cross3(gu, n, gv);
     }
-    static const int sx[4] = { -1, 1, -1, 1 }, sy[4] = { -1, -1, 1, 1 };
-    for (int v = 0; v < 4; v++)
-        for (int k = 0; k < 3; k++) quad[3 * v + k] = (float)(center[k] + ext * (sx[v] * gu[k] + sy[v] * gv[k]));
     return true;
 }
 
@@ -616,7 +613,6 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     /* the fog: the ground around the scene stays clear however far the camera is */
     const double spacing = wb_nice_step(R / 6), fog = 2 * dc + 3 * ext;
     double center[3], gu[3], gv[3], gn[3];
-    float quad[12];
     int planes = 0;
     int32_t nc = wb_collider_count(w);
     for (int32_t i = 0; i < nc && (o->colliders || o->grid); i++) {
@@ -625,14 +621,14 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
         double h;
         const bool floor = floor_height(&d, &h);
         if (d.shape != WB_SHAPE_PLANE || !(o->colliders || (o->grid && floor))) continue;
-        if (plane_quad(d.normal, d.offset, c, ext, quad, center, gu, gv, gn)) {
+        if (plane_frame(d.normal, d.offset, c, center, gu, gv, gn)) {
             draw_grid(r, center, gu, gv, gn, spacing, ext, floor, fog);
             planes++;
         }
     }
     if (!planes && o->grid) {
         wb_real up[3] = { 0, 1, 0 };
-        if (plane_quad(up, fmin(cur.lo[1], r->view_lo[1]), c, ext, quad, center, gu, gv, gn))
+        if (plane_frame(up, fmin(cur.lo[1], r->view_lo[1]), c, center, gu, gv, gn))
             draw_grid(r, center, gu, gv, gn, spacing, ext, true, fog);
     }
 
