@@ -79,10 +79,12 @@ static const char light_fs[] =
     "}\n"
     /* gamma 2 instead of 2.2: a square root is much cheaper than pow on llvmpipe */
     "vec4 to_srgb(vec3 c, float a) { return vec4(sqrt(clamp(c, 0.0, 1.0)), a); }\n"
-    /* the ground: diffuse only, its cost is most of the frame's */
-    "vec3 lit_matte(vec3 base, vec3 n, vec3 p) {\n"
+    /* the ground: diffuse only, its cost is most of the frame's; the shadow map is
+     * looked up only where a shadow can fall (`near`: inside the map's box) */
+    "vec3 lit_matte(vec3 base, vec3 n, vec3 p, bool near) {\n"
     "  float ndl = dot(n, u_light);\n"
-    "  float sh = ndl > 0.0 ? shadow_at(p, n, n) : 0.0;\n"
+    "  float sh = ndl > 0.0 ? 1.0 : 0.0;\n"
+    "  if (near && ndl > 0.0) sh = shadow_at(p, n, n);\n"
     "  vec3 amb = mix(vec3(0.16, 0.14, 0.13), vec3(0.30, 0.34, 0.42), n.y * 0.5 + 0.5);\n"
     "  return base * (amb + vec3(1.0, 0.96, 0.9) * max(ndl, 0.0) * sh);\n"
     "}\n";
@@ -134,13 +136,13 @@ static const char line_fs[] =
     "out vec4 o_col;\n"
     "void main() { o_col = vec4(sqrt(v_col.rgb), 1.0); }\n";
 
-/* the ground: a full-screen triangle; each pixel's view ray meets the plane (grid_fs) */
+/* the ground: the part of the screen below the plane's horizon (render.c clips the
+ * frame's square to it, a fan of up to 5 corners in NDC); each pixel's view ray meets
+ * the plane (grid_fs). Pixels above the horizon would only be discarded */
 static const char grid_vs[] =
     "#version 330 core\n"
-    "void main() {\n"
-    "  vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);\n"
-    "  gl_Position = vec4(p, 0.0, 1.0);\n"
-    "}\n";
+    "uniform vec2 u_poly[5];\n"
+    "void main() { gl_Position = vec4(u_poly[gl_VertexID], 0.0, 1.0); }\n";
 
 /* the ground where each pixel's view ray meets the plane (n.x = u_offset): a floor
  * reaches the horizon, fogged with distance into the sky's colour at that row (the sky
@@ -169,6 +171,8 @@ static const char grid_fs[] =
     "uniform vec3 u_top;\n"
     "uniform vec3 u_bottom;\n"
     "uniform float u_height;\n"
+    "uniform vec3 u_sc;\n"    /* beyond sqrt(u_sr2) of u_sc, outside the shadow map's box: no shadow */
+    "uniform float u_sr2;\n"
     "float grid(vec2 uv, vec2 fw) {\n"
     "  vec2 g = abs(fract(uv - 0.5) - 0.5) / max(fw, vec2(1e-6));\n"
     "  float fade = 1.0 - smoothstep(0.12, 0.4, max(fw.x, fw.y));\n"
@@ -185,19 +189,23 @@ static const char grid_fs[] =
     "  if (clip.w <= 0.0) discard;\n"
     "  gl_FragDepth = min(clip.z / clip.w * 0.5 + 0.5, 0.99999);\n"
     "  vec3 d = p - u_center;\n"
-    "  float a = u_floor != 0 ? exp(-pow(length(p - u_eye) / u_fog, 2.0))\n"
+    "  float f = t * length(dir) / u_fog;\n"  /* the distance, in fog lengths */
+    "  float a = u_floor != 0 ? exp(-f * f)\n"
     "                         : 1.0 - smoothstep(0.45, 1.0, length(d) / u_extent);\n"
     "  if (a <= 0.002) discard;\n"
     "  vec2 uv = vec2(dot(d, u_gu), dot(d, u_gv)) / u_spacing;\n"
     "  vec3 base = u_base;\n"
     "  vec2 fw = fwidth(uv);\n"
-    "  base = mix(base, base * 0.62, grid(uv, fw) * 0.7);\n"
-    "  base = mix(base, base * 0.45, grid(uv / 5.0, fw / 5.0));\n"
+    /* the lines have faded out where a major cell is under 2.5 pixels (grid's fade) */
+    "  if (max(fw.x, fw.y) < 2.0) {\n"
+    "    base = mix(base, base * 0.62, grid(uv, fw) * 0.7);\n"
+    "    base = mix(base, base * 0.45, grid(uv / 5.0, fw / 5.0));\n"
+    "  }\n"
     "  vec3 n = dot(u_eye - p, u_gn) >= 0.0 ? u_gn : -u_gn;\n"  /* the side seen */
     /* opaque: faded into the sky's colour here, so the sky is drawn last and only
      * where nothing else is (the cheapest pixels are those never shaded) */
     "  vec3 sky = mix(u_bottom, u_top, clamp(gl_FragCoord.y / u_height, 0.0, 1.0));\n"
-    "  o_col = vec4(mix(sky, to_srgb(lit_matte(base, n, p), 1.0).rgb, a), 1.0);\n"
+    "  o_col = vec4(mix(sky, to_srgb(lit_matte(base, n, p, dot(p - u_sc, p - u_sc) < u_sr2), 1.0).rgb, a), 1.0);\n"
     "}\n";
 
 /* the sky: a vertical gradient over a full-screen triangle */
@@ -469,13 +477,13 @@ bool wb_gl_init(wb_gl *g, int w, int h, int *samples, char *err, size_t n)
         snprintf(err, n, "out of memory building meshes");
         return false;
     }
-    GLuint bufs[7];
-    glGenBuffers(7, bufs);
+    GLuint bufs[6];
+    glGenBuffers(6, bufs);
     g->vbo_mesh = bufs[0], g->ebo_mesh = bufs[1], g->vbo_inst = bufs[2], g->vbo_surf = bufs[3];
-    g->ebo_surf = bufs[4], g->vbo_seg = bufs[5], g->vbo_grid = bufs[6];
-    GLuint vaos[5];
-    glGenVertexArrays(5, vaos);
-    g->vao_mesh = vaos[0], g->vao_surf = vaos[1], g->vao_line = vaos[2], g->vao_grid = vaos[3], g->vao_empty = vaos[4];
+    g->ebo_surf = bufs[4], g->vbo_seg = bufs[5];
+    GLuint vaos[4];
+    glGenVertexArrays(4, vaos);
+    g->vao_mesh = vaos[0], g->vao_surf = vaos[1], g->vao_line = vaos[2], g->vao_empty = vaos[3];
 
     glBindVertexArray(g->vao_mesh);
     glBindBuffer(GL_ARRAY_BUFFER, g->vbo_mesh);
@@ -512,12 +520,6 @@ bool wb_gl_init(wb_gl *g, int w, int h, int *samples, char *err, size_t n)
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(wb_seg), (const void *)offsetof(wb_seg, a));
     glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(wb_seg), (const void *)offsetof(wb_seg, b));
     glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, sizeof(wb_seg), (const void *)offsetof(wb_seg, c));
-
-    glBindVertexArray(g->vao_grid);
-    glBindBuffer(GL_ARRAY_BUFFER, g->vbo_grid);
-    glBufferData(GL_ARRAY_BUFFER, 12 * sizeof(float), NULL, GL_STREAM_DRAW);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), (const void *)0);
     glBindVertexArray(0);
 
     if (!targets(g, w, h, samples, err, n)) return false;
@@ -534,10 +536,10 @@ void wb_gl_free(wb_gl *g)
     GLuint progs[] = { g->prog_mesh, g->prog_depth, g->prog_line, g->prog_grid, g->prog_bg };
     for (size_t k = 0; k < sizeof progs / sizeof *progs; k++)
         if (progs[k]) glDeleteProgram(progs[k]);
-    GLuint bufs[] = { g->vbo_mesh, g->ebo_mesh, g->vbo_inst, g->vbo_surf, g->ebo_surf, g->vbo_seg, g->vbo_grid };
-    glDeleteBuffers(7, bufs);
-    GLuint vaos[] = { g->vao_mesh, g->vao_surf, g->vao_line, g->vao_grid, g->vao_empty };
-    glDeleteVertexArrays(5, vaos);
+    GLuint bufs[] = { g->vbo_mesh, g->ebo_mesh, g->vbo_inst, g->vbo_surf, g->ebo_surf, g->vbo_seg };
+    glDeleteBuffers(6, bufs);
+    GLuint vaos[] = { g->vao_mesh, g->vao_surf, g->vao_line, g->vao_empty };
+    glDeleteVertexArrays(4, vaos);
     GLuint fbos[] = { g->fbo_ms, g->fbo_shadow };
     glDeleteFramebuffers(2, fbos);
     GLuint rbs[] = { g->rb_color, g->rb_depth };

@@ -78,8 +78,8 @@ void wb_strain_srgb(double t, float out[3]);
 
 typedef struct wb_gl {
     GLuint prog_mesh, prog_depth, prog_line, prog_grid, prog_bg;
-    GLuint vao_mesh, vao_surf, vao_line, vao_grid, vao_empty;
-    GLuint vbo_mesh, ebo_mesh, vbo_inst, vbo_surf, ebo_surf, vbo_seg, vbo_grid;
+    GLuint vao_mesh, vao_surf, vao_line, vao_empty;
+    GLuint vbo_mesh, ebo_mesh, vbo_inst, vbo_surf, ebo_surf, vbo_seg;
     GLint mesh_first[MESH_COUNT], mesh_count[MESH_COUNT];   /* index ranges */
     GLuint fbo_ms, rb_color, rb_depth;                        /* the (multisample) target */
     GLuint fbo_shadow, tex_shadow;

@@ -13,6 +13,7 @@
 
 #include "render.h"
 #include "gl.h"
+#include "layers_int.h"
 
 /* colours, sRGB */
 static const float col_particle[3] = { 0.22f, 0.47f, 0.80f };
@@ -21,9 +22,6 @@ static const float col_attach[3] = { 0.16f, 0.70f, 0.30f };  /* attached to a co
 static const float col_grab[3] = { 0.85f, 0.15f, 0.75f };    /* grabbed, its target and line */
 static const float col_collider[3] = { 0.55f, 0.58f, 0.64f };
 static const float col_rigid[3] = { 0.86f, 0.50f, 0.20f };  /* rigid bodies: a warm orange */
-static const float col_rest[3] = { 0.40f, 0.40f, 0.42f };
-static const float col_tension[3] = { 0.92f, 0.08f, 0.06f };
-static const float col_compress[3] = { 0.12f, 0.32f, 0.92f };
 /* a surface coloured by strain: light and neutral at rest, so red and blue stand out */
 static const float col_cloth[3] = { 0.68f, 0.68f, 0.67f };
 static const float col_surface[][3] = {
@@ -31,29 +29,6 @@ static const float col_surface[][3] = {
 };
 static const float col_skin[3] = { 0.86f, 0.76f, 0.62f };
 static const float surface_shine = 0.12f;
-
-/* per particle: on a drawn surface; covered by a drawn skin; in a volume, shape-matching
- * or pressure constraint (l->mstrain holds its strain) */
-enum { F_SURFACE = 1, F_HIDDEN = 2, F_MATERIAL = 4, F_ON_SURFACE = 8 /* on any surface (auto_scale) */ };
-
-void wb_lin3(const float s[3], float o[3])
-{
-    for (int k = 0; k < 3; k++) o[k] = s[k] * s[k];   /* the shaders output with gamma 2 */
-}
-
-/* grow *p to hold n elements of size sz */
-static bool grow(void *pp, size_t *cap, size_t n, size_t sz)
-{
-    void **p = pp;
-    if (n <= *cap) return true;
-    size_t c = *cap ? *cap : 256;
-    while (c < n) c *= 2;
-    void *q = realloc(*p, c * sz);
-    if (!q) return false;
-    *p = q;
-    *cap = c;
-    return true;
-}
 
 void wb_layers_free(wb_layers *l)
 {
@@ -68,21 +43,6 @@ void wb_layers_free(wb_layers *l)
     free(l->flags);
     free(l->scratch);
     memset(l, 0, sizeof *l);
-}
-
-/* a particle sphere's colour (sRGB: inst_set linearises): grey at rest, red expanded,
- * blue compressed, fully at +-scale */
-static void strain_colour_srgb(double strain, double scale, float out[3])
-{
-    double t = strain / scale;
-    t = t > 1 ? 1 : t < -1 ? -1 : t;
-    const float *to = t >= 0 ? col_tension : col_compress;
-    for (int c = 0; c < 3; c++) out[c] = (float)(col_rest[c] + (to[c] - col_rest[c]) * fabs(t));
-}
-
-void wb_strain_srgb(double t, float out[3])
-{
-    strain_colour_srgb(t, 1, out);
 }
 
 /* ---- instances -------------------------------------------------------------------------- */
@@ -133,7 +93,7 @@ static bool build_instances(wb_layers *l, const wb_world *w, const wb_draw_opts 
     int32_t np = wb_particle_count(w), nc = wb_collider_count(w), nr = o->rigids ? wb_rigid_count(w) : 0;
     const int32_t na = wb_attach_count(w), ng = wb_grab_count(w);
     size_t need = (size_t)np + 3 * (size_t)nc + 3 * (size_t)nr + (size_t)na + 2 * (size_t)ng;
-    if (!grow(&l->inst, &l->inst_cap, need + 1, sizeof *l->inst)) return false;
+    if (!wb_grow(&l->inst, &l->inst_cap, need + 1, sizeof *l->inst)) return false;
     const wb_real *x = wb_particle_positions(w);
     size_t k = 0;
     l->first[WB_G_LO] = 0;
@@ -145,7 +105,7 @@ static bool build_instances(wb_layers *l, const wb_world *w, const wb_draw_opts 
         if (pin && o->pins) inst_sphere(&l->inst[k++], p, fmax(1.6 * rad, 0.006 * unit), col_pin, 0.5f);
         else if (o->particles && !(l->flags[i] & (F_SURFACE | F_HIDDEN))) {
             float col[3];
-            if (o->materials && (l->flags[i] & F_MATERIAL)) strain_colour_srgb(l->mstrain[i], l->scale, col);
+            if (o->materials && (l->flags[i] & F_MATERIAL)) wb_strain_colour_srgb(l->mstrain[i], l->scale, col);
             else memcpy(col, col_particle, sizeof col);
             inst_sphere(&l->inst[k++], p, rad, col, 0.5f);
         }
@@ -229,232 +189,12 @@ static bool build_instances(wb_layers *l, const wb_world *w, const wb_draw_opts 
     return true;
 }
 
-/* ---- strain ------------------------------------------------------------------------------ */
-/* grey at rest, shading to red stretched and blue compressed, fully at +-strain_scale */
-static void strain_colour(double strain, double scale, const float rest[3], float out[3])
-{
-    float ten[3], com[3];
-    wb_lin3(col_tension, ten), wb_lin3(col_compress, com);
-    double t = strain / scale;
-    t = t > 1 ? 1 : t < -1 ? -1 : t;
-    const float *to = t >= 0 ? ten : com;
-    for (int c = 0; c < 3; c++) out[c] = (float)(rest[c] + (to[c] - rest[c]) * fabs(t));
-}
-
-/* the distance constraints and their strains, and per particle the strain its
- * surface shows (l->vstrain[0..np); the rest is scratch) */
-static bool load_pairs(wb_layers *l, const wb_world *w)
-{
-    int32_t n = wb_world_distance_pairs(w, NULL, NULL), np = wb_particle_count(w);
-    size_t had = l->pair_cap;
-    if (!grow(&l->pairs, &l->pair_cap, 2 * (size_t)n + 2, sizeof *l->pairs)) return false;
-    if (l->pair_cap != had || !l->strain) {   /* the strains share the capacity count */
-        void *q = realloc(l->strain, (l->pair_cap / 2 + 1) * sizeof *l->strain);
-        if (!q) return false;
-        l->strain = q;
-    }
-    if (!grow(&l->vstrain, &l->vstrain_cap, 3 * (size_t)np + 1, sizeof *l->vstrain)) return false;
-    l->npairs = wb_world_distance_pairs(w, l->pairs, l->strain);
-    /* the largest stretch at each particle (compression in a sheet is its folds, which
-     * the shading shows: in colour it would be noise), then averaged over its links'
-     * other ends: peaks stay, the checkerboard of stretched and sheared links goes */
-    float *peak = l->vstrain + np, *count = l->vstrain + 2 * (size_t)np, *v = l->vstrain;
-    memset(peak, 0, 2 * (size_t)np * sizeof *peak);
-    for (int32_t i = 0; i < l->npairs; i++)
-        for (int e = 0; e < 2; e++) {
-            float *pk = &peak[l->pairs[2 * i + e]];
-            if (l->strain[i] > *pk) *pk = (float)l->strain[i];
-        }
-    memcpy(v, peak, (size_t)np * sizeof *v);
-    for (int32_t i = 0; i < np; i++) count[i] = 1;
-    for (int32_t i = 0; i < l->npairs; i++) {
-        int32_t a = l->pairs[2 * i], b = l->pairs[2 * i + 1];
-        v[a] += peak[b], count[a]++;
-        v[b] += peak[a], count[b]++;
-    }
-    for (int32_t i = 0; i < np; i++) v[i] /= count[i];
-    return true;
-}
-
-/* a material's strain e at particle i: where several apply, the largest in magnitude */
-static void put_material(wb_layers *l, int32_t i, double e)
-{
-    if (!isfinite(e)) return;
-    if (!(l->flags[i] & F_MATERIAL) || fabs(e) > fabs(l->mstrain[i])) l->mstrain[i] = (float)e;
-    l->flags[i] |= F_MATERIAL;
-}
-
-/* per particle, the strain of the materials it belongs to (l->mstrain[0..np), flag
- * F_MATERIAL; the rest is scratch): the volumetric strain (V - V0) / V0 averaged over
- * its tets (volume constraints and Neo-Hookean tets); a shape-matching cluster's strain (wb_shape_match_strain), negative when the
- * cluster drew in (its spread about the centre of mass below the rest shape's); a
- * pressure body's V / (pressure V0) - 1 on its surface; a bend's angle off its rest
- * (load_bends) */
-static bool load_materials(wb_layers *l, const wb_world *w)
-{
-    const int32_t np = wb_particle_count(w), nv = wb_volume_count(w);
-    if (!grow(&l->mstrain, &l->mstrain_cap, 3 * (size_t)np + 1, sizeof *l->mstrain)) return false;
-    float *sum = l->mstrain + np, *count = l->mstrain + 2 * (size_t)np;
-    memset(l->mstrain, 0, 3 * (size_t)np * sizeof *l->mstrain);
-    for (int32_t i = 0; i < nv; i++) {
-        const double v0 = wb_volume_rest(w, i);
-        if (v0 == 0) continue;
-        const double e = (wb_volume_current(w, i) - v0) / v0;
-        if (!isfinite(e)) continue;
-        int32_t p[4];
-        wb_volume_particles(w, i, p);
-        for (int k = 0; k < 4; k++) sum[p[k]] += (float)e, count[p[k]]++;
-    }
-    /* Neo-Hookean tets the same way, by det F - 1 (their (V - V0) / V0) or, where larger,
-     * their shape change (wb_tet_strain: a shear keeps the volume) */
-    const int32_t nt = wb_tet_count(w);
-    for (int32_t i = 0; i < nt; i++) {
-        const double e = wb_tet_strain(w, i);
-        if (!isfinite(e)) continue;
-        int32_t p[4];
-        wb_tet_particles(w, i, p);
-        for (int k = 0; k < 4; k++) sum[p[k]] += (float)e, count[p[k]]++;
-    }
-    for (int32_t i = 0; nv + nt > 0 && i < np; i++)
-        if (count[i] > 0) put_material(l, i, sum[i] / count[i]);
-    const wb_real *x = wb_particle_positions(w);
-    for (int32_t s = 0; s < wb_shape_match_count(w); s++) {
-        const int32_t n = wb_shape_match_size(w, s);
-        double c[3] = { 0, 0, 0 }, m = 0, now = 0, rest = 0;
-        for (int32_t i = 0; i < n; i++) {
-            const int32_t p = wb_shape_match_particle(w, s, i);
-            const double mi = wb_particle_mass(w, p);
-            for (int k = 0; k < 3; k++) c[k] += mi * x[3 * p + k];
-            m += mi;
-        }
-        if (!(m > 0)) continue;
-        for (int i = 0; i < n; i++) {
-            const int32_t p = wb_shape_match_particle(w, s, i);
-            const double mi = wb_particle_mass(w, p);
-            wb_real r[3];
-            wb_shape_match_rest(w, s, i, r);
-            for (int k = 0; k < 3; k++) {
-                const double d = x[3 * p + k] - c[k] / m;
-                now += mi * d * d, rest += mi * (double)r[k] * r[k];
-            }
-        }
-        const double e = (now < rest ? -1 : 1) * (double)wb_shape_match_strain(w, s);
-        for (int32_t i = 0; i < n; i++) put_material(l, wb_shape_match_particle(w, s, i), e);
-    }
-    for (int32_t i = 0; i < wb_pressure_count(w); i++) {
-        const double target = wb_pressure_get_def(w, i).pressure * wb_pressure_rest_volume(w, i);
-        if (!(target > 0)) continue;
-        const double e = wb_pressure_volume(w, i) / target - 1;
-        int32_t nt = 0;
-        const int32_t *t = wb_surface_triangles(w, wb_pressure_surface(w, i), &nt);
-        for (int32_t k = 0; k < 3 * nt; k++) put_material(l, t[k], e);
-    }
-    return true;
-}
-
-/* the k-th smallest of v[0..n) in place (quickselect) */
-static float select_k(float *v, size_t n, size_t k)
-{
-    size_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-        const float pivot = v[lo + (hi - lo) / 2];
-        size_t i = lo, j = hi;
-        while (i <= j) {
-            while (v[i] < pivot) i++;
-            while (v[j] > pivot) j--;
-            if (i <= j) {
-                const float t = v[i];
-                v[i] = v[j], v[j] = t;
-                i++;
-                if (j == 0) break;
-                j--;
-            }
-        }
-        if (k <= j) hi = j;
-        else if (k >= i) lo = i;
-        else break;
-    }
-    return v[k];
-}
-
-/* the automatic strain scale: the 95th percentile of |strain| over the links and the
- * materials' particles, so the most strained few percent are in full colour and the
- * rest shades (a fixed 2 % turns any loaded body uniformly red); at least 0.5 %, or a
- * body settling would show its noise (0.1 %, the logo's letters at rest) in full colour. Eased over frames in log
- * scale: a fifth of the way up per frame (a blow shows within a few frames), a
- * twentieth down (a settling body fades over about a second at 60 fps); the same frame
- * drawn again, or another world, takes it as it is. Bends are left out: their colour is
- * a part of the scale (load_bends). */
-#define AUTO_PERCENTILE 0.95
-#define AUTO_MIN 0.005
-static bool auto_scale(wb_layers *l, const wb_world *w, const wb_draw_opts *o)
-{
-    const int32_t np = wb_particle_count(w);
-    const size_t want = (o->constraints ? (size_t)l->npairs : 0) + (o->materials ? (size_t)np : 0) + 1;
-    if (!grow(&l->scratch, &l->scratch_cap, want, sizeof *l->scratch)) return false;
-    /* the strains as shown: a free link's, a surface particle's stretch (vstrain), a
-     * material's */
-    for (int32_t s = 0; o->surfaces && s < wb_surface_count(w); s++) {
-        int32_t nt = 0;
-        const int32_t *t = wb_surface_triangles(w, s, &nt);
-        for (int32_t i = 0; i < 3 * nt; i++) l->flags[t[i]] |= F_ON_SURFACE;
-    }
-    size_t n = 0;
-    for (int32_t i = 0; o->constraints && i < l->npairs; i++)
-        if (isfinite(l->strain[i]) && !((l->flags[l->pairs[2 * i]] | l->flags[l->pairs[2 * i + 1]]) & F_ON_SURFACE))
-            l->scratch[n++] = (float)fabs(l->strain[i]);
-    for (int32_t i = 0; i < np; i++) {
-        float e = 0;
-        if (o->constraints && (l->flags[i] & F_ON_SURFACE)) e = l->vstrain[i];
-        if (o->materials && (l->flags[i] & F_MATERIAL) && fabsf(l->mstrain[i]) > e) e = fabsf(l->mstrain[i]);
-        if ((o->constraints && (l->flags[i] & F_ON_SURFACE)) || (o->materials && (l->flags[i] & F_MATERIAL)))
-            if (isfinite(e)) l->scratch[n++] = e;
-    }
-    double target = AUTO_MIN;
-    if (n > 0) target = fmax(target, select_k(l->scratch, n, (size_t)(AUTO_PERCENTILE * (double)(n - 1))));
-    const int64_t frame = wb_world_frame(w);
-    if (l->auto_world == w && frame > l->auto_frame && l->auto_scale > 0) {
-        /* per frame stepped since the last draw */
-        const double rate = 1 - pow(target > l->auto_scale ? 0.8 : 0.95, (double)(frame - l->auto_frame));
-        l->auto_scale = exp(log(l->auto_scale) + rate * (log(target) - log(l->auto_scale)));
-    } else {
-        l->auto_scale = target;
-    }
-    l->auto_world = w;
-    l->auto_frame = frame;
-    l->scale = l->auto_scale;
-    return true;
-}
-
-/* bends at their hinge's two particles (after the other materials: their colour is a
- * part of the scale) */
-static void load_bends(wb_layers *l, const wb_world *w, double scale)
-{
-    /* |angle - rest| / (pi/4) of strain_scale (a
-     * bend pi/4 off its rest is as full a colour as a link strain_scale off its); red
-     * when bent further than its rest (further from flat, or through to the other side),
-     * blue when opened out flatter. The angle's sign follows the wings' order, so only
-     * its size against the rest's says which way */
-    for (int32_t i = 0; i < wb_bend_count(w); i++) {
-        const wb_bend_id b = wb_bend_at(w, i);
-        const double a = wb_bend_angle(w, b), r = wb_bend_rest(w, b);
-        double d = a - r;
-        if (!isfinite(d)) continue;
-        d = fabs(remainder(d, 2 * M_PI));
-        const bool flatter = a * r >= 0 && fabs(a) < fabs(r);
-        const double e = (flatter ? -1 : 1) * scale * d / (M_PI / 4);
-        int32_t p[4];
-        wb_bend_particles(w, b, p);
-        put_material(l, p[0], e), put_material(l, p[1], e);
-    }
-}
-
 /* links as segments; those touching a drawn surface are shown by its colour (a dense
  * cloth's links would cover it like a fence; a block's inner links would poke through
  * its hull as dots), those under a skin not at all */
 static bool build_segments(wb_layers *l, const wb_world *w)
 {
-    if (!grow(&l->seg, &l->seg_cap, (size_t)l->npairs + 1, sizeof *l->seg)) return false;
+    if (!wb_grow(&l->seg, &l->seg_cap, (size_t)l->npairs + 1, sizeof *l->seg)) return false;
     const wb_real *x = wb_particle_positions(w);
     float rest[3];
     wb_lin3(col_rest, rest);
@@ -464,7 +204,7 @@ static bool build_segments(wb_layers *l, const wb_world *w)
         if (((l->flags[a] | l->flags[b]) & F_SURFACE) || (l->flags[a] & l->flags[b] & F_HIDDEN)) continue;
         wb_seg *s = &l->seg[k++];
         for (int c = 0; c < 3; c++) s->a[c] = (float)x[3 * a + c], s->b[c] = (float)x[3 * b + c];
-        strain_colour(l->strain[i], l->scale, rest, s->c);
+        wb_strain_colour(l->strain[i], l->scale, rest, s->c);
         s->c[3] = 1;
     }
     l->nseg = k;
@@ -476,7 +216,7 @@ static bool build_grab_lines(wb_layers *l, const wb_world *w)
 {
     const int32_t ng = wb_grab_count(w);
     if (ng == 0) return true;
-    if (!grow(&l->seg, &l->seg_cap, l->nseg + (size_t)ng, sizeof *l->seg)) return false;
+    if (!wb_grow(&l->seg, &l->seg_cap, l->nseg + (size_t)ng, sizeof *l->seg)) return false;
     wb_grab_id *ids = malloc((size_t)ng * sizeof *ids);
     if (!ids) return false;
     wb_grab_list(w, ids, ng);
@@ -654,7 +394,7 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
     const size_t nmesh = mesh_collider_triangles(w, o);
     total += 3 * nmesh;
     nv += 3 * nmesh;
-    if (!grow(&l->si, &l->si_cap, total + 1, sizeof *l->si)) return false;
+    if (!wb_grow(&l->si, &l->si_cap, total + 1, sizeof *l->si)) return false;
     size_t nb = 0;
     uint64_t *broken = ns ? broken_pairs(w, &nb) : NULL;
     double *acc = calloc((size_t)np * 3 + 3, sizeof *acc);
@@ -711,7 +451,7 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
             }
     }
     nv += extra;
-    if (!grow(&l->sv, &l->sv_cap, WB_SV * nv + WB_SV, sizeof *l->sv)) {
+    if (!wb_grow(&l->sv, &l->sv_cap, WB_SV * nv + WB_SV, sizeof *l->sv)) {
         ok = false;
         goto done;
     }
@@ -724,8 +464,8 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
             /* the material's strain, or its links' stretch where that is larger */
             double e = l->mstrain[i];
             if (o->constraints && fabs(l->vstrain[i]) > fabs(e)) e = l->vstrain[i];
-            strain_colour(e, l->scale, cloth, col);
-        } else if (o->constraints) strain_colour(l->vstrain[i], l->scale, cloth, col);
+            wb_strain_colour(e, l->scale, cloth, col);
+        } else if (o->constraints) wb_strain_colour(l->vstrain[i], l->scale, cloth, col);
         else wb_lin3(col_surface[owner[i] < 0 ? 0 : owner[i]], col);
         norm3(acc + 3 * i);
         const double off = out[i] * (double)wb_particle_radius(w, i);
@@ -786,7 +526,7 @@ bool wb_layers_build(wb_layers *l, const wb_world *w, const wb_draw_opts *o, con
                      double unit)
 {
     int32_t np = wb_particle_count(w);
-    if (!grow(&l->flags, &l->flag_cap, (size_t)np + 1, 1)) return false;
+    if (!wb_grow(&l->flags, &l->flag_cap, (size_t)np + 1, 1)) return false;
     memset(l->flags, 0, (size_t)np + 1);
     /* the particles a drawn skin is bound to are its cage: the skin shows them */
     for (int i = 0; !o->cage && i < nsk; i++)
@@ -795,11 +535,11 @@ bool wb_layers_build(wb_layers *l, const wb_world *w, const wb_draw_opts *o, con
             if (p >= 0 && p < np) l->flags[p] |= F_HIDDEN;
         }
     l->npairs = 0;
-    if (o->constraints && !load_pairs(l, w)) return false;
-    if (o->materials && !load_materials(l, w)) return false;
+    if (o->constraints && !wb_strain_pairs(l, w)) return false;
+    if (o->materials && !wb_strain_materials(l, w)) return false;
     l->scale = o->strain_scale;
-    if (o->strain_auto && (o->constraints || o->materials) && !auto_scale(l, w, o)) return false;
-    if (o->materials) load_bends(l, w, l->scale);
+    if (o->strain_auto && (o->constraints || o->materials) && !wb_strain_auto(l, w, o)) return false;
+    if (o->materials) wb_strain_bends(l, w, l->scale);
     l->nv = l->nidx = l->nseg = 0;
     l->surfaces = (o->surfaces && wb_surface_count(w) > 0 && np > 0) || nsk > 0 || mesh_collider_triangles(w, o) > 0;
     if (l->surfaces && !build_surfaces(l, w, o, sk, nsk)) return false;

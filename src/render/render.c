@@ -363,10 +363,10 @@ static void draw_surfaces(wb_renderer *r)
     glDrawElements(GL_TRIANGLES, (GLsizei)r->layers.nidx, GL_UNSIGNED_INT, (const void *)0);
 }
 
-/* a plane as a square of half size ext around the point nearest c; returns false
- * when the normal is degenerate */
-static bool plane_quad(const wb_real nrm[3], double offset, const double c[3], double ext, float quad[12],
-                       double center[3], double gu[3], double gv[3], double gn[3])
+/* a plane's frame: the point nearest c, the grid's axes gu and gv and the unit normal gn;
+ * returns false when the normal is degenerate */
+static bool plane_frame(const wb_real nrm[3], double offset, const double c[3],
+                        double center[3], double gu[3], double gv[3], double gn[3])
 {
     double n[3] = { nrm[0], nrm[1], nrm[2] };
     double l = norm3(n);
@@ -384,18 +384,42 @@ static bool plane_quad(const wb_real nrm[3], double offset, const double c[3], d
         norm3(gu);
         cross3(gu, n, gv);
     }
-    static const int sx[4] = { -1, 1, -1, 1 }, sy[4] = { -1, -1, 1, 1 };
-    for (int v = 0; v < 4; v++)
-        for (int k = 0; k < 3; k++) quad[3 * v + k] = (float)(center[k] + ext * (sx[v] * gu[k] + sy[v] * gv[k]));
     return true;
 }
 
-/* a plane (n.x = offset) through the full-screen triangle; a floor reaches the horizon,
- * fogged over `fog`; any other plane is a disc of radius ext around center */
-static void draw_grid(wb_renderer *r, const double center[3], const double gu[3], const double gv[3],
-                      const double gn[3], double spacing, double ext, bool floor, double fog)
+/* where view rays meet the plane gn.x = gn.eye + s (t > 0): the ray's denominator
+ * gn.(cf + x cr + y cu) is linear in the pixel's NDC (x, y), so that is a half-plane of
+ * the screen; the screen's square clipped to it (at most 5 corners, 0 when the plane is
+ * not seen). Its edge is the horizon, where the ground has fogged out or ended anyway */
+static int below_horizon(const double gn[3], double s, const double cam[3][3], float poly[10])
+{
+    static const double sq[4][2] = { { -1, -1 }, { 1, -1 }, { 1, 1 }, { -1, 1 } };
+    if (!(s != 0)) return 0;
+    const double sg = s > 0 ? 1 : -1, a = sg * dot3(gn, cam[0]), b = sg * dot3(gn, cam[1]), c = sg * dot3(gn, cam[2]);
+    int n = 0;
+    for (int i = 0; i < 4; i++) {
+        const double *p = sq[i], *q = sq[(i + 1) % 4];
+        const double vp = a + b * p[0] + c * p[1], vq = a + b * q[0] + c * q[1];
+        if (vp > 0) poly[2 * n] = (float)p[0], poly[2 * n + 1] = (float)p[1], n++;
+        if ((vp > 0) != (vq > 0)) {
+            const double t = vp / (vp - vq);
+            poly[2 * n] = (float)(p[0] + t * (q[0] - p[0])), poly[2 * n + 1] = (float)(p[1] + t * (q[1] - p[1])), n++;
+        }
+    }
+    return n >= 3 ? n : 0;
+}
+
+/* a plane (n.x = offset) over the part of the screen below its horizon; a floor reaches
+ * the horizon, fogged over `fog`; any other plane is a disc of radius ext around center.
+ * cam: the view rays' axes (camera_rays) */
+static void draw_grid(wb_renderer *r, const double cam[3][3], const double center[3], const double gu[3],
+                      const double gv[3], const double gn[3], double spacing, double ext, bool floor, double fog)
 {
     GLuint p = r->gl.prog_grid;
+    float poly[10];
+    const int np = below_horizon(gn, dot3(gn, center) - dot3(gn, r->cam_eye), cam, poly);
+    if (!np) return;
+    glUniform2fv(glGetUniformLocation(p, "u_poly"), 5, poly);
     glBindVertexArray(r->gl.vao_empty);
     set_vec(p, "u_center", center[0], center[1], center[2]);
     set_vec(p, "u_gu", gu[0], gu[1], gu[2]);
@@ -409,12 +433,12 @@ static void draw_grid(wb_renderer *r, const double center[3], const double gu[3]
     float g[3];
     wb_lin3(col_ground, g);
     glUniform3f(glGetUniformLocation(p, "u_base"), g[0], g[1], g[2]);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDrawArrays(GL_TRIANGLE_FAN, 0, np);
 }
 
 /* the camera's axes for the ground's view rays: forward, and right and up scaled to
- * the frame's edges (a pixel's ray is f + x r + y u, x and y in -1..1) */
-static void camera_rays(const wb_renderer *r, GLuint p)
+ * the frame's edges (a pixel's ray is f + x r + y u, x and y in -1..1), also in cam */
+static void camera_rays(const wb_renderer *r, GLuint p, double cam[3][3])
 {
     double f[3], s[3], u[3];
     for (int k = 0; k < 3; k++) f[k] = r->cam_target[k] - r->cam_eye[k];
@@ -426,6 +450,7 @@ static void camera_rays(const wb_renderer *r, GLuint p)
     set_vec(p, "u_cf", f[0], f[1], f[2]);
     set_vec(p, "u_cr", tx * s[0], tx * s[1], tx * s[2]);
     set_vec(p, "u_cu", ty * u[0], ty * u[1], ty * u[2]);
+    for (int k = 0; k < 3; k++) cam[0][k] = f[k], cam[1][k] = tx * s[k], cam[2][k] = ty * u[k];
     glUniform2f(glGetUniformLocation(p, "u_size"), (float)r->w, (float)r->h);
     set_mat(p, "u_vp", r->vp);
 }
@@ -612,11 +637,14 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     glUniform3f(glGetUniformLocation(g->prog_grid, "u_top"), col_sky_top[0], col_sky_top[1], col_sky_top[2]);
     glUniform3f(glGetUniformLocation(g->prog_grid, "u_bottom"), col_sky_bottom[0], col_sky_bottom[1], col_sky_bottom[2]);
     glUniform1f(glGetUniformLocation(g->prog_grid, "u_height"), (float)r->h);
-    camera_rays(r, g->prog_grid);
+    double cam[3][3];
+    camera_rays(r, g->prog_grid, cam);
+    /* the shadow map's box (ortho, below) lies within sqrt(6) R of c: no shadow beyond */
+    set_vec(g->prog_grid, "u_sc", c[0], c[1], c[2]);
+    glUniform1f(glGetUniformLocation(g->prog_grid, "u_sr2"), (float)(6.05 * R * R));
     /* the fog: the ground around the scene stays clear however far the camera is */
     const double spacing = wb_nice_step(R / 6), fog = 2 * dc + 3 * ext;
     double center[3], gu[3], gv[3], gn[3];
-    float quad[12];
     int planes = 0;
     int32_t nc = wb_collider_count(w);
     for (int32_t i = 0; i < nc && (o->colliders || o->grid); i++) {
@@ -625,15 +653,15 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
         double h;
         const bool floor = floor_height(&d, &h);
         if (d.shape != WB_SHAPE_PLANE || !(o->colliders || (o->grid && floor))) continue;
-        if (plane_quad(d.normal, d.offset, c, ext, quad, center, gu, gv, gn)) {
-            draw_grid(r, center, gu, gv, gn, spacing, ext, floor, fog);
+        if (plane_frame(d.normal, d.offset, c, center, gu, gv, gn)) {
+            draw_grid(r, cam, center, gu, gv, gn, spacing, ext, floor, fog);
             planes++;
         }
     }
     if (!planes && o->grid) {
         wb_real up[3] = { 0, 1, 0 };
-        if (plane_quad(up, fmin(cur.lo[1], r->view_lo[1]), c, ext, quad, center, gu, gv, gn))
-            draw_grid(r, center, gu, gv, gn, spacing, ext, true, fog);
+        if (plane_frame(up, fmin(cur.lo[1], r->view_lo[1]), c, center, gu, gv, gn))
+            draw_grid(r, cam, center, gu, gv, gn, spacing, ext, true, fog);
     }
 
     /* solids, then the surfaces pushed back a little so links on them stay visible */
