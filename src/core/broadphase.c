@@ -338,21 +338,20 @@ static void make_grid(grid *g, const wb_broad *b, const wb_real *x, const wb_rea
     wb__grid_shape(&g->g, lo, hi, cs, m);
 }
 
-int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
-                       int32_t n, int threads, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
+/* the pairs appended to o (from o->n on; its ij grown as needed) */
+static int32_t broad(wb_broad *b, wb_pairbuf *o, const wb_real *x, const wb_real *reach, const int32_t *skip,
+                     int32_t n, int threads, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
 {
-    if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
-    wb_broad *b = c->bp;
     if (!grow((void **)&b->cand, &b->cap_cand, n, sizeof *b->cand)) return -1;
     int32_t na = 0;
     for (int32_t i = 0; i < n; i++) {
         const wb_real *p = &x[3 * i];
         if (reach[i] >= 0 && isfinite(reach[i]) && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])) b->cand[na++] = i;
     }
-    if (na < 2) return c->n;
+    if (na < 2) return o->n;
     const int32_t m = cull(b, x, reach, skip, na);
     if (m < 0) return -1;
-    if (m < 2) return c->n;
+    if (m < 2) return o->n;
 
     grid g;
     make_grid(&g, b, x, reach, m);
@@ -403,17 +402,17 @@ int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, c
         #pragma omp parallel for num_threads(nt) schedule(static)
         for (int t = 0; t < nt; t++) scan_part(&ctx, t, nt);
     }
-    int64_t total = c->n;
+    int64_t total = o->n;
     for (int t = 0; t < nt; t++) {
         if (b->out[t].fail) return -1;
         total += b->out[t].n;
     }
-    if (!grow((void **)&c->ij, &c->cap, 2 * total, sizeof *c->ij) ||
+    if (!grow((void **)&o->ij, &o->cap, 2 * total, sizeof *o->ij) ||
         !grow((void **)&b->first, &b->cap_first, (int64_t)n + 1, sizeof *b->first))
         return -1;
     /* in (i, j) order: a counting sort by i, then j sorted in each i's handful. The list
      * is then the set of pairs alone, whatever the grid, the ranges or the threads */
-    int32_t *first = b->first, *ij = &c->ij[2 * c->n];
+    int32_t *first = b->first, *ij = &o->ij[2 * o->n];
     memset(first, 0, sizeof *first * ((size_t)n + 1));
     for (int t = 0; t < nt; t++)
         for (int32_t k = 0; k < b->out[t].n; k++) first[b->out[t].ij[2 * k] + 1]++;
@@ -433,7 +432,98 @@ int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, c
         }
         at = first[i];
     }
-    c->n = (int32_t)total;
+    o->n = (int32_t)total;
+    return o->n;
+}
+
+int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
+                       int32_t n, int threads, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
+{
+    if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
+    wb_pairbuf o = { c->ij, c->n, c->cap, 0, NULL, 0 };
+    const int32_t r = broad(c->bp, &o, x, reach, skip, n, threads, keep, ud);
+    c->ij = o.ij;
+    c->cap = o.cap;
+    if (r >= 0) c->n = r;
+    return r;
+}
+
+/* ---- the list kept from frame to frame --------------------------------------------------------- */
+/* A neighbour list with a skin (the Verlet lists of molecular dynamics): the pairs within
+ * R_i + R_j, R_i = reach_i + skin_i, found at positions X_i, hold every pair within
+ * reach_i + reach_j now while each particle has |x_i - X_i| + reach_i <= R_i, since then
+ * |X_i - X_j| <= |x_i - x_j| + |x_i - X_i| + |x_j - X_j| < R_i + R_j. Each call checks
+ * that (a thousandth of the slack spared for round-off), and that the same particles
+ * take part with the same skip keys; the list is rebuilt when any fails, else only
+ * filtered with the search's own test (the same bits) in its (i, j) order: the same
+ * pairs in the same order as wb__broadphase's. */
+#ifndef SKIN
+#define SKIN 0.25
+#endif
+/* skin_i = SKIN x reach_i */
+
+static inline int takes_part(const wb_real *x, const wb_real *reach, int32_t i)
+{
+    const wb_real *p = &x[3 * i];
+    return reach[i] >= 0 && isfinite(reach[i]) && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+}
+
+static int list_valid(const wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t n)
+{
+    if (b->vn != n || n == 0) return 0;
+    const wb_real *X = b->vx, *R = b->vr;
+    const int32_t *K = b->vskip;
+    for (int32_t i = 0; i < n; i++) {
+        const int in = takes_part(x, reach, i);
+        if (in != (R[i] >= 0) || (skip ? skip[i] : 0) != K[i]) return 0;
+        if (!in) continue;
+        const wb_real *p = &x[3 * i];
+        const wb_real d0 = p[0] - X[3 * i], d1 = p[1] - X[3 * i + 1], d2 = p[2] - X[3 * i + 2];
+        const wb_real slack = (R[i] - reach[i]) * (wb_real)0.999;
+        /* round-off in the pair distances: a slack far above the coordinates' ulps */
+        const wb_real mag = fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + R[i];
+        if (!(slack > (wb_real)1e-9 * mag) || !(d0 * d0 + d1 * d1 + d2 * d2 <= slack * slack)) return 0;
+    }
+    return 1;
+}
+
+int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
+                            int32_t n, int threads, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
+{
+    if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
+    wb_broad *b = c->bp;
+    if (!list_valid(b, x, reach, skip, n)) {
+        b->vn = 0;
+        if (!grow((void **)&b->vx, &b->cap_vx, 3 * (int64_t)n, sizeof *b->vx) ||
+            !grow((void **)&b->vr, &b->cap_vr, n, sizeof *b->vr) ||
+            !grow((void **)&b->vskip, &b->cap_vskip, n, sizeof *b->vskip))
+            return -1;
+        for (int32_t i = 0; i < n; i++) {
+            wb_real r = takes_part(x, reach, i) ? reach[i] * (1 + (wb_real)SKIN) : -1;
+            /* a reach that overflows with the skin: none (the check then rebuilds) */
+            b->vr[i] = isfinite(r) ? r : reach[i];
+            b->vskip[i] = skip ? skip[i] : 0;
+        }
+        if (n > 0) memcpy(b->vx, x, sizeof *x * 3 * (size_t)n);
+        b->list.n = 0;
+        if (broad(b, &b->list, x, b->vr, skip, n, threads, NULL, NULL) < 0) return -1;
+        b->vn = n;
+        b->rebuilds++;
+    }
+    if (!grow((void **)&c->ij, &c->cap, 2 * ((int64_t)c->n + b->list.n), sizeof *c->ij)) return -1;
+    int32_t *out = c->ij, at = c->n;
+    const int32_t *ij = b->list.ij;
+    for (int32_t k = 0; k < b->list.n; k++) {
+        const int32_t i = ij[2 * k], j = ij[2 * k + 1];
+        const wb_real *p = &x[3 * i], *q = &x[3 * j];
+        const wb_real d0 = q[0] - p[0], d1 = q[1] - p[1], d2 = q[2] - p[2], r = reach[i] + reach[j];
+        if (d0 * d0 + d1 * d1 + d2 * d2 >= r * r) continue;
+        if (keep && !keep(ud, i, j)) continue;
+        out[2 * at] = i;
+        out[2 * at + 1] = j;
+        at++;
+    }
+    c->n = at;
     return c->n;
 }
 
@@ -554,7 +644,7 @@ void wb__contacts_begin(wb_world *w)
          * distance test, and its inside is culled by its bounds */
         skip[i] = gi > 0 && !(f & WB_CF_SELF) ? gi : 0;
     }
-    if (wb__broadphase(c, w->s.x, reach, skip, m->np, m->def.threads, may_touch, w) < 0) {
+    if (wb__broadphase_kept(c, w->s.x, reach, skip, m->np, m->def.threads, may_touch, w) < 0) {
         c->n = 0;
         wb__warn(w, "out of memory in the contact broad phase; contacts skipped");
     }

@@ -205,6 +205,11 @@ static inline int64_t wb__cell_of(wb_real v, wb_real o, wb_real inv)
 typedef struct wb_broad wb_broad;
 int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
                        int32_t n, int threads, int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
+/* the same pairs from a neighbour list kept from call to call in c->bp and rebuilt (by
+ * wb__broadphase) only when some particle moved past its skin, or the particles' reach
+ * >= 0 or skip keys changed (broadphase.c) */
+int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
+                            int32_t n, int threads, int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
 /* its scratch, kept from frame to frame (defined here so that the world frees it
  * without calling back into broadphase.c) */
 typedef struct wb_pairbuf {
@@ -222,6 +227,13 @@ struct wb_broad {
     wb_real *boxes; int32_t cap_boxes; /* (lo, hi) of runs' overlaps */
     wb_pairbuf *out; int nout;         /* one per thread */
     int32_t *first; int32_t cap_first; /* (n + 1) sorting the pairs by i */
+    /* the kept list (wb__broadphase_kept): positions, reaches with the skin (-1: left
+     * out) and skip keys it was built with, its pairs (keep not applied) */
+    int32_t vn;                        /* particles it was built for; 0: none */
+    wb_real *vx, *vr; int32_t cap_vx, cap_vr;
+    int32_t *vskip; int32_t cap_vskip;
+    wb_pairbuf list;
+    int64_t rebuilds;                  /* for the tests */
 };
 static inline void wb__broadphase_free(wb_contacts *c)
 {
@@ -232,6 +244,7 @@ static inline void wb__broadphase_free(wb_contacts *c)
     if (!b) return;
     free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key);
     free(b->runs); free(b->boxes); free(b->first);
+    free(b->vx); free(b->vr); free(b->vskip); free(b->list.ij); free(b->list.hit);
     for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
     free(b->out);
     free(b);
