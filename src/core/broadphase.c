@@ -60,9 +60,7 @@ typedef struct wb_broad_run {
 typedef wb_pairbuf pairbuf;
 
 typedef struct grid {
-    wb_real o[3], inv;
-    int64_t nc[3];                     /* cells per axis */
-    int wrap;                          /* coordinates wrap around (a sparse, huge volume) */
+    wb_grid g;                         /* origin, cell, shape (grid.c) */
     wb_real big;                       /* reach past which a particle is big */
     wb_real rn;                        /* the largest reach up to big */
 } grid;
@@ -76,19 +74,11 @@ static int grow(void **p, int32_t *cap, int64_t need, size_t elem)
     return 1;
 }
 
-/* cell coordinate, clamped to [0, 1e15] so that the cast stays defined for huge or
- * infinite offsets (far particles share the last cell: still found, merely tested
- * against more of them); monotone in v, so a search range never misses a cell */
-static inline int64_t cell_of(wb_real v, wb_real o, wb_real inv)
-{
-    const wb_real c = (v - o) * inv;
-    /* truncation is floor for c > 0 (and no libm call without SSE4.1) */
-    return c > 0 ? (c < 1e15 ? (int64_t)c : (int64_t)1e15) : 0;
-}
+static inline int64_t cell_of(wb_real v, wb_real o, wb_real inv) { return wb__cell_of(v, o, inv); }
 
 static inline int64_t wrap_to(int64_t c, int64_t n) { return c % n; }
 
-static inline int32_t cell_index(const grid *g, const wb_real *x)
+static inline int32_t cell_index(const wb_grid *g, const wb_real *x)
 {
     int64_t c[3];
     for (int a = 0; a < 3; a++) {
@@ -203,8 +193,8 @@ static void push(pairbuf *o, int32_t i, int32_t j)
     o->n++;
 }
 
-/* an axis's search range [c - 2 reach, c + 2 reach] as at most two runs of grid cells */
-static inline int axis_ranges(const grid *g, int a, wb_real v, wb_real e, int64_t r[4])
+/* an axis's search range [v - e, v + e] as at most two runs of grid cells */
+static inline int axis_ranges(const wb_grid *g, int a, wb_real v, wb_real e, int64_t r[4])
 {
     int64_t lo = cell_of(v - e, g->o[a], g->inv), hi = cell_of(v + e, g->o[a], g->inv);
     const int64_t n = g->nc[a];
@@ -220,91 +210,118 @@ static inline int axis_ranges(const grid *g, int a, wb_real v, wb_real e, int64_
     return 2;
 }
 
-/* one candidate pair: not of one skip key, within reach, kept */
-
-/* the sorted positions [q0, q1) that s pairs with. big: s is big, partners of a smaller
- * reach (ties: a higher index); else partners that are not big. The distance test
- * first: it fails for most (a branch that predicts well), the skip key after */
-static inline void try_range(const wb_broad *b, const grid *g, int32_t s, int32_t q0, int32_t q1, int big,
-                             pairbuf *o, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
+/* the sorted positions [q0, q1) closer to p (x, y, z, reach) than the two reaches and not
+ * of its skip key ks (kz: it has none), appended to hit from nh. Branch-free: most fail,
+ * and a branch per test mispredicts */
+static inline int32_t gather(const wb_real *restrict P, const int32_t *restrict key, const wb_real *restrict p,
+                             int32_t ks, int kz, int32_t q0, int32_t q1, int32_t *restrict hit, int32_t nh)
 {
-    const wb_real *P = b->p, *p = &P[4 * s], rs = p[3], T = g->big;
-    const int32_t *key = b->key, *id = b->id, ks = key[s], i = id[s];
+    const wb_real px = p[0], py = p[1], pz = p[2], rs = p[3];
     for (int32_t t = q0; t < q1; t++) {
-        const wb_real *q = &P[4 * t], rt = q[3];
-        const wb_real d0 = q[0] - p[0], d1 = q[1] - p[1], d2 = q[2] - p[2], r = rs + rt;
-        if (d0 * d0 + d1 * d1 + d2 * d2 >= r * r) continue;
-        if (ks != 0 && key[t] == ks) continue;
-        if (big ? rt > rs || (rt == rs && id[t] <= i) : rt > T) continue;
-        const int32_t j = id[t];
+        const wb_real *q = &P[4 * t];
+        const wb_real d0 = q[0] - px, d1 = q[1] - py, d2 = q[2] - pz, r = rs + q[3];
+        hit[nh] = t;
+        nh += (d0 * d0 + d1 * d1 + d2 * d2 < r * r) & ((key[t] != ks) | kz);
+    }
+    return nh;
+}
+
+/* s's hits into pairs, kept. big: s is big, partners of a smaller reach (ties: a higher
+ * index); else partners that are not big */
+static void emit(const wb_broad *b, const grid *g, int32_t s, int big, const int32_t *hit, int32_t nh, pairbuf *o,
+                 int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
+{
+    const wb_real *P = b->p, rs = P[4 * s + 3], T = g->big;
+    const int32_t *id = b->id, i = id[s];
+    for (int32_t h = 0; h < nh; h++) {
+        const int32_t t = hit[h], j = id[t];
+        const wb_real rt = P[4 * t + 3];
+        if (big ? rt > rs || (rt == rs && j <= i) : rt > T) continue;
         if (keep && !keep(ud, i < j ? i : j, i < j ? j : i)) continue;
         push(o, i, j);
     }
 }
 
-/* pass 3 over the sorted positions [lo, hi). A pair of two ordinary particles (reach
- * up to g->big) is found from the one earlier in the sorted array, which searches
- * reach + g->rn (rows wholly before it are skipped); a pair with a big particle from
- * the one with the larger reach (ties: the lower index), which searches twice its
- * reach over the whole neighbourhood */
-static void scan(const wb_broad *b, const grid *g, int32_t lo, int32_t hi, pairbuf *o,
+/* pass 3 over the sorted positions [lo, hi) (hit: scratch for hi - lo ... at most every
+ * position). A pair of two ordinary particles (reach up to g->big) is found from the one
+ * earlier in the sorted array, which searches reach + g->rn (rows wholly before it are
+ * skipped); a pair with a big particle from the one with the larger reach (ties: the
+ * lower index), which searches twice its reach over the whole neighbourhood */
+static void scan(const wb_broad *b, const grid *g, int32_t lo, int32_t hi, int32_t *restrict hit, pairbuf *o,
                  int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
 {
-    const int32_t *start = b->start;
-    const wb_real *P = b->p, T = g->big;
-    const int64_t nx = g->nc[0], ny = g->nc[1];
+    const int32_t *restrict start = b->start, *restrict key = b->key;
+    const wb_real *restrict P = b->p, T = g->big;
+    const wb_grid *G = &g->g;
+    const int64_t nx = G->nc[0], ny = G->nc[1], nz = G->nc[2];
+    const wb_real ox = G->o[0], oy = G->o[1], oz = G->o[2], inv = G->inv;
     for (int32_t s = lo; s < hi; s++) {
         const wb_real *p = &P[4 * s], rs = p[3];
-        const int big = rs > T;
+        const int32_t ks = key[s];
+        const int kz = ks == 0, big = rs > T;
         const wb_real e = big ? 2 * rs : rs + g->rn;
-        int64_t rx[4], ry[4], rz[4];
-        const int kx = axis_ranges(g, 0, p[0], e, rx), ky = axis_ranges(g, 1, p[1], e, ry),
-                  kz = axis_ranges(g, 2, p[2], e, rz);
-        if (!g->wrap && !big) {
+        int32_t nh = 0;
+        if (!G->wrap && !big) {
             /* rows wholly before s in the sorted order hold no partner of it: from its
              * own row on (its own from s + 1) */
-            const int64_t y0 = cell_of(p[1], g->o[1], g->inv), z0 = cell_of(p[2], g->o[2], g->inv);
-            for (int64_t z = z0; z <= rz[1]; z++)
-                for (int64_t y = z == z0 ? y0 : ry[0]; y <= ry[1]; y++) {
-                    const int64_t row = nx * (y + ny * z);
-                    const int32_t q0 = y == y0 && z == z0 ? s + 1 : start[row + rx[0]], q1 = start[row + rx[1] + 1];
-                    if (q0 < q1) try_range(b, g, s, q0, q1, 0, o, keep, ud);
+            const int64_t x0 = cell_of(p[0] - e, ox, inv), x1r = cell_of(p[0] + e, ox, inv),
+                          y1r = cell_of(p[1] + e, oy, inv), z1r = cell_of(p[2] + e, oz, inv);
+            const int64_t x1 = x1r < nx - 1 ? x1r : nx - 1, y1 = y1r < ny - 1 ? y1r : ny - 1,
+                          z1 = z1r < nz - 1 ? z1r : nz - 1;
+            const int64_t y0 = cell_of(p[1], oy, inv), z0 = cell_of(p[2], oz, inv), ylo = cell_of(p[1] - e, oy, inv);
+            int64_t row = nx * (y0 + ny * z0);
+            nh = gather(P, key, p, ks, kz, s + 1, start[row + x1 + 1], hit, nh);
+            for (int64_t z = z0; z <= z1; z++)
+                for (int64_t y = z == z0 ? y0 + 1 : ylo; y <= y1; y++) {
+                    row = nx * (y + ny * z);
+                    nh = gather(P, key, p, ks, kz, start[row + x0], start[row + x1 + 1], hit, nh);
                 }
+            emit(b, g, s, 0, hit, nh, o, keep, ud);
             continue;
         }
-        for (int az = 0; az < kz; az++)
+        int64_t rx[4], ry[4], rz[4];
+        const int kx = axis_ranges(G, 0, p[0], e, rx), ky = axis_ranges(G, 1, p[1], e, ry),
+                  kw = axis_ranges(G, 2, p[2], e, rz);
+        for (int az = 0; az < kw; az++)
             for (int64_t z = rz[2 * az]; z <= rz[2 * az + 1]; z++)
                 for (int ay = 0; ay < ky; ay++)
                     for (int64_t y = ry[2 * ay]; y <= ry[2 * ay + 1]; y++) {
                         const int64_t row = nx * (y + ny * z);
                         for (int ax = 0; ax < kx; ax++) {
-                                    int32_t q0 = start[row + rx[2 * ax]];
+                            int32_t q0 = start[row + rx[2 * ax]];
                             const int32_t q1 = start[row + rx[2 * ax + 1] + 1];
                             if (!big) {
                                 if (q1 <= s + 1) continue;
                                 if (q0 < s + 1) q0 = s + 1;
                             }
-                            try_range(b, g, s, q0, q1, big, o, keep, ud);
+                            nh = gather(P, key, p, ks, kz, q0, q1, hit, nh);
                         }
                     }
+        emit(b, g, s, big, hit, nh, o, keep, ud);
     }
 }
 
-static int cmp_real(const void *a, const void *b)
+/* one thread's share of pass 3: the t-th of nt contiguous ranges of the sorted array */
+typedef struct scan_ctx {
+    const wb_broad *b;
+    const grid *g;
+    int32_t m;
+    int (*keep)(void *ud, int32_t i, int32_t j);
+    void *ud;
+} scan_ctx;
+
+static void scan_part(void *ctx, int t, int nt)
 {
-    const wb_real x = *(const wb_real *)a, y = *(const wb_real *)b;
-    return x < y ? -1 : x > y;
+    const scan_ctx *c = ctx;
+    const int32_t lo = (int32_t)((int64_t)c->m * t / nt), hi = (int32_t)((int64_t)c->m * (t + 1) / nt);
+    pairbuf *o = &c->b->out[t];
+    scan(c->b, c->g, lo, hi, o->hit, o, c->keep, c->ud);
 }
 
-/* pass 2: the grid's origin, cell size and shape */
+/* pass 2: the grid's origin, cell size and shape; the cell is the typical reach */
 static void make_grid(grid *g, const wb_broad *b, const wb_real *x, const wb_real *reach, int32_t m)
 {
-    /* the typical reach: the median of up to 31 reaches sampled evenly over the list */
-    wb_real sample[31];
-    const int ns = m < 31 ? (int)m : 31;
-    for (int k = 0; k < ns; k++) sample[k] = reach[b->cand[(int64_t)m * k / ns]];
-    qsort(sample, (size_t)ns, sizeof *sample, cmp_real);
-    const wb_real typical = sample[ns / 2];
+    const wb_real typical = wb__grid_typical(reach, b->cand, m);
     g->big = 2 * typical;
     g->rn = 0;
     wb_real lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY }, rmax = 0;
@@ -319,80 +336,27 @@ static void make_grid(grid *g, const wb_broad *b, const wb_real *x, const wb_rea
     }
     wb_real cs = typical;
     if (!(cs > 0)) cs = 2 * rmax;
-    if (!(cs > 1e-300)) cs = 1e-300;
-    /* at most ~2 cells per particle: cells grown by 2^(1/3) until the box fits, past
-     * 2^20 times the reach the coordinates wrap instead */
-    const double budget = 2.0 * m + 64;
-    double dims[3];
-    wb_real inv = 1 / cs;
-    for (int grow_step = 0;; grow_step++) {
-        double prod = 1;
-        inv = 1 / cs;
-        for (int a = 0; a < 3; a++) {
-            /* as cell_of computes it: the last particle's cell is inside */
-            dims[a] = floor((hi[a] - lo[a]) * inv) + 1;
-            if (!(dims[a] < 1e15)) dims[a] = 1e15;
-            prod *= dims[a];
-        }
-        g->wrap = prod > budget;
-        if (!g->wrap || grow_step == 60) break;
-        cs *= 1.2599210498948732;
-    }
-    if (g->wrap) {
-        /* the budget shared out from the thinnest axis up */
-        int order[3] = { 0, 1, 2 };
-        for (int a = 0; a < 2; a++)
-            for (int c = a + 1; c < 3; c++)
-                if (dims[order[c]] < dims[order[a]]) { int t = order[a]; order[a] = order[c]; order[c] = t; }
-        double left = budget;
-        for (int k = 0; k < 3; k++) {
-            const int a = order[k];
-            double cap = floor(pow(left, 1.0 / (3 - k)) + 1e-9);
-            if (cap < 1) cap = 1;
-            if (dims[a] > cap) dims[a] = cap;
-            left /= dims[a];
-        }
-    }
-    for (int a = 0; a < 3; a++) { g->o[a] = lo[a]; g->nc[a] = (int64_t)dims[a]; }
-    g->inv = inv;
+    wb__grid_shape(&g->g, lo, hi, cs, m);
 }
 
-/* pass 3 on the pool: part t scans its contiguous range into its own buffer */
-typedef struct scan_job {
-    wb_broad *b;
-    const grid *g;
-    int32_t m;
-    int (*keep)(void *ud, int32_t i, int32_t j);
-    void *ud;
-} scan_job;
-
-static void scan_part(void *ctx, int t, int nt)
+/* the pairs appended to o (from o->n on; its ij grown as needed) */
+static int32_t broad(wb_broad *b, wb_pairbuf *o, const wb_real *x, const wb_real *reach, const int32_t *skip,
+                     int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
 {
-    const scan_job *j = ctx;
-    const int32_t lo = (int32_t)((int64_t)j->m * t / nt), hi = (int32_t)((int64_t)j->m * (t + 1) / nt);
-    scan(j->b, j->g, lo, hi, &j->b->out[t], j->keep, j->ud);
-}
-
-int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
-                       int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
-{
-    const int threads = wb__pool_threads(pool);
-    if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
-    wb_broad *b = c->bp;
     if (!grow((void **)&b->cand, &b->cap_cand, n, sizeof *b->cand)) return -1;
     int32_t na = 0;
     for (int32_t i = 0; i < n; i++) {
         const wb_real *p = &x[3 * i];
         if (reach[i] >= 0 && isfinite(reach[i]) && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])) b->cand[na++] = i;
     }
-    if (na < 2) return c->n;
+    if (na < 2) return o->n;
     const int32_t m = cull(b, x, reach, skip, na);
     if (m < 0) return -1;
-    if (m < 2) return c->n;
+    if (m < 2) return o->n;
 
     grid g;
     make_grid(&g, b, x, reach, m);
-    const int64_t ncell = g.nc[0] * g.nc[1] * g.nc[2];
+    const int64_t ncell = g.g.nc[0] * g.g.nc[1] * g.g.nc[2];
     if (!grow((void **)&b->start, &b->cap_start, ncell + 1, sizeof *b->start) ||
         !grow((void **)&b->cell, &b->cap_cell, m, sizeof *b->cell) ||
         !grow((void **)&b->p, &b->cap_p, 4 * (int64_t)m, sizeof *b->p) ||
@@ -403,7 +367,7 @@ int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, c
     int32_t *start = b->start;
     memset(start, 0, sizeof *start * (size_t)(ncell + 1));
     for (int32_t k = 0; k < m; k++) {
-        const int32_t cl = cell_index(&g, &x[3 * b->cand[k]]);
+        const int32_t cl = cell_index(&g.g, &x[3 * b->cand[k]]);
         b->cell[k] = cl;
         start[cl + 1]++;
     }
@@ -420,6 +384,7 @@ int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, c
     start[0] = 0;
 
     /* pass 3: contiguous ranges of the sorted array, one pair buffer each */
+    const int threads = wb__pool_threads(pool);
     int nt = threads > 1 && m >= PAR_MIN ? threads : 1;
     if (nt > b->nout) {
         pairbuf *o = realloc(b->out, sizeof *o * (size_t)nt);
@@ -428,23 +393,25 @@ int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, c
         b->out = o;
         b->nout = nt;
     }
-    for (int t = 0; t < nt; t++) { b->out[t].n = 0; b->out[t].fail = 0; }
-    if (nt == 1) scan(b, &g, 0, m, &b->out[0], keep, ud);
-    else {
-        scan_job j = { b, &g, m, keep, ud };
-        wb__pool_run(pool, scan_part, &j); /* nt parts: nt == the pool's threads */
+    for (int t = 0; t < nt; t++) {
+        b->out[t].n = 0;
+        b->out[t].fail = 0;
+        if (!grow((void **)&b->out[t].hit, &b->out[t].cap_hit, m, sizeof *b->out[t].hit)) return -1;
     }
-    int64_t total = c->n;
+    scan_ctx ctx = { b, &g, m, keep, ud };
+    if (nt == 1) scan_part(&ctx, 0, 1);
+    else wb__pool_run(pool, scan_part, &ctx); /* nt parts: nt == the pool's threads */
+    int64_t total = o->n;
     for (int t = 0; t < nt; t++) {
         if (b->out[t].fail) return -1;
         total += b->out[t].n;
     }
-    if (!grow((void **)&c->ij, &c->cap, 2 * total, sizeof *c->ij) ||
+    if (!grow((void **)&o->ij, &o->cap, 2 * total, sizeof *o->ij) ||
         !grow((void **)&b->first, &b->cap_first, (int64_t)n + 1, sizeof *b->first))
         return -1;
     /* in (i, j) order: a counting sort by i, then j sorted in each i's handful. The list
      * is then the set of pairs alone, whatever the grid, the ranges or the threads */
-    int32_t *first = b->first, *ij = &c->ij[2 * c->n];
+    int32_t *first = b->first, *ij = &o->ij[2 * o->n];
     memset(first, 0, sizeof *first * ((size_t)n + 1));
     for (int t = 0; t < nt; t++)
         for (int32_t k = 0; k < b->out[t].n; k++) first[b->out[t].ij[2 * k] + 1]++;
@@ -464,7 +431,98 @@ int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, c
         }
         at = first[i];
     }
-    c->n = (int32_t)total;
+    o->n = (int32_t)total;
+    return o->n;
+}
+
+int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
+                       int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
+{
+    if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
+    wb_pairbuf o = { c->ij, c->n, c->cap, 0, NULL, 0 };
+    const int32_t r = broad(c->bp, &o, x, reach, skip, n, pool, keep, ud);
+    c->ij = o.ij;
+    c->cap = o.cap;
+    if (r >= 0) c->n = r;
+    return r;
+}
+
+/* ---- the list kept from frame to frame --------------------------------------------------------- */
+/* A neighbour list with a skin (the Verlet lists of molecular dynamics): the pairs within
+ * R_i + R_j, R_i = reach_i + skin_i, found at positions X_i, hold every pair within
+ * reach_i + reach_j now while each particle has |x_i - X_i| + reach_i <= R_i, since then
+ * |X_i - X_j| <= |x_i - x_j| + |x_i - X_i| + |x_j - X_j| < R_i + R_j. Each call checks
+ * that (a thousandth of the slack spared for round-off), and that the same particles
+ * take part with the same skip keys; the list is rebuilt when any fails, else only
+ * filtered with the search's own test (the same bits) in its (i, j) order: the same
+ * pairs in the same order as wb__broadphase's. */
+#ifndef SKIN
+#define SKIN 0.25
+#endif
+/* skin_i = SKIN x reach_i */
+
+static inline int takes_part(const wb_real *x, const wb_real *reach, int32_t i)
+{
+    const wb_real *p = &x[3 * i];
+    return reach[i] >= 0 && isfinite(reach[i]) && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+}
+
+static int list_valid(const wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t n)
+{
+    if (b->vn != n || n == 0) return 0;
+    const wb_real *X = b->vx, *R = b->vr;
+    const int32_t *K = b->vskip;
+    for (int32_t i = 0; i < n; i++) {
+        const int in = takes_part(x, reach, i);
+        if (in != (R[i] >= 0) || (skip ? skip[i] : 0) != K[i]) return 0;
+        if (!in) continue;
+        const wb_real *p = &x[3 * i];
+        const wb_real d0 = p[0] - X[3 * i], d1 = p[1] - X[3 * i + 1], d2 = p[2] - X[3 * i + 2];
+        const wb_real slack = (R[i] - reach[i]) * (wb_real)0.999;
+        /* round-off in the pair distances: a slack far above the coordinates' ulps */
+        const wb_real mag = fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + R[i];
+        if (!(slack > (wb_real)1e-9 * mag) || !(d0 * d0 + d1 * d1 + d2 * d2 <= slack * slack)) return 0;
+    }
+    return 1;
+}
+
+int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
+                            int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
+{
+    if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
+    wb_broad *b = c->bp;
+    if (!list_valid(b, x, reach, skip, n)) {
+        b->vn = 0;
+        if (!grow((void **)&b->vx, &b->cap_vx, 3 * (int64_t)n, sizeof *b->vx) ||
+            !grow((void **)&b->vr, &b->cap_vr, n, sizeof *b->vr) ||
+            !grow((void **)&b->vskip, &b->cap_vskip, n, sizeof *b->vskip))
+            return -1;
+        for (int32_t i = 0; i < n; i++) {
+            wb_real r = takes_part(x, reach, i) ? reach[i] * (1 + (wb_real)SKIN) : -1;
+            /* a reach that overflows with the skin: none (the check then rebuilds) */
+            b->vr[i] = isfinite(r) ? r : reach[i];
+            b->vskip[i] = skip ? skip[i] : 0;
+        }
+        if (n > 0) memcpy(b->vx, x, sizeof *x * 3 * (size_t)n);
+        b->list.n = 0;
+        if (broad(b, &b->list, x, b->vr, skip, n, pool, NULL, NULL) < 0) return -1;
+        b->vn = n;
+        b->rebuilds++;
+    }
+    if (!grow((void **)&c->ij, &c->cap, 2 * ((int64_t)c->n + b->list.n), sizeof *c->ij)) return -1;
+    int32_t *out = c->ij, at = c->n;
+    const int32_t *ij = b->list.ij;
+    for (int32_t k = 0; k < b->list.n; k++) {
+        const int32_t i = ij[2 * k], j = ij[2 * k + 1];
+        const wb_real *p = &x[3 * i], *q = &x[3 * j];
+        const wb_real d0 = q[0] - p[0], d1 = q[1] - p[1], d2 = q[2] - p[2], r = reach[i] + reach[j];
+        if (d0 * d0 + d1 * d1 + d2 * d2 >= r * r) continue;
+        if (keep && !keep(ud, i, j)) continue;
+        out[2 * at] = i;
+        out[2 * at + 1] = j;
+        at++;
+    }
+    c->n = at;
     return c->n;
 }
 
@@ -585,7 +643,7 @@ void wb__contacts_begin(wb_world *w)
          * distance test, and its inside is culled by its bounds */
         skip[i] = gi > 0 && !(f & WB_CF_SELF) ? gi : 0;
     }
-    if (wb__broadphase(c, w->s.x, reach, skip, m->np, wb__world_pool(w), may_touch, w) < 0) {
+    if (wb__broadphase_kept(c, w->s.x, reach, skip, m->np, wb__world_pool(w), may_touch, w) < 0) {
         c->n = 0;
         wb__warn(w, "out of memory in the contact broad phase; contacts skipped");
     }

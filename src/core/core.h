@@ -176,6 +176,28 @@ typedef struct wb_contacts {
     int32_t cap_load;
 } wb_contacts;
 
+/* grid.c: the sorted grids of the broad phases (broadphase.c, tribroad.c). Cell (i, j, k)
+ * of a point is floor((x - o) * inv) per axis, clamped to [0, 1e15] (wb__cell_of), taken
+ * modulo nc when wrap is set (points spread over a volume too big for the budget) */
+typedef struct wb_grid {
+    wb_real o[3], inv;     /* origin, 1 / cell */
+    int64_t nc[3];         /* cells per axis */
+    int wrap;              /* coordinates wrap around */
+} wb_grid;
+/* the median of up to 31 reaches sampled evenly over list (n > 0) */
+wb_real wb__grid_typical(const wb_real *reach, const int32_t *list, int32_t n);
+/* the grid over the points inside [lo, hi]: cell cs or larger, at most ~2 cells per
+ * point (n), wrapping past that */
+void wb__grid_shape(wb_grid *g, const wb_real lo[3], const wb_real hi[3], wb_real cs, int32_t n);
+/* a coordinate's cell, monotone in v (a search range never misses a cell); clamped so
+ * that the cast stays defined for huge or infinite offsets; truncation is floor for
+ * c > 0 (and no libm call without SSE4.1) */
+static inline int64_t wb__cell_of(wb_real v, wb_real o, wb_real inv)
+{
+    const wb_real c = (v - o) * inv;
+    return c > 0 ? (c < 1e15 ? (int64_t)c : (int64_t)1e15) : 0;
+}
+
 /* broadphase.c: every pair i < j with |x_i - x_j| < reach_i + reach_j (particles with
  * reach < 0 or a non-finite position left out; pairs with one nonzero skip key too,
  * skip may be NULL), each once, in (i, j) order (so the same for any thread count);
@@ -184,9 +206,17 @@ typedef struct wb_contacts {
 typedef struct wb_broad wb_broad;
 int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
                        int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
+/* the same pairs from a neighbour list kept from call to call in c->bp and rebuilt (by
+ * wb__broadphase) only when some particle moved past its skin, or the particles' reach
+ * >= 0 or skip keys changed (broadphase.c) */
+int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
+                            int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
 /* its scratch, kept from frame to frame (defined here so that the world frees it
  * without calling back into broadphase.c) */
-typedef struct wb_pairbuf { int32_t *ij; int32_t n, cap; int fail; } wb_pairbuf;
+typedef struct wb_pairbuf {
+    int32_t *ij; int32_t n, cap; int fail;
+    int32_t *hit; int32_t cap_hit;     /* broadphase.c: one particle's hits */
+} wb_pairbuf;
 struct wb_broad {
     int32_t *cand; int32_t cap_cand;   /* candidates in index order, then the survivors */
     int32_t *cell; int32_t cap_cell;   /* cell of each survivor */
@@ -198,6 +228,13 @@ struct wb_broad {
     wb_real *boxes; int32_t cap_boxes; /* (lo, hi) of runs' overlaps */
     wb_pairbuf *out; int nout;         /* one per thread */
     int32_t *first; int32_t cap_first; /* (n + 1) sorting the pairs by i */
+    /* the kept list (wb__broadphase_kept): positions, reaches with the skin (-1: left
+     * out) and skip keys it was built with, its pairs (keep not applied) */
+    int32_t vn;                        /* particles it was built for; 0: none */
+    wb_real *vx, *vr; int32_t cap_vx, cap_vr;
+    int32_t *vskip; int32_t cap_vskip;
+    wb_pairbuf list;
+    int64_t rebuilds;                  /* for the tests */
 };
 static inline void wb__broadphase_free(wb_contacts *c)
 {
@@ -208,7 +245,8 @@ static inline void wb__broadphase_free(wb_contacts *c)
     if (!b) return;
     free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key);
     free(b->runs); free(b->boxes); free(b->first);
-    for (int t = 0; t < b->nout; t++) free(b->out[t].ij);
+    free(b->vx); free(b->vr); free(b->vskip); free(b->list.ij); free(b->list.hit);
+    for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
     free(b->out);
     free(b);
     c->bp = NULL;
@@ -234,9 +272,7 @@ typedef struct wb_tricontacts {
 /* tribroad.c's scratch, kept from frame to frame (defined here so that the world frees it
  * without calling into tribroad.c) */
 typedef struct wb_trilevel {
-    wb_real o[3], inv;     /* grid origin, 1 / cell */
-    int64_t nc[3];         /* cells per axis */
-    int wrap;              /* coordinates wrap around (a sparse, huge volume) */
+    wb_grid g;             /* its grid */
     wb_real rn;            /* the largest reach of its points */
     int32_t first, count;  /* its points' sorted positions [first, first + count) */
     int64_t start0;        /* its cells' offsets: start[start0 .. start0 + cells] */
@@ -268,7 +304,7 @@ static inline void wb__tribroad_free(wb_tricontacts *c)
     void *p[] = { b->reach, b->mv, b->tbox, b->tkey, b->pc, b->tc, b->prun, b->trun, b->tmp, b->runs, b->boxes,
                   b->sp, b->sid, b->skey, b->scell, b->start, b->first, b->pt2, b->okey };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
-    for (int t = 0; t < b->nout; t++) free(b->out[t].ij);
+    for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
     free(b->out);
     free(b);
     c->bp = NULL;

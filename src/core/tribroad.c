@@ -279,31 +279,8 @@ static int cull(struct wb_tribroad *b, const wb_world *w, int32_t *np_, int32_t 
 }
 
 /* ---- pass 2: the levels' sorted grids ------------------------------------------------------------ */
-static inline int64_t cell_of(wb_real v, wb_real o, wb_real inv)
-{
-    const wb_real c = (v - o) * inv;
-    return c > 0 ? (c < 1e15 ? (int64_t)c : (int64_t)1e15) : 0;
-}
-
-static int cmp_real(const void *a, const void *b)
-{
-    const wb_real x = *(const wb_real *)a, y = *(const wb_real *)b;
-    return x < y ? -1 : x > y;
-}
-
-/* the median of up to 31 reaches sampled evenly over list */
-static wb_real typical_reach(const wb_real *reach, const int32_t *list, int32_t n)
-{
-    wb_real sample[31];
-    const int ns = n < 31 ? (int)n : 31;
-    for (int k = 0; k < ns; k++) sample[k] = reach[list[(int64_t)n * k / ns]];
-    qsort(sample, (size_t)ns, sizeof *sample, cmp_real);
-    return sample[ns / 2];
-}
-
-/* a level's origin, cell and shape over list (n points): at most ~2 cells per point,
- * cells grown by 2^(1/3) until the box fits, past that the coordinates wrap */
-static void make_grid(level *g, const wb_real *x, const wb_real *reach, const int32_t *list, int32_t n,
+/* a level's grid over list (n points): cell twice the typical reach (grid.c's rule) */
+static void make_grid(level *l, const wb_real *x, const wb_real *reach, const int32_t *list, int32_t n,
                       wb_real typical)
 {
     wb_real lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY }, rmax = 0;
@@ -315,42 +292,10 @@ static void make_grid(level *g, const wb_real *x, const wb_real *reach, const in
         }
         if (reach[i] > rmax) rmax = reach[i];
     }
-    g->rn = rmax;
+    l->rn = rmax;
     wb_real cs = 2 * typical;
     if (!(cs > 0)) cs = 2 * rmax;
-    if (!(cs > 1e-300)) cs = 1e-300;
-    const double budget = 2.0 * n + 64;
-    double dims[3];
-    wb_real inv = 1 / cs;
-    for (int step = 0;; step++) {
-        double prod = 1;
-        inv = 1 / cs;
-        for (int a = 0; a < 3; a++) {
-            dims[a] = floor((hi[a] - lo[a]) * inv) + 1;
-            if (!(dims[a] < 1e15)) dims[a] = 1e15;
-            prod *= dims[a];
-        }
-        g->wrap = prod > budget;
-        if (!g->wrap || step == 60) break;
-        cs *= 1.2599210498948732;
-    }
-    if (g->wrap) {
-        /* the budget shared out from the thinnest axis up */
-        int order[3] = { 0, 1, 2 };
-        for (int a = 0; a < 2; a++)
-            for (int c = a + 1; c < 3; c++)
-                if (dims[order[c]] < dims[order[a]]) { int t = order[a]; order[a] = order[c]; order[c] = t; }
-        double left = budget;
-        for (int k = 0; k < 3; k++) {
-            const int a = order[k];
-            double cap = floor(pow(left, 1.0 / (3 - k)) + 1e-9);
-            if (cap < 1) cap = 1;
-            if (dims[a] > cap) dims[a] = cap;
-            left /= dims[a];
-        }
-    }
-    for (int a = 0; a < 3; a++) { g->o[a] = lo[a]; g->nc[a] = (int64_t)dims[a]; }
-    g->inv = inv;
+    wb__grid_shape(&l->g, lo, hi, cs, n);
 }
 
 /* the levels over the kept points b->pc (n); -1 when out of memory */
@@ -367,8 +312,9 @@ static int make_levels(struct wb_tribroad *b, const wb_world *w, int32_t n)
     int64_t cells = 0;
     b->nlv = 0;
     while (rest > 0) {
-        level *g = &b->lv[b->nlv];
-        const wb_real typical = typical_reach(reach, list, rest);
+        level *l = &b->lv[b->nlv];
+        const wb_grid *g = &l->g;
+        const wb_real typical = wb__grid_typical(reach, list, rest);
         const wb_real limit = b->nlv == WB_TRI_LEVELS - 1 ? INFINITY : 2 * typical;
         /* this level's points to the front of list, the others after them, both in order */
         int32_t nl = 0, nr = 0;
@@ -378,21 +324,21 @@ static int make_levels(struct wb_tribroad *b, const wb_world *w, int32_t n)
             else b->tmp[nr++] = i;
         }
         memcpy(list + nl, b->tmp, sizeof *list * (size_t)nr);
-        make_grid(g, x, reach, list, nl, typical);
-        g->first = done;
-        g->count = nl;
-        g->start0 = cells;
+        make_grid(l, x, reach, list, nl, typical);
+        l->first = done;
+        l->count = nl;
+        l->start0 = cells;
         const int64_t nc = g->nc[0] * g->nc[1] * g->nc[2];
         cells += nc + 1;
         if (!grow((void **)&b->start, &b->cap_start, cells, sizeof *b->start)) return -1;
         /* counting sort by cell: stable */
-        int32_t *start = b->start + g->start0;
+        int32_t *start = b->start + l->start0;
         memset(start, 0, sizeof *start * (size_t)(nc + 1));
         for (int32_t k = 0; k < nl; k++) {
             const wb_real *p = &x[3 * list[k]];
             int64_t c[3];
             for (int a = 0; a < 3; a++) {
-                c[a] = cell_of(p[a], g->o[a], g->inv);
+                c[a] = wb__cell_of(p[a], g->o[a], g->inv);
                 if (g->wrap) c[a] %= g->nc[a];
             }
             const int32_t cl = (int32_t)(c[0] + g->nc[0] * (c[1] + g->nc[1] * c[2]));
@@ -453,9 +399,9 @@ static void tri_try(const struct wb_tribroad *b, const wb_world *w, const wb_rea
 }
 
 /* an axis's search range [lo, hi] as at most two runs of grid cells */
-static inline int axis_ranges(const level *g, int a, wb_real lo, wb_real hi, int64_t r[4])
+static inline int axis_ranges(const wb_grid *g, int a, wb_real lo, wb_real hi, int64_t r[4])
 {
-    int64_t c0 = cell_of(lo, g->o[a], g->inv), c1 = cell_of(hi, g->o[a], g->inv);
+    int64_t c0 = wb__cell_of(lo, g->o[a], g->inv), c1 = wb__cell_of(hi, g->o[a], g->inv);
     const int64_t n = g->nc[a];
     if (!g->wrap) {
         r[0] = c0; r[1] = c1 < n - 1 ? c1 : n - 1;
@@ -480,11 +426,12 @@ static void tri_scan(const struct wb_tribroad *b, const wb_world *w, int32_t k0,
         wb_real lo[3], hi[3];
         for (int a = 0; a < 3; a++) lo[a] = tb[a] - tb[6], hi[a] = tb[3 + a] + tb[6];
         for (int l = 0; l < b->nlv; l++) {
-            const level *g = &b->lv[l];
+            const level *lv = &b->lv[l];
+            const wb_grid *g = &lv->g;
             int64_t r[3][4];
             int kr[3];
             for (int a = 0; a < 3; a++) {
-                const wb_real e0 = pad(lo[a], g->rn), e1 = pad(hi[a], g->rn);
+                const wb_real e0 = pad(lo[a], lv->rn), e1 = pad(hi[a], lv->rn);
                 kr[a] = axis_ranges(g, a, lo[a] - e0, hi[a] + e1, r[a]);
             }
             if (!kr[0] || !kr[1] || !kr[2]) continue;
@@ -494,11 +441,11 @@ static void tri_scan(const struct wb_tribroad *b, const wb_world *w, int32_t k0,
                 for (int q = 0; q < kr[a]; q++) c += r[a][2 * q + 1] - r[a][2 * q] + 1;
                 rows = a == 1 ? c : rows * c;
             }
-            if (rows > g->count) { /* cheaper to look at every point of the level */
-                tri_try(b, w, tb, lo, hi, skipkey, t, g->first, g->first + g->count, o);
+            if (rows > lv->count) { /* cheaper to look at every point of the level */
+                tri_try(b, w, tb, lo, hi, skipkey, t, lv->first, lv->first + lv->count, o);
                 continue;
             }
-            const int32_t *start = b->start + g->start0;
+            const int32_t *start = b->start + lv->start0;
             for (int az = 0; az < kr[2]; az++)
                 for (int64_t z = r[2][2 * az]; z <= r[2][2 * az + 1]; z++)
                     for (int ay = 0; ay < kr[1]; ay++)

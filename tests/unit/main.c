@@ -45,6 +45,7 @@
     X(contact_broadphase_matches_brute_force)            \
     X(contact_broadphase_huge_and_clustered_input)       \
     X(contact_broadphase_bodies_fast_particles_and_threads) \
+    X(contact_broadphase_kept_list_matches_fresh_search) \
     X(contact_builders_get_own_groups)                   \
     X(contact_self_collision_skips_rest_neighbours)      \
     X(contact_clone_keeps_groups)
