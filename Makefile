@@ -15,7 +15,7 @@ PCMODS  := lua5.4 libcjson assimp osmesa glfw3
 MISSING  = missing=""; for p in $(PKGS); do \
 	     dpkg-query -W -f='$${db:Status-Abbrev}' $$p 2>/dev/null | grep -q '^ii' || missing="$$missing $$p"; done
 
-CFLAGS_BASE := -std=c11 $(OPT) -g -Wall -Wextra -Werror -pthread -fno-math-errno -D_GNU_SOURCE -Isrc \
+CFLAGS_BASE := -std=c11 $(OPT) -g -Wall -Wextra -Werror -pthread -fno-math-errno -ffp-contract=off -D_GNU_SOURCE -Isrc \
                -DWB_ROOT='"$(CURDIR)"' -DWB_PREFIX='"$(PREFIX)"'
 CFLAGS  += $(CFLAGS_BASE) $(EXTRA_CFLAGS)
 LDFLAGS += -pthread $(EXTRA_LDFLAGS)
@@ -137,7 +137,7 @@ FUZZ_CC      ?= clang
 FUZZ_BUILD   := build-fuzz
 FUZZ_TARGETS := json mesh mesh_obj
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined
-FUZZ_CFLAGS  := -std=c11 -O1 -g -fno-omit-frame-pointer -pthread -fno-math-errno -D_GNU_SOURCE -Isrc -Wall -Wextra
+FUZZ_CFLAGS  := -std=c11 -O1 -g -fno-omit-frame-pointer -pthread -fno-math-errno -ffp-contract=off -D_GNU_SOURCE -Isrc -Wall -Wextra
 FUZZ_SRC     := $(CORE_SRC) $(wildcard src/io/*.c)
 FUZZ_OBJ     := $(FUZZ_SRC:src/%.c=$(FUZZ_BUILD)/obj/%.o)
 # the same targets under gcc, run once per file of the corpus by tests/fuzz/replay.sh

@@ -98,11 +98,13 @@ static int add_grid(sweep *s, const char *arg) {
     grid *g = &s->g[s->ng++];
     g->key = key;
     g->vals = calloc(strlen(eq) + 1, sizeof *g->vals);
+    if (!g->vals) return sweep_error("out of memory%s%s", "", "");
     for (const char *v = eq + 1;; ) {
         const char *c = strchr(v, ',');
         size_t n = c ? (size_t)(c - v) : strlen(v);
         if (n == 0) return sweep_error("--grid %s: an empty value (two commas, or one at an end)%s", arg, "");
         char *val = strndup(v, n);
+        if (!val) return sweep_error("out of memory%s%s", "", "");
         g->vals[g->n++] = val;  /* freed with the grid, also after an error */
         if (strchr(val, '\n')) return sweep_error("--grid %s: a value holds a line break%s", arg, "");
         if (overflows(val)) return sweep_error("--grid %s: the number %s is out of range (not finite)", arg, val);
@@ -117,6 +119,7 @@ static int parse(int argc, char **argv, sweep *s) {
     s->repeat = 1;
     s->g = calloc((size_t)argc, sizeof *s->g);
     s->sets = calloc((size_t)argc, sizeof *s->sets);
+    if (!s->g || !s->sets) return sweep_error("out of memory%s%s", "", "");
     for (int i = 2; i < argc; i++) {
         const char *a = argv[i];
         if (a[0] != '-' || !a[1]) {
@@ -421,8 +424,8 @@ static int make_sweep(sweep *sp) {
         if (count * s.g[j].n > MAX_RUNS) return sweep_error("the grids make more than %s runs%s", "1000000", "");
         count *= s.g[j].n;
     }
-    char scene[PATH_MAX], exe[PATH_MAX], dir[PATH_MAX], err[PATH_MAX + 128];
-    struct stat st;
+    char scene[PATH_MAX], exe[PATH_MAX], dir[PATH_MAX], err[PATH_MAX + 128] = "";
+    struct stat st = { 0 };
     if (stat(s.scene, &st) != 0 || !S_ISREG(st.st_mode) || !realpath(s.scene, scene)) {
         fprintf(stderr, "wobble sweep: cannot open the scene %s: %s\n", s.scene,
                 errno && !S_ISDIR(st.st_mode) ? strerror(errno) : "not a file");
@@ -505,7 +508,7 @@ static int make_sweep(sweep *sp) {
     free(slurm);
     free(json);
     if (!ok) {
-        fprintf(stderr, "wobble sweep: --out %s: %s\n", s.out, jobs && slurm ? err : "out of memory");
+        fprintf(stderr, "wobble sweep: --out %s: %s\n", s.out, jobs && slurm && json ? err : "out of memory");
         return EXIT_SCRIPT;
     }
     if (!s.run) {

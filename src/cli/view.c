@@ -545,24 +545,12 @@ static void draw_world(lua_State *L, int world_index)
     world_index = lua_absindex(L, world_index);
     wbl_world *ud = wbl_checkworld_ud(L, world_index);
     if (!ud->w) return;   /* closed by the script */
-    wbl_push_world_skins(L, world_index);
-    int len = (int)lua_rawlen(L, -1);
-    wb_draw_skin *sk = calloc((size_t)(len ? len : 1), sizeof *sk);
-    for (int i = 1; sk && i <= len; i++) {
-        lua_rawgeti(L, -1, i);
-        wb_world *w = NULL;
-        wb_skin *s = wbl_toskin(L, -1, &w);
-        lua_pop(L, 1);
-        if (!s) continue;
-        const wb_mesh *m = wb_skin_rest(s);
-        sk[nsk++] = (wb_draw_skin){ wb_skin_vertices(s, w), wb_skin_normals(s, w), m->tri, m->nv, m->nt, s };
-    }
-    lua_settop(L, top);
+    const wb_draw_skin *sk = wbl_world_skins(L, world_index, &nsk);  /* on the stack until settop */
     wb_draw_opts o = wb_draw_default_opts();
     char err[512];
     if (wb_renderer_draw(V.r, ud->w, &o, sk, nsk, err, sizeof err)) V.drawn = true;
     else snprintf(V.note, sizeof V.note, "drawing failed: %.200s", err);
-    free(sk);
+    lua_settop(L, top);
 }
 
 /* wait for events until `until` (monotonic seconds) or something to do */

@@ -337,23 +337,6 @@ static int32_t att_count(const wb_world *w) { return wb_attach_count(w); }
 
 /* once per step: attachments whose collider was removed die; the particle -> collider
  * skip table is rebuilt when anything changed */
-/* x = A^-1 b for a symmetric positive definite 3 x 3 A (Cramer's rule); 0 when singular */
-static int solve3(const wb_real A[9], const wb_real b[3], wb_real x[3])
-{
-    const wb_real c0[3] = { A[0], A[3], A[6] }, c1[3] = { A[1], A[4], A[7] }, c2[3] = { A[2], A[5], A[8] };
-    wb_real t[3];
-    v3_cross(t, c1, c2);
-    const wb_real det = v3_dot(c0, t);
-    if (!(fabs(det) > 0) || !isfinite(det)) return 0;
-    wb_real u[3];
-    x[0] = v3_dot(b, t) / det;
-    v3_cross(u, b, c2);
-    x[1] = v3_dot(c0, u) / det;
-    v3_cross(u, c1, b);
-    x[2] = v3_dot(c0, u) / det;
-    return 1;
-}
-
 static wb_status att_prepare(wb_world *w)
 {
     wb_attaches *a = w->att;
@@ -437,7 +420,7 @@ static void att_project(wb_world *w, wb_real h)
                 K[4 * k] += wp + at;
                 rhs[k] = t[k] - xp[k] - at * l[k];
             }
-            if (!solve3(K, rhs, dl)) continue;
+            if (!wb__solve3(K, rhs, dl)) continue;
             v3_add(l, l, dl);
             wb_real dp[3];
             v3_scale(dp, dl, -1);

@@ -359,22 +359,6 @@ static void grab_substep_begin(wb_world *w)
     if (g->n > 0) memset(g->lambda, 0, sizeof(wb_real) * 3 * (size_t)g->n);
 }
 
-/* x = A^-1 b for the 3 x 3 A (Cramer's rule); 0 when singular */
-static int solve3(const wb_real A[9], const wb_real b[3], wb_real x[3])
-{
-    const wb_real c0[3] = { A[0], A[3], A[6] }, c1[3] = { A[1], A[4], A[7] }, c2[3] = { A[2], A[5], A[8] };
-    wb_real t[3], u[3];
-    v3_cross(t, c1, c2);
-    const wb_real det = v3_dot(c0, t);
-    if (!(fabs(det) > 0) || !isfinite(det)) return 0;
-    x[0] = v3_dot(b, t) / det;
-    v3_cross(u, b, c2);
-    x[1] = v3_dot(c0, u) / det;
-    v3_cross(u, c1, b);
-    x[2] = v3_dot(c0, u) / det;
-    return 1;
-}
-
 /* a body's point pulled to the target: (K + alpha~ E) dlambda = t - x - alpha~ lambda with
  * K the body's response at the point (as attach.c's rigid case, the target immovable) */
 static void project_rigid(wb_world *w, wb_grabs *g, int32_t s, wb_real h, wb_real f)
@@ -391,7 +375,7 @@ static void project_rigid(wb_world *w, wb_grabs *g, int32_t s, wb_real h, wb_rea
         K[4 * k] += at;
         rhs[k] = t - x[k] - at * l[k];
     }
-    if (!solve3(K, rhs, dl)) return;
+    if (!wb__solve3(K, rhs, dl)) return;
     v3_add(l, l, dl);
     wb__rigid_apply(w, r, x, dl);
 }

@@ -86,6 +86,21 @@ void wb__rigid_apply(wb_world *w, int32_t r, const wb_real x[3], const wb_real d
  * impulse there, 1/m E - [d]x I^-1 [d]x (d = x - centre): a point constraint in 3D (an
  * attachment) solves K dlambda = -C at once instead of along C's direction only */
 void wb__rigid_point_response(const wb_world *w, int32_t r, const wb_real x[3], wb_real K[9]);
+/* x = A^-1 b for a 3 x 3 A (Cramer's rule; attachments and grabs to a body); 0 when singular */
+static inline int wb__solve3(const wb_real A[9], const wb_real b[3], wb_real x[3])
+{
+    const wb_real c0[3] = { A[0], A[3], A[6] }, c1[3] = { A[1], A[4], A[7] }, c2[3] = { A[2], A[5], A[8] };
+    wb_real t[3], u[3];
+    v3_cross(t, c1, c2);
+    const wb_real det = v3_dot(c0, t);
+    if (!(fabs(det) > 0) || !isfinite(det)) return 0;
+    x[0] = v3_dot(b, t) / det;
+    v3_cross(u, b, c2);
+    x[1] = v3_dot(c0, u) / det;
+    v3_cross(u, c1, b);
+    x[2] = v3_dot(c0, u) / det;
+    return 1;
+}
 /* world point of a body-local point, and body-local of a world point, at the current pose */
 void wb__rigid_to_world(const wb_world *w, int32_t r, const wb_real local[3], wb_real out[3]);
 void wb__rigid_to_local(const wb_world *w, int32_t r, const wb_real world[3], wb_real out[3]);

@@ -178,7 +178,7 @@ static void stop_recording(lua_State *L, wbl_renderer *u)
 
 /* the skins made on the world at world_index, for drawing (an array in a userdata left
  * on the stack, collected with it); *n their count */
-static wb_draw_skin *world_skins(lua_State *L, int world_index, int *n)
+wb_draw_skin *wbl_world_skins(lua_State *L, int world_index, int *n)
 {
     wbl_push_world_skins(L, world_index);
     int len = (int)lua_rawlen(L, -1), k = 0;
@@ -207,7 +207,7 @@ static bool draw_frame(lua_State *L, wbl_renderer *u, int world_index, const wb_
 {
     int top = lua_gettop(L), nsk = 0;
     wb_world *w = wbl_checkworld(L, world_index);
-    wb_draw_skin *sk = o->skins ? world_skins(L, world_index, &nsk) : NULL;
+    wb_draw_skin *sk = o->skins ? wbl_world_skins(L, world_index, &nsk) : NULL;
     /* a world of a million links takes hundreds of MB to draw: charged before drawing,
      * then what the renderer holds after (its buffers grow by doubling and stay) */
     size_t want = wb_renderer_draw_bytes(u->r, w, sk, nsk);

@@ -208,7 +208,10 @@ int wbl_result_write(void *taken, const wbl_run_info *info, char *err, size_t n)
     if (f) {
         ok = fputs(text, f) >= 0 && fputc('\n', f) != EOF;
         ok = (fclose(f) == 0) && ok && rename(tmp, path) == 0;
-        if (!ok) snprintf(err, n, "cannot write %s: %s", path, strerror(errno));
+        if (!ok) {
+            snprintf(err, n, "cannot write %s: %s", path, strerror(errno));
+            remove(tmp);  /* no stray half file beside the run's output */
+        }
     } else {
         snprintf(err, n, "cannot write %s: %s", tmp, strerror(errno));
     }

@@ -197,6 +197,9 @@ void wbl_open_renderer(lua_State *L);   /* wobble.renderer, probe, read_png, rea
  * camera, every layer) and added to OUT, a path of the user's choice */
 bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n);
 bool wbl_record_end(lua_State *L, char *err, size_t n);   /* finish the file; prints where it went */
+/* the live skins of the world at world_index, ready to draw (Lua userdata left on the
+ * stack, collected with it); *n their count (the viewer draws with it too) */
+wb_draw_skin *wbl_world_skins(lua_State *L, int world_index, int *n);
 /* w:run{plot = path}: push a plot sampler for the path in field `key` of the options
  * at `opts` (nil when absent; the path is checked through the sandbox now, and the
  * world's state sampled); sample after each frame; write the PNG when the run ends */

@@ -194,7 +194,8 @@ static float select_k(float *v, size_t n, size_t k)
 bool wb_strain_auto(wb_layers *l, const wb_world *w, const wb_draw_opts *o)
 {
     const int32_t np = wb_particle_count(w);
-    const size_t want = (o->constraints ? (size_t)l->npairs : 0) + (o->materials ? (size_t)np : 0) + 1;
+    /* a free link's strain each, and at most one per particle (a surface's or a material's) */
+    const size_t want = (o->constraints ? (size_t)l->npairs : 0) + (o->constraints || o->materials ? (size_t)np : 0) + 1;
     if (!wb_grow(&l->scratch, &l->scratch_cap, want, sizeof *l->scratch)) return false;
     /* the strains as shown: a free link's, a surface particle's stretch (vstrain), a
      * material's */

@@ -61,9 +61,10 @@ test("64 boxes and spheres poured into a bin: no two overlap, none leaves the bi
   for a = 1, #bodies do
     local pa, ra = points(bodies[a])
     for _, p in ipairs(pa) do
-      expect.lt(math.abs(p[1]), W + 1e-3, "inside the bin (x)")
-      expect.lt(math.abs(p[3]), W + 1e-3, "inside the bin (z)")
-      expect.gt(p[2], -1e-3 - ra, "above the ground")
+      -- ra: a sphere's radius (its one point is its centre), 0 for a box's corners
+      expect.lt(math.abs(p[1]) + ra, W + 1e-3, "inside the bin (x)")
+      expect.lt(math.abs(p[3]) + ra, W + 1e-3, "inside the bin (z)")
+      expect.gt(p[2] - ra, -1e-3, "above the ground")
     end
     for b = 1, #bodies do
       if a ~= b and (bodies[b].kind == "box" or bodies[a].kind == "sphere") then
