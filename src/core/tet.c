@@ -37,8 +37,9 @@
 #include "snapshot.h"
 #include "tet.h"
 
-/* a packed tet (tet.h pd): Dm^-1, V0, mu, lam */
+/* a packed tet (tet.h pd): Dm^-1, 1/(mu V0 h^2), 1/(lam V0 h^2), 1 + mu/lam */
 #define PD 12
+enum { PD_AD = 9, PD_AH = 10, PD_A = 11 };
 
 #define TET_BYTES (9 * sizeof(int32_t) + 28 * sizeof(wb_real))
 
@@ -84,7 +85,7 @@ wb_status wb__tet_reserve(wb_world *w, int64_t extra)
         { (void **)&v->ijkl, 4 * sizeof(int32_t) }, { (void **)&v->dminv, 9 * sizeof(wb_real) },
         { (void **)&v->v0, sizeof(wb_real) }, { (void **)&v->young, sizeof(wb_real) },
         { (void **)&v->poisson, sizeof(wb_real) }, { (void **)&v->mu, sizeof(wb_real) },
-        { (void **)&v->lam, sizeof(wb_real) }, { (void **)&v->lambda, 2 * sizeof(wb_real) },
+        { (void **)&v->lam, sizeof(wb_real) }, { (void **)&v->ld, sizeof(wb_real) }, { (void **)&v->lh, sizeof(wb_real) },
         { (void **)&v->order, sizeof(int32_t) }, { (void **)&v->pk, 4 * sizeof(int32_t) },
         { (void **)&v->pd, PD * sizeof(wb_real) },
     };
@@ -110,7 +111,7 @@ void wb__tet_put(wb_world *w, const int32_t p[4], const wb_real dminv[9], wb_rea
     v->young[i] = young;
     v->poisson[i] = poisson;
     lame(young, poisson, &v->mu[i], &v->lam[i]);
-    v->lambda[2 * i] = v->lambda[2 * i + 1] = 0;
+    v->ld[i] = v->lh[i] = 0;
 }
 
 /* Dm^-1 (row-major) and the signed volume of the tet at x; false when flat */
@@ -395,10 +396,9 @@ static wb_status tet_prepare(wb_world *w)
             memcpy(&nv->pk[4 * j], &nv->ijkl[4 * i], 4 * sizeof(int32_t));
             wb_real *d = &nv->pd[PD * j];
             memcpy(d, &nv->dminv[9 * i], 9 * sizeof(wb_real));
-            d[9] = nv->v0[i];
-            d[10] = nv->mu[i];
-            d[11] = nv->lam[i];
+            d[PD_A] = 1 + nv->mu[i] / nv->lam[i];
         }
+        nv->pd_h = 0; /* the compliances: at the next projection */
     }
     int32_t at;
     const wb_real h = w->m.def.dt / w->m.def.substeps, r = wave_ratio(w, h, &at);
@@ -441,12 +441,15 @@ static void tet_frame_end(wb_world *w)
 
 static void tet_substep_begin(wb_world *w)
 {
-    if (w->neo && w->neo->n > 0) memset(w->neo->lambda, 0, 2 * sizeof(wb_real) * (size_t)w->neo->n);
+    if (w->neo && w->neo->n > 0) {
+        memset(w->neo->ld, 0, sizeof(wb_real) * (size_t)w->neo->n);
+        memset(w->neo->lh, 0, sizeof(wb_real) * (size_t)w->neo->n);
+    }
 }
 
 /* dC/dx_k of a constraint with dC/dF = G (row-major): column k-1 of G Dm^-T for k = 1..3,
  * minus their sum for k = 0 */
-static void grads(const wb_real *dminv, const wb_real G[9], wb_real g[4][3])
+static inline void grads(const wb_real *dminv, const wb_real G[9], wb_real g[4][3])
 {
     for (int k = 0; k < 3; k++)
         for (int r = 0; r < 3; r++)
@@ -454,7 +457,7 @@ static void grads(const wb_real *dminv, const wb_real G[9], wb_real g[4][3])
     for (int r = 0; r < 3; r++) g[0][r] = -(g[1][r] + g[2][r] + g[3][r]);
 }
 
-static wb_real wdot(const wb_real wk[4], wb_real a[4][3], wb_real b[4][3])
+static inline wb_real wdot(const wb_real wk[4], wb_real a[4][3], wb_real b[4][3])
 {
     wb_real s = 0;
     for (int k = 0; k < 4; k++) s += wk[k] * v3_dot(a[k], b[k]);
@@ -466,19 +469,19 @@ static wb_real wdot(const wb_real wk[4], wb_real a[4][3], wb_real b[4][3])
  * sqrt 3, C_H = -mu/lam), balanced only through the compliances; projected in turn, each
  * under-converged pass leaves a bias that squeezes the solid (measured: a hanging bar
  * shortened instead of stretched). Solved together, the rest shape is a fixed point of a
- * single iteration at any stiffness, and the error is that of the linearisation. */
-static void project_range(wb_world *w, const int32_t *order, int32_t lo, int32_t hi, wb_real h)
+ * single iteration at any stiffness, and the error is that of the linearisation.
+ * Packed tets [lo, hi) (batch positions). This loop is the reference: project_range4 does
+ * the same operations in the same order, four tets at a time. */
+static void project_scalar(wb_world *w, int32_t lo, int32_t hi)
 {
-    (void)order; /* the packed copies are in batch order already */
     wb_neos *v = w->neo;
-    const wb_real inv_h2 = 1 / (h * h);
     const wb_real *wv = w->m.w;
     wb_real *x = w->s.x;
     for (int32_t j = lo; j < hi; j++) {
         const int32_t *p = &v->pk[4 * j];
         const wb_real wk[4] = { wv[p[0]], wv[p[1]], wv[p[2]], wv[p[3]] };
         if (wk[0] + wk[1] + wk[2] + wk[3] == 0) continue;
-        const wb_real *dm = &v->pd[PD * j], v0 = dm[9], mu = dm[10], lam = dm[11];
+        const wb_real *dm = &v->pd[PD * j], ad = dm[PD_AD], ah = dm[PD_AH];
         wb_real F[9], G[9], gd[4][3], gh[4][3];
         deformation_of(p, dm, x, F);
         wb_real ic = 0;
@@ -498,14 +501,12 @@ static void project_range(wb_world *w, const int32_t *order, int32_t lo, int32_t
         v3_cross(c2, f0, f1);
         for (int r = 0; r < 3; r++) { G[3 * r] = c0[r]; G[3 * r + 1] = c1[r]; G[3 * r + 2] = c2[r]; }
         grads(dm, G, gh);
-        const wb_real ch = v3_dot(f0, c0) - (1 + mu / lam);
-        const wb_real ad = inv_h2 / (mu * v0), ah = inv_h2 / (lam * v0);
-        wb_real *ld = &v->lambda[2 * j], *lh = &v->lambda[2 * j + 1]; /* by batch position */
-        const wb_real rh = -ch - ah * *lh;
+        const wb_real ch = v3_dot(f0, c0) - dm[PD_A];
+        const wb_real rh = -ch - ah * v->lh[j];
         const wb_real a22 = wdot(wk, gh, gh) + ah;
         wb_real dd = 0, dh;
         if (dev) {
-            const wb_real k22 = a22 - ah, k12 = wdot(wk, gd, gh), k11 = wdot(wk, gd, gd), rd = -cd - ad * *ld;
+            const wb_real k22 = a22 - ah, k12 = wdot(wk, gd, gh), k11 = wdot(wk, gd, gd), rd = -cd - ad * v->ld[j];
             /* det = k11 k22 - k12^2 + ad k22 + ah k11 + ad ah; the gradients are nearly
              * parallel near rest, so k11 k22 - k12^2 (>= 0) is not formed by subtraction
              * (it cancels to noise on stiff or sliver tets) but as k22 |gd - (k12/k22) gh|^2 */
@@ -526,12 +527,196 @@ static void project_range(wb_world *w, const int32_t *order, int32_t lo, int32_t
             if (!(a22 > 0) || !isfinite(a22)) continue;
             dh = rh / a22;
         }
-        *ld += dd;
-        *lh += dh;
+        v->ld[j] += dd;
+        v->lh[j] += dh;
         for (int k = 0; k < 4; k++)
             if (wk[k] > 0)
                 for (int r = 0; r < 3; r++) x[3 * p[k] + r] += wk[k] * ((dev ? gd[k][r] * dd : 0) + gh[k][r] * dh);
     }
+}
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(WB_FLOAT)
+#define WB_TET_AVX2 1
+#include <immintrin.h>
+
+typedef __m256d V4;
+#define TGT __attribute__((always_inline, target("avx2"))) static inline
+TGT V4 add(V4 a, V4 b) { return _mm256_add_pd(a, b); }
+TGT V4 sub(V4 a, V4 b) { return _mm256_sub_pd(a, b); }
+TGT V4 mul(V4 a, V4 b) { return _mm256_mul_pd(a, b); }
+TGT V4 dv(V4 a, V4 b) { return _mm256_div_pd(a, b); }
+TGT V4 neg(V4 a) { return _mm256_xor_pd(a, _mm256_set1_pd(-0.0)); }
+/* b where m, else a */
+TGT V4 pick(V4 a, V4 b, V4 m) { return _mm256_blendv_pd(a, b, m); }
+TGT V4 dot3(const V4 a[3], const V4 b[3]) { return add(add(mul(a[0], b[0]), mul(a[1], b[1])), mul(a[2], b[2])); }
+
+/* columns of the 4x4 block of rows r0..r3 */
+TGT void transpose4(V4 r0, V4 r1, V4 r2, V4 r3, V4 *c)
+{
+    const V4 t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
+    const V4 t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+    c[0] = _mm256_permute2f128_pd(t0, t2, 0x20);
+    c[1] = _mm256_permute2f128_pd(t1, t3, 0x20);
+    c[2] = _mm256_permute2f128_pd(t0, t2, 0x31);
+    c[3] = _mm256_permute2f128_pd(t1, t3, 0x31);
+}
+
+/* the x, y, z of 4 particles as lanes (distance.c's load4): maskload leaves the 4th double
+ * alone (the last particle ends the array) */
+TGT void load4(const wb_real *x, int32_t i0, int32_t i1, int32_t i2, int32_t i3, V4 out[3])
+{
+    const __m256i m = _mm256_set_epi64x(0, -1, -1, -1);
+    V4 c[4];
+    transpose4(_mm256_maskload_pd(&x[3 * i0], m), _mm256_maskload_pd(&x[3 * i1], m), _mm256_maskload_pd(&x[3 * i2], m),
+               _mm256_maskload_pd(&x[3 * i3], m), c);
+    out[0] = c[0]; out[1] = c[1]; out[2] = c[2];
+}
+
+/* the gradients of a constraint with dC/dF = G (G[3r + c] lanes), grads() lane by lane */
+TGT void grads4(const V4 *D, const V4 *G, V4 g[4][3])
+{
+    for (int k = 0; k < 3; k++)
+        for (int r = 0; r < 3; r++)
+            g[k + 1][r] = add(add(mul(G[3 * r], D[3 * k]), mul(G[3 * r + 1], D[3 * k + 1])), mul(G[3 * r + 2], D[3 * k + 2]));
+    for (int r = 0; r < 3; r++) g[0][r] = neg(add(add(g[1][r], g[2][r]), g[3][r]));
+}
+
+TGT V4 wdot4(const V4 wk[4], V4 a[4][3], V4 b[4][3])
+{
+    V4 s = _mm256_setzero_pd();
+    for (int k = 0; k < 4; k++) s = add(s, mul(wk[k], dot3(a[k], b[k])));
+    return s;
+}
+
+/* project_scalar four tets at a time (a conflict-free batch: no tet reads a particle that
+ * another writes), every lane doing the scalar operations in the scalar order without FMA
+ * (-ffp-contract=off), so the bits are the scalar loop's whatever the lanes' grouping:
+ * the same for any chunking of a batch, so for any thread count. The branches are masks
+ * and blends; the writes are scalar. */
+static __attribute__((target("avx2"))) void project_range4(wb_world *w, int32_t lo, int32_t hi)
+{
+    wb_neos *v = w->neo;
+    const wb_real *wv = w->m.w;
+    wb_real *x = w->s.x;
+    const V4 zero = _mm256_setzero_pd(), inf = _mm256_set1_pd(INFINITY), tiny = _mm256_set1_pd(1e-12);
+    int32_t j = lo;
+    for (; j + 4 <= hi; j += 4) {
+        const int32_t *p = &v->pk[4 * j]; /* p[4 l + k]: corner k of lane l */
+        V4 wk[4];
+        for (int k = 0; k < 4; k++) wk[k] = _mm256_set_pd(wv[p[12 + k]], wv[p[8 + k]], wv[p[4 + k]], wv[p[k]]);
+        const V4 any = _mm256_cmp_pd(add(add(add(wk[0], wk[1]), wk[2]), wk[3]), zero, _CMP_NEQ_UQ);
+        if (!_mm256_movemask_pd(any)) continue;
+        V4 D[12];
+        const wb_real *pd = &v->pd[PD * j];
+        for (int b = 0; b < 3; b++)
+            transpose4(_mm256_loadu_pd(&pd[4 * b]), _mm256_loadu_pd(&pd[PD + 4 * b]),
+                       _mm256_loadu_pd(&pd[2 * PD + 4 * b]), _mm256_loadu_pd(&pd[3 * PD + 4 * b]), &D[4 * b]);
+        const V4 ad = D[PD_AD], ah = D[PD_AH];
+        V4 X[4][3], e[3][3], F[9], G[9], gd[4][3], gh[4][3];
+        for (int k = 0; k < 4; k++) load4(x, p[k], p[4 + k], p[8 + k], p[12 + k], X[k]);
+        for (int k = 0; k < 3; k++)
+            for (int r = 0; r < 3; r++) e[k][r] = sub(X[k + 1][r], X[0][r]);
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++)
+                F[3 * r + c] = add(add(mul(e[0][r], D[c]), mul(e[1][r], D[3 + c])), mul(e[2][r], D[6 + c]));
+        V4 ic = zero;
+        for (int k = 0; k < 9; k++) ic = add(ic, mul(F[k], F[k]));
+        const V4 cd = _mm256_sqrt_pd(ic);
+        const V4 dev = _mm256_cmp_pd(cd, tiny, _CMP_GT_OQ);
+        for (int k = 0; k < 9; k++) G[k] = dv(F[k], cd);
+        grads4(D, G, gd);
+        const V4 f0[3] = { F[0], F[3], F[6] }, f1[3] = { F[1], F[4], F[7] }, f2[3] = { F[2], F[5], F[8] };
+        for (int r = 0; r < 3; r++) { /* v3_cross, componentwise */
+            const int r1 = (r + 1) % 3, r2 = (r + 2) % 3;
+            G[3 * r] = sub(mul(f1[r1], f2[r2]), mul(f1[r2], f2[r1]));
+            G[3 * r + 1] = sub(mul(f2[r1], f0[r2]), mul(f2[r2], f0[r1]));
+            G[3 * r + 2] = sub(mul(f0[r1], f1[r2]), mul(f0[r2], f1[r1]));
+        }
+        grads4(D, G, gh);
+        const V4 c0[3] = { G[0], G[3], G[6] };
+        const V4 ch = sub(dot3(f0, c0), D[PD_A]);
+        const V4 lh = _mm256_loadu_pd(&v->lh[j]), ld = _mm256_loadu_pd(&v->ld[j]);
+        const V4 rh = sub(neg(ch), mul(ah, lh));
+        const V4 a22 = add(wdot4(wk, gh, gh), ah);
+        /* the deviatoric lanes */
+        const V4 k22 = sub(a22, ah), k12 = wdot4(wk, gd, gh), k11 = wdot4(wk, gd, gd);
+        const V4 rd = sub(neg(cd), mul(ad, ld));
+        const V4 c = dv(k12, k22);
+        V4 o[4][3];
+        for (int k = 0; k < 4; k++)
+            for (int r = 0; r < 3; r++) o[k][r] = sub(gd[k][r], mul(c, gh[k][r]));
+        const V4 gram = pick(zero, mul(k22, wdot4(wk, o, o)), _mm256_cmp_pd(k22, zero, _CMP_GT_OQ));
+        const V4 a11 = add(k11, ad);
+        const V4 det = add(add(add(gram, mul(ad, k22)), mul(ah, k11)), mul(ad, ah));
+        const V4 okd = _mm256_and_pd(_mm256_cmp_pd(det, zero, _CMP_GT_OQ), _mm256_cmp_pd(det, inf, _CMP_LT_OQ));
+        const V4 dd = pick(zero, dv(sub(mul(rd, a22), mul(k12, rh)), det), dev);
+        V4 dh = dv(sub(mul(a11, rh), mul(k12, rd)), det), ok = okd;
+        if (_mm256_movemask_pd(dev) != 15) { /* a lane crushed to a point: the hydrostatic one alone */
+            const V4 okh = _mm256_and_pd(_mm256_cmp_pd(a22, zero, _CMP_GT_OQ), _mm256_cmp_pd(a22, inf, _CMP_LT_OQ));
+            dh = pick(dv(rh, a22), dh, dev);
+            ok = pick(okh, okd, dev);
+        }
+        const V4 live = _mm256_and_pd(any, ok);
+        const int lm = _mm256_movemask_pd(live);
+        if (!lm) continue;
+        _mm256_storeu_pd(&v->ld[j], pick(ld, add(ld, dd), live));
+        _mm256_storeu_pd(&v->lh[j], pick(lh, add(lh, dh), live));
+        double cx[4][3][4] __attribute__((aligned(32)));
+        int wm[4];
+        for (int k = 0; k < 4; k++) {
+            for (int r = 0; r < 3; r++)
+                _mm256_store_pd(cx[k][r], mul(wk[k], add(pick(zero, mul(gd[k][r], dd), dev), mul(gh[k][r], dh))));
+            wm[k] = _mm256_movemask_pd(_mm256_cmp_pd(wk[k], zero, _CMP_GT_OQ)) & lm;
+        }
+        for (int l = 0; l < 4; l++)
+            for (int k = 0; k < 4; k++)
+                if (wm[k] >> l & 1) {
+                    wb_real *q = &x[3 * p[4 * l + k]];
+                    q[0] += cx[k][0][l]; q[1] += cx[k][1][l]; q[2] += cx[k][2][l];
+                }
+    }
+    if (j < hi) project_scalar(w, j, hi);
+}
+#endif
+
+/* the vector path: -1 not yet decided, 0 off (no AVX2, or turned off), 1 on */
+static int simd_state = -1;
+
+/* Internal switch for tests (distance.c's wb__distance_simd for the tets): on = 0 forces
+ * the scalar loop, on = 1 uses the vector path where the CPU has it; returns whether the
+ * vector path is on. Not thread-safe: call it between steps. */
+int wb__tet_simd(int on);
+int wb__tet_simd(int on)
+{
+#ifdef WB_TET_AVX2
+    __builtin_cpu_init();
+    const int s = on && __builtin_cpu_supports("avx2");
+#else
+    const int s = 0;
+    (void)on;
+#endif
+    __atomic_store_n(&simd_state, s, __ATOMIC_RELAXED);
+    return s;
+}
+
+/* order[lo, hi) of one batch (batch.h): the packed copies are in that order already */
+static void project_range(wb_world *w, const int32_t *order, int32_t lo, int32_t hi, wb_real h)
+{
+    (void)order;
+    (void)h;
+#ifdef WB_TET_AVX2
+    const wb_batches *bt = &w->neo->bt;
+    /* the lanes need a conflict-free batch: never the serial tail */
+    if (hi - lo >= 4 && hi <= bt->colour_start[bt->serial_start]) {
+        int s = __atomic_load_n(&simd_state, __ATOMIC_RELAXED); /* possibly decided by several threads at once */
+        if (s < 0) s = wb__tet_simd(1);
+        if (s) {
+            project_range4(w, lo, hi);
+            return;
+        }
+    }
+#endif
+    project_scalar(w, lo, hi);
 }
 
 /* batch after batch in colour order, a batch in parallel chunks (a batch shares no
@@ -540,6 +725,17 @@ static void tet_project(wb_world *w, wb_real h)
 {
     wb_neos *v = w->neo;
     if (!v) return;
+    if (v->pd_h != h) {
+        /* the compliances over h^2, divided once per substep length instead of per
+         * projection (the same divisions: the same bits) */
+        const wb_real inv_h2 = 1 / (h * h);
+        for (int32_t j = 0; j < v->n; j++) {
+            const int32_t i = v->order[j];
+            v->pd[PD * j + PD_AD] = inv_h2 / (v->mu[i] * v->v0[i]);
+            v->pd[PD * j + PD_AH] = inv_h2 / (v->lam[i] * v->v0[i]);
+        }
+        v->pd_h = h;
+    }
     wb__batches_run(&v->bt, w, 64, project_range, v->order, h);
     w->k.projections += v->n; /* a tet (both of its constraints) is one projection */
 }

@@ -15,11 +15,13 @@ typedef struct wb_neos {
     wb_real *v0;           /* (n) model: rest volume, m^3 (> 0) */
     wb_real *young, *poisson; /* (n) model: as given */
     wb_real *mu, *lam;     /* (n) derived: Lamé parameters of the constraint form */
-    wb_real *lambda;       /* (n x 2) cache: deviatoric, hydrostatic multipliers of the substep,
+    wb_real *ld, *lh;      /* (n) cache: deviatoric, hydrostatic multipliers of the substep,
                               by batch position */
     int32_t *order;        /* (n) cache: slots by colour batch (batch.h) */
     int32_t *pk;           /* (n x 4) cache: corners in batch order */
-    wb_real *pd;           /* (n x 12) cache: Dm^-1, V0, mu, lam in batch order */
+    wb_real *pd;           /* (n x 12) cache in batch order: Dm^-1 (9), the compliances over h^2
+                              1/(mu V0 h^2), 1/(lam V0 h^2), and 1 + mu/lam (tet.c) */
+    wb_real pd_h;          /* the substep those compliances are for (0: none yet) */
     wb_batches bt;         /* cache: the batches, rebuilt when n changes */
     size_t charged;        /* bytes charged to def.memory */
     wb_real warned_h;      /* the substep last warned about as too long (0: none), tet.c */
@@ -41,7 +43,7 @@ static inline void wb__tet_free(wb_world *w)
     wb_neos *v = w->neo;
     if (!v) return;
     if (w->m.def.memory) w->m.def.memory->used -= v->charged;
-    void *a[] = { v->ijkl, v->dminv, v->v0, v->young, v->poisson, v->mu, v->lam, v->lambda, v->order, v->pk, v->pd };
+    void *a[] = { v->ijkl, v->dminv, v->v0, v->young, v->poisson, v->mu, v->lam, v->ld, v->lh, v->order, v->pk, v->pd };
     for (size_t i = 0; i < sizeof a / sizeof a[0]; i++) free(a[i]);
     free(v);
     w->neo = NULL;
