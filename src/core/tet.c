@@ -592,7 +592,7 @@ TGT V4 wdot4(const V4 wk[4], V4 a[4][3], V4 b[4][3])
  * another writes), every lane doing the scalar operations in the scalar order without FMA
  * (-ffp-contract=off), so the bits are the scalar loop's whatever the lanes' grouping:
  * the same for any chunking of a batch, so for any thread count. The branches are masks
- * and blends; the writes are scalar. */
+ * and blends. */
 static __attribute__((target("avx2"))) void project_range4(wb_world *w, int32_t lo, int32_t hi)
 {
     wb_neos *v = w->neo;
@@ -661,19 +661,23 @@ static __attribute__((target("avx2"))) void project_range4(wb_world *w, int32_t 
         if (!lm) continue;
         _mm256_storeu_pd(&v->ld[j], pick(ld, add(ld, dd), live));
         _mm256_storeu_pd(&v->lh[j], pick(lh, add(lh, dh), live));
-        double cx[4][3][4] __attribute__((aligned(32)));
-        int wm[4];
+        /* the new positions (x + wk ((gd dd) + gh dh), as the scalar +=) back in rows:
+         * 3 doubles a particle, stored where the corner moves */
         for (int k = 0; k < 4; k++) {
+            V4 q[4];
             for (int r = 0; r < 3; r++)
-                _mm256_store_pd(cx[k][r], mul(wk[k], add(pick(zero, mul(gd[k][r], dd), dev), mul(gh[k][r], dh))));
-            wm[k] = _mm256_movemask_pd(_mm256_cmp_pd(wk[k], zero, _CMP_GT_OQ)) & lm;
-        }
-        for (int l = 0; l < 4; l++)
-            for (int k = 0; k < 4; k++)
-                if (wm[k] >> l & 1) {
-                    wb_real *q = &x[3 * p[4 * l + k]];
-                    q[0] += cx[k][0][l]; q[1] += cx[k][1][l]; q[2] += cx[k][2][l];
+                q[r] = add(X[k][r], mul(wk[k], add(pick(zero, mul(gd[k][r], dd), dev), mul(gh[k][r], dh))));
+            q[3] = zero;
+            const int wm = _mm256_movemask_pd(_mm256_cmp_pd(wk[k], zero, _CMP_GT_OQ)) & lm;
+            V4 row[4];
+            transpose4(q[0], q[1], q[2], q[3], row);
+            for (int l = 0; l < 4; l++)
+                if (wm >> l & 1) {
+                    wb_real *o = &x[3 * p[4 * l + k]];
+                    _mm_storeu_pd(o, _mm256_castpd256_pd128(row[l]));
+                    _mm_store_sd(o + 2, _mm256_extractf128_pd(row[l], 1));
                 }
+        }
     }
     if (j < hi) project_scalar(w, j, hi);
 }
