@@ -367,48 +367,91 @@ load4(const wb_real *p, const int32_t i[4], __m256d v[3])
 #define VMADD3(o, a, s) ((o)[0] = VADD((o)[0], VMUL((a)[0], (s))), (o)[1] = VADD((o)[1], VMUL((a)[1], (s))), \
                          (o)[2] = VADD((o)[2], VMUL((a)[2], (s))))
 
+/* the 4 x 4 particles of bends i .. i + 3, transposed: ix[k] = the k-th particle of each */
+static inline __attribute__((always_inline, target("avx2"))) void
+indices4(const int32_t *s_ij, int32_t i, int32_t *ix0, int32_t *ix1, int32_t *ix2, int32_t *ix3)
+{
+    const __m128i r0 = _mm_loadu_si128((const __m128i *)&s_ij[4 * i]);
+    const __m128i r1 = _mm_loadu_si128((const __m128i *)&s_ij[4 * i + 4]);
+    const __m128i r2 = _mm_loadu_si128((const __m128i *)&s_ij[4 * i + 8]);
+    const __m128i r3 = _mm_loadu_si128((const __m128i *)&s_ij[4 * i + 12]);
+    const __m128i t0 = _mm_unpacklo_epi32(r0, r1), t1 = _mm_unpackhi_epi32(r0, r1);
+    const __m128i t2 = _mm_unpacklo_epi32(r2, r3), t3 = _mm_unpackhi_epi32(r2, r3);
+    _mm_store_si128((__m128i *)ix0, _mm_unpacklo_epi64(t0, t2));
+    _mm_store_si128((__m128i *)ix1, _mm_unpackhi_epi64(t0, t2));
+    _mm_store_si128((__m128i *)ix2, _mm_unpacklo_epi64(t1, t3));
+    _mm_store_si128((__m128i *)ix3, _mm_unpackhi_epi64(t1, t3));
+}
+
+/* x, y, z of 4 lanes back into the rows of their particles (load4 undone), only the
+ * lanes of mask: 3 doubles each, the next particle's untouched */
+static inline __attribute__((always_inline, target("avx2"))) void
+store4(wb_real *p, const int32_t i[4], const __m256d v[3], int mask)
+{
+    const __m256d t0 = _mm256_unpacklo_pd(v[0], v[1]), t1 = _mm256_unpackhi_pd(v[0], v[1]); /* x0 y0 x2 y2, x1 y1 x3 y3 */
+    const __m256d u0 = _mm256_unpacklo_pd(v[2], v[2]), u1 = _mm256_unpackhi_pd(v[2], v[2]); /* z0 . z2 ., z1 . z3 . */
+    __m256d r[4];
+    r[0] = _mm256_permute2f128_pd(t0, u0, 0x20);
+    r[1] = _mm256_permute2f128_pd(t1, u1, 0x20);
+    r[2] = _mm256_permute2f128_pd(t0, u0, 0x31);
+    r[3] = _mm256_permute2f128_pd(t1, u1, 0x31);
+    for (int l = 0; l < 4; l++)
+        if (mask >> l & 1) {
+            _mm_storeu_pd(&p[3 * i[l]], _mm256_castpd256_pd128(r[l]));
+            _mm_store_sd(&p[3 * i[l] + 2], _mm256_extractf128_pd(r[l], 1));
+        }
+}
+
+/* lanes whose flag (4 bytes of s_flag) has any bit of f */
+static inline __attribute__((always_inline, target("avx2"))) __m256d flag4(uint32_t fl, int f)
+{
+    const __m256i v = _mm256_and_si256(_mm256_cvtepu8_epi64(_mm_cvtsi32_si128((int)fl)), _mm256_set1_epi64x(f));
+    return _mm256_castsi256_pd(_mm256_xor_si256(_mm256_cmpeq_epi64(v, _mm256_setzero_si256()), _mm256_set1_epi64x(-1)));
+}
+
 /* project_range for 4 bends of a conflict-free batch at a time, in double, every lane
  * doing exactly the scalar loop's operations in its order (dihedral() inlined; no FMA:
  * the Makefile's -ffp-contract=off), so the bits are the scalar loop's for any split of
- * the batch. atan2 stays the library's, called per lane. The skipped lanes (the
- * `continue`s) are masked, the damping's isinf(gamma) limit blended; a chunk's
- * corrections are kept and written after it (no lane reads a movable particle another
- * lane of the batch writes), only where the lane goes on and w > 0. */
+ * the batch. A chunk of CH bends in three passes: the geometry (gradients, den, the
+ * skip tests: none of it needs the angle), the angles (the library's atan2 per lane, in
+ * a loop of their own: a call inside the vector code spills every ymm register), then
+ * the multipliers and corrections, written after the chunk (no lane reads a movable
+ * particle another lane of the batch writes), only where the lane goes on and w > 0.
+ * The skipped lanes (the `continue`s) are masked, the damping's isinf(gamma) limit
+ * blended. */
 static __attribute__((target("avx2"))) void
 project_range_avx2(wb_bends *b, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp, int32_t lo,
                    int32_t hi)
 {
     enum { CH = 32 };
-    double corr[4][3][CH] __attribute__((aligned(32)));
-    double ya[4] __attribute__((aligned(32))), xa[4] __attribute__((aligned(32))), tha[4] __attribute__((aligned(32)));
-    int32_t ix[4][4] __attribute__((aligned(16)));
+    /* per bend of the chunk: its particles and their positions, the gradients, w, den,
+     * the lanes going on (a mask per lane), atan2's arguments and result */
+    int32_t ib[4][CH] __attribute__((aligned(16)));
+    double pb[4][3][CH] __attribute__((aligned(32)));
+    double gb[4][3][CH] __attribute__((aligned(32))), wb[4][CH] __attribute__((aligned(32)));
+    double den_b[CH] __attribute__((aligned(32))), live_b[CH] __attribute__((aligned(32)));
+    double ya[CH] __attribute__((aligned(32))), xa[CH] __attribute__((aligned(32))), tha[CH] __attribute__((aligned(32)));
     const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1), tiny = _mm256_set1_pd(1e-24);
     const __m256d inf = _mm256_set1_pd(INFINITY), negz = _mm256_set1_pd(-0.0);
     const __m256d absmask = _mm256_castsi256_pd(_mm256_set1_epi64x(INT64_MAX));
     const __m256d pi = _mm256_set1_pd(PI_R), mpi = _mm256_set1_pd(-PI_R), twopi = _mm256_set1_pd(2 * PI_R);
     wb_real *restrict lambda = b->lambda;
+    memset(tha, 0, sizeof tha); /* the angle of a lane that has none: read, masked */
     int32_t i = lo;
     while (i + 4 <= hi) {
         const int32_t c0 = i, cn = (hi - i) / 4 * 4 < CH ? (hi - i) / 4 * 4 : CH;
-        uint32_t wr[4] = { 0, 0, 0, 0 }; /* per bend of the chunk: its k-th particle is written */
-        for (int g = 0; g < cn; g += 4, i += 4) {
+        uint64_t lanes = 0; /* bit g: bend c0 + g goes on to its angle */
+        /* pass 1: dihedral() but the angle, the gradients and den */
+        for (int g = 0; g < cn; g += 4) {
             uint32_t fl;
-            memcpy(&fl, &b->s_flag[i], 4);
+            memcpy(&fl, &b->s_flag[c0 + g], 4);
             if ((fl & 0x01010101u) == 0x01010101u) continue; /* all four skipped */
-            /* the 4 x 4 particles, transposed: ix[k] = the k-th particle of each lane */
-            const __m128i r0 = _mm_loadu_si128((const __m128i *)&b->s_ij[4 * i]);
-            const __m128i r1 = _mm_loadu_si128((const __m128i *)&b->s_ij[4 * i + 4]);
-            const __m128i r2 = _mm_loadu_si128((const __m128i *)&b->s_ij[4 * i + 8]);
-            const __m128i r3 = _mm_loadu_si128((const __m128i *)&b->s_ij[4 * i + 12]);
-            const __m128i t0 = _mm_unpacklo_epi32(r0, r1), t1 = _mm_unpackhi_epi32(r0, r1);
-            const __m128i t2 = _mm_unpacklo_epi32(r2, r3), t3 = _mm_unpackhi_epi32(r2, r3);
-            _mm_store_si128((__m128i *)ix[0], _mm_unpacklo_epi64(t0, t2));
-            _mm_store_si128((__m128i *)ix[1], _mm_unpackhi_epi64(t0, t2));
-            _mm_store_si128((__m128i *)ix[2], _mm_unpacklo_epi64(t1, t3));
-            _mm_store_si128((__m128i *)ix[3], _mm_unpackhi_epi64(t1, t3));
+            indices4(b->s_ij, c0 + g, &ib[0][g], &ib[1][g], &ib[2][g], &ib[3][g]);
             __m256d p[4][3];
-            for (int k = 0; k < 4; k++) load4(x, ix[k], p[k]);
-            /* dihedral(): e, the wings, the normals and the degenerate test */
+            for (int k = 0; k < 4; k++) {
+                load4(x, &ib[k][g], p[k]);
+                for (int j = 0; j < 3; j++) _mm256_store_pd(&pb[k][j][g], p[k][j]);
+            }
             __m256d e[3], a3[3], a4[3], n1[3], n2[3], c[3], t[3];
             VSUB3(e, p[1], p[0]);
             VSUB3(a3, p[2], p[0]);
@@ -417,20 +460,13 @@ project_range_avx2(wb_bends *b, const wb_real *restrict wv, wb_real *x, const wb
             VCROSS3(n2, a4, e);
             const __m256d ee = VDOT3(e, e), q1 = VDOT3(n1, n1), q2 = VDOT3(n2, n2);
             const __m256d lim = VMUL(VMUL(tiny, ee), ee);
-            const __m256i fz = _mm256_cmpeq_epi64(_mm256_and_si256(_mm256_cvtepu8_epi64(_mm_cvtsi32_si128((int)fl)),
-                                                                    _mm256_set1_epi64x(SKIP)),
-                                                   _mm256_setzero_si256());
-            __m256d live = _mm256_and_pd(_mm256_castsi256_pd(fz), _mm256_cmp_pd(ee, tiny, _CMP_GT_OQ));
+            __m256d live = _mm256_andnot_pd(flag4(fl, SKIP), _mm256_cmp_pd(ee, tiny, _CMP_GT_OQ));
             live = _mm256_and_pd(live, _mm256_and_pd(_mm256_cmp_pd(q1, lim, _CMP_GT_OQ), _mm256_cmp_pd(q2, lim, _CMP_GT_OQ)));
-            int mask = _mm256_movemask_pd(live);
-            if (!mask) continue;
+            if (!_mm256_movemask_pd(live)) continue;
             const __m256d le = _mm256_sqrt_pd(ee);
             VCROSS3(c, n1, n2);
-            _mm256_store_pd(ya, VDIV(VDOT3(c, e), le));
-            _mm256_store_pd(xa, VDOT3(n1, n2));
-            for (int l = 0; l < 4; l++) tha[l] = mask >> l & 1 ? atan2(ya[l], xa[l]) : 0;
-            const __m256d th = _mm256_load_pd(tha);
-            /* the gradients */
+            _mm256_store_pd(&ya[g], VDIV(VDOT3(c, e), le));
+            _mm256_store_pd(&xa[g], VDOT3(n1, n2));
             __m256d b3[3], b4[3], gr[4][3], s;
             VSCALE3(b3, n1, VDIV(one, q1));
             VSCALE3(b4, n2, VDIV(one, q2));
@@ -447,30 +483,51 @@ project_range_avx2(wb_bends *b, const wb_real *restrict wv, wb_real *x, const wb
             VSCALE3(gr[1], b3, s);
             s = VDIV(VDOT3(a4, e), le);
             VMADD3(gr[1], b4, s);
-            /* the projection */
-            __m256d wk[4], den = zero;
+            __m256d den = zero;
             for (int k = 0; k < 4; k++) {
-                wk[k] = _mm256_set_pd(wv[ix[k][3]], wv[ix[k][2]], wv[ix[k][1]], wv[ix[k][0]]);
-                den = VADD(den, VMUL(wk[k], VDOT3(gr[k], gr[k])));
+                const int32_t *ik = &ib[k][g];
+                const __m256d wk = _mm256_set_pd(wv[ik[3]], wv[ik[2]], wv[ik[1]], wv[ik[0]]);
+                den = VADD(den, VMUL(wk, VDOT3(gr[k], gr[k])));
+                _mm256_store_pd(&wb[k][g], wk);
+                for (int j = 0; j < 3; j++) _mm256_store_pd(&gb[k][j][g], gr[k][j]);
             }
             live = _mm256_and_pd(live, _mm256_and_pd(_mm256_cmp_pd(den, zero, _CMP_GT_OQ),
                                                      _mm256_cmp_pd(_mm256_and_pd(den, absmask), inf, _CMP_LT_OQ)));
-            const __m256d at = _mm256_loadu_pd(&b->s_at[i]), lam = _mm256_loadu_pd(&lambda[i]);
-            const __m256d dd = VSUB(th, _mm256_loadu_pd(&b->s_rest[i]));
+            _mm256_store_pd(&den_b[g], den);
+            _mm256_store_pd(&live_b[g], live);
+            lanes |= (uint64_t)_mm256_movemask_pd(live) << g;
+        }
+        /* pass 2: the angles */
+        for (uint64_t m = lanes; m; m &= m - 1) {
+            const int j = __builtin_ctzll(m);
+            tha[j] = atan2(ya[j], xa[j]);
+        }
+        /* pass 3: the multipliers and the corrections, written at once: the chunk's
+         * reads are done and the batch writes no particle twice */
+        for (int g = 0; g < cn; g += 4) {
+            if (!(lanes >> g & 15)) continue;
+            const int32_t i4 = c0 + g;
+            __m256d live = _mm256_load_pd(&live_b[g]);
+            const __m256d den = _mm256_load_pd(&den_b[g]);
+            const __m256d at = _mm256_loadu_pd(&b->s_at[i4]), lam = _mm256_loadu_pd(&lambda[i4]);
+            const __m256d dd = VSUB(_mm256_load_pd(&tha[g]), _mm256_loadu_pd(&b->s_rest[i4]));
             const __m256d wrapped = _mm256_blendv_pd(_mm256_blendv_pd(dd, VADD(dd, twopi), _mm256_cmp_pd(dd, mpi, _CMP_LE_OQ)),
                                                      VSUB(dd, twopi), _mm256_cmp_pd(dd, pi, _CMP_GT_OQ));
             __m256d num = VSUB(_mm256_xor_pd(wrapped, negz), VMUL(at, lam)), d = VADD(den, at);
-            const __m256i fd = _mm256_cmpeq_epi64(_mm256_and_si256(_mm256_cvtepu8_epi64(_mm_cvtsi32_si128((int)fl)),
-                                                                    _mm256_set1_epi64x(DAMPED)),
-                                                   _mm256_set1_epi64x(DAMPED));
-            const __m256d damped = _mm256_and_pd(_mm256_castsi256_pd(fd), live);
+            uint32_t fl;
+            memcpy(&fl, &b->s_flag[i4], 4);
+            const __m256d damped = _mm256_and_pd(flag4(fl, DAMPED), live);
             if (_mm256_movemask_pd(damped)) {
-                const __m256d gamma = _mm256_loadu_pd(&b->s_gamma[i]);
-                __m256d rel = zero, q[3], v[3];
+                const __m256d gamma = _mm256_loadu_pd(&b->s_gamma[i4]);
+                __m256d rel = zero, q[3], v[3], pk[3], gk[3];
                 for (int k = 0; k < 4; k++) {
-                    load4(xp, ix[k], q);
-                    VSUB3(v, p[k], q);
-                    rel = VADD(rel, VDOT3(gr[k], v));
+                    load4(xp, &ib[k][g], q);
+                    for (int j = 0; j < 3; j++) {
+                        pk[j] = _mm256_load_pd(&pb[k][j][g]);
+                        gk[j] = _mm256_load_pd(&gb[k][j][g]);
+                    }
+                    VSUB3(v, pk, q);
+                    rel = VADD(rel, VDOT3(gk, v));
                 }
                 const __m256d ginf = _mm256_cmp_pd(_mm256_and_pd(gamma, absmask), inf, _CMP_EQ_OQ);
                 const __m256d nd = _mm256_blendv_pd(VSUB(num, VMUL(gamma, rel)), _mm256_xor_pd(rel, negz), ginf);
@@ -481,19 +538,18 @@ project_range_avx2(wb_bends *b, const wb_real *restrict wv, wb_real *x, const wb
             const __m256d dl = VDIV(num, d);
             live = _mm256_and_pd(live, _mm256_cmp_pd(_mm256_and_pd(dl, absmask), inf, _CMP_LT_OQ));
             /* a blend and a plain store: a masked store is slow on AMD */
-            _mm256_storeu_pd(&lambda[i], _mm256_blendv_pd(lam, VADD(lam, dl), live));
+            _mm256_storeu_pd(&lambda[i4], _mm256_blendv_pd(lam, VADD(lam, dl), live));
             for (int k = 0; k < 4; k++) {
-                const __m256d f = VMUL(wk[k], dl);
-                for (int j = 0; j < 3; j++) _mm256_store_pd(&corr[k][j][g], VMUL(gr[k][j], f));
-                wr[k] |= (uint32_t)_mm256_movemask_pd(_mm256_and_pd(live, _mm256_cmp_pd(wk[k], zero, _CMP_GT_OQ))) << g;
+                const __m256d wk = _mm256_load_pd(&wb[k][g]), f = VMUL(wk, dl);
+                const int wr = _mm256_movemask_pd(_mm256_and_pd(live, _mm256_cmp_pd(wk, zero, _CMP_GT_OQ)));
+                if (!wr) continue;
+                __m256d nx[3]; /* x += g w dl, as v3_madd */
+                for (int j = 0; j < 3; j++)
+                    nx[j] = VADD(_mm256_load_pd(&pb[k][j][g]), VMUL(_mm256_load_pd(&gb[k][j][g]), f));
+                store4(x, &ib[k][g], nx, wr);
             }
         }
-        for (int k = 0; k < 4; k++)
-            for (uint32_t m = wr[k]; m; m &= m - 1) {
-                const int j = __builtin_ctz(m);
-                wb_real *o = &x[3 * b->s_ij[4 * (c0 + j) + k]];
-                o[0] += corr[k][0][j]; o[1] += corr[k][1][j]; o[2] += corr[k][2][j];
-            }
+        i += cn;
     }
     if (i < hi) project_range(b, wv, x, xp, i, hi);
 }
