@@ -337,19 +337,19 @@ static void project_range(wb_bends *b, const wb_real *restrict wv, wb_real *x, c
 #define WB_BEND_AVX2 1
 #include <immintrin.h>
 
-/* the x, y, z of 4 particles as 3 vectors of lanes: rows loaded without the 4th double
- * (maskload does not touch it: the last particle ends the array), then transposed */
+/* the x, y, z of 4 particles as 3 vectors of lanes: x y pairs and z apart, plain loads
+ * (none past a particle: the last one ends the array), put together by lane pairs */
 static inline __attribute__((always_inline, target("avx2"))) void
 load4(const wb_real *p, const int32_t i[4], __m256d v[3])
 {
-    const __m256i m = _mm256_set_epi64x(0, -1, -1, -1);
-    const __m256d r0 = _mm256_maskload_pd(&p[3 * i[0]], m), r1 = _mm256_maskload_pd(&p[3 * i[1]], m);
-    const __m256d r2 = _mm256_maskload_pd(&p[3 * i[2]], m), r3 = _mm256_maskload_pd(&p[3 * i[3]], m);
-    const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1); /* x0 x1 z0 z1, y0 y1 . . */
-    const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
-    v[0] = _mm256_permute2f128_pd(t0, t2, 0x20);
-    v[1] = _mm256_permute2f128_pd(t1, t3, 0x20);
-    v[2] = _mm256_permute2f128_pd(t0, t2, 0x31);
+    const wb_real *p0 = &p[3 * i[0]], *p1 = &p[3 * i[1]], *p2 = &p[3 * i[2]], *p3 = &p[3 * i[3]];
+    const __m256d a02 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(p0)), _mm_loadu_pd(p2), 1);
+    const __m256d a13 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(p1)), _mm_loadu_pd(p3), 1);
+    const __m256d z02 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_load_sd(p0 + 2)), _mm_load_sd(p2 + 2), 1);
+    const __m256d z13 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_load_sd(p1 + 2)), _mm_load_sd(p3 + 2), 1);
+    v[0] = _mm256_unpacklo_pd(a02, a13); /* x0 x1 x2 x3 */
+    v[1] = _mm256_unpackhi_pd(a02, a13);
+    v[2] = _mm256_unpacklo_pd(z02, z13);
 }
 
 #define VADD _mm256_add_pd
