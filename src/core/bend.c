@@ -12,7 +12,10 @@
  * Colour batches (colour.c, four particles per constraint) are projected batch after
  * batch, a batch in parallel chunks: the same result for any thread count. Under the
  * Jacobi solver bends are still projected Gauss-Seidel (their batches are conflict-free,
- * so this needs no accumulator and stays deterministic). */
+ * so this needs no accumulator and stays deterministic). What the projection reads is
+ * packed in its order at colour time; on a CPU with AVX2 a conflict-free batch goes 4
+ * bends at a time (project_range_avx2), with the scalar loop's bits (issue 12: about 2x
+ * less CPU per bend, see README, Benchmark). */
 #include <assert.h>
 #include <stdlib.h>
 
@@ -584,12 +587,12 @@ int wb__bend_simd(int on)
     return v;
 }
 
-/* [lo, hi) of one batch; free: it shares no movable particle (not the serial tail) */
-static void project_batch(wb_world *w, int32_t lo, int32_t hi, int free)
+/* [lo, hi) of one batch; apart: it shares no movable particle (not the serial tail) */
+static void project_batch(wb_world *w, int32_t lo, int32_t hi, int apart)
 {
     wb_bends *b = &w->bend;
 #ifdef WB_BEND_AVX2
-    if (free && hi - lo >= 4) {
+    if (apart && hi - lo >= 4) {
         /* decided once, possibly by several threads at once (the same answer) */
         int v = __atomic_load_n(&simd_state, __ATOMIC_RELAXED);
         if (v < 0) v = wb__bend_simd(1);
@@ -599,7 +602,7 @@ static void project_batch(wb_world *w, int32_t lo, int32_t hi, int free)
         }
     }
 #else
-    (void)free;
+    (void)apart;
 #endif
     project_range(b, w->m.w, w->s.x, w->s.x_prev, lo, hi);
 }
