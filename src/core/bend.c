@@ -12,7 +12,10 @@
  * Colour batches (colour.c, four particles per constraint) are projected batch after
  * batch, a batch in parallel chunks: the same result for any thread count. Under the
  * Jacobi solver bends are still projected Gauss-Seidel (their batches are conflict-free,
- * so this needs no accumulator and stays deterministic). */
+ * so this needs no accumulator and stays deterministic). What the projection reads is
+ * packed in its order at colour time; on a CPU with AVX2 a conflict-free batch goes 4
+ * bends at a time (project_range_avx2), with the scalar loop's bits (issue 12: about 2x
+ * less CPU per bend, see README, Benchmark). */
 #include <assert.h>
 #include <stdlib.h>
 
@@ -21,12 +24,15 @@
 #define PI_R ((wb_real)3.14159265358979323846)
 
 /* bytes per constraint over the model and cache arrays, for the memory budget */
-#define BEND_BYTES (8 * sizeof(int32_t) + 5 * sizeof(wb_real) + 2 * sizeof(int32_t) + 1)
+#define BEND_BYTES (4 * sizeof(int32_t) + 5 * sizeof(wb_real) + 2 * sizeof(int32_t) + 1 + PACK_BYTES)
+/* the packed block (bend.h): particles, rest, at, gamma, flag */
+#define PACK_BYTES (4 * sizeof(int32_t) + 3 * sizeof(wb_real) + 1)
+enum { SKIP = 1, DAMPED = 2 };
 
 /* ---- geometry ---------------------------------------------------------------------------- */
 /* the dihedral angle across x1-x2 (0 flat, sign: the wings folding towards n1 x n2 . e)
  * and, when g is not NULL, its gradient for the four particles. 0 when degenerate. */
-static int dihedral(const wb_real *x1, const wb_real *x2, const wb_real *x3, const wb_real *x4, wb_real *theta,
+static inline __attribute__((always_inline)) int dihedral(const wb_real *x1, const wb_real *x2, const wb_real *x3, const wb_real *x4, wb_real *theta,
                     wb_real g[4][3])
 {
     wb_real e[3], a3[3], a4[3], n1[3], n2[3], c[3];
@@ -99,7 +105,7 @@ static wb_status grow(wb_world *w, int32_t need)
     struct { void **p; size_t elem; } arr[] = {
         { (void **)&b->ij, 4 * sizeof(int32_t) }, { (void **)&b->alpha, sizeof(wb_real) },
         { (void **)&b->beta, sizeof(wb_real) }, { (void **)&b->rest, sizeof(wb_real) },
-        { (void **)&b->s_ij, 4 * sizeof(int32_t) }, { (void **)&b->s_slot, sizeof(int32_t) },
+        { (void **)&b->s_slot, sizeof(int32_t) },
         { (void **)&b->pack, sizeof(int32_t) }, { (void **)&b->lambda, sizeof(wb_real) },
         { (void **)&b->btorque, sizeof(wb_real) }, { (void **)&b->broken, 1 },
     };
@@ -227,6 +233,23 @@ static int32_t bend_count(const wb_world *w) { return w->bend.n; }
 
 static int always(const void *ud, int32_t i) { (void)ud; (void)i; return 1; }
 
+/* the packed block for n entries: one allocation (bend.h), grown only */
+static int pack_alloc(wb_bends *b, int32_t n)
+{
+    if (n <= b->cap_s && b->s_ij) return 1;
+    const size_t cap = (size_t)(n > 0 ? n : 1);
+    void *q = malloc(cap * PACK_BYTES);
+    if (!q) return 0;
+    free(b->s_ij);
+    b->s_ij = q;
+    b->s_rest = (wb_real *)(b->s_ij + 4 * cap); /* reals after the int32 quadruples: aligned */
+    b->s_at = b->s_rest + cap;
+    b->s_gamma = b->s_at + cap;
+    b->s_flag = (uint8_t *)(b->s_gamma + cap);
+    b->cap_s = (int32_t)cap;
+    return 1;
+}
+
 static wb_status bend_prepare(wb_world *w)
 {
     wb_bends *b = &w->bend;
@@ -234,7 +257,8 @@ static wb_status bend_prepare(wb_world *w)
     if (!b->dirty) return WB_OK;
     uint8_t *colour = malloc((size_t)(b->n > 0 ? b->n : 1));
     int32_t count[WB_MAX_COLOURS + 1], start[WB_MAX_COLOURS + 1];
-    if (!colour || !wb__colour_greedy(w->m.inv_mass, w->m.np, b->ij, 4, b->n, always, NULL, colour, count)) {
+    if (!colour || !pack_alloc(b, b->n) ||
+        !wb__colour_greedy(w->m.inv_mass, w->m.np, b->ij, 4, b->n, always, NULL, colour, count)) {
         free(colour);
         return WB_ERR_NOMEM;
     }
@@ -242,11 +266,13 @@ static wb_status bend_prepare(wb_world *w)
     for (int32_t s = 0; s < b->n; s++) {
         const int32_t i = start[colour[s]]++;
         memcpy(&b->s_ij[4 * i], &b->ij[4 * s], 4 * sizeof(int32_t));
+        b->s_rest[i] = b->rest[s];
         b->s_slot[i] = s;
         b->pack[s] = i;
         b->lambda[i] = 0;
     }
     free(colour);
+    b->h_at = NAN; /* s_at, s_gamma, s_flag: at the next projection */
     b->dirty = 0;
     return WB_OK;
 }
@@ -256,27 +282,42 @@ static void bend_substep_begin(wb_world *w)
     if (w->bend.n > 0) memset(w->bend.lambda, 0, sizeof(wb_real) * (size_t)w->bend.n);
 }
 
+/* the per-constraint constants of a substep h, in the packed order: computed as the
+ * loop computed them in the loop before (the same bits) */
+static void pack_constants(wb_bends *b, wb_real h, wb_real inv_h2)
+{
+    for (int32_t i = 0; i < b->n; i++) {
+        const int32_t s = b->s_slot[i];
+        const wb_real at = b->alpha[s] * inv_h2;
+        b->s_at[i] = at;
+        b->s_gamma[i] = at * b->beta[s] * h;
+        b->s_flag[i] = (uint8_t)(b->broken[s] || isinf(at) ? SKIP : b->beta[s] > 0 && at > 0 ? DAMPED : 0);
+    }
+    b->h_at = h;
+}
+
 /* XPBD on packed [lo, hi): dlambda = (-C - at lambda - gamma grad C . (x - x_prev)) /
  * ((1 + gamma) sum w |grad|^2 + at), each movable particle moved by w grad dlambda;
- * particles with w = 0 are never written */
-static void project_range(wb_world *w, int32_t lo, int32_t hi, wb_real h, wb_real inv_h2)
+ * particles with w = 0 are never written. The reference for the AVX2 path below: any
+ * change here must be made there too, operation for operation. */
+static void project_range(wb_bends *b, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
+                          int32_t lo, int32_t hi)
 {
-    wb_bends *b = &w->bend;
-    const wb_real *wv = w->m.w, *xp = w->s.x_prev;
-    wb_real *x = w->s.x;
+    const uint8_t *restrict flag = b->s_flag;
+    wb_real *restrict lambda = b->lambda;
     for (int32_t i = lo; i < hi; i++) {
-        const int32_t *p = &b->s_ij[4 * i], s = b->s_slot[i];
-        if (b->broken[s]) continue;
+        if (flag[i] & SKIP) continue;
+        const int32_t *p = &b->s_ij[4 * i];
         wb_real g[4][3], th;
         if (!dihedral(&x[3 * p[0]], &x[3 * p[1]], &x[3 * p[2]], &x[3 * p[3]], &th, g)) continue;
         wb_real den = 0;
         for (int k = 0; k < 4; k++) den += wv[p[k]] * v3_dot(g[k], g[k]);
-        const wb_real at = b->alpha[s] * inv_h2;
-        if (!(den > 0) || isinf(at) || !isfinite(den)) continue;
-        wb_real num = -wrap(th - b->rest[s]) - at * b->lambda[i], d = den + at;
-        if (b->beta[s] > 0 && at > 0) {
+        if (!(den > 0) || !isfinite(den)) continue;
+        const wb_real at = b->s_at[i];
+        wb_real num = -wrap(th - b->s_rest[i]) - at * lambda[i], d = den + at;
+        if (flag[i] & DAMPED) {
             /* gamma = alpha~ beta~ / h with beta~ = h^2 beta, as a distance's damping */
-            const wb_real gamma = at * b->beta[s] * h;
+            const wb_real gamma = b->s_gamma[i];
             wb_real rel = 0;
             for (int k = 0; k < 4; k++) {
                 wb_real v[3];
@@ -289,34 +330,305 @@ static void project_range(wb_world *w, int32_t lo, int32_t hi, wb_real h, wb_rea
         }
         const wb_real dl = num / d;
         if (!isfinite(dl)) continue;
-        b->lambda[i] += dl;
+        lambda[i] += dl;
         for (int k = 0; k < 4; k++)
             if (wv[p[k]] > 0) v3_madd(&x[3 * p[k]], g[k], wv[p[k]] * dl);
     }
 }
 
-typedef struct bend_job { wb_world *w; int32_t lo; wb_real h, inv_h2; } bend_job;
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(WB_FLOAT)
+#define WB_BEND_AVX2 1
+#include <immintrin.h>
+
+/* the x, y, z of 4 particles as 3 vectors of lanes: x y pairs and z apart, plain loads
+ * (none past a particle: the last one ends the array), put together by lane pairs */
+static inline __attribute__((always_inline, target("avx2"))) void
+load4(const wb_real *p, const int32_t i[4], __m256d v[3])
+{
+    const wb_real *p0 = &p[3 * i[0]], *p1 = &p[3 * i[1]], *p2 = &p[3 * i[2]], *p3 = &p[3 * i[3]];
+    const __m256d a02 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(p0)), _mm_loadu_pd(p2), 1);
+    const __m256d a13 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(p1)), _mm_loadu_pd(p3), 1);
+    const __m256d z02 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_load_sd(p0 + 2)), _mm_load_sd(p2 + 2), 1);
+    const __m256d z13 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_load_sd(p1 + 2)), _mm_load_sd(p3 + 2), 1);
+    v[0] = _mm256_unpacklo_pd(a02, a13); /* x0 x1 x2 x3 */
+    v[1] = _mm256_unpackhi_pd(a02, a13);
+    v[2] = _mm256_unpacklo_pd(z02, z13);
+}
+
+#define VADD _mm256_add_pd
+#define VSUB _mm256_sub_pd
+#define VMUL _mm256_mul_pd
+#define VDIV _mm256_div_pd
+/* v3_sub, v3_dot, v3_cross of core.h on vectors of lanes, the same operations in order */
+#define VSUB3(o, a, b) ((o)[0] = VSUB((a)[0], (b)[0]), (o)[1] = VSUB((a)[1], (b)[1]), (o)[2] = VSUB((a)[2], (b)[2]))
+#define VDOT3(a, b) VADD(VADD(VMUL((a)[0], (b)[0]), VMUL((a)[1], (b)[1])), VMUL((a)[2], (b)[2]))
+#define VCROSS3(o, a, b)                                                                                             \
+    ((o)[0] = VSUB(VMUL((a)[1], (b)[2]), VMUL((a)[2], (b)[1])),                                                     \
+     (o)[1] = VSUB(VMUL((a)[2], (b)[0]), VMUL((a)[0], (b)[2])),                                                     \
+     (o)[2] = VSUB(VMUL((a)[0], (b)[1]), VMUL((a)[1], (b)[0])))
+#define VSCALE3(o, a, s) ((o)[0] = VMUL((a)[0], (s)), (o)[1] = VMUL((a)[1], (s)), (o)[2] = VMUL((a)[2], (s)))
+#define VMADD3(o, a, s) ((o)[0] = VADD((o)[0], VMUL((a)[0], (s))), (o)[1] = VADD((o)[1], VMUL((a)[1], (s))), \
+                         (o)[2] = VADD((o)[2], VMUL((a)[2], (s))))
+
+/* the 4 x 4 particles of bends i .. i + 3, transposed: ix[k] = the k-th particle of each */
+static inline __attribute__((always_inline, target("avx2"))) void
+indices4(const int32_t *s_ij, int32_t i, int32_t *ix0, int32_t *ix1, int32_t *ix2, int32_t *ix3)
+{
+    const __m128i r0 = _mm_loadu_si128((const __m128i *)&s_ij[4 * i]);
+    const __m128i r1 = _mm_loadu_si128((const __m128i *)&s_ij[4 * i + 4]);
+    const __m128i r2 = _mm_loadu_si128((const __m128i *)&s_ij[4 * i + 8]);
+    const __m128i r3 = _mm_loadu_si128((const __m128i *)&s_ij[4 * i + 12]);
+    const __m128i t0 = _mm_unpacklo_epi32(r0, r1), t1 = _mm_unpackhi_epi32(r0, r1);
+    const __m128i t2 = _mm_unpacklo_epi32(r2, r3), t3 = _mm_unpackhi_epi32(r2, r3);
+    _mm_store_si128((__m128i *)ix0, _mm_unpacklo_epi64(t0, t2));
+    _mm_store_si128((__m128i *)ix1, _mm_unpackhi_epi64(t0, t2));
+    _mm_store_si128((__m128i *)ix2, _mm_unpacklo_epi64(t1, t3));
+    _mm_store_si128((__m128i *)ix3, _mm_unpackhi_epi64(t1, t3));
+}
+
+/* x, y, z of 4 lanes back into the rows of their particles (load4 undone), only the
+ * lanes of mask: 3 doubles each, the next particle's untouched */
+static inline __attribute__((always_inline, target("avx2"))) void
+store4(wb_real *p, const int32_t i[4], const __m256d v[3], int mask)
+{
+    const __m256d t0 = _mm256_unpacklo_pd(v[0], v[1]), t1 = _mm256_unpackhi_pd(v[0], v[1]); /* x0 y0 x2 y2, x1 y1 x3 y3 */
+    const __m256d u0 = _mm256_unpacklo_pd(v[2], v[2]), u1 = _mm256_unpackhi_pd(v[2], v[2]); /* z0 . z2 ., z1 . z3 . */
+    __m256d r[4];
+    r[0] = _mm256_permute2f128_pd(t0, u0, 0x20);
+    r[1] = _mm256_permute2f128_pd(t1, u1, 0x20);
+    r[2] = _mm256_permute2f128_pd(t0, u0, 0x31);
+    r[3] = _mm256_permute2f128_pd(t1, u1, 0x31);
+    for (int l = 0; l < 4; l++)
+        if (mask >> l & 1) {
+            _mm_storeu_pd(&p[3 * i[l]], _mm256_castpd256_pd128(r[l]));
+            _mm_store_sd(&p[3 * i[l] + 2], _mm256_extractf128_pd(r[l], 1));
+        }
+}
+
+/* lanes whose flag (4 bytes of s_flag) has any bit of f */
+static inline __attribute__((always_inline, target("avx2"))) __m256d flag4(uint32_t fl, int f)
+{
+    const __m256i v = _mm256_and_si256(_mm256_cvtepu8_epi64(_mm_cvtsi32_si128((int)fl)), _mm256_set1_epi64x(f));
+    return _mm256_castsi256_pd(_mm256_xor_si256(_mm256_cmpeq_epi64(v, _mm256_setzero_si256()), _mm256_set1_epi64x(-1)));
+}
+
+/* project_range for 4 bends of a conflict-free batch at a time, in double, every lane
+ * doing exactly the scalar loop's operations in its order (dihedral() inlined; no FMA:
+ * the Makefile's -ffp-contract=off), so the bits are the scalar loop's for any split of
+ * the batch. A chunk of CH bends in three passes: the geometry (gradients, den, the
+ * skip tests: none of it needs the angle), the angles (the library's atan2 per lane, in
+ * a loop of their own: a call inside the vector code spills every ymm register), then
+ * the multipliers and corrections, written after the chunk (no lane reads a movable
+ * particle another lane of the batch writes), only where the lane goes on and w > 0.
+ * The skipped lanes (the `continue`s) are masked, the damping's isinf(gamma) limit
+ * blended. */
+static __attribute__((target("avx2"))) void
+project_range_avx2(wb_bends *b, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp, int32_t lo,
+                   int32_t hi)
+{
+    enum { CH = 32 };
+    /* per bend of the chunk: its particles and their positions, the gradients, w, den,
+     * the lanes going on (a mask per lane), atan2's arguments and result */
+    int32_t ib[4][CH] __attribute__((aligned(16)));
+    double pb[4][3][CH] __attribute__((aligned(32)));
+    double gb[4][3][CH] __attribute__((aligned(32))), wb[4][CH] __attribute__((aligned(32)));
+    double den_b[CH] __attribute__((aligned(32))), live_b[CH] __attribute__((aligned(32)));
+    double ya[CH] __attribute__((aligned(32))), xa[CH] __attribute__((aligned(32))), tha[CH] __attribute__((aligned(32)));
+    const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1), tiny = _mm256_set1_pd(1e-24);
+    const __m256d inf = _mm256_set1_pd(INFINITY), negz = _mm256_set1_pd(-0.0);
+    const __m256d absmask = _mm256_castsi256_pd(_mm256_set1_epi64x(INT64_MAX));
+    const __m256d pi = _mm256_set1_pd(PI_R), mpi = _mm256_set1_pd(-PI_R), twopi = _mm256_set1_pd(2 * PI_R);
+    wb_real *restrict lambda = b->lambda;
+    memset(tha, 0, sizeof tha); /* the angle of a lane that has none: read, masked */
+    int32_t i = lo;
+    while (i + 4 <= hi) {
+        const int32_t c0 = i, cn = (hi - i) / 4 * 4 < CH ? (hi - i) / 4 * 4 : CH;
+        uint64_t lanes = 0; /* bit g: bend c0 + g goes on to its angle */
+        /* pass 1: dihedral() but the angle, the gradients and den */
+        for (int g = 0; g < cn; g += 4) {
+            uint32_t fl;
+            memcpy(&fl, &b->s_flag[c0 + g], 4);
+            if ((fl & 0x01010101u) == 0x01010101u) continue; /* all four skipped */
+            indices4(b->s_ij, c0 + g, &ib[0][g], &ib[1][g], &ib[2][g], &ib[3][g]);
+            __m256d p[4][3];
+            for (int k = 0; k < 4; k++) {
+                load4(x, &ib[k][g], p[k]);
+                for (int j = 0; j < 3; j++) _mm256_store_pd(&pb[k][j][g], p[k][j]);
+            }
+            __m256d e[3], a3[3], a4[3], n1[3], n2[3], c[3], t[3];
+            VSUB3(e, p[1], p[0]);
+            VSUB3(a3, p[2], p[0]);
+            VSUB3(a4, p[3], p[0]);
+            VCROSS3(n1, e, a3);
+            VCROSS3(n2, a4, e);
+            const __m256d ee = VDOT3(e, e), q1 = VDOT3(n1, n1), q2 = VDOT3(n2, n2);
+            const __m256d lim = VMUL(VMUL(tiny, ee), ee);
+            __m256d live = _mm256_andnot_pd(flag4(fl, SKIP), _mm256_cmp_pd(ee, tiny, _CMP_GT_OQ));
+            live = _mm256_and_pd(live, _mm256_and_pd(_mm256_cmp_pd(q1, lim, _CMP_GT_OQ), _mm256_cmp_pd(q2, lim, _CMP_GT_OQ)));
+            if (!_mm256_movemask_pd(live)) continue;
+            const __m256d le = _mm256_sqrt_pd(ee);
+            VCROSS3(c, n1, n2);
+            _mm256_store_pd(&ya[g], VDIV(VDOT3(c, e), le));
+            _mm256_store_pd(&xa[g], VDOT3(n1, n2));
+            __m256d b3[3], b4[3], gr[4][3], s;
+            VSCALE3(b3, n1, VDIV(one, q1));
+            VSCALE3(b4, n2, VDIV(one, q2));
+            const __m256d mle = _mm256_xor_pd(le, negz);
+            VSCALE3(gr[2], b3, mle);
+            VSCALE3(gr[3], b4, mle);
+            VSUB3(t, p[2], p[1]);
+            s = VDIV(VDOT3(t, e), le);
+            VSCALE3(gr[0], b3, _mm256_xor_pd(s, negz));
+            VSUB3(t, p[3], p[1]);
+            s = VDIV(VDOT3(t, e), le);
+            VMADD3(gr[0], b4, _mm256_xor_pd(s, negz));
+            s = VDIV(VDOT3(a3, e), le);
+            VSCALE3(gr[1], b3, s);
+            s = VDIV(VDOT3(a4, e), le);
+            VMADD3(gr[1], b4, s);
+            __m256d den = zero;
+            for (int k = 0; k < 4; k++) {
+                const int32_t *ik = &ib[k][g];
+                const __m256d wk = _mm256_set_pd(wv[ik[3]], wv[ik[2]], wv[ik[1]], wv[ik[0]]);
+                den = VADD(den, VMUL(wk, VDOT3(gr[k], gr[k])));
+                _mm256_store_pd(&wb[k][g], wk);
+                for (int j = 0; j < 3; j++) _mm256_store_pd(&gb[k][j][g], gr[k][j]);
+            }
+            live = _mm256_and_pd(live, _mm256_and_pd(_mm256_cmp_pd(den, zero, _CMP_GT_OQ),
+                                                     _mm256_cmp_pd(_mm256_and_pd(den, absmask), inf, _CMP_LT_OQ)));
+            _mm256_store_pd(&den_b[g], den);
+            _mm256_store_pd(&live_b[g], live);
+            lanes |= (uint64_t)_mm256_movemask_pd(live) << g;
+        }
+        /* pass 2: the angles */
+        for (uint64_t m = lanes; m; m &= m - 1) {
+            const int j = __builtin_ctzll(m);
+            tha[j] = atan2(ya[j], xa[j]);
+        }
+        /* pass 3: the multipliers and the corrections, written at once: the chunk's
+         * reads are done and the batch writes no particle twice */
+        for (int g = 0; g < cn; g += 4) {
+            if (!(lanes >> g & 15)) continue;
+            const int32_t i4 = c0 + g;
+            __m256d live = _mm256_load_pd(&live_b[g]);
+            const __m256d den = _mm256_load_pd(&den_b[g]);
+            const __m256d at = _mm256_loadu_pd(&b->s_at[i4]), lam = _mm256_loadu_pd(&lambda[i4]);
+            const __m256d dd = VSUB(_mm256_load_pd(&tha[g]), _mm256_loadu_pd(&b->s_rest[i4]));
+            const __m256d wrapped = _mm256_blendv_pd(_mm256_blendv_pd(dd, VADD(dd, twopi), _mm256_cmp_pd(dd, mpi, _CMP_LE_OQ)),
+                                                     VSUB(dd, twopi), _mm256_cmp_pd(dd, pi, _CMP_GT_OQ));
+            __m256d num = VSUB(_mm256_xor_pd(wrapped, negz), VMUL(at, lam)), d = VADD(den, at);
+            uint32_t fl;
+            memcpy(&fl, &b->s_flag[i4], 4);
+            const __m256d damped = _mm256_and_pd(flag4(fl, DAMPED), live);
+            if (_mm256_movemask_pd(damped)) {
+                const __m256d gamma = _mm256_loadu_pd(&b->s_gamma[i4]);
+                __m256d rel = zero, q[3], v[3], pk[3], gk[3];
+                for (int k = 0; k < 4; k++) {
+                    load4(xp, &ib[k][g], q);
+                    for (int j = 0; j < 3; j++) {
+                        pk[j] = _mm256_load_pd(&pb[k][j][g]);
+                        gk[j] = _mm256_load_pd(&gb[k][j][g]);
+                    }
+                    VSUB3(v, pk, q);
+                    rel = VADD(rel, VDOT3(gk, v));
+                }
+                const __m256d ginf = _mm256_cmp_pd(_mm256_and_pd(gamma, absmask), inf, _CMP_EQ_OQ);
+                const __m256d nd = _mm256_blendv_pd(VSUB(num, VMUL(gamma, rel)), _mm256_xor_pd(rel, negz), ginf);
+                const __m256d dn = _mm256_blendv_pd(VADD(d, VMUL(gamma, den)), den, ginf);
+                num = _mm256_blendv_pd(num, nd, damped);
+                d = _mm256_blendv_pd(d, dn, damped);
+            }
+            const __m256d dl = VDIV(num, d);
+            live = _mm256_and_pd(live, _mm256_cmp_pd(_mm256_and_pd(dl, absmask), inf, _CMP_LT_OQ));
+            /* a blend and a plain store: a masked store is slow on AMD */
+            _mm256_storeu_pd(&lambda[i4], _mm256_blendv_pd(lam, VADD(lam, dl), live));
+            for (int k = 0; k < 4; k++) {
+                const __m256d wk = _mm256_load_pd(&wb[k][g]), f = VMUL(wk, dl);
+                const int wr = _mm256_movemask_pd(_mm256_and_pd(live, _mm256_cmp_pd(wk, zero, _CMP_GT_OQ)));
+                if (!wr) continue;
+                __m256d nx[3]; /* x += g w dl, as v3_madd */
+                for (int j = 0; j < 3; j++)
+                    nx[j] = VADD(_mm256_load_pd(&pb[k][j][g]), VMUL(_mm256_load_pd(&gb[k][j][g]), f));
+                store4(x, &ib[k][g], nx, wr);
+            }
+        }
+        i += cn;
+    }
+    if (i < hi) project_range(b, wv, x, xp, i, hi);
+}
+#undef VADD
+#undef VSUB
+#undef VMUL
+#undef VDIV
+#undef VSUB3
+#undef VDOT3
+#undef VCROSS3
+#undef VSCALE3
+#undef VMADD3
+#endif
+
+/* the vector path: -1 not yet decided, 0 off (no AVX2, or turned off), 1 on */
+static int simd_state = -1;
+
+/* Internal switch for tests: on = 0 forces the scalar loop, on = 1 uses the vector
+ * path where the CPU has it; returns whether the vector path is on. Not thread-safe:
+ * call it between steps. */
+int wb__bend_simd(int on);
+int wb__bend_simd(int on)
+{
+#ifdef WB_BEND_AVX2
+    __builtin_cpu_init();
+    const int v = on && __builtin_cpu_supports("avx2");
+#else
+    const int v = 0;
+    (void)on;
+#endif
+    __atomic_store_n(&simd_state, v, __ATOMIC_RELAXED);
+    return v;
+}
+
+/* [lo, hi) of one batch; apart: it shares no movable particle (not the serial tail) */
+static void project_batch(wb_world *w, int32_t lo, int32_t hi, int apart)
+{
+    wb_bends *b = &w->bend;
+#ifdef WB_BEND_AVX2
+    if (apart && hi - lo >= 4) {
+        /* decided once, possibly by several threads at once (the same answer) */
+        int v = __atomic_load_n(&simd_state, __ATOMIC_RELAXED);
+        if (v < 0) v = wb__bend_simd(1);
+        if (v) {
+            project_range_avx2(b, w->m.w, w->s.x, w->s.x_prev, lo, hi);
+            return;
+        }
+    }
+#else
+    (void)apart;
+#endif
+    project_range(b, w->m.w, w->s.x, w->s.x_prev, lo, hi);
+}
+
+typedef struct bend_job { wb_world *w; int32_t lo; } bend_job;
 
 static void bend_part(void *ctx, int32_t lo, int32_t hi)
 {
     const bend_job *j = ctx;
-    project_range(j->w, j->lo + lo, j->lo + hi, j->h, j->inv_h2);
+    project_batch(j->w, j->lo + lo, j->lo + hi, 1);
 }
 
 static void bend_project(wb_world *w, wb_real h)
 {
     wb_bends *b = &w->bend;
-    const wb_real inv_h2 = 1 / (h * h);
     w->k.projections += b->n;
+    if (!(h == b->h_at)) pack_constants(b, h, 1 / (h * h));
     for (int32_t c = 0; c < b->ncolours; c++) {
         const int32_t lo = b->colour_start[c], hi = b->colour_start[c + 1];
         wb_pool *pool = c < b->serial_start && hi - lo >= 256 ? wb__world_pool(w) : NULL;
         if (!pool) {
-            project_range(w, lo, hi, h, inv_h2);
+            project_batch(w, lo, hi, c < b->serial_start);
             continue;
         }
         /* contiguous chunks on the pool: a batch shares no movable particle */
-        bend_job j = { w, lo, h, inv_h2 };
+        bend_job j = { w, lo };
         wb__pool_for(pool, hi - lo, 128, bend_part, &j);
     }
 }
@@ -349,6 +661,7 @@ static void bend_frame_end(wb_world *w)
         const int32_t s = b->s_slot[i];
         if (!(b->btorque[s] > 0) || b->broken[s] || !(fabs(b->lambda[i]) * inv_h2 > b->btorque[s])) continue;
         b->broken[s] = 1;
+        b->s_flag[i] |= SKIP;
         wb_bend_id id = { (uint32_t)s + 1, 1 };
         wb_bend_id *q = wb__grow(b->breaks, &b->cap_breaks, b->nbreaks + 1, sizeof *q);
         if (q) { b->breaks = q; b->breaks[b->nbreaks++] = id; }

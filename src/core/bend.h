@@ -23,11 +23,19 @@ typedef struct wb_bends {
     int dirty;
     int32_t ncolours, serial_start;
     int32_t colour_start[WB_MAX_COLOURS + 2];
+    /* what the projection reads, packed in its order at colour time: one allocation
+     * starting at s_ij (world.c frees it), cap_s entries; s_at, s_gamma and the skip
+     * flag hold for the substep h_at (recomputed when h changes: NaN = not yet) */
     int32_t *s_ij;         /* (n x 4) packed particles */
+    wb_real *s_rest;       /* (n) rest angle */
+    wb_real *s_at;         /* (n) alpha / h^2 */
+    wb_real *s_gamma;      /* (n) alpha / h^2 * beta * h, the damping's gamma */
+    uint8_t *s_flag;       /* (n) 1: skipped (broken, or alpha / h^2 = inf); 2: damped */
+    wb_real h_at;
+    int32_t cap_s;
     int32_t *s_slot;       /* (n) slot of each packed entry */
     int32_t *pack;         /* (n) packed index of each slot */
     wb_real *lambda;       /* (n) multipliers of the current substep, by packed index */
-    int32_t cap_s;
 } wb_bends;
 
 #endif

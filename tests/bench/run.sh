@@ -20,6 +20,7 @@ case $JSON in /*) ;; *) JSON=$PWD/$JSON ;; esac
 mkdir -p "$(dirname "$JSON")" && : >"$JSON" || exit 2
 SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2 scale32 scale64 scale128 scale256 scale512 contacts sheet tets tets_t2"
 FLOAT_SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2"
+SCENES="$SCENES bend"   # the bending scene (tests/bench/bend.lua)
 
 # scene EXE NAME HEADER(1/0): one row (and the header when asked)
 scene() {

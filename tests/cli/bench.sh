@@ -102,4 +102,22 @@ check "a Bullet peer that made another sheet stops the benchmark" 2 err "the Bul
 code=$?
 check "the Bullet peer without --unsafe is refused, not skipped" 2 err "needs --unsafe"
 
+# ---- the bending scene: the 128x128 cloth with its 48,133 bends, ns per bend projection
+# measured (the solver with the bends less without them); --set bends=0: none, null
+"$W" bench --json --set scenes=bend --frames 2 --quiet --time-limit 300 --out "$TMP/b" >"$TMP/bend.out" 2>"$TMP/err"
+rc=$?
+validate "$TMP/bend.out" bend 2
+[ $rc -eq 0 ] || code="bench exit code $rc"
+grep -q '"bends": 48133,' "$TMP/bend.out" || code="$code (no \"bends\": 48133)"
+grep -q '"constraints": 96774,' "$TMP/bend.out" || code="$code (constraints are not links + bends)"
+grep -q '"ns_per_bend": -*[0-9]' "$TMP/bend.out" || code="$code (ns_per_bend not measured)"
+check "bench --set scenes=bend: one row, 48,133 bends, ns per bend projection measured" 0 out "scene bend" out "rows 1"
+"$W" bench --json --set scenes=bend --set bends=0 --frames 2 --quiet --time-limit 300 --out "$TMP/b" \
+    >"$TMP/bend0.out" 2>"$TMP/err"
+rc=$?
+validate "$TMP/bend0.out" bend 2
+[ $rc -eq 0 ] || code="bench exit code $rc"
+grep -q '"bends": 0,.*"ns_per_bend": null' "$TMP/bend0.out" || code="$code (bends=0: ns_per_bend is not null)"
+check "bench --set scenes=bend --set bends=0: no bends, ns per bend null" 0 out "rows 1"
+
 echo "$passed passed, $failed failed"

@@ -111,6 +111,8 @@
     X(bend_threads_identical)                    \
     X(bend_conserves_momentum)                   \
     X(bend_hinges_and_refusals)                  \
+    X(bend_simd_bit_identical_to_scalar)         \
+    X(bend_simd_threads_identical)               \
     X(collider_distance_plane)                   \
     X(collider_distance_sphere)                  \
     X(collider_distance_box_rotated)             \
