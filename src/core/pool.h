@@ -52,6 +52,10 @@ int64_t wb__pool_solo_jobs(const wb_pool *p);
 int64_t wb__pool_late_jobs(const wb_pool *p);
 int wb__pool_workers(const wb_pool *p);
 
+/* on = 0: every job big enough goes to the workers, never solo (tests that must
+ * exercise the threads on a busy machine); 1, the default: solo after late jobs */
+void wb__pool_adapt(wb_pool *p, int on);
+
 /* 1 once per pool when no worker thread could be started (to report it once), else 0 */
 int wb__pool_failure_news(wb_pool *p);
 
