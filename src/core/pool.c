@@ -124,8 +124,11 @@ static int work(wb_pool *p, uint32_t g, int is_worker)
             if (atomic_compare_exchange_weak(&p->ticket, &t, t + 1)) break;
         }
         /* (sched_getcpu reads the kernel's rseq area: a few ns) */
-        if (is_worker && ran == 0 && sched_getcpu() == atomic_load_explicit(&p->caller_cpu, memory_order_relaxed))
-            atomic_store_explicit(&p->same_cpu, 1, memory_order_relaxed);
+        if (is_worker && ran == 0) {
+            const int cpu = sched_getcpu(); /* -1: unknown, not the same */
+            if (cpu >= 0 && cpu == atomic_load_explicit(&p->caller_cpu, memory_order_relaxed))
+                atomic_store_explicit(&p->same_cpu, 1, memory_order_relaxed);
+        }
         run_part(p, run, rfor, ctx, n, np, (int32_t)(uint32_t)t);
         t = atomic_load(&p->ticket);
     }
