@@ -12,10 +12,10 @@
  * A worker the OS preempts in the middle of a part (its core shared with another
  * process) holds the caller until it runs again, often milliseconds. The caller keeps
  * the account: each job's time against what the caller alone would have taken at its
- * own pace (`credit`, capped). When a late job drives it below zero, the pool has lost
- * time overall, and the caller runs the jobs alone for a while ("solo": the same parts
- * inline, so the same results), twice as long each time it happens again, halved after
- * as long a time without. A stall the gains have paid for (an oversubscribed machine,
+ * own pace (`credit`, capped; a worker on the caller's own CPU counts as a loss). When
+ * it falls below zero, the pool has lost time overall, and the caller runs the jobs
+ * alone for a while ("solo": the same parts inline, so the same results), twice as long
+ * each time it happens again, halved after as long a time without. A stall the gains have paid for (an oversubscribed machine,
  * where two threads also get two shares of the CPU) does not make it go solo. */
 #include "pool.h"
 
@@ -43,13 +43,14 @@
 #define SPIN_NS 5000
 #define MAX_PARTS_PER_THREAD 4
 /* a job is late when it took this much longer than the caller alone would have (a
- * preempted worker costs milliseconds; a futex wake-up or an uneven split, microseconds) */
+ * preempted worker costs milliseconds; a futex wake-up or an uneven split, microseconds);
+ * the credit going below minus this much makes the caller go solo */
 #define LATE_NS 50000
 /* the most the gains of good jobs can pay for a late one */
 #define CREDIT_MAX_NS 2000000
-/* how long the caller then runs alone: from 2 ms, doubled at each late job up to 256 ms
- * (then a preempted worker costs at most about 1% of the time), halved again after as
- * long without a late job */
+/* how long the caller then runs alone: from 2 ms, doubled each time up to 256 ms (then a
+ * preempted worker costs at most about 1% of the time), halved again after as long
+ * without going solo */
 #define SOLO_MIN_NS 2000000
 #define SOLO_MAX_NS 256000000
 /* after no worker could be started: the next attempt at most this much later */
