@@ -135,6 +135,9 @@ local columns = {
 }
 
 function M.report(r, note)
+  -- --set row=NAME: the row's name instead of the scene's (make bench runs a scene again
+  -- beside a busy core as another row)
+  if args.row ~= nil and args.row ~= "" then r.scene = tostring(args.row) end
   if args.json_file then   -- make bench JSON=FILE: the rows as JSON lines too (--unsafe)
     local f = assert(io.open(args.json_file, "a"))
     f:write(M.json(r), "\n")

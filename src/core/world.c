@@ -105,7 +105,11 @@ wb_world *wb_world_create(const wb_world_def *def)
 wb_pool *wb__world_pool(const wb_world *w)
 {
     wb_world *mw = (wb_world *)w; /* worlds are heap objects: the pool is a mutable cache */
-    return wb__pool_get(&mw->pool, w->m.def.threads);
+    wb_pool *p = wb__pool_get(&mw->pool, w->m.def.threads);
+    if (wb__pool_failure_news(p))
+        wb__warn(mw, "threads = %d: no worker thread could be started; the steps run on one thread "
+                 "(the same results)", w->m.def.threads);
+    return p;
 }
 
 void wb_world_destroy(wb_world *w)

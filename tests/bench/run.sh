@@ -22,12 +22,15 @@ SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2 scale32 scale64 scale128 scale25
 FLOAT_SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2"
 SCENES="$SCENES bend"   # the bending scene (tests/bench/bend.lua)
 
-# scene EXE NAME HEADER(1/0): one row (and the header when asked)
+# scene EXE NAME HEADER(1/0) [ROW]: one row (and the header when asked); with ROW the row
+# is named ROW and has no Bullet figures (the busy-core rows: Bullet ran without the spinner)
 scene() {
+    peer=$PEER row=${4:-$2}
+    [ -z "$4" ] || peer=
     out=$("$1" bench --unsafe --quiet --out "$BUILD/bench-out" --set scenes="$2" --set header="$3" \
-          --set bullet="$PEER" --set bullet_cache="$CACHE" --set json_file="$JSON" 2>&1)
+          --set bullet="$peer" --set bullet_cache="$CACHE" --set json_file="$JSON" --set row="$row" 2>&1)
     rc=$?
-    if [ $rc -ne 0 ] || ! echo "$out" | grep -q "^$2 "; then
+    if [ $rc -ne 0 ] || ! echo "$out" | grep -q "^$row "; then
         echo "$out" | grep -v '^# tests/bench/' >&2
         echo "bench: the scene $2 failed ($1, exit code $rc)" >&2
         exit 1
@@ -56,6 +59,25 @@ if [ -n "$FLOAT" ]; then
     done
 fi
 
+# the other core busy: a spinning process beside the cloth scenes (issue 12: 2 threads
+# never more than 10% slower than one, also then). The spinner stops on any exit of this
+# script (trap) and, should the script be killed outright, by itself once its parent is gone.
+SPIN=
+spin_stop() { [ -z "$SPIN" ] || kill "$SPIN" 2>/dev/null; SPIN=; }
+trap spin_stop EXIT
+trap 'spin_stop; exit 130' INT HUP TERM
+sh -c 'i=0; while :; do i=$((i + 1)); [ $i -lt 200000 ] || { i=0; kill -0 "$1" 2>/dev/null || exit 0; }; done' \
+    spin $$ &
+SPIN=$!
+echo
+echo "== the other core busy (a spinning process beside; $BUILD, double)"
+first=1
+for s in cloth128 cloth128_t2 cloth32 cloth32_t2; do
+    scene "$BUILD/wobble" "$s" $first "busy${s#cloth}"
+    first=0
+done
+spin_stop
+
 # fig SCENE PRECISION KEY: one figure of the JSON rows ("" when missing or null)
 fig() {
     grep "\"scene\": \"$1\"" "$JSON" | grep "\"precision\": \"$2\"" | head -n 1 |
@@ -78,6 +100,8 @@ goal "cloth128: Bullet / wobble, 2 threads" "$(fig cloth128_t2 double bullet_rat
 goal "cloth32 (3000 frames): Bullet / wobble" "$(fig cloth32 double bullet_ratio)" 4
 goal "cloth128: 2 threads / 1 thread (speed-up)" "$(speedup cloth128 double)" 1.5
 goal "cloth32: 2 threads / 1 thread (not slower)" "$(speedup cloth32 double)" 0.9
+goal "busy core: cloth128, 2 threads / 1 thread" "$(speedup busy128 double)" 0.9
+goal "busy core: cloth32, 2 threads / 1 thread" "$(speedup busy32 double)" 0.9
 if [ -n "$FLOAT" ]; then
     goal "cloth128, WB_FLOAT: Bullet / wobble, 1 thread" "$(fig cloth128 float bullet_ratio)" 12
     goal "cloth128, WB_FLOAT: Bullet / wobble, 2 threads" "$(fig cloth128_t2 float bullet_ratio)" 18

@@ -87,7 +87,9 @@
     X(pool_many_successive_jobs)                         \
     X(pool_destroyed_at_once_or_idle)                    \
     X(pool_nested_call_runs_inline)                      \
-    X(pool_world_identical_for_1_2_3_threads)
+    X(pool_held_up_worker_then_solo)                     \
+    X(pool_world_identical_for_1_2_3_threads)            \
+    X(pool_without_threads_runs_inline)
 
 /* every test, in the order they run: add a line here for each TEST() */
 #define TEST_LIST(X)                             \
