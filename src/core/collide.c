@@ -713,7 +713,7 @@ int wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1, const
     if (!cs) { wb__warn(w, "out of memory in collision"); return 0; }
     k->c_sub = cs;
     static_plane *pl = (static_plane *)(void *)&cs[m->nc > 0 ? m->nc : 1];
-    int planes = !(w->att && w->att->skip_np > 0);
+    int planes = !k->no_fuse && !(w->att && w->att->skip_np > 0); /* (no_fuse: the tests' plain path) */
     for (int32_t c = 0; c < m->nc; c++) {
         if (!(m->c_gen[c] & 1u)) continue;
         sub_pose *sp = &cs[nlive++];

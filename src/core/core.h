@@ -367,8 +367,9 @@ typedef struct wb_cache {
     wb_tricontacts tc;     /* particle-triangle contacts (tricontact.c) */
     int64_t projections;
     double step_ms, solve_ms;
-    int no_fuse;           /* tests: the next substep's prediction never fused into the
-                              collision pass (solver.c); the results must not change */
+    int no_fuse;           /* tests: the plain order, the next substep's prediction never
+                              fused into the collision pass (solver.c), nor the static-plane
+                              fast path taken (collide.c); the results must not change */
     int64_t fused;         /* substeps predicted in the collision pass so far (tests) */
     int32_t nonfinite;     /* the last substep's pass scanned x and v (solver.c): the first
                               non-finite particle, -1 none; -2 when it did not scan */
