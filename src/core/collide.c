@@ -577,6 +577,13 @@ typedef struct collide_job {
 #define WB_INLINE static inline
 #endif
 
+/* x - x is 0 for a finite x and NaN for inf and NaN: one test for six values */
+static inline int finite6(const wb_real x[3], const wb_real v[3])
+{
+    const wb_real z = (x[0] - x[0]) + (x[1] - x[1]) + (x[2] - x[2]) + (v[0] - v[0]) + (v[1] - v[1]) + (v[2] - v[2]);
+    return z == z;
+}
+
 /* The pass over particles [lo, hi), instantiated for constant flags (the branches go at
  * compile time): planes, the fast path for static planes (2: exactly one) (resolve and contact_velocity
  * with the collider velocity vc = 0 written out: v - 0 is v and x + -0 is x, so the bits
@@ -607,46 +614,56 @@ WB_INLINE void collide_range(collide_job *j, int32_t lo, int32_t hi, const int p
         if (wv[i] == 0) { /* pinned and immovable: at rest */
             v3_set(vi, 0, 0, 0);
         } else if (planes) {
+            /* x, x_prev and v in locals, stored once at the end: a 16-byte load of two
+             * values just stored one by one cannot be forwarded from the stores (a stall
+             * per particle that cost more than the fused pass saved) */
+            wb_real xx[3] = { xi[0], xi[1], xi[2] }, vv[3] = { vi[0], vi[1], vi[2] };
+            const wb_real pp[3] = { pi[0], pi[1], pi[2] };
             /* contacts: the plane, its depth, the normal velocity before (vc = 0) */
             int32_t cp[MAX_CONTACTS];
             wb_real cd[MAX_CONTACTS], cvn[MAX_CONTACTS];
             int nct = 0;
             for (int32_t c = 0; c < nlive; c++) {
                 const static_plane *sp = planes == 2 ? &one : &pl[c];
-                const wb_real depth = rad[i] + sp->off - v3_dot(sp->n, xi);
+                const wb_real depth = rad[i] + sp->off - v3_dot(sp->n, xx);
                 if (!(depth > 0)) continue;
-                v3_madd(xi, sp->n, depth);
+                v3_madd(xx, sp->n, depth);
                 if (sp->friction > 0) {
                     wb_real slip[3];
-                    v3_sub(slip, xi, pi);
+                    v3_sub(slip, xx, pp);
                     v3_madd(slip, sp->n, -v3_dot(slip, sp->n));
-                    if (v3_len(slip) < sp->friction * depth) v3_madd(xi, slip, -1);
+                    if (v3_len(slip) < sp->friction * depth) v3_madd(xx, slip, -1);
                 }
                 if (nct < MAX_CONTACTS) {
                     cp[nct] = c;
                     cd[nct] = depth;
-                    cvn[nct] = v3_dot(vi, sp->n);
+                    cvn[nct] = v3_dot(vv, sp->n);
                 }
                 nct++;
             }
-            for (int c = 0; c < 3; c++) vi[c] = (xi[c] - pi[c]) * inv_h;
+            for (int c = 0; c < 3; c++) vv[c] = (xx[c] - pp[c]) * inv_h;
             for (int c = 0; c < nct && c < MAX_CONTACTS; c++) {
                 const static_plane *sp = planes == 2 ? &one : &pl[cp[c]];
                 wb_real vt[3];
-                const wb_real vn = v3_dot(vi, sp->n);
-                v3_copy(vt, vi);
+                const wb_real vn = v3_dot(vv, sp->n);
+                v3_copy(vt, vv);
                 v3_madd(vt, sp->n, -vn);
                 const wb_real vt_len = v3_len(vt);
                 if (sp->friction > 0 && vt_len > 0) {
                     const wb_real dv = sp->friction * cd[c] / h;
-                    v3_madd(vi, vt, -(dv < vt_len ? dv : vt_len) / vt_len);
+                    v3_madd(vv, vt, -(dv < vt_len ? dv : vt_len) / vt_len);
                 }
                 if (cvn[c] < 0) {
                     const wb_real e = -cvn[c] > 2 * g * h ? sp->restitution : 0;
-                    v3_madd(vi, sp->n, -e * cvn[c] - vn);
+                    v3_madd(vv, sp->n, -e * cvn[c] - vn);
                 }
             }
             ncontacts += nct;
+            if (fuse) wb__predict_one(&pr, wv[i], xx, pi, vv);
+            v3_copy(xi, xx);
+            v3_copy(vi, vv);
+            if (scan && bad == INT32_MAX && !finite6(xx, vv)) bad = i;
+            continue;
         } else {
             contact ct[MAX_CONTACTS];
             int nct = 0;
@@ -671,12 +688,7 @@ WB_INLINE void collide_range(collide_job *j, int32_t lo, int32_t hi, const int p
             ncontacts += nct;
         }
         if (fuse) wb__predict_one(&pr, wv[i], xi, pi, vi);
-        if (scan && bad == INT32_MAX) {
-            /* x - x is 0 for a finite x and NaN for inf and NaN: one test for six values */
-            const wb_real z = (xi[0] - xi[0]) + (xi[1] - xi[1]) + (xi[2] - xi[2]) + (vi[0] - vi[0]) +
-                              (vi[1] - vi[1]) + (vi[2] - vi[2]);
-            if (z != z) bad = i;
-        }
+        if (scan && bad == INT32_MAX && !finite6(xi, vi)) bad = i;
     }
     j->ncontacts += ncontacts; /* a sum of integers: the same in any order */
     if (scan && bad != INT32_MAX) {
