@@ -3,9 +3,11 @@
  * Per frame, `substeps` times: predict, project the constraints `iterations` times
  * (XPBD, Gauss-Seidel over colour batches or Jacobi), project collisions (static
  * friction at position level), update velocities, then dynamic friction and restitution
- * at velocity level. Plastic flow, breaking
- * and the finiteness check run once per frame. The constraints are projected type by
- * type from the table wb__ctypes (ctype.h): each type is a file of its own. */
+ * at velocity level (each substep's prediction but the first runs inside the previous
+ * substep's collision pass when nothing between them moves particles: fusable()).
+ * Plastic flow, breaking and the finiteness check run once per frame. The constraints
+ * are projected type by type from the table wb__ctypes (ctype.h): each type is a file of
+ * its own. */
 #include <stdio.h>
 #include <time.h>
 
