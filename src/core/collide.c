@@ -7,6 +7,8 @@
  * with extended position based dynamics"): static at position level, dynamic at
  * velocity level, with the normal impulse taken from the penetration depth. */
 #include <assert.h>
+#include <stdatomic.h>
+#include <stdint.h>
 #include <stdlib.h>
 
 #include "core.h"
@@ -552,71 +554,178 @@ static void contact_velocity(wb_real v[3], const contact *ct, wb_real h, wb_real
     }
 }
 
+/* a static plane of the fast path: world normal, offset, its material */
+typedef struct static_plane {
+    wb_real n[3], off, friction, restitution;
+} static_plane;
+
 typedef struct collide_job {
     wb_world *w;
     const sub_pose *cs;
     int32_t nlive;
     wb_real h;
+    const static_plane *planes; /* nlive of them when every collider is a static plane
+                                   and no particle skips one (attachments), else NULL */
+    const wb_predict *next;     /* the next substep's prediction, fused; NULL: none */
     _Atomic int64_t ncontacts;
+    _Atomic int32_t bad;        /* scan: the first non-finite particle, INT32_MAX none */
 } collide_job;
 
-/* particles [lo, hi) of wb__collide_and_update */
-static void collide_part(void *ctx, int32_t lo, int32_t hi)
+#if defined(__GNUC__)
+#define WB_INLINE static inline __attribute__((always_inline))
+#else
+#define WB_INLINE static inline
+#endif
+
+/* x - x is 0 for a finite x and NaN for inf and NaN: one test for six values */
+static inline int finite6(const wb_real x[3], const wb_real v[3])
 {
-    collide_job *j = ctx;
+    const wb_real z = (x[0] - x[0]) + (x[1] - x[1]) + (x[2] - x[2]) + (v[0] - v[0]) + (v[1] - v[1]) + (v[2] - v[2]);
+    return z == z;
+}
+
+/* The pass over particles [lo, hi), instantiated for constant flags (the branches go at
+ * compile time): planes, the fast path for static planes (2: exactly one) (resolve and contact_velocity
+ * with the collider velocity vc = 0 written out: v - 0 is v and x + -0 is x, so the bits
+ * are those of the general path); fuse, the next substep's prediction (wb__predict_one)
+ * once the particle's velocity is final; scan, whether x and v ended finite. */
+WB_INLINE void collide_range(collide_job *j, int32_t lo, int32_t hi, const int planes, const int fuse,
+                             const int scan)
+{
     wb_world *w = j->w;
     const wb_model *m = &w->m;
     const sub_pose *cs = j->cs;
-    const int32_t nlive = j->nlive;
+    const static_plane *pl = j->planes;
+    /* planes == 2: exactly one plane (a ground), held in locals */
+    const int32_t nlive = planes == 2 ? 1 : j->nlive;
+    const static_plane one = planes == 2 ? pl[0] : (static_plane){ { 0, 0, 0 }, 0, 0, 0 };
     const wb_real h = j->h, inv_h = 1 / h, g = v3_len(m->def.gravity);
     /* restrict: the arrays are distinct, so the compiler keeps values in registers
      * across the stores (the same operations, the same bits) */
     const wb_real *restrict wv = m->w, *restrict rad = m->radius;
     wb_real *restrict x = w->s.x, *restrict v = w->s.v;
-    const wb_real *restrict xp = w->s.x_prev;
+    wb_real *restrict xp = w->s.x_prev;
     const wb_attaches *att = w->att && w->att->skip_np > 0 ? w->att : NULL; /* attached: no contact */
+    const wb_predict pr = fuse ? *j->next : (wb_predict){ 0, { 0, 0, 0 }, 0 };
     int64_t ncontacts = 0;
+    int32_t bad = INT32_MAX;
     for (int32_t i = lo; i < hi; i++) {
-        wb_real *restrict xi = &x[3 * i], *restrict vi = &v[3 * i];
-        const wb_real *restrict pi = &xp[3 * i];
-        if (wv[i] == 0) { v3_set(vi, 0, 0, 0); continue; } /* pinned and immovable: at rest */
-        contact ct[MAX_CONTACTS];
-        int nct = 0;
-        for (int32_t c = 0; c < nlive; c++) {
-            const sub_pose *sp = &cs[c];
-            if (att && wb__attach_skip(att, i, sp->slot)) continue;
-            wb_real n[3], depth;
-            if (sp->s->shape == WB_SHAPE_PLANE) {
-                depth = rad[i] + sp->off - v3_dot(sp->n, xi);
-                v3_copy(n, sp->n);
-            } else if (sp->s->shape == WB_SHAPE_MESH) {
-                depth = mesh_depth(sp, xi, pi, rad[i], n);
-            } else {
-                depth = rad[i] - wb__shape_distance(sp->s, sp->p1, sp->q1, xi, n);
+        wb_real *restrict xi = &x[3 * i], *restrict vi = &v[3 * i], *restrict pi = &xp[3 * i];
+        if (wv[i] == 0) { /* pinned and immovable: at rest */
+            v3_set(vi, 0, 0, 0);
+        } else if (planes) {
+            /* x, x_prev and v in locals, stored once at the end: a 16-byte load of two
+             * values just stored one by one cannot be forwarded from the stores (a stall
+             * per particle that cost more than the fused pass saved) */
+            wb_real xx[3] = { xi[0], xi[1], xi[2] }, vv[3] = { vi[0], vi[1], vi[2] };
+            const wb_real pp[3] = { pi[0], pi[1], pi[2] };
+            /* contacts: the plane, its depth, the normal velocity before (vc = 0) */
+            int32_t cp[MAX_CONTACTS];
+            wb_real cd[MAX_CONTACTS], cvn[MAX_CONTACTS];
+            int nct = 0;
+            for (int32_t c = 0; c < nlive; c++) {
+                const static_plane *sp = planes == 2 ? &one : &pl[c];
+                const wb_real depth = rad[i] + sp->off - v3_dot(sp->n, xx);
+                if (!(depth > 0)) continue;
+                v3_madd(xx, sp->n, depth);
+                if (sp->friction > 0) {
+                    wb_real slip[3];
+                    v3_sub(slip, xx, pp);
+                    v3_madd(slip, sp->n, -v3_dot(slip, sp->n));
+                    if (v3_len(slip) < sp->friction * depth) v3_madd(xx, slip, -1);
+                }
+                if (nct < MAX_CONTACTS) {
+                    cp[nct] = c;
+                    cd[nct] = depth;
+                    cvn[nct] = v3_dot(vv, sp->n);
+                }
+                nct++;
             }
-            if (!(depth > 0)) continue;
-            resolve(xi, pi, vi, sp, n, depth, h, nct < MAX_CONTACTS ? &ct[nct] : NULL);
-            nct++;
+            for (int c = 0; c < 3; c++) vv[c] = (xx[c] - pp[c]) * inv_h;
+            for (int c = 0; c < nct && c < MAX_CONTACTS; c++) {
+                const static_plane *sp = planes == 2 ? &one : &pl[cp[c]];
+                wb_real vt[3];
+                const wb_real vn = v3_dot(vv, sp->n);
+                v3_copy(vt, vv);
+                v3_madd(vt, sp->n, -vn);
+                const wb_real vt_len = v3_len(vt);
+                if (sp->friction > 0 && vt_len > 0) {
+                    const wb_real dv = sp->friction * cd[c] / h;
+                    v3_madd(vv, vt, -(dv < vt_len ? dv : vt_len) / vt_len);
+                }
+                if (cvn[c] < 0) {
+                    const wb_real e = -cvn[c] > 2 * g * h ? sp->restitution : 0;
+                    v3_madd(vv, sp->n, -e * cvn[c] - vn);
+                }
+            }
+            ncontacts += nct;
+            if (fuse) wb__predict_one(&pr, wv[i], xx, pi, vv);
+            v3_copy(xi, xx);
+            v3_copy(vi, vv);
+            if (scan && bad == INT32_MAX && !finite6(xx, vv)) bad = i;
+            continue;
+        } else {
+            contact ct[MAX_CONTACTS];
+            int nct = 0;
+            for (int32_t c = 0; c < nlive; c++) {
+                const sub_pose *sp = &cs[c];
+                if (att && wb__attach_skip(att, i, sp->slot)) continue;
+                wb_real n[3], depth;
+                if (sp->s->shape == WB_SHAPE_PLANE) {
+                    depth = rad[i] + sp->off - v3_dot(sp->n, xi);
+                    v3_copy(n, sp->n);
+                } else if (sp->s->shape == WB_SHAPE_MESH) {
+                    depth = mesh_depth(sp, xi, pi, rad[i], n);
+                } else {
+                    depth = rad[i] - wb__shape_distance(sp->s, sp->p1, sp->q1, xi, n);
+                }
+                if (!(depth > 0)) continue;
+                resolve(xi, pi, vi, sp, n, depth, h, nct < MAX_CONTACTS ? &ct[nct] : NULL);
+                nct++;
+            }
+            for (int c = 0; c < 3; c++) vi[c] = (xi[c] - pi[c]) * inv_h;
+            for (int c = 0; c < nct && c < MAX_CONTACTS; c++) contact_velocity(vi, &ct[c], h, g);
+            ncontacts += nct;
         }
-        for (int c = 0; c < 3; c++) vi[c] = (xi[c] - pi[c]) * inv_h;
-        for (int c = 0; c < nct && c < MAX_CONTACTS; c++) contact_velocity(vi, &ct[c], h, g);
-        ncontacts += nct;
+        if (fuse) wb__predict_one(&pr, wv[i], xi, pi, vi);
+        if (scan && bad == INT32_MAX && !finite6(xi, vi)) bad = i;
     }
     j->ncontacts += ncontacts; /* a sum of integers: the same in any order */
+    if (scan && bad != INT32_MAX) {
+        /* the least index over the parts: the same in any order */
+        int32_t cur = atomic_load(&j->bad);
+        while (bad < cur && !atomic_compare_exchange_weak(&j->bad, &cur, bad)) {}
+    }
 }
+
+static void part_any(void *ctx, int32_t lo, int32_t hi) { collide_range(ctx, lo, hi, 0, 0, 0); }
+static void part_any_fuse(void *ctx, int32_t lo, int32_t hi) { collide_range(ctx, lo, hi, 0, 1, 0); }
+static void part_any_scan(void *ctx, int32_t lo, int32_t hi) { collide_range(ctx, lo, hi, 0, 0, 1); }
+static void part_planes(void *ctx, int32_t lo, int32_t hi) { collide_range(ctx, lo, hi, 1, 0, 0); }
+static void part_planes_fuse(void *ctx, int32_t lo, int32_t hi) { collide_range(ctx, lo, hi, 1, 1, 0); }
+static void part_planes_scan(void *ctx, int32_t lo, int32_t hi) { collide_range(ctx, lo, hi, 1, 0, 1); }
+static void part_plane(void *ctx, int32_t lo, int32_t hi) { collide_range(ctx, lo, hi, 2, 0, 0); }
+static void part_plane_fuse(void *ctx, int32_t lo, int32_t hi) { collide_range(ctx, lo, hi, 2, 1, 0); }
+static void part_plane_scan(void *ctx, int32_t lo, int32_t hi) { collide_range(ctx, lo, hi, 2, 0, 1); }
 
 /* One pass per particle after the constraints: push it out of every collider at the
  * collider's substep-end pose, set v = (x - x_prev) / h, then friction and
  * restitution for the contacts it has. Particles are independent here, so the pass
- * runs in parallel with results identical for any thread count. */
-void wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1)
+ * runs in parallel with results identical for any thread count. The caller may fold
+ * the next substep's prediction into it (next), or the frame's finiteness check (scan):
+ * both per particle too. */
+int wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1, const wb_predict *next, int scan)
 {
     wb_model *m = &w->m;
     wb_cache *k = &w->k;
     int32_t nlive = 0;
-    sub_pose *cs = wb__grow(k->c_sub, &k->cap_c_sub, m->nc > 0 ? m->nc : 1, sizeof *cs);
-    if (!cs) { wb__warn(w, "out of memory in collision"); return; }
+    /* the sub_poses, then as many static_planes (the fast path) */
+    const size_t need = (size_t)(m->nc > 0 ? m->nc : 1) * (sizeof(sub_pose) + sizeof(static_plane));
+    sub_pose *cs = wb__grow(k->c_sub, &k->cap_c_sub, (int32_t)need, 1);
+    if (!cs) { wb__warn(w, "out of memory in collision"); return 0; }
     k->c_sub = cs;
+    static_plane *pl = (static_plane *)(void *)&cs[m->nc > 0 ? m->nc : 1];
+    int planes = !k->no_fuse && !(w->att && w->att->skip_np > 0); /* (no_fuse: the tests' plain path) */
     for (int32_t c = 0; c < m->nc; c++) {
         if (!(m->c_gen[c] & 1u)) continue;
         sub_pose *sp = &cs[nlive++];
@@ -627,9 +736,21 @@ void wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1)
         sp->moving = memcmp(sp->p0, sp->p1, sizeof sp->p0) || memcmp(sp->q0, sp->q1, sizeof sp->q0);
         q_rotate(sp->q1, sp->s->n, sp->n);
         sp->off = v3_dot(sp->n, sp->p1);
+        if (sp->s->shape != WB_SHAPE_PLANE || sp->moving) planes = 0;
+        static_plane *p = &pl[nlive - 1];
+        v3_copy(p->n, sp->n);
+        p->off = sp->off;
+        p->friction = sp->s->friction;
+        p->restitution = sp->s->restitution;
     }
-    collide_job j = { w, cs, nlive, h, 0 };
-    wb__pool_for(m->np >= 4096 ? wb__world_pool(w) : NULL, m->np, 2048, collide_part, &j);
+    collide_job j = { w, cs, nlive, h, planes ? pl : NULL, next, 0, INT32_MAX };
+    static const wb_pool_for_fn fns[3][3] = { { part_any, part_any_fuse, part_any_scan },
+                                              { part_planes, part_planes_fuse, part_planes_scan },
+                                              { part_plane, part_plane_fuse, part_plane_scan } };
+    if (planes && nlive == 1) planes = 2;
+    wb__pool_for(m->np >= 4096 ? wb__world_pool(w) : NULL, m->np, 2048, fns[planes][next ? 1 : scan ? 2 : 0], &j);
     k->last_contacts = (int32_t)j.ncontacts;
+    if (next) k->fused++;
+    if (scan && !next) k->nonfinite = j.bad == INT32_MAX ? -1 : j.bad;
+    return 1;
 }
-

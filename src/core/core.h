@@ -41,6 +41,22 @@ static inline void v3_cross(wb_real *o, const wb_real *a, const wb_real *b)
 }
 static inline wb_real clampr(wb_real x, wb_real lo, wb_real hi) { return x < lo ? lo : x > hi ? hi : x; }
 
+/* a substep's prediction, per particle: damping, gravity, x += h v (x_prev = x first; a
+ * particle with w = 0 stays). solver.c's pass and collide.c's fused one share it, so
+ * that fused or not the operations and the bits are the same */
+typedef struct wb_predict {
+    wb_real keep, g[3], h; /* velocity kept against damping; gravity x h; the substep */
+} wb_predict;
+static inline void wb__predict_one(const wb_predict *p, wb_real w, wb_real *restrict x, wb_real *restrict xp,
+                                   wb_real *restrict v)
+{
+    v3_copy(xp, x);
+    if (w == 0) return;
+    /* drag on the velocity only: a body at rest still weighs m g */
+    v[0] = v[0] * p->keep + p->g[0]; v[1] = v[1] * p->keep + p->g[1]; v[2] = v[2] * p->keep + p->g[2];
+    x[0] += p->h * v[0]; x[1] += p->h * v[1]; x[2] += p->h * v[2];
+}
+
 /* quaternions (w, x, y, z) */
 void q_normalize(wb_real q[4]);
 void q_rotate(const wb_real q[4], const wb_real v[3], wb_real out[3]);      /* q v q* */
@@ -336,7 +352,8 @@ typedef struct wb_cache {
     wb_real *dx;           /* (np x 3) Jacobi accumulators */
     int32_t *ncount;       /* (np) constraints per particle (for s_jac) */
     wb_real *x_save, *v_save; /* (np x 3) last finite frame, for recovery */
-    void *c_sub;           /* (nc) collider poses at the substep's start and end (collide.c) */
+    void *c_sub;           /* (nc) collider poses at the substep's start and end, then (nc)
+                              static planes (collide.c); cap_c_sub in bytes */
     int32_t cap_c_sub;
     wb_distance_id *breaks;
     int32_t nbreaks, cap_breaks;
@@ -350,6 +367,12 @@ typedef struct wb_cache {
     wb_tricontacts tc;     /* particle-triangle contacts (tricontact.c) */
     int64_t projections;
     double step_ms, solve_ms;
+    int no_fuse;           /* tests: the plain order, the next substep's prediction never
+                              fused into the collision pass (solver.c), nor the static-plane
+                              fast path taken (collide.c); the results must not change */
+    int64_t fused;         /* substeps predicted in the collision pass so far (tests) */
+    int32_t nonfinite;     /* the last substep's pass scanned x and v (solver.c): the first
+                              non-finite particle, -1 none; -2 when it did not scan */
 } wb_cache;
 
 struct wb_world {
@@ -388,8 +411,10 @@ wb_real wb__bend_angle_of(const wb_real *x, const int32_t *p, int *ok);
 /* bend.c: the interior edges of a triangle list (each shared by exactly two triangles), as
  * hinges p1 p2 p3 p4 into out (room for 3 ntri / 2 x 4), in edge order; -1 when out of memory */
 int32_t wb__bend_hinges(const int32_t *tri, int32_t ntri, int32_t *out);
-/* collide.c: collisions, then v = (x - x_prev)/h, friction and restitution */
-void wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1);
+/* collide.c: collisions, then v = (x - x_prev)/h, friction and restitution; then, per
+ * particle in the same pass, the next substep's prediction when next != NULL, or (scan)
+ * the finiteness check of x and v into k.nonfinite. 0 when out of memory (nothing done) */
+int wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1, const wb_predict *next, int scan);
 void wb__collider_pose_at(const wb_collider_pose *cp, wb_real t, wb_real p[3], wb_real q[4]);
 wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real q[4],
                            const wb_real x[3], wb_real n[3]);

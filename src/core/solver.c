@@ -3,9 +3,11 @@
  * Per frame, `substeps` times: predict, project the constraints `iterations` times
  * (XPBD, Gauss-Seidel over colour batches or Jacobi), project collisions (static
  * friction at position level), update velocities, then dynamic friction and restitution
- * at velocity level. Plastic flow, breaking
- * and the finiteness check run once per frame. The constraints are projected type by
- * type from the table wb__ctypes (ctype.h): each type is a file of its own. */
+ * at velocity level (each substep's prediction but the first runs inside the previous
+ * substep's collision pass when nothing between them moves particles: fusable()).
+ * Plastic flow, breaking and the finiteness check run once per frame. The constraints
+ * are projected type by type from the table wb__ctypes (ctype.h): each type is a file of
+ * its own. */
 #include <stdio.h>
 #include <time.h>
 
@@ -42,23 +44,54 @@ static void solve_constraints(wb_world *w, wb_real h)
         for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->project(w, h);
 }
 
-static void predict(wb_world *w, wb_real h)
+static wb_predict predict_of(const wb_world *w, wb_real h)
 {
     const wb_world_def *d = &w->m.def;
-    const wb_real keep = d->damping > 0 ? (d->damping * h < 1 ? 1 - d->damping * h : 0) : 1;
-    const wb_real g0 = d->gravity[0] * h, g1 = d->gravity[1] * h, g2 = d->gravity[2] * h;
-    wb_real *restrict x = w->s.x, *restrict xp = w->s.x_prev, *restrict v = w->s.v;
-    const wb_real *restrict wv = w->m.w;
-    for (int32_t i = 0; i < w->m.np; i++) {
-        wb_real *xi = &x[3 * i], *vi = &v[3 * i];
-        v3_copy(&xp[3 * i], xi);
-        if (wv[i] == 0) continue;
-        /* drag on the velocity only: a body at rest still weighs m g */
-        vi[0] = vi[0] * keep + g0; vi[1] = vi[1] * keep + g1; vi[2] = vi[2] * keep + g2;
-        xi[0] += h * vi[0]; xi[1] += h * vi[1]; xi[2] += h * vi[2];
-    }
+    const wb_predict p = { d->damping > 0 ? (d->damping * h < 1 ? 1 - d->damping * h : 0) : 1,
+                           { d->gravity[0] * h, d->gravity[1] * h, d->gravity[2] * h }, h };
+    return p;
 }
 
+typedef struct predict_job {
+    wb_world *w;
+    wb_predict p;
+    int save; /* the frame's first: x and v into x_save, v_save first (undo) */
+} predict_job;
+
+static void predict_part(void *ctx, int32_t lo, int32_t hi)
+{
+    const predict_job *j = ctx;
+    wb_world *w = j->w;
+    const wb_predict p = j->p;
+    wb_real *restrict x = w->s.x, *restrict xp = w->s.x_prev, *restrict v = w->s.v;
+    const wb_real *restrict wv = w->m.w;
+    if (lo >= hi) return; /* an empty world: no arrays at all (memcpy from NULL is undefined) */
+    if (j->save) {
+        const size_t a = 3 * (size_t)lo, n = 3 * (size_t)(hi - lo);
+        memcpy(w->k.x_save + a, x + a, sizeof(wb_real) * n);
+        memcpy(w->k.v_save + a, v + a, sizeof(wb_real) * n);
+    }
+    for (int32_t i = lo; i < hi; i++) wb__predict_one(&p, wv[i], &x[3 * i], &xp[3 * i], &v[3 * i]);
+}
+
+/* a substep's prediction on its own (the first substep's, or when the collision pass
+ * could not take it), in parallel as the collision pass */
+static void predict(wb_world *w, wb_real h, int save)
+{
+    predict_job j = { w, predict_of(w, h), save };
+    wb__pool_for(w->m.np >= 4096 ? wb__world_pool(w) : NULL, w->m.np, 2048, predict_part, &j);
+}
+
+/* Between the collision pass of one substep and the prediction of the next run the
+ * velocity passes of the particle contacts, the triangle contacts and the particle-rigid
+ * contacts (the rigid bodies' own passes touch no particle). When none of them has a
+ * contact this substep they change nothing, and the next prediction can run in the
+ * collision pass, particle by particle; so can the frame's finiteness check after the
+ * last substep. (wb_cache.no_fuse: the tests' switch to the unfused order.) */
+static int fusable(const wb_world *w)
+{
+    return !w->k.no_fuse && w->k.pc.nact == 0 && w->k.tc.nact == 0 && !(w->rb && w->rb->npct > 0);
+}
 
 /* put the particles back as they were at the frame's start; the multipliers of the
  * abandoned frame mean nothing (and may be NaN): force() reads 0 until the next step */
@@ -120,12 +153,18 @@ static int check_finite(wb_world *w)
         undo_particles(w);
         return 0;
     }
-    const int32_t n = 3 * w->m.np;
-    const wb_real *x = w->s.x, *v = w->s.v;
-    for (int32_t i = 0; i < n; i++) {
-        if (isfinite(x[i]) && isfinite(v[i])) continue;
+    /* the first non-finite particle: found by the last substep's pass, or looked for */
+    int32_t badp = w->k.nonfinite;
+    if (badp == -2) {
+        const int32_t n = 3 * w->m.np;
+        const wb_real *x = w->s.x, *v = w->s.v;
+        badp = -1;
+        for (int32_t i = 0; i < n && badp < 0; i++)
+            if (!(isfinite(x[i]) && isfinite(v[i]))) badp = i / 3;
+    }
+    if (badp >= 0) {
         wb__warn(w, "frame %lld: particle %d became non-finite; its frame was undone (reduce dt, "
-                    "raise substeps or compliance)", (long long)w->s.frame + 1, i / 3 + 1);
+                    "raise substeps or compliance)", (long long)w->s.frame + 1, badp + 1);
         undo_particles(w);
         return 0;
     }
@@ -144,11 +183,6 @@ wb_status wb_world_step(wb_world *w)
     }
     const wb_world_def *d = &w->m.def;
     const wb_real dt = d->dt, h = dt / d->substeps;
-    const int32_t np = w->m.np;
-    if (np > 0) { /* (memcpy from a NULL array of an empty world is undefined) */
-        memcpy(k->x_save, w->s.x, sizeof(wb_real) * 3 * (size_t)np);
-        memcpy(k->v_save, w->s.v, sizeof(wb_real) * 3 * (size_t)np);
-    }
     wb__rigids_save(w);
     k->nbreaks = 0;
     k->projections = 0;
@@ -165,6 +199,12 @@ wb_status wb_world_step(wb_world *w)
     wb__contacts_begin(w);
     wb__tricontacts_begin(w);
     wb__rigid_particles_begin(w);
+    /* the particles saved for undo (none of the above moves them) and the first
+     * substep's prediction, in one pass */
+    predict(w, h, 1);
+    int predicted = 1;  /* the substep's prediction is done */
+    k->nonfinite = -2;
+    const wb_predict next = predict_of(w, h);
     double solve = 0;
     for (int sub = 0; sub < d->substeps; sub++) {
         if (k->interrupt && k->interrupt(k->interrupt_ud)) {
@@ -174,7 +214,7 @@ wb_status wb_world_step(wb_world *w)
             k->step_ms = now_ms() - t_begin;
             return WB_ERR_INTERRUPTED;
         }
-        predict(w, h);
+        if (!predicted) predict(w, h, 0);
         wb__rigids_predict(w, h);
         double t0 = now_ms();
         /* TYPE HOOK: the constraint types, walked from the table (wb__ctypes) */
@@ -186,7 +226,10 @@ wb_status wb_world_step(wb_world *w)
         wb__contacts_friction(w, h);
         wb__rigids_solve(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
         wb__rigid_particles_solve(w);
-        wb__collide_and_update(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
+        const int last = sub + 1 == d->substeps, fuse = fusable(w);
+        predicted = wb__collide_and_update(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps,
+                                           fuse && !last ? &next : NULL, fuse && last) &&
+                    fuse && !last;
         wb__rigids_update(w, h);
         wb__contacts_velocity(w, h);
         wb__tricontacts_velocity(w, h);

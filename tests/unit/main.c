@@ -91,6 +91,14 @@
     X(pool_world_identical_for_1_2_3_threads)            \
     X(pool_without_threads_runs_inline)
 
+/* test_fused.c: the next substep's prediction fused into the collision pass */
+#define FUSED_TESTS(X)                                   \
+    X(fused_predict_bits_one_plane)                      \
+    X(fused_predict_bits_planes)                         \
+    X(fused_predict_bits_mixed_colliders)                \
+    X(fused_predict_bits_with_particle_contacts)         \
+    X(fused_scan_finds_the_first_nonfinite_particle)
+
 /* every test, in the order they run: add a line here for each TEST() */
 #define TEST_LIST(X)                             \
     X(world_def_defaults)                        \
@@ -178,7 +186,8 @@
     RIGID_TESTS(X)                               \
     NARROW_TESTS(X)                              \
     X(distance_simd_bit_identical_to_scalar)     \
-    POOL_TESTS(X)
+    POOL_TESTS(X)                                \
+    FUSED_TESTS(X)
 
 #define DECLARE(name) TEST(name);
 #define ENTRY(name) { #name, test_##name },
