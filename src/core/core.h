@@ -330,6 +330,8 @@ typedef struct wb_cache {
     wb_real *s_rest, *s_alpha, *s_beta; /* (ns) */
     wb_real *s_lambda;     /* (ns) multipliers of the current substep */
     wb_real *s_jac;        /* (ns) Jacobi scale 1/max(n_a, n_b), n = constraints at a movable end */
+    wb_real *s_wa, *s_wc;  /* (ns) m.w of each end, refreshed every step (wb__colour): views into
+                              s_jac's allocation (3 ns), freed with it */
     int32_t *s_slot;       /* (ns) constraint slot of each packed entry */
     int32_t *slot_pack;    /* (nd) packed index of each slot, -1 when not packed */
     int any_damping;

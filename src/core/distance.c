@@ -22,11 +22,32 @@ static int packable(const void *ud, int32_t s)
 }
 
 /* ---- packing: rebuild the colour batches when the topology changed --------------------- */
+static wb_status colour(wb_world *w);
+
+/* prepare, once per step: recolour when the topology changed; then the ends' inverse
+ * masses in packed order (the vector path loads them instead of gathering from m.w;
+ * pin, unpin, set mass and snapshot loads change m.w between steps only) */
 wb_status wb__colour(wb_world *w)
+{
+    wb_cache *k = &w->k;
+    if (w->m.topology_dirty) {
+        const wb_status st = colour(w);
+        if (st != WB_OK) return st;
+    }
+    const wb_real *wv = w->m.w;
+    const int32_t *restrict sa = k->s_a, *restrict sb = k->s_b;
+    wb_real *restrict wa = k->s_wa, *restrict wc = k->s_wc;
+    for (int32_t i = 0; i < k->ns; i++) {
+        wa[i] = wv[sa[i]];
+        wc[i] = wv[sb[i]];
+    }
+    return WB_OK;
+}
+
+static wb_status colour(wb_world *w)
 {
     wb_model *m = &w->m;
     wb_cache *k = &w->k;
-    if (!m->topology_dirty) return WB_OK;
     k->pc.keys_dirty = 1; /* the constraint pairs that self-collision skips */
 
     int32_t ns = 0;
@@ -38,13 +59,15 @@ wb_status wb__colour(wb_world *w)
         !realloc_n((void **)&k->s_a, ns, sizeof(int32_t)) || !realloc_n((void **)&k->s_b, ns, sizeof(int32_t)) ||
         !realloc_n((void **)&k->s_rest, ns, sizeof(wb_real)) || !realloc_n((void **)&k->s_alpha, ns, sizeof(wb_real)) ||
         !realloc_n((void **)&k->s_beta, ns, sizeof(wb_real)) || !realloc_n((void **)&k->s_lambda, ns, sizeof(wb_real)) ||
-        !realloc_n((void **)&k->s_jac, ns, sizeof(wb_real)) ||
+        !realloc_n((void **)&k->s_jac, 3 * ns, sizeof(wb_real)) ||
         !realloc_n((void **)&k->s_slot, ns, sizeof(int32_t)) ||
         !realloc_n((void **)&k->colour_start, WB_MAX_COLOURS + 2, sizeof(int32_t)) ||
         !wb__colour_greedy(m->inv_mass, m->np, m->d_ij, 2, m->nd, packable, w, colour, count)) {
         free(colour);
         return WB_ERR_NOMEM;
     }
+    k->s_wa = k->s_jac + ns;
+    k->s_wc = k->s_jac + 2 * ns;
     int32_t start[WB_MAX_COLOURS + 1];
     k->ns = wb__colour_ranges(count, k->colour_start, &k->ncolours, &k->serial_start, start);
     k->any_damping = 0;
@@ -154,11 +177,11 @@ project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const w
 /* the x, y, z of 4 particles as 3 vectors of lanes: rows loaded without the 4th double
  * (maskload does not touch it: the last particle ends the array), then transposed */
 static inline __attribute__((always_inline, target("avx2"))) void
-load4(const wb_real *p, const int32_t i[4], __m256d *X, __m256d *Y, __m256d *Z)
+load4(const wb_real *p, const size_t o[4], __m256d *X, __m256d *Y, __m256d *Z)
 {
     const __m256i m = _mm256_set_epi64x(0, -1, -1, -1);
-    const __m256d r0 = _mm256_maskload_pd(&p[3 * i[0]], m), r1 = _mm256_maskload_pd(&p[3 * i[1]], m);
-    const __m256d r2 = _mm256_maskload_pd(&p[3 * i[2]], m), r3 = _mm256_maskload_pd(&p[3 * i[3]], m);
+    const __m256d r0 = _mm256_maskload_pd(&p[o[0]], m), r1 = _mm256_maskload_pd(&p[o[1]], m);
+    const __m256d r2 = _mm256_maskload_pd(&p[o[2]], m), r3 = _mm256_maskload_pd(&p[o[3]], m);
     const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1); /* x0 x1 z0 z1, y0 y1 . . */
     const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
     *X = _mm256_permute2f128_pd(t0, t2, 0x20);
@@ -166,39 +189,75 @@ load4(const wb_real *p, const int32_t i[4], __m256d *X, __m256d *Y, __m256d *Z)
     *Z = _mm256_permute2f128_pd(t0, t2, 0x31);
 }
 
+/* the rows' offsets (3 i) of a group's 4 a and 4 c ends, computed once for its loads
+ * and stores (unsigned: one instruction fewer per particle than sign extension) */
+static inline __attribute__((always_inline)) void
+offsets(const int32_t *a, const int32_t *c, size_t oa[4], size_t oc[4])
+{
+    for (int l = 0; l < 4; l++) {
+        oa[l] = 3 * (size_t)(uint32_t)a[l];
+        oc[l] = 3 * (size_t)(uint32_t)c[l];
+    }
+}
+
+/* the inverse of load4: the x, y, z lanes of 4 particles stored back as rows of 3 */
+static inline __attribute__((always_inline, target("avx2"))) void
+store4(wb_real *p, const size_t i[4], __m256d X, __m256d Y, __m256d Z)
+{
+    const __m256d t0 = _mm256_unpacklo_pd(X, Y), t1 = _mm256_unpackhi_pd(X, Y); /* x0 y0 x2 y2, x1 y1 x3 y3 */
+    const __m128d zl = _mm256_castpd256_pd128(Z), zh = _mm256_extractf128_pd(Z, 1);
+    _mm_storeu_pd(&p[i[0]], _mm256_castpd256_pd128(t0));
+    _mm_storel_pd(&p[i[0] + 2], zl);
+    _mm_storeu_pd(&p[i[1]], _mm256_castpd256_pd128(t1));
+    _mm_storeh_pd(&p[i[1] + 2], zl);
+    _mm_storeu_pd(&p[i[2]], _mm256_extractf128_pd(t0, 1));
+    _mm_storel_pd(&p[i[2] + 2], zh);
+    _mm_storeu_pd(&p[i[3]], _mm256_extractf128_pd(t1, 1));
+    _mm_storeh_pd(&p[i[3] + 2], zh);
+}
+
 /* project_range for 4 constraints of a conflict-free batch at a time, in double, with
- * every lane doing exactly the scalar operations in the scalar order (no FMA: -std=c11
- * keeps contraction off), so the bits are the scalar loop's. The skipped lanes (the
- * `continue`s) are masked; the isinf(gamma) limit is blended; the writes are scalar.
- * Measured (AMD EPYC VM, 128x128 cloth, CPU time from perf samples, 2 runs): 9.1-9.4
- * -> 7.5-7.6 ns per projection at -O2, 8.8-9.4 -> 7.3-7.6 at -O3 -march=native. A group
- * at a time (writes right after each group) gained nothing; chunks of 16 or 32 gained
- * less than 64; prefetching the particles 16 or 64 constraints ahead cost 0.3-0.5 ns;
- * for Gauss-Seidel, storing the new positions from the vectors instead of updating
- * them in the scalar writes gained nothing measurable. */
+ * every lane doing exactly the scalar operations in the scalar order (no FMA:
+ * -ffp-contract=off), so the bits are the scalar loop's. The skipped lanes (the
+ * `continue`s) are masked; the isinf(gamma) limit is blended.
+ * A chunk of CH constraints in two passes: the first computes each constraint's s (and
+ * lambda), its groups independent so that their square roots and divisions overlap;
+ * the second reloads the ends, recomputes d (the same bits: nothing of the chunk was
+ * written yet but the group itself) and stores x - wa s d, x + wc s d (or dx -/+ for
+ * Jacobi) from the vectors when all 4 lanes write both ends (nearly every group of a
+ * cloth), else lane by lane under the masks. No lane reads a particle another lane of
+ * the batch writes (conflict-free for movable particles; immovable ones are never
+ * written), so this is the scalar order's result.
+ * Measured (AMD EPYC VM, CPU time from perf samples, instructions from callgrind, see
+ * README Benchmark): the previous version (one pass computing the corrections into
+ * buffers, then a scalar loop re-reading x and adding them; wa, wc gathered from m.w
+ * by 8 scalar loads per group) took 70 instructions per projection on cloth32; storing
+ * each group right after it (one pass, no buffers) cut that to 48 but left the groups'
+ * square root -> division chains waiting on each other (the reorder window holds
+ * about one group): no faster. Earlier: prefetching 16 or 64 constraints ahead cost
+ * 0.3-0.5 ns. */
 static inline __attribute__((always_inline, target("avx2"))) void
 project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
                wb_real *out, int32_t b, int32_t e, wb_real h, wb_real inv_h2, wb_real omega,
                const int damped, const int jacobi)
 {
     const int32_t *restrict sa = k->s_a, *restrict sb = k->s_b;
+    const wb_real *restrict swa = k->s_wa, *restrict swc = k->s_wc;
     wb_real *restrict lambda = k->s_lambda;
     const __m256d zero = _mm256_setzero_pd(), tiny = _mm256_set1_pd(1e-24), inf = _mm256_set1_pd(INFINITY);
     const __m256d absmask = _mm256_castsi256_pd(_mm256_set1_epi64x(INT64_MAX));
     const __m256d vih2 = _mm256_set1_pd(inv_h2), vh = _mm256_set1_pd(h), vomega = _mm256_set1_pd(omega);
-    /* a chunk's corrections are computed first and written after: the square roots and
-     * divisions of its groups then overlap (a group at a time leaves the loop waiting on
-     * their latency), and no lane reads a particle another lane of the batch writes */
-    enum { CH = 64 }; /* 16 and 32 measured slower */
-    double ca[3][CH] __attribute__((aligned(32))), cc[3][CH] __attribute__((aligned(32)));
+    enum { CH = 64 };
+    double sv[CH] __attribute__((aligned(32)));
+    uint8_t wr[CH / 4]; /* per group: bit j, lane j writes its a end; bit 4 + j, its c end */
     int32_t i = b;
     while (i + 4 <= e) {
         const int32_t c0 = i, cn = (e - i) / 4 * 4 < CH ? (e - i) / 4 * 4 : CH;
-        uint64_t wra = 0, wrc = 0; /* per constraint of the chunk: its a / c end is written */
-        for (int g = 0; g < cn; g += 4, i += 4) {
-            const int32_t *ia = &sa[i], *ic = &sb[i];
-            const __m256d wa = _mm256_set_pd(wv[ia[3]], wv[ia[2]], wv[ia[1]], wv[ia[0]]);
-            const __m256d wc = _mm256_set_pd(wv[ic[3]], wv[ic[2]], wv[ic[1]], wv[ic[0]]);
+        for (int g = 0; g < cn; g += 4) {
+            const int32_t j = c0 + g;
+            size_t ia[4], ic[4];
+            offsets(&sa[j], &sb[j], ia, ic);
+            const __m256d wa = _mm256_loadu_pd(&swa[j]), wc = _mm256_loadu_pd(&swc[j]);
             const __m256d wsum = _mm256_add_pd(wa, wc);
             __m256d xa0, xa1, xa2, xc0, xc1, xc2;
             load4(x, ia, &xa0, &xa1, &xa2);
@@ -206,18 +265,21 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
             const __m256d d0 = _mm256_sub_pd(xc0, xa0), d1 = _mm256_sub_pd(xc1, xa1), d2 = _mm256_sub_pd(xc2, xa2);
             const __m256d len2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)),
                                                _mm256_mul_pd(d2, d2));
-            const __m256d at = _mm256_mul_pd(_mm256_loadu_pd(&k->s_alpha[i]), vih2);
+            const __m256d at = _mm256_mul_pd(_mm256_loadu_pd(&k->s_alpha[j]), vih2);
             /* the lanes that go on: !(wsum == 0 || len2 < 1e-24) && !isinf(at), NaN going on */
             const __m256d live = _mm256_and_pd(
                 _mm256_and_pd(_mm256_cmp_pd(wsum, zero, _CMP_NEQ_UQ), _mm256_cmp_pd(len2, tiny, _CMP_NLT_UQ)),
                 _mm256_cmp_pd(_mm256_and_pd(at, absmask), inf, _CMP_NEQ_UQ));
+            const int wra = _mm256_movemask_pd(_mm256_and_pd(live, _mm256_cmp_pd(wa, zero, _CMP_GT_OQ)));
+            const int wrc = _mm256_movemask_pd(_mm256_and_pd(live, _mm256_cmp_pd(wc, zero, _CMP_GT_OQ)));
+            wr[g / 4] = (uint8_t)(wra | wrc << 4);
             if (!_mm256_movemask_pd(live)) continue;
             const __m256d len = _mm256_sqrt_pd(len2);
-            const __m256d lam = _mm256_loadu_pd(&lambda[i]);
-            __m256d num = _mm256_sub_pd(_mm256_sub_pd(_mm256_loadu_pd(&k->s_rest[i]), len), _mm256_mul_pd(at, lam));
+            const __m256d lam = _mm256_loadu_pd(&lambda[j]);
+            __m256d num = _mm256_sub_pd(_mm256_sub_pd(_mm256_loadu_pd(&k->s_rest[j]), len), _mm256_mul_pd(at, lam));
             __m256d den = _mm256_add_pd(wsum, at);
             if (damped) {
-                const __m256d gamma = _mm256_mul_pd(_mm256_mul_pd(at, _mm256_loadu_pd(&k->s_beta[i])), vh);
+                const __m256d gamma = _mm256_mul_pd(_mm256_mul_pd(at, _mm256_loadu_pd(&k->s_beta[j])), vh);
                 __m256d pa0, pa1, pa2, pc0, pc1, pc2;
                 load4(xp, ia, &pa0, &pa1, &pa2);
                 load4(xp, ic, &pc0, &pc1, &pc2);
@@ -233,29 +295,55 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
                 den = _mm256_blendv_pd(dfin, wsum, ginf);
             }
             __m256d s = _mm256_div_pd(num, _mm256_mul_pd(den, len));
-            if (jacobi) s = _mm256_mul_pd(s, _mm256_mul_pd(vomega, _mm256_loadu_pd(&k->s_jac[i])));
+            if (jacobi) s = _mm256_mul_pd(s, _mm256_mul_pd(vomega, _mm256_loadu_pd(&k->s_jac[j])));
             /* a blend and a plain store: a masked store is slow on AMD */
-            _mm256_storeu_pd(&lambda[i], _mm256_blendv_pd(lam, _mm256_add_pd(lam, _mm256_mul_pd(s, len)), live));
-            const __m256d fa = _mm256_mul_pd(wa, s), fc = _mm256_mul_pd(wc, s);
-            _mm256_store_pd(&ca[0][g], _mm256_mul_pd(fa, d0));
-            _mm256_store_pd(&ca[1][g], _mm256_mul_pd(fa, d1));
-            _mm256_store_pd(&ca[2][g], _mm256_mul_pd(fa, d2));
-            _mm256_store_pd(&cc[0][g], _mm256_mul_pd(fc, d0));
-            _mm256_store_pd(&cc[1][g], _mm256_mul_pd(fc, d1));
-            _mm256_store_pd(&cc[2][g], _mm256_mul_pd(fc, d2));
-            wra |= (uint64_t)_mm256_movemask_pd(_mm256_and_pd(live, _mm256_cmp_pd(wa, zero, _CMP_GT_OQ))) << g;
-            wrc |= (uint64_t)_mm256_movemask_pd(_mm256_and_pd(live, _mm256_cmp_pd(wc, zero, _CMP_GT_OQ))) << g;
+            _mm256_storeu_pd(&lambda[j], _mm256_blendv_pd(lam, _mm256_add_pd(lam, _mm256_mul_pd(s, len)), live));
+            _mm256_store_pd(&sv[g], s);
         }
-        for (int j = 0; j < cn; j++) {
-            if (wra >> j & 1) {
-                wb_real *oa = &out[3 * sa[c0 + j]];
-                oa[0] -= ca[0][j]; oa[1] -= ca[1][j]; oa[2] -= ca[2][j];
+        for (int g = 0; g < cn; g += 4) {
+            const int m = wr[g / 4];
+            if (!m) continue;
+            const int32_t j = c0 + g;
+            size_t ia[4], ic[4];
+            offsets(&sa[j], &sb[j], ia, ic);
+            __m256d xa0, xa1, xa2, xc0, xc1, xc2;
+            load4(x, ia, &xa0, &xa1, &xa2);
+            load4(x, ic, &xc0, &xc1, &xc2);
+            const __m256d d0 = _mm256_sub_pd(xc0, xa0), d1 = _mm256_sub_pd(xc1, xa1), d2 = _mm256_sub_pd(xc2, xa2);
+            const __m256d s = _mm256_load_pd(&sv[g]);
+            const __m256d fa = _mm256_mul_pd(_mm256_loadu_pd(&swa[j]), s), fc = _mm256_mul_pd(_mm256_loadu_pd(&swc[j]), s);
+            __m256d oa0 = xa0, oa1 = xa1, oa2 = xa2, oc0 = xc0, oc1 = xc1, oc2 = xc2;
+            if (jacobi) {
+                load4(out, ia, &oa0, &oa1, &oa2);
+                load4(out, ic, &oc0, &oc1, &oc2);
             }
-            if (wrc >> j & 1) {
-                wb_real *oc = &out[3 * sb[c0 + j]];
-                oc[0] += cc[0][j]; oc[1] += cc[1][j]; oc[2] += cc[2][j];
+            oa0 = _mm256_sub_pd(oa0, _mm256_mul_pd(fa, d0));
+            oa1 = _mm256_sub_pd(oa1, _mm256_mul_pd(fa, d1));
+            oa2 = _mm256_sub_pd(oa2, _mm256_mul_pd(fa, d2));
+            oc0 = _mm256_add_pd(oc0, _mm256_mul_pd(fc, d0));
+            oc1 = _mm256_add_pd(oc1, _mm256_mul_pd(fc, d1));
+            oc2 = _mm256_add_pd(oc2, _mm256_mul_pd(fc, d2));
+            if (m == 0xff) {
+                store4(out, ia, oa0, oa1, oa2);
+                store4(out, ic, oc0, oc1, oc2);
+                continue;
+            }
+            /* a pinned end or a skipped lane in the group: lane by lane */
+            double na[3][4] __attribute__((aligned(32))), nc[3][4] __attribute__((aligned(32)));
+            _mm256_store_pd(na[0], oa0); _mm256_store_pd(na[1], oa1); _mm256_store_pd(na[2], oa2);
+            _mm256_store_pd(nc[0], oc0); _mm256_store_pd(nc[1], oc1); _mm256_store_pd(nc[2], oc2);
+            for (int l = 0; l < 4; l++) {
+                if (m >> l & 1) {
+                    wb_real *o = &out[ia[l]];
+                    o[0] = na[0][l]; o[1] = na[1][l]; o[2] = na[2][l];
+                }
+                if (m >> (4 + l) & 1) {
+                    wb_real *o = &out[ic[l]];
+                    o[0] = nc[0][l]; o[1] = nc[1][l]; o[2] = nc[2][l];
+                }
             }
         }
+        i += cn;
     }
     if (i < e) project_range(k, wv, x, xp, out, i, e, h, inv_h2, omega, damped, jacobi);
 }
