@@ -24,6 +24,19 @@ static int packable(const void *ud, int32_t s)
 /* ---- packing: rebuild the colour batches when the topology changed --------------------- */
 static wb_status colour(wb_world *w);
 
+/* alpha / h^2 per constraint for the substep h, and which constraints need none of the
+ * vector path's masks (after s_wa, s_wc) */
+static void refresh_at(wb_cache *k, wb_real h)
+{
+    const wb_real inv_h2 = 1 / (h * h);
+    for (int32_t i = 0; i < k->ns; i++) {
+        const wb_real at = k->s_alpha[i] * inv_h2;
+        k->s_at[i] = at;
+        k->s_ok[i] = k->s_wa[i] > 0 && k->s_wc[i] > 0 && !isinf(at);
+    }
+    k->s_at_h = h;
+}
+
 /* prepare, once per step: recolour when the topology changed; then the ends' inverse
  * masses in packed order (the vector path loads them instead of gathering from m.w;
  * pin, unpin, set mass and snapshot loads change m.w between steps only) */
@@ -41,6 +54,8 @@ wb_status wb__colour(wb_world *w)
         wa[i] = wv[sa[i]];
         wc[i] = wv[sb[i]];
     }
+    /* the solver's substep as it computes it; distance_project checks it */
+    refresh_at(k, w->m.def.dt / w->m.def.substeps);
     return WB_OK;
 }
 
@@ -59,8 +74,8 @@ static wb_status colour(wb_world *w)
         !realloc_n((void **)&k->s_a, ns, sizeof(int32_t)) || !realloc_n((void **)&k->s_b, ns, sizeof(int32_t)) ||
         !realloc_n((void **)&k->s_rest, ns, sizeof(wb_real)) || !realloc_n((void **)&k->s_alpha, ns, sizeof(wb_real)) ||
         !realloc_n((void **)&k->s_beta, ns, sizeof(wb_real)) || !realloc_n((void **)&k->s_lambda, ns, sizeof(wb_real)) ||
-        !realloc_n((void **)&k->s_jac, 3 * ns, sizeof(wb_real)) ||
-        !realloc_n((void **)&k->s_slot, ns, sizeof(int32_t)) ||
+        !realloc_n((void **)&k->s_jac, 4 * ns, sizeof(wb_real)) ||
+        !realloc_n((void **)&k->s_slot, 13 * ns, 1) ||
         !realloc_n((void **)&k->colour_start, WB_MAX_COLOURS + 2, sizeof(int32_t)) ||
         !wb__colour_greedy(m->inv_mass, m->np, m->d_ij, 2, m->nd, packable, w, colour, count)) {
         free(colour);
@@ -68,6 +83,11 @@ static wb_status colour(wb_world *w)
     }
     k->s_wa = k->s_jac + ns;
     k->s_wc = k->s_jac + 2 * ns;
+    k->s_at = k->s_jac + 3 * ns;
+    k->s_oa = (uint32_t *)(k->s_slot + ns);
+    k->s_oc = (uint32_t *)(k->s_slot + 2 * ns);
+    k->s_ok = (uint8_t *)(k->s_slot + 3 * ns);
+    k->s_at_h = NAN; /* none yet: h != NaN */
     int32_t start[WB_MAX_COLOURS + 1];
     k->ns = wb__colour_ranges(count, k->colour_start, &k->ncolours, &k->serial_start, start);
     k->any_damping = 0;
@@ -83,6 +103,8 @@ static wb_status colour(wb_world *w)
         k->s_beta[i] = m->d_beta[s];
         k->s_lambda[i] = 0;
         k->s_slot[i] = s;
+        k->s_oa[i] = 3 * (uint32_t)a;
+        k->s_oc[i] = 3 * (uint32_t)b;
         k->slot_pack[s] = i;
         k->ncount[a]++;
         k->ncount[b]++;
@@ -189,14 +211,14 @@ load4(const wb_real *p, const size_t o[4], __m256d *X, __m256d *Y, __m256d *Z)
     *Z = _mm256_permute2f128_pd(t0, t2, 0x31);
 }
 
-/* the rows' offsets (3 i) of a group's 4 a and 4 c ends, computed once for its loads
- * and stores (unsigned: one instruction fewer per particle than sign extension) */
+/* the rows' offsets of a group's 4 a and 4 c ends (s_oa, s_oc: 3 i precomputed, unsigned:
+ * a load and no arithmetic per particle) */
 static inline __attribute__((always_inline)) void
-offsets(const int32_t *a, const int32_t *c, size_t oa[4], size_t oc[4])
+offsets(const uint32_t *a, const uint32_t *c, size_t oa[4], size_t oc[4])
 {
     for (int l = 0; l < 4; l++) {
-        oa[l] = 3 * (size_t)(uint32_t)a[l];
-        oc[l] = 3 * (size_t)(uint32_t)c[l];
+        oa[l] = a[l];
+        oc[l] = c[l];
     }
 }
 
@@ -241,52 +263,72 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
                wb_real *out, int32_t b, int32_t e, wb_real h, wb_real inv_h2, wb_real omega,
                const int damped, const int jacobi)
 {
-    const int32_t *restrict sa = k->s_a, *restrict sb = k->s_b;
+    const uint32_t *restrict soa = k->s_oa, *restrict soc = k->s_oc;
     const wb_real *restrict swa = k->s_wa, *restrict swc = k->s_wc;
     wb_real *restrict lambda = k->s_lambda;
     const __m256d zero = _mm256_setzero_pd(), tiny = _mm256_set1_pd(1e-24), inf = _mm256_set1_pd(INFINITY);
     const __m256d absmask = _mm256_castsi256_pd(_mm256_set1_epi64x(INT64_MAX));
-    const __m256d vih2 = _mm256_set1_pd(inv_h2), vh = _mm256_set1_pd(h), vomega = _mm256_set1_pd(omega);
+    const __m256d vh = _mm256_set1_pd(h), vomega = _mm256_set1_pd(omega);
     enum { CH = 64 };
-    double sv[CH] __attribute__((aligned(32)));
+    /* per constraint of the chunk: s; |d|; rel (damped); the lane going on (all bits) */
+    double sv[CH] __attribute__((aligned(32))), lv[CH] __attribute__((aligned(32)));
+    double rv[CH] __attribute__((aligned(32))), gv[CH] __attribute__((aligned(32)));
     uint8_t wr[CH / 4]; /* per group: bit j, lane j writes its a end; bit 4 + j, its c end */
+    uint8_t go[CH / 4]; /* per group: some lane goes on */
     int32_t i = b;
     while (i + 4 <= e) {
         const int32_t c0 = i, cn = (e - i) / 4 * 4 < CH ? (e - i) / 4 * 4 : CH;
+        /* 1: the lengths (and the relative velocities), the masks */
         for (int g = 0; g < cn; g += 4) {
             const int32_t j = c0 + g;
             size_t ia[4], ic[4];
-            offsets(&sa[j], &sb[j], ia, ic);
-            const __m256d wa = _mm256_loadu_pd(&swa[j]), wc = _mm256_loadu_pd(&swc[j]);
-            const __m256d wsum = _mm256_add_pd(wa, wc);
+            offsets(&soa[j], &soc[j], ia, ic);
             __m256d xa0, xa1, xa2, xc0, xc1, xc2;
             load4(x, ia, &xa0, &xa1, &xa2);
             load4(x, ic, &xc0, &xc1, &xc2);
             const __m256d d0 = _mm256_sub_pd(xc0, xa0), d1 = _mm256_sub_pd(xc1, xa1), d2 = _mm256_sub_pd(xc2, xa2);
             const __m256d len2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)),
                                                _mm256_mul_pd(d2, d2));
-            const __m256d at = _mm256_mul_pd(_mm256_loadu_pd(&k->s_alpha[j]), vih2);
-            /* the lanes that go on: !(wsum == 0 || len2 < 1e-24) && !isinf(at), NaN going on */
-            const __m256d live = _mm256_and_pd(
-                _mm256_and_pd(_mm256_cmp_pd(wsum, zero, _CMP_NEQ_UQ), _mm256_cmp_pd(len2, tiny, _CMP_NLT_UQ)),
-                _mm256_cmp_pd(_mm256_and_pd(at, absmask), inf, _CMP_NEQ_UQ));
-            const int wra = _mm256_movemask_pd(_mm256_and_pd(live, _mm256_cmp_pd(wa, zero, _CMP_GT_OQ)));
-            const int wrc = _mm256_movemask_pd(_mm256_and_pd(live, _mm256_cmp_pd(wc, zero, _CMP_GT_OQ)));
-            wr[g / 4] = (uint8_t)(wra | wrc << 4);
-            if (!_mm256_movemask_pd(live)) continue;
-            const __m256d len = _mm256_sqrt_pd(len2);
-            const __m256d lam = _mm256_loadu_pd(&lambda[j]);
-            __m256d num = _mm256_sub_pd(_mm256_sub_pd(_mm256_loadu_pd(&k->s_rest[j]), len), _mm256_mul_pd(at, lam));
-            __m256d den = _mm256_add_pd(wsum, at);
+            __m256d live = _mm256_cmp_pd(len2, tiny, _CMP_NLT_UQ);
+            uint32_t ok;
+            memcpy(&ok, &k->s_ok[j], sizeof ok);
+            if (ok == 0x01010101u && _mm256_movemask_pd(live) == 15) {
+                wr[g / 4] = 0xff; /* every lane goes on and writes both ends */
+            } else {
+                /* the lanes that go on: !(wsum == 0 || len2 < 1e-24) && !isinf(at), NaN going on */
+                const __m256d wa = _mm256_loadu_pd(&swa[j]), wc = _mm256_loadu_pd(&swc[j]);
+                const __m256d at = _mm256_loadu_pd(&k->s_at[j]);
+                live = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(_mm256_add_pd(wa, wc), zero, _CMP_NEQ_UQ), live),
+                                     _mm256_cmp_pd(_mm256_and_pd(at, absmask), inf, _CMP_NEQ_UQ));
+                const int wra = _mm256_movemask_pd(_mm256_and_pd(live, _mm256_cmp_pd(wa, zero, _CMP_GT_OQ)));
+                const int wrc = _mm256_movemask_pd(_mm256_and_pd(live, _mm256_cmp_pd(wc, zero, _CMP_GT_OQ)));
+                wr[g / 4] = (uint8_t)(wra | wrc << 4);
+            }
+            go[g / 4] = _mm256_movemask_pd(live) != 0;
+            _mm256_store_pd(&gv[g], live);
+            _mm256_store_pd(&lv[g], _mm256_sqrt_pd(len2));
             if (damped) {
-                const __m256d gamma = _mm256_mul_pd(_mm256_mul_pd(at, _mm256_loadu_pd(&k->s_beta[j])), vh);
                 __m256d pa0, pa1, pa2, pc0, pc1, pc2;
                 load4(xp, ia, &pa0, &pa1, &pa2);
                 load4(xp, ic, &pc0, &pc1, &pc2);
                 const __m256d r0 = _mm256_mul_pd(_mm256_sub_pd(_mm256_sub_pd(xc0, pc0), _mm256_sub_pd(xa0, pa0)), d0);
                 const __m256d r1 = _mm256_mul_pd(_mm256_sub_pd(_mm256_sub_pd(xc1, pc1), _mm256_sub_pd(xa1, pa1)), d1);
                 const __m256d r2 = _mm256_mul_pd(_mm256_sub_pd(_mm256_sub_pd(xc2, pc2), _mm256_sub_pd(xa2, pa2)), d2);
-                const __m256d rel = _mm256_add_pd(_mm256_add_pd(r0, r1), r2);
+                _mm256_store_pd(&rv[g], _mm256_add_pd(_mm256_add_pd(r0, r1), r2));
+            }
+        }
+        /* 2: s and lambda */
+        for (int g = 0; g < cn; g += 4) {
+            if (!go[g / 4]) continue;
+            const int32_t j = c0 + g;
+            const __m256d wsum = _mm256_add_pd(_mm256_loadu_pd(&swa[j]), _mm256_loadu_pd(&swc[j]));
+            const __m256d at = _mm256_loadu_pd(&k->s_at[j]), len = _mm256_load_pd(&lv[g]);
+            const __m256d lam = _mm256_loadu_pd(&lambda[j]);
+            __m256d num = _mm256_sub_pd(_mm256_sub_pd(_mm256_loadu_pd(&k->s_rest[j]), len), _mm256_mul_pd(at, lam));
+            __m256d den = _mm256_add_pd(wsum, at);
+            if (damped) {
+                const __m256d gamma = _mm256_mul_pd(_mm256_mul_pd(at, _mm256_loadu_pd(&k->s_beta[j])), vh);
+                const __m256d rel = _mm256_load_pd(&rv[g]);
                 const __m256d ginf = _mm256_cmp_pd(_mm256_and_pd(gamma, absmask), inf, _CMP_EQ_OQ);
                 const __m256d nfin = _mm256_sub_pd(num, _mm256_div_pd(_mm256_mul_pd(gamma, rel), len));
                 const __m256d dfin = _mm256_add_pd(den, _mm256_mul_pd(gamma, wsum));
@@ -297,15 +339,17 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
             __m256d s = _mm256_div_pd(num, _mm256_mul_pd(den, len));
             if (jacobi) s = _mm256_mul_pd(s, _mm256_mul_pd(vomega, _mm256_loadu_pd(&k->s_jac[j])));
             /* a blend and a plain store: a masked store is slow on AMD */
-            _mm256_storeu_pd(&lambda[j], _mm256_blendv_pd(lam, _mm256_add_pd(lam, _mm256_mul_pd(s, len)), live));
+            _mm256_storeu_pd(&lambda[j], _mm256_blendv_pd(lam, _mm256_add_pd(lam, _mm256_mul_pd(s, len)),
+                                                          _mm256_load_pd(&gv[g])));
             _mm256_store_pd(&sv[g], s);
         }
+        /* 3: the corrections */
         for (int g = 0; g < cn; g += 4) {
             const int m = wr[g / 4];
             if (!m) continue;
             const int32_t j = c0 + g;
             size_t ia[4], ic[4];
-            offsets(&sa[j], &sb[j], ia, ic);
+            offsets(&soa[j], &soc[j], ia, ic);
             __m256d xa0, xa1, xa2, xc0, xc1, xc2;
             load4(x, ia, &xa0, &xa1, &xa2);
             load4(x, ic, &xc0, &xc1, &xc2);
@@ -443,6 +487,7 @@ static void distance_project(wb_world *w, wb_real h)
     const wb_real inv_h2 = 1 / (h * h);
     const int32_t np = w->m.np;
     k->projections += k->ns;
+    if (h != k->s_at_h) refresh_at(k, h);
     if (w->m.def.solver == WB_SOLVER_GAUSS_SEIDEL) {
         project_batches(w, NULL, h, inv_h2);
         return;
