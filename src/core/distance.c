@@ -211,6 +211,36 @@ load4(const wb_real *p, const size_t o[4], __m256d *X, __m256d *Y, __m256d *Z)
     *Z = _mm256_permute2f128_pd(t0, t2, 0x31);
 }
 
+/* load4 on 4 row pointers, and its inverse (the corrections' pass: each row's address
+ * made once for its load and its two stores) */
+static inline __attribute__((always_inline, target("avx2"))) void
+load4p(wb_real *const r[4], __m256d *X, __m256d *Y, __m256d *Z)
+{
+    const __m256i m = _mm256_set_epi64x(0, -1, -1, -1);
+    const __m256d r0 = _mm256_maskload_pd(r[0], m), r1 = _mm256_maskload_pd(r[1], m);
+    const __m256d r2 = _mm256_maskload_pd(r[2], m), r3 = _mm256_maskload_pd(r[3], m);
+    const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
+    const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+    *X = _mm256_permute2f128_pd(t0, t2, 0x20);
+    *Y = _mm256_permute2f128_pd(t1, t3, 0x20);
+    *Z = _mm256_permute2f128_pd(t0, t2, 0x31);
+}
+
+static inline __attribute__((always_inline, target("avx2"))) void
+store4p(wb_real *const r[4], __m256d X, __m256d Y, __m256d Z)
+{
+    const __m256d t0 = _mm256_unpacklo_pd(X, Y), t1 = _mm256_unpackhi_pd(X, Y);
+    const __m128d zl = _mm256_castpd256_pd128(Z), zh = _mm256_extractf128_pd(Z, 1);
+    _mm_storeu_pd(r[0], _mm256_castpd256_pd128(t0));
+    _mm_storel_pd(r[0] + 2, zl);
+    _mm_storeu_pd(r[1], _mm256_castpd256_pd128(t1));
+    _mm_storeh_pd(r[1] + 2, zl);
+    _mm_storeu_pd(r[2], _mm256_extractf128_pd(t0, 1));
+    _mm_storel_pd(r[2] + 2, zh);
+    _mm_storeu_pd(r[3], _mm256_extractf128_pd(t1, 1));
+    _mm_storeh_pd(r[3] + 2, zh);
+}
+
 /* the rows' offsets of a group's 4 a and 4 c ends (s_oa, s_oc: 3 i precomputed, unsigned:
  * a load and no arithmetic per particle) */
 static inline __attribute__((always_inline)) void
@@ -220,22 +250,6 @@ offsets(const uint32_t *a, const uint32_t *c, size_t oa[4], size_t oc[4])
         oa[l] = a[l];
         oc[l] = c[l];
     }
-}
-
-/* the inverse of load4: the x, y, z lanes of 4 particles stored back as rows of 3 */
-static inline __attribute__((always_inline, target("avx2"))) void
-store4(wb_real *p, const size_t i[4], __m256d X, __m256d Y, __m256d Z)
-{
-    const __m256d t0 = _mm256_unpacklo_pd(X, Y), t1 = _mm256_unpackhi_pd(X, Y); /* x0 y0 x2 y2, x1 y1 x3 y3 */
-    const __m128d zl = _mm256_castpd256_pd128(Z), zh = _mm256_extractf128_pd(Z, 1);
-    _mm_storeu_pd(&p[i[0]], _mm256_castpd256_pd128(t0));
-    _mm_storel_pd(&p[i[0] + 2], zl);
-    _mm_storeu_pd(&p[i[1]], _mm256_castpd256_pd128(t1));
-    _mm_storeh_pd(&p[i[1] + 2], zl);
-    _mm_storeu_pd(&p[i[2]], _mm256_extractf128_pd(t0, 1));
-    _mm_storel_pd(&p[i[2] + 2], zh);
-    _mm_storeu_pd(&p[i[3]], _mm256_extractf128_pd(t1, 1));
-    _mm_storeh_pd(&p[i[3] + 2], zh);
 }
 
 /* project_range for 4 constraints of a conflict-free batch at a time, in double, with
@@ -348,18 +362,25 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
             const int m = wr[g / 4];
             if (!m) continue;
             const int32_t j = c0 + g;
-            size_t ia[4], ic[4];
-            offsets(&soa[j], &soc[j], ia, ic);
+            wb_real *const ra[4] = { out + soa[j], out + soa[j + 1], out + soa[j + 2], out + soa[j + 3] };
+            wb_real *const rc[4] = { out + soc[j], out + soc[j + 1], out + soc[j + 2], out + soc[j + 3] };
             __m256d xa0, xa1, xa2, xc0, xc1, xc2;
-            load4(x, ia, &xa0, &xa1, &xa2);
-            load4(x, ic, &xc0, &xc1, &xc2);
+            if (jacobi) {
+                size_t ia[4], ic[4];
+                offsets(&soa[j], &soc[j], ia, ic);
+                load4(x, ia, &xa0, &xa1, &xa2);
+                load4(x, ic, &xc0, &xc1, &xc2);
+            } else { /* out is x */
+                load4p(ra, &xa0, &xa1, &xa2);
+                load4p(rc, &xc0, &xc1, &xc2);
+            }
             const __m256d d0 = _mm256_sub_pd(xc0, xa0), d1 = _mm256_sub_pd(xc1, xa1), d2 = _mm256_sub_pd(xc2, xa2);
             const __m256d s = _mm256_load_pd(&sv[g]);
             const __m256d fa = _mm256_mul_pd(_mm256_loadu_pd(&swa[j]), s), fc = _mm256_mul_pd(_mm256_loadu_pd(&swc[j]), s);
             __m256d oa0 = xa0, oa1 = xa1, oa2 = xa2, oc0 = xc0, oc1 = xc1, oc2 = xc2;
             if (jacobi) {
-                load4(out, ia, &oa0, &oa1, &oa2);
-                load4(out, ic, &oc0, &oc1, &oc2);
+                load4p(ra, &oa0, &oa1, &oa2);
+                load4p(rc, &oc0, &oc1, &oc2);
             }
             oa0 = _mm256_sub_pd(oa0, _mm256_mul_pd(fa, d0));
             oa1 = _mm256_sub_pd(oa1, _mm256_mul_pd(fa, d1));
@@ -368,8 +389,8 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
             oc1 = _mm256_add_pd(oc1, _mm256_mul_pd(fc, d1));
             oc2 = _mm256_add_pd(oc2, _mm256_mul_pd(fc, d2));
             if (m == 0xff) {
-                store4(out, ia, oa0, oa1, oa2);
-                store4(out, ic, oc0, oc1, oc2);
+                store4p(ra, oa0, oa1, oa2);
+                store4p(rc, oc0, oc1, oc2);
                 continue;
             }
             /* a pinned end or a skipped lane in the group: lane by lane */
@@ -378,11 +399,11 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
             _mm256_store_pd(nc[0], oc0); _mm256_store_pd(nc[1], oc1); _mm256_store_pd(nc[2], oc2);
             for (int l = 0; l < 4; l++) {
                 if (m >> l & 1) {
-                    wb_real *o = &out[ia[l]];
+                    wb_real *o = ra[l];
                     o[0] = na[0][l]; o[1] = na[1][l]; o[2] = na[2][l];
                 }
                 if (m >> (4 + l) & 1) {
-                    wb_real *o = &out[ic[l]];
+                    wb_real *o = rc[l];
                     o[0] = nc[0][l]; o[1] = nc[1][l]; o[2] = nc[2][l];
                 }
             }
