@@ -43,14 +43,15 @@ static void refresh_at(wb_cache *k, wb_real h)
 wb_status wb__colour(wb_world *w)
 {
     wb_cache *k = &w->k;
-    if (w->m.topology_dirty) {
+    const int recoloured = w->m.topology_dirty;
+    if (recoloured) {
         const wb_status st = colour(w);
         if (st != WB_OK) return st;
     }
     const wb_real *wv = w->m.w;
     const int32_t *restrict sa = k->s_a, *restrict sb = k->s_b;
     wb_real *restrict wa = k->s_wa, *restrict wc = k->s_wc;
-    for (int32_t i = 0; i < k->ns; i++) {
+    for (int32_t i = 0, n = k->ns; i < n; i++) {
         wa[i] = wv[sa[i]];
         wc[i] = wv[sb[i]];
     }
@@ -255,23 +256,29 @@ offsets(const uint32_t *a, const uint32_t *c, size_t oa[4], size_t oc[4])
 /* project_range for 4 constraints of a conflict-free batch at a time, in double, with
  * every lane doing exactly the scalar operations in the scalar order (no FMA:
  * -ffp-contract=off), so the bits are the scalar loop's. The skipped lanes (the
- * `continue`s) are masked; the isinf(gamma) limit is blended.
- * A chunk of CH constraints in two passes: the first computes each constraint's s (and
- * lambda), its groups independent so that their square roots and divisions overlap;
- * the second reloads the ends, recomputes d (the same bits: nothing of the chunk was
- * written yet but the group itself) and stores x - wa s d, x + wc s d (or dx -/+ for
- * Jacobi) from the vectors when all 4 lanes write both ends (nearly every group of a
- * cloth), else lane by lane under the masks. No lane reads a particle another lane of
- * the batch writes (conflict-free for movable particles; immovable ones are never
- * written), so this is the scalar order's result.
- * Measured (AMD EPYC VM, CPU time from perf samples, instructions from callgrind, see
- * README Benchmark): the previous version (one pass computing the corrections into
- * buffers, then a scalar loop re-reading x and adding them; wa, wc gathered from m.w
- * by 8 scalar loads per group) took 70 instructions per projection on cloth32; storing
- * each group right after it (one pass, no buffers) cut that to 48 but left the groups'
- * square root -> division chains waiting on each other (the reorder window holds
- * about one group): no faster. Earlier: prefetching 16 or 64 constraints ahead cost
- * 0.3-0.5 ns. */
+ * `continue`s) are masked; the isinf(gamma) limit is blended; a group whose 4
+ * constraints all have s_ok (movable ends, finite alpha/h^2) and a length skips the
+ * mask arithmetic. A chunk of CH constraints in three passes: 1, the lengths (one
+ * square root per group) and masks; 2, s and lambda (one division); 3, the ends
+ * reloaded and x - wa s d, x + wc s d (dx -/+ for Jacobi) stored from the vectors when
+ * all 4 lanes write both ends (nearly every group of a cloth), else lane by lane. Each
+ * pass's groups are independent, so their square roots and divisions overlap. No lane
+ * reads a particle another lane of the batch writes (conflict-free for movable
+ * particles; immovable ones are never written), so pass 3 recomputes d's bits and the
+ * result is the scalar order's.
+ * Measured (AMD EPYC (Zen 3) VM, loaded: CPU time from perf samples, medians of 5-6
+ * interleaved runs; instructions from callgrind): cloth32 9.7 -> 7.3 ns per projection
+ * (70 -> 56 instructions), cloth128 11.1 -> 8.5. The steps: wa, wc packed per
+ * constraint instead of 8 scalar gathers per group, and the corrections stored from
+ * the vectors instead of a scalar loop re-reading x: 70 -> 48 instructions but one
+ * pass, each group's sqrt -> div chain waiting on the last (the reorder window held
+ * about one group): no faster; two passes (s, then corrections): -6%; alpha/h^2,
+ * s_ok and 3i offsets precomputed: -17%; the lengths in a pass of their own: -18%;
+ * the corrections addressed through row pointers made once (fewer spills): -25%.
+ * Tried and dropped: d stored by pass 1 and the corrections made end by end (+10%);
+ * pass 1's transposed rows kept for pass 3 instead of reloading (-1% cloth32, +2%
+ * cloth128: noise); CH 32 or 128 (no difference). Earlier: prefetching 16 or 64
+ * constraints ahead cost 0.3-0.5 ns. */
 static inline __attribute__((always_inline, target("avx2"))) void
 project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
                wb_real *out, int32_t b, int32_t e, wb_real h, wb_real inv_h2, wb_real omega,
@@ -523,6 +530,10 @@ static void distance_project(wb_world *w, wb_real h)
         if (wv[i] > 0) v3_add(&w->s.x[3 * i], &w->s.x[3 * i], &k->dx[3 * i]);
 }
 
+/* (Not clearing lambda here but having the first iteration read it as 0 would save
+ * the memset, 1% of cloth32's CPU time (6% of its callgrind instructions: rep stos
+ * counts per byte), but force() and undo_particles also rely on the zeros this leaves:
+ * not worth the bookkeeping.) */
 static void distance_substep_begin(wb_world *w)
 {
     if (w->k.ns > 0) memset(w->k.s_lambda, 0, sizeof(wb_real) * (size_t)w->k.ns);
