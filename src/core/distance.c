@@ -272,9 +272,10 @@ offsets(const uint32_t *a, const uint32_t *c, size_t oa[4], size_t oc[4])
  * constraint instead of 8 scalar gathers per group, and the corrections stored from
  * the vectors instead of a scalar loop re-reading x: 70 -> 48 instructions but one
  * pass, each group's sqrt -> div chain waiting on the last (the reorder window held
- * about one group): no faster; two passes (s, then corrections): -6%; alpha/h^2,
- * s_ok and 3i offsets precomputed: -17%; the lengths in a pass of their own: -18%;
- * the corrections addressed through row pointers made once (fewer spills): -25%.
+ * about one group): no faster; cumulative from there: two passes (s, then
+ * corrections): -6%; alpha/h^2, s_ok and 3i offsets precomputed: -17%; the lengths in a
+ * pass of their own: -18%; the corrections addressed through row pointers made once
+ * (fewer spills): -25%.
  * Tried and dropped: d stored by pass 1 and the corrections made end by end (+10%);
  * pass 1's transposed rows kept for pass 3 instead of reloading (-1% cloth32, +2%
  * cloth128: noise); CH 32 or 128 (no difference). Earlier: prefetching 16 or 64
