@@ -75,8 +75,8 @@ static wb_status colour(wb_world *w)
         !realloc_n((void **)&k->s_a, ns, sizeof(int32_t)) || !realloc_n((void **)&k->s_b, ns, sizeof(int32_t)) ||
         !realloc_n((void **)&k->s_rest, ns, sizeof(wb_real)) || !realloc_n((void **)&k->s_alpha, ns, sizeof(wb_real)) ||
         !realloc_n((void **)&k->s_beta, ns, sizeof(wb_real)) || !realloc_n((void **)&k->s_lambda, ns, sizeof(wb_real)) ||
-        !realloc_n((void **)&k->s_jac, 4 * ns, sizeof(wb_real)) ||
-        !realloc_n((void **)&k->s_slot, 13 * ns, 1) ||
+        !realloc_n((void **)&k->s_jac, ns, 4 * sizeof(wb_real)) ||
+        !realloc_n((void **)&k->s_slot, ns, 3 * sizeof(int32_t) + 1) ||
         !realloc_n((void **)&k->colour_start, WB_MAX_COLOURS + 2, sizeof(int32_t)) ||
         !wb__colour_greedy(m->inv_mass, m->np, m->d_ij, 2, m->nd, packable, w, colour, count)) {
         free(colour);
