@@ -346,6 +346,13 @@ typedef struct wb_cache {
     wb_real *s_rest, *s_alpha, *s_beta; /* (ns) */
     wb_real *s_lambda;     /* (ns) multipliers of the current substep */
     wb_real *s_jac;        /* (ns) Jacobi scale 1/max(n_a, n_b), n = constraints at a movable end */
+    /* the vector path's per-constraint data (distance.c), views into the allocations of
+     * s_jac (4 ns reals) and s_slot (3 ns int32 + ns bytes), freed with them: */
+    wb_real *s_wa, *s_wc;  /* (ns) m.w of each end, refreshed every step (wb__colour) */
+    wb_real *s_at;         /* (ns) alpha / h^2 for h = s_at_h */
+    uint32_t *s_oa, *s_oc; /* (ns) 3 a, 3 c: the ends' offsets in x */
+    uint8_t *s_ok;         /* (ns) 1: wa > 0, wc > 0 and alpha / h^2 finite (no masked case) */
+    wb_real s_at_h;        /* the substep s_at and s_ok are for */
     int32_t *s_slot;       /* (ns) constraint slot of each packed entry */
     int32_t *slot_pack;    /* (nd) packed index of each slot, -1 when not packed */
     int any_damping;

@@ -6,7 +6,10 @@
  * (w = 0), an immovable pair (wsum = 0), coincident particles (len2 tiny), compliance
  * that overflows over h^2 (isinf(at)), damping and infinitely damped links
  * (isinf(gamma)), the undamped and the damped loops, Jacobi with over-relaxation,
- * and 2 threads (batches split between them). */
+ * and 2 threads (batches split between them); with 3 iterations per substep (lambda
+ * accumulating from a non-zero start), and with the inverse masses and the substep
+ * changed between frames (pin, unpin, dt: the vector path's per-constraint copies of
+ * w and alpha/h^2 must follow, the scalar loop reads them fresh). */
 #include <float.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -16,11 +19,12 @@
 
 int wb__distance_simd(int on); /* distance.c's internal switch */
 
-static wb_world *scene(int solver, int threads, int damped)
+static wb_world *scene(int solver, int threads, int damped, int iterations)
 {
     wb_world_def d = wb_world_default_def();
     d.threads = threads;
     d.substeps = 4;
+    d.iterations = iterations;
     d.solver = solver;
     if (solver == WB_SOLVER_JACOBI) d.relaxation = 1.5;
     wb_world *w = wb_world_create(&d);
@@ -90,14 +94,34 @@ TEST(distance_simd_bit_identical_to_scalar)
 #else
     CHECK_EQ(on, 0);
 #endif
-    const int cases[][3] = { { WB_SOLVER_GAUSS_SEIDEL, 1, 0 }, { WB_SOLVER_GAUSS_SEIDEL, 1, 1 },
-                             { WB_SOLVER_JACOBI, 1, 1 },       { WB_SOLVER_JACOBI, 1, 0 },
-                             { WB_SOLVER_GAUSS_SEIDEL, 2, 1 } };
+    /* solver, threads, damped, iterations, changes between frames */
+    const int cases[][5] = { { WB_SOLVER_GAUSS_SEIDEL, 1, 0, 1, 0 }, { WB_SOLVER_GAUSS_SEIDEL, 1, 1, 1, 0 },
+                             { WB_SOLVER_JACOBI, 1, 1, 1, 0 },       { WB_SOLVER_JACOBI, 1, 0, 1, 0 },
+                             { WB_SOLVER_GAUSS_SEIDEL, 2, 1, 1, 0 }, { WB_SOLVER_GAUSS_SEIDEL, 1, 0, 3, 1 },
+                             { WB_SOLVER_GAUSS_SEIDEL, 1, 1, 3, 1 }, { WB_SOLVER_JACOBI, 1, 1, 3, 1 },
+                             { WB_SOLVER_GAUSS_SEIDEL, 2, 0, 3, 1 } };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
-        wb_world *v = scene(cases[c][0], cases[c][1], cases[c][2]), *s = scene(cases[c][0], cases[c][1], cases[c][2]);
+        const int *cs = cases[c];
+        wb_world *v = scene(cs[0], cs[1], cs[2], cs[3]), *s = scene(cs[0], cs[1], cs[2], cs[3]);
         REQUIRE(v && s);
         int diff = 0;
         for (int f = 0; f < 30 && !diff; f++) {
+            if (cs[4]) {
+                wb_world *ws[2] = { v, s };
+                for (int k = 0; k < 2; k++) {
+                    /* a cloth end freed, then pinned again (w changes with no new topology);
+                     * a particle mid-cloth pinned; the substep shortened */
+                    const int32_t p1 = 2 + 39; /* the cloth's second pinned corner */
+                    if (f == 8) wb_particle_unpin(ws[k], p1);
+                    if (f == 14) wb_particle_pin(ws[k], p1, NULL);
+                    if (f == 11) wb_particle_pin(ws[k], 2 + 20 * 40 + 20, NULL);
+                    if (f == 17) {
+                        wb_world_def d = ws[k]->m.def;
+                        d.dt *= 0.5;
+                        CHECK_EQ(wb_world_set_def(ws[k], &d), WB_OK);
+                    }
+                }
+            }
             wb__distance_simd(1);
             CHECK_EQ(wb_world_step(v), WB_OK);
             wb__distance_simd(0);
