@@ -176,7 +176,7 @@ int64_t wb_world_frame(const wb_world *w) { return w->s.frame; }
 /* bytes per particle and per constraint over all the arrays that grow with them
  * (model, state and solver cache), for the memory limit */
 #define PARTICLE_BYTES (25 * sizeof(wb_real) + 5 + 8 + 5)
-#define CONSTRAINT_BYTES (11 * sizeof(wb_real) + 33)
+#define CONSTRAINT_BYTES (14 * sizeof(wb_real) + 42)
 
 /* charge the arrays at capacities (cap_p, cap_d) to the budget; 0 when it would pass
  * the limit (nothing charged then) */
