@@ -10,6 +10,24 @@ static int cmp_real(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
+void wb__grid_bounds(const wb_real *x, const wb_real *reach, const int32_t *list, int32_t n, wb_real big,
+                     wb_real lo[3], wb_real hi[3], wb_real *rmax, wb_real *rn)
+{
+    for (int a = 0; a < 3; a++) lo[a] = INFINITY, hi[a] = -INFINITY;
+    wb_real rm = 0, rb = 0;
+    for (int32_t k = 0; k < n; k++) {
+        const int32_t i = list[k];
+        for (int a = 0; a < 3; a++) {
+            if (x[3 * i + a] < lo[a]) lo[a] = x[3 * i + a];
+            if (x[3 * i + a] > hi[a]) hi[a] = x[3 * i + a];
+        }
+        if (reach[i] > rm) rm = reach[i];
+        if (reach[i] > rb && !(reach[i] > big)) rb = reach[i];
+    }
+    *rmax = rm;
+    *rn = rb;
+}
+
 wb_real wb__grid_typical(const wb_real *reach, const int32_t *list, int32_t n)
 {
     wb_real sample[31];

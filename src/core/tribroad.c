@@ -105,8 +105,9 @@ static wb_real box_dist2(const wb_real p[3], const wb_real lo[3], const wb_real 
     return s;
 }
 
-/* the candidate test itself: point p (reach rp > 0) against triangle t (its record tb) */
-static int candidate(const wb_world *w, const wb_real *tb, int32_t t, int32_t p, wb_real rp)
+/* the candidate test itself: point p (reach rp > 0) against triangle t (its record tb);
+ * the kept list's search leaves out the plane (plane 0) */
+static int candidate(const wb_world *w, const wb_real *tb, int32_t t, int32_t p, wb_real rp, int plane)
 {
     const wb_model *m = &w->m;
     const wb_real *x = w->s.x, reach = rp + tb[6];
@@ -118,7 +119,7 @@ static int candidate(const wb_world *w, const wb_real *tb, int32_t t, int32_t p,
     if (!rules_allow(m, p, v, &same)) return 0;
     wb_real d[3];
     v3_sub(d, &x[3 * p], &x[3 * v[0]]);
-    if (!(fabs(v3_dot(d, tb + 7)) < reach)) return 0;
+    if (plane && !(fabs(v3_dot(d, tb + 7)) < reach)) return 0;
     wb_real bary[3], q[3];
     if (!(wb__tri_closest(&x[3 * p], &x[3 * v[0]], &x[3 * v[1]], &x[3 * v[2]], bary, q) < reach * reach)) return 0;
     return !(same && !rest_apart(m, p, v));
@@ -143,7 +144,7 @@ static inline void item_box(const struct wb_tribroad *b, const wb_real *x, int32
         const wb_real *tb = &b->tbox[TB * i];
         for (int a = 0; a < 3; a++) lo[a] = tb[a] - tb[6], hi[a] = tb[3 + a] + tb[6];
     } else {
-        const wb_real r = b->reach[i];
+        const wb_real r = b->sr[i];
         for (int a = 0; a < 3; a++) lo[a] = x[3 * i + a] - r, hi[a] = x[3 * i + a] + r;
     }
 }
@@ -283,15 +284,8 @@ static int cull(struct wb_tribroad *b, const wb_world *w, int32_t *np_, int32_t 
 static void make_grid(level *l, const wb_real *x, const wb_real *reach, const int32_t *list, int32_t n,
                       wb_real typical)
 {
-    wb_real lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY }, rmax = 0;
-    for (int32_t k = 0; k < n; k++) {
-        const int32_t i = list[k];
-        for (int a = 0; a < 3; a++) {
-            if (x[3 * i + a] < lo[a]) lo[a] = x[3 * i + a];
-            if (x[3 * i + a] > hi[a]) hi[a] = x[3 * i + a];
-        }
-        if (reach[i] > rmax) rmax = reach[i];
-    }
+    wb_real lo[3], hi[3], rmax, rn;
+    wb__grid_bounds(x, reach, list, n, INFINITY, lo, hi, &rmax, &rn);
     l->rn = rmax;
     wb_real cs = 2 * typical;
     if (!(cs > 0)) cs = 2 * rmax;
@@ -301,7 +295,7 @@ static void make_grid(level *l, const wb_real *x, const wb_real *reach, const in
 /* the levels over the kept points b->pc (n); -1 when out of memory */
 static int make_levels(struct wb_tribroad *b, const wb_world *w, int32_t n)
 {
-    const wb_real *x = w->s.x, *reach = b->reach;
+    const wb_real *x = w->s.x, *reach = b->sr;
     if (!grow((void **)&b->sp, &b->cap_sp, 4 * (int64_t)n, sizeof *b->sp) ||
         !grow((void **)&b->sid, &b->cap_sid, n, sizeof *b->sid) ||
         !grow((void **)&b->skey, &b->cap_skey, n, sizeof *b->skey) ||
@@ -335,13 +329,7 @@ static int make_levels(struct wb_tribroad *b, const wb_world *w, int32_t n)
         int32_t *start = b->start + l->start0;
         memset(start, 0, sizeof *start * (size_t)(nc + 1));
         for (int32_t k = 0; k < nl; k++) {
-            const wb_real *p = &x[3 * list[k]];
-            int64_t c[3];
-            for (int a = 0; a < 3; a++) {
-                c[a] = wb__cell_of(p[a], g->o[a], g->inv);
-                if (g->wrap) c[a] %= g->nc[a];
-            }
-            const int32_t cl = (int32_t)(c[0] + g->nc[0] * (c[1] + g->nc[1] * c[2]));
+            const int32_t cl = wb__grid_cell(g, &x[3 * list[k]]);
             b->scell[k] = cl;
             start[cl + 1]++;
         }
@@ -394,7 +382,7 @@ static void tri_try(const struct wb_tribroad *b, const wb_world *w, const wb_rea
             (p[1] < lo[1] && lo[1] - p[1] >= rp) || (p[1] > hi[1] && p[1] - hi[1] >= rp) ||
             (p[2] < lo[2] && lo[2] - p[2] >= rp) || (p[2] > hi[2] && p[2] - hi[2] >= rp))
             continue;
-        if (candidate(w, tb, t, b->sid[s], rp)) push(o, b->sid[s], t);
+        if (candidate(w, tb, t, b->sid[s], rp, !b->building)) push(o, b->sid[s], t);
     }
 }
 
@@ -569,93 +557,96 @@ static void tri_part(void *ctx, int k, int nth)
              &j->b->out[k]);
 }
 
-static int broadphase(wb_world *w)
+/* triangle t's record from the motions mv (and, for the kept list's search, the most
+ * skin of its corners on top of its motion; NULL: none): box, motion; -1 in tb[6] when
+ * left out (no corner may collide, or not finite). Returns the extent that sizes the
+ * order's cell (NAN when left out) */
+static wb_real tri_box(const wb_model *m, const wb_real *x, const wb_real *mvp, const wb_real *skin, int32_t t,
+                       wb_real *tb)
+{
+    const int32_t *tv = &m->tri[3 * t];
+    tb[6] = -1;
+    if (!((m->cflags[tv[0]] | m->cflags[tv[1]] | m->cflags[tv[2]]) & (WB_CF_COLLIDE | WB_CF_SELF))) return NAN;
+    /* the corners' box in locals (tb may alias nothing, the compiler cannot know) */
+    const wb_real *p0 = &x[3 * tv[0]], *p1 = &x[3 * tv[1]], *p2 = &x[3 * tv[2]];
+    wb_real lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = p0[a], hi[a] = p0[a];
+        lo[a] = p1[a] < lo[a] ? p1[a] : lo[a];
+        hi[a] = p1[a] > hi[a] ? p1[a] : hi[a];
+        lo[a] = p2[a] < lo[a] ? p2[a] : lo[a];
+        hi[a] = p2[a] > hi[a] ? p2[a] : hi[a];
+    }
+    wb_real mv = mvp[tv[0]] > 0 ? mvp[tv[0]] : 0;
+    mv = mvp[tv[1]] > mv ? mvp[tv[1]] : mv;
+    mv = mvp[tv[2]] > mv ? mvp[tv[2]] : mv;
+    const wb_real e = max_(hi[0] - lo[0], max_(hi[1] - lo[1], hi[2] - lo[2])) + 2 * mv;
+    if (!isfinite(e)) return NAN;
+    if (skin) mv += max_(skin[tv[0]], max_(skin[tv[1]], skin[tv[2]]));
+    for (int a = 0; a < 3; a++) tb[a] = lo[a], tb[3 + a] = hi[a];
+    tb[6] = mv;
+    return e;
+}
+
+/* the unit normal (0 when degenerate): a point farther than its reach from the plane is
+ * farther from the triangle */
+static void tri_normal(const wb_model *m, const wb_real *x, int32_t t, wb_real *n)
+{
+    const int32_t *tv = &m->tri[3 * t];
+    wb_real e1[3], e2[3];
+    v3_sub(e1, &x[3 * tv[1]], &x[3 * tv[0]]);
+    v3_sub(e2, &x[3 * tv[2]], &x[3 * tv[0]]);
+    v3_cross(n, e1, e2);
+    const wb_real ln = v3_len(n);
+    if (ln > 0 && isfinite(ln)) v3_scale(n, n, 1 / ln);
+    else v3_set(n, 0, 0, 0);
+}
+
+/* the pairs of points of reach `reach` and triangles of motions mvp (+ skin) into b->pt2
+ * by point, each point's by triangle (*total); *ext: the triangles' extents summed, *nt
+ * how many. -1 when out of memory */
+static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, const wb_real *mvp, const wb_real *skin,
+                  int64_t *total, wb_real *ext, int32_t *ntri)
 {
     wb_model *m = &w->m;
-    wb_tricontacts *c = &w->k.tc;
-    if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
-    struct wb_tribroad *b = c->bp;
-    const wb_real *x = w->s.x, *v = w->s.v;
-    if (!grow((void **)&b->reach, &b->cap_reach, m->np, sizeof *b->reach) ||
-        !grow((void **)&b->mv, &b->cap_mv, m->np, sizeof *b->mv) ||
-        !grow((void **)&b->tbox, &b->cap_tbox, TB * (int64_t)m->ntri, sizeof *b->tbox) ||
+    const wb_real *x = w->s.x;
+    *total = 0;
+    if (!grow((void **)&b->tbox, &b->cap_tbox, TB * (int64_t)m->ntri, sizeof *b->tbox) ||
         !grow((void **)&b->tkey, &b->cap_tkey, m->ntri, sizeof *b->tkey) ||
         !grow((void **)&b->pc, &b->cap_pc, m->np, sizeof *b->pc) ||
         !grow((void **)&b->tc, &b->cap_tc, m->ntri, sizeof *b->tc))
         return -1;
-    wb_real *reach = b->reach, *mvp = b->mv, *tbox = b->tbox;
-    /* how far a particle may get this frame (velocity and gravity over dt, and a quarter
-     * of its radius for what the constraints move it, as contact.c); a point's reach
-     * adds its radius */
-    const wb_real dt = m->def.dt, g = v3_len(m->def.gravity) * dt * dt;
-    int32_t na = 0, nr = 0;
-    wb_real rmax = 0, rsum = 0, ext = 0;
+    /* a zero reach or a position not finite meets no triangle (the exact test fails) */
+    int32_t na = 0;
+    wb_real rmax = 0;
     for (int32_t i = 0; i < m->np; i++) {
-        mvp[i] = v3_len_safe(&v[3 * i]) * dt + g + m->radius[i] / 4;
-        reach[i] = (m->cflags[i] & (WB_CF_COLLIDE | WB_CF_SELF)) ? m->radius[i] + mvp[i] : -1;
-        if (!isfinite(reach[i])) reach[i] = -1;
-        if (reach[i] >= 0) nr++, rsum += reach[i];
-        /* a zero reach or a position not finite meets no triangle (the exact test fails) */
         const wb_real *p = &x[3 * i];
         if (reach[i] > 0 && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])) {
             b->pc[na++] = i;
             if (reach[i] > rmax) rmax = reach[i];
         }
     }
-    /* triangles: box, motion (-1: left out); and the body no point of which may touch it
-     * (its corners' body when it does not self-collide; else 0) */
+    /* triangles: box, motion; and the body no point of which may touch it (its corners'
+     * body when it does not self-collide; else 0) */
     int32_t nt = 0;
+    wb_real sum = 0;
     for (int32_t t = 0; t < m->ntri; t++) {
+        const wb_real e = tri_box(m, x, mvp, skin, t, &b->tbox[TB * t]);
+        if (e != e) continue;
         const int32_t *tv = &m->tri[3 * t];
-        wb_real *tb = &tbox[TB * t];
-        tb[6] = -1;
-        const uint8_t f0 = m->cflags[tv[0]], f1 = m->cflags[tv[1]], f2 = m->cflags[tv[2]];
-        if (!((f0 | f1 | f2) & (WB_CF_COLLIDE | WB_CF_SELF))) continue;
         const int32_t g0 = m->group[tv[0]];
-        b->tkey[t] = g0 > 0 && m->group[tv[1]] == g0 && m->group[tv[2]] == g0 && !(f0 & f1 & f2 & WB_CF_SELF) ? g0 : 0;
-        /* the corners' box in locals (tb may alias nothing, the compiler cannot know) */
-        const wb_real *p0 = &x[3 * tv[0]], *p1 = &x[3 * tv[1]], *p2 = &x[3 * tv[2]];
-        wb_real lo[3], hi[3];
-        for (int a = 0; a < 3; a++) {
-            lo[a] = p0[a], hi[a] = p0[a];
-            lo[a] = p1[a] < lo[a] ? p1[a] : lo[a];
-            hi[a] = p1[a] > hi[a] ? p1[a] : hi[a];
-            lo[a] = p2[a] < lo[a] ? p2[a] : lo[a];
-            hi[a] = p2[a] > hi[a] ? p2[a] : hi[a];
-        }
-        wb_real mv = mvp[tv[0]] > 0 ? mvp[tv[0]] : 0;
-        mv = mvp[tv[1]] > mv ? mvp[tv[1]] : mv;
-        mv = mvp[tv[2]] > mv ? mvp[tv[2]] : mv;
-        const wb_real e = max_(hi[0] - lo[0], max_(hi[1] - lo[1], hi[2] - lo[2])) + 2 * mv;
-        if (!isfinite(e)) continue;
-        for (int a = 0; a < 3; a++) tb[a] = lo[a], tb[3 + a] = hi[a];
-        tb[6] = mv;
+        b->tkey[t] = g0 > 0 && m->group[tv[1]] == g0 && m->group[tv[2]] == g0 &&
+                     !(m->cflags[tv[0]] & m->cflags[tv[1]] & m->cflags[tv[2]] & WB_CF_SELF) ? g0 : 0;
         b->tc[nt++] = t;
-        ext += e;
+        sum += e;
     }
+    *ext = sum;
+    *ntri = nt;
     if (na == 0 || nt == 0) return 0;
-    /* the cell of the order (see order_as_grid) */
-    const wb_real ocell = max_(ext / nt, 2 * rsum / nr);
+    b->sr = reach;
     if (cull(b, w, &na, &nt, rmax) < 0) return -1;
     if (na == 0 || nt == 0) return 0;
-    /* the kept triangles' unit normals (0 when degenerate): a point farther than its
-     * reach from the plane is farther from the triangle */
-    for (int32_t k = 0; k < nt; k++) {
-        const int32_t *tv = &m->tri[3 * b->tc[k]];
-        wb_real *n = &tbox[TB * b->tc[k] + 7], e1[3], e2[3];
-        v3_sub(e1, &x[3 * tv[1]], &x[3 * tv[0]]);
-        v3_sub(e2, &x[3 * tv[2]], &x[3 * tv[0]]);
-        v3_cross(n, e1, e2);
-        const wb_real ln = v3_len(n);
-        if (ln > 0 && isfinite(ln)) v3_scale(n, n, 1 / ln);
-        else v3_set(n, 0, 0, 0);
-        if (ocell > 0 && isfinite(ocell)) {
-            wb_real *tb = &tbox[TB * b->tc[k]];
-            int64_t c0[3];
-            tb[13] = ocells(tb, tb + 3, tb[6], 1 / ocell, c0);
-            for (int a = 0; a < 3; a++) tb[10 + a] = (wb_real)c0[a]; /* |c| <= 1e15: exact */
-        }
-    }
+    for (int32_t k = 0; k < nt; k++) tri_normal(m, x, b->tc[k], &b->tbox[TB * b->tc[k] + 7]);
     if (make_levels(b, w, na) < 0) return -1;
 
     /* contiguous ranges of the kept triangles, one pair buffer each */
@@ -673,18 +664,16 @@ static int broadphase(wb_world *w)
         tri_job j = { b, w, nt };
         wb__pool_run(wb__world_pool(w), tri_part, &j); /* nth parts: nth == the pool's threads */
     }
-    int64_t total = 0;
+    int64_t n = 0;
     for (int k = 0; k < nth; k++) {
         if (b->out[k].fail) return -1;
-        total += b->out[k].n;
+        n += b->out[k].n;
     }
-    if (!grow((void **)&c->pt, &c->cap, 2 * total, sizeof *c->pt) ||
-        !grow((void **)&b->pt2, &b->cap_pt2, 2 * total, sizeof *b->pt2) ||
+    if (!grow((void **)&b->pt2, &b->cap_pt2, 2 * n, sizeof *b->pt2) ||
         !grow((void **)&b->first, &b->cap_first, (int64_t)m->np + 1, sizeof *b->first))
         return -1;
-    /* by point first (stable: a thread's pairs of one point come in ascending triangle
-     * order, the threads' ranges ascend), then in the order of the hashed grid this
-     * replaced (order_as_grid) */
+    /* by point (stable: a thread's pairs of one point come in ascending triangle order,
+     * the threads' ranges ascend) */
     int32_t *first = b->first, *by_p = b->pt2;
     memset(first, 0, sizeof *first * ((size_t)m->np + 1));
     for (int k = 0; k < nth; k++)
@@ -696,9 +685,215 @@ static int broadphase(wb_world *w)
             by_p[2 * at] = b->out[k].ij[2 * q];
             by_p[2 * at + 1] = b->out[k].ij[2 * q + 1];
         }
+    *total = n;
+    return 0;
+}
+
+/* b->pt2 (total pairs by point) into c->pt in the projection's order; the order's cell is
+ * the larger of the mean extent of the nt triangles (ext summed) and of the points'
+ * reaches (twice rsum over nr) */
+static int finish(struct wb_tribroad *b, wb_world *w, int64_t total, wb_real ext, int32_t nt, wb_real rsum,
+                  int32_t nr)
+{
+    wb_tricontacts *c = &w->k.tc;
+    if (!grow((void **)&c->pt, &c->cap, 2 * total, sizeof *c->pt)) return -1;
+    const wb_real ocell = max_(ext / nt, 2 * rsum / nr);
+    if (ocell > 0 && isfinite(ocell))
+        for (int64_t q = 0; q < total; q++) { /* each pair's triangle: its first order cell, whether big */
+            wb_real *tb = &b->tbox[TB * b->pt2[2 * q + 1]];
+            int64_t c0[3];
+            tb[13] = ocells(tb, tb + 3, tb[6], 1 / ocell, c0);
+            for (int a = 0; a < 3; a++) tb[10 + a] = (wb_real)c0[a]; /* |c| <= 1e15: exact */
+        }
     if (!order_as_grid(b, w, ocell, total, c->pt)) return -1;
     c->n = (int32_t)total;
     return 0;
+}
+
+/* ---- the list kept from frame to frame ------------------------------------------------------------ */
+/* As broadphase.c's kept list (Verlet lists with a skin): the pairs found with each point's
+ * reach grown by its skin s_i (a quarter of radius + motion) and each triangle's motion
+ * by the most skin of its corners, at positions X, hold every candidate of a later frame
+ * while each particle stays within s_i / 2 of X_i and its motion grows by at most s_i / 2
+ * (the distance from p to t then changes by at most (s_p + max s_c) / 2 ... the grown
+ * reaches cover that with room to spare). The search for the kept list skips the plane
+ * test (its normal is not the frame's), the other tests are monotone in the reaches.
+ * The list is rebuilt when either fails (a thousandth spared for round-off; a skin far
+ * above the coordinates' ulps), when a position or motion is not finite, or when
+ * anything the rules read (triangles, flags, groups, radii, rest positions, inverse
+ * masses) differs from the build's copy; else each kept pair is tested exactly as the
+ * search does, in the kept (point, triangle) order: the same list as a fresh search. */
+#ifndef SKIN
+#define SKIN 0.25
+#endif
+
+/* the arrays the rules read, one after the other: copied into b->kmodel (store), or
+ * compared with it */
+static int model_same(struct wb_tribroad *b, const wb_model *m, int store)
+{
+    const struct { const void *p; size_t n; } a[] = {
+        { m->tri, sizeof *m->tri * 3 * (size_t)m->ntri }, { m->cflags, sizeof *m->cflags * (size_t)m->np },
+        { m->group, sizeof *m->group * (size_t)m->np },   { m->radius, sizeof *m->radius * (size_t)m->np },
+        { m->w, sizeof *m->w * (size_t)m->np },           { m->x0, sizeof *m->x0 * 3 * (size_t)m->np },
+    };
+    size_t at = 0;
+    for (size_t k = 0; k < sizeof a / sizeof a[0]; k++) at += a[k].n;
+    if (store) {
+        if (at > INT32_MAX / 2 || !grow((void **)&b->kmodel, &b->cap_kmodel, (int64_t)at, 1)) return 0;
+        b->kbytes = (int64_t)at;
+    } else if (b->kbytes != (int64_t)at)
+        return 0;
+    at = 0;
+    for (size_t k = 0; k < sizeof a / sizeof a[0]; k++) {
+        if (a[k].n == 0) continue;
+        if (store) memcpy(b->kmodel + at, a[k].p, a[k].n);
+        else if (memcmp(b->kmodel + at, a[k].p, a[k].n)) return 0;
+        at += a[k].n;
+    }
+    return 1;
+}
+
+/* a new kept list at these positions and motions (b->reach, b->mv); 0 when it cannot be
+ * kept (some skin too thin for round-off), -1 when out of memory */
+static int kept_build(struct wb_tribroad *b, wb_world *w)
+{
+    const wb_model *m = &w->m;
+    const wb_real *x = w->s.x;
+    b->kvalid = 0;
+    if (!grow((void **)&b->kx, &b->cap_kx, 3 * (int64_t)m->np, sizeof *b->kx) ||
+        !grow((void **)&b->kmv, &b->cap_kmv, 2 * (int64_t)m->np, sizeof *b->kmv) ||
+        !grow((void **)&b->kreach, &b->cap_kreach, 2 * (int64_t)m->np, sizeof *b->kreach))
+        return -1;
+    /* kmv: the motion, then the skin; kreach: the reach grown by the skin, then the reach */
+    wb_real *skin = b->kmv + m->np;
+    int ok = 1;
+    for (int32_t i = 0; i < m->np; i++) {
+        const wb_real *p = &x[3 * i], s = (wb_real)SKIN * (m->radius[i] + b->mv[i]);
+        const wb_real mag = fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + m->radius[i] + b->mv[i];
+        ok &= s > (wb_real)1e-9 * mag;
+        b->kmv[i] = b->mv[i];
+        skin[i] = s;
+        b->kreach[i] = b->reach[i] > 0 ? b->reach[i] + s : b->reach[i];
+        b->kreach[m->np + i] = b->reach[i];
+    }
+    if (!ok) return 0;
+    memcpy(b->kx, x, sizeof *x * 3 * (size_t)m->np);
+    if (!model_same(b, m, 1) || !grow((void **)&b->tstamp, &b->cap_tstamp, m->ntri, sizeof *b->tstamp)) return -1;
+    memset(b->tstamp, 0, sizeof *b->tstamp * (size_t)m->ntri); /* no record of this frame yet */
+    b->stamp = 0;
+    int64_t total;
+    wb_real ext;
+    int32_t nt;
+    b->building = 1;
+    const int r = search(b, w, b->kreach, b->kmv, skin, &total, &ext, &nt);
+    b->building = 0;
+    if (r < 0) return -1;
+    if (!grow((void **)&b->kpt, &b->cap_kpt, 2 * total, sizeof *b->kpt)) return -1;
+    if (total > 0) memcpy(b->kpt, b->pt2, sizeof *b->kpt * (size_t)(2 * total));
+    b->kn = total;
+    b->knp = m->np;
+    b->knt = m->ntri;
+    b->kvalid = 1;
+    b->rebuilds++;
+    return 1;
+}
+
+/* whether the kept list holds this frame (b->reach, b->mv) */
+static int kept_holds(struct wb_tribroad *b, const wb_world *w)
+{
+    const wb_model *m = &w->m;
+    if (!b->kvalid || b->knp != m->np || b->knt != m->ntri || !model_same(b, m, 0)) return 0;
+    const wb_real *x = w->s.x, *X = b->kx, *mv0 = b->kmv, *skin = b->kmv + m->np, *r0 = b->kreach + m->np;
+    int ok = 1;
+    for (int32_t i = 0; i < m->np; i++) {
+        const wb_real *p = &x[3 * i];
+        const wb_real d0 = p[0] - X[3 * i], d1 = p[1] - X[3 * i + 1], d2 = p[2] - X[3 * i + 2];
+        const wb_real room = skin[i] * (wb_real)0.4995;
+        /* the same points (a reach > 0 then and now), moved and sped up within the skin */
+        ok &= (d0 * d0 + d1 * d1 + d2 * d2 <= room * room) & (b->mv[i] <= mv0[i] + room) &
+              ((b->reach[i] > 0) == (r0[i] > 0));
+    }
+    return ok;
+}
+
+/* the kept pairs that are candidates this frame into b->pt2 (by point, as the search's) */
+static int kept_filter(struct wb_tribroad *b, wb_world *w, int64_t *total)
+{
+    const wb_model *m = &w->m;
+    const wb_real *x = w->s.x;
+    if (!grow((void **)&b->pt2, &b->cap_pt2, 2 * b->kn, sizeof *b->pt2)) return -1;
+    if (++b->stamp == 0) { /* wrapped: every record stale */
+        memset(b->tstamp, 0, sizeof *b->tstamp * (size_t)m->ntri);
+        b->stamp = 1;
+    }
+    int64_t n = 0;
+    for (int64_t q = 0; q < b->kn; q++) {
+        const int32_t p = b->kpt[2 * q], t = b->kpt[2 * q + 1];
+        wb_real *tb = &b->tbox[TB * t];
+        if (b->tstamp[t] != b->stamp) { /* its record of this frame, once */
+            b->tstamp[t] = b->stamp;
+            tri_box(m, x, b->mv, NULL, t, tb);
+            if (tb[6] >= 0) tri_normal(m, x, t, tb + 7);
+        }
+        if (!(b->reach[p] > 0) || !(tb[6] >= 0) || !candidate(w, tb, t, p, b->reach[p], 1)) continue;
+        b->pt2[2 * n] = p;
+        b->pt2[2 * n + 1] = t;
+        n++;
+    }
+    *total = n;
+    return 0;
+}
+
+static int broadphase(wb_world *w)
+{
+    wb_model *m = &w->m;
+    wb_tricontacts *c = &w->k.tc;
+    if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
+    struct wb_tribroad *b = c->bp;
+    const wb_real *x = w->s.x, *v = w->s.v;
+    if (!grow((void **)&b->reach, &b->cap_reach, m->np, sizeof *b->reach) ||
+        !grow((void **)&b->mv, &b->cap_mv, m->np, sizeof *b->mv) ||
+        !grow((void **)&b->tbox, &b->cap_tbox, TB * (int64_t)m->ntri, sizeof *b->tbox))
+        return -1;
+    wb_real *reach = b->reach, *mvp = b->mv;
+    /* how far a particle may get this frame (velocity and gravity over dt, and a quarter
+     * of its radius for what the constraints move it, as contact.c); a point's reach
+     * adds its radius */
+    const wb_real dt = m->def.dt, g = v3_len(m->def.gravity) * dt * dt;
+    int32_t nr = 0;
+    wb_real rsum = 0;
+    int finite = 1;
+    for (int32_t i = 0; i < m->np; i++) {
+        mvp[i] = v3_len_safe(&v[3 * i]) * dt + g + m->radius[i] / 4;
+        reach[i] = (m->cflags[i] & (WB_CF_COLLIDE | WB_CF_SELF)) ? m->radius[i] + mvp[i] : -1;
+        if (!isfinite(reach[i])) reach[i] = -1;
+        if (reach[i] >= 0) nr++, rsum += reach[i];
+        const wb_real *p = &x[3 * i];
+        finite &= isfinite(p[0] + p[1] + p[2] + mvp[i]);
+    }
+    int64_t total;
+    wb_real ext;
+    int32_t nt;
+    if (finite && !b->fresh_only) {
+        if (!kept_holds(b, w)) {
+            const int r = kept_build(b, w);
+            if (r < 0) return -1;
+            if (r == 0) goto fresh;
+        }
+        if (kept_filter(b, w, &total) < 0) return -1;
+        if (total == 0) return 0;
+        /* the order's cell: every triangle's extent, summed as the search does */
+        ext = 0, nt = 0;
+        for (int32_t t = 0; t < m->ntri; t++) {
+            const wb_real e = tri_box(m, x, mvp, NULL, t, &b->tbox[TB * t]);
+            if (e == e) ext += e, nt++;
+        }
+        return finish(b, w, total, ext, nt, rsum, nr);
+    }
+fresh: /* the kept list, if any, stays: it holds or not by the positions alone */
+    if (search(b, w, reach, mvp, NULL, &total, &ext, &nt) < 0) return -1;
+    if (total == 0) return 0;
+    return finish(b, w, total, ext, nt, rsum, nr);
 }
 
 void wb__tricontacts_begin(wb_world *w)
@@ -716,6 +911,7 @@ void wb__tricontacts_begin(wb_world *w)
     const double t0 = now_ms();
     if (broadphase(w) < 0) {
         c->n = 0;
+        if (c->bp) c->bp->kvalid = 0;
         wb__warn(w, "out of memory in the triangle contact broad phase; triangle contacts skipped");
     }
     c->broad_ms = now_ms() - t0;

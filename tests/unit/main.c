@@ -61,7 +61,9 @@
 #define TRIBROAD_TESTS(X)                                \
     X(tribroad_matches_brute_force_heap)                 \
     X(tribroad_matches_brute_force_cloth)                \
-    X(tribroad_matches_brute_force_sparse)
+    X(tribroad_matches_brute_force_sparse)               \
+    X(tribroad_kept_list_matches_fresh_search_over_frames) \
+    X(tribroad_kept_list_same_steps_as_fresh_search)
 
 /* test_narrow.c: rigid shapes' contact manifolds */
 #define NARROW_TESTS(X)                                  \
