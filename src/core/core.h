@@ -310,15 +310,12 @@ struct wb_tribroad {
     int32_t *pt2; int32_t cap_pt2;       /* (2 x candidates) the list sorted by point */
     uint64_t *okey; int32_t cap_okey;    /* (candidates) sort keys of the projection's order */
     const wb_real *sr;                   /* the reaches the search runs with */
-    int building;                        /* the search is the kept list's */
-    /* the kept list: positions, motions then skins, grown reaches then reaches it was built
-     * with; a copy of what the rules read; its pairs; per triangle the frame its record is of */
-    wb_real *kx, *kmv, *kreach; int32_t cap_kx, cap_kmv, cap_kreach;
+    /* the quick answer's triangle runs (key, first, end corner), their corners, how many
+     * (-1: too many); a copy of what they depend on (triangles, flags, groups) */
+    int32_t *qrun, *qcorner; int32_t cap_qrun, cap_qcorner, nq;
     uint8_t *kmodel; int32_t cap_kmodel; int64_t kbytes;
-    int32_t *kpt; int32_t cap_kpt; int64_t kn;
-    uint32_t *tstamp; int32_t cap_tstamp; uint32_t stamp;
     int32_t knp, knt;
-    int kvalid, fresh_only;              /* fresh_only: never keep (the tests' reference) */
+    int qvalid, fresh_only;              /* fresh_only: the search every frame (the tests' reference) */
     int64_t rebuilds;                    /* for the tests */
 };
 static inline void wb__tribroad_free(wb_tricontacts *c)
@@ -327,7 +324,7 @@ static inline void wb__tribroad_free(wb_tricontacts *c)
     if (!b) return;
     void *p[] = { b->reach, b->mv, b->tbox, b->tkey, b->pc, b->tc, b->prun, b->trun, b->tmp, b->runs, b->boxes,
                   b->sp, b->sid, b->skey, b->scell, b->start, b->first, b->pt2, b->okey,
-                  b->kx, b->kmv, b->kreach, b->kmodel, b->kpt, b->tstamp };
+                  b->qrun, b->qcorner, b->kmodel };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
     free(b->out);

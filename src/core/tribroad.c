@@ -31,6 +31,8 @@
  *     in the projection's order (order_as_grid), a function of the positions: the list
  *     is the same for any thread count. */
 #include <time.h>
+#include <stdio.h>
+#include <stdlib.h>
 
 #include "core.h"
 
@@ -105,9 +107,8 @@ static wb_real box_dist2(const wb_real p[3], const wb_real lo[3], const wb_real 
     return s;
 }
 
-/* the candidate test itself: point p (reach rp > 0) against triangle t (its record tb);
- * the kept list's search leaves out the plane (plane 0) */
-static int candidate(const wb_world *w, const wb_real *tb, int32_t t, int32_t p, wb_real rp, int plane)
+/* the candidate test itself: point p (reach rp > 0) against triangle t (its record tb) */
+static int candidate(const wb_world *w, const wb_real *tb, int32_t t, int32_t p, wb_real rp)
 {
     const wb_model *m = &w->m;
     const wb_real *x = w->s.x, reach = rp + tb[6];
@@ -119,7 +120,7 @@ static int candidate(const wb_world *w, const wb_real *tb, int32_t t, int32_t p,
     if (!rules_allow(m, p, v, &same)) return 0;
     wb_real d[3];
     v3_sub(d, &x[3 * p], &x[3 * v[0]]);
-    if (plane && !(fabs(v3_dot(d, tb + 7)) < reach)) return 0;
+    if (!(fabs(v3_dot(d, tb + 7)) < reach)) return 0;
     wb_real bary[3], q[3];
     if (!(wb__tri_closest(&x[3 * p], &x[3 * v[0]], &x[3 * v[1]], &x[3 * v[2]], bary, q) < reach * reach)) return 0;
     return !(same && !rest_apart(m, p, v));
@@ -382,7 +383,7 @@ static void tri_try(const struct wb_tribroad *b, const wb_world *w, const wb_rea
             (p[1] < lo[1] && lo[1] - p[1] >= rp) || (p[1] > hi[1] && p[1] - hi[1] >= rp) ||
             (p[2] < lo[2] && lo[2] - p[2] >= rp) || (p[2] > hi[2] && p[2] - hi[2] >= rp))
             continue;
-        if (candidate(w, tb, t, b->sid[s], rp, !b->building)) push(o, b->sid[s], t);
+        if (candidate(w, tb, t, b->sid[s], rp)) push(o, b->sid[s], t);
     }
 }
 
@@ -557,12 +558,10 @@ static void tri_part(void *ctx, int k, int nth)
              &j->b->out[k]);
 }
 
-/* triangle t's record from the motions mv (and, for the kept list's search, the most
- * skin of its corners on top of its motion; NULL: none): box, motion; -1 in tb[6] when
- * left out (no corner may collide, or not finite). Returns the extent that sizes the
- * order's cell (NAN when left out) */
-static wb_real tri_box(const wb_model *m, const wb_real *x, const wb_real *mvp, const wb_real *skin, int32_t t,
-                       wb_real *tb)
+/* triangle t's record from the motions mvp: box, motion; -1 in tb[6] when left out (no
+ * corner may collide, or not finite). Returns the extent that sizes the order's cell
+ * (NAN when left out) */
+static wb_real tri_box(const wb_model *m, const wb_real *x, const wb_real *mvp, int32_t t, wb_real *tb)
 {
     const int32_t *tv = &m->tri[3 * t];
     tb[6] = -1;
@@ -582,7 +581,6 @@ static wb_real tri_box(const wb_model *m, const wb_real *x, const wb_real *mvp, 
     mv = mvp[tv[2]] > mv ? mvp[tv[2]] : mv;
     const wb_real e = max_(hi[0] - lo[0], max_(hi[1] - lo[1], hi[2] - lo[2])) + 2 * mv;
     if (!isfinite(e)) return NAN;
-    if (skin) mv += max_(skin[tv[0]], max_(skin[tv[1]], skin[tv[2]]));
     for (int a = 0; a < 3; a++) tb[a] = lo[a], tb[3 + a] = hi[a];
     tb[6] = mv;
     return e;
@@ -602,10 +600,10 @@ static void tri_normal(const wb_model *m, const wb_real *x, int32_t t, wb_real *
     else v3_set(n, 0, 0, 0);
 }
 
-/* the pairs of points of reach `reach` and triangles of motions mvp (+ skin) into b->pt2
+/* the pairs of points of reach `reach` and triangles of motions mvp into b->pt2
  * by point, each point's by triangle (*total); *ext: the triangles' extents summed, *nt
  * how many. -1 when out of memory */
-static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, const wb_real *mvp, const wb_real *skin,
+static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, const wb_real *mvp,
                   int64_t *total, wb_real *ext, int32_t *ntri)
 {
     wb_model *m = &w->m;
@@ -631,7 +629,7 @@ static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, cons
     int32_t nt = 0;
     wb_real sum = 0;
     for (int32_t t = 0; t < m->ntri; t++) {
-        const wb_real e = tri_box(m, x, mvp, skin, t, &b->tbox[TB * t]);
+        const wb_real e = tri_box(m, x, mvp, t, &b->tbox[TB * t]);
         if (e != e) continue;
         const int32_t *tv = &m->tri[3 * t];
         const int32_t g0 = m->group[tv[0]];
@@ -710,38 +708,35 @@ static int finish(struct wb_tribroad *b, wb_world *w, int64_t total, wb_real ext
     return 0;
 }
 
-/* ---- the list kept from frame to frame ------------------------------------------------------------ */
-/* As broadphase.c's kept list (Verlet lists with a skin): the pairs found with each point's
- * reach grown by its skin s_i (a quarter of radius + motion) and each triangle's motion
- * by the most skin of its corners, at positions X, hold every candidate of a later frame
- * while each particle stays within s_i / 2 of X_i and its motion grows by at most s_i / 2
- * (the distance from p to t then changes by at most (s_p + max s_c) / 2 ... the grown
- * reaches cover that with room to spare). The search for the kept list skips the plane
- * test (its normal is not the frame's), the other tests are monotone in the reaches.
- * The list is rebuilt when either fails (a thousandth spared for round-off; a skin far
- * above the coordinates' ulps), when a position or motion is not finite, or when
- * anything the rules read (triangles, flags, groups, radii, rest positions, inverse
- * masses) differs from the build's copy; else each kept pair is tested exactly as the
- * search does, in the kept (point, triangle) order: the same list as a fresh search. */
-#ifndef SKIN
-#define SKIN 0.25
-#endif
+/* ---- the quick answer: no candidate this frame ------------------------------------------------- */
+/* In a resting heap every frame's list is empty, yet the search computes the box of every
+ * triangle to find that out. The body culling's runs of triangles are fixed by the
+ * topology, flags and groups alone; each run's box (the union of its triangles' boxes
+ * grown by their motions) lies inside the box of its corners grown by their largest
+ * motion. So the runs are kept between frames with their corners (rebuilt when anything
+ * they depend on changes), their boxes come from the corners (about half the particles,
+ * once each, instead of 9 coordinates per triangle), and the points are culled against
+ * them as in pass 1: when no point is left, no pair can pass the exact test and the
+ * list is empty, as the search would find (the larger boxes only keep more). Else the
+ * search runs as before: the list is the search's either way. */
 
-/* the arrays the rules read, one after the other: copied into b->kmodel (store), or
- * compared with it */
+/* the arrays the runs depend on (triangles, flags, groups), one after the other: copied
+ * into b->kmodel (store), or compared with it */
 static int model_same(struct wb_tribroad *b, const wb_model *m, int store)
 {
     const struct { const void *p; size_t n; } a[] = {
-        { m->tri, sizeof *m->tri * 3 * (size_t)m->ntri }, { m->cflags, sizeof *m->cflags * (size_t)m->np },
-        { m->group, sizeof *m->group * (size_t)m->np },   { m->radius, sizeof *m->radius * (size_t)m->np },
-        { m->w, sizeof *m->w * (size_t)m->np },           { m->x0, sizeof *m->x0 * 3 * (size_t)m->np },
+        { m->tri, sizeof *m->tri * 3 * (size_t)m->ntri },
+        { m->cflags, sizeof *m->cflags * (size_t)m->np },
+        { m->group, sizeof *m->group * (size_t)m->np },
     };
     size_t at = 0;
     for (size_t k = 0; k < sizeof a / sizeof a[0]; k++) at += a[k].n;
     if (store) {
         if (at > INT32_MAX / 2 || !grow((void **)&b->kmodel, &b->cap_kmodel, (int64_t)at, 1)) return 0;
         b->kbytes = (int64_t)at;
-    } else if (b->kbytes != (int64_t)at)
+        b->knp = m->np;
+        b->knt = m->ntri;
+    } else if (b->kbytes != (int64_t)at || b->knp != m->np || b->knt != m->ntri)
         return 0;
     at = 0;
     for (size_t k = 0; k < sizeof a / sizeof a[0]; k++) {
@@ -753,95 +748,106 @@ static int model_same(struct wb_tribroad *b, const wb_model *m, int store)
     return 1;
 }
 
-/* a new kept list at these positions and motions (b->reach, b->mv); 0 when it cannot be
- * kept (some skin too thin for round-off), -1 when out of memory */
-static int kept_build(struct wb_tribroad *b, wb_world *w)
+static int cmp_i32(const void *a, const void *b)
 {
-    const wb_model *m = &w->m;
-    const wb_real *x = w->s.x;
-    b->kvalid = 0;
-    if (!grow((void **)&b->kx, &b->cap_kx, 3 * (int64_t)m->np, sizeof *b->kx) ||
-        !grow((void **)&b->kmv, &b->cap_kmv, 2 * (int64_t)m->np, sizeof *b->kmv) ||
-        !grow((void **)&b->kreach, &b->cap_kreach, 2 * (int64_t)m->np, sizeof *b->kreach))
-        return -1;
-    /* kmv: the motion, then the skin; kreach: the reach grown by the skin, then the reach */
-    wb_real *skin = b->kmv + m->np;
-    int ok = 1;
-    for (int32_t i = 0; i < m->np; i++) {
-        const wb_real *p = &x[3 * i], s = (wb_real)SKIN * (m->radius[i] + b->mv[i]);
-        const wb_real mag = fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + m->radius[i] + b->mv[i];
-        ok &= s > (wb_real)1e-9 * mag;
-        b->kmv[i] = b->mv[i];
-        skin[i] = s;
-        b->kreach[i] = b->reach[i] > 0 ? b->reach[i] + s : b->reach[i];
-        b->kreach[m->np + i] = b->reach[i];
+    const int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* the triangle runs (as make_runs forms them) and each run's corners, once each: b->qrun
+ * (key, first corner, end), b->qcorner; b->nq = -1 when too many runs. 0 when out of memory */
+static int quick_runs(struct wb_tribroad *b, const wb_model *m)
+{
+    b->qvalid = 0;
+    if (!model_same(b, m, 1) || !grow((void **)&b->tmp, &b->cap_tmp, m->ntri, sizeof *b->tmp)) return 0;
+    int32_t *rid = b->tmp, nq = 0, keyless = -1, last = -1;
+    int32_t keys[RUNS_MAX];
+    for (int32_t t = 0; t < m->ntri; t++) {
+        const int32_t *tv = &m->tri[3 * t];
+        const uint8_t f0 = m->cflags[tv[0]], f1 = m->cflags[tv[1]], f2 = m->cflags[tv[2]];
+        rid[t] = -1;
+        if (!((f0 | f1 | f2) & (WB_CF_COLLIDE | WB_CF_SELF))) continue;
+        const int32_t g0 = m->group[tv[0]];
+        const int32_t key = g0 > 0 && m->group[tv[1]] == g0 && m->group[tv[2]] == g0 && !(f0 & f1 & f2 & WB_CF_SELF) ? g0 : 0;
+        int32_t r;
+        if (key == 0 && keyless >= 0) r = keyless;
+        else if (key > 0 && last >= 0 && keys[last] == key) r = last;
+        else {
+            if (nq == RUNS_MAX) { b->nq = -1; b->qvalid = 1; return 1; }
+            r = nq++;
+            keys[r] = key;
+            if (key == 0) keyless = r;
+        }
+        if (key != 0) last = r;
+        rid[t] = r;
     }
-    if (!ok) return 0;
-    memcpy(b->kx, x, sizeof *x * 3 * (size_t)m->np);
-    if (!model_same(b, m, 1) || !grow((void **)&b->tstamp, &b->cap_tstamp, m->ntri, sizeof *b->tstamp)) return -1;
-    memset(b->tstamp, 0, sizeof *b->tstamp * (size_t)m->ntri); /* no record of this frame yet */
-    b->stamp = 0;
-    int64_t total;
-    wb_real ext;
-    int32_t nt;
-    b->building = 1;
-    const int r = search(b, w, b->kreach, b->kmv, skin, &total, &ext, &nt);
-    b->building = 0;
-    if (r < 0) return -1;
-    if (!grow((void **)&b->kpt, &b->cap_kpt, 2 * total, sizeof *b->kpt)) return -1;
-    if (total > 0) memcpy(b->kpt, b->pt2, sizeof *b->kpt * (size_t)(2 * total));
-    b->kn = total;
-    b->knp = m->np;
-    b->knt = m->ntri;
-    b->kvalid = 1;
+    /* corners by run (a counting sort), then each run's sorted and made unique */
+    if (!grow((void **)&b->qrun, &b->cap_qrun, 3 * (int64_t)nq + 3, sizeof *b->qrun) ||
+        !grow((void **)&b->qcorner, &b->cap_qcorner, 3 * (int64_t)m->ntri, sizeof *b->qcorner))
+        return 0;
+    int32_t *q = b->qrun;
+    for (int32_t r = 0; r <= nq; r++) q[3 * r + 1] = 0;
+    for (int32_t t = 0; t < m->ntri; t++)
+        if (rid[t] >= 0) q[3 * rid[t] + 4] += 3;
+    for (int32_t r = 0; r < nq; r++) q[3 * r + 4] += q[3 * r + 1], q[3 * r] = keys[r], q[3 * r + 2] = q[3 * r + 1];
+    for (int32_t t = 0; t < m->ntri; t++)
+        if (rid[t] >= 0)
+            for (int k = 0; k < 3; k++) b->qcorner[q[3 * rid[t] + 2]++] = m->tri[3 * t + k];
+    for (int32_t r = 0; r < nq; r++) {
+        int32_t *c = b->qcorner + q[3 * r + 1], n = q[3 * r + 2] - q[3 * r + 1], u = 0;
+        qsort(c, (size_t)n, sizeof *c, cmp_i32);
+        for (int32_t k = 0; k < n; k++)
+            if (k == 0 || c[k] != c[u - 1]) c[u++] = c[k];
+        q[3 * r + 2] = q[3 * r + 1] + u;
+    }
+    b->nq = nq;
+    b->qvalid = 1;
     b->rebuilds++;
     return 1;
 }
 
-/* whether the kept list holds this frame (b->reach, b->mv) */
-static int kept_holds(struct wb_tribroad *b, const wb_world *w)
+/* 1 when no point can meet a triangle this frame (the points b->pc, na, their largest
+ * reach rmax; positions and motions finite), 0 when some may, -1 when out of memory */
+static int quick_empty(struct wb_tribroad *b, wb_world *w, int32_t na, wb_real rmax)
 {
     const wb_model *m = &w->m;
-    if (!b->kvalid || b->knp != m->np || b->knt != m->ntri || !model_same(b, m, 0)) return 0;
-    const wb_real *x = w->s.x, *X = b->kx, *mv0 = b->kmv, *skin = b->kmv + m->np, *r0 = b->kreach + m->np;
-    int ok = 1;
-    for (int32_t i = 0; i < m->np; i++) {
-        const wb_real *p = &x[3 * i];
-        const wb_real d0 = p[0] - X[3 * i], d1 = p[1] - X[3 * i + 1], d2 = p[2] - X[3 * i + 2];
-        const wb_real room = skin[i] * (wb_real)0.4995;
-        /* the same points (a reach > 0 then and now), moved and sped up within the skin */
-        ok &= (d0 * d0 + d1 * d1 + d2 * d2 <= room * room) & (b->mv[i] <= mv0[i] + room) &
-              ((b->reach[i] > 0) == (r0[i] > 0));
+    const wb_real *x = w->s.x, *mvp = b->mv;
+    if (!b->qvalid || !model_same(b, m, 0)) {
+        if (!quick_runs(b, m)) return -1;
     }
-    return ok;
-}
-
-/* the kept pairs that are candidates this frame into b->pt2 (by point, as the search's) */
-static int kept_filter(struct wb_tribroad *b, wb_world *w, int64_t *total)
-{
-    const wb_model *m = &w->m;
-    const wb_real *x = w->s.x;
-    if (!grow((void **)&b->pt2, &b->cap_pt2, 2 * b->kn, sizeof *b->pt2)) return -1;
-    if (++b->stamp == 0) { /* wrapped: every record stale */
-        memset(b->tstamp, 0, sizeof *b->tstamp * (size_t)m->ntri);
-        b->stamp = 1;
-    }
-    int64_t n = 0;
-    for (int64_t q = 0; q < b->kn; q++) {
-        const int32_t p = b->kpt[2 * q], t = b->kpt[2 * q + 1];
-        wb_real *tb = &b->tbox[TB * t];
-        if (b->tstamp[t] != b->stamp) { /* its record of this frame, once */
-            b->tstamp[t] = b->stamp;
-            tri_box(m, x, b->mv, NULL, t, tb);
-            if (tb[6] >= 0) tri_normal(m, x, t, tb + 7);
+    if (b->nq < 0) return 0;
+    if (na == 0 || b->nq == 0) return 1;
+    if (!grow((void **)&b->prun, &b->cap_prun, na, sizeof *b->prun)) return -1;
+    const wb_real eps = 1e-14 * rmax;
+    const int32_t npr = make_runs(b, 0, b->pc, na, 0, w, b->prun, eps);
+    if (npr == -2) return -1;
+    if (npr < 0) return 0;
+    if (!grow((void **)&b->runs, &b->cap_runs, npr + b->nq, sizeof *b->runs)) return -1;
+    for (int32_t r = 0; r < b->nq; r++) { /* the corners' box grown by their largest motion */
+        const int32_t *q = &b->qrun[3 * r];
+        run *R = &b->runs[npr + r];
+        wb_real lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY }, mv = 0;
+        for (int32_t k = q[1]; k < q[2]; k++) {
+            const int32_t i = b->qcorner[k];
+            const wb_real *p = &x[3 * i];
+            for (int a = 0; a < 3; a++) {
+                lo[a] = p[a] < lo[a] ? p[a] : lo[a];
+                hi[a] = p[a] > hi[a] ? p[a] : hi[a];
+            }
+            mv = mvp[i] > mv ? mvp[i] : mv;
         }
-        if (!(b->reach[p] > 0) || !(tb[6] >= 0) || !candidate(w, tb, t, p, b->reach[p], 1)) continue;
-        b->pt2[2 * n] = p;
-        b->pt2[2 * n + 1] = t;
-        n++;
+        R->key = q[0];
+        for (int a = 0; a < 3; a++) {
+            R->lo[a] = lo[a] - mv, R->hi[a] = hi[a] + mv;
+            const wb_real e = 1e-14 * max_(fabs(R->lo[a]), fabs(R->hi[a])) + eps; /* as make_runs */
+            R->lo[a] -= e;
+            R->hi[a] += e;
+        }
     }
-    *total = n;
-    return 0;
+    int32_t nb = 0;
+    for (int32_t r = 0; r < npr; r++)
+        if (!overlaps(b, r, npr, npr + b->nq, &nb)) return -1;
+    return keep(b, b->pc, b->prun, na, 0, x) == 0;
 }
 
 static int broadphase(wb_world *w)
@@ -853,15 +859,15 @@ static int broadphase(wb_world *w)
     const wb_real *x = w->s.x, *v = w->s.v;
     if (!grow((void **)&b->reach, &b->cap_reach, m->np, sizeof *b->reach) ||
         !grow((void **)&b->mv, &b->cap_mv, m->np, sizeof *b->mv) ||
-        !grow((void **)&b->tbox, &b->cap_tbox, TB * (int64_t)m->ntri, sizeof *b->tbox))
+        !grow((void **)&b->pc, &b->cap_pc, m->np, sizeof *b->pc))
         return -1;
     wb_real *reach = b->reach, *mvp = b->mv;
     /* how far a particle may get this frame (velocity and gravity over dt, and a quarter
      * of its radius for what the constraints move it, as contact.c); a point's reach
      * adds its radius */
     const wb_real dt = m->def.dt, g = v3_len(m->def.gravity) * dt * dt;
-    int32_t nr = 0;
-    wb_real rsum = 0;
+    int32_t nr = 0, na = 0;
+    wb_real rsum = 0, rmax = 0;
     int finite = 1;
     for (int32_t i = 0; i < m->np; i++) {
         mvp[i] = v3_len_safe(&v[3 * i]) * dt + g + m->radius[i] / 4;
@@ -870,28 +876,21 @@ static int broadphase(wb_world *w)
         if (reach[i] >= 0) nr++, rsum += reach[i];
         const wb_real *p = &x[3 * i];
         finite &= isfinite(p[0] + p[1] + p[2] + mvp[i]);
+        if (reach[i] > 0) {
+            b->pc[na++] = i;
+            if (reach[i] > rmax) rmax = reach[i];
+        }
+    }
+    b->sr = reach;
+    if (finite && !b->fresh_only) {
+        const int r = quick_empty(b, w, na, rmax);
+        if (r < 0) return -1;
+        if (r) return 0;
     }
     int64_t total;
     wb_real ext;
     int32_t nt;
-    if (finite && !b->fresh_only) {
-        if (!kept_holds(b, w)) {
-            const int r = kept_build(b, w);
-            if (r < 0) return -1;
-            if (r == 0) goto fresh;
-        }
-        if (kept_filter(b, w, &total) < 0) return -1;
-        if (total == 0) return 0;
-        /* the order's cell: every triangle's extent, summed as the search does */
-        ext = 0, nt = 0;
-        for (int32_t t = 0; t < m->ntri; t++) {
-            const wb_real e = tri_box(m, x, mvp, NULL, t, &b->tbox[TB * t]);
-            if (e == e) ext += e, nt++;
-        }
-        return finish(b, w, total, ext, nt, rsum, nr);
-    }
-fresh: /* the kept list, if any, stays: it holds or not by the positions alone */
-    if (search(b, w, reach, mvp, NULL, &total, &ext, &nt) < 0) return -1;
+    if (search(b, w, reach, mvp, &total, &ext, &nt) < 0) return -1;
     if (total == 0) return 0;
     return finish(b, w, total, ext, nt, rsum, nr);
 }
@@ -911,7 +910,7 @@ void wb__tricontacts_begin(wb_world *w)
     const double t0 = now_ms();
     if (broadphase(w) < 0) {
         c->n = 0;
-        if (c->bp) c->bp->kvalid = 0;
+        if (c->bp) c->bp->qvalid = 0;
         wb__warn(w, "out of memory in the triangle contact broad phase; triangle contacts skipped");
     }
     c->broad_ms = now_ms() - t0;
