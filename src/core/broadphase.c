@@ -367,16 +367,8 @@ static int32_t broad(wb_broad *b, wb_pairbuf *o, const wb_real *x, const wb_real
     /* pass 3: contiguous ranges of the sorted array, one pair buffer each */
     const int threads = wb__pool_threads(pool);
     int nt = threads > 1 && m >= PAR_MIN ? threads : 1;
-    if (nt > b->nout) {
-        pairbuf *o = realloc(b->out, sizeof *o * (size_t)nt);
-        if (!o) return -1;
-        memset(o + b->nout, 0, sizeof *o * (size_t)(nt - b->nout));
-        b->out = o;
-        b->nout = nt;
-    }
+    if (!wb__pairbufs(&b->out, &b->nout, nt)) return -1;
     for (int t = 0; t < nt; t++) {
-        b->out[t].n = 0;
-        b->out[t].fail = 0;
         if (!grow((void **)&b->out[t].hit, &b->out[t].cap_hit, m, sizeof *b->out[t].hit)) return -1;
     }
     scan_ctx ctx = { b, &g, m, keep, ud };

@@ -230,6 +230,8 @@ typedef struct wb_pairbuf {
     int32_t *ij; int32_t n, cap; int fail;
     int32_t *hit; int32_t cap_hit;     /* broadphase.c: one particle's hits */
 } wb_pairbuf;
+/* grid.c: n pair buffers (one per thread) in *out, grown as needed, emptied; 0 when out of memory */
+int wb__pairbufs(wb_pairbuf **out, int *nout, int n);
 struct wb_broad {
     int32_t *cand; int32_t cap_cand;   /* candidates in index order, then the survivors */
     int32_t *cell; int32_t cap_cell;   /* cell of each survivor */

@@ -1,6 +1,7 @@
 /* grid.c: the shape of the sorted grids of the two broad phases (broadphase.c, tribroad.c):
  * one rule, so that both size their cells alike. */
 #include <stdlib.h>
+#include <string.h>
 
 #include "core.h"
 
@@ -76,4 +77,17 @@ void wb__grid_shape(wb_grid *g, const wb_real lo[3], const wb_real hi[3], wb_rea
     }
     for (int a = 0; a < 3; a++) { g->o[a] = lo[a]; g->nc[a] = (int64_t)dims[a]; }
     g->inv = inv;
+}
+
+int wb__pairbufs(wb_pairbuf **out, int *nout, int n)
+{
+    if (n > *nout) {
+        wb_pairbuf *o = realloc(*out, sizeof *o * (size_t)n);
+        if (!o) return 0;
+        memset(o + *nout, 0, sizeof *o * (size_t)(n - *nout));
+        *out = o;
+        *nout = n;
+    }
+    for (int k = 0; k < n; k++) (*out)[k].n = 0, (*out)[k].fail = 0;
+    return 1;
 }

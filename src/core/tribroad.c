@@ -649,14 +649,7 @@ static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, cons
 
     /* contiguous ranges of the kept triangles, one pair buffer each */
     const int nth = m->def.threads > 1 && nt >= PAR_MIN ? m->def.threads : 1;
-    if (nth > b->nout) {
-        wb_pairbuf *o = realloc(b->out, sizeof *o * (size_t)nth);
-        if (!o) return -1;
-        memset(o + b->nout, 0, sizeof *o * (size_t)(nth - b->nout));
-        b->out = o;
-        b->nout = nth;
-    }
-    for (int k = 0; k < nth; k++) { b->out[k].n = 0; b->out[k].fail = 0; }
+    if (!wb__pairbufs(&b->out, &b->nout, nth)) return -1;
     if (nth == 1) tri_scan(b, w, 0, nt, &b->out[0]);
     else {
         tri_job j = { b, w, nt };
