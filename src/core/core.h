@@ -318,6 +318,7 @@ struct wb_tribroad {
     uint8_t *kmodel; int32_t cap_kmodel; int64_t kbytes;
     int32_t knp, knt;
     int qvalid, fresh_only;              /* fresh_only: the search every frame (the tests' reference) */
+    int qback, qwait;                    /* frames the quick answer waits after it could not answer */
     int64_t rebuilds;                    /* for the tests */
 };
 static inline void wb__tribroad_free(wb_tricontacts *c)

@@ -600,11 +600,11 @@ static void tri_normal(const wb_model *m, const wb_real *x, int32_t t, wb_real *
     else v3_set(n, 0, 0, 0);
 }
 
-/* the pairs of points of reach `reach` and triangles of motions mvp into b->pt2
- * by point, each point's by triangle (*total); *ext: the triangles' extents summed, *nt
- * how many. -1 when out of memory */
-static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, const wb_real *mvp,
-                  int64_t *total, wb_real *ext, int32_t *ntri)
+/* the pairs of points of reach `reach` (rsum summed over nr) and triangles of motions mvp
+ * into b->pt2 by point, each point's by triangle (*total); *ocell: the cell of the
+ * projection's order. -1 when out of memory */
+static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, const wb_real *mvp, wb_real rsum,
+                  int32_t nr, int64_t *total, wb_real *ocell)
 {
     wb_model *m = &w->m;
     const wb_real *x = w->s.x;
@@ -638,13 +638,22 @@ static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, cons
         b->tc[nt++] = t;
         sum += e;
     }
-    *ext = sum;
-    *ntri = nt;
     if (na == 0 || nt == 0) return 0;
+    /* the cell of the order (see order_as_grid): the larger of the triangles' mean extent
+     * and twice the points' mean reach */
+    const wb_real oc = *ocell = max_(sum / nt, 2 * rsum / nr);
     b->sr = reach;
     if (cull(b, w, &na, &nt, rmax) < 0) return -1;
     if (na == 0 || nt == 0) return 0;
-    for (int32_t k = 0; k < nt; k++) tri_normal(m, x, b->tc[k], &b->tbox[TB * b->tc[k] + 7]);
+    for (int32_t k = 0; k < nt; k++) {
+        wb_real *tb = &b->tbox[TB * b->tc[k]];
+        tri_normal(m, x, b->tc[k], tb + 7);
+        if (oc > 0 && isfinite(oc)) { /* its first cell in the order, whether it is big there */
+            int64_t c0[3];
+            tb[13] = ocells(tb, tb + 3, tb[6], 1 / oc, c0);
+            for (int a = 0; a < 3; a++) tb[10 + a] = (wb_real)c0[a]; /* |c| <= 1e15: exact */
+        }
+    }
     if (make_levels(b, w, na) < 0) return -1;
 
     /* contiguous ranges of the kept triangles, one pair buffer each */
@@ -680,22 +689,11 @@ static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, cons
     return 0;
 }
 
-/* b->pt2 (total pairs by point) into c->pt in the projection's order; the order's cell is
- * the larger of the mean extent of the nt triangles (ext summed) and of the points'
- * reaches (twice rsum over nr) */
-static int finish(struct wb_tribroad *b, wb_world *w, int64_t total, wb_real ext, int32_t nt, wb_real rsum,
-                  int32_t nr)
+/* b->pt2 (total pairs by point) into c->pt in the projection's order (cell ocell) */
+static int finish(struct wb_tribroad *b, wb_world *w, int64_t total, wb_real ocell)
 {
     wb_tricontacts *c = &w->k.tc;
     if (!grow((void **)&c->pt, &c->cap, 2 * total, sizeof *c->pt)) return -1;
-    const wb_real ocell = max_(ext / nt, 2 * rsum / nr);
-    if (ocell > 0 && isfinite(ocell))
-        for (int64_t q = 0; q < total; q++) { /* each pair's triangle: its first order cell, whether big */
-            wb_real *tb = &b->tbox[TB * b->pt2[2 * q + 1]];
-            int64_t c0[3];
-            tb[13] = ocells(tb, tb + 3, tb[6], 1 / ocell, c0);
-            for (int a = 0; a < 3; a++) tb[10 + a] = (wb_real)c0[a]; /* |c| <= 1e15: exact */
-        }
     if (!order_as_grid(b, w, ocell, total, c->pt)) return -1;
     c->n = (int32_t)total;
     return 0;
@@ -875,17 +873,24 @@ static int broadphase(wb_world *w)
         }
     }
     b->sr = reach;
-    if (finite && !b->fresh_only) {
+    /* after a frame it could not answer, the quick answer waits 1, 2, 4 ... 16 frames (a
+     * scene always in touch pays for it once in a while only; the list is the same) */
+    if (b->qwait > 0) b->qwait--;
+    else if (finite && !b->fresh_only) {
         const int r = quick_empty(b, w, na, rmax);
         if (r < 0) return -1;
-        if (r) return 0;
+        if (r) {
+            b->qback = 0;
+            return 0;
+        }
+        b->qback = b->qback ? (b->qback < 16 ? 2 * b->qback : 16) : 1;
+        b->qwait = b->qback - 1;
     }
     int64_t total;
-    wb_real ext;
-    int32_t nt;
-    if (search(b, w, reach, mvp, &total, &ext, &nt) < 0) return -1;
+    wb_real ocell;
+    if (search(b, w, reach, mvp, rsum, nr, &total, &ocell) < 0) return -1;
     if (total == 0) return 0;
-    return finish(b, w, total, ext, nt, rsum, nr);
+    return finish(b, w, total, ocell);
 }
 
 void wb__tricontacts_begin(wb_world *w)
