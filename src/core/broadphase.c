@@ -78,16 +78,6 @@ static inline int64_t cell_of(wb_real v, wb_real o, wb_real inv) { return wb__ce
 
 static inline int64_t wrap_to(int64_t c, int64_t n) { return c % n; }
 
-static inline int32_t cell_index(const wb_grid *g, const wb_real *x)
-{
-    int64_t c[3];
-    for (int a = 0; a < 3; a++) {
-        c[a] = cell_of(x[a], g->o[a], g->inv);
-        if (g->wrap) c[a] = wrap_to(c[a], g->nc[a]);
-    }
-    return (int32_t)(c[0] + g->nc[0] * (c[1] + g->nc[1] * c[2]));
-}
-
 static inline int box_overlap(const wb_real *alo, const wb_real *ahi, const wb_real *blo, const wb_real *bhi)
 {
     return alo[0] <= bhi[0] && blo[0] <= ahi[0] && alo[1] <= bhi[1] && blo[1] <= ahi[1] &&
@@ -323,17 +313,8 @@ static void make_grid(grid *g, const wb_broad *b, const wb_real *x, const wb_rea
 {
     const wb_real typical = wb__grid_typical(reach, b->cand, m);
     g->big = 2 * typical;
-    g->rn = 0;
-    wb_real lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY }, rmax = 0;
-    for (int32_t k = 0; k < m; k++) {
-        const int32_t i = b->cand[k];
-        for (int a = 0; a < 3; a++) {
-            if (x[3 * i + a] < lo[a]) lo[a] = x[3 * i + a];
-            if (x[3 * i + a] > hi[a]) hi[a] = x[3 * i + a];
-        }
-        if (reach[i] > rmax) rmax = reach[i];
-        if (reach[i] > g->rn && !(reach[i] > g->big)) g->rn = reach[i];
-    }
+    wb_real lo[3], hi[3], rmax;
+    wb__grid_bounds(x, reach, b->cand, m, g->big, lo, hi, &rmax, &g->rn);
     wb_real cs = typical;
     if (!(cs > 0)) cs = 2 * rmax;
     wb__grid_shape(&g->g, lo, hi, cs, m);
@@ -367,7 +348,7 @@ static int32_t broad(wb_broad *b, wb_pairbuf *o, const wb_real *x, const wb_real
     int32_t *start = b->start;
     memset(start, 0, sizeof *start * (size_t)(ncell + 1));
     for (int32_t k = 0; k < m; k++) {
-        const int32_t cl = cell_index(&g.g, &x[3 * b->cand[k]]);
+        const int32_t cl = wb__grid_cell(&g.g, &x[3 * b->cand[k]]);
         b->cell[k] = cl;
         start[cl + 1]++;
     }
@@ -386,16 +367,8 @@ static int32_t broad(wb_broad *b, wb_pairbuf *o, const wb_real *x, const wb_real
     /* pass 3: contiguous ranges of the sorted array, one pair buffer each */
     const int threads = wb__pool_threads(pool);
     int nt = threads > 1 && m >= PAR_MIN ? threads : 1;
-    if (nt > b->nout) {
-        pairbuf *o = realloc(b->out, sizeof *o * (size_t)nt);
-        if (!o) return -1;
-        memset(o + b->nout, 0, sizeof *o * (size_t)(nt - b->nout));
-        b->out = o;
-        b->nout = nt;
-    }
+    if (!wb__pairbufs(&b->out, &b->nout, nt)) return -1;
     for (int t = 0; t < nt; t++) {
-        b->out[t].n = 0;
-        b->out[t].fail = 0;
         if (!grow((void **)&b->out[t].hit, &b->out[t].cap_hit, m, sizeof *b->out[t].hit)) return -1;
     }
     scan_ctx ctx = { b, &g, m, keep, ud };

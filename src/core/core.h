@@ -200,6 +200,9 @@ typedef struct wb_grid {
     int64_t nc[3];         /* cells per axis */
     int wrap;              /* coordinates wrap around */
 } wb_grid;
+/* the box of the points of list (n) and their largest reach, and the largest up to big */
+void wb__grid_bounds(const wb_real *x, const wb_real *reach, const int32_t *list, int32_t n, wb_real big,
+                     wb_real lo[3], wb_real hi[3], wb_real *rmax, wb_real *rn);
 /* the median of up to 31 reaches sampled evenly over list (n > 0) */
 wb_real wb__grid_typical(const wb_real *reach, const int32_t *list, int32_t n);
 /* the grid over the points inside [lo, hi]: cell cs or larger, at most ~2 cells per
@@ -212,6 +215,16 @@ static inline int64_t wb__cell_of(wb_real v, wb_real o, wb_real inv)
 {
     const wb_real c = (v - o) * inv;
     return c > 0 ? (c < 1e15 ? (int64_t)c : (int64_t)1e15) : 0;
+}
+/* a point's cell in g, row-major (x fastest) */
+static inline int32_t wb__grid_cell(const wb_grid *g, const wb_real *p)
+{
+    int64_t c[3];
+    for (int a = 0; a < 3; a++) {
+        c[a] = wb__cell_of(p[a], g->o[a], g->inv);
+        if (g->wrap) c[a] %= g->nc[a];
+    }
+    return (int32_t)(c[0] + g->nc[0] * (c[1] + g->nc[1] * c[2]));
 }
 
 /* broadphase.c: every pair i < j with |x_i - x_j| < reach_i + reach_j (particles with
@@ -233,6 +246,8 @@ typedef struct wb_pairbuf {
     int32_t *ij; int32_t n, cap; int fail;
     int32_t *hit; int32_t cap_hit;     /* broadphase.c: one particle's hits */
 } wb_pairbuf;
+/* grid.c: n pair buffers (one per thread) in *out, grown as needed, emptied; 0 when out of memory */
+int wb__pairbufs(wb_pairbuf **out, int *nout, int n);
 struct wb_broad {
     int32_t *cand; int32_t cap_cand;   /* candidates in index order, then the survivors */
     int32_t *cell; int32_t cap_cell;   /* cell of each survivor */
@@ -312,13 +327,23 @@ struct wb_tribroad {
     int32_t *first; int32_t cap_first;   /* (np + 1) sorting them by point */
     int32_t *pt2; int32_t cap_pt2;       /* (2 x candidates) the list sorted by point */
     uint64_t *okey; int32_t cap_okey;    /* (candidates) sort keys of the projection's order */
+    const wb_real *sr;                   /* the reaches the search runs with */
+    /* the quick answer's triangle runs (key, first, end corner), their corners, how many
+     * (-1: too many); a copy of what they depend on (triangles, flags, groups) */
+    int32_t *qrun, *qcorner; int32_t cap_qrun, cap_qcorner, nq;
+    uint8_t *kmodel; int32_t cap_kmodel; int64_t kbytes;
+    int32_t knp, knt;
+    int qvalid, fresh_only;              /* fresh_only: the search every frame (the tests' reference) */
+    int qback, qwait;                    /* frames the quick answer waits after it could not answer */
+    int64_t rebuilds;                    /* for the tests */
 };
 static inline void wb__tribroad_free(wb_tricontacts *c)
 {
     struct wb_tribroad *b = c->bp;
     if (!b) return;
     void *p[] = { b->reach, b->mv, b->tbox, b->tkey, b->pc, b->tc, b->prun, b->trun, b->tmp, b->runs, b->boxes,
-                  b->sp, b->sid, b->skey, b->scell, b->start, b->first, b->pt2, b->okey };
+                  b->sp, b->sid, b->skey, b->scell, b->start, b->first, b->pt2, b->okey,
+                  b->qrun, b->qcorner, b->kmodel };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
     free(b->out);

@@ -1,6 +1,7 @@
 /* grid.c: the shape of the sorted grids of the two broad phases (broadphase.c, tribroad.c):
  * one rule, so that both size their cells alike. */
 #include <stdlib.h>
+#include <string.h>
 
 #include "core.h"
 
@@ -8,6 +9,24 @@ static int cmp_real(const void *a, const void *b)
 {
     const wb_real x = *(const wb_real *)a, y = *(const wb_real *)b;
     return x < y ? -1 : x > y;
+}
+
+void wb__grid_bounds(const wb_real *x, const wb_real *reach, const int32_t *list, int32_t n, wb_real big,
+                     wb_real lo[3], wb_real hi[3], wb_real *rmax, wb_real *rn)
+{
+    for (int a = 0; a < 3; a++) lo[a] = INFINITY, hi[a] = -INFINITY;
+    wb_real rm = 0, rb = 0;
+    for (int32_t k = 0; k < n; k++) {
+        const int32_t i = list[k];
+        for (int a = 0; a < 3; a++) {
+            if (x[3 * i + a] < lo[a]) lo[a] = x[3 * i + a];
+            if (x[3 * i + a] > hi[a]) hi[a] = x[3 * i + a];
+        }
+        if (reach[i] > rm) rm = reach[i];
+        if (reach[i] > rb && !(reach[i] > big)) rb = reach[i];
+    }
+    *rmax = rm;
+    *rn = rb;
 }
 
 wb_real wb__grid_typical(const wb_real *reach, const int32_t *list, int32_t n)
@@ -58,4 +77,17 @@ void wb__grid_shape(wb_grid *g, const wb_real lo[3], const wb_real hi[3], wb_rea
     }
     for (int a = 0; a < 3; a++) { g->o[a] = lo[a]; g->nc[a] = (int64_t)dims[a]; }
     g->inv = inv;
+}
+
+int wb__pairbufs(wb_pairbuf **out, int *nout, int n)
+{
+    if (n > *nout) {
+        wb_pairbuf *o = realloc(*out, sizeof *o * (size_t)n);
+        if (!o) return 0;
+        memset(o + *nout, 0, sizeof *o * (size_t)(n - *nout));
+        *out = o;
+        *nout = n;
+    }
+    for (int k = 0; k < n; k++) (*out)[k].n = 0, (*out)[k].fail = 0;
+    return 1;
 }

@@ -31,6 +31,8 @@
  *     in the projection's order (order_as_grid), a function of the positions: the list
  *     is the same for any thread count. */
 #include <time.h>
+#include <stdio.h>
+#include <stdlib.h>
 
 #include "core.h"
 
@@ -143,7 +145,7 @@ static inline void item_box(const struct wb_tribroad *b, const wb_real *x, int32
         const wb_real *tb = &b->tbox[TB * i];
         for (int a = 0; a < 3; a++) lo[a] = tb[a] - tb[6], hi[a] = tb[3 + a] + tb[6];
     } else {
-        const wb_real r = b->reach[i];
+        const wb_real r = b->sr[i];
         for (int a = 0; a < 3; a++) lo[a] = x[3 * i + a] - r, hi[a] = x[3 * i + a] + r;
     }
 }
@@ -283,15 +285,8 @@ static int cull(struct wb_tribroad *b, const wb_world *w, int32_t *np_, int32_t 
 static void make_grid(level *l, const wb_real *x, const wb_real *reach, const int32_t *list, int32_t n,
                       wb_real typical)
 {
-    wb_real lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY }, rmax = 0;
-    for (int32_t k = 0; k < n; k++) {
-        const int32_t i = list[k];
-        for (int a = 0; a < 3; a++) {
-            if (x[3 * i + a] < lo[a]) lo[a] = x[3 * i + a];
-            if (x[3 * i + a] > hi[a]) hi[a] = x[3 * i + a];
-        }
-        if (reach[i] > rmax) rmax = reach[i];
-    }
+    wb_real lo[3], hi[3], rmax, rn;
+    wb__grid_bounds(x, reach, list, n, INFINITY, lo, hi, &rmax, &rn);
     l->rn = rmax;
     wb_real cs = 2 * typical;
     if (!(cs > 0)) cs = 2 * rmax;
@@ -301,7 +296,7 @@ static void make_grid(level *l, const wb_real *x, const wb_real *reach, const in
 /* the levels over the kept points b->pc (n); -1 when out of memory */
 static int make_levels(struct wb_tribroad *b, const wb_world *w, int32_t n)
 {
-    const wb_real *x = w->s.x, *reach = b->reach;
+    const wb_real *x = w->s.x, *reach = b->sr;
     if (!grow((void **)&b->sp, &b->cap_sp, 4 * (int64_t)n, sizeof *b->sp) ||
         !grow((void **)&b->sid, &b->cap_sid, n, sizeof *b->sid) ||
         !grow((void **)&b->skey, &b->cap_skey, n, sizeof *b->skey) ||
@@ -335,13 +330,7 @@ static int make_levels(struct wb_tribroad *b, const wb_world *w, int32_t n)
         int32_t *start = b->start + l->start0;
         memset(start, 0, sizeof *start * (size_t)(nc + 1));
         for (int32_t k = 0; k < nl; k++) {
-            const wb_real *p = &x[3 * list[k]];
-            int64_t c[3];
-            for (int a = 0; a < 3; a++) {
-                c[a] = wb__cell_of(p[a], g->o[a], g->inv);
-                if (g->wrap) c[a] %= g->nc[a];
-            }
-            const int32_t cl = (int32_t)(c[0] + g->nc[0] * (c[1] + g->nc[1] * c[2]));
+            const int32_t cl = wb__grid_cell(g, &x[3 * list[k]]);
             b->scell[k] = cl;
             start[cl + 1]++;
         }
@@ -569,90 +558,99 @@ static void tri_part(void *ctx, int k, int nth)
              &j->b->out[k]);
 }
 
-static int broadphase(wb_world *w)
+/* triangle t's record from the motions mvp: box, motion; -1 in tb[6] when left out (no
+ * corner may collide, or not finite). Returns the extent that sizes the order's cell
+ * (NAN when left out) */
+static wb_real tri_box(const wb_model *m, const wb_real *x, const wb_real *mvp, int32_t t, wb_real *tb)
+{
+    const int32_t *tv = &m->tri[3 * t];
+    tb[6] = -1;
+    if (!((m->cflags[tv[0]] | m->cflags[tv[1]] | m->cflags[tv[2]]) & (WB_CF_COLLIDE | WB_CF_SELF))) return NAN;
+    /* the corners' box in locals (tb may alias nothing, the compiler cannot know) */
+    const wb_real *p0 = &x[3 * tv[0]], *p1 = &x[3 * tv[1]], *p2 = &x[3 * tv[2]];
+    wb_real lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = p0[a], hi[a] = p0[a];
+        lo[a] = p1[a] < lo[a] ? p1[a] : lo[a];
+        hi[a] = p1[a] > hi[a] ? p1[a] : hi[a];
+        lo[a] = p2[a] < lo[a] ? p2[a] : lo[a];
+        hi[a] = p2[a] > hi[a] ? p2[a] : hi[a];
+    }
+    wb_real mv = mvp[tv[0]] > 0 ? mvp[tv[0]] : 0;
+    mv = mvp[tv[1]] > mv ? mvp[tv[1]] : mv;
+    mv = mvp[tv[2]] > mv ? mvp[tv[2]] : mv;
+    const wb_real e = max_(hi[0] - lo[0], max_(hi[1] - lo[1], hi[2] - lo[2])) + 2 * mv;
+    if (!isfinite(e)) return NAN;
+    for (int a = 0; a < 3; a++) tb[a] = lo[a], tb[3 + a] = hi[a];
+    tb[6] = mv;
+    return e;
+}
+
+/* the unit normal (0 when degenerate): a point farther than its reach from the plane is
+ * farther from the triangle */
+static void tri_normal(const wb_model *m, const wb_real *x, int32_t t, wb_real *n)
+{
+    const int32_t *tv = &m->tri[3 * t];
+    wb_real e1[3], e2[3];
+    v3_sub(e1, &x[3 * tv[1]], &x[3 * tv[0]]);
+    v3_sub(e2, &x[3 * tv[2]], &x[3 * tv[0]]);
+    v3_cross(n, e1, e2);
+    const wb_real ln = v3_len(n);
+    if (ln > 0 && isfinite(ln)) v3_scale(n, n, 1 / ln);
+    else v3_set(n, 0, 0, 0);
+}
+
+/* the pairs of points of reach `reach` (rsum summed over nr) and triangles of motions mvp
+ * into b->pt2 by point, each point's by triangle (*total); *ocell: the cell of the
+ * projection's order. -1 when out of memory */
+static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, const wb_real *mvp, wb_real rsum,
+                  int32_t nr, int64_t *total, wb_real *ocell)
 {
     wb_model *m = &w->m;
-    wb_tricontacts *c = &w->k.tc;
-    if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
-    struct wb_tribroad *b = c->bp;
-    const wb_real *x = w->s.x, *v = w->s.v;
-    if (!grow((void **)&b->reach, &b->cap_reach, m->np, sizeof *b->reach) ||
-        !grow((void **)&b->mv, &b->cap_mv, m->np, sizeof *b->mv) ||
-        !grow((void **)&b->tbox, &b->cap_tbox, TB * (int64_t)m->ntri, sizeof *b->tbox) ||
+    const wb_real *x = w->s.x;
+    *total = 0;
+    if (!grow((void **)&b->tbox, &b->cap_tbox, TB * (int64_t)m->ntri, sizeof *b->tbox) ||
         !grow((void **)&b->tkey, &b->cap_tkey, m->ntri, sizeof *b->tkey) ||
         !grow((void **)&b->pc, &b->cap_pc, m->np, sizeof *b->pc) ||
         !grow((void **)&b->tc, &b->cap_tc, m->ntri, sizeof *b->tc))
         return -1;
-    wb_real *reach = b->reach, *mvp = b->mv, *tbox = b->tbox;
-    /* how far a particle may get this frame (velocity and gravity over dt, and a quarter
-     * of its radius for what the constraints move it, as contact.c); a point's reach
-     * adds its radius */
-    const wb_real dt = m->def.dt, g = v3_len(m->def.gravity) * dt * dt;
-    int32_t na = 0, nr = 0;
-    wb_real rmax = 0, rsum = 0, ext = 0;
+    /* a zero reach or a position not finite meets no triangle (the exact test fails) */
+    int32_t na = 0;
+    wb_real rmax = 0;
     for (int32_t i = 0; i < m->np; i++) {
-        mvp[i] = v3_len_safe(&v[3 * i]) * dt + g + m->radius[i] / 4;
-        reach[i] = (m->cflags[i] & (WB_CF_COLLIDE | WB_CF_SELF)) ? m->radius[i] + mvp[i] : -1;
-        if (!isfinite(reach[i])) reach[i] = -1;
-        if (reach[i] >= 0) nr++, rsum += reach[i];
-        /* a zero reach or a position not finite meets no triangle (the exact test fails) */
         const wb_real *p = &x[3 * i];
         if (reach[i] > 0 && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])) {
             b->pc[na++] = i;
             if (reach[i] > rmax) rmax = reach[i];
         }
     }
-    /* triangles: box, motion (-1: left out); and the body no point of which may touch it
-     * (its corners' body when it does not self-collide; else 0) */
+    /* triangles: box, motion; and the body no point of which may touch it (its corners'
+     * body when it does not self-collide; else 0) */
     int32_t nt = 0;
+    wb_real sum = 0;
     for (int32_t t = 0; t < m->ntri; t++) {
+        const wb_real e = tri_box(m, x, mvp, t, &b->tbox[TB * t]);
+        if (e != e) continue;
         const int32_t *tv = &m->tri[3 * t];
-        wb_real *tb = &tbox[TB * t];
-        tb[6] = -1;
-        const uint8_t f0 = m->cflags[tv[0]], f1 = m->cflags[tv[1]], f2 = m->cflags[tv[2]];
-        if (!((f0 | f1 | f2) & (WB_CF_COLLIDE | WB_CF_SELF))) continue;
         const int32_t g0 = m->group[tv[0]];
-        b->tkey[t] = g0 > 0 && m->group[tv[1]] == g0 && m->group[tv[2]] == g0 && !(f0 & f1 & f2 & WB_CF_SELF) ? g0 : 0;
-        /* the corners' box in locals (tb may alias nothing, the compiler cannot know) */
-        const wb_real *p0 = &x[3 * tv[0]], *p1 = &x[3 * tv[1]], *p2 = &x[3 * tv[2]];
-        wb_real lo[3], hi[3];
-        for (int a = 0; a < 3; a++) {
-            lo[a] = p0[a], hi[a] = p0[a];
-            lo[a] = p1[a] < lo[a] ? p1[a] : lo[a];
-            hi[a] = p1[a] > hi[a] ? p1[a] : hi[a];
-            lo[a] = p2[a] < lo[a] ? p2[a] : lo[a];
-            hi[a] = p2[a] > hi[a] ? p2[a] : hi[a];
-        }
-        wb_real mv = mvp[tv[0]] > 0 ? mvp[tv[0]] : 0;
-        mv = mvp[tv[1]] > mv ? mvp[tv[1]] : mv;
-        mv = mvp[tv[2]] > mv ? mvp[tv[2]] : mv;
-        const wb_real e = max_(hi[0] - lo[0], max_(hi[1] - lo[1], hi[2] - lo[2])) + 2 * mv;
-        if (!isfinite(e)) continue;
-        for (int a = 0; a < 3; a++) tb[a] = lo[a], tb[3 + a] = hi[a];
-        tb[6] = mv;
+        b->tkey[t] = g0 > 0 && m->group[tv[1]] == g0 && m->group[tv[2]] == g0 &&
+                     !(m->cflags[tv[0]] & m->cflags[tv[1]] & m->cflags[tv[2]] & WB_CF_SELF) ? g0 : 0;
         b->tc[nt++] = t;
-        ext += e;
+        sum += e;
     }
     if (na == 0 || nt == 0) return 0;
-    /* the cell of the order (see order_as_grid) */
-    const wb_real ocell = max_(ext / nt, 2 * rsum / nr);
+    /* the cell of the order (see order_as_grid): the larger of the triangles' mean extent
+     * and twice the points' mean reach */
+    const wb_real oc = *ocell = max_(sum / nt, 2 * rsum / nr);
+    b->sr = reach;
     if (cull(b, w, &na, &nt, rmax) < 0) return -1;
     if (na == 0 || nt == 0) return 0;
-    /* the kept triangles' unit normals (0 when degenerate): a point farther than its
-     * reach from the plane is farther from the triangle */
     for (int32_t k = 0; k < nt; k++) {
-        const int32_t *tv = &m->tri[3 * b->tc[k]];
-        wb_real *n = &tbox[TB * b->tc[k] + 7], e1[3], e2[3];
-        v3_sub(e1, &x[3 * tv[1]], &x[3 * tv[0]]);
-        v3_sub(e2, &x[3 * tv[2]], &x[3 * tv[0]]);
-        v3_cross(n, e1, e2);
-        const wb_real ln = v3_len(n);
-        if (ln > 0 && isfinite(ln)) v3_scale(n, n, 1 / ln);
-        else v3_set(n, 0, 0, 0);
-        if (ocell > 0 && isfinite(ocell)) {
-            wb_real *tb = &tbox[TB * b->tc[k]];
+        wb_real *tb = &b->tbox[TB * b->tc[k]];
+        tri_normal(m, x, b->tc[k], tb + 7);
+        if (oc > 0 && isfinite(oc)) { /* its first cell in the order, whether it is big there */
             int64_t c0[3];
-            tb[13] = ocells(tb, tb + 3, tb[6], 1 / ocell, c0);
+            tb[13] = ocells(tb, tb + 3, tb[6], 1 / oc, c0);
             for (int a = 0; a < 3; a++) tb[10 + a] = (wb_real)c0[a]; /* |c| <= 1e15: exact */
         }
     }
@@ -660,31 +658,22 @@ static int broadphase(wb_world *w)
 
     /* contiguous ranges of the kept triangles, one pair buffer each */
     const int nth = m->def.threads > 1 && nt >= PAR_MIN ? m->def.threads : 1;
-    if (nth > b->nout) {
-        wb_pairbuf *o = realloc(b->out, sizeof *o * (size_t)nth);
-        if (!o) return -1;
-        memset(o + b->nout, 0, sizeof *o * (size_t)(nth - b->nout));
-        b->out = o;
-        b->nout = nth;
-    }
-    for (int k = 0; k < nth; k++) { b->out[k].n = 0; b->out[k].fail = 0; }
+    if (!wb__pairbufs(&b->out, &b->nout, nth)) return -1;
     if (nth == 1) tri_scan(b, w, 0, nt, &b->out[0]);
     else {
         tri_job j = { b, w, nt };
         wb__pool_run(wb__world_pool(w), tri_part, &j); /* nth parts: nth == the pool's threads */
     }
-    int64_t total = 0;
+    int64_t n = 0;
     for (int k = 0; k < nth; k++) {
         if (b->out[k].fail) return -1;
-        total += b->out[k].n;
+        n += b->out[k].n;
     }
-    if (!grow((void **)&c->pt, &c->cap, 2 * total, sizeof *c->pt) ||
-        !grow((void **)&b->pt2, &b->cap_pt2, 2 * total, sizeof *b->pt2) ||
+    if (!grow((void **)&b->pt2, &b->cap_pt2, 2 * n, sizeof *b->pt2) ||
         !grow((void **)&b->first, &b->cap_first, (int64_t)m->np + 1, sizeof *b->first))
         return -1;
-    /* by point first (stable: a thread's pairs of one point come in ascending triangle
-     * order, the threads' ranges ascend), then in the order of the hashed grid this
-     * replaced (order_as_grid) */
+    /* by point (stable: a thread's pairs of one point come in ascending triangle order,
+     * the threads' ranges ascend) */
     int32_t *first = b->first, *by_p = b->pt2;
     memset(first, 0, sizeof *first * ((size_t)m->np + 1));
     for (int k = 0; k < nth; k++)
@@ -696,9 +685,212 @@ static int broadphase(wb_world *w)
             by_p[2 * at] = b->out[k].ij[2 * q];
             by_p[2 * at + 1] = b->out[k].ij[2 * q + 1];
         }
+    *total = n;
+    return 0;
+}
+
+/* b->pt2 (total pairs by point) into c->pt in the projection's order (cell ocell) */
+static int finish(struct wb_tribroad *b, wb_world *w, int64_t total, wb_real ocell)
+{
+    wb_tricontacts *c = &w->k.tc;
+    if (!grow((void **)&c->pt, &c->cap, 2 * total, sizeof *c->pt)) return -1;
     if (!order_as_grid(b, w, ocell, total, c->pt)) return -1;
     c->n = (int32_t)total;
     return 0;
+}
+
+/* ---- the quick answer: no candidate this frame ------------------------------------------------- */
+/* In a resting heap every frame's list is empty, yet the search computes the box of every
+ * triangle to find that out. The body culling's runs of triangles are fixed by the
+ * topology, flags and groups alone; each run's box (the union of its triangles' boxes
+ * grown by their motions) lies inside the box of its corners grown by their largest
+ * motion. So the runs are kept between frames with their corners (rebuilt when anything
+ * they depend on changes), their boxes come from the corners (about half the particles,
+ * once each, instead of 9 coordinates per triangle), and the points are culled against
+ * them as in pass 1: when no point is left, no pair can pass the exact test and the
+ * list is empty, as the search would find (the larger boxes only keep more). Else the
+ * search runs as before: the list is the search's either way. */
+
+/* the arrays the runs depend on (triangles, flags, groups), one after the other: copied
+ * into b->kmodel (store), or compared with it */
+static int model_same(struct wb_tribroad *b, const wb_model *m, int store)
+{
+    const struct { const void *p; size_t n; } a[] = {
+        { m->tri, sizeof *m->tri * 3 * (size_t)m->ntri },
+        { m->cflags, sizeof *m->cflags * (size_t)m->np },
+        { m->group, sizeof *m->group * (size_t)m->np },
+    };
+    size_t at = 0;
+    for (size_t k = 0; k < sizeof a / sizeof a[0]; k++) at += a[k].n;
+    if (store) {
+        if (at > INT32_MAX / 2 || !grow((void **)&b->kmodel, &b->cap_kmodel, (int64_t)at, 1)) return 0;
+        b->kbytes = (int64_t)at;
+        b->knp = m->np;
+        b->knt = m->ntri;
+    } else if (b->kbytes != (int64_t)at || b->knp != m->np || b->knt != m->ntri)
+        return 0;
+    at = 0;
+    for (size_t k = 0; k < sizeof a / sizeof a[0]; k++) {
+        if (a[k].n == 0) continue;
+        if (store) memcpy(b->kmodel + at, a[k].p, a[k].n);
+        else if (memcmp(b->kmodel + at, a[k].p, a[k].n)) return 0;
+        at += a[k].n;
+    }
+    return 1;
+}
+
+static int cmp_i32(const void *a, const void *b)
+{
+    const int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* the triangle runs (as make_runs forms them) and each run's corners, once each: b->qrun
+ * (key, first corner, end), b->qcorner; b->nq = -1 when too many runs. 0 when out of memory */
+static int quick_runs(struct wb_tribroad *b, const wb_model *m)
+{
+    b->qvalid = 0;
+    if (!model_same(b, m, 1) || !grow((void **)&b->tmp, &b->cap_tmp, m->ntri, sizeof *b->tmp)) return 0;
+    int32_t *rid = b->tmp, nq = 0, keyless = -1, last = -1;
+    int32_t keys[RUNS_MAX];
+    for (int32_t t = 0; t < m->ntri; t++) {
+        const int32_t *tv = &m->tri[3 * t];
+        const uint8_t f0 = m->cflags[tv[0]], f1 = m->cflags[tv[1]], f2 = m->cflags[tv[2]];
+        rid[t] = -1;
+        if (!((f0 | f1 | f2) & (WB_CF_COLLIDE | WB_CF_SELF))) continue;
+        const int32_t g0 = m->group[tv[0]];
+        const int32_t key = g0 > 0 && m->group[tv[1]] == g0 && m->group[tv[2]] == g0 && !(f0 & f1 & f2 & WB_CF_SELF) ? g0 : 0;
+        int32_t r;
+        if (key == 0 && keyless >= 0) r = keyless;
+        else if (key > 0 && last >= 0 && keys[last] == key) r = last;
+        else {
+            if (nq == RUNS_MAX) { b->nq = -1; b->qvalid = 1; return 1; }
+            r = nq++;
+            keys[r] = key;
+            if (key == 0) keyless = r;
+        }
+        if (key != 0) last = r;
+        rid[t] = r;
+    }
+    /* corners by run (a counting sort), then each run's sorted and made unique */
+    if (!grow((void **)&b->qrun, &b->cap_qrun, 3 * (int64_t)nq + 3, sizeof *b->qrun) ||
+        !grow((void **)&b->qcorner, &b->cap_qcorner, 3 * (int64_t)m->ntri, sizeof *b->qcorner))
+        return 0;
+    int32_t *q = b->qrun;
+    for (int32_t r = 0; r <= nq; r++) q[3 * r + 1] = 0;
+    for (int32_t t = 0; t < m->ntri; t++)
+        if (rid[t] >= 0) q[3 * rid[t] + 4] += 3;
+    for (int32_t r = 0; r < nq; r++) q[3 * r + 4] += q[3 * r + 1], q[3 * r] = keys[r], q[3 * r + 2] = q[3 * r + 1];
+    for (int32_t t = 0; t < m->ntri; t++)
+        if (rid[t] >= 0)
+            for (int k = 0; k < 3; k++) b->qcorner[q[3 * rid[t] + 2]++] = m->tri[3 * t + k];
+    for (int32_t r = 0; r < nq; r++) {
+        int32_t *c = b->qcorner + q[3 * r + 1], n = q[3 * r + 2] - q[3 * r + 1], u = 0;
+        qsort(c, (size_t)n, sizeof *c, cmp_i32);
+        for (int32_t k = 0; k < n; k++)
+            if (k == 0 || c[k] != c[u - 1]) c[u++] = c[k];
+        q[3 * r + 2] = q[3 * r + 1] + u;
+    }
+    b->nq = nq;
+    b->qvalid = 1;
+    b->rebuilds++;
+    return 1;
+}
+
+/* 1 when no point can meet a triangle this frame (the points b->pc, na, their largest
+ * reach rmax; positions and motions finite), 0 when some may, -1 when out of memory */
+static int quick_empty(struct wb_tribroad *b, wb_world *w, int32_t na, wb_real rmax)
+{
+    const wb_model *m = &w->m;
+    const wb_real *x = w->s.x, *mvp = b->mv;
+    if (!b->qvalid || !model_same(b, m, 0)) {
+        if (!quick_runs(b, m)) return -1;
+    }
+    if (b->nq < 0) return 0;
+    if (na == 0 || b->nq == 0) return 1;
+    if (!grow((void **)&b->prun, &b->cap_prun, na, sizeof *b->prun)) return -1;
+    const wb_real eps = 1e-14 * rmax;
+    const int32_t npr = make_runs(b, 0, b->pc, na, 0, w, b->prun, eps);
+    if (npr == -2) return -1;
+    if (npr < 0) return 0;
+    if (!grow((void **)&b->runs, &b->cap_runs, npr + b->nq, sizeof *b->runs)) return -1;
+    for (int32_t r = 0; r < b->nq; r++) { /* the corners' box grown by their largest motion */
+        const int32_t *q = &b->qrun[3 * r];
+        run *R = &b->runs[npr + r];
+        wb_real lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY }, mv = 0;
+        for (int32_t k = q[1]; k < q[2]; k++) {
+            const int32_t i = b->qcorner[k];
+            const wb_real *p = &x[3 * i];
+            for (int a = 0; a < 3; a++) {
+                lo[a] = p[a] < lo[a] ? p[a] : lo[a];
+                hi[a] = p[a] > hi[a] ? p[a] : hi[a];
+            }
+            mv = mvp[i] > mv ? mvp[i] : mv;
+        }
+        R->key = q[0];
+        for (int a = 0; a < 3; a++) {
+            R->lo[a] = lo[a] - mv, R->hi[a] = hi[a] + mv;
+            const wb_real e = 1e-14 * max_(fabs(R->lo[a]), fabs(R->hi[a])) + eps; /* as make_runs */
+            R->lo[a] -= e;
+            R->hi[a] += e;
+        }
+    }
+    int32_t nb = 0;
+    for (int32_t r = 0; r < npr; r++)
+        if (!overlaps(b, r, npr, npr + b->nq, &nb)) return -1;
+    return keep(b, b->pc, b->prun, na, 0, x) == 0;
+}
+
+static int broadphase(wb_world *w)
+{
+    wb_model *m = &w->m;
+    wb_tricontacts *c = &w->k.tc;
+    if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
+    struct wb_tribroad *b = c->bp;
+    const wb_real *x = w->s.x, *v = w->s.v;
+    if (!grow((void **)&b->reach, &b->cap_reach, m->np, sizeof *b->reach) ||
+        !grow((void **)&b->mv, &b->cap_mv, m->np, sizeof *b->mv) ||
+        !grow((void **)&b->pc, &b->cap_pc, m->np, sizeof *b->pc))
+        return -1;
+    wb_real *reach = b->reach, *mvp = b->mv;
+    /* how far a particle may get this frame (velocity and gravity over dt, and a quarter
+     * of its radius for what the constraints move it, as contact.c); a point's reach
+     * adds its radius */
+    const wb_real dt = m->def.dt, g = v3_len(m->def.gravity) * dt * dt;
+    int32_t nr = 0, na = 0;
+    wb_real rsum = 0, rmax = 0;
+    int finite = 1;
+    for (int32_t i = 0; i < m->np; i++) {
+        mvp[i] = v3_len_safe(&v[3 * i]) * dt + g + m->radius[i] / 4;
+        reach[i] = (m->cflags[i] & (WB_CF_COLLIDE | WB_CF_SELF)) ? m->radius[i] + mvp[i] : -1;
+        if (!isfinite(reach[i])) reach[i] = -1;
+        if (reach[i] >= 0) nr++, rsum += reach[i];
+        const wb_real *p = &x[3 * i];
+        finite &= isfinite(p[0] + p[1] + p[2] + mvp[i]);
+        if (reach[i] > 0) {
+            b->pc[na++] = i;
+            if (reach[i] > rmax) rmax = reach[i];
+        }
+    }
+    b->sr = reach;
+    /* after a frame it could not answer, the quick answer waits 1, 2, 4 ... 16 frames (a
+     * scene always in touch pays for it once in a while only; the list is the same) */
+    if (b->qwait > 0) b->qwait--;
+    else if (finite && !b->fresh_only) {
+        const int r = quick_empty(b, w, na, rmax);
+        if (r < 0) return -1;
+        if (r) {
+            b->qback = 0;
+            return 0;
+        }
+        b->qback = b->qback ? (b->qback < 16 ? 2 * b->qback : 16) : 1;
+        b->qwait = b->qback - 1;
+    }
+    int64_t total;
+    wb_real ocell;
+    if (search(b, w, reach, mvp, rsum, nr, &total, &ocell) < 0) return -1;
+    if (total == 0) return 0;
+    return finish(b, w, total, ocell);
 }
 
 void wb__tricontacts_begin(wb_world *w)
@@ -716,6 +908,7 @@ void wb__tricontacts_begin(wb_world *w)
     const double t0 = now_ms();
     if (broadphase(w) < 0) {
         c->n = 0;
+        if (c->bp) c->bp->qvalid = 0;
         wb__warn(w, "out of memory in the triangle contact broad phase; triangle contacts skipped");
     }
     c->broad_ms = now_ms() - t0;

@@ -61,7 +61,10 @@
 #define TRIBROAD_TESTS(X)                                \
     X(tribroad_matches_brute_force_heap)                 \
     X(tribroad_matches_brute_force_cloth)                \
-    X(tribroad_matches_brute_force_sparse)
+    X(tribroad_matches_brute_force_sparse)               \
+    X(tribroad_quick_answer_matches_search_over_frames)  \
+    X(tribroad_quick_answer_at_the_edge_of_reach)        \
+    X(tribroad_quick_answer_same_steps_as_search)
 
 /* test_narrow.c: rigid shapes' contact manifolds */
 #define NARROW_TESTS(X)                                  \

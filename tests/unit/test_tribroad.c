@@ -263,3 +263,190 @@ TEST(tribroad_matches_brute_force_sparse)
     CHECK(check_world(w) > 20);
     wb_world_destroy(w);
 }
+
+/* ---- the quick answer (no candidate this frame) --------------------------------------------------- */
+/* this frame's list (threads as given), and the search's every frame (fresh_only) */
+static int32_t *quick_and_fresh(wb_world *w, int threads, int32_t *n, int32_t **fresh, int32_t *nf)
+{
+    int32_t *l = broad_list(w, threads, n);
+    if (w->k.tc.bp) w->k.tc.bp->fresh_only = 1;
+    *fresh = broad_list(w, 1, nf);
+    if (w->k.tc.bp) w->k.tc.bp->fresh_only = 0;
+    return l;
+}
+
+static int64_t rebuilds(const wb_world *w) { return w->k.tc.bp ? w->k.tc.bp->rebuilds : 0; }
+
+/* Every frame the list must be the search's, pair for pair in order (and now and then the
+ * brute force's set on 1-3 threads), while soft blocks in a row close in on each other
+ * (empty lists first, then not), drift, now and then a particle jumps or speeds up, and
+ * between frames triangles and a body are added, a particle is pinned and freed, a
+ * body's self-collision, a group and a radius change, a position goes NaN and back, and
+ * the last particle is removed. The runs kept between frames must be rebuilt on each
+ * change of triangles, flags, groups or particles, and only then (they are used). */
+TEST(tribroad_quick_answer_matches_search_over_frames)
+{
+    rng = 0x243F6A8885A308D3ull; /* the same scene whichever tests ran before */
+    wb_world *w = world_new();
+    wb_body bodies[6];
+    for (int b = 0; b < 6; b++) {
+        wb_lattice_def l = wb_lattice_default_def();
+        for (int a = 0; a < 3; a++) {
+            l.min[a] = a == 0 ? 0.45 * b : 0.1 * urand();
+            l.max[a] = l.min[a] + 0.3;
+            l.res[a] = 4;
+        }
+        l.radius = 0.03;
+        REQUIRE(wb_lattice(w, &l, &bodies[b]) == WB_OK);
+    }
+    /* small loose triangles (the catch-all run) in a row above the blocks */
+    const int32_t first = wb_particle_count(w);
+    int32_t tri[3 * 20];
+    for (int i = 0; i < 60; i++) {
+        const wb_real p[3] = { 0.12 * (i / 3) + 0.04 * urand(), 1.5 + 0.04 * urand(), 0.04 * urand() };
+        tri[i] = wb_particle_add(w, p, NULL, 0.01, 0.01);
+    }
+    REQUIRE(wb_surface_add(w, tri, 20) >= 0);
+    for (int32_t i = 0; i < wb_particle_count(w); i++) random_velocity(w, i, 0.2);
+    enum { FRAMES = 90 };
+    int bad = 0, missed = 0, needless = 0, empty = 0, full = 0;
+    for (int f = 0; f < FRAMES; f++) {
+        wb_model *m = &w->m;
+        int change = 1;
+        /* the row closes in (x towards 1.2 by 2% a frame), with a drift of up to 1 mm */
+        for (int32_t i = 0; i < m->np; i++) {
+            wb_real *p = &w->s.x[3 * i];
+            if (p[1] < 1.2) p[0] = 1.2 + (p[0] - 1.2) * 0.98;
+            for (int a = 0; a < 3; a++) p[a] += 0.002 * (urand() - 0.5);
+        }
+        if (f % 9 == 4) v3_set(&w->s.x[3 * (f * 37 % first)], 2 * urand(), f < 40 ? 3 : 0.3 * urand(), 0.4 * urand()), change = 0;
+        else if (f % 11 == 6) random_velocity(w, f * 53 % m->np, 3), change = 0;
+        else if (f == 20) { /* triangles added, across two bodies */
+            const int32_t t2[6] = { first + 1, first + 4, first + 8, bodies[0].first, first + 9, bodies[2].first + 5 };
+            REQUIRE(wb_surface_add(w, t2, 2) >= 0);
+        } else if (f == 25) { /* a body added */
+            wb_lattice_def l = wb_lattice_default_def();
+            for (int a = 0; a < 3; a++) l.min[a] = a == 0 ? 1.0 : 0.5, l.max[a] = l.min[a] + 0.2, l.res[a] = 3;
+            l.radius = 0.03;
+            wb_body b;
+            REQUIRE(wb_lattice(w, &l, &b) == WB_OK);
+        } else if (f == 30) wb_particle_pin(w, bodies[1].first + 21, NULL), change = 0;
+        else if (f == 33) wb_particle_unpin(w, bodies[1].first + 21), change = 0;
+        else if (f == 37) wb_group_set_self_collide(w, bodies[0].group, true);
+        else if (f == 41) wb_particle_set_group(w, first + 3, bodies[3].group);
+        else if (f == 46) wb_particle_set_radius(w, bodies[2].first, 0.09), change = 0;
+        else if (f == 50) w->s.x[3 * (bodies[4].first + 10) + 1] = NAN, change = 0;
+        else if (f == 52) w->s.x[3 * (bodies[4].first + 10) + 1] = 0.1, change = 0;
+        else if (f == 57) { /* the last particle removed (the new body's corner), its triangles with it */
+            m->np--;
+            int32_t nt = 0;
+            for (int32_t t = 0; t < m->ntri; t++)
+                if (m->tri[3 * t] < m->np && m->tri[3 * t + 1] < m->np && m->tri[3 * t + 2] < m->np) {
+                    memmove(&m->tri[3 * nt], &m->tri[3 * t], sizeof *m->tri * 3);
+                    nt++;
+                }
+            m->ntri = nt;
+        } else change = 0;
+        const int64_t r0 = rebuilds(w);
+        if (w->k.tc.bp) w->k.tc.bp->qwait = 0; /* the quick answer every frame, however often it failed */
+        int32_t n, nf, *fresh;
+        int32_t *l = quick_and_fresh(w, 1 + f % 3, &n, &fresh, &nf);
+        /* f == 52: the frame before had a NaN (no quick answer, no look at the runs) */
+        if (f > 0 && change && rebuilds(w) == r0) missed++;
+        if (f > 0 && !change && f != 52 && rebuilds(w) != r0) needless++;
+        if (n != nf || memcmp(l, fresh, sizeof *l * (size_t)(2 * n))) bad++;
+        if (n == 0) empty++;
+        else full++;
+        free(l);
+        free(fresh);
+        if (f % 15 == 14) CHECK(check_world(w) >= 0);
+    }
+    CHECK_EQ(bad, 0);
+    CHECK_EQ(missed, 0);
+    CHECK_EQ(needless, 0);
+    CHECK(empty >= 10);
+    CHECK(full >= 10);
+    wb_world_destroy(w);
+}
+
+/* One point moved in steps of 1 mm towards an immovable triangle (a body of its own), over
+ * its middle and past its edge: the frames where the point is within its reach + the triangle's motion of
+ * the triangle but farther than its reach from its corners' box (the boxes must grow by
+ * the motion), and a single point left after culling, must give the search's list. */
+TEST(tribroad_quick_answer_at_the_edge_of_reach)
+{
+    for (int side = 0; side < 2; side++) {
+        wb_world *w = world_new();
+        const wb_real c[3][3] = { { 0, 0, 0 }, { 0.3, 0, 0 }, { 0, 0, 0.3 } };
+        int32_t tri[3];
+        const int32_t g = wb_group_new(w);
+        for (int k = 0; k < 3; k++) tri[k] = wb_particle_add(w, c[k], NULL, 0, 0.01);
+        for (int k = 0; k < 3; k++) wb_particle_set_group(w, tri[k], g); /* a body: its corners culled */
+        REQUIRE(wb_surface_add(w, tri, 1) >= 0);
+        const wb_real v[3] = { 0, -1, 0 };
+        const wb_real p0[3] = { side ? -0.1 : 0.1, side ? 0 : 0.1, 0.1 };
+        const int32_t p = wb_particle_add(w, p0, v, 0.01, 0.02);
+        wb_particle_add(w, (wb_real[3]){ 5, 5, 5 }, NULL, 0.01, 0.02); /* far away: one more point */
+        int bad = 0, empty = 0, full = 0;
+        for (int f = 0; f < 100; f++) {
+            wb_real *x = &w->s.x[3 * p];
+            if (side) x[0] += 0.001; /* towards the edge x = 0, in the plane */
+            else x[1] -= 0.001;      /* down onto the middle */
+            int32_t n, nf, *fresh;
+            int32_t *l = quick_and_fresh(w, 1, &n, &fresh, &nf);
+            if (n != nf || memcmp(l, fresh, sizeof *l * (size_t)(2 * n))) bad++;
+            if (n == 0) empty++;
+            else full++;
+            free(l);
+            free(fresh);
+        }
+        CHECK_EQ(bad, 0);
+        CHECK(empty >= 20);
+        CHECK(full >= 20);
+        wb_world_destroy(w);
+    }
+}
+
+/* A real pile: soft blocks dropped on a pinned cloth and on each other, stepped 120
+ * frames with the quick answer and again with the search every frame, on 1 and 3
+ * threads: the same hash (the projection sees the same list in the same order). */
+TEST(tribroad_quick_answer_same_steps_as_search)
+{
+    uint64_t h[4];
+    for (int run = 0; run < 4; run++) {
+        wb_world_def d = wb_world_default_def();
+        d.threads = run / 2 ? 3 : 1;
+        wb_world *w = wb_world_create(&d);
+        REQUIRE(w);
+        wb_cloth_def c = wb_cloth_default_def();
+        c.res[0] = c.res[1] = 10;
+        c.size[0] = c.size[1] = 1;
+        c.radius = 0.03;
+        wb_body cloth;
+        REQUIRE(wb_cloth(w, &c, &cloth) == WB_OK);
+        for (int32_t i = cloth.first; i < cloth.first + cloth.count; i++) wb_particle_pin(w, i, NULL);
+        for (int b = 0; b < 4; b++) {
+            wb_lattice_def l = wb_lattice_default_def();
+            for (int a = 0; a < 3; a++) {
+                l.min[a] = (a == 1 ? 0.1 + 0.25 * b : 0.2 + 0.1 * b);
+                l.max[a] = l.min[a] + 0.2;
+                l.res[a] = 3;
+            }
+            l.radius = 0.03;
+            wb_body body;
+            REQUIRE(wb_lattice(w, &l, &body) == WB_OK);
+        }
+        int64_t touching = 0;
+        for (int f = 0; f < 120; f++) {
+            if (f == 1 && run % 2) w->k.tc.bp->fresh_only = 1;
+            REQUIRE(wb_world_step(w) == WB_OK);
+            touching += w->k.tc.n;
+        }
+        CHECK(touching > 1000);
+        h[run] = wb_world_hash(w);
+        wb_world_destroy(w);
+    }
+    CHECK(h[0] == h[1]);
+    CHECK(h[2] == h[3]);
+    CHECK(h[0] == h[2]);
+}
