@@ -106,6 +106,7 @@ typedef struct wb_model {
     uint32_t *c_gen;       /* (nc) odd = live */
 
     int topology_dirty;    /* colour batches must be rebuilt */
+    uint32_t w_gen;        /* bumped when w changes without a topology change (pin, unpin) */
     size_t charged;        /* bytes charged to def.memory */
     size_t charged_mesh;   /* bytes of mesh colliders' copies, charged to def.memory too */
 
@@ -381,6 +382,8 @@ typedef struct wb_cache {
     int32_t *s_slot;       /* (ns) constraint slot of each packed entry */
     int32_t *slot_pack;    /* (nd) packed index of each slot, -1 when not packed */
     int any_damping;
+    int any_frame_end;     /* a packed distance constraint can break or flow (distance_frame_end) */
+    uint32_t s_w_gen;      /* the m.w_gen s_wa, s_wc were copied at */
     wb_real *dx;           /* (np x 3) Jacobi accumulators */
     int32_t *ncount;       /* (np) constraints per particle (for s_jac) */
     wb_real *x_save, *v_save; /* (np x 3) last finite frame, for recovery */

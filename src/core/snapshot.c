@@ -487,6 +487,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
         memcpy(m->x0, g->x0, 3 * np * sizeof *m->x0);
     }
     for (size_t i = 0; i < np; i++) m->w[i] = g->pinned[i] ? 0 : g->inv_mass[i];
+    m->w_gen++;
     m->nd = g->nd;
     m->nd_live = 0;
     if (nd) {

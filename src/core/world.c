@@ -282,6 +282,7 @@ void wb_particle_pin(wb_world *w, int32_t p, const wb_real *pos)
     if (pos) wb_particle_set_position(w, p, pos);
     w->m.pinned[p] = 1;
     w->m.w[p] = 0;
+    w->m.w_gen++;
     v3_set(&w->s.v[3 * p], 0, 0, 0);
 }
 
@@ -290,6 +291,7 @@ void wb_particle_unpin(wb_world *w, int32_t p)
     CHECK_P(w, p);
     w->m.pinned[p] = 0;
     w->m.w[p] = w->m.inv_mass[p];
+    w->m.w_gen++;
 }
 
 /* ---- distance constraints --------------------------------------------------------- */

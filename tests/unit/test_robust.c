@@ -167,7 +167,7 @@ TEST(memory_budget_shared_by_worlds)
     wb_world *a = wb_world_create(&d), *b = wb_world_create(&d);
     REQUIRE(a && b);
     wb_cloth_def c = wb_cloth_default_def();
-    c.res[0] = c.res[1] = 300; /* 90k particles, 269k links: about 47 MB */
+    c.res[0] = c.res[1] = 250; /* 62.5k particles, 187k links: over half the 64 MB */
     wb_body body;
     CHECK_EQ(wb_cloth(a, &c, &body), WB_OK);
     CHECK(mem.used > (32u << 20) && mem.used <= mem.limit);
