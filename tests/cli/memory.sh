@@ -149,7 +149,7 @@ check "renderers are charged what llvmpipe takes; dropped ones are given back" \
     err "renderers.lua:10: a 320x240 renderer needs about 14 MB" out "dropped 5 renderers" !out "should not get here"
 
 run draw_world.lua
-check "drawing a world of a million links is charged before the frame" \
+check "drawing a world of 0.8 million links is charged before the frame" \
     err "draw_world.lua:6: drawing this world needs about" !out "should not get here"
 
 # ---- renderers made and closed over and over give their memory back (to the system:
