@@ -1,7 +1,8 @@
 /* test_fused.c: the collision pass that also predicts the next substep (solver.c,
  * collide.c) gives the bits of the unfused order: every scene runs twice, fused and with
  * the tests' switch wb_cache.no_fuse, and the hashes must agree; so must the folded
- * finiteness check's warning and undo. */
+ * finiteness check's warning and undo. The one-plane pass's AVX2 groups against its
+ * scalar code (wb_cache.no_simd) at the end. */
 #include <stdlib.h>
 
 #include "core/core.h"
