@@ -698,6 +698,140 @@ WB_INLINE void collide_range(collide_job *j, int32_t lo, int32_t hi, const int p
     }
 }
 
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(WB_FLOAT)
+#include <immintrin.h>
+#define WB_PLANE_AVX2 1
+#define AVX2_INLINE static inline __attribute__((always_inline, target("avx2")))
+
+/* four particles' triples (x0 y0 z0 x1 | y1 z1 x2 y2 | z2 x3 y3 z3) to x, y, z and back */
+AVX2_INLINE void soa4(const wb_real *p, __m256d *x, __m256d *y, __m256d *z)
+{
+    const __m256d a = _mm256_loadu_pd(p), b = _mm256_loadu_pd(p + 4), c = _mm256_loadu_pd(p + 8);
+    const __m256d m = _mm256_permute2f128_pd(a, c, 0x21); /* a2 a3 c0 c1 */
+    const __m256d u = _mm256_blend_pd(a, b, 0xC);        /* a0 a1 b2 b3 */
+    const __m256d v = _mm256_blend_pd(b, c, 0xC);        /* b0 b1 c2 c3 */
+    *x = _mm256_blend_pd(_mm256_blend_pd(a, m, 0xA), b, 0x4);
+    *y = _mm256_shuffle_pd(u, v, 0x5);
+    *z = _mm256_shuffle_pd(m, v, 0xA);
+}
+
+AVX2_INLINE void aos4(wb_real *p, __m256d x, __m256d y, __m256d z)
+{
+    const __m256d u = _mm256_unpacklo_pd(x, y);   /* x0 y0 x2 y2 */
+    const __m256d v = _mm256_unpackhi_pd(y, z);   /* y1 z1 y3 z3 */
+    const __m256d m = _mm256_shuffle_pd(z, x, 0xA); /* z0 x1 z2 x3 */
+    _mm256_storeu_pd(p, _mm256_permute2f128_pd(u, m, 0x20));
+    _mm256_storeu_pd(p + 4, _mm256_blend_pd(v, u, 0xC));
+    _mm256_storeu_pd(p + 8, _mm256_permute2f128_pd(m, v, 0x31));
+}
+
+/* The one-plane pass (collide_range, planes == 2) four particles at a time: the same
+ * operations in the same order per value (lanes out of contact blended back, not
+ * computed differently), so the same bits. Groups with a pinned particle, or in contact
+ * with a plane that has friction (the slip's length per particle), run the scalar code. */
+AVX2_INLINE void plane_range_avx2(collide_job *j, int32_t lo, int32_t hi, const int fuse, const int scan)
+{
+    wb_world *w = j->w;
+    const wb_model *m = &w->m;
+    const static_plane one = j->planes[0];
+    const wb_real h = j->h, inv_h = 1 / h, g = v3_len(m->def.gravity);
+    const wb_real *restrict wv = m->w, *restrict rad = m->radius;
+    wb_real *restrict x = w->s.x, *restrict v = w->s.v;
+    wb_real *restrict xp = w->s.x_prev;
+    const wb_predict pr = fuse ? *j->next : (wb_predict){ 0, { 0, 0, 0 }, 0 };
+    const __m256d n0 = _mm256_set1_pd(one.n[0]), n1 = _mm256_set1_pd(one.n[1]), n2 = _mm256_set1_pd(one.n[2]);
+    const __m256d off = _mm256_set1_pd(one.off), rest = _mm256_set1_pd(one.restitution);
+    const __m256d vih = _mm256_set1_pd(inv_h), g2h = _mm256_set1_pd(2 * g * h);
+    const __m256d zero = _mm256_setzero_pd(), sign = _mm256_set1_pd(-0.0);
+    const __m256d keep = _mm256_set1_pd(pr.keep), ph = _mm256_set1_pd(pr.h);
+    const __m256d gx = _mm256_set1_pd(pr.g[0]), gy = _mm256_set1_pd(pr.g[1]), gz = _mm256_set1_pd(pr.g[2]);
+    const int fric = one.friction > 0;
+    int64_t ncontacts = 0;
+    int32_t bad = INT32_MAX;
+    int32_t run = lo; /* [run, i): groups left to the scalar code, run at the next vector group */
+    int32_t i = lo;
+    for (; i + 4 <= hi; i += 4) {
+        if (_mm256_movemask_pd(_mm256_cmp_pd(_mm256_loadu_pd(&wv[i]), zero, _CMP_EQ_OQ))) continue;
+        __m256d X, Y, Z;
+        soa4(&x[3 * i], &X, &Y, &Z);
+        const __m256d depth = _mm256_sub_pd(_mm256_add_pd(_mm256_loadu_pd(&rad[i]), off),
+                                            _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(n0, X), _mm256_mul_pd(n1, Y)),
+                                                          _mm256_mul_pd(n2, Z)));
+        const __m256d in = _mm256_cmp_pd(depth, zero, _CMP_GT_OQ);
+        const int inm = _mm256_movemask_pd(in);
+        if (inm && fric) continue;
+        if (run < i) collide_range(j, run, i, 2, fuse, scan);
+        run = i + 4;
+        __m256d PX, PY, PZ, VX, VY, VZ;
+        soa4(&xp[3 * i], &PX, &PY, &PZ);
+        soa4(&v[3 * i], &VX, &VY, &VZ);
+        __m256d cvn = zero;
+        if (inm) {
+            X = _mm256_blendv_pd(X, _mm256_add_pd(X, _mm256_mul_pd(n0, depth)), in);
+            Y = _mm256_blendv_pd(Y, _mm256_add_pd(Y, _mm256_mul_pd(n1, depth)), in);
+            Z = _mm256_blendv_pd(Z, _mm256_add_pd(Z, _mm256_mul_pd(n2, depth)), in);
+            cvn = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(VX, n0), _mm256_mul_pd(VY, n1)), _mm256_mul_pd(VZ, n2));
+        }
+        VX = _mm256_mul_pd(_mm256_sub_pd(X, PX), vih);
+        VY = _mm256_mul_pd(_mm256_sub_pd(Y, PY), vih);
+        VZ = _mm256_mul_pd(_mm256_sub_pd(Z, PZ), vih);
+        if (inm) {
+            const __m256d upd = _mm256_and_pd(in, _mm256_cmp_pd(cvn, zero, _CMP_LT_OQ));
+            if (_mm256_movemask_pd(upd)) {
+                const __m256d vn =
+                    _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(VX, n0), _mm256_mul_pd(VY, n1)), _mm256_mul_pd(VZ, n2));
+                /* e = -cvn > 2 g h ? restitution : 0; vv += n (-e cvn - vn) */
+                const __m256d e =
+                    _mm256_and_pd(rest, _mm256_cmp_pd(_mm256_xor_pd(cvn, sign), g2h, _CMP_GT_OQ));
+                const __m256d k = _mm256_sub_pd(_mm256_mul_pd(_mm256_xor_pd(e, sign), cvn), vn);
+                VX = _mm256_blendv_pd(VX, _mm256_add_pd(VX, _mm256_mul_pd(n0, k)), upd);
+                VY = _mm256_blendv_pd(VY, _mm256_add_pd(VY, _mm256_mul_pd(n1, k)), upd);
+                VZ = _mm256_blendv_pd(VZ, _mm256_add_pd(VZ, _mm256_mul_pd(n2, k)), upd);
+            }
+            ncontacts += __builtin_popcount((unsigned)inm);
+        }
+        if (fuse) {
+            aos4(&xp[3 * i], X, Y, Z);
+            VX = _mm256_add_pd(_mm256_mul_pd(VX, keep), gx);
+            VY = _mm256_add_pd(_mm256_mul_pd(VY, keep), gy);
+            VZ = _mm256_add_pd(_mm256_mul_pd(VZ, keep), gz);
+            X = _mm256_add_pd(X, _mm256_mul_pd(ph, VX));
+            Y = _mm256_add_pd(Y, _mm256_mul_pd(ph, VY));
+            Z = _mm256_add_pd(Z, _mm256_mul_pd(ph, VZ));
+        }
+        aos4(&x[3 * i], X, Y, Z);
+        aos4(&v[3 * i], VX, VY, VZ);
+        if (scan && bad == INT32_MAX) {
+            /* x - x: 0 when finite, NaN otherwise (finite6) */
+            const __m256d s = _mm256_add_pd(
+                _mm256_add_pd(_mm256_add_pd(_mm256_sub_pd(X, X), _mm256_sub_pd(Y, Y)), _mm256_sub_pd(Z, Z)),
+                _mm256_add_pd(_mm256_add_pd(_mm256_sub_pd(VX, VX), _mm256_sub_pd(VY, VY)), _mm256_sub_pd(VZ, VZ)));
+            const int nf = _mm256_movemask_pd(_mm256_cmp_pd(s, s, _CMP_UNORD_Q));
+            if (nf) bad = i + __builtin_ctz((unsigned)nf);
+        }
+    }
+    if (run < hi) collide_range(j, run, hi, 2, fuse, scan);
+    j->ncontacts += ncontacts;
+    if (scan && bad != INT32_MAX) {
+        int32_t cur = atomic_load(&j->bad);
+        while (bad < cur && !atomic_compare_exchange_weak(&j->bad, &cur, bad)) {}
+    }
+}
+
+static __attribute__((target("avx2"))) void plane_avx2(void *ctx, int32_t lo, int32_t hi)
+{
+    plane_range_avx2(ctx, lo, hi, 0, 0);
+}
+static __attribute__((target("avx2"))) void plane_fuse_avx2(void *ctx, int32_t lo, int32_t hi)
+{
+    plane_range_avx2(ctx, lo, hi, 1, 0);
+}
+static __attribute__((target("avx2"))) void plane_scan_avx2(void *ctx, int32_t lo, int32_t hi)
+{
+    plane_range_avx2(ctx, lo, hi, 0, 1);
+}
+#endif
+
 static void part_any(void *ctx, int32_t lo, int32_t hi) { collide_range(ctx, lo, hi, 0, 0, 0); }
 static void part_any_fuse(void *ctx, int32_t lo, int32_t hi) { collide_range(ctx, lo, hi, 0, 1, 0); }
 static void part_any_scan(void *ctx, int32_t lo, int32_t hi) { collide_range(ctx, lo, hi, 0, 0, 1); }
@@ -748,7 +882,13 @@ int wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1, const
                                               { part_planes, part_planes_fuse, part_planes_scan },
                                               { part_plane, part_plane_fuse, part_plane_scan } };
     if (planes && nlive == 1) planes = 2;
-    wb__pool_for(m->np >= 4096 ? wb__world_pool(w) : NULL, m->np, 2048, fns[planes][next ? 1 : scan ? 2 : 0], &j);
+    wb_pool_for_fn fn = fns[planes][next ? 1 : scan ? 2 : 0];
+#ifdef WB_PLANE_AVX2
+    /* (no_simd: the tests' scalar one-plane pass) */
+    if (planes == 2 && !k->no_simd && __builtin_cpu_supports("avx2"))
+        fn = next ? plane_fuse_avx2 : scan ? plane_scan_avx2 : plane_avx2;
+#endif
+    wb__pool_for(m->np >= 4096 ? wb__world_pool(w) : NULL, m->np, 2048, fn, &j);
     k->last_contacts = (int32_t)j.ncontacts;
     if (next) k->fused++;
     if (scan && !next) k->nonfinite = j.bad == INT32_MAX ? -1 : j.bad;

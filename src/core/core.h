@@ -405,6 +405,8 @@ typedef struct wb_cache {
     int no_fuse;           /* tests: the plain order, the next substep's prediction never
                               fused into the collision pass (solver.c), nor the static-plane
                               fast path taken (collide.c); the results must not change */
+    int no_simd;           /* tests: the one-plane pass (collide.c) without its AVX2 groups
+                              of four; the results must not change */
     int64_t fused;         /* substeps predicted in the collision pass so far (tests) */
     int32_t nonfinite;     /* the last substep's pass scanned x and v (solver.c): the first
                               non-finite particle, -1 none; -2 when it did not scan */
