@@ -107,7 +107,7 @@ static int32_t *broad_list(wb_world *w, int threads, int32_t *n)
     *n = w->k.tc.n;
     int32_t *l = malloc(sizeof *l * (size_t)(2 * *n + 1));
     if (!l) abort();
-    memcpy(l, w->k.tc.pt, sizeof *l * (size_t)(2 * *n));
+    if (*n > 0) memcpy(l, w->k.tc.pt, sizeof *l * (size_t)(2 * *n)); /* (pt may be NULL when empty) */
     return l;
 }
 
