@@ -182,6 +182,9 @@ wb_pool *wb__pool_create(int threads)
     if (!p) return NULL;
     p->threads = threads;
     p->solo_ns = SOLO_MIN_NS;
+    /* trusted at first: a slow first job (threads starting, pages touched) is no reason
+     * to run alone; a worker held up again and again still uses this up within a job */
+    p->credit = CREDIT_MAX_NS;
     p->th = calloc((size_t)threads, sizeof *p->th);
     if (!p->th) { free(p); return NULL; }
     start_workers(p);
