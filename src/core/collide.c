@@ -532,26 +532,36 @@ static void resolve(wb_real *restrict xi, const wb_real *restrict pi, const wb_r
     ct->vn_pre = v3_dot(rel, n);
 }
 
-/* dynamic friction and restitution on the velocity the positions imply */
+/* dynamic friction and restitution on the velocity v the positions imply, for a contact
+ * of normal n and depth whose normal velocity was vn_pre before, against a surface moving
+ * at vc (NULL: a static one, the same bits as a zero vc); one copy for every path */
+static inline __attribute__((always_inline)) void
+velocity_response(wb_real v[3], const wb_real n[3], const wb_real *vc, wb_real depth, wb_real vn_pre,
+                  wb_real friction, wb_real restitution, wb_real h, wb_real g)
+{
+    wb_real rel[3], vt[3];
+    if (vc) v3_sub(rel, v, vc);
+    else v3_copy(rel, v);
+    const wb_real vn = v3_dot(rel, n);
+    v3_copy(vt, rel);
+    v3_madd(vt, n, -vn);
+    const wb_real vt_len = v3_len(vt);
+    if (friction > 0 && vt_len > 0) {
+        /* the normal impulse per unit mass is depth / h: |dv_t| <= mu |dv_n| */
+        const wb_real dv = friction * depth / h;
+        v3_madd(v, vt, -(dv < vt_len ? dv : vt_len) / vt_len);
+    }
+    if (vn_pre < 0) {
+        /* no bounce below 2|g|h: resting contact must not jitter */
+        const wb_real e = -vn_pre > 2 * g * h ? restitution : 0;
+        v3_madd(v, n, -e * vn_pre - vn);
+    }
+}
+
 static void contact_velocity(wb_real v[3], const contact *ct, wb_real h, wb_real g)
 {
     const wb_cshape *s = ct->c->s;
-    wb_real rel[3], vt[3];
-    v3_sub(rel, v, ct->vc);
-    const wb_real vn = v3_dot(rel, ct->n);
-    v3_copy(vt, rel);
-    v3_madd(vt, ct->n, -vn);
-    const wb_real vt_len = v3_len(vt);
-    if (s->friction > 0 && vt_len > 0) {
-        /* the normal impulse per unit mass is depth / h: |dv_t| <= mu |dv_n| */
-        const wb_real dv = s->friction * ct->depth / h;
-        v3_madd(v, vt, -(dv < vt_len ? dv : vt_len) / vt_len);
-    }
-    if (ct->vn_pre < 0) {
-        /* no bounce below 2|g|h: resting contact must not jitter */
-        const wb_real e = -ct->vn_pre > 2 * g * h ? s->restitution : 0;
-        v3_madd(v, ct->n, -e * ct->vn_pre - vn);
-    }
+    velocity_response(v, ct->n, ct->vc, ct->depth, ct->vn_pre, s->friction, s->restitution, h, g);
 }
 
 /* a static plane of the fast path: world normal, offset, its material */
@@ -644,19 +654,7 @@ WB_INLINE void collide_range(collide_job *j, int32_t lo, int32_t hi, const int p
             for (int c = 0; c < 3; c++) vv[c] = (xx[c] - pp[c]) * inv_h;
             for (int c = 0; c < nct && c < MAX_CONTACTS; c++) {
                 const static_plane *sp = planes == 2 ? &one : &pl[cp[c]];
-                wb_real vt[3];
-                const wb_real vn = v3_dot(vv, sp->n);
-                v3_copy(vt, vv);
-                v3_madd(vt, sp->n, -vn);
-                const wb_real vt_len = v3_len(vt);
-                if (sp->friction > 0 && vt_len > 0) {
-                    const wb_real dv = sp->friction * cd[c] / h;
-                    v3_madd(vv, vt, -(dv < vt_len ? dv : vt_len) / vt_len);
-                }
-                if (cvn[c] < 0) {
-                    const wb_real e = -cvn[c] > 2 * g * h ? sp->restitution : 0;
-                    v3_madd(vv, sp->n, -e * cvn[c] - vn);
-                }
+                velocity_response(vv, sp->n, NULL, cd[c], cvn[c], sp->friction, sp->restitution, h, g);
             }
             ncontacts += nct;
             if (fuse) wb__predict_one(&pr, wv[i], xx, pi, vv);
