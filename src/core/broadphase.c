@@ -445,16 +445,25 @@ static int list_valid(const wb_broad *b, const wb_real *x, const wb_real *reach,
     if (b->vn != n || n == 0) return 0;
     const wb_real *X = b->vx, *R = b->vr;
     const int32_t *K = b->vskip;
+    if (skip && memcmp(skip, K, sizeof *K * (size_t)n)) return 0;
+    for (int32_t i = 0; !skip && i < n; i++)
+        if (K[i] != 0) return 0;
     for (int32_t i = 0; i < n; i++) {
-        const int in = takes_part(x, reach, i);
-        if (in != (R[i] >= 0) || (skip ? skip[i] : 0) != K[i]) return 0;
-        if (!in) continue;
+        /* takes_part(i) == (R[i] >= 0), its cheap half first: one that was left out (R < 0)
+         * must still be; one that took part must have a reach >= 0 and finite, and a
+         * position within its slack (a position not finite fails that test) */
+        const wb_real Ri = R[i], ri = reach[i];
+        if (Ri < 0) {
+            if (takes_part(x, reach, i)) return 0;
+            continue;
+        }
+        if (!(ri >= 0) || !(ri < INFINITY)) return 0;
         const wb_real *p = &x[3 * i];
         const wb_real d0 = p[0] - X[3 * i], d1 = p[1] - X[3 * i + 1], d2 = p[2] - X[3 * i + 2];
-        const wb_real slack = (R[i] - reach[i]) * (wb_real)0.999;
+        const wb_real slack = (Ri - ri) * (wb_real)0.999;
         /* round-off in the pair distances: a slack far above the coordinates' ulps */
-        const wb_real mag = fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + R[i];
-        if (!(slack > (wb_real)1e-9 * mag) || !(d0 * d0 + d1 * d1 + d2 * d2 <= slack * slack)) return 0;
+        const wb_real mag = fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + Ri;
+        if (!(d0 * d0 + d1 * d1 + d2 * d2 <= slack * slack) || !(slack > (wb_real)1e-9 * mag)) return 0;
     }
     return 1;
 }
@@ -608,9 +617,7 @@ void wb__contacts_begin(wb_world *w)
         const int32_t gi = m->group[i];
         /* may_touch's rules: other bodies need `collide`, its own body `self_collide` */
         if (!((f & WB_CF_COLLIDE) || (gi > 0 && (f & WB_CF_SELF)))) { reach[i] = -1; continue; }
-        const wb_real vv = v3_dot(&v[3 * i], &v[3 * i]);
-        const wb_real sp = vv < 1e300 ? sqrt(vv) : v3_len_safe(&v[3 * i]);
-        reach[i] = m->radius[i] * (wb_real)1.25 + sp * dt + g;
+        reach[i] = m->radius[i] * (wb_real)1.25 + v3_len_fast(&v[3 * i]) * dt + g;
         if (!isfinite(reach[i])) reach[i] = -1;
         /* a body that does not collide with itself: its pairs are left out before the
          * distance test, and its inside is culled by its bounds */

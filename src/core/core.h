@@ -34,6 +34,12 @@ static inline wb_real v3_len_safe(const wb_real *a)
     wb_real b[3] = { a[0] / m, a[1] / m, a[2] / m };
     return m * v3_len(b);
 }
+/* the same, the quick way while the square cannot overflow (the broad phases' speeds) */
+static inline wb_real v3_len_fast(const wb_real *a)
+{
+    const wb_real s = v3_dot(a, a);
+    return s < 1e300 ? sqrt(s) : v3_len_safe(a);
+}
 static inline void v3_cross(wb_real *o, const wb_real *a, const wb_real *b)
 {
     wb_real x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2], z = a[0] * b[1] - a[1] * b[0];
@@ -331,11 +337,11 @@ struct wb_tribroad {
     const wb_real *sr;                   /* the reaches the search runs with */
     /* the quick answer's triangle runs (key, first, end corner), their corners, how many
      * (-1: too many); a copy of what they depend on (triangles, flags, groups) */
-    int32_t *qrun, *qcorner; int32_t cap_qrun, cap_qcorner, nq;
+    int32_t *qrun, *qcorner, *qtrun; int32_t cap_qrun, cap_qcorner, cap_qtrun, nq; /* qtrun: a triangle's run, -1 */
     uint8_t *kmodel; int32_t cap_kmodel; int64_t kbytes;
     int32_t knp, knt;
     int qvalid, fresh_only;              /* fresh_only: the search every frame (the tests' reference) */
-    int qback, qwait;                    /* frames the quick answer waits after it could not answer */
+    int qback, qwait;                    /* frames the quick answer waits after it left many points */
     int64_t rebuilds;                    /* for the tests */
 };
 static inline void wb__tribroad_free(wb_tricontacts *c)
@@ -344,7 +350,7 @@ static inline void wb__tribroad_free(wb_tricontacts *c)
     if (!b) return;
     void *p[] = { b->reach, b->mv, b->tbox, b->tkey, b->pc, b->tc, b->prun, b->trun, b->tmp, b->runs, b->boxes,
                   b->sp, b->sid, b->skey, b->scell, b->start, b->first, b->pt2, b->okey,
-                  b->qrun, b->qcorner, b->kmodel };
+                  b->qrun, b->qcorner, b->qtrun, b->kmodel };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
     free(b->out);

@@ -604,7 +604,7 @@ static void tri_normal(const wb_model *m, const wb_real *x, int32_t t, wb_real *
  * into b->pt2 by point, each point's by triangle (*total); *ocell: the cell of the
  * projection's order. -1 when out of memory */
 static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, const wb_real *mvp, wb_real rsum,
-                  int32_t nr, int64_t *total, wb_real *ocell)
+                  int32_t nr, int32_t npts, const uint8_t *need, int64_t *total, wb_real *ocell)
 {
     wb_model *m = &w->m;
     const wb_real *x = w->s.x;
@@ -614,21 +614,28 @@ static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, cons
         !grow((void **)&b->pc, &b->cap_pc, m->np, sizeof *b->pc) ||
         !grow((void **)&b->tc, &b->cap_tc, m->ntri, sizeof *b->tc))
         return -1;
-    /* a zero reach or a position not finite meets no triangle (the exact test fails) */
+    /* a zero reach or a position not finite meets no triangle (the exact test fails); the
+     * quick answer's points when it gave them (npts >= 0, in b->pc: such points, in order) */
     int32_t na = 0;
     wb_real rmax = 0;
-    for (int32_t i = 0; i < m->np; i++) {
-        const wb_real *p = &x[3 * i];
-        if (reach[i] > 0 && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])) {
-            b->pc[na++] = i;
-            if (reach[i] > rmax) rmax = reach[i];
+    if (npts >= 0) {
+        na = npts;
+        for (int32_t k = 0; k < na; k++) rmax = reach[b->pc[k]] > rmax ? reach[b->pc[k]] : rmax;
+    } else
+        for (int32_t i = 0; i < m->np; i++) {
+            const wb_real *p = &x[3 * i];
+            if (reach[i] > 0 && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])) {
+                b->pc[na++] = i;
+                if (reach[i] > rmax) rmax = reach[i];
+            }
         }
-    }
     /* triangles: box, motion; and the body no point of which may touch it (its corners'
-     * body when it does not self-collide; else 0) */
+     * body when it does not self-collide; else 0); only the quick answer's runs a point
+     * may meet when it gave them (need) */
     int32_t nt = 0;
     wb_real sum = 0;
     for (int32_t t = 0; t < m->ntri; t++) {
+        if (need && (b->qtrun[t] < 0 || !need[b->qtrun[t]])) continue;
         const wb_real e = tri_box(m, x, mvp, t, &b->tbox[TB * t]);
         if (e != e) continue;
         const int32_t *tv = &m->tri[3 * t];
@@ -639,21 +646,11 @@ static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, cons
         sum += e;
     }
     if (na == 0 || nt == 0) return 0;
-    /* the cell of the order (see order_as_grid): the larger of the triangles' mean extent
-     * and twice the points' mean reach */
-    const wb_real oc = *ocell = max_(sum / nt, 2 * rsum / nr);
+    const int32_t nt_all = nt;
     b->sr = reach;
     if (cull(b, w, &na, &nt, rmax) < 0) return -1;
     if (na == 0 || nt == 0) return 0;
-    for (int32_t k = 0; k < nt; k++) {
-        wb_real *tb = &b->tbox[TB * b->tc[k]];
-        tri_normal(m, x, b->tc[k], tb + 7);
-        if (oc > 0 && isfinite(oc)) { /* its first cell in the order, whether it is big there */
-            int64_t c0[3];
-            tb[13] = ocells(tb, tb + 3, tb[6], 1 / oc, c0);
-            for (int a = 0; a < 3; a++) tb[10 + a] = (wb_real)c0[a]; /* |c| <= 1e15: exact */
-        }
-    }
+    for (int32_t k = 0; k < nt; k++) tri_normal(m, x, b->tc[k], &b->tbox[TB * b->tc[k]] + 7);
     if (make_levels(b, w, na) < 0) return -1;
 
     /* contiguous ranges of the kept triangles, one pair buffer each */
@@ -686,6 +683,27 @@ static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, cons
             by_p[2 * at + 1] = b->out[k].ij[2 * q + 1];
         }
     *total = n;
+    if (n == 0) return 0;
+    /* the cell of the order (see order_as_grid): the larger of every triangle's mean extent
+     * (the boxes of the runs left out worked out now: only lists that are not empty need
+     * it) and twice the points' mean reach; each listed triangle's first cell in it */
+    int32_t nsum = nt_all;
+    if (need) {
+        sum = 0;
+        nsum = 0;
+        for (int32_t t = 0; t < m->ntri; t++) {
+            const wb_real e = tri_box(m, x, mvp, t, &b->tbox[TB * t]); /* (the same bits again) */
+            if (e == e) sum += e, nsum++;
+        }
+    }
+    const wb_real oc = *ocell = max_(sum / nsum, 2 * rsum / nr);
+    if (oc > 0 && isfinite(oc))
+        for (int32_t k = 0; k < nt; k++) { /* its first cell in the order, whether it is big there */
+            wb_real *tb = &b->tbox[TB * b->tc[k]];
+            int64_t c0[3];
+            tb[13] = ocells(tb, tb + 3, tb[6], 1 / oc, c0);
+            for (int a = 0; a < 3; a++) tb[10 + a] = (wb_real)c0[a]; /* |c| <= 1e15: exact */
+        }
     return 0;
 }
 
@@ -750,8 +768,8 @@ static int cmp_i32(const void *a, const void *b)
 static int quick_runs(struct wb_tribroad *b, const wb_model *m)
 {
     b->qvalid = 0;
-    if (!model_same(b, m, 1) || !grow((void **)&b->tmp, &b->cap_tmp, m->ntri, sizeof *b->tmp)) return 0;
-    int32_t *rid = b->tmp, nq = 0, keyless = -1, last = -1;
+    if (!model_same(b, m, 1) || !grow((void **)&b->qtrun, &b->cap_qtrun, m->ntri, sizeof *b->qtrun)) return 0;
+    int32_t *rid = b->qtrun, nq = 0, keyless = -1, last = -1;
     int32_t keys[RUNS_MAX];
     for (int32_t t = 0; t < m->ntri; t++) {
         const int32_t *tv = &m->tri[3 * t];
@@ -798,9 +816,12 @@ static int quick_runs(struct wb_tribroad *b, const wb_model *m)
 }
 
 /* 1 when no point can meet a triangle this frame (the points b->pc, na, their largest
- * reach rmax; positions and motions finite), 0 when some may, -1 when out of memory */
-static int quick_empty(struct wb_tribroad *b, wb_world *w, int32_t na, wb_real rmax)
+ * reach rmax; positions and motions finite), 0 when some may, -1 when out of memory.
+ * When some may, the points that may are left first in b->pc, *left of them (-1: not
+ * worked out), and need[r] says whether one may meet a triangle of run r */
+static int quick_empty(struct wb_tribroad *b, wb_world *w, int32_t na, wb_real rmax, int32_t *left, uint8_t *need)
 {
+    *left = -1;
     const wb_model *m = &w->m;
     const wb_real *x = w->s.x, *mvp = b->mv;
     if (!b->qvalid || !model_same(b, m, 0)) {
@@ -838,7 +859,23 @@ static int quick_empty(struct wb_tribroad *b, wb_world *w, int32_t na, wb_real r
     int32_t nb = 0;
     for (int32_t r = 0; r < npr; r++)
         if (!overlaps(b, r, npr, npr + b->nq, &nb)) return -1;
-    return keep(b, b->pc, b->prun, na, 0, x) == 0;
+    const int32_t n = keep(b, b->pc, b->prun, na, 0, x);
+    if (n == 0) return 1;
+    /* the triangle runs some point left meets (its box against the run's, as overlaps
+     * tests runs), when that is cheap next to boxing every triangle */
+    *left = n;
+    const int all = (int64_t)n * b->nq > 4 * (int64_t)m->ntri + 1024;
+    memset(need, all, (size_t)b->nq);
+    for (int32_t k = 0; !all && k < n; k++) {
+        const int32_t p = b->pc[k], key = m->group[p];
+        wb_real lo[3], hi[3];
+        item_box(b, x, p, 0, lo, hi);
+        for (int32_t r = 0; r < b->nq; r++) {
+            const run *R = &b->runs[npr + r];
+            if (!need[r] && !(key != 0 && R->key == key) && box_overlap(lo, hi, R->lo, R->hi)) need[r] = 1;
+        }
+    }
+    return 0;
 }
 
 static int broadphase(wb_world *w)
@@ -861,7 +898,7 @@ static int broadphase(wb_world *w)
     wb_real rsum = 0, rmax = 0;
     int finite = 1;
     for (int32_t i = 0; i < m->np; i++) {
-        mvp[i] = v3_len_safe(&v[3 * i]) * dt + g + m->radius[i] / 4;
+        mvp[i] = v3_len_fast(&v[3 * i]) * dt + g + m->radius[i] / 4;
         reach[i] = (m->cflags[i] & (WB_CF_COLLIDE | WB_CF_SELF)) ? m->radius[i] + mvp[i] : -1;
         if (!isfinite(reach[i])) reach[i] = -1;
         if (reach[i] >= 0) nr++, rsum += reach[i];
@@ -873,22 +910,26 @@ static int broadphase(wb_world *w)
         }
     }
     b->sr = reach;
-    /* after a frame it could not answer, the quick answer waits 1, 2, 4 ... 16 frames (a
-     * scene always in touch pays for it once in a while only; the list is the same) */
+    /* the quick answer; when it has none, the search takes the points it left and the
+     * triangles of the runs they may meet (the list is the same). When it leaves more
+     * than half the points, it waits 1, 2, 4 ... 16 frames (a scene always in touch pays
+     * for it once in a while only) */
+    int32_t left = -1;
+    uint8_t need[RUNS_MAX];
     if (b->qwait > 0) b->qwait--;
     else if (finite && !b->fresh_only) {
-        const int r = quick_empty(b, w, na, rmax);
+        const int r = quick_empty(b, w, na, rmax, &left, need);
         if (r < 0) return -1;
-        if (r) {
-            b->qback = 0;
-            return 0;
+        if (r || (left >= 0 && left <= na / 2)) b->qback = 0;
+        else {
+            b->qback = b->qback ? (b->qback < 16 ? 2 * b->qback : 16) : 1;
+            b->qwait = b->qback - 1;
         }
-        b->qback = b->qback ? (b->qback < 16 ? 2 * b->qback : 16) : 1;
-        b->qwait = b->qback - 1;
+        if (r) return 0;
     }
     int64_t total;
     wb_real ocell;
-    if (search(b, w, reach, mvp, rsum, nr, &total, &ocell) < 0) return -1;
+    if (search(b, w, reach, mvp, rsum, nr, left, left >= 0 ? need : NULL, &total, &ocell) < 0) return -1;
     if (total == 0) return 0;
     return finish(b, w, total, ocell);
 }

@@ -35,7 +35,7 @@ static wb_real motion(const wb_world *w, int32_t i)
 {
     const wb_model *m = &w->m;
     const wb_real dt = m->def.dt, g = v3_len(m->def.gravity) * dt * dt;
-    return v3_len_safe(&w->s.v[3 * i]) * dt + g + m->radius[i] / 4;
+    return v3_len_fast(&w->s.v[3 * i]) * dt + g + m->radius[i] / 4;
 }
 
 /* whether (p, t) is a candidate of this frame */
@@ -348,7 +348,7 @@ TEST(tribroad_quick_answer_matches_search_over_frames)
             m->ntri = nt;
         } else change = 0;
         const int64_t r0 = rebuilds(w);
-        if (w->k.tc.bp) w->k.tc.bp->qwait = 0; /* the quick answer every frame, however often it failed */
+        if (w->k.tc.bp) w->k.tc.bp->qwait = 0; /* the quick answer every frame, however many points it left */
         int32_t n, nf, *fresh;
         int32_t *l = quick_and_fresh(w, 1 + f % 3, &n, &fresh, &nf);
         /* f == 52: the frame before had a NaN (no quick answer, no look at the runs) */
