@@ -279,7 +279,8 @@ static int64_t rebuilds(const wb_world *w) { return w->k.tc.bp ? w->k.tc.bp->reb
 
 /* Every frame the list must be the search's, pair for pair in order (and now and then the
  * brute force's set on 1-3 threads), while soft blocks in a row close in on each other
- * (empty lists first, then not), drift, now and then a particle jumps or speeds up, and
+ * (empty lists first, then not) below loose triangles that loose points come among,
+ * drift, now and then a particle jumps or speeds up, and
  * between frames triangles and a body are added, a particle is pinned and freed, a
  * body's self-collision, a group and a radius change, a position goes NaN and back, and
  * the last particle is removed. The runs kept between frames must be rebuilt on each
@@ -307,6 +308,11 @@ TEST(tribroad_quick_answer_matches_search_over_frames)
         tri[i] = wb_particle_add(w, p, NULL, 0.01, 0.01);
     }
     REQUIRE(wb_surface_add(w, tri, 20) >= 0);
+    const int32_t among = wb_particle_count(w); /* loose points above them, among them from frame 60 */
+    for (int k = 0; k < 10; k++) {
+        const wb_real p[3] = { 0.12 * k + 0.02, 1.8, 0.02 };
+        wb_particle_add(w, p, NULL, 0.01, 0.01);
+    }
     for (int32_t i = 0; i < wb_particle_count(w); i++) random_velocity(w, i, 0.2);
     enum { FRAMES = 90 };
     int bad = 0, missed = 0, needless = 0, empty = 0, full = 0;
@@ -336,6 +342,10 @@ TEST(tribroad_quick_answer_matches_search_over_frames)
         else if (f == 41) wb_particle_set_group(w, first + 3, bodies[3].group);
         else if (f == 46) wb_particle_set_radius(w, bodies[2].first, 0.09), change = 0;
         else if (f == 50) w->s.x[3 * (bodies[4].first + 10) + 1] = NAN, change = 0;
+        else if (f == 60) { /* no body on either side: the loose points meet the loose triangles */
+            for (int k = 0; k < 10; k++) v3_set(&w->s.x[3 * (among + k)], 0.12 * k + 0.02, 1.52, 0.02);
+            change = 0;
+        }
         else if (f == 52) w->s.x[3 * (bodies[4].first + 10) + 1] = 0.1, change = 0;
         else if (f == 57) { /* the last particle removed (the new body's corner), its triangles with it */
             m->np--;
@@ -375,22 +385,22 @@ TEST(tribroad_quick_answer_matches_search_over_frames)
  * the motion), and a single point left after culling, must give the search's list. */
 TEST(tribroad_quick_answer_at_the_edge_of_reach)
 {
-    for (int side = 0; side < 2; side++) {
+    for (int side = 0; side < 3; side++) { /* 2: as 0 with loose corners (no body on either side) */
         wb_world *w = world_new();
         const wb_real c[3][3] = { { 0, 0, 0 }, { 0.3, 0, 0 }, { 0, 0, 0.3 } };
         int32_t tri[3];
         const int32_t g = wb_group_new(w);
         for (int k = 0; k < 3; k++) tri[k] = wb_particle_add(w, c[k], NULL, 0, 0.01);
-        for (int k = 0; k < 3; k++) wb_particle_set_group(w, tri[k], g); /* a body: its corners culled */
+        for (int k = 0; k < 3 && side < 2; k++) wb_particle_set_group(w, tri[k], g); /* a body: its corners culled */
         REQUIRE(wb_surface_add(w, tri, 1) >= 0);
         const wb_real v[3] = { 0, -1, 0 };
-        const wb_real p0[3] = { side ? -0.1 : 0.1, side ? 0 : 0.1, 0.1 };
+        const wb_real p0[3] = { side == 1 ? -0.1 : 0.1, side == 1 ? 0 : 0.1, 0.1 };
         const int32_t p = wb_particle_add(w, p0, v, 0.01, 0.02);
         wb_particle_add(w, (wb_real[3]){ 5, 5, 5 }, NULL, 0.01, 0.02); /* far away: one more point */
         int bad = 0, empty = 0, full = 0;
         for (int f = 0; f < 100; f++) {
             wb_real *x = &w->s.x[3 * p];
-            if (side) x[0] += 0.001; /* towards the edge x = 0, in the plane */
+            if (side == 1) x[0] += 0.001; /* towards the edge x = 0, in the plane */
             else x[1] -= 0.001;      /* down onto the middle */
             int32_t n, nf, *fresh;
             int32_t *l = quick_and_fresh(w, 1, &n, &fresh, &nf);
