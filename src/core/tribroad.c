@@ -150,19 +150,20 @@ static inline void item_box(const struct wb_tribroad *b, const wb_real *x, int32
     }
 }
 
-/* the runs of list (n items) into b->runs from r0, the run of each item in rid; the run
+/* the runs of the triangles of list (n; keys: tkey) into b->runs from r0, the run of each
+ * in rid (point_runs below forms the points'); the run
  * boxes grown by a few ulps of their coordinates and of the largest reach (eps): the
  * exact test passes only for boxes that overlap but for round-off, and a pair's boxes
  * then meet inside both runs' grown boxes. Returns the runs, -1 when too many, -2 when
  * out of memory */
-static int32_t make_runs(struct wb_tribroad *b, int32_t r0, const int32_t *list, int32_t n, int tris,
-                         const wb_world *w, int32_t *rid, wb_real eps)
+static int32_t make_runs(struct wb_tribroad *b, int32_t r0, const int32_t *list, int32_t n, const wb_world *w,
+                         int32_t *rid, wb_real eps)
 {
     int32_t nr = 0, keyless = -1, last = -1, cur = -1;
     wb_real blo[3] = { INFINITY, INFINITY, INFINITY }, bhi[3] = { -INFINITY, -INFINITY, -INFINITY };
     for (int32_t k = 0; k <= n; k++) {
         /* the current run's box is gathered in blo, bhi and merged when the run changes */
-        const int32_t i = k < n ? list[k] : -1, key = k == n ? -1 : tris ? b->tkey[i] : w->m.group[i];
+        const int32_t i = k < n ? list[k] : -1, key = k == n ? -1 : b->tkey[i];
         int32_t next;
         if (key == 0 && keyless >= 0) next = keyless;
         else if (key > 0 && last >= 0 && b->runs[r0 + last].key == key) next = last;
@@ -188,7 +189,7 @@ static int32_t make_runs(struct wb_tribroad *b, int32_t r0, const int32_t *list,
         if (key != 0) last = cur;
         rid[k] = r0 + cur;
         wb_real lo[3], hi[3];
-        item_box(b, w->s.x, i, tris, lo, hi);
+        item_box(b, w->s.x, i, 1, lo, hi);
         for (int a = 0; a < 3; a++) {
             blo[a] = lo[a] < blo[a] ? lo[a] : blo[a];
             bhi[a] = hi[a] > bhi[a] ? hi[a] : bhi[a];
@@ -202,6 +203,57 @@ static int32_t make_runs(struct wb_tribroad *b, int32_t r0, const int32_t *list,
             R->hi[a] += e;
         }
     }
+    return nr;
+}
+
+/* make_runs for points (their keys: groups): the same runs, each stretch of consecutive
+ * points of one key gathered in one tight loop, the stretches (first, end, run) into seg
+ * (*nseg; at most n). The quick answer and the cull pass over every point each frame */
+static int32_t point_runs(struct wb_tribroad *b, const int32_t *list, int32_t n, const wb_world *w, int32_t *seg,
+                          int32_t *nseg, wb_real eps)
+{
+    const int32_t *group = w->m.group;
+    const wb_real *x = w->s.x, *sr = b->sr;
+    int32_t nr = 0, keyless = -1, last = -1, ns = 0;
+    for (int32_t k = 0; k < n;) {
+        const int32_t key = group[list[k]];
+        int32_t r;
+        if (key == 0 && keyless >= 0) r = keyless;
+        else if (key > 0 && last >= 0 && b->runs[last].key == key) r = last;
+        else {
+            if (nr == RUNS_MAX) return -1;
+            if (!grow((void **)&b->runs, &b->cap_runs, nr + 1, sizeof *b->runs)) return -2;
+            r = nr++;
+            run *R = &b->runs[r];
+            R->key = key;
+            for (int a = 0; a < 3; a++) { R->lo[a] = INFINITY; R->hi[a] = -INFINITY; }
+            if (key == 0) keyless = r;
+        }
+        if (key != 0) last = r;
+        wb_real l0 = INFINITY, l1 = INFINITY, l2 = INFINITY, h0 = -INFINITY, h1 = -INFINITY, h2 = -INFINITY;
+        int32_t k1 = k;
+        for (; k1 < n && group[list[k1]] == key; k1++) {
+            const wb_real *p = &x[3 * list[k1]], ri = sr[list[k1]];
+            const wb_real a0 = p[0] - ri, a1 = p[1] - ri, a2 = p[2] - ri, c0 = p[0] + ri, c1 = p[1] + ri, c2 = p[2] + ri;
+            l0 = a0 < l0 ? a0 : l0, l1 = a1 < l1 ? a1 : l1, l2 = a2 < l2 ? a2 : l2;
+            h0 = c0 > h0 ? c0 : h0, h1 = c1 > h1 ? c1 : h1, h2 = c2 > h2 ? c2 : h2;
+        }
+        run *R = &b->runs[r];
+        R->lo[0] = min_(R->lo[0], l0), R->lo[1] = min_(R->lo[1], l1), R->lo[2] = min_(R->lo[2], l2);
+        R->hi[0] = max_(R->hi[0], h0), R->hi[1] = max_(R->hi[1], h1), R->hi[2] = max_(R->hi[2], h2);
+        seg[3 * ns] = k, seg[3 * ns + 1] = k1, seg[3 * ns + 2] = r;
+        ns++;
+        k = k1;
+    }
+    for (int32_t r = 0; r < nr; r++) {
+        run *R = &b->runs[r];
+        for (int a = 0; a < 3; a++) {
+            const wb_real e = 1e-14 * max_(fabs(R->lo[a]), fabs(R->hi[a])) + eps; /* as make_runs */
+            R->lo[a] -= e;
+            R->hi[a] += e;
+        }
+    }
+    *nseg = ns;
     return nr;
 }
 
@@ -237,21 +289,38 @@ static int overlaps(struct wb_tribroad *b, int32_t ra, int32_t s0, int32_t s1, i
     return 1;
 }
 
-/* the items of list whose box meets one of their run's overlaps, kept in order */
-static int32_t keep(const struct wb_tribroad *b, int32_t *list, const int32_t *rid, int32_t n, int tris,
-                    const wb_real *x)
+/* whether item i (tris: a triangle, else a point) of run A is kept: A covered by one box,
+ * or i's box meets one of A's overlaps */
+static inline int kept_item(const struct wb_tribroad *b, const run *A, const wb_real *x, int32_t i, int tris)
+{
+    if (A->nbox < 0) return 1;
+    wb_real lo[3], hi[3];
+    item_box(b, x, i, tris, lo, hi);
+    for (int32_t q = A->box0; q < A->box0 + A->nbox; q++)
+        if (box_overlap(lo, hi, &b->boxes[6 * q], &b->boxes[6 * q + 3])) return 1;
+    return 0;
+}
+
+/* the triangles of list whose box meets one of their run's overlaps, kept in order */
+static int32_t keep(const struct wb_tribroad *b, int32_t *list, const int32_t *rid, int32_t n, const wb_real *x)
 {
     int32_t m = 0;
-    for (int32_t k = 0; k < n; k++) {
-        const int32_t i = list[k];
-        const run *A = &b->runs[rid[k]];
-        if (A->nbox < 0) { list[m++] = i; continue; }
-        wb_real lo[3], hi[3];
-        item_box(b, x, i, tris, lo, hi);
-        for (int32_t q = A->box0; q < A->box0 + A->nbox; q++) {
-            const wb_real *bx = &b->boxes[6 * q];
-            if (box_overlap(lo, hi, bx, bx + 3)) { list[m++] = i; break; }
-        }
+    for (int32_t k = 0; k < n; k++)
+        if (kept_item(b, &b->runs[rid[k]], x, list[k], 1)) list[m++] = list[k];
+    return m;
+}
+
+/* keep for points, a stretch at a time (point_runs' seg): the stretch of a run that meets
+ * no triangle run is dropped whole */
+static int32_t keep_points(const struct wb_tribroad *b, int32_t *list, const int32_t *seg, int32_t nseg,
+                           const wb_real *x)
+{
+    int32_t m = 0;
+    for (int32_t s = 0; s < nseg; s++) {
+        const run *A = &b->runs[seg[3 * s + 2]];
+        if (A->nbox == 0) continue;
+        for (int32_t k = seg[3 * s]; k < seg[3 * s + 1]; k++)
+            if (kept_item(b, A, x, list[k], 0)) list[m++] = list[k];
     }
     return m;
 }
@@ -260,14 +329,15 @@ static int32_t keep(const struct wb_tribroad *b, int32_t *list, const int32_t *r
  * out of memory */
 static int cull(struct wb_tribroad *b, const wb_world *w, int32_t *np_, int32_t *nt_, wb_real rmax)
 {
-    if (!grow((void **)&b->prun, &b->cap_prun, *np_, sizeof *b->prun) ||
+    if (!grow((void **)&b->prun, &b->cap_prun, 3 * (int64_t)*np_, sizeof *b->prun) ||
         !grow((void **)&b->trun, &b->cap_trun, *nt_, sizeof *b->trun))
         return -1;
     const wb_real eps = 1e-14 * rmax;
-    const int32_t npr = make_runs(b, 0, b->pc, *np_, 0, w, b->prun, eps);
+    int32_t nseg;
+    const int32_t npr = point_runs(b, b->pc, *np_, w, b->prun, &nseg, eps);
     if (npr == -2) return -1;
     if (npr < 0) return 0;
-    const int32_t ntr = make_runs(b, npr, b->tc, *nt_, 1, w, b->trun, eps);
+    const int32_t ntr = make_runs(b, npr, b->tc, *nt_, w, b->trun, eps);
     if (ntr == -2) return -1;
     if (ntr < 0) return 0;
     int32_t nb = 0;
@@ -275,8 +345,8 @@ static int cull(struct wb_tribroad *b, const wb_world *w, int32_t *np_, int32_t 
         if (!overlaps(b, r, npr, npr + ntr, &nb)) return -1;
     for (int32_t r = npr; r < npr + ntr; r++)
         if (!overlaps(b, r, 0, npr, &nb)) return -1;
-    *np_ = keep(b, b->pc, b->prun, *np_, 0, w->s.x);
-    *nt_ = keep(b, b->tc, b->trun, *nt_, 1, w->s.x);
+    *np_ = keep_points(b, b->pc, b->prun, nseg, w->s.x);
+    *nt_ = keep(b, b->tc, b->trun, *nt_, w->s.x);
     return 0;
 }
 
@@ -829,9 +899,10 @@ static int quick_empty(struct wb_tribroad *b, wb_world *w, int32_t na, wb_real r
     }
     if (b->nq < 0) return 0;
     if (na == 0 || b->nq == 0) return 1;
-    if (!grow((void **)&b->prun, &b->cap_prun, na, sizeof *b->prun)) return -1;
+    if (!grow((void **)&b->prun, &b->cap_prun, 3 * (int64_t)na, sizeof *b->prun)) return -1;
     const wb_real eps = 1e-14 * rmax;
-    const int32_t npr = make_runs(b, 0, b->pc, na, 0, w, b->prun, eps);
+    int32_t nseg;
+    const int32_t npr = point_runs(b, b->pc, na, w, b->prun, &nseg, eps);
     if (npr == -2) return -1;
     if (npr < 0) return 0;
     if (!grow((void **)&b->runs, &b->cap_runs, npr + b->nq, sizeof *b->runs)) return -1;
@@ -859,7 +930,7 @@ static int quick_empty(struct wb_tribroad *b, wb_world *w, int32_t na, wb_real r
     int32_t nb = 0;
     for (int32_t r = 0; r < npr; r++)
         if (!overlaps(b, r, npr, npr + b->nq, &nb)) return -1;
-    const int32_t n = keep(b, b->pc, b->prun, na, 0, x);
+    const int32_t n = keep_points(b, b->pc, b->prun, nseg, x);
     if (n == 0) return 1;
     /* the triangle runs some point left meets (its box against the run's, as overlaps
      * tests runs), when that is cheap next to boxing every triangle */
