@@ -22,8 +22,9 @@ SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2 scale32 scale64 scale128 scale25
 FLOAT_SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2"
 SCENES="$SCENES bend"   # the bending scene (tests/bench/bend.lua)
 
-# scene EXE NAME HEADER(1/0) [ROW]: one row (and the header when asked); with ROW the row
-# is named ROW and has no Bullet figures (the busy-core rows: Bullet ran without the spinner).
+# scene EXE NAME HEADER(1/0) [ROW [SET]]: one row (and the header when asked); with ROW the row
+# is named ROW and has no Bullet figures (the busy-core rows: Bullet ran without the spinner);
+# SET: one more --set for the scene (contacts_off: contacts=0).
 # Best of REPEAT runs (default 3), each a process of its own: the lowest ms per frame, the
 # usual way to see past a shared host's hiccups (one run of a scene under a second varies
 # by up to 50% on the 2-core VM). Bullet's figures are measured once (the cache).
@@ -37,7 +38,8 @@ scene() {
         k=$((k + 1))
         : >"$ONE" || exit 2
         out=$("$1" bench --unsafe --quiet --out "$BUILD/bench-out" --set scenes="$2" --set header="$3" \
-              --set bullet="$peer" --set bullet_cache="$CACHE" --set json_file="$ONE" --set row="$row" 2>&1)
+              --set bullet="$peer" --set bullet_cache="$CACHE" --set json_file="$ONE" --set row="$row" \
+              ${5:+--set "$5"} 2>&1)
         rc=$?
         if [ $rc -ne 0 ] || ! echo "$out" | grep -q "^$row "; then
             echo "$out" | grep -v '^# tests/bench/' >&2
@@ -64,6 +66,7 @@ for s in $SCENES; do
     scene "$BUILD/wobble" "$s" $first
     first=0
 done
+scene "$BUILD/wobble" contacts 0 contacts_off contacts=0   # issue 8: what contacts add
 if [ -n "$FLOAT" ]; then
     echo
     echo "== WB_FLOAT ($FLOAT): the cloth scenes (Bullet's figures as above)"
@@ -117,6 +120,18 @@ goal "cloth128: 2 threads / 1 thread (speed-up)" "$(speedup cloth128 double)" 1.
 goal "cloth32: 2 threads / 1 thread (not slower)" "$(speedup cloth32 double)" 0.9
 goal "busy core: cloth128, 2 threads / 1 thread" "$(speedup busy128 double)" 0.9
 goal "busy core: cloth32, 2 threads / 1 thread" "$(speedup busy32 double)" 0.9
+# the aims of issue 8 (smaller is better): the contact broad phase against one distance
+# sweep over the same particles, and what contacts add to the frame
+aim() {
+    awk -v l="$1" -v v="$2" -v g="$3" 'BEGIN {
+        if (v == "") { printf "  %-46s %8s   aim < %5.2f\n", l, "-", g; exit }
+        printf "  %-46s %8.2f   aim < %5.2f  %s\n", l, v, g, (v + 0 < g ? "met" : "not met") }'
+}
+row() { grep "\"scene\": \"$1\"" "$JSON" | head -n 1 | sed -n "s/.*\"$2\": \([-0-9.e+]*\)[,}].*/\1/p"; }
+echo "== the aims of issue 8 (contacts.lua; wall clock)"
+aim "broad phase / one distance sweep" "$(row contacts broad_sweeps)" 1
+on=$(row contacts ms_per_frame) off=$(row contacts_off ms_per_frame)
+aim "frame with contacts / without" "$([ -n "$on" ] && [ -n "$off" ] && awk -v a="$on" -v b="$off" 'BEGIN { printf "%.4f", a / b }')" 2
 if [ -n "$FLOAT" ]; then
     # the goals are for the default double build; WB_FLOAT is reported beside them (its
     # projections have no vector paths: they are double-only)
