@@ -451,7 +451,7 @@ static int list_valid(const wb_broad *b, const wb_real *x, const wb_real *reach,
     for (int32_t i = 0; i < n; i++) {
         /* takes_part(i) == (R[i] >= 0), its cheap half first: one that was left out (R < 0)
          * must still be; one that took part must have a reach >= 0 and finite, and a
-         * position within its slack (a position not finite fails that test) */
+         * position within its slack (a position not finite fails one of the two tests) */
         const wb_real Ri = R[i], ri = reach[i];
         if (Ri < 0) {
             if (takes_part(x, reach, i)) return 0;

@@ -75,6 +75,18 @@ static int pair_allowed(const wb_model *m, int32_t p, int32_t v)
     return (m->cflags[p] & m->cflags[v] & WB_CF_SELF) != 0;
 }
 
+/* the body no point of which may touch triangle tv: its corners' body when that does not
+ * collide with itself, else 0 (the search, tri_scan and the quick answer's runs all cull
+ * by it: one rule) */
+static inline int32_t tri_key(const wb_model *m, const int32_t *tv)
+{
+    const int32_t g0 = m->group[tv[0]];
+    return g0 > 0 && m->group[tv[1]] == g0 && m->group[tv[2]] == g0 &&
+                   !(m->cflags[tv[0]] & m->cflags[tv[1]] & m->cflags[tv[2]] & WB_CF_SELF)
+               ? g0
+               : 0;
+}
+
 /* the rules without geometry: not its own corner, and each corner allowed; *same: some
  * corner is of the point's own body (the rest rule then applies) */
 static int rules_allow(const wb_model *m, int32_t p, const int32_t *v, int *same)
@@ -208,7 +220,7 @@ static int32_t make_runs(struct wb_tribroad *b, int32_t r0, const int32_t *list,
 
 /* make_runs for points (their keys: groups): the same runs, each stretch of consecutive
  * points of one key gathered in one tight loop, the stretches (first, end, run) into seg
- * (*nseg; at most n). The quick answer and the cull pass over every point each frame */
+ * (*nseg; at most n). The quick answer passes over every point each frame */
 static int32_t point_runs(struct wb_tribroad *b, const int32_t *list, int32_t n, const wb_world *w, int32_t *seg,
                           int32_t *nseg, wb_real eps)
 {
@@ -672,7 +684,9 @@ static void tri_normal(const wb_model *m, const wb_real *x, int32_t t, wb_real *
 
 /* the pairs of points of reach `reach` (rsum summed over nr) and triangles of motions mvp
  * into b->pt2 by point, each point's by triangle (*total); *ocell: the cell of the
- * projection's order. -1 when out of memory */
+ * projection's order (set when *total > 0). The points: b->pc[0 .. npts) when npts >= 0
+ * (what the quick answer left), else all; the triangles: those of the quick answer's runs
+ * marked in need, else all. -1 when out of memory */
 static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, const wb_real *mvp, wb_real rsum,
                   int32_t nr, int32_t npts, const uint8_t *need, int64_t *total, wb_real *ocell)
 {
@@ -708,10 +722,7 @@ static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, cons
         if (need && (b->qtrun[t] < 0 || !need[b->qtrun[t]])) continue;
         const wb_real e = tri_box(m, x, mvp, t, &b->tbox[TB * t]);
         if (e != e) continue;
-        const int32_t *tv = &m->tri[3 * t];
-        const int32_t g0 = m->group[tv[0]];
-        b->tkey[t] = g0 > 0 && m->group[tv[1]] == g0 && m->group[tv[2]] == g0 &&
-                     !(m->cflags[tv[0]] & m->cflags[tv[1]] & m->cflags[tv[2]] & WB_CF_SELF) ? g0 : 0;
+        b->tkey[t] = tri_key(m, &m->tri[3 * t]);
         b->tc[nt++] = t;
         sum += e;
     }
@@ -797,7 +808,8 @@ static int finish(struct wb_tribroad *b, wb_world *w, int64_t total, wb_real oce
  * once each, instead of 9 coordinates per triangle), and the points are culled against
  * them as in pass 1: when no point is left, no pair can pass the exact test and the
  * list is empty, as the search would find (the larger boxes only keep more). Else the
- * search runs as before: the list is the search's either way. */
+ * search takes the points left and the triangles of the runs their boxes meet (what
+ * is left out meets nothing, by the same boxes): the list is the search's either way. */
 
 /* the arrays the runs depend on (triangles, flags, groups), one after the other: copied
  * into b->kmodel (store), or compared with it */
@@ -846,8 +858,7 @@ static int quick_runs(struct wb_tribroad *b, const wb_model *m)
         const uint8_t f0 = m->cflags[tv[0]], f1 = m->cflags[tv[1]], f2 = m->cflags[tv[2]];
         rid[t] = -1;
         if (!((f0 | f1 | f2) & (WB_CF_COLLIDE | WB_CF_SELF))) continue;
-        const int32_t g0 = m->group[tv[0]];
-        const int32_t key = g0 > 0 && m->group[tv[1]] == g0 && m->group[tv[2]] == g0 && !(f0 & f1 & f2 & WB_CF_SELF) ? g0 : 0;
+        const int32_t key = tri_key(m, tv);
         int32_t r;
         if (key == 0 && keyless >= 0) r = keyless;
         else if (key > 0 && last >= 0 && keys[last] == key) r = last;
@@ -888,10 +899,12 @@ static int quick_runs(struct wb_tribroad *b, const wb_model *m)
 /* 1 when no point can meet a triangle this frame (the points b->pc, na, their largest
  * reach rmax; positions and motions finite), 0 when some may, -1 when out of memory.
  * When some may, the points that may are left first in b->pc, *left of them (-1: not
- * worked out), and need[r] says whether one may meet a triangle of run r */
-static int quick_empty(struct wb_tribroad *b, wb_world *w, int32_t na, wb_real rmax, int32_t *left, uint8_t *need)
+ * worked out), and when *tris need[r] says whether one may meet a triangle of run r */
+static int quick_empty(struct wb_tribroad *b, wb_world *w, int32_t na, wb_real rmax, int32_t *left, uint8_t *need,
+                       int *tris)
 {
     *left = -1;
+    *tris = 0;
     const wb_model *m = &w->m;
     const wb_real *x = w->s.x, *mvp = b->mv;
     if (!b->qvalid || !model_same(b, m, 0)) {
@@ -935,9 +948,9 @@ static int quick_empty(struct wb_tribroad *b, wb_world *w, int32_t na, wb_real r
     /* the triangle runs some point left meets (its box against the run's, as overlaps
      * tests runs), when that is cheap next to boxing every triangle */
     *left = n;
-    const int all = (int64_t)n * b->nq > 4 * (int64_t)m->ntri + 1024;
-    memset(need, all, (size_t)b->nq);
-    for (int32_t k = 0; !all && k < n; k++) {
+    *tris = (int64_t)n * b->nq <= 4 * (int64_t)m->ntri + 1024; /* else every triangle */
+    memset(need, 0, (size_t)b->nq);
+    for (int32_t k = 0; *tris && k < n; k++) {
         const int32_t p = b->pc[k], key = m->group[p];
         wb_real lo[3], hi[3];
         item_box(b, x, p, 0, lo, hi);
@@ -983,13 +996,14 @@ static int broadphase(wb_world *w)
     b->sr = reach;
     /* the quick answer; when it has none, the search takes the points it left and the
      * triangles of the runs they may meet (the list is the same). When it leaves more
-     * than half the points, it waits 1, 2, 4 ... 16 frames (a scene always in touch pays
-     * for it once in a while only) */
+     * than half the points (or cannot answer: too many runs), it waits 1, 2, 4 ... 16
+     * frames (a scene always in touch pays for it once in a while only) */
     int32_t left = -1;
     uint8_t need[RUNS_MAX];
+    int tris = 0;
     if (b->qwait > 0) b->qwait--;
     else if (finite && !b->fresh_only) {
-        const int r = quick_empty(b, w, na, rmax, &left, need);
+        const int r = quick_empty(b, w, na, rmax, &left, need, &tris);
         if (r < 0) return -1;
         if (r || (left >= 0 && left <= na / 2)) b->qback = 0;
         else {
@@ -1000,7 +1014,7 @@ static int broadphase(wb_world *w)
     }
     int64_t total;
     wb_real ocell;
-    if (search(b, w, reach, mvp, rsum, nr, left, left >= 0 ? need : NULL, &total, &ocell) < 0) return -1;
+    if (search(b, w, reach, mvp, rsum, nr, left, tris ? need : NULL, &total, &ocell) < 0) return -1;
     if (total == 0) return 0;
     return finish(b, w, total, ocell);
 }
