@@ -321,8 +321,8 @@ struct wb_tribroad {
     wb_real *mv; int32_t cap_mv;         /* (np) how far it may move this frame (reach without radius) */
     wb_real *tbox; int32_t cap_tbox;     /* (ntri x 14) box, motion, normal, order cell (tribroad.c) */
     int32_t *tkey; int32_t cap_tkey;     /* (ntri) the body none of whose points may touch it, or 0 */
-    int32_t *pc, *tc, *prun, *trun, *tmp; /* points, triangles kept; the points' stretches (first,
-                                             end, run), the triangles' runs; scratch */
+    int32_t *pc, *tc, *prun, *trun, *tmp; /* points, triangles kept; their stretches (first, end,
+                                             run: tribroad.c's make_runs); scratch */
     int32_t cap_pc, cap_tc, cap_prun, cap_trun, cap_tmp;
     struct wb_tribroad_run *runs; int32_t cap_runs;
     wb_real *boxes; int32_t cap_boxes;   /* (lo, hi) of runs' overlaps */

@@ -162,111 +162,89 @@ static inline void item_box(const struct wb_tribroad *b, const wb_real *x, int32
     }
 }
 
-/* the runs of the triangles of list (n; keys: tkey) into b->runs from r0, the run of each
- * in rid (point_runs below forms the points'); the run
- * boxes grown by a few ulps of their coordinates and of the largest reach (eps): the
- * exact test passes only for boxes that overlap but for round-off, and a pair's boxes
- * then meet inside both runs' grown boxes. Returns the runs, -1 when too many, -2 when
- * out of memory */
-static int32_t make_runs(struct wb_tribroad *b, int32_t r0, const int32_t *list, int32_t n, const wb_world *w,
-                         int32_t *rid, wb_real eps)
+/* The runs: consecutive items of one body key share a run, and every keyless item (key
+ * 0) shares one wherever it stands. One rule for the points' runs, the triangles' and
+ * the quick answer's (pick_run; a picker starts as {0, -1, -1, 0}) */
+typedef struct { int32_t n, keyless, last, last_key; } run_picker;
+
+/* the run of the next item (key); *fresh when it is a new one (the last, n - 1); -1 when
+ * there would be more than RUNS_MAX */
+static inline int32_t pick_run(run_picker *q, int32_t key, int *fresh)
 {
-    int32_t nr = 0, keyless = -1, last = -1, cur = -1;
-    wb_real blo[3] = { INFINITY, INFINITY, INFINITY }, bhi[3] = { -INFINITY, -INFINITY, -INFINITY };
-    for (int32_t k = 0; k <= n; k++) {
-        /* the current run's box is gathered in blo, bhi and merged when the run changes */
-        const int32_t i = k < n ? list[k] : -1, key = k == n ? -1 : b->tkey[i];
-        int32_t next;
-        if (key == 0 && keyless >= 0) next = keyless;
-        else if (key > 0 && last >= 0 && b->runs[r0 + last].key == key) next = last;
-        else next = -1;
-        if (next < 0 || next != cur || k == n) {
-            if (cur >= 0) {
-                run *R = &b->runs[r0 + cur];
-                for (int a = 0; a < 3; a++) R->lo[a] = min_(R->lo[a], blo[a]), R->hi[a] = max_(R->hi[a], bhi[a]);
-            }
-            if (k == n) break;
-            if (next < 0) {
-                if (nr == RUNS_MAX) return -1;
-                if (!grow((void **)&b->runs, &b->cap_runs, r0 + nr + 1, sizeof *b->runs)) return -2;
-                next = nr++;
-                run *R = &b->runs[r0 + next];
-                R->key = key;
-                for (int a = 0; a < 3; a++) { R->lo[a] = INFINITY; R->hi[a] = -INFINITY; }
-                if (key == 0) keyless = next;
-            }
-            cur = next;
-            for (int a = 0; a < 3; a++) blo[a] = INFINITY, bhi[a] = -INFINITY;
-        }
-        if (key != 0) last = cur;
-        rid[k] = r0 + cur;
-        wb_real lo[3], hi[3];
-        item_box(b, w->s.x, i, 1, lo, hi);
-        for (int a = 0; a < 3; a++) {
-            blo[a] = lo[a] < blo[a] ? lo[a] : blo[a];
-            bhi[a] = hi[a] > bhi[a] ? hi[a] : bhi[a];
-        }
+    int32_t r;
+    *fresh = 0;
+    if (key == 0 && q->keyless >= 0) r = q->keyless;
+    else if (key > 0 && q->last >= 0 && q->last_key == key) r = q->last;
+    else {
+        if (q->n == RUNS_MAX) return -1;
+        r = q->n++;
+        *fresh = 1;
+        if (key == 0) q->keyless = r;
     }
-    for (int32_t r = r0; r < r0 + nr; r++) {
-        run *R = &b->runs[r];
-        for (int a = 0; a < 3; a++) {
-            const wb_real e = 1e-14 * max_(fabs(R->lo[a]), fabs(R->hi[a])) + eps;
-            R->lo[a] -= e;
-            R->hi[a] += e;
-        }
-    }
-    return nr;
+    if (key != 0) q->last = r, q->last_key = key;
+    return r;
 }
 
-/* make_runs for points (their keys: groups): the same runs, each stretch of consecutive
- * points of one key gathered in one tight loop, the stretches (first, end, run) into seg
- * (*nseg; at most n). The quick answer passes over every point each frame */
-static int32_t point_runs(struct wb_tribroad *b, const int32_t *list, int32_t n, const wb_world *w, int32_t *seg,
-                          int32_t *nseg, wb_real eps)
+/* run boxes grown by a few ulps of their coordinates and of the largest reach (eps): the
+ * exact test passes only for boxes that overlap but for round-off, and a pair's boxes
+ * then meet inside both runs' grown boxes */
+static void pad_runs(run *R, int32_t n, wb_real eps)
 {
-    const int32_t *group = w->m.group;
-    const wb_real *x = w->s.x, *sr = b->sr;
-    int32_t nr = 0, keyless = -1, last = -1, ns = 0;
+    for (int32_t r = 0; r < n; r++)
+        for (int a = 0; a < 3; a++) {
+            const wb_real e = 1e-14 * max_(fabs(R[r].lo[a]), fabs(R[r].hi[a])) + eps;
+            R[r].lo[a] -= e;
+            R[r].hi[a] += e;
+        }
+}
+
+/* lo, hi grown to item i's box */
+static inline void add_item(const struct wb_tribroad *b, const wb_real *x, int32_t i, int tris, wb_real lo[3],
+                            wb_real hi[3])
+{
+    wb_real l[3], h[3];
+    item_box(b, x, i, tris, l, h);
+    for (int a = 0; a < 3; a++) {
+        lo[a] = l[a] < lo[a] ? l[a] : lo[a];
+        hi[a] = h[a] > hi[a] ? h[a] : hi[a];
+    }
+}
+
+/* the runs of list (n items; tris: triangles keyed by tkey, else points keyed by group)
+ * into b->runs from r0, padded (pad_runs); each stretch of consecutive items of one key
+ * gathered in one tight loop, the stretches (first, end, run) into seg (*nseg; at most
+ * n). Returns the runs, -1 when too many, -2 when out of memory */
+static int32_t make_runs(struct wb_tribroad *b, int32_t r0, const int32_t *list, int32_t n, const wb_world *w,
+                         int tris, int32_t *seg, int32_t *nseg, wb_real eps)
+{
+    const int32_t *keys = tris ? b->tkey : w->m.group;
+    const wb_real *x = w->s.x;
+    run_picker q = { 0, -1, -1, 0 };
+    int32_t ns = 0;
     for (int32_t k = 0; k < n;) {
-        const int32_t key = group[list[k]];
-        int32_t r;
-        if (key == 0 && keyless >= 0) r = keyless;
-        else if (key > 0 && last >= 0 && b->runs[last].key == key) r = last;
-        else {
-            if (nr == RUNS_MAX) return -1;
-            if (!grow((void **)&b->runs, &b->cap_runs, nr + 1, sizeof *b->runs)) return -2;
-            r = nr++;
-            run *R = &b->runs[r];
+        const int32_t key = keys[list[k]];
+        int fresh;
+        const int32_t r = pick_run(&q, key, &fresh);
+        if (r < 0) return -1;
+        if (fresh) {
+            if (!grow((void **)&b->runs, &b->cap_runs, r0 + r + 1, sizeof *b->runs)) return -2;
+            run *R = &b->runs[r0 + r];
             R->key = key;
             for (int a = 0; a < 3; a++) { R->lo[a] = INFINITY; R->hi[a] = -INFINITY; }
-            if (key == 0) keyless = r;
         }
-        if (key != 0) last = r;
-        wb_real l0 = INFINITY, l1 = INFINITY, l2 = INFINITY, h0 = -INFINITY, h1 = -INFINITY, h2 = -INFINITY;
+        wb_real lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
         int32_t k1 = k;
-        for (; k1 < n && group[list[k1]] == key; k1++) {
-            const wb_real *p = &x[3 * list[k1]], ri = sr[list[k1]];
-            const wb_real a0 = p[0] - ri, a1 = p[1] - ri, a2 = p[2] - ri, c0 = p[0] + ri, c1 = p[1] + ri, c2 = p[2] + ri;
-            l0 = a0 < l0 ? a0 : l0, l1 = a1 < l1 ? a1 : l1, l2 = a2 < l2 ? a2 : l2;
-            h0 = c0 > h0 ? c0 : h0, h1 = c1 > h1 ? c1 : h1, h2 = c2 > h2 ? c2 : h2;
-        }
-        run *R = &b->runs[r];
-        R->lo[0] = min_(R->lo[0], l0), R->lo[1] = min_(R->lo[1], l1), R->lo[2] = min_(R->lo[2], l2);
-        R->hi[0] = max_(R->hi[0], h0), R->hi[1] = max_(R->hi[1], h1), R->hi[2] = max_(R->hi[2], h2);
-        seg[3 * ns] = k, seg[3 * ns + 1] = k1, seg[3 * ns + 2] = r;
+        if (tris) for (; k1 < n && keys[list[k1]] == key; k1++) add_item(b, x, list[k1], 1, lo, hi);
+        else for (; k1 < n && keys[list[k1]] == key; k1++) add_item(b, x, list[k1], 0, lo, hi);
+        run *R = &b->runs[r0 + r];
+        for (int a = 0; a < 3; a++) R->lo[a] = min_(R->lo[a], lo[a]), R->hi[a] = max_(R->hi[a], hi[a]);
+        seg[3 * ns] = k, seg[3 * ns + 1] = k1, seg[3 * ns + 2] = r0 + r;
         ns++;
         k = k1;
     }
-    for (int32_t r = 0; r < nr; r++) {
-        run *R = &b->runs[r];
-        for (int a = 0; a < 3; a++) {
-            const wb_real e = 1e-14 * max_(fabs(R->lo[a]), fabs(R->hi[a])) + eps; /* as make_runs */
-            R->lo[a] -= e;
-            R->hi[a] += e;
-        }
-    }
+    pad_runs(b->runs + r0, q.n, eps);
     *nseg = ns;
-    return nr;
+    return q.n;
 }
 
 /* run A's overlaps with the runs [s0, s1) of keys it may touch; 0 when out of memory */
@@ -313,26 +291,18 @@ static inline int kept_item(const struct wb_tribroad *b, const run *A, const wb_
     return 0;
 }
 
-/* the triangles of list whose box meets one of their run's overlaps, kept in order */
-static int32_t keep(const struct wb_tribroad *b, int32_t *list, const int32_t *rid, int32_t n, const wb_real *x)
-{
-    int32_t m = 0;
-    for (int32_t k = 0; k < n; k++)
-        if (kept_item(b, &b->runs[rid[k]], x, list[k], 1)) list[m++] = list[k];
-    return m;
-}
-
-/* keep for points, a stretch at a time (point_runs' seg): the stretch of a run that meets
- * no triangle run is dropped whole */
-static int32_t keep_points(const struct wb_tribroad *b, int32_t *list, const int32_t *seg, int32_t nseg,
-                           const wb_real *x)
+/* the items of list (make_runs' seg, nseg stretches; tris: triangles, else points) that
+ * kept_item keeps, in order; the stretch of a run that meets no run of the other kind is
+ * dropped whole */
+static int32_t keep(const struct wb_tribroad *b, int32_t *list, const int32_t *seg, int32_t nseg, const wb_real *x,
+                    int tris)
 {
     int32_t m = 0;
     for (int32_t s = 0; s < nseg; s++) {
         const run *A = &b->runs[seg[3 * s + 2]];
         if (A->nbox == 0) continue;
         for (int32_t k = seg[3 * s]; k < seg[3 * s + 1]; k++)
-            if (kept_item(b, A, x, list[k], 0)) list[m++] = list[k];
+            if (kept_item(b, A, x, list[k], tris)) list[m++] = list[k];
     }
     return m;
 }
@@ -342,14 +312,14 @@ static int32_t keep_points(const struct wb_tribroad *b, int32_t *list, const int
 static int cull(struct wb_tribroad *b, const wb_world *w, int32_t *np_, int32_t *nt_, wb_real rmax)
 {
     if (!grow((void **)&b->prun, &b->cap_prun, 3 * (int64_t)*np_, sizeof *b->prun) ||
-        !grow((void **)&b->trun, &b->cap_trun, *nt_, sizeof *b->trun))
+        !grow((void **)&b->trun, &b->cap_trun, 3 * (int64_t)*nt_, sizeof *b->trun))
         return -1;
     const wb_real eps = 1e-14 * rmax;
-    int32_t nseg;
-    const int32_t npr = point_runs(b, b->pc, *np_, w, b->prun, &nseg, eps);
+    int32_t nps, nts;
+    const int32_t npr = make_runs(b, 0, b->pc, *np_, w, 0, b->prun, &nps, eps);
     if (npr == -2) return -1;
     if (npr < 0) return 0;
-    const int32_t ntr = make_runs(b, npr, b->tc, *nt_, w, b->trun, eps);
+    const int32_t ntr = make_runs(b, npr, b->tc, *nt_, w, 1, b->trun, &nts, eps);
     if (ntr == -2) return -1;
     if (ntr < 0) return 0;
     int32_t nb = 0;
@@ -357,8 +327,8 @@ static int cull(struct wb_tribroad *b, const wb_world *w, int32_t *np_, int32_t 
         if (!overlaps(b, r, npr, npr + ntr, &nb)) return -1;
     for (int32_t r = npr; r < npr + ntr; r++)
         if (!overlaps(b, r, 0, npr, &nb)) return -1;
-    *np_ = keep_points(b, b->pc, b->prun, nseg, w->s.x);
-    *nt_ = keep(b, b->tc, b->trun, *nt_, w->s.x);
+    *np_ = keep(b, b->pc, b->prun, nps, w->s.x, 0);
+    *nt_ = keep(b, b->tc, b->trun, nts, w->s.x, 1);
     return 0;
 }
 
@@ -845,32 +815,27 @@ static int cmp_i32(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-/* the triangle runs (as make_runs forms them) and each run's corners, once each: b->qrun
+/* the triangle runs (pick_run's rule) and each run's corners, once each: b->qrun
  * (key, first corner, end), b->qcorner; b->nq = -1 when too many runs. 0 when out of memory */
 static int quick_runs(struct wb_tribroad *b, const wb_model *m)
 {
     b->qvalid = 0;
     if (!model_same(b, m, 1) || !grow((void **)&b->qtrun, &b->cap_qtrun, m->ntri, sizeof *b->qtrun)) return 0;
-    int32_t *rid = b->qtrun, nq = 0, keyless = -1, last = -1;
+    int32_t *rid = b->qtrun;
     int32_t keys[RUNS_MAX];
+    run_picker pick = { 0, -1, -1, 0 };
     for (int32_t t = 0; t < m->ntri; t++) {
         const int32_t *tv = &m->tri[3 * t];
         const uint8_t f0 = m->cflags[tv[0]], f1 = m->cflags[tv[1]], f2 = m->cflags[tv[2]];
         rid[t] = -1;
         if (!((f0 | f1 | f2) & (WB_CF_COLLIDE | WB_CF_SELF))) continue;
         const int32_t key = tri_key(m, tv);
-        int32_t r;
-        if (key == 0 && keyless >= 0) r = keyless;
-        else if (key > 0 && last >= 0 && keys[last] == key) r = last;
-        else {
-            if (nq == RUNS_MAX) { b->nq = -1; b->qvalid = 1; return 1; }
-            r = nq++;
-            keys[r] = key;
-            if (key == 0) keyless = r;
-        }
-        if (key != 0) last = r;
-        rid[t] = r;
+        int fresh;
+        rid[t] = pick_run(&pick, key, &fresh);
+        if (rid[t] < 0) { b->nq = -1; b->qvalid = 1; return 1; }
+        if (fresh) keys[rid[t]] = key;
     }
+    const int32_t nq = pick.n;
     /* corners by run (a counting sort), then each run's sorted and made unique */
     if (!grow((void **)&b->qrun, &b->cap_qrun, 3 * (int64_t)nq + 3, sizeof *b->qrun) ||
         !grow((void **)&b->qcorner, &b->cap_qcorner, 3 * (int64_t)m->ntri, sizeof *b->qcorner))
@@ -915,7 +880,7 @@ static int quick_empty(struct wb_tribroad *b, wb_world *w, int32_t na, wb_real r
     if (!grow((void **)&b->prun, &b->cap_prun, 3 * (int64_t)na, sizeof *b->prun)) return -1;
     const wb_real eps = 1e-14 * rmax;
     int32_t nseg;
-    const int32_t npr = point_runs(b, b->pc, na, w, b->prun, &nseg, eps);
+    const int32_t npr = make_runs(b, 0, b->pc, na, w, 0, b->prun, &nseg, eps);
     if (npr == -2) return -1;
     if (npr < 0) return 0;
     if (!grow((void **)&b->runs, &b->cap_runs, npr + b->nq, sizeof *b->runs)) return -1;
@@ -933,17 +898,13 @@ static int quick_empty(struct wb_tribroad *b, wb_world *w, int32_t na, wb_real r
             mv = mvp[i] > mv ? mvp[i] : mv;
         }
         R->key = q[0];
-        for (int a = 0; a < 3; a++) {
-            R->lo[a] = lo[a] - mv, R->hi[a] = hi[a] + mv;
-            const wb_real e = 1e-14 * max_(fabs(R->lo[a]), fabs(R->hi[a])) + eps; /* as make_runs */
-            R->lo[a] -= e;
-            R->hi[a] += e;
-        }
+        for (int a = 0; a < 3; a++) R->lo[a] = lo[a] - mv, R->hi[a] = hi[a] + mv;
     }
+    pad_runs(b->runs + npr, b->nq, eps);
     int32_t nb = 0;
     for (int32_t r = 0; r < npr; r++)
         if (!overlaps(b, r, npr, npr + b->nq, &nb)) return -1;
-    const int32_t n = keep_points(b, b->pc, b->prun, nseg, x);
+    const int32_t n = keep(b, b->pc, b->prun, nseg, x, 0);
     if (n == 0) return 1;
     /* the triangle runs some point left meets (its box against the run's, as overlaps
      * tests runs), when that is cheap next to boxing every triangle */
