@@ -53,22 +53,16 @@ wb_status wb__attach_reserve(wb_world *w, int64_t extra)
     const int64_t need = a->n + extra;
     if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     if (need <= a->cap) return WB_OK;
-    int64_t cap = a->cap ? 2 * (int64_t)a->cap : 16;
-    while (cap < need) cap *= 2;
-    if (cap > WB_MAX_CONSTRAINTS) cap = WB_MAX_CONSTRAINTS;
+    const int32_t cap = wb__grown_cap(a->cap, need, 16);
     if (!wb__material_charge(w, &a->charged, (size_t)cap * ATTACH_BYTES)) return WB_ERR_NOMEM;
-    struct { void **p; size_t elem; } arr[] = {
+    const wb_soa arr[] = {
         { (void **)&a->p, sizeof(int32_t) }, { (void **)&a->kind, 1 }, { (void **)&a->tindex, sizeof(int32_t) },
         { (void **)&a->tgen, sizeof(uint32_t) }, { (void **)&a->local, 3 * sizeof(wb_real) },
         { (void **)&a->alpha, sizeof(wb_real) }, { (void **)&a->gen, sizeof(uint32_t) },
         { (void **)&a->lambda, 3 * sizeof(wb_real) },
     };
-    for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
-        void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
-        if (!q) return WB_ERR_NOMEM; /* arrays already grown are merely larger */
-        *arr[i].p = q;
-    }
-    a->cap = (int32_t)cap;
+    if (WB_SOA_RESIZE(arr, cap) != WB_OK) return WB_ERR_NOMEM;
+    a->cap = cap;
     return WB_OK;
 }
 

@@ -102,18 +102,14 @@ static wb_status grow(wb_world *w, int32_t need)
         cap = need;
         if (!charge(w, cap)) return WB_ERR_NOMEM;
     }
-    struct { void **p; size_t elem; } arr[] = {
+    const wb_soa arr[] = {
         { (void **)&b->ij, 4 * sizeof(int32_t) }, { (void **)&b->alpha, sizeof(wb_real) },
         { (void **)&b->beta, sizeof(wb_real) }, { (void **)&b->rest, sizeof(wb_real) },
         { (void **)&b->s_slot, sizeof(int32_t) },
         { (void **)&b->pack, sizeof(int32_t) }, { (void **)&b->lambda, sizeof(wb_real) },
         { (void **)&b->btorque, sizeof(wb_real) }, { (void **)&b->broken, 1 },
     };
-    for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
-        void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
-        if (!q) return WB_ERR_NOMEM; /* arrays already grown are merely larger */
-        *arr[i].p = q;
-    }
+    if (WB_SOA_RESIZE(arr, cap) != WB_OK) return WB_ERR_NOMEM;
     b->cap = cap;
     return WB_OK;
 }

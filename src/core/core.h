@@ -485,6 +485,15 @@ wb_status wb__surface_reserve(wb_world *w, int32_t ntri);
  * lazily, the same pool from call to call. A cache: callable on a const world */
 wb_pool *wb__world_pool(const wb_world *w);
 void *wb__grow(void *ptr, int32_t *cap, int32_t need, size_t elem); /* world.c: realloc helper */
+/* one array of a structure of arrays: where its pointer is, the bytes of an element */
+typedef struct { void **p; size_t elem; } wb_soa;
+/* world.c: each of the n arrays reallocated to cap elements; WB_ERR_NOMEM when one fails
+ * (the arrays grown before it are merely larger, all still valid) */
+wb_status wb__soa_resize(const wb_soa *arr, size_t n, int64_t cap);
+/* world.c: a capacity for need (> cap) elements: cap (first when 0) doubled until it
+ * holds them, at most WB_MAX_CONSTRAINTS */
+int32_t wb__grown_cap(int32_t cap, int64_t need, int32_t first);
+#define WB_SOA_RESIZE(arr, cap) wb__soa_resize((arr), sizeof(arr) / sizeof((arr)[0]), (cap))
 void wb__set_error(const char *fmt, ...);
 void wb__warn(wb_world *w, const char *fmt, ...);
 

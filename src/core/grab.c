@@ -38,22 +38,16 @@ wb_status wb__grab_reserve(wb_world *w, int64_t extra)
     const int64_t need = g->n + extra;
     if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     if (need <= g->cap) return WB_OK;
-    int64_t cap = g->cap ? 2 * (int64_t)g->cap : 16;
-    while (cap < need) cap *= 2;
-    if (cap > WB_MAX_CONSTRAINTS) cap = WB_MAX_CONSTRAINTS;
+    const int32_t cap = wb__grown_cap(g->cap, need, 16);
     if (!wb__material_charge(w, &g->charged, (size_t)cap * GRAB_BYTES)) return WB_ERR_NOMEM;
-    struct { void **p; size_t elem; } arr[] = {
+    const wb_soa arr[] = {
         { (void **)&g->p, sizeof(int32_t) }, { (void **)&g->alpha, sizeof(wb_real) },
         { (void **)&g->kind, 1 }, { (void **)&g->tgen, sizeof(uint32_t) }, { (void **)&g->local, 3 * sizeof(wb_real) },
         { (void **)&g->gen, sizeof(uint32_t) }, { (void **)&g->target, 3 * sizeof(wb_real) },
         { (void **)&g->from, 3 * sizeof(wb_real) }, { (void **)&g->lambda, 3 * sizeof(wb_real) },
     };
-    for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
-        void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
-        if (!q) return WB_ERR_NOMEM; /* arrays already grown are merely larger */
-        *arr[i].p = q;
-    }
-    g->cap = (int32_t)cap;
+    if (WB_SOA_RESIZE(arr, cap) != WB_OK) return WB_ERR_NOMEM;
+    g->cap = cap;
     return WB_OK;
 }
 

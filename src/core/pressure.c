@@ -35,13 +35,6 @@
 #define BYTES_V (sizeof(int32_t))
 #define BYTES_T (3 * sizeof(int32_t))
 
-static int32_t grown(int32_t cap, int64_t need)
-{
-    int64_t c = cap ? cap : 16;
-    while (c < need) c *= 2;
-    return (int32_t)(c < WB_MAX_CONSTRAINTS ? c : WB_MAX_CONSTRAINTS);
-}
-
 /* room for n_extra constraints over nv_extra particles and nt_extra triangles in all */
 static wb_status reserve(wb_world *w, int64_t n_extra, int64_t nv_extra, int64_t nt_extra)
 {
@@ -49,23 +42,21 @@ static wb_status reserve(wb_world *w, int64_t n_extra, int64_t nv_extra, int64_t
     const int64_t n = p->n + n_extra + 1, nv = p->nverts + nv_extra, nt = p->ntri + nt_extra;
     if (n > WB_MAX_CONSTRAINTS || nv > WB_MAX_CONSTRAINTS || nt > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     if (n <= p->cap && nv <= p->cap_verts && nt <= p->cap_tri) return WB_OK;
-    const int32_t cn = n <= p->cap ? p->cap : grown(p->cap, n);
-    const int32_t cv = nv <= p->cap_verts ? p->cap_verts : grown(p->cap_verts, nv);
-    const int32_t ct = nt <= p->cap_tri ? p->cap_tri : grown(p->cap_tri, nt);
+    const int32_t cn = n <= p->cap ? p->cap : wb__grown_cap(p->cap, n, 16);
+    const int32_t cv = nv <= p->cap_verts ? p->cap_verts : wb__grown_cap(p->cap_verts, nv, 16);
+    const int32_t ct = nt <= p->cap_tri ? p->cap_tri : wb__grown_cap(p->cap_tri, nt, 16);
     if (!wb__material_charge(w, &p->charged, (size_t)cn * BYTES_P + (size_t)cv * BYTES_V + (size_t)ct * BYTES_T))
         return WB_ERR_NOMEM;
-    struct { void **a; size_t elem; int32_t cap; } a[] = {
-        { (void **)&p->surface, sizeof(int32_t), cn }, { (void **)&p->pressure, sizeof(wb_real), cn },
-        { (void **)&p->alpha, sizeof(wb_real), cn }, { (void **)&p->v0, sizeof(wb_real), cn },
-        { (void **)&p->lambda, sizeof(wb_real), cn }, { (void **)&p->vstart, sizeof(int32_t), cn },
-        { (void **)&p->tstart, sizeof(int32_t), cn }, { (void **)&p->verts, sizeof(int32_t), cv },
-        { (void **)&p->tri, 3 * sizeof(int32_t), ct },
+    const wb_soa per[] = {
+        { (void **)&p->surface, sizeof(int32_t) }, { (void **)&p->pressure, sizeof(wb_real) },
+        { (void **)&p->alpha, sizeof(wb_real) }, { (void **)&p->v0, sizeof(wb_real) },
+        { (void **)&p->lambda, sizeof(wb_real) }, { (void **)&p->vstart, sizeof(int32_t) },
+        { (void **)&p->tstart, sizeof(int32_t) },
     };
-    for (size_t i = 0; i < sizeof a / sizeof a[0]; i++) {
-        void *q = realloc(*a[i].a, (size_t)a[i].cap * a[i].elem);
-        if (!q) return WB_ERR_NOMEM;
-        *a[i].a = q;
-    }
+    const wb_soa verts[] = { { (void **)&p->verts, sizeof(int32_t) } };
+    const wb_soa tris[] = { { (void **)&p->tri, 3 * sizeof(int32_t) } };
+    if (WB_SOA_RESIZE(per, cn) != WB_OK || WB_SOA_RESIZE(verts, cv) != WB_OK || WB_SOA_RESIZE(tris, ct) != WB_OK)
+        return WB_ERR_NOMEM;
     if (p->cap == 0) p->vstart[0] = p->tstart[0] = 0;
     p->cap = cn;
     p->cap_verts = cv;

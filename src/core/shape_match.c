@@ -65,13 +65,6 @@ int wb__material_charge(wb_world *w, size_t *charged, size_t want)
     return 1;
 }
 
-static int32_t grown(int32_t cap, int64_t need)
-{
-    int64_t c = cap ? cap : 16;
-    while (c < need) c *= 2;
-    return (int32_t)(c < WB_MAX_CONSTRAINTS ? c : WB_MAX_CONSTRAINTS);
-}
-
 /* room for n_extra more clusters of ids_extra particles in all; after it, adding them
  * cannot fail */
 static wb_status reserve(wb_world *w, int64_t n_extra, int64_t ids_extra)
@@ -80,21 +73,19 @@ static wb_status reserve(wb_world *w, int64_t n_extra, int64_t ids_extra)
     const int64_t nc = sm->n + n_extra, ni = sm->nids + ids_extra;
     if (nc + 1 > WB_MAX_CONSTRAINTS || ni > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     if (nc + 1 <= sm->cap && ni <= sm->cap_ids) return WB_OK;
-    const int32_t cc = nc + 1 <= sm->cap ? sm->cap : grown(sm->cap, nc + 1);
-    const int32_t ci = ni <= sm->cap_ids ? sm->cap_ids : grown(sm->cap_ids, ni);
+    const int32_t cc = nc + 1 <= sm->cap ? sm->cap : wb__grown_cap(sm->cap, nc + 1, 16);
+    const int32_t ci = ni <= sm->cap_ids ? sm->cap_ids : wb__grown_cap(sm->cap_ids, ni, 16);
     if (!wb__material_charge(w, &sm->charged, (size_t)cc * BYTES_CLUSTER + (size_t)ci * BYTES_ID)) return WB_ERR_NOMEM;
-    struct { void **p; size_t elem; int32_t cap; } a[] = {
-        { (void **)&sm->start, sizeof(int32_t), cc }, { (void **)&sm->stiff, sizeof(wb_real), cc },
-        { (void **)&sm->yield, sizeof(wb_real), cc }, { (void **)&sm->creep, sizeof(wb_real), cc },
-        { (void **)&sm->q, 4 * sizeof(wb_real), cc }, { (void **)&sm->qk, 4 * sizeof(wb_real), cc },
-        { (void **)&sm->ids, sizeof(int32_t), ci }, { (void **)&sm->rest, 3 * sizeof(wb_real), ci },
-        { (void **)&sm->lambda, 3 * sizeof(wb_real), ci },
+    const wb_soa clusters[] = {
+        { (void **)&sm->start, sizeof(int32_t) }, { (void **)&sm->stiff, sizeof(wb_real) },
+        { (void **)&sm->yield, sizeof(wb_real) }, { (void **)&sm->creep, sizeof(wb_real) },
+        { (void **)&sm->q, 4 * sizeof(wb_real) }, { (void **)&sm->qk, 4 * sizeof(wb_real) },
     };
-    for (size_t i = 0; i < sizeof a / sizeof a[0]; i++) {
-        void *q = realloc(*a[i].p, (size_t)a[i].cap * a[i].elem);
-        if (!q) return WB_ERR_NOMEM; /* arrays already grown are merely larger */
-        *a[i].p = q;
-    }
+    const wb_soa ids[] = {
+        { (void **)&sm->ids, sizeof(int32_t) }, { (void **)&sm->rest, 3 * sizeof(wb_real) },
+        { (void **)&sm->lambda, 3 * sizeof(wb_real) },
+    };
+    if (WB_SOA_RESIZE(clusters, cc) != WB_OK || WB_SOA_RESIZE(ids, ci) != WB_OK) return WB_ERR_NOMEM;
     if (sm->cap == 0) sm->start[0] = 0;
     sm->cap = cc;
     sm->cap_ids = ci;

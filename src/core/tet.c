@@ -74,14 +74,9 @@ wb_status wb__tet_reserve(wb_world *w, int64_t extra)
     const int64_t need = v->n + extra;
     if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     if (need <= v->cap) return WB_OK;
-    int64_t cap = v->cap ? v->cap : 64;
-    while (cap < need) cap *= 2;
-    if (cap > WB_MAX_CONSTRAINTS) cap = WB_MAX_CONSTRAINTS;
-    wb_memory *mem = w->m.def.memory;
-    const size_t want = (size_t)cap * TET_BYTES;
-    if (mem && mem->limit > 0 && (double)mem->used - (double)v->charged + (double)want > (double)mem->limit)
-        return WB_ERR_NOMEM;
-    struct { void **p; size_t elem; } arr[] = {
+    const int32_t cap = wb__grown_cap(v->cap, need, 64);
+    if (!wb__material_charge(w, &v->charged, (size_t)cap * TET_BYTES)) return WB_ERR_NOMEM;
+    const wb_soa arr[] = {
         { (void **)&v->ijkl, 4 * sizeof(int32_t) }, { (void **)&v->dminv, 9 * sizeof(wb_real) },
         { (void **)&v->v0, sizeof(wb_real) }, { (void **)&v->young, sizeof(wb_real) },
         { (void **)&v->poisson, sizeof(wb_real) }, { (void **)&v->mu, sizeof(wb_real) },
@@ -89,14 +84,8 @@ wb_status wb__tet_reserve(wb_world *w, int64_t extra)
         { (void **)&v->order, sizeof(int32_t) }, { (void **)&v->pk, 4 * sizeof(int32_t) },
         { (void **)&v->pd, PD * sizeof(wb_real) },
     };
-    for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
-        void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
-        if (!q) return WB_ERR_NOMEM; /* arrays already grown are merely larger */
-        *arr[i].p = q;
-    }
-    if (mem) mem->used = mem->used - v->charged + want;
-    v->charged = want;
-    v->cap = (int32_t)cap;
+    if (WB_SOA_RESIZE(arr, cap) != WB_OK) return WB_ERR_NOMEM;
+    v->cap = cap;
     return WB_OK;
 }
 

@@ -49,6 +49,23 @@ void *wb__grow(void *ptr, int32_t *cap, int32_t need, size_t elem)
     return q;
 }
 
+wb_status wb__soa_resize(const wb_soa *arr, size_t n, int64_t cap)
+{
+    for (size_t i = 0; i < n; i++) {
+        void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
+        if (!q) return WB_ERR_NOMEM;
+        *arr[i].p = q;
+    }
+    return WB_OK;
+}
+
+int32_t wb__grown_cap(int32_t cap, int64_t need, int32_t first)
+{
+    int64_t c = cap ? cap : first;
+    while (c < need) c *= 2;
+    return (int32_t)(c < WB_MAX_CONSTRAINTS ? c : WB_MAX_CONSTRAINTS);
+}
+
 static int finite3(const wb_real *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
 
 /* ---- world ---------------------------------------------------------------------- */
@@ -204,7 +221,7 @@ static wb_status grow_particles(wb_world *w, int32_t need)
         cap = need; /* exact fit when doubling would cross the limit */
         if (!charge(w, cap, m->cap_d)) return WB_ERR_NOMEM;
     }
-    struct { void **p; size_t elem; } arr[] = {
+    const wb_soa arr[] = {
         { (void **)&m->inv_mass, sizeof(wb_real) }, { (void **)&m->w, sizeof(wb_real) },
         { (void **)&m->radius, sizeof(wb_real) }, { (void **)&m->pinned, 1 },
         { (void **)&w->s.x, 3 * sizeof(wb_real) }, { (void **)&w->s.x_prev, 3 * sizeof(wb_real) },
@@ -214,11 +231,7 @@ static wb_status grow_particles(wb_world *w, int32_t need)
         { (void **)&m->group, sizeof(int32_t) }, { (void **)&m->cflags, 1 },
         { (void **)&m->cfric, sizeof(wb_real) }, { (void **)&m->x0, 3 * sizeof(wb_real) },
     };
-    for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
-        void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
-        if (!q) return WB_ERR_NOMEM; /* arrays already grown are merely larger: still valid */
-        *arr[i].p = q;
-    }
+    if (WB_SOA_RESIZE(arr, cap) != WB_OK) return WB_ERR_NOMEM;
     m->cap_p = cap;
     return WB_OK;
 }
@@ -327,7 +340,7 @@ static wb_status grow_distances(wb_world *w, int32_t need)
         cap = need;
         if (!charge(w, m->cap_p, cap)) return WB_ERR_NOMEM;
     }
-    struct { void **p; size_t elem; } arr[] = {
+    const wb_soa arr[] = {
         { (void **)&m->d_ij, 2 * sizeof(int32_t) }, { (void **)&m->d_alpha, sizeof(wb_real) },
         { (void **)&m->d_beta, sizeof(wb_real) }, { (void **)&m->d_yield, sizeof(wb_real) },
         { (void **)&m->d_creep, sizeof(wb_real) }, { (void **)&m->d_break, sizeof(wb_real) },
@@ -336,11 +349,7 @@ static wb_status grow_distances(wb_world *w, int32_t need)
         { (void **)&w->s.d_rest, sizeof(wb_real) }, { (void **)&w->s.d_broken, 1 },
         { (void **)&w->k.slot_pack, sizeof(int32_t) },
     };
-    for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
-        void *q = realloc(*arr[i].p, (size_t)cap * arr[i].elem);
-        if (!q) return WB_ERR_NOMEM; /* arrays already grown are merely larger */
-        *arr[i].p = q;
-    }
+    if (WB_SOA_RESIZE(arr, cap) != WB_OK) return WB_ERR_NOMEM;
     m->cap_d = cap;
     return WB_OK;
 }

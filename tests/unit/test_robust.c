@@ -179,6 +179,46 @@ TEST(memory_budget_shared_by_worlds)
     CHECK_EQ(mem.used, 0);
 }
 
+/* adds tets (kind 0) or volume constraints (kind 1) over the same four particles until one
+ * is refused, at most cap of them; returns how many were added */
+static int32_t add_until_refused(wb_world *w, const int32_t p[4], int kind, int32_t cap, int32_t *last)
+{
+    const wb_tet_def td = wb_tet_default_def();
+    const wb_volume_def vd = wb_volume_default_def();
+    int32_t n = 0;
+    *last = 0;
+    while (n < cap && (*last = kind ? wb_volume_add(w, p, &vd) : wb_tet_add(w, p, &td)) >= 0) n++;
+    return n;
+}
+
+TEST(memory_budget_charges_tets_and_volumes)
+{
+    /* a tet holds about 260 bytes and a volume constraint about 80: under a budget 1 MB
+     * above what the particles took, adding them is refused (WB_ERR_NOMEM) after a few
+     * thousand, the budget is never passed, what was added stays, and destroying the
+     * world gives it all back */
+    static const wb_real x[4][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+    for (int kind = 0; kind < 2; kind++) {
+        wb_memory mem = { 0, 0 };
+        wb_world_def d = wb_world_default_def();
+        d.memory = &mem;
+        wb_world *w = wb_world_create(&d);
+        REQUIRE(w);
+        int32_t p[4];
+        for (int k = 0; k < 4; k++) p[k] = wb_particle_add(w, x[k], NULL, 1, 0);
+        mem.limit = mem.used + (1u << 20);
+        int32_t last;
+        const int32_t n = add_until_refused(w, p, kind, 1 << 20, &last);
+        CHECK_EQ(last, WB_ERR_NOMEM);
+        CHECK(n >= 1000 && n < 20000);
+        CHECK(mem.used <= mem.limit);
+        CHECK_EQ(kind ? wb_volume_count(w) : wb_tet_count(w), n);
+        CHECK_EQ(wb_world_step(w), WB_OK);
+        wb_world_destroy(w);
+        CHECK_EQ(mem.used, 0);
+    }
+}
+
 TEST(distance_ids_match_distance_at)
 {
     /* the bulk listing is the same as the one-at-a-time scan, holes and reused slots
