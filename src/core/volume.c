@@ -45,7 +45,9 @@ const char *wb_volume_def_check(const wb_volume_def *d)
     return NULL;
 }
 
-/* room for `extra` more constraints, charged to the memory budget (all or nothing) */
+/* room for `extra` more constraints, charged to the memory budget: refused, nothing made,
+ * when it would pass the budget (a failed allocation leaves the larger charge until the
+ * next reserve, as wb__material_charge's other users do) */
 wb_status wb__volume_reserve(wb_world *w, int64_t extra)
 {
     wb_volumes *v = w->vol;

@@ -61,6 +61,7 @@ wb_status wb__soa_resize(const wb_soa *arr, size_t n, int64_t cap)
 
 int32_t wb__grown_cap(int32_t cap, int64_t need, int32_t first)
 {
+    assert(first > 0);
     int64_t c = cap ? cap : first;
     while (c < need) c *= 2;
     return (int32_t)(c < WB_MAX_CONSTRAINTS ? c : WB_MAX_CONSTRAINTS);

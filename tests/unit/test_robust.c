@@ -193,10 +193,11 @@ static int32_t add_until_refused(wb_world *w, const int32_t p[4], int kind, int3
 
 TEST(memory_budget_charges_tets_and_volumes)
 {
-    /* a tet holds about 260 bytes and a volume constraint about 80: under a budget 1 MB
-     * above what the particles took, adding them is refused (WB_ERR_NOMEM) after a few
-     * thousand, the budget is never passed, what was added stays, and destroying the
-     * world gives it all back */
+    /* a tet holds 148 to 260 bytes (float or double) and a volume constraint 60 to 80,
+     * their arrays doubling from 64: under a budget 1 MiB above what the particles took,
+     * adding them is refused (WB_ERR_NOMEM) at a capacity between 2048 (double tets) and
+     * 16384 (float volumes), the refused one charging nothing; the budget is never
+     * passed, what was added stays, and destroying the world gives it all back */
     static const wb_real x[4][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
     for (int kind = 0; kind < 2; kind++) {
         wb_memory mem = { 0, 0 };
@@ -205,13 +206,20 @@ TEST(memory_budget_charges_tets_and_volumes)
         wb_world *w = wb_world_create(&d);
         REQUIRE(w);
         int32_t p[4];
-        for (int k = 0; k < 4; k++) p[k] = wb_particle_add(w, x[k], NULL, 1, 0);
+        for (int k = 0; k < 4; k++) {
+            p[k] = wb_particle_add(w, x[k], NULL, 1, 0);
+            REQUIRE(p[k] >= 0);
+        }
         mem.limit = mem.used + (1u << 20);
         int32_t last;
-        const int32_t n = add_until_refused(w, p, kind, 1 << 20, &last);
-        CHECK_EQ(last, WB_ERR_NOMEM);
-        CHECK(n >= 1000 && n < 20000);
+        const int32_t n = add_until_refused(w, p, kind, 1 << 16, &last);
+        REQUIRE(last == WB_ERR_NOMEM); /* a world past the budget is not stepped */
+        CHECK(n >= 2048 && n <= 16384 && (n & (n - 1)) == 0);
         CHECK(mem.used <= mem.limit);
+        const size_t used = mem.used;
+        CHECK_EQ(add_until_refused(w, p, kind, 1, &last), 0);
+        CHECK_EQ(last, WB_ERR_NOMEM);
+        CHECK_EQ(mem.used, used);
         CHECK_EQ(kind ? wb_volume_count(w) : wb_tet_count(w), n);
         CHECK_EQ(wb_world_step(w), WB_OK);
         wb_world_destroy(w);
