@@ -5,7 +5,9 @@
 -- volume (an XPBD constraint over all its triangles), so it stays round, squashes where
 -- the box squeezes it against a wall and bulges elsewhere. Then the box backs off and the
 -- balloon is inflated to pressure 1.5. Try --set pressure=0 for the bag without pressure.
--- Run: build/wobble run scripts/balloon.lua [--record out/balloon/]
+-- Run: build/wobble run scripts/balloon.lua [--set record=balloon/]
+--   (--set record: drawn with this script's own camera into out/balloon/; --record OUT
+--   draws with the default camera instead)
 local args = wobble.args
 local w = wobble.world{ substeps = 10 }
 w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.5 }

@@ -5,7 +5,9 @@
 -- shape; every ball is a contact group of its own, so balls push each other while a
 -- ball's own particles do not. The box is a floor plane and four box colliders. Try --set contacts=0 to
 -- watch the balls fall into one another and merge in a heap on the floor.
--- Run: build/wobble run scripts/contact_pile.lua [--record out/pile/]
+-- Run: build/wobble run scripts/contact_pile.lua [--set record=pile/]
+--   (--set record: drawn with this script's own camera into out/pile/; --record OUT
+--   draws with the default camera instead)
 local args = wobble.args
 local w = wobble.world{ substeps = 20, iterations = 2, contacts = args.contacts ~= 0 }
 -- the box's inner half-width and its walls' height (m): the walls stand higher than the

@@ -6,7 +6,9 @@
 -- back. Right: stiffness 0.2 with yield = 0.04, a plastic one that keeps the dent of
 -- its landing (its rest shape flows towards the squashed one past a strain of 0.04).
 -- Try --set stiffness=0.05 for a softer jelly in the middle.
--- Run: build/wobble run scripts/jelly_shape.lua [--record out/jelly/]
+-- Run: build/wobble run scripts/jelly_shape.lua [--set record=jelly/]
+--   (--set record: drawn with this script's own camera into out/jelly/; --record OUT
+--   draws with the default camera instead)
 local args = wobble.args
 local w = wobble.world{ substeps = 10, damping = 0.5 }
 w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.6 }
