@@ -234,6 +234,8 @@ static int32_t make_runs(struct wb_tribroad *b, int32_t r0, const int32_t *list,
         }
         wb_real lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
         int32_t k1 = k;
+        /* two loops, so that each inlines item_box for its kind (the points' is the quick
+         * answer's every frame) */
         if (tris) for (; k1 < n && keys[list[k1]] == key; k1++) add_item(b, x, list[k1], 1, lo, hi);
         else for (; k1 < n && keys[list[k1]] == key; k1++) add_item(b, x, list[k1], 0, lo, hi);
         run *R = &b->runs[r0 + r];

@@ -342,10 +342,6 @@ TEST(tribroad_quick_answer_matches_search_over_frames)
         else if (f == 41) wb_particle_set_group(w, first + 3, bodies[3].group);
         else if (f == 46) wb_particle_set_radius(w, bodies[2].first, 0.09), change = 0;
         else if (f == 50) w->s.x[3 * (bodies[4].first + 10) + 1] = NAN, change = 0;
-        else if (f == 60) { /* no body on either side: the loose points meet the loose triangles */
-            for (int k = 0; k < 10; k++) v3_set(&w->s.x[3 * (among + k)], 0.12 * k + 0.02, 1.52, 0.02);
-            change = 0;
-        }
         else if (f == 52) w->s.x[3 * (bodies[4].first + 10) + 1] = 0.1, change = 0;
         else if (f == 57) { /* the last particle removed (the new body's corner), its triangles with it */
             m->np--;
@@ -356,6 +352,9 @@ TEST(tribroad_quick_answer_matches_search_over_frames)
                     nt++;
                 }
             m->ntri = nt;
+        } else if (f == 60) { /* no body on either side: the loose points meet the loose triangles */
+            for (int k = 0; k < 10; k++) v3_set(&w->s.x[3 * (among + k)], 0.12 * k + 0.02, 1.52, 0.02);
+            change = 0;
         } else change = 0;
         const int64_t r0 = rebuilds(w);
         if (w->k.tc.bp) w->k.tc.bp->qwait = 0; /* the quick answer every frame, however many points it left */
