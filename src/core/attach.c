@@ -448,5 +448,5 @@ static wb_real att_energy(const wb_world *w)
 }
 
 const wb_ctype wb__attach_type = {
-    "attach", att_count, att_prepare, att_substep_begin, att_project, NULL, att_energy,
+    "attach", att_count, att_prepare, att_substep_begin, att_project, NULL, att_energy, NULL,
 };

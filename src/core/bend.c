@@ -664,6 +664,8 @@ static void bend_frame_end(wb_world *w)
     }
 }
 
+static void bend_links(const wb_world *w, wb_link_fn fn, void *ud) { wb__link_quads(w->bend.ij, w->bend.n, fn, ud); }
+
 const wb_ctype wb__bend_type = {
     .name = "bend",
     .count = bend_count,
@@ -672,6 +674,7 @@ const wb_ctype wb__bend_type = {
     .project = bend_project,
     .frame_end = bend_frame_end,
     .energy = bend_energy,
+    .links = bend_links,
 };
 
 /* ---- hinges of a triangle list ----------------------------------------------------------------- */

@@ -34,6 +34,7 @@
 #include <time.h>
 
 #include "core.h"
+#include "ctype.h"
 
 static double now_ms(void)
 {
@@ -520,23 +521,96 @@ static uint64_t pair_key(int32_t a, int32_t b)
     return a < b ? (uint64_t)(uint32_t)a << 32 | (uint32_t)b : (uint64_t)(uint32_t)b << 32 | (uint32_t)a;
 }
 
-/* the live constraints' pairs, sorted, for the self-collision rule */
-static int build_keys(wb_world *w)
+/* ---- the rest-neighbour rule's data: joined pairs and loose graphs ----------------------------- */
+typedef struct links_ud {
+    wb_contacts *c;
+    const wb_model *m;
+    int32_t n, cap;        /* keys so far */
+    int fail;
+} links_ud;
+
+/* the root of a graph, halving the path on the way (union-find) */
+static int32_t graph_root(int32_t *g, int32_t i)
+{
+    while (g[i] != i) {
+        g[i] = g[g[i]];
+        i = g[i];
+    }
+    return i;
+}
+
+static void add_link(void *ud, int32_t a, int32_t b, int joined)
+{
+    links_ud *u = ud;
+    wb_contacts *c = u->c;
+    if (a == b) return;
+    if (joined) {
+        if (u->n == u->cap) {
+            uint64_t *k = wb__grow(c->keys, &c->cap_keys, u->n + 1, sizeof *k);
+            if (!k) { u->fail = 1; return; }
+            c->keys = k;
+            u->cap = c->cap_keys;
+        }
+        c->keys[u->n++] = pair_key(a, b);
+    }
+    /* a loose particle's graph: the loose particles its links reach (a body's particles
+     * are their body's already) */
+    if (u->m->group[a] == 0 && u->m->group[b] == 0) {
+        const int32_t ra = graph_root(c->graph, a), rb = graph_root(c->graph, b);
+        if (ra < rb) c->graph[rb] = ra;
+        else c->graph[ra] = rb;
+    }
+}
+
+/* what the pair rule asks (may_touch, tribroad.c's): every type's links as sorted keys,
+ * each once, and the loose particles' graphs; 0 when out of memory */
+static int build_rules(wb_world *w)
 {
     wb_contacts *c = &w->k.pc;
     const wb_model *m = &w->m;
-    uint64_t *k = wb__grow(c->keys, &c->cap_keys, m->nd_live > 0 ? m->nd_live : 1, sizeof *k);
-    if (!k) return 0;
-    c->keys = k;
-    c->nkeys = 0;
-    for (int32_t s = 0; s < m->nd; s++)
-        if (m->d_gen[s] & 1u) k[c->nkeys++] = pair_key(m->d_ij[2 * s], m->d_ij[2 * s + 1]);
-    qsort(k, (size_t)c->nkeys, sizeof *k, cmp_u64);
+    int32_t *g = wb__grow(c->graph, &c->cap_graph, m->np > 0 ? m->np : 1, sizeof *g);
+    if (!g) return 0;
+    c->graph = g;
+    for (int32_t i = 0; i < m->np; i++) g[i] = i;
+    links_ud u = { c, m, 0, c->cap_keys, 0 };
+    for (int t = 0; t < wb__nctypes && !u.fail; t++)
+        if (wb__ctypes[t]->links) wb__ctypes[t]->links(w, add_link, &u);
+    if (u.fail) return 0;
+    for (int32_t i = 0; i < m->np; i++) g[i] = graph_root(g, i);
+    qsort(c->keys, (size_t)u.n, sizeof *c->keys, cmp_u64);
+    int32_t n = 0;
+    c->cross = 0;
+    for (int32_t k = 0; k < u.n; k++) {
+        if (n > 0 && c->keys[n - 1] == c->keys[k]) continue;
+        c->keys[n++] = c->keys[k];
+        const int32_t a = (int32_t)(c->keys[k] >> 32), b = (int32_t)(uint32_t)c->keys[k];
+        if (wb__graph_of(c, m, a) != wb__graph_of(c, m, b)) c->cross = 1;
+    }
+    c->nkeys = n;
     c->keys_dirty = 0;
     return 1;
 }
 
-static int joined(const wb_contacts *c, int32_t i, int32_t j)
+/* the particles and each type's constraints, so that adding any rebuilds the rules */
+static uint64_t rules_sig(const wb_world *w)
+{
+    uint64_t h = 1469598103934665603ull ^ (uint64_t)(uint32_t)w->m.np;
+    for (int t = 0; t < wb__nctypes; t++)
+        h = (h ^ (uint64_t)(uint32_t)wb__ctypes[t]->count(w)) * 1099511628211ull;
+    return h;
+}
+
+int wb__contact_rules(wb_world *w)
+{
+    wb_contacts *c = &w->k.pc;
+    const uint64_t sig = rules_sig(w);
+    if (!c->keys_dirty && !c->scan_dirty && c->keys_sig == sig && c->graph) return 1;
+    if (!build_rules(w)) return 0;
+    c->keys_sig = sig;
+    return 1;
+}
+
+int wb__joined(const wb_contacts *c, int32_t i, int32_t j)
 {
     const uint64_t key = pair_key(i, j);
     int32_t lo = 0, hi = c->nkeys;
@@ -548,20 +622,24 @@ static int joined(const wb_contacts *c, int32_t i, int32_t j)
     return lo < c->nkeys && c->keys[lo] == key;
 }
 
+/* DESIGN.md §2: particles of two bodies (or graphs) touch when both collide, unless a
+ * constraint joins them; of one, only when it collides with itself (a loose graph
+ * always does), and never rest neighbours: joined, or made closer than r_i + r_j (or
+ * in touch: WB_REST_TOUCH) */
 static int may_touch(void *ud, int32_t i, int32_t j)
 {
     const wb_world *w = ud;
     const wb_model *m = &w->m;
+    const wb_contacts *c = &w->k.pc;
     if (m->w[i] == 0 && m->w[j] == 0) return 0;
-    const int32_t gi = m->group[i], gj = m->group[j];
-    if (gi != gj || gi == 0) return (m->cflags[i] & m->cflags[j] & WB_CF_COLLIDE) != 0;
-    /* one body: only when it self-collides, and never between rest neighbours */
-    if (!(m->cflags[i] & m->cflags[j] & WB_CF_SELF)) return 0;
+    if (wb__graph_of(c, m, i) != wb__graph_of(c, m, j))
+        return (m->cflags[i] & m->cflags[j] & WB_CF_COLLIDE) && !(c->cross && wb__joined(c, i, j));
+    if (m->group[i] > 0 && !(m->cflags[i] & m->cflags[j] & WB_CF_SELF)) return 0;
     wb_real d[3];
     v3_sub(d, &m->x0[3 * j], &m->x0[3 * i]);
-    const wb_real r = m->radius[i] + m->radius[j];
+    const wb_real r = (m->radius[i] + m->radius[j]) * WB_REST_TOUCH;
     if (v3_dot(d, d) < r * r) return 0;
-    return !joined(&w->k.pc, i, j);
+    return !wb__joined(c, i, j);
 }
 
 /* whether any pair could collide at all: one body without self-collision costs nothing */
@@ -592,6 +670,11 @@ void wb__contacts_begin(wb_world *w)
     c->fresh = 1;
     c->broad_ms = 0;
     if (!m->def.contacts || m->np < 2) return;
+    if (!wb__contact_rules(w)) {
+        c->possible = 0; /* the triangles' broad phase asks the same rules */
+        wb__warn(w, "out of memory in the contact broad phase; contacts skipped");
+        return;
+    }
     if (c->scan_dirty || c->scanned_np != m->np) {
         c->possible = any_possible(m);
         c->scanned_np = m->np;
@@ -599,9 +682,6 @@ void wb__contacts_begin(wb_world *w)
     }
     if (!c->possible) return;
     const double t0 = now_ms();
-    if (c->keys_dirty || c->nkeys == 0) {
-        if (!build_keys(w)) { wb__warn(w, "out of memory in the contact broad phase; contacts skipped"); return; }
-    }
     wb_real *reach = wb__grow(c->reach, &c->cap_reach, m->np, sizeof *reach);
     if (!reach) { wb__warn(w, "out of memory in the contact broad phase; contacts skipped"); return; }
     c->reach = reach;

@@ -185,9 +185,16 @@ typedef struct wb_contacts {
     int32_t *skip;         /* (np) broad-phase skip key: a body without self-collision, else 0 */
     int32_t cap_skip;
     struct wb_broad *bp;   /* broad-phase scratch (broadphase.c) */
-    uint64_t *keys;        /* sorted (a << 32 | b) of live constraints: neighbours at rest */
+    uint64_t *keys;        /* sorted (a << 32 | b), each once: the pairs constraints join,
+                              which never touch (the ctypes' links) */
     int32_t nkeys, cap_keys;
+    int32_t *graph;        /* (np) a loose particle's graph (the least particle of its
+                              connected component over the links); its own index in a body */
+    int32_t cap_graph;
+    int cross;             /* some joined pair is not in one body or one graph: the pair
+                              rule asks keys for pairs of two bodies too */
     int keys_dirty;        /* set when the topology changes */
+    uint64_t keys_sig;     /* particles and constraints of each type the keys were built for */
     int32_t scanned_np;    /* particles when `possible` was worked out */
     int scan_dirty;        /* groups or flags changed since */
     int possible;          /* some pair could collide */
@@ -198,6 +205,21 @@ typedef struct wb_contacts {
                               (contact.c's friction pass; pairs' and triangles' together) */
     int32_t cap_load;
 } wb_contacts;
+
+/* rest neighbours (DESIGN.md §2) include pairs made in touch: created r_i + r_j apart, to
+ * round-off (a rope of spacing s and radius 2 s: its particles four apart), they would
+ * touch at its slightest bend */
+#define WB_REST_TOUCH ((wb_real)(1 + 1e-9))
+/* broadphase.c: the contact rules' data (keys, graph, cross) brought up to date with the
+ * constraints and groups; 0 when out of memory. wb__joined: a constraint joins i and j */
+int wb__contact_rules(wb_world *w);
+int wb__joined(const wb_contacts *c, int32_t i, int32_t j);
+/* the body a particle is in for the contact rules: its group, or for a loose particle its
+ * graph (the loose particles its constraints reach), as -1 - the graph's least particle */
+static inline int32_t wb__graph_of(const wb_contacts *c, const wb_model *m, int32_t i)
+{
+    return m->group[i] > 0 ? m->group[i] : -1 - c->graph[i];
+}
 
 /* grid.c: the sorted grids of the broad phases (broadphase.c, tribroad.c). Cell (i, j, k)
  * of a point is floor((x - o) * inv) per axis, clamped to [0, 1e15] (wb__cell_of), taken

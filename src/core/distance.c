@@ -613,6 +613,14 @@ static wb_real distance_energy(const wb_world *w)
 
 static int32_t distance_count(const wb_world *w) { return w->m.nd_live; }
 
+/* every live link joins its two ends (a torn one too: they were neighbours) */
+static void distance_links(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    const wb_model *m = &w->m;
+    for (int32_t s = 0; s < m->nd; s++)
+        if (m->d_gen[s] & 1u) fn(ud, m->d_ij[2 * s], m->d_ij[2 * s + 1], 1);
+}
+
 const wb_ctype wb__distance_type = {
     .name = "distance",
     .count = distance_count,
@@ -621,4 +629,5 @@ const wb_ctype wb__distance_type = {
     .project = distance_project,
     .frame_end = distance_frame_end,
     .energy = distance_energy,
+    .links = distance_links,
 };

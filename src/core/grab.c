@@ -430,5 +430,5 @@ static wb_real grab_energy(const wb_world *w)
 }
 
 const wb_ctype wb__grab_type = {
-    "grab", grab_count, grab_prepare, grab_substep_begin, grab_project, grab_frame_end, grab_energy,
+    "grab", grab_count, grab_prepare, grab_substep_begin, grab_project, grab_frame_end, grab_energy, NULL,
 };

@@ -252,8 +252,17 @@ static wb_real sm_energy(const wb_world *w)
     return u;
 }
 
+/* a cluster is one graph (its particles keep their rest shape, so only pairs made
+ * overlapping could touch, and the rest rule takes those): a chain through it */
+static void sm_links(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    const wb_smatch *sm = &w->sm;
+    for (int32_t c = 0; c < sm->n; c++)
+        for (int32_t i = sm->start[c] + 1; i < sm->start[c + 1]; i++) fn(ud, sm->ids[i - 1], sm->ids[i], 0);
+}
+
 const wb_ctype wb__shape_type = { "shape_match", sm_count, sm_prepare, sm_substep_begin, sm_project, sm_frame_end,
-                                  sm_energy };
+                                  sm_energy, sm_links };
 
 /* ---- API ------------------------------------------------------------------------------------ */
 wb_shape_match_def wb_shape_match_default_def(void)

@@ -6,7 +6,7 @@
  * at velocity level (each substep's prediction but the first runs inside the previous
  * substep's collision pass when nothing between them moves particles: fusable()).
  * Plastic flow, breaking and the finiteness check run once per frame. The constraints
- * are projected type by type from the table wb__ctypes (ctype.h): each type is a file of
+ * are projected type by type from the table wb__ctypes (ctype.c): each type is a file of
  * its own. */
 #include <stdio.h>
 #include <time.h>
@@ -20,20 +20,6 @@ static double now_ms(void)
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
-
-/* the constraint types the step walks, in projection order (ctype.h; DESIGN.md §2):
- * adding a type adds its line here. */
-const wb_ctype *const wb__ctypes[] = {
-    &wb__distance_type,
-    &wb__bend_type,
-    &wb__volume_type,
-    &wb__tet_type,
-    &wb__shape_type,
-    &wb__pressure_type,
-    &wb__attach_type,
-    &wb__grab_type,
-};
-const int wb__nctypes = (int)(sizeof wb__ctypes / sizeof wb__ctypes[0]);
 
 /* one pass of every type, `iterations` times: the types run one after the other (Gauss-
  * Seidel between types; inside one, as the type projects: batches or Jacobi) */

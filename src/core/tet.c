@@ -742,6 +742,11 @@ static wb_real tet_energy(const wb_world *w)
     return e;
 }
 
+static void tet_links(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    if (w->neo) wb__link_quads(w->neo->ijkl, w->neo->n, fn, ud);
+}
+
 const wb_ctype wb__tet_type = {
-    "tet", tet_count, tet_prepare, tet_substep_begin, tet_project, tet_frame_end, tet_energy,
+    "tet", tet_count, tet_prepare, tet_substep_begin, tet_project, tet_frame_end, tet_energy, tet_links,
 };

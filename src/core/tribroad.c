@@ -67,12 +67,13 @@ static int grow(void **p, int32_t *cap, int64_t need, size_t elem)
 }
 
 /* ---- who may touch ------------------------------------------------------------------------------ */
-/* contact.c's pair rule without its rest-neighbour part (applied per triangle below) */
-static int pair_allowed(const wb_model *m, int32_t p, int32_t v)
+/* broadphase.c's pair rule (may_touch) without its rest-neighbour part (applied per
+ * triangle below); *same: one body or loose graph */
+static int pair_allowed(const wb_model *m, const wb_contacts *c, int32_t p, int32_t v, int *same)
 {
-    const int32_t gp = m->group[p], gv = m->group[v];
-    if (gp != gv || gp == 0) return (m->cflags[p] & m->cflags[v] & WB_CF_COLLIDE) != 0;
-    return (m->cflags[p] & m->cflags[v] & WB_CF_SELF) != 0;
+    if (wb__graph_of(c, m, p) != wb__graph_of(c, m, v)) return (m->cflags[p] & m->cflags[v] & WB_CF_COLLIDE) != 0;
+    *same = 1;
+    return m->group[p] == 0 || (m->cflags[p] & m->cflags[v] & WB_CF_SELF) != 0;
 }
 
 /* the body no point of which may touch triangle tv: its corners' body when that does not
@@ -88,17 +89,23 @@ static inline int32_t tri_key(const wb_model *m, const int32_t *tv)
 }
 
 /* the rules without geometry: not its own corner, and each corner allowed; *same: some
- * corner is of the point's own body (the rest rule then applies) */
-static int rules_allow(const wb_model *m, int32_t p, const int32_t *v, int *same)
+ * corner is of the point's own body or graph (the rest rule then applies) */
+static int rules_allow(const wb_model *m, const wb_contacts *c, int32_t p, const int32_t *v, int *same)
 {
     if (p == v[0] || p == v[1] || p == v[2]) return 0;
     *same = 0;
-    for (int k = 0; k < 3; k++) {
-        if (!pair_allowed(m, p, v[k])) return 0;
-        *same |= m->group[p] != 0 && m->group[p] == m->group[v[k]];
-    }
+    for (int k = 0; k < 3; k++)
+        if (!pair_allowed(m, c, p, v[k], same)) return 0;
     const wb_real *wv = m->w;
     return wv[p] != 0 || wv[v[0]] != 0 || wv[v[1]] != 0 || wv[v[2]] != 0;
+}
+
+/* a constraint joins p to a corner: rest neighbours never touch (asked only where the
+ * rules say one may: in one body or graph, or with cross-body links) */
+static int joined_corner(const wb_contacts *c, int same, int32_t p, const int32_t *v)
+{
+    if (!same && !c->cross) return 0;
+    return wb__joined(c, p, v[0]) || wb__joined(c, p, v[1]) || wb__joined(c, p, v[2]);
 }
 
 /* one body: not a point that lay within its radius of the triangle at rest */
@@ -106,7 +113,8 @@ static int rest_apart(const wb_model *m, int32_t p, const int32_t *v)
 {
     wb_real bary[3], q[3];
     const wb_real d2 = wb__tri_closest(&m->x0[3 * p], &m->x0[3 * v[0]], &m->x0[3 * v[1]], &m->x0[3 * v[2]], bary, q);
-    return !(d2 < m->radius[p] * m->radius[p]);
+    const wb_real r = m->radius[p] * WB_REST_TOUCH;
+    return !(d2 < r * r);
 }
 
 static wb_real box_dist2(const wb_real p[3], const wb_real lo[3], const wb_real hi[3])
@@ -128,14 +136,15 @@ static int candidate(const wb_world *w, const wb_real *tb, int32_t t, int32_t p,
     for (int k = 0; k < 3; k++) lo[k] = tb[k] - tb[6], hi[k] = tb[3 + k] + tb[6];
     if (!(box_dist2(&x[3 * p], lo, hi) < rp * rp)) return 0;
     const int32_t *v = &m->tri[3 * t];
+    const wb_contacts *pc = &w->k.pc;
     int same;
-    if (!rules_allow(m, p, v, &same)) return 0;
+    if (!rules_allow(m, pc, p, v, &same)) return 0;
     wb_real d[3];
     v3_sub(d, &x[3 * p], &x[3 * v[0]]);
     if (!(fabs(v3_dot(d, tb + 7)) < reach)) return 0;
     wb_real bary[3], q[3];
     if (!(wb__tri_closest(&x[3 * p], &x[3 * v[0]], &x[3 * v[1]], &x[3 * v[2]], bary, q) < reach * reach)) return 0;
-    return !(same && !rest_apart(m, p, v));
+    return !(same && !rest_apart(m, p, v)) && !joined_corner(pc, same, p, v);
 }
 
 /* fmax and fmin (a NaN argument gives the other), without the call into libm */

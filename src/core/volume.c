@@ -233,6 +233,11 @@ static wb_real vol_energy(const wb_world *w)
     return e;
 }
 
+static void vol_links(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    if (w->vol) wb__link_quads(w->vol->ijkl, w->vol->n, fn, ud);
+}
+
 const wb_ctype wb__volume_type = {
-    "volume", vol_count, vol_prepare, vol_substep_begin, vol_project, NULL, vol_energy,
+    "volume", vol_count, vol_prepare, vol_substep_begin, vol_project, NULL, vol_energy, vol_links,
 };

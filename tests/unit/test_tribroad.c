@@ -24,11 +24,45 @@ static double urand(void)
 }
 
 /* ---- the rules, brute force --------------------------------------------------------------------- */
-static int allowed(const wb_model *m, int32_t p, int32_t v)
+/* a loose particle's graph, found here by a walk over the links (the world's distance
+ * constraints: the tests make no other type): the least loose particle it reaches */
+static int32_t graph_brute(const wb_model *m, int32_t p)
 {
-    const int32_t gp = m->group[p], gv = m->group[v];
-    if (gp != gv || gp == 0) return (m->cflags[p] & m->cflags[v] & WB_CF_COLLIDE) != 0;
-    return (m->cflags[p] & m->cflags[v] & WB_CF_SELF) != 0;
+    if (m->group[p] > 0) return m->group[p];
+    int32_t least = p, changed = 1;
+    uint8_t *in = calloc((size_t)m->np, 1);
+    in[p] = 1;
+    while (changed) {
+        changed = 0;
+        for (int32_t s = 0; s < m->nd; s++) {
+            if (!(m->d_gen[s] & 1u)) continue;
+            const int32_t a = m->d_ij[2 * s], b = m->d_ij[2 * s + 1];
+            if (m->group[a] > 0 || m->group[b] > 0 || in[a] == in[b]) continue;
+            in[a] = in[b] = 1;
+            changed = 1;
+            if (a < least) least = a;
+            if (b < least) least = b;
+        }
+    }
+    free(in);
+    return -1 - least;
+}
+
+static int linked(const wb_model *m, int32_t p, int32_t v)
+{
+    for (int32_t s = 0; s < m->nd; s++)
+        if ((m->d_gen[s] & 1u) && ((m->d_ij[2 * s] == p && m->d_ij[2 * s + 1] == v) ||
+                                   (m->d_ij[2 * s] == v && m->d_ij[2 * s + 1] == p)))
+            return 1;
+    return 0;
+}
+
+static int allowed(const wb_model *m, int32_t p, int32_t v, int *same)
+{
+    if (linked(m, p, v)) return 0;
+    if (graph_brute(m, p) != graph_brute(m, v)) return (m->cflags[p] & m->cflags[v] & WB_CF_COLLIDE) != 0;
+    *same = 1;
+    return m->group[p] == 0 || (m->cflags[p] & m->cflags[v] & WB_CF_SELF) != 0;
 }
 
 static wb_real motion(const wb_world *w, int32_t i)
@@ -66,10 +100,8 @@ static int brute_pair(const wb_world *w, int32_t p, int32_t t)
     /* the rules */
     if (p == v[0] || p == v[1] || p == v[2]) return 0;
     int same = 0;
-    for (int k = 0; k < 3; k++) {
-        if (!allowed(m, p, v[k])) return 0;
-        same |= m->group[p] != 0 && m->group[p] == m->group[v[k]];
-    }
+    for (int k = 0; k < 3; k++)
+        if (!allowed(m, p, v[k], &same)) return 0;
     if (m->w[p] == 0 && m->w[v[0]] == 0 && m->w[v[1]] == 0 && m->w[v[2]] == 0) return 0;
     /* the plane, then the triangle, within rp + mv */
     const wb_real reach = rp + mv;
@@ -85,7 +117,7 @@ static int brute_pair(const wb_world *w, int32_t p, int32_t t)
     if (!(wb__tri_closest(&x[3 * p], &x[3 * v[0]], &x[3 * v[1]], &x[3 * v[2]], bary, q) < reach * reach)) return 0;
     /* one body: not within r_p of the triangle at rest */
     if (same && wb__tri_closest(&m->x0[3 * p], &m->x0[3 * v[0]], &m->x0[3 * v[1]], &m->x0[3 * v[2]], bary, q) <
-                    m->radius[p] * m->radius[p])
+                    m->radius[p] * m->radius[p] * WB_REST_TOUCH * WB_REST_TOUCH)
         return 0;
     return 1;
 }

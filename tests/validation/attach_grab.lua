@@ -11,7 +11,7 @@ local g = 9.81
 
 -- a chain of n particles of mass m, d apart, hanging from a grab on its top particle
 local function chain(n, m, d, substeps)
-  local w = wobble.world{ gravity = {0, -g, 0}, substeps = substeps or 20, contacts = false }
+  local w = wobble.world{ gravity = {0, -g, 0}, substeps = substeps or 20 }
   local ids = {}
   for i = 0, n - 1 do ids[#ids + 1] = w:particle{ pos = {0, 2 - d * i, 0}, mass = m } end
   -- link damping settles the chain's bounce (it vanishes at rest: no force then)
@@ -179,8 +179,8 @@ test("removing an attachment or its collider lets the particle go", function()
   local w = wobble.world{ gravity = {0, -g, 0} }
   local c1 = w:collider{ shape = "sphere", center = {0, 0, 0}, radius = 0.1 }
   local c2 = w:collider{ shape = "sphere", center = {5, 0, 0}, radius = 0.1 }
-  local p = w:particle{ pos = {0, 1, 0}, radius = 0 }
-  local q = w:particle{ pos = {5, 1, 0}, radius = 0 }
+  local p = w:particle{ pos = {0, 1, 0} }
+  local q = w:particle{ pos = {5, 1, 0} }
   local a1, a2 = w:attach(p, c1), w:attach(q, c2)
   w:run{ frames = 10 }
   expect.eq(w:stats().attachments, 2)

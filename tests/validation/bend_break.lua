@@ -12,7 +12,7 @@
 local M, D, G = 2, 0.5, 9.81
 
 local function hinge(break_torque, frames)
-  local w = wobble.world{ contacts = false, gravity = {0, -G, 0} }
+  local w = wobble.world{ gravity = {0, -G, 0} }
   local p1 = w:particle{ pos = {0, 1, 0}, mass = 0 }
   local p2 = w:particle{ pos = {0, 1, 1}, mass = 0 }
   local p3 = w:particle{ pos = {-D, 1, 0.5}, mass = 0 }

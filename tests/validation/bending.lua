@@ -12,7 +12,7 @@ local PI = math.pi
 -- resist gravity. Returns the mean tip sag (m) after it settles (velocity drag, which
 -- does not change the equilibrium, damps it in 5 s).
 local function cantilever(substeps, bend)
-  local w = wobble.world{ substeps = substeps, damping = 3, contacts = false }
+  local w = wobble.world{ substeps = substeps, damping = 3 }
   local nx = 6
   local b = w:cloth{ origin = {0, 0, 0}, size = {1, 0.2}, res = {nx, 3}, mass = 0.1, compliance = 0, bend = bend }
   for j = 0, 2 do
@@ -53,7 +53,7 @@ end)
 -- 90 degrees to each other. Gravity turns the pair about the hinge, but only the bend
 -- keeps the angle between the wings: without it both hang straight down, folded over.
 local function folded_pair(with_bend)
-  local w = wobble.world{ damping = 2, contacts = false, substeps = 20 }
+  local w = wobble.world{ damping = 2, substeps = 20 }
   local p1 = w:particle{ pos = {0, 1, 0}, mass = 0 }
   local p2 = w:particle{ pos = {1, 1, 0}, mass = 0 }
   local p3 = w:particle{ pos = {0.5, 1, 0.6}, mass = 0.5 }
@@ -86,7 +86,7 @@ end)
 
 test("angle stays finite and continuous through flat and folded over", function()
   for _, rest in ipairs{ 0, PI, -PI / 2 } do
-    local w = wobble.world{ gravity = {0, 0, 0}, contacts = false }
+    local w = wobble.world{ gravity = {0, 0, 0} }
     local p1 = w:particle{ pos = {0, 0, 0}, mass = 0 }
     local p2 = w:particle{ pos = {1, 0, 0}, mass = 0 }
     local p3 = w:particle{ pos = {0.5, 0, 1}, mass = 0 }
@@ -121,7 +121,7 @@ end)
 -- a mass m on a rigid link from a pinned particle: the link pulls m g, exactly, from the
 -- first substep on (it starts at rest at its rest length), so break_force decides at once
 local function hanging(break_force)
-  local w = wobble.world{ contacts = false }
+  local w = wobble.world{}
   local top = w:particle{ pos = {0, 1, 0}, mass = 0 }
   local m = w:particle{ pos = {0, 0.5, 0}, mass = 2 }
   local c = w:distance(top, m, { break_force = break_force })
@@ -142,7 +142,7 @@ test("break_force: a link breaks at the force it carries", function()
   local _, y = w:position(select(2, c2:particles()))
   expect.lt(y, 0, "and the mass falls")
   -- break_strain alone never fires on a rigid link carrying the same load
-  local w3 = wobble.world{ contacts = false }
+  local w3 = wobble.world{}
   local top = w3:particle{ pos = {0, 1, 0}, mass = 0 }
   local m = w3:particle{ pos = {0, 0.5, 0}, mass = 2 }
   local c3 = w3:distance(top, m, { break_strain = 1e-6 })
@@ -151,7 +151,7 @@ test("break_force: a link breaks at the force it carries", function()
   -- builders pass it on: a rope's top link carries the whole rope, the next one less.
   -- 20 iterations: one Gauss-Seidel pass over a chain starting at rest overshoots the top
   -- link's force by 2% in the first frame (measured); 20 converge it to the static value
-  local w4 = wobble.world{ contacts = false, iterations = 20 }
+  local w4 = wobble.world{ iterations = 20 }
   local rope = w4:rope{ from = {0, 1, 0}, to = {0, 0, 0}, segments = 4, mass = 1, break_force = 0.9 * 9.81 }
   w4:pin(rope.particles[1])
   w4:step()
@@ -160,7 +160,7 @@ test("break_force: a link breaks at the force it carries", function()
   -- the top link holds 4/5 of the 1 kg (the pinned particle's share is its own): 0.8 g
   -- < 0.9 g, so nothing breaks; at 0.7 g the top link alone goes
   expect.eq(table.concat(broken), "0000")
-  local w5 = wobble.world{ contacts = false, iterations = 20 }
+  local w5 = wobble.world{ iterations = 20 }
   local rope5 = w5:rope{ from = {0, 1, 0}, to = {0, 0, 0}, segments = 4, mass = 1, break_force = 0.7 * 9.81 }
   w5:pin(rope5.particles[1])
   w5:step()

@@ -98,7 +98,7 @@ local function chain(substeps, iterations, seconds)
     if i <= half then x, y = -D / 2 + (D / 2) * i / half, -d * i / half
     else x, y = (D / 2) * (i - half) / half, -d + d * (i - half) / half end
     local ends = i == 0 or i == N
-    ids[#ids + 1] = w:particle{ pos = { x, y, 0 }, mass = ends and 0 or 1 / (N - 1), radius = 0 }
+    ids[#ids + 1] = w:particle{ pos = { x, y, 0 }, mass = ends and 0 or 1 / (N - 1) }
   end
   for i = 1, N do w:distance(ids[i], ids[i + 1], { compliance = 0, rest = L / N }) end
   w:run{ seconds = seconds }
