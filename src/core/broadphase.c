@@ -577,7 +577,7 @@ static int build_rules(wb_world *w)
         if (wb__ctypes[t]->links) wb__ctypes[t]->links(w, add_link, &u);
     if (u.fail) return 0;
     for (int32_t i = 0; i < m->np; i++) g[i] = graph_root(g, i);
-    qsort(c->keys, (size_t)u.n, sizeof *c->keys, cmp_u64);
+    if (u.n > 1) qsort(c->keys, (size_t)u.n, sizeof *c->keys, cmp_u64); /* keys is NULL while none */
     int32_t n = 0;
     c->cross = 0;
     for (int32_t k = 0; k < u.n; k++) {
