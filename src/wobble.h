@@ -266,7 +266,7 @@ void wb_body_set_contacts(wb_world *w, wb_body b, bool collide, bool self_collid
 void wb_group_set_self_collide(wb_world *w, int32_t group, bool on); /* every particle of the group */
 bool wb_group_self_collide(const wb_world *w, int32_t group);  /* some particle of it self-collides */
 void wb_particle_set_radius(wb_world *w, int32_t p, wb_real r); /* r >= 0, finite */
-/* the mean over the body's particles of their shortest constraint (0 when none): the
+/* the mean over the body's particles of their shortest link, any constraint's (0 when none): the
  * spacing a default contact radius is taken from */
 wb_real wb_body_spacing(const wb_world *w, wb_body b);
 /* the particle-particle contacts that corrected positions in the last substep of the last

@@ -21,6 +21,7 @@
 #include <stdlib.h>
 
 #include "core.h"
+#include "ctype.h"
 
 /* a contact's record for the velocity pass and the readout (act_nd): normal (i -> j),
  * depth, normal force, old overlap pushed back in full (err), mu when sliding (else 0) */
@@ -86,22 +87,31 @@ bool wb_group_self_collide(const wb_world *w, int32_t group)
 
 void wb_particle_set_radius(wb_world *w, int32_t p, wb_real r) { w->m.radius[p] = r; }
 
+/* the body's links (any constraint type's: a Neo-Hookean lattice has tets and no
+ * distances) shortening each end's shortest */
+typedef struct spacing_ud { const wb_world *w; wb_body b; wb_real *shortest; } spacing_ud;
+
+static void shorten(void *ud, int32_t a, int32_t b, int joined)
+{
+    const spacing_ud *u = ud;
+    if (!joined) return;
+    wb_real d[3];
+    v3_sub(d, &u->w->s.x[3 * b], &u->w->s.x[3 * a]);
+    const wb_real len = v3_len(d);
+    const int32_t e[2] = { a - u->b.first, b - u->b.first };
+    for (int k = 0; k < 2; k++)
+        if (e[k] >= 0 && e[k] < u->b.count && len > 0 && len < u->shortest[e[k]]) u->shortest[e[k]] = len;
+}
+
 wb_real wb_body_spacing(const wb_world *w, wb_body b)
 {
-    const wb_model *m = &w->m;
     if (b.count <= 0) return 0;
     wb_real *shortest = malloc(sizeof *shortest * (size_t)b.count);
     if (!shortest) return 0;
     for (int32_t i = 0; i < b.count; i++) shortest[i] = INFINITY;
-    for (int32_t s = 0; s < m->nd; s++) {
-        if (!(m->d_gen[s] & 1u)) continue;
-        const int32_t e[2] = { m->d_ij[2 * s] - b.first, m->d_ij[2 * s + 1] - b.first };
-        wb_real d[3];
-        v3_sub(d, &w->s.x[3 * m->d_ij[2 * s + 1]], &w->s.x[3 * m->d_ij[2 * s]]);
-        const wb_real len = v3_len(d);
-        for (int k = 0; k < 2; k++)
-            if (e[k] >= 0 && e[k] < b.count && len > 0 && len < shortest[e[k]]) shortest[e[k]] = len;
-    }
+    spacing_ud u = { w, b, shortest };
+    for (int t = 0; t < wb__nctypes; t++)
+        if (wb__ctypes[t]->links) wb__ctypes[t]->links(w, shorten, &u);
     wb_real sum = 0;
     int32_t n = 0;
     for (int32_t i = 0; i < b.count; i++)
