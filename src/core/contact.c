@@ -84,7 +84,11 @@ bool wb_group_self_collide(const wb_world *w, int32_t group)
     return false;
 }
 
-void wb_particle_set_radius(wb_world *w, int32_t p, wb_real r) { w->m.radius[p] = r; }
+void wb_particle_set_radius(wb_world *w, int32_t p, wb_real r)
+{
+    w->m.radius[p] = r;
+    w->k.pc.scan_dirty = 1; /* the triangles a body's spheres cover (wb__contact_rules) */
+}
 
 wb_real wb_body_spacing(const wb_world *w, wb_body b)
 {
