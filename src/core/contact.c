@@ -85,7 +85,11 @@ bool wb_group_self_collide(const wb_world *w, int32_t group)
     return false;
 }
 
-void wb_particle_set_radius(wb_world *w, int32_t p, wb_real r) { w->m.radius[p] = r; }
+void wb_particle_set_radius(wb_world *w, int32_t p, wb_real r)
+{
+    w->m.radius[p] = r;
+    w->k.pc.scan_dirty = 1; /* the triangles a body's spheres cover (wb__contact_rules) */
+}
 
 /* the body's links (any constraint type's: a Neo-Hookean lattice has tets and no
  * distances) shortening each end's shortest */

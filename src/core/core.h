@@ -193,6 +193,10 @@ typedef struct wb_contacts {
     int32_t cap_graph;
     int cross;             /* some joined pair is not in one body or one graph: the pair
                               rule asks keys for pairs of two bodies too */
+    uint8_t *tcov;         /* (ntri) 1: a triangle of one body that its corners' spheres cover
+                              (wb__contact_rules): its own body's points leave it to the
+                              particle pairs */
+    int32_t cap_tcov;
     int keys_dirty;        /* set when the topology changes */
     uint64_t keys_sig;     /* particles and constraints of each type the keys were built for */
     int32_t scanned_np;    /* particles when `possible` was worked out */

@@ -76,14 +76,14 @@ static int pair_allowed(const wb_model *m, const wb_contacts *c, int32_t p, int3
     return m->group[p] == 0 || (m->cflags[p] & m->cflags[v] & WB_CF_SELF) != 0;
 }
 
-/* the body no point of which may touch triangle tv: its corners' body when that does not
- * collide with itself, else 0 (the search, tri_scan and the quick answer's runs all cull
- * by it: one rule) */
-static inline int32_t tri_key(const wb_model *m, const int32_t *tv)
+/* the body no point of which may touch triangle t: its corners' body when that does not
+ * collide with itself, or when its spheres cover the triangle (broadphase.c's tcov); else
+ * 0 (the search, tri_scan and the quick answer's runs all cull by it: one rule) */
+static inline int32_t tri_key(const wb_model *m, const wb_contacts *c, int32_t t)
 {
-    const int32_t g0 = m->group[tv[0]];
+    const int32_t *tv = &m->tri[3 * t], g0 = m->group[tv[0]];
     return g0 > 0 && m->group[tv[1]] == g0 && m->group[tv[2]] == g0 &&
-                   !(m->cflags[tv[0]] & m->cflags[tv[1]] & m->cflags[tv[2]] & WB_CF_SELF)
+                   (c->tcov[t] || !(m->cflags[tv[0]] & m->cflags[tv[1]] & m->cflags[tv[2]] & WB_CF_SELF))
                ? g0
                : 0;
 }
@@ -138,7 +138,7 @@ static int candidate(const wb_world *w, const wb_real *tb, int32_t t, int32_t p,
     const int32_t *v = &m->tri[3 * t];
     const wb_contacts *pc = &w->k.pc;
     int same;
-    if (!rules_allow(m, pc, p, v, &same)) return 0;
+    if (!rules_allow(m, pc, p, v, &same) || (pc->tcov[t] && m->group[p] == m->group[v[0]])) return 0;
     wb_real d[3];
     v3_sub(d, &x[3 * p], &x[3 * v[0]]);
     if (!(fabs(v3_dot(d, tb + 7)) < reach)) return 0;
@@ -703,7 +703,7 @@ static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, cons
         if (need && (b->qtrun[t] < 0 || !need[b->qtrun[t]])) continue;
         const wb_real e = tri_box(m, x, mvp, t, &b->tbox[TB * t]);
         if (e != e) continue;
-        b->tkey[t] = tri_key(m, &m->tri[3 * t]);
+        b->tkey[t] = tri_key(m, &w->k.pc, t);
         b->tc[nt++] = t;
         sum += e;
     }
@@ -792,14 +792,15 @@ static int finish(struct wb_tribroad *b, wb_world *w, int64_t total, wb_real oce
  * search takes the points left and the triangles of the runs their boxes meet (what
  * is left out meets nothing, by the same boxes): the list is the search's either way. */
 
-/* the arrays the runs depend on (triangles, flags, groups), one after the other: copied
+/* the arrays the runs depend on (triangles, flags, groups, covers), one after the other: copied
  * into b->kmodel (store), or compared with it */
-static int model_same(struct wb_tribroad *b, const wb_model *m, int store)
+static int model_same(struct wb_tribroad *b, const wb_model *m, const uint8_t *cov, int store)
 {
     const struct { const void *p; size_t n; } a[] = {
         { m->tri, sizeof *m->tri * 3 * (size_t)m->ntri },
         { m->cflags, sizeof *m->cflags * (size_t)m->np },
         { m->group, sizeof *m->group * (size_t)m->np },
+        { cov, sizeof *cov * (size_t)m->ntri },
     };
     size_t at = 0;
     for (size_t k = 0; k < sizeof a / sizeof a[0]; k++) at += a[k].n;
@@ -828,10 +829,11 @@ static int cmp_i32(const void *a, const void *b)
 
 /* the triangle runs (pick_run's rule) and each run's corners, once each: b->qrun
  * (key, first corner, end), b->qcorner; b->nq = -1 when too many runs. 0 when out of memory */
-static int quick_runs(struct wb_tribroad *b, const wb_model *m)
+static int quick_runs(struct wb_tribroad *b, const wb_world *w)
 {
+    const wb_model *m = &w->m;
     b->qvalid = 0;
-    if (!model_same(b, m, 1) || !grow((void **)&b->qtrun, &b->cap_qtrun, m->ntri, sizeof *b->qtrun)) return 0;
+    if (!model_same(b, m, w->k.pc.tcov, 1) || !grow((void **)&b->qtrun, &b->cap_qtrun, m->ntri, sizeof *b->qtrun)) return 0;
     int32_t *rid = b->qtrun;
     int32_t keys[RUNS_MAX];
     run_picker pick = { 0, -1, -1, 0 };
@@ -840,7 +842,7 @@ static int quick_runs(struct wb_tribroad *b, const wb_model *m)
         const uint8_t f0 = m->cflags[tv[0]], f1 = m->cflags[tv[1]], f2 = m->cflags[tv[2]];
         rid[t] = -1;
         if (!((f0 | f1 | f2) & (WB_CF_COLLIDE | WB_CF_SELF))) continue;
-        const int32_t key = tri_key(m, tv);
+        const int32_t key = tri_key(m, &w->k.pc, t);
         int fresh;
         rid[t] = pick_run(&pick, key, &fresh);
         if (rid[t] < 0) { b->nq = -1; b->qvalid = 1; return 1; }
@@ -883,8 +885,8 @@ static int quick_empty(struct wb_tribroad *b, wb_world *w, int32_t na, wb_real r
     *tris = 0;
     const wb_model *m = &w->m;
     const wb_real *x = w->s.x, *mvp = b->mv;
-    if (!b->qvalid || !model_same(b, m, 0)) {
-        if (!quick_runs(b, m)) return -1;
+    if (!b->qvalid || !model_same(b, m, w->k.pc.tcov, 0)) {
+        if (!quick_runs(b, w)) return -1;
     }
     if (b->nq < 0) return 0;
     if (na == 0 || b->nq == 0) return 1;

@@ -21,6 +21,7 @@ mkdir -p "$(dirname "$JSON")" && : >"$JSON" || exit 2
 SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2 scale32 scale64 scale128 scale256 scale512 contacts sheet tets tets_t2"
 FLOAT_SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2"
 SCENES="$SCENES bend"   # the bending scene (tests/bench/bend.lua)
+SCENES="$SCENES self128 loose128 heap128"   # self-collision against none (tests/bench/self_collide.lua)
 
 # scene EXE NAME HEADER(1/0) [ROW [SET]]: one row (and the header when asked); with ROW the row
 # is named ROW and has no Bullet figures (the busy-core rows: Bullet ran without the spinner);
@@ -142,6 +143,12 @@ echo "== the aims of issue 8 (contacts.lua; wall clock)"
 aim "broad phase / one distance sweep" "$(row contacts broad_sweeps)" 1
 on=$(row contacts ms_per_frame) off=$(row contacts_off ms_per_frame)
 aim "frame with contacts / without" "$([ -n "$on" ] && [ -n "$off" ] && awk -v a="$on" -v b="$off" 'BEGIN { printf "%.4f", a / b }')" 2
+# self-collision's aims (smaller is better): each scene against itself without it
+echo
+echo "== the aims of self-collision (tests/bench/self_collide.lua; wall clock)"
+aim "self128: self-colliding / not" "$(row self128 ratio_off)" 1.3
+aim "loose128: hand-built, contacts / none" "$(row loose128 ratio_off)" 1.3
+aim "heap128: self-colliding heap / not" "$(row heap128 ratio_off)" 3
 echo
 echo "JSON lines: $JSON"
 exit 0

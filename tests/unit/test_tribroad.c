@@ -73,6 +73,25 @@ static wb_real motion(const wb_world *w, int32_t i)
 }
 
 /* whether (p, t) is a candidate of this frame */
+/* a triangle of one body that its corners' spheres cover: its circumradius at rest, with
+ * 25% to spare, within the body's least radius + its corners' least (broadphase.c) */
+static int covered(const wb_model *m, int32_t t)
+{
+    const int32_t *v = &m->tri[3 * t], g = m->group[v[0]];
+    if (g <= 0 || m->group[v[1]] != g || m->group[v[2]] != g) return 0;
+    wb_real rmin = INFINITY;
+    for (int32_t i = 0; i < m->np; i++)
+        if (m->group[i] == g && m->radius[i] < rmin) rmin = m->radius[i];
+    const wb_real rc = fmin(m->radius[v[0]], fmin(m->radius[v[1]], m->radius[v[2]]));
+    wb_real a[3], b[3], c[3], n[3];
+    v3_sub(a, &m->x0[3 * v[1]], &m->x0[3 * v[0]]);
+    v3_sub(b, &m->x0[3 * v[2]], &m->x0[3 * v[1]]);
+    v3_sub(c, &m->x0[3 * v[0]], &m->x0[3 * v[2]]);
+    v3_cross(n, a, c);
+    const wb_real area = v3_len(n) / 2;
+    return area > 0 && v3_len(a) * v3_len(b) * v3_len(c) / (4 * area) * 1.25 <= rmin + rc * (1 + 1e-12);
+}
+
 static int brute_pair(const wb_world *w, int32_t p, int32_t t)
 {
     const wb_model *m = &w->m;
@@ -102,6 +121,7 @@ static int brute_pair(const wb_world *w, int32_t p, int32_t t)
     int same = 0;
     for (int k = 0; k < 3; k++)
         if (!allowed(m, p, v[k], &same)) return 0;
+    if (m->group[p] == m->group[v[0]] && covered(m, t)) return 0;
     if (m->w[p] == 0 && m->w[v[0]] == 0 && m->w[v[1]] == 0 && m->w[v[2]] == 0) return 0;
     /* the plane, then the triangle, within rp + mv */
     const wb_real reach = rp + mv;

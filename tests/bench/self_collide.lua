@@ -1,0 +1,92 @@
+-- self_collide.lua: what self-collision costs, each scene against itself without it in the
+-- same process (the goals of self-collision at scale: at most 1.3x for a hanging cloth and
+-- for a hand-built one, at most 3x for a heap). 10 substeps x 1 iteration, one thread.
+--  self128   a w:cloth of 128 x 128 (2 m, radius half its spacing), pinned at two
+--            corners, swinging down for 60 frames: self_collide = true against false
+--  loose128  the same sheet built by hand (w:particle + w:distance: loose particles,
+--            default radius 0.02 > half the 1.57 cm spacing): contacts on against off
+--  heap128   a w:cloth of 128 x 128 (1.5 m) hung straight down over the floor, rippled,
+--            let fall into a heap on itself for 120 frames: self_collide = true against
+--            false (without, the folds pass through each other)
+-- Columns as the other scenes'; the note gives both frames and their ratio.
+-- Run: make bench   (or build/wobble bench [--json]; --set frames=N for a quick look)
+local bench = require("wobble.bench")
+local args = wobble.args
+
+local function hanging(self)
+  local w = wobble.world{ threads = args.threads or 1 }
+  local c = w:cloth{ origin = {-1, 2, -1}, size = {2, 2}, res = {128, 128}, mass = 1, self_collide = self }
+  w:pin(c.particles[1])
+  w:pin(c.particles[128])
+  return w
+end
+
+local function hand_built(contacts)
+  local w = wobble.world{ threads = args.threads or 1, contacts = contacts }
+  local n, s, id = 128, 2 / 127, {}
+  for j = 0, n - 1 do
+    for i = 0, n - 1 do id[j * n + i] = w:particle{ pos = {i * s - 1, 2, j * s - 1}, mass = 1 / (n * n) } end
+  end
+  for j = 0, n - 1 do
+    for i = 0, n - 1 do
+      if i < n - 1 then w:distance(id[j * n + i], id[j * n + i + 1]) end
+      if j < n - 1 then w:distance(id[j * n + i], id[(j + 1) * n + i]) end
+    end
+  end
+  w:pin(id[0])
+  w:pin(id[n - 1])
+  return w
+end
+
+local function heap(self)
+  local w = wobble.world{ threads = args.threads or 1, damping = 0.5 }
+  w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.8 }
+  local c = w:cloth{ origin = {-0.75, 0, 0}, size = {1.5, 1.5}, res = {128, 128}, mass = 1, self_collide = self,
+                     friction = 0.8, compliance = 1e-6 }
+  -- the sheet as built lies in x-z; stand it up in x-y, its lower edge 2 radii above the floor
+  local r = w:radius(c.particles[1])
+  for _, p in ipairs(c.particles) do
+    local x, _, z = w:position(p)
+    w:set_position(p, x, z + 2 * r, 0.02 * math.sin(20 * z + 2 * x))
+    w:set_velocity(p, -0.3 * x * z, 0, 0.2 * math.sin(9 * z + 1.5 * x))
+  end
+  return w
+end
+
+-- ms per frame of frames steps; the stats of the last
+local function run(w, frames)
+  local step_ms, solve_ms, projections = 0, 0, 0
+  for _ = 1, frames do
+    w:step()
+    local s = w:stats()
+    step_ms, solve_ms, projections = step_ms + s.step_ms, solve_ms + s.solve_ms, projections + s.projections
+  end
+  return step_ms / frames, solve_ms, projections, w:stats()
+end
+
+local function scene(name, make, frames, what)
+  if not bench.want(name) then return end
+  frames = bench.frames(frames)
+  collectgarbage()
+  local rss0 = bench.rss()
+  local w = make(true)
+  local ms, solve_ms, projections, s = run(w, frames)
+  local bytes = bench.bytes_per(rss0, s.particles)
+  local contacts = s.particle_contacts
+  w = nil
+  collectgarbage()
+  local ms_off = run(make(false), frames)
+  local r = {
+    scene = name, particles = s.particles, constraints = s.distances, substeps = s.substeps,
+    iterations = s.iterations, threads = s.threads, frames = frames, ms_per_frame = ms,
+    ms_per_frame_off = ms_off, ratio_off = ms / ms_off,
+    ns_per_projection = ms * frames * 1e6 / projections, ns_per_projection_solve = solve_ms * 1e6 / projections,
+    bytes_per_particle = bytes,
+  }
+  bench.report(r, string.format("%s: %.3f ms/frame, %.2fx; %d contacts at the end", what, ms_off, r.ratio_off,
+                                contacts))
+end
+
+scene("self128", hanging, 60, "without self-collision")
+scene("loose128", hand_built, 60, "contacts = false")
+scene("heap128", heap, 120, "without self-collision")

@@ -1,0 +1,94 @@
+-- self_collision.lua: a fine cloth (radius half its spacing, the builders' default) folded
+-- onto itself by a script never passes through itself. Its triangles are covered by its
+-- particles' spheres, so its self-collision is the particle pairs' alone (broadphase.c,
+-- "Self-collision by particles where they cover the surface"): a particle of one layer
+-- cannot slip between two of the other's without touching them.
+--
+-- A 1 m cloth of 25 x 25 lies on the floor; its edge at x = 1 is grabbed and carried over
+-- in a half circle of radius 0.25 m onto the other half, then let go. Two layers must
+-- result: every particle of the folded part that lies over the other part rests on it:
+-- the floor holds the lower layer at y = r, and a sphere of the upper layer sits at most
+-- as deep as the hollow of four touching lower ones, sqrt(2) r above their centres, so at
+-- y >= (1 + sqrt 2) r; a fold that passed through would lie at r or below. And no
+-- pair but rest neighbours overlaps by more than 5% of 2 r (the links pull back after
+-- the contact pass). Without self-collision the same fold interpenetrates: the twin.
+
+local function fold(self_collide)
+  local w = wobble.world{ damping = 1 }
+  w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.5 }
+  local n = 25
+  local c = w:cloth{ origin = {0, 0, 0}, size = {1, 1}, res = {n, n}, mass = 0.5, self_collide = self_collide,
+                     friction = 0.5 }
+  local r = w:radius(c.particles[1])
+  for _, p in ipairs(c.particles) do
+    local x, _, z = w:position(p)
+    w:set_position(p, x, r, z) -- resting on the floor
+  end
+  -- the edge x = 1, grabbed where it is
+  local grabs, edge = {}, {}
+  for _, p in ipairs(c.particles) do
+    local x, y, z = w:position(p)
+    if x > 1 - 1e-9 then
+      grabs[#grabs + 1] = { g = w:grab(p, {x, y, z}), z = z }
+      edge[#edge + 1] = p
+    end
+  end
+  -- carried over the fold line x = 0.5 on a half circle of radius 0.25 about (0.75 -> 0.25)
+  local frames = 120
+  w:run{ frames = frames, on_frame = function(w, f)
+    local a = math.pi * math.min(f / frames, 1)
+    for _, e in ipairs(grabs) do
+      e.g:move(0.5 + 0.5 * math.cos(a) * 0.5 + 0.25 * math.cos(a), r + 0.25 * math.sin(a) + 4 * r * math.sin(a / 2) ^ 2,
+               e.z)
+    end
+  end }
+  for _, e in ipairs(grabs) do e.g:release() end
+  w:run{ seconds = 2 }
+  return w, c, r
+end
+
+local function layers(w, c, r)
+  -- the folded part: particles whose built x was > 0.55 (built: the cloth's order); how
+  -- many of those now lie over the lower part (x < 0.45) and how low the lowest is
+  local low, over = math.huge, 0
+  for k, p in ipairs(c.particles) do
+    local bx = ((k - 1) % 25) / 24
+    local x, y = w:position(p)
+    if bx > 0.55 and x < 0.45 then
+      over = over + 1
+      low = math.min(low, y)
+    end
+  end
+  return over, low
+end
+
+test("a fine cloth folded over onto itself by a script lies in two layers", function()
+  local w, c, r = fold(true)
+  local over, low = layers(w, c, r)
+  expect.gt(over, 100, "folded particles lying over the other half")
+  -- (1 + sqrt 2) r, less the links' pull after the contact pass (5% of 2 r)
+  expect.gt(low, (1 + math.sqrt(2)) * r - 0.1 * r, "the lowest folded particle rests on the lower layer")
+  -- no pair overlapping by more than 5% of 2 r, but rest neighbours (within 2 r when built)
+  local ps, worst = c.particles, 0
+  local built = {}
+  for k, p in ipairs(ps) do built[p] = { ((k - 1) % 25) / 24, ((k - 1) // 25) / 24 } end
+  for i = 1, #ps do
+    local xi, yi, zi = w:position(ps[i])
+    for j = i + 1, #ps do
+      local bi, bj = built[ps[i]], built[ps[j]]
+      if (bi[1] - bj[1]) ^ 2 + (bi[2] - bj[2]) ^ 2 > (2 * r) ^ 2 * 1.0001 then
+        local xj, yj, zj = w:position(ps[j])
+        local d = math.sqrt((xi - xj) ^ 2 + (yi - yj) ^ 2 + (zi - zj) ^ 2)
+        worst = math.max(worst, (2 * r - d) / (2 * r))
+      end
+    end
+  end
+  expect.lt(worst, 0.05, "deepest overlap of a non-neighbour pair, share of 2 r")
+end)
+
+test("without self-collision the same fold passes into the lower layer (the test has power)", function()
+  local w, c, r = fold(false)
+  local over, low = layers(w, c, r)
+  expect.gt(over, 100, "folded particles lying over the other half")
+  expect.lt(low, 2 * r, "the folded part sank into the lower layer")
+end)
