@@ -25,7 +25,8 @@
 -- (the old behaviour: the block leaves at 14 m/s, the stack is thrown 9.6 m, the rigid box
 -- jumps its 1 cm in one frame, the particle leaves the box at 2.1 m/s). The dropped block
 -- is the other side and passes with or without the limit: what a substep drives in is
--- pushed out in full, or the block would sink into the ground by (v - vmax) dt per frame.
+-- pushed out in full, or the block would sink into the ground by (v - vmax) dt per frame;
+-- so is the particle under four others, pushed into the ground by their repairs.
 
 local VMAX = 0.25 -- the default max_depenetration, m/s
 local dt = 1 / 60
@@ -174,6 +175,25 @@ for _, deep in ipairs{ 0, 0.05 } do
     if deep == 0 then expect.lt(speed, 2 * VMAX, "the blocks' centres") end
   end)
 end
+
+test("what other contacts' repairs push into the ground goes out in full: a particle under four made inside it", function()
+  -- four heavy particles made half inside a light one resting on the ground: each pair
+  -- pushes it down at max_depenetration, moving x_prev with x, four times what one
+  -- substep of the limit would take; the ground counts none of it as kept (the
+  -- particle had none there) and puts it back each substep. Counted as made it sank
+  -- 3.7 cm into the ground (measured with an x_prev overlap taken as kept)
+  local w = world()
+  w:collider{ shape = "plane" }
+  local r = 0.05
+  local p = w:particle{ pos = {0, r, 0}, mass = 0.1, radius = r }
+  for k = 0, 3 do
+    local a = k * math.pi / 2
+    w:particle{ pos = {0.05 * math.cos(a), r + 0.06, 0.05 * math.sin(a)}, mass = 2, radius = r }
+  end
+  local lowest = math.huge
+  w:run{ seconds = 1, on_frame = function(w) lowest = math.min(lowest, select(2, w:position(p)) - r) end }
+  expect.ge(lowest, -1e-9, "no frame ends with it inside the ground")
+end)
 
 test("a rigid box made 1 cm into the ground rises at max_depenetration with no speed", function()
   local w = world()
