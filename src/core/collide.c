@@ -446,10 +446,11 @@ typedef struct contact {
  * sides: the particle stays on the side it was on at the substep's start (x_prev in the
  * collider's start pose), so one that crossed the sheet within the substep goes back
  * rather than out the far side. */
-static wb_real mesh_depth(const sub_pose *sp, const wb_real x[3], const wb_real xprev[3], wb_real r, wb_real n[3])
+static wb_real mesh_depth(const sub_pose *sp, const wb_real x[3], const wb_real xprev[3], wb_real r, wb_real n[3],
+                          int32_t *tri)
 {
     const wb_colmesh *cm = sp->s->mesh;
-    wb_real u[3], l[3], nl[3], c[3], pn[3];
+    wb_real u[3], l[3], nl[3], pn[3], c[3];
     v3_sub(u, x, sp->p1);
     q_rotate_inv(sp->q1, u, l);
     /* far from the tree's box: no contact, and no query */
@@ -466,12 +467,13 @@ static wb_real mesh_depth(const sub_pose *sp, const wb_real x[3], const wb_real 
         if (l[k] < root->lo[k] - reach || l[k] > root->hi[k] + reach) return 0;
     wb_real depth;
     if (cm->closed) {
-        depth = r - wb__colmesh_distance(cm, l, nl, c, pn);
+        depth = r - wb__colmesh_distance_tri(cm, l, nl, c, pn, tri);
     } else {
         int32_t t;
         int region;
         const wb_real d2 = wb__colmesh_closest_within(cm, l, reach * reach, c, &t, &region);
         if (t < 0) return 0;
+        *tri = t;
         wb__colmesh_pseudo_normal(cm, t, region, pn);
         const wb_real lpn = v3_len(pn), d = sqrt(d2);
         wb_real a[3], b[3];
@@ -496,9 +498,12 @@ static wb_real mesh_depth(const sub_pose *sp, const wb_real x[3], const wb_real 
 }
 
 /* The overlap a particle of radius r at x_prev had with the collider at its start pose:
- * what it began the substep with (made_contact). An open mesh: on the side it was on
- * then, the unsigned distance */
-static wb_real start_depth(const sub_pose *sp, const wb_real xprev[3], wb_real r)
+ * what it began the substep with (made_contact). A mesh: against triangle tri, the one
+ * closest to x (a second search of the tree cost as much as the first: +20% for a cloth
+ * draped on a mesh); the same unless the closest feature changed within the substep,
+ * and then a little off, which moves no kept overlap faster than max_depenetration (that
+ * bound is `left`'s). Closed: signed; open: the unsigned distance, the side it was on */
+static wb_real start_depth(const sub_pose *sp, const wb_real xprev[3], wb_real r, int32_t tri)
 {
     if (sp->s->shape == WB_SHAPE_PLANE) return r + sp->off0 - v3_dot(sp->n0, xprev);
     if (sp->s->shape != WB_SHAPE_MESH) {
@@ -506,17 +511,17 @@ static wb_real start_depth(const sub_pose *sp, const wb_real xprev[3], wb_real r
         return r - wb__shape_distance(sp->s, sp->p0, sp->q0, xprev, n);
     }
     const wb_colmesh *cm = sp->s->mesh;
-    wb_real u[3], l[3], c[3];
+    if (tri < 0) return 0;
+    wb_real u[3], l[3], q[3], pn[3];
     v3_sub(u, xprev, sp->p0);
     q_rotate_inv(sp->q0, u, l);
-    const wb_bvh_node *root = &cm->nodes[0];
-    for (int k = 0; k < 3; k++)
-        if (l[k] < root->lo[k] - r || l[k] > root->hi[k] + r) return 0;
-    if (cm->closed) return r - wb__colmesh_distance(cm, l, NULL, NULL, NULL);
-    int32_t t;
+    const int32_t *v = &cm->tri[3 * tri];
     int region;
-    const wb_real d2 = wb__colmesh_closest_within(cm, l, r * r, c, &t, &region);
-    return t < 0 ? 0 : r - sqrt(d2);
+    const wb_real d = sqrt(wb__closest_on_triangle(l, &cm->v[3 * v[0]], &cm->v[3 * v[1]], &cm->v[3 * v[2]], q, &region));
+    if (!cm->closed) return r - d;
+    wb__colmesh_pseudo_normal(cm, tri, region, pn);
+    v3_sub(u, l, q);
+    return v3_dot(u, pn) < 0 ? r + d : r - d;
 }
 
 /* more simultaneous contacts than this on one particle keep their position
@@ -739,17 +744,18 @@ WB_INLINE void collide_range(collide_job *j, int32_t lo, int32_t hi, const int p
                 const sub_pose *sp = &cs[c];
                 if (att && wb__attach_skip(att, i, sp->slot)) continue;
                 wb_real n[3], depth;
+                int32_t tri = -1;
                 if (sp->s->shape == WB_SHAPE_PLANE) {
                     depth = rad[i] + sp->off - v3_dot(sp->n, xi);
                     v3_copy(n, sp->n);
                 } else if (sp->s->shape == WB_SHAPE_MESH) {
-                    depth = mesh_depth(sp, xi, pi, rad[i], n);
+                    depth = mesh_depth(sp, xi, pi, rad[i], n, &tri);
                 } else {
                     depth = rad[i] - wb__shape_distance(sp->s, sp->p1, sp->q1, xi, n);
                 }
                 if (!(depth > 0)) continue;
                 wb_real shift;
-                depth = made_contact(depth, start_depth(sp, pi, rad[i]), left, fresh, step, &lmax, &shift);
+                depth = made_contact(depth, start_depth(sp, pi, rad[i], tri), left, fresh, step, &lmax, &shift);
                 resolve(xi, pi, vi, sp, n, depth, shift, h, nct < MAX_CONTACTS ? &ct[nct] : NULL);
                 nct++;
             }
