@@ -343,10 +343,17 @@ static void out_dir(const wb_real p[3], const wb_real c[3], wb_real d, const wb_
 
 wb_real wb__colmesh_distance(const wb_colmesh *cm, const wb_real p[3], wb_real n[3], wb_real c[3], wb_real pn[3])
 {
+    return wb__colmesh_distance_tri(cm, p, n, c, pn, NULL);
+}
+
+wb_real wb__colmesh_distance_tri(const wb_colmesh *cm, const wb_real p[3], wb_real n[3], wb_real c[3], wb_real pn[3],
+                                 int32_t *tri)
+{
     wb_real q[3], nn[3], pnn[3];
     int32_t t;
     int region;
     const wb_real d2 = closest_within(cm, p, INFINITY, q, &t, &region);
+    if (tri) *tri = t;
     if (t < 0) {
         if (n) v3_set(n, 0, 1, 0);
         return INFINITY;

@@ -51,5 +51,8 @@ void wb__colmesh_pseudo_normal(const wb_colmesh *cm, int32_t t, int region, wb_r
  * |p - c|. n (may be NULL): the unit direction out of the surface at p; c, pn: the
  * closest point and its pseudo-normal (either may be NULL) */
 wb_real wb__colmesh_distance(const wb_colmesh *cm, const wb_real p[3], wb_real n[3], wb_real c[3], wb_real pn[3]);
+/* the same, and the triangle of the closest point (*tri, -1 for none) */
+wb_real wb__colmesh_distance_tri(const wb_colmesh *cm, const wb_real p[3], wb_real n[3], wb_real c[3], wb_real pn[3],
+                                 int32_t *tri);
 
 #endif

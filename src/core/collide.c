@@ -430,6 +430,7 @@ typedef struct sub_pose {
     int moving;
     wb_real p0[3], q0[4], p1[3], q1[4];
     wb_real n[3], off;     /* plane: world normal and offset at the substep's end */
+    wb_real n0[3], off0;   /* and at its start (the same bits when it does not move) */
 } sub_pose;
 
 typedef struct contact {
@@ -445,10 +446,11 @@ typedef struct contact {
  * sides: the particle stays on the side it was on at the substep's start (x_prev in the
  * collider's start pose), so one that crossed the sheet within the substep goes back
  * rather than out the far side. */
-static wb_real mesh_depth(const sub_pose *sp, const wb_real x[3], const wb_real xprev[3], wb_real r, wb_real n[3])
+static wb_real mesh_depth(const sub_pose *sp, const wb_real x[3], const wb_real xprev[3], wb_real r, wb_real n[3],
+                          int32_t *tri)
 {
     const wb_colmesh *cm = sp->s->mesh;
-    wb_real u[3], l[3], nl[3], c[3], pn[3];
+    wb_real u[3], l[3], nl[3], pn[3], c[3];
     v3_sub(u, x, sp->p1);
     q_rotate_inv(sp->q1, u, l);
     /* far from the tree's box: no contact, and no query */
@@ -465,12 +467,13 @@ static wb_real mesh_depth(const sub_pose *sp, const wb_real x[3], const wb_real 
         if (l[k] < root->lo[k] - reach || l[k] > root->hi[k] + reach) return 0;
     wb_real depth;
     if (cm->closed) {
-        depth = r - wb__colmesh_distance(cm, l, nl, c, pn);
+        depth = r - wb__colmesh_distance_tri(cm, l, nl, c, pn, tri);
     } else {
         int32_t t;
         int region;
         const wb_real d2 = wb__colmesh_closest_within(cm, l, reach * reach, c, &t, &region);
         if (t < 0) return 0;
+        *tri = t;
         wb__colmesh_pseudo_normal(cm, t, region, pn);
         const wb_real lpn = v3_len(pn), d = sqrt(d2);
         wb_real a[3], b[3];
@@ -494,15 +497,47 @@ static wb_real mesh_depth(const sub_pose *sp, const wb_real x[3], const wb_real 
     return depth;
 }
 
+/* The overlap a particle of radius r at x_prev had with the collider at its start pose:
+ * what it began the substep with (made_contact). A mesh: against triangle tri, the one
+ * closest to x (a second search of the tree cost as much as the first: +20% for a cloth
+ * draped on a mesh); the same unless the closest feature changed within the substep,
+ * and then a little off, which moves no kept overlap faster than max_depenetration (that
+ * bound is `left`'s). Closed: signed; open: the unsigned distance, the side it was on */
+static wb_real start_depth(const sub_pose *sp, const wb_real xprev[3], wb_real r, int32_t tri)
+{
+    if (sp->s->shape == WB_SHAPE_PLANE) return r + sp->off0 - v3_dot(sp->n0, xprev);
+    if (sp->s->shape != WB_SHAPE_MESH) {
+        wb_real n[3];
+        return r - wb__shape_distance(sp->s, sp->p0, sp->q0, xprev, n);
+    }
+    const wb_colmesh *cm = sp->s->mesh;
+    if (tri < 0) return 0;
+    wb_real u[3], l[3], q[3], pn[3];
+    v3_sub(u, xprev, sp->p0);
+    q_rotate_inv(sp->q0, u, l);
+    const int32_t *v = &cm->tri[3 * tri];
+    int region;
+    const wb_real d = sqrt(wb__closest_on_triangle(l, &cm->v[3 * v[0]], &cm->v[3 * v[1]], &cm->v[3 * v[2]], q, &region));
+    if (!cm->closed) return r - d;
+    wb__colmesh_pseudo_normal(cm, tri, region, pn);
+    v3_sub(u, l, q);
+    return v3_dot(u, pn) < 0 ? r + d : r - d;
+}
+
 /* more simultaneous contacts than this on one particle keep their position
  * correction but lose their velocity pass (friction, restitution) */
 #define MAX_CONTACTS 16
 
-/* push particle i out along n by depth and apply static friction */
-static void resolve(wb_real *restrict xi, const wb_real *restrict pi, const wb_real *restrict vi, const sub_pose *c,
-                    const wb_real n[3], wb_real depth, wb_real h, contact *ct)
+/* push particle i out along n by depth, of which shift (overlap it began the substep
+ * with: made_contact) moves x_prev too, and apply static friction. The contact's normal
+ * impulse (friction's bound, here and in the velocity pass) is what the substep drove
+ * in, depth - shift: the repair of an overlap it already had is no force */
+static void resolve(wb_real *restrict xi, wb_real *restrict pi, const wb_real *restrict vi, const sub_pose *c,
+                    const wb_real n[3], wb_real depth, wb_real shift, wb_real h, contact *ct)
 {
     v3_madd(xi, n, depth);
+    if (shift > 0) v3_madd(pi, n, shift);
+    depth -= shift;
     /* the surface point's motion over the substep, carried rigidly by the collider */
     wb_real vc[3] = { 0, 0, 0 };
     if (c->moving) {
@@ -574,6 +609,8 @@ typedef struct collide_job {
     const sub_pose *cs;
     int32_t nlive;
     wb_real h;
+    wb_real *left;              /* (np) the overlap each particle kept (made_contact) */
+    int fresh;                  /* the frame's first substep: `left` from the state */
     const static_plane *planes; /* nlive of them when every collider is a static plane
                                    and no particle skips one (attachments), else NULL */
     const wb_predict *next;     /* the next substep's prediction, fused; NULL: none */
@@ -586,6 +623,30 @@ typedef struct collide_job {
 #else
 #define WB_INLINE static inline
 #endif
+
+/* Made overlap (DESIGN.md §2). A contact's overlap ov is corrected as contact.c corrects
+ * a pair's (wb__contact_depth): what of d0, the overlap the particle began the substep
+ * with (at x_prev, against the collider's start pose), it kept from substep to substep
+ * (`left`: bodies made resting on the ground, half inside it) goes at no more than
+ * max_depenetration x h per substep; what the substep drove in goes in full, and so does
+ * the rest of d0 (what other contacts' repairs carried into the collider by moving
+ * x_prev: a heap's upper layers pressing a made overlap down, which must not sink). All
+ * of d0 that goes moves x_prev with x (*shift, Macklin et al. 2014 §4.2): a position
+ * change, no speed. This pass is the substep's last to move particles, so where it left
+ * a particle is where the next substep starts: one `left` per particle, the most any of
+ * its contacts kept (a particle in a corner keeps each overlap below it). At a frame's
+ * first substep `left` comes from the state alone, contact.c's rule: an overlap one
+ * substep would not take counts as kept; a resting contact (pushed out in full) starts
+ * each substep at none. *lmax: the particle's new `left` so far; returns the correction */
+static inline wb_real made_contact(wb_real ov, wb_real d0, wb_real left, int fresh, wb_real step, wb_real *lmax,
+                                   wb_real *shift)
+{
+    wb_real lk = fresh ? (d0 > step ? d0 : 0) : left, slow, fast;
+    const wb_real c = wb__contact_depth(ov, d0, &lk, step, &slow, &fast);
+    *lmax = lk > *lmax ? lk : *lmax;
+    *shift = slow + fast;
+    return c;
+}
 
 /* x - x is 0 for a finite x and NaN for inf and NaN: one test for six values */
 static inline int finite6(const wb_real x[3], const wb_real v[3])
@@ -609,7 +670,9 @@ WB_INLINE void collide_range(collide_job *j, int32_t lo, int32_t hi, const int p
     /* planes == 2: exactly one plane (a ground), held in locals */
     const int32_t nlive = planes == 2 ? 1 : j->nlive;
     const static_plane one = planes == 2 ? pl[0] : (static_plane){ { 0, 0, 0 }, 0, 0, 0 };
-    const wb_real h = j->h, inv_h = 1 / h, g = v3_len(m->def.gravity);
+    const wb_real h = j->h, inv_h = 1 / h, g = v3_len(m->def.gravity), step = m->def.max_depenetration * h;
+    wb_real *restrict cl = j->left;
+    const int fresh = j->fresh;
     /* restrict: the arrays are distinct, so the compiler keeps values in registers
      * across the stores (the same operations, the same bits) */
     const wb_real *restrict wv = m->w, *restrict rad = m->radius;
@@ -623,21 +686,29 @@ WB_INLINE void collide_range(collide_job *j, int32_t lo, int32_t hi, const int p
         wb_real *restrict xi = &x[3 * i], *restrict vi = &v[3 * i], *restrict pi = &xp[3 * i];
         if (wv[i] == 0) { /* pinned and immovable: at rest */
             v3_set(vi, 0, 0, 0);
+            if (fresh) cl[i] = 0;
         } else if (planes) {
             /* x, x_prev and v in locals, stored once at the end: a 16-byte load of two
              * values just stored one by one cannot be forwarded from the stores (a stall
              * per particle that cost more than the fused pass saved) */
             wb_real xx[3] = { xi[0], xi[1], xi[2] }, vv[3] = { vi[0], vi[1], vi[2] };
-            const wb_real pp[3] = { pi[0], pi[1], pi[2] };
+            wb_real pp[3] = { pi[0], pi[1], pi[2] };
+            int moved = 0; /* x_prev: an old overlap's repair moved it (resolve) */
+            const wb_real left = cl[i];
+            wb_real lmax = 0;
             /* contacts: the plane, its depth, the normal velocity before (vc = 0) */
             int32_t cp[MAX_CONTACTS];
             wb_real cd[MAX_CONTACTS], cvn[MAX_CONTACTS];
             int nct = 0;
             for (int32_t c = 0; c < nlive; c++) {
                 const static_plane *sp = planes == 2 ? &one : &pl[c];
-                const wb_real depth = rad[i] + sp->off - v3_dot(sp->n, xx);
+                wb_real depth = rad[i] + sp->off - v3_dot(sp->n, xx);
                 if (!(depth > 0)) continue;
+                wb_real shift;
+                depth = made_contact(depth, rad[i] + sp->off - v3_dot(sp->n, pp), left, fresh, step, &lmax, &shift);
                 v3_madd(xx, sp->n, depth);
+                if (shift > 0) v3_madd(pp, sp->n, shift), moved = 1;
+                depth -= shift;
                 if (sp->friction > 0) {
                     wb_real slip[3];
                     v3_sub(slip, xx, pp);
@@ -657,7 +728,9 @@ WB_INLINE void collide_range(collide_job *j, int32_t lo, int32_t hi, const int p
                 velocity_response(vv, sp->n, NULL, cd[c], cvn[c], sp->friction, sp->restitution, h, g);
             }
             ncontacts += nct;
+            if (nct || fresh) cl[i] = lmax;
             if (fuse) wb__predict_one(&pr, wv[i], xx, pi, vv);
+            else if (moved) v3_copy(pi, pp);
             v3_copy(xi, xx);
             v3_copy(vi, vv);
             if (scan && bad == INT32_MAX && !finite6(xx, vv)) bad = i;
@@ -665,25 +738,31 @@ WB_INLINE void collide_range(collide_job *j, int32_t lo, int32_t hi, const int p
         } else {
             contact ct[MAX_CONTACTS];
             int nct = 0;
+            const wb_real left = cl[i];
+            wb_real lmax = 0;
             for (int32_t c = 0; c < nlive; c++) {
                 const sub_pose *sp = &cs[c];
                 if (att && wb__attach_skip(att, i, sp->slot)) continue;
                 wb_real n[3], depth;
+                int32_t tri = -1;
                 if (sp->s->shape == WB_SHAPE_PLANE) {
                     depth = rad[i] + sp->off - v3_dot(sp->n, xi);
                     v3_copy(n, sp->n);
                 } else if (sp->s->shape == WB_SHAPE_MESH) {
-                    depth = mesh_depth(sp, xi, pi, rad[i], n);
+                    depth = mesh_depth(sp, xi, pi, rad[i], n, &tri);
                 } else {
                     depth = rad[i] - wb__shape_distance(sp->s, sp->p1, sp->q1, xi, n);
                 }
                 if (!(depth > 0)) continue;
-                resolve(xi, pi, vi, sp, n, depth, h, nct < MAX_CONTACTS ? &ct[nct] : NULL);
+                wb_real shift;
+                depth = made_contact(depth, start_depth(sp, pi, rad[i], tri), left, fresh, step, &lmax, &shift);
+                resolve(xi, pi, vi, sp, n, depth, shift, h, nct < MAX_CONTACTS ? &ct[nct] : NULL);
                 nct++;
             }
             for (int c = 0; c < 3; c++) vi[c] = (xi[c] - pi[c]) * inv_h;
             for (int c = 0; c < nct && c < MAX_CONTACTS; c++) contact_velocity(vi, &ct[c], h, g);
             ncontacts += nct;
+            if (nct || fresh) cl[i] = lmax;
         }
         if (fuse) wb__predict_one(&pr, wv[i], xi, pi, vi);
         if (scan && bad == INT32_MAX && !finite6(xi, vi)) bad = i;
@@ -740,6 +819,9 @@ AVX2_INLINE void plane_range_avx2(collide_job *j, int32_t lo, int32_t hi, const 
     const __m256d n0 = _mm256_set1_pd(one.n[0]), n1 = _mm256_set1_pd(one.n[1]), n2 = _mm256_set1_pd(one.n[2]);
     const __m256d off = _mm256_set1_pd(one.off), rest = _mm256_set1_pd(one.restitution);
     const __m256d vih = _mm256_set1_pd(inv_h), g2h = _mm256_set1_pd(2 * g * h);
+    const __m256d stepv = _mm256_set1_pd(m->def.max_depenetration * h);
+    wb_real *restrict cl = j->left;
+    const int fresh = j->fresh;
     const __m256d zero = _mm256_setzero_pd(), sign = _mm256_set1_pd(-0.0);
     const __m256d keep = _mm256_set1_pd(pr.keep), ph = _mm256_set1_pd(pr.h);
     const __m256d gx = _mm256_set1_pd(pr.g[0]), gy = _mm256_set1_pd(pr.g[1]), gz = _mm256_set1_pd(pr.g[2]);
@@ -752,9 +834,9 @@ AVX2_INLINE void plane_range_avx2(collide_job *j, int32_t lo, int32_t hi, const 
         if (_mm256_movemask_pd(_mm256_cmp_pd(_mm256_loadu_pd(&wv[i]), zero, _CMP_EQ_OQ))) continue;
         __m256d X, Y, Z;
         soa4(&x[3 * i], &X, &Y, &Z);
-        const __m256d depth = _mm256_sub_pd(_mm256_add_pd(_mm256_loadu_pd(&rad[i]), off),
-                                            _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(n0, X), _mm256_mul_pd(n1, Y)),
-                                                          _mm256_mul_pd(n2, Z)));
+        const __m256d ro = _mm256_add_pd(_mm256_loadu_pd(&rad[i]), off);
+        const __m256d depth = _mm256_sub_pd(ro, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(n0, X), _mm256_mul_pd(n1, Y)),
+                                                              _mm256_mul_pd(n2, Z)));
         const __m256d in = _mm256_cmp_pd(depth, zero, _CMP_GT_OQ);
         const int inm = _mm256_movemask_pd(in);
         if (inm && fric) continue;
@@ -763,11 +845,31 @@ AVX2_INLINE void plane_range_avx2(collide_job *j, int32_t lo, int32_t hi, const 
         __m256d PX, PY, PZ, VX, VY, VZ;
         soa4(&xp[3 * i], &PX, &PY, &PZ);
         soa4(&v[3 * i], &VX, &VY, &VZ);
-        __m256d cvn = zero;
+        __m256d cvn = zero, lnew = zero;
+        int moved = 0; /* some lane's x_prev moved (an old overlap's repair) */
         if (inm) {
-            X = _mm256_blendv_pd(X, _mm256_add_pd(X, _mm256_mul_pd(n0, depth)), in);
-            Y = _mm256_blendv_pd(Y, _mm256_add_pd(Y, _mm256_mul_pd(n1, depth)), in);
-            Z = _mm256_blendv_pd(Z, _mm256_add_pd(Z, _mm256_mul_pd(n2, depth)), in);
+            /* made_contact: the overlap at x_prev, what of it was kept, what stays, the
+             * correction; the new left and x_prev's shift */
+            const __m256d d0 =
+                _mm256_sub_pd(ro, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(n0, PX), _mm256_mul_pd(n1, PY)),
+                                                _mm256_mul_pd(n2, PZ)));
+            const __m256d lk = fresh ? _mm256_and_pd(_mm256_cmp_pd(d0, stepv, _CMP_GT_OQ), d0) : _mm256_loadu_pd(&cl[i]);
+            const __m256d d0c = _mm256_and_pd(_mm256_cmp_pd(d0, zero, _CMP_GT_OQ), _mm256_min_pd(d0, depth));
+            const __m256d kept = _mm256_min_pd(d0c, lk), t = _mm256_sub_pd(lk, stepv);
+            const __m256d kp = _mm256_and_pd(_mm256_cmp_pd(t, zero, _CMP_GT_OQ), _mm256_min_pd(t, d0c));
+            const __m256d shift = _mm256_add_pd(_mm256_sub_pd(kept, kp), _mm256_sub_pd(d0c, kept));
+            const __m256d corr = _mm256_sub_pd(depth, kp);
+            lnew = kp;
+            X = _mm256_blendv_pd(X, _mm256_add_pd(X, _mm256_mul_pd(n0, corr)), in);
+            Y = _mm256_blendv_pd(Y, _mm256_add_pd(Y, _mm256_mul_pd(n1, corr)), in);
+            Z = _mm256_blendv_pd(Z, _mm256_add_pd(Z, _mm256_mul_pd(n2, corr)), in);
+            const __m256d mv = _mm256_and_pd(in, _mm256_cmp_pd(shift, zero, _CMP_GT_OQ));
+            if (_mm256_movemask_pd(mv)) {
+                PX = _mm256_blendv_pd(PX, _mm256_add_pd(PX, _mm256_mul_pd(n0, shift)), mv);
+                PY = _mm256_blendv_pd(PY, _mm256_add_pd(PY, _mm256_mul_pd(n1, shift)), mv);
+                PZ = _mm256_blendv_pd(PZ, _mm256_add_pd(PZ, _mm256_mul_pd(n2, shift)), mv);
+                moved = 1;
+            }
             cvn = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(VX, n0), _mm256_mul_pd(VY, n1)), _mm256_mul_pd(VZ, n2));
         }
         VX = _mm256_mul_pd(_mm256_sub_pd(X, PX), vih);
@@ -788,6 +890,10 @@ AVX2_INLINE void plane_range_avx2(collide_job *j, int32_t lo, int32_t hi, const 
             }
             ncontacts += __builtin_popcount((unsigned)inm);
         }
+        /* left: the contacts' new one, the others' as it was (at a frame's start, none) */
+        if (inm || fresh)
+            _mm256_storeu_pd(&cl[i], _mm256_blendv_pd(fresh ? zero : _mm256_loadu_pd(&cl[i]), lnew, in));
+        if (!fuse && moved) aos4(&xp[3 * i], PX, PY, PZ);
         if (fuse) {
             aos4(&xp[3 * i], X, Y, Z);
             VX = _mm256_add_pd(_mm256_mul_pd(VX, keep), gx);
@@ -868,6 +974,8 @@ int wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1, const
         sp->moving = memcmp(sp->p0, sp->p1, sizeof sp->p0) || memcmp(sp->q0, sp->q1, sizeof sp->q0);
         q_rotate(sp->q1, sp->s->n, sp->n);
         sp->off = v3_dot(sp->n, sp->p1);
+        q_rotate(sp->q0, sp->s->n, sp->n0);
+        sp->off0 = v3_dot(sp->n0, sp->p0);
         if (sp->s->shape != WB_SHAPE_PLANE || sp->moving) planes = 0;
         static_plane *p = &pl[nlive - 1];
         v3_copy(p->n, sp->n);
@@ -875,7 +983,14 @@ int wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1, const
         p->friction = sp->s->friction;
         p->restitution = sp->s->restitution;
     }
-    collide_job j = { w, cs, nlive, h, planes ? pl : NULL, next, 0, INT32_MAX };
+    /* the overlap each particle kept (made_contact), zeroed where new (read, not used, at
+     * a frame's first substep, which writes every particle's) */
+    const int32_t cap0 = k->cap_c_left;
+    wb_real *left = wb__grow(k->c_left, &k->cap_c_left, m->np > 0 ? m->np : 1, sizeof *left);
+    if (!left) { wb__warn(w, "out of memory in collision"); return 0; }
+    k->c_left = left;
+    if (k->cap_c_left > cap0) memset(left + cap0, 0, sizeof *left * (size_t)(k->cap_c_left - cap0));
+    collide_job j = { w, cs, nlive, h, left, !(f0 > 0), planes ? pl : NULL, next, 0, INT32_MAX };
     static const wb_pool_for_fn fns[3][3] = { { part_any, part_any_fuse, part_any_scan },
                                               { part_planes, part_planes_fuse, part_planes_scan },
                                               { part_plane, part_plane_fuse, part_plane_scan } };

@@ -423,6 +423,8 @@ typedef struct wb_cache {
     void *c_sub;           /* (nc) collider poses at the substep's start and end, then (nc)
                               static planes (collide.c); cap_c_sub in bytes */
     int32_t cap_c_sub;
+    wb_real *c_left;       /* (np) overlap with the colliders each particle kept (collide.c) */
+    int32_t cap_c_left;
     wb_distance_id *breaks;
     int32_t nbreaks, cap_breaks;
     wb_real *c_save;       /* (nc x 7) collider poses at the frame's start, for undo */

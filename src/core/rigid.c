@@ -360,6 +360,18 @@ void wb__rigid_apply(wb_world *w, int32_t r, const wb_real x[3], const wb_real d
     rb->moved[r] = 1;
 }
 
+void wb__rigid_apply_start(wb_world *w, int32_t r, const wb_real x[3], const wb_real dp[3])
+{
+    wb_rigids *rb = w->rb;
+    wb_real d[3], t[3];
+    v3_sub(d, x, &rb->x[3 * r]);
+    v3_cross(t, d, dp);
+    inv_inertia_world(rb, r, t, t);
+    v3_madd(&rb->x_prev[3 * r], dp, rb->inv_mass[r]);
+    turn(&rb->q_prev[4 * r], t);
+    turn(&rb->q_pred[4 * r], t);
+}
+
 void wb__rigid_point_response(const wb_world *w, int32_t r, const wb_real x[3], wb_real K[9])
 {
     const wb_rigids *rb = w->rb;
@@ -585,6 +597,61 @@ static void static_friction_pairs(wb_world *w)
     }
 }
 
+/* ---- made overlap ---------------------------------------------------------------------------- */
+/* A manifold's made overlap (DESIGN.md §2: bodies made inside each other or a collider)
+ * is kept as contact.c keeps a pair's: `left`, what of the overlap it started with its
+ * own last solve left, goes at no more than max_depenetration; what the substep drove in
+ * since goes in full, and so does what the other manifolds pushed back after its solve
+ * (the bodies of a stack sink into each other by a little every sweep, which the next
+ * substep finds at its start: counted as made, that repair, capped, let a stack of 10
+ * boxes sink into itself at 1 cm/s). A manifold is known by its two sides, one table per
+ * frame; at its first solve of a frame its overlap at the substep's start counts as made
+ * when one substep would not take it (contact.c's rule), so a world loaded from a
+ * snapshot goes on as the one saved. The speed the capped repair makes needs nothing
+ * more: the velocity pass sets the points' normal speed (wb__rigids_velocity). */
+#define MADE_NONE UINT64_MAX
+
+static uint64_t made_key(int32_t a, int32_t b) { return (uint64_t)(uint32_t)a << 32 | (uint32_t)b; }
+
+static int32_t made_slot(const uint64_t *mk, int32_t cap, uint64_t key)
+{
+    int32_t i = (int32_t)((key * 0x9E3779B97F4A7C15u) >> 40) & (cap - 1);
+    while (mk[i] != MADE_NONE && mk[i] != key) i = (i + 1) & (cap - 1);
+    return i;
+}
+
+/* the manifold's entry (added, *fresh, at its first solve of the frame); NULL when out
+ * of memory */
+static wb_real *made_left(wb_rigids *rb, uint64_t key, int *fresh)
+{
+    if (2 * (rb->nm + 1) > rb->cap_m) {
+        const int32_t cap = rb->cap_m > 0 ? 2 * rb->cap_m : 64;
+        uint64_t *mk = malloc(sizeof *mk * (size_t)cap);
+        wb_real *ml = malloc(sizeof *ml * (size_t)cap);
+        if (!mk || !ml) { free(mk); free(ml); return NULL; }
+        for (int32_t i = 0; i < cap; i++) mk[i] = MADE_NONE;
+        for (int32_t i = 0; i < rb->cap_m; i++) {
+            if (rb->mk[i] == MADE_NONE) continue;
+            const int32_t j = made_slot(mk, cap, rb->mk[i]);
+            mk[j] = rb->mk[i];
+            ml[j] = rb->ml[i];
+        }
+        free(rb->mk);
+        free(rb->ml);
+        rb->mk = mk;
+        rb->ml = ml;
+        rb->cap_m = cap;
+    }
+    const int32_t i = made_slot(rb->mk, rb->cap_m, key);
+    *fresh = rb->mk[i] == MADE_NONE;
+    if (*fresh) {
+        rb->mk[i] = key;
+        rb->ml[i] = 0;
+        rb->nm++;
+    }
+    return &rb->ml[i];
+}
+
 /* The manifold's normal corrections are solved together: point after point (Gauss-Seidel
  * over the points, each moving the body before the next) tilts a box resting on four
  * corners a little differently every substep, and the tilts, not commuting, pump a spin
@@ -593,7 +660,7 @@ static void static_friction_pairs(wb_world *w)
  * generalized inverse masses at this pose) by projected Gauss-Seidel on the small system,
  * and the bodies move once: a symmetric contact gives a symmetric push. */
 static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_cshape *sa, const wb_cshape *sb,
-                           const wb_manifold *m, wb_real h)
+                           const wb_manifold *m, uint64_t key, wb_real h)
 {
     wb_rigids *rb = w->rb;
     const wb_real mu = fmax(sa->friction, sb->friction), e = fmax(sa->restitution, sb->restitution);
@@ -601,6 +668,7 @@ static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_c
     const int np = m->n < WB_MANIFOLD_MAX ? m->n : WB_MANIFOLD_MAX;
     wb_real la[WB_MANIFOLD_MAX][3], lb[WB_MANIFOLD_MAX][3], d[WB_MANIFOLD_MAX], vn_pre[WB_MANIFOLD_MAX];
     wb_real vcs[WB_MANIFOLD_MAX][3], ja[WB_MANIFOLD_MAX][3], jb[WB_MANIFOLD_MAX][3], lam[WB_MANIFOLD_MAX];
+    wb_real d0[WB_MANIFOLD_MAX];
     int any = 0;
     for (int k = 0; k < np; k++) {
         wb_real pa[3], pa0[3], pb[3], pb0[3], d3[3], va[3], vb[3], rel[3], ra[3], rr[3];
@@ -610,7 +678,8 @@ static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_c
         side_points(rb, B, lb[k], pb, pb0);
         v3_sub(d3, pa, pb);
         d[k] = v3_dot(d3, n);
-        any |= d[k] > 0;
+        v3_sub(d3, pa0, pb0);
+        d0[k] = v3_dot(d3, n); /* at the substep's start */
         /* the velocities the bodies came in with */
         v3_sub(vcs[k], pa, pa0);
         v3_scale(vcs[k], vcs[k], 1 / h);
@@ -625,6 +694,28 @@ static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_c
         v3_cross(jb[k], rr, n);
         lam[k] = 0;
     }
+    /* a made overlap: what of it the manifold kept goes at no more than half a substep's
+     * max_depenetration x h per solve (it is solved twice per substep, the sweeps forward
+     * and back); the rest in full (see made_left) */
+    int fresh;
+    wb_real *left = made_left(rb, key, &fresh);
+    if (!left) wb__warn(w, "out of memory in rigid contacts; a made overlap is pushed out at once");
+    if (left && fresh) {
+        wb_real most = 0;
+        for (int k = 0; k < np; k++)
+            if (d[k] > 0 && d0[k] > most) most = d0[k];
+        *left = most > rb->step ? most : 0;
+    }
+    wb_real kept = 0;
+    for (int k = 0; k < np; k++) {
+        if (left && d[k] > 0) {
+            wb_real lk = *left, slow, err;
+            d[k] = wb__contact_depth(d[k], d0[k], &lk, rb->step / 2, &slow, &err);
+            if (lk > kept) kept = lk;
+        }
+        any |= d[k] > 0;
+    }
+    if (left) *left = kept;
     if (!any) return;
     wb_real ia[WB_MANIFOLD_MAX][3], ib[WB_MANIFOLD_MAX][3], K[WB_MANIFOLD_MAX][WB_MANIFOLD_MAX];
     const wb_real wa = A->r >= 0 ? rb->inv_mass[A->r] : 0, wbm = B->r >= 0 ? rb->inv_mass[B->r] : 0;
@@ -720,7 +811,7 @@ static void solve_manifold(wb_world *w, const side *A, const side *B, const wb_c
 void wb__rigid_contact_rigid(wb_world *w, int32_t a, int32_t b, const wb_manifold *m, wb_real h)
 {
     const side A = { a, NULL, NULL, NULL, NULL }, B = { b, NULL, NULL, NULL, NULL };
-    solve_manifold(w, &A, &B, &w->rb->shape[a], &w->rb->shape[b], m, h);
+    solve_manifold(w, &A, &B, &w->rb->shape[a], &w->rb->shape[b], m, made_key(a, b), h);
 }
 
 void wb__rigid_contact_collider(wb_world *w, int32_t c, const wb_real p0[3], const wb_real q0[4],
@@ -728,7 +819,7 @@ void wb__rigid_contact_collider(wb_world *w, int32_t c, const wb_real p0[3], con
                                 const wb_manifold *m, wb_real h)
 {
     const side A = { -1, p0, q0, p1, q1 }, B = { r, NULL, NULL, NULL, NULL };
-    solve_manifold(w, &A, &B, &w->m.c_shape[c], &w->rb->shape[r], m, h);
+    solve_manifold(w, &A, &B, &w->m.c_shape[c], &w->rb->shape[r], m, made_key(-1 - c, r), h);
 }
 
 /* the colliders' poses at the substep's start and end, and a bounding radius about the
@@ -885,6 +976,7 @@ void wb__rigids_solve(wb_world *w, wb_real h, wb_real f0, wb_real f1)
         wb__warn(w, "out of memory in rigid contacts; the substep's contacts are skipped");
         return;
     }
+    rb->step = w->m.def.max_depenetration * h;
     for (int32_t r = 0; r < rb->n; r++)
         if (live(rb, r)) touch_colliders(w, r, h);
     const int sweep = candidate_pairs(w, h);
@@ -1017,6 +1109,9 @@ void wb__rigids_save(wb_world *w)
 {
     wb_rigids *rb = w->rb;
     if (!rb) return;
+    /* the made overlaps of a new frame, worked out from the state (made_left) */
+    for (int32_t i = 0; i < rb->cap_m; i++) rb->mk[i] = MADE_NONE;
+    rb->nm = 0;
     for (int32_t r = 0; r < rb->n; r++) {
         wb_real *s = &rb->save[13 * r];
         v3_copy(s, &rb->x[3 * r]);

@@ -48,6 +48,10 @@ typedef struct wb_rigids {
     uint8_t *moved;        /* (n) a correction moved it this substep: its velocities come from the poses */
     wb_rcontact *ct;       /* contacts of the current substep */
     int32_t nct, cap_ct;
+    /* a made overlap each manifold was left with (rigid.c, made_left): an open-addressed
+     * table of the frame, (side A, body B) -> overlap, cleared at the frame's start */
+    uint64_t *mk; wb_real *ml; int32_t cap_m, nm;
+    wb_real step;          /* max_depenetration x h of the current substep */
     wb_rfric *fr;          /* body pairs' static friction of the current substep */
     int32_t nfr, cap_fr;
     int record_fr;         /* the forward sweep records them */
@@ -60,6 +64,7 @@ typedef struct wb_rigids {
     size_t charged;        /* bytes charged to def.memory */
     /* particle contacts (rigid_particle.c): the frame's candidates, the substep's active ones */
     int32_t *pc, npc, cap_pc;      /* (npc x 2) particle, body slot */
+    wb_real *pc_left; int32_t cap_left; /* (npc) overlap a candidate was left with (wb__contact_depth) */
     wb_real *pc_sph; int32_t cap_sph; /* bodies' swept spheres (scratch) */
     int32_t *pc_slot, cap_slot;    /* their slots (scratch) */
     int32_t *pc_cnt, cap_cnt;      /* (n) contacts per body in the substep */
@@ -72,6 +77,9 @@ typedef struct wb_rpcontact {
     int32_t i, r;          /* particle, body slot */
     wb_real n[3];          /* unit, out of the body */
     wb_real depth, lambda; /* overlap corrected, positional impulse (N s^2) */
+    wb_real slow, err;     /* of depth: a made overlap's repair, pushed with the start poses
+                              (slow) or in full with its speed taken out (err): wb__contact_depth */
+    wb_real lslow;         /* the positional impulse of slow (N s^2) */
     wb_real vn_pre;        /* normal relative velocity (particle - body) before the solve */
     wb_real arm[3];        /* where the body takes the impulses: offset from its centre */
     wb_real dp[3];         /* the body's impulse of the pass (scratch) */
@@ -104,6 +112,11 @@ static inline int wb__solve3(const wb_real A[9], const wb_real b[3], wb_real x[3
 /* world point of a body-local point, and body-local of a world point, at the current pose */
 void wb__rigid_to_world(const wb_world *w, int32_t r, const wb_real local[3], wb_real out[3]);
 void wb__rigid_to_local(const wb_world *w, int32_t r, const wb_real world[3], wb_real out[3]);
+
+/* the same positional impulse on body r's pose at the substep's start (x_prev, q_prev) and
+ * its predicted rotation (q_pred), turned as its pose now would turn: the pose moves
+ * without the move becoming speed (a made overlap's repair) */
+void wb__rigid_apply_start(wb_world *w, int32_t r, const wb_real x[3], const wb_real dp[3]);
 
 /* velocity impulse p at world point x on body r (v += p/m, om += I^-1 (r x p)) */
 void wb__rigid_impulse(wb_world *w, int32_t r, const wb_real x[3], const wb_real p[3]);
@@ -146,8 +159,8 @@ static inline void wb__rigids_free(wb_world *w, wb_rigids *rb)
     if (!rb) return;
     if (w->m.def.memory) w->m.def.memory->used -= rb->charged;
     void *p[] = { rb->shape, rb->mass, rb->inv_mass, rb->inertia, rb->inv_inertia, rb->bound, rb->gen, rb->x, rb->q,
-                  rb->v, rb->om, rb->x_prev, rb->q_prev, rb->q_pred, rb->save, rb->ct, rb->fr, rb->moved, rb->cpose, rb->box, rb->ord, rb->pair,
-                  rb->pc, rb->pc_sph, rb->pc_slot, rb->pc_cnt, rb->pct };
+                  rb->v, rb->om, rb->x_prev, rb->q_prev, rb->q_pred, rb->save, rb->mk, rb->ml, rb->ct, rb->fr, rb->moved, rb->cpose, rb->box, rb->ord, rb->pair,
+                  rb->pc, rb->pc_left, rb->pc_sph, rb->pc_slot, rb->pc_cnt, rb->pct };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     free(rb);
 }

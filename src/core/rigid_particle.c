@@ -129,6 +129,18 @@ void wb__rigid_particles_begin(wb_world *w)
             rb->npc++;
         }
     }
+    /* the overlap each candidate has now counts as made (kept) unless one substep would
+     * take it all anyway, as contact.c does at a frame's start: from the state alone */
+    wb_real *left = wb__grow(rb->pc_left, &rb->cap_left, rb->npc > 0 ? rb->npc : 1, sizeof *left);
+    if (!left) goto nomem;
+    rb->pc_left = left;
+    const wb_real step = m->def.max_depenetration * dt / m->def.substeps;
+    for (int32_t k = 0; k < rb->npc; k++) {
+        const int32_t i = rb->pc[2 * k], r = rb->pc[2 * k + 1];
+        wb_real n[3];
+        const wb_real d0 = m->radius[i] - wb__shape_distance(&rb->shape[r], &rb->x[3 * r], &rb->q[4 * r], &x[3 * i], n);
+        left[k] = d0 > step ? d0 : 0;
+    }
     return;
 nomem:
     rb->npc = 0;
@@ -157,7 +169,8 @@ void wb__rigid_particles_solve(wb_world *w)
     rb->npct = 0;
     if (rb->npc == 0) return;
     const wb_model *m = &w->m;
-    wb_real *x = w->s.x, *xp = w->s.x_prev;
+    wb_real *x = w->s.x, *xp = w->s.x_prev, *left = rb->pc_left;
+    const wb_real step = m->def.max_depenetration * w->k.h_last;
     int32_t *cnt = wb__grow(rb->pc_cnt, &rb->cap_cnt, rb->n, sizeof *cnt);
     if (!cnt) goto nomem;
     rb->pc_cnt = cnt;
@@ -166,8 +179,16 @@ void wb__rigid_particles_solve(wb_world *w)
     for (int32_t k = 0; k < rb->npc; k++) {
         const int32_t i = rb->pc[2 * k], r = rb->pc[2 * k + 1];
         if (!live(rb, r)) continue;
-        wb_real n[3];
-        const wb_real depth = m->radius[i] - wb__shape_distance(&rb->shape[r], &rb->x[3 * r], &rb->q[4 * r], &x[3 * i], n);
+        wb_real n[3], n0[3];
+        wb_real depth = m->radius[i] - wb__shape_distance(&rb->shape[r], &rb->x[3 * r], &rb->q[4 * r], &x[3 * i], n);
+        if (!(depth > 0)) { left[k] = 0; continue; }
+        /* the overlap at the substep's start (the particle's x_prev, the body's start
+         * pose): what of it the candidate kept goes at no more than max_depenetration, its
+         * push moving the start poses too (slow), the rest in full with its speed taken
+         * out in the velocity pass (err); what the substep drove in, in full (contact.c) */
+        const wb_real d0 = m->radius[i] - wb__shape_distance(&rb->shape[r], &rb->x_prev[3 * r], &rb->q_prev[4 * r], &xp[3 * i], n0);
+        wb_real slow, err;
+        depth = wb__contact_depth(depth, d0, &left[k], step, &slow, &err);
         if (!(depth > 0)) continue;
         wb_rpcontact *ct = wb__grow(rb->pct, &rb->cap_pct, rb->npct + 1, sizeof *ct);
         if (!ct) goto nomem;
@@ -177,6 +198,8 @@ void wb__rigid_particles_solve(wb_world *w)
         ct->r = r;
         v3_copy(ct->n, n);
         ct->depth = depth;
+        ct->slow = slow;
+        ct->err = err;
         /* where the positional impulses act on the body: the particle's offset from the
          * centre at the substep's start (see the file's head) */
         v3_sub(ct->arm, &xp[3 * i], &rb->x_prev[3 * r]);
@@ -196,8 +219,10 @@ void wb__rigid_particles_solve(wb_world *w)
         const wb_real wsum = wp + split * wb__rigid_w(w, r, at, n);
         const wb_real lam = wsum > 0 ? ct->depth / wsum : 0;
         ct->lambda = lam;
+        ct->lslow = wsum > 0 ? ct->slow / wsum : 0;
         v3_scale(ct->dp, n, -lam);
         v3_madd(xi, n, wp * lam);
+        if (ct->lslow > 0) v3_madd(&xp[3 * i], n, wp * ct->lslow);
         /* static friction (§3.5): undo the relative tangential slip of the substep when the
          * impulse it takes stays inside the cone, mu x lambda */
         if (!(mu > 0) || !(lam > 0)) continue;
@@ -223,6 +248,11 @@ void wb__rigid_particles_solve(wb_world *w)
         wb_real at[3];
         v3_add(at, ct->arm, &rb->x[3 * ct->r]);
         wb__rigid_apply(w, ct->r, at, ct->dp);
+        if (ct->lslow > 0) {
+            wb_real ds[3];
+            v3_scale(ds, ct->n, -ct->lslow);
+            wb__rigid_apply_start(w, ct->r, at, ds);
+        }
     }
     return;
 nomem:
@@ -251,6 +281,15 @@ void wb__rigid_particles_velocity(wb_world *w, wb_real h)
         body_velocity(rb, r, xi, vb);
         v3_sub(u, vi, vb);
         wb_real un = v3_dot(u, n);
+        /* no separating speed made of old overlap pushed out in full (err), at most the
+         * speed there is (contact.c) */
+        const wb_real se = fmin(ct->err / h, un);
+        if (se > 0) {
+            const wb_real dl = se / (wp + split * wb__rigid_w(w, r, xi, n));
+            v3_madd(ct->dp, n, dl);
+            v3_madd(vi, n, -wp * dl);
+            un -= se;
+        }
         if (s->friction > 0) {
             wb_real ut[3];
             v3_copy(ut, u);
@@ -259,7 +298,9 @@ void wb__rigid_particles_velocity(wb_world *w, wb_real h)
             if (vt > 0) {
                 wb_real t[3];
                 v3_scale(t, ut, 1 / vt);
-                const wb_real P = fmin(s->friction * ct->lambda / h, vt / (wp + split * wb__rigid_w(w, r, xi, t)));
+                /* the normal impulse that stayed speed: without err's, as contact.c */
+                const wb_real ln = ct->err > 0 ? ct->lambda * (ct->depth - ct->err) / ct->depth : ct->lambda;
+                const wb_real P = fmin(s->friction * ln / h, vt / (wp + split * wb__rigid_w(w, r, xi, t)));
                 v3_madd(ct->dp, t, P);
                 v3_madd(vi, t, -wp * P);
                 v3_madd(u, t, -wp * P - P * wb__rigid_w(w, r, xi, t)); /* (its normal part: none) */

@@ -100,6 +100,7 @@
     X(fused_predict_bits_planes)                         \
     X(fused_predict_bits_mixed_colliders)                \
     X(fused_predict_bits_with_particle_contacts)         \
+    X(fused_predict_bits_made_overlapping)               \
     X(fused_scan_finds_the_first_nonfinite_particle)     \
     X(fused_plane_simd_bits)                             \
     X(fused_plane_simd_scan_nonfinite)

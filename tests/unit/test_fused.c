@@ -2,7 +2,9 @@
  * collide.c) gives the bits of the unfused order: every scene runs twice, fused and with
  * the tests' switch wb_cache.no_fuse, and the hashes must agree; so must the folded
  * finiteness check's warning and undo. The one-plane pass's AVX2 groups against its
- * scalar code (wb_cache.no_simd) at the end. */
+ * scalar code (wb_cache.no_simd) at the end. Scenes also run made half inside their
+ * plane (sunk): the overlap goes out at max_depenetration over many frames, through the
+ * particles' kept overlap (wb_cache.c_left) and x_prev's shift, in every path. */
 #include <stdlib.h>
 
 #include "core/core.h"
@@ -15,7 +17,19 @@ enum { SCENE_PLANE, SCENE_PLANES, SCENE_MIXED, SCENE_BODIES };
  * SCENE_MIXED a plane and a moving sphere (the general path), SCENE_BODIES two cloths
  * that touch (particle contacts: some substeps cannot fuse). res 64: 4096 particles,
  * the pool's threshold */
-static wb_world *scene(int kind, int threads, int no_fuse)
+/* the particles still inside the first collider by more than one substep's
+ * max_depenetration x h: kept overlap (the made path at work) */
+static int32_t kept_inside(const wb_world *w)
+{
+    const wb_real step = w->m.def.max_depenetration * w->m.def.dt / w->m.def.substeps;
+    wb_collider_id c = wb_collider_at(w, 0);
+    int32_t n = 0;
+    for (int32_t i = 0; i < w->m.np; i++)
+        n += wb_collider_distance(w, c, &w->s.x[3 * i]) < w->m.radius[i] - step;
+    return n;
+}
+
+static wb_world *scene(int kind, int threads, int no_fuse, int sunk)
 {
     wb_world_def d = wb_world_default_def();
     d.threads = threads;
@@ -41,6 +55,10 @@ static wb_world *scene(int kind, int threads, int no_fuse)
     wb_collider_def pl = wb_collider_default_def(WB_SHAPE_PLANE);
     pl.friction = 0.4;
     pl.restitution = 0.6;
+    if (sunk) { /* through the cloth: up to 10 cm inside it, by x */
+        pl.normal[0] = 0.1;
+        pl.offset = 0.3;
+    }
     wb_collider_add(w, &pl, NULL);
     if (kind == SCENE_PLANES) {
         wb_collider_def p2 = wb_collider_default_def(WB_SHAPE_PLANE);
@@ -61,13 +79,14 @@ static wb_world *scene(int kind, int threads, int no_fuse)
     return w;
 }
 
-static void fused_case(int kind, int threads)
+static void fused_case(int kind, int threads, int sunk)
 {
-    wb_world *a = scene(kind, threads, 0), *b = scene(kind, threads, 1);
+    wb_world *a = scene(kind, threads, 0, sunk), *b = scene(kind, threads, 1, sunk);
     REQUIRE(a && b);
     for (int f = 0; f < 30; f++) {
         wb_world_step(a);
         wb_world_step(b);
+        if (sunk && f == 2) CHECK(kept_inside(a) > 100);
     }
     CHECK(wb_world_hash(a) == wb_world_hash(b));
     CHECK(memcmp(a->s.x_prev, b->s.x_prev, sizeof(wb_real) * 3 * (size_t)a->m.np) == 0);
@@ -82,17 +101,25 @@ static void fused_case(int kind, int threads)
     wb_world_destroy(b);
 }
 
-TEST(fused_predict_bits_one_plane) { fused_case(SCENE_PLANE, 1); fused_case(SCENE_PLANE, 2); }
-TEST(fused_predict_bits_planes) { fused_case(SCENE_PLANES, 1); fused_case(SCENE_PLANES, 2); }
-TEST(fused_predict_bits_mixed_colliders) { fused_case(SCENE_MIXED, 1); fused_case(SCENE_MIXED, 3); }
-TEST(fused_predict_bits_with_particle_contacts) { fused_case(SCENE_BODIES, 1); }
+TEST(fused_predict_bits_one_plane) { fused_case(SCENE_PLANE, 1, 0); fused_case(SCENE_PLANE, 2, 0); }
+TEST(fused_predict_bits_planes) { fused_case(SCENE_PLANES, 1, 0); fused_case(SCENE_PLANES, 2, 0); }
+TEST(fused_predict_bits_mixed_colliders) { fused_case(SCENE_MIXED, 1, 0); fused_case(SCENE_MIXED, 3, 0); }
+TEST(fused_predict_bits_with_particle_contacts) { fused_case(SCENE_BODIES, 1, 0); }
+TEST(fused_predict_bits_made_overlapping)
+{
+    fused_case(SCENE_PLANE, 1, 1);
+    fused_case(SCENE_PLANE, 2, 1);
+    fused_case(SCENE_PLANES, 2, 1);
+    fused_case(SCENE_MIXED, 3, 1);
+    fused_case(SCENE_BODIES, 1, 1);
+}
 
 /* the last substep's pass checks x and v: a particle gone non-finite undoes the frame
  * with the warning (and particle) of the unfused check */
 TEST(fused_scan_finds_the_first_nonfinite_particle)
 {
     for (int threads = 1; threads <= 2; threads++) {
-        wb_world *a = scene(SCENE_PLANE, threads, 0), *b = scene(SCENE_PLANE, threads, 1);
+        wb_world *a = scene(SCENE_PLANE, threads, 0, 0), *b = scene(SCENE_PLANE, threads, 1, 0);
         REQUIRE(a && b);
         wb_world_step(a);
         wb_world_step(b);
@@ -126,7 +153,7 @@ TEST(fused_scan_finds_the_first_nonfinite_particle)
  * wb_cache.no_simd; x, x_prev, v and the hash must agree after every frame. res 31: a
  * count of particles not a multiple of four (the scalar tail); pins: groups with w = 0;
  * friction: groups in contact take the scalar code; restitution: the bounce's lanes. */
-static wb_world *ground_cloth(int res, int pins, wb_real friction, wb_real restitution, int no_simd)
+static wb_world *ground_cloth(int res, int pins, wb_real friction, wb_real restitution, int sunk, int no_simd)
 {
     wb_world_def d = wb_world_default_def();
     d.substeps = 5;
@@ -146,14 +173,19 @@ static wb_world *ground_cloth(int res, int pins, wb_real friction, wb_real resti
     wb_collider_def pl = wb_collider_default_def(WB_SHAPE_PLANE);
     pl.friction = friction;
     pl.restitution = restitution;
+    if (sunk) { /* through the cloth, tilted both ways: lanes in and out of it, kept or not */
+        pl.normal[0] = 0.1;
+        pl.normal[2] = 0.05;
+        pl.offset = 0.2;
+    }
     wb_collider_add(w, &pl, NULL);
     return w;
 }
 
-static void simd_case(int res, int pins, wb_real friction, wb_real restitution)
+static void simd_case(int res, int pins, wb_real friction, wb_real restitution, int sunk)
 {
-    wb_world *a = ground_cloth(res, pins, friction, restitution, 0);
-    wb_world *b = ground_cloth(res, pins, friction, restitution, 1);
+    wb_world *a = ground_cloth(res, pins, friction, restitution, sunk, 0);
+    wb_world *b = ground_cloth(res, pins, friction, restitution, sunk, 1);
     REQUIRE(a && b);
     const size_t bytes = sizeof(wb_real) * 3 * (size_t)a->m.np;
     int same = 1, touched = 0;
@@ -172,6 +204,7 @@ static void simd_case(int res, int pins, wb_real friction, wb_real restitution)
         if (!same) printf("    res %d pins %d friction %g restitution %g: frame %d differs\n", res, pins,
                           (double)friction, (double)restitution, f);
         touched += wb_world_stats(a).contacts > a->m.np / 2; /* most of it on the ground */
+        if (sunk && f == 2) CHECK(kept_inside(a) > 0);
     }
     CHECK(same);
     CHECK(touched > 5);
@@ -183,16 +216,19 @@ static void simd_case(int res, int pins, wb_real friction, wb_real restitution)
 
 TEST(fused_plane_simd_bits)
 {
-    simd_case(32, 0, 0, 0);     /* the bench's cloth: every group in vectors */
-    simd_case(31, 3, 0, 0);     /* the tail, pinned groups */
-    simd_case(32, 2, 0, 0.8);   /* bounces */
-    simd_case(31, 0, 0.5, 0.4); /* friction: contact groups scalar */
+    simd_case(32, 0, 0, 0, 0);     /* the bench's cloth: every group in vectors */
+    simd_case(31, 3, 0, 0, 0);     /* the tail, pinned groups */
+    simd_case(32, 2, 0, 0.8, 0);   /* bounces */
+    simd_case(31, 0, 0.5, 0.4, 0); /* friction: contact groups scalar */
+    simd_case(32, 0, 0, 0, 1);     /* made half inside the ground: kept overlap in lanes */
+    simd_case(31, 3, 0, 0.8, 1);
+    simd_case(31, 0, 0.5, 0, 1);
 }
 
 /* the scan of the last substep in groups of four: the same first non-finite particle */
 TEST(fused_plane_simd_scan_nonfinite)
 {
-    wb_world *a = ground_cloth(32, 0, 0, 0, 0), *b = ground_cloth(32, 0, 0, 0, 1);
+    wb_world *a = ground_cloth(32, 0, 0, 0, 0, 0), *b = ground_cloth(32, 0, 0, 0, 0, 1);
     REQUIRE(a && b);
     wb_world_step(a);
     wb_world_step(b);

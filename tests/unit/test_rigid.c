@@ -214,6 +214,9 @@ TEST(rigid_pair_manifold_pushes_apart_by_inverse_mass)
     v3_set(m.pt[0].pb, 0.4, 0, 0);
     m.pt[0].depth = 0.1;
     w->rb->nct = 0;
+    /* driven in by the substep: b was touching a at its start (a made overlap would go
+     * out at max_depenetration only) */
+    w->rb->x_prev[3 * ((int32_t)b.index - 1)] = 1.0;
     wb__rigid_contact_rigid(w, (int32_t)a.index - 1, (int32_t)b.index - 1, &m, 1.0 / 600);
     wb_real xa[3], xb[3], q[4];
     wb_rigid_position(w, a, xa);

@@ -2,8 +2,10 @@
 --
 -- Normals: a particle just inside a box is pushed out through the nearest face,
 -- along that face's outward normal, to its own radius outside the face; the other
--- two coordinates do not change. One substep without gravity or velocity makes the
--- push the only motion, so positions are exact up to rounding (1e-12 m).
+-- two coordinates do not change. Made inside, it goes out at max_depenetration (0.25 m/s:
+-- one step of 1/60 s without substeps takes 0.25/60 m of its 0.05 m) and keeps no
+-- speed; without gravity or velocity the push is the only motion, so positions are
+-- exact up to rounding (1e-12 m) once it is out, after 12 steps (17 for the last case).
 --
 -- Surface velocity (a conveyor): a box moving sideways at v carries a particle
 -- resting on it with friction mu. Kinetic friction accelerates the particle at
@@ -29,6 +31,15 @@ test("a particle just inside a face leaves through that face", function()
   local ids = {}
   for i, c in ipairs(cases) do ids[i] = w:particle{ pos = c[1], radius = R } end
   w:step()
+  -- one step: max_depenetration x dt along the normal, no speed
+  for i, c in ipairs(cases) do
+    local x, y, z = w:position(ids[i])
+    local d = math.sqrt((x - c[1][1]) ^ 2 + (y - c[1][2]) ^ 2 + (z - c[1][3]) ^ 2)
+    expect.near(d, 0.25 / 60, 1e-12, "case " .. i .. " moved")
+    local vx, vy, vz = w:velocity(ids[i])
+    expect.lt(math.abs(vx) + math.abs(vy) + math.abs(vz), 1e-12, "case " .. i .. " speed")
+  end
+  w:run{ frames = 20 }
   for i, c in ipairs(cases) do
     local x, y, z = w:position(ids[i])
     local e = c[2]
@@ -45,7 +56,7 @@ test("a rotated box: the face normal turns with the box", function()
   w:collider{ shape = "box", center = {0, 0, 0}, half = {1, 0.5, 2}, rotation = {s, 0, 0, s} }
   local a = w:particle{ pos = {0.1, 0.97, 0.3}, radius = R }   -- local (0.97, -0.1, 0.3): face +x
   local b = w:particle{ pos = {0.47, -0.2, -0.4}, radius = R } -- local (-0.2, -0.47, -0.4): face -y
-  w:step()
+  w:run{ frames = 20 } -- out at max_depenetration (above)
   local x, y, z = w:position(a)
   expect.near(x, 0.1, 1e-12); expect.near(y, 1 + R, 1e-12); expect.near(z, 0.3, 1e-12)
   x, y, z = w:position(b)
