@@ -489,13 +489,17 @@ wb_status wb__colour(wb_world *w);                 /* distance.c: rebuild the di
 int wb__momentum_prepare(wb_world *w);
 void wb__momentum_restore(wb_world *w, wb_real h);
 /* colour.c: greedy colouring of n constraints of k particles each (constraint i joins
- * idx[k i .. k i + k - 1]); those live() refuses get WB_NO_COLOUR, the others a colour
- * in [0, WB_MAX_COLOURS] (WB_MAX_COLOURS: the serial overflow batch), counted in count.
- * 0 when out of memory */
+ * idx[k i .. k i + k - 1]), mirror images alike (colour.c's header); those live() refuses
+ * get WB_NO_COLOUR, the others a colour in [0, WB_MAX_COLOURS] (WB_MAX_COLOURS: the serial
+ * overflow batch), counted in count. 0 when out of memory */
 #define WB_NO_COLOUR 255
-int wb__colour_greedy(const wb_real *inv_mass, int32_t np, const int32_t *idx, int k, int32_t n,
+int wb__colour_greedy(const wb_model *m, const int32_t *idx, int k, int32_t n,
                       int (*live)(const void *ud, int32_t i), const void *ud, uint8_t *colour,
                       int32_t count[WB_MAX_COLOURS + 1]);
+/* colour.c, tests: on = 0 colours in creation order (as before mirror keys), 1 with mirror
+ * keys (the default) from the next colouring on; returns the previous setting. Not
+ * thread-safe: call it between steps */
+int wb__colour_symmetric(int on);
 /* batch ranges from the counts: colour_start (ncolours + 1), the first serial batch, and
  * start[c] the first packed index of colour c; returns the packed total */
 int32_t wb__colour_ranges(const int32_t count[WB_MAX_COLOURS + 1], int32_t *colour_start, int32_t *ncolours,

@@ -399,7 +399,7 @@ static wb_status tet_prepare(wb_world *w)
     /* colour batches when tets were added since (they are never removed) */
     wb_neos *nv = w->neo;
     if (nv->n != nv->bt.n) {
-        if (!wb__batches_build(&nv->bt, w->m.inv_mass, w->m.np, nv->ijkl, 4, nv->n, nv->order)) return WB_ERR_NOMEM;
+        if (!wb__batches_build(&nv->bt, &w->m, nv->ijkl, 4, nv->n, nv->order)) return WB_ERR_NOMEM;
         /* what a projection reads, copied in batch order: a batch streams through memory
          * (through the order array it jumped across the whole block, 10% slower) */
         for (int32_t j = 0; j < nv->n; j++) {

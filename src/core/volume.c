@@ -173,7 +173,7 @@ static wb_status vol_prepare(wb_world *w)
 {
     wb_volumes *v = w->vol;
     if (!v || v->n == v->bt.n) return WB_OK;
-    if (!wb__batches_build(&v->bt, w->m.inv_mass, w->m.np, v->ijkl, 4, v->n, v->order)) return WB_ERR_NOMEM;
+    if (!wb__batches_build(&v->bt, &w->m, v->ijkl, 4, v->n, v->order)) return WB_ERR_NOMEM;
     /* what a projection reads, copied in batch order: a batch streams through memory */
     for (int32_t j = 0; j < v->n; j++) {
         const int32_t i = v->order[j];

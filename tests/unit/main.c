@@ -121,6 +121,7 @@
     X(builder_failure_changes_nothing)           \
     X(colour_batches_valid)                      \
     X(colour_broken_constraints_unpacked)        \
+    X(colour_mirror_images_alike)                \
     X(volume_tet_batches_valid)                  \
     X(volume_tet_threads_identical)              \
     X(bend_batches_valid)                        \
