@@ -7,7 +7,7 @@
 
 /* the interrupt hook runs before every substep: from frame 90 on (past the grace after the
  * world was made) it gives particle 0 a speed the scene has nowhere to take from, as a
- * solve gone wrong would; 0: the step goes on */
+ * solve gone wrong would (a push of speed x h along x each substep); 0: the step goes on */
 typedef struct kick {
     wb_world *w;
     wb_real speed;
@@ -16,7 +16,10 @@ typedef struct kick {
 static int kick_substep(void *ud)
 {
     const kick *k = ud;
-    if (wb_world_frame(k->w) >= 90) k->w->s.v[0] = k->speed;
+    /* a displacement after the substep's prediction (which may already have run, fused
+     * into the last collision pass): the velocity update turns it into the speed */
+    const wb_world_def *d = &k->w->m.def;
+    if (wb_world_frame(k->w) >= 90) k->w->s.x[0] += k->speed * d->dt / d->substeps;
     return 0;
 }
 
