@@ -198,8 +198,11 @@ static wb_real speed_scale(wb_world *w, wb_real dt)
     wb_real lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
     for (int32_t i = 0; i < np; i++)
         for (int c = 0; c < 3; c++) {
-            lo[c] = fmin(lo[c], x[3 * i + c]);
-            hi[c] = fmax(hi[c], x[3 * i + c]);
+            /* comparisons, not fmin / fmax (libm calls in the frame's hot path; a NaN is
+             * never in a finite frame's positions) */
+            const wb_real xc = x[3 * i + c];
+            lo[c] = xc < lo[c] ? xc : lo[c];
+            hi[c] = xc > hi[c] ? xc : hi[c];
         }
     wb_real s = k->bl_user;
     /* a fall across the scene */
@@ -254,8 +257,10 @@ static int given(wb_world *w)
     wb_cache *k = &w->k;
     int g = !k->bl_have || k->mc_changed || k->bl_np != m->np || k->bl_wgen != m->w_gen ||
             memcmp(&k->bl_def, &m->def, sizeof k->bl_def);
+    const wb_real *xs = k->x_save, *bx = k->bl_x;
     for (int32_t i = 0; !g && i < m->np; i++)
-        g = m->w[i] > 0 && memcmp(&k->x_save[3 * i], &k->bl_x[3 * i], 3 * sizeof(wb_real));
+        g = m->w[i] > 0 &&
+            (xs[3 * i] != bx[3 * i] || xs[3 * i + 1] != bx[3 * i + 1] || xs[3 * i + 2] != bx[3 * i + 2]);
     k->mc_changed = 0;
     k->bl_wgen = m->w_gen;
     k->bl_def = m->def;
@@ -275,7 +280,11 @@ static void check_speeds(wb_world *w)
     /* the fastest particle at the frame's start; a speed from outside when faster than any
      * the last frame ended with (a script's w:set_velocity, a new particle) */
     wb_real s0 = 0, end = 0;
-    for (int32_t i = 0; i < np; i++) s0 = fmax(s0, v3_len(&v0[3 * i]));
+    for (int32_t i = 0; i < np; i++) {
+        const wb_real q = v3_dot(&v0[3 * i], &v0[3 * i]);
+        s0 = q > s0 ? q : s0;
+    }
+    s0 = sqrt(s0);
     if (!k->bl_have || s0 > k->bl_vend) k->bl_user = fmax(k->bl_user, s0);
     /* (the time is the frame's start's: it advances after this) */
     if (given(w)) k->bl_given = w->s.time;
@@ -288,6 +297,7 @@ static void check_speeds(wb_world *w)
         int32_t worst = -1;
         wb_real top = 0;
         for (int32_t i = 0; i < np; i++) {
+            if (!(v3_dot(&v[3 * i], &v[3 * i]) > lo * lo)) continue; /* the common case, no root */
             const wb_real s = v3_len(&v[3 * i]);
             if (s > lo && s > v3_len(&v0[3 * i]) + fall && s > top) { top = s; worst = i; }
         }
@@ -312,7 +322,11 @@ static void check_speeds(wb_world *w)
             }
         }
     }
-    for (int32_t i = 0; i < np; i++) end = fmax(end, v3_len(&v[3 * i]));
+    for (int32_t i = 0; i < np; i++) {
+        const wb_real q = v3_dot(&v[3 * i], &v[3 * i]);
+        end = q > end ? q : end;
+    }
+    end = sqrt(end);
     k->bl_vend = end;
     k->bl_have = 1;
     wb_real *bx = wb__grow(k->bl_x, &k->cap_bl_x, 3 * (np > 0 ? np : 1), sizeof *bx);
