@@ -61,7 +61,8 @@ static int32_t root(int32_t *parent, int32_t p)
 static int64_t quant(wb_real v, wb_real inv_q)
 {
     wb_real s = v * inv_q;
-    s = s > 0x1p62 ? 0x1p62 : s < -0x1p62 ? -0x1p62 : s;
+    /* (NaN: 0 x an infinite scale, a scene 5e-324 across: any key will do) */
+    s = s > 0x1p62 ? 0x1p62 : s < -0x1p62 ? -0x1p62 : s == s ? s : 0;
     return s >= 0 ? (int64_t)(s + (wb_real)0.5) : -(int64_t)((wb_real)0.5 - s);
 }
 
