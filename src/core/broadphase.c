@@ -723,6 +723,43 @@ static int any_possible(const wb_model *m)
 }
 
 /* ---- the step ---------------------------------------------------------------------------------- */
+/* the candidate list for the next t seconds from where the particles are: each one's reach
+ * is how far it can get in that time (its velocity and gravity), plus a quarter of its
+ * radius for what the constraints move it; kept in c->xf for the substeps' checks.
+ * Returns the pairs, or -1 when out of memory */
+static int32_t make_list(wb_world *w, wb_real t)
+{
+    wb_model *m = &w->m;
+    wb_contacts *c = &w->k.pc;
+    c->check = 0;
+    wb_real *reach = wb__grow(c->reach, &c->cap_reach, m->np, sizeof *reach);
+    if (reach) c->reach = reach;
+    int32_t *skip = wb__grow(c->skip, &c->cap_skip, m->np, sizeof *skip);
+    if (skip) c->skip = skip;
+    wb_real *xf = wb__grow(c->xf, &c->cap_xf, 3 * m->np, sizeof *xf);
+    if (xf) c->xf = xf;
+    if (!reach || !skip || !xf) return -1;
+    const wb_real g = v3_len(m->def.gravity) * t * t;
+    const wb_real *v = w->s.v;
+    for (int32_t i = 0; i < m->np; i++) {
+        const uint8_t f = m->cflags[i];
+        const int32_t gi = m->group[i];
+        /* may_touch's rules: other bodies need `collide`, its own body `self_collide` */
+        if (!((f & WB_CF_COLLIDE) || (gi > 0 && (f & WB_CF_SELF)))) { reach[i] = -1; continue; }
+        const wb_real *p = &w->s.x[3 * i];
+        reach[i] = m->radius[i] * (wb_real)1.25 + v3_len_fast(&v[3 * i]) * t + g;
+        if (!isfinite(reach[i] + p[0] + p[1] + p[2])) reach[i] = -1;
+        /* a body that does not collide with itself: its pairs are left out before the
+         * distance test, and its inside is culled by its bounds */
+        skip[i] = gi > 0 && !(f & WB_CF_SELF) ? gi : 0;
+    }
+    memcpy(xf, w->s.x, sizeof *xf * 3 * (size_t)m->np);
+    c->n = 0;
+    const int32_t r = wb__broadphase_kept(c, w->s.x, reach, skip, m->np, wb__world_pool(w), may_touch, w);
+    c->check = r >= 0;
+    return r;
+}
+
 void wb__contacts_begin(wb_world *w)
 {
     wb_model *m = &w->m;
@@ -732,6 +769,8 @@ void wb__contacts_begin(wb_world *w)
     c->last = 0;
     c->fresh = 1;
     c->broad_ms = 0;
+    c->check = 0;
+    c->sub = 0;
     if (!m->def.contacts || m->np < 2) return;
     if (!wb__contact_rules(w)) {
         c->possible = 0; /* the triangles' broad phase asks the same rules */
@@ -745,30 +784,69 @@ void wb__contacts_begin(wb_world *w)
     }
     if (!c->possible) return;
     const double t0 = now_ms();
-    wb_real *reach = wb__grow(c->reach, &c->cap_reach, m->np, sizeof *reach);
-    if (!reach) { wb__warn(w, "out of memory in the contact broad phase; contacts skipped"); return; }
-    c->reach = reach;
-    /* swept bounds: how far a particle can get this frame (its velocity and gravity over
-     * dt), plus a quarter of its radius for what the constraints move it */
-    int32_t *skip = wb__grow(c->skip, &c->cap_skip, m->np, sizeof *skip);
-    if (!skip) { wb__warn(w, "out of memory in the contact broad phase; contacts skipped"); return; }
-    c->skip = skip;
-    const wb_real dt = m->def.dt, g = v3_len(m->def.gravity) * dt * dt;
-    const wb_real *v = w->s.v;
-    for (int32_t i = 0; i < m->np; i++) {
-        const uint8_t f = m->cflags[i];
-        const int32_t gi = m->group[i];
-        /* may_touch's rules: other bodies need `collide`, its own body `self_collide` */
-        if (!((f & WB_CF_COLLIDE) || (gi > 0 && (f & WB_CF_SELF)))) { reach[i] = -1; continue; }
-        reach[i] = m->radius[i] * (wb_real)1.25 + v3_len_fast(&v[3 * i]) * dt + g;
-        if (!isfinite(reach[i])) reach[i] = -1;
-        /* a body that does not collide with itself: its pairs are left out before the
-         * distance test, and its inside is culled by its bounds */
-        skip[i] = gi > 0 && !(f & WB_CF_SELF) ? gi : 0;
-    }
-    if (wb__broadphase_kept(c, w->s.x, reach, skip, m->np, wb__world_pool(w), may_touch, w) < 0) {
+    if (make_list(w, m->def.dt) < 0) {
         c->n = 0;
         wb__warn(w, "out of memory in the contact broad phase; contacts skipped");
     }
     c->broad_ms = now_ms() - t0;
+}
+
+/* The reach assumes each particle moves at most a quarter of its radius farther than its
+ * velocity and gravity carry it; a link yanking a particle (a stiff cloth landing, a
+ * whip) can move it farther, and a pair the list lacks could pass through each other.
+ * So each substep checks every particle against that, and one that moved farther (the
+ * list would then be missing pairs) has the list made again from where the particles
+ * are, for the rest of the frame. */
+int wb__contacts_recheck(wb_world *w, wb_real h)
+{
+    wb_model *m = &w->m;
+    wb_contacts *c = &w->k.pc;
+    if (!c->check || c->no_recheck) return 0;
+    const int32_t sub = c->sub++;
+    const wb_real *x = w->s.x, *xf = c->xf, *reach = c->reach, *rad = m->radius;
+    int moved = 0;
+    for (int32_t i = 0; i < m->np; i++) {
+        const wb_real e = reach[i] - rad[i];
+        const wb_real d0 = x[3 * i] - xf[3 * i], d1 = x[3 * i + 1] - xf[3 * i + 1], d2 = x[3 * i + 2] - xf[3 * i + 2];
+        /* (a reach < 0 is no candidate; a position gone non-finite fails and is left out
+         * by the remade list) */
+        moved |= (reach[i] >= 0) & !(d0 * d0 + d1 * d1 + d2 * d2 <= e * e);
+    }
+    if (!moved) return 0;
+    /* the old list kept for what its pairs were left with */
+    int32_t *io = wb__grow(c->ij_old, &c->cap_old, 2 * (c->n > 0 ? c->n : 1), sizeof *io);
+    if (!io) { c->n = 0; c->check = 0; return -1; }
+    c->ij_old = io;
+    if (c->n > 0) memcpy(io, c->ij, sizeof *io * 2 * (size_t)c->n);
+    c->n_old = c->n;
+    c->remakes++;
+    /* what is left of the frame, this substep included */
+    const wb_real left = m->def.dt - (wb_real)sub * h;
+    const double t0 = now_ms();
+    const int32_t r = make_list(w, left > h ? left : h);
+    c->broad_ms += now_ms() - t0;
+    if (r < 0) { c->n = 0; c->check = 0; return -1; }
+    return 1;
+}
+
+void wb__contacts_brute(wb_world *w)
+{
+    const wb_model *m = &w->m;
+    wb_contacts *c = &w->k.pc;
+    const wb_real *x = w->s.x;
+    if (!m->def.contacts) return;
+    for (int32_t i = 0; i < m->np; i++)
+        for (int32_t j = i + 1; j < m->np; j++) {
+            wb_real d[3];
+            v3_sub(d, &x[3 * j], &x[3 * i]);
+            const wb_real r = m->radius[i] + m->radius[j];
+            if (!(v3_dot(d, d) < r * r) || !may_touch(w, i, j)) continue;
+            int32_t lo = 0, hi = c->n;
+            while (lo < hi) {
+                const int32_t mid = lo + (hi - lo) / 2, a = c->ij[2 * mid], b = c->ij[2 * mid + 1];
+                if (a < i || (a == i && b < j)) lo = mid + 1;
+                else hi = mid;
+            }
+            c->missed += !(lo < c->n && c->ij[2 * lo] == i && c->ij[2 * lo + 1] == j);
+        }
 }

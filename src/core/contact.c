@@ -147,10 +147,31 @@ wb_real wb_body_spacing(const wb_world *w, wb_body b)
  *    out in the velocity pass (err). Not through x_prev: a settled stack would then rest
  *    on position corrections alone and keep a velocity (-g h / 3 in a stack of three).
  * wb__contact_depth (core.h) works the parts out; tricontact.c uses it too. */
+/* what a pair of a new list counts as already overlapping (see below) */
+static wb_real fresh_left(const wb_contacts *c, const wb_real *xp, const wb_real *rad, wb_real step, int32_t k)
+{
+    const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];
+    wb_real d[3];
+    v3_sub(d, &xp[3 * j], &xp[3 * i]);
+    const wb_real d0 = rad[i] + rad[j] - v3_len(d);
+    return d0 > step ? d0 : 0;
+}
+
 void wb__contacts_project(wb_world *w, wb_real h)
 {
     wb_contacts *c = &w->k.pc;
     c->nact = 0;
+    /* the list still holds (else it is made again, and each old pair's left is kept) */
+    const int32_t n_before = c->n;
+    const int remade = wb__contacts_recheck(w, h);
+    if (remade < 0) wb__warn(w, "out of memory in the contact broad phase; contacts skipped");
+    if (remade > 0 && !c->fresh && n_before > 0) {
+        wb_real *lo = wb__grow(c->left_old, &c->cap_left_old, n_before, sizeof *lo);
+        if (!lo) { c->fresh = 1; goto nomem; }
+        c->left_old = lo;
+        memcpy(lo, c->left, sizeof *lo * (size_t)n_before);
+    }
+    if (c->brute) wb__contacts_brute(w);
     if (c->n == 0) { c->last = 0; return; }
     int32_t touching = 0;
     const wb_model *m = &w->m;
@@ -171,14 +192,17 @@ void wb__contacts_project(wb_world *w, wb_real h)
      * frame, and a settled stack stays exactly at rest). Worked out from the state
      * alone, so a step interrupted and run again gives the same result */
     if (c->fresh) {
-        for (int32_t k = 0; k < c->n; k++) {
-            const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];
-            wb_real d[3];
-            v3_sub(d, &xp[3 * j], &xp[3 * i]);
-            const wb_real d0 = rad[i] + rad[j] - v3_len(d);
-            left[k] = d0 > vmax * h ? d0 : 0;
-        }
+        for (int32_t k = 0; k < c->n; k++) left[k] = fresh_left(c, xp, rad, vmax * h, k);
         c->fresh = 0;
+    } else if (remade) {
+        /* a list made again within the frame: a pair it had keeps what it was left with
+         * (both lists are in (i, j) order), a new one starts as a new list's */
+        const int32_t *io = c->ij_old, no = c->n_old;
+        for (int32_t k = 0, q = 0; k < c->n; k++) {
+            const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];
+            while (q < no && (io[2 * q] < i || (io[2 * q] == i && io[2 * q + 1] < j))) q++;
+            left[k] = q < no && io[2 * q] == i && io[2 * q + 1] == j ? c->left_old[q] : fresh_left(c, xp, rad, vmax * h, k);
+        }
     }
     for (int32_t k = 0; k < c->n; k++) {
         const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];

@@ -208,6 +208,21 @@ typedef struct wb_contacts {
     wb_real *load;         /* (np) static friction budget of the substep, mu x normal impulse
                               (contact.c's friction pass; pairs' and triangles' together) */
     int32_t cap_load;
+    /* each substep checks that no particle moved farther than its reach allowed since the
+     * list was made (broadphase.c: wb__contacts_recheck), else the list is made again */
+    int check;             /* a list was made this frame: check it */
+    int32_t sub;           /* substeps of the frame checked so far */
+    wb_real *xf;           /* (np x 3) where the list's reaches were measured from */
+    int32_t cap_xf;
+    int32_t n_old, cap_old;
+    int32_t *ij_old;       /* the list before a remake, and what each pair was left with */
+    wb_real *left_old;
+    int32_t cap_left_old;
+    int64_t remakes;       /* lists made again within a frame (stats) */
+    int no_recheck;        /* tests: the list is not checked within the frame */
+    int brute;             /* tests: each substep, every touching pair that may touch is looked
+                              for in the list; missed counts those it lacks */
+    int64_t missed;
 } wb_contacts;
 
 /* rest neighbours (DESIGN.md §2) include pairs made in touch: created r_i + r_j apart, to
@@ -218,6 +233,12 @@ typedef struct wb_contacts {
  * constraints and groups; 0 when out of memory. wb__joined: a constraint joins i and j */
 int wb__contact_rules(wb_world *w);
 int wb__joined(const wb_contacts *c, int32_t i, int32_t j);
+/* at a substep (the frame's sub-th, step h): 1 when some particle moved past what its
+ * reach allowed and the list was made again for the rest of the frame (the old one in
+ * ij_old, n_old), 0 when it holds, -1 when out of memory (the list is then empty).
+ * wb__contacts_brute: the tests' count of touching pairs the list lacks (brute) */
+int wb__contacts_recheck(wb_world *w, wb_real h);
+void wb__contacts_brute(wb_world *w);
 /* the body a particle is in for the contact rules: its group, or for a loose particle its
  * graph (the loose particles its constraints reach), as -1 - the graph's least particle */
 static inline int32_t wb__graph_of(const wb_contacts *c, const wb_model *m, int32_t i)
@@ -306,6 +327,10 @@ static inline void wb__broadphase_free(wb_contacts *c)
     free(c->skip);
     c->skip = NULL;
     c->cap_skip = 0;
+    free(c->xf); free(c->ij_old); free(c->left_old);
+    c->xf = c->left_old = NULL;
+    c->ij_old = NULL;
+    c->cap_xf = c->cap_old = c->cap_left_old = 0;
     if (!b) return;
     free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key);
     free(b->runs); free(b->boxes); free(b->first);

@@ -48,6 +48,7 @@
     X(contact_broadphase_kept_list_matches_fresh_search) \
     X(contact_builders_get_own_groups)                   \
     X(contact_self_collision_skips_rest_neighbours)      \
+    X(contact_list_complete_every_substep)               \
     X(contact_clone_keeps_groups)
 
 /* test_tricontact.c: particle-triangle contacts */
