@@ -551,7 +551,7 @@ static wb_real start_depth(const sub_pose *sp, const wb_real xprev[3], wb_real r
  * slid a whole substep's slip and the links pulled the others along (a 4 x 4 x 4
  * lattice at tan theta = 0.8 mu: 1.6 cm/s). Returns the normal correction left to the
  * velocity pass's dynamic friction: depth, or 0 when the budget was spent here. */
-WB_INLINE wb_real static_friction(wb_real *restrict x, const wb_real slip[3], const wb_real v[3], const wb_real gh[3],
+WB_INLINE wb_real static_friction(wb_real *restrict x, const wb_real slip[3], const wb_real v[3], const wb_real grav[3],
                                   const wb_real *vc, const wb_real n[3], wb_real mu, wb_real depth, wb_real h)
 {
     const wb_real sl = v3_len(slip), cap = mu * depth;
@@ -560,8 +560,8 @@ WB_INLINE wb_real static_friction(wb_real *restrict x, const wb_real slip[3], co
         return depth;
     }
     if (!(cap > 0)) return depth;
-    wb_real u[3];
-    v3_sub(u, v, gh);
+    /* wb_predict's g h taken back out of the predicted v */
+    wb_real u[3] = { v[0] - grav[0] * h, v[1] - grav[1] * h, v[2] - grav[2] * h };
     if (vc) v3_sub(u, u, vc);
     v3_madd(u, n, -v3_dot(u, n));
     if (v3_len(u) * h > cap) return depth;
@@ -574,7 +574,7 @@ WB_INLINE wb_real static_friction(wb_real *restrict x, const wb_real slip[3], co
  * impulse (friction's bound, here and in the velocity pass) is what the substep drove
  * in, depth - shift: the repair of an overlap it already had is no force */
 static void resolve(wb_real *restrict xi, wb_real *restrict pi, const wb_real *restrict vi, const sub_pose *c,
-                    const wb_real n[3], wb_real depth, wb_real shift, wb_real h, const wb_real gh[3], contact *ct)
+                    const wb_real n[3], wb_real depth, wb_real shift, wb_real h, const wb_real grav[3], contact *ct)
 {
     v3_madd(xi, n, depth);
     if (shift > 0) v3_madd(pi, n, shift);
@@ -596,7 +596,7 @@ static void resolve(wb_real *restrict xi, wb_real *restrict pi, const wb_real *r
         v3_sub(slip, xi, pi);
         v3_madd(slip, vc, -h);
         v3_madd(slip, n, -v3_dot(slip, n));
-        fdepth = static_friction(xi, slip, vi, gh, vc, n, c->s->friction, depth, h);
+        fdepth = static_friction(xi, slip, vi, grav, vc, n, c->s->friction, depth, h);
     }
     if (!ct) return;
     ct->c = c;
@@ -706,8 +706,6 @@ WB_INLINE void collide_range(collide_job *j, int32_t lo, int32_t hi, const int p
     const int32_t nlive = planes == 2 ? 1 : j->nlive;
     const static_plane one = planes == 2 ? pl[0] : (static_plane){ { 0, 0, 0 }, 0, 0, 0 };
     const wb_real h = j->h, inv_h = 1 / h, g = v3_len(m->def.gravity), step = m->def.max_depenetration * h;
-    /* the substep's gravity in the predicted v (wb_predict's g): static friction's regime */
-    const wb_real gh[3] = { m->def.gravity[0] * h, m->def.gravity[1] * h, m->def.gravity[2] * h };
     wb_real *restrict cl = j->left;
     const int fresh = j->fresh;
     /* restrict: the arrays are distinct, so the compiler keeps values in registers
@@ -751,7 +749,7 @@ WB_INLINE void collide_range(collide_job *j, int32_t lo, int32_t hi, const int p
                     wb_real slip[3];
                     v3_sub(slip, xx, pp);
                     v3_madd(slip, sp->n, -v3_dot(slip, sp->n));
-                    fdepth = static_friction(xx, slip, vv, gh, NULL, sp->n, sp->friction, depth, h);
+                    fdepth = static_friction(xx, slip, vv, m->def.gravity, NULL, sp->n, sp->friction, depth, h);
                 }
                 if (nct < MAX_CONTACTS) {
                     cp[nct] = c;
@@ -794,7 +792,7 @@ WB_INLINE void collide_range(collide_job *j, int32_t lo, int32_t hi, const int p
                 if (!(depth > 0)) continue;
                 wb_real shift;
                 depth = made_contact(depth, start_depth(sp, pi, rad[i], tri), left, fresh, step, &lmax, &shift);
-                resolve(xi, pi, vi, sp, n, depth, shift, h, gh, nct < MAX_CONTACTS ? &ct[nct] : NULL);
+                resolve(xi, pi, vi, sp, n, depth, shift, h, m->def.gravity, nct < MAX_CONTACTS ? &ct[nct] : NULL);
                 nct++;
             }
             for (int c = 0; c < 3; c++) vi[c] = (xi[c] - pi[c]) * inv_h;
