@@ -4,8 +4,8 @@
 local w = wobble.world{ substeps = 20, iterations = 2 }
 w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.8 }
 -- the block's particles have a contact radius of half their spacing (0.0625 m); its
--- bottom layer starts just above the ground by that (a block made inside the ground is
--- pushed out within a substep and its links throw it up)
+-- bottom layer starts just above the ground by that, so it rests where it is made (one
+-- made inside the ground rises out of it gently, at max_depenetration)
 local y0 = wobble.args.y0 or 0.07
 local block = w:lattice{ min = {-0.4, y0, -0.4}, max = {0.4, y0 + 0.5, 0.4}, res = {7, 5, 7},
                          mass = 3, compliance = 2e-4, damping = 0.02 }

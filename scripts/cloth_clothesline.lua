@@ -15,8 +15,8 @@ local cloth = w:cloth{ origin = {-0.75, 2, 0}, size = {1.5, 1.5}, res = {res, re
                        mass = 0.3, compliance = 2e-6, bend = 100 }
 -- the line: a thin capsule the cloth is pegged under, touching the pegged edge's
 -- particles (contact radius: half their spacing) without overlapping them: a particle
--- made inside a collider is pushed out within a substep, and the cloth's edge flew off
--- at 7 m/s when the line cut through it
+-- made inside a collider would be pushed out slowly (max_depenetration), sagging the
+-- pegged edge over the line for the first frames
 local r = w:radius(cloth.particles[1])
 w:collider{ shape = "capsule", a = {-1.5, 2 + r + 0.011, 0}, b = {1.5, 2 + r + 0.011, 0}, radius = 0.01 }
 -- the pegs: the two corners on the line (z = 0) and the middle of that edge

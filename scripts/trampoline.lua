@@ -17,7 +17,7 @@ local bodies = {
   w:rigid{ shape = "box", half = {0.12, 0.12, 0.12}, mass = 1.5, pos = {0.35, 2.3, 0.2},
            rotation = {0.9, 0.3, 0, 0.3}, friction = 0.5 },
   w:rigid{ shape = "sphere", radius = 0.14, mass = 0.8, pos = {0.0, 2.8, 0.45}, friction = 0.5 },
-  w:rigid{ shape = "capsule", a = {0.3, 3.3, -0.5}, b = {0.6, 3.4, -0.4}, radius = 0.08, mass = 0.7, friction = 0.5 },
+  w:rigid{ shape = "capsule", a = {0.3, 3.3, -0.3}, b = {0.6, 3.4, -0.2}, radius = 0.08, mass = 0.7, friction = 0.5 },
 }
 
 -- per body: lowest centre, and whether it rose again after its first dip (thrown back)

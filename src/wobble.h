@@ -448,6 +448,7 @@ typedef struct wb_volume_def {
     wb_real compliance;   /* m^3/Pa; 0 = incompressible */
     bool has_rest;        /* false: the current signed volume */
     wb_real rest;         /* the signed rest volume, when has_rest */
+    wb_real yield, creep; /* plastic flow of the rest volume as a distance's; 0: none */
 } wb_volume_def;
 
 wb_volume_def wb_volume_default_def(void);                    /* incompressible, rest = current */
@@ -468,6 +469,7 @@ void wb_world_volume_total(const wb_world *w, wb_real *current, wb_real *rest);
 typedef struct wb_tet_def {
     wb_real young;        /* Young's modulus, Pa (> 0), default 1e5 */
     wb_real poisson;      /* Poisson's ratio in [0, 0.5), default 0.3 */
+    wb_real yield, creep; /* plastic flow of the rest shape (tet.c); 0: none */
 } wb_tet_def;
 wb_tet_def wb_tet_default_def(void);
 const char *wb_tet_def_check(const wb_tet_def *def);          /* NULL or what is wrong */

@@ -15,8 +15,7 @@ typedef struct wb_batches {
 
 /* colour n constraints of k particles (idx, k per constraint) into order (n slots, by
  * colour then creation); 0 when out of memory (nothing changed) */
-int wb__batches_build(wb_batches *b, const wb_real *inv_mass, int32_t np, const int32_t *idx, int k, int32_t n,
-                      int32_t *order);
+int wb__batches_build(wb_batches *b, const wb_model *m, const int32_t *idx, int k, int32_t n, int32_t *order);
 
 /* project order[lo, hi) of one batch (or of the serial tail) */
 typedef void (*wb_range_fn)(wb_world *w, const int32_t *order, int32_t lo, int32_t hi, wb_real h);

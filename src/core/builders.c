@@ -265,14 +265,14 @@ wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
     const bool neo = d->young != 0;
     if (neo && !d->tets) return bad("young needs tets = true");
     if (neo) {
-        const wb_tet_def td = { d->young, d->poisson };
+        const wb_tet_def td = { d->young, d->poisson, 0, 0 };
         const char *e = wb_tet_def_check(&td);
         if (e) return bad(e);
     }
     if ((st = wb__reserve(w, np, neo ? 0 : nd)) != WB_OK || (st = wb__surface_reserve(w, (int32_t)ntri)) != WB_OK ||
         (d->tets && (st = neo ? wb__tet_reserve(w, 6 * cells) : wb__volume_reserve(w, 6 * cells)) != WB_OK))
         return st;
-    const int32_t first = w->m.np;
+    const int32_t first = w->m.np, first_vol = wb_volume_count(w), first_tet = wb_tet_count(w);
     const wb_real m = d->mass / (wb_real)np;
     for (int64_t i = 0; i < np; i++) {
         wb_real p[3];
@@ -334,5 +334,8 @@ wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
         free(tri);
     }
 #undef ID
+    /* the links' plastic flow for the tets too: one rest shape for the whole body */
+    wb__volume_plastic(w, first_vol, d->link.yield, d->link.creep);
+    wb__tet_plastic(w, first_tet, d->link.yield, d->link.creep);
     return wb__body_finish(w, first, (int32_t)np, out);
 }

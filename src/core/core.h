@@ -445,6 +445,26 @@ typedef struct wb_cache {
     int64_t fused;         /* substeps predicted in the collision pass so far (tests) */
     int32_t nonfinite;     /* the last substep's pass scanned x and v (solver.c): the first
                               non-finite particle, -1 none; -2 when it did not scan */
+    /* the bodies whose angular momentum the solve keeps (momentum.c) */
+    int32_t *mc_body;      /* (np) body of each particle, -1 none */
+    int32_t *mc_root;      /* (bodies) first particle of each */
+    double *mc_acc;        /* (bodies x 16) sums; [0] < 0: held from outside the solve */
+    int32_t cap_mc_body, cap_mc_root, cap_mc_acc, mc_nbody, mc_free;
+    int mc_built, mc_changed;
+    int64_t mc_sig[8];     /* what the bodies were found for (besides m.topology_dirty) */
+    /* the blow-up check at a frame's end (solver.c) */
+    wb_real *bl_x;         /* (bl_np x 3) positions at the last frame's end: pinned ones' moves */
+    int32_t cap_bl_x, bl_np;
+    wb_real bl_user;       /* the fastest speed given from outside (scripts, new particles) */
+    wb_real bl_vend;       /* the fastest particle at the last frame's end */
+    int bl_have;           /* bl_vend is known (a step ended since the world was made or loaded) */
+    int bl_warned;         /* the blow-up was reported (once per world) */
+    int32_t bl_hot;        /* consecutive frames with a particle past the lower limit */
+    int bl_armed;          /* a blow-up was found: the lower limit holds from then on */
+    double bl_given;       /* time the script last gave the world energy (made constraints,
+                              moved particles, changed settings) */
+    uint32_t bl_wgen;      /* m.w_gen then */
+    wb_world_def bl_def;   /* the settings then */
 } wb_cache;
 
 struct wb_world {
@@ -464,14 +484,22 @@ struct wb_world {
 
 /* internal entry points */
 wb_status wb__colour(wb_world *w);                 /* distance.c: rebuild the distance batches if dirty */
+/* momentum.c: once per step before the types' prepare (0: out of memory, nothing kept this
+ * step); after each substep's solve, every free body's angular momentum back as it was */
+int wb__momentum_prepare(wb_world *w);
+void wb__momentum_restore(wb_world *w, wb_real h);
 /* colour.c: greedy colouring of n constraints of k particles each (constraint i joins
- * idx[k i .. k i + k - 1]); those live() refuses get WB_NO_COLOUR, the others a colour
- * in [0, WB_MAX_COLOURS] (WB_MAX_COLOURS: the serial overflow batch), counted in count.
- * 0 when out of memory */
+ * idx[k i .. k i + k - 1]), mirror images alike (colour.c's header); those live() refuses
+ * get WB_NO_COLOUR, the others a colour in [0, WB_MAX_COLOURS] (WB_MAX_COLOURS: the serial
+ * overflow batch), counted in count. 0 when out of memory */
 #define WB_NO_COLOUR 255
-int wb__colour_greedy(const wb_real *inv_mass, int32_t np, const int32_t *idx, int k, int32_t n,
+int wb__colour_greedy(const wb_model *m, const int32_t *idx, int k, int32_t n,
                       int (*live)(const void *ud, int32_t i), const void *ud, uint8_t *colour,
                       int32_t count[WB_MAX_COLOURS + 1]);
+/* colour.c, tests: on = 0 colours in creation order (as before mirror keys), 1 with mirror
+ * keys (the default) from the next colouring on; returns the previous setting. Not
+ * thread-safe: call it between steps */
+int wb__colour_symmetric(int on);
 /* batch ranges from the counts: colour_start (ncolours + 1), the first serial batch, and
  * start[c] the first packed index of colour c; returns the packed total */
 int32_t wb__colour_ranges(const int32_t count[WB_MAX_COLOURS + 1], int32_t *colour_start, int32_t *ncolours,

@@ -84,7 +84,7 @@ static wb_status colour(wb_world *w)
         !realloc_n((void **)&k->s_jac, ns, 4 * sizeof(wb_real)) ||
         !realloc_n((void **)&k->s_slot, ns, 3 * sizeof(int32_t) + 1) ||
         !realloc_n((void **)&k->colour_start, WB_MAX_COLOURS + 2, sizeof(int32_t)) ||
-        !wb__colour_greedy(m->inv_mass, m->np, m->d_ij, 2, m->nd, packable, w, colour, count)) {
+        !wb__colour_greedy(m, m->d_ij, 2, m->nd, packable, w, colour, count)) {
         free(colour);
         return WB_ERR_NOMEM;
     }

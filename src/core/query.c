@@ -3,6 +3,8 @@
 #include "attach.h"
 #include "grab.h"
 #include "rigid.h"
+#include "tet.h"
+#include "volume.h"
 
 static wb_real mass_of(const wb_world *w, int32_t i) { return w->m.w[i] > 0 ? 1 / w->m.w[i] : 0; }
 
@@ -168,6 +170,21 @@ uint64_t wb_world_hash(const wb_world *w)
         h = fnv(h, pr->pressure, sizeof(wb_real) * (size_t)pr->n);
         h = fnv(h, pr->alpha, sizeof(wb_real) * (size_t)pr->n);
         h = fnv(h, pr->v0, sizeof(wb_real) * (size_t)pr->n);
+    }
+    /* plastic volume constraints and tets: their rest state flows (state), and how (worlds
+     * without any hash as they always did) */
+    const wb_volumes *vo = w->vol;
+    if (vo && vo->plastic) {
+        h = fnv(h, vo->rest, sizeof(wb_real) * (size_t)vo->n);
+        h = fnv(h, vo->yield, sizeof(wb_real) * (size_t)vo->n);
+        h = fnv(h, vo->creep, sizeof(wb_real) * (size_t)vo->n);
+    }
+    const wb_neos *ne = w->neo;
+    if (ne && ne->plastic) {
+        h = fnv(h, ne->dminv, sizeof(wb_real) * 9 * (size_t)ne->n);
+        h = fnv(h, ne->v0, sizeof(wb_real) * (size_t)ne->n);
+        h = fnv(h, ne->yield, sizeof(wb_real) * (size_t)ne->n);
+        h = fnv(h, ne->creep, sizeof(wb_real) * (size_t)ne->n);
     }
     /* attachments and grabs: the live ones in slot order (a snapshot keeps that order;
      * it drops an attachment whose collider was removed, so the hash does too) */

@@ -89,16 +89,19 @@ wb_status wb_image_alloc_volumes(wb_image *g, int32_t n)
     free(g->vol_ijkl);
     free(g->vol_alpha);
     free(g->vol_rest);
+    free(g->vol_plastic);
     g->nvol = n;
     g->vol_ijkl = zalloc(4 * (int64_t)n, sizeof *g->vol_ijkl);
     g->vol_alpha = zalloc(n, sizeof *g->vol_alpha);
     g->vol_rest = zalloc(n, sizeof *g->vol_rest);
-    if (g->vol_ijkl && g->vol_alpha && g->vol_rest) return WB_OK;
+    g->vol_plastic = zalloc(2 * (int64_t)n, sizeof *g->vol_plastic);
+    if (g->vol_ijkl && g->vol_alpha && g->vol_rest && g->vol_plastic) return WB_OK;
     free(g->vol_ijkl);
     free(g->vol_alpha);
     free(g->vol_rest);
+    free(g->vol_plastic);
     g->vol_ijkl = NULL;
-    g->vol_alpha = g->vol_rest = NULL;
+    g->vol_alpha = g->vol_rest = g->vol_plastic = NULL;
     g->nvol = 0;
     return WB_ERR_NOMEM;
 }
@@ -110,9 +113,11 @@ void wb_image_free(wb_image *g)
     free(g->tet_v0);
     free(g->tet_young);
     free(g->tet_poisson);
+    free(g->tet_plastic);
     free(g->vol_ijkl);
     free(g->vol_alpha);
     free(g->vol_rest);
+    free(g->vol_plastic);
     for (int32_t i = 0; g->c && i < g->nc; i++) {
         free(g->c[i].mv);
         free(g->c[i].mt);
@@ -220,6 +225,10 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
         memcpy(g->vol_ijkl, w->vol->ijkl, 4 * (size_t)nvol * sizeof *g->vol_ijkl);
         memcpy(g->vol_alpha, w->vol->alpha, (size_t)nvol * sizeof *g->vol_alpha);
         memcpy(g->vol_rest, w->vol->rest, (size_t)nvol * sizeof *g->vol_rest);
+        for (int32_t i = 0; i < nvol; i++) {
+            g->vol_plastic[2 * i] = w->vol->yield[i];
+            g->vol_plastic[2 * i + 1] = w->vol->creep[i];
+        }
     }
     if ((st = wb__tet_image_of(w, g)) != WB_OK || (st = wb__smatch_image_of(w, g)) != WB_OK ||
         (st = wb__pressure_image_of(w, g)) != WB_OK || (st = wb__attach_image_of(w, g)) != WB_OK ||
@@ -334,7 +343,7 @@ const char *wb_image_check(const wb_image *g)
             for (int j = 0; j < k; j++)
                 if (p[j] == p[k]) return "a volume constraint needs four distinct particles";
         }
-        const wb_volume_def d = { g->vol_alpha[i], true, g->vol_rest[i] };
+        const wb_volume_def d = { g->vol_alpha[i], true, g->vol_rest[i], g->vol_plastic[2 * i], g->vol_plastic[2 * i + 1] };
         if ((e = wb_volume_def_check(&d))) return e;
     }
     if ((e = wb__tet_image_check(g)) || (e = wb__smatch_image_check(g)) || (e = wb__pressure_image_check(g)) ||
@@ -350,6 +359,7 @@ static void put_volumes(wb_world *w, const wb_image *g, int32_t shift)
         int32_t p[4];
         for (int k = 0; k < 4; k++) p[k] = g->vol_ijkl[4 * i + k] + shift;
         wb__volume_put(w, p, g->vol_alpha[i], g->vol_rest[i]);
+        wb__volume_plastic(w, w->vol->n - 1, g->vol_plastic[2 * i], g->vol_plastic[2 * i + 1]);
     }
 }
 

@@ -113,11 +113,13 @@ typedef struct wb_image {
     int32_t nvol;
     int32_t *vol_ijkl;     /* (nvol x 4) */
     wb_real *vol_alpha, *vol_rest; /* (nvol) compliance, signed rest volume */
+    wb_real *vol_plastic;  /* (nvol x 2) yield, creep (0: none) */
     /* Neo-Hookean tets (tet.c), in creation order: allocated by wb_image_alloc_tets */
     int32_t ntet;
     int32_t *tet_ijkl;     /* (ntet x 4) */
     wb_real *tet_dminv;    /* (ntet x 9) rest edge matrix inverse, row-major */
     wb_real *tet_v0, *tet_young, *tet_poisson; /* (ntet) rest volume (> 0), E, nu */
+    wb_real *tet_plastic;  /* (ntet x 2) yield, creep (0: none) */
     wb_image_smatch sm;    /* empty unless wb_image_alloc_smatch */
     wb_image_pressure pr;  /* empty unless wb_image_alloc_pressure */
     wb_image_attach att;   /* empty unless wb_image_alloc_attach */

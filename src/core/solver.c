@@ -12,6 +12,7 @@
 #include <time.h>
 
 #include "ctype.h"
+#include "grab.h"
 #include "rigid.h"
 
 static double now_ms(void)
@@ -157,11 +158,193 @@ static int check_finite(wb_world *w)
     return 1;
 }
 
+/* ---- blow-ups ------------------------------------------------------------------------ */
+/* Constraints that cannot all hold (a stiff body squeezed flat by a kinematic press) can
+ * feed particle speeds the scene has no source for. The scene's speed scale is the fastest
+ * of: a kinematic collider's surface (its move over the frame, its turn times the reach to
+ * the farthest particle), a rigid body's (|v| + |om| x its bound), a grab's target, a
+ * pinned particle the script moves, the fastest speed a script gave (w:set_velocity, a new
+ * particle, what a change by hand set free: below), and a fall across the scene,
+ * sqrt(2 |g| H) (H: the particles' extent along g), which also covers what one body passes
+ * to another. A particle is past a limit L when it is faster than L and faster than it was
+ * at the frame's start by more than BLOW_G |g| dt (so that no fall, however long, is).
+ * A blow-up is
+ *   a particle past BLOW_K2 x scale + BLOW_F2 (no scene of the suite comes near), or
+ *   BLOW_RUN frames in a row with a particle past BLOW_K1 x scale + BLOW_F1 (a spring let
+ *   go, a whip does it for a frame or two; a body that blows up keeps doing it).
+ * From then on, every particle past the lower limit is slowed to it (its direction kept),
+ * and the first time the world warns, once. Energy a script gives by hand (a constraint
+ * made away from its rest, a particle moved into a strained shape, a setting changed) is let
+ * go first: nothing is judged during BLOW_GRACE seconds after such a change, and the speeds
+ * it reached count as given. Stored elastic energy is no source: the squeezed body that
+ * blows up holds more of it (C^2 / 2 alpha of links its solve cannot satisfy) than would
+ * explain any speed. Measured over every test and scripts/ scene run in full: nothing
+ * passes the upper limit, the lower one 2 frames in a row at most (logo_spring.lua's
+ * letters springing back, momentum.lua's whipping rope, volume.lua's squeezed block). */
+#define BLOW_K1 ((wb_real)3)
+#define BLOW_F1 ((wb_real)3)      /* m/s */
+#define BLOW_RUN 5
+#define BLOW_K2 ((wb_real)16)
+#define BLOW_F2 ((wb_real)20)     /* m/s */
+#define BLOW_G ((wb_real)3)
+#define BLOW_GRACE 0.5            /* s */
+
+static wb_real speed_scale(wb_world *w, wb_real dt)
+{
+    const wb_model *m = &w->m;
+    wb_cache *k = &w->k;
+    const int32_t np = m->np;
+    const wb_real *x = w->s.x;
+    wb_real lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+    for (int32_t i = 0; i < np; i++)
+        for (int c = 0; c < 3; c++) {
+            /* comparisons, not fmin / fmax (libm calls in the frame's hot path; a NaN is
+             * never in a finite frame's positions) */
+            const wb_real xc = x[3 * i + c];
+            lo[c] = xc < lo[c] ? xc : lo[c];
+            hi[c] = xc > hi[c] ? xc : hi[c];
+        }
+    wb_real s = k->bl_user;
+    /* a fall across the scene */
+    const wb_real g = v3_len(m->def.gravity);
+    if (g > 0 && np > 0) {
+        wb_real ext = 0;
+        for (int c = 0; c < 3; c++) ext += fabs(m->def.gravity[c]) / g * (hi[c] - lo[c]);
+        s = fmax(s, sqrt(2 * g * ext));
+    }
+    /* kinematic colliders: the move and turn over this frame, from the pose the step saved
+     * at its start */
+    for (int32_t c = 0; c < m->nc; c++) {
+        if (!(m->c_gen[c] & 1u) || np == 0) continue;
+        const wb_collider_pose *cp = &w->s.c_pose[c];
+        const wb_real *p0 = &k->c_save[7 * c], *q0 = &k->c_save[7 * c + 3];
+        wb_real d[3], reach = 0;
+        v3_sub(d, cp->p, p0);
+        for (int a = 0; a < 3; a++) {
+            const wb_real e = fmax(fabs(lo[a] - cp->p[a]), fabs(hi[a] - cp->p[a]));
+            reach += e * e;
+        }
+        const wb_real dot = fabs(q0[0] * cp->q[0] + q0[1] * cp->q[1] + q0[2] * cp->q[2] + q0[3] * cp->q[3]);
+        const wb_real turn = 2 * acos(dot < 1 ? dot : 1);
+        s = fmax(s, (v3_len(d) + turn * sqrt(reach)) / dt);
+    }
+    const wb_rigids *rb = w->rb;
+    for (int32_t i = 0; rb && i < rb->n; i++)
+        if (rb->gen[i] & 1u) s = fmax(s, v3_len(&rb->v[3 * i]) + v3_len(&rb->om[3 * i]) * rb->bound[i]);
+    const wb_grabs *gr = w->grab;
+    for (int32_t i = 0; gr && i < gr->n; i++) {
+        if (!(gr->gen[i] & 1u)) continue;
+        wb_real d[3];
+        v3_sub(d, &gr->target[3 * i], &gr->from[3 * i]);
+        s = fmax(s, v3_len(d) / dt);
+    }
+    /* pinned particles the script moves (between frames: against the last frame's end) */
+    if (k->bl_np == np)
+        for (int32_t i = 0; i < np; i++)
+            if (!(m->w[i] > 0)) {
+                wb_real d[3];
+                v3_sub(d, &x[3 * i], &k->bl_x[3 * i]);
+                s = fmax(s, v3_len(d) / dt);
+            }
+    return s;
+}
+
+/* did the script give the world energy by hand since the last frame (see above)? The
+ * frame's start positions are in k->x_save */
+static int given(wb_world *w)
+{
+    const wb_model *m = &w->m;
+    wb_cache *k = &w->k;
+    int g = !k->bl_have || k->mc_changed || k->bl_np != m->np || k->bl_wgen != m->w_gen ||
+            memcmp(&k->bl_def, &m->def, sizeof k->bl_def);
+    const wb_real *xs = k->x_save, *bx = k->bl_x;
+    for (int32_t i = 0; !g && i < m->np; i++)
+        g = m->w[i] > 0 &&
+            (xs[3 * i] != bx[3 * i] || xs[3 * i + 1] != bx[3 * i + 1] || xs[3 * i + 2] != bx[3 * i + 2]);
+    k->mc_changed = 0;
+    k->bl_wgen = m->w_gen;
+    k->bl_def = m->def;
+    return g;
+}
+
+/* after a finite frame: the blow-up check (above); the frame's start velocities are in
+ * k->v_save */
+static void check_speeds(wb_world *w)
+{
+    const wb_model *m = &w->m;
+    wb_cache *k = &w->k;
+    const int32_t np = m->np;
+    const wb_real dt = m->def.dt, g = v3_len(m->def.gravity), fall = BLOW_G * g * dt;
+    wb_real *v = w->s.v;
+    const wb_real *v0 = k->v_save;
+    /* the fastest particle at the frame's start; a speed from outside when faster than any
+     * the last frame ended with (a script's w:set_velocity, a new particle) */
+    wb_real s0 = 0, end = 0;
+    for (int32_t i = 0; i < np; i++) {
+        const wb_real q = v3_dot(&v0[3 * i], &v0[3 * i]);
+        s0 = q > s0 ? q : s0;
+    }
+    s0 = sqrt(s0);
+    if (!k->bl_have || s0 > k->bl_vend) k->bl_user = fmax(k->bl_user, s0);
+    /* (the time is the frame's start's: it advances after this) */
+    if (given(w)) k->bl_given = w->s.time;
+    if (w->s.time - k->bl_given < BLOW_GRACE - 0.5 * dt) {
+        /* what a change by hand sets free counts as given */
+        for (int32_t i = 0; i < np; i++) k->bl_user = fmax(k->bl_user, v3_len(&v[3 * i]));
+        k->bl_hot = 0;
+    } else {
+        const wb_real scale = speed_scale(w, dt), lo = BLOW_K1 * scale + BLOW_F1, hi = BLOW_K2 * scale + BLOW_F2;
+        int32_t worst = -1;
+        wb_real top = 0;
+        for (int32_t i = 0; i < np; i++) {
+            if (!(v3_dot(&v[3 * i], &v[3 * i]) > lo * lo)) continue; /* the common case, no root */
+            const wb_real s = v3_len(&v[3 * i]);
+            if (s > lo && s > v3_len(&v0[3 * i]) + fall && s > top) { top = s; worst = i; }
+        }
+        k->bl_hot = worst >= 0 ? k->bl_hot + 1 : 0;
+        if (worst >= 0 && (top > hi || k->bl_hot >= BLOW_RUN)) k->bl_armed = 1;
+        if (worst >= 0 && k->bl_armed) {
+            int32_t count = 0;
+            for (int32_t i = 0; i < np; i++) {
+                wb_real *vi = &v[3 * i];
+                const wb_real s = v3_len(vi);
+                if (s > lo && s > v3_len(&v0[3 * i]) + fall) {
+                    v3_scale(vi, vi, lo / s);
+                    count++;
+                }
+            }
+            if (!k->bl_warned) {
+                k->bl_warned = 1;
+                /* (one line of last_warning: what, where, what was done, what to do) */
+                wb__warn(w, "frame %lld: particle %d at %.3g m/s, the scene explains %.3g: a blow-up (constraints "
+                            "fighting?); %d past %.3g m/s slowed; raise iterations or compliance",
+                         (long long)w->s.frame + 1, worst + 1, top, scale, count, lo);
+            }
+        }
+    }
+    for (int32_t i = 0; i < np; i++) {
+        const wb_real q = v3_dot(&v[3 * i], &v[3 * i]);
+        end = q > end ? q : end;
+    }
+    end = sqrt(end);
+    k->bl_vend = end;
+    k->bl_have = 1;
+    wb_real *bx = wb__grow(k->bl_x, &k->cap_bl_x, 3 * (np > 0 ? np : 1), sizeof *bx);
+    if (bx) {
+        k->bl_x = bx;
+        if (np > 0) memcpy(bx, w->s.x, sizeof *bx * 3 * (size_t)np);
+        k->bl_np = np;
+    } else {
+        k->bl_np = -1;
+    }
+}
+
 wb_status wb_world_step(wb_world *w)
 {
     const double t_begin = now_ms();
     wb_cache *k = &w->k;
     wb_status prep = WB_OK;
+    wb__momentum_prepare(w); /* (first: the types' prepare clears the topology flag it reads) */
     for (int t = 0; t < wb__nctypes && prep == WB_OK; t++) prep = wb__ctypes[t]->prepare(w);
     if (prep != WB_OK || !save_colliders(w)) {
         wb__warn(w, "frame %lld: out of memory preparing the step; frame skipped", (long long)w->s.frame + 1);
@@ -206,6 +389,7 @@ wb_status wb_world_step(wb_world *w)
         /* TYPE HOOK: the constraint types, walked from the table (wb__ctypes) */
         for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->substep_begin(w);
         solve_constraints(w, h);
+        wb__momentum_restore(w, h);
         solve += now_ms() - t0;
         wb__contacts_project(w, h);
         wb__tricontacts_project(w, h);
@@ -223,10 +407,13 @@ wb_status wb_world_step(wb_world *w)
         wb__rigid_particles_velocity(w, h);
     }
 
-    /* a frame gone non-finite is undone before it can bend or break anything */
-    if (check_finite(w))
+    /* a frame gone non-finite is undone before it can bend or break anything; a blow-up is
+     * slowed (velocities only: plastic flow and breaking read positions) */
+    if (check_finite(w)) {
+        check_speeds(w);
         for (int t = 0; t < wb__nctypes; t++)
             if (wb__ctypes[t]->frame_end) wb__ctypes[t]->frame_end(w);
+    }
     for (int32_t c = 0; c < w->m.nc; c++) {
         wb_collider_pose *cp = &w->s.c_pose[c];
         v3_copy(cp->p0, cp->p);

@@ -41,11 +41,11 @@
 #define PD 12
 enum { PD_AD = 9, PD_AH = 10, PD_A = 11 };
 
-#define TET_BYTES (9 * sizeof(int32_t) + 28 * sizeof(wb_real))
+#define TET_BYTES (9 * sizeof(int32_t) + 30 * sizeof(wb_real))
 
 wb_tet_def wb_tet_default_def(void)
 {
-    wb_tet_def d = { 1e5, 0.3 };
+    wb_tet_def d = { 1e5, 0.3, 0, 0 };
     return d;
 }
 
@@ -54,6 +54,8 @@ const char *wb_tet_def_check(const wb_tet_def *d)
     /* the bound: 100x diamond's modulus; far past it mu V0 and the energy overflow */
     if (!(d->young > 0) || !(d->young <= 1e14)) return "young must be in (0, 1e14] (Pa)";
     if (!(d->poisson >= 0 && d->poisson < 0.5)) return "poisson must be in [0, 0.5)";
+    if (!(d->yield >= 0) || !isfinite(d->yield)) return "yield must be >= 0";
+    if (!(d->creep >= 0) || !isfinite(d->creep)) return "creep must be >= 0";
     return NULL;
 }
 
@@ -82,7 +84,8 @@ wb_status wb__tet_reserve(wb_world *w, int64_t extra)
         { (void **)&v->poisson, sizeof(wb_real) }, { (void **)&v->mu, sizeof(wb_real) },
         { (void **)&v->lam, sizeof(wb_real) }, { (void **)&v->ld, sizeof(wb_real) }, { (void **)&v->lh, sizeof(wb_real) },
         { (void **)&v->order, sizeof(int32_t) }, { (void **)&v->pk, 4 * sizeof(int32_t) },
-        { (void **)&v->pd, PD * sizeof(wb_real) },
+        { (void **)&v->pd, PD * sizeof(wb_real) }, { (void **)&v->yield, sizeof(wb_real) },
+        { (void **)&v->creep, sizeof(wb_real) },
     };
     if (WB_SOA_RESIZE(arr, cap) != WB_OK) return WB_ERR_NOMEM;
     v->cap = cap;
@@ -101,6 +104,18 @@ void wb__tet_put(wb_world *w, const int32_t p[4], const wb_real dminv[9], wb_rea
     v->poisson[i] = poisson;
     lame(young, poisson, &v->mu[i], &v->lam[i]);
     v->ld[i] = v->lh[i] = 0;
+    v->yield[i] = v->creep[i] = 0;
+}
+
+void wb__tet_plastic(wb_world *w, int32_t first, wb_real yield, wb_real creep)
+{
+    wb_neos *v = w->neo;
+    if (!v || !(yield > 0) || !(creep > 0)) return;
+    for (int32_t i = first < 0 ? 0 : first; i < v->n; i++) {
+        v->yield[i] = yield;
+        v->creep[i] = creep;
+    }
+    if (v->n > first) v->plastic = 1;
 }
 
 /* Dm^-1 (row-major) and the signed volume of the tet at x; false when flat */
@@ -165,6 +180,7 @@ int32_t wb_tet_add(wb_world *w, const int32_t p[4], const wb_tet_def *def)
     wb_status st = wb__tet_reserve(w, 1);
     if (st != WB_OK) return st;
     wb__tet_put(w, p, inv, fabs(vol), def->young, def->poisson);
+    wb__tet_plastic(w, w->neo->n - 1, def->yield, def->creep);
     return w->neo->n - 1;
 }
 
@@ -261,17 +277,18 @@ void wb_tet_material(const wb_world *w, int32_t i, wb_real *young, wb_real *pois
 wb_status wb_image_alloc_tets(wb_image *g, int32_t n)
 {
     void **a[] = { (void **)&g->tet_ijkl, (void **)&g->tet_dminv, (void **)&g->tet_v0, (void **)&g->tet_young,
-                   (void **)&g->tet_poisson };
-    const size_t el[] = { 4 * sizeof(int32_t), 9 * sizeof(wb_real), sizeof(wb_real), sizeof(wb_real), sizeof(wb_real) };
+                   (void **)&g->tet_poisson, (void **)&g->tet_plastic };
+    const size_t el[] = { 4 * sizeof(int32_t), 9 * sizeof(wb_real), sizeof(wb_real), sizeof(wb_real), sizeof(wb_real),
+                          2 * sizeof(wb_real) };
     bool ok = true;
-    for (int k = 0; k < 5; k++) {
+    for (int k = 0; k < 6; k++) {
         free(*a[k]);
         *a[k] = calloc(n > 0 ? (size_t)n : 1, el[k]);
         ok = ok && *a[k];
     }
     g->ntet = n;
     if (ok) return WB_OK;
-    for (int k = 0; k < 5; k++) { free(*a[k]); *a[k] = NULL; }
+    for (int k = 0; k < 6; k++) { free(*a[k]); *a[k] = NULL; }
     g->ntet = 0;
     return WB_ERR_NOMEM;
 }
@@ -287,6 +304,10 @@ wb_status wb__tet_image_of(const wb_world *w, wb_image *g)
     memcpy(g->tet_v0, v->v0, sizeof(wb_real) * (size_t)n);
     memcpy(g->tet_young, v->young, sizeof(wb_real) * (size_t)n);
     memcpy(g->tet_poisson, v->poisson, sizeof(wb_real) * (size_t)n);
+    for (int32_t i = 0; i < n; i++) {
+        g->tet_plastic[2 * i] = v->yield[i];
+        g->tet_plastic[2 * i + 1] = v->creep[i];
+    }
     return WB_OK;
 }
 
@@ -300,7 +321,7 @@ const char *wb__tet_image_check(const wb_image *g)
             for (int j = 0; j < k; j++)
                 if (p[j] == p[k]) return "a tet needs four distinct particles";
         }
-        const wb_tet_def d = { g->tet_young[i], g->tet_poisson[i] };
+        const wb_tet_def d = { g->tet_young[i], g->tet_poisson[i], g->tet_plastic[2 * i], g->tet_plastic[2 * i + 1] };
         const char *e = wb_tet_def_check(&d);
         if (e) return e;
         if (!(g->tet_v0[i] > 0) || !isfinite(g->tet_v0[i])) return "a tet's rest volume must be > 0";
@@ -327,6 +348,7 @@ void wb__tet_image_put(wb_world *w, const wb_image *g, int32_t shift)
         int32_t p[4];
         for (int k = 0; k < 4; k++) p[k] = g->tet_ijkl[4 * i + k] + shift;
         wb__tet_put(w, p, &g->tet_dminv[9 * i], g->tet_v0[i], g->tet_young[i], g->tet_poisson[i]);
+        wb__tet_plastic(w, w->neo->n - 1, g->tet_plastic[2 * i], g->tet_plastic[2 * i + 1]);
     }
 }
 
@@ -377,7 +399,7 @@ static wb_status tet_prepare(wb_world *w)
     /* colour batches when tets were added since (they are never removed) */
     wb_neos *nv = w->neo;
     if (nv->n != nv->bt.n) {
-        if (!wb__batches_build(&nv->bt, w->m.inv_mass, w->m.np, nv->ijkl, 4, nv->n, nv->order)) return WB_ERR_NOMEM;
+        if (!wb__batches_build(&nv->bt, &w->m, nv->ijkl, 4, nv->n, nv->order)) return WB_ERR_NOMEM;
         /* what a projection reads, copied in batch order: a batch streams through memory
          * (through the order array it jumped across the whole block, 10% slower) */
         for (int32_t j = 0; j < nv->n; j++) {
@@ -407,11 +429,110 @@ static wb_status tet_prepare(wb_world *w)
     return WB_OK;
 }
 
-/* a frame ending with many tets inside out is a solid that collapsed (too long a substep,
- * a crushing contact): said once per world, as it costs only a determinant per tet a frame */
+/* the eigenvalues d and eigenvectors (the columns of q, row-major) of the symmetric a:
+ * cyclic Jacobi rotations, a fixed order (the same bits everywhere) */
+static void eigen_sym3(const double a_in[9], double d[3], double q[9])
+{
+    double a[9];
+    memcpy(a, a_in, sizeof a);
+    for (int k = 0; k < 9; k++) q[k] = k % 4 == 0;
+    for (int sweep = 0; sweep < 32; sweep++) {
+        const double off = a[1] * a[1] + a[2] * a[2] + a[5] * a[5];
+        const double diag = a[0] * a[0] + a[4] * a[4] + a[8] * a[8];
+        if (!(off > 1e-30 * diag)) break;
+        static const int pairs[3][2] = { { 0, 1 }, { 0, 2 }, { 1, 2 } };
+        for (int t = 0; t < 3; t++) {
+            const int p = pairs[t][0], r = pairs[t][1];
+            const double apr = a[3 * p + r];
+            if (apr == 0) continue;
+            const double th = (a[3 * r + r] - a[3 * p + p]) / (2 * apr);
+            const double tn = (th >= 0 ? 1 : -1) / (fabs(th) + sqrt(th * th + 1));
+            const double c = 1 / sqrt(tn * tn + 1), sn = tn * c;
+            /* a <- J^T a J with J the rotation in the (p, r) plane; q <- q J */
+            for (int k = 0; k < 3; k++) {
+                const double akp = a[3 * k + p], akr = a[3 * k + r];
+                a[3 * k + p] = c * akp - sn * akr;
+                a[3 * k + r] = sn * akp + c * akr;
+            }
+            for (int k = 0; k < 3; k++) {
+                const double apk = a[3 * p + k], ark = a[3 * r + k];
+                a[3 * p + k] = c * apk - sn * ark;
+                a[3 * r + k] = sn * apk + c * ark;
+            }
+            for (int k = 0; k < 3; k++) {
+                const double qkp = q[3 * k + p], qkr = q[3 * k + r];
+                q[3 * k + p] = c * qkp - sn * qkr;
+                q[3 * k + r] = sn * qkp + c * qkr;
+            }
+        }
+    }
+    for (int k = 0; k < 3; k++) d[k] = a[4 * k];
+}
+
+/* Plastic flow, once per frame on the frame's final shape, the rule of the distance links
+ * (distance.c) in the tet's principal directions: with F = R S (S = sqrt(F^T F), principal
+ * stretches s_k), the strain is e = max |s_k - 1| (a link along a principal direction
+ * would have s_k - 1); past yield the rest shape moves towards the deformed one seen in the
+ * rest frame, Dm <- T Dm with T = I + f (S - I), f = min(1, creep dt) (e - yield) / e: so
+ * Dm^-1 <- Dm^-1 T^-1 and V0 <- V0 det T, and F becomes R S T^-1 (f = 1: R, at rest).
+ * Shape matching and volume constraints flow the same way, so a body whose links yield
+ * keeps one rest shape for all its constraints. An inverted tet (det F <= 0) is no shape to
+ * flow to and does not. */
+static void tet_flow(wb_world *w)
+{
+    wb_neos *v = w->neo;
+    const wb_real dt = w->m.def.dt;
+    int changed = 0;
+    for (int32_t j = 0; j < v->bt.n; j++) {
+        const int32_t i = v->order[j];
+        const wb_real y = v->yield[i];
+        if (!(y > 0) || !(v->creep[i] > 0)) continue;
+        wb_real F[9];
+        deformation(v, w->s.x, i, F);
+        if (!(det3(F) > 0)) continue;
+        double C[9], lam[3], Q[9], s[3], e = 0;
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++)
+                C[3 * r + c] = (double)F[r] * F[c] + (double)F[3 + r] * F[3 + c] + (double)F[6 + r] * F[6 + c];
+        eigen_sym3(C, lam, Q);
+        for (int k = 0; k < 3; k++) {
+            s[k] = sqrt(lam[k] > 0 ? lam[k] : 0);
+            if (fabs(s[k] - 1) > e) e = fabs(s[k] - 1);
+        }
+        if (!(e > y) || !isfinite(e)) continue;
+        const double rate = v->creep[i] * dt < 1 ? v->creep[i] * dt : 1, f = rate * (e - y) / e;
+        double t[3], Ti[9], vt = 1;
+        for (int k = 0; k < 3; k++) {
+            t[k] = 1 + f * (s[k] - 1); /* > 0: s_k >= 0 and f <= 1 */
+            vt *= t[k];
+        }
+        if (!(vt > 0)) continue;
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++)
+                Ti[3 * r + c] = Q[3 * r] * Q[3 * c] / t[0] + Q[3 * r + 1] * Q[3 * c + 1] / t[1] + Q[3 * r + 2] * Q[3 * c + 2] / t[2];
+        wb_real *dm = &v->dminv[9 * i], nd[9];
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++)
+                nd[3 * r + c] = (wb_real)(dm[3 * r] * Ti[c] + dm[3 * r + 1] * Ti[3 + c] + dm[3 * r + 2] * Ti[6 + c]);
+        const wb_real nv0 = (wb_real)(v->v0[i] * vt);
+        bool ok = nv0 > 0 && isfinite(nv0);
+        for (int k = 0; k < 9 && ok; k++) ok = isfinite(nd[k]);
+        if (!ok) continue;
+        memcpy(dm, nd, sizeof nd);
+        memcpy(&v->pd[PD * j], nd, sizeof nd); /* the packed copy the projection reads */
+        v->v0[i] = nv0;
+        changed = 1;
+    }
+    if (changed) v->pd_h = 0; /* the compliances 1/(mu V0 h^2), 1/(lam V0 h^2): anew */
+}
+
+/* plastic flow; then a frame ending with many tets inside out is a solid that collapsed
+ * (too long a substep, a crushing contact): said once per world, as it costs only a
+ * determinant per tet a frame */
 static void tet_frame_end(wb_world *w)
 {
     wb_neos *v = w->neo;
+    if (v && v->plastic) tet_flow(w);
     if (!v || v->n == 0 || v->inverted_warned) return;
     int32_t bad = 0;
     for (int32_t i = 0; i < v->n; i++) {

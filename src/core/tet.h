@@ -11,8 +11,11 @@
 typedef struct wb_neos {
     int32_t n, cap;
     int32_t *ijkl;         /* (n x 4) model: corners */
-    wb_real *dminv;        /* (n x 9) model: rest edge matrix inverse, row-major */
-    wb_real *v0;           /* (n) model: rest volume, m^3 (> 0) */
+    wb_real *dminv;        /* (n x 9) state: rest edge matrix inverse, row-major (plastic flow
+                              changes it) */
+    wb_real *v0;           /* (n) state: rest volume, m^3 (> 0), with Dm^-1 */
+    wb_real *yield, *creep; /* (n) model: plastic flow of the rest shape (tet.c); 0 none */
+    int plastic;           /* some tet has yield and creep > 0 */
     wb_real *young, *poisson; /* (n) model: as given */
     wb_real *mu, *lam;     /* (n) derived: Lamé parameters of the constraint form */
     wb_real *ld, *lh;      /* (n) cache: deviatoric, hydrostatic multipliers of the substep,
@@ -36,6 +39,9 @@ wb_status wb__tet_reserve(wb_world *w, int64_t extra);
 void wb__tet_put(wb_world *w, const int32_t p[4], const wb_real dminv[9], wb_real v0, wb_real young, wb_real poisson);
 /* append one at rest in its current shape; false (nothing added) when it is flat */
 bool wb__tet_put_current(wb_world *w, const int32_t p[4], wb_real young, wb_real poisson);
+/* plastic flow (yield, creep) for the tets from `first` on: a body's builder gives them
+ * its links' options */
+void wb__tet_plastic(wb_world *w, int32_t first, wb_real yield, wb_real creep);
 
 /* world.c's destroy (inline so that world.c and tet.c do not call each other) */
 static inline void wb__tet_free(wb_world *w)
@@ -43,7 +49,8 @@ static inline void wb__tet_free(wb_world *w)
     wb_neos *v = w->neo;
     if (!v) return;
     if (w->m.def.memory) w->m.def.memory->used -= v->charged;
-    void *a[] = { v->ijkl, v->dminv, v->v0, v->young, v->poisson, v->mu, v->lam, v->ld, v->lh, v->order, v->pk, v->pd };
+    void *a[] = { v->ijkl, v->dminv, v->v0, v->young, v->poisson, v->mu, v->lam, v->ld, v->lh, v->order, v->pk, v->pd,
+                  v->yield, v->creep };
     for (size_t i = 0; i < sizeof a / sizeof a[0]; i++) free(a[i]);
     free(v);
     w->neo = NULL;

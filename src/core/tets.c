@@ -147,7 +147,7 @@ wb_status wb_tet_body(wb_world *w, const wb_real *v, int32_t nv, const int32_t *
     if (!(d->volume_compliance >= 0) || !isfinite(d->volume_compliance)) return bad("volume_compliance must be >= 0", 0, 0);
     const bool neo = d->young != 0;
     if (neo) {
-        const wb_tet_def td = { d->young, d->poisson };
+        const wb_tet_def td = { d->young, d->poisson, 0, 0 };
         if ((e = wb_tet_def_check(&td))) { wb__set_error("%s", e); return WB_ERR_ARG; }
     }
     if (nv < 4 || nt < 1) return bad("a tet mesh needs at least 4 nodes and 1 tet (got %lld nodes, %lld tets)", nv, nt);
@@ -212,7 +212,7 @@ wb_status wb_tet_body(wb_world *w, const wb_real *v, int32_t nv, const int32_t *
     if (st == WB_OK) st = wb__surface_reserve(w, ntri);
     if (st == WB_OK) st = neo ? wb__tet_reserve(w, nt) : wb__volume_reserve(w, nt);
     if (st == WB_OK) {
-        const int32_t first = w->m.np;
+        const int32_t first = w->m.np, first_vol = wb_volume_count(w), first_tet = wb_tet_count(w);
         for (int32_t i = 0; i < nv; i++) {
             /* a node no tet uses (a stray one in a file) weighs as much as an average node */
             const wb_real mi = mass[i] > 0 ? mass[i] : d->mass / nv;
@@ -230,6 +230,9 @@ wb_status wb_tet_body(wb_world *w, const wb_real *v, int32_t nv, const int32_t *
         }
         for (int64_t i = 0; i < 3 * (int64_t)ntri; i++) tri[i] += first;
         wb_surface_add(w, tri, ntri);
+        /* the links' plastic flow for the tets too: one rest shape for the whole body */
+        wb__volume_plastic(w, first_vol, d->link.yield, d->link.creep);
+        wb__tet_plastic(w, first_tet, d->link.yield, d->link.creep);
         st = wb__body_finish(w, first, nv, out);
     }
     free(tet);

@@ -8,7 +8,8 @@
  * (its faces' area normals) to be pushed apart along. The corrections are mass-weighted:
  * sum_k m_k dx_k = dlambda sum_k grad_k V = 0, momentum is conserved.
  *
- * Model: the corners, compliance and signed rest volume (a step changes none of them).
+ * Model: the corners, compliance, yield and creep. State: the signed rest volume, which
+ * only plastic flow changes (once per frame, vol_frame_end).
  * Cache: the multipliers of the current substep (force readback) and the colour batches
  * (batch.h, four particles a constraint): Gauss-Seidel batch after batch, each batch in
  * parallel chunks, so the result is the same for any thread count. */
@@ -20,7 +21,7 @@
 #include "volume.h"
 
 
-#define VOLUME_BYTES (10 * sizeof(int32_t) + 5 * sizeof(wb_real))
+#define VOLUME_BYTES (10 * sizeof(int32_t) + 7 * sizeof(wb_real))
 
 wb_real wb_tet_signed_volume(const wb_real *a, const wb_real *b, const wb_real *c, const wb_real *d)
 {
@@ -34,7 +35,7 @@ wb_real wb_tet_signed_volume(const wb_real *a, const wb_real *b, const wb_real *
 
 wb_volume_def wb_volume_default_def(void)
 {
-    wb_volume_def d = { 0, false, 0 };
+    wb_volume_def d = { 0, false, 0, 0, 0 };
     return d;
 }
 
@@ -42,6 +43,8 @@ const char *wb_volume_def_check(const wb_volume_def *d)
 {
     if (!(d->compliance >= 0) || !isfinite(d->compliance)) return "compliance must be >= 0";
     if (d->has_rest && !isfinite(d->rest)) return "rest must be finite";
+    if (!(d->yield >= 0) || !isfinite(d->yield)) return "yield must be >= 0";
+    if (!(d->creep >= 0) || !isfinite(d->creep)) return "creep must be >= 0";
     return NULL;
 }
 
@@ -64,6 +67,7 @@ wb_status wb__volume_reserve(wb_world *w, int64_t extra)
     const wb_soa arr[] = {
         { (void **)&v->ijkl, 4 * sizeof(int32_t) }, { (void **)&v->alpha, sizeof(wb_real) },
         { (void **)&v->rest, sizeof(wb_real) }, { (void **)&v->lambda, sizeof(wb_real) },
+        { (void **)&v->yield, sizeof(wb_real) }, { (void **)&v->creep, sizeof(wb_real) },
         { (void **)&v->order, sizeof(int32_t) }, { (void **)&v->pos, sizeof(int32_t) },
         { (void **)&v->pk, 4 * sizeof(int32_t) }, { (void **)&v->pa, 2 * sizeof(wb_real) },
     };
@@ -81,7 +85,19 @@ void wb__volume_put(wb_world *w, const int32_t p[4], wb_real alpha, wb_real rest
     memcpy(&v->ijkl[4 * i], p, 4 * sizeof *p);
     v->alpha[i] = alpha;
     v->rest[i] = rest;
+    v->yield[i] = v->creep[i] = 0;
     v->lambda[i] = 0;
+}
+
+void wb__volume_plastic(wb_world *w, int32_t first, wb_real yield, wb_real creep)
+{
+    wb_volumes *v = w->vol;
+    if (!v || !(yield > 0) || !(creep > 0)) return;
+    for (int32_t i = first < 0 ? 0 : first; i < v->n; i++) {
+        v->yield[i] = yield;
+        v->creep[i] = creep;
+    }
+    if (v->n > first) v->plastic = 1;
 }
 
 int32_t wb_volume_add(wb_world *w, const int32_t p[4], const wb_volume_def *def)
@@ -103,6 +119,7 @@ int32_t wb_volume_add(wb_world *w, const int32_t p[4], const wb_volume_def *def)
     wb_status st = wb__volume_reserve(w, 1);
     if (st != WB_OK) return st;
     wb__volume_put(w, p, def->compliance, rest);
+    wb__volume_plastic(w, w->vol->n - 1, def->yield, def->creep);
     return w->vol->n - 1;
 }
 
@@ -156,7 +173,7 @@ static wb_status vol_prepare(wb_world *w)
 {
     wb_volumes *v = w->vol;
     if (!v || v->n == v->bt.n) return WB_OK;
-    if (!wb__batches_build(&v->bt, w->m.inv_mass, w->m.np, v->ijkl, 4, v->n, v->order)) return WB_ERR_NOMEM;
+    if (!wb__batches_build(&v->bt, &w->m, v->ijkl, 4, v->n, v->order)) return WB_ERR_NOMEM;
     /* what a projection reads, copied in batch order: a batch streams through memory */
     for (int32_t j = 0; j < v->n; j++) {
         const int32_t i = v->order[j];
@@ -233,11 +250,37 @@ static wb_real vol_energy(const wb_world *w)
     return e;
 }
 
+/* Plastic flow, once per frame on the frame's final shape, as a distance constraint's
+ * (distance.c): past |e| = |V - V0| / |V0| > yield the rest volume moves towards the
+ * volume by the part of the strain past yield, at min(1, creep dt) per frame. A body
+ * whose links flow but whose volumes kept the volume it was made with would fight its
+ * own links for ever once it yielded (its links' rest shape encloses another volume).
+ * A tet turned inside out is no shape to flow to: it does not flow. */
+static void vol_frame_end(wb_world *w)
+{
+    wb_volumes *v = w->vol;
+    if (!v || !v->plastic) return;
+    const wb_real dt = w->m.def.dt;
+    for (int32_t i = 0; i < v->n; i++) {
+        const wb_real y = v->yield[i], r = v->rest[i];
+        if (!(y > 0) || !(v->creep[i] > 0) || r == 0) continue;
+        const wb_real c = current(w, i);
+        if (!(c * r > 0) || !isfinite(c)) continue;
+        const wb_real a = fabs((c - r) / r);
+        if (!(a > y)) continue;
+        const wb_real rate = v->creep[i] * dt < 1 ? v->creep[i] * dt : 1;
+        const wb_real past = isinf(a) ? 1 : (a - y) / a;
+        v->rest[i] = r + rate * (c - r) * past;
+        /* the packed copy the projection reads (a constraint added since is packed anew) */
+        if (i < v->bt.n) v->pa[2 * v->pos[i] + 1] = v->rest[i];
+    }
+}
+
 static void vol_links(const wb_world *w, wb_link_fn fn, void *ud)
 {
     if (w->vol) wb__link_quads(w->vol->ijkl, w->vol->n, fn, ud);
 }
 
 const wb_ctype wb__volume_type = {
-    "volume", vol_count, vol_prepare, vol_substep_begin, vol_project, NULL, vol_energy, vol_links,
+    "volume", vol_count, vol_prepare, vol_substep_begin, vol_project, vol_frame_end, vol_energy, vol_links,
 };

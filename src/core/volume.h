@@ -12,7 +12,9 @@ typedef struct wb_volumes {
     int32_t n, cap;
     int32_t *ijkl;         /* (n x 4) model: corners */
     wb_real *alpha;        /* (n) model: compliance, m^3/Pa */
-    wb_real *rest;         /* (n) model: signed rest volume, m^3 */
+    wb_real *rest;         /* (n) state: signed rest volume, m^3 (plastic flow moves it) */
+    wb_real *yield, *creep; /* (n) model: plastic flow past |V - V0| / |V0| = yield, 1/s */
+    int plastic;           /* some constraint has yield and creep > 0 */
     wb_real *lambda;       /* (n) cache: multipliers of the current substep, by batch position */
     int32_t *order;        /* (n) cache: slots by colour batch (batch.h) */
     int32_t *pos;          /* (n) cache: the batch position of each slot (order's inverse) */
@@ -25,6 +27,9 @@ typedef struct wb_volumes {
 /* room for `extra` more, charged to the memory budget; after it wb__volume_put cannot fail */
 wb_status wb__volume_reserve(wb_world *w, int64_t extra);
 void wb__volume_put(wb_world *w, const int32_t p[4], wb_real alpha, wb_real rest);
+/* plastic flow (yield, creep as a distance's) for the constraints from `first` on: a body's
+ * builder gives them its links' */
+void wb__volume_plastic(wb_world *w, int32_t first, wb_real yield, wb_real creep);
 /* tets.c: a lattice cell's 6 tets (Kuhn), corner c at base + (c&1) sx + (c&2) sy + (c&4) sz:
  * volume constraints of compliance alpha, or Neo-Hookean tets (tet.h) when young > 0 */
 void wb__kuhn_tets(wb_world *w, int32_t base, int32_t sx, int32_t sy, int32_t sz, wb_real alpha,
@@ -40,6 +45,8 @@ static inline void wb__volume_free(wb_world *w)
     free(v->ijkl);
     free(v->alpha);
     free(v->rest);
+    free(v->yield);
+    free(v->creep);
     free(v->lambda);
     free(v->order);
     free(v->pos);

@@ -367,17 +367,18 @@ static int read_constraints(rd *r, const sections *s, const defaults *d, wb_imag
     return 0;
 }
 
-/* "volumes": [ {"particles": [a, b, c, d], "rest": V, "compliance": alpha}, ... ]: volume
- * constraints (the tet's signed volume kept at rest, default the particles' current one) */
+/* "volumes": [ {"particles": [a, b, c, d], "rest": V, "compliance": alpha, "yield": y,
+ * "creep": c}, ... ]: volume constraints (the tet's signed volume kept at rest, default the
+ * particles' current one; yield and creep: plastic flow of the rest volume, 0 by default) */
 static int read_volumes(rd *r, const cJSON *arr, const defaults *d, wb_image *g)
 {
-    static const char *const keys[] = { "particles", "rest", "compliance", NULL };
+    static const char *const keys[] = { "particles", "rest", "compliance", "yield", "creep", NULL };
     kp top = { NULL, "volumes", 0 };
     int32_t i = 0;
     (void)d;
     if (!arr) return 0;
     for (const cJSON *c = arr->child; c; c = c->next, i++) {
-        const cJSON *f[4];
+        const cJSON *f[6];
         kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
         if (jv_get_object(r, c, &p, keys, f)) return -1;
         if (!f[0]) return jv_missing(r, c, &p, "particles");
@@ -398,7 +399,10 @@ static int read_volumes(rd *r, const cJSON *arr, const defaults *d, wb_image *g)
         const wb_real *x = g->x;
         g->vol_rest[i] = wb_tet_signed_volume(&x[3 * ijkl[0]], &x[3 * ijkl[1]], &x[3 * ijkl[2]], &x[3 * ijkl[3]]);
         g->vol_alpha[i] = 0;
-        if (jv_opt_real(r, f[1], &p, "rest", &g->vol_rest[i]) || jv_opt_nonneg(r, f[2], &p, "compliance", &g->vol_alpha[i]))
+        g->vol_plastic[2 * i] = g->vol_plastic[2 * i + 1] = 0;
+        if (jv_opt_real(r, f[1], &p, "rest", &g->vol_rest[i]) || jv_opt_nonneg(r, f[2], &p, "compliance", &g->vol_alpha[i]) ||
+            jv_opt_nonneg(r, f[3], &p, "yield", &g->vol_plastic[2 * i]) ||
+            jv_opt_nonneg(r, f[4], &p, "creep", &g->vol_plastic[2 * i + 1]))
             return -1;
         if (!isfinite(g->vol_rest[i])) return jv_fail(r, f[0], 0, &pp, "the particles are too far apart (their volume overflows)");
     }

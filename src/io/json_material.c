@@ -127,19 +127,20 @@ int jm_read_pressures(rd *r, const cJSON *arr, wb_image *g)
 }
 
 /* "tets": [ {"particles": [a, b, c, d], "young": E, "poisson": nu, "rest_inverse": [9],
- * "rest_volume": V0}, ... ]: Neo-Hookean tets (core/tet.c). young is required, poisson
- * 0.3 by default; the rest state (Dm^-1 row-major and V0 > 0, both or neither; w:save
- * writes them so a reload has the same future) is the particles' shape by default. */
+ * "rest_volume": V0, "yield": y, "creep": c}, ... ]: Neo-Hookean tets (core/tet.c). young is
+ * required, poisson 0.3 by default; the rest state (Dm^-1 row-major and V0 > 0, both or
+ * neither; w:save writes them so a reload has the same future) is the particles' shape by
+ * default; yield and creep (plastic flow of the rest shape) 0. */
 int jm_read_tets(rd *r, const cJSON *arr, wb_image *g)
 {
-    static const char *const keys[] = { "particles", "young", "poisson", "rest_inverse", "rest_volume", NULL };
+    static const char *const keys[] = { "particles", "young", "poisson", "rest_inverse", "rest_volume", "yield", "creep", NULL };
     kp top = { NULL, "tets", 0 };
     int32_t n = 0, i = 0;
     if (!arr) return 0;
     if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
     if (wb_image_alloc_tets(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
     for (const cJSON *c = arr->child; c; c = c->next, i++) {
-        const cJSON *f[5];
+        const cJSON *f[8];
         kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
         if (jv_get_object(r, c, &p, keys, f)) return -1;
         if (!f[0]) return jv_missing(r, c, &p, "particles");
@@ -165,6 +166,10 @@ int jm_read_tets(rd *r, const cJSON *arr, wb_image *g)
         if (!(nu >= 0 && nu < 0.5)) return jv_fail(r, f[2], 0, &nq, "must be in [0, 0.5)");
         g->tet_young[i] = y;
         g->tet_poisson[i] = nu;
+        g->tet_plastic[2 * i] = g->tet_plastic[2 * i + 1] = 0;
+        if (jv_opt_nonneg(r, f[5], &p, "yield", &g->tet_plastic[2 * i]) ||
+            jv_opt_nonneg(r, f[6], &p, "creep", &g->tet_plastic[2 * i + 1]))
+            return -1;
         if (!f[3] != !f[4]) return jv_fail(r, c, 0, &p, "rest_inverse and rest_volume go together");
         if (f[3]) {
             kp vq = { &p, "rest_volume", 0 };

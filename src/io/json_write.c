@@ -156,6 +156,16 @@ static void write_constraints(out *o, const wb_image *g)
     fputs(first ? "],\n" : "\n  ],\n", f);
 }
 
+/* a volume's or a tet's plastic flow, only when it has one (files without stay as they were) */
+static void plastic(out *o, const wb_real yc[2])
+{
+    if (!(yc[0] > 0) && !(yc[1] > 0)) return;
+    fputs(", \"yield\": ", o->f);
+    num(o, yc[0]);
+    fputs(", \"creep\": ", o->f);
+    num(o, yc[1]);
+}
+
 /* "volumes" (only when there are any: a config without stays as it was) */
 static void write_volumes(out *o, const wb_image *g)
 {
@@ -168,6 +178,7 @@ static void write_volumes(out *o, const wb_image *g)
         num(o, g->vol_rest[i]);
         fputs(", \"compliance\": ", f);
         num(o, g->vol_alpha[i]);
+        plastic(o, &g->vol_plastic[2 * i]);
         fputc('}', f);
     }
     fputs("\n  ],\n", f);
@@ -189,6 +200,7 @@ static void write_tets(out *o, const wb_image *g)
         num(o, g->tet_v0[i]);
         fputs(", \"rest_inverse\": ", f);
         vec(o, &g->tet_dminv[9 * i], 9);
+        plastic(o, &g->tet_plastic[2 * i]);
         fputc('}', f);
     }
     fputs("\n  ],\n", f);

@@ -1,8 +1,8 @@
 /* volume.c: volume constraints and tetrahedral solids from scripts:
- *   w:volume(p1, p2, p3, p4, {compliance, rest}) -> index    w:volume_count()
+ *   w:volume(p1, p2, p3, p4, {compliance, rest, yield, creep}) -> index    w:volume_count()
  *   w:volume_info(i) -> volume, rest, pressure               w:total_volume() -> volume, rest
  *   w:load_tets(path, {...}) -> body (tetgen's .node/.ele)   w:save_tets(path [, body])
- *   w:tet(p1, p2, p3, p4, {young, poisson}) -> index (Neo-Hookean, core/tet.c)
+ *   w:tet(p1, p2, p3, p4, {young, poisson, yield, creep}) -> index (Neo-Hookean, core/tet.c)
  *   w:tet_count()   w:tet_info(i) -> det F, energy, rest volume
  * and the helpers of the tets branch of w:from_mesh (lua/mesh.c: tetgen run on the mesh).
  * Volume constraints are plain indices (1-based): they are never removed. */
@@ -15,7 +15,14 @@
 #include "util.h"
 #include "sandbox.h"
 
-static const char *const volume_keys[] = { "compliance", "rest", NULL };
+static const char *const volume_keys[] = { "compliance", "rest", "yield", "creep", NULL };
+
+/* yield and creep (plastic flow, as a distance's) of the options at arg 6 */
+static void read_plastic(lua_State *L, wb_real *yield, wb_real *creep)
+{
+    if (wbl_optreal(L, 6, "yield", yield) && !(*yield >= 0)) wbl_fielderror(L, 6, "yield", "must be >= 0");
+    if (wbl_optreal(L, 6, "creep", creep) && !(*creep >= 0)) wbl_fielderror(L, 6, "creep", "must be >= 0");
+}
 
 static int w_volume(lua_State *L)
 {
@@ -27,6 +34,7 @@ static int w_volume(lua_State *L)
         if (wbl_optreal(L, 6, "compliance", &d.compliance) && d.compliance < 0)
             return wbl_fielderror(L, 6, "compliance", "must be >= 0");
         d.has_rest = wbl_optreal(L, 6, "rest", &d.rest);
+        read_plastic(L, &d.yield, &d.creep);
     }
     const int32_t i = wb_volume_add(w, p, &d);
     /* the options were checked: an argument error is about the particles (one twice) */
@@ -70,9 +78,10 @@ static int w_total_volume(lua_State *L)
 }
 
 /* ---- Neo-Hookean tets ------------------------------------------------------------------------ */
-static const char *const tet_keys[] = { "young", "poisson", NULL };
+static const char *const tet_keys[] = { "young", "poisson", "yield", "creep", NULL };
 
-/* w:tet(p1, p2, p3, p4, {young = 1e5, poisson = 0.3}) -> index: rest shape = the current one */
+/* w:tet(p1, p2, p3, p4, {young = 1e5, poisson = 0.3, yield = 0, creep = 0}) -> index: rest
+ * shape = the current one */
 static int w_tet(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
@@ -83,6 +92,7 @@ static int w_tet(lua_State *L)
         if (wbl_optreal(L, 6, "young", &d.young) && !(d.young > 0)) return wbl_fielderror(L, 6, "young", "must be > 0 (Pa)");
         if (wbl_optreal(L, 6, "poisson", &d.poisson) && !(d.poisson >= 0 && d.poisson < 0.5))
             return wbl_fielderror(L, 6, "poisson", "must be in [0, 0.5)");
+        read_plastic(L, &d.yield, &d.creep);
     }
     const int32_t i = wb_tet_add(w, p, &d);
     if (i == WB_ERR_ARG) return luaL_argerror(L, 5, wb_last_error());

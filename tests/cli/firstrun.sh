@@ -101,7 +101,9 @@ test("the cloth rests on the sphere's top", function()
     local above = math.sqrt(x * x + (y - 0.5) ^ 2 + z * z) - 0.4
     if x * x + z * z < 0.2 ^ 2 and y > 0.5 and above < 0.05 then on_top = on_top + 1 end
   end
-  expect.gt(on_top, 10, "particles of the cloth lying on the sphere's top")
+  -- the cloth still swings at 3 s: 6 to 15 particles there at single frames of the last
+  -- second (mean 9.3 to 9.6 with either colouring order); one slid off leaves none
+  expect.gt(on_top, 5, "particles of the cloth lying on the sphere's top")
 end)
 LUA
 "$W" test "$TMP/drape.lua" --quiet --out "$TMP/drape-out" >"$TMP/out" 2>"$TMP/err"

@@ -128,10 +128,14 @@ test("target = N: a coarse graph by vertex clustering", function()
   expect.eq(w:from_mesh(m, { target = 10 ^ 6 }).count, m:vertex_count())
 end)
 
+-- (With 8 neighbours at 1e-5 m/N the sphere's poles, each held by 8 nearly flat links to
+-- its first ring, snapped through and back: 157 m/s after it landed, and it came to rest
+-- where it did by luck; 12 neighbours hold the poles, and at 1e-4 it lands calmly: 11 m/s
+-- at most, the impact's glitch.)
 test("a mesh body falls and lands on the ground", function()
   local w = wobble.world{ substeps = 20 }
   w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.5 }
-  local b = w:from_mesh(sphere(24, 12, 0.5, {0, 1.5, 0}), { compliance = 1e-5, neighbours = 8, radius = 0.02 })
+  local b = w:from_mesh(sphere(24, 12, 0.5, {0, 1.5, 0}), { compliance = 1e-4, neighbours = 12, radius = 0.02 })
   w:run{ seconds = 2 }
   local _, y0, _, _, y1 = w:bounds()
   expect.near(y0, 0.02, 0.01)

@@ -121,6 +121,7 @@
     X(builder_failure_changes_nothing)           \
     X(colour_batches_valid)                      \
     X(colour_broken_constraints_unpacked)        \
+    X(colour_mirror_images_alike)                \
     X(volume_tet_batches_valid)                  \
     X(volume_tet_threads_identical)              \
     X(bend_batches_valid)                        \
@@ -185,6 +186,8 @@
     X(tet_strain_volume_shape_and_shear)         \
     X(tet_simd_bit_identical_to_scalar)          \
     X(tet_threads_1_and_2_same_bits)             \
+    X(blowup_slowed_and_reported_once)           \
+    X(blowup_not_a_long_fall_nor_a_thrown_particle) \
     X(attach_grab_forces_cleared_by_an_undone_frame) \
     X(attach_grab_clone_same_future)             \
     X(attach_grab_ids_and_memory)                \

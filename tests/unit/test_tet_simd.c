@@ -59,7 +59,7 @@ static wb_world *scene(int threads)
                                    at[2] + r * sin(phi) + 0.03 * (k == 3) };
             p[k] = wb_particle_add(w, x, NULL, 0.01, 0.01);
         }
-        const wb_tet_def td = { 10, 0.3 };
+        const wb_tet_def td = { 10, 0.3, 0, 0 };
         if (wb_tet_add(w, p, &td) < 0) { wb_world_destroy(w); return NULL; }
         const wb_real *q = &wb_particle_positions(w)[3 * p[1]], s = 1 + 0.2 * sin(7 * t);
         const wb_real x[3] = { at[0] + (q[0] - at[0]) * s, at[1] + (q[1] - at[1]) * s, at[2] + (q[2] - at[2]) * s };
@@ -78,7 +78,7 @@ static wb_world *scene(int threads)
             }
             p[k] = wb_particle_add(w, x, NULL, 0.01 + rnd(), 0.01);
         }
-        wb_tet_def td = { 1e3 * pow(10, 5 * rnd()), 0.49 * rnd() };
+        wb_tet_def td = { 1e3 * pow(10, 5 * rnd()), 0.49 * rnd(), 0, 0 };
         if (t % 37 == 3) td.young = 1e-300; /* compliance / h^2 = inf */
         if (t % 41 == 5) td.young = 1e14;
         if (wb_tet_add(w, p, &td) < 0) { wb_world_destroy(w); return NULL; }

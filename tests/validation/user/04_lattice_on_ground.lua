@@ -46,9 +46,10 @@ test("a lattice made on the ground (from y = 0) is not launched and settles on i
   -- pushed out of the ground by at most its radius: the COM may rise by r (plus 5 mm);
   -- anything more is the block being thrown
   expect.le(top_com, y0 + r + 0.005, "COM rises at most by the contact radius")
-  -- README: an overlap is pushed out at no more than max_depenetration (0.25 m/s) for
-  -- particle pairs; a gentle settle of the ground's overlap should be no faster
-  expect.lt(max_up, 0.3, "COM never moves up faster than the depenetration speed")
+  -- README: an overlap is pushed out at no more than max_depenetration (0.25 m/s); the
+  -- bottom layer is driven up at that speed from rest, and an elastic body whose base is
+  -- driven at v overshoots it by at most v (undamped: its COM speed oscillates in [0, 2v])
+  expect.lt(max_up, 2 * 0.25, "COM never moves up faster than twice the depenetration speed")
   expect.lt(max_speed, 1.0, "no particle flung")
   -- resting: bottom layer r above the ground (within 1 cm of sag), at rest
   expect.near(miny, r, 0.01, "bottom layer rests r above the ground")
