@@ -45,18 +45,14 @@ local function block_case(tan_t)
   return along(w, b.particles, d) - s0, th
 end
 
--- (the lattice block held below tan theta = mu creeps at 1.6 cm/s today: a known defect,
--- tests/known_defects/slope_friction_block.lua, run apart until collider friction is fixed)
 for _, case in ipairs{ { "particle", particle_case }, { "lattice block", block_case } } do
   local name, f = case[1], case[2]
-  if name == "particle" then
   test(name .. " on a slope with tan(theta) = 0.4 < mu = 0.5 stays put", function()
     local moved = f(0.4)
     print(string.format("%s, tan 0.4: moved %.2e m downhill in 1 s", name, moved))
     -- static friction holds it exactly at position level: 1 mm allowed
     expect.lt(math.abs(moved), 1e-3, "no sliding below tan theta = mu")
   end)
-  end
   test(name .. " on a slope with tan(theta) = 0.7 > mu = 0.5 slides with g (sin - mu cos)", function()
     local moved, th = f(0.7)
     local a = g * (math.sin(th) - MU * math.cos(th))
