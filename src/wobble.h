@@ -316,6 +316,8 @@ typedef struct wb_stats {
     int32_t particle_contacts; /* particle pairs and particle-triangle pairs overlapping or in touch
                                   in the last substep */
     double broad_ms;          /* broad phase of the last step */
+    int32_t broad_remakes;    /* particle contact lists made again within the last step (a
+                                 particle moved farther than the list's reach allowed) */
     int64_t projections;      /* constraint projections in the last step, every type's (a
                                  shape-matching cluster or a pressure body counts one) */
     double step_ms;           /* wall time of the last step */

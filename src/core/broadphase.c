@@ -516,6 +516,13 @@ static int cmp_u64(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
+/* pairs (i, j) in (i, j) order */
+static int cmp_pair(const void *pa, const void *pb)
+{
+    const int32_t *a = pa, *b = pb;
+    return a[0] != b[0] ? (a[0] < b[0] ? -1 : 1) : (a[1] > b[1]) - (a[1] < b[1]);
+}
+
 static uint64_t pair_key(int32_t a, int32_t b)
 {
     return a < b ? (uint64_t)(uint32_t)a << 32 | (uint32_t)b : (uint64_t)(uint32_t)b << 32 | (uint32_t)a;
@@ -727,7 +734,7 @@ static int any_possible(const wb_model *m)
  * is how far it can get in that time (its velocity and gravity), plus a quarter of its
  * radius for what the constraints move it; kept in c->xf for the substeps' checks.
  * Returns the pairs, or -1 when out of memory */
-static int32_t make_list(wb_world *w, wb_real t)
+static int32_t make_list(wb_world *w, wb_real t, wb_real margin)
 {
     wb_model *m = &w->m;
     wb_contacts *c = &w->k.pc;
@@ -747,7 +754,7 @@ static int32_t make_list(wb_world *w, wb_real t)
         /* may_touch's rules: other bodies need `collide`, its own body `self_collide` */
         if (!((f & WB_CF_COLLIDE) || (gi > 0 && (f & WB_CF_SELF)))) { reach[i] = -1; continue; }
         const wb_real *p = &w->s.x[3 * i];
-        reach[i] = m->radius[i] * (wb_real)1.25 + v3_len_fast(&v[3 * i]) * t + g;
+        reach[i] = m->radius[i] * (1 + margin) + v3_len_fast(&v[3 * i]) * t + g;
         if (!isfinite(reach[i] + p[0] + p[1] + p[2])) reach[i] = -1;
         /* a body that does not collide with itself: its pairs are left out before the
          * distance test, and its inside is culled by its bounds */
@@ -771,6 +778,7 @@ void wb__contacts_begin(wb_world *w)
     c->broad_ms = 0;
     c->check = 0;
     c->sub = 0;
+    c->remakes_frame = 0;
     if (!m->def.contacts || m->np < 2) return;
     if (!wb__contact_rules(w)) {
         c->possible = 0; /* the triangles' broad phase asks the same rules */
@@ -784,7 +792,7 @@ void wb__contacts_begin(wb_world *w)
     }
     if (!c->possible) return;
     const double t0 = now_ms();
-    if (make_list(w, m->def.dt) < 0) {
+    if (make_list(w, m->def.dt, (wb_real)0.25) < 0) {
         c->n = 0;
         wb__warn(w, "out of memory in the contact broad phase; contacts skipped");
     }
@@ -797,6 +805,64 @@ void wb__contacts_begin(wb_world *w)
  * So each substep checks every particle against that, and one that moved farther (the
  * list would then be missing pairs) has the list made again from where the particles
  * are, for the rest of the frame. */
+/* a particle that moved too far, when only a few did: its reach made again from where it
+ * is, for the rest of the frame t, and its pairs looked for among every particle's
+ * frame bounds (a particle within its reach stays within reach_j - r_j of xf_j, so one it
+ * could touch is within reach_i + reach_j of it). The new pairs are merged into the
+ * list. Returns 0 when out of memory */
+#define REPAIR_MAX 64
+
+static int repair(wb_world *w, const int32_t *moved, int32_t nm, wb_real t, wb_real margin)
+{
+    wb_model *m = &w->m;
+    wb_contacts *c = &w->k.pc;
+    wb_real *xf = c->xf, *reach = c->reach;
+    const wb_real *x = w->s.x, *v = w->s.v, g = v3_len(m->def.gravity) * t * t;
+    for (int32_t k = 0; k < nm; k++) {
+        const int32_t i = moved[k];
+        const wb_real *p = &x[3 * i];
+        v3_copy(&xf[3 * i], p);
+        const wb_real r = m->radius[i] * (1 + margin) + v3_len_fast(&v[3 * i]) * t + g;
+        reach[i] = isfinite(r + p[0] + p[1] + p[2]) ? r : -1;
+    }
+    int32_t na = 0;
+    for (int32_t k = 0; k < nm; k++) {
+        const int32_t i = moved[k];
+        if (reach[i] < 0) continue;
+        const wb_real *p = &x[3 * i];
+        for (int32_t j = 0; j < m->np; j++) {
+            if (j == i || reach[j] < 0) continue;
+            const wb_real d0 = xf[3 * j] - p[0], d1 = xf[3 * j + 1] - p[1], d2 = xf[3 * j + 2] - p[2];
+            const wb_real R = reach[i] + reach[j];
+            if (!(d0 * d0 + d1 * d1 + d2 * d2 < R * R)) continue;
+            const int32_t a = i < j ? i : j, b = i < j ? j : i;
+            if (c->skip[a] != 0 && c->skip[a] == c->skip[b]) continue;
+            if (!may_touch(w, a, b)) continue;
+            if (!grow((void **)&c->add, &c->cap_add, 2 * ((int64_t)na + 1), sizeof *c->add)) return 0;
+            c->add[2 * na] = a;
+            c->add[2 * na + 1] = b;
+            na++;
+        }
+    }
+    if (na == 0) return 1;
+    qsort(c->add, (size_t)na, 2 * sizeof *c->add, cmp_pair);
+    /* the list and the new pairs merged, each pair once (the old list is in ij_old) */
+    if (!grow((void **)&c->ij, &c->cap, 2 * ((int64_t)c->n + na), sizeof *c->ij)) return 0;
+    const int32_t *A = c->ij_old, *B = c->add, nA = c->n_old;
+    int32_t p = 0, q = 0, o = 0;
+    while (p < nA || q < na) {
+        const int32_t *src;
+        if (q == na || (p < nA && cmp_pair(&A[2 * p], &B[2 * q]) <= 0)) src = &A[2 * p++];
+        else src = &B[2 * q++];
+        if (o > 0 && c->ij[2 * o - 2] == src[0] && c->ij[2 * o - 1] == src[1]) continue;
+        c->ij[2 * o] = src[0];
+        c->ij[2 * o + 1] = src[1];
+        o++;
+    }
+    c->n = o;
+    return 1;
+}
+
 int wb__contacts_recheck(wb_world *w, wb_real h)
 {
     wb_model *m = &w->m;
@@ -808,8 +874,7 @@ int wb__contacts_recheck(wb_world *w, wb_real h)
     for (int32_t i = 0; i < m->np; i++) {
         const wb_real e = reach[i] - rad[i];
         const wb_real d0 = x[3 * i] - xf[3 * i], d1 = x[3 * i + 1] - xf[3 * i + 1], d2 = x[3 * i + 2] - xf[3 * i + 2];
-        /* (a reach < 0 is no candidate; a position gone non-finite fails and is left out
-         * by the remade list) */
+        /* (a reach < 0 is no candidate; a position gone non-finite fails and is left out) */
         moved |= (reach[i] >= 0) & !(d0 * d0 + d1 * d1 + d2 * d2 <= e * e);
     }
     if (!moved) return 0;
@@ -820,10 +885,28 @@ int wb__contacts_recheck(wb_world *w, wb_real h)
     if (c->n > 0) memcpy(io, c->ij, sizeof *io * 2 * (size_t)c->n);
     c->n_old = c->n;
     c->remakes++;
-    /* what is left of the frame, this substep included */
-    const wb_real left = m->def.dt - (wb_real)sub * h;
+    c->remakes_frame++;
     const double t0 = now_ms();
-    const int32_t r = make_list(w, left > h ? left : h);
+    /* what is left of the frame, this substep included; the constraints moved some
+     * particle farther than its margin allowed: the rest of the frame allows twice as
+     * much each time, so a frame makes the list again a few times at most */
+    const wb_real left = m->def.dt - (wb_real)sub * h, t = left > h ? left : h;
+    const wb_real margin = (wb_real)0.25 * (wb_real)(1 << (c->remakes_frame < 4 ? c->remakes_frame : 4));
+    int32_t nm = 0, r;
+    int32_t *mv = wb__grow(c->fix, &c->cap_fix, REPAIR_MAX, sizeof *mv);
+    if (mv) {
+        c->fix = mv;
+        for (int32_t i = 0; i < m->np && nm <= REPAIR_MAX; i++) {
+            const wb_real e = reach[i] - rad[i];
+            const wb_real d0 = x[3 * i] - xf[3 * i], d1 = x[3 * i + 1] - xf[3 * i + 1], d2 = x[3 * i + 2] - xf[3 * i + 2];
+            if (reach[i] >= 0 && !(d0 * d0 + d1 * d1 + d2 * d2 <= e * e)) {
+                if (nm < REPAIR_MAX) mv[nm] = i;
+                nm++;
+            }
+        }
+    }
+    if (mv && nm <= REPAIR_MAX) r = repair(w, mv, nm, t, margin) ? c->n : -1;
+    else r = make_list(w, t, margin);
     c->broad_ms += now_ms() - t0;
     if (r < 0) { c->n = 0; c->check = 0; return -1; }
     return 1;

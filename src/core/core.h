@@ -218,7 +218,10 @@ typedef struct wb_contacts {
     int32_t *ij_old;       /* the list before a remake, and what each pair was left with */
     wb_real *left_old;
     int32_t cap_left_old;
-    int64_t remakes;       /* lists made again within a frame (stats) */
+    int64_t remakes;       /* lists made again within a frame (tests) */
+    int32_t remakes_frame; /* ... within this frame */
+    int32_t *fix, cap_fix; /* the particles that moved too far */
+    int32_t *add, cap_add; /* (2 x) their new pairs */
     int no_recheck;        /* tests: the list is not checked within the frame */
     int brute;             /* tests: each substep, every touching pair that may touch is looked
                               for in the list; missed counts those it lacks */
@@ -327,10 +330,10 @@ static inline void wb__broadphase_free(wb_contacts *c)
     free(c->skip);
     c->skip = NULL;
     c->cap_skip = 0;
-    free(c->xf); free(c->ij_old); free(c->left_old);
+    free(c->xf); free(c->ij_old); free(c->left_old); free(c->fix); free(c->add);
     c->xf = c->left_old = NULL;
-    c->ij_old = NULL;
-    c->cap_xf = c->cap_old = c->cap_left_old = 0;
+    c->ij_old = c->fix = c->add = NULL;
+    c->cap_xf = c->cap_old = c->cap_left_old = c->cap_fix = c->cap_add = 0;
     if (!b) return;
     free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key);
     free(b->runs); free(b->boxes); free(b->first);

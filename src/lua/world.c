@@ -450,6 +450,7 @@ static int w_stats(lua_State *L)
     SETI("rigids", s.rigids);
     SETI("rigid_contacts", s.rigid_contacts);
     SETN("broad_ms", s.broad_ms);
+    SETN("broad_remakes", s.broad_remakes);
     SETI("projections", s.projections);
     SETN("step_ms", s.step_ms);
     SETN("solve_ms", s.solve_ms);
