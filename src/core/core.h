@@ -222,6 +222,7 @@ typedef struct wb_contacts {
     int32_t remakes_frame; /* ... within this frame */
     int32_t *fix, cap_fix; /* the particles that moved too far */
     int32_t *add, cap_add; /* (2 x) their new pairs */
+    int32_t *fixed, cap_fixed, nfixed; /* the particles mended this frame */
     int no_recheck;        /* tests: the list is not checked within the frame */
     int brute;             /* tests: each substep, every touching pair that may touch is looked
                               for in the list; missed counts those it lacks */
@@ -236,9 +237,11 @@ typedef struct wb_contacts {
  * constraints and groups; 0 when out of memory. wb__joined: a constraint joins i and j */
 int wb__contact_rules(wb_world *w);
 int wb__joined(const wb_contacts *c, int32_t i, int32_t j);
-/* at a substep (the frame's sub-th, step h): 1 when some particle moved past what its
- * reach allowed and the list was made again for the rest of the frame (the old one in
- * ij_old, n_old), 0 when it holds, -1 when out of memory (the list is then empty).
+/* at a substep (the frame's sub-th, step h): 0 when the list holds; when some particle
+ * moved past what its reach allowed, 2 when its pairs were added to the list in place
+ * (with left NaN, and the rest of left moved along when the list had it), 1 when the
+ * list was made again for the rest of the frame (the old one in ij_old, n_old); -1 when
+ * out of memory (the list is then empty).
  * wb__contacts_brute: the tests' count of touching pairs the list lacks (brute) */
 int wb__contacts_recheck(wb_world *w, wb_real h);
 void wb__contacts_brute(wb_world *w);
@@ -323,6 +326,13 @@ struct wb_broad {
     int32_t *vskip; int32_t cap_vskip;
     wb_pairbuf list;
     int64_t rebuilds;                  /* for the tests */
+    /* the grid of the last search (cand, start, p, id), when it is the kept list's
+     * (lgrid): its shape, particles, whether they are all the candidates (none culled),
+     * and their largest reach */
+    int lgrid, lfull;
+    wb_grid lg;
+    int32_t lm;
+    wb_real lrmax;
 };
 static inline void wb__broadphase_free(wb_contacts *c)
 {
@@ -330,10 +340,10 @@ static inline void wb__broadphase_free(wb_contacts *c)
     free(c->skip);
     c->skip = NULL;
     c->cap_skip = 0;
-    free(c->xf); free(c->ij_old); free(c->left_old); free(c->fix); free(c->add);
+    free(c->xf); free(c->ij_old); free(c->left_old); free(c->fix); free(c->add); free(c->fixed);
     c->xf = c->left_old = NULL;
-    c->ij_old = c->fix = c->add = NULL;
-    c->cap_xf = c->cap_old = c->cap_left_old = c->cap_fix = c->cap_add = 0;
+    c->ij_old = c->fix = c->add = c->fixed = NULL;
+    c->cap_xf = c->cap_old = c->cap_left_old = c->cap_fix = c->cap_add = c->cap_fixed = 0;
     if (!b) return;
     free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key);
     free(b->runs); free(b->boxes); free(b->first);
