@@ -415,6 +415,8 @@ typedef struct wb_cache {
     int32_t *s_slot;       /* (ns) constraint slot of each packed entry */
     int32_t *slot_pack;    /* (nd) packed index of each slot, -1 when not packed */
     int any_damping;
+    int s_lambda_stale;    /* s_lambda is the last substep's: the next projection reads it as 0
+                              and writes every one (distance.c); force() reads 0 */
     int any_frame_end;     /* a packed distance constraint can break or flow (distance_frame_end) */
     uint32_t s_w_gen;      /* the m.w_gen s_wa, s_wc were copied at */
     wb_real *dx;           /* (np x 3) Jacobi accumulators */

@@ -438,7 +438,7 @@ wb_real wb_distance_force(const wb_world *w, wb_distance_id c)
 {
     int32_t s = SLOT(w, c);
     int32_t k = w->k.slot_pack[s];
-    if (k < 0 || k >= w->k.ns) return 0; /* not stepped since it was made */
+    if (k < 0 || k >= w->k.ns || w->k.s_lambda_stale) return 0; /* not stepped since it was made (or undone) */
     const wb_real h = w->k.h_last; /* of the step that made lambda, whatever dt is now */
     return fabs(w->k.s_lambda[k]) / (h * h);
 }
