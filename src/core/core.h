@@ -453,6 +453,8 @@ typedef struct wb_cache {
     int32_t *s_slot;       /* (ns) constraint slot of each packed entry */
     int32_t *slot_pack;    /* (nd) packed index of each slot, -1 when not packed */
     int any_damping;
+    int s_lambda_stale;    /* s_lambda is the last substep's: the next projection reads it as 0
+                              and writes every one (distance.c); force() reads 0 */
     int any_frame_end;     /* a packed distance constraint can break or flow (distance_frame_end) */
     uint32_t s_w_gen;      /* the m.w_gen s_wa, s_wc were copied at */
     wb_real *dx;           /* (np x 3) Jacobi accumulators */
@@ -487,12 +489,17 @@ typedef struct wb_cache {
     int32_t *mc_body;      /* (np) body of each particle, -1 none */
     int32_t *mc_root;      /* (bodies) first particle of each */
     double *mc_acc;        /* (bodies x 16) sums; [0] < 0: held from outside the solve */
-    int32_t cap_mc_body, cap_mc_root, cap_mc_acc, mc_nbody, mc_free;
+    uint8_t *mc_pinned;    /* (bodies) has an immovable particle, as of m.w_gen mc_wgen */
+    int32_t cap_mc_body, cap_mc_root, cap_mc_acc, cap_mc_pinned, mc_nbody, mc_free;
     int mc_built, mc_changed;
+    uint32_t mc_wgen;
     int64_t mc_sig[8];     /* what the bodies were found for (besides m.topology_dirty) */
     /* the blow-up check at a frame's end (solver.c) */
-    wb_real *bl_x;         /* (bl_np x 3) positions at the last frame's end: pinned ones' moves */
-    int32_t cap_bl_x, bl_np;
+    int32_t bl_np;         /* x_save holds the last frame's end (or its start: an undone frame)
+                              for this many particles */
+    wb_real bl_v0;         /* the fastest particle's squared speed at the frame's start */
+    wb_real bl_pin;        /* the farthest the script moved a pinned particle, squared, and */
+    int bl_moved;          /* whether it moved a movable one, since the last frame's check */
     wb_real bl_user;       /* the fastest speed given from outside (scripts, new particles) */
     wb_real bl_vend;       /* the fastest particle at the last frame's end */
     int bl_have;           /* bl_vend is known (a step ended since the world was made or loaded) */

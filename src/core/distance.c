@@ -147,7 +147,7 @@ static wb_status colour(wb_world *w)
 static inline __attribute__((always_inline)) void
 project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
               wb_real *out, int32_t b, int32_t e, wb_real h, wb_real inv_h2, wb_real omega,
-              const int damped, const int jacobi)
+              const int damped, const int jacobi, const int fresh)
 {
     const int32_t *restrict sa = k->s_a, *restrict sb = k->s_b;
     const wb_real *restrict rest = k->s_rest, *restrict alpha = k->s_alpha, *restrict beta = k->s_beta;
@@ -160,13 +160,14 @@ project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const w
         const wb_real d0 = xc[0] - xa[0], d1 = xc[1] - xa[1], d2 = xc[2] - xa[2];
         const wb_real len2 = d0 * d0 + d1 * d1 + d2 * d2;
         /* immovable pair, or coincident particles: nothing to push along */
-        if (wsum == 0 || len2 < (wb_real)1e-24) continue;
+        if (wsum == 0 || len2 < (wb_real)1e-24) { if (fresh) lambda[i] = 0; continue; }
         const wb_real at = alpha[i] * inv_h2;
         /* compliance/h^2 overflowed: the limit is a constraint with no stiffness (it would
          * otherwise give inf * 0 = NaN below and undo the frame) */
-        if (isinf(at)) continue;
+        if (isinf(at)) { if (fresh) lambda[i] = 0; continue; }
         const wb_real len = sqrt(len2);
-        wb_real num = rest[i] - len - at * lambda[i];
+        const wb_real lam = fresh ? 0 : lambda[i];
+        wb_real num = rest[i] - len - at * lam;
         wb_real den = wsum + at;
         if (damped) {
             /* gamma = alpha~ beta~ / h with beta~ = h^2 beta */
@@ -187,7 +188,7 @@ project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const w
         /* s = dlambda / len, so the correction is s * d without normalising d */
         wb_real s = num / (den * len);
         if (jacobi) s *= omega * jac[i];
-        lambda[i] += s * len;
+        lambda[i] = lam + s * len;
         if (wa > 0) {
             wb_real *oa = &out[3 * ia];
             const wb_real f = wa * s;
@@ -291,7 +292,7 @@ offsets(const uint32_t *a, const uint32_t *c, size_t oa[4], size_t oc[4])
 static inline __attribute__((always_inline, target("avx2"))) void
 project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
                wb_real *out, int32_t b, int32_t e, wb_real h, wb_real inv_h2, wb_real omega,
-               const int damped, const int jacobi)
+               const int damped, const int jacobi, const int fresh)
 {
     const uint32_t *restrict soa = k->s_oa, *restrict soc = k->s_oc;
     const wb_real *restrict swa = k->s_wa, *restrict swc = k->s_wc;
@@ -349,11 +350,14 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
         }
         /* 2: s and lambda */
         for (int g = 0; g < cn; g += 4) {
-            if (!go[g / 4]) continue;
+            if (!go[g / 4]) {
+                if (fresh) _mm256_storeu_pd(&lambda[c0 + g], zero);
+                continue;
+            }
             const int32_t j = c0 + g;
             const __m256d wsum = _mm256_add_pd(_mm256_loadu_pd(&swa[j]), _mm256_loadu_pd(&swc[j]));
             const __m256d at = _mm256_loadu_pd(&k->s_at[j]), len = _mm256_load_pd(&lv[g]);
-            const __m256d lam = _mm256_loadu_pd(&lambda[j]);
+            const __m256d lam = fresh ? zero : _mm256_loadu_pd(&lambda[j]);
             __m256d num = _mm256_sub_pd(_mm256_sub_pd(_mm256_loadu_pd(&k->s_rest[j]), len), _mm256_mul_pd(at, lam));
             __m256d den = _mm256_add_pd(wsum, at);
             if (damped) {
@@ -426,7 +430,7 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
         }
         i += cn;
     }
-    if (i < e) project_range(k, wv, x, xp, out, i, e, h, inv_h2, omega, damped, jacobi);
+    if (i < e) project_range(k, wv, x, xp, out, i, e, h, inv_h2, omega, damped, jacobi, fresh);
 }
 
 static __attribute__((target("avx2"))) void
@@ -434,13 +438,14 @@ project_distances_avx2(const wb_world *w, wb_real *dx, int32_t b, int32_t e, wb_
 {
     const wb_cache *k = &w->k;
     const wb_real *wv = w->m.w, *xp = w->s.x_prev, omega = w->m.def.relaxation;
+    const int fresh = k->s_lambda_stale;
     wb_real *x = w->s.x;
     if (dx) {
-        if (k->any_damping) project_range4(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1);
-        else project_range4(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1);
+        if (k->any_damping) project_range4(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1, fresh);
+        else project_range4(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1, fresh);
     } else {
-        if (k->any_damping) project_range4(k, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0);
-        else project_range4(k, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0);
+        if (k->any_damping) project_range4(k, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0, fresh);
+        else project_range4(k, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0, fresh);
     }
 }
 #endif
@@ -481,13 +486,14 @@ static void project_distances(const wb_world *w, wb_real *dx, int32_t b, int32_t
     }
 #endif
     const wb_real *wv = w->m.w, *xp = w->s.x_prev, omega = w->m.def.relaxation;
+    const int fresh = k->s_lambda_stale;
     wb_real *x = w->s.x;
     if (dx) {
-        if (k->any_damping) project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1);
-        else project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1);
+        if (k->any_damping) project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1, fresh);
+        else project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1, fresh);
     } else {
-        if (k->any_damping) project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0);
-        else project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0);
+        if (k->any_damping) project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0, fresh);
+        else project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0, fresh);
     }
 }
 
@@ -527,6 +533,7 @@ static void distance_project(wb_world *w, wb_real h)
     if (h != k->s_at_h) refresh_at(k, h);
     if (w->m.def.solver == WB_SOLVER_GAUSS_SEIDEL) {
         project_batches(w, NULL, h, inv_h2);
+        k->s_lambda_stale = 0;
         return;
     }
     /* Jacobi: every correction from the same positions, scaled per constraint
@@ -534,19 +541,17 @@ static void distance_project(wb_world *w, wb_real h)
     if (np == 0) return;
     memset(k->dx, 0, sizeof(wb_real) * 3 * (size_t)np);
     project_batches(w, k->dx, h, inv_h2);
+    k->s_lambda_stale = 0;
     const wb_real *wv = w->m.w;
     for (int32_t i = 0; i < np; i++)
         if (wv[i] > 0) v3_add(&w->s.x[3 * i], &w->s.x[3 * i], &k->dx[3 * i]);
 }
 
-/* (Not clearing lambda here but having the first iteration read it as 0 would save
- * the memset, 1% of cloth32's CPU time (6% of its callgrind instructions: rep stos
- * counts per byte), but force() and undo_particles also rely on the zeros this leaves:
- * not worth the bookkeeping.) */
-static void distance_substep_begin(wb_world *w)
-{
-    if (w->k.ns > 0) memset(w->k.s_lambda, 0, sizeof(wb_real) * (size_t)w->k.ns);
-}
+/* The multipliers start each substep at 0: the first projection reads them as 0 and
+ * writes every one, skipped constraints included (a memset of them all cost 2% of the
+ * 128 x 128 cloth's frame); until it has, force() reads 0 (an undone frame, no
+ * iterations) and distance_frame_end clears them. */
+static void distance_substep_begin(wb_world *w) { w->k.s_lambda_stale = 1; }
 
 static void report_break(wb_world *w, int32_t s)
 {
@@ -566,6 +571,10 @@ static void distance_frame_end(wb_world *w)
     wb_cache *k = &w->k;
     const wb_real dt = m->def.dt, inv_h2 = 1 / (k->h_last * k->h_last);
     if (!k->any_frame_end) return; /* nothing can break or flow: no walk over them all */
+    if (k->s_lambda_stale && k->ns > 0) { /* (no iterations: nothing projected) */
+        memset(k->s_lambda, 0, sizeof(wb_real) * (size_t)k->ns);
+        k->s_lambda_stale = 0;
+    }
     for (int32_t i = 0; i < k->ns; i++) {
         const int32_t s = k->s_slot[i];
         if (m->d_break[s] <= 0 && m->d_yield[s] <= 0 && m->d_bforce[s] <= 0) continue;

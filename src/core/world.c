@@ -164,7 +164,7 @@ void wb_world_destroy(wb_world *w)
                      w->sm.start, w->sm.stiff, w->sm.yield, w->sm.creep, w->sm.ids, w->sm.rest, w->sm.q,
                      w->sm.qk, w->sm.lambda, w->pr.surface, w->pr.pressure, w->pr.alpha, w->pr.v0, w->pr.vstart,
                      w->pr.tstart, w->pr.verts, w->pr.tri, w->pr.lambda, w->pr.grad,
-                     k->tc.pt, k->tc.act, k->tc.act_d, k->tc.left, k->mc_body, k->mc_root, k->mc_acc, k->bl_x };
+                     k->tc.pt, k->tc.act, k->tc.act_d, k->tc.left, k->mc_body, k->mc_root, k->mc_acc, k->mc_pinned };
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
     free(w);
 }
@@ -438,7 +438,7 @@ wb_real wb_distance_force(const wb_world *w, wb_distance_id c)
 {
     int32_t s = SLOT(w, c);
     int32_t k = w->k.slot_pack[s];
-    if (k < 0 || k >= w->k.ns) return 0; /* not stepped since it was made */
+    if (k < 0 || k >= w->k.ns || w->k.s_lambda_stale) return 0; /* not stepped since it was made (or undone) */
     const wb_real h = w->k.h_last; /* of the step that made lambda, whatever dt is now */
     return fabs(w->k.s_lambda[k]) / (h * h);
 }
