@@ -345,6 +345,16 @@ wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real
 {
     wb_real r[3], l[3], nl[3];
     v3_sub(r, x, p);
+    if (s->shape == WB_SHAPE_SPHERE) {
+        /* round: no turn into its frame and back (two quaternion rotations a contact) */
+        const wb_real len = v3_len(r);
+        if (len > 0) v3_scale(n, r, 1 / len);
+        else {
+            v3_set(nl, 0, 1, 0);
+            q_rotate(q, nl, n);
+        }
+        return len - s->radius;
+    }
     q_rotate_inv(q, r, l);
     wb_real dist;
     switch (s->shape) {

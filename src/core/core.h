@@ -490,7 +490,9 @@ typedef struct wb_cache {
     int32_t *mc_root;      /* (bodies) first particle of each */
     double *mc_acc;        /* (bodies x 16) sums; [0] < 0: held from outside the solve */
     uint8_t *mc_pinned;    /* (bodies) has an immovable particle, as of m.w_gen mc_wgen */
-    int32_t cap_mc_body, cap_mc_root, cap_mc_acc, cap_mc_pinned, mc_nbody, mc_free;
+    int32_t *mc_end;       /* (bodies) one past its last particle when its particles are
+                              consecutive (a builder's body), else -1 */
+    int32_t cap_mc_body, cap_mc_root, cap_mc_acc, cap_mc_pinned, cap_mc_end, mc_nbody, mc_free;
     int mc_built, mc_changed;
     uint32_t mc_wgen;
     int64_t mc_sig[8];     /* what the bodies were found for (besides m.topology_dirty) */

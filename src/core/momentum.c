@@ -129,9 +129,21 @@ static int build(wb_world *w)
         if (r == i) cnt[i] = cnt[i] >= 2 ? -1 - nb++ : 0;
         parent[i] = cnt[r] < 0 ? -1 - cnt[r] : -1;
     }
-    /* each body's first particle, the reference of its sums */
+    /* each body's first particle, the reference of its sums, and one past its last when
+     * they are consecutive (sizes counted in end first, then checked) */
     for (int32_t i = np - 1; i >= 0; i--)
         if (parent[i] >= 0) cnt[parent[i]] = i;
+    if (!grow((void **)&k->mc_end, &k->cap_mc_end, nb > 0 ? nb : 1, sizeof(int32_t))) return 0;
+    int32_t *end = k->mc_end;
+    for (int32_t b = 0; b < nb; b++) end[b] = 0;
+    for (int32_t i = 0; i < np; i++)
+        if (parent[i] >= 0) end[parent[i]]++;
+    /* consecutive: no particle past first + size (a body's first is its least) */
+    for (int32_t i = 0; i < np; i++) {
+        const int32_t b = parent[i];
+        if (b >= 0 && end[b] > 0 && i >= cnt[b] + end[b]) end[b] = -end[b];
+    }
+    for (int32_t b = 0; b < nb; b++) end[b] = end[b] > 0 ? cnt[b] + end[b] : -1;
     k->mc_nbody = nb;
     if (!grow((void **)&k->mc_acc, &k->cap_mc_acc, (int64_t)ACC * (nb > 0 ? nb : 1), sizeof(double))) return 0;
     if (!grow((void **)&k->mc_pinned, &k->cap_mc_pinned, nb > 0 ? nb : 1, 1)) return 0;
@@ -177,6 +189,58 @@ int wb__momentum_prepare(wb_world *w)
     return 1;
 }
 
+/* the sums of particles [i0, i1) of a body whose first particle is o into A (see ACC) */
+static inline void accumulate(double *restrict A, const wb_real *restrict x, const wb_real *restrict xp,
+                              const wb_real *restrict v, const wb_real *restrict wv, wb_real h, int32_t o,
+                              int32_t i0, int32_t i1)
+{
+    double s[ACC];
+    for (int c = 0; c < ACC; c++) s[c] = A[c];
+    const wb_real o0 = xp[3 * o] + h * v[3 * o], o1 = xp[3 * o + 1] + h * v[3 * o + 1],
+                  o2 = xp[3 * o + 2] + h * v[3 * o + 2];
+    const wb_real oc[3] = { o0, o1, o2 };
+    for (int32_t i = i0; i < i1; i++) {
+        const double m = 1 / wv[i];
+        double r[3], d[3];
+        for (int c = 0; c < 3; c++) {
+            /* x~ as the prediction made it (x_prev + h v, the same operations) */
+            const wb_real xt = xp[3 * i + c] + h * v[3 * i + c];
+            r[c] = (double)xt - (double)oc[c];
+            d[c] = (double)x[3 * i + c] - (double)xt;
+        }
+        s[0] += m;
+        for (int c = 0; c < 3; c++) s[1 + c] += m * r[c];
+        s[4] += m * (r[1] * d[2] - r[2] * d[1]);
+        s[5] += m * (r[2] * d[0] - r[0] * d[2]);
+        s[6] += m * (r[0] * d[1] - r[1] * d[0]);
+        for (int c = 0; c < 3; c++) s[7 + c] += m * d[c];
+        s[10] += m * r[0] * r[0];
+        s[11] += m * r[1] * r[1];
+        s[12] += m * r[2] * r[2];
+        s[13] += m * r[0] * r[1];
+        s[14] += m * r[0] * r[2];
+        s[15] += m * r[1] * r[2];
+    }
+    for (int c = 0; c < ACC; c++) A[c] = s[c];
+}
+
+/* particles [i0, i1) of a body whose first particle is o turned by -w about its centre
+ * (A: c in 1-3, w in 4-6) */
+static inline void turn(const double *restrict A, wb_real *restrict x, const wb_real *restrict xp,
+                        const wb_real *restrict v, wb_real h, int32_t o, int32_t i0, int32_t i1)
+{
+    const wb_real oc[3] = { xp[3 * o] + h * v[3 * o], xp[3 * o + 1] + h * v[3 * o + 1], xp[3 * o + 2] + h * v[3 * o + 2] };
+    const double c0 = A[1], c1 = A[2], c2 = A[3], w0 = A[4], w1 = A[5], w2 = A[6];
+    for (int32_t i = i0; i < i1; i++) {
+        const double r0 = (double)(xp[3 * i] + h * v[3 * i]) - (double)oc[0] - c0;
+        const double r1 = (double)(xp[3 * i + 1] + h * v[3 * i + 1]) - (double)oc[1] - c1;
+        const double r2 = (double)(xp[3 * i + 2] + h * v[3 * i + 2]) - (double)oc[2] - c2;
+        x[3 * i] -= (wb_real)(w1 * r2 - w2 * r1);
+        x[3 * i + 1] -= (wb_real)(w2 * r0 - w0 * r2);
+        x[3 * i + 2] -= (wb_real)(w0 * r1 - w1 * r0);
+    }
+}
+
 /* after the solve of a substep of length h: each free body's angular momentum back to
  * what it was before the solve (see the top of the file) */
 void wb__momentum_restore(wb_world *w, wb_real h)
@@ -209,31 +273,15 @@ void wb__momentum_restore(wb_world *w, wb_real h)
     if (w->rb)
         for (int32_t c = 0; c < w->rb->npct; c++)
             if (body[w->rb->pc[2 * c]] >= 0 && acc[ACC * body[w->rb->pc[2 * c]]] >= 0) acc[ACC * body[w->rb->pc[2 * c]]] = -2;
+    /* a body of consecutive particles (a builder's) summed in one run, in registers; the
+     * others particle by particle; either way in particle order, the same bits */
+    const int32_t *end = k->mc_end;
+    for (int32_t b = 0; b < k->mc_nbody; b++)
+        if (acc[ACC * b] >= 0 && end[b] >= 0) accumulate(&acc[ACC * b], x, xp, v, wv, h, root[b], root[b], end[b]);
     for (int32_t i = 0; i < np; i++) {
         const int32_t b = body[i];
-        if (b < 0 || acc[ACC * b] < 0) continue;
-        double *A = &acc[ACC * b];
-        const int32_t o = root[b];
-        const double m = 1 / wv[i];
-        double r[3], d[3];
-        for (int c = 0; c < 3; c++) {
-            /* x~ as the prediction made it (x_prev + h v, the same operations) */
-            const wb_real xt = xp[3 * i + c] + h * v[3 * i + c];
-            r[c] = (double)xt - (double)(xp[3 * o + c] + h * v[3 * o + c]);
-            d[c] = (double)x[3 * i + c] - (double)xt;
-        }
-        A[0] += m;
-        for (int c = 0; c < 3; c++) A[1 + c] += m * r[c];
-        A[4] += m * (r[1] * d[2] - r[2] * d[1]);
-        A[5] += m * (r[2] * d[0] - r[0] * d[2]);
-        A[6] += m * (r[0] * d[1] - r[1] * d[0]);
-        for (int c = 0; c < 3; c++) A[7 + c] += m * d[c];
-        A[10] += m * r[0] * r[0];
-        A[11] += m * r[1] * r[1];
-        A[12] += m * r[2] * r[2];
-        A[13] += m * r[0] * r[1];
-        A[14] += m * r[0] * r[2];
-        A[15] += m * r[1] * r[2];
+        if (b < 0 || acc[ACC * b] < 0 || end[b] >= 0) continue;
+        accumulate(&acc[ACC * b], x, xp, v, wv, h, root[b], i, i + 1);
     }
     /* per body: the centre c (relative to its root), w = I^-1 L about c, kept in A[1..6] */
     for (int32_t b = 0; b < k->mc_nbody; b++) {
@@ -264,19 +312,12 @@ void wb__momentum_restore(wb_world *w, wb_real h)
         A[1] = c[0]; A[2] = c[1]; A[3] = c[2];
         A[4] = om[0]; A[5] = om[1]; A[6] = om[2];
     }
+    for (int32_t b = 0; b < k->mc_nbody; b++)
+        if (acc[ACC * b] > 0 && end[b] >= 0) turn(&acc[ACC * b], x, xp, v, h, root[b], root[b], end[b]);
     for (int32_t i = 0; i < np; i++) {
         const int32_t b = body[i];
-        if (b < 0 || !(acc[ACC * b] > 0)) continue;
-        const double *A = &acc[ACC * b];
-        const int32_t o = root[b];
-        double r[3];
-        for (int c = 0; c < 3; c++) {
-            const wb_real xt = xp[3 * i + c] + h * v[3 * i + c];
-            r[c] = (double)xt - (double)(xp[3 * o + c] + h * v[3 * o + c]) - A[1 + c];
-        }
-        x[3 * i] -= (wb_real)(A[5] * r[2] - A[6] * r[1]);
-        x[3 * i + 1] -= (wb_real)(A[6] * r[0] - A[4] * r[2]);
-        x[3 * i + 2] -= (wb_real)(A[4] * r[1] - A[5] * r[0]);
+        if (b < 0 || !(acc[ACC * b] > 0) || end[b] >= 0) continue;
+        turn(&acc[ACC * b], x, xp, v, h, root[b], i, i + 1);
     }
     /* the bodies skipped for their contacts are judged again next substep */
     for (int32_t b = 0; b < k->mc_nbody; b++)

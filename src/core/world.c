@@ -164,7 +164,7 @@ void wb_world_destroy(wb_world *w)
                      w->sm.start, w->sm.stiff, w->sm.yield, w->sm.creep, w->sm.ids, w->sm.rest, w->sm.q,
                      w->sm.qk, w->sm.lambda, w->pr.surface, w->pr.pressure, w->pr.alpha, w->pr.v0, w->pr.vstart,
                      w->pr.tstart, w->pr.verts, w->pr.tri, w->pr.lambda, w->pr.grad,
-                     k->tc.pt, k->tc.act, k->tc.act_d, k->tc.left, k->mc_body, k->mc_root, k->mc_acc, k->mc_pinned };
+                     k->tc.pt, k->tc.act, k->tc.act_d, k->tc.left, k->mc_body, k->mc_root, k->mc_acc, k->mc_pinned, k->mc_end };
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
     free(w);
 }
