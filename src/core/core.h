@@ -449,6 +449,9 @@ typedef struct wb_cache {
     wb_real *s_at;         /* (ns) alpha / h^2 for h = s_at_h */
     uint32_t *s_oa, *s_oc; /* (ns) 3 a, 3 c: the ends' offsets in x */
     uint8_t *s_ok;         /* (ns) 1: wa > 0, wc > 0 and alpha / h^2 finite (no masked case) */
+    uint8_t *s_backed;     /* (ns) 1: both ends are corners of volume or tet constraints (a
+                              compressed link's lengthening is bounded: distance.c) */
+    int32_t s_backed_vt[2]; /* the volume and tet counts s_backed was worked out for */
     wb_real s_at_h;        /* the substep s_at and s_ok are for */
     int32_t *s_slot;       /* (ns) constraint slot of each packed entry */
     int32_t *slot_pack;    /* (nd) packed index of each slot, -1 when not packed */

@@ -43,6 +43,7 @@ typedef struct watchdog {
     pthread_mutex_t mu;               /* guards what follows but `expired` */
     pthread_cond_t cv;                /* CLOCK_MONOTONIC; wakes the thread for stop and pause */
     int stop;                         /* wb_rt_close: the thread ends */
+    int started;                      /* the thread is in its loop (watchdog_start waits for it) */
     int paused;                       /* the command line's own cleanup runs (wb_rt_pause_watchdog) */
     double resumed;                   /* the last end of a pause: the grace counts from it */
     double deadline, grace;
@@ -276,6 +277,8 @@ static struct timespec monotonic_at(double t) {
 static void *watchdog_main(void *arg) {
     watchdog *wd = arg;
     pthread_mutex_lock(&wd->mu);
+    wd->started = 1;
+    pthread_cond_broadcast(&wd->cv);
     while (!wd->stop) {
         double t = now(), wake = -1;  /* -1: until woken */
         if (!atomic_load(&wd->expired)) {
@@ -353,6 +356,15 @@ static void watchdog_start(rt_state *rt, lua_State *L) {
         }
         return;
     }
+    /* Back only once the thread waits in its loop: a thread still starting (its stack,
+     * its TLS, a sanitizer's bookkeeping) may hold an allocator lock, and a process that
+     * forks then (the mesh importer and tetgen run in forked children, without exec) gives
+     * the child that lock held for ever. Measured under make asan: 5 imports in 150, run
+     * at once after the start, hung in the child on ASan's allocator mutex; none since.
+     * Waiting, the thread touches no lock but its own mutex until the deadline. */
+    pthread_mutex_lock(&wd->mu);
+    while (!wd->started) pthread_cond_wait(&wd->cv, &wd->mu);
+    pthread_mutex_unlock(&wd->mu);
     wd->on = 1;
 }
 

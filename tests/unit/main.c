@@ -189,6 +189,7 @@
     X(tet_threads_1_and_2_same_bits)             \
     X(blowup_slowed_and_reported_once)           \
     X(blowup_not_a_long_fall_nor_a_thrown_particle) \
+    X(distance_compressed_link_regains_a_bounded_share) \
     X(attach_grab_forces_cleared_by_an_undone_frame) \
     X(attach_grab_clone_same_future)             \
     X(attach_grab_ids_and_memory)                \
