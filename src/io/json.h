@@ -33,6 +33,11 @@ typedef struct rd {
     size_t errn;
 } rd;
 
+/* json.c: realloc and free for everything a read allocates on its way (the text, cJSON's
+ * nodes, the positions), charged to the memory budget of the read under way, if any */
+void *jb_realloc(void *p, size_t n);
+void jb_free(void *p);
+
 /* positions: record every value of text (valid JSON) from s->p on, then number cJSON's
  * items in the same pre-order (their valueint holds the index) */
 void jv_sk_value(scan *s, int32_t key);

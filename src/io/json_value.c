@@ -34,7 +34,7 @@ void jv_sk_value(scan *s, int32_t key)
     sk_ws(s);
     if (s->n == s->cap) {
         int32_t cap = s->cap ? 2 * s->cap : 1024;
-        int32_t *v = realloc(s->voff, sizeof *v * (size_t)cap), *k = v ? realloc(s->koff, sizeof *k * (size_t)cap) : NULL;
+        int32_t *v = jb_realloc(s->voff, sizeof *v * (size_t)cap), *k = v ? jb_realloc(s->koff, sizeof *k * (size_t)cap) : NULL;
         if (v) s->voff = v;
         if (!v || !k) { s->oom = 1; return; }
         s->koff = k;
