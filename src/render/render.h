@@ -157,9 +157,18 @@ typedef struct wb_media_info {
 typedef struct wb_media_stop { int (*fn)(void *ud); void *ud; } wb_media_stop;
 bool wb_media_probe(const char *path, wb_media_info *info, const wb_media_stop *stop, char *err, size_t n);
 /* frame `index` (0 first) of a video decoded by ffmpeg: RGB8, top row first (malloc'd,
- * free()), NULL with a message. For tests that compare a file with what was drawn. */
+ * free()), NULL with a message. For tests that compare a file with what was drawn.
+ * *w x *h (> 0) is the size expected (wb_media_frame_size): a frame of another size is
+ * refused; 0 x 0: any size */
 uint8_t *wb_media_read_frame(const char *path, int64_t index, const wb_media_stop *stop, int *w, int *h, char *err,
                              size_t n);
+/* the frame size of a video (its first video stream) or PNG from its header, nothing
+ * decoded (ffprobe for a video); false with a message */
+bool wb_media_frame_size(const char *path, const wb_media_stop *stop, int *w, int *h, char *err, size_t n);
+/* about what wb_media_read_frame of a w x h frame takes at its peak, ffmpeg included;
+ * what ffprobe or ffmpeg alone takes decoding such frames (0 x 0: started, no frame) */
+size_t wb_media_frame_bytes(int w, int h);
+size_t wb_media_helper_bytes(int w, int h);
 
 /* start prog (found through PATH) with argv, its stdin, stdout and stderr the
  * descriptors fds[0..2] (-1: /dev/null) and no other descriptor of ours; SIGPIPE
