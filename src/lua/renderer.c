@@ -48,13 +48,14 @@ static void release(wbl_renderer *u, size_t *slot)
     *slot = 0;
 }
 
-/* finish the recording (the frames' memory is given back); false with the message */
+/* finish the recording (the frames' and the encoder's memory is given back); false with the message */
 static bool end_recording(wbl_renderer *u, char *err, size_t n)
 {
     wb_recorder *rec = u->rec;
     u->rec = NULL;
+    bool ok = wb_recorder_close(rec, err, n);   /* the encoder lives until it finishes the file */
     release(u, &u->rec_charged);
-    return wb_recorder_close(rec, err, n);
+    return ok;
 }
 
 static wbl_renderer *checkud(lua_State *L, int arg)
@@ -307,8 +308,12 @@ static int r_record(lua_State *L)
     const char *path = script_path(L, 2, 1, buf, sizeof buf);
     wb_media kind = wb_media_of(given, path, err, sizeof err);   /* the name decides, not where it leads */
     int w, h;
+    char what[96];
     wb_renderer_size(u->r, &w, &h);
-    charge(L, &u->rec_charged, wb_recorder_bytes(w, h), "recording");
+    /* the frames queued and, for a video, ffmpeg encoding them (hundreds of MB for large
+     * frames): a size whose encoder does not fit is refused before anything starts */
+    snprintf(what, sizeof what, "recording %dx%d frames%s", w, h, kind == WB_MEDIA_FOLDER ? "" : " (ffmpeg included)");
+    charge(L, &u->rec_charged, wb_recorder_bytes(kind, w, h), what);
     u->rec = wb_recorder_open(path, kind, w, h, err, sizeof err);
     if (!u->rec) {
         release(u, &u->rec_charged);
@@ -638,10 +643,11 @@ bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n)
     wbl_renderer *u = checkud(L, -1);
     int w, h;
     wb_renderer_size(u->r, &w, &h);
-    size_t bytes = wb_recorder_bytes(w, h);
+    size_t bytes = wb_recorder_bytes(kind, w, h);
     if (over_budget(u->mem, bytes)) {
-        snprintf(err, n, "--record: the frames need about %.0f MB, over the memory budget of %.0f MB (--memory-limit MB)",
-                 bytes / 1048576.0, u->mem->limit / 1048576.0);
+        snprintf(err, n, "--record: the frames%s need about %.0f MB, over the memory budget of %.0f MB (--memory-limit MB)",
+                 kind == WB_MEDIA_FOLDER ? "" : " and ffmpeg encoding them", bytes / 1048576.0,
+                 u->mem->limit / 1048576.0);
         lua_settop(L, top);
         return false;
     }

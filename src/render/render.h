@@ -130,8 +130,10 @@ wb_media wb_media_of(const char *given, const char *path, char *err, size_t n);
  * the encoder starts with the first frame. A file made here is removed again when no
  * frame comes; a file that was there is never removed. */
 wb_recorder *wb_recorder_open(const char *path, wb_media kind, int w, int h, char *err, size_t n);
-/* about how many bytes a recording of w x h frames holds (the queued frames) */
-size_t wb_recorder_bytes(int w, int h);
+/* about how many bytes a recording of w x h frames holds: the queued frames and, for a
+ * video, the ffmpeg encoding it (its peak resident memory, measured; its thread count is
+ * fixed, at most 4, so that this holds on any machine) */
+size_t wb_recorder_bytes(wb_media kind, int w, int h);
 /* frames per second of the file; settable until the first frame (default 60) */
 void wb_recorder_set_fps(wb_recorder *rec, double fps);
 bool wb_recorder_started(const wb_recorder *rec);
