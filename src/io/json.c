@@ -12,7 +12,6 @@
  * file is read and checked into a wb_image before anything is built. */
 #include <ctype.h>
 #include <errno.h>
-#include <malloc.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -773,52 +772,17 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
     return e ? jv_fail(r, root, 0, NULL, "%s", e) : 0;
 }
 
-/* ---- the memory budget of a read ---------------------------------------------------------------- */
-/* a read under a budget: what its transient allocations hold (chunks, malloc's header
- * included), and whether one was refused */
-typedef struct jbudget { wb_memory *mem; size_t held; bool over; } jbudget;
-static _Thread_local jbudget *jb;
-
-static size_t chunk(void *p) { return p ? malloc_usable_size(p) + sizeof(size_t) : 0; }
-
-void *jb_realloc(void *p, size_t n)
-{
-    if (!jb || !jb->mem) return realloc(p, n);
-    wb_memory *m = jb->mem;
-    const size_t had = chunk(p), need = n + 2 * sizeof(size_t);
-    if (m->limit && (need > m->limit || m->used - had > m->limit - need)) {
-        jb->over = true;
-        return NULL;
-    }
-    void *q = realloc(p, n);
-    if (!q) return NULL;
-    m->used = m->used - had + chunk(q);
-    jb->held = jb->held - had + chunk(q);
-    return q;
-}
-
-void jb_free(void *p)
-{
-    if (jb && jb->mem && p) {
-        jb->mem->used -= chunk(p);
-        jb->held -= chunk(p);
-    }
-    free(p);
-}
-
-static void *jb_malloc(size_t n) { return jb_realloc(NULL, n); }
-
 /* the image read from a tree is at most a third of it: a number is an 80-byte node of
  * the tree and at most 8 bytes of an array, an entry (a particle, a link) has a node of
  * its own and adds at most 30 bytes of flags and generations. Charged before the arrays
  * are made, kept with the config; 0 when it does not fit */
 static int reserve_image(wbio_config *cfg)
 {
-    if (!jb || !jb->mem) return 1;
-    wb_memory *m = jb->mem;
-    const size_t r = jb->held / 3;
+    if (!jv_budget || !jv_budget->mem) return 1;
+    wb_memory *m = jv_budget->mem;
+    const size_t r = jv_budget->held / 3;
     if (m->limit && (r > m->limit || m->used > m->limit - r)) {
-        jb->over = true;
+        jv_budget->over = true;
         return 0;
     }
     m->used += r;
@@ -950,11 +914,11 @@ int wbio_read_config_within(const char *path, const char *shown, wbio_config *cf
                             char *err, size_t errn)
 {
     jbudget b = { mem, 0, false };
-    jbudget *outer = jb;
+    jbudget *outer = jv_budget;
     const size_t left = mem && mem->used < mem->limit ? mem->limit - mem->used : 0;
-    jb = &b;
+    jv_budget = &b;
     int rc = wbio_read_config(path, shown, cfg, err, errn);
-    jb = outer;
+    jv_budget = outer;
     *over = b.over;
     if (rc && b.over)   /* cJSON says "syntax error" where its allocation was refused */
         snprintf(err, errn, "%s: reading it needs more than the %.0f MB left of the memory budget of %.0f MB", shown,

@@ -33,9 +33,14 @@ typedef struct rd {
     size_t errn;
 } rd;
 
-/* json.c: realloc and free for everything a read allocates on its way (the text, cJSON's
- * nodes, the positions), charged to the memory budget of the read under way, if any */
+/* the memory budget of the read under way (json.c sets it; NULL: none): what its
+ * transient allocations hold (chunks, malloc's header included), and whether one was
+ * refused. realloc, malloc and free for everything a read allocates on its way (the
+ * text, cJSON's nodes, the positions), charged to it */
+typedef struct jbudget { wb_memory *mem; size_t held; bool over; } jbudget;
+extern _Thread_local jbudget *jv_budget;
 void *jb_realloc(void *p, size_t n);
+void *jb_malloc(size_t n);
 void jb_free(void *p);
 
 /* positions: record every value of text (valid JSON) from s->p on, then number cJSON's

@@ -77,7 +77,7 @@ bcheck "a finalizer at exit that swallows its refused allocations for ever: ende
 
 # ---- a refusal caught by pcall spends the budget for good
 run pcall_rep.lua
-bcheck "pcall(string.rep, 'y', 3e8) in a loop" err "pcall_rep.lua:3: $EXCEEDED"
+bcheck "pcall(string.rep, 'y', 3e8) a million times" err "pcall_rep.lua:4: $EXCEEDED" !out "should not get here"
 
 # ---- worlds and their threads live outside the Lua heap
 run worlds.lua
