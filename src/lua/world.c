@@ -62,7 +62,8 @@ int wbl_world_new(lua_State *L)
     ud->warned = 0;
     luaL_setmetatable(L, WBL_WORLD);
     ud->w = wb_world_create(&d);
-    if (!ud->w) return wb_rt_budget_error(L, "out of memory creating a world");
+    /* the world itself and its worker threads are charged too (hundreds of bytes; 32 kB a thread) */
+    if (!ud->w) return wbl_status_error(L, 1, WB_ERR_NOMEM, "creating a world");
     return 1;
 }
 

@@ -174,6 +174,7 @@
     X(collider_absurd_velocity_recovers)         \
     X(hash_covers_collider_velocity_mass_radius) \
     X(memory_budget_shared_by_worlds)           \
+    X(memory_budget_charges_worlds_and_threads) \
     X(memory_budget_charges_tets_and_volumes)   \
     X(distance_ids_match_distance_at)            \
     X(bvh_point_triangle_projection)             \
