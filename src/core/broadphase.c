@@ -855,6 +855,9 @@ static int grid_pairs(wb_world *w, const wb_broad *b, int32_t i, wb_real e, int3
     if (!(e * G->inv <= 8)) return 0;
     int64_t rx[4], ry[4], rz[4];
     const int kx = axis_ranges(G, 0, p[0], e, rx), ky = axis_ranges(G, 1, p[1], e, ry), kz = axis_ranges(G, 2, p[2], e, rz);
+    /* a particle past the grid's far side (it moved out of the box the grid was made
+     * for): an axis's range is empty there, and no grid particle is near it that way */
+    if (rx[0] > rx[1] || ry[0] > ry[1] || rz[0] > rz[1]) return 1;
     for (int az = 0; az < kz; az++)
         for (int64_t z = rz[2 * az]; z <= rz[2 * az + 1]; z++)
             for (int ay = 0; ay < ky; ay++)
