@@ -254,7 +254,7 @@ static wb_status bend_prepare(wb_world *w)
     uint8_t *colour = malloc((size_t)(b->n > 0 ? b->n : 1));
     int32_t count[WB_MAX_COLOURS + 1], start[WB_MAX_COLOURS + 1];
     if (!colour || !pack_alloc(b, b->n) ||
-        !wb__colour_greedy(&w->m, b->ij, 4, b->n, always, NULL, colour, count)) {
+        !wb__colour_greedy(&w->m, b->ij, 4, b->n, always, NULL, colour, count, NULL)) {
         free(colour);
         return WB_ERR_NOMEM;
     }

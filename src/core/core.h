@@ -439,6 +439,10 @@ typedef struct wb_cache {
     int32_t ncolours;
     int32_t *colour_start; /* (ncolours + 1) batch ranges */
     int32_t serial_start;  /* batches from here on are projected serially (overflow colours) */
+    int32_t split_start;   /* the compounds (colour.c's split) fill [split_start, ns) */
+    int32_t ncomp;
+    int32_t *comp_start;   /* (ncomp + 1) compound bounds in packed order, then s_nsp */
+    int32_t *s_nsp;        /* (2 (ns - split_start)) members of its compound at each end */
     int32_t *s_a, *s_b;    /* (ns) particles */
     wb_real *s_rest, *s_alpha, *s_beta; /* (ns) */
     wb_real *s_lambda;     /* (ns) multipliers of the current substep */
@@ -544,9 +548,20 @@ void wb__momentum_restore(wb_world *w, wb_real h);
  * get WB_NO_COLOUR, the others a colour in [0, WB_MAX_COLOURS] (WB_MAX_COLOURS: the serial
  * overflow batch), counted in count. 0 when out of memory */
 #define WB_NO_COLOUR 255
+/* With split (not NULL, mirror keys on): the groups of mirror images that share a movable
+ * particle (links meeting on a mirror plane), which no colouring can keep alike, are not
+ * coloured (WB_SPLIT_COLOUR, not counted) but returned as compounds: each a set of images
+ * joined through shared particles, to be projected together from the same positions
+ * (distance.c). split->member (n slots) gets them compound by compound in visiting order,
+ * split->comp_start (n + 1 slots) the ncomp + 1 compound bounds into member. */
+#define WB_SPLIT_COLOUR 254
+typedef struct wb_split {
+    int32_t n, first, ncomp; /* members, coloured constraints (visit_order's), compounds */
+    int32_t *member, *comp_start;
+} wb_split;
 int wb__colour_greedy(const wb_model *m, const int32_t *idx, int k, int32_t n,
                       int (*live)(const void *ud, int32_t i), const void *ud, uint8_t *colour,
-                      int32_t count[WB_MAX_COLOURS + 1]);
+                      int32_t count[WB_MAX_COLOURS + 1], wb_split *split);
 /* colour.c, tests: on = 0 colours in creation order (as before mirror keys), 1 with mirror
  * keys (the default) from the next colouring on; returns the previous setting. Not
  * thread-safe: call it between steps */

@@ -102,15 +102,20 @@ static wb_status colour(wb_world *w)
 
     uint8_t *colour = malloc((size_t)(m->nd > 0 ? m->nd : 1));
     int32_t count[WB_MAX_COLOURS + 1];
-    if (!colour ||
+    wb_split split = { 0, 0, 0, malloc(sizeof(int32_t) * (size_t)(m->nd > 0 ? m->nd : 1)),
+                       malloc(sizeof(int32_t) * ((size_t)m->nd + 1)) };
+    if (!colour || !split.member || !split.comp_start ||
         !realloc_n((void **)&k->s_a, ns, sizeof(int32_t)) || !realloc_n((void **)&k->s_b, ns, sizeof(int32_t)) ||
         !realloc_n((void **)&k->s_rest, ns, sizeof(wb_real)) || !realloc_n((void **)&k->s_alpha, ns, sizeof(wb_real)) ||
         !realloc_n((void **)&k->s_beta, ns, sizeof(wb_real)) || !realloc_n((void **)&k->s_lambda, ns, sizeof(wb_real)) ||
         !realloc_n((void **)&k->s_jac, ns, 4 * sizeof(wb_real)) ||
         !realloc_n((void **)&k->s_slot, ns, 3 * sizeof(int32_t) + 2) ||
         !realloc_n((void **)&k->colour_start, WB_MAX_COLOURS + 2, sizeof(int32_t)) ||
-        !wb__colour_greedy(m, m->d_ij, 2, m->nd, packable, w, colour, count)) {
+        !wb__colour_greedy(m, m->d_ij, 2, m->nd, packable, w, colour, count, &split) ||
+        !realloc_n((void **)&k->comp_start, split.ncomp + 1 + 2 * split.n, sizeof(int32_t))) {
         free(colour);
+        free(split.member);
+        free(split.comp_start);
         return WB_ERR_NOMEM;
     }
     k->s_wa = k->s_jac + ns;
@@ -122,13 +127,18 @@ static wb_status colour(wb_world *w)
     k->s_backed = k->s_ok + ns;
     k->s_at_h = NAN; /* none yet: h != NaN */
     int32_t start[WB_MAX_COLOURS + 1];
-    k->ns = wb__colour_ranges(count, k->colour_start, &k->ncolours, &k->serial_start, start);
+    /* the batches, then the compounds (colour.c) in their order */
+    k->split_start = wb__colour_ranges(count, k->colour_start, &k->ncolours, &k->serial_start, start);
+    k->ns = k->split_start + split.n;
+    k->ncomp = split.ncomp;
+    for (int32_t c = 0; c <= split.ncomp; c++) k->comp_start[c] = k->split_start + split.comp_start[c];
+    for (int32_t j = 0; j < split.n; j++) k->slot_pack[split.member[j]] = k->split_start + j;
     k->any_damping = 0;
     k->any_frame_end = 0;
     for (int32_t i = 0; i < m->np; i++) k->ncount[i] = 0;
     for (int32_t s = 0; s < m->nd; s++) {
         if (colour[s] == WB_NO_COLOUR) { k->slot_pack[s] = -1; continue; }
-        int32_t i = start[colour[s]]++;
+        int32_t i = colour[s] == WB_SPLIT_COLOUR ? k->slot_pack[s] : start[colour[s]]++;
         int32_t a = m->d_ij[2 * s], b = m->d_ij[2 * s + 1];
         k->s_a[i] = a;
         k->s_b[i] = b;
@@ -152,7 +162,20 @@ static wb_status colour(wb_world *w)
         const int32_t na = m->inv_mass[a] > 0 ? k->ncount[a] : 1, nb = m->inv_mass[b] > 0 ? k->ncount[b] : 1;
         k->s_jac[i] = (wb_real)1 / (na > nb ? na : nb);
     }
+    /* a compound member's ends: how many of its compound's members meet there */
+    k->s_nsp = k->comp_start + k->ncomp + 1;
+    for (int32_t c = 0; c < k->ncomp; c++)
+        for (int32_t i = k->comp_start[c]; i < k->comp_start[c + 1]; i++) {
+            int32_t *n = &k->s_nsp[2 * (i - k->split_start)];
+            n[0] = n[1] = 0;
+            for (int32_t j = k->comp_start[c]; j < k->comp_start[c + 1]; j++) {
+                n[0] += k->s_a[j] == k->s_a[i] || k->s_b[j] == k->s_a[i];
+                n[1] += k->s_a[j] == k->s_b[i] || k->s_b[j] == k->s_b[i];
+            }
+        }
     free(colour);
+    free(split.member);
+    free(split.comp_start);
     m->topology_dirty = 0;
     return WB_OK;
 }
@@ -195,7 +218,7 @@ static wb_status colour(wb_world *w)
 static inline __attribute__((always_inline)) void
 project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
               wb_real *out, int32_t b, int32_t e, wb_real h, wb_real inv_h2, wb_real omega,
-              const int damped, const int jacobi, const int fresh)
+              const int damped, const int jacobi, const int fresh, const int split)
 {
     const int32_t *restrict sa = k->s_a, *restrict sb = k->s_b;
     const wb_real *restrict rest = k->s_rest, *restrict alpha = k->s_alpha, *restrict beta = k->s_beta;
@@ -205,6 +228,10 @@ project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const w
     for (int32_t i = b; i < e; i++) {
         const int32_t ia = sa[i], ic = sb[i];
         const wb_real wa = wv[ia], wc = wv[ic], wsum = wa + wc;
+        /* a compound member sees each shared end's mass split among the members there
+         * (their corrections add up) */
+        const int32_t *nsp = split ? &k->s_nsp[2 * (i - k->split_start)] : NULL;
+        const wb_real wden = split ? wa * (wb_real)nsp[0] + wc * (wb_real)nsp[1] : wsum;
         const wb_real *xa = &x[3 * ia], *xc = &x[3 * ic];
         const wb_real d0 = xc[0] - xa[0], d1 = xc[1] - xa[1], d2 = xc[2] - xa[2];
         const wb_real len2 = d0 * d0 + d1 * d1 + d2 * d2;
@@ -217,7 +244,7 @@ project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const w
         const wb_real len = sqrt(len2);
         const wb_real lam = fresh ? 0 : lambda[i];
         wb_real num = rest[i] - len - at * lam;
-        wb_real den = wsum + at;
+        wb_real den = wden + at;
         if (damped) {
             /* gamma = alpha~ beta~ / h with beta~ = h^2 beta */
             const wb_real gamma = at * beta[i] * h;
@@ -228,10 +255,10 @@ project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const w
                 /* alpha~ beta h overflowed: the limit gamma -> inf of num/den, a correction
                  * that removes the relative velocity along d (inf * 0 would be NaN) */
                 num = -rel / len;
-                den = wsum;
+                den = wden;
             } else {
                 num -= gamma * rel / len;
-                den += gamma * wsum;
+                den += gamma * wden;
             }
         }
         /* s = dlambda / len, so the correction is s * d without normalising d */
@@ -497,7 +524,7 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
         }
         i += cn;
     }
-    if (i < e) project_range(k, wv, x, xp, out, i, e, h, inv_h2, omega, damped, jacobi, fresh);
+    if (i < e) project_range(k, wv, x, xp, out, i, e, h, inv_h2, omega, damped, jacobi, fresh, 0);
 }
 
 static __attribute__((target("avx2"))) void
@@ -556,11 +583,42 @@ static void project_distances(const wb_world *w, wb_real *dx, int32_t b, int32_t
     const int fresh = k->s_lambda_stale;
     wb_real *x = w->s.x;
     if (dx) {
-        if (k->any_damping) project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1, fresh);
-        else project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1, fresh);
+        if (k->any_damping) project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1, fresh, 0);
+        else project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1, fresh, 0);
     } else {
-        if (k->any_damping) project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0, fresh);
-        else project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0, fresh);
+        if (k->any_damping) project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0, fresh, 0);
+        else project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0, fresh, 0);
+    }
+}
+
+/* Gauss-Seidel over the compounds, one after another, after the batches: a compound's
+ * members are worked out from the same positions (into dx, zeroed at their ends before
+ * and after) and applied together. A compound is its own mirror image, so is its update;
+ * projected one by one, as a colouring would, the images would lean the way they follow
+ * each other (a box dropped on a 7 x 4 x 7 block turned at 0.69 rad/s). Each shared end's
+ * mass is split among the members there (mass splitting: their corrections add up to
+ * about one link's, not overshoot) */
+static void project_compounds(wb_world *w, wb_real h, wb_real inv_h2)
+{
+    wb_cache *k = &w->k;
+    const wb_real *wv = w->m.w, *xp = w->s.x_prev;
+    const int fresh = k->s_lambda_stale;
+    wb_real *x = w->s.x, *dx = k->dx;
+    for (int32_t c = 0; c < k->ncomp; c++) {
+        const int32_t b = k->comp_start[c], e = k->comp_start[c + 1];
+        for (int32_t i = b; i < e; i++) {
+            v3_set(&dx[3 * k->s_a[i]], 0, 0, 0);
+            v3_set(&dx[3 * k->s_b[i]], 0, 0, 0);
+        }
+        if (k->any_damping) project_range(k, wv, x, xp, dx, b, e, h, inv_h2, 1, 1, 0, fresh, 1);
+        else project_range(k, wv, x, xp, dx, b, e, h, inv_h2, 1, 0, 0, fresh, 1);
+        for (int32_t i = b; i < e; i++)
+            for (int end = 0; end < 2; end++) {
+                const int32_t p = end ? k->s_b[i] : k->s_a[i];
+                if (!(wv[p] > 0)) continue;
+                v3_add(&x[3 * p], &x[3 * p], &dx[3 * p]);
+                v3_set(&dx[3 * p], 0, 0, 0);
+            }
     }
 }
 
@@ -600,6 +658,7 @@ static void distance_project(wb_world *w, wb_real h)
     if (h != k->s_at_h) refresh_at(k, h);
     if (w->m.def.solver == WB_SOLVER_GAUSS_SEIDEL) {
         project_batches(w, NULL, h, inv_h2);
+        project_compounds(w, h, inv_h2);
         k->s_lambda_stale = 0;
         return;
     }
@@ -608,6 +667,7 @@ static void distance_project(wb_world *w, wb_real h)
     if (np == 0) return;
     memset(k->dx, 0, sizeof(wb_real) * 3 * (size_t)np);
     project_batches(w, k->dx, h, inv_h2);
+    if (k->ns > k->split_start) project_distances(w, k->dx, k->split_start, k->ns, h, inv_h2);
     k->s_lambda_stale = 0;
     const wb_real *wv = w->m.w;
     for (int32_t i = 0; i < np; i++)

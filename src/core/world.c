@@ -185,7 +185,7 @@ void wb_world_destroy(wb_world *w)
     void *ptrs[] = { m->inv_mass, m->w, m->radius, m->pinned, m->d_ij, m->d_alpha, m->d_beta,
                      m->d_yield, m->d_creep, m->d_break, m->d_bforce, m->d_gen, m->d_free, m->c_shape, m->c_gen, m->surf_start, m->tri,
                      s->x, s->x_prev, s->v, s->d_rest, s->d_broken, s->c_pose,
-                     k->colour_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda, k->s_jac,
+                     k->colour_start, k->comp_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda, k->s_jac,
                      k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->c_sub, k->c_left, k->c_save,
                      k->breaks, m->group, m->cflags, m->cfric, m->x0, k->pc.ij, k->pc.act, k->pc.act_nd,
                      k->pc.left, k->pc.reach, k->pc.keys, k->pc.graph, k->pc.tcov, k->pc.load,
