@@ -500,6 +500,7 @@ typedef struct wb_cache {
     int32_t *mc_end;       /* (bodies) one past its last particle when its particles are
                               consecutive (a builder's body), else -1 */
     int32_t cap_mc_body, cap_mc_root, cap_mc_acc, cap_mc_pinned, cap_mc_end, mc_nbody, mc_free;
+    int32_t mc_scattered;  /* bodies whose particles are not consecutive (end -1) */
     int mc_built, mc_changed;
     uint32_t mc_wgen;
     int64_t mc_sig[8];     /* what the bodies were found for (besides m.topology_dirty) */
@@ -536,6 +537,25 @@ struct wb_world {
     wb_pool *pool;         /* the threads (pool.h), NULL until a step runs with threads > 1 */
     size_t charged_self;   /* the struct and its worker threads, charged to def.memory (world.c) */
 };
+
+/* The vector paths' switches (distance.c, bend.c, tet.c, momentum.c: wb__*_simd): *state
+ * (-1 until decided) set to on where the build and the CPU have AVX2; returns it. The
+ * vector paths give the scalar loops' bits, so this only picks the faster. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(WB_FLOAT)
+#define WB_HAVE_AVX2 1
+#endif
+static inline int wb__simd_set(int *state, int on)
+{
+#ifdef WB_HAVE_AVX2
+    __builtin_cpu_init();
+    const int v = on && __builtin_cpu_supports("avx2");
+#else
+    const int v = 0;
+    (void)on;
+#endif
+    __atomic_store_n(state, v, __ATOMIC_RELAXED);
+    return v;
+}
 
 /* internal entry points */
 wb_status wb__colour(wb_world *w);                 /* distance.c: rebuild the distance batches if dirty */

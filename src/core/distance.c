@@ -551,18 +551,7 @@ static int simd_state = -1;
  * path where the CPU has it; returns whether the vector path is on. Not thread-safe:
  * call it between steps. */
 int wb__distance_simd(int on);
-int wb__distance_simd(int on)
-{
-#ifdef WB_DISTANCE_AVX2
-    __builtin_cpu_init();
-    const int v = on && __builtin_cpu_supports("avx2");
-#else
-    const int v = 0;
-    (void)on;
-#endif
-    __atomic_store_n(&simd_state, v, __ATOMIC_RELAXED);
-    return v;
-}
+int wb__distance_simd(int on) { return wb__simd_set(&simd_state, on); }
 
 static void project_distances(const wb_world *w, wb_real *dx, int32_t b, int32_t e, wb_real h, wb_real inv_h2)
 {

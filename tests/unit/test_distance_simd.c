@@ -106,13 +106,7 @@ static int differing(const wb_world *a, const wb_world *b)
 
 TEST(distance_simd_bit_identical_to_scalar)
 {
-    const int on = wb__distance_simd(1);
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(WB_FLOAT)
-    __builtin_cpu_init();
-    CHECK_EQ(on, __builtin_cpu_supports("avx2") ? 1 : 0); /* the vector path really runs here */
-#else
-    CHECK_EQ(on, 0);
-#endif
+    CHECK_SIMD_RUNS(wb__distance_simd(1));
     /* solver, threads, damped, iterations, changes between frames */
     const int cases[][5] = { { WB_SOLVER_GAUSS_SEIDEL, 1, 0, 1, 0 }, { WB_SOLVER_GAUSS_SEIDEL, 1, 1, 1, 0 },
                              { WB_SOLVER_JACOBI, 1, 1, 1, 0 },       { WB_SOLVER_JACOBI, 1, 0, 1, 0 },
