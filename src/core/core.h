@@ -212,8 +212,15 @@ typedef struct wb_contacts {
      * list was made (broadphase.c: wb__contacts_recheck), else the list is made again */
     int check;             /* a list was made this frame: check it */
     int32_t sub;           /* substeps of the frame checked so far */
-    wb_real *xf;           /* (np x 3) where the list's reaches were measured from */
+    wb_real *xf;           /* (np x 3) where the list's reaches were measured from (a particle
+                              mended within the frame: where the reference motion below takes
+                              to where it was then) */
     int32_t cap_xf;
+    /* the reference motion the reaches are measured against (broadphase.c): velocity
+     * ref_v and turn ref_om about ref_c, with the world's gravity and drag, from the
+     * substep ref_k0 on (the substeps predicted when the list was made) */
+    wb_real ref_v[3], ref_om[3], ref_c[3];
+    int32_t ref_k0;
     int32_t n_old, cap_old;
     int32_t *ij_old;       /* the list before a remake, and what each pair was left with */
     wb_real *left_old;
@@ -563,6 +570,10 @@ wb_status wb__colour(wb_world *w);                 /* distance.c: rebuild the di
  * step); after each substep's solve, every free body's angular momentum back as it was */
 int wb__momentum_prepare(wb_world *w);
 void wb__momentum_restore(wb_world *w, wb_real h);
+/* momentum.c: om = I^-1 L, I the inertia tensor of a set of points whose second moments
+ * about their mass centre are S (xx yy zz xy xz yz): the turn that carries angular
+ * momentum L; 0 when singular or not finite (broadphase.c's reference motion too) */
+void wb__turn_rate(const double S[6], const double L[3], double om[3]);
 /* colour.c: greedy colouring of n constraints of k particles each (constraint i joins
  * idx[k i .. k i + k - 1]), mirror images alike (colour.c's header); those live() refuses
  * get WB_NO_COLOUR, the others a colour in [0, WB_MAX_COLOURS] (WB_MAX_COLOURS: the serial

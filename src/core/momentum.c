@@ -393,6 +393,25 @@ static void turn_run(const double *restrict A, wb_real *restrict x, const wb_rea
     turn(A, x, xp, v, h, i0, i, i1);
 }
 
+void wb__turn_rate(const double S[6], const double L[3], double om[3])
+{
+    const double xx = S[0], yy = S[1], zz = S[2], xy = S[3], xz = S[4], yz = S[5], tr = xx + yy + zz;
+    /* a set on a line has no inertia about it (and no torque about it either): the tiny
+     * regularisation only keeps the solve finite */
+    const double reg = 1e-12 * tr;
+    const double I[9] = { yy + zz + reg, -xy, -xz, -xy, xx + zz + reg, -yz, -xz, -yz, xx + yy + reg };
+    const double det = I[0] * (I[4] * I[8] - I[5] * I[7]) - I[1] * (I[3] * I[8] - I[5] * I[6]) +
+                       I[2] * (I[3] * I[7] - I[4] * I[6]);
+    om[0] = om[1] = om[2] = 0;
+    if (det > 0 && isfinite(det)) {
+        const double inv[9] = { I[4] * I[8] - I[5] * I[7], I[2] * I[7] - I[1] * I[8], I[1] * I[5] - I[2] * I[4],
+                                I[5] * I[6] - I[3] * I[8], I[0] * I[8] - I[2] * I[6], I[2] * I[3] - I[0] * I[5],
+                                I[3] * I[7] - I[4] * I[6], I[1] * I[6] - I[0] * I[7], I[0] * I[4] - I[1] * I[3] };
+        for (int r = 0; r < 3; r++) om[r] = (inv[3 * r] * L[0] + inv[3 * r + 1] * L[1] + inv[3 * r + 2] * L[2]) / det;
+    }
+    if (!(isfinite(om[0]) && isfinite(om[1]) && isfinite(om[2]))) om[0] = om[1] = om[2] = 0;
+}
+
 /* after the solve of a substep of length h: each free body's angular momentum back to
  * what it was before the solve (see the top of the file) */
 void wb__momentum_restore(wb_world *w, wb_real h)
@@ -446,21 +465,9 @@ void wb__momentum_restore(wb_world *w, wb_real h)
         /* second moments about c, then the inertia tensor */
         const double xx = A[10] - M * c[0] * c[0], yy = A[11] - M * c[1] * c[1], zz = A[12] - M * c[2] * c[2];
         const double xy = A[13] - M * c[0] * c[1], xz = A[14] - M * c[0] * c[2], yz = A[15] - M * c[1] * c[2];
-        const double tr = xx + yy + zz;
-        /* a body on a line has no inertia about it (and no torque about it either): the
-         * tiny regularisation only keeps the solve finite */
-        const double reg = 1e-12 * tr;
-        const double I[9] = { yy + zz + reg, -xy, -xz, -xy, xx + zz + reg, -yz, -xz, -yz, xx + yy + reg };
-        const double det = I[0] * (I[4] * I[8] - I[5] * I[7]) - I[1] * (I[3] * I[8] - I[5] * I[6]) +
-                           I[2] * (I[3] * I[7] - I[4] * I[6]);
-        double om[3] = { 0, 0, 0 };
-        if (det > 0 && isfinite(det)) {
-            const double inv[9] = { I[4] * I[8] - I[5] * I[7], I[2] * I[7] - I[1] * I[8], I[1] * I[5] - I[2] * I[4],
-                                    I[5] * I[6] - I[3] * I[8], I[0] * I[8] - I[2] * I[6], I[2] * I[3] - I[0] * I[5],
-                                    I[3] * I[7] - I[4] * I[6], I[1] * I[6] - I[0] * I[7], I[0] * I[4] - I[1] * I[3] };
-            for (int r = 0; r < 3; r++) om[r] = (inv[3 * r] * L[0] + inv[3 * r + 1] * L[1] + inv[3 * r + 2] * L[2]) / det;
-        }
-        if (!(isfinite(om[0]) && isfinite(om[1]) && isfinite(om[2]))) om[0] = om[1] = om[2] = 0;
+        const double S[6] = { xx, yy, zz, xy, xz, yz };
+        double om[3];
+        wb__turn_rate(S, L, om);
         A[1] = c[0]; A[2] = c[1]; A[3] = c[2];
         A[4] = om[0]; A[5] = om[1]; A[6] = om[2];
     }
