@@ -6,9 +6,7 @@
 -- back. Right: stiffness 0.2 with yield = 0.04, a plastic one that keeps the dent of
 -- its landing (its rest shape flows towards the squashed one past a strain of 0.04).
 -- Try --set stiffness=0.05 for a softer jelly in the middle.
--- Run: build/wobble run scripts/jelly_shape.lua [--set record=jelly/]
---   (--set record: drawn with this script's own camera into out/jelly/; --record OUT
---   draws with the default camera instead)
+-- Run: build/wobble run scripts/jelly_shape.lua [--record out/jelly/] (the three side by side)
 local args = wobble.args
 local w = wobble.world{ substeps = 10, damping = 0.5 }
 w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.6 }
@@ -30,11 +28,8 @@ local rigid, rs = cube(-1.2, { stiffness = 1 })
 local jelly, js = cube(0, { stiffness = args.stiffness or 0.2 })
 local dent, ds = cube(1.2, { stiffness = args.stiffness or 0.2, yield = 0.04, creep = 10 })
 
-local r = args.record and wobble.renderer{ width = 800, height = 450 }
-if r then
-  r:camera{ eye = {0, 1.5, 3.8}, target = {0, 0.4, 0} }
-  r:record(args.record)
-end
+-- the camera `--record` draws with and `wobble view` starts with
+wobble.camera{ eye = {0, 1.5, 3.8}, target = {0, 0.4, 0} }
 local squash = 1 -- the jelly's lowest height / H while landing
 local function height(b)
   local lo, hi = math.huge, -math.huge
@@ -46,7 +41,6 @@ local function height(b)
 end
 w:run{ seconds = args.seconds or 4, on_frame = function(w)
   squash = math.min(squash, height(jelly) / H)
-  if r then r:draw(w) end
 end }
 
 local hr, hj, hd = height(rigid) / H, height(jelly) / H, height(dent) / H
