@@ -5,9 +5,8 @@
 -- volume (an XPBD constraint over all its triangles), so it stays round, squashes where
 -- the box squeezes it against a wall and bulges elsewhere. Then the box backs off and the
 -- balloon is inflated to pressure 1.5. Try --set pressure=0 for the bag without pressure.
--- Run: build/wobble run scripts/balloon.lua [--set record=balloon/]
---   (--set record: drawn with this script's own camera into out/balloon/; --record OUT
---   draws with the default camera instead)
+-- Run: build/wobble run scripts/balloon.lua [--record out/balloon/] (seen from the front,
+--   the squeeze between wall and box in view)
 local args = wobble.args
 local w = wobble.world{ substeps = 10 }
 w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.5 }
@@ -70,11 +69,8 @@ local function volume()
 end
 local V0 = volume()
 
-local r = args.record and wobble.renderer{ width = 800, height = 450 }
-if r then
-  r:camera{ eye = {0.3, 1.3, 3.2}, target = {0.2, 0.35, 0} }
-  r:record(args.record)
-end
+-- the camera `--record` draws with and `wobble view` starts with
+wobble.camera{ eye = {0.3, 1.3, 3.2}, target = {0.2, 0.35, 0} }
 local worst_pushed, deepest, squeezed, tallest = 0, 0, math.huge, 0
 w:run{ seconds = args.seconds or 5, on_frame = function(w, frame, t)
   if t < 3.5 then
@@ -93,7 +89,6 @@ w:run{ seconds = args.seconds or 5, on_frame = function(w, frame, t)
     local x, y, z = w:position(id)
     for _, c in ipairs(w:colliders()) do deepest = math.max(deepest, -c:distance(x, y, z)) end
   end
-  if r then r:draw(w) end
 end }
 local final = volume() / V0
 print(string.format("volume / rest volume: worst %.2f%% off while squeezed, %.3f at the end (pressure %g); " ..

@@ -2,13 +2,16 @@
 -- keeps its volume. A box presses it to half its height; it bulges sideways instead of
 -- flattening (its volume stays), and springs back when the box lifts. Without the volume
 -- constraints (--set tets=0) the same soft links let it squash flat and lose its volume.
--- Run: build/wobble run scripts/block_jelly.lua [--set tets=0]
+-- Run: build/wobble run scripts/block_jelly.lua [--set tets=0] [--record out/jelly/]
 local tets = wobble.args.tets ~= 0
 local w = wobble.world{ substeps = 20 }
 w:collider{ shape = "plane", normal = { 0, 1, 0 }, offset = 0, friction = 0.8 }
 local jelly = w:lattice{ min = { -0.3, 0.01, -0.3 }, max = { 0.3, 0.61, 0.3 }, res = { 6, 6, 6 }, mass = 2,
                          radius = 0.01, compliance = 2e-2, damping = 0.05, tets = tets, volume_compliance = tets and 0 or nil }
 local press = w:collider{ shape = "box", center = { 0, 1.0, 0 }, half = { 0.8, 0.1, 0.8 } }
+-- the camera `--record` draws with and `wobble view` starts with: in front, below the
+-- press's lowest (0.31 m), so that its wide plate does not hide the bulge
+wobble.camera{ eye = {0.5, 0.2, 2.3}, target = {0, 0.28, 0} }
 local v0 = w:total_volume()
 local low, kept = math.huge, 1
 w:run{ seconds = wobble.args.seconds or 4, on_frame = function(w, f, t)

@@ -5,9 +5,8 @@
 -- shape; every ball is a contact group of its own, so balls push each other while a
 -- ball's own particles do not. The box is a floor plane and four box colliders. Try --set contacts=0 to
 -- watch the balls fall into one another and merge in a heap on the floor.
--- Run: build/wobble run scripts/contact_pile.lua [--set record=pile/]
---   (--set record: drawn with this script's own camera into out/pile/; --record OUT
---   draws with the default camera instead)
+-- Run: build/wobble run scripts/contact_pile.lua [--record out/pile/] (seen from above,
+--   into the box)
 local args = wobble.args
 local w = wobble.world{ substeps = 20, iterations = 2, contacts = args.contacts ~= 0 }
 -- the box's inner half-width and its walls' height (m): the walls stand higher than the
@@ -68,14 +67,9 @@ for _, d in ipairs(drops) do
   m:close()
 end
 
-local r = args.record and wobble.renderer{ width = 640, height = 480 }
-if r then
-  r:camera{ eye = {0.5, 2.4, 0.8}, target = {0, 0.1, 0} }
-  r:record(args.record)
-end
-w:run{ seconds = args.seconds or 5, on_frame = function(w)
-  if r then r:draw(w) end
-end }
+-- the camera `--record` draws with and `wobble view` starts with
+wobble.camera{ eye = {0.5, 2.4, 0.8}, target = {0, 0.1, 0} }
+w:run{ seconds = args.seconds or 5 }
 
 -- the deepest overlap between particles of different balls, as a fraction of the
 -- contact distance r_i + r_j (every pair: 12 x 11 / 2 x 42^2, quick enough)

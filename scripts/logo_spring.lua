@@ -8,7 +8,8 @@
 -- a strain of `yield`): the letters keep a dent, the reference thesis's plastic
 -- deformation (§3.1) for whole bodies. Drawn, the letters turn blue while squashed (the
 -- clusters' strain: r:draw's materials layer).
--- Run:     build/wobble run scripts/logo_spring.lua [--record out/logo_spring/]
+-- Run:     build/wobble run scripts/logo_spring.lua [--record out/logo_spring/] (seen from the front, at the
+--          height of the press's lowest)
 -- Options: --set shape=0 (links only), --set plastic=1 (--set yield=0.1 --set creep=1.5: they
 --          end at about half their height), --set stiffness=0.95 (per 1/60 s), --set gap=0.05
 --          (the press's lowest, m above the ground), --set friction=1.5 (the press's: a rough
@@ -36,6 +37,10 @@ local function height(part)
   end
   return hi - lo
 end
+
+-- the camera `--record` draws with and `wobble view` starts with: in front at 7 cm, level
+-- with the gap under the press (it comes down to 5 cm), so the press hides nothing
+wobble.camera{ eye = {0.3, 0.07, 2.2}, target = {0, 0.3, 0} }
 
 local rest, squashed = {}, {}
 for i, part in ipairs(logo.parts) do rest[i], squashed[i] = height(part), math.huge end

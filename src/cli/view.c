@@ -58,6 +58,7 @@ typedef struct viewer {
     double last_present, fps;
     /* the camera: the renderer's default (following the scene) until the mouse moves it */
     bool cam_fixed;
+    bool scene_cam;            /* the last frame drawn with the scene's camera (wobble.camera) */
     double eye[3], target[3], up[3], fov;
     /* the mouse: 0 none, 1 orbit, 2 pan, 3 grab */
     int drag;
@@ -358,8 +359,9 @@ static void on_key(GLFWwindow *win, int key, int scancode, int action, int mods)
     if (key == GLFW_KEY_ESCAPE) V.quit = true;
     else if (key == GLFW_KEY_SPACE) V.paused = !V.paused, V.dirty = true;
     else if (key == GLFW_KEY_R) V.restart = true;
-    else if (key == GLFW_KEY_A) {   /* back to the camera that follows the scene */
+    else if (key == GLFW_KEY_A) {   /* back to the scene's camera, or the one that follows the scene */
         V.cam_fixed = false;
+        V.scene_cam = false;
         wb_renderer_auto_camera(V.r);
         V.dirty = true;
     }
@@ -548,6 +550,15 @@ static void draw_world(lua_State *L, int world_index)
     const wb_draw_skin *sk = wbl_world_skins(L, world_index, &nsk);  /* on the stack until settop */
     wb_draw_opts o = wb_draw_default_opts();
     char err[512];
+    /* until the mouse moves it, the scene's camera when it set one (wobble.camera) */
+    double e[3], t[3], v[3], fov;
+    if (!V.cam_fixed && wbl_scene_camera(L, e, t, v, &fov)) {
+        wb_renderer_camera(V.r, e, t, v, fov);
+        V.scene_cam = true;
+    } else if (!V.cam_fixed && V.scene_cam) {
+        wb_renderer_auto_camera(V.r);
+        V.scene_cam = false;
+    }
     if (wb_renderer_draw(V.r, ud->w, &o, sk, nsk, err, sizeof err)) V.drawn = true;
     else snprintf(V.note, sizeof V.note, "drawing failed: %.200s", err);
     lua_settop(L, top);

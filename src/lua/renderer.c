@@ -23,6 +23,7 @@ typedef struct wbl_renderer {
     wb_recorder *rec;     /* the recording, or NULL */
     bool fps_set;         /* r:record{fps = ...}: the world's dt does not decide */
     int64_t draws;
+    bool scene_cam;       /* --record's renderer: drawn last with the scene's camera */
     /* the buffers live outside the Lua heap: charged to the runtime's memory budget */
     wb_memory *mem;
     size_t charged, rec_charged;
@@ -117,6 +118,26 @@ static int l_renderer(lua_State *L)
 /* ---- camera --------------------------------------------------------------------------- */
 static const char *const camera_keys[] = { "eye", "target", "up", "fov", NULL };
 
+/* the camera table at idx checked: eye, target, up = {0,1,0}, fov = 40 (vertical degrees) */
+static void check_camera(lua_State *L, int idx, double e[3], double t[3], double v[3], double *fov_out)
+{
+    wbl_checkopts(L, idx, camera_keys, false);
+    wb_real eye[3], target[3], up[3] = { 0, 1, 0 }, fov = 40;
+    if (!wbl_optvec(L, idx, "eye", 3, eye)) wbl_fielderror(L, idx, "eye", "missing ({x,y,z} expected)");
+    if (!wbl_optvec(L, idx, "target", 3, target)) wbl_fielderror(L, idx, "target", "missing ({x,y,z} expected)");
+    wbl_optvec(L, idx, "up", 3, up);
+    if (wbl_optreal(L, idx, "fov", &fov) && !(fov > 0 && fov < 180))
+        wbl_fielderror(L, idx, "fov", "must be between 0 and 180 degrees");
+    double d[3], c[3];
+    for (int k = 0; k < 3; k++) e[k] = eye[k], t[k] = target[k], v[k] = up[k], d[k] = t[k] - e[k];
+    double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), vl = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (!(dl > 0)) luaL_argerror(L, idx, "eye and target must differ");
+    c[0] = d[1] * v[2] - d[2] * v[1], c[1] = d[2] * v[0] - d[0] * v[2], c[2] = d[0] * v[1] - d[1] * v[0];
+    if (!(vl > 0) || sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) < 1e-9 * dl * vl)
+        wbl_fielderror(L, idx, "up", "must not be zero or along the line of sight");
+    *fov_out = fov;
+}
+
 /* r:camera{eye, target, up = {0,1,0}, fov = 40}; r:camera() frames the world again */
 static int r_camera(lua_State *L)
 {
@@ -125,30 +146,31 @@ static int r_camera(lua_State *L)
         wb_renderer_auto_camera(u->r);
         return 0;
     }
-    wbl_checkopts(L, 2, camera_keys, false);
-    wb_real eye[3], target[3], up[3] = { 0, 1, 0 }, fov = 40;
-    if (!wbl_optvec(L, 2, "eye", 3, eye)) return wbl_fielderror(L, 2, "eye", "missing ({x,y,z} expected)");
-    if (!wbl_optvec(L, 2, "target", 3, target)) return wbl_fielderror(L, 2, "target", "missing ({x,y,z} expected)");
-    wbl_optvec(L, 2, "up", 3, up);
-    if (wbl_optreal(L, 2, "fov", &fov) && !(fov > 0 && fov < 180))
-        return wbl_fielderror(L, 2, "fov", "must be between 0 and 180 degrees");
-    double e[3], t[3], v[3], d[3], c[3];
-    for (int k = 0; k < 3; k++) e[k] = eye[k], t[k] = target[k], v[k] = up[k], d[k] = t[k] - e[k];
-    double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), vl = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    if (!(dl > 0)) return luaL_argerror(L, 2, "eye and target must differ");
-    c[0] = d[1] * v[2] - d[2] * v[1], c[1] = d[2] * v[0] - d[0] * v[2], c[2] = d[0] * v[1] - d[1] * v[0];
-    if (!(vl > 0) || sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) < 1e-9 * dl * vl)
-        return wbl_fielderror(L, 2, "up", "must not be zero or along the line of sight");
+    double e[3], t[3], v[3], fov;
+    check_camera(L, 2, e, t, v, &fov);
     wb_renderer_camera(u->r, e, t, v, fov);
     return 0;
 }
 
-/* the camera of the last frame: {eye = {..}, target = {..}, up = {..}, fov = n} */
-static int r_get_camera(lua_State *L)
+/* the scene's camera (wobble.camera): registry[&scene_cam_key] = 10 doubles (eye,
+ * target, up, fov) as a full userdata, absent when the scene leaves the framing automatic */
+static const char scene_cam_key = 0;
+
+bool wbl_scene_camera(lua_State *L, double eye[3], double target[3], double up[3], double *fov)
 {
-    wbl_renderer *u = checkrenderer(L, 1);
-    double e[3], t[3], v[3], fov;
-    wb_renderer_get_camera(u->r, e, t, v, &fov);
+    bool set = false;
+    if (lua_rawgetp(L, LUA_REGISTRYINDEX, &scene_cam_key) == LUA_TUSERDATA) {
+        const double *c = (const double *)lua_touserdata(L, -1);
+        for (int k = 0; k < 3; k++) eye[k] = c[k], target[k] = c[3 + k], up[k] = c[6 + k];
+        *fov = c[9];
+        set = true;
+    }
+    lua_pop(L, 1);
+    return set;
+}
+
+static void push_camera(lua_State *L, const double e[3], const double t[3], const double v[3], double fov)
+{
     lua_createtable(L, 0, 4);
     const double *vs[3] = { e, t, v };
     const char *names[3] = { "eye", "target", "up" };
@@ -162,6 +184,42 @@ static int r_get_camera(lua_State *L)
     }
     lua_pushnumber(L, fov);
     lua_setfield(L, -2, "fov");
+}
+
+/* wobble.camera{eye, target, up, fov}: the scene's camera, the one `wobble run --record`
+ * draws with and `wobble view` starts with; wobble.camera(false) gives the framing back
+ * to the automatic camera; wobble.camera() -> the table set, or nil (so that a script's
+ * own renderer can take it: r:camera(wobble.camera())) */
+static int l_camera(lua_State *L)
+{
+    if (lua_isnone(L, 1)) {
+        double e[3], t[3], v[3], fov;
+        if (!wbl_scene_camera(L, e, t, v, &fov)) return 0;
+        push_camera(L, e, t, v, fov);
+        return 1;
+    }
+    if (lua_isboolean(L, 1) && !lua_toboolean(L, 1)) {
+        lua_pushnil(L);
+        lua_rawsetp(L, LUA_REGISTRYINDEX, &scene_cam_key);
+        return 0;
+    }
+    luaL_checktype(L, 1, LUA_TTABLE);
+    double e[3], t[3], v[3], fov;
+    check_camera(L, 1, e, t, v, &fov);
+    double *c = (double *)lua_newuserdatauv(L, 10 * sizeof(double), 0);
+    for (int k = 0; k < 3; k++) c[k] = e[k], c[3 + k] = t[k], c[6 + k] = v[k];
+    c[9] = fov;
+    lua_rawsetp(L, LUA_REGISTRYINDEX, &scene_cam_key);
+    return 0;
+}
+
+/* the camera of the last frame: {eye = {..}, target = {..}, up = {..}, fov = n} */
+static int r_get_camera(lua_State *L)
+{
+    wbl_renderer *u = checkrenderer(L, 1);
+    double e[3], t[3], v[3], fov;
+    wb_renderer_get_camera(u->r, e, t, v, &fov);
+    push_camera(L, e, t, v, fov);
     return 1;
 }
 
@@ -615,6 +673,15 @@ static int record_hook(lua_State *L)
         return 0;
     }
     wbl_checkworld(L, 1);
+    /* the scene's camera when it set one (wobble.camera), else the automatic framing */
+    double e[3], t[3], v[3], fov;
+    if (wbl_scene_camera(L, e, t, v, &fov)) {
+        wb_renderer_camera(u->r, e, t, v, fov);
+        u->scene_cam = true;
+    } else if (u->scene_cam) {   /* given back (wobble.camera(false)): framing starts afresh */
+        wb_renderer_auto_camera(u->r);
+        u->scene_cam = false;
+    }
     wb_draw_opts o = wb_draw_default_opts();
     char err[1024];
     if (!draw_frame(L, u, 1, &o, err, sizeof err)) {
@@ -741,5 +808,7 @@ void wbl_open_renderer(lua_State *L)
     lua_setfield(L, -2, "read_frame");
     lua_pushcfunction(L, l_clock);
     lua_setfield(L, -2, "clock");
+    lua_pushcfunction(L, l_camera);
+    lua_setfield(L, -2, "camera");
     wbl_open_plot(L);
 }

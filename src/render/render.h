@@ -204,10 +204,12 @@ void wb_chart_label(char *buf, size_t n, double v, double step);
 /* ---- the Lua side (lua/renderer.c, lua/plot.c) --------------------------------------- */
 typedef struct lua_State lua_State;
 void wbl_open_renderer(lua_State *L);   /* wobble.renderer, probe, read_png, read_frame, clock */
-/* `wobble run --record OUT`: every frame any w:run / w:step makes is drawn (default
+/* `wobble run --record OUT`: every frame any w:run / w:step makes is drawn (the scene's
  * camera, every layer) and added to OUT, a path of the user's choice */
 bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n);
 bool wbl_record_end(lua_State *L, char *err, size_t n);   /* finish the file; prints where it went */
+/* the camera the scene set with wobble.camera{...}; false when it left the framing automatic */
+bool wbl_scene_camera(lua_State *L, double eye[3], double target[3], double up[3], double *fov);
 /* the live skins of the world at world_index, ready to draw (Lua userdata left on the
  * stack, collected with it); *n their count (the viewer draws with it too) */
 wb_draw_skin *wbl_world_skins(lua_State *L, int world_index, int *n);

@@ -162,6 +162,15 @@ if [ "$(grep '^hash' "$TMP/out")" = "$(grep '^hash' "$TMP/out.run")" ]; then why
 else why="view: $(grep '^hash' "$TMP/out"), run: $(grep '^hash' "$TMP/out.run")"; fi
 result "untouched, the viewer's run ends on the same hash as wobble run" "$why"
 
+# ---- the scene's camera (wobble.camera) is the one the window starts with: looking away
+# from the rope, the same window shows none of its particles
+view $F/rope_away.lua --size 320x240 --frames 20 --screenshot "$TMP/away.png"
+finish 20
+"$W" run $F/png_stats.lua --unsafe --set png="$TMP/away.png" >"$TMP/stats" 2>&1
+blue=$(sed -n 's/^blue_above //p' "$TMP/stats")
+if [ -n "$blue" ] && [ "$blue" -lt 5 ]; then why=""; else why="${blue:-no} blue (particle) pixels above the legend: $(cat "$TMP/stats")"; fi
+result "the viewer starts with the scene's camera (wobble.camera)" "$why"
+
 # ---- a scene with its own (OSMesa) renderer: both pictures are drawn (GLX skipped
 # binding the window's context again once OSMesa had taken the dispatch: a crash)
 view $F/own_renderer.lua --size 320x240 --frames 20 --screenshot "$TMP/shot2.png" --out "$TMP/o"

@@ -110,6 +110,13 @@ mkdir -p "$TMP/link/data" && : >"$TMP/link/data/clip" && ln -s data/clip "$TMP/l
 run "$W" run $F/record.lua --quiet --out "$TMP/link" --set name=v.mp4
 [ "$code" = 0 ] && [ "$(field "$TMP/link/data/clip" codec_name)" = h264 ] && [ "$(frames "$TMP/link/data/clip")" = 3 ]; ok "r:record(v.mp4), a symlink to a file without extension: an MP4" $?
 
+# --record draws with the scene's camera (wobble.camera): its frame is the one the scene
+# draws itself with that camera, byte for byte, and not the automatic framing's
+run "$W" run $F/camera.lua --quiet --out "$TMP/cam" --set own=1 --record "$TMP/camrec/"
+[ "$code" = 0 ] && cmp -s "$TMP/cam/own.png" "$TMP/camrec/frame_000002.png"; ok "--record uses the scene's camera (wobble.camera)" $?
+run "$W" run $F/camera.lua --quiet --out "$TMP/cam2" --set auto=1 --record "$TMP/camauto/"
+[ "$code" = 0 ] && [ -s "$TMP/camauto/frame_000002.png" ] && ! cmp -s "$TMP/camauto/frame_000002.png" "$TMP/camrec/frame_000002.png"; ok "... and the automatic framing when the scene sets none" $?
+
 # the renderer's buffers count against --memory-limit
 run "$W" run $F/big.lua --memory-limit 64
 [ "$code" = 3 ] && grep -q "4096x4096 renderer needs about .* MB, over the memory budget of 64 MB" "$TMP/err"; ok "a renderer too large for --memory-limit: exit 3, says why" $?
