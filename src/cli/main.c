@@ -64,7 +64,7 @@ static const char usage_text[] =
     "  --replay INPUT.json (run) apply the grabs of an input log after their frames; exit\n"
     "                      code 1 when some were not applied (the scene ended or differs)\n"
     "  --out DIR           output folder, the only place a script writes (default out);\n"
-    "                      run writes DIR/result.json there (wobble collect)\n"
+    "                      run --out DIR writes DIR/result.json (wobble collect)\n"
     "  --set key=value     wobble.args.key = value (numbers, true/false converted); repeatable\n"
     "  --threads N         default thread count of new worlds, 1 to 256 (default 1)\n"
     "  --unsafe            no sandbox: any path, os.execute, io.popen, C modules, debug\n"
@@ -90,6 +90,7 @@ typedef struct opts {
     const char *replay;        /* run --replay INPUT.json, or NULL */
     int nsets, npos;
     int json;                  /* bench --json */
+    int out_given;             /* --out named: run writes result.json there */
     wb_view_opts view;         /* view's own options (view.h) */
 } opts;
 
@@ -215,6 +216,7 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
         } else if (!strcmp(name, "--out")) {
             if (!*val) return usage_error("%s", "--out expects a folder");
             o->rt.out_dir = val;
+            o->out_given = 1;
         } else {
             const char *e = strchr(val, '=');
             if (!e || e == val) return usage_error("--set expects key=value, got '%s'", val);
@@ -801,11 +803,13 @@ static int run_scene(const opts *o, const char *path, run_report *rep) {
     return code;
 }
 
-/* wobble run: the scene, then OUTDIR/result.json (DESIGN §4 collect). The file is
- * first written saying "running", so a run ended from outside (a signal, the
- * watchdog past --time-limit, the OOM killer, Slurm) leaves a run that started and
- * never finished, which collect shows as crashed. */
+/* wobble run: the scene, then OUTDIR/result.json (DESIGN §4 collect) when --out names
+ * the folder (a sweep's runs always do): a run typed by hand leaves no file it did not
+ * ask for. The file is first written saying "running", so a run ended from outside (a
+ * signal, the watchdog past --time-limit, the OOM killer, Slurm) leaves a run that
+ * started and never finished, which collect shows as crashed. */
 static int cmd_run(const opts *o, const char *path) {
+    if (!o->out_given) return run_scene(o, path, NULL);
     run_report rep = { 0 };
     char err[PATH_MAX + 128], dir[PATH_MAX];
     struct timespec t0, t1;

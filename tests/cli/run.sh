@@ -32,6 +32,14 @@ run run $F/args.lua --no-such-option
 check "unknown option" 2 err "unknown option --no-such-option"
 run run $F/args.lua --record out.avi
 check "--record checks the extension (more in tests/render/run.sh)" 2 err "unknown extension '.avi'"
+# result.json: written when --out names the folder (a sweep's runs do), not by a run
+# typed without it (it left out/result.json in whatever folder the user was in)
+mkdir -p "$TMP/cwd"
+(cd "$TMP/cwd" && "$OLDPWD/$W" run "$OLDPWD/$F/frames.lua" --frames 2 >"$TMP/out" 2>"$TMP/err"); code=$?
+check "run without --out writes no out/result.json (nor out/)" 0 out "ran 2 frames" none "$TMP/cwd/out"
+run run $F/frames.lua --frames 2 --out "$TMP/named"
+cat "$TMP/named/result.json" >"$TMP/out" 2>/dev/null
+check "run --out DIR writes DIR/result.json, how the run ended" 0 out '"status":	"ok"' out '"frames":	2'
 # --size WxH of run: the recorded frames' size (a PNG's width and height, bytes 16-23)
 png_size() { od -An -tu1 -j16 -N8 "$1" | awk '{ printf "%dx%d", $3 * 256 + $4, $7 * 256 + $8 }'; }
 run run $F/frames.lua --frames 2 --quiet --size 320x200 --record "$TMP/sized/"
