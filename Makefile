@@ -44,9 +44,14 @@ check-deps:
 	@if command -v dpkg-query >/dev/null 2>&1; then $(MISSING); [ -z "$$missing" ]; \
 	else pkg-config --exists $(PCMODS) 2>/dev/null; fi || $(MAKE) --no-print-directory deps
 
-# apt's output (about 1,400 lines for a fresh system) goes to $(DEPS_LOG), shown when it
-# fails; without root and without sudo it says what to run instead
+# apt's output (about 1,400 lines for a fresh system) goes whole to $(DEPS_LOG) (its tail
+# shown when it fails); its progress is shown as it works (mk/apt_progress.awk: one
+# updating line on a terminal, a line each 10% elsewhere). Without root and without sudo
+# it says what to run instead. A pipe hides apt-get's exit status from sh (no pipefail in
+# dash), so it is passed through $(DEPS_LOG).rc
 DEPS_LOG = $(BUILD)/deps.log
+APT_STEP = { $$SUDO env DEBIAN_FRONTEND=noninteractive apt-get -o APT::Status-Fd=1 $(1) 2>&1; echo $$? >$(DEPS_LOG).rc; } \
+	   | tee -a $(DEPS_LOG) | awk -v tty=$$tty -f mk/apt_progress.awk; [ "$$(cat $(DEPS_LOG).rc)" = 0 ]
 deps:
 	@$(MISSING); \
 	if [ -z "$$missing" ]; then echo "all Debian packages present"; exit 0; fi; \
@@ -54,28 +59,40 @@ deps:
 	elif command -v sudo >/dev/null 2>&1; then SUDO=sudo; \
 	else echo "wobble needs these Debian packages:$$missing" >&2; \
 	  echo "run as root (su -), then make again: apt-get update && apt-get install -y$$missing" >&2; exit 1; fi; \
+	tty=0; [ -t 1 ] && tty=1; \
 	mkdir -p $(BUILD) && : >$(DEPS_LOG); \
-	echo "installing Debian packages:$$missing (apt-get's output: $(DEPS_LOG))"; \
-	if $$SUDO apt-get update -qq >>$(DEPS_LOG) 2>&1 && \
-	  $$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >>$(DEPS_LOG) 2>&1; then \
-	  echo "installed:$$missing"; \
-	else echo "apt-get failed; the end of its output ($(DEPS_LOG)):" >&2; tail -n 20 $(DEPS_LOG) >&2; exit 1; fi
+	echo "installing Debian packages:$$missing"; \
+	echo "  (apt-get's whole output: $(DEPS_LOG); a fresh system takes a few minutes)"; \
+	echo "  apt-get update: reading the package lists"; \
+	if $(call APT_STEP,update -q) && \
+	  echo "  apt-get install: the packages above and what they need" && \
+	  $(call APT_STEP,install -y -q $$missing); then \
+	  rm -f $(DEPS_LOG).rc; echo "installed:$$missing"; \
+	else rm -f $(DEPS_LOG).rc; echo "apt-get failed; the end of its output ($(DEPS_LOG)):" >&2; tail -n 20 $(DEPS_LOG) >&2; exit 1; fi
+
+# short build lines (CC src/core/bend.c, LD build/wobble); `make V=1` shows the commands
+V ?= 0
+ifeq ($(V),1)
+  quiet =
+else
+  quiet = @printf '  %-4s %s\n' $(1) $(2);
+endif
 
 $(BUILD)/obj/%.o: src/%.c $(HEADERS) | $(addprefix $(BUILD)/obj/,$(LAYERS))
-	$(CC) $(CFLAGS) $(PC_CFLAGS) -c $< -o $@
+	$(call quiet,CC,$<)$(CC) $(CFLAGS) $(PC_CFLAGS) -c $< -o $@
 
 $(addprefix $(BUILD)/obj/,$(LAYERS)):
 	@mkdir -p $@
 
 $(BUILD)/libwobble.a: $(CORE_OBJ)
-	ar rcs $@ $^
+	$(call quiet,AR,$@)ar rcs $@ $^
 
 $(BUILD)/wobble: $(APP_OBJ) $(BUILD)/libwobble.a
-	$(CC) $(LDFLAGS) -o $@ $(APP_OBJ) $(BUILD)/libwobble.a $(PC_LIBS) -lm
+	$(call quiet,LD,$@)$(CC) $(LDFLAGS) -o $@ $(APP_OBJ) $(BUILD)/libwobble.a $(PC_LIBS) -lm
 
 # C unit tests of the core alone: links only libwobble.a
 $(BUILD)/unit_tests: $(UNIT_SRC) $(wildcard tests/unit/*.h) $(BUILD)/libwobble.a
-	$(CC) $(CFLAGS) -o $@ $(UNIT_SRC) $(BUILD)/libwobble.a $(LDFLAGS) -lm
+	$(call quiet,CCLD,$@)$(CC) $(CFLAGS) -o $@ $(UNIT_SRC) $(BUILD)/libwobble.a $(LDFLAGS) -lm
 
 test: check-deps
 	@$(MAKE) --no-print-directory build
@@ -106,7 +123,7 @@ bench: check-deps
 # the Bullet peer: Bullet's headers as system headers (they do not pass -Wextra -Werror)
 $(BUILD)/bullet_cloth: tests/bench/bullet_cloth.cpp
 	@mkdir -p $(BUILD)
-	g++ -std=c++11 $(BENCH_OPT) -Wall -Wextra -Werror $(patsubst -I%,-isystem %,$(shell pkg-config --cflags bullet)) \
+	$(call quiet,CXX,$@)g++ -std=c++11 $(BENCH_OPT) -Wall -Wextra -Werror $(patsubst -I%,-isystem %,$(shell pkg-config --cflags bullet)) \
 	  -o $@ $< $(shell pkg-config --libs bullet)
 
 # the clothesline, 6 s at 1280x720 with every layer, as an H.264 video
@@ -148,15 +165,15 @@ fuzz_src      = tests/fuzz/fuzz_$(if $(filter mesh_obj,$(1)),mesh,$(1)).c
 build: $(FUZZ_REPLAY)
 
 $(BUILD)/fuzz_%_replay: tests/fuzz/fuzz_json.c tests/fuzz/fuzz_mesh.c tests/fuzz/replay.c $(IO_OBJ) $(BUILD)/libwobble.a
-	$(CC) $(CFLAGS) $(PC_CFLAGS) $(call fuzz_def,$*) -o $@ $(call fuzz_src,$*) tests/fuzz/replay.c \
+	$(call quiet,CCLD,$@)$(CC) $(CFLAGS) $(PC_CFLAGS) $(call fuzz_def,$*) -o $@ $(call fuzz_src,$*) tests/fuzz/replay.c \
 	  $(IO_OBJ) $(BUILD)/libwobble.a $(LDFLAGS) $(PC_LIBS) -lm
 
 $(FUZZ_BUILD)/obj/%.o: src/%.c $(HEADERS)
 	@mkdir -p $(dir $@)
-	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link $(FUZZ_SAN) $(PC_CFLAGS) -c $< -o $@
+	$(call quiet,CC,$<)$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link $(FUZZ_SAN) $(PC_CFLAGS) -c $< -o $@
 
 $(FUZZ_BUILD)/fuzz_%: tests/fuzz/fuzz_json.c tests/fuzz/fuzz_mesh.c $(FUZZ_OBJ)
-	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $(FUZZ_SAN) $(PC_CFLAGS) $(call fuzz_def,$*) -o $@ \
+	$(call quiet,CCLD,$@)$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $(FUZZ_SAN) $(PC_CFLAGS) $(call fuzz_def,$*) -o $@ \
 	  $(call fuzz_src,$*) $(FUZZ_OBJ) $(PC_LIBS) -lm
 
 fuzz-build: $(FUZZ_TARGETS:%=$(FUZZ_BUILD)/fuzz_%)
@@ -183,12 +200,12 @@ fuzz: check-deps
 DRIVER_OBJ = $(filter-out $(BUILD)/obj/cli/%,$(APP_OBJ))
 build: $(BUILD)/input_driver
 $(BUILD)/input_driver: tests/cli/input_driver.c $(DRIVER_OBJ) $(BUILD)/libwobble.a $(HEADERS)
-	$(CC) $(CFLAGS) $(PC_CFLAGS) -o $@ tests/cli/input_driver.c $(DRIVER_OBJ) $(BUILD)/libwobble.a \
+	$(call quiet,CCLD,$@)$(CC) $(CFLAGS) $(PC_CFLAGS) -o $@ tests/cli/input_driver.c $(DRIVER_OBJ) $(BUILD)/libwobble.a \
 	  $(LDFLAGS) $(PC_LIBS) -lm
 # tests/cli/budget.sh: the peak resident memory of a run's whole process tree
 build: $(BUILD)/treepeak
 $(BUILD)/treepeak: tests/cli/treepeak.c
-	$(CC) $(CFLAGS) -o $@ $< $(LDFLAGS)
+	$(call quiet,CCLD,$@)$(CC) $(CFLAGS) -o $@ $< $(LDFLAGS)
 # ---- a one-node Slurm (README, "Sweeps"): `make test-cluster` starts munged, slurmctld and
 # slurmd in a temporary folder, runs a sweep's job array through sbatch and collects it;
 # CLUSTER_PKGS are installed by it alone, never by `make test`; needs root

@@ -32,11 +32,16 @@ local fmt, find = string.format, string.find
 
 local show
 
--- numbers in full precision (%.17g round-trips a double); integers as they are
+-- numbers in the shortest of %.15g, %.16g, %.17g that reads back as the same double
+-- (0.6, not 0.59999999999999998); integers as they are
 local function num(x)
   if mtype(x) == "integer" then return tostring(x) end
   if x ~= x then return "nan" end
   if x == huge then return "inf" elseif x == -huge then return "-inf" end
+  for _, f in ipairs({ "%.15g", "%.16g" }) do
+    local s = fmt(f, x)
+    if tonumber(s) == x then return s end
+  end
   return fmt("%.17g", x)
 end
 

@@ -60,10 +60,11 @@ static const char usage_text[] =
     "options of run, test and bench:\n"
     "  --frames N          w:run stops after N frames; bench: each scene runs N frames\n"
     "  --record OUT        (run) draw every frame into OUT: .mp4, .gif or a folder of PNGs\n"
+    "  --size WxH          (run) --record's frame size (default 1280x720; a .gif 640x360)\n"
     "  --replay INPUT.json (run) apply the grabs of an input log after their frames; exit\n"
     "                      code 1 when some were not applied (the scene ended or differs)\n"
     "  --out DIR           output folder, the only place a script writes (default out);\n"
-    "                      run writes DIR/result.json there (wobble collect)\n"
+    "                      run --out DIR writes DIR/result.json (wobble collect)\n"
     "  --set key=value     wobble.args.key = value (numbers, true/false converted); repeatable\n"
     "  --threads N         default thread count of new worlds, 1 to 256 (default 1)\n"
     "  --unsafe            no sandbox: any path, os.execute, io.popen, C modules, debug\n"
@@ -89,6 +90,7 @@ typedef struct opts {
     const char *replay;        /* run --replay INPUT.json, or NULL */
     int nsets, npos;
     int json;                  /* bench --json */
+    int out_given;             /* --out named: run writes result.json there */
     wb_view_opts view;         /* view's own options (view.h) */
 } opts;
 
@@ -157,16 +159,19 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
             continue;
         }
         if (!strcmp(name, "--record-input") || !strcmp(name, "--screenshot") || !strcmp(name, "--size")) {
-            if (strcmp(cmd, "view")) return usage_error("%s is an option of view", name);
+            if (!strcmp(name, "--size") && !strcmp(cmd, "run")) {
+            } else if (strcmp(cmd, "view")) {
+                return usage_error(!strcmp(name, "--size") ? "%s is an option of run and view" : "%s is an option of view", name);
+            }
             if (eq) val = eq + 1;
             else if (i + 1 < argc) val = argv[++i];
             else return usage_error("%s needs a value", name);
             if (!*val) return usage_error("%s needs a value", name);
-            int vw, vh, k = 0;
+            int vw = 0, vh = 0, k = 0;
             if (!strcmp(name, "--record-input")) o->view.record_input = val;
             else if (!strcmp(name, "--screenshot")) o->view.screenshot = val;
             else if (sscanf(val, "%dx%d%n", &vw, &vh, &k) != 2 || val[k] || vw < 16 || vh < 16 || vw > 4096 || vh > 4096)
-                return usage_error("--size expects WIDTHxHEIGHT from 16x16 to 4096x4096, got '%s'", val);
+                return usage_error("--size expects WIDTHxHEIGHT, each from 16 to 4096 (as 1280x720), got '%s'", val);
             else o->view.width = vw, o->view.height = vh;
             continue;
         }
@@ -211,6 +216,7 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
         } else if (!strcmp(name, "--out")) {
             if (!*val) return usage_error("%s", "--out expects a folder");
             o->rt.out_dir = val;
+            o->out_given = 1;
         } else {
             const char *e = strchr(val, '=');
             if (!e || e == val) return usage_error("--set expects key=value, got '%s'", val);
@@ -734,7 +740,7 @@ static int run_scene(const opts *o, const char *path, run_report *rep) {
         wb_rt_close(L);
         return EXIT_SCRIPT;
     }
-    if (o->record && !wbl_record_begin(L, o->record, rerr, sizeof rerr)) {
+    if (o->record && !wbl_record_begin(L, o->record, o->view.width, o->view.height, rerr, sizeof rerr)) {
         fprintf(stderr, "wobble: %s\n", rerr);
         report_error(rep, rerr);
         report_take(rep, L);
@@ -797,11 +803,13 @@ static int run_scene(const opts *o, const char *path, run_report *rep) {
     return code;
 }
 
-/* wobble run: the scene, then OUTDIR/result.json (DESIGN §4 collect). The file is
- * first written saying "running", so a run ended from outside (a signal, the
- * watchdog past --time-limit, the OOM killer, Slurm) leaves a run that started and
- * never finished, which collect shows as crashed. */
+/* wobble run: the scene, then OUTDIR/result.json (DESIGN §4 collect) when --out names
+ * the folder (a sweep's runs always do): a run typed by hand leaves no file it did not
+ * ask for. The file is first written saying "running", so a run ended from outside (a
+ * signal, the watchdog past --time-limit, the OOM killer, Slurm) leaves a run that
+ * started and never finished, which collect shows as crashed. */
 static int cmd_run(const opts *o, const char *path) {
+    if (!o->out_given) return run_scene(o, path, NULL);
     run_report rep = { 0 };
     char err[PATH_MAX + 128], dir[PATH_MAX];
     struct timespec t0, t1;
@@ -928,6 +936,8 @@ int main(int argc, char **argv) {
     if (code == EXIT_PASS) {
         if (!strcmp(cmd, "run")) {
             if (o.npos != 1) code = usage_error("%s", o.npos ? "run takes one scene script" : "run needs a scene script");
+            /* run draws nothing else: a --size alone would be silently ignored */
+            else if (o.view.width && !o.record) code = usage_error("%s", "--size sets --record's frame size: give --record OUT too");
             else code = cmd_run(&o, o.pos[0]);
         } else if (!strcmp(cmd, "view")) {
             code = cmd_view(&o);

@@ -692,7 +692,7 @@ static int record_hook(lua_State *L)
     return 0;
 }
 
-bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n)
+bool wbl_record_begin(lua_State *L, const char *path, int w, int h, char *err, size_t n)
 {
     char e[PATH_MAX + 256];
     wb_media kind = wb_media_of(path, NULL, e, sizeof e);
@@ -700,15 +700,24 @@ bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n)
         snprintf(err, n, "--record: %s", e);
         return false;
     }
+    /* a GIF at 1280x720 is tens of MB for a few seconds: half that size unless asked */
+    if (w <= 0 || h <= 0) {
+        w = kind == WB_MEDIA_GIF ? WB_RECORD_GIF_WIDTH : WB_RECORD_WIDTH;
+        h = kind == WB_MEDIA_GIF ? WB_RECORD_GIF_HEIGHT : WB_RECORD_HEIGHT;
+    }
     int top = lua_gettop(L);
     lua_pushcfunction(L, l_renderer);
-    if (lua_pcall(L, 0, 1, 0) != LUA_OK) {
+    lua_createtable(L, 0, 2);
+    lua_pushinteger(L, w);
+    lua_setfield(L, -2, "width");
+    lua_pushinteger(L, h);
+    lua_setfield(L, -2, "height");
+    if (lua_pcall(L, 1, 1, 0) != LUA_OK) {
         snprintf(err, n, "--record: %s", lua_tostring(L, -1) ? lua_tostring(L, -1) : "cannot create the renderer");
         lua_settop(L, top);
         return false;
     }
     wbl_renderer *u = checkud(L, -1);
-    int w, h;
     wb_renderer_size(u->r, &w, &h);
     size_t bytes = wb_recorder_bytes(kind, w, h);
     if (over_budget(u->mem, bytes)) {

@@ -205,8 +205,13 @@ void wb_chart_label(char *buf, size_t n, double v, double step);
 typedef struct lua_State lua_State;
 void wbl_open_renderer(lua_State *L);   /* wobble.renderer, probe, read_png, read_frame, clock */
 /* `wobble run --record OUT`: every frame any w:run / w:step makes is drawn (the scene's
- * camera, every layer) and added to OUT, a path of the user's choice */
-bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n);
+ * camera, every layer) and added to OUT, a path of the user's choice; frames of w x h
+ * pixels (--size), or with w = 0 the default: 1280x720, a .gif 640x360 (for the web) */
+#define WB_RECORD_WIDTH 1280
+#define WB_RECORD_HEIGHT 720
+#define WB_RECORD_GIF_WIDTH 640
+#define WB_RECORD_GIF_HEIGHT 360
+bool wbl_record_begin(lua_State *L, const char *path, int w, int h, char *err, size_t n);
 bool wbl_record_end(lua_State *L, char *err, size_t n);   /* finish the file; prints where it went */
 /* the camera the scene set with wobble.camera{...}; false when it left the framing automatic */
 bool wbl_scene_camera(lua_State *L, double eye[3], double target[3], double up[3], double *fov);

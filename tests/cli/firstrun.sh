@@ -19,7 +19,7 @@ MAKE_BIN=$(command -v make)
 if [ -n "$MAKE_BIN" ]; then
     B="$TMP/bin"
     mkdir -p "$B"
-    for tool in grep mkdir tail env cat; do ln -s "$(command -v $tool)" "$B/$tool"; done
+    for tool in grep mkdir tail env cat tee awk rm; do ln -s "$(command -v $tool)" "$B/$tool"; done
     # dpkg-query: installed unless named in $FAKE_MISSING
     cat >"$B/dpkg-query" <<'SH'
 #!/bin/sh
@@ -35,9 +35,10 @@ SH
 #!/bin/sh
 echo "apt-get $* DEBIAN_FRONTEND=$DEBIAN_FRONTEND" >>"$FAKE_LOG"
 case $FAKE_APT in
-noisy) [ "$1" = install ] || exit 0; i=0; while [ $i -lt 1500 ]; do echo "Unpacking libfoo$i (1.0-1) ..."; i=$((i + 1)); done
+noisy) [ "$3" = install ] || exit 0; i=0; while [ $i -lt 1500 ]; do echo "Unpacking libfoo$i (1.0-1) ..."
+       echo "pmstatus:libfoo$i:$((i / 15)).0000:Unpacking libfoo$i (amd64)"; i=$((i + 1)); done
        echo "debconf: unable to initialize frontend: Dialog" >&2 ;;
-fail) [ "$1" = install ] && { echo "E: Unable to locate package ffmpeg" >&2; exit 100; } ;;
+fail) [ "$3" = install ] && { echo "E: Unable to locate package ffmpeg" >&2; exit 100; } ;;
 esac
 exit 0
 SH
@@ -63,17 +64,20 @@ SH
     deps FAKE_UID=1000
     cat "$TMP/apt.log" >>"$TMP/out" 2>/dev/null
     check "make deps, not root: through sudo, noninteractive apt-get" 0 \
-        out "sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq gcc ffmpeg" \
-        out "apt-get install -y -qq gcc ffmpeg DEBIAN_FRONTEND=noninteractive"
+        out "sudo env DEBIAN_FRONTEND=noninteractive apt-get -o APT::Status-Fd=1 install -y -q gcc ffmpeg" \
+        out "apt-get -o APT::Status-Fd=1 install -y -q gcc ffmpeg DEBIAN_FRONTEND=noninteractive"
     rm -f "$B/sudo"
 
     deps FAKE_UID=0 FAKE_APT=noisy
     lines=$(cat "$TMP/out" "$TMP/err" | wc -l)
     logged=$(grep -c "^Unpacking" "$TMP/b/deps.log" 2>/dev/null)
-    [ "$lines" -le 3 ] && [ "${logged:-0}" -eq 1500 ] || code="$code ($lines lines shown, ${logged:-0} logged)"
-    check "make deps as root: one line on what it installs, apt's 1,500 lines in the log" 0 \
-        out "installing Debian packages: gcc ffmpeg (apt-get's output: $TMP/b/deps.log)" !out "Unpacking" \
-        !err "debconf"
+    progress=$(grep -c "^  installing \[" "$TMP/out")
+    [ "$lines" -le 20 ] && [ "$progress" -ge 10 ] && [ "${logged:-0}" -eq 1500 ] ||
+        code="$code ($lines lines shown, $progress of progress, ${logged:-0} logged)"
+    check "make deps as root: what it installs, apt's progress a line each 10% (not a terminal), apt's 1,500 lines in the log" 0 \
+        out "installing Debian packages: gcc ffmpeg" out "apt-get's whole output: $TMP/b/deps.log" \
+        out "  installing [  0%] Unpacking libfoo0 (amd64)" out "  installing [ 90%] Unpacking libfoo1350 (amd64)" \
+        out "installed: gcc ffmpeg" !out "Unpacking libfoo0 (1.0-1)" !err "debconf"
 
     deps FAKE_UID=0 FAKE_APT=fail
     check "make deps: apt fails: exit 2, the end of its log and where the log is" 2 \

@@ -54,6 +54,9 @@ run "$W" run $F/swing.lua --frames 5 --record "$TMP/swing.gif"
 # 8 frames at 60 fps last 0.133 s; a GIF shows them at 50 fps (2 cs a frame): 7 frames, 0.14 s
 [ "$code" = 0 ] && [ "$(frames "$TMP/swing.gif")" = 7 ] && near "$(duration "$TMP/swing.gif")" 0.14 0.015; ok "--record .gif with --frames 5: 5 + 3 frames, as long as they last" $?
 grep -q "recorded 8 frames to $TMP/swing.gif" "$TMP/err"; ok "--record says where the frames went" $?
+[ "$(field "$TMP/swing.gif" width)" = 640 ] && [ "$(field "$TMP/swing.gif" height)" = 360 ]; ok "--record .gif: 640x360 by default (for the web)" $?
+run "$W" run $F/swing.lua --quiet --frames 2 --size 480x270 --record "$TMP/sized.gif"
+[ "$code" = 0 ] && [ "$(field "$TMP/sized.gif" width)" = 480 ] && [ "$(field "$TMP/sized.gif" height)" = 270 ]; ok "--record .gif --size 480x270: the size asked" $?
 
 run "$W" run $F/swing.lua --quiet --frames 2 --record "$TMP/pngs/"
 [ "$code" = 0 ] && [ -s "$TMP/pngs/frame_000000.png" ] && [ -s "$TMP/pngs/frame_000004.png" ] && [ ! -e "$TMP/pngs/frame_000005.png" ]; ok "--record folder/: numbered PNGs" $?
