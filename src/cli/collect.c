@@ -694,7 +694,7 @@ static int plot(const table *t, const char *spec, const char *png) {
     }
     text(&im, 20, 12, title, ink, 2);
     char err[PATH_MAX + 128];
-    int ok = wb_image_write_png(png, im.px, im.w, im.h, err, sizeof err);
+    int ok = wbl_write_png(png, im.px, im.w, im.h, err, sizeof err);
     free(im.px);
     if (!ok) return collect_error("--plot %s: %s", png, err);
     return EXIT_PASS;

@@ -1,6 +1,7 @@
 /* main.c: the `wobble` command line (DESIGN §4): run a scene, run scenario tests as
  * TAP 13, run the benchmark scenes. Exit codes: 0 ok, 1 a test or expectation
  * failed, 2 script or input error, 3 a budget was exceeded. */
+#include "io/io.h"
 #include "lua/input.h"
 #include "lua/wobble_lua.h"
 #include "render/render.h"
@@ -889,6 +890,7 @@ static int cmd_bench(opts *o) {
 
 int main(int argc, char **argv) {
     setvbuf(stdout, NULL, _IOLBF, 0);  /* TAP lines and script output in order through a pipe */
+    wbio_clean_on_signals();  /* Ctrl-C, kill, a closed terminal: no half-written file left */
     if (argc < 2) {
         fputs(usage_text, stderr);
         return EXIT_SCRIPT;

@@ -5,6 +5,7 @@
  * the Lua library folder. */
 #include "wobble_lua.h"
 #include "sandbox.h"
+#include "io/io.h"
 
 #include <lualib.h>
 
@@ -236,6 +237,7 @@ static void kill_children(void) {
 /* the grace period is over: the script cannot be stopped from inside, so end it */
 static _Noreturn void end_process(watchdog *wd) {
     kill_children();
+    wbio_remove_temporaries();  /* a file being written keeps its old version */
     /* what the script printed and stdio still holds, unless the main thread is inside
      * a write (its lock taken) */
     struct pollfd p = { STDOUT_FILENO, POLLOUT, 0 };
