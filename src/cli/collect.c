@@ -8,6 +8,7 @@
  * when both are grid keys, else a line per COLOUR value; failed and non-finite runs
  * are crossed out, so the picture is a stability map. */
 #include "sweep.h"
+#include "lua/util.h"
 #include "render/render.h"
 
 #include <cjson/cJSON.h>

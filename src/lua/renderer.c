@@ -63,21 +63,6 @@ static void release(wbl_renderer *u, size_t *slot)
     *slot = 0;
 }
 
-bool wbl_write_png(const char *path, const uint8_t *rgb, int w, int h, char *err, size_t n)
-{
-    size_t bytes;
-    char e[PATH_MAX + 160];
-    void *png = wb_image_encode_png(rgb, w, h, &bytes);
-    if (!png) {
-        snprintf(err, n, "out of memory encoding %s", path);
-        return false;
-    }
-    const bool ok = wbio_write_bytes(AT_FDCWD, path, path, png, bytes, e, sizeof e) == 0;
-    free(png);
-    if (!ok) snprintf(err, n, "cannot write %s", e);
-    return ok;
-}
-
 static bool write_frame(void *ud, const char *name, const void *data, size_t n, char *err, size_t en)
 {
     const rec_files *f = ud;

@@ -207,9 +207,6 @@ void wbl_open_renderer(lua_State *L);   /* wobble.renderer, probe, read_png, rea
  * camera, every layer) and added to OUT, a path of the user's choice */
 bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n);
 bool wbl_record_end(lua_State *L, char *err, size_t n);   /* finish the file; prints where it went */
-/* a PNG of rgb written whole to path (a temporary renamed into place, a link at path
- * replaced, not followed); false with "cannot write path: reason" */
-bool wbl_write_png(const char *path, const uint8_t *rgb, int w, int h, char *err, size_t n);
 /* the live skins of the world at world_index, ready to draw (Lua userdata left on the
  * stack, collected with it); *n their count (the viewer draws with it too) */
 wb_draw_skin *wbl_world_skins(lua_State *L, int world_index, int *n);
