@@ -456,9 +456,10 @@ static int w_record_vtk(lua_State *L)
     const char *pvd_name = lua_pushfstring(L, "%s.pvd", stem);
     char pvd[PATH_MAX], dir[PATH_MAX], err[1024];
     wbl_path(L, pvd_name, 1, pvd, sizeof pvd);
-    /* the folder beside it, made by resolving a file inside it */
-    wbl_path(L, lua_pushfstring(L, "%s/frame_000000.vtp", stem), 1, dir, sizeof dir);
-    *strrchr(dir, '/') = '\0';
+    /* the folder beside it, made by resolving it as a folder; its frames are written
+     * each whole, a link among them replaced, never followed */
+    wbl_path(L, lua_pushfstring(L, "%s/", stem), 1, dir, sizeof dir);
+    for (size_t k = strlen(dir); k > 1 && dir[k - 1] == '/'; k--) dir[k - 1] = '\0';
     const char *base = strrchr(stem, '/');
     base = base ? base + 1 : stem;
     lua_settop(L, 3);
