@@ -94,7 +94,7 @@ SEC=$TMP/secret
 cat >"$S/writers.lua" <<'EOF'
 local how, name = wobble.args.how, wobble.args.name
 local w = wobble.world{}
-local body = w:lattice{ min = {0, 0, 0}, max = {1, 1, 1}, res = {2, 2, 2} }
+local body = w:lattice{ min = {0, 0, 0}, max = {1, 1, 1}, res = {2, 2, 2}, tets = true }
 local m = wobble.mesh{ vertices = { {0, 0, 0}, {1, 0, 0}, {0, 1, 0} }, triangles = { {1, 2, 3} } }
 local function r() return wobble.renderer{ width = 16, height = 16, backend = "null" } end
 local calls = {
@@ -144,6 +144,14 @@ link_case() {
         result "$how: a link at $link to $([ $kind = made ] && echo nothing || echo a file outside)" "$why"
     done
 }
+ctl=""  # without a link in the way every one of them writes (so a refusal below is the link's)
+for c in io_w:f.txt io_a:f.txt io_rw:f.txt io_output:g.txt save_vtp:f.vtp save:f.json save_obj:m.obj \
+         skin_obj:s.obj save_ply:m.ply save_stl:m.stl save_tets:t pc2:c.pc2 pc2_rest:d.pc2 vtk:v \
+         save_png:p.png plot:q.png record:v.mp4 record:frames/; do
+    run "$WD" run "$S/writers.lua" --out "$TMP/lk-plain" --set how=${c%%:*} --set name=${c#*:}
+    grep -q "wrote ${c#*:}" "$TMP/out" || ctl="$ctl ${c%%:*}"
+done
+result "every writer writes where no link is in the way" "${ctl:+failed:$ctl}"
 for how in io_w io_a io_rw io_output save_vtp save; do link_case $how f.txt f.txt; done
 link_case save_obj m.obj m.obj
 link_case skin_obj s.obj s.obj
