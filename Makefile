@@ -185,6 +185,10 @@ build: $(BUILD)/input_driver
 $(BUILD)/input_driver: tests/cli/input_driver.c $(DRIVER_OBJ) $(BUILD)/libwobble.a $(HEADERS)
 	$(CC) $(CFLAGS) $(PC_CFLAGS) -o $@ tests/cli/input_driver.c $(DRIVER_OBJ) $(BUILD)/libwobble.a \
 	  $(LDFLAGS) $(PC_LIBS) -lm
+# tests/cli/budget.sh: the peak resident memory of a run's whole process tree
+build: $(BUILD)/treepeak
+$(BUILD)/treepeak: tests/cli/treepeak.c
+	$(CC) $(CFLAGS) -o $@ $< $(LDFLAGS)
 # ---- a one-node Slurm (README, "Sweeps"): `make test-cluster` starts munged, slurmctld and
 # slurmd in a temporary folder, runs a sweep's job array through sbatch and collects it;
 # CLUSTER_PKGS are installed by it alone, never by `make test`; needs root

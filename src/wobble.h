@@ -74,15 +74,19 @@ typedef struct wb_world_def {
     bool contacts;        /* particle-particle contacts, default true */
     wb_real max_depenetration; /* m/s: how fast contacts push out an overlap a pair already had
                                   (bodies made inside each other), default 0.25; >= 0 */
-    wb_memory *memory;    /* budget the world's arrays are charged to; NULL = none (not copied by set_def) */
+    wb_memory *memory;    /* budget the world, its worker threads and its arrays are charged to; NULL =
+                             none (not copied by set_def) */
 } wb_world_def;
 
 wb_world_def wb_world_default_def(void);                      /* the defaults above */
 const char *wb_world_def_check(const wb_world_def *def);      /* NULL, or what is wrong ("dt must be > 0") */
-wb_world *wb_world_create(const wb_world_def *def);           /* NULL when out of memory; def must pass check */
+wb_world *wb_world_create(const wb_world_def *def);           /* NULL when out of memory (or over def->memory,
+                                                                 which is charged the world and its threads);
+                                                                 def must pass check */
 void wb_world_destroy(wb_world *w);                           /* NULL is fine */
 wb_world_def wb_world_get_def(const wb_world *w);             /* current settings */
-wb_status wb_world_set_def(wb_world *w, const wb_world_def *def); /* change settings between steps */
+wb_status wb_world_set_def(wb_world *w, const wb_world_def *def); /* change settings between steps;
+                                                                    WB_ERR_NOMEM: the threads do not fit the budget */
 
 wb_status wb_world_step(wb_world *w);                         /* one frame of dt, all substeps */
 /* polled once per substep; a nonzero answer abandons the step (WB_ERR_INTERRUPTED),
@@ -316,6 +320,8 @@ typedef struct wb_stats {
     int32_t particle_contacts; /* particle pairs and particle-triangle pairs overlapping or in touch
                                   in the last substep */
     double broad_ms;          /* broad phase of the last step */
+    int32_t broad_remakes;    /* particle contact lists made again within the last step (a
+                                 particle moved farther than the list's reach allowed) */
     int64_t projections;      /* constraint projections in the last step, every type's (a
                                  shape-matching cluster or a pressure body counts one) */
     double step_ms;           /* wall time of the last step */

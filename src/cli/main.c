@@ -480,12 +480,17 @@ static void tap_result(tap *t, int code, const char *file, const char *name, con
  * the summary, so the TAP stream ends as it does for any other budget. */
 static void tap_last_words(lua_State *L, const tap *t, const char *file, const char *what) {
     double limit = wb_rt_get(L)->time_budget;
+    size_t mem = wb_rt_get(L)->memory_budget;
     char *buf = NULL, msg[PATH_MAX + 256];
     size_t len = 0;
     FILE *f;
-    if (limit <= 0 || !(f = open_memstream(&buf, &len))) return;
-    snprintf(msg, sizeof msg, "%s: time limit of %g s exceeded (--time-limit SECONDS); ended by the watchdog", file,
-             limit);
+    if ((limit <= 0 && !mem) || !(f = open_memstream(&buf, &len))) return;
+    if (limit > 0)
+        snprintf(msg, sizeof msg, "%s: time limit of %g s exceeded (--time-limit SECONDS); ended by the watchdog", file,
+                 limit);
+    else
+        snprintf(msg, sizeof msg, "%s: memory limit of %d MB exceeded (--memory-limit MB); ended by the watchdog", file,
+                 (int)(mem >> 20));
     tap_line(f, t->n + 1, EXIT_BUDGET, file, what, msg);
     fprintf(f, "1..%d\n%d passed, %d failed\n", t->n + 1, t->passed, t->failed + 1);
     if (fclose(f) == 0) wb_rt_set_last_words(L, buf);
@@ -611,11 +616,17 @@ static void list_free(list *l) {
 /* the finalizers run under the time budget: past it, they fail the file */
 static void close_test_state(lua_State *L, tap *t, const char *path) {
     double limit = wb_rt_get(L)->time_budget;
+    size_t mem = wb_rt_get(L)->memory_budget;
     tap_last_words(L, t, path, "closing the file (finalizers)");
-    if (wb_rt_close(L)) {
+    int late = wb_rt_close(L);
+    if (late) {
         char msg[PATH_MAX + 128];
-        snprintf(msg, sizeof msg, "%s: time limit of %g s exceeded (--time-limit SECONDS) while the finalizers (__gc) ran",
-                 path, limit);
+        if (late == WB_RT_LATE_TIME)
+            snprintf(msg, sizeof msg, "%s: time limit of %g s exceeded (--time-limit SECONDS) while the finalizers (__gc) ran",
+                     path, limit);
+        else
+            snprintf(msg, sizeof msg, "%s: memory limit of %d MB exceeded (--memory-limit MB) while the finalizers (__gc) ran",
+                     path, (int)(mem >> 20));
         tap_result(t, EXIT_BUDGET, path, "closing the file (finalizers)", msg);
     }
 }
@@ -772,10 +783,16 @@ static int run_scene(const opts *o, const char *path, run_report *rep) {
     }
     wb_rt_pause_watchdog(L, 0);
     report_take(rep, L);
-    if (wb_rt_close(L) && code < EXIT_BUDGET) {  /* finalizers ran past the limit */
+    int late = wb_rt_close(L);
+    if (late == WB_RT_LATE_TIME && code < EXIT_BUDGET) {  /* finalizers ran past the limit */
         report_error(rep, "time limit exceeded while the finalizers (__gc) ran at the end");
         fprintf(stderr, "%s: time limit of %g s exceeded (--time-limit SECONDS) while the finalizers (__gc) ran at the end\n",
                 path, o->rt.time_budget);
+        code = EXIT_BUDGET;
+    } else if (late == WB_RT_LATE_MEMORY && code < EXIT_BUDGET) {
+        report_error(rep, "memory limit exceeded while the finalizers (__gc) ran at the end");
+        fprintf(stderr, "%s: memory limit of %d MB exceeded (--memory-limit MB) while the finalizers (__gc) ran at the end\n",
+                path, (int)(o->rt.memory_budget >> 20));
         code = EXIT_BUDGET;
     }
     return code;

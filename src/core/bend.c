@@ -254,7 +254,7 @@ static wb_status bend_prepare(wb_world *w)
     uint8_t *colour = malloc((size_t)(b->n > 0 ? b->n : 1));
     int32_t count[WB_MAX_COLOURS + 1], start[WB_MAX_COLOURS + 1];
     if (!colour || !pack_alloc(b, b->n) ||
-        !wb__colour_greedy(&w->m, b->ij, 4, b->n, always, NULL, colour, count)) {
+        !wb__colour_greedy(&w->m, b->ij, 4, b->n, always, NULL, colour, count, NULL)) {
         free(colour);
         return WB_ERR_NOMEM;
     }
@@ -570,18 +570,7 @@ static int simd_state = -1;
  * path where the CPU has it; returns whether the vector path is on. Not thread-safe:
  * call it between steps. */
 int wb__bend_simd(int on);
-int wb__bend_simd(int on)
-{
-#ifdef WB_BEND_AVX2
-    __builtin_cpu_init();
-    const int v = on && __builtin_cpu_supports("avx2");
-#else
-    const int v = 0;
-    (void)on;
-#endif
-    __atomic_store_n(&simd_state, v, __ATOMIC_RELAXED);
-    return v;
-}
+int wb__bend_simd(int on) { return wb__simd_set(&simd_state, on); }
 
 /* [lo, hi) of one batch; apart: it shares no movable particle (not the serial tail) */
 static void project_batch(wb_world *w, int32_t lo, int32_t hi, int apart)

@@ -364,6 +364,13 @@ static int32_t broad(wb_broad *b, wb_pairbuf *o, const wb_real *x, const wb_real
     }
     for (int64_t q = ncell; q > 0; q--) start[q] = start[q - 1]; /* back to starts */
     start[0] = 0;
+    /* the grid stays for the kept list's mends (wb__contacts_recheck): whether it holds
+     * every candidate, its shape and its largest reach */
+    b->lg = g.g;
+    b->lm = m;
+    b->lfull = m == na;
+    b->lrmax = 0;
+    for (int32_t k = 0; k < m; k++) b->lrmax = b->p[4 * k + 3] > b->lrmax ? b->p[4 * k + 3] : b->lrmax;
 
     /* pass 3: contiguous ranges of the sorted array, one pair buffer each */
     const int threads = wb__pool_threads(pool);
@@ -415,6 +422,8 @@ int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, c
     if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
     wb_pairbuf o = { c->ij, c->n, c->cap, 0, NULL, 0 };
     const int32_t r = broad(c->bp, &o, x, reach, skip, n, pool, keep, ud);
+    c->bp->vn = 0; /* its grid is no longer the kept list's */
+    c->bp->lgrid = 0;
     c->ij = o.ij;
     c->cap = o.cap;
     if (r >= 0) c->n = r;
@@ -488,7 +497,9 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
         }
         if (n > 0) memcpy(b->vx, x, sizeof *x * 3 * (size_t)n);
         b->list.n = 0;
+        b->lgrid = 0;
         if (broad(b, &b->list, x, b->vr, skip, n, pool, NULL, NULL) < 0) return -1;
+        b->lgrid = 1;
         b->vn = n;
         b->rebuilds++;
     }
@@ -514,6 +525,13 @@ static int cmp_u64(const void *a, const void *b)
 {
     uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
     return x < y ? -1 : x > y;
+}
+
+/* pairs (i, j) in (i, j) order */
+static int cmp_pair(const void *pa, const void *pb)
+{
+    const int32_t *a = pa, *b = pb;
+    return a[0] != b[0] ? (a[0] < b[0] ? -1 : 1) : (a[1] > b[1]) - (a[1] < b[1]);
 }
 
 static uint64_t pair_key(int32_t a, int32_t b)
@@ -727,11 +745,12 @@ static int any_possible(const wb_model *m)
  * is how far it can get in that time (its velocity and gravity), plus a quarter of its
  * radius for what the constraints move it; kept in c->xf for the substeps' checks.
  * Returns the pairs, or -1 when out of memory */
-static int32_t make_list(wb_world *w, wb_real t)
+static int32_t make_list(wb_world *w, wb_real t, wb_real margin)
 {
     wb_model *m = &w->m;
     wb_contacts *c = &w->k.pc;
     c->check = 0;
+    c->nfixed = 0; /* every particle's xf and reach from here */
     wb_real *reach = wb__grow(c->reach, &c->cap_reach, m->np, sizeof *reach);
     if (reach) c->reach = reach;
     int32_t *skip = wb__grow(c->skip, &c->cap_skip, m->np, sizeof *skip);
@@ -747,7 +766,7 @@ static int32_t make_list(wb_world *w, wb_real t)
         /* may_touch's rules: other bodies need `collide`, its own body `self_collide` */
         if (!((f & WB_CF_COLLIDE) || (gi > 0 && (f & WB_CF_SELF)))) { reach[i] = -1; continue; }
         const wb_real *p = &w->s.x[3 * i];
-        reach[i] = m->radius[i] * (wb_real)1.25 + v3_len_fast(&v[3 * i]) * t + g;
+        reach[i] = m->radius[i] * (1 + margin) + v3_len_fast(&v[3 * i]) * t + g;
         if (!isfinite(reach[i] + p[0] + p[1] + p[2])) reach[i] = -1;
         /* a body that does not collide with itself: its pairs are left out before the
          * distance test, and its inside is culled by its bounds */
@@ -771,6 +790,7 @@ void wb__contacts_begin(wb_world *w)
     c->broad_ms = 0;
     c->check = 0;
     c->sub = 0;
+    c->remakes_frame = 0;
     if (!m->def.contacts || m->np < 2) return;
     if (!wb__contact_rules(w)) {
         c->possible = 0; /* the triangles' broad phase asks the same rules */
@@ -784,7 +804,7 @@ void wb__contacts_begin(wb_world *w)
     }
     if (!c->possible) return;
     const double t0 = now_ms();
-    if (make_list(w, m->def.dt) < 0) {
+    if (make_list(w, m->def.dt, (wb_real)0.25) < 0) {
         c->n = 0;
         wb__warn(w, "out of memory in the contact broad phase; contacts skipped");
     }
@@ -797,6 +817,131 @@ void wb__contacts_begin(wb_world *w)
  * So each substep checks every particle against that, and one that moved farther (the
  * list would then be missing pairs) has the list made again from where the particles
  * are, for the rest of the frame. */
+/* A particle that moved too far: its reach made again from where it is, for the rest of
+ * the frame t, and its pairs looked for among every particle's frame bounds: one within
+ * its reach stays within reach_j - r_j of xf_j, so one it could touch is within
+ * reach_i + reach_j of it. The kept list's grid finds them: xf_j is within R_j - reach_j
+ * of where the grid has j (the list held, or was made, at xf), so they are within
+ * reach_i + R_j of the grid's j. Particles mended earlier in the frame (their xf and
+ * reach changed) are tried one by one, and every particle when the grid lacks some (its
+ * bodies culled) or would be searched too widely. The new pairs are merged into the
+ * list. Returns 0 when out of memory */
+#define REPAIR_MAX 1024
+
+static int add_pair(wb_world *w, int32_t i, int32_t j, int32_t *na)
+{
+    wb_contacts *c = &w->k.pc;
+    const wb_real *xf = c->xf, *reach = c->reach, *p = &w->s.x[3 * i];
+    if (j == i || reach[j] < 0) return 1;
+    const wb_real d0 = xf[3 * j] - p[0], d1 = xf[3 * j + 1] - p[1], d2 = xf[3 * j + 2] - p[2];
+    const wb_real R = reach[i] + reach[j];
+    if (!(d0 * d0 + d1 * d1 + d2 * d2 < R * R)) return 1;
+    const int32_t a = i < j ? i : j, b = i < j ? j : i;
+    if (c->skip[a] != 0 && c->skip[a] == c->skip[b]) return 1;
+    if (!may_touch(w, a, b)) return 1;
+    if (!grow((void **)&c->add, &c->cap_add, 2 * ((int64_t)*na + 1), sizeof *c->add)) return 0;
+    c->add[2 * *na] = a;
+    c->add[2 * *na + 1] = b;
+    (*na)++;
+    return 1;
+}
+
+/* the grid's particles within e of p, through add_pair; 0: too wide a search (or out of
+ * memory: *fail) */
+static int grid_pairs(wb_world *w, const wb_broad *b, int32_t i, wb_real e, int32_t *na, int *fail)
+{
+    const wb_grid *G = &b->lg;
+    const wb_real *p = &w->s.x[3 * i];
+    if (!(e * G->inv <= 8)) return 0;
+    int64_t rx[4], ry[4], rz[4];
+    const int kx = axis_ranges(G, 0, p[0], e, rx), ky = axis_ranges(G, 1, p[1], e, ry), kz = axis_ranges(G, 2, p[2], e, rz);
+    /* a particle past the grid's far side (it moved out of the box the grid was made
+     * for): an axis's range is empty there, and no grid particle is near it that way */
+    if (rx[0] > rx[1] || ry[0] > ry[1] || rz[0] > rz[1]) return 1;
+    for (int az = 0; az < kz; az++)
+        for (int64_t z = rz[2 * az]; z <= rz[2 * az + 1]; z++)
+            for (int ay = 0; ay < ky; ay++)
+                for (int64_t y = ry[2 * ay]; y <= ry[2 * ay + 1]; y++) {
+                    const int64_t row = G->nc[0] * (y + G->nc[1] * z);
+                    for (int ax = 0; ax < kx; ax++)
+                        for (int32_t t = b->start[row + rx[2 * ax]]; t < b->start[row + rx[2 * ax + 1] + 1]; t++)
+                            if (!add_pair(w, i, b->id[t], na)) { *fail = 1; return 1; }
+                }
+    return 1;
+}
+
+static int repair(wb_world *w, const int32_t *moved, int32_t nm, wb_real t, wb_real margin)
+{
+    wb_model *m = &w->m;
+    wb_contacts *c = &w->k.pc;
+    const wb_broad *b = c->bp;
+    wb_real *xf = c->xf, *reach = c->reach;
+    const wb_real *x = w->s.x, *v = w->s.v, g = v3_len(m->def.gravity) * t * t;
+    /* the particles mended this frame: these and the earlier ones */
+    if (!grow((void **)&c->fixed, &c->cap_fixed, (int64_t)c->nfixed + nm, sizeof *c->fixed)) return 0;
+    for (int32_t k = 0; k < nm; k++) {
+        const int32_t i = moved[k];
+        const wb_real *p = &x[3 * i];
+        v3_copy(&xf[3 * i], p);
+        const wb_real r = m->radius[i] * (1 + margin) + v3_len_fast(&v[3 * i]) * t + g;
+        reach[i] = isfinite(r + p[0] + p[1] + p[2]) ? r : -1;
+        c->fixed[c->nfixed++] = i;
+    }
+    const int use_grid = b && b->lgrid && b->lfull && b->vn == m->np;
+    int32_t na = 0;
+    int fail = 0;
+    for (int32_t k = 0; k < nm && !fail; k++) {
+        const int32_t i = moved[k];
+        if (reach[i] < 0) continue;
+        if (use_grid && grid_pairs(w, b, i, reach[i] + b->lrmax, &na, &fail)) {
+            for (int32_t q = 0; q < c->nfixed && !fail; q++) fail = !add_pair(w, i, c->fixed[q], &na);
+            continue;
+        }
+        for (int32_t j = 0; j < m->np && !fail; j++) fail = !add_pair(w, i, j, &na);
+    }
+    if (fail) return 0;
+    if (na == 0) return 1;
+    /* the new pairs in order, each once and not already listed */
+    qsort(c->add, (size_t)na, 2 * sizeof *c->add, cmp_pair);
+    int32_t nb = 0;
+    for (int32_t q = 0; q < na; q++) {
+        const int32_t *e = &c->add[2 * q];
+        if (nb > 0 && cmp_pair(&c->add[2 * nb - 2], e) == 0) continue;
+        int32_t lo = 0, hi = c->n;
+        while (lo < hi) {
+            const int32_t mid = lo + (hi - lo) / 2;
+            if (cmp_pair(&c->ij[2 * mid], e) < 0) lo = mid + 1;
+            else hi = mid;
+        }
+        if (lo < c->n && cmp_pair(&c->ij[2 * lo], e) == 0) continue;
+        c->add[2 * nb] = e[0];
+        c->add[2 * nb + 1] = e[1];
+        nb++;
+    }
+    if (nb == 0) return 1;
+    /* merged from the back into the list, and what each pair was left with along with
+     * it (a new pair: NaN, worked out by contact.c) */
+    const int have_left = !c->fresh && c->left && c->cap_left >= c->n;
+    if (!grow((void **)&c->ij, &c->cap, 2 * ((int64_t)c->n + nb), sizeof *c->ij)) return 0;
+    if (have_left && !grow((void **)&c->left, &c->cap_left, (int64_t)c->n + nb, sizeof *c->left)) return 0;
+    int32_t *ij = c->ij, p = c->n - 1, q = nb - 1, o = c->n + nb - 1;
+    for (; q >= 0; o--) {
+        if (p >= 0 && cmp_pair(&ij[2 * p], &c->add[2 * q]) > 0) {
+            ij[2 * o] = ij[2 * p];
+            ij[2 * o + 1] = ij[2 * p + 1];
+            if (have_left) c->left[o] = c->left[p];
+            p--;
+        } else {
+            ij[2 * o] = c->add[2 * q];
+            ij[2 * o + 1] = c->add[2 * q + 1];
+            if (have_left) c->left[o] = NAN;
+            q--;
+        }
+    }
+    c->n += nb;
+    return 1;
+}
+
 int wb__contacts_recheck(wb_world *w, wb_real h)
 {
     wb_model *m = &w->m;
@@ -808,22 +953,44 @@ int wb__contacts_recheck(wb_world *w, wb_real h)
     for (int32_t i = 0; i < m->np; i++) {
         const wb_real e = reach[i] - rad[i];
         const wb_real d0 = x[3 * i] - xf[3 * i], d1 = x[3 * i + 1] - xf[3 * i + 1], d2 = x[3 * i + 2] - xf[3 * i + 2];
-        /* (a reach < 0 is no candidate; a position gone non-finite fails and is left out
-         * by the remade list) */
+        /* (a reach < 0 is no candidate; a position gone non-finite fails and is left out) */
         moved |= (reach[i] >= 0) & !(d0 * d0 + d1 * d1 + d2 * d2 <= e * e);
     }
     if (!moved) return 0;
+    c->remakes++;
+    c->remakes_frame++;
+    const double t0 = now_ms();
+    /* what is left of the frame, this substep included; the constraints moved some
+     * particle farther than its margin allowed: the rest of the frame allows twice as
+     * much each time, so a frame makes the list again a few times at most */
+    const wb_real left = m->def.dt - (wb_real)sub * h, t = left > h ? left : h;
+    const wb_real margin = (wb_real)0.25 * (wb_real)(1 << (c->remakes_frame < 4 ? c->remakes_frame : 4));
+    int32_t nm = 0, r;
+    int32_t *mv = wb__grow(c->fix, &c->cap_fix, REPAIR_MAX, sizeof *mv);
+    if (mv) {
+        c->fix = mv;
+        for (int32_t i = 0; i < m->np && nm <= REPAIR_MAX; i++) {
+            const wb_real e = reach[i] - rad[i];
+            const wb_real d0 = x[3 * i] - xf[3 * i], d1 = x[3 * i + 1] - xf[3 * i + 1], d2 = x[3 * i + 2] - xf[3 * i + 2];
+            if (reach[i] >= 0 && !(d0 * d0 + d1 * d1 + d2 * d2 <= e * e)) {
+                if (nm < REPAIR_MAX) mv[nm] = i;
+                nm++;
+            }
+        }
+    }
+    if (mv && nm <= REPAIR_MAX) {
+        r = repair(w, mv, nm, t, margin);
+        c->broad_ms += now_ms() - t0;
+        if (!r) { c->n = 0; c->check = 0; return -1; }
+        return 2;
+    }
     /* the old list kept for what its pairs were left with */
     int32_t *io = wb__grow(c->ij_old, &c->cap_old, 2 * (c->n > 0 ? c->n : 1), sizeof *io);
     if (!io) { c->n = 0; c->check = 0; return -1; }
     c->ij_old = io;
     if (c->n > 0) memcpy(io, c->ij, sizeof *io * 2 * (size_t)c->n);
     c->n_old = c->n;
-    c->remakes++;
-    /* what is left of the frame, this substep included */
-    const wb_real left = m->def.dt - (wb_real)sub * h;
-    const double t0 = now_ms();
-    const int32_t r = make_list(w, left > h ? left : h);
+    r = make_list(w, t, margin);
     c->broad_ms += now_ms() - t0;
     if (r < 0) { c->n = 0; c->check = 0; return -1; }
     return 1;

@@ -345,6 +345,16 @@ wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real
 {
     wb_real r[3], l[3], nl[3];
     v3_sub(r, x, p);
+    if (s->shape == WB_SHAPE_SPHERE) {
+        /* round: no turn into its frame and back (two quaternion rotations a contact) */
+        const wb_real len = v3_len(r);
+        if (len > 0) v3_scale(n, r, 1 / len);
+        else {
+            v3_set(nl, 0, 1, 0);
+            q_rotate(q, nl, n);
+        }
+        return len - s->radius;
+    }
     q_rotate_inv(q, r, l);
     wb_real dist;
     switch (s->shape) {
@@ -838,6 +848,35 @@ AVX2_INLINE void aos4(wb_real *p, __m256d x, __m256d y, __m256d z)
     _mm256_storeu_pd(p + 8, _mm256_permute2f128_pd(m, v, 0x31));
 }
 
+/* the made-overlap correction of a group some of whose contacts began inside or keep an
+ * overlap (out of line: the common loop keeps its registers) */
+static __attribute__((noinline, target("avx2"))) void
+made_group(__m256d *pX, __m256d *pY, __m256d *pZ, __m256d *pPX, __m256d *pPY, __m256d *pPZ, __m256d *plnew,
+           int *pmoved, __m256d depth, __m256d d0, __m256d lk, __m256d pos, __m256d in, __m256d n0, __m256d n1,
+           __m256d n2, __m256d stepv)
+{
+    const __m256d zero = _mm256_setzero_pd();
+    __m256d X = *pX, Y = *pY, Z = *pZ, PX = *pPX, PY = *pPY, PZ = *pPZ, lnew;
+    int moved = 0;
+    const __m256d d0c = _mm256_and_pd(pos, _mm256_min_pd(d0, depth));
+    const __m256d kept = _mm256_min_pd(d0c, lk), t = _mm256_sub_pd(lk, stepv);
+    const __m256d kp = _mm256_and_pd(_mm256_cmp_pd(t, zero, _CMP_GT_OQ), _mm256_min_pd(t, d0c));
+    const __m256d shift = _mm256_add_pd(_mm256_sub_pd(kept, kp), _mm256_sub_pd(d0c, kept));
+    const __m256d corr = _mm256_sub_pd(depth, kp);
+    lnew = kp;
+    X = _mm256_blendv_pd(X, _mm256_add_pd(X, _mm256_mul_pd(n0, corr)), in);
+    Y = _mm256_blendv_pd(Y, _mm256_add_pd(Y, _mm256_mul_pd(n1, corr)), in);
+    Z = _mm256_blendv_pd(Z, _mm256_add_pd(Z, _mm256_mul_pd(n2, corr)), in);
+    const __m256d mv = _mm256_and_pd(in, _mm256_cmp_pd(shift, zero, _CMP_GT_OQ));
+    if (_mm256_movemask_pd(mv)) {
+        PX = _mm256_blendv_pd(PX, _mm256_add_pd(PX, _mm256_mul_pd(n0, shift)), mv);
+        PY = _mm256_blendv_pd(PY, _mm256_add_pd(PY, _mm256_mul_pd(n1, shift)), mv);
+        PZ = _mm256_blendv_pd(PZ, _mm256_add_pd(PZ, _mm256_mul_pd(n2, shift)), mv);
+        moved = 1;
+    }
+    *pX = X; *pY = Y; *pZ = Z; *pPX = PX; *pPY = PY; *pPZ = PZ; *plnew = lnew; *pmoved = moved;
+}
+
 /* The one-plane pass (collide_range, planes == 2) four particles at a time: the same
  * operations in the same order per value (lanes out of contact blended back, not
  * computed differently), so the same bits. Groups with a pinned particle, or in contact
@@ -883,6 +922,7 @@ AVX2_INLINE void plane_range_avx2(collide_job *j, int32_t lo, int32_t hi, const 
         soa4(&v[3 * i], &VX, &VY, &VZ);
         __m256d cvn = zero, lnew = zero;
         int moved = 0; /* some lane's x_prev moved (an old overlap's repair) */
+        int nokeep = 0;
         if (inm) {
             /* made_contact: the overlap at x_prev, what of it was kept, what stays, the
              * correction; the new left and x_prev's shift */
@@ -890,21 +930,16 @@ AVX2_INLINE void plane_range_avx2(collide_job *j, int32_t lo, int32_t hi, const 
                 _mm256_sub_pd(ro, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(n0, PX), _mm256_mul_pd(n1, PY)),
                                                 _mm256_mul_pd(n2, PZ)));
             const __m256d lk = fresh ? _mm256_and_pd(_mm256_cmp_pd(d0, stepv, _CMP_GT_OQ), d0) : _mm256_loadu_pd(&cl[i]);
-            const __m256d d0c = _mm256_and_pd(_mm256_cmp_pd(d0, zero, _CMP_GT_OQ), _mm256_min_pd(d0, depth));
-            const __m256d kept = _mm256_min_pd(d0c, lk), t = _mm256_sub_pd(lk, stepv);
-            const __m256d kp = _mm256_and_pd(_mm256_cmp_pd(t, zero, _CMP_GT_OQ), _mm256_min_pd(t, d0c));
-            const __m256d shift = _mm256_add_pd(_mm256_sub_pd(kept, kp), _mm256_sub_pd(d0c, kept));
-            const __m256d corr = _mm256_sub_pd(depth, kp);
-            lnew = kp;
-            X = _mm256_blendv_pd(X, _mm256_add_pd(X, _mm256_mul_pd(n0, corr)), in);
-            Y = _mm256_blendv_pd(Y, _mm256_add_pd(Y, _mm256_mul_pd(n1, corr)), in);
-            Z = _mm256_blendv_pd(Z, _mm256_add_pd(Z, _mm256_mul_pd(n2, corr)), in);
-            const __m256d mv = _mm256_and_pd(in, _mm256_cmp_pd(shift, zero, _CMP_GT_OQ));
-            if (_mm256_movemask_pd(mv)) {
-                PX = _mm256_blendv_pd(PX, _mm256_add_pd(PX, _mm256_mul_pd(n0, shift)), mv);
-                PY = _mm256_blendv_pd(PY, _mm256_add_pd(PY, _mm256_mul_pd(n1, shift)), mv);
-                PZ = _mm256_blendv_pd(PZ, _mm256_add_pd(PZ, _mm256_mul_pd(n2, shift)), mv);
-                moved = 1;
+            const __m256d pos = _mm256_cmp_pd(d0, zero, _CMP_GT_OQ);
+            if (!_mm256_movemask_pd(_mm256_and_pd(in, _mm256_or_pd(pos, _mm256_cmp_pd(lk, zero, _CMP_NEQ_UQ))))) {
+                /* no contact began the substep inside nor keeps an overlap: all of it is
+                 * new, pushed out in full (shift 0, left 0) */
+                X = _mm256_blendv_pd(X, _mm256_add_pd(X, _mm256_mul_pd(n0, depth)), in);
+                Y = _mm256_blendv_pd(Y, _mm256_add_pd(Y, _mm256_mul_pd(n1, depth)), in);
+                Z = _mm256_blendv_pd(Z, _mm256_add_pd(Z, _mm256_mul_pd(n2, depth)), in);
+                nokeep = 1;
+            } else {
+                made_group(&X, &Y, &Z, &PX, &PY, &PZ, &lnew, &moved, depth, d0, lk, pos, in, n0, n1, n2, stepv);
             }
             cvn = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(VX, n0), _mm256_mul_pd(VY, n1)), _mm256_mul_pd(VZ, n2));
         }
@@ -927,7 +962,7 @@ AVX2_INLINE void plane_range_avx2(collide_job *j, int32_t lo, int32_t hi, const 
             ncontacts += __builtin_popcount((unsigned)inm);
         }
         /* left: the contacts' new one, the others' as it was (at a frame's start, none) */
-        if (inm || fresh)
+        if ((inm && !nokeep) || fresh)
             _mm256_storeu_pd(&cl[i], _mm256_blendv_pd(fresh ? zero : _mm256_loadu_pd(&cl[i]), lnew, in));
         if (!fuse && moved) aos4(&xp[3 * i], PX, PY, PZ);
         if (fuse) {

@@ -82,7 +82,8 @@ static uint64_t key_hash(const int64_t *key)
  * the groups whose members share a movable particle last. Returns how many (-1: out of
  * memory). A hash table finds the groups; only the groups are sorted. */
 static int32_t visit_order(const wb_model *m, const int32_t *idx, int k, int32_t n,
-                           int (*live)(const void *ud, int32_t i), const void *ud, int32_t *order)
+                           int (*live)(const void *ud, int32_t i), const void *ud, int32_t *order,
+                           wb_split *split)
 {
     const int32_t np = m->np;
     const size_t npa = (size_t)(np > 0 ? np : 1), na = (size_t)(n > 0 ? n : 1);
@@ -93,9 +94,11 @@ static int32_t visit_order(const wb_model *m, const int32_t *idx, int k, int32_t
     int32_t *table = malloc(sizeof *table * tsize);
     int64_t *key = malloc(sizeof *key * NKEY * na);
     wb_real *box = malloc(sizeof *box * 6 * npa);
+    /* (split: each particle's member in the group being split, and a union-find over them) */
+    int32_t *owner = split ? malloc(sizeof *owner * npa) : NULL, *uf = split ? malloc(sizeof *uf * 3 * (na + 1)) : NULL;
     gkey *gk = NULL;
     int32_t nl = -1;
-    if (!parent || !con || !group || !first || !table || !key || !box) goto out;
+    if (!parent || !con || !group || !first || !table || !key || !box || (split && (!owner || !uf))) goto out;
     /* the bodies (union-find over the live constraints) and their bounds */
     for (int32_t p = 0; p < np; p++) parent[p] = p;
     int32_t nlive = 0;
@@ -189,12 +192,51 @@ static int32_t visit_order(const wb_model *m, const int32_t *idx, int k, int32_t
                 parent[c[x]] = g;
             }
         }
-        for (int32_t j = first[g]; j < first[g + 1]; j++) {
-            if (shared) con[nlast++] = sorted[j];
-            else order[nfirst++] = sorted[j];
+        if (!shared) {
+            for (int32_t j = first[g]; j < first[g + 1]; j++) order[nfirst++] = sorted[j];
+        } else if (!split) {
+            for (int32_t j = first[g]; j < first[g + 1]; j++) con[nlast++] = sorted[j];
+        } else {
+            /* the group's compounds: its members joined through shared movable particles,
+             * each in the order of its first member, members in group order */
+            const int32_t *mem = &sorted[first[g]], gn = first[g + 1] - first[g];
+            for (int32_t t = 0; t < gn; t++)
+                for (int x = 0; x < k; x++) owner[idx[(size_t)k * (size_t)mem[t] + (size_t)x]] = -1;
+            for (int32_t t = 0; t < gn; t++) {
+                uf[t] = t;
+                for (int x = 0; x < k; x++) {
+                    const int32_t p = idx[(size_t)k * (size_t)mem[t] + (size_t)x];
+                    if (!(m->inv_mass[p] > 0)) continue;
+                    if (owner[p] < 0) owner[p] = t;
+                    else uf[root(uf, t)] = root(uf, owner[p]);
+                }
+            }
+            /* compound ids in the order of first members (cid: by root, then by member),
+             * then a counting sort of the members by compound */
+            int32_t *cid = uf + (na + 1), *cstart = uf + 2 * (na + 1), nc = 0;
+            for (int32_t t = 0; t < gn; t++) cid[t] = -1;
+            for (int32_t t = 0; t < gn; t++) {
+                const int32_t r = root(uf, t);
+                if (cid[r] < 0) cid[r] = nc++;
+                cstart[t] = cid[r]; /* for now: member t's compound */
+            }
+            int32_t *cnt = cid; /* reused: nc <= gn counters */
+            for (int32_t c = 0; c <= nc; c++) cnt[c] = 0;
+            for (int32_t t = 0; t < gn; t++) cnt[cstart[t] + 1]++;
+            for (int32_t c = 0; c < nc; c++) {
+                cnt[c + 1] += cnt[c];
+                split->comp_start[split->ncomp++] = nlast + cnt[c];
+            }
+            for (int32_t t = 0; t < gn; t++) con[nlast + cnt[cstart[t]]++] = mem[t];
+            nlast += gn;
         }
     }
     if (nlast > 0) memcpy(order + nfirst, con, sizeof *con * (size_t)nlast);
+    if (split) {
+        split->comp_start[split->ncomp] = nlast;
+        split->n = nlast;
+        split->first = nfirst;
+    }
     nl = nlive;
 out:
     free(parent);
@@ -205,12 +247,14 @@ out:
     free(key);
     free(box);
     free(gk);
+    free(owner);
+    free(uf);
     return nl;
 }
 
 int wb__colour_greedy(const wb_model *m, const int32_t *idx, int k, int32_t n,
                       int (*live)(const void *ud, int32_t i), const void *ud, uint8_t *colour,
-                      int32_t count[WB_MAX_COLOURS + 1])
+                      int32_t count[WB_MAX_COLOURS + 1], wb_split *split)
 {
     /* a bit per colour and particle: the colours its constraints already took */
     uint64_t *used = calloc((size_t)(m->np > 0 ? m->np : 1), sizeof *used);
@@ -218,13 +262,21 @@ int wb__colour_greedy(const wb_model *m, const int32_t *idx, int k, int32_t n,
     int32_t nl = 0;
     if (!used || !order) goto fail;
     if (__atomic_load_n(&symmetric, __ATOMIC_RELAXED)) {
-        if ((nl = visit_order(m, idx, k, n, live, ud, order)) < 0) goto fail;
+        if (split) split->n = split->first = split->ncomp = 0;
+        if ((nl = visit_order(m, idx, k, n, live, ud, order, split)) < 0) goto fail;
+        if (split) {
+            /* the compounds' members are not coloured */
+            memcpy(split->member, order + split->first, sizeof *order * (size_t)split->n);
+            nl = split->first;
+        }
     } else {
+        if (split) split->n = split->first = split->ncomp = 0, split->comp_start[0] = 0;
         for (int32_t i = 0; i < n; i++)
             if (live(ud, i)) order[nl++] = i;
     }
     for (int c = 0; c <= WB_MAX_COLOURS; c++) count[c] = 0;
     for (int32_t i = 0; i < n; i++) colour[i] = WB_NO_COLOUR;
+    for (int32_t j = 0; split && j < split->n; j++) colour[split->member[j]] = WB_SPLIT_COLOUR;
     /* the lowest colour free at every end; immovable particles never conflict */
     for (int32_t j = 0; j < nl; j++) {
         const int32_t i = order[j];
@@ -273,7 +325,7 @@ int wb__batches_build(wb_batches *b, const wb_model *m, const int32_t *idx, int 
 {
     uint8_t *colour = malloc((size_t)(n > 0 ? n : 1));
     int32_t count[WB_MAX_COLOURS + 1], start[WB_MAX_COLOURS + 1];
-    if (!colour || !wb__colour_greedy(m, idx, k, n, all_live, NULL, colour, count)) {
+    if (!colour || !wb__colour_greedy(m, idx, k, n, all_live, NULL, colour, count, NULL)) {
         free(colour);
         return 0;
     }

@@ -165,7 +165,7 @@ void wb__contacts_project(wb_world *w, wb_real h)
     const int32_t n_before = c->n;
     const int remade = wb__contacts_recheck(w, h);
     if (remade < 0) wb__warn(w, "out of memory in the contact broad phase; contacts skipped");
-    if (remade > 0 && !c->fresh && n_before > 0) {
+    if (remade == 1 && !c->fresh && n_before > 0) {
         wb_real *lo = wb__grow(c->left_old, &c->cap_left_old, n_before, sizeof *lo);
         if (!lo) { c->fresh = 1; goto nomem; }
         c->left_old = lo;
@@ -194,7 +194,11 @@ void wb__contacts_project(wb_world *w, wb_real h)
     if (c->fresh) {
         for (int32_t k = 0; k < c->n; k++) left[k] = fresh_left(c, xp, rad, vmax * h, k);
         c->fresh = 0;
-    } else if (remade) {
+    } else if (remade == 2) {
+        /* pairs added to the list in place: theirs is NaN */
+        for (int32_t k = 0; k < c->n; k++)
+            if (left[k] != left[k]) left[k] = fresh_left(c, xp, rad, vmax * h, k);
+    } else if (remade == 1) {
         /* a list made again within the frame: a pair it had keeps what it was left with
          * (both lists are in (i, j) order), a new one starts as a new list's */
         const int32_t *io = c->ij_old, no = c->n_old;

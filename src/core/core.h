@@ -218,7 +218,11 @@ typedef struct wb_contacts {
     int32_t *ij_old;       /* the list before a remake, and what each pair was left with */
     wb_real *left_old;
     int32_t cap_left_old;
-    int64_t remakes;       /* lists made again within a frame (stats) */
+    int64_t remakes;       /* lists made again within a frame (tests) */
+    int32_t remakes_frame; /* ... within this frame */
+    int32_t *fix, cap_fix; /* the particles that moved too far */
+    int32_t *add, cap_add; /* (2 x) their new pairs */
+    int32_t *fixed, cap_fixed, nfixed; /* the particles mended this frame */
     int no_recheck;        /* tests: the list is not checked within the frame */
     int brute;             /* tests: each substep, every touching pair that may touch is looked
                               for in the list; missed counts those it lacks */
@@ -233,9 +237,11 @@ typedef struct wb_contacts {
  * constraints and groups; 0 when out of memory. wb__joined: a constraint joins i and j */
 int wb__contact_rules(wb_world *w);
 int wb__joined(const wb_contacts *c, int32_t i, int32_t j);
-/* at a substep (the frame's sub-th, step h): 1 when some particle moved past what its
- * reach allowed and the list was made again for the rest of the frame (the old one in
- * ij_old, n_old), 0 when it holds, -1 when out of memory (the list is then empty).
+/* at a substep (the frame's sub-th, step h): 0 when the list holds; when some particle
+ * moved past what its reach allowed, 2 when its pairs were added to the list in place
+ * (with left NaN, and the rest of left moved along when the list had it), 1 when the
+ * list was made again for the rest of the frame (the old one in ij_old, n_old); -1 when
+ * out of memory (the list is then empty).
  * wb__contacts_brute: the tests' count of touching pairs the list lacks (brute) */
 int wb__contacts_recheck(wb_world *w, wb_real h);
 void wb__contacts_brute(wb_world *w);
@@ -320,6 +326,13 @@ struct wb_broad {
     int32_t *vskip; int32_t cap_vskip;
     wb_pairbuf list;
     int64_t rebuilds;                  /* for the tests */
+    /* the grid of the last search (cand, start, p, id), when it is the kept list's
+     * (lgrid): its shape, particles, whether they are all the candidates (none culled),
+     * and their largest reach */
+    int lgrid, lfull;
+    wb_grid lg;
+    int32_t lm;
+    wb_real lrmax;
 };
 static inline void wb__broadphase_free(wb_contacts *c)
 {
@@ -327,10 +340,10 @@ static inline void wb__broadphase_free(wb_contacts *c)
     free(c->skip);
     c->skip = NULL;
     c->cap_skip = 0;
-    free(c->xf); free(c->ij_old); free(c->left_old);
+    free(c->xf); free(c->ij_old); free(c->left_old); free(c->fix); free(c->add); free(c->fixed);
     c->xf = c->left_old = NULL;
-    c->ij_old = NULL;
-    c->cap_xf = c->cap_old = c->cap_left_old = 0;
+    c->ij_old = c->fix = c->add = c->fixed = NULL;
+    c->cap_xf = c->cap_old = c->cap_left_old = c->cap_fix = c->cap_add = c->cap_fixed = 0;
     if (!b) return;
     free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key);
     free(b->runs); free(b->boxes); free(b->first);
@@ -426,6 +439,10 @@ typedef struct wb_cache {
     int32_t ncolours;
     int32_t *colour_start; /* (ncolours + 1) batch ranges */
     int32_t serial_start;  /* batches from here on are projected serially (overflow colours) */
+    int32_t split_start;   /* the compounds (colour.c's split) fill [split_start, ns) */
+    int32_t ncomp;
+    int32_t *comp_start;   /* (ncomp + 1) compound bounds in packed order, then s_nsp */
+    int32_t *s_nsp;        /* (2 (ns - split_start)) members of its compound at each end */
     int32_t *s_a, *s_b;    /* (ns) particles */
     wb_real *s_rest, *s_alpha, *s_beta; /* (ns) */
     wb_real *s_lambda;     /* (ns) multipliers of the current substep */
@@ -436,10 +453,15 @@ typedef struct wb_cache {
     wb_real *s_at;         /* (ns) alpha / h^2 for h = s_at_h */
     uint32_t *s_oa, *s_oc; /* (ns) 3 a, 3 c: the ends' offsets in x */
     uint8_t *s_ok;         /* (ns) 1: wa > 0, wc > 0 and alpha / h^2 finite (no masked case) */
+    uint8_t *s_backed;     /* (ns) 1: both ends are corners of volume or tet constraints (a
+                              compressed link's lengthening is bounded: distance.c) */
+    int32_t s_backed_vt[2]; /* the volume and tet counts s_backed was worked out for */
     wb_real s_at_h;        /* the substep s_at and s_ok are for */
     int32_t *s_slot;       /* (ns) constraint slot of each packed entry */
     int32_t *slot_pack;    /* (nd) packed index of each slot, -1 when not packed */
     int any_damping;
+    int s_lambda_stale;    /* s_lambda is the last substep's: the next projection reads it as 0
+                              and writes every one (distance.c); force() reads 0 */
     int any_frame_end;     /* a packed distance constraint can break or flow (distance_frame_end) */
     uint32_t s_w_gen;      /* the m.w_gen s_wa, s_wc were copied at */
     wb_real *dx;           /* (np x 3) Jacobi accumulators */
@@ -474,12 +496,20 @@ typedef struct wb_cache {
     int32_t *mc_body;      /* (np) body of each particle, -1 none */
     int32_t *mc_root;      /* (bodies) first particle of each */
     double *mc_acc;        /* (bodies x 16) sums; [0] < 0: held from outside the solve */
-    int32_t cap_mc_body, cap_mc_root, cap_mc_acc, mc_nbody, mc_free;
+    uint8_t *mc_pinned;    /* (bodies) has an immovable particle, as of m.w_gen mc_wgen */
+    int32_t *mc_end;       /* (bodies) one past its last particle when its particles are
+                              consecutive (a builder's body), else -1 */
+    int32_t cap_mc_body, cap_mc_root, cap_mc_acc, cap_mc_pinned, cap_mc_end, mc_nbody, mc_free;
+    int32_t mc_scattered;  /* bodies whose particles are not consecutive (end -1) */
     int mc_built, mc_changed;
+    uint32_t mc_wgen;
     int64_t mc_sig[8];     /* what the bodies were found for (besides m.topology_dirty) */
     /* the blow-up check at a frame's end (solver.c) */
-    wb_real *bl_x;         /* (bl_np x 3) positions at the last frame's end: pinned ones' moves */
-    int32_t cap_bl_x, bl_np;
+    int32_t bl_np;         /* x_save holds the last frame's end (or its start: an undone frame)
+                              for this many particles */
+    wb_real bl_v0;         /* the fastest particle's squared speed at the frame's start */
+    wb_real bl_pin;        /* the farthest the script moved a pinned particle, squared, and */
+    int bl_moved;          /* whether it moved a movable one, since the last frame's check */
     wb_real bl_user;       /* the fastest speed given from outside (scripts, new particles) */
     wb_real bl_vend;       /* the fastest particle at the last frame's end */
     int bl_have;           /* bl_vend is known (a step ended since the world was made or loaded) */
@@ -505,7 +535,27 @@ struct wb_world {
     struct wb_grabs *grab;  /* grabs (grab.h), NULL until the first */
     struct wb_rigids *rb;  /* rigid bodies (rigid.h), NULL until the first */
     wb_pool *pool;         /* the threads (pool.h), NULL until a step runs with threads > 1 */
+    size_t charged_self;   /* the struct and its worker threads, charged to def.memory (world.c) */
 };
+
+/* The vector paths' switches (distance.c, bend.c, tet.c, momentum.c: wb__*_simd): *state
+ * (-1 until decided) set to on where the build and the CPU have AVX2; returns it. The
+ * vector paths give the scalar loops' bits, so this only picks the faster. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(WB_FLOAT)
+#define WB_HAVE_AVX2 1
+#endif
+static inline int wb__simd_set(int *state, int on)
+{
+#ifdef WB_HAVE_AVX2
+    __builtin_cpu_init();
+    const int v = on && __builtin_cpu_supports("avx2");
+#else
+    const int v = 0;
+    (void)on;
+#endif
+    __atomic_store_n(state, v, __ATOMIC_RELAXED);
+    return v;
+}
 
 /* internal entry points */
 wb_status wb__colour(wb_world *w);                 /* distance.c: rebuild the distance batches if dirty */
@@ -518,9 +568,20 @@ void wb__momentum_restore(wb_world *w, wb_real h);
  * get WB_NO_COLOUR, the others a colour in [0, WB_MAX_COLOURS] (WB_MAX_COLOURS: the serial
  * overflow batch), counted in count. 0 when out of memory */
 #define WB_NO_COLOUR 255
+/* With split (not NULL, mirror keys on): the groups of mirror images that share a movable
+ * particle (links meeting on a mirror plane), which no colouring can keep alike, are not
+ * coloured (WB_SPLIT_COLOUR, not counted) but returned as compounds: each a set of images
+ * joined through shared particles, to be projected together from the same positions
+ * (distance.c). split->member (n slots) gets them compound by compound in visiting order,
+ * split->comp_start (n + 1 slots) the ncomp + 1 compound bounds into member. */
+#define WB_SPLIT_COLOUR 254
+typedef struct wb_split {
+    int32_t n, first, ncomp; /* members, coloured constraints (visit_order's), compounds */
+    int32_t *member, *comp_start;
+} wb_split;
 int wb__colour_greedy(const wb_model *m, const int32_t *idx, int k, int32_t n,
                       int (*live)(const void *ud, int32_t i), const void *ud, uint8_t *colour,
-                      int32_t count[WB_MAX_COLOURS + 1]);
+                      int32_t count[WB_MAX_COLOURS + 1], wb_split *split);
 /* colour.c, tests: on = 0 colours in creation order (as before mirror keys), 1 with mirror
  * keys (the default) from the next colouring on; returns the previous setting. Not
  * thread-safe: call it between steps */

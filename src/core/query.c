@@ -252,6 +252,7 @@ wb_stats wb_world_stats(const wb_world *w)
     st.contacts = w->k.last_contacts;
     st.particle_contacts = w->k.pc.last + w->k.tc.last;
     st.broad_ms = w->k.pc.broad_ms + w->k.tc.broad_ms;
+    st.broad_remakes = w->k.pc.remakes_frame;
     st.projections = w->k.projections;
     st.step_ms = w->k.step_ms;
     st.solve_ms = w->k.solve_ms;

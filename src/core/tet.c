@@ -802,18 +802,7 @@ static int simd_state = -1;
  * the scalar loop, on = 1 uses the vector path where the CPU has it; returns whether the
  * vector path is on. Not thread-safe: call it between steps. */
 int wb__tet_simd(int on);
-int wb__tet_simd(int on)
-{
-#ifdef WB_TET_AVX2
-    __builtin_cpu_init();
-    const int s = on && __builtin_cpu_supports("avx2");
-#else
-    const int s = 0;
-    (void)on;
-#endif
-    __atomic_store_n(&simd_state, s, __ATOMIC_RELAXED);
-    return s;
-}
+int wb__tet_simd(int on) { return wb__simd_set(&simd_state, on); }
 
 /* order[lo, hi) of one batch (batch.h): the packed copies are in that order already */
 static void project_range(wb_world *w, const int32_t *order, int32_t lo, int32_t hi, wb_real h)

@@ -111,11 +111,41 @@ const char *wb_world_def_check(const wb_world_def *d)
     return NULL;
 }
 
+/* what a world takes before it holds anything: the struct (malloc's header too) and, for
+ * threads > 1, its worker threads (the stack pages a step touches, thread-local storage:
+ * about 18 kB each measured; 256 threads = 255 workers) */
+#define THREAD_BYTES ((size_t)32 << 10)
+static size_t self_bytes(int threads)
+{
+    return sizeof(wb_world) + 16 + (threads > 1 ? (size_t)(threads - 1) * THREAD_BYTES : 0);
+}
+
+/* charge the world's own bytes for `threads` to its budget; 0 when that would pass
+ * the limit (nothing changed then) */
+static int charge_self(wb_world *w, wb_memory *mem, int threads)
+{
+    const size_t want = self_bytes(threads);
+    if (!mem) return 1;
+    if (want > w->charged_self) {
+        const size_t more = want - w->charged_self;
+        if (mem->limit > 0 && (more > mem->limit || mem->used > mem->limit - more)) return 0;
+        mem->used += more;
+    } else {
+        mem->used -= w->charged_self - want;
+    }
+    w->charged_self = want;
+    return 1;
+}
+
 wb_world *wb_world_create(const wb_world_def *def)
 {
     assert(wb_world_def_check(def) == NULL);
     wb_world *w = calloc(1, sizeof *w);
     if (!w) return NULL;
+    if (!charge_self(w, def->memory, def->threads)) {
+        free(w);
+        return NULL;
+    }
     w->m.def = *def;
     return w;
 }
@@ -143,7 +173,7 @@ void wb_world_destroy(wb_world *w)
     for (int32_t i = 0; i < m->nc; i++) wb__colmesh_free(m->c_shape[i].mesh); /* mesh colliders' copies */
     /* the bends' arrays (bend.c owns their use; freed here so that no circle joins the files) */
     wb_bends *bd = &w->bend;
-    if (m->def.memory) m->def.memory->used -= bd->charged;
+    if (m->def.memory) m->def.memory->used -= bd->charged + w->charged_self;
     void *bp[] = { bd->ij, bd->alpha, bd->beta, bd->rest, bd->s_ij, bd->s_slot, bd->pack, bd->lambda, bd->btorque,
                    bd->broken, bd->breaks };
     for (size_t i = 0; i < sizeof bp / sizeof bp[0]; i++) free(bp[i]);
@@ -155,7 +185,7 @@ void wb_world_destroy(wb_world *w)
     void *ptrs[] = { m->inv_mass, m->w, m->radius, m->pinned, m->d_ij, m->d_alpha, m->d_beta,
                      m->d_yield, m->d_creep, m->d_break, m->d_bforce, m->d_gen, m->d_free, m->c_shape, m->c_gen, m->surf_start, m->tri,
                      s->x, s->x_prev, s->v, s->d_rest, s->d_broken, s->c_pose,
-                     k->colour_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda, k->s_jac,
+                     k->colour_start, k->comp_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda, k->s_jac,
                      k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->c_sub, k->c_left, k->c_save,
                      k->breaks, m->group, m->cflags, m->cfric, m->x0, k->pc.ij, k->pc.act, k->pc.act_nd,
                      k->pc.left, k->pc.reach, k->pc.keys, k->pc.graph, k->pc.tcov, k->pc.load,
@@ -164,7 +194,7 @@ void wb_world_destroy(wb_world *w)
                      w->sm.start, w->sm.stiff, w->sm.yield, w->sm.creep, w->sm.ids, w->sm.rest, w->sm.q,
                      w->sm.qk, w->sm.lambda, w->pr.surface, w->pr.pressure, w->pr.alpha, w->pr.v0, w->pr.vstart,
                      w->pr.tstart, w->pr.verts, w->pr.tri, w->pr.lambda, w->pr.grad,
-                     k->tc.pt, k->tc.act, k->tc.act_d, k->tc.left, k->mc_body, k->mc_root, k->mc_acc, k->bl_x };
+                     k->tc.pt, k->tc.act, k->tc.act_d, k->tc.left, k->mc_body, k->mc_root, k->mc_acc, k->mc_pinned, k->mc_end };
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
     free(w);
 }
@@ -176,6 +206,7 @@ wb_status wb_world_set_def(wb_world *w, const wb_world_def *def)
     const char *err = wb_world_def_check(def);
     if (err) { wb__set_error("%s", err); return WB_ERR_ARG; }
     wb_memory *mem = w->m.def.memory; /* charged to it: a world keeps its budget */
+    if (!charge_self(w, mem, def->threads)) return WB_ERR_NOMEM; /* more threads than the budget has room for */
     w->m.def = *def;
     w->m.def.memory = mem;
     return WB_OK;
@@ -438,7 +469,7 @@ wb_real wb_distance_force(const wb_world *w, wb_distance_id c)
 {
     int32_t s = SLOT(w, c);
     int32_t k = w->k.slot_pack[s];
-    if (k < 0 || k >= w->k.ns) return 0; /* not stepped since it was made */
+    if (k < 0 || k >= w->k.ns || w->k.s_lambda_stale) return 0; /* not stepped since it was made (or undone) */
     const wb_real h = w->k.h_last; /* of the step that made lambda, whatever dt is now */
     return fabs(w->k.s_lambda[k]) / (h * h);
 }

@@ -70,10 +70,19 @@ typedef struct wbio_config {
     wbio_part *parts;
     int32_t nskins;
     wbio_skin_spec *skins;
+    wb_memory *mem;        /* the budget charged for the arrays read (wbio_read_config_within) */
+    size_t charged;
 } wbio_config;
 
 /* read and check the whole file; on error nothing is allocated (cfg zeroed) */
 int wbio_read_config(const char *path, const char *shown, wbio_config *cfg, char *err, size_t errn);
+/* the same under a memory budget (NULL: none): the file's text, cJSON's tree (about 40
+ * times the text for a file of small numbers) and the positions of its values are
+ * charged to mem while the read runs, and the arrays read (a third of that at most) until
+ * wbio_config_free. A read that would pass mem->limit fails with *over set and a message
+ * saying so; nothing stays charged then */
+int wbio_read_config_within(const char *path, const char *shown, wbio_config *cfg, wb_memory *mem, bool *over,
+                            char *err, size_t errn);
 /* the same from a text in memory (len bytes, no NUL needed): what a file would give */
 int wbio_parse_config(const char *data, size_t len, const char *shown, wbio_config *cfg, char *err, size_t errn);
 void wbio_config_free(wbio_config *cfg);

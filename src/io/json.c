@@ -772,6 +772,25 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
     return e ? jv_fail(r, root, 0, NULL, "%s", e) : 0;
 }
 
+/* the image read from a tree is at most a third of it: a number is an 80-byte node of
+ * the tree and at most 8 bytes of an array, an entry (a particle, a link) has a node of
+ * its own and adds at most 30 bytes of flags and generations. Charged before the arrays
+ * are made, kept with the config; 0 when it does not fit */
+static int reserve_image(wbio_config *cfg)
+{
+    if (!jv_budget || !jv_budget->mem) return 1;
+    wb_memory *m = jv_budget->mem;
+    const size_t r = jv_budget->held / 3;
+    if (m->limit && (r > m->limit || m->used > m->limit - r)) {
+        jv_budget->over = true;
+        return 0;
+    }
+    m->used += r;
+    cfg->mem = m;
+    cfg->charged = r;
+    return 1;
+}
+
 static char *read_text(const char *path, const char *shown, size_t *len, char *err, size_t errn)
 {
     FILE *fp = fopen(path, "rb");
@@ -783,10 +802,10 @@ static char *read_text(const char *path, const char *shown, size_t *len, char *e
         return NULL;
     }
     size_t cap = 1 << 16, n = 0;
-    char *t = malloc(cap);
+    char *t = jb_realloc(NULL, cap);
     while (t) {
         if (n + 1 >= cap) {
-            char *u = cap < (size_t)MAX_FILE ? realloc(t, cap * 2) : NULL;
+            char *u = cap < (size_t)MAX_FILE ? jb_realloc(t, cap * 2) : NULL;
             if (!u) break;
             t = u;
             cap *= 2;
@@ -794,7 +813,7 @@ static char *read_text(const char *path, const char *shown, size_t *len, char *e
         size_t got = fread(t + n, 1, cap - n - 1, fp);
         n += got;
         if (got == 0) {
-            if (ferror(fp)) { snprintf(err, errn, "%s: %s", shown, strerror(errno)); free(t); fclose(fp); return NULL; }
+            if (ferror(fp)) { snprintf(err, errn, "%s: %s", shown, strerror(errno)); jb_free(t); fclose(fp); return NULL; }
             t[n] = '\0';
             fclose(fp);
             *len = n;
@@ -802,7 +821,7 @@ static char *read_text(const char *path, const char *shown, size_t *len, char *e
         }
     }
     snprintf(err, errn, "%s: %s", shown, t ? "too large (2 GiB at most)" : "out of memory");
-    free(t);
+    jb_free(t);
     fclose(fp);
     return NULL;
 }
@@ -823,6 +842,25 @@ static int json_depth(const char *text, const char *end)
     return depth;
 }
 
+/* cJSON with its nodes charged to the read's budget (its hooks are global: set for the
+ * call alone, and the tree is deleted under the same ones) */
+static cJSON *parse_tree(const char *text, const char **end)
+{
+    cJSON_Hooks h = { jb_malloc, jb_free };
+    cJSON_InitHooks(&h);
+    cJSON *root = cJSON_ParseWithOpts(text, end, 1);
+    cJSON_InitHooks(NULL);
+    return root;
+}
+
+static void delete_tree(cJSON *root)
+{
+    cJSON_Hooks h = { jb_malloc, jb_free };
+    cJSON_InitHooks(&h);
+    cJSON_Delete(root);
+    cJSON_InitHooks(NULL);
+}
+
 /* the parse of a whole text (text[len] is a NUL the reader put there); frees text */
 static int parse_text(char *text, size_t len, const char *shown, wbio_config *cfg, char *err, size_t errn)
 {
@@ -837,7 +875,7 @@ static int parse_text(char *text, size_t len, const char *shown, wbio_config *cf
         snprintf(err, errn, "%s:%d:%d: not a text file (a NUL byte)", shown, line, col);
     } else if (!*p) {
         snprintf(err, errn, "%s: empty file (a particle config is a JSON object)", shown);
-    } else if (!(root = cJSON_ParseWithOpts(text, &end, 1))) {
+    } else if (!(root = parse_tree(text, &end))) {
         /* cJSON's error pointer, turned into a line and column */
         const int32_t off = end ? (int32_t)(end - text) : 0;
         char near[24] = "";
@@ -854,12 +892,12 @@ static int parse_text(char *text, size_t len, const char *shown, wbio_config *cf
         int32_t k = 0;
         jv_number_items(root, &k);
         r.pos = !s.oom && k == s.n ? &s : NULL; /* without positions, messages still name the key */
-        rc = read_root(&r, root, cfg);
+        rc = reserve_image(cfg) ? read_root(&r, root, cfg) : -1;
     }
-    cJSON_Delete(root);
-    free(s.voff);
-    free(s.koff);
-    free(text);
+    delete_tree(root);
+    jb_free(s.voff);
+    jb_free(s.koff);
+    jb_free(text);
     if (rc) wbio_config_free(cfg);
     return rc;
 }
@@ -870,6 +908,22 @@ int wbio_read_config(const char *path, const char *shown, wbio_config *cfg, char
     size_t len = 0;
     char *text = read_text(path, shown, &len, err, errn);
     return text ? parse_text(text, len, shown, cfg, err, errn) : -1;
+}
+
+int wbio_read_config_within(const char *path, const char *shown, wbio_config *cfg, wb_memory *mem, bool *over,
+                            char *err, size_t errn)
+{
+    jbudget b = { mem, 0, false };
+    jbudget *outer = jv_budget;
+    const size_t left = mem && mem->used < mem->limit ? mem->limit - mem->used : 0;
+    jv_budget = &b;
+    int rc = wbio_read_config(path, shown, cfg, err, errn);
+    jv_budget = outer;
+    *over = b.over;
+    if (rc && b.over)   /* cJSON says "syntax error" where its allocation was refused */
+        snprintf(err, errn, "%s: reading it needs more than the %.0f MB left of the memory budget of %.0f MB", shown,
+                 left / 1048576.0, mem->limit / 1048576.0);
+    return rc;
 }
 
 int wbio_parse_config(const char *data, size_t len, const char *shown, wbio_config *cfg, char *err, size_t errn)
@@ -888,6 +942,7 @@ int wbio_parse_config(const char *data, size_t len, const char *shown, wbio_conf
 
 void wbio_config_free(wbio_config *cfg)
 {
+    if (cfg->mem) cfg->mem->used -= cfg->charged;
     wb_image_free(&cfg->img);
     for (int32_t i = 0; cfg->parts && i < cfg->nparts; i++) free(cfg->parts[i].name);
     for (int32_t i = 0; cfg->skins && i < cfg->nskins; i++) {

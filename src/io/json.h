@@ -33,6 +33,16 @@ typedef struct rd {
     size_t errn;
 } rd;
 
+/* the memory budget of the read under way (json.c sets it; NULL: none): what its
+ * transient allocations hold (chunks, malloc's header included), and whether one was
+ * refused. realloc, malloc and free for everything a read allocates on its way (the
+ * text, cJSON's nodes, the positions), charged to it */
+typedef struct jbudget { wb_memory *mem; size_t held; bool over; } jbudget;
+extern _Thread_local jbudget *jv_budget;
+void *jb_realloc(void *p, size_t n);
+void *jb_malloc(size_t n);
+void jb_free(void *p);
+
 /* positions: record every value of text (valid JSON) from s->p on, then number cJSON's
  * items in the same pre-order (their valueint holds the index) */
 void jv_sk_value(scan *s, int32_t key);

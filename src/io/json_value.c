@@ -5,6 +5,7 @@
  * offending value or key, and its key path. Keys are case-sensitive; an unknown or
  * repeated key is an error (cJSON itself keeps duplicates). */
 #include <ctype.h>
+#include <malloc.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -13,6 +14,40 @@
 #include <strings.h>
 
 #include "json.h"
+
+/* ---- the memory budget of a read ----------------------------------------------------------------- */
+_Thread_local jbudget *jv_budget;
+
+static size_t chunk(void *p) { return p ? malloc_usable_size(p) + sizeof(size_t) : 0; }
+
+void *jb_realloc(void *p, size_t n)
+{
+    jbudget *b = jv_budget;
+    if (!b || !b->mem) return realloc(p, n);
+    wb_memory *m = b->mem;
+    const size_t had = chunk(p), need = n + 2 * sizeof(size_t);
+    if (m->limit && (need > m->limit || m->used - had > m->limit - need)) {
+        b->over = true;
+        return NULL;
+    }
+    void *q = realloc(p, n);
+    if (!q) return NULL;
+    m->used = m->used - had + chunk(q);
+    b->held = b->held - had + chunk(q);
+    return q;
+}
+
+void *jb_malloc(size_t n) { return jb_realloc(NULL, n); }
+
+void jb_free(void *p)
+{
+    jbudget *b = jv_budget;
+    if (b && b->mem && p) {
+        b->mem->used -= chunk(p);
+        b->held -= chunk(p);
+    }
+    free(p);
+}
 
 /* ---- the text and the positions of its values --------------------------------------------- */
 
@@ -34,7 +69,7 @@ void jv_sk_value(scan *s, int32_t key)
     sk_ws(s);
     if (s->n == s->cap) {
         int32_t cap = s->cap ? 2 * s->cap : 1024;
-        int32_t *v = realloc(s->voff, sizeof *v * (size_t)cap), *k = v ? realloc(s->koff, sizeof *k * (size_t)cap) : NULL;
+        int32_t *v = jb_realloc(s->voff, sizeof *v * (size_t)cap), *k = v ? jb_realloc(s->koff, sizeof *k * (size_t)cap) : NULL;
         if (v) s->voff = v;
         if (!v || !k) { s->oom = 1; return; }
         s->koff = k;

@@ -15,6 +15,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <malloc.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -220,10 +221,14 @@ static void child_import(int fd, const char *path, wbio_allow_fn allow, void *ud
         child_fail(fd, why);
         return;
     }
+    /* the scene goes before the arrays are sent: the caller makes its copy of them while
+     * this process still holds its own, and both count against one budget */
+    aiReleaseImport(sc);
+    malloc_trim(0);
     import_head h = { 1, 0, nv, nt };
     if (write_all(fd, &h, sizeof h) == 0 && write_all(fd, v, sizeof *v * 3 * (size_t)nv) == 0)
         write_all(fd, tri, sizeof *tri * 3 * (size_t)nt);
-    /* no aiReleaseImport or free: the process ends now */
+    /* no free: the process ends now */
 }
 
 static double now_s(void)
@@ -329,8 +334,11 @@ static int import_isolated(const char *path, const wbio_mesh_opts *mo, wbio_budg
     import_head h;
     int r = read_all(fds[0], &h, sizeof h, deadline, o);
     if (r == 0 && h.ok == 1) {
-        /* the arrays on their way, then the mesh made of them (wbio_load_mesh) */
-        const double need = (double)h.nv * (3 * sizeof **v + 6 * sizeof(wb_real)) + (double)h.nt * 6 * sizeof **tri;
+        /* the arrays on their way, then the mesh made of them (wbio_load_mesh) while they
+         * are still held, and the weld's grid over its vertices (map, buckets, chain,
+         * cells: 52 bytes a vertex) */
+        const double weld = mo->weld ? 52 : 0;
+        const double need = (double)h.nv * (3 * sizeof **v + 6 * sizeof(wb_real) + weld) + (double)h.nt * 6 * sizeof **tri;
         if (h.nv < 1 || h.nt < 1 || h.nv > WB_MAX_PARTICLES || h.nt > WB_MAX_CONSTRAINTS) r = -1;
         else if (need > (double)budget) r = -5;
         else {

@@ -34,6 +34,22 @@ static wbio_config *push_config(lua_State *L)
     return c;
 }
 
+/* read the config at path into c under the run's memory budget: a file too big for what
+ * is left of it is a budget error (after one collection: configs and meshes that are
+ * garbage give back their charges); 0, or -1 and err for a file that cannot be read */
+static int read_config(lua_State *L, const char *path, const char *name, wbio_config *c, char *err, size_t n)
+{
+    wb_memory *mem = &wb_rt_get(L)->memory;
+    bool over = false;
+    int rc = wbio_read_config_within(path, name, c, mem, &over, err, n);
+    if (rc && over) {
+        lua_gc(L, LUA_GCCOLLECT);
+        rc = wbio_read_config_within(path, name, c, mem, &over, err, n);
+        if (rc && over) wb_rt_budget_error(L, "%s (--memory-limit MB)", err);
+    }
+    return rc;
+}
+
 static int config_gc(lua_State *L)
 {
     wbio_config_free((wbio_config *)luaL_checkudata(L, 1, WBL_CONFIG));
@@ -56,9 +72,9 @@ static const char *load_skin_meshes(lua_State *L, const char *config_path, const
         if (!wb_sandbox_path(L, rel, 0, path, sizeof path, &perr))
             return lua_pushfstring(L, "%s: %s", k->where, perr ? perr : "refused");
         wbio_mesh_opts o = { k->scale, true, -1, 0 };
-        wb_mesh **slot = wbl_push_mesh_slot(L);
-        *slot = wbio_load_mesh(path, k->mesh, &o, wbl_allow, L, err, sizeof err);
-        if (!*slot) return lua_pushfstring(L, "%s: %s", k->where, err);
+        /* under the run's budgets, as wobble.load_mesh */
+        if (!wbl_import_mesh(L, path, k->mesh, &o, k->where, err, sizeof err))
+            return lua_pushfstring(L, "%s: %s", k->where, err);
         lua_rawseti(L, -2, i + 1);
     }
     return NULL;
@@ -98,7 +114,7 @@ static int w_load_particles(lua_State *L)
     lua_settop(L, 2);
     wbl_path(L, name, 0, path, sizeof path);
     wbio_config *c = push_config(L); /* 3 */
-    if (wbio_read_config(path, name, c, err, sizeof err)) return fail_with(L, err);
+    if (read_config(L, path, name, c, err, sizeof err)) return fail_with(L, err);
     const char *msg = load_skin_meshes(L, path, c); /* 4: meshes */
     if (msg) {
         luaL_pushfail(L);
@@ -154,6 +170,7 @@ static int w_load_particles(lua_State *L)
     lua_createtable(L, c->nskins, 0);
     make_skins(L, 1, 4, c, b.first, b.count);
     lua_setfield(L, 6, "skins");
+    wbio_config_free(c);   /* scratch: its charge goes back now, not at a collection */
     lua_settop(L, 6);
     return 1;
 }
@@ -166,7 +183,7 @@ static int l_load(lua_State *L)
     lua_settop(L, 1);
     wbl_path(L, name, 0, path, sizeof path);
     wbio_config *c = push_config(L); /* 2 */
-    if (wbio_read_config(path, name, c, err, sizeof err)) return fail_with(L, err);
+    if (read_config(L, path, name, c, err, sizeof err)) return fail_with(L, err);
     const char *msg = load_skin_meshes(L, path, c); /* 3 */
     if (msg) return fail_with(L, msg);
     if (!c->snapshot) {
@@ -186,6 +203,7 @@ static int l_load(lua_State *L)
     if (!ud->w) return wb_rt_budget_error(L, "out of memory loading %s", name);
     lua_createtable(L, c->nskins, 0);
     make_skins(L, 4, 3, c, 0, c->img.np);
+    wbio_config_free(c);   /* scratch: its charge goes back now, not at a collection */
     lua_settop(L, 4);
     return 1;
 }

@@ -181,6 +181,17 @@ static int l_load_mesh(lua_State *L)
     }
     char path[4096], err[1024];
     wbl_path(L, name, 0, path, sizeof path);
+    if (!wbl_import_mesh(L, path, name, &o, "load_mesh", err, sizeof err)) {
+        luaL_pushfail(L);
+        lua_pushstring(L, err);
+        return 2;
+    }
+    return 1;
+}
+
+wb_mesh *wbl_import_mesh(lua_State *L, const char *path, const char *name, const wbio_mesh_opts *o, const char *who,
+                         char *err, size_t n)
+{
     /* the import may take what is left of the memory budget, and stops with the run's
      * other budgets (the time limit): either is a budget error, not a file's failure */
     const wb_memory *mem = &wb_rt_get(L)->memory;
@@ -191,19 +202,14 @@ static int l_load_mesh(lua_State *L)
     }
     wb_rt_interrupt(L, &b.interrupt, &b.interrupt_ud);
     wb_mesh **slot = wbl_push_mesh_slot(L);
-    *slot = wbio_load_mesh_within(path, name, &o, &b, wbl_allow, L, err, sizeof err);
+    *slot = wbio_load_mesh_within(path, name, o, &b, wbl_allow, L, err, n);
     if (b.stopped) {
         wb_rt_check_budgets(L);   /* the time limit: its own message */
-        return wb_rt_budget_error(L, "load_mesh: %s: memory limit of %.0f MB exceeded (--memory-limit MB)", err,
-                                  mem->limit / 1048576.0);
+        wb_rt_budget_error(L, "%s: %s: memory limit of %.0f MB exceeded (--memory-limit MB)", who, err,
+                           mem->limit / 1048576.0);
     }
-    if (!*slot) {
-        luaL_pushfail(L);
-        lua_pushstring(L, err);
-        return 2;
-    }
-    charge_top(L, (*slot)->nv, (*slot)->nt, name);
-    return 1;
+    if (*slot) charge_top(L, (*slot)->nv, (*slot)->nt, name);
+    return *slot;
 }
 
 /* ---- methods ---------------------------------------------------------------------------------- */

@@ -33,6 +33,13 @@ wb_mesh **wbl_push_mesh_slot(lua_State *L);
 /* the same, with a mesh of nv vertices and nt triangles charged to the memory budget
  * first (given back when the mesh is closed or collected); raises a budget error */
 wb_mesh **wbl_push_mesh_charged(lua_State *L, int64_t nv, int64_t nt, const char *what);
+/* import the file at path (shown as name) through assimp's child under the run's
+ * budgets: what is left of the memory budget and the time limit stop it with a budget
+ * error whose message starts with `who`; the mesh is pushed (charged) and returned, or
+ * NULL with the file's failure in err (a slot holding NULL pushed all the same) */
+struct wbio_mesh_opts;
+wb_mesh *wbl_import_mesh(lua_State *L, const char *path, const char *name, const struct wbio_mesh_opts *o,
+                         const char *who, char *err, size_t n);
 
 /* ---- skins (skin.c) ------------------------------------------------------------------- */
 /* the skin at idx and its world (NULL when not a skin or either is closed); vertices read

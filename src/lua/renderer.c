@@ -123,7 +123,7 @@ static wb_recorder *begin_recording(wbl_renderer *u, const char *path, wb_media 
     return rec;
 }
 
-/* finish the recording (the frames' memory is given back); false with the message. The
+/* finish the recording (the frames' and the encoder's memory is given back); false with the message. The
  * file takes its name only when every frame went into it */
 static bool end_recording(wbl_renderer *u, char *err, size_t n)
 {
@@ -131,9 +131,9 @@ static bool end_recording(wbl_renderer *u, char *err, size_t n)
     rec_files *f = u->files;
     u->rec = NULL;
     u->files = NULL;
-    release(u, &u->rec_charged);
     const bool started = wb_recorder_started(rec);
-    bool ok = wb_recorder_close(rec, err, n);
+    bool ok = wb_recorder_close(rec, err, n);   /* the encoder lives until it finishes the file */
+    release(u, &u->rec_charged);
     close_files(f, ok && started, err, n, &ok);
     return ok;
 }
@@ -388,8 +388,12 @@ static int r_record(lua_State *L)
     const char *path = script_path(L, 2, 1, buf, sizeof buf);
     wb_media kind = wb_media_of(given, path, err, sizeof err);   /* the name decides, not where it leads */
     int w, h;
+    char what[96];
     wb_renderer_size(u->r, &w, &h);
-    charge(L, &u->rec_charged, wb_recorder_bytes(w, h), "recording");
+    /* the frames queued and, for a video, ffmpeg encoding them (hundreds of MB for large
+     * frames): a size whose encoder does not fit is refused before anything starts */
+    snprintf(what, sizeof what, "recording %dx%d frames%s", w, h, kind == WB_MEDIA_FOLDER ? "" : " (ffmpeg included)");
+    charge(L, &u->rec_charged, wb_recorder_bytes(kind, w, h), what);
     u->rec = begin_recording(u, path, kind, w, h, err, sizeof err);
     if (!u->rec) {
         release(u, &u->rec_charged);
@@ -530,15 +534,39 @@ static int r_tostring(lua_State *L)
 }
 
 /* ---- media files ---------------------------------------------------------------------------- */
+/* the frame size of the file at path from its header (ffprobe, charged while it runs);
+ * false with nil and the message pushed */
+static bool frame_size(lua_State *L, const char *path, const wb_media_stop *stop, int *w, int *h)
+{
+    char err[PATH_MAX + 128];
+    const size_t helper = wb_media_helper_bytes(0, 0);
+    wbl_charge(L, helper, "starting ffprobe");
+    bool ok = wb_media_frame_size(path, stop, w, h, err, sizeof err);
+    wbl_release(L, helper);
+    if (ok) return true;
+    wb_rt_check_budgets(L);
+    luaL_pushfail(L);
+    lua_pushstring(L, err);
+    return false;
+}
+
 /* wobble.probe(path) -> {width, height, frames, codec, pix_fmt, duration} or nil, message */
 static int l_probe(lua_State *L)
 {
-    char buf[PATH_MAX], err[PATH_MAX + 128];
+    char buf[PATH_MAX], err[PATH_MAX + 128], what[96];
     const char *path = script_path(L, 1, 0, buf, sizeof buf);
     wb_media_info mi;
     wb_media_stop stop;
     wb_rt_interrupt(L, &stop.fn, &stop.ud);   /* ffprobe may wait forever (a FIFO): the budgets end it */
-    if (!wb_media_probe(path, &mi, &stop, err, sizeof err)) {
+    /* ffprobe decodes every frame to count them: charged for frames of the header's size */
+    int w, h;
+    if (!frame_size(L, path, &stop, &w, &h)) return 2;
+    const size_t helper = wb_media_helper_bytes(w, h);
+    snprintf(what, sizeof what, "probe: ffprobe decoding %dx%d frames", w, h);
+    wbl_charge(L, helper, what);
+    bool ok = wb_media_probe(path, &mi, &stop, err, sizeof err);
+    wbl_release(L, helper);
+    if (!ok) {
         wb_rt_check_budgets(L);
         luaL_pushfail(L);
         lua_pushstring(L, err);
@@ -610,8 +638,17 @@ static int l_read_frame(lua_State *L)
     int w, h;
     wb_media_stop stop;
     wb_rt_interrupt(L, &stop.fn, &stop.ud);
+    /* the size from the header first, as read_png: ffmpeg's decode and ours are charged
+     * while they run, then the pixels while Lua copies them */
+    if (!frame_size(L, path, &stop, &w, &h)) return 2;
+    char what[96];
+    const size_t dec = wb_media_frame_bytes(w, h), rgb = (size_t)w * (size_t)h * 3;
+    snprintf(what, sizeof what, "read_frame: a %dx%d frame", w, h);
+    wbl_charge(L, dec + rgb, what);
     uint8_t *px = wb_media_read_frame(path, (int64_t)index, &stop, &w, &h, err, sizeof err);
+    wbl_release(L, dec);
     if (!px) {
+        wbl_release(L, rgb);
         wb_rt_check_budgets(L);
         luaL_pushfail(L);
         lua_pushstring(L, err);
@@ -619,8 +656,14 @@ static int l_read_frame(lua_State *L)
     }
     lua_pushinteger(L, w);
     lua_pushinteger(L, h);
-    lua_pushlstring(L, (const char *)px, (size_t)w * h * 3);
+    /* protected, so that a refused string cannot leak the pixels */
+    lua_pushcfunction(L, push_pixels);
+    lua_pushlightuserdata(L, px);
+    lua_pushinteger(L, (lua_Integer)w * h * 3);
+    const int st = lua_pcall(L, 2, 1, 0);
     free(px);
+    wbl_release(L, rgb);
+    if (st != LUA_OK) return lua_error(L);
     return 3;
 }
 
@@ -680,10 +723,11 @@ bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n)
     wbl_renderer *u = checkud(L, -1);
     int w, h;
     wb_renderer_size(u->r, &w, &h);
-    size_t bytes = wb_recorder_bytes(w, h);
+    size_t bytes = wb_recorder_bytes(kind, w, h);
     if (over_budget(u->mem, bytes)) {
-        snprintf(err, n, "--record: the frames need about %.0f MB, over the memory budget of %.0f MB (--memory-limit MB)",
-                 bytes / 1048576.0, u->mem->limit / 1048576.0);
+        snprintf(err, n, "--record: the frames%s need about %.0f MB, over the memory budget of %.0f MB (--memory-limit MB)",
+                 kind == WB_MEDIA_FOLDER ? "" : " and ffmpeg encoding them", bytes / 1048576.0,
+                 u->mem->limit / 1048576.0);
         lua_settop(L, top);
         return false;
     }

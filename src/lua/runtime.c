@@ -13,6 +13,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <malloc.h>
 #include <poll.h>
 #include <pthread.h>
 #include <signal.h>
@@ -26,9 +27,10 @@
 #include <unistd.h>
 
 #define HOOK_COUNT (1 << 20)          /* instructions between two budget checks */
-#define MEM_SLACK ((size_t)64 << 20)  /* granted past the memory limit so the error can be reported */
+#define MEM_SLACK ((size_t)64 << 20)  /* at most granted past the memory limit so the error can be reported */
 #define GRACE_MIN 5.0                 /* the watchdog's grace: 5 s or 10% of the limit, the longer */
 #define GRACE_PART 0.1
+#define MEM_GRACE 3.0                 /* after a spent memory budget: seconds to come back to a check */
 #define REARM_SIGNAL SIGURG           /* ignored by default: one arriving after close does nothing */
 
 /* The watchdog: a thread that sleeps until the deadline of --time-limit, raises
@@ -41,25 +43,32 @@
 typedef struct watchdog {
     pthread_t th;
     int on;                           /* the thread runs */
+    int sync;                         /* mu and cv are made */
     pthread_mutex_t mu;               /* guards what follows but `expired` */
     pthread_cond_t cv;                /* CLOCK_MONOTONIC; wakes the thread for stop and pause */
     int stop;                         /* wb_rt_close: the thread ends */
+    int started;                      /* the thread is in its loop (watchdog_start waits for it) */
     int paused;                       /* the command line's own cleanup runs (wb_rt_pause_watchdog) */
     double resumed;                   /* the last end of a pause: the grace counts from it */
-    double deadline, grace;
+    double deadline, grace;           /* deadline < 0: no time budget */
+    double spent_at;                  /* when the memory budget was spent (< 0: it is not) */
     atomic_int expired;               /* the deadline passed */
     pthread_t main;                   /* the thread running the script: REARM_SIGNAL goes to it */
     int rearm;                        /* this runtime owns REARM_SIGNAL's handler (one runtime at a time) */
     struct sigaction old_sa;          /* the handler before ours */
     char msg[PATH_MAX + 512];         /* made in advance: the thread only writes it */
+    char mem_msg[PATH_MAX + 512];     /* the same for a spent memory budget */
     char words[2048];                 /* wb_rt_set_last_words */
 } watchdog;
 
 typedef struct rt_state {
     wb_runtime pub;                   /* first: what wb_rt_get hands out */
     wb_sandbox sb;                    /* the file rules and the folders */
-    int mem_refused;                  /* the last growing allocation was refused */
-    int mem_over;                     /* refused twice in a row: the budget is exhausted */
+    lua_State *L;                     /* the main thread: its hook is armed when the budget is spent */
+    int mem_refused;                  /* the last growing allocation was refused: ref_* was the request */
+    void *ref_ptr;
+    size_t ref_old, ref_new;
+    int mem_over;                     /* a refusal was final: the budget is spent, for good */
     int budget_hit;                   /* a budget error was raised; it is raised again at every step */
     double t0;                        /* wall clock at wb_rt_open */
     char budget_msg[256];
@@ -94,34 +103,72 @@ static double now(void) {
 
 /* ---- budgets ------------------------------------------------------------------------- */
 
+static void rt_hook(lua_State *L, lua_Debug *ar);
+static void mem_alarm(rt_state *rt);
+
+/* the memory budget is spent: for good, whatever the script catches. The main thread
+ * checks at its next instruction (a loop of big allocations would otherwise reach the
+ * count hook only after minutes); code that runs without hooks (a __gc finalizer) has
+ * the watchdog's grace to come back */
+static void spend(rt_state *rt) {
+    if (rt->mem_over) return;
+    rt->mem_over = 1;
+    /* lua_sethook only sets fields: safe here, as in a signal handler */
+    if (rt->L) lua_sethook(rt->L, rt_hook, LUA_MASKCOUNT, 1);
+    mem_alarm(rt);
+}
+
+/* what a block really takes of the heap: its usable size and malloc's header (small
+ * blocks: a 33-byte string is a 48-byte chunk; the requested sizes alone let the
+ * process grow half as much again as the budget) */
+#define CHUNK_HEADER sizeof(size_t)
+static size_t chunk_bytes(void *p) { return p ? malloc_usable_size(p) + CHUNK_HEADER : 0; }
+
+/* past the limit, what reporting the error may take: a sixteenth of the limit, 4 to 64 MB */
+static size_t mem_slack(size_t limit) {
+    size_t s = limit / 16;
+    return s < ((size_t)4 << 20) ? (size_t)4 << 20 : s > MEM_SLACK ? MEM_SLACK : s;
+}
+
 static void *rt_alloc(void *ud, void *ptr, size_t osize, size_t nsize) {
     rt_state *rt = ud;
     size_t old = ptr ? osize : 0;  /* for a new block osize is a type tag */
+    size_t held = chunk_bytes(ptr);
     if (nsize == 0) {
         free(ptr);
-        rt->pub.memory.used -= old;
+        rt->pub.memory.used -= held;
         return NULL;
     }
     size_t limit = rt->pub.memory_budget;
     if (limit && nsize > old) {
-        if (rt->mem_over) limit = limit > SIZE_MAX - MEM_SLACK ? SIZE_MAX : limit + MEM_SLACK;
-        size_t grow = nsize - old;
+        /* Lua answers a refusal by collecting garbage and asking again at once, the
+         * same request; any other request next means that the refusal stood (lauxlib's
+         * buffers ask once: string.rep, table.concat) and a memory error was raised,
+         * which pcall may have caught. The budget is spent then. */
+        if (rt->mem_refused && (ptr != rt->ref_ptr || old != rt->ref_old || nsize != rt->ref_new)) spend(rt);
+        if (rt->mem_over) limit = limit > SIZE_MAX - MEM_SLACK ? SIZE_MAX : limit + mem_slack(limit);
         /* one account for the Lua heap and every world's arrays */
-        if (grow > limit || rt->pub.memory.used > limit - grow) {
-            /* Lua collects garbage and asks again once: only the second refusal is final */
-            if (rt->mem_refused) rt->mem_over = 1;
+        size_t need = nsize > SIZE_MAX - 2 * CHUNK_HEADER ? SIZE_MAX : nsize + 2 * CHUNK_HEADER;
+        size_t others = rt->pub.memory.used - held;
+        if (need > limit || others > limit - need) {
+            if (rt->mem_refused) spend(rt);  /* the second try refused too */
             rt->mem_refused = 1;
+            rt->ref_ptr = ptr, rt->ref_old = old, rt->ref_new = nsize;
             return NULL;
         }
     }
     void *p = realloc(ptr, nsize);
     if (!p) return NULL;
-    rt->pub.memory.used = rt->pub.memory.used - old + nsize;
+    rt->pub.memory.used = rt->pub.memory.used - held + chunk_bytes(p);
     if (nsize > old) rt->mem_refused = 0;
     return p;
 }
 
-static void rt_hook(lua_State *L, lua_Debug *ar);
+/* the watchdog's flag, or the clock when no watchdog runs (it could not start) */
+static int time_over(const rt_state *rt) {
+    if (rt->pub.time_budget <= 0) return 0;
+    return atomic_load_explicit(&rt->wd.expired, memory_order_relaxed) || now() - rt->t0 > rt->pub.time_budget;
+}
 
 int wb_rt_budget_error(lua_State *L, const char *fmt, ...) {
     rt_state *rt = rt_from(L);
@@ -135,18 +182,15 @@ int wb_rt_budget_error(lua_State *L, const char *fmt, ...) {
         rt->budget_hit = 1;
         /* from now on every instruction fails, so a script cannot pcall its way past */
         lua_sethook(L, rt_hook, LUA_MASKCOUNT, 1);
+        /* and what runs without hooks has a grace to end (the time limit's watchdog has
+         * its own) */
+        if (!time_over(rt)) mem_alarm(rt);
     }
     luaL_where(L, 1);
     if (!*lua_tostring(L, -1)) { lua_pop(L, 1); luaL_where(L, 0); }
     lua_pushstring(L, msg);
     lua_concat(L, 2);
     return lua_error(L);
-}
-
-/* the watchdog's flag, or the clock when no watchdog runs (it could not start) */
-static int time_over(const rt_state *rt) {
-    if (rt->pub.time_budget <= 0) return 0;
-    return atomic_load_explicit(&rt->wd.expired, memory_order_relaxed) || now() - rt->t0 > rt->pub.time_budget;
 }
 
 static void check_budgets(lua_State *L, rt_state *rt) {
@@ -235,7 +279,7 @@ static void kill_children(void) {
 }
 
 /* the grace period is over: the script cannot be stopped from inside, so end it */
-static _Noreturn void end_process(watchdog *wd) {
+static _Noreturn void end_process(watchdog *wd, const char *msg) {
     kill_children();
     wbio_remove_temporaries();  /* a file being written keeps its old version */
     /* what the script printed and stdio still holds, unless the main thread is inside
@@ -246,7 +290,7 @@ static _Noreturn void end_process(watchdog *wd) {
         funlockfile(stdout);
     }
     say(STDOUT_FILENO, wd->words);
-    say(STDERR_FILENO, wd->msg);
+    say(STDERR_FILENO, msg);
     _exit(3);  /* DESIGN §4: a budget was exceeded */
 }
 
@@ -278,9 +322,13 @@ static struct timespec monotonic_at(double t) {
 static void *watchdog_main(void *arg) {
     watchdog *wd = arg;
     pthread_mutex_lock(&wd->mu);
+    wd->started = 1;
+    pthread_cond_broadcast(&wd->cv);
     while (!wd->stop) {
         double t = now(), wake = -1;  /* -1: until woken */
-        if (!atomic_load(&wd->expired)) {
+        if (wd->deadline < 0) {
+            /* no time budget: the thread is here for a spent memory budget */
+        } else if (!atomic_load(&wd->expired)) {
             if (t >= wd->deadline) {
                 /* the hook, the step's interrupt and the probes read this */
                 atomic_store(&wd->expired, 1);
@@ -290,8 +338,13 @@ static void *watchdog_main(void *arg) {
             wake = wd->deadline;
         } else if (!wd->paused) {
             double end = (wd->resumed > wd->deadline ? wd->resumed : wd->deadline) + wd->grace;
-            if (t >= end) end_process(wd);
+            if (t >= end) end_process(wd, wd->msg);
             wake = end;
+        }
+        if (wd->spent_at >= 0 && !wd->paused) {
+            double end = (wd->resumed > wd->spent_at ? wd->resumed : wd->spent_at) + MEM_GRACE;
+            if (t >= end) end_process(wd, wd->mem_msg);
+            if (wake < 0 || end < wake) wake = end;
         }
         if (wake < 0) {
             pthread_cond_wait(&wd->cv, &wd->mu);
@@ -304,19 +357,17 @@ static void *watchdog_main(void *arg) {
     return NULL;
 }
 
-/* only with a time budget; without a thread (it could not start) the hook and the
- * clock hold the budget wherever they run */
-static void watchdog_start(rt_state *rt, lua_State *L) {
+/* the lock and the condition, made with the state: a spent memory budget may start the
+ * thread at any time */
+static void watchdog_init(rt_state *rt) {
     watchdog *wd = &rt->wd;
-    double limit = rt->pub.time_budget;
-    if (limit <= 0) return;
-    wd->deadline = rt->t0 + limit;
-    wd->grace = limit * GRACE_PART > GRACE_MIN ? limit * GRACE_PART : GRACE_MIN;
-    snprintf(wd->msg, sizeof wd->msg,
-             "%s: time limit of %g s exceeded (--time-limit SECONDS); the script did not come back to a budget "
-             "check within the grace period of %g s (a __gc finalizer, one long C call such as a backtracking "
-             "string pattern, or a read that never ends), so wobble ended it\n",
-             rt->pub.script ? rt->pub.script : "wobble", limit, wd->grace);
+    wd->deadline = -1;
+    wd->spent_at = -1;
+    snprintf(wd->mem_msg, sizeof wd->mem_msg,
+             "%s: memory limit of %.0f MB exceeded (--memory-limit MB); the script did not come back to a budget "
+             "check within %g s (a __gc finalizer that goes on after its allocations were refused), so wobble "
+             "ended it\n",
+             rt->pub.script ? rt->pub.script : "wobble", rt->pub.memory_budget / 1048576.0, MEM_GRACE);
     pthread_condattr_t ca;
     if (pthread_condattr_init(&ca) != 0) return;
     int e = pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
@@ -327,6 +378,43 @@ static void watchdog_start(rt_state *rt, lua_State *L) {
         pthread_cond_destroy(&wd->cv);
         return;
     }
+    wd->sync = 1;
+}
+
+/* the thread, once (wd->mu held); 0 when it could not start */
+static int watchdog_thread(watchdog *wd) {
+    if (wd->on) return 1;
+    if (!wd->sync) return 0;
+    /* signals (SIGINT, SIGPIPE of the script's writes) stay the main thread's */
+    sigset_t all, old;
+    sigfillset(&all);
+    pthread_sigmask(SIG_SETMASK, &all, &old);
+    int e = pthread_create(&wd->th, NULL, watchdog_main, wd);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    if (e) return 0;
+    /* Back only once the thread waits in its loop: a thread still starting (its stack,
+     * its TLS, a sanitizer's bookkeeping) may hold an allocator lock, and a process that
+     * forks then (the mesh importer and tetgen run in forked children, without exec) gives
+     * the child that lock held for ever. Measured under make asan: 5 imports in 150, run
+     * at once after the start, hung in the child on ASan's allocator mutex; none since.
+     * (The caller holds wd->mu: the wait lets the thread take it.) */
+    while (!wd->started) pthread_cond_wait(&wd->cv, &wd->mu);
+    wd->on = 1;
+    return 1;
+}
+
+/* only with a time budget; without a thread (it could not start) the hook and the
+ * clock hold the budget wherever they run */
+static void watchdog_start(rt_state *rt, lua_State *L) {
+    watchdog *wd = &rt->wd;
+    double limit = rt->pub.time_budget;
+    if (limit <= 0 || !wd->sync) return;
+    wd->grace = limit * GRACE_PART > GRACE_MIN ? limit * GRACE_PART : GRACE_MIN;
+    snprintf(wd->msg, sizeof wd->msg,
+             "%s: time limit of %g s exceeded (--time-limit SECONDS); the script did not come back to a budget "
+             "check within the grace period of %g s (a __gc finalizer, one long C call such as a backtracking "
+             "string pattern, or a read that never ends), so wobble ended it\n",
+             rt->pub.script ? rt->pub.script : "wobble", limit, wd->grace);
     /* the re-arm signal, when no other runtime has it (SA_RESTART: reads go on) */
     lua_State *none = NULL;
     wd->main = pthread_self();
@@ -339,43 +427,53 @@ static void watchdog_start(rt_state *rt, lua_State *L) {
         if (sigaction(REARM_SIGNAL, &sa, &wd->old_sa) == 0) wd->rearm = 1;
         else atomic_store(&rearm_state, NULL);
     }
-    /* signals (SIGINT, SIGPIPE of the script's writes) stay the main thread's */
-    sigset_t all, old;
-    sigfillset(&all);
-    pthread_sigmask(SIG_SETMASK, &all, &old);
-    e = pthread_create(&wd->th, NULL, watchdog_main, wd);
-    pthread_sigmask(SIG_SETMASK, &old, NULL);
-    if (e) {
-        pthread_mutex_destroy(&wd->mu);
-        pthread_cond_destroy(&wd->cv);
+    wd->deadline = rt->t0 + limit;
+    pthread_mutex_lock(&wd->mu);
+    const int started = watchdog_thread(wd);
+    pthread_mutex_unlock(&wd->mu);
+    if (!started) {
+        wd->deadline = -1;
         if (wd->rearm) {
             atomic_store(&rearm_state, NULL);
             sigaction(REARM_SIGNAL, &wd->old_sa, NULL);
             wd->rearm = 0;
         }
-        return;
     }
-    wd->on = 1;
+}
+
+/* a memory budget was spent: the script has MEM_GRACE seconds (not counting pauses) to
+ * come back to a check and end; the thread starts now if no time budget runs it */
+static void mem_alarm(rt_state *rt) {
+    watchdog *wd = &rt->wd;
+    if (!wd->sync || !rt->pub.memory_budget || wd->spent_at >= 0) return;
+    pthread_mutex_lock(&wd->mu);
+    wd->spent_at = now();
+    if (watchdog_thread(wd)) pthread_cond_signal(&wd->cv);
+    pthread_mutex_unlock(&wd->mu);
 }
 
 static void watchdog_stop(rt_state *rt) {
     watchdog *wd = &rt->wd;
-    if (!wd->on) return;
-    pthread_mutex_lock(&wd->mu);
-    wd->stop = 1;
-    pthread_cond_signal(&wd->cv);
-    pthread_mutex_unlock(&wd->mu);
-    pthread_join(wd->th, NULL);
-    pthread_mutex_destroy(&wd->mu);
-    pthread_cond_destroy(&wd->cv);
+    if (wd->on) {
+        pthread_mutex_lock(&wd->mu);
+        wd->stop = 1;
+        pthread_cond_signal(&wd->cv);
+        pthread_mutex_unlock(&wd->mu);
+        pthread_join(wd->th, NULL);
+        wd->on = 0;
+    }
     if (wd->rearm) sigaction(REARM_SIGNAL, &wd->old_sa, NULL);  /* rearm_state is NULL by now */
     wd->rearm = 0;
-    wd->on = 0;
+    if (wd->sync) {
+        pthread_mutex_destroy(&wd->mu);
+        pthread_cond_destroy(&wd->cv);
+        wd->sync = 0;
+    }
 }
 
 void wb_rt_pause_watchdog(lua_State *L, int paused) {
     rt_state *rt = rt_from(L);
-    if (!rt || !rt->wd.on) return;
+    if (!rt || !rt->wd.sync) return;
     pthread_mutex_lock(&rt->wd.mu);
     rt->wd.paused = paused;
     if (!paused) rt->wd.resumed = now();
@@ -385,7 +483,7 @@ void wb_rt_pause_watchdog(lua_State *L, int paused) {
 
 void wb_rt_set_last_words(lua_State *L, const char *text) {
     rt_state *rt = rt_from(L);
-    if (!rt || !rt->wd.on) return;
+    if (!rt || !rt->wd.sync) return;
     pthread_mutex_lock(&rt->wd.mu);
     snprintf(rt->wd.words, sizeof rt->wd.words, "%s", text ? text : "");
     pthread_mutex_unlock(&rt->wd.mu);
@@ -534,11 +632,14 @@ lua_State *wb_rt_open(const wb_runtime *cfg) {
     rt->pub.out_dir = rt->sb.out;
     rt->pub.lib_dir = rt->sb.lib[0] ? rt->sb.lib : NULL;
     rt->t0 = now();
+    watchdog_init(rt);
     lua_State *L = lua_newstate(rt_alloc, rt);
     if (!L) {
+        watchdog_stop(rt);
         free(rt);
         return NULL;
     }
+    rt->L = L;
     lua_atpanic(L, panic);
     lua_setwarnf(L, warn_off, L);
     lua_pushcfunction(L, rt_init);
@@ -557,14 +658,16 @@ lua_State *wb_rt_open(const wb_runtime *cfg) {
 int wb_rt_close(lua_State *L) {
     if (!L) return 0;
     rt_state *rt = rt_from(L);
-    int before = rt && time_over(rt);
+    int before = rt && time_over(rt), spent = rt && (rt->mem_over || rt->mem_refused || rt->budget_hit);
     /* no re-arm from here on: the state goes (finalizers run without hooks anyway) */
     if (rt && rt->wd.rearm) atomic_store(&rearm_state, NULL);
-    /* finalizers may allocate past a spent memory budget, but the time budget stays:
-     * Lua runs them without hooks, and the watchdog ends one that never returns */
-    if (rt) rt->pub.memory_budget = rt->pub.memory.limit = 0;
+    /* finalizers run under both budgets: an allocation past the memory limit fails
+     * (Lua reports it as a warning and goes on with the next finalizer), and the
+     * watchdog ends one that never returns */
     lua_close(L);
-    int late = rt && !before && time_over(rt);
+    int late = 0;
+    if (rt && !before && time_over(rt)) late = WB_RT_LATE_TIME;
+    else if (rt && !spent && (rt->mem_over || rt->mem_refused)) late = WB_RT_LATE_MEMORY;
     if (rt) watchdog_stop(rt);
     free(rt);
     return late;

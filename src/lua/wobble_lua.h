@@ -55,15 +55,20 @@ void wb_rt_after_frame(lua_State *L, int world_index);
 lua_State *wb_rt_open(const wb_runtime *cfg); /* standard libraries, sandbox unless cfg->unsafe, budgets,
                                                  `wobble` global + package.loaded, wobble.args = {};
                                                  NULL (message on stderr) on failure */
-int wb_rt_close(lua_State *L);                /* lua_close (finalizers run under the time budget) + free
-                                                 the runtime; 1 when the time limit ran out while it closed */
+/* lua_close (finalizers run under both budgets) + free the runtime; WB_RT_LATE_TIME when
+ * the time limit ran out while it closed, WB_RT_LATE_MEMORY when a finalizer's allocation
+ * was refused by the memory budget (not spent before), else 0 */
+enum { WB_RT_LATE_TIME = 1, WB_RT_LATE_MEMORY = 2 };
+int wb_rt_close(lua_State *L);
 int wb_rt_budget_hit(lua_State *L);           /* 1 once a budget error was raised: exit code 3 */
 int wb_rt_msgh(lua_State *L);                 /* lua_pcall message handler: message (any value) + traceback */
 void wb_rt_add_frame_hook(lua_State *L, int index); /* wb_rt_after_frame calls the function at index(w) */
 /* --time-limit's watchdog: a thread that, a grace period past the limit (5 s or 10% of
  * the limit, the longer), ends a script that never came back to a budget check (a __gc
  * finalizer, one long C call): children killed, the last words on stdout, a message
- * naming cfg->script on stderr, exit code 3. At the limit itself it signals the opening
+ * naming cfg->script on stderr, exit code 3. A spent memory budget starts it too (with
+ * no time limit), with a grace of 3 s: a finalizer that goes on after its allocations
+ * were refused is ended the same way. At the limit itself it signals the opening
  * thread (SIGURG, handled while the state is open) to check every instruction. Paused,
  * it waits (the caller's own cleanup, bounded by its own timeouts, such as finishing a
  * recording); the grace counts again from the end of the pause. */

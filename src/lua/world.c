@@ -62,7 +62,8 @@ int wbl_world_new(lua_State *L)
     ud->warned = 0;
     luaL_setmetatable(L, WBL_WORLD);
     ud->w = wb_world_create(&d);
-    if (!ud->w) return wb_rt_budget_error(L, "out of memory creating a world");
+    /* the world itself and its worker threads are charged too (hundreds of bytes; 32 kB a thread) */
+    if (!ud->w) return wbl_status_error(L, 1, WB_ERR_NOMEM, "creating a world");
     return 1;
 }
 
@@ -450,6 +451,7 @@ static int w_stats(lua_State *L)
     SETI("rigids", s.rigids);
     SETI("rigid_contacts", s.rigid_contacts);
     SETN("broad_ms", s.broad_ms);
+    SETN("broad_remakes", s.broad_remakes);
     SETI("projections", s.projections);
     SETN("step_ms", s.step_ms);
     SETN("solve_ms", s.solve_ms);

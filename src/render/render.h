@@ -140,8 +140,10 @@ typedef struct wb_media_out {
  * into out; the encoder starts with the first frame */
 wb_recorder *wb_recorder_open(const char *path, wb_media kind, int w, int h, const wb_media_out *out, char *err,
                               size_t n);
-/* about how many bytes a recording of w x h frames holds (the queued frames) */
-size_t wb_recorder_bytes(int w, int h);
+/* about how many bytes a recording of w x h frames holds: the queued frames and, for a
+ * video, the ffmpeg encoding it (its peak resident memory, measured; its thread count is
+ * fixed, at most 4, so that this holds on any machine) */
+size_t wb_recorder_bytes(wb_media kind, int w, int h);
 /* frames per second of the file; settable until the first frame (default 60) */
 void wb_recorder_set_fps(wb_recorder *rec, double fps);
 bool wb_recorder_started(const wb_recorder *rec);
@@ -167,9 +169,18 @@ typedef struct wb_media_info {
 typedef struct wb_media_stop { int (*fn)(void *ud); void *ud; } wb_media_stop;
 bool wb_media_probe(const char *path, wb_media_info *info, const wb_media_stop *stop, char *err, size_t n);
 /* frame `index` (0 first) of a video decoded by ffmpeg: RGB8, top row first (malloc'd,
- * free()), NULL with a message. For tests that compare a file with what was drawn. */
+ * free()), NULL with a message. For tests that compare a file with what was drawn.
+ * *w x *h (> 0) is the size expected (wb_media_frame_size): a frame of another size is
+ * refused; 0 x 0: any size */
 uint8_t *wb_media_read_frame(const char *path, int64_t index, const wb_media_stop *stop, int *w, int *h, char *err,
                              size_t n);
+/* the frame size of a video (its first video stream) or PNG from its header, nothing
+ * decoded (ffprobe for a video); false with a message */
+bool wb_media_frame_size(const char *path, const wb_media_stop *stop, int *w, int *h, char *err, size_t n);
+/* about what wb_media_read_frame of a w x h frame takes at its peak, ffmpeg included;
+ * what ffprobe or ffmpeg alone takes decoding such frames (0 x 0: started, no frame) */
+size_t wb_media_frame_bytes(int w, int h);
+size_t wb_media_helper_bytes(int w, int h);
 
 /* start prog (found through PATH) with argv, its stdin, stdout and stderr the
  * descriptors fds[0..2] (-1: /dev/null) and no other descriptor of ours; SIGPIPE

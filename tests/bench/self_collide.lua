@@ -3,6 +3,8 @@
 -- for a hand-built one, at most 3x for a heap). 10 substeps x 1 iteration, one thread.
 --  self128   a w:cloth of 128 x 128 (2 m, radius half its spacing), pinned at two
 --            corners, swinging down for 60 frames: self_collide = true against false
+--  self32, self64, self128_30, self256: the same for 30 frames at each size, with the
+--            cost per particle of the contacts and of their broad phase (the aim: flat)
 --  loose128  the same sheet built by hand (w:particle + w:distance: loose particles,
 --            default radius 0.02 > half the 1.57 cm spacing): contacts on against off
 --  heap128   a w:cloth of 128 x 128 (1.5 m) hung straight down over the floor, rippled,
@@ -13,13 +15,16 @@
 local bench = require("wobble.bench")
 local args = wobble.args
 
-local function hanging(self)
-  local w = wobble.world{ threads = args.threads or 1 }
-  local c = w:cloth{ origin = {-1, 2, -1}, size = {2, 2}, res = {128, 128}, mass = 1, self_collide = self }
-  w:pin(c.particles[1])
-  w:pin(c.particles[128])
-  return w
+local function hanging_n(n)
+  return function(self)
+    local w = wobble.world{ threads = args.threads or 1 }
+    local c = w:cloth{ origin = {-1, 2, -1}, size = {2, 2}, res = {n, n}, mass = 1, self_collide = self }
+    w:pin(c.particles[1])
+    w:pin(c.particles[n])
+    return w
+  end
 end
+local hanging = hanging_n(128)
 
 local function hand_built(contacts)
   local w = wobble.world{ threads = args.threads or 1, contacts = contacts }
@@ -55,13 +60,14 @@ end
 
 -- ms per frame of frames steps; the stats of the last
 local function run(w, frames)
-  local step_ms, solve_ms, projections = 0, 0, 0
+  local step_ms, solve_ms, projections, broad_ms = 0, 0, 0, 0
   for _ = 1, frames do
     w:step()
     local s = w:stats()
     step_ms, solve_ms, projections = step_ms + s.step_ms, solve_ms + s.solve_ms, projections + s.projections
+    broad_ms = broad_ms + s.broad_ms
   end
-  return step_ms / frames, solve_ms, projections, w:stats()
+  return step_ms / frames, solve_ms, projections, w:stats(), broad_ms / frames
 end
 
 local function scene(name, make, frames, what)
@@ -70,7 +76,7 @@ local function scene(name, make, frames, what)
   collectgarbage()
   local rss0 = bench.rss()
   local w = make(true)
-  local ms, solve_ms, projections, s = run(w, frames)
+  local ms, solve_ms, projections, s, broad_ms = run(w, frames)
   local bytes = bench.bytes_per(rss0, s.particles)
   local contacts = s.particle_contacts
   w = nil
@@ -83,10 +89,20 @@ local function scene(name, make, frames, what)
     ns_per_projection = ms * frames * 1e6 / projections, ns_per_projection_solve = solve_ms * 1e6 / projections,
     bytes_per_particle = bytes,
   }
-  bench.report(r, string.format("%s: %.3f ms/frame, %.2fx; %d contacts at the end", what, ms_off, r.ratio_off,
-                                contacts))
+  -- per particle: what the contacts add to the frame, and the broad phase's part of it
+  r.ns_per_particle_contacts = (ms - ms_off) * 1e6 / s.particles
+  r.ns_per_particle_broad = broad_ms * 1e6 / s.particles
+  bench.report(r, string.format("%s: %.3f ms/frame, %.2fx; %d contacts at the end; per particle %.0f ns "
+                                .. "(broad phase %.0f)", what, ms_off, r.ratio_off, contacts,
+                                r.ns_per_particle_contacts, r.ns_per_particle_broad))
 end
 
 scene("self128", hanging, 60, "without self-collision")
+-- the same hanging cloth at other sizes, the same 2 m (finer with size): the aim is a
+-- flat cost per particle from 32^2 to 256^2 (within 30%)
+scene("self32", hanging_n(32), 30, "without self-collision")
+scene("self64", hanging_n(64), 30, "without self-collision")
+scene("self128_30", hanging, 30, "without self-collision")
+scene("self256", hanging_n(256), 30, "without self-collision")
 scene("loose128", hand_built, 60, "contacts = false")
 scene("heap128", heap, 120, "without self-collision")

@@ -97,8 +97,9 @@ check "wobble.probe with a helper that never answers: exit 3 at the script's lin
 stray=$(left "$TMP/fakebin/stuck-helper")
 code=$?
 check "no ffprobe left behind${stray:+ (pids$stray)}" 0
-WOBBLE_FFMPEG="$TMP/fakebin/stuck-helper" run run $F/probe_fifo.lua --out "$TMP/out-fifo" --set path=still.mp4 \
-    --set frame=true --time-limit 2
+# (read_frame asks ffprobe for the frame's size before ffmpeg decodes it: both stuck)
+WOBBLE_FFPROBE="$TMP/fakebin/stuck-helper" WOBBLE_FFMPEG="$TMP/fakebin/stuck-helper" run run $F/probe_fifo.lua \
+    --out "$TMP/out-fifo" --set path=still.mp4 --set frame=true --time-limit 2
 check "wobble.read_frame with a helper that never answers: exit 3 at the script's line (${secs} s)" 3 \
     err "$F/probe_fifo.lua:6: $LIMIT" !out "should not get here"
 stray=$(left "$TMP/fakebin/stuck-helper")

@@ -174,6 +174,7 @@
     X(collider_absurd_velocity_recovers)         \
     X(hash_covers_collider_velocity_mass_radius) \
     X(memory_budget_shared_by_worlds)           \
+    X(memory_budget_charges_worlds_and_threads) \
     X(memory_budget_charges_tets_and_volumes)   \
     X(distance_ids_match_distance_at)            \
     X(bvh_point_triangle_projection)             \
@@ -189,6 +190,7 @@
     X(tet_threads_1_and_2_same_bits)             \
     X(blowup_slowed_and_reported_once)           \
     X(blowup_not_a_long_fall_nor_a_thrown_particle) \
+    X(distance_compressed_link_regains_a_bounded_share) \
     X(attach_grab_forces_cleared_by_an_undone_frame) \
     X(attach_grab_clone_same_future)             \
     X(attach_grab_ids_and_memory)                \
@@ -197,6 +199,7 @@
     RIGID_TESTS(X)                               \
     NARROW_TESTS(X)                              \
     X(distance_simd_bit_identical_to_scalar)     \
+    X(momentum_simd_bit_identical_to_scalar)     \
     POOL_TESTS(X)                                \
     FUSED_TESTS(X)
 

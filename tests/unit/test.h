@@ -54,6 +54,18 @@ void test_fail(const char *file, int line, const char *fmt, ...)
                       #a, #b, a_, b_);                                              \
     } while (0)
 
+/* a vector path's switch (wb__*_simd(1)) turned it on wherever the build and the CPU
+ * have AVX2: the bit-identity tests then really compare it with the scalar loop */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(WB_FLOAT)
+#define CHECK_SIMD_RUNS(on)                                                         \
+    do {                                                                            \
+        __builtin_cpu_init();                                                       \
+        CHECK_EQ((on), __builtin_cpu_supports("avx2") ? 1 : 0);                     \
+    } while (0)
+#else
+#define CHECK_SIMD_RUNS(on) CHECK_EQ((on), 0)
+#endif
+
 /* the string s (may be NULL) contains sub */
 #define CHECK_HAS(s, sub)                                                           \
     do {                                                                            \

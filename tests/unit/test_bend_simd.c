@@ -121,13 +121,7 @@ static int differing(const wb_world *a, const wb_world *b)
 
 TEST(bend_simd_bit_identical_to_scalar)
 {
-    const int on = wb__bend_simd(1);
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(WB_FLOAT)
-    __builtin_cpu_init();
-    CHECK_EQ(on, __builtin_cpu_supports("avx2") ? 1 : 0); /* the vector path really runs here */
-#else
-    CHECK_EQ(on, 0);
-#endif
+    CHECK_SIMD_RUNS(wb__bend_simd(1));
     const int cases[][2] = { { 1, 0 }, { 1, 1 }, { 2, 1 } };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
         wb_world *v = scene(cases[c][0], cases[c][1]), *s = scene(cases[c][0], cases[c][1]);

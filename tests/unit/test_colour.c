@@ -21,8 +21,29 @@ static void check_colouring(wb_world *w)
     /* ranges */
     REQUIRE(k->ncolours >= 0 && k->serial_start >= 0 && k->serial_start <= k->ncolours);
     CHECK_EQ(k->ncolours > 0 ? k->colour_start[0] : 0, 0);
-    CHECK_EQ(k->ncolours > 0 ? k->colour_start[k->ncolours] : 0, k->ns);
+    CHECK_EQ(k->ncolours > 0 ? k->colour_start[k->ncolours] : 0, k->split_start);
     for (int32_t c = 0; c < k->ncolours; c++) CHECK(k->colour_start[c] < k->colour_start[c + 1]);
+    /* the compounds fill [split_start, ns), each a non-empty run of links joined through
+     * shared movable particles, whose ends count the members meeting there */
+    REQUIRE(k->ncomp >= 0);
+    CHECK_EQ(k->comp_start[0], k->split_start);
+    CHECK_EQ(k->comp_start[k->ncomp], k->ns);
+    int bad_comp = 0;
+    for (int32_t c = 0; c < k->ncomp; c++) {
+        const int32_t b = k->comp_start[c], e = k->comp_start[c + 1];
+        if (e <= b) { bad_comp++; continue; }
+        for (int32_t i = b; i < e; i++) {
+            int n[2] = { 0, 0 }, joined = e - b == 1;
+            for (int32_t j = b; j < e; j++) {
+                n[0] += k->s_a[j] == k->s_a[i] || k->s_b[j] == k->s_a[i];
+                n[1] += k->s_a[j] == k->s_b[i] || k->s_b[j] == k->s_b[i];
+            }
+            joined |= n[0] > 1 || n[1] > 1;
+            const int32_t *nsp = &k->s_nsp[2 * (i - k->split_start)];
+            bad_comp += !joined || nsp[0] != n[0] || nsp[1] != n[1];
+        }
+    }
+    CHECK_EQ(bad_comp, 0);
     /* conflict-free batches */
     int32_t *owner = malloc(sizeof(int32_t) * (size_t)(m->np > 0 ? m->np : 1));
     REQUIRE(owner);
@@ -149,7 +170,8 @@ TEST(colour_broken_constraints_unpacked)
 }
 
 /* the colour of the packed distance constraint joining local particles a and b of a
- * lattice body (first .. first + np - 1), -1 when none: a dense np x np table */
+ * lattice body (first .. first + np - 1), 1000 + its compound's run (below) for a
+ * compound's member, -1 when none: a dense np x np table */
 static int *lattice_colours(const wb_world *w, int32_t first, int32_t np)
 {
     int *col = malloc(sizeof *col * (size_t)np * (size_t)np);
@@ -161,13 +183,32 @@ static int *lattice_colours(const wb_world *w, int32_t first, int32_t np)
             const int32_t a = k->s_a[i] - first, b = k->s_b[i] - first;
             col[a * np + b] = col[b * np + a] = c;
         }
+    /* compounds touching none of the run they follow commute with it: a run projects as
+     * one, in any order (each compound's images are in its run) */
+    int32_t *run = malloc(sizeof *run * (size_t)np);
+    if (!run) { free(col); return NULL; }
+    for (int32_t p = 0; p < np; p++) run[p] = -1;
+    int32_t cur = 0;
+    for (int32_t c = 0; c < k->ncomp; c++) {
+        int shares = 0;
+        for (int32_t i = k->comp_start[c]; i < k->comp_start[c + 1]; i++)
+            shares |= run[k->s_a[i] - first] == cur || run[k->s_b[i] - first] == cur;
+        if (shares) cur++;
+        for (int32_t i = k->comp_start[c]; i < k->comp_start[c + 1]; i++) {
+            const int32_t a = k->s_a[i] - first, b = k->s_b[i] - first;
+            run[a] = run[b] = cur;
+            col[a * np + b] = col[b * np + a] = 1000 + cur;
+        }
+    }
+    free(run);
     return col;
 }
 
 /* a lattice n x ny x n centred on x = z = 0, coloured with (on = 1) or without mirror
  * keys; counts the links whose images across x = 0 or z = 0 have another colour:
- * mism[0] of links with no particle on either plane, mism[1] of the others */
-static void mirror_mismatches(int n, int ny, int on, int mism[2])
+ * mism[0] of links with no particle on either plane, mism[1] of the others; mism[2]: the
+ * compounds */
+static void mirror_mismatches(int n, int ny, int on, int mism[3])
 {
     const int was = wb__colour_symmetric(on);
     wb_world_def wd = wb_world_default_def();
@@ -185,6 +226,10 @@ static void mirror_mismatches(int n, int ny, int on, int mism[2])
     const int32_t np = b.count;
     int *col = lattice_colours(w, b.first, np);
     REQUIRE(col);
+    /* a lattice's compounds are the 2 or 4 images meeting at a particle on a plane */
+    const wb_cache *k = &w->k;
+    for (int32_t c = 0; c < k->ncomp; c++) CHECK(k->comp_start[c + 1] - k->comp_start[c] <= 4);
+    mism[2] = k->ncomp;
     mism[0] = mism[1] = 0;
     for (int32_t p = 0; p < np; p++)
         for (int32_t q = p + 1; q < np; q++) {
@@ -203,20 +248,22 @@ static void mirror_mismatches(int n, int ny, int on, int mism[2])
 /* A body symmetric about vertical planes is coloured symmetrically: a link and its
  * mirror images get the same colour, so every Gauss-Seidel sweep is symmetric (a box
  * dropped centred on a soft block stays upright: tests/validation/symmetric_drop.lua).
- * Exactly with no particle on the planes; with particles on them, the links that meet
- * there cannot be, and they are coloured last so that all others still are. The
+ * With particles on the planes, the images that meet there cannot share a colour: they
+ * form one compound, projected together (its images in the same compound). The
  * creation-order colouring mirrored neither. */
 TEST(colour_mirror_images_alike)
 {
-    int m[2];
+    int m[3];
     mirror_mismatches(6, 4, 1, m); /* no particle on the planes */
     CHECK_EQ(m[0], 0);
     CHECK_EQ(m[1], 0);
+    CHECK_EQ(m[2], 0);
     mirror_mismatches(6, 4, 0, m);
     CHECK(m[0] > 0);
     mirror_mismatches(7, 3, 1, m); /* a column of particles on each plane */
     CHECK_EQ(m[0], 0);
-    CHECK(m[1] > 0);
+    CHECK_EQ(m[1], 0);
+    CHECK(m[2] > 0);
     mirror_mismatches(7, 3, 0, m);
     CHECK(m[0] > 0);
 }

@@ -179,6 +179,40 @@ TEST(memory_budget_shared_by_worlds)
     CHECK_EQ(mem.used, 0);
 }
 
+TEST(memory_budget_charges_worlds_and_threads)
+{
+    /* an empty world is charged what it is (the struct, over a kilobyte), and a world
+     * of 256 threads its 255 workers too (32 kB each, 8 MB): 10^7 empty worlds or a few
+     * dozen of 256 threads must not pass a budget that only saw their Lua handles */
+    wb_memory mem = { 4u << 20, 0 };
+    wb_world_def d = wb_world_default_def();
+    d.memory = &mem;
+    wb_world *w = wb_world_create(&d);
+    REQUIRE(w);
+    const size_t one = mem.used;
+    CHECK(one > 1024);
+    d.threads = WB_MAX_THREADS;
+    CHECK(wb_world_create(&d) == NULL); /* 8 MB of threads in 4 MB */
+    CHECK_EQ(mem.used, one);
+    CHECK_EQ(wb_world_set_def(w, &d), WB_ERR_NOMEM); /* nor made so afterwards */
+    CHECK_EQ(wb_world_get_def(w).threads, 1);
+    CHECK_EQ(mem.used, one);
+    d.threads = 8;
+    CHECK_EQ(wb_world_set_def(w, &d), WB_OK);
+    CHECK(mem.used >= one + 7 * (size_t)(32 << 10));
+    d.threads = 1;
+    CHECK_EQ(wb_world_set_def(w, &d), WB_OK); /* fewer threads give it back */
+    CHECK_EQ(mem.used, one);
+    /* as many as fit, then a refusal */
+    wb_world *many[8192];
+    int n = 0;
+    while (n < 8192 && (many[n] = wb_world_create(&d))) n++;
+    CHECK(n < 8192 && mem.used <= mem.limit && mem.used + one > mem.limit);
+    for (int i = 0; i < n; i++) wb_world_destroy(many[i]);
+    wb_world_destroy(w);
+    CHECK_EQ(mem.used, 0);
+}
+
 /* adds tets (kind 0) or volume constraints (kind 1) over the same four particles until one
  * is refused, at most cap of them; returns how many were added */
 static int32_t add_until_refused(wb_world *w, const int32_t p[4], int kind, int32_t cap, int32_t *last)

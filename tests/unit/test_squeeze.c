@@ -77,3 +77,49 @@ TEST(blowup_not_a_long_fall_nor_a_thrown_particle)
     CHECK_EQ(wb_world_warnings(w), 0);
     wb_world_destroy(w);
 }
+
+/* one projection of a link made at twice its length (rest 2 m, 1 m apart, equal masses,
+ * no gravity, one substep) whose ends are corners of volume constraints: its full
+ * correction would double it; the lengthening is bent (distance.c, STRETCH_FREE = 1/8) to
+ * 1/8 (2 - 1/8) = 15/64 of its length: 1.234375 m, exactly in binary. Each end's volume
+ * has its other three corners in the plane y = 1, so moving the end along x keeps it (no
+ * volume correction). A link shortened by 1/11 of its rest (a lengthening of 0.1 < 1/8)
+ * is corrected in full, as before; so is the link of 2 m between ends on no volume (a
+ * truss's links keep their full push: nothing else stops it folding). (One link runs the
+ * scalar loop; test_distance_simd.c holds the vector path to its bits.) */
+TEST(distance_compressed_link_regains_a_bounded_share)
+{
+    const wb_real rests[3] = { 2, 1.1, 2 }, want[3] = { 1.234375, 1.1, 2 };
+    for (int c = 0; c < 3; c++) {
+        wb_world_def d = wb_world_default_def();
+        d.gravity[1] = 0;
+        d.substeps = 1;
+        wb_world *w = wb_world_create(&d);
+        REQUIRE(w);
+        const wb_real a[3] = { 0, 0, 0 }, b[3] = { 1, 0, 0 };
+        const int32_t p = wb_particle_add(w, a, NULL, 1, 0.01), q = wb_particle_add(w, b, NULL, 1, 0.01);
+        if (c < 2)
+            for (int e = 0; e < 2; e++) {
+                /* three corners far from each other and from the link (no contact) */
+                const wb_real o = 10 * e - 5;
+                const wb_real c1[3] = { o, 1, -3 }, c2[3] = { o, 1, 3 }, c3[3] = { o + 3, 1, 0 };
+                const int32_t t[4] = { e ? q : p, wb_particle_add(w, c1, NULL, 1, 0.01), wb_particle_add(w, c2, NULL, 1, 0.01),
+                                       wb_particle_add(w, c3, NULL, 1, 0.01) };
+                const wb_volume_def vd = wb_volume_default_def();
+                REQUIRE(wb_volume_add(w, t, &vd) >= 0);
+            }
+        wb_distance_def dd = wb_distance_default_def();
+        dd.rest = rests[c];
+        wb_status st;
+        wb_distance_add(w, p, q, &dd, &st);
+        REQUIRE(st == WB_OK);
+        CHECK_EQ(wb_world_step(w), WB_OK);
+        wb_real xp[3], xq[3];
+        wb_particle_position(w, p, xp);
+        wb_particle_position(w, q, xq);
+        CHECK_NEAR(xq[0] - xp[0], want[c], 1e-12);
+        CHECK_NEAR(xp[0] + xq[0], 1, 1e-12); /* equal and opposite */
+        CHECK_NEAR(xp[1], 0, 1e-12);
+        wb_world_destroy(w);
+    }
+}

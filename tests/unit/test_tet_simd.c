@@ -164,13 +164,7 @@ static int same_bits(wb_world **w, const int *simd, int nw, int frames)
 
 TEST(tet_simd_bit_identical_to_scalar)
 {
-    const int on = wb__tet_simd(1);
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(WB_FLOAT)
-    __builtin_cpu_init();
-    CHECK_EQ(on, __builtin_cpu_supports("avx2") ? 1 : 0); /* the vector path really runs here */
-#else
-    CHECK_EQ(on, 0);
-#endif
+    CHECK_SIMD_RUNS(wb__tet_simd(1));
     wb_world *w[2] = { scene(1), scene(1) };
     REQUIRE(w[0] && w[1]);
     const int simd[2] = { 1, 0 };
