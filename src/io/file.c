@@ -14,6 +14,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -59,10 +60,19 @@ static void unlist_temp(int slot)
     atomic_store(&temps[slot].state, 0);
 }
 
+/* A temporary is made and listed between a rise and a fall of `opening`, with the
+ * caller's signals blocked; the removal first sets `dying`, then waits (bounded) for the
+ * makings under way, so another thread cannot make a temporary after the removal ran
+ * over the list and before the process is gone: a making that starts after it sees
+ * `dying` and makes nothing */
+static atomic_int opening, dying;
+
 /* async-signal-safe: unlinkat and getpid only */
 void wbio_remove_temporaries(void)
 {
     const pid_t me = getpid();
+    atomic_store(&dying, 1);
+    for (long spin = 0; atomic_load(&opening) > 0 && spin < 100000000L; spin++) {}
     for (int i = 0; i < NTEMP; i++)
         if (atomic_load(&temps[i].state) == 2 && temps[i].pid == me) unlinkat(temps[i].dir, temps[i].name, 0);
 }
@@ -140,7 +150,12 @@ int wbio_out_open(wbio_out *o, int dir, const char *name, const char *shown, cha
     const char *slash = strrchr(name, '/'), *base = slash ? slash + 1 : name;
     const int dl = slash ? (int)(slash - name + 1) : 0;
     int fd = -1;
-    for (int tries = 0; fd < 0 && tries < 100; tries++) {
+    sigset_t all, old;
+    sigfillset(&all);
+    pthread_sigmask(SIG_BLOCK, &all, &old);
+    atomic_fetch_add(&opening, 1);
+    if (atomic_load(&dying)) errno = EINTR;
+    for (int tries = 0; fd < 0 && tries < 100 && !atomic_load(&dying); tries++) {
         /* hidden, and named after its file so a stray one says where it came from */
         if (snprintf(o->tmp, sizeof o->tmp, "%.*s.%.200s.%ld-%u.tmp", dl, name, base, (long)getpid(),
                      atomic_fetch_add(&seq, 1)) >= (int)sizeof o->tmp) {
@@ -150,11 +165,14 @@ int wbio_out_open(wbio_out *o, int dir, const char *name, const char *shown, cha
         fd = openat(dir, o->tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
         if (fd < 0 && errno != EEXIST) break;
     }
+    if (fd >= 0) o->slot = list_temp(dir, o->tmp);
+    const int e = errno;
+    atomic_fetch_sub(&opening, 1);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
     if (fd < 0) {
-        set_err(err, errn, shown, errno);
+        set_err(err, errn, shown, e);
         return -1;
     }
-    o->slot = list_temp(dir, o->tmp);
     /* the new file keeps the old one's permissions */
     if (exists && S_ISREG(st.st_mode)) (void)fchmod(fd, st.st_mode & 07777);
     if (!(o->f = fdopen(fd, "wb"))) {
