@@ -316,9 +316,14 @@ static bool spawn_encoder(wb_recorder *rec, char *err, size_t n)
                            "-i", "pipe:0", "-an", "-threads", threads };
     for (size_t k = 0; k < sizeof head / sizeof *head; k++) argv[a++] = head[k];
     if (rec->kind == WB_MEDIA_MP4) {
-        /* yuv420p plays everywhere but needs even sizes: pad odd ones by a pixel */
-        const char *mp4[] = { "-c:v", "libx264", "-preset", "veryfast", "-crf", "18", "-pix_fmt", "yuv420p",
-                              "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-movflags", "+faststart", "-f", "mp4" };
+        /* yuv420p plays everywhere but needs even sizes: pad odd ones by a pixel. The
+         * conversion uses the BT.709 matrix in limited range and the stream says so:
+         * players assume BT.709 for HD, and an untagged BT.601 conversion (ffmpeg's
+         * default) shifted saturated colours (the strain's red) */
+        const char *mp4[] = { "-c:v", "libx264", "-preset", "veryfast", "-crf", "18",
+                              "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2,scale=out_color_matrix=bt709:out_range=tv,format=yuv420p",
+                              "-pix_fmt", "yuv420p", "-colorspace", "bt709", "-color_primaries", "bt709",
+                              "-color_trc", "bt709", "-color_range", "tv", "-movflags", "+faststart", "-f", "mp4" };
         for (size_t k = 0; k < sizeof mp4 / sizeof *mp4; k++) argv[a++] = mp4[k];
     } else {
         /* a GIF's delays are whole centiseconds and players show one under 2 cs as 10:
