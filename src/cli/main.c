@@ -61,6 +61,8 @@ static const char usage_text[] =
     "options of run, test and bench:\n"
     "  --frames N          w:run stops after N frames; bench: each scene runs N frames\n"
     "  --record OUT        (run) draw every frame into OUT: .mp4, .gif or a folder of PNGs\n"
+    "  --size WxH          (run) the size of --record's frames (default 1280x720; a .gif\n"
+    "                      480x270, small enough for a web page)\n"
     "  --replay INPUT.json (run) apply the grabs of an input log after their frames; exit\n"
     "                      code 1 when some were not applied (the scene ended or differs)\n"
     "  --out DIR           output folder, the only place a script writes (default out);\n"
@@ -158,7 +160,8 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
             continue;
         }
         if (!strcmp(name, "--record-input") || !strcmp(name, "--screenshot") || !strcmp(name, "--size")) {
-            if (strcmp(cmd, "view")) return usage_error("%s is an option of view", name);
+            if (strcmp(cmd, "view") && (strcmp(name, "--size") || strcmp(cmd, "run")))
+                return usage_error("%s is an option of view", name);
             if (eq) val = eq + 1;
             else if (i + 1 < argc) val = argv[++i];
             else return usage_error("%s needs a value", name);
@@ -219,6 +222,8 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
             o->sets[o->nsets++] = val;
         }
     }
+    if (!strcmp(cmd, "run") && o->view.width && !o->record)
+        return usage_error("%s", "--size with run is the size of --record's frames: give --record OUT");
     return EXIT_PASS;
 }
 
@@ -735,7 +740,7 @@ static int run_scene(const opts *o, const char *path, run_report *rep) {
         wb_rt_close(L);
         return EXIT_SCRIPT;
     }
-    if (o->record && !wbl_record_begin(L, o->record, rerr, sizeof rerr)) {
+    if (o->record && !wbl_record_begin(L, o->record, o->view.width, o->view.height, rerr, sizeof rerr)) {
         fprintf(stderr, "wobble: %s\n", rerr);
         report_error(rep, rerr);
         report_take(rep, L);

@@ -705,7 +705,7 @@ static int record_hook(lua_State *L)
     return 0;
 }
 
-bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n)
+bool wbl_record_begin(lua_State *L, const char *path, int width, int height, char *err, size_t n)
 {
     char e[PATH_MAX + 256];
     wb_media kind = wb_media_of(path, NULL, e, sizeof e);
@@ -713,9 +713,20 @@ bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n)
         snprintf(err, n, "--record: %s", e);
         return false;
     }
+    /* a GIF holds a palette image per frame: at 1280x720 two seconds took 17.6 MB, too
+     * much for a web page; 480x270 (about a tenth of that) unless a size is asked for */
+    if (width <= 0 || height <= 0) {
+        width = kind == WB_MEDIA_GIF ? 480 : 1280;
+        height = kind == WB_MEDIA_GIF ? 270 : 720;
+    }
     int top = lua_gettop(L);
     lua_pushcfunction(L, l_renderer);
-    if (lua_pcall(L, 0, 1, 0) != LUA_OK) {
+    lua_createtable(L, 0, 2);
+    lua_pushinteger(L, width);
+    lua_setfield(L, -2, "width");
+    lua_pushinteger(L, height);
+    lua_setfield(L, -2, "height");
+    if (lua_pcall(L, 1, 1, 0) != LUA_OK) {
         snprintf(err, n, "--record: %s", lua_tostring(L, -1) ? lua_tostring(L, -1) : "cannot create the renderer");
         lua_settop(L, top);
         return false;

@@ -215,8 +215,9 @@ void wb_chart_label(char *buf, size_t n, double v, double step);
 typedef struct lua_State lua_State;
 void wbl_open_renderer(lua_State *L);   /* wobble.renderer, probe, read_png, read_frame, clock */
 /* `wobble run --record OUT`: every frame any w:run / w:step makes is drawn (default
- * camera, every layer) and added to OUT, a path of the user's choice */
-bool wbl_record_begin(lua_State *L, const char *path, char *err, size_t n);
+ * camera, every layer) and added to OUT, a path of the user's choice; frames of w x h
+ * (0: 1280x720, a GIF 480x270) */
+bool wbl_record_begin(lua_State *L, const char *path, int w, int h, char *err, size_t n);
 bool wbl_record_end(lua_State *L, char *err, size_t n);   /* finish the file; prints where it went */
 /* the live skins of the world at world_index, ready to draw (Lua userdata left on the
  * stack, collected with it); *n their count (the viewer draws with it too) */

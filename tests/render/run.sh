@@ -54,6 +54,11 @@ run "$W" run $F/swing.lua --frames 5 --record "$TMP/swing.gif"
 # 8 frames at 60 fps last 0.133 s; a GIF shows them at 50 fps (2 cs a frame): 7 frames, 0.14 s
 [ "$code" = 0 ] && [ "$(frames "$TMP/swing.gif")" = 7 ] && near "$(duration "$TMP/swing.gif")" 0.14 0.015; ok "--record .gif with --frames 5: 5 + 3 frames, as long as they last" $?
 grep -q "recorded 8 frames to $TMP/swing.gif" "$TMP/err"; ok "--record says where the frames went" $?
+[ "$(field "$TMP/swing.gif" width)" = 480 ] && [ "$(field "$TMP/swing.gif" height)" = 270 ]; ok "--record .gif: 480x270 by default (1280x720 made GIFs too large for the web)" $?
+run "$W" run $F/swing.lua --quiet --frames 2 --size 320x180 --record "$TMP/small.gif"
+[ "$code" = 0 ] && [ "$(field "$TMP/small.gif" width),$(field "$TMP/small.gif" height)" = "320,180" ]; ok "--record with --size 320x180: frames of that size" $?
+run "$W" run $F/swing.lua --quiet --frames 2 --size 320x180
+[ "$code" = 2 ] && grep -q "size with run is the size of --record's frames" "$TMP/err"; ok "--size without --record is refused" $?
 
 run "$W" run $F/swing.lua --quiet --frames 2 --record "$TMP/pngs/"
 [ "$code" = 0 ] && [ -s "$TMP/pngs/frame_000000.png" ] && [ -s "$TMP/pngs/frame_000004.png" ] && [ ! -e "$TMP/pngs/frame_000005.png" ]; ok "--record folder/: numbered PNGs" $?
