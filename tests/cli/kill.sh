@@ -40,8 +40,8 @@ stop() {
     pid=""
 }
 
-# temps DIR: the temporaries left in DIR (hidden names ending in .tmp), one line each
-temps() { find "$1" -name '.*.tmp' 2>/dev/null; }
+# temps DIR: the temporaries left in DIR (.NAME.PID-N.tmp; main's w:save used NAME.tmpPID), one line each
+temps() { find "$1" -name '*.tmp*' 2>/dev/null; }
 
 # one_shot HOW N NAME FILE...: FILE(s) in the output folder, written by HOW; N the size
 one_shot() {
