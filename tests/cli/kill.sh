@@ -21,7 +21,9 @@ trap 'exit 130' INT TERM
 start() {
     out=$1
     shift
-    "$W" run "$F/kill_writer.lua" --quiet --out "$out" "$@" >"$TMP/out" 2>"$TMP/err" &
+    # a background job of a script starts with SIGINT ignored (and wobble leaves an
+    # ignored signal alone, as under nohup): give it back its default for the INT case
+    env --default-signal=INT "$W" run "$F/kill_writer.lua" --quiet --out "$out" "$@" >"$TMP/out" 2>"$TMP/err" &
     pid=$!
     for _ in $(seq 600); do
         grep -q writing "$TMP/out" 2>/dev/null && return 0
