@@ -10,6 +10,7 @@
 #       tests/cli/extreme.sh                    extreme input (overflowing builders, rest lengths, KNN ties)
 #       tests/cli/memory.sh                     --memory-limit outside the Lua heap: meshes, renderers, PNGs, assimp
 #       tests/cli/budget.sh                     --memory-limit with no time limit: the process tree's peak RSS
+#       tests/cli/kill.sh                       writers killed mid-write: the old file or a complete new one
 #   (e) tests/render/run.sh                     wobble run --record, encoders that fail
 #   (f) tests/layers.sh                         the layers of DESIGN §1: no upward call, no circle
 #   (g) tests/cli/firstrun.sh                   what a new user meets: make deps, bench --frames, print
@@ -125,6 +126,7 @@ part "sandbox escapes (tests/cli/sandbox.sh)" sh tests/cli/sandbox.sh "$BUILD"
 part "extreme input from the command line (tests/cli/extreme.sh)" sh tests/cli/extreme.sh "$BUILD"
 part "memory budgets (tests/cli/memory.sh)" sh tests/cli/memory.sh "$BUILD"
 part "memory budgets without a time limit (tests/cli/budget.sh)" sh tests/cli/budget.sh "$BUILD"
+part "writers killed mid-write (tests/cli/kill.sh)" sh tests/cli/kill.sh "$BUILD"
 part "recording from the command line (tests/render/run.sh)" sh tests/render/run.sh "$BUILD"
 part "layers (tests/layers.sh)" sh tests/layers.sh "$BUILD"
 part "first run (tests/cli/firstrun.sh)" sh tests/cli/firstrun.sh "$BUILD"

@@ -8,10 +8,12 @@
  * when both are grid keys, else a line per COLOUR value; failed and non-finite runs
  * are crossed out, so the picture is a stability map. */
 #include "sweep.h"
+#include "lua/util.h"
 #include "render/render.h"
 
 #include <cjson/cJSON.h>
 #include <errno.h>
+#include <float.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -426,7 +428,7 @@ static void colour_bar(const image *im, int x, int y0, int y1, double lo, double
     frame(im, x, y0, x + 18, y1);
     char b[64];
     for (int k = 0; k <= 4; k++) {
-        double v = hi - (hi - lo) * k / 4;
+        double v = hi * (1 - k / 4.0) + lo * (k / 4.0);   /* finite for ends near DBL_MAX */
         int y = y0 + (y1 - y0) * k / 4;
         short_num(b, sizeof b, v);
         wb_chart_rect(im->px, im->w, im->h, x + 18, y, x + 23, y + 1, frame_col);
@@ -454,14 +456,19 @@ static void heat_map(const table *t, const char *X, const char *Y, const char *C
         if (!strcmp(w->status, "missing")) miss[c]++;
         else if (bad_run(t, w, C)) bad[c]++;
         if (!C) sum[c] += !strcmp(w->status, "ok"), cnt[c] += strcmp(w->status, "missing") != 0;
-        else if (!bad_run(t, w, C) && number(t, w, C, &v) == 1) sum[c] += v, cnt[c]++;
+        else if (!bad_run(t, w, C) && number(t, w, C, &v) == 1) {
+            /* a running mean: a sum of values near DBL_MAX would overflow */
+            cnt[c]++;
+            sum[c] += (v / 2 - sum[c] / 2) * (2.0 / cnt[c]);
+        }
     }
     double lo = INFINITY, hi = -INFINITY;
     for (int c = 0; c < nx * ny; c++)
-        if (cnt[c]) lo = fmin(lo, sum[c] / cnt[c]), hi = fmax(hi, sum[c] / cnt[c]);
+        if (cnt[c]) lo = fmin(lo, C ? sum[c] : sum[c] / cnt[c]), hi = fmax(hi, C ? sum[c] : sum[c] / cnt[c]);
     if (!C) lo = 0, hi = 1;
     if (!(lo <= hi)) lo = 0, hi = 1;
-    if (hi - lo < 1e-12 * fmax(1, fabs(hi))) lo -= 0.5, hi += 0.5;
+    /* halves: the span of values near DBL_MAX overflows */
+    if (hi / 2 - lo / 2 < 0.5e-12 * fmax(1, fabs(hi))) lo = fmax(lo - 0.5, -DBL_MAX), hi = fmin(hi + 0.5, DBL_MAX);
     double cw = (double)(right - left) / nx, ch = (double)(bottom - top) / ny;
     for (int yi = 0; yi < ny; yi++)
         for (int xi = 0; xi < nx; xi++) {
@@ -469,8 +476,8 @@ static void heat_map(const table *t, const char *X, const char *Y, const char *C
             int x0 = left + (int)lrint(xi * cw), x1 = left + (int)lrint((xi + 1) * cw);
             int y1 = bottom - (int)lrint(yi * ch), y0 = bottom - (int)lrint((yi + 1) * ch);  /* first value at the bottom */
             uint8_t col[3] = { empty_col[0], empty_col[1], empty_col[2] };
-            double v = cnt[c] ? sum[c] / cnt[c] : NAN;
-            if (cnt[c]) ramp((v - lo) / (hi - lo), col);
+            double v = !cnt[c] ? NAN : C ? sum[c] : sum[c] / cnt[c];
+            if (cnt[c]) ramp((v / 2 - lo / 2) / (hi / 2 - lo / 2), col);
             wb_chart_rect(im->px, im->w, im->h, x0 + 1, y0 + 1, x1 - 1, y1 - 1, col);
             double mx = (x0 + x1) / 2.0, my = (y0 + y1) / 2.0;
             if (bad[c]) cross(im, mx, my, fmin(cw, ch) * 0.32, bad_col);
@@ -502,34 +509,48 @@ static void heat_map(const table *t, const char *X, const char *Y, const char *C
     free(sum), free(cnt), free(bad), free(miss), free(all);
 }
 
-/* an axis: linear, or logarithmic when the values span three decades or more */
-typedef struct axis { double lo, hi; int log; } axis;
+/* an axis: linear, or logarithmic when the values span three decades or more. Values
+ * near DBL_MAX stay finite on either: a log axis keeps its ends as powers of ten (10^309
+ * would be infinite), a linear one is measured in halves (hi - lo can overflow) */
+typedef struct axis { double lo, hi; int log, elo, ehi; } axis;
 
 static double ax_pos(const axis *a, double v) {
-    return a->log ? (log10(v) - log10(a->lo)) / (log10(a->hi) - log10(a->lo)) : (v - a->lo) / (a->hi - a->lo);
+    return a->log ? (log10(v) - a->elo) / (a->ehi - a->elo) : (v / 2 - a->lo / 2) / (a->hi / 2 - a->lo / 2);
 }
 
 static void ax_fit(axis *a, double lo, double hi, int allow_log) {
-    if (!(lo <= hi)) lo = 0, hi = 1;
+    if (!(lo <= hi) || !isfinite(lo) || !isfinite(hi)) lo = 0, hi = 1;
     a->log = allow_log && lo > 0 && hi / lo >= 1000;
     if (a->log) {
-        a->lo = pow(10, floor(log10(lo) - 0.05)), a->hi = pow(10, ceil(log10(hi) + 0.05));
+        a->elo = (int)floor(log10(lo) - 0.05), a->ehi = (int)ceil(log10(hi) + 0.05);
+        a->lo = lo, a->hi = hi;
         return;
     }
-    if (hi - lo < 1e-12 * fmax(1, fabs(hi))) lo -= fmax(1e-3, fabs(lo) * 0.1), hi += fmax(1e-3, fabs(hi) * 0.1);
-    double pad = 0.06 * (hi - lo);
-    a->lo = lo - pad, a->hi = hi + pad;
+    if (hi / 2 - lo / 2 < 0.5e-12 * fmax(1, fabs(hi))) {
+        lo -= fmax(1e-3, fabs(lo) * 0.1), hi += fmax(1e-3, fabs(hi) * 0.1);
+        lo = fmax(lo, -DBL_MAX), hi = fmin(hi, DBL_MAX);
+    }
+    double pad = 0.06 * (hi / 2 - lo / 2) * 2;
+    a->lo = fmax(lo - pad, -DBL_MAX), a->hi = fmin(hi + pad, DBL_MAX);
 }
 
 /* grid lines and labels of an axis; vertical: the y axis */
 static void ax_draw(const image *im, const axis *a, int vertical, int x0, int y0, int x1, int y1) {
     char b[64];
-    double first, step;
-    if (a->log) first = floor(log10(a->lo)), step = 1;
-    else step = wb_nice_step((a->hi - a->lo) / (vertical ? 5 : 8)), first = ceil(a->lo / step - 1e-9) * step;
-    double end = a->log ? log10(a->hi) : a->hi;
-    for (double v = first; v <= end + 1e-9 * step; v += step) {
-        double val = a->log ? pow(10, v) : v, f = ax_pos(a, val);
+    double first, step, end;
+    if (a->log) {  /* whole decades, a few labels even over 600 of them */
+        step = fmax(1, ceil(wb_nice_step((double)(a->ehi - a->elo) / (vertical ? 5 : 8))));
+        first = ceil(a->elo / step) * step, end = a->ehi;
+    }
+    else {
+        step = wb_nice_step((a->hi / 2 - a->lo / 2) / (vertical ? 2.5 : 4));
+        first = ceil(a->lo / step - 1e-9) * step, end = a->hi;
+    }
+    /* a step that rounding makes vanish (or an overflow) must not loop forever */
+    for (int k = 0; k < 64; k++) {
+        const double v = first + k * step;
+        if (!isfinite(v) || v > end + 1e-9 * step) break;
+        double f = a->log ? (v - a->elo) / (a->ehi - a->elo) : ax_pos(a, v);
         if (a->log) snprintf(b, sizeof b, "1e%d", (int)lrint(v));
         else wb_chart_label(b, sizeof b, v, step);
         if (vertical) {
@@ -694,7 +715,7 @@ static int plot(const table *t, const char *spec, const char *png) {
     }
     text(&im, 20, 12, title, ink, 2);
     char err[PATH_MAX + 128];
-    int ok = wb_image_write_png(png, im.px, im.w, im.h, err, sizeof err);
+    int ok = wbl_write_png(png, im.px, im.w, im.h, err, sizeof err);
     free(im.px);
     if (!ok) return collect_error("--plot %s: %s", png, err);
     return EXIT_PASS;

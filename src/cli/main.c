@@ -1,6 +1,7 @@
 /* main.c: the `wobble` command line (DESIGN §4): run a scene, run scenario tests as
  * TAP 13, run the benchmark scenes. Exit codes: 0 ok, 1 a test or expectation
  * failed, 2 script or input error, 3 a budget was exceeded. */
+#include "io/io.h"
 #include "lua/input.h"
 #include "lua/wobble_lua.h"
 #include "render/render.h"
@@ -224,6 +225,8 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
             o->sets[o->nsets++] = val;
         }
     }
+    if (!strcmp(cmd, "run") && o->view.width && !o->record)
+        return usage_error("%s", "--size with run is the size of --record's frames: give --record OUT");
     return EXIT_PASS;
 }
 
@@ -914,6 +917,7 @@ static int cmd_bench(opts *o) {
 
 int main(int argc, char **argv) {
     setvbuf(stdout, NULL, _IOLBF, 0);  /* TAP lines and script output in order through a pipe */
+    wbio_clean_on_signals();  /* Ctrl-C, kill, a closed terminal: no half-written file left */
     if (argc < 2) {
         fputs(usage_text, stderr);
         return EXIT_SCRIPT;

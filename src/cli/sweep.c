@@ -5,10 +5,12 @@
  * which `wobble collect` reads. wobble schedules nothing itself: those engines do; only
  * `--run` starts GNU parallel on this machine. */
 #include "sweep.h"
+#include "io/io.h"
 
 #include <cjson/cJSON.h>
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <ftw.h>
 #include <limits.h>
 #include <math.h>
@@ -346,11 +348,10 @@ static cJSON *describe(const sweep *s, const char *exe, const char *scene, const
 static int write_file(const char *dir, const char *name, const char *text, int mode, char *err, size_t n) {
     char p[PATH_MAX + 64];
     snprintf(p, sizeof p, "%s/%s", dir, name);
-    FILE *f = fopen(p, "w");
-    int ok = f && fputs(text, f) >= 0;
-    if (f && fclose(f) != 0) ok = 0;
+    char e[2 * PATH_MAX];
+    int ok = wbio_write_bytes(AT_FDCWD, p, p, text, strlen(text), e, sizeof e) == 0;
     if (ok && mode) chmod(p, (mode_t)mode);
-    if (!ok) snprintf(err, n, "cannot write %s: %s", p, strerror(errno));
+    if (!ok) snprintf(err, n, "cannot write %.*s", (int)(n > 16 ? n - 16 : 0), e);
     return ok;
 }
 

@@ -725,7 +725,7 @@ static int run_once(void)
     /* the window's last picture, before the world it names is gone */
     if (code && o->screenshot) {
         char err[1024];
-        if (!wb_image_write_png(o->screenshot, V.frame, V.W, V.H, err, sizeof err)) {
+        if (!wbl_write_png(o->screenshot, V.frame, V.W, V.H, err, sizeof err)) {
             fprintf(stderr, "wobble: --screenshot: %s\n", err);
             if (code == 1) code = 1 + 2;
         }

@@ -2,25 +2,32 @@
  *
  * PC2 (Blender's Mesh Cache modifier): a 32-byte header ("POINTCACHE2\0", version 1,
  * point count, start frame, sample rate, sample count), then float32 x y z per point per
- * sample, little-endian. The sample count in the header is patched after every sample,
- * so a run stopped early still leaves a readable cache of what was written.
+ * sample, little-endian. The cache grows in a temporary beside its name (file.c), its
+ * header's sample count patched after every sample, and takes the name when the
+ * recording closes: an old cache of that name stays whole until then.
  *
- * VTK (ParaView): a .pvd collection naming one XML PolyData (.vtp) file per frame. The
+ * VTK (ParaView): a .pvd collection naming one XML PolyData (.vtp) file per frame. Each
+ * frame's .vtp is written whole, then the .pvd is written again whole, listing every
+ * frame so far: whenever the run stops, the .pvd on disk is complete and names only
+ * complete frames. The
  * points are the particles, with point data velocity, speed, strain (the largest |strain|
  * of the particle's constraints), mass and pinned; the cells are the particles (vertices),
  * the constraints (lines) and the surfaces' triangles (polygons). ASCII, so the files are
  * diffable and need no base64 or compression library. */
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "io.h"
 
 /* ---- PC2 ---------------------------------------------------------------------------------- */
 struct wbio_pc2 {
-    FILE *f;
+    wbio_out out;
+    FILE *f;               /* out's stream */
     int32_t n, samples;
     float *buf;            /* (n x 3) one sample, converted */
 };
@@ -49,13 +56,12 @@ wbio_pc2 *wbio_pc2_open(const char *path, const char *shown, int32_t npoints, do
         return NULL;
     }
     p->n = npoints;
-    p->f = fopen(path, "wb");
-    if (!p->f) {
-        snprintf(err, errn, "%s: %s", shown, strerror(errno));
+    if (wbio_out_open(&p->out, AT_FDCWD, path, shown, err, errn)) {
         free(p->buf);
         free(p);
         return NULL;
     }
+    p->f = p->out.f;
     unsigned char h[32];
     memcpy(h, "POINTCACHE2", 12);          /* 11 characters and the terminating zero */
     le32(h + 12, 1);                       /* file version */
@@ -65,7 +71,7 @@ wbio_pc2 *wbio_pc2_open(const char *path, const char *shown, int32_t npoints, do
     le32(h + 28, 0);                       /* samples: patched as they come */
     if (fwrite(h, 1, sizeof h, p->f) != sizeof h) {
         snprintf(err, errn, "%s: %s", shown, strerror(errno));
-        fclose(p->f);
+        wbio_out_abort(&p->out);
         free(p->buf);
         free(p);
         return NULL;
@@ -82,8 +88,8 @@ int wbio_pc2_write(wbio_pc2 *p, const wb_real *pts, char *err, size_t errn)
         return -1;
     }
     p->samples++;
-    /* the count in the header follows every sample, so a run that stops without closing
-     * (an error, a budget) still leaves a valid cache */
+    /* the count in the header follows every sample: the temporary is a valid cache of
+     * what it holds at any moment */
     unsigned char c[4];
     le32(c, (uint32_t)p->samples);
     if (fseek(p->f, 28, SEEK_SET) != 0 || fwrite(c, 1, 4, p->f) != 4 || fseek(p->f, 0, SEEK_END) != 0 || fflush(p->f) != 0) {
@@ -95,11 +101,12 @@ int wbio_pc2_write(wbio_pc2 *p, const wb_real *pts, char *err, size_t errn)
 
 int32_t wbio_pc2_samples(const wbio_pc2 *p) { return p->samples; }
 
-int wbio_pc2_close(wbio_pc2 *p, char *err, size_t errn)
+int wbio_pc2_close(wbio_pc2 *p, int keep, char *err, size_t errn)
 {
     if (!p) return 0;
-    int rc = fclose(p->f) != 0 ? -1 : 0;
-    if (rc) snprintf(err, errn, "%s", strerror(errno ? errno : EIO));
+    int rc = 0;
+    if (!keep) wbio_out_abort(&p->out);
+    else if (wbio_out_commit(&p->out, "", err, errn)) rc = -1;
     free(p->buf);
     free(p);
     return rc;
@@ -107,9 +114,12 @@ int wbio_pc2_close(wbio_pc2 *p, char *err, size_t errn)
 
 /* ---- VTK ------------------------------------------------------------------------------------- */
 struct wbio_vtk {
-    FILE *pvd;
-    char *dir, *rel;       /* the .vtp folder, and as the .pvd names it */
-    int32_t frames;
+    char *pvd;             /* the .pvd's path */
+    int dir;               /* the .vtp folder, held open: every frame lands in it */
+    char *rel;             /* that folder as the .pvd names it */
+    int32_t frames, cap;
+    int64_t *frame;        /* (frames) the world's frame of each .vtp, and its time */
+    double *time;
 };
 
 static void vtk_list(FILE *f, const char *name, const char *type, int comps)
@@ -207,25 +217,22 @@ wbio_vtk *wbio_vtk_open(const char *pvd_path, const char *dir, const char *rel_d
 {
     wbio_vtk *v = calloc(1, sizeof *v);
     if (v) {
-        v->dir = strdup(dir);
+        v->dir = -1;
+        v->pvd = strdup(pvd_path);
         v->rel = strdup(rel_dir);
     }
-    if (!v || !v->dir || !v->rel) {
+    if (!v || !v->pvd || !v->rel) {
         snprintf(err, errn, "%s: out of memory", shown);
-        if (v) { free(v->dir); free(v->rel); }
-        free(v);
+        wbio_vtk_close(v, err, 0);
         return NULL;
     }
-    v->pvd = fopen(pvd_path, "w");
-    if (!v->pvd) {
-        snprintf(err, errn, "%s: %s", shown, strerror(errno));
-        free(v->dir);
-        free(v->rel);
-        free(v);
+    /* the folder is checked by the caller; O_NOFOLLOW: it is not swapped for a link since */
+    v->dir = open(dir, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+    if (v->dir < 0) {
+        snprintf(err, errn, "%s: %s: %s", shown, dir, strerror(errno));
+        wbio_vtk_close(v, err, 0);
         return NULL;
     }
-    fputs("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-          "  <Collection>\n", v->pvd);
     return v;
 }
 
@@ -244,31 +251,54 @@ static void xml_attr(FILE *f, const char *s)
     }
 }
 
+/* the .pvd, whole, naming the frames written so far */
+static int write_pvd(const wbio_vtk *v, char *err, size_t errn)
+{
+    wbio_out o;
+    if (wbio_out_open(&o, AT_FDCWD, v->pvd, v->pvd, err, errn)) return -1;
+    fputs("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+          "  <Collection>\n", o.f);
+    for (int32_t i = 0; i < v->frames; i++) {
+        fprintf(o.f, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"", v->time[i]);
+        xml_attr(o.f, v->rel);
+        fprintf(o.f, "/frame_%06lld.vtp\"/>\n", (long long)v->frame[i]);
+    }
+    fputs("  </Collection>\n</VTKFile>\n", o.f);
+    return wbio_out_commit(&o, v->pvd, err, errn);
+}
+
 int wbio_vtk_write(wbio_vtk *v, const wb_world *w, char *err, size_t errn)
 {
-    char path[4200], name[64];
+    char name[64];
     const long long frame = (long long)wb_world_frame(w);
     snprintf(name, sizeof name, "frame_%06lld.vtp", frame);
-    if (snprintf(path, sizeof path, "%s/%s", v->dir, name) >= (int)sizeof path) {
-        snprintf(err, errn, "path too long");
-        return -1;
+    if (v->frames == v->cap) {
+        const int32_t cap = v->cap ? 2 * v->cap : 64;
+        int64_t *f = realloc(v->frame, sizeof *f * (size_t)cap);
+        if (f) v->frame = f;
+        double *t = f ? realloc(v->time, sizeof *t * (size_t)cap) : NULL;
+        if (t) v->time = t;
+        if (!f || !t) {
+            snprintf(err, errn, "out of memory");
+            return -1;
+        }
+        v->cap = cap;
     }
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        snprintf(err, errn, "%s: %s", path, strerror(errno));
-        return -1;
-    }
-    int rc = wbio_write_vtp(f, w);
-    if (fclose(f) != 0) rc = -1;
-    if (rc) {
-        snprintf(err, errn, "%s: %s", path, strerror(errno ? errno : EIO));
-        return -1;
-    }
-    fprintf(v->pvd, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"", wb_world_time(w));
-    xml_attr(v->pvd, v->rel);
-    fprintf(v->pvd, "/%s\"/>\n", name);
-    fflush(v->pvd);
+    wbio_out o;
+    char shown[PATH_MAX + 80];
+    snprintf(shown, sizeof shown, "%s/%s", v->rel, name);
+    if (wbio_out_open(&o, v->dir, name, shown, err, errn)) return -1;
+    if (wbio_write_vtp(o.f, w)) o.failed = errno ? errno : EIO;
+    if (wbio_out_commit(&o, shown, err, errn)) return -1;
+    /* the frame's time as frame x dt: a running sum of dt drifts (frame 30 at 1/60 would
+     * read 0.49999999999999994, and ParaView would show frame 31 for 0.5 s) */
+    v->frame[v->frames] = frame;
+    v->time[v->frames] = (double)frame * (double)wb_world_get_def(w).dt;
     v->frames++;
+    if (write_pvd(v, err, errn)) {
+        v->frames--;
+        return -1;
+    }
     return 0;
 }
 
@@ -276,13 +306,13 @@ int32_t wbio_vtk_frames(const wbio_vtk *v) { return v->frames; }
 
 int wbio_vtk_close(wbio_vtk *v, char *err, size_t errn)
 {
+    (void)err, (void)errn;
     if (!v) return 0;
-    fputs("  </Collection>\n</VTKFile>\n", v->pvd);
-    int rc = ferror(v->pvd) ? -1 : 0;
-    if (fclose(v->pvd) != 0) rc = -1;
-    if (rc) snprintf(err, errn, "%s", strerror(errno ? errno : EIO));
-    free(v->dir);
+    if (v->dir >= 0) close(v->dir);
+    free(v->pvd);
     free(v->rel);
+    free(v->frame);
+    free(v->time);
     free(v);
-    return rc;
+    return 0;
 }

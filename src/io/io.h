@@ -9,6 +9,7 @@
 #ifndef WB_IO_H
 #define WB_IO_H
 
+#include <limits.h>
 #include <stdio.h>
 
 #include "core/snapshot.h"
@@ -17,6 +18,35 @@
 /* may the file at path be opened (write = 0 read, 1 write)? 1 yes; 0 no, with a reason
  * in err. Files a format pulls in by itself (an OBJ's .mtl, a glTF's .bin) ask too. */
 typedef int (*wbio_allow_fn)(void *ud, const char *path, int write, char *err, size_t errn);
+
+/* ---- files written whole (file.c) ------------------------------------------------------ */
+/* A file is written into a temporary beside its name and renamed over it once complete:
+ * whatever stops the writer, the name holds the old file or the new one. A symbolic link
+ * at the name is never followed (it is replaced); a FIFO or a device there is written in
+ * place. The temporaries in progress are removed by wbio_remove_temporaries, on SIGINT,
+ * SIGTERM and SIGHUP once wbio_clean_on_signals ran, and at exit(). */
+typedef struct wbio_out {
+    FILE *f;               /* the temporary, open for writing (NULL once closed) */
+    int dir;               /* the folder name and tmp are relative to (AT_FDCWD: paths) */
+    int slot;              /* in the table the signal handler reads, or -1 */
+    int direct;            /* a FIFO or a device written in place: no temporary */
+    int failed;            /* an errno once a write failed: commit refuses */
+    char name[PATH_MAX], tmp[PATH_MAX];
+} wbio_out;
+/* the temporary for name (in dir); -1 with "shown: reason" in err */
+int wbio_out_open(wbio_out *o, int dir, const char *name, const char *shown, char *err, size_t errn);
+/* close the temporary's stream (its errors kept for commit); the errno of a failure or 0 */
+int wbio_out_close_file(wbio_out *o);
+/* close and rename into place; on any failure the temporary is removed and the old file stays */
+int wbio_out_commit(wbio_out *o, const char *shown, char *err, size_t errn);
+void wbio_out_abort(wbio_out *o);      /* remove the temporary: the old file stays */
+/* n bytes as the whole file name (in dir) */
+int wbio_write_bytes(int dir, const char *name, const char *shown, const void *data, size_t n, char *err, size_t errn);
+/* a path named by the user (the command line), whose link is theirs to follow: where it
+ * leads when it is a link to something that exists, else the path itself */
+int wbio_follow_link(const char *path, char *out, size_t n);
+void wbio_remove_temporaries(void);   /* async-signal-safe */
+void wbio_clean_on_signals(void);     /* once, for the process: SIGINT, SIGTERM, SIGHUP and exit() */
 
 /* ---- JSON particle configs and snapshots (json.c) ------------------------------------- */
 #define WBIO_FORMAT "wobble-particles"
@@ -114,19 +144,23 @@ typedef struct wbio_pc2 wbio_pc2;
 wbio_pc2 *wbio_pc2_open(const char *path, const char *shown, int32_t npoints, double start_frame,
                         double sample_rate, char *err, size_t errn);
 int wbio_pc2_write(wbio_pc2 *p, const wb_real *pts, char *err, size_t errn); /* (npoints x 3) */
-int wbio_pc2_close(wbio_pc2 *p, char *err, size_t errn);     /* NULL is fine; frees */
+/* keep: the cache takes its name (else it is removed, an old file of the name stays);
+ * NULL is fine; frees */
+int wbio_pc2_close(wbio_pc2 *p, int keep, char *err, size_t errn);
 int32_t wbio_pc2_samples(const wbio_pc2 *p);
 
 /* VTK series for ParaView: a .pvd collection and one .vtp PolyData per frame in a folder
  * beside it (points = particles with velocity, speed, strain, mass, pinned; cells = the
- * particles, the constraints and the surfaces' triangles) */
+ * particles, the constraints and the surfaces' triangles). Each frame writes its .vtp
+ * and then the whole .pvd again, each file whole (file.c): the series on disk is
+ * complete after every frame. Times are frame x dt. */
 typedef struct wbio_vtk wbio_vtk;
 /* pvd_path: the .pvd file; dir: the folder for the .vtp files (exists); rel_dir: that
  * folder as the .pvd names it (relative, so the series can be moved) */
 wbio_vtk *wbio_vtk_open(const char *pvd_path, const char *dir, const char *rel_dir, const char *shown,
                         char *err, size_t errn);
 int wbio_vtk_write(wbio_vtk *v, const wb_world *w, char *err, size_t errn);
-int wbio_vtk_close(wbio_vtk *v, char *err, size_t errn);     /* NULL is fine; frees */
+int wbio_vtk_close(wbio_vtk *v, char *err, size_t errn);     /* NULL is fine; frees; nothing left to write */
 int32_t wbio_vtk_frames(const wbio_vtk *v);
 int wbio_write_vtp(FILE *f, const wb_world *w);               /* one frame */
 

@@ -2,6 +2,7 @@
  * (settings, clock, slot tables), so that wobble.load restores it bit for bit. Doubles are
  * written with "%.17g", which round-trips every double through strtod (cJSON's reader). */
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -389,18 +390,12 @@ int wbio_write_snapshot(const wb_world *w, const char *path, const char *shown, 
         return -1;
     }
     /* a temporary file beside the target, renamed over it once complete */
-    char tmp[4200];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid()) >= (int)sizeof tmp) {
-        snprintf(err, errn, "%s: path too long", shown);
+    wbio_out file;
+    if (wbio_out_open(&file, AT_FDCWD, path, shown, err, errn)) {
         wb_image_free(&g);
         return -1;
     }
-    out o = { fopen(tmp, "wb"), 0, 0 };
-    if (!o.f) {
-        snprintf(err, errn, "%s: %s", shown, strerror(errno));
-        wb_image_free(&g);
-        return -1;
-    }
+    out o = { file.f, 0, 0 };
     setvbuf(o.f, NULL, _IOFBF, 1 << 20);
     fprintf(o.f, "{\n  \"format\": \"%s\",\n  \"version\": %d,\n  \"description\": \"wobble %s snapshot at frame %lld\",\n",
             WBIO_FORMAT, WBIO_VERSION, WB_VERSION, (long long)g.frame);
@@ -415,14 +410,13 @@ int wbio_write_snapshot(const wb_world *w, const char *path, const char *shown, 
     write_colliders(&o, &g);
     write_surfaces(&o, &g);
     fputs("}\n", o.f);
-    int werr = ferror(o.f) ? errno : o.nomem ? ENOMEM : 0;
-    if (fclose(o.f) != 0 && !werr) werr = errno ? errno : EIO;
     wb_image_free(&g);
-    if (o.bad || werr || rename(tmp, path) != 0) {
-        if (!werr && !o.bad) werr = errno;
-        snprintf(err, errn, "%s: %s", shown, o.bad ? "the state holds a non-finite number" : strerror(werr));
-        remove(tmp);
+    if (o.bad) {
+        wbio_out_abort(&file);
+        snprintf(err, errn, "%s: the state holds a non-finite number", shown);
         return -1;
     }
+    if (o.nomem) file.failed = ENOMEM;
+    if (wbio_out_commit(&file, shown, err, errn)) return -1;
     return 0;
 }

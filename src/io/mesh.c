@@ -13,6 +13,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <malloc.h>
 #include <math.h>
@@ -35,6 +36,8 @@ typedef struct guard {
     wbio_allow_fn allow;
     void *ud;
     char refused[512];     /* the first refusal, reported if the import then fails */
+    wbio_out outs[8];      /* an export's files, kept aside until the whole export worked */
+    int nouts;
 } guard;
 
 static size_t f_read(struct aiFile *f, char *buf, size_t size, size_t n) { return fread(buf, size, n, (FILE *)f->UserData); }
@@ -58,17 +61,22 @@ static struct aiFile *f_open(struct aiFileIO *io, const char *path, const char *
 {
     guard *g = (guard *)io->UserData;
     const int write = strpbrk(mode, "wa+") != NULL;
-    char why[512];
+    char why[512] = "too many files in one export";
     if (g->allow && !g->allow(g->ud, path, write, why, sizeof why)) {
         if (!g->refused[0]) snprintf(g->refused, sizeof g->refused, "%s", why);
         return NULL;
     }
     struct stat st;
     if (!write && (stat(path, &st) != 0 || S_ISDIR(st.st_mode))) return NULL;
-    FILE *fp = fopen(path, mode);
+    FILE *fp = NULL;
+    if (!write) fp = fopen(path, mode);
+    else if (g->nouts < (int)(sizeof g->outs / sizeof *g->outs) &&
+             wbio_out_open(&g->outs[g->nouts], AT_FDCWD, path, path, why, sizeof why) == 0)
+        fp = g->outs[g->nouts++].f;
+    else if (!g->refused[0]) snprintf(g->refused, sizeof g->refused, "%s", why);
     struct aiFile *f = fp ? calloc(1, sizeof *f) : NULL;
     if (!f) {
-        if (fp) fclose(fp);
+        if (fp && !write) fclose(fp);
         return NULL;
     }
     f->ReadProc = f_read;
@@ -83,9 +91,12 @@ static struct aiFile *f_open(struct aiFileIO *io, const char *path, const char *
 
 static void f_close(struct aiFileIO *io, struct aiFile *f)
 {
-    (void)io;
+    guard *g = (guard *)io->UserData;
     if (!f) return;
-    fclose((FILE *)f->UserData);
+    int k = 0;
+    while (k < g->nouts && g->outs[k].f != (FILE *)f->UserData) k++;
+    if (k < g->nouts) wbio_out_close_file(&g->outs[k]);   /* renamed once the export is whole */
+    else fclose((FILE *)f->UserData);
     free(f);
 }
 
@@ -195,7 +206,7 @@ static const char *import_error(const guard *g)
 /* the child's whole work: import, flatten every triangle mesh into one pair of arrays */
 static void child_import(int fd, const char *path, wbio_allow_fn allow, void *ud)
 {
-    guard g = { allow, ud, "" };
+    guard g = { allow, ud, "", { { 0 } }, 0 };
     struct aiFileIO io = { f_open, f_close, (aiUserData)&g };
     const struct aiScene *sc = aiImportFileEx(path, import_flags, &io);
     if (!sc) {
@@ -454,7 +465,7 @@ wb_mesh *wbio_mesh_from_arrays(wb_real *v, int64_t nv, const int32_t *tri, int64
 wb_mesh *wbio_mesh_from_memory(const void *data, size_t n, const char *hint, const wbio_mesh_opts *o,
                                const char *shown, char *err, size_t errn)
 {
-    guard g = { NULL, NULL, "" };
+    guard g = { NULL, NULL, "", { { 0 } }, 0 };
     /* assimp asserts (aborts) on an empty buffer; its length is an unsigned int */
     if (n == 0 || n > UINT_MAX) {
         snprintf(err, errn, "%s: %s", shown, n ? "too large" : "empty file");
@@ -566,6 +577,10 @@ static int export_assimp(const wb_mesh *m, const wb_real *v, const char *path, c
         struct aiFileIO io = { f_open, f_close, (aiUserData)g };
         if (aiExportSceneEx(&sc, format, path, &io, 0) == aiReturn_SUCCESS) rc = 0;
         else snprintf(msg, n, "%s", g->refused[0] ? g->refused : aiGetErrorString());
+        for (int k = 0; k < g->nouts; k++) {
+            if (rc == 0 && wbio_out_commit(&g->outs[k], g->outs[k].name, msg, n)) rc = -1;
+            else wbio_out_abort(&g->outs[k]);   /* nothing left behind, nothing half replaced */
+        }
     } else {
         snprintf(msg, n, "out of memory");
     }
@@ -584,16 +599,15 @@ int wbio_save_mesh(const wb_mesh *m, const wb_real *v, const char *path, const c
     const char *ext = extension(path);
     if (!v) v = m->v;
     if (!strcasecmp(ext, "obj") || !strcasecmp(ext, "ply")) {
-        FILE *f = fopen(path, "w");
-        if (!f) { snprintf(err, errn, "%s: %s", shown, strerror(errno)); return -1; }
-        int rc = strcasecmp(ext, "obj") ? wbio_write_ply(f, m, v, NULL) : wbio_write_obj(f, m, v, NULL);
-        if (fclose(f) != 0) rc = -1;
-        if (rc) snprintf(err, errn, "%s: %s", shown, strerror(errno ? errno : EIO));
-        return rc;
+        wbio_out o;
+        if (wbio_out_open(&o, AT_FDCWD, path, shown, err, errn)) return -1;
+        if (strcasecmp(ext, "obj") ? wbio_write_ply(o.f, m, v, NULL) : wbio_write_obj(o.f, m, v, NULL))
+            o.failed = errno ? errno : EIO;
+        return wbio_out_commit(&o, shown, err, errn);
     }
     for (int i = 0; formats[i][0]; i++) {
         if (strcasecmp(ext, formats[i][0])) continue;
-        guard g = { allow, ud, "" };
+        guard g = { allow, ud, "", { { 0 } }, 0 };
         char msg[512] = "";
         if (export_assimp(m, v, path, formats[i][1], &g, msg, sizeof msg) == 0) return 0;
         snprintf(err, errn, "%s: %s", shown, msg[0] ? msg : "assimp could not write it");

@@ -190,20 +190,34 @@ int wbio_read_tets(const char *node_path, const char *node_shown, const char *el
 int wbio_write_tets(const char *node_path, const char *node_shown, const char *ele_path, const char *ele_shown,
                     const wb_real *v, int32_t nv, const int32_t *tet, int32_t nt, char *err, size_t errn)
 {
-    FILE *f = fopen(node_path, "w");
-    if (!f) { snprintf(err, errn, "%s: %s", node_shown, strerror(errno)); return -1; }
+    /* both written aside first, then renamed one after the other: a stop while they are
+     * written leaves the old pair */
+    wbio_out node, ele;
+    if (wbio_out_open(&node, AT_FDCWD, node_path, node_shown, err, errn)) return -1;
+    if (wbio_out_open(&ele, AT_FDCWD, ele_path, ele_shown, err, errn)) {
+        wbio_out_abort(&node);
+        return -1;
+    }
     /* %.17g: every double read back as itself */
-    fprintf(f, "# wobble %s: %d points\n%d 3 0 0\n", WB_VERSION, (int)nv, (int)nv);
+    fprintf(node.f, "# wobble %s: %d points\n%d 3 0 0\n", WB_VERSION, (int)nv, (int)nv);
     for (int32_t i = 0; i < nv; i++)
-        fprintf(f, "%d %.17g %.17g %.17g\n", (int)i + 1, (double)v[3 * i], (double)v[3 * i + 1], (double)v[3 * i + 2]);
-    if (fclose(f) != 0) { snprintf(err, errn, "%s: write error", node_shown); return -1; }
-    f = fopen(ele_path, "w");
-    if (!f) { snprintf(err, errn, "%s: %s", ele_shown, strerror(errno)); return -1; }
-    fprintf(f, "# wobble %s: %d tets\n%d 4 0\n", WB_VERSION, (int)nt, (int)nt);
+        fprintf(node.f, "%d %.17g %.17g %.17g\n", (int)i + 1, (double)v[3 * i], (double)v[3 * i + 1], (double)v[3 * i + 2]);
+    fprintf(ele.f, "# wobble %s: %d tets\n%d 4 0\n", WB_VERSION, (int)nt, (int)nt);
     for (int32_t i = 0; i < nt; i++)
-        fprintf(f, "%d %d %d %d %d\n", (int)i + 1, tet[4 * i] + 1, tet[4 * i + 1] + 1, tet[4 * i + 2] + 1, tet[4 * i + 3] + 1);
-    if (fclose(f) != 0) { snprintf(err, errn, "%s: write error", ele_shown); return -1; }
-    return 0;
+        fprintf(ele.f, "%d %d %d %d %d\n", (int)i + 1, tet[4 * i] + 1, tet[4 * i + 1] + 1, tet[4 * i + 2] + 1,
+                tet[4 * i + 3] + 1);
+    const int enode = wbio_out_close_file(&node), eele = wbio_out_close_file(&ele);
+    if (enode || eele) {
+        snprintf(err, errn, "%s: %s", enode ? node_shown : ele_shown, strerror(enode ? enode : eele));
+        wbio_out_abort(&node);
+        wbio_out_abort(&ele);
+        return -1;
+    }
+    if (wbio_out_commit(&node, node_shown, err, errn)) {
+        wbio_out_abort(&ele);
+        return -1;
+    }
+    return wbio_out_commit(&ele, ele_shown, err, errn);
 }
 
 /* ---- tetgen -------------------------------------------------------------------------------- */

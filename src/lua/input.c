@@ -3,6 +3,8 @@
  * log back and applies its events from a frame hook after the same frames, so that a
  * headless run reproduces the live one bit for bit (the same w:hash()). */
 #include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,6 +14,7 @@
 #include <cJSON.h>
 
 #include "input.h"
+#include "io/io.h"
 #include "io/json.h"
 #include "util.h"
 
@@ -238,18 +241,18 @@ bool wbl_input_log_save(const wbl_input_log *log, const char *path, const char *
         snprintf(err, n, "%s: out of memory", path);
         return false;
     }
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        snprintf(err, n, "%s: %s", path, strerror(errno));
+    /* the user's file (--record-input), written whole; a link of theirs is followed */
+    char real[PATH_MAX];
+    wbio_out f;
+    if (n) err[0] = 0;
+    if (wbio_follow_link(path, real, sizeof real) || wbio_out_open(&f, AT_FDCWD, real, path, err, n)) {
+        if (!*err) snprintf(err, n, "%s: path too long", path);
         free(text);
         return false;
     }
-    bool ok = fputs(text, f) >= 0 && fputc('\n', f) != EOF;
-    int e = errno;
-    if (fclose(f) != 0 && ok) ok = false, e = errno;
+    if (fputs(text, f.f) < 0 || fputc('\n', f.f) == EOF) f.failed = errno ? errno : EIO;
     free(text);
-    if (!ok) snprintf(err, n, "%s: %s", path, strerror(e));
-    return ok;
+    return wbio_out_commit(&f, path, err, n) == 0;
 }
 
 /* ---- world ordinals ------------------------------------------------------------------------ */

@@ -5,6 +5,7 @@
  * A file that cannot be read or written is an expected failure: nil and "file: reason"
  * (with line, column and key path for JSON), and the world is left as it was. */
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
 #include <stdlib.h>
@@ -263,11 +264,12 @@ typedef struct wbl_rec {
     char name[256];        /* as the script named it, for messages */
 } wbl_rec;                 /* user values: 1 the world, 2 the skin (PC2 of a skin) */
 
-static int rec_finish(wbl_rec *r, char *err, size_t n)
+/* keep: the file takes its name (a PC2 grows aside until then); else an old file stays */
+static int rec_finish(wbl_rec *r, int keep, char *err, size_t n)
 {
     int rc = 0;
     if (!r->closed) {
-        rc = r->kind == REC_PC2 ? wbio_pc2_close(r->pc2, err, n) : wbio_vtk_close(r->vtk, err, n);
+        rc = r->kind == REC_PC2 ? wbio_pc2_close(r->pc2, keep, err, n) : wbio_vtk_close(r->vtk, err, n);
         r->closed = 1;
         r->pc2 = NULL;
         r->vtk = NULL;
@@ -314,7 +316,7 @@ static int rec_hook(lua_State *L)
     if (rec_write(L, lua_upvalueindex(1), r, err, sizeof err)) {
         char msg[800];
         snprintf(msg, sizeof msg, "recording %s: %s", r->name, err);
-        rec_finish(r, err, sizeof err);
+        rec_finish(r, 0, err, sizeof err);
         return luaL_error(L, "%s", msg);
     }
     return 0;
@@ -374,7 +376,7 @@ static int start_pc2(lua_State *L, wbl_rec *r, int rec_idx, const wb_mesh *rest,
     if (!r->pc2) return fail_with(L, err);
     r->closed = 0;
     if (rec_write(L, rec_idx, r, err, sizeof err)) { /* the pose now is the first sample */
-        rec_finish(r, err, sizeof err);
+        rec_finish(r, 0, err, sizeof err);
         return fail_with(L, lua_pushfstring(L, "%s: %s", name, err));
     }
     install(L, rec_idx);
@@ -472,9 +474,10 @@ static int w_record_vtk(lua_State *L)
     const char *pvd_name = lua_pushfstring(L, "%s.pvd", stem);
     char pvd[PATH_MAX], dir[PATH_MAX], err[1024];
     wbl_path(L, pvd_name, 1, pvd, sizeof pvd);
-    /* the folder beside it, made by resolving a file inside it */
-    wbl_path(L, lua_pushfstring(L, "%s/frame_000000.vtp", stem), 1, dir, sizeof dir);
-    *strrchr(dir, '/') = '\0';
+    /* the folder beside it, made by resolving it as a folder; its frames are written
+     * each whole, a link among them replaced, never followed */
+    wbl_path(L, lua_pushfstring(L, "%s/", stem), 1, dir, sizeof dir);
+    for (size_t k = strlen(dir); k > 1 && dir[k - 1] == '/'; k--) dir[k - 1] = '\0';
     const char *base = strrchr(stem, '/');
     base = base ? base + 1 : stem;
     lua_settop(L, 3);
@@ -483,7 +486,7 @@ static int w_record_vtk(lua_State *L)
     if (!r->vtk) return fail_with(L, err);
     r->closed = 0;
     if (rec_write(L, 4, r, err, sizeof err)) {
-        rec_finish(r, err, sizeof err);
+        rec_finish(r, 0, err, sizeof err);
         return fail_with(L, lua_pushfstring(L, "%s: %s", name, err));
     }
     install(L, 4);
@@ -496,12 +499,12 @@ static int w_save_vtp(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
     const char *name = wbl_checkfilename(L, 2);
-    char path[PATH_MAX];
+    char path[PATH_MAX], err[PATH_MAX + 128];
     wbl_path(L, name, 1, path, sizeof path);
-    FILE *f = fopen(path, "w");
-    int rc = f ? wbio_write_vtp(f, w) : -1;
-    if (f && fclose(f) != 0) rc = -1;
-    if (rc) return fail_with(L, lua_pushfstring(L, "%s: %s", name, strerror(errno ? errno : EIO)));
+    wbio_out o;
+    if (wbio_out_open(&o, AT_FDCWD, path, name, err, sizeof err)) return fail_with(L, err);
+    if (wbio_write_vtp(o.f, w)) o.failed = errno ? errno : EIO;
+    if (wbio_out_commit(&o, name, err, sizeof err)) return fail_with(L, err);
     lua_pushboolean(L, 1);
     return 1;
 }
@@ -511,7 +514,7 @@ static int r_close(lua_State *L)
 {
     wbl_rec *r = (wbl_rec *)luaL_checkudata(L, 1, WBL_RECORDER);
     char err[512];
-    if (rec_finish(r, err, sizeof err)) return fail_with(L, lua_pushfstring(L, "%s: %s", r->name, err));
+    if (rec_finish(r, 1, err, sizeof err)) return fail_with(L, lua_pushfstring(L, "%s: %s", r->name, err));
     lua_pushboolean(L, 1);
     return 1;
 }
@@ -519,7 +522,7 @@ static int r_close(lua_State *L)
 static int r_gc(lua_State *L)
 {
     char err[512];
-    rec_finish((wbl_rec *)luaL_checkudata(L, 1, WBL_RECORDER), err, sizeof err);
+    rec_finish((wbl_rec *)luaL_checkudata(L, 1, WBL_RECORDER), 1, err, sizeof err);
     return 0;
 }
 

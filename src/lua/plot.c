@@ -68,7 +68,7 @@ void wbl_plot_finish(lua_State *L, int plot)
     wb_plot_destroy(u->p);
     u->p = NULL;
     if (!px) wb_rt_budget_error(L, "out of memory drawing the plot");
-    bool ok = wb_image_write_png(u->path, px, PLOT_W, PLOT_H, err, sizeof err);
+    bool ok = wbl_write_png(u->path, px, PLOT_W, PLOT_H, err, sizeof err);
     free(px);
     if (!ok) luaL_error(L, "plot: %s", err);
 }

@@ -2,15 +2,19 @@
  * record, pixels for tests), wobble.probe and wobble.read_png, and the recording
  * behind `wobble run --record OUT`. Every path a script names goes through the
  * sandbox (wb_sandbox_path); --record's path is the user's own. */
+#include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
+#include "io/io.h"
 #include "mesh.h"
 #include "util.h"
 #include "render/render.h"
@@ -18,9 +22,20 @@
 
 #define WBL_RENDERER "wobble.renderer"
 
+/* where a recording goes, each file whole (io's files): a video grows in a temporary
+ * beside its name and takes the name when the recording finishes well, so an old video
+ * of that name stays until then; frames land one by one in the folder held open (a
+ * link in it is replaced, never followed) */
+typedef struct rec_files {
+    wbio_out video;
+    int dir;              /* the folder of PNG frames, or -1 */
+    char path[PATH_MAX];  /* the file or folder, for messages */
+} rec_files;
+
 typedef struct wbl_renderer {
     wb_renderer *r;       /* NULL once closed: __gc and __close may run twice */
     wb_recorder *rec;     /* the recording, or NULL */
+    rec_files *files;     /* its files */
     bool fps_set;         /* r:record{fps = ...}: the world's dt does not decide */
     int64_t draws;
     bool scene_cam;       /* --record's renderer: drawn last with the scene's camera */
@@ -49,13 +64,78 @@ static void release(wbl_renderer *u, size_t *slot)
     *slot = 0;
 }
 
-/* finish the recording (the frames' and the encoder's memory is given back); false with the message */
+static bool write_frame(void *ud, const char *name, const void *data, size_t n, char *err, size_t en)
+{
+    const rec_files *f = ud;
+    char shown[PATH_MAX + 80], e[PATH_MAX + 160];
+    snprintf(shown, sizeof shown, "%s%s%s", f->path, f->path[strlen(f->path) - 1] == '/' ? "" : "/", name);
+    if (wbio_write_bytes(f->dir, name, shown, data, n, e, sizeof e) == 0) return true;
+    snprintf(err, en, "cannot write %s", e);
+    return false;
+}
+
+static void close_files(rec_files *f, bool keep, char *err, size_t n, bool *ok)
+{
+    if (!f) return;
+    if (f->dir >= 0) close(f->dir);
+    else if (!keep) wbio_out_abort(&f->video);
+    else if (wbio_out_commit(&f->video, f->path, err, n)) *ok = false;
+    free(f);
+}
+
+/* the destination of a recording of `kind` to path (resolved: the file or folder itself),
+ * made and checked now rather than at the first frame; the recorder on it */
+static wb_recorder *begin_recording(wbl_renderer *u, const char *path, wb_media kind, int w, int h, char *err, size_t n)
+{
+    rec_files *f = calloc(1, sizeof *f);
+    if (!f) {
+        snprintf(err, n, "out of memory");
+        return NULL;
+    }
+    f->dir = -1;
+    snprintf(f->path, sizeof f->path, "%s", path);
+    wb_media_out out = { f, write_frame, "" };
+    char e[PATH_MAX + 160];
+    if (kind == WB_MEDIA_FOLDER) {
+        if (mkdir(path, 0777) != 0 && errno != EEXIST) {
+            snprintf(err, n, "cannot create the folder %s: %s", path, strerror(errno));
+            free(f);
+            return NULL;
+        }
+        f->dir = open(path, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+        if (f->dir < 0 || faccessat(f->dir, ".", W_OK, AT_EACCESS) != 0) {
+            snprintf(err, n, "cannot write into %s: %s", path, strerror(errno));
+            close_files(f, false, NULL, 0, NULL);
+            return NULL;
+        }
+    } else {
+        /* the encoder's file, made now (proving the folder writable), empty until it starts */
+        if (wbio_out_open(&f->video, AT_FDCWD, path, path, e, sizeof e)) {
+            snprintf(err, n, "cannot write %s", e);
+            free(f);
+            return NULL;
+        }
+        wbio_out_close_file(&f->video);
+        out.encode_to = f->video.tmp;
+    }
+    wb_recorder *rec = wb_recorder_open(path, kind, w, h, &out, err, n);
+    if (!rec) close_files(f, false, NULL, 0, NULL);
+    else u->files = f;
+    return rec;
+}
+
+/* finish the recording (the frames' and the encoder's memory is given back); false with the message. The
+ * file takes its name only when every frame went into it */
 static bool end_recording(wbl_renderer *u, char *err, size_t n)
 {
     wb_recorder *rec = u->rec;
+    rec_files *f = u->files;
     u->rec = NULL;
+    u->files = NULL;
+    const bool started = wb_recorder_started(rec);
     bool ok = wb_recorder_close(rec, err, n);   /* the encoder lives until it finishes the file */
     release(u, &u->rec_charged);
+    close_files(f, ok && started, err, n, &ok);
     return ok;
 }
 
@@ -344,7 +424,7 @@ static int r_save_png(lua_State *L)
     if (!u->draws) return luaL_error(L, "nothing to save: call r:draw(world) first");
     int w, h;
     wb_renderer_size(u->r, &w, &h);
-    if (!wb_image_write_png(path, wb_renderer_pixels(u->r), w, h, err, sizeof err)) return luaL_error(L, "%s", err);
+    if (!wbl_write_png(path, wb_renderer_pixels(u->r), w, h, err, sizeof err)) return luaL_error(L, "%s", err);
     return 0;
 }
 
@@ -372,7 +452,7 @@ static int r_record(lua_State *L)
      * frames): a size whose encoder does not fit is refused before anything starts */
     snprintf(what, sizeof what, "recording %dx%d frames%s", w, h, kind == WB_MEDIA_FOLDER ? "" : " (ffmpeg included)");
     charge(L, &u->rec_charged, wb_recorder_bytes(kind, w, h), what);
-    u->rec = wb_recorder_open(path, kind, w, h, err, sizeof err);
+    u->rec = begin_recording(u, path, kind, w, h, err, sizeof err);
     if (!u->rec) {
         release(u, &u->rec_charged);
         return luaL_error(L, "%s", err);
@@ -729,7 +809,9 @@ bool wbl_record_begin(lua_State *L, const char *path, int w, int h, char *err, s
     }
     u->mem->used += bytes;
     u->rec_charged = bytes;
-    u->rec = wb_recorder_open(path, kind, w, h, e, sizeof e);
+    char real[PATH_MAX];   /* the user's path: a link of theirs is followed */
+    if (wbio_follow_link(path, real, sizeof real)) snprintf(real, sizeof real, "%s", path);
+    u->rec = begin_recording(u, real, kind, w, h, e, sizeof e);
     if (!u->rec) {
         release(u, &u->rec_charged);
         snprintf(err, n, "--record: %s", e);

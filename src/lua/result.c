@@ -3,9 +3,11 @@
  * world stepped (its hash and warnings, kept even when the script closes it), written
  * by the command line as OUTDIR/result.json. */
 #include "util.h"
+#include "io/io.h"
 
 #include <cjson/cJSON.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
@@ -171,7 +173,7 @@ static const char *status_name(int code) {
 
 int wbl_result_write(void *taken, const wbl_run_info *info, char *err, size_t n) {
     cJSON *o = cJSON_CreateObject(), *sets = NULL, *figures = taken;
-    char path[4096], tmp[4200];
+    char path[4096];
     int ok = 0;
     if (n) err[0] = 0;
     if (!o) goto done;
@@ -203,18 +205,13 @@ int wbl_result_write(void *taken, const wbl_run_info *info, char *err, size_t n)
     if (!text) goto done;
     /* written aside and renamed: a reader never sees half a file */
     snprintf(path, sizeof path, "%s/result.json", info->out_dir);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (f) {
-        ok = fputs(text, f) >= 0 && fputc('\n', f) != EOF;
-        ok = (fclose(f) == 0) && ok && rename(tmp, path) == 0;
-        if (!ok) {
-            snprintf(err, n, "cannot write %s: %s", path, strerror(errno));
-            remove(tmp);  /* no stray half file beside the run's output */
-        }
-    } else {
-        snprintf(err, n, "cannot write %s: %s", tmp, strerror(errno));
+    wbio_out f;
+    char e[sizeof path + 128];
+    if (wbio_out_open(&f, AT_FDCWD, path, path, e, sizeof e) == 0) {
+        if (fputs(text, f.f) < 0 || fputc('\n', f.f) == EOF) f.failed = errno ? errno : EIO;
+        ok = wbio_out_commit(&f, path, e, sizeof e) == 0;
     }
+    if (!ok) snprintf(err, n, "cannot write %s", e);
     free(text);
 done:
     if (!o) snprintf(err, n, "out of memory writing result.json");

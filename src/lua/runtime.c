@@ -5,6 +5,7 @@
  * the Lua library folder. */
 #include "wobble_lua.h"
 #include "sandbox.h"
+#include "io/io.h"
 
 #include <lualib.h>
 
@@ -280,6 +281,7 @@ static void kill_children(void) {
 /* the grace period is over: the script cannot be stopped from inside, so end it */
 static _Noreturn void end_process(watchdog *wd, const char *msg) {
     kill_children();
+    wbio_remove_temporaries();  /* a file being written keeps its old version */
     /* what the script printed and stdio still holds, unless the main thread is inside
      * a write (its lock taken) */
     struct pollfd p = { STDOUT_FILENO, POLLOUT, 0 };
@@ -541,9 +543,27 @@ int wb_rt_msgh(lua_State *L) {
     if (!has_position(msg))
         for (int level = 1; lua_getstack(L, level, &ar); level++)
             if (lua_getinfo(L, "Sl", &ar) && ar.currentline > 0) {
-                msg = lua_pushfstring(L, "%s:%d: %s", ar.short_src, ar.currentline, msg);
+                msg = lua_pushfstring(L, "%s:%d: %s", ar.source[0] == '@' ? ar.source + 1 : ar.short_src,
+                                      ar.currentline, msg);
                 break;
             }
+    /* Lua shortens a long file name in a position to "...its end" (LUA_IDSIZE, 60 bytes):
+     * a script in a deep folder (a sweep names its scene by its absolute path) would be
+     * named by a fragment. The file of a function on the stack whose name ends so is
+     * named whole */
+    if (!strncmp(msg, "...", 3)) {
+        const char *tail = msg + 3, *colon = strchr(tail, ':');
+        while (colon && !(colon[1] >= '0' && colon[1] <= '9')) colon = strchr(colon + 1, ':');
+        const size_t tn = colon ? (size_t)(colon - tail) : 0;
+        for (int level = 0; tn && lua_getstack(L, level, &ar); level++) {
+            if (!lua_getinfo(L, "S", &ar) || ar.source[0] != '@') continue;
+            const size_t sn = strlen(ar.source + 1);
+            if (sn > tn && !strncmp(ar.source + 1 + sn - tn, tail, tn)) {
+                msg = lua_pushfstring(L, "%s%s", ar.source + 1, colon);
+                break;
+            }
+        }
+    }
     luaL_traceback(L, L, msg, 1);
     return 1;
 }

@@ -1,14 +1,20 @@
 /* sandbox.c: the file rules of DESIGN §4. Every path a script names is made absolute
  * and canonical (no ".." or symlink can leave a folder unnoticed); reads are allowed
  * under the scene, assets and output folders, writes only under the output folder.
- * The standard libraries are opened without process control, bytecode or debug, and
- * their file functions are wrapped to go through the same rules. */
+ * A write through a symbolic link that leads nowhere is refused (its target would be
+ * created wherever it points), and the files themselves are opened without following a
+ * link at their name (io.open here; wobble's writers through io/file.c), so a link
+ * placed in the output folder cannot take a write elsewhere. Refusals name the path as
+ * the script gave it, never where it resolves. The standard libraries are opened
+ * without process control, bytecode or debug, and their file functions are wrapped to
+ * go through the same rules. */
 #include "sandbox.h"
 
 #include <lauxlib.h>
 #include <lualib.h>
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -72,6 +78,41 @@ static int canon(const char *abs, char *out) {
     return 0;
 }
 
+/* Does a component of the canonical path c exist as a symbolic link? canon() resolved
+ * every link it could follow, so one left is a link to nothing: a write would create its
+ * target, wherever that is. */
+static int through_link(const char *c) {
+    char p[PATH_MAX];
+    if (snprintf(p, sizeof p, "%s", c) >= (int)sizeof p) return 1;
+    for (char *s = p + 1;; s++) {
+        if (*s != '/' && *s) continue;
+        char save = *s;
+        *s = 0;
+        struct stat st;
+        int r = lstat(p, &st);
+        *s = save;
+        if (r != 0) return 0;  /* nothing below exists */
+        if (S_ISLNK(st.st_mode)) return 1;
+        if (!save) return 0;
+    }
+}
+
+/* canon() of the folder holding abs, then its last name as it is: the entry itself, a
+ * link not followed (os.remove and os.rename act on a link, not on what it names) */
+static int canon_entry(const char *abs, char *out) {
+    char dir[PATH_MAX];
+    const char *slash = strrchr(abs, '/'), *base = slash ? slash + 1 : abs;
+    if (!slash || !*base || !strcmp(base, ".") || !strcmp(base, "..")) return canon(abs, out);
+    snprintf(dir, sizeof dir, "%.*s", (int)(slash - abs + 1), abs);
+    if (canon(dir, out)) return -1;
+    size_t ol = strlen(out);
+    if (ol > 1 && out[ol - 1] == '/') out[--ol] = 0;
+    if (ol + strlen(base) + 2 > PATH_MAX) return -1;
+    if (ol > 1) out[ol++] = '/';
+    strcpy(out + ol, base);
+    return 0;
+}
+
 static int under(const char *path, const char *root) {
     size_t rl = strlen(root);
     if (rl == 1 && root[0] == '/') return 1;
@@ -101,16 +142,9 @@ static int make_parents(char *path) {
     return 0;
 }
 
-/* "path" or, when the script wrote something else, "given (path)" */
-static const char *show(char *buf, size_t n, const char *given, const char *path) {
-    if (strcmp(given, path) == 0) snprintf(buf, n, "%s", path);
-    else snprintf(buf, n, "%s (%s)", given, path);
-    return buf;
-}
-
 const char *wb_sandbox_path(lua_State *L, const char *path, int write, char *buf, size_t n, const char **err) {
     wb_sandbox *sb = sb_from(L);
-    char full[PATH_MAX], c[PATH_MAX], named[2 * PATH_MAX + 8];
+    char full[PATH_MAX], c[PATH_MAX];
     *err = NULL;
     if (!sb) {  /* no sandbox: no rules */
         if (snprintf(buf, n, "%s", path) >= (int)n) return *err = "path too long", NULL;
@@ -118,17 +152,27 @@ const char *wb_sandbox_path(lua_State *L, const char *path, int write, char *buf
     }
     if (!*path) return *err = "empty path", NULL;
     if (write) {
-        /* a relative path is taken inside the output folder */
-        if (join(full, sizeof full, sb->out, path) || canon(full, c)) return *err = "path too long", NULL;
+        /* a relative path is taken inside the output folder; the messages name the
+         * path as given and the folder as the user named it: where a link leads, or
+         * the current folder, is not the script's to learn */
+        if (join(full, sizeof full, sb->out, path) || (write == 2 ? canon_entry(full, c) : canon(full, c)))
+            return *err = "path too long", NULL;
         if (!sb->unsafe && !under(c, sb->out)) {
             if (snprintf(sb->err, sizeof sb->err, "writing %s is outside the output folder %s; use --out DIR or --unsafe",
-                         show(named, sizeof named, path, c), sb->out) >= (int)sizeof sb->err)
+                         path, sb->out_shown) >= (int)sizeof sb->err)
                 return *err = "writing outside the output folder; use --out DIR or --unsafe", NULL;
+            return *err = sb->err, NULL;
+        }
+        if (!sb->unsafe && write != 2 && through_link(c)) {
+            if (snprintf(sb->err, sizeof sb->err, "writing %s goes through a symbolic link to nothing, which could "
+                         "lead outside the output folder %s; remove the link or use --unsafe", path, sb->out_shown)
+                >= (int)sizeof sb->err)
+                return *err = "writing through a symbolic link to nothing; remove the link or use --unsafe", NULL;
             return *err = sb->err, NULL;
         }
         /* never outside the output folder, not even with --unsafe: no surprise folders */
         if (under(c, sb->out) && make_parents(c)) {
-            snprintf(sb->err, sizeof sb->err, "cannot create the folders of %s: %s", c, strerror(errno));
+            snprintf(sb->err, sizeof sb->err, "cannot create the folders of %s: %s", path, strerror(errno));
             return *err = sb->err, NULL;
         }
     } else {
@@ -148,8 +192,7 @@ const char *wb_sandbox_path(lua_State *L, const char *path, int write, char *buf
             return *err = "path too long", NULL;
         if (!sb->unsafe && !may_read(sb, c)) {
             snprintf(sb->err, sizeof sb->err,
-                     "reading %s is outside the allowed folders (scene, assets, out); use --unsafe",
-                     show(named, sizeof named, path, c));
+                     "reading %s is outside the allowed folders (scene, assets, out); use --unsafe", path);
             return *err = sb->err, NULL;
         }
         if (sb->on_read && exists(c)) sb->on_read(sb->on_read_ud, c);
@@ -196,10 +239,59 @@ static int call_original(lua_State *L) {
     return lua_gettop(L);
 }
 
+/* the io library's own test of a mode: [rwa]+?b* */
+static int valid_mode(const char *mode) {
+    return *mode != '\0' && strchr("rwa", *(mode++)) != NULL && (*mode != '+' || ((void)(++mode), 1)) &&
+           strspn(mode, "b") == strlen(mode);
+}
+
+static int stream_close(lua_State *L) {
+    luaL_Stream *p = (luaL_Stream *)luaL_checkudata(L, 1, LUA_FILEHANDLE);
+    return luaL_fileresult(L, fclose(p->f) == 0, NULL);
+}
+
+/* a file of the io library, opened for writing at path (resolved) without following a
+ * link at its name: pushed, or nil, "given: reason", errno as io.open returns them */
+static int open_for_writing(lua_State *L, const char *path, const char *given, const char *mode) {
+    int flags = mode[1] == '+' ? O_RDWR : mode[0] == 'r' ? O_RDONLY : O_WRONLY;
+    if (mode[0] == 'w') flags |= O_CREAT | O_TRUNC;
+    if (mode[0] == 'a') flags |= O_CREAT | O_APPEND;
+    if (!sb_from(L)->unsafe) flags |= O_NOFOLLOW;
+    luaL_Stream *p = (luaL_Stream *)lua_newuserdatauv(L, sizeof *p, 0);
+    p->closef = NULL;  /* not a file until it is open */
+    luaL_setmetatable(L, LUA_FILEHANDLE);
+    int fd = open(path, flags | O_CLOEXEC, 0666);
+    if (fd >= 0 && !(p->f = fdopen(fd, mode))) {
+        int e = errno;
+        close(fd);
+        errno = e;
+        fd = -1;
+    }
+    if (fd < 0) {
+        int e = errno;
+        lua_pop(L, 1);
+        luaL_pushfail(L);
+        if (e == ELOOP) lua_pushfstring(L, "%s: a symbolic link (the sandbox does not write through one)", given);
+        else lua_pushfstring(L, "%s: %s", given, strerror(e));
+        lua_pushinteger(L, e);
+        return 3;
+    }
+    p->closef = stream_close;
+    return 1;
+}
+
 static int sb_io_open(lua_State *L) {
     const char *mode = luaL_optstring(L, 2, "r");
-    check_arg(L, 1, strpbrk(mode, "wa+") != NULL);
-    return call_original(L);
+    if (!strpbrk(mode, "wa+")) {
+        check_arg(L, 1, 0);
+        return call_original(L);
+    }
+    const char *given = wbl_checkfilename(L, 1);
+    luaL_argcheck(L, valid_mode(mode), 2, "invalid mode");
+    char buf[PATH_MAX];
+    const char *err, *p = wb_sandbox_path(L, given, 1, buf, sizeof buf, &err);
+    if (!p) return luaL_error(L, "%s", err);
+    return open_for_writing(L, p, given, mode);
 }
 
 static int sb_io_lines(lua_State *L) {  /* io.lines(): the default input; else a file name, read */
@@ -211,21 +303,33 @@ static int sb_io_lines(lua_State *L) {  /* io.lines(): the default input; else a
 static int handle_or_name(lua_State *L, int write) {
     if (lua_isnoneornil(L, 1) || luaL_testudata(L, 1, LUA_FILEHANDLE)) return call_original(L);
     if (lua_type(L, 1) != LUA_TSTRING) luaL_typeerror(L, 1, "file name or file handle");
-    check_arg(L, 1, write);
+    if (!write) {
+        check_arg(L, 1, 0);
+        return call_original(L);
+    }
+    /* opened here, as io.open does, and handed over as a file handle */
+    const char *given = wbl_checkfilename(L, 1);
+    char buf[PATH_MAX];
+    const char *err, *p = wb_sandbox_path(L, given, 1, buf, sizeof buf, &err);
+    if (!p) return luaL_error(L, "%s", err);
+    if (open_for_writing(L, p, given, "w") != 1) return luaL_error(L, "cannot open file %s", lua_tostring(L, -2));
+    lua_replace(L, 1);
     return call_original(L);
 }
 
 static int sb_io_input(lua_State *L) { return handle_or_name(L, 0); }
 static int sb_io_output(lua_State *L) { return handle_or_name(L, 1); }
 
+/* os.remove and os.rename act on the names themselves: a link is removed or moved, not
+ * what it leads to (2: the entry, its last name not followed) */
 static int sb_os_remove(lua_State *L) {
-    check_arg(L, 1, 1);
+    check_arg(L, 1, 2);
     return call_original(L);
 }
 
 static int sb_os_rename(lua_State *L) {
-    check_arg(L, 1, 1);
-    check_arg(L, 2, 1);
+    check_arg(L, 1, 2);
+    check_arg(L, 2, 2);
     return call_original(L);
 }
 
@@ -490,6 +594,7 @@ int wb_sandbox_init(wb_sandbox *sb, const char *scene_dir, const char *out_dir, 
     char full[PATH_MAX];
     memset(sb, 0, sizeof *sb);
     sb->unsafe = unsafe;
+    snprintf(sb->out_shown, sizeof sb->out_shown, "%s", out_dir ? out_dir : "out");
     if (!getcwd(sb->cwd, sizeof sb->cwd) ||
         join(full, sizeof full, sb->cwd, scene_dir ? scene_dir : ".") || canon(full, sb->scene) ||
         join(full, sizeof full, sb->cwd, out_dir ? out_dir : "out") || canon(full, sb->out) ||

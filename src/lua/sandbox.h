@@ -12,6 +12,7 @@
 typedef struct wb_sandbox {
     int unsafe;                                 /* --unsafe: paths resolved, nothing refused */
     char cwd[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], lib[PATH_MAX];  /* canonical; lib may be "" */
+    char out_shown[PATH_MAX];                   /* the output folder as the user named it, for messages */
     char roots[WB_SANDBOX_ROOTS][PATH_MAX];     /* canonical folders a script may read */
     int nroots;
     char err[2 * PATH_MAX + 128];               /* the last refusal's message */
@@ -30,8 +31,12 @@ int wb_sandbox_init(wb_sandbox *sb, const char *scene_dir, const char *out_dir, 
 void wb_sandbox_open(lua_State *L, wb_sandbox *sb);
 /* Resolve a path a script names. write=0: the file is read (scene folder, assets
  * folders, output folder); write=1: it is written (only under the output folder; a
- * relative path is taken inside it; parent folders are created). Returns buf, or NULL
- * with *err set to a message naming the path. A state without a sandbox: no rules. */
+ * relative path is taken inside it; parent folders are created; a path through a
+ * symbolic link to nothing is refused); write=2: the same for the name itself (its last
+ * name not followed when it is a link: os.remove, os.rename). Returns buf, or NULL with
+ * *err set to a message naming the path as given. A state without a sandbox: no rules.
+ * The caller opens the file without following a link at its name (O_NOFOLLOW, or
+ * io/file.c's writers). */
 const char *wb_sandbox_path(lua_State *L, const char *path, int write, char *buf, size_t n, const char **err);
 /* the file name at arg: a string without a zero byte, else an argument error. A number
  * is refused, not converted (as Lua's own functions would): a name is a string */

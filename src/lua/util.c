@@ -1,10 +1,15 @@
 /* util.c: argument checking and small helpers shared by the binding files. */
+#include <fcntl.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "util.h"
+#include "io/io.h"
+#include "render/render.h"
 
 /* ---- the world userdata (its methods: world.c) ---- */
 wbl_world *wbl_checkworld_ud(lua_State *L, int arg)
@@ -402,4 +407,20 @@ void wbl_read_neo(lua_State *L, int arg, wb_real *young, wb_real *poisson)
         if (!(*poisson >= 0 && *poisson < 0.5)) wbl_fielderror(L, arg, "poisson", "must be in [0, 0.5)");
         if (!has_young) wbl_fielderror(L, arg, "poisson", "needs young");
     }
+}
+
+/* ---- files ---- */
+bool wbl_write_png(const char *path, const uint8_t *rgb, int w, int h, char *err, size_t n)
+{
+    size_t bytes;
+    char e[PATH_MAX + 160];
+    void *png = wb_image_encode_png(rgb, w, h, &bytes);
+    if (!png) {
+        snprintf(err, n, "out of memory encoding %s", path);
+        return false;
+    }
+    const bool ok = wbio_write_bytes(AT_FDCWD, path, path, png, bytes, e, sizeof e) == 0;
+    free(png);
+    if (!ok) snprintf(err, n, "cannot write %s", e);
+    return ok;
 }

@@ -8,6 +8,7 @@
 #define WB_LUA_UTIL_H
 
 #include <stdbool.h>
+#include <stdint.h>
 
 #include "wobble_lua.h"
 
@@ -118,6 +119,10 @@ void wbl_apply_contact_opts(wb_world *w, wb_body b, const wbl_contact_opts *o);
 /* the builders' default radius: half the spacing of the body's particles, so that
  * neighbouring particles' contact spheres touch and other bodies cannot pass between */
 void wbl_default_radius(wb_world *w, wb_body b);
+
+/* a PNG of rgb written whole to path (a temporary renamed into place, a link at path
+ * replaced, not followed); false with "cannot write path: reason" */
+bool wbl_write_png(const char *path, const uint8_t *rgb, int w, int h, char *err, size_t n);
 
 /* ---- what a run reports (result.c) ---------------------------------------------- */
 void wbl_open_result(lua_State *L);   /* wobble.result, into the module table on top */

@@ -1,7 +1,8 @@
-/* media.c: images and videos. PNG through stb_image_write (fast compression,
- * every write checked: a full disk is an error, not a short file); MP4 (H.264,
- * yuv420p) and GIF by piping raw RGB frames to the ffmpeg program; a folder of
- * numbered PNGs. Frames are encoded on a writer thread so the caller simulates the
+/* media.c: images and videos. PNG through stb_image_write (fast compression, into
+ * memory: the layer above writes the bytes, each file whole); MP4 (H.264, yuv420p) and
+ * GIF by piping raw RGB frames to the ffmpeg program, which writes the file the caller
+ * names (a temporary it renames when the recording went well); a folder of numbered
+ * PNGs, each handed to the caller's write_frame. Frames are encoded on a writer thread so the caller simulates the
  * next frame meanwhile. A failed encoder is an error, never a hang: SIGPIPE is
  * blocked on the writer thread (EPIPE instead), the exit status is checked, and an
  * encoder that stops taking frames is killed after a timeout. */
@@ -63,58 +64,6 @@ static void mem_write(void *ctx, void *data, int size)
     m->n += (size_t)size;
 }
 
-/* write all of data to f, checking every step (fclose reports a full disk late) */
-static bool write_stream(FILE *f, const void *data, size_t n, int *e)
-{
-    bool ok = fwrite(data, 1, n, f) == n;
-    *e = ok ? 0 : errno ? errno : EIO;
-    if (fclose(f) != 0 && ok) ok = false, *e = errno;
-    return ok;
-}
-
-/* write data to path without ever losing what was there: into a new file next to it,
- * renamed over the path once complete, so a failure removes only that new file. A
- * path that exists and is no regular file (a device, a pipe) is written in place and
- * never removed. */
-static bool write_file(const char *path, const void *data, size_t n, char *err, size_t en)
-{
-    static _Atomic unsigned seq;
-    char real[PATH_MAX], tmp[PATH_MAX + 64];
-    struct stat st;
-    int e = 0;
-    /* a symlink: replace its target, not the link */
-    if (lstat(path, &st) == 0 && S_ISLNK(st.st_mode) && realpath(path, real)) path = real;
-    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
-        FILE *f = fopen(path, "wb");
-        if (f && write_stream(f, data, n, &e)) return true;
-        snprintf(err, en, "cannot write %s: %s", path, strerror(f ? e : errno));
-        return false;
-    }
-    const char *slash = strrchr(path, '/');
-    int dl = slash ? (int)(slash - path + 1) : 0, fd = -1;
-    for (int tries = 0; fd < 0 && tries < 100; tries++) {
-        if (snprintf(tmp, sizeof tmp, "%.*s.%s.%ld-%u.tmp", dl, path, path + dl, (long)getpid(), seq++) >= (int)sizeof tmp) {
-            snprintf(err, en, "cannot write %s: path too long", path);
-            return false;
-        }
-        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd < 0 && errno != EEXIST) break;
-    }
-    FILE *f = fd >= 0 ? fdopen(fd, "wb") : NULL;
-    if (!f) {
-        snprintf(err, en, "cannot write %s: %s", path, strerror(errno));
-        if (fd >= 0) close(fd), unlink(tmp);
-        return false;
-    }
-    bool ok = write_stream(f, data, n, &e);
-    if (ok && rename(tmp, path) != 0) ok = false, e = errno;
-    if (!ok) {
-        snprintf(err, en, "cannot write %s: %s", path, strerror(e));
-        unlink(tmp);
-    }
-    return ok;
-}
-
 static bool png_encode(membuf *m, const uint8_t *rgb, int w, int h)
 {
     /* level 1: about as small as 8 for rendered frames, several times faster */
@@ -122,14 +71,15 @@ static bool png_encode(membuf *m, const uint8_t *rgb, int w, int h)
     return stbi_write_png_to_func(mem_write, m, w, h, 3, rgb, w * 3) && !m->oom;
 }
 
-bool wb_image_write_png(const char *path, const uint8_t *rgb, int w, int h, char *err, size_t n)
+void *wb_image_encode_png(const uint8_t *rgb, int w, int h, size_t *n)
 {
     membuf m = { 0 };
-    bool ok = png_encode(&m, rgb, w, h);
-    if (!ok) snprintf(err, n, "out of memory encoding %s", path);
-    else ok = write_file(path, m.p, m.n, err, n);
-    free(m.p);
-    return ok;
+    if (!png_encode(&m, rgb, w, h)) {
+        free(m.p);
+        return NULL;
+    }
+    *n = m.n;
+    return m.p;
 }
 
 size_t wb_image_png_bytes(const char *path, int *w, int *h)
@@ -189,9 +139,8 @@ wb_media wb_media_of(const char *given, const char *path, char *err, size_t n)
 struct wb_recorder {
     wb_media kind;
     char path[PATH_MAX];
-    bool created;                 /* the file at path is ours (dev, ino): made by open */
-    dev_t dev;
-    ino_t ino;
+    wb_media_out out;             /* where the frames or the encoder's file go */
+    char encode_to[PATH_MAX];
     int w, h;
     double fps, timeout;
     size_t bytes;                 /* of one frame */
@@ -215,40 +164,16 @@ static const char *ffmpeg_prog(void)
     return p && *p ? p : "ffmpeg";
 }
 
-wb_recorder *wb_recorder_open(const char *path, wb_media kind, int w, int h, char *err, size_t n)
+wb_recorder *wb_recorder_open(const char *path, wb_media kind, int w, int h, const wb_media_out *out, char *err,
+                              size_t n)
 {
     if (kind == WB_MEDIA_NONE) {
         snprintf(err, n, "cannot record to '%s': no media kind", path);
         return NULL;
     }
-    if (strlen(path) >= PATH_MAX - 32) {
+    if (strlen(path) >= PATH_MAX - 32 || (kind != WB_MEDIA_FOLDER && strlen(out->encode_to) >= PATH_MAX)) {
         snprintf(err, n, "path too long");
         return NULL;
-    }
-    struct stat made;
-    bool created = false;
-    /* find out now that the destination is unusable, not at the first frame */
-    if (kind == WB_MEDIA_FOLDER) {
-        if (mkdir(path, 0777) != 0 && errno != EEXIST) {
-            snprintf(err, n, "cannot create the folder %s: %s", path, strerror(errno));
-            return NULL;
-        }
-        if (access(path, W_OK) != 0) {
-            snprintf(err, n, "cannot write into %s: %s", path, strerror(errno));
-            return NULL;
-        }
-    } else {
-        /* a file made here is removed again when no frame comes; one that was there
-         * before (or anything not a regular file) is never removed */
-        created = true;
-        int fd = open(path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd < 0 && errno == EEXIST) created = false, fd = open(path, O_WRONLY | O_CLOEXEC);
-        if (fd < 0) {
-            snprintf(err, n, "cannot write %s: %s", path, strerror(errno));
-            return NULL;
-        }
-        if (fstat(fd, &made) != 0) created = false;
-        close(fd);
     }
     wb_recorder *rec = calloc(1, sizeof *rec);
     if (!rec) {
@@ -256,8 +181,9 @@ wb_recorder *wb_recorder_open(const char *path, wb_media kind, int w, int h, cha
         return NULL;
     }
     rec->kind = kind;
-    rec->created = created;
-    if (created) rec->dev = made.st_dev, rec->ino = made.st_ino;
+    rec->out = *out;
+    if (kind != WB_MEDIA_FOLDER) snprintf(rec->encode_to, sizeof rec->encode_to, "%s", out->encode_to);
+    rec->out.encode_to = NULL;   /* the caller's string need not outlive this call */
     snprintf(rec->path, sizeof rec->path, "%s", path);
     rec->w = w, rec->h = h;
     rec->fps = 60;
@@ -330,10 +256,17 @@ static bool write_all(int fd, const uint8_t *p, size_t n, int *e)
 static bool emit(wb_recorder *rec, const uint8_t *rgb, int64_t index, char *m, size_t mn)
 {
     if (rec->kind == WB_MEDIA_FOLDER) {
-        char p[PATH_MAX + 32];
-        snprintf(p, sizeof p, "%s%sframe_%06lld.png", rec->path, rec->path[strlen(rec->path) - 1] == '/' ? "" : "/",
-                 (long long)index);
-        return wb_image_write_png(p, rgb, rec->w, rec->h, m, mn);
+        char name[64];
+        snprintf(name, sizeof name, "frame_%06lld.png", (long long)index);
+        size_t bytes;
+        void *png = wb_image_encode_png(rgb, rec->w, rec->h, &bytes);
+        if (!png) {
+            snprintf(m, mn, "out of memory encoding %s", name);
+            return false;
+        }
+        bool ok = rec->out.write_frame(rec->out.ud, name, png, bytes, m, mn);
+        free(png);
+        return ok;
     }
     int e = 0;
     if (write_all(rec->fd, rgb, rec->bytes, &e)) return true;
@@ -372,7 +305,7 @@ static bool spawn_encoder(wb_recorder *rec, char *err, size_t n)
     snprintf(size, sizeof size, "%dx%d", rec->w, rec->h);
     snprintf(rate, sizeof rate, "%.6g", rec->fps);
     /* "file:" so neither a leading '-' nor a colon in the name means something else */
-    snprintf(out, sizeof out, "file:%s%s", rec->path[0] == '/' ? "" : "./", rec->path);
+    snprintf(out, sizeof out, "file:%s%s", rec->encode_to[0] == '/' ? "" : "./", rec->encode_to);
     const char *prog = ffmpeg_prog();
     const char *argv[48];
     int a = 0;
@@ -383,9 +316,14 @@ static bool spawn_encoder(wb_recorder *rec, char *err, size_t n)
                            "-i", "pipe:0", "-an", "-threads", threads };
     for (size_t k = 0; k < sizeof head / sizeof *head; k++) argv[a++] = head[k];
     if (rec->kind == WB_MEDIA_MP4) {
-        /* yuv420p plays everywhere but needs even sizes: pad odd ones by a pixel */
-        const char *mp4[] = { "-c:v", "libx264", "-preset", "veryfast", "-crf", "18", "-pix_fmt", "yuv420p",
-                              "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-movflags", "+faststart", "-f", "mp4" };
+        /* yuv420p plays everywhere but needs even sizes: pad odd ones by a pixel. The
+         * conversion uses the BT.709 matrix in limited range and the stream says so:
+         * players assume BT.709 for HD, and an untagged BT.601 conversion (ffmpeg's
+         * default) shifted saturated colours (the strain's red) */
+        const char *mp4[] = { "-c:v", "libx264", "-preset", "veryfast", "-crf", "18",
+                              "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2,scale=out_color_matrix=bt709:out_range=tv,format=yuv420p",
+                              "-pix_fmt", "yuv420p", "-colorspace", "bt709", "-color_primaries", "bt709",
+                              "-color_trc", "bt709", "-color_range", "tv", "-movflags", "+faststart", "-f", "mp4" };
         for (size_t k = 0; k < sizeof mp4 / sizeof *mp4; k++) argv[a++] = mp4[k];
     } else {
         /* a GIF's delays are whole centiseconds and players show one under 2 cs as 10:
@@ -528,15 +466,6 @@ static void encoder_says(wb_recorder *rec, char *out, size_t n)
     memcpy(out, s, strlen(s) + 1);
 }
 
-/* remove the empty file the recorder made, if it is still that one */
-static void remove_ours(const wb_recorder *rec)
-{
-    struct stat st;
-    if (rec->created && lstat(rec->path, &st) == 0 && S_ISREG(st.st_mode) && st.st_dev == rec->dev &&
-        st.st_ino == rec->ino && st.st_size == 0)
-        unlink(rec->path);
-}
-
 bool wb_recorder_close(wb_recorder *rec, char *err, size_t n)
 {
     if (!rec) return true;
@@ -583,7 +512,6 @@ bool wb_recorder_close(wb_recorder *rec, char *err, size_t n)
         ok = false;
     }
     if (rec->errfd >= 0) close(rec->errfd);
-    if (!rec->started) remove_ours(rec);   /* no frames: no empty file */
     for (int k = 0; k < NSLOT; k++) free(rec->slot[k]);
     pthread_mutex_destroy(&rec->mu);
     pthread_cond_destroy(&rec->cv);

@@ -109,7 +109,8 @@ bool wb_renderer_project(const wb_renderer *r, const double p[3], double *x, dou
 void wb_renderer_get_camera(const wb_renderer *r, double eye[3], double target[3], double up[3], double *fov);
 
 /* ---- images ------------------------------------------------------------------------ */
-bool wb_image_write_png(const char *path, const uint8_t *rgb, int w, int h, char *err, size_t n);
+/* a PNG file's bytes in memory (malloc'd, free()); NULL when out of memory */
+void *wb_image_encode_png(const uint8_t *rgb, int w, int h, size_t *n);
 /* RGB8 pixels of a PNG (malloc'd, free()), NULL with a message */
 uint8_t *wb_image_read_png(const char *path, int *w, int *h, char *err, size_t n);
 /* from the PNG's header alone: its size and about how many bytes wb_image_read_png takes
@@ -126,10 +127,19 @@ typedef struct wb_recorder wb_recorder;
  * `path`, where the name resolves to (NULL: the name itself), exists as one);
  * WB_MEDIA_NONE with a message for anything else */
 wb_media wb_media_of(const char *given, const char *path, char *err, size_t n);
-/* record `kind` (from wb_media_of) to path: the destination is checked (writable) now,
- * the encoder starts with the first frame. A file made here is removed again when no
- * frame comes; a file that was there is never removed. */
-wb_recorder *wb_recorder_open(const char *path, wb_media kind, int w, int h, char *err, size_t n);
+/* Where a recording's bytes go; the caller makes and checks the destination (the
+ * renderer writes no file of its own). A folder: write_frame(ud, "frame_NNNNNN.png",
+ * bytes) for each frame, called on the writer thread, false with a message. A video:
+ * the encoder writes the file encode_to (copied) */
+typedef struct wb_media_out {
+    void *ud;
+    bool (*write_frame)(void *ud, const char *name, const void *data, size_t n, char *err, size_t en);
+    const char *encode_to;
+} wb_media_out;
+/* record `kind` (from wb_media_of) of the file or folder path (the name messages show)
+ * into out; the encoder starts with the first frame */
+wb_recorder *wb_recorder_open(const char *path, wb_media kind, int w, int h, const wb_media_out *out, char *err,
+                              size_t n);
 /* about how many bytes a recording of w x h frames holds: the queued frames and, for a
  * video, the ffmpeg encoding it (its peak resident memory, measured; its thread count is
  * fixed, at most 4, so that this holds on any machine) */

@@ -72,6 +72,34 @@ bad_sweep "a set value that is not a string" "runs[1].set.g: expected a string" 
 bad_sweep "repeat out of range" "repeat: expected a number from 1" '{"grid":[],"runs":[],"repeat":1e300}'
 bad_sweep "cut short" "not JSON, or cut short" '{"grid":'
 
+# --plot of values near DBL_MAX: the log axis's end rounded to 10^309 = inf and its grid
+# loop never ended; a linear span of -1.7e308..1.7e308 and a mean of repeats overflowed.
+# Each plot must end (a time limit: the old code looped forever) with a finite picture
+H=$TMP/huge
+mkdir -p "$H/runs/0001" "$H/runs/0002" "$H/runs/0003" "$H/runs/0004"
+printf '%s' '{"grid":[{"key":"a","values":["1","2"]},{"key":"b","values":["1","2"]}],"repeat":1,"runs":[{"run":"0001","set":{"a":"1","b":"1"}},{"run":"0002","set":{"a":"2","b":"1"}},{"run":"0003","set":{"a":"1","b":"2"}},{"run":"0004","set":{"a":"2","b":"2"}}]}' >"$H/sweep.json"
+k=0
+for v in "1e300 1.7e308 -1.7e308" "1e-300 9.9e307 1.7976931348623157e308" "1 1.79e308 1.79e308" "1e308 1.7e308 -1e308"; do
+    k=$((k + 1))
+    set -- $v
+    printf '{"status":"ok","result":{"x":%s,"y":%s,"z":%s}}' "$1" "$2" "$3" >"$H/runs/000$k/result.json"
+done
+for p in x,y x,z y,z a,b,y a,b,z; do
+    rm -f "$TMP/huge.png"
+    "$W" collect "$H" --plot $p "$TMP/huge.png" >"$TMP/out" 2>"$TMP/err" &
+    cpid=$!
+    ( sleep 20; kill -9 $cpid 2>/dev/null ) &
+    wpid=$!
+    wait $cpid
+    code=$?
+    kill $wpid 2>/dev/null
+    wait $wpid 2>/dev/null
+    why=""
+    [ "$code" = 0 ] || why="exit $code (137: still drawing after 20 s)"
+    [ -s "$TMP/huge.png" ] || why="${why:+$why; }no picture"
+    result "collect --plot $p of values near 1.8e308 ends with a picture" "$why"
+done
+
 # a grid value longer than a job line's old 4 KiB buffer reaches the run whole
 long=$(awk 'BEGIN { for (i = 0; i < 5000; i++) printf "x"; printf "'"'"'end" }')
 cat >"$TMP/echo.lua" <<'LUA'

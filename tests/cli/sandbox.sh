@@ -86,6 +86,99 @@ done
 run "$WD" run "$S/bin.lua" --set how=loadfile_t --set name=binmod.lua --unsafe
 check "--unsafe: loadfile(name, 't') still refuses a binary chunk" 2 err "attempt to load a binary chunk (mode is 't')"
 
+# ---- a symbolic link already in the output folder: every writer refuses a link at its
+# name that leads nowhere (its target would be made wherever it points) or out of the
+# folder, and a recorder's frames replace a link in their folder instead of writing
+# through it. Links to nothing ($SEC/made-*) and to a file outside ($SEC/victim-*).
+SEC=$TMP/secret
+cat >"$S/writers.lua" <<'EOF'
+local how, name = wobble.args.how, wobble.args.name
+local w = wobble.world{}
+local body = w:lattice{ min = {0, 0, 0}, max = {1, 1, 1}, res = {2, 2, 2}, tets = true }
+local m = wobble.mesh{ vertices = { {0, 0, 0}, {1, 0, 0}, {0, 1, 0} }, triangles = { {1, 2, 3} } }
+local function r() return wobble.renderer{ width = 16, height = 16, backend = "null" } end
+local calls = {
+  io_w = function() local f = assert(io.open(name, "w")); f:write("x"); f:close() end,
+  io_a = function() local f = assert(io.open(name, "a")); f:write("x"); f:close() end,
+  io_rw = function() local f = assert(io.open(name, "r+")); f:write("x"); f:close() end,
+  io_output = function() io.output(name); io.write("x"); io.close() end,
+  save_obj = function() assert(m:save_obj(name)) end,
+  save_ply = function() assert(m:save(name)) end,
+  save_stl = function() assert(m:save(name)) end,
+  skin_obj = function() assert(w:skin(m, body):save_obj(name)) end,
+  save_vtp = function() assert(w:save_vtp(name)) end,
+  save = function() assert(w:save(name)) end,
+  save_tets = function() assert(w:save_tets(name, body)) end,
+  pc2 = function() local rec = assert(w:record_pc2(name, { rest = false })); w:step(); assert(rec:close()) end,
+  pc2_rest = function() local rec = assert(w:record_pc2(name)); w:step(); assert(rec:close()) end,
+  vtk = function() local rec = assert(w:record_vtk(name)); w:run{ frames = 2 }; assert(rec:close()) end,
+  save_png = function() local x = r(); x:draw(w); x:save_png(name) end,
+  plot = function() w:run{ frames = 2, plot = name } end,
+  record = function() local x = r(); x:record(name); for _ = 1, 3 do w:step(); x:draw(w) end; x:stop() end,
+}
+calls[how]()
+print("wrote " .. name)
+EOF
+# link_case HOW NAME LINK [MUST_REFUSE]: LINK (a path in the output folder) leads to
+# nothing, then to a file outside; neither may be written, nor named in a message
+link_case() {
+    how=$1 name=$2 link=$3 refuse=${4:-yes}
+    for kind in made victim; do
+        out=$TMP/lk-$how-$kind
+        rm -rf "$out" "$SEC/made-$how" "$SEC/victim-$how"
+        mkdir -p "$(dirname "$out/$link")"
+        [ $kind = victim ] && echo precious >"$SEC/victim-$how"
+        ln -s "$SEC/$kind-$how" "$out/$link"
+        run "$WD" run "$S/writers.lua" --out "$out" --set how=$how --set name=$name
+        why=""
+        [ -e "$SEC/made-$how" ] && why="$SEC/made-$how was created"
+        [ $kind = victim ] && [ "$(cat "$SEC/victim-$how")" != precious ] && why="$SEC/victim-$how was overwritten"
+        grep -q "$SEC" "$TMP/out" "$TMP/err" && why="${why:+$why; }a message names $SEC"
+        if [ $refuse = yes ]; then
+            grep -q "wrote $name" "$TMP/out" && why="${why:+$why; }the write went through"
+            grep -qE "symbolic link to nothing|outside the output folder" "$TMP/err" ||
+                why="${why:+$why; }no refusal on stderr"
+        else
+            grep -q "wrote $name" "$TMP/out" || why="${why:+$why; }the recording failed (exit $code)"
+        fi
+        result "$how: a link at $link to $([ $kind = made ] && echo nothing || echo a file outside)" "$why"
+    done
+}
+ctl=""  # without a link in the way every one of them writes (so a refusal below is the link's)
+for c in io_w:f.txt io_a:f.txt io_rw:f.txt io_output:g.txt save_vtp:f.vtp save:f.json save_obj:m.obj \
+         skin_obj:s.obj save_ply:m.ply save_stl:m.stl save_tets:t pc2:c.pc2 pc2_rest:d.pc2 vtk:v \
+         save_png:p.png plot:q.png record:v.mp4 record:frames/; do
+    run "$WD" run "$S/writers.lua" --out "$TMP/lk-plain" --set how=${c%%:*} --set name=${c#*:}
+    grep -q "wrote ${c#*:}" "$TMP/out" || ctl="$ctl ${c%%:*}"
+done
+result "every writer writes where no link is in the way" "${ctl:+failed:$ctl}"
+for how in io_w io_a io_rw io_output save_vtp save; do link_case $how f.txt f.txt; done
+link_case save_obj m.obj m.obj
+link_case skin_obj s.obj s.obj
+link_case save_ply m.ply m.ply
+link_case save_stl m.stl m.stl
+link_case save_tets t t.node
+link_case pc2 c.pc2 c.pc2
+link_case pc2_rest c.pc2 c.obj
+link_case vtk v v.pvd
+link_case vtk v v/frame_000001.vtp no
+link_case save_png p.png p.png
+link_case plot p.png p.png
+link_case record v.mp4 v.mp4
+link_case record frames/ frames/frame_000002.png no
+run "$WD" run "$S/writers.lua" --set how=io_w --set name="$SEC/x/../escape.txt"
+check "a refusal names the path as the script gave it, not where it resolves" 2 \
+    err "writing $SEC/x/../escape.txt is outside the output folder out;" !err "$SEC/escape.txt"
+mkdir -p "$WD/out" && ln -s "$SEC/made-dangling" "$WD/out/dl"
+run "$WD" run "$S/writers.lua" --set how=io_w --set name=dl
+check "... and so does the refusal of a link to nothing" 2 \
+    err "writing dl goes through a symbolic link to nothing" !err "made-dangling" none "$SEC/made-dangling"
+printf 'assert(os.remove("dl"))\nprint("removed")\n' >"$S/unlink.lua"
+run "$WD" run "$S/unlink.lua"
+check "os.remove of a link removes the link, not what it names" 0 out removed
+result "... the link is gone" "$([ -L "$WD/out/dl" ] && echo "still there")"
+rm -rf "$WD/out"
+
 # ---- media naming other files: an HLS playlist (called .mp4) that plays a video kept
 # outside the allowed folders; refused in both modes (ffmpeg is not the sandbox's to lift)
 if ffmpeg -v error -y -f lavfi -i color=red:s=32x32:d=0.2 -pix_fmt yuv420p "$TMP/secret/s.mp4" </dev/null; then

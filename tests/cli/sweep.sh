@@ -66,6 +66,14 @@ h=$(sed -n 's/.*"h":	"\([0-9a-f]*\)".*/\1/p' "$S/runs/0001/result.json")
 result "result.json's hash is the last world's w:hash(), though the scene closed it" "$why"
 has "result.json of a script error: exit 2 and the message (no traceback)" "$S/runs/0003/result.json" \
     '"status":	"error"' '"exit":	2' '"error":	"'"$(pwd)/$F"'/sweep_scene.lua:8: boom: failing on purpose"' '"hash":	null'
+# a scene in a deep folder (a long checkout path): Lua shortens a long file name in a
+# position to "...its end"; the error names the scene by its whole path
+L=$TMP/a-folder-deep-enough-that-lua-would-shorten-the-name-of-its-scene/and-deeper
+mkdir -p "$L" && cp $F/sweep_scene.lua "$L/"
+run sweep "$L/sweep_scene.lua" --grid g=boom --out "$TMP/deep"
+sh -c "$(sed -n 1p "$TMP/deep/jobs.txt")" >/dev/null 2>&1
+has "a scene in a deep folder: result.json's error names it by its whole path" "$TMP/deep/runs/0001/result.json" \
+    '"error":	"'"$L"'/sweep_scene.lua:8: boom: failing on purpose"'
 grep -q "stack traceback" "$S/runs/0003/result.json" && why="the traceback is in it" || why=""
 result "result.json's error is the message alone" "$why"
 has "result.json: a NaN result is text, and listed in non_finite" "$S/runs/0004/result.json" '"odd":	"nan"' \

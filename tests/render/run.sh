@@ -119,6 +119,18 @@ run "$W" run $F/camera.lua --quiet --out "$TMP/cam" --set own=1 --record "$TMP/c
 [ "$code" = 0 ] && cmp -s "$TMP/cam/own.png" "$TMP/camrec/frame_000002.png"; ok "--record uses the scene's camera (wobble.camera)" $?
 run "$W" run $F/camera.lua --quiet --out "$TMP/cam2" --set auto=1 --record "$TMP/camauto/"
 [ "$code" = 0 ] && [ -s "$TMP/camauto/frame_000002.png" ] && ! cmp -s "$TMP/camauto/frame_000002.png" "$TMP/camrec/frame_000002.png"; ok "... and the automatic framing when the scene sets none" $?
+# MP4 colours: converted with the BT.709 matrix in limited range and tagged so. A player
+# reads an HD video as BT.709 (untagged too): the frame decoded so matches what was drawn
+# (the untagged BT.601 conversion before: 8.1 levels off on the strain's reds; now 2.3)
+run "$W" run $F/colour.lua --quiet --out "$TMP/col"
+[ "$code" = 0 ] && [ "$(field "$TMP/col/c.mp4" color_space,color_primaries,color_transfer,color_range)" = "tv,bt709,bt709,bt709" ]
+ok "--record .mp4: tagged BT.709 (matrix, primaries, transfer), limited range" $?
+ffmpeg -v error -nostdin -y -i "$TMP/col/c.mp4" -vf "select=eq(n\\,2),scale=in_color_matrix=bt709:in_range=tv" \
+    -frames:v 1 "$TMP/col/as709.png" 2>"$TMP/err"
+run "$W" run $F/colour.lua --out "$TMP/col" --set with=as709.png
+e=$(sed -n 's/^colour error \([0-9.]*\) over \([0-9]*\) pixels$/\1 \2/p' "$TMP/out")
+[ "$code" = 0 ] && [ -n "$e" ] && echo "$e" | awk '{ exit !($1 < 4 && $2 > 1000) }'
+ok "--record .mp4 read as BT.709: the strain's reds within 4 levels of the drawn frame ($e)" $?
 
 # the renderer's buffers count against --memory-limit
 run "$W" run $F/big.lua --memory-limit 64

@@ -62,6 +62,22 @@ test("a series: one .vtp per frame, listed with its time in the .pvd", function(
   expect.eq(offs[#offs], 54)
 end)
 
+test("the .pvd's times are frame x dt, exactly (a running sum of dt drifts)", function()
+  local w = wobble.world{}
+  w:particle{ pos = {0, 1, 0} }
+  local rec = assert(w:record_vtk("export_vtk/times"))
+  w:run{ frames = 30 }
+  rec:close()
+  local n = 0
+  for t in read("export_vtk/times.pvd"):gmatch('timestep="(%S+)"') do
+    expect.eq(tonumber(t), n * (1 / 60), "frame " .. n)
+    n = n + 1
+  end
+  expect.eq(n, 31)
+  -- ParaView shows the frame whose time is 0.5 s for 0.5 s (a sum made it 0.49999999999999994)
+  expect.truthy(read("export_vtk/times.pvd"):find('timestep="0.5" group="" part="0" file="times/frame_000030.vtp"', 1, true))
+end)
+
 test("every = k and a single frame", function()
   local w = wobble.world{}
   w:rope{ from = {0, 1, 0}, to = {1, 1, 0}, segments = 3 }

@@ -6,11 +6,12 @@ test("a folder is not inside another whose name is its prefix (scenarios-evil is
   -- tests/scenarios-evil shares the prefix but is outside (nothing is created)
   expect.error(function() io.open("../scenarios-evil/x.txt") end, "is outside the allowed folders")
   expect.error(function() io.open("../scenariosx") end, "is outside the allowed folders")
-  -- the output folder, found from the rule's own message
+  -- the output folder, found from the rule's own message (as the user named it: its
+  -- sibling can be named only when that is an absolute path, as under make test)
   local err = expect.error(function() io.open("/tmp/wobble-sandbox-never-created/x.txt", "w") end)
   local out = tostring(err):match("outside the output folder (%S+);")
   expect.truthy(out, "the message names the output folder")
-  if out then
+  if out and out:sub(1, 1) == "/" then
     out = out:gsub("/$", "")
     expect.error(function() io.open(out .. "-evil/x.txt") end, "is outside the allowed folders")
   end
