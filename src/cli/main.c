@@ -225,8 +225,6 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
             o->sets[o->nsets++] = val;
         }
     }
-    if (!strcmp(cmd, "run") && o->view.width && !o->record)
-        return usage_error("%s", "--size with run is the size of --record's frames: give --record OUT");
     return EXIT_PASS;
 }
 
