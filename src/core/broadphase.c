@@ -754,8 +754,9 @@ static int any_possible(const wb_model *m)
  * map for every particle: any two bodies, however each moves. A swinging cloth then
  * needs reaches of about its radius, not of how far it travels in a frame (|v| dt).
  * Gravity stays in every reach (|g| dt^2), not in the reference: a particle resting on
- * the floor does not fall with it. When the fit does not make the reaches smaller in sum
- * (bodies moving every which way), the reference stands still, as before. */
+ * the floor does not fall with it. When the fit does not cut the volume the reaches search
+ * to a quarter (bodies moving every which way, a heap), the reference stands still, as
+ * before. */
 typedef struct ref_step { wb_real S, vf; } ref_step;
 
 /* after j substeps of h from the list's start: S_j, and the factor vf of the
@@ -793,7 +794,7 @@ static inline void ref_rel(const wb_contacts *c, const ref_step *rs, const wb_re
 }
 
 /* the reference fitted to the candidates (reach >= 0) at x with velocities v; kept only
- * if it makes their reaches smaller in sum than gravity and drag alone */
+ * where it shrinks the volume their reaches search (below) */
 static void fit_reference(wb_world *w, const wb_real *reach, wb_real t)
 {
     wb_contacts *c = &w->k.pc;

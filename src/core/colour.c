@@ -213,21 +213,21 @@ static int32_t visit_order(const wb_model *m, const int32_t *idx, int k, int32_t
             }
             /* compound ids in the order of first members (cid: by root, then by member),
              * then a counting sort of the members by compound */
-            int32_t *cid = uf + (na + 1), *cstart = uf + 2 * (na + 1), nc = 0;
+            int32_t *cid = uf + (na + 1), *comp_of = uf + 2 * (na + 1), nc = 0;
             for (int32_t t = 0; t < gn; t++) cid[t] = -1;
             for (int32_t t = 0; t < gn; t++) {
                 const int32_t r = root(uf, t);
                 if (cid[r] < 0) cid[r] = nc++;
-                cstart[t] = cid[r]; /* for now: member t's compound */
+                comp_of[t] = cid[r];
             }
             int32_t *cnt = cid; /* reused: nc <= gn counters */
             for (int32_t c = 0; c <= nc; c++) cnt[c] = 0;
-            for (int32_t t = 0; t < gn; t++) cnt[cstart[t] + 1]++;
+            for (int32_t t = 0; t < gn; t++) cnt[comp_of[t] + 1]++;
             for (int32_t c = 0; c < nc; c++) {
                 cnt[c + 1] += cnt[c];
                 split->comp_start[split->ncomp++] = nlast + cnt[c];
             }
-            for (int32_t t = 0; t < gn; t++) con[nlast + cnt[cstart[t]]++] = mem[t];
+            for (int32_t t = 0; t < gn; t++) con[nlast + cnt[comp_of[t]]++] = mem[t];
             nlast += gn;
         }
     }

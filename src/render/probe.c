@@ -175,6 +175,21 @@ static int input_args(const char **argv, int a, const char *fmt, const char *in)
     return a;
 }
 
+
+/* prog (ffprobe) on path read as fmt with the arguments tail (NULL-ended): its output, at
+ * most cap bytes (NULL with the message); *ok: it ended with 0 */
+static char *ffprobe(const char *prog, const char *path, const char *fmt, const char *const *tail, size_t cap,
+                     const wb_media_stop *stop, bool *ok, char *err, size_t n)
+{
+    char in[PATH_MAX + 16];
+    ff_input(in, sizeof in, path);
+    const char *argv[32] = { prog, "-v", "error" };
+    int a = input_args(argv, 3, fmt, in);
+    for (size_t k = 0; tail[k]; k++) argv[a++] = tail[k];
+    argv[a] = NULL;
+    size_t len;
+    return capture(argv, cap, stop, &len, ok, err, n);
+}
 bool wb_media_probe(const char *path, wb_media_info *info, const wb_media_stop *stop, char *err, size_t n)
 {
     memset(info, 0, sizeof *info);
@@ -193,17 +208,11 @@ bool wb_media_probe(const char *path, wb_media_info *info, const wb_media_stop *
     const char *fmt = demuxer_of(path, err, n);
     if (!fmt) return false;
     const char *prog = tool("WOBBLE_FFPROBE", "ffprobe");
-    char in[PATH_MAX + 16];
-    ff_input(in, sizeof in, path);
-    const char *argv[32] = { prog, "-v", "error" };
-    int a = input_args(argv, 3, fmt, in);
     const char *tail[] = { "-count_frames", "-select_streams", "v:0", "-show_entries",
                            "stream=width,height,codec_name,pix_fmt,nb_read_frames:format=duration", "-of",
                            "default=noprint_wrappers=1", NULL };
-    for (size_t k = 0; k < sizeof tail / sizeof *tail; k++) argv[a++] = tail[k];
-    size_t len;
     bool ok;
-    char *out = capture(argv, 65536, stop, &len, &ok, err, n);
+    char *out = ffprobe(prog, path, fmt, tail, 65536, stop, &ok, err, n);
     if (!out) return false;
     char *save = NULL;
     for (char *line = strtok_r(out, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
@@ -246,16 +255,10 @@ bool wb_media_frame_size(const char *path, const wb_media_stop *stop, int *w, in
         return false;
     }
     const char *prog = tool("WOBBLE_FFPROBE", "ffprobe");
-    char in[PATH_MAX + 16];
-    ff_input(in, sizeof in, path);
-    const char *argv[32] = { prog, "-v", "error" };
-    int a = input_args(argv, 3, fmt, in);
     const char *tail[] = { "-select_streams", "v:0", "-show_entries", "stream=width,height", "-of",
                            "default=noprint_wrappers=1", NULL };
-    for (size_t k = 0; k < sizeof tail / sizeof *tail; k++) argv[a++] = tail[k];
-    size_t len;
     bool ok;
-    char *out = capture(argv, 4096, stop, &len, &ok, err, n);
+    char *out = ffprobe(prog, path, fmt, tail, 4096, stop, &ok, err, n);
     if (!out) return false;
     char *save = NULL;
     for (char *line = strtok_r(out, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {

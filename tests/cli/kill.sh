@@ -44,6 +44,14 @@ stop() {
 
 # temps DIR: the temporaries left in DIR (.NAME.PID-N.tmp; main's w:save used NAME.tmpPID), one line each
 temps() { find "$1" -name '*.tmp*' 2>/dev/null; }
+# no_temps DIR MUST: the temporaries left in DIR are removed; with MUST = 1 (a stop that
+# can clean up: SIGTERM, SIGINT, a limit) any counts against the case (in why)
+no_temps() {
+    left=$(temps "$1")
+    [ "$2" = 1 ] && [ -n "$left" ] && why="${why:+$why; }left behind: $left"
+    [ -n "$left" ] && rm -f $left
+    return 0
+}
 
 # one_shot HOW N NAME FILE...: FILE(s) in the output folder, written by HOW; N the size
 one_shot() {
@@ -71,9 +79,7 @@ one_shot() {
                 cmp -s "$D/$f" "$TMP/old/$f" || cmp -s "$D/$f" "$TMP/ref/$f" ||
                     why="${why:+$why; }$f is neither the old file nor a complete new one ($(wc -c <"$D/$f" 2>/dev/null) bytes)"
             done
-            left=$(temps "$D")
-            [ $sig = TERM ] && [ -n "$left" ] && why="${why:+$why; }left behind: $left"
-            [ -n "$left" ] && rm -f $left
+            no_temps "$D" $([ $sig = TERM ] && echo 1)
             result "$how ($*) killed by SIG$sig ${t} s into its writes: old or complete" "$why"
         done
     done
@@ -94,9 +100,7 @@ for sig in KILL TERM; do
         start "$D" --set how=pc2 --set name=c.pc2 --set n=100 --set loops=1000000 || why="did not start"
         stop $sig $t
         cmp -s "$D/c.pc2" "$TMP/old.pc2" || why="${why:+$why; }c.pc2 is not the old cache ($(wc -c <"$D/c.pc2") bytes)"
-        left=$(temps "$D")
-        [ $sig = TERM ] && [ -n "$left" ] && why="${why:+$why; }left behind: $left"
-        [ -n "$left" ] && rm -f $left
+        no_temps "$D" $([ $sig = TERM ] && echo 1)
         result "record_pc2 killed by SIG$sig ${t} s into the recording: the old cache intact" "$why"
     done
 done
@@ -112,8 +116,7 @@ code=$?
 why=""
 [ $code = 3 ] || why="exit $code, expected 3"
 pc2_ok "$D/c.pc2" || why="${why:+$why; }c.pc2 is not a complete cache of more than 3 samples"
-left=$(temps "$D")
-[ -n "$left" ] && why="${why:+$why; }left behind: $left" && rm -f $left
+no_temps "$D" 1
 result "record_pc2 stopped by --time-limit: the cache of the frames so far, whole, and no temporary" "$why"
 cp "$TMP/old.pc2" "$D/c.pc2"
 t0=$(date +%s)
@@ -123,8 +126,7 @@ code=$?
 why=""
 [ $code = 3 ] && grep -q "grace period" "$TMP/err" || why="exit $code, expected 3 from the watchdog"
 cmp -s "$D/c.pc2" "$TMP/old.pc2" || why="${why:+$why; }c.pc2 is not the old cache"
-left=$(temps "$D")
-[ -n "$left" ] && why="${why:+$why; }left behind: $left" && rm -f $left
+no_temps "$D" 1
 result "a run the watchdog ends while it records ($(($(date +%s) - t0)) s): the old cache, no temporary" "$why"
 
 # ---- VTK: after every frame the .pvd is whole and names complete frames only
@@ -142,8 +144,7 @@ for sig in KILL TERM; do
             tail -n 1 "$D/$f" 2>/dev/null | grep -qx '</VTKFile>' || why="${why:+$why; }$f is not complete"
         done
         [ $k -ge 1 ] || why="${why:+$why; }v.pvd names no frame"
-        left=$(temps "$D")
-        [ $sig = TERM ] && [ -n "$left" ] && why="${why:+$why; }left behind: $left"
+        no_temps "$D" $([ $sig = TERM ] && echo 1)
         result "record_vtk killed by SIG$sig ${t} s in: v.pvd whole, its $k frames complete" "$why"
     done
 done
@@ -162,8 +163,7 @@ for sig in KILL TERM; do
         tail -c 8 "$f" | head -c 4 | grep -q IEND || why="${why:+$why; }$f is not complete"
     done
     [ $k -ge 1 ] || why="${why:+$why; }no frame written"
-    left=$(temps "$D")
-    [ $sig = TERM ] && [ -n "$left" ] && why="${why:+$why; }left behind: $left"
+    no_temps "$D" $([ $sig = TERM ] && echo 1)
     result "r:record(folder) killed by SIG$sig: its $k frames complete" "$why"
 done
 
@@ -180,9 +180,7 @@ if command -v ffmpeg >/dev/null 2>&1; then
         start "$D" --set how=steps --set n=8 --set loops=1000000 --record "$D/v.mp4" || why="did not start"
         stop $sig 1.5
         cmp -s "$D/v.mp4" "$TMP/old.mp4" || why="${why:+$why; }v.mp4 is not the old video ($(wc -c <"$D/v.mp4") bytes)"
-        left=$(temps "$D")
-        [ $sig != KILL ] && [ -n "$left" ] && why="${why:+$why; }left behind: $left"
-        [ -n "$left" ] && rm -f $left
+        no_temps "$D" $([ $sig != KILL ] && echo 1)
         result "--record v.mp4 over a video, killed by SIG$sig: the old video intact" "$why"
     done
     "$W" run "$F/kill_writer.lua" --quiet --out "$D" --set how=steps --set n=8 --set loops=10 --record "$D/v.mp4" \
