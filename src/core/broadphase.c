@@ -478,19 +478,37 @@ static int list_valid(const wb_broad *b, const wb_real *x, const wb_real *reach,
     return 1;
 }
 
+static int skin_pays(wb_broad *b, const wb_real *x, const wb_real *reach, int32_t n)
+{
+    if (b->vn != n) return 1;
+    int32_t out = 0, in = 0;
+    for (int32_t i = 0; i < n; i++) {
+        if (!(b->vr[i] >= 0) || !(reach[i] >= 0)) continue;
+        const wb_real *p = &x[3 * i], *X = &b->vx[3 * i], e = (wb_real)SKIN * reach[i];
+        const wb_real d0 = p[0] - X[0], d1 = p[1] - X[1], d2 = p[2] - X[2];
+        if (d0 * d0 + d1 * d1 + d2 * d2 > e * e) out++;
+        else in++;
+    }
+    return out <= in;
+}
+
 int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
                             int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
 {
     if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
     wb_broad *b = c->bp;
     if (!list_valid(b, x, reach, skip, n)) {
+        /* a skin pays only where a list lasts: where most particles moved farther than a
+         * skin since the last list, the next one is built without (a swinging cloth,
+         * every particle on the move: the skin only doubled the pairs searched) */
+        const wb_real grow_by = skin_pays(b, x, reach, n) ? 1 + (wb_real)SKIN : 1;
         b->vn = 0;
         if (!grow((void **)&b->vx, &b->cap_vx, 3 * (int64_t)n, sizeof *b->vx) ||
             !grow((void **)&b->vr, &b->cap_vr, n, sizeof *b->vr) ||
             !grow((void **)&b->vskip, &b->cap_vskip, n, sizeof *b->vskip))
             return -1;
         for (int32_t i = 0; i < n; i++) {
-            wb_real r = takes_part(x, reach, i) ? reach[i] * (1 + (wb_real)SKIN) : -1;
+            wb_real r = takes_part(x, reach, i) ? reach[i] * grow_by : -1;
             /* a reach that overflows with the skin: none (the check then rebuilds) */
             b->vr[i] = isfinite(r) ? r : reach[i];
             b->vskip[i] = skip ? skip[i] : 0;
@@ -521,6 +539,12 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
 }
 
 /* ---- which pairs may touch -------------------------------------------------------------------- */
+static int cmp_i32(const void *a, const void *b)
+{
+    const int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+    return (x > y) - (x < y);
+}
+
 static int cmp_u64(const void *a, const void *b)
 {
     uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
@@ -606,6 +630,14 @@ static int build_rules(wb_world *w)
     }
     c->nkeys = n;
     c->keys_dirty = 0;
+    /* each particle's row of keys (they are sorted by their less particle): wb__joined
+     * then searches a handful, not all of them */
+    int32_t *row = wb__grow(c->key_row, &c->cap_key_row, m->np + 1, sizeof *row);
+    if (!row) return 0;
+    c->key_row = row;
+    memset(row, 0, sizeof *row * ((size_t)m->np + 1));
+    for (int32_t k = 0; k < n; k++) row[(c->keys[k] >> 32) + 1]++;
+    for (int32_t i = 0; i < m->np; i++) row[i + 1] += row[i];
     return 1;
 }
 
@@ -693,14 +725,16 @@ int wb__contact_rules(wb_world *w)
 
 int wb__joined(const wb_contacts *c, int32_t i, int32_t j)
 {
+    if (c->nkeys == 0) return 0;
     const uint64_t key = pair_key(i, j);
-    int32_t lo = 0, hi = c->nkeys;
+    const int32_t a = i < j ? i : j;
+    int32_t lo = c->key_row[a], hi = c->key_row[a + 1];
     while (lo < hi) {
         const int32_t mid = lo + (hi - lo) / 2;
         if (c->keys[mid] < key) lo = mid + 1;
         else hi = mid;
     }
-    return lo < c->nkeys && c->keys[lo] == key;
+    return lo < c->key_row[a + 1] && c->keys[lo] == key;
 }
 
 /* DESIGN.md §2: particles of two bodies (or graphs) touch when both collide, unless a
@@ -851,6 +885,76 @@ static void fit_reference(wb_world *w, const wb_real *reach, wb_real t)
     for (int a = 0; a < 3; a++) c->ref_v[a] = (wb_real)V[a], c->ref_om[a] = (wb_real)om[a], c->ref_c[a] = (wb_real)cc[a];
 }
 
+/* Straight paths. Each particle is also checked against the straight line its velocity
+ * takes it on from the list's start, p_i(s) = y_i + S u_i (S as above: what the substeps'
+ * drag leaves of the time), within eps_i, the part of its reach that is not velocity (its
+ * margin and gravity). That implies the reference check: p_i(s) - Phi_s(y_i) =
+ * S (u_i - Psi(y_i)), no longer than |u_i - Psi(y_i)| t, the velocity's part of the
+ * reach. And two particles within their paths' allowances are at least
+ * min_s |p_i(s) - p_j(s)| - eps_i - eps_j apart: a pair of the search whose paths never
+ * come within r_i + r_j + eps_i + eps_j over the list's time cannot touch, and is left out
+ * of the list (a swinging or falling cloth: neighbours move alike, so only the pairs
+ * that close in on each other are projected). p_i - p_j is linear in S: its least length
+ * over S in [0, t] in closed form */
+static inline int paths_meet(const wb_contacts *c, const wb_real *rad, int32_t i, int32_t j)
+{
+    const wb_real *P = &c->path[8 * i], *Q = &c->path[8 * j];
+    const wb_real d0 = Q[0] - P[0], d1 = Q[1] - P[1], d2 = Q[2] - P[2];
+    const wb_real q0 = Q[4] - P[4], q1 = Q[5] - P[5], q2 = Q[6] - P[6];
+    const wb_real qq = q0 * q0 + q1 * q1 + q2 * q2, dq = d0 * q0 + d1 * q1 + d2 * q2;
+    wb_real S = 0;
+    if (dq < 0 && qq > 0) S = -dq < c->path_t * qq ? -dq / qq : c->path_t;
+    const wb_real e0 = d0 + S * q0, e1 = d1 + S * q1, e2 = d2 + S * q2, R = rad[i] + rad[j] + P[3] + Q[3];
+    return !(e0 * e0 + e1 * e1 + e2 * e2 >= R * R);
+}
+
+/* particle i's straight path from y with velocity u, allowance eps */
+static inline void set_path(wb_contacts *c, int32_t i, const wb_real *y, const wb_real *u, wb_real eps)
+{
+    wb_real *P = &c->path[8 * i];
+    v3_copy(P, y);
+    P[3] = eps;
+    v3_copy(&P[4], u);
+    P[7] = 0;
+}
+
+/* the list's pairs whose paths meet stay in it, in its order; the others are dormant,
+ * found by either particle through dorm_row. Every particle starts on its path. 0 when
+ * out of memory */
+static int split_dormant(wb_contacts *c, const wb_model *m, int32_t r)
+{
+    const int32_t np = m->np;
+    if (!grow((void **)&c->dorm, &c->cap_dorm, 2 * (int64_t)(r > 0 ? r : 1), sizeof *c->dorm) ||
+        !grow((void **)&c->dorm_row, &c->cap_dorm_row, (int64_t)np + 1, sizeof *c->dorm_row) ||
+        !grow((void **)&c->off_path, &c->cap_off_path, np, sizeof *c->off_path))
+        return 0;
+    int32_t *ij = c->ij, *d = c->dorm, n = 0, nd = 0;
+    for (int32_t k = 0; k < r; k++) {
+        const int32_t i = ij[2 * k], j = ij[2 * k + 1];
+        int32_t *o = paths_meet(c, m->radius, i, j) ? &ij[2 * n++] : &d[2 * nd++];
+        o[0] = i;
+        o[1] = j;
+    }
+    c->n = n;
+    c->nd = nd;
+    memset(c->off_path, 0, (size_t)np);
+    if (!grow((void **)&c->dorm_at, &c->cap_dorm_at, 2 * (int64_t)(nd > 0 ? nd : 1), sizeof *c->dorm_at) ||
+        !grow((void **)&c->dorm_on, &c->cap_dorm_on, nd > 0 ? nd : 1, sizeof *c->dorm_on))
+        return 0;
+    int32_t *row = c->dorm_row;
+    memset(row, 0, sizeof *row * ((size_t)np + 1));
+    for (int32_t q = 0; q < 2 * nd; q++) row[d[q] + 1]++;
+    for (int32_t i = 0; i < np; i++) row[i + 1] += row[i];
+    for (int32_t q = 0; q < nd; q++) {
+        c->dorm_at[row[d[2 * q]]++] = q;
+        c->dorm_at[row[d[2 * q + 1]]++] = q;
+    }
+    for (int32_t i = np; i > 0; i--) row[i] = row[i - 1];
+    row[0] = 0;
+    memset(c->dorm_on, 0, (size_t)nd);
+    return 1;
+}
+
 /* the candidate list for the next t seconds (k0 substeps of h into the frame) from where
  * the particles are: each one's reach is how far it can get from the reference motion in
  * that time, plus a quarter of its radius for what the constraints move it; kept in c->xf
@@ -867,7 +971,9 @@ static int32_t make_list(wb_world *w, wb_real t, wb_real margin, int32_t k0)
     if (skip) c->skip = skip;
     wb_real *xf = wb__grow(c->xf, &c->cap_xf, 3 * m->np, sizeof *xf);
     if (xf) c->xf = xf;
-    if (!reach || !skip || !xf) return -1;
+    wb_real *path = wb__grow(c->path, &c->cap_path, 8 * m->np, sizeof *path);
+    if (path) c->path = path;
+    if (!reach || !skip || !xf || !path) return -1;
     const wb_real gt2 = v3_len(m->def.gravity) * t * t, *v = w->s.v;
     for (int32_t i = 0; i < m->np; i++) {
         const uint8_t f = m->cflags[i];
@@ -878,18 +984,23 @@ static int32_t make_list(wb_world *w, wb_real t, wb_real margin, int32_t k0)
     }
     fit_reference(w, reach, t);
     c->ref_k0 = k0;
+    c->path_t = t;
     const ref_step rs0 = { 0, 1 };
+    static const wb_real still[3] = { 0, 0, 0 };
     for (int32_t i = 0; i < m->np; i++) {
         if (reach[i] < 0) continue;
-        const wb_real *p = &w->s.x[3 * i];
+        const wb_real *p = &w->s.x[3 * i], eps = m->radius[i] * margin + gt2;
+        const int movable = m->w[i] > 0;
         wb_real u[3];
-        ref_rel(c, &rs0, p, &v[3 * i], m->w[i] > 0, u);
-        reach[i] = m->radius[i] * (1 + margin) + v3_len_fast(u) * t + gt2;
+        ref_rel(c, &rs0, p, &v[3 * i], movable, u);
+        reach[i] = m->radius[i] + eps + v3_len_fast(u) * t;
         if (!isfinite(reach[i] + p[0] + p[1] + p[2])) reach[i] = -1;
+        set_path(c, i, p, movable ? &v[3 * i] : still, eps);
     }
     memcpy(xf, w->s.x, sizeof *xf * 3 * (size_t)m->np);
     c->n = 0;
-    const int32_t r = wb__broadphase_kept(c, w->s.x, reach, skip, m->np, wb__world_pool(w), may_touch, w);
+    int32_t r = wb__broadphase_kept(c, w->s.x, reach, skip, m->np, wb__world_pool(w), may_touch, w);
+    if (r >= 0 && !split_dormant(c, m, r)) r = -1;
     c->check = r >= 0;
     return r;
 }
@@ -985,7 +1096,8 @@ static int grid_pairs(wb_world *w, const wb_broad *b, int32_t i, wb_real e, int3
     return 1;
 }
 
-static int repair(wb_world *w, const int32_t *moved, int32_t nm, wb_real t, wb_real margin, const ref_step *rs)
+static int repair(wb_world *w, const int32_t *moved, int32_t nm, const int32_t *soft, int32_t ns, wb_real t,
+                  wb_real margin, const ref_step *rs)
 {
     wb_model *m = &w->m;
     wb_contacts *c = &w->k.pc;
@@ -1009,9 +1121,12 @@ static int repair(wb_world *w, const int32_t *moved, int32_t nm, wb_real t, wb_r
         for (int e = 0; e < 3; e++) y[e] = cc[e] + (bb[e] - axb[e] + ab * a[e]) / aa;
         v3_copy(&xf[3 * i], y);
         ref_rel(c, rs, y, &v[3 * i], m->w[i] > 0, u);
-        const wb_real r = m->radius[i] * (1 + margin) + v3_len_fast(u) * t + gt2;
+        const wb_real eps = m->radius[i] * margin + gt2, r = m->radius[i] + eps + v3_len_fast(u) * t;
         reach[i] = isfinite(r + y[0] + y[1] + y[2]) ? r : -1;
         c->fixed[c->nfixed++] = i;
+        /* its pairs are all searched for again: its dormant ones are no longer */
+        c->off_path[i] = 1;
+        for (int32_t q = c->dorm_row[i]; q < c->dorm_row[i + 1]; q++) c->dorm_on[c->dorm_at[q]] = 1;
     }
     const int use_grid = b && b->lgrid && b->lfull && b->vn == m->np;
     int32_t na = 0;
@@ -1026,9 +1141,24 @@ static int repair(wb_world *w, const int32_t *moved, int32_t nm, wb_real t, wb_r
         for (int32_t j = 0; j < m->np && !fail; j++) fail = !add_pair(w, i, j, &na);
     }
     if (fail) return 0;
-    if (na == 0) return 1;
+    /* a particle off its path but within its reach: its dormant pairs listed again (none
+     * is listed yet: a mended particle's are no longer dormant), and from here on it is
+     * checked against the reference alone */
+    int32_t nq = 0;
+    for (int32_t k = 0; k < ns; k++) {
+        const int32_t i = soft[k];
+        c->off_path[i] = 1;
+        for (int32_t a = c->dorm_row[i]; a < c->dorm_row[i + 1]; a++) {
+            const int32_t q = c->dorm_at[a];
+            if (c->dorm_on[q]) continue;
+            c->dorm_on[q] = 1;
+            if (!grow((void **)&c->qs, &c->cap_qs, (int64_t)nq + 1, sizeof *c->qs)) return 0;
+            c->qs[nq++] = q;
+        }
+    }
+    if (na == 0 && nq == 0) return 1;
     /* the new pairs in order, each once and not already listed */
-    qsort(c->add, (size_t)na, 2 * sizeof *c->add, cmp_pair);
+    if (na > 1) qsort(c->add, (size_t)na, 2 * sizeof *c->add, cmp_pair);
     int32_t nb = 0;
     for (int32_t q = 0; q < na; q++) {
         const int32_t *e = &c->add[2 * q];
@@ -1044,6 +1174,22 @@ static int repair(wb_world *w, const int32_t *moved, int32_t nm, wb_real t, wb_r
         c->add[2 * nb + 1] = e[1];
         nb++;
     }
+    /* with the dormant ones, in order as the dormant list is (merged from the back) */
+    if (nq > 1) qsort(c->qs, (size_t)nq, sizeof *c->qs, cmp_i32);
+    if (!grow((void **)&c->add, &c->cap_add, 2 * ((int64_t)nb + nq), sizeof *c->add)) return 0;
+    for (int32_t o = nb + nq - 1, p = nb - 1, q = nq - 1; q >= 0; o--) {
+        const int32_t *d = &c->dorm[2 * c->qs[q]];
+        if (p >= 0 && cmp_pair(&c->add[2 * p], d) > 0) {
+            c->add[2 * o] = c->add[2 * p];
+            c->add[2 * o + 1] = c->add[2 * p + 1];
+            p--;
+        } else {
+            c->add[2 * o] = d[0];
+            c->add[2 * o + 1] = d[1];
+            q--;
+        }
+    }
+    nb += nq;
     if (nb == 0) return 1;
     /* merged from the back into the list, and what each pair was left with along with
      * it (a new pair: NaN, worked out by contact.c) */
@@ -1070,14 +1216,23 @@ static int repair(wb_world *w, const int32_t *moved, int32_t nm, wb_real t, wb_r
 
 /* particle i is farther from where the reference motion takes xf_i than its reach
  * allows (a reach < 0 is no candidate; a position gone non-finite fails and is left out) */
-static inline __attribute__((always_inline)) int strays(const wb_contacts *c, const wb_real *x, const wb_real *rad,
-                                                        const ref_step *rs, int32_t i, const int moving)
+/* 0: particle i is within eps_i of its path (or, off its path, within reach_i - r_i of
+ * where the reference motion takes xf_i); 1: off its path but within that; 2: farther
+ * (a reach < 0 is no candidate: 0; a position gone non-finite: 2) */
+static inline int strays(const wb_contacts *c, const wb_real *x, const wb_real *rad, const ref_step *rs, int32_t i)
 {
+    if (c->reach[i] < 0) return 0;
+    const wb_real *P = &c->path[8 * i], *p = &x[3 * i];
+    if (!c->off_path[i]) {
+        const wb_real d0 = p[0] - P[0] - rs->S * P[4], d1 = p[1] - P[1] - rs->S * P[5], d2 = p[2] - P[2] - rs->S * P[6];
+        if (d0 * d0 + d1 * d1 + d2 * d2 <= P[3] * P[3]) return 0;
+    }
     const wb_real e = c->reach[i] - rad[i], *y = &c->xf[3 * i];
-    wb_real mv[3] = { 0, 0, 0 };
-    if (moving) ref_vel(c, rs->S, y, mv);
-    const wb_real d0 = x[3 * i] - y[0] - mv[0], d1 = x[3 * i + 1] - y[1] - mv[1], d2 = x[3 * i + 2] - y[2] - mv[2];
-    return (c->reach[i] >= 0) & !(d0 * d0 + d1 * d1 + d2 * d2 <= e * e);
+    wb_real mv[3];
+    ref_vel(c, rs->S, y, mv);
+    const wb_real d0 = p[0] - y[0] - mv[0], d1 = p[1] - y[1] - mv[1], d2 = p[2] - y[2] - mv[2];
+    if (d0 * d0 + d1 * d1 + d2 * d2 <= e * e) return !c->off_path[i];
+    return 2;
 }
 
 int wb__contacts_recheck(wb_world *w, wb_real h)
@@ -1086,22 +1241,28 @@ int wb__contacts_recheck(wb_world *w, wb_real h)
     wb_contacts *c = &w->k.pc;
     if (!c->check || c->no_recheck) return 0;
     const int32_t sub = c->sub++;
-    const wb_real *x = w->s.x, *rad = m->radius;
+    const wb_real *x = w->s.x;
     /* the substep's prediction is done: sub + 1 of the frame's, sub + 1 - ref_k0 since the
      * list was made */
     const ref_step rs = ref_at(w, sub + 1 - c->ref_k0, h);
+    const wb_real *rad = m->radius;
     int moved = 0;
-    /* (a reference standing still: the displacement alone, as cheap as before it) */
-    const int moving = c->ref_v[0] != 0 || c->ref_v[1] != 0 || c->ref_v[2] != 0 || c->ref_om[0] != 0 ||
-                       c->ref_om[1] != 0 || c->ref_om[2] != 0;
-    if (moving)
-        for (int32_t i = 0; i < m->np; i++) moved |= strays(c, x, rad, &rs, i, 1);
-    else
-        for (int32_t i = 0; i < m->np; i++) moved |= strays(c, x, rad, &rs, i, 0);
+    for (int32_t i = 0; i < m->np; i++) moved |= strays(c, x, rad, &rs, i);
     if (!moved) return 0;
+    const double t0 = now_ms();
+    int32_t *soft = wb__grow(c->soft, &c->cap_soft, m->np, sizeof *soft), ns = 0;
+    if (!soft) { c->n = 0; c->check = 0; return -1; }
+    c->soft = soft;
+    if (!(moved & 2)) { /* off their paths alone */
+        for (int32_t i = 0; i < m->np; i++)
+            if (strays(c, x, rad, &rs, i)) soft[ns++] = i;
+        const int r = repair(w, NULL, 0, soft, ns, 0, 0, &rs);
+        c->broad_ms += now_ms() - t0;
+        if (!r) { c->n = 0; c->check = 0; return -1; }
+        return 2;
+    }
     c->remakes++;
     c->remakes_frame++;
-    const double t0 = now_ms();
     /* what is left of the frame, this substep included; the constraints moved some
      * particle farther than its margin allowed: the rest of the frame allows twice as
      * much each time, so a frame makes the list again a few times at most */
@@ -1111,14 +1272,16 @@ int wb__contacts_recheck(wb_world *w, wb_real h)
     int32_t *mv = wb__grow(c->fix, &c->cap_fix, REPAIR_MAX, sizeof *mv);
     if (mv) {
         c->fix = mv;
-        for (int32_t i = 0; i < m->np && nm <= REPAIR_MAX; i++)
-            if (strays(c, x, rad, &rs, i, moving)) {
-                if (nm < REPAIR_MAX) mv[nm] = i;
-                nm++;
-            }
+        for (int32_t i = 0; i < m->np && nm <= REPAIR_MAX; i++) {
+            const int k = strays(c, x, rad, &rs, i);
+            if (k == 1) soft[ns++] = i;
+            if (k < 2) continue;
+            if (nm < REPAIR_MAX) mv[nm] = i;
+            nm++;
+        }
     }
     if (mv && nm <= REPAIR_MAX) {
-        r = repair(w, mv, nm, t, margin, &rs);
+        r = repair(w, mv, nm, soft, ns, t, margin, &rs);
         c->broad_ms += now_ms() - t0;
         if (!r) { c->n = 0; c->check = 0; return -1; }
         return 2;

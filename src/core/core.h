@@ -188,6 +188,8 @@ typedef struct wb_contacts {
     uint64_t *keys;        /* sorted (a << 32 | b), each once: the pairs constraints join,
                               which never touch (the ctypes' links) */
     int32_t nkeys, cap_keys;
+    int32_t *key_row;      /* (np + 1) keys[key_row[a] .. key_row[a + 1]) are a's (a < b) */
+    int32_t cap_key_row;
     int32_t *graph;        /* (np) a loose particle's graph (the least particle of its
                               connected component over the links); its own index in a body */
     int32_t cap_graph;
@@ -221,6 +223,23 @@ typedef struct wb_contacts {
      * substep ref_k0 on (the substeps predicted when the list was made) */
     wb_real ref_v[3], ref_om[3], ref_c[3];
     int32_t ref_k0;
+    /* (np x 8) each particle's straight path from the list's start, which the substeps
+     * check it against: start y (3), allowance eps, velocity u (3), unused; a pair is
+     * listed only when the two paths come within r_i + r_j + eps_i + eps_j in the next
+     * path_t seconds (broadphase.c) */
+    wb_real *path;
+    int32_t cap_path;
+    wb_real path_t;
+    /* the pairs the paths left out (dormant, 2 x nd), each particle's of them (dorm_row:
+     * np + 1 offsets into dorm_at, pair indices), which are listed again (dorm_on), and
+     * the particles that left their path (off_path: checked against the reference alone) */
+    int32_t *dorm, nd, cap_dorm;
+    int32_t *dorm_row, cap_dorm_row;
+    int32_t *dorm_at, cap_dorm_at;
+    uint8_t *dorm_on, *off_path;
+    int32_t cap_dorm_on, cap_off_path;
+    int32_t *soft, cap_soft;
+    int32_t *qs, cap_qs;   /* the dormant pairs a substep lists again */
     int32_t n_old, cap_old;
     int32_t *ij_old;       /* the list before a remake, and what each pair was left with */
     wb_real *left_old;
@@ -347,6 +366,15 @@ static inline void wb__broadphase_free(wb_contacts *c)
     free(c->skip);
     c->skip = NULL;
     c->cap_skip = 0;
+    free(c->key_row); free(c->path); free(c->dorm); free(c->dorm_row); free(c->dorm_at); free(c->dorm_on);
+    free(c->off_path); free(c->soft); free(c->qs);
+    c->key_row = c->dorm = c->dorm_row = c->dorm_at = c->soft = c->qs = NULL;
+    c->cap_qs = 0;
+    c->path = NULL;
+    c->dorm_on = c->off_path = NULL;
+    c->cap_key_row = c->cap_path = c->cap_dorm = c->cap_dorm_row = c->cap_dorm_at = c->cap_dorm_on = 0;
+    c->cap_off_path = c->cap_soft = 0;
+    c->nd = 0;
     free(c->xf); free(c->ij_old); free(c->left_old); free(c->fix); free(c->add); free(c->fixed);
     c->xf = c->left_old = NULL;
     c->ij_old = c->fix = c->add = c->fixed = NULL;
