@@ -452,7 +452,7 @@ static inline int takes_part(const wb_real *x, const wb_real *reach, int32_t i)
 
 static int list_valid(const wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t n)
 {
-    if (b->vn != n || n == 0) return 0;
+    if (b->vn != n || n == 0 || b->bare) return 0;
     const wb_real *X = b->vx, *R = b->vr;
     const int32_t *K = b->vskip;
     if (skip && memcmp(skip, K, sizeof *K * (size_t)n)) return 0;
@@ -501,7 +501,8 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
         /* a skin pays only where a list lasts: where most particles moved farther than a
          * skin since the last list, the next one is built without (a swinging cloth,
          * every particle on the move: the skin only doubled the pairs searched) */
-        const wb_real grow_by = skin_pays(b, x, reach, n) ? 1 + (wb_real)SKIN : 1;
+        const int skin = skin_pays(b, x, reach, n);
+        const wb_real grow_by = skin ? 1 + (wb_real)SKIN : 1;
         b->vn = 0;
         if (!grow((void **)&b->vx, &b->cap_vx, 3 * (int64_t)n, sizeof *b->vx) ||
             !grow((void **)&b->vr, &b->cap_vr, n, sizeof *b->vr) ||
@@ -516,10 +517,19 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
         if (n > 0) memcpy(b->vx, x, sizeof *x * 3 * (size_t)n);
         b->list.n = 0;
         b->lgrid = 0;
-        if (broad(b, &b->list, x, b->vr, skip, n, pool, NULL, NULL) < 0) return -1;
+        /* a list without a skin serves this call alone: keep applied in the search (not
+         * to be kept: keep's rules may change by the next), and nothing to filter */
+        b->bare = !skin;
+        if (broad(b, &b->list, x, b->vr, skip, n, pool, b->bare ? keep : NULL, ud) < 0) return -1;
         b->lgrid = 1;
         b->vn = n;
         b->rebuilds++;
+        if (b->bare) {
+            if (!grow((void **)&c->ij, &c->cap, 2 * ((int64_t)c->n + b->list.n), sizeof *c->ij)) return -1;
+            memcpy(&c->ij[2 * c->n], b->list.ij, sizeof *c->ij * 2 * (size_t)b->list.n);
+            c->n += b->list.n;
+            return c->n;
+        }
     }
     if (!grow((void **)&c->ij, &c->cap, 2 * ((int64_t)c->n + b->list.n), sizeof *c->ij)) return -1;
     int32_t *out = c->ij, at = c->n;
@@ -1151,11 +1161,18 @@ static int repair(wb_world *w, const int32_t *moved, int32_t nm, const int32_t *
         for (int32_t a = c->dorm_row[i]; a < c->dorm_row[i + 1]; a++) {
             const int32_t q = c->dorm_at[a];
             if (c->dorm_on[q]) continue;
-            c->dorm_on[q] = 1;
+            c->dorm_on[q] = 2; /* new in this call */
             if (!grow((void **)&c->qs, &c->cap_qs, (int64_t)nq + 1, sizeof *c->qs)) return 0;
             c->qs[nq++] = q;
         }
     }
+    /* in order: sorted, or when they are many, read off the marks in order */
+    if ((int64_t)nq * 16 > c->nd) {
+        nq = 0;
+        for (int32_t q = 0; q < c->nd; q++)
+            if (c->dorm_on[q] == 2) c->qs[nq++] = q;
+    } else if (nq > 1) qsort(c->qs, (size_t)nq, sizeof *c->qs, cmp_i32);
+    for (int32_t k = 0; k < nq; k++) c->dorm_on[c->qs[k]] = 1;
     if (na == 0 && nq == 0) return 1;
     /* the new pairs in order, each once and not already listed */
     if (na > 1) qsort(c->add, (size_t)na, 2 * sizeof *c->add, cmp_pair);
@@ -1175,7 +1192,6 @@ static int repair(wb_world *w, const int32_t *moved, int32_t nm, const int32_t *
         nb++;
     }
     /* with the dormant ones, in order as the dormant list is (merged from the back) */
-    if (nq > 1) qsort(c->qs, (size_t)nq, sizeof *c->qs, cmp_i32);
     if (!grow((void **)&c->add, &c->cap_add, 2 * ((int64_t)nb + nq), sizeof *c->add)) return 0;
     for (int32_t o = nb + nq - 1, p = nb - 1, q = nq - 1; q >= 0; o--) {
         const int32_t *d = &c->dorm[2 * c->qs[q]];

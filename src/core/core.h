@@ -352,6 +352,7 @@ struct wb_broad {
     int32_t *vskip; int32_t cap_vskip;
     wb_pairbuf list;
     int64_t rebuilds;                  /* for the tests */
+    int bare;                          /* the list was built without a skin, keep applied */
     /* the grid of the last search (cand, start, p, id), when it is the kept list's
      * (lgrid): its shape, particles, whether they are all the candidates (none culled),
      * and their largest reach */
