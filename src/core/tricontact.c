@@ -247,7 +247,7 @@ static wb_real tri_mu(const wb_real *cf, int32_t p, const int32_t *v, const wb_r
 /* ---- friction (contact.c's pass: the regimes and the budget per particle explained there) -- */
 /* a contact sliding (p's speed relative to the triangle's point q = sum b_i x_i, along it,
  * more than one substep of dynamic friction takes away) gets mu in its record for the
- * velocity pass; the others add their normal impulse lambda = depth / W to the particles'
+ * velocity pass; the others add their normal impulse lambda = (depth - err) / W to the particles'
  * budgets: mu lambda for the point, b_i mu lambda for corner i, the normal correction's
  * weights */
 void wb__tricontacts_load(wb_world *w, wb_real h, wb_real *load)
@@ -269,7 +269,7 @@ void wb__tricontacts_load(wb_world *w, wb_real h, wb_real *load)
             continue;
         }
         const wb_real W = wv[p] + b[0] * b[0] * wv[v[0]] + b[1] * b[1] * wv[v[1]] + b[2] * b[2] * wv[v[2]];
-        const wb_real l = mu * b[6] / W;
+        const wb_real l = mu * (b[6] - b[8]) / W; /* the part that holds them apart (contact.c) */
         load[p] += l;
         for (int i = 0; i < 3; i++) load[v[i]] += b[i] * l;
     }
