@@ -450,9 +450,54 @@ static inline int takes_part(const wb_real *x, const wb_real *reach, int32_t i)
     return reach[i] >= 0 && isfinite(reach[i]) && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
 }
 
-static int list_valid(const wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t n)
+/* The list's particles moved as one since it was made: the rigid motion M(X) = c + Q (X - C)
+ * that best maps where they were onto where they are (the centres and the rotation of
+ * their cross-covariance). M keeps distances, so a pair now within reach_i + reach_j was
+ * within reach_i + reach_j + |e_i| + |e_j| at X, e = x - M(X): the list holds while each
+ * particle's deviation from M, not its whole displacement, is within its skin. A cloth
+ * falling or swinging as a whole keeps its list. */
+static void motion_identity(wb_motion *mo)
 {
-    if (b->vn != n || n == 0 || b->bare) return 0;
+    for (int a = 0; a < 9; a++) mo->Q[a] = a % 4 == 0;
+    for (int a = 0; a < 3; a++) mo->C[a] = mo->c[a] = 0;
+}
+
+static inline void motion_apply(const wb_motion *mo, const wb_real *X, wb_real out[3])
+{
+    const wb_real r0 = X[0] - mo->C[0], r1 = X[1] - mo->C[1], r2 = X[2] - mo->C[2];
+    for (int a = 0; a < 3; a++) out[a] = mo->c[a] + mo->Q[3 * a] * r0 + mo->Q[3 * a + 1] * r1 + mo->Q[3 * a + 2] * r2;
+}
+
+/* M fitted to the particles that took part (vr >= 0) and are finite now; 0 when none */
+static int motion_fit(wb_broad *b, const wb_real *x, int32_t n, wb_motion *mo)
+{
+    double C[3] = { 0, 0, 0 }, c[3] = { 0, 0, 0 };
+    int32_t k = 0;
+    for (int32_t i = 0; i < n; i++) {
+        const wb_real *p = &x[3 * i], *X = &b->vx[3 * i];
+        if (!(b->vr[i] >= 0) || !isfinite(p[0] + p[1] + p[2])) continue;
+        for (int a = 0; a < 3; a++) C[a] += X[a], c[a] += p[a];
+        k++;
+    }
+    if (k == 0) return 0;
+    for (int a = 0; a < 3; a++) C[a] /= k, c[a] /= k;
+    wb_real A[9] = { 0 };
+    for (int32_t i = 0; i < n; i++) {
+        const wb_real *p = &x[3 * i], *X = &b->vx[3 * i];
+        if (!(b->vr[i] >= 0) || !isfinite(p[0] + p[1] + p[2])) continue;
+        for (int a = 0; a < 3; a++)
+            for (int e = 0; e < 3; e++) A[3 * a + e] += (wb_real)((p[a] - c[a]) * (X[e] - C[e]));
+    }
+    wb_extract_rotation(A, b->mq, 20);
+    wb_quat_to_matrix(b->mq, mo->Q);
+    for (int a = 0; a < 3; a++) mo->C[a] = (wb_real)C[a], mo->c[a] = (wb_real)c[a];
+    return isfinite(mo->Q[0] + mo->Q[4] + mo->Q[8] + mo->c[0] + mo->c[1] + mo->c[2]);
+}
+
+static int list_valid(const wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t n,
+                      uint64_t gen, const wb_motion *mo)
+{
+    if (b->vn != n || n == 0 || b->bare || b->vgen != gen) return 0;
     const wb_real *X = b->vx, *R = b->vr;
     const int32_t *K = b->vskip;
     if (skip && memcmp(skip, K, sizeof *K * (size_t)n)) return 0;
@@ -469,7 +514,9 @@ static int list_valid(const wb_broad *b, const wb_real *x, const wb_real *reach,
         }
         if (!(ri >= 0) || !(ri < INFINITY)) return 0;
         const wb_real *p = &x[3 * i];
-        const wb_real d0 = p[0] - X[3 * i], d1 = p[1] - X[3 * i + 1], d2 = p[2] - X[3 * i + 2];
+        wb_real y[3];
+        motion_apply(mo, &X[3 * i], y);
+        const wb_real d0 = p[0] - y[0], d1 = p[1] - y[1], d2 = p[2] - y[2];
         const wb_real slack = (Ri - ri) * (wb_real)0.999;
         /* round-off in the pair distances: a slack far above the coordinates' ulps */
         const wb_real mag = fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + Ri;
@@ -478,14 +525,16 @@ static int list_valid(const wb_broad *b, const wb_real *x, const wb_real *reach,
     return 1;
 }
 
-static int skin_pays(wb_broad *b, const wb_real *x, const wb_real *reach, int32_t n)
+static int skin_pays(wb_broad *b, const wb_real *x, const wb_real *reach, int32_t n, const wb_motion *mo)
 {
     if (b->vn != n) return 1;
     int32_t out = 0, in = 0;
     for (int32_t i = 0; i < n; i++) {
         if (!(b->vr[i] >= 0) || !(reach[i] >= 0)) continue;
-        const wb_real *p = &x[3 * i], *X = &b->vx[3 * i], e = (wb_real)SKIN * reach[i];
-        const wb_real d0 = p[0] - X[0], d1 = p[1] - X[1], d2 = p[2] - X[2];
+        const wb_real *p = &x[3 * i], e = (wb_real)SKIN * reach[i];
+        wb_real y[3];
+        motion_apply(mo, &b->vx[3 * i], y);
+        const wb_real d0 = p[0] - y[0], d1 = p[1] - y[1], d2 = p[2] - y[2];
         if (d0 * d0 + d1 * d1 + d2 * d2 > e * e) out++;
         else in++;
     }
@@ -493,15 +542,35 @@ static int skin_pays(wb_broad *b, const wb_real *x, const wb_real *reach, int32_
 }
 
 int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
-                            int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
+                            int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), uint64_t gen,
+                            int (*keep_now)(void *ud, int32_t i, int32_t j), void *ud)
 {
     if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
     wb_broad *b = c->bp;
-    if (!list_valid(b, x, reach, skip, n)) {
+    wb_motion mo;
+    motion_identity(&mo);
+    int valid = list_valid(b, x, reach, skip, n, gen, &mo);
+    if (!valid && b->vn == n && !b->bare && b->vgen == gen && motion_fit(b, x, n, &mo))
+        valid = list_valid(b, x, reach, skip, n, gen, &mo);
+    if (valid) {
+        b->mo = mo;
+        b->used = 1;
+    } else {
         /* a skin pays only where a list lasts: where most particles moved farther than a
-         * skin since the last list, the next one is built without (a swinging cloth,
-         * every particle on the move: the skin only doubled the pairs searched) */
-        const int skin = skin_pays(b, x, reach, n);
+         * skin (from the motion they share) since the last list, the next one is built
+         * without (a cloth on the move every which way: the skin only doubled the pairs
+         * searched), and after a list with a skin that was never used again, the next
+         * 1, 2, 4 or 8 in a row as that goes on (a cloth sliding slowly over a sphere: a
+         * few particles leave their skin every frame) */
+        if (!b->bare) {
+            b->bare_run = b->used || b->vn != n ? 0 : b->bare_run ? (b->bare_run < 8 ? 2 * b->bare_run : 8) : 1;
+            b->bare_left = b->bare_run;
+        }
+        const int skin = b->bare_left == 0 && skin_pays(b, x, reach, n, &mo);
+        if (b->bare_left > 0) b->bare_left--;
+        b->used = 0;
+        motion_identity(&b->mo);
+        b->mq[0] = 1, b->mq[1] = b->mq[2] = b->mq[3] = 0;
         const wb_real grow_by = skin ? 1 + (wb_real)SKIN : 1;
         b->vn = 0;
         if (!grow((void **)&b->vx, &b->cap_vx, 3 * (int64_t)n, sizeof *b->vx) ||
@@ -517,17 +586,25 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
         if (n > 0) memcpy(b->vx, x, sizeof *x * 3 * (size_t)n);
         b->list.n = 0;
         b->lgrid = 0;
-        /* a list without a skin serves this call alone: keep applied in the search (not
-         * to be kept: keep's rules may change by the next), and nothing to filter */
+        /* keep's rules applied in the search (the list is rebuilt when they change); a list
+         * without a skin serves this call alone, with no distances to test again */
         b->bare = !skin;
-        if (broad(b, &b->list, x, b->vr, skip, n, pool, b->bare ? keep : NULL, ud) < 0) return -1;
+        if (broad(b, &b->list, x, b->vr, skip, n, pool, keep, ud) < 0) return -1;
         b->lgrid = 1;
         b->vn = n;
+        b->vgen = gen;
         b->rebuilds++;
         if (b->bare) {
             if (!grow((void **)&c->ij, &c->cap, 2 * ((int64_t)c->n + b->list.n), sizeof *c->ij)) return -1;
-            memcpy(&c->ij[2 * c->n], b->list.ij, sizeof *c->ij * 2 * (size_t)b->list.n);
-            c->n += b->list.n;
+            int32_t *out = c->ij, at = c->n;
+            for (int32_t k = 0; k < b->list.n; k++) {
+                const int32_t i = b->list.ij[2 * k], j = b->list.ij[2 * k + 1];
+                if (keep_now && !keep_now(ud, i, j)) continue;
+                out[2 * at] = i;
+                out[2 * at + 1] = j;
+                at++;
+            }
+            c->n = at;
             return c->n;
         }
     }
@@ -539,7 +616,7 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
         const wb_real *p = &x[3 * i], *q = &x[3 * j];
         const wb_real d0 = q[0] - p[0], d1 = q[1] - p[1], d2 = q[2] - p[2], r = reach[i] + reach[j];
         if (d0 * d0 + d1 * d1 + d2 * d2 >= r * r) continue;
-        if (keep && !keep(ud, i, j)) continue;
+        if (keep_now && !keep_now(ud, i, j)) continue;
         out[2 * at] = i;
         out[2 * at + 1] = j;
         at++;
@@ -730,6 +807,7 @@ int wb__contact_rules(wb_world *w)
     if (!c->keys_dirty && !c->scan_dirty && c->keys_sig == sig && c->graph) return 1;
     if (!build_rules(w) || !build_cover(w)) return 0;
     c->keys_sig = sig;
+    c->rules_gen++;
     return 1;
 }
 
@@ -751,12 +829,11 @@ int wb__joined(const wb_contacts *c, int32_t i, int32_t j)
  * constraint joins them; of one, only when it collides with itself (a loose graph
  * always does), and never rest neighbours: joined, or made closer than r_i + r_j (or
  * in touch: WB_REST_TOUCH) */
-static int may_touch(void *ud, int32_t i, int32_t j)
+static int may_touch_rules(void *ud, int32_t i, int32_t j)
 {
     const wb_world *w = ud;
     const wb_model *m = &w->m;
     const wb_contacts *c = &w->k.pc;
-    if (m->w[i] == 0 && m->w[j] == 0) return 0;
     if (wb__graph_of(c, m, i) != wb__graph_of(c, m, j))
         return (m->cflags[i] & m->cflags[j] & WB_CF_COLLIDE) && !(c->cross && wb__joined(c, i, j));
     if (m->group[i] > 0 && !(m->cflags[i] & m->cflags[j] & WB_CF_SELF)) return 0;
@@ -766,6 +843,15 @@ static int may_touch(void *ud, int32_t i, int32_t j)
     if (v3_dot(d, d) < r * r) return 0;
     return !wb__joined(c, i, j);
 }
+
+/* ... and not both immovable (pins change from frame to frame; the rules do not) */
+static int movable_pair(void *ud, int32_t i, int32_t j)
+{
+    const wb_model *m = &((const wb_world *)ud)->m;
+    return m->w[i] != 0 || m->w[j] != 0;
+}
+
+static int may_touch(void *ud, int32_t i, int32_t j) { return movable_pair(ud, i, j) && may_touch_rules(ud, i, j); }
 
 /* whether any pair could collide at all: one body without self-collision costs nothing */
 static int any_possible(const wb_model *m)
@@ -1009,7 +1095,8 @@ static int32_t make_list(wb_world *w, wb_real t, wb_real margin, int32_t k0)
     }
     memcpy(xf, w->s.x, sizeof *xf * 3 * (size_t)m->np);
     c->n = 0;
-    int32_t r = wb__broadphase_kept(c, w->s.x, reach, skip, m->np, wb__world_pool(w), may_touch, w);
+    int32_t r = wb__broadphase_kept(c, w->s.x, reach, skip, m->np, wb__world_pool(w), may_touch_rules, c->rules_gen,
+                                    movable_pair, w);
     if (r >= 0 && !split_dormant(c, m, r)) r = -1;
     c->check = r >= 0;
     return r;
@@ -1087,7 +1174,12 @@ static int add_pair(wb_world *w, int32_t i, int32_t j, int32_t *na)
 static int grid_pairs(wb_world *w, const wb_broad *b, int32_t i, wb_real e, int32_t *na, int *fail)
 {
     const wb_grid *G = &b->lg;
-    const wb_real *p = &w->k.pc.xf[3 * i];
+    /* the grid holds the list's positions X: where M^-1 takes xf_i (each xf_j is within
+     * its skin of M(X_j)) */
+    const wb_real *xi = &w->k.pc.xf[3 * i], *Q = b->mo.Q;
+    const wb_real r0 = xi[0] - b->mo.c[0], r1 = xi[1] - b->mo.c[1], r2 = xi[2] - b->mo.c[2];
+    wb_real p[3];
+    for (int a = 0; a < 3; a++) p[a] = b->mo.C[a] + Q[a] * r0 + Q[3 + a] * r1 + Q[6 + a] * r2;
     if (!(e * G->inv <= 8)) return 0;
     int64_t rx[4], ry[4], rz[4];
     const int kx = axis_ranges(G, 0, p[0], e, rx), ky = axis_ranges(G, 1, p[1], e, ry), kz = axis_ranges(G, 2, p[2], e, rz);

@@ -201,6 +201,7 @@ typedef struct wb_contacts {
     int32_t cap_tcov;
     int keys_dirty;        /* set when the topology changes */
     uint64_t keys_sig;     /* particles and constraints of each type the keys were built for */
+    uint64_t rules_gen;    /* counts the rules' rebuilds (the kept list applies them) */
     int32_t scanned_np;    /* particles when `possible` was worked out */
     int scan_dirty;        /* groups or flags changed since */
     int possible;          /* some pair could collide */
@@ -322,10 +323,13 @@ typedef struct wb_broad wb_broad;
 int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
                        int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
 /* the same pairs from a neighbour list kept from call to call in c->bp and rebuilt (by
- * wb__broadphase) only when some particle moved past its skin, or the particles' reach
- * >= 0 or skip keys changed (broadphase.c) */
+ * wb__broadphase) only when some particle moved past its skin (from the motion they
+ * share), the particles' reach >= 0 or skip keys changed, or keep's rules did (gen: a
+ * number that changes with them; keep is applied when the list is built); keep_now
+ * (NULL: none) filters each call's pairs (broadphase.c) */
 int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
-                            int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
+                            int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), uint64_t gen,
+                            int (*keep_now)(void *ud, int32_t i, int32_t j), void *ud);
 /* its scratch, kept from frame to frame (defined here so that the world frees it
  * without calling back into broadphase.c) */
 typedef struct wb_pairbuf {
@@ -334,6 +338,8 @@ typedef struct wb_pairbuf {
 } wb_pairbuf;
 /* grid.c: n pair buffers (one per thread) in *out, grown as needed, emptied; 0 when out of memory */
 int wb__pairbufs(wb_pairbuf **out, int *nout, int n);
+/* a rigid motion X -> c + Q (X - C) (Q row-major) */
+typedef struct wb_motion { wb_real Q[9], C[3], c[3]; } wb_motion;
 struct wb_broad {
     int32_t *cand; int32_t cap_cand;   /* candidates in index order, then the survivors */
     int32_t *cell; int32_t cap_cell;   /* cell of each survivor */
@@ -353,6 +359,12 @@ struct wb_broad {
     wb_pairbuf list;
     int64_t rebuilds;                  /* for the tests */
     int bare;                          /* the list was built without a skin, keep applied */
+    wb_motion mo;                      /* the motion it was last used under (list_valid) */
+    uint64_t vgen;                     /* keep's rules it was built with */
+    int used;                          /* it was used again since it was built */
+    int bare_left, bare_run;           /* lists still to build without a skin; how many
+                                          the last run had */
+    wb_real mq[4];                     /* its rotation, the next fit's start */
     /* the grid of the last search (cand, start, p, id), when it is the kept list's
      * (lgrid): its shape, particles, whether they are all the candidates (none culled),
      * and their largest reach */

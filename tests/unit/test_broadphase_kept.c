@@ -56,7 +56,7 @@ TEST(contact_broadphase_kept_list_matches_fresh_search)
         if (f == 41)
             for (int32_t i = 400; i < 440; i++) skip[i] = skip[440]; /* two touching bodies made one */
         kept.n = 0;
-        const int32_t got = wb__broadphase_kept(&kept, x, reach, skip, N, f % 2 ? pool : NULL, keep_some, NULL);
+        const int32_t got = wb__broadphase_kept(&kept, x, reach, skip, N, f % 2 ? pool : NULL, keep_some, 0, NULL, NULL);
         wb_contacts fresh;
         memset(&fresh, 0, sizeof fresh);
         const int32_t want = wb__broadphase(&fresh, x, reach, skip, N, NULL, keep_some, NULL);
