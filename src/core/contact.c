@@ -153,7 +153,7 @@ wb_real wb_body_spacing(const wb_world *w, wb_body b)
  * pushes (no speed: x_prev moves with x) stretch the links, and the links give it back
  * as speed (two lattices made stacked, the upper one's bottom layer level with the
  * lower one's top layer half a spacing aside, flew apart at 86 m/s). So when a made pair
- * of two bodies is deep (its line more than 60 degrees off the way out, below), what the
+ * of two bodies is deep (below), what the
  * two keep is taken out by moving the bodies whole, a translation of x and x_prev alike
  * (no strain, no speed), apart along u, the shortest way out of the overlap of their
  * bounding boxes at the frame's start (the line between their centres slanted for
@@ -306,10 +306,15 @@ static int made_shift(wb_world *w, made *mb, const wb_real *left, wb_real step, 
         v3_scale(u, p->u, i_first ? 1 : -1);
         const wb_real rs = rad[i] + rad[j], sep = sep_along(d, u, rs);
         if (sep > p->keep) p->keep = sep;
-        /* deep: the pair's own line is more than 60 degrees off the way out (b's particle
-         * beside a's, level with it or past it): pushing along it sends the bodies
-         * sideways or into each other. Shallower ones part pair by pair */
-        if (v3_dot(d, u) < (wb_real)0.5 * v3_len(d) + (wb_real)0.01 * rs) p->deep = 1;
+        /* deep: b's particle past a's on the way out, or on it, or, moved along u to
+         * touch, ending more than 44 degrees off u (in a hollow: 45). Pushed along its
+         * own line such a pair sends the bodies into each other or sideways (blocks made
+         * offset half a spacing and half a contact distance into the hollows part at 8.7
+         * m/s). Pairs that part (nearly) along u, or beside each other (a tower made
+         * interleaved, moved sideways), part pair by pair as before */
+        const wb_real du = v3_dot(d, u);
+        if (du < (wb_real)-0.01 * rs || v3_len(d) < (wb_real)0.01 * rs || du + sep < (wb_real)0.72 * rs)
+            p->deep = 1;
     }
     /* a pair moved in the last substep goes on until it is out */
     for (int32_t q = 0; q < mb->np; q++)
@@ -353,7 +358,9 @@ void wb__contacts_project(wb_world *w, wb_real h)
 {
     wb_contacts *c = &w->k.pc;
     c->nact = 0;
-    const int32_t nprev = c->nmade;
+    /* the body pairs moved in the last substep, within the frame only: a frame's start
+     * works them out from the state alone (a snapshot's future is the same) */
+    const int32_t nprev = c->fresh ? 0 : c->nmade;
     c->nmade = 0;
     /* the list still holds (else it is made again, and each old pair's left is kept) */
     const int32_t n_before = c->n;
