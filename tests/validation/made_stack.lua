@@ -23,7 +23,8 @@
 -- defaults), balls on balls roll into the hollows later, as they would made apart: a
 -- drop of (2 - sqrt 2) r = 5.9 cm, sqrt(2 g (2 - sqrt 2) r) = 1.07 m/s; so the bound is
 -- 2 vmax + 1.07 m/s, and the upper one ends over the lower, at least sqrt(2) r above
--- its top layer. Measured: at most 1.24 m/s (aligned, rolling into the hollows).
+-- its top layer. Measured: at most 1.06 m/s (aligned, rolling into the hollows; 0.06 m/s
+-- offset).
 --
 -- Before (particle pairs pushed out along their own lines, the upper one's particles
 -- past the lower one's top layer pushed deeper by it): with friction the aligned stack
