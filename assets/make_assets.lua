@@ -4,6 +4,8 @@
 --   build/wobble run assets/make_assets.lua --out assets
 --
 --   rounded_cube.obj  a high-poly rounded cube, 1 m across (Wavefront OBJ)
+--   cube.obj          the coarsest closed mesh: a cube 1 m across, 8 corners, 12 triangles
+--                     wound outwards (Wavefront OBJ)
 --   torus.ply         a high-poly torus, 1 m across (Stanford PLY)
 --   logo.json         the "WOBBLE" logo as six soft letters on a ground plane: a particle
 --                     config (format wobble-particles, version 1), one part per letter
@@ -202,6 +204,14 @@ end
 local cube = rounded_cube(32, 0.2)
 assert(cube:save_obj("rounded_cube.obj"))
 print(string.format("rounded_cube.obj: %d vertices, %d triangles", cube:vertex_count(), cube:triangle_count()))
+
+local box = wobble.mesh{
+  vertices = { { -0.5, -0.5, -0.5 }, { 0.5, -0.5, -0.5 }, { 0.5, 0.5, -0.5 }, { -0.5, 0.5, -0.5 },
+               { -0.5, -0.5, 0.5 }, { 0.5, -0.5, 0.5 }, { 0.5, 0.5, 0.5 }, { -0.5, 0.5, 0.5 } },
+  triangles = { { 1, 3, 2 }, { 1, 4, 3 }, { 5, 6, 7 }, { 5, 7, 8 }, { 1, 2, 6 }, { 1, 6, 5 },
+                { 2, 3, 7 }, { 2, 7, 6 }, { 3, 4, 8 }, { 3, 8, 7 }, { 4, 1, 5 }, { 4, 5, 8 } } }
+assert(box:save_obj("cube.obj"))
+print(string.format("cube.obj: %d vertices, %d triangles", box:vertex_count(), box:triangle_count()))
 
 local ring = torus(0.35, 0.15, 128, 48)
 assert(ring:save("torus.ply"))

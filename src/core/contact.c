@@ -147,6 +147,95 @@ wb_real wb_body_spacing(const wb_world *w, wb_body b)
  *    out in the velocity pass (err). Not through x_prev: a settled stack would then rest
  *    on position corrections alone and keep a velocity (-g h / 3 in a stack of three).
  * wb__contact_depth (core.h) works the parts out; tricontact.c uses it too. */
+/* Made overlap between two bodies. Pushed out pair by pair along the pairs' own lines, a
+ * body made into another as deep as a contact distance does not come out: a particle
+ * level with or past the other's first layer is pushed sideways or back into it, the
+ * pushes (no speed: x_prev moves with x) stretch the links, and the links give it back
+ * as speed (two lattices made stacked, the upper one's bottom layer level with the
+ * lower one's top layer half a spacing aside, flew apart at 86 m/s). So when a made pair
+ * of two bodies is deep (below), what the
+ * two keep is taken out by moving the bodies whole, a translation of x and x_prev alike
+ * (no strain, no speed), apart along u, the shortest way out of the overlap of their
+ * bounding boxes at the frame's start (the line between their centres slanted for
+ * blocks stacked a little aside and slid the upper one off), by at most
+ * max_depenetration x h per substep, until no made pair of theirs overlaps. One over the
+ * other (u within 60 degrees of gravity): the upper one is lifted, and takes all of the
+ * substep's contact corrections between them, the lower most likely resting on
+ * something (moved down into the ground, it was pushed back into the upper one); else
+ * they share by their masses; a body with a pinned particle stays. What they keep is the
+ * most that a made pair of theirs must move apart along u to touch (sep_along). While
+ * they move, their pairs leave the overlap they began the substep with to the shift and
+ * take back only the substep's approach along u (along a pair's own line, a particle
+ * past the first layer is seen parting as it sinks deeper), and their particle-triangle
+ * contacts wait (tricontact.c). tests/validation/made_stack.lua: stacks made up to 1.5
+ * contact distances in part below 0.1 m/s and rest stacked. */
+typedef struct made {
+    int32_t ng;            /* groups 0..ng-1 */
+    wb_real *box;          /* (ng x 7) each body's bounds at the frame's start (its particles'
+                              spheres), lo then hi, then its mass (INFINITY: a pinned particle) */
+    wb_real *shift;        /* (ng x 3) each body's translation this substep */
+    int32_t np, cap;       /* body pairs with a made overlap this substep */
+    struct made_pair { int32_t a, b; wb_real u[3], keep, s, fa; int deep; } *p;
+    int tried;
+} made;
+
+static void made_free(made *mb)
+{
+    free(mb->box);
+    free(mb->shift);
+    free(mb->p);
+}
+
+static int body_boxes(const wb_world *w, made *mb)
+{
+    if (mb->tried) return mb->box != NULL;
+    mb->tried = 1;
+    const int32_t np = w->m.np, *g = w->m.group;
+    int32_t ng = 0;
+    for (int32_t i = 0; i < np; i++)
+        if (g[i] >= ng) ng = g[i] + 1;
+    wb_real *box = malloc(sizeof *box * 7 * (size_t)ng);
+    mb->shift = calloc((size_t)ng * 3, sizeof *mb->shift);
+    if (!box || !mb->shift) {
+        free(box);
+        free(mb->shift);
+        mb->shift = NULL;
+        return 0;
+    }
+    for (int32_t k = 0; k < ng; k++)
+        for (int c = 0; c < 3; c++) box[7 * k + c] = INFINITY, box[7 * k + 3 + c] = -INFINITY, box[7 * k + 6] = 0;
+    /* at the frame's start (the undo copy): one way out for the whole frame */
+    const wb_real *xs = w->k.x_save ? w->k.x_save : w->s.x_prev, *wv = w->m.w, *rad = w->m.radius;
+    for (int32_t i = 0; i < np; i++) {
+        wb_real *q = &box[7 * g[i]];
+        for (int c = 0; c < 3; c++) {
+            const wb_real lo = xs[3 * i + c] - rad[i], hi = xs[3 * i + c] + rad[i];
+            if (lo < q[c]) q[c] = lo;
+            if (hi > q[3 + c]) q[3 + c] = hi;
+        }
+        q[6] += wv[i] > 0 ? 1 / wv[i] : INFINITY;
+    }
+    mb->ng = ng;
+    mb->box = box;
+    return 1;
+}
+
+/* i and j are in two bodies (whose boxes are known) */
+static int two_bodies(const wb_world *w, made *mb, int32_t i, int32_t j)
+{
+    const int32_t gi = w->m.group[i], gj = w->m.group[j];
+    return gi > 0 && gj > 0 && gi != gj && body_boxes(w, mb);
+}
+
+/* how far j must move from i along u for the two to touch (d = x_j - x_i; 0 when apart) */
+static wb_real sep_along(const wb_real d[3], const wb_real u[3], wb_real r)
+{
+    const wb_real d2 = v3_dot(d, d);
+    if (!(d2 < r * r)) return 0;
+    const wb_real s = v3_dot(d, u);
+    return -s + sqrt(r * r - d2 + s * s);
+}
+
 /* what a pair of a new list counts as already overlapping (see below) */
 static wb_real fresh_left(const wb_contacts *c, const wb_real *xp, const wb_real *rad, wb_real step, int32_t k)
 {
@@ -157,10 +246,122 @@ static wb_real fresh_left(const wb_contacts *c, const wb_real *xp, const wb_real
     return d0 > step ? d0 : 0;
 }
 
+/* the body pair of groups (a, b), a < b, added when new with u from a's box to b's, the
+ * shortest way out of their overlap (the first of the shortest, in axis order); NULL when
+ * out of memory */
+static struct made_pair *made_pair_of(made *mb, int32_t a, int32_t b)
+{
+    for (int32_t q = 0; q < mb->np; q++)
+        if (mb->p[q].a == a && mb->p[q].b == b) return &mb->p[q];
+    if (mb->np == mb->cap) {
+        const int32_t cap = mb->cap ? 2 * mb->cap : 8;
+        struct made_pair *p = realloc(mb->p, sizeof *p * (size_t)cap);
+        if (!p) return NULL;
+        mb->p = p;
+        mb->cap = cap;
+    }
+    struct made_pair *p = &mb->p[mb->np++];
+    p->a = a;
+    p->b = b;
+    const wb_real *A = &mb->box[7 * a], *B = &mb->box[7 * b];
+    wb_real best = INFINITY;
+    v3_set(p->u, 0, 1, 0);
+    for (int c = 0; c < 3; c++) {
+        const wb_real up = A[3 + c] - B[c], down = B[3 + c] - A[c]; /* b moved +c, -c */
+        if (up < best) best = up, v3_set(p->u, 0, 0, 0), p->u[c] = 1;
+        if (down < best) best = down, v3_set(p->u, 0, 0, 0), p->u[c] = -1;
+    }
+    p->keep = 0;
+    p->s = 0;
+    p->fa = 0.5;
+    p->deep = 0;
+    return p;
+}
+
+/* the body pair of groups a and b when it is moved apart this substep, else NULL */
+static const struct made_pair *moving(const made *mb, int32_t a, int32_t b)
+{
+    if (a <= 0 || b <= 0 || a == b) return NULL;
+    if (a > b) { const int32_t t = a; a = b; b = t; }
+    for (int32_t q = 0; q < mb->np; q++)
+        if (mb->p[q].a == a && mb->p[q].b == b) return mb->p[q].s > 0 ? &mb->p[q] : NULL;
+    return NULL;
+}
+
+/* the bodies that keep a made overlap moved apart (above); 0 when none is */
+static int made_shift(wb_world *w, made *mb, const wb_real *left, wb_real step, int32_t nprev)
+{
+    wb_contacts *c = &w->k.pc;
+    const int32_t *g = w->m.group;
+    const wb_real *xp = w->s.x_prev, *rad = w->m.radius;
+    for (int32_t k = 0; k < c->n; k++) {
+        if (!(left[k] > step)) continue; /* a resting contact's g h^2 is no made overlap */
+        const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];
+        if (!two_bodies(w, mb, i, j)) continue;
+        const int i_first = g[i] < g[j];
+        struct made_pair *p = made_pair_of(mb, i_first ? g[i] : g[j], i_first ? g[j] : g[i]);
+        if (!p) return 0;
+        wb_real d[3], u[3];
+        v3_sub(d, &xp[3 * j], &xp[3 * i]);
+        v3_scale(u, p->u, i_first ? 1 : -1);
+        const wb_real rs = rad[i] + rad[j], sep = sep_along(d, u, rs);
+        if (sep > p->keep) p->keep = sep;
+        /* deep: b's particle past a's on the way out, or on it, or, moved along u to
+         * touch, ending more than 44 degrees off u (in a hollow: 45). Pushed along its
+         * own line such a pair sends the bodies into each other or sideways (blocks made
+         * offset half a spacing and half a contact distance into the hollows part at 8.7
+         * m/s). Pairs that part (nearly) along u, or beside each other (a tower made
+         * interleaved, moved sideways), part pair by pair as before */
+        const wb_real du = v3_dot(d, u);
+        if (du < (wb_real)-0.01 * rs || v3_len(d) < (wb_real)0.01 * rs || du + sep < (wb_real)0.72 * rs)
+            p->deep = 1;
+    }
+    /* a pair moved in the last substep goes on until it is out */
+    for (int32_t q = 0; q < mb->np; q++)
+        for (int32_t e = 0; e < nprev && !mb->p[q].deep; e++)
+            if (c->made_ab[2 * e] == mb->p[q].a && c->made_ab[2 * e + 1] == mb->p[q].b) mb->p[q].deep = 1;
+    int any = 0;
+    for (int32_t q = 0; q < mb->np; q++) {
+        struct made_pair *p = &mb->p[q];
+        const wb_real ma = mb->box[7 * p->a + 6], mbb = mb->box[7 * p->b + 6];
+        if (isinf(ma) && isinf(mbb)) continue; /* both held: their pairs push as any contact */
+        if (!p->deep) continue; /* shallower: the pairs part it (as any contact's made overlap) */
+        p->s = p->keep < step ? p->keep : step;
+        wb_real fa = isinf(ma) ? 0 : isinf(mbb) ? 1 : mbb / (ma + mbb);
+        const wb_real *gv = w->m.def.gravity, gl = v3_len(gv), ug = gl > 0 ? v3_dot(p->u, gv) / gl : 0;
+        if (!isinf(ma) && !isinf(mbb) && fabs(ug) > (wb_real)0.5) fa = ug > 0 ? 1 : 0;
+        p->fa = fa;
+        v3_madd(&mb->shift[3 * p->a], p->u, -p->s * fa);
+        v3_madd(&mb->shift[3 * p->b], p->u, p->s * (1 - fa));
+        any |= p->s > 0;
+    }
+    if (!any) return 0;
+    /* the pairs moved, for tricontact.c and the next substep */
+    int32_t *ab = wb__grow(c->made_ab, &c->cap_made, 2 * mb->np, sizeof *ab);
+    if (ab) {
+        c->made_ab = ab;
+        c->nmade = 0;
+        for (int32_t q = 0; q < mb->np; q++)
+            if (mb->p[q].s > 0) ab[2 * c->nmade] = mb->p[q].a, ab[2 * c->nmade++ + 1] = mb->p[q].b;
+    }
+    wb_real *x = w->s.x, *xo = w->s.x_prev;
+    for (int32_t i = 0; i < w->m.np; i++) {
+        const wb_real *s = &mb->shift[3 * g[i]];
+        if (g[i] <= 0 || w->m.w[i] == 0 || (s[0] == 0 && s[1] == 0 && s[2] == 0)) continue;
+        v3_add(&x[3 * i], &x[3 * i], s);
+        v3_add(&xo[3 * i], &xo[3 * i], s);
+    }
+    return 1;
+}
+
 void wb__contacts_project(wb_world *w, wb_real h)
 {
     wb_contacts *c = &w->k.pc;
     c->nact = 0;
+    /* the body pairs moved in the last substep, within the frame only: a frame's start
+     * works them out from the state alone (a snapshot's future is the same) */
+    const int32_t nprev = c->fresh ? 0 : c->nmade;
+    c->nmade = 0;
     /* the list still holds (else it is made again, and each old pair's left is kept) */
     const int32_t n_before = c->n;
     const int remade = wb__contacts_recheck(w, h);
@@ -191,6 +392,8 @@ void wb__contacts_project(wb_world *w, wb_real h)
      * resting contact's g h^2: then its repair is taken out of the speed as within a
      * frame, and a settled stack stays exactly at rest). Worked out from the state
      * alone, so a step interrupted and run again gives the same result */
+    made mb;
+    memset(&mb, 0, sizeof mb);
     if (c->fresh) {
         for (int32_t k = 0; k < c->n; k++) left[k] = fresh_left(c, xp, rad, vmax * h, k);
         c->fresh = 0;
@@ -208,6 +411,7 @@ void wb__contacts_project(wb_world *w, wb_real h)
             left[k] = q < no && io[2 * q] == i && io[2 * q + 1] == j ? c->left_old[q] : fresh_left(c, xp, rad, vmax * h, k);
         }
     }
+    const int shifted = made_shift(w, &mb, left, vmax * h, nprev);
     for (int32_t k = 0; k < c->n; k++) {
         const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];
         const wb_real wi = wv[i], wj = wv[j], wsum = wi + wj;
@@ -224,16 +428,42 @@ void wb__contacts_project(wb_world *w, wb_real h)
             left[k] = 0;
             continue;
         }
-        wb_real n[3];
+        wb_real n[3], dp[3], slow, err, depth;
+        v3_sub(dp, pj, pi);
         const wb_real len = sqrt(d2);
         if (len > r * (wb_real)1e-9) v3_scale(n, d, 1 / len);
         else v3_set(n, 0, 1, 0); /* coincident: any direction separates them */
-        wb_real dp[3], slow, err;
-        v3_sub(dp, pj, pi);
-        const wb_real depth = wb__contact_depth(r - len, r - v3_len(dp), &left[k], vmax * h, &slow, &err);
+        const struct made_pair *mp = shifted ? moving(&mb, m->group[i], m->group[j]) : NULL;
+        if (mp) {
+            /* two bodies being moved apart: the overlap the pair began the substep with
+             * is theirs to take out. Along the pair's line a particle past the other
+             * body's first layer is seen parting as it sinks deeper into it: what the
+             * substep drove in is the pair's approach along the bodies' line, undone */
+            const wb_real d0 = r - v3_len(dp);
+            left[k] = d0 > 0 ? d0 : 0;
+            if (mp->a == m->group[i]) v3_copy(n, mp->u);
+            else v3_scale(n, mp->u, -1);
+            wb_real dd[3];
+            v3_sub(dd, d, dp);
+            depth = -v3_dot(dd, n);
+            slow = err = 0;
+        } else {
+            depth = wb__contact_depth(r - len, r - v3_len(dp), &left[k], vmax * h, &slow, &err);
+        }
         if (!(depth > 0)) { touching++; continue; }
-        if (wi > 0) v3_madd(xi, n, -depth * wi / wsum), v3_madd(pi, n, -slow * wi / wsum);
-        if (wj > 0) v3_madd(xj, n, depth * wj / wsum), v3_madd(pj, n, slow * wj / wsum);
+        if (mp && (mp->fa == 0 || mp->fa == 1)) {
+            /* one of the two stays (above): the other takes all of it */
+            const int i_stays = (mp->fa == 0) == (mp->a == m->group[i]);
+            if (i_stays && wj > 0) v3_madd(xj, n, depth);
+            else if (!i_stays && wi > 0) v3_madd(xi, n, -depth);
+            else {
+                if (wi > 0) v3_madd(xi, n, -depth * wi / wsum);
+                if (wj > 0) v3_madd(xj, n, depth * wj / wsum);
+            }
+        } else {
+            if (wi > 0) v3_madd(xi, n, -depth * wi / wsum), v3_madd(pi, n, -slow * wi / wsum);
+            if (wj > 0) v3_madd(xj, n, depth * wj / wsum), v3_madd(pj, n, slow * wj / wsum);
+        }
         /* normal and depth, kept for the velocity pass; the normal force for the readout
          * (XPBD multiplier of a zero-compliance contact, depth / (w_i + w_j), over h^2) */
         act[c->nact] = k;
@@ -244,6 +474,7 @@ void wb__contacts_project(wb_world *w, wb_real h)
         nds[ND * c->nact + 6] = 0; /* the friction pass sets it */
         c->nact++;
     }
+    made_free(&mb);
     c->last = c->nact + touching;
     return;
 nomem:

@@ -254,6 +254,9 @@ typedef struct wb_contacts {
     int brute;             /* tests: each substep, every touching pair that may touch is looked
                               for in the list; missed counts those it lacks */
     int64_t missed;
+    int32_t *made_ab;      /* (nmade x 2) the body pairs (groups a < b) contact.c moved apart this
+                              substep for a made overlap: tricontact.c leaves theirs to it */
+    int32_t nmade, cap_made;
 } wb_contacts;
 
 /* rest neighbours (DESIGN.md §2) include pairs made in touch: created r_i + r_j apart, to

@@ -115,6 +115,18 @@ wb_real wb__tri_closest(const wb_real p[3], const wb_real a[3], const wb_real b[
 }
 
 /* ---- projection -------------------------------------------------------------------------------------- */
+/* p's body and the triangle's are a pair contact.c moves apart this substep */
+static int made_moving(const wb_world *w, int32_t p, int32_t corner)
+{
+    const wb_contacts *pc = &w->k.pc;
+    const int32_t g1 = w->m.group[p], g2 = w->m.group[corner];
+    if (pc->nmade == 0 || g1 <= 0 || g2 <= 0 || g1 == g2) return 0;
+    const int32_t a = g1 < g2 ? g1 : g2, b = g1 < g2 ? g2 : g1;
+    for (int32_t q = 0; q < pc->nmade; q++)
+        if (pc->made_ab[2 * q] == a && pc->made_ab[2 * q + 1] == b) return 1;
+    return 0;
+}
+
 void wb__tricontacts_project(wb_world *w, wb_real h)
 {
     wb_tricontacts *c = &w->k.tc;
@@ -152,6 +164,10 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
         const wb_real r = rad[p];
         /* what it was left with, until it is found overlapping again */
         wb_real lk = left[k];
+        /* two bodies made inside each other, which contact.c moves apart whole: theirs
+         * to take out (a triangle's normal is no way out of a body made inside another:
+         * it pushes the point deeper in as often as out); kept as it is until they stop */
+        if (made_moving(w, p, v[0])) continue;
         left[k] = 0;
         /* the side now and at the substep's start (the plane of the triangle then) */
         v3_sub(e1, xb, xa);

@@ -181,13 +181,17 @@ int wbio_write_tets(const char *node_path, const char *node_shown, const char *e
 typedef struct wbio_tetgen_opts {
     double max_volume;     /* tetgen -a: largest tet volume, m^3; 0 = none */
     double quality;        /* tetgen -q: largest radius-edge ratio; 0 = none */
-    bool keep_surface;     /* tetgen -Y: the mesh's triangles stay the surface (nodes 0..nv-1 are its vertices) */
+    int keep_surface;      /* tetgen -Y: the mesh's triangles stay the surface (nodes 0..nv-1 are
+                              its vertices): 1 always, 0 never (tetgen may split them), -1 when
+                              max_volume can be met so, else split */
+    bool bound_given;      /* max_volume is the caller's promise (missed: an error), not a target */
     double timeout;        /* seconds; 0 = 60 */
+    bool kept;             /* out: the mesh's triangles were kept (-Y) */
 } wbio_tetgen_opts;
 /* fill the closed mesh m with tets by running the tetgen program in a private temporary
  * folder (removed after), under b's memory (the child's address space) and interrupt.
  * Refuses an open mesh before running anything; an input that intersects itself is named
  * as such; without tetgen installed, the message names the Debian package */
-int wbio_tetgen(const wb_mesh *m, const wbio_tetgen_opts *o, wbio_budget *b, wbio_tets *out, char *err, size_t errn);
+int wbio_tetgen(const wb_mesh *m, wbio_tetgen_opts *o, wbio_budget *b, wbio_tets *out, char *err, size_t errn);
 
 #endif

@@ -376,9 +376,23 @@ static size_t tetgen_bytes(const wbio_budget *b)
     return pages > 0 && page > 0 ? (size_t)pages / 2 * (size_t)page : (size_t)1 << 32;
 }
 
-int wbio_tetgen(const wb_mesh *m, const wbio_tetgen_opts *o, wbio_budget *b, wbio_tets *out, char *err, size_t errn)
+/* tetgen's switches: a PLC (p), the surface kept (Y), quality (q ratio), volume bound (a,
+ * fixed point: tetgen does not read exponents), no .face/.edge (F) */
+static void switches(char *sw, size_t n, const wbio_tetgen_opts *o, int keep)
+{
+    int len = snprintf(sw, n, "-p%sF", keep ? "Y" : "");
+    if (o->quality > 0) len += snprintf(sw + len, n - (size_t)len, "q%.6f", o->quality);
+    if (o->max_volume > 0) {
+        int dec = 6 - (int)floor(log10(o->max_volume));
+        dec = dec < 6 ? 6 : dec > 40 ? 40 : dec;
+        snprintf(sw + len, n - (size_t)len, "a%.*f", dec, o->max_volume);
+    }
+}
+
+int wbio_tetgen(const wb_mesh *m, wbio_tetgen_opts *o, wbio_budget *b, wbio_tets *out, char *err, size_t errn)
 {
     memset(out, 0, sizeof *out);
+    o->kept = false;
     int32_t ea = 0, eb = 0;
     const int32_t open_edges = wb_mesh_open_edges(m, &ea, &eb);
     if (open_edges < 0) { snprintf(err, errn, "out of memory"); return -1; }
@@ -403,51 +417,52 @@ int wbio_tetgen(const wb_mesh *m, const wbio_tetgen_opts *o, wbio_budget *b, wbi
         remove_dir(dir);
         return -1;
     }
-    /* switches: a PLC (p), the surface kept (Y), quality (q ratio), volume bound (a, fixed
-     * point: tetgen does not read exponents), no .face/.edge (F) */
-    char sw[128];
-    int len = snprintf(sw, sizeof sw, "-p%sF", o->keep_surface ? "Y" : "");
-    if (o->quality > 0) len += snprintf(sw + len, sizeof sw - (size_t)len, "q%.6f", o->quality);
-    if (o->max_volume > 0) {
-        int dec = 6 - (int)floor(log10(o->max_volume));
-        dec = dec < 6 ? 6 : dec > 40 ? 40 : dec;
-        snprintf(sw + len, sizeof sw - (size_t)len, "a%.*f", dec, o->max_volume);
-    }
     /* line-buffered through stdbuf where there is one: tetgen aborts on some inputs, and a
      * full buffer would lose the line that says why */
     const int have_stdbuf = find_program("stdbuf", stdbuf, sizeof stdbuf);
+    char sw[128];
     const char *argv_sb[] = { stdbuf, "-oL", tetgen, sw, "in.poly", NULL };
     const char *argv_pl[] = { tetgen, sw, "in.poly", NULL };
     const size_t bytes = tetgen_bytes(b);
     const double timeout = o->timeout > 0 ? o->timeout : 60;
     int status = 0;
     double peak = 0;
-    int r = run_child(dir, have_stdbuf ? argv_sb : argv_pl, bytes, timeout, b, &status, &peak);
+    int keep = o->keep_surface != 0;
+    int r;
     char why[512];
+again:
+    switches(sw, sizeof sw, o, keep);
+    r = run_child(dir, have_stdbuf ? argv_sb : argv_pl, bytes, timeout, b, &status, &peak);
     if (r == 0) {
         char node[PATH_MAX + 16], ele[PATH_MAX + 16];
         snprintf(node, sizeof node, "%s/in.1.node", dir);
         snprintf(ele, sizeof ele, "%s/in.1.ele", dir);
         char e2[512];
+        /* 0.1 %: tetgen rounds its points' coordinates */
         if (wbio_read_tets(node, "in.1.node", ele, "in.1.ele", out, e2, sizeof e2))
             snprintf(err, errn, "tetgen's output could not be read: %s", e2);
         else if (out->nv < m->nv)
             snprintf(err, errn, "tetgen's output has fewer points (%d) than the mesh (%d)", (int)out->nv, (int)m->nv);
-        else if (o->max_volume > 0 && largest_tet(out) > o->max_volume * (1 + 1e-3)) {
-            /* tetgen -Y splits no boundary triangle, so a tet on a large one stays large, and
-             * its refinement inside stops short of the bound near the surface too: the bound
-             * the README promises is checked, and said when missed (0.1 %: tetgen rounds its
-             * points' coordinates) */
-            if (o->keep_surface)
-                snprintf(err, errn, "max_volume = %g cannot be met with keep_surface = true: tetgen keeps the mesh's "
-                         "triangles, and its largest tet is %g m^3 (keep_surface = false lets tetgen split the "
-                         "surface; or give a finer mesh, or a larger max_volume)", o->max_volume, largest_tet(out));
-            else
-                snprintf(err, errn, "tetgen did not meet max_volume = %g: its largest tet is %g m^3", o->max_volume,
-                         largest_tet(out));
-        } else {
+        else if (!(o->max_volume > 0 && largest_tet(out) > o->max_volume * (1 + 1e-3)) ||
+                 (!o->bound_given && !(keep && o->keep_surface < 0))) {
+            /* met, or missed where the bound was only a target and the surface stays as
+             * asked */
+            o->kept = keep;
             remove_dir(dir);
             return 0;
+        } else if (keep && o->keep_surface < 0) {
+            /* tetgen -Y splits no boundary triangle, so a tet on a large one stays large (a
+             * cube of 8 corners gets no interior point at all): let it split them */
+            wbio_tets_free(out);
+            keep = 0;
+            goto again;
+        } else if (keep) {
+            snprintf(err, errn, "max_volume = %g cannot be met with keep_surface = true: tetgen keeps the mesh's "
+                     "triangles, and its largest tet is %g m^3 (keep_surface = false, or left out, lets tetgen "
+                     "split the surface; or give a finer mesh, or a larger max_volume)", o->max_volume, largest_tet(out));
+        } else {
+            snprintf(err, errn, "tetgen did not meet max_volume = %g: its largest tet is %g m^3", o->max_volume,
+                     largest_tet(out));
         }
         wbio_tets_free(out);
         remove_dir(dir);

@@ -337,6 +337,23 @@ static const char *const from_mesh_tets_keys[] = {
     "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
 };
 
+/* the volume a closed mesh encloses (divergence theorem over its triangles), m^3 */
+static double enclosed_volume(const wb_mesh *m)
+{
+    if (m->nv == 0) return 0;
+    double v = 0, o[3] = { m->v[0], m->v[1], m->v[2] }; /* about a vertex: far from 0 it loses no digits */
+    for (int32_t t = 0; t < m->nt; t++) {
+        double p[3], q[3], r[3];
+        for (int c = 0; c < 3; c++) {
+            p[c] = m->v[3 * m->tri[3 * t] + c] - o[c];
+            q[c] = m->v[3 * m->tri[3 * t + 1] + c] - o[c];
+            r[c] = m->v[3 * m->tri[3 * t + 2] + c] - o[c];
+        }
+        v += (p[0] * (q[1] * r[2] - q[2] * r[1]) - p[1] * (q[0] * r[2] - q[2] * r[0]) + p[2] * (q[0] * r[1] - q[1] * r[0])) / 6;
+    }
+    return isfinite(v) ? fabs(v) : 0;
+}
+
 static int from_mesh_tets(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
@@ -346,11 +363,17 @@ static int from_mesh_tets(lua_State *L)
     const bool auto_radius = wbl_read_tet_body(L, 3, &d);
     wbl_contact_opts co;
     wbl_read_contact_opts(L, 3, &co);
-    wbio_tetgen_opts o = { 0, 2, true, 0 };
+    wbio_tetgen_opts o = { 0, 2, -1, false, 0, false };
     wb_real x;
     if (wbl_optreal(L, 3, "max_volume", &x)) {
         if (!(x > 0)) return wbl_fielderror(L, 3, "max_volume", "must be > 0 (m^3)");
         o.max_volume = x;
+        o.bound_given = true;
+    } else {
+        /* a solid resolved whatever the mesh: tets of at most a thousandth of the enclosed
+         * volume (a cube: ~700 particles, ~2,400 tets; the count does not change with the
+         * mesh's scale, and a fine mesh's own vertices add to it) */
+        o.max_volume = enclosed_volume(m) / 1000;
     }
     /* quality: tetgen's radius-edge ratio bound (-q), default 2; false: none */
     lua_getfield(L, 3, "quality");
@@ -362,7 +385,8 @@ static int from_mesh_tets(lua_State *L)
         o.quality = x;
     }
     lua_pop(L, 1);
-    wbl_optbool(L, 3, "keep_surface", &o.keep_surface);
+    bool keep;
+    if (wbl_optbool(L, 3, "keep_surface", &keep)) o.keep_surface = keep;
     if (wbl_optreal(L, 3, "timeout", &x)) {
         if (!(x > 0)) return wbl_fielderror(L, 3, "timeout", "must be > 0");
         o.timeout = x;
@@ -388,7 +412,7 @@ static int from_mesh_tets(lua_State *L)
     }
     /* with the surface kept, the mesh's vertices are tetgen's first nodes: its triangles are
      * the body's surface, as they were; else the tets' boundary (tetgen split it) */
-    int keep = o.keep_surface && t->nv >= m->nv;
+    keep = o.kept && t->nv >= m->nv;
     for (int64_t i = 0; keep && i < 3 * (int64_t)m->nv; i++) {
         const wb_real a = t->v[i], c = m->v[i];
         keep = fabs(a - c) <= 1e-9 * (1 + fabs(c));

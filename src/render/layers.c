@@ -422,14 +422,24 @@ static bool build_surfaces(wb_layers *l, const wb_world *w, const wb_draw_opts *
             cross3(e1, e2, f);
             memcpy(f + 3, f, 3 * sizeof *f);
             hull[k / 3] = sign != 0;
+            norm3(f);
             for (int j = 0; j < 3; j++) {
-                for (int c = 0; c < 3; c++) acc[3 * v[j] + c] += f[c];
+                /* weighted by the triangle's angle at the particle, not its area: a flat
+                 * face then counts alike however it is cut, so the particles along a
+                 * cube's edge all sit out along its diagonal (by area each leaned to
+                 * whichever side had the larger triangles there, and the edge drawn out
+                 * along those normals was a saw-tooth) */
+                const wb_real *p0 = &x[3 * v[j]], *p1 = &x[3 * v[(j + 1) % 3]], *p2 = &x[3 * v[(j + 2) % 3]];
+                double a[3], b[3];
+                for (int c = 0; c < 3; c++) a[c] = p1[c] - p0[c], b[c] = p2[c] - p0[c];
+                const double la = norm3(a), lb = norm3(b);
+                const double cs = dot3(a, b), ang = la > 0 && lb > 0 ? acos(cs < -1 ? -1 : cs > 1 ? 1 : cs) : 0;
+                for (int c = 0; c < 3; c++) acc[3 * v[j] + c] += ang * f[c];
                 l->si[k++] = (GLuint)v[j];
                 l->flags[v[j]] |= F_SURFACE;
                 start[v[j] + 1]++;
                 if (owner[v[j]] < 0) owner[v[j]] = (int16_t)(s % 4);
             }
-            norm3(f);
         }
     }
     const size_t ncorner = k;

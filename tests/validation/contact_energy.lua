@@ -10,7 +10,8 @@
 -- 4 vmax bounds every body here (1/2 M (4 vmax)^2). The measure, every frame from the
 -- start: the mechanical energy K + m g y (the elastic energy, >= 0, left out) never
 -- exceeds the energy they were made with (at rest: m g y) by more than that bound.
--- Measured with the fix: 4.3 J of the 11.8 J allowed for the eight blocks, 0.13 J of
+-- Measured with the fix: 4.3 J of the 11.8 J allowed for the eight blocks (1.5 J since
+-- bodies made deep inside each other part as wholes, contact.c), 0.13 J of
 -- 4.4 J for the squeezed block, 0.24 J of 1 J for the row of particles. Before it,
 -- the blocks gained 150 J and 13 J (a triangle contact repaired all of its overlap in
 -- one substep, as speed; a contact counted the links' pull-back as old overlap and
@@ -82,7 +83,9 @@ test("eight blocks made interleaved (the contacts.lua pile) part and settle with
   -- of neighbours 0.05 m apart, overlapping by d = 0.1 m. A 2.7 m tower that topples:
   -- it spreads over about its height, and a block thrown off it tumbles on along the
   -- floor (with dynamic contact friction at velocity level one went 5.0 m, at 2 m/s):
-  -- 6 m is where it must have stopped, far short of where blocks gaining energy fly
+  -- 7 m is where it must have stopped, far short of where blocks gaining energy fly
+  -- (which block is thrown, and how far, changes with any change to the parting: 5.0 m,
+  -- then 6.3 m once the blocks parted as wholes, with less energy gained)
   local w = wobble.world{ substeps = 8 }
   floor(w)
   for i = 0, 7 do
@@ -90,7 +93,7 @@ test("eight blocks made interleaved (the contacts.lua pile) part and settle with
     w:lattice{ min = {x, 0.3 + 0.3 * i, z}, max = {x + 0.3, 0.6 + 0.3 * i, z + 0.3}, res = {3, 3, 3},
                compliance = 1e-5, friction = 0.3 }
   end
-  check(w, 0.1, 300, 6)
+  check(w, 0.1, 300, 7)
 end)
 
 test("a block made squeezed between two others parts from them without gaining energy", function()
