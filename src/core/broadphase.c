@@ -75,6 +75,8 @@ static int grow(void **p, int32_t *cap, int64_t need, size_t elem)
     return 1;
 }
 
+static int cmp_pair(const void *pa, const void *pb);
+
 static inline int64_t cell_of(wb_real v, wb_real o, wb_real inv) { return wb__cell_of(v, o, inv); }
 
 static inline int64_t wrap_to(int64_t c, int64_t n) { return c % n; }
@@ -494,25 +496,106 @@ static int motion_fit(wb_broad *b, const wb_real *x, int32_t n, wb_motion *mo)
     return isfinite(mo->Q[0] + mo->Q[4] + mo->Q[8] + mo->c[0] + mo->c[1] + mo->c[2]);
 }
 
-static int list_valid(const wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t n,
-                      uint64_t gen, const wb_motion *mo)
+/* fn(ctx, j) for every particle the kept list's grid has in the cells within e of p (where
+ * the list was built); stops at the first fn that returns 0, and returns 0 then */
+static int grid_each(const wb_broad *b, const wb_real *p, wb_real e, int (*fn)(void *ctx, int32_t j), void *ctx)
 {
-    if (b->vn != n || n == 0 || b->bare || b->vgen != gen) return 0;
+    const wb_grid *G = &b->lg;
+    int64_t rx[4], ry[4], rz[4];
+    const int kx = axis_ranges(G, 0, p[0], e, rx), ky = axis_ranges(G, 1, p[1], e, ry), kz = axis_ranges(G, 2, p[2], e, rz);
+    /* a point past the grid's far side: an axis's range is empty there, and no grid
+     * particle is near it that way */
+    if (rx[0] > rx[1] || ry[0] > ry[1] || rz[0] > rz[1]) return 1;
+    for (int az = 0; az < kz; az++)
+        for (int64_t z = rz[2 * az]; z <= rz[2 * az + 1]; z++)
+            for (int ay = 0; ay < ky; ay++)
+                for (int64_t y = ry[2 * ay]; y <= ry[2 * ay + 1]; y++) {
+                    const int64_t row = G->nc[0] * (y + G->nc[1] * z);
+                    for (int ax = 0; ax < kx; ax++)
+                        for (int32_t t = b->start[row + rx[2 * ax]]; t < b->start[row + rx[2 * ax + 1] + 1]; t++)
+                            if (!fn(ctx, b->id[t])) return 0;
+                }
+    return 1;
+}
+
+/* the pairs of add (n, in any order) in (i, j) order, each once, less those of the sorted
+ * list (nl) already; returns how many */
+static int32_t new_pairs(int32_t *add, int32_t n, const int32_t *list, int32_t nl)
+{
+    if (n > 1) qsort(add, (size_t)n, 2 * sizeof *add, cmp_pair);
+    int32_t nb = 0;
+    for (int32_t q = 0; q < n; q++) {
+        const int32_t *e = &add[2 * q];
+        if (nb > 0 && cmp_pair(&add[2 * nb - 2], e) == 0) continue;
+        int32_t lo = 0, hi = nl;
+        while (lo < hi) {
+            const int32_t mid = lo + (hi - lo) / 2;
+            if (cmp_pair(&list[2 * mid], e) < 0) lo = mid + 1;
+            else hi = mid;
+        }
+        if (lo < nl && cmp_pair(&list[2 * lo], e) == 0) continue;
+        add[2 * nb] = e[0];
+        add[2 * nb + 1] = e[1];
+        nb++;
+    }
+    return nb;
+}
+
+/* i and j into o when within their list reaches (list positions), not of one skip key, and
+ * kept */
+typedef struct mend_ctx {
+    const wb_broad *b;
+    const int32_t *skip;
+    int32_t i;
+    int (*keep)(void *ud, int32_t i, int32_t j);
+    void *ud;
+    pairbuf *o;
+} mend_ctx;
+
+static void mend_try(const wb_broad *b, const int32_t *skip, int32_t i, int32_t j,
+                     int (*keep)(void *ud, int32_t i, int32_t j), void *ud, pairbuf *o)
+{
+    if (i == j || !(b->vr[j] >= 0)) return;
+    const wb_real *P = &b->vx[3 * i], *Q = &b->vx[3 * j];
+    const wb_real d0 = Q[0] - P[0], d1 = Q[1] - P[1], d2 = Q[2] - P[2], R = b->vr[i] + b->vr[j];
+    if (!(d0 * d0 + d1 * d1 + d2 * d2 < R * R)) return;
+    if (skip && skip[i] != 0 && skip[i] == skip[j]) return;
+    const int32_t a = i < j ? i : j, c = i < j ? j : i;
+    if (keep && !keep(ud, a, c)) return;
+    push(o, a, c);
+}
+
+/* the grid's particles not mended since it was built (those are tried one by one) */
+static int mend_grid(void *ctx, int32_t j)
+{
+    const mend_ctx *m = ctx;
+    if (!m->b->is_moved[j]) mend_try(m->b, m->skip, m->i, j, m->keep, m->ud, m->o);
+    return 1;
+}
+
+/* the particles that left their skin (up to nbad of them in bad; past that nbad + 1), or
+ * -1 when the list cannot serve at all (other particles, skip keys or rules, or a particle
+ * that joined or left) */
+static int32_t list_strays(const wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t n,
+                           uint64_t gen, const wb_motion *mo, int32_t *bad, int32_t nbad)
+{
+    if (b->vn != n || n == 0 || b->bare || b->vgen != gen) return -1;
     const wb_real *X = b->vx, *R = b->vr;
     const int32_t *K = b->vskip;
-    if (skip && memcmp(skip, K, sizeof *K * (size_t)n)) return 0;
+    if (skip && memcmp(skip, K, sizeof *K * (size_t)n)) return -1;
     for (int32_t i = 0; !skip && i < n; i++)
-        if (K[i] != 0) return 0;
+        if (K[i] != 0) return -1;
+    int32_t nb = 0;
     for (int32_t i = 0; i < n; i++) {
         /* takes_part(i) == (R[i] >= 0), its cheap half first: one that was left out (R < 0)
          * must still be; one that took part must have a reach >= 0 and finite, and a
          * position within its slack (a position not finite fails one of the two tests) */
         const wb_real Ri = R[i], ri = reach[i];
         if (Ri < 0) {
-            if (takes_part(x, reach, i)) return 0;
+            if (takes_part(x, reach, i)) return -1;
             continue;
         }
-        if (!(ri >= 0) || !(ri < INFINITY)) return 0;
+        if (!(ri >= 0) || !(ri < INFINITY)) return -1;
         const wb_real *p = &x[3 * i];
         wb_real y[3];
         motion_apply(mo, &X[3 * i], y);
@@ -520,8 +603,78 @@ static int list_valid(const wb_broad *b, const wb_real *x, const wb_real *reach,
         const wb_real slack = (Ri - ri) * (wb_real)0.999;
         /* round-off in the pair distances: a slack far above the coordinates' ulps */
         const wb_real mag = fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + Ri;
-        if (!(d0 * d0 + d1 * d1 + d2 * d2 <= slack * slack) || !(slack > (wb_real)1e-9 * mag)) return 0;
+        if (!(d0 * d0 + d1 * d1 + d2 * d2 <= slack * slack) || !(slack > (wb_real)1e-9 * mag)) {
+            if (!isfinite(d0 + d1 + d2)) return -1;
+            if (nb == nbad) return nbad + 1;
+            bad[nb++] = i;
+        }
     }
+    return nb;
+}
+
+static int list_valid(const wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t n,
+                      uint64_t gen, const wb_motion *mo)
+{
+    return list_strays(b, x, reach, skip, n, gen, mo, NULL, 0) == 0;
+}
+
+/* The kept list mended where few particles left their skin (a cloth sliding slowly over a
+ * sphere): each one's list position and reach made again from where it is (M^-1 x, in the
+ * list's frame), and its pairs looked for among the grid's particles (where the list was
+ * built; reach + the grid's largest) and the ones mended before it one by one. Its old
+ * pairs stay (each call filters by distance). Every pair the skin argument needs is then
+ * listed: two unmended particles' as before, a mended one's by its own search or the
+ * later one's. The grid stays the list's, with the mended ones (moved) to try one by one.
+ * 0 when out of memory */
+static int mend_list(wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t n,
+                     const wb_motion *mo, const int32_t *bad, int32_t nb,
+                     int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
+{
+    if (!grow((void **)&b->moved, &b->cap_moved, (int64_t)b->nmoved + nb, sizeof *b->moved) ||
+        !grow((void **)&b->is_moved, &b->cap_is_moved, n, sizeof *b->is_moved))
+        return 0;
+    if (b->nmoved == 0) memset(b->is_moved, 0, (size_t)n);
+    const wb_real *Q = mo->Q;
+    for (int32_t k = 0; k < nb; k++) {
+        const int32_t i = bad[k];
+        const wb_real *p = &x[3 * i], r0 = p[0] - mo->c[0], r1 = p[1] - mo->c[1], r2 = p[2] - mo->c[2];
+        wb_real *X = &b->vx[3 * i];
+        for (int a = 0; a < 3; a++) X[a] = mo->C[a] + Q[a] * r0 + Q[3 + a] * r1 + Q[6 + a] * r2;
+        const wb_real R = reach[i] * (1 + (wb_real)SKIN);
+        b->vr[i] = isfinite(R) ? R : reach[i];
+        if (!b->is_moved[i]) {
+            b->is_moved[i] = 1;
+            b->moved[b->nmoved++] = i;
+        }
+    }
+    pairbuf *o = &b->mend;
+    o->n = 0;
+    o->fail = 0;
+    for (int32_t k = 0; k < nb; k++) {
+        const int32_t i = bad[k];
+        /* the grid's, then the mended ones' (a pair of two mended ones: found from both) */
+        mend_ctx mc = { b, skip, i, keep, ud, o };
+        grid_each(b, &b->vx[3 * i], b->vr[i] + b->lrmax, mend_grid, &mc);
+        for (int32_t q = 0; q < b->nmoved; q++) mend_try(b, skip, i, b->moved[q], keep, ud, o);
+    }
+    if (o->fail) return 0;
+    if (o->n == 0) return 1;
+    /* in order, each once, those the list lacks, merged in */
+    const int32_t na = new_pairs(o->ij, o->n, b->list.ij, b->list.n);
+    if (!grow((void **)&b->list.ij, &b->list.cap, 2 * ((int64_t)b->list.n + na), sizeof *b->list.ij)) return 0;
+    int32_t *ij = b->list.ij;
+    for (int32_t p = b->list.n - 1, q = na - 1, w = b->list.n + na - 1; q >= 0; w--) {
+        if (p >= 0 && cmp_pair(&ij[2 * p], &o->ij[2 * q]) > 0) {
+            ij[2 * w] = ij[2 * p];
+            ij[2 * w + 1] = ij[2 * p + 1];
+            p--;
+        } else {
+            ij[2 * w] = o->ij[2 * q];
+            ij[2 * w + 1] = o->ij[2 * q + 1];
+            q--;
+        }
+    }
+    b->list.n += na;
     return 1;
 }
 
@@ -550,8 +703,20 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
     wb_motion mo;
     motion_identity(&mo);
     int valid = list_valid(b, x, reach, skip, n, gen, &mo);
-    if (!valid && b->vn == n && !b->bare && b->vgen == gen && motion_fit(b, x, n, &mo))
-        valid = list_valid(b, x, reach, skip, n, gen, &mo);
+    if (!valid && b->vn == n && !b->bare && b->vgen == gen && motion_fit(b, x, n, &mo)) {
+        /* a few particles out of their skin: the list mended for them (up to 1 in 32, and
+         * 1 in 8 mended since it was built) */
+        const int32_t most = n / 32 > 16 ? n / 32 : 16;
+        int32_t *bad = wb__grow(b->bad, &b->cap_bad, most, sizeof *bad);
+        if (bad) b->bad = bad;
+        const int32_t nb = bad ? list_strays(b, x, reach, skip, n, gen, &mo, bad, most) : -1;
+        valid = nb == 0;
+        if (nb > 0 && nb <= most && b->lgrid && b->lfull && b->nmoved + nb <= n / 8 + 16) {
+            if (!mend_list(b, x, reach, skip, n, &mo, bad, nb, keep, ud)) return -1;
+            b->mends++;
+            valid = 1;
+        }
+    }
     if (valid) {
         b->mo = mo;
         b->used = 1;
@@ -571,6 +736,7 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
         b->used = 0;
         motion_identity(&b->mo);
         b->mq[0] = 1, b->mq[1] = b->mq[2] = b->mq[3] = 0;
+        b->nmoved = 0;
         const wb_real grow_by = skin ? 1 + (wb_real)SKIN : 1;
         b->vn = 0;
         if (!grow((void **)&b->vx, &b->cap_vx, 3 * (int64_t)n, sizeof *b->vx) ||
@@ -1169,6 +1335,14 @@ static int add_pair(wb_world *w, int32_t i, int32_t j, int32_t *na)
     return 1;
 }
 
+typedef struct add_ctx { wb_world *w; int32_t i; int32_t *na; } add_ctx;
+
+static int add_grid(void *ctx, int32_t j)
+{
+    const add_ctx *a = ctx;
+    return add_pair(a->w, a->i, j, a->na);
+}
+
 /* the grid's particles within e of p, through add_pair; 0: too wide a search (or out of
  * memory: *fail) */
 static int grid_pairs(wb_world *w, const wb_broad *b, int32_t i, wb_real e, int32_t *na, int *fail)
@@ -1181,20 +1355,8 @@ static int grid_pairs(wb_world *w, const wb_broad *b, int32_t i, wb_real e, int3
     wb_real p[3];
     for (int a = 0; a < 3; a++) p[a] = b->mo.C[a] + Q[a] * r0 + Q[3 + a] * r1 + Q[6 + a] * r2;
     if (!(e * G->inv <= 8)) return 0;
-    int64_t rx[4], ry[4], rz[4];
-    const int kx = axis_ranges(G, 0, p[0], e, rx), ky = axis_ranges(G, 1, p[1], e, ry), kz = axis_ranges(G, 2, p[2], e, rz);
-    /* a particle past the grid's far side (it moved out of the box the grid was made
-     * for): an axis's range is empty there, and no grid particle is near it that way */
-    if (rx[0] > rx[1] || ry[0] > ry[1] || rz[0] > rz[1]) return 1;
-    for (int az = 0; az < kz; az++)
-        for (int64_t z = rz[2 * az]; z <= rz[2 * az + 1]; z++)
-            for (int ay = 0; ay < ky; ay++)
-                for (int64_t y = ry[2 * ay]; y <= ry[2 * ay + 1]; y++) {
-                    const int64_t row = G->nc[0] * (y + G->nc[1] * z);
-                    for (int ax = 0; ax < kx; ax++)
-                        for (int32_t t = b->start[row + rx[2 * ax]]; t < b->start[row + rx[2 * ax + 1] + 1]; t++)
-                            if (!add_pair(w, i, b->id[t], na)) { *fail = 1; return 1; }
-                }
+    add_ctx ac = { w, i, na };
+    if (!grid_each(b, p, e, add_grid, &ac)) *fail = 1;
     return 1;
 }
 
@@ -1238,6 +1400,7 @@ static int repair(wb_world *w, const int32_t *moved, int32_t nm, const int32_t *
         if (reach[i] < 0) continue;
         if (use_grid && grid_pairs(w, b, i, reach[i] + b->lrmax, &na, &fail)) {
             for (int32_t q = 0; q < c->nfixed && !fail; q++) fail = !add_pair(w, i, c->fixed[q], &na);
+            for (int32_t q = 0; q < b->nmoved && !fail; q++) fail = !add_pair(w, i, b->moved[q], &na);
             continue;
         }
         for (int32_t j = 0; j < m->np && !fail; j++) fail = !add_pair(w, i, j, &na);
@@ -1267,22 +1430,7 @@ static int repair(wb_world *w, const int32_t *moved, int32_t nm, const int32_t *
     for (int32_t k = 0; k < nq; k++) c->dorm_on[c->qs[k]] = 1;
     if (na == 0 && nq == 0) return 1;
     /* the new pairs in order, each once and not already listed */
-    if (na > 1) qsort(c->add, (size_t)na, 2 * sizeof *c->add, cmp_pair);
-    int32_t nb = 0;
-    for (int32_t q = 0; q < na; q++) {
-        const int32_t *e = &c->add[2 * q];
-        if (nb > 0 && cmp_pair(&c->add[2 * nb - 2], e) == 0) continue;
-        int32_t lo = 0, hi = c->n;
-        while (lo < hi) {
-            const int32_t mid = lo + (hi - lo) / 2;
-            if (cmp_pair(&c->ij[2 * mid], e) < 0) lo = mid + 1;
-            else hi = mid;
-        }
-        if (lo < c->n && cmp_pair(&c->ij[2 * lo], e) == 0) continue;
-        c->add[2 * nb] = e[0];
-        c->add[2 * nb + 1] = e[1];
-        nb++;
-    }
+    int32_t nb = new_pairs(c->add, na, c->ij, c->n);
     /* with the dormant ones, in order as the dormant list is (merged from the back) */
     if (!grow((void **)&c->add, &c->cap_add, 2 * ((int64_t)nb + nq), sizeof *c->add)) return 0;
     for (int32_t o = nb + nq - 1, p = nb - 1, q = nq - 1; q >= 0; o--) {

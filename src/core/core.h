@@ -365,6 +365,13 @@ struct wb_broad {
     wb_motion mo;                      /* the motion it was last used under (list_valid) */
     uint64_t vgen;                     /* keep's rules it was built with */
     int used;                          /* it was used again since it was built */
+    /* particles whose list position and reach were made again since it was built (the
+     * grid has them where it was built), a flag each; scratch for the mends */
+    int32_t *moved, nmoved, cap_moved;
+    uint8_t *is_moved; int32_t cap_is_moved;
+    int32_t *bad, cap_bad;
+    wb_pairbuf mend;
+    int64_t mends;                     /* for the tests */
     int bare_left, bare_run;           /* lists still to build without a skin; how many
                                           the last run had */
     wb_real mq[4];                     /* its rotation, the next fit's start */
@@ -399,6 +406,7 @@ static inline void wb__broadphase_free(wb_contacts *c)
     free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key);
     free(b->runs); free(b->boxes); free(b->first);
     free(b->vx); free(b->vr); free(b->vskip); free(b->list.ij); free(b->list.hit);
+    free(b->moved); free(b->is_moved); free(b->bad); free(b->mend.ij); free(b->mend.hit);
     for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
     free(b->out);
     free(b);

@@ -21,7 +21,8 @@ mkdir -p "$(dirname "$JSON")" && : >"$JSON" || exit 2
 SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2 scale32 scale64 scale128 scale256 scale512 contacts sheet tets tets_t2"
 FLOAT_SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2"
 SCENES="$SCENES bend"   # the bending scene (tests/bench/bend.lua)
-SCENES="$SCENES self128 loose128 heap128"   # self-collision against none (tests/bench/self_collide.lua)
+SCENES="$SCENES self128 loose128 heap128 drape128"   # self-collision against none (tests/bench/self_collide.lua)
+SCENES="$SCENES self32 self64 self128_30 self256"   # ... per size (the cost per particle: flat)
 
 # scene EXE NAME HEADER(1/0) [ROW [SET]]: one row (and the header when asked); with ROW the row
 # is named ROW and has no Bullet figures (the busy-core rows: Bullet ran without the spinner);
@@ -149,6 +150,7 @@ echo "== the aims of self-collision (tests/bench/self_collide.lua; wall clock)"
 aim "self128: self-colliding / not" "$(row self128 ratio_off)" 1.3
 aim "loose128: hand-built, contacts / none" "$(row loose128 ratio_off)" 1.3
 aim "heap128: self-colliding heap / not" "$(row heap128 ratio_off)" 3
+aim "drape128: self-colliding, draped / not" "$(row drape128 ratio_off)" 1.3
 echo
 echo "JSON lines: $JSON"
 exit 0

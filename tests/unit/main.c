@@ -46,6 +46,7 @@
     X(contact_broadphase_huge_and_clustered_input)       \
     X(contact_broadphase_bodies_fast_particles_and_threads) \
     X(contact_broadphase_kept_list_matches_fresh_search) \
+    X(contact_broadphase_kept_list_mended_matches_fresh_search) \
     X(contact_builders_get_own_groups)                   \
     X(contact_self_collision_skips_rest_neighbours)      \
     X(contact_list_complete_every_substep)               \

@@ -25,7 +25,9 @@ static int keep_some(void *ud, int32_t i, int32_t j)
     return (i * 31 + j * 17) % 10 != 3;
 }
 
-TEST(contact_broadphase_kept_list_matches_fresh_search)
+/* keys: bodies with skip keys (culled: the list's grid lacks some, so no mends), else every
+ * particle keyless (one grid of all: few strays are mended in the list, not rebuilt) */
+static void kept_matches_fresh(int keys)
 {
     enum { N = 1200, FRAMES = 60 };
     wb_real *x = malloc(sizeof(wb_real) * 3 * N), *reach = malloc(sizeof(wb_real) * N);
@@ -38,7 +40,7 @@ TEST(contact_broadphase_kept_list_matches_fresh_search)
         x[3 * i + 1] = ((b / 5) % 3) * 0.45 + ((k / 4) % 5) * 0.1;
         x[3 * i + 2] = (b / 15) * 0.15 + (k / 20) * 0.1;
         reach[i] = 0.03 + 0.01 * urand();
-        skip[i] = b % 5 == 4 ? 0 : b + 1;
+        skip[i] = !keys || b % 5 == 4 ? 0 : b + 1;
     }
     wb_contacts kept;
     memset(&kept, 0, sizeof kept);
@@ -49,11 +51,19 @@ TEST(contact_broadphase_kept_list_matches_fresh_search)
         for (int32_t i = 0; i < 3 * N; i++) x[i] += 0.002 * (urand() - 0.5) + (i % 3 == 1 ? -0.0008 : 0);
         if (f % 9 == 4) v3_set(&x[3 * (f * 37 % N)], 0.5 * urand(), 0.5 * urand(), 0.2 * urand()); /* a jump */
         if (f % 11 == 6) reach[f * 53 % N] *= 1.4;                                             /* faster */
+        /* two neighbours made faster a frame apart: the second's mend must find the first's
+         * pair among the ones mended before it (the grid has the first where it was) */
+        if (f % 13 == 7 && !keys) reach[f * 29 % (N - 1)] *= 2;
+        if (f % 13 == 8 && !keys) reach[(f - 1) * 29 % (N - 1) + 1] *= 2;
+        /* a jump, and a frame later another particle jumps beside it: the second's mend must
+         * find the first among the ones mended before it (the grid has it where it was) */
+        if (f % 10 == 2 && !keys) v3_set(&x[3 * (f * 41 % N)], 0.9, 0.5 + 0.01 * f, 0.4);
+        if (f % 10 == 3 && !keys) v3_set(&x[3 * ((f * 43 + 7) % N)], 0.95, 0.5 + 0.01 * (f - 1), 0.4);
         if (f == 20) reach[77] = -1;                                                        /* out */
         if (f == 24) reach[77] = 0.035;                                                     /* back */
         if (f == 30) x[3 * 500 + 2] = NAN;
         if (f == 33) x[3 * 500 + 2] = 0.1;
-        if (f == 41)
+        if (f == 41 && keys)
             for (int32_t i = 400; i < 440; i++) skip[i] = skip[440]; /* two touching bodies made one */
         kept.n = 0;
         const int32_t got = wb__broadphase_kept(&kept, x, reach, skip, N, f % 2 ? pool : NULL, keep_some, 0, NULL, NULL);
@@ -70,8 +80,12 @@ TEST(contact_broadphase_kept_list_matches_fresh_search)
     CHECK_EQ(checked, FRAMES);
     /* used: rebuilt now and then (the drift, the jumps, the changes), not every frame */
     const int64_t rebuilds = kept.bp ? kept.bp->rebuilds : -1;
-    CHECK(rebuilds > 5);
+    const int64_t mends = kept.bp ? kept.bp->mends : -1;
+    printf("# %s: rebuilt %lld times, mended %lld times in %d frames\n", keys ? "bodies" : "keyless",
+           (long long)rebuilds, (long long)mends, FRAMES);
+    CHECK(rebuilds > (keys ? 5 : 1));
     CHECK(rebuilds < FRAMES / 2);
+    if (!keys) CHECK(mends > 5); /* the jumps and faster particles are mended in place */
     wb__broadphase_free(&kept);
     wb__pool_destroy(pool);
     free(kept.ij);
@@ -79,3 +93,6 @@ TEST(contact_broadphase_kept_list_matches_fresh_search)
     free(reach);
     free(skip);
 }
+
+TEST(contact_broadphase_kept_list_matches_fresh_search) { kept_matches_fresh(1); }
+TEST(contact_broadphase_kept_list_mended_matches_fresh_search) { kept_matches_fresh(0); }
