@@ -30,6 +30,7 @@ struct wb_renderer {
     /* the last frame's camera and view-projection (row-major 4x4, doubles) */
     double cam_eye[3], cam_target[3], cam_up[3], cam_fov, vp[16];
     wb_layers layers;             /* what the layers draw, rebuilt every frame */
+    size_t hi_small;              /* its fine spheres drawn coarse (small_spheres_first) */
 };
 
 /* colours, sRGB (the layers' own are in layers.c) */
@@ -340,16 +341,47 @@ static void set_vec(GLuint prog, const char *name, double x, double y, double z)
     glUniform3f(glGetUniformLocation(prog, name), (float)x, (float)y, (float)z);
 }
 
+/* the fine spheres (colliders, capsule caps) seen under this many pixels of radius are
+ * drawn with the coarse mesh: 16 slices are then within a fifth of a pixel of round, and a
+ * capsule's thin caps took 3,000 triangles each, rasterised per sample */
+#define SPHERE_LO_PIXELS 10.0
+
+/* the fine spheres seen small first in their group (order does not matter: opaque,
+ * depth-tested); returns how many */
+static size_t small_spheres_first(wb_layers *l, const double vp[16], double fov, int h)
+{
+    const double f = 0.5 * h / tan(fov * M_PI / 360);
+    size_t k = l->first[WB_G_HI];
+    const size_t end = k + l->count[WB_G_HI];
+    for (size_t i = k; i < end; i++) {
+        const float *m = l->inst[i].m;
+        const double rad = sqrt((double)m[0] * m[0] + (double)m[1] * m[1] + (double)m[2] * m[2]);
+        const double wc = vp[12] * m[12] + vp[13] * m[13] + vp[14] * m[14] + vp[15];
+        if (!(wc > rad && rad * f / wc < SPHERE_LO_PIXELS)) continue;
+        if (i != k) {
+            wb_inst t = l->inst[k];
+            l->inst[k] = l->inst[i], l->inst[i] = t;
+        }
+        k++;
+    }
+    return k - l->first[WB_G_HI];
+}
+
 static void draw_meshes(wb_renderer *r)
 {
     static const int mesh_of[WB_G_COUNT] = { MESH_SPHERE_LO, MESH_SPHERE_HI, MESH_CYLINDER, MESH_BOX };
     const wb_layers *l = &r->layers;
     for (int g = 0; g < WB_G_COUNT; g++) {
-        if (!l->count[g]) continue;
-        wb_gl_inst_attribs(&r->gl, l->first[g]);
-        glDrawElementsInstanced(GL_TRIANGLES, r->gl.mesh_count[mesh_of[g]], GL_UNSIGNED_INT,
-                                (const void *)((size_t)r->gl.mesh_first[mesh_of[g]] * sizeof(GLuint)),
-                                (GLsizei)l->count[g]);
+        /* the fine spheres' group in two draws: those seen small with the coarse mesh */
+        for (int part = 0; part < (g == WB_G_HI ? 2 : 1); part++) {
+            const size_t small = g == WB_G_HI ? r->hi_small : 0;
+            const size_t first = l->first[g] + (part ? small : 0), count = g != WB_G_HI ? l->count[g] : part ? l->count[g] - small : small;
+            const int mesh = g == WB_G_HI && part == 0 ? MESH_SPHERE_LO : mesh_of[g];
+            if (!count) continue;
+            wb_gl_inst_attribs(&r->gl, first);
+            glDrawElementsInstanced(GL_TRIANGLES, r->gl.mesh_count[mesh], GL_UNSIGNED_INT,
+                                    (const void *)((size_t)r->gl.mesh_first[mesh] * sizeof(GLuint)), (GLsizei)count);
+        }
     }
 }
 
@@ -770,6 +802,7 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
         return false;
     }
     wb_gl *g = &r->gl;
+    r->hi_small = small_spheres_first(l, r->vp, r->cam_fov, r->h);
     size_t ninst = l->first[WB_G_COUNT - 1] + l->count[WB_G_COUNT - 1];
     wb_gl_upload(GL_ARRAY_BUFFER, g->vbo_inst, &g->inst_cap, l->inst, ninst * sizeof *l->inst);
     bool surfaces = l->surfaces && l->nidx > 0;
