@@ -36,7 +36,6 @@ static const char mesh_vs[] =
 /* lighting shared by solids and the ground: a warm key light with a filtered shadow
  * map, a sky/ground ambient, a little specular; colours are linear, output sRGB */
 static const char light_fs[] =
-    "#version 330 core\n"
     "uniform vec3 u_eye;\n"
     "uniform vec3 u_light;\n"
     "uniform mat4 u_lvp;\n"
@@ -79,12 +78,16 @@ static const char light_fs[] =
     "}\n"
     /* gamma 2 instead of 2.2: a square root is much cheaper than pow on llvmpipe */
     "vec4 to_srgb(vec3 c, float a) { return vec4(sqrt(clamp(c, 0.0, 1.0)), a); }\n"
-    /* the ground: diffuse only, its cost is most of the frame's; the shadow map is
-     * looked up only where a shadow can fall (`near`: inside the map's box) */
+    /* the ground: diffuse only, its cost is most of the frame's. llvmpipe runs both
+     * sides of a branch (masked), so a lookup skipped at run time costs as much as one
+     * made: the ground has two programs, with the shadow map (SHADOWED, drawn where a
+     * shadow can fall; `near`: inside the map's box) and without (everywhere else) */
     "vec3 lit_matte(vec3 base, vec3 n, vec3 p, bool near) {\n"
     "  float ndl = dot(n, u_light);\n"
     "  float sh = ndl > 0.0 ? 1.0 : 0.0;\n"
+    "#ifdef SHADOWED\n"
     "  if (near && ndl > 0.0) sh = shadow_at(p, n, n);\n"
+    "#endif\n"
     "  vec3 amb = mix(vec3(0.16, 0.14, 0.13), vec3(0.30, 0.34, 0.42), n.y * 0.5 + 0.5);\n"
     "  return base * (amb + vec3(1.0, 0.96, 0.9) * max(ndl, 0.0) * sh);\n"
     "}\n";
@@ -243,11 +246,12 @@ static GLuint compile(GLenum type, const char *const *src, int nsrc, char *err, 
     return s;
 }
 
-static GLuint program(const char *vs, const char *fs, bool with_light, char *err, size_t n)
+/* defs: lines of #define after the light's #version (NULL: none) */
+static GLuint program(const char *vs, const char *fs, bool with_light, const char *defs, char *err, size_t n)
 {
-    const char *fsrc[2] = { light_fs, fs };
+    const char *fsrc[4] = { "#version 330 core\n", defs ? defs : "", light_fs, fs };
     GLuint v = compile(GL_VERTEX_SHADER, &vs, 1, err, n);
-    GLuint f = v ? compile(GL_FRAGMENT_SHADER, with_light ? fsrc : fsrc + 1, with_light ? 2 : 1, err, n) : 0;
+    GLuint f = v ? compile(GL_FRAGMENT_SHADER, with_light ? fsrc : fsrc + 3, with_light ? 4 : 1, err, n) : 0;
     if (!f) {
         if (v) glDeleteShader(v);
         return 0;
@@ -453,11 +457,12 @@ static bool targets(wb_gl *g, int w, int h, int *samples, char *err, size_t n)
 bool wb_gl_init(wb_gl *g, int w, int h, int *samples, char *err, size_t n)
 {
     memset(g, 0, sizeof *g);
-    if (!(g->prog_mesh = program(mesh_vs, mesh_fs, true, err, n)) ||
-        !(g->prog_depth = program(mesh_vs, depth_fs, false, err, n)) ||
-        !(g->prog_line = program(line_vs, line_fs, false, err, n)) ||
-        !(g->prog_grid = program(grid_vs, grid_fs, true, err, n)) ||
-        !(g->prog_bg = program(bg_vs, bg_fs, false, err, n)))
+    if (!(g->prog_mesh = program(mesh_vs, mesh_fs, true, NULL, err, n)) ||
+        !(g->prog_depth = program(mesh_vs, depth_fs, false, NULL, err, n)) ||
+        !(g->prog_line = program(line_vs, line_fs, false, NULL, err, n)) ||
+        !(g->prog_grid = program(grid_vs, grid_fs, true, "#define SHADOWED\n", err, n)) ||
+        !(g->prog_grid_plain = program(grid_vs, grid_fs, true, NULL, err, n)) ||
+        !(g->prog_bg = program(bg_vs, bg_fs, false, NULL, err, n)))
         return false;
 
     mesh_build m = { 0 };
@@ -533,7 +538,7 @@ bool wb_gl_init(wb_gl *g, int w, int h, int *samples, char *err, size_t n)
 
 void wb_gl_free(wb_gl *g)
 {
-    GLuint progs[] = { g->prog_mesh, g->prog_depth, g->prog_line, g->prog_grid, g->prog_bg };
+    GLuint progs[] = { g->prog_mesh, g->prog_depth, g->prog_line, g->prog_grid, g->prog_grid_plain, g->prog_bg };
     for (size_t k = 0; k < sizeof progs / sizeof *progs; k++)
         if (progs[k]) glDeleteProgram(progs[k]);
     GLuint bufs[] = { g->vbo_mesh, g->ebo_mesh, g->vbo_inst, g->vbo_surf, g->ebo_surf, g->vbo_seg };

@@ -78,6 +78,7 @@ void wb_strain_srgb(double t, float out[3]);
 
 typedef struct wb_gl {
     GLuint prog_mesh, prog_depth, prog_line, prog_grid, prog_bg;
+    GLuint prog_grid_plain;   /* the ground without the shadow map's lookup */
     GLuint vao_mesh, vao_surf, vao_line, vao_empty;
     GLuint vbo_mesh, ebo_mesh, vbo_inst, vbo_surf, ebo_surf, vbo_seg;
     GLint mesh_first[MESH_COUNT], mesh_count[MESH_COUNT];   /* index ranges */

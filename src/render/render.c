@@ -30,6 +30,7 @@ struct wb_renderer {
     /* the last frame's camera and view-projection (row-major 4x4, doubles) */
     double cam_eye[3], cam_target[3], cam_up[3], cam_fov, vp[16];
     wb_layers layers;             /* what the layers draw, rebuilt every frame */
+    size_t hi_small;              /* its fine spheres drawn coarse (small_spheres_first) */
 };
 
 /* colours, sRGB (the layers' own are in layers.c) */
@@ -340,16 +341,47 @@ static void set_vec(GLuint prog, const char *name, double x, double y, double z)
     glUniform3f(glGetUniformLocation(prog, name), (float)x, (float)y, (float)z);
 }
 
+/* the fine spheres (colliders, capsule caps) seen under this many pixels of radius are
+ * drawn with the coarse mesh: 16 slices are then within a fifth of a pixel of round, and a
+ * capsule's thin caps took 3,000 triangles each, rasterised per sample */
+#define SPHERE_LO_PIXELS 10.0
+
+/* the fine spheres seen small first in their group (order does not matter: opaque,
+ * depth-tested); returns how many */
+static size_t small_spheres_first(wb_layers *l, const double vp[16], double fov, int h)
+{
+    const double f = 0.5 * h / tan(fov * M_PI / 360);
+    size_t k = l->first[WB_G_HI];
+    const size_t end = k + l->count[WB_G_HI];
+    for (size_t i = k; i < end; i++) {
+        const float *m = l->inst[i].m;
+        const double rad = sqrt((double)m[0] * m[0] + (double)m[1] * m[1] + (double)m[2] * m[2]);
+        const double wc = vp[12] * m[12] + vp[13] * m[13] + vp[14] * m[14] + vp[15];
+        if (!(wc > rad && rad * f / wc < SPHERE_LO_PIXELS)) continue;
+        if (i != k) {
+            wb_inst t = l->inst[k];
+            l->inst[k] = l->inst[i], l->inst[i] = t;
+        }
+        k++;
+    }
+    return k - l->first[WB_G_HI];
+}
+
 static void draw_meshes(wb_renderer *r)
 {
     static const int mesh_of[WB_G_COUNT] = { MESH_SPHERE_LO, MESH_SPHERE_HI, MESH_CYLINDER, MESH_BOX };
     const wb_layers *l = &r->layers;
     for (int g = 0; g < WB_G_COUNT; g++) {
-        if (!l->count[g]) continue;
-        wb_gl_inst_attribs(&r->gl, l->first[g]);
-        glDrawElementsInstanced(GL_TRIANGLES, r->gl.mesh_count[mesh_of[g]], GL_UNSIGNED_INT,
-                                (const void *)((size_t)r->gl.mesh_first[mesh_of[g]] * sizeof(GLuint)),
-                                (GLsizei)l->count[g]);
+        /* the fine spheres' group in two draws: those seen small with the coarse mesh */
+        for (int part = 0; part < (g == WB_G_HI ? 2 : 1); part++) {
+            const size_t small = g == WB_G_HI ? r->hi_small : 0;
+            const size_t first = l->first[g] + (part ? small : 0), count = g != WB_G_HI ? l->count[g] : part ? l->count[g] - small : small;
+            const int mesh = g == WB_G_HI && part == 0 ? MESH_SPHERE_LO : mesh_of[g];
+            if (!count) continue;
+            wb_gl_inst_attribs(&r->gl, first);
+            glDrawElementsInstanced(GL_TRIANGLES, r->gl.mesh_count[mesh], GL_UNSIGNED_INT,
+                                    (const void *)((size_t)r->gl.mesh_first[mesh] * sizeof(GLuint)), (GLsizei)count);
+        }
     }
 }
 
@@ -409,31 +441,213 @@ static int below_horizon(const double gn[3], double s, const double cam[3][3], f
     return n >= 3 ? n : 0;
 }
 
+/* where a shadow can fall, for the ground's two programs: the light's view (row-major,
+ * its x and y rows are light-space x and y), what the shadow pass drew and how far past
+ * a caster's light-space bounds a lookup reaches */
+typedef struct shadow_reach {
+    double lview[16], margin;
+    const wb_layers *l;
+    bool surfaces;
+} shadow_reach;
+
+#define SHADOW_TILE 32   /* pixels: the ground's programs are chosen per tile */
+
+/* a plane's light-space (x, y) -> clip space map: the plane's point with those light-space
+ * coordinates is P0 + x A + y B, so its clip position is q0 + x qa + y qb */
+typedef struct plane_map { double q0[4], qa[4], qb[4]; } plane_map;
+
+static bool plane_map_of(const wb_renderer *r, const shadow_reach *s, const double gn[3], double off, plane_map *m)
+{
+    const double *ex = s->lview, *ey = s->lview + 4;
+    /* the rows ex, ey, gn of a 3x3 system: its inverse's columns by cross products */
+    double c0[3], c1[3], c2[3];
+    cross3(ey, gn, c0);
+    cross3(gn, ex, c1);
+    cross3(ex, ey, c2);
+    const double det = dot3(ex, c0);
+    if (!(fabs(det) > 1e-6)) return false;   /* the light along the plane */
+    double p0[3], a[3], b[3];
+    for (int k = 0; k < 3; k++)
+        p0[k] = (-ex[3] * c0[k] - ey[3] * c1[k] + off * c2[k]) / det, a[k] = c0[k] / det, b[k] = c1[k] / det;
+    for (int i = 0; i < 4; i++) {
+        const double *v = r->vp + 4 * i;
+        m->q0[i] = v[0] * p0[0] + v[1] * p0[1] + v[2] * p0[2] + v[3];
+        m->qa[i] = v[0] * a[0] + v[1] * a[1] + v[2] * a[2];
+        m->qb[i] = v[0] * b[0] + v[1] * b[1] + v[2] * b[2];
+    }
+    return true;
+}
+
+/* mark the tiles where the plane's points of light-space bounds lo..hi (a parallelogram)
+ * are seen; false when a corner is behind the camera (then anything may be) */
+static bool mark_footprint(const wb_renderer *r, const plane_map *m, const double lo[2], const double hi[2],
+                           uint8_t *tiles, int tw, int th)
+{
+    double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+    for (int k = 0; k < 4; k++) {
+        const double X = k & 1 ? hi[0] : lo[0], Y = k & 2 ? hi[1] : lo[1];
+        double q[4];
+        for (int i = 0; i < 4; i++) q[i] = m->q0[i] + X * m->qa[i] + Y * m->qb[i];
+        if (!(q[3] > 1e-9)) return false;
+        /* window pixels, rows from the bottom (GL's) */
+        const double x = (q[0] / q[3] * 0.5 + 0.5) * r->w, y = (q[1] / q[3] * 0.5 + 0.5) * r->h;
+        if (k == 0 || x < x0) x0 = x;
+        if (k == 0 || x > x1) x1 = x;
+        if (k == 0 || y < y0) y0 = y;
+        if (k == 0 || y > y1) y1 = y;
+    }
+    /* a pixel more each side: every pixel centre inside is in a marked tile */
+    const int tx0 = (int)fmax(0, floor((x0 - 1) / SHADOW_TILE)), tx1 = (int)fmin(tw - 1, floor((x1 + 1) / SHADOW_TILE));
+    const int ty0 = (int)fmax(0, floor((y0 - 1) / SHADOW_TILE)), ty1 = (int)fmin(th - 1, floor((y1 + 1) / SHADOW_TILE));
+    for (int ty = ty0; ty <= ty1; ty++)
+        for (int tx = tx0; tx <= tx1; tx++) tiles[ty * tw + tx] = 1;
+    return true;
+}
+
+/* the tiles of the frame where the plane gn.x = off may have a shadow: under each
+ * instance (its unit cube holds the sphere, cylinder and box meshes) and each surface
+ * triangle along the light; false: all of them (it cannot be told) */
+static bool shadow_tiles(const wb_renderer *r, const shadow_reach *s, const double gn[3], double off, uint8_t *tiles,
+                         int tw, int th)
+{
+    plane_map m;
+    if (!plane_map_of(r, s, gn, off, &m)) return false;
+    const double *V = s->lview, e = s->margin;
+    const wb_layers *l = s->l;
+    const size_t ninst = l->first[WB_G_COUNT - 1] + l->count[WB_G_COUNT - 1];
+    for (size_t i = 0; i < ninst; i++) {
+        const float *t = l->inst[i].m;
+        /* the mesh's box: y in 0..1 for a cylinder, -1..1 otherwise; cut along its
+         * longest axis into near-cubes (a long thin capsule's bounds across the light
+         * would cover much of the ground) */
+        const bool cyl = i >= l->first[WB_G_CYL] && i < l->first[WB_G_CYL] + l->count[WB_G_CYL];
+        double len[3];
+        int j = 0;
+        for (int col = 0; col < 3; col++) {
+            len[col] = sqrt((double)t[4 * col] * t[4 * col] + (double)t[4 * col + 1] * t[4 * col + 1] +
+                            (double)t[4 * col + 2] * t[4 * col + 2]) * (cyl && col == 1 ? 0.5 : 1);
+            if (len[col] > len[j]) j = col;
+        }
+        const double thin = fmax(fmin(len[(j + 1) % 3], len[(j + 2) % 3]), 1e-9 * len[j]);
+        const int pieces = (int)fmin(64, fmax(1, ceil(len[j] / thin)));
+        const double y0 = cyl ? 0 : -1, span = cyl ? 1 : 2;
+        for (int piece = 0; piece < pieces; piece++) {
+            double lo[2], hi[2];
+            const double mid = y0 + span * (piece + 0.5) / pieces, half = 0.5 * span / pieces;
+            for (int a = 0; a < 2; a++) {
+                const double *row = V + 4 * a;
+                double c = row[3], h = e;
+                for (int k = 0; k < 3; k++) c += row[k] * t[12 + k];
+                for (int col = 0; col < 3; col++) {
+                    const double d = row[0] * t[4 * col] + row[1] * t[4 * col + 1] + row[2] * t[4 * col + 2];
+                    const double cm = cyl && col == 1 ? 0.5 : 0, hm = cyl && col == 1 ? 0.5 : 1;
+                    if (col == j) c += d * mid, h += fabs(d) * half;
+                    else c += d * cm, h += fabs(d) * hm;
+                }
+                lo[a] = c - h, hi[a] = c + h;
+            }
+            if (!mark_footprint(r, &m, lo, hi, tiles, tw, th)) return false;
+        }
+    }
+    for (size_t i = 0; s->surfaces && i + 2 < l->nidx; i += 3) {
+        double lo[2], hi[2];
+        for (int k = 0; k < 3; k++) {
+            const float *q = l->sv + WB_SV * (size_t)l->si[i + k];
+            for (int a = 0; a < 2; a++) {
+                const double *row = V + 4 * a, c = row[0] * q[0] + row[1] * q[1] + row[2] * q[2] + row[3];
+                if (k == 0 || c - e < lo[a]) lo[a] = c - e;
+                if (k == 0 || c + e > hi[a]) hi[a] = c + e;
+            }
+        }
+        if (!mark_footprint(r, &m, lo, hi, tiles, tw, th)) return false;
+    }
+    return true;
+}
+
+/* the tiles of value v as rectangles of window pixels (x, y, width, height): each row's
+ * runs, a run the same as the one below it merged into that rectangle; returns how many */
+static int tile_rects(const uint8_t *tiles, int tw, int th, uint8_t v, int w, int h, int (*out)[4], int *open)
+{
+    int n = 0;
+    for (int x = 0; x < tw; x++) open[x] = -1;
+    for (int ty = 0; ty < th; ty++) {
+        const int y0 = ty * SHADOW_TILE, y1 = y0 + SHADOW_TILE < h ? y0 + SHADOW_TILE : h;
+        for (int tx = 0; tx < tw;) {
+            if (tiles[ty * tw + tx] != v) {
+                open[tx++] = -1;
+                continue;
+            }
+            int end = tx;
+            while (end < tw && tiles[ty * tw + end] == v) end++;
+            const int x0 = tx * SHADOW_TILE, x1 = end * SHADOW_TILE < w ? end * SHADOW_TILE : w, o = open[tx];
+            if (o >= 0 && out[o][0] == x0 && out[o][2] == x1 - x0 && out[o][1] + out[o][3] == y0) {
+                out[o][3] = y1 - out[o][1];
+            } else {
+                out[n][0] = x0, out[n][1] = y0, out[n][2] = x1 - x0, out[n][3] = y1 - y0;
+                open[tx] = n++;
+            }
+            for (int k = tx + 1; k < end; k++) open[k] = -1;
+            tx = end;
+        }
+    }
+    return n;
+}
+
 /* a plane (n.x = offset) over the part of the screen below its horizon; a floor reaches
  * the horizon, fogged over `fog`; any other plane is a disc of radius ext around center.
- * cam: the view rays' axes (camera_rays) */
+ * cam: the view rays' axes (camera_rays). Two programs draw it: the one that looks up
+ * the shadow map on the tiles where a shadow can fall (shadow_tiles), the one that does
+ * not on the others; outside a shadow both give the same colour, so no seam */
 static void draw_grid(wb_renderer *r, const double cam[3][3], const double center[3], const double gu[3],
-                      const double gv[3], const double gn[3], double spacing, double ext, bool floor, double fog)
+                      const double gv[3], const double gn[3], double spacing, double ext, bool floor, double fog,
+                      const shadow_reach *sr)
 {
-    GLuint p = r->gl.prog_grid;
     float poly[10];
     const int np = below_horizon(gn, dot3(gn, center) - dot3(gn, r->cam_eye), cam, poly);
     if (!np) return;
-    glUniform2fv(glGetUniformLocation(p, "u_poly"), 5, poly);
+    const int tw = (r->w + SHADOW_TILE - 1) / SHADOW_TILE, th = (r->h + SHADOW_TILE - 1) / SHADOW_TILE;
+    const size_t nt = (size_t)tw * (size_t)th;
+    /* the tiles, then the rectangles of each program and a row's open runs */
+    uint8_t *tiles = calloc(nt, 1);
+    int (*rects)[4] = tiles ? malloc(2 * nt * sizeof *rects) : NULL;
+    int *open = rects ? malloc((size_t)tw * sizeof *open) : NULL;
+    int nrect[2] = { 1, 0 };
+    int whole[4] = { 0, 0, r->w, r->h };
+    const bool tiled = open && shadow_tiles(r, sr, gn, dot3(gn, center), tiles, tw, th);
+    if (tiled) {
+        nrect[0] = tile_rects(tiles, tw, th, 1, r->w, r->h, rects, open);
+        nrect[1] = tile_rects(tiles, tw, th, 0, r->w, r->h, rects + nt, open);
+    }
     glBindVertexArray(r->gl.vao_empty);
-    set_vec(p, "u_center", center[0], center[1], center[2]);
-    set_vec(p, "u_gu", gu[0], gu[1], gu[2]);
-    set_vec(p, "u_gv", gv[0], gv[1], gv[2]);
-    set_vec(p, "u_gn", gn[0], gn[1], gn[2]);
-    glUniform1f(glGetUniformLocation(p, "u_offset"), (float)dot3(gn, center));
-    glUniform1f(glGetUniformLocation(p, "u_spacing"), (float)spacing);
-    glUniform1f(glGetUniformLocation(p, "u_extent"), (float)ext);
-    glUniform1f(glGetUniformLocation(p, "u_fog"), (float)fog);
-    glUniform1i(glGetUniformLocation(p, "u_floor"), floor);
-    float g[3];
-    wb_lin3(col_ground, g);
-    glUniform3f(glGetUniformLocation(p, "u_base"), g[0], g[1], g[2]);
-    glDrawArrays(GL_TRIANGLE_FAN, 0, np);
+    glEnable(GL_SCISSOR_TEST);
+    for (int pass = 0; pass < 2; pass++) {
+        if (!nrect[pass]) continue;
+        GLuint p = pass == 0 ? r->gl.prog_grid : r->gl.prog_grid_plain;
+        glUseProgram(p);
+        glUniform2fv(glGetUniformLocation(p, "u_poly"), 5, poly);
+        set_vec(p, "u_center", center[0], center[1], center[2]);
+        set_vec(p, "u_gu", gu[0], gu[1], gu[2]);
+        set_vec(p, "u_gv", gv[0], gv[1], gv[2]);
+        set_vec(p, "u_gn", gn[0], gn[1], gn[2]);
+        glUniform1f(glGetUniformLocation(p, "u_offset"), (float)dot3(gn, center));
+        glUniform1f(glGetUniformLocation(p, "u_spacing"), (float)spacing);
+        glUniform1f(glGetUniformLocation(p, "u_extent"), (float)ext);
+        glUniform1f(glGetUniformLocation(p, "u_fog"), (float)fog);
+        glUniform1i(glGetUniformLocation(p, "u_floor"), floor);
+        float g[3];
+        wb_lin3(col_ground, g);
+        glUniform3f(glGetUniformLocation(p, "u_base"), g[0], g[1], g[2]);
+        for (int k = 0; k < nrect[pass]; k++) {
+            /* untold (or out of memory for the tiles): all of it with the shadow map */
+            const int *q = tiled ? rects[pass * nt + k] : whole;
+            glScissor(q[0], q[1], q[2], q[3]);
+            glDrawArrays(GL_TRIANGLE_FAN, 0, np);
+        }
+    }
+    glDisable(GL_SCISSOR_TEST);
+    free(open);
+    free(rects);
+    free(tiles);
 }
 
 /* the camera's axes for the ground's view rays: forward, and right and up scaled to
@@ -588,6 +802,7 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
         return false;
     }
     wb_gl *g = &r->gl;
+    r->hi_small = small_spheres_first(l, r->vp, r->cam_fov, r->h);
     size_t ninst = l->first[WB_G_COUNT - 1] + l->count[WB_G_COUNT - 1];
     wb_gl_upload(GL_ARRAY_BUFFER, g->vbo_inst, &g->inst_cap, l->inst, ninst * sizeof *l->inst);
     bool surfaces = l->surfaces && l->nidx > 0;
@@ -632,16 +847,24 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, g->tex_shadow);
 
-    /* the ground: every plane collider, or a floor under the scene */
-    light_uniforms(g->prog_grid, r->vp, lvp, r->cam_eye, L, bias, true);
-    glUniform3f(glGetUniformLocation(g->prog_grid, "u_top"), col_sky_top[0], col_sky_top[1], col_sky_top[2]);
-    glUniform3f(glGetUniformLocation(g->prog_grid, "u_bottom"), col_sky_bottom[0], col_sky_bottom[1], col_sky_bottom[2]);
-    glUniform1f(glGetUniformLocation(g->prog_grid, "u_height"), (float)r->h);
+    /* the ground: every plane collider, or a floor under the scene; its two programs
+     * (draw_grid) take the same uniforms */
     double cam[3][3];
-    camera_rays(r, g->prog_grid, cam);
-    /* the shadow map's box (ortho, below) lies within sqrt(6) R of c: no shadow beyond */
-    set_vec(g->prog_grid, "u_sc", c[0], c[1], c[2]);
-    glUniform1f(glGetUniformLocation(g->prog_grid, "u_sr2"), (float)(6.05 * R * R));
+    for (int k = 0; k < 2; k++) {
+        const GLuint p = k ? g->prog_grid_plain : g->prog_grid;
+        light_uniforms(p, r->vp, lvp, r->cam_eye, L, bias, true);
+        glUniform3f(glGetUniformLocation(p, "u_top"), col_sky_top[0], col_sky_top[1], col_sky_top[2]);
+        glUniform3f(glGetUniformLocation(p, "u_bottom"), col_sky_bottom[0], col_sky_bottom[1], col_sky_bottom[2]);
+        glUniform1f(glGetUniformLocation(p, "u_height"), (float)r->h);
+        camera_rays(r, p, cam);
+        /* the shadow map's box (ortho, below) lies within sqrt(6) R of c: no shadow beyond */
+        set_vec(p, "u_sc", c[0], c[1], c[2]);
+        glUniform1f(glGetUniformLocation(p, "u_sr2"), (float)(6.05 * R * R));
+    }
+    /* a lookup reaches past its point by the normal offset (at most 8 biases) and the
+     * filter's texel: 16 texels of margin (a texel is 2R / shadow_size) */
+    shadow_reach sr = { .margin = 32 * R / g->shadow_size, .l = l, .surfaces = surfaces };
+    memcpy(sr.lview, lview, sizeof sr.lview);
     /* the fog: the ground around the scene stays clear however far the camera is */
     const double spacing = wb_nice_step(R / 6), fog = 2 * dc + 3 * ext;
     double center[3], gu[3], gv[3], gn[3];
@@ -654,14 +877,14 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
         const bool floor = floor_height(&d, &h);
         if (d.shape != WB_SHAPE_PLANE || !(o->colliders || (o->grid && floor))) continue;
         if (plane_frame(d.normal, d.offset, c, center, gu, gv, gn)) {
-            draw_grid(r, cam, center, gu, gv, gn, spacing, ext, floor, fog);
+            draw_grid(r, cam, center, gu, gv, gn, spacing, ext, floor, fog, &sr);
             planes++;
         }
     }
     if (!planes && o->grid) {
         wb_real up[3] = { 0, 1, 0 };
         if (plane_frame(up, fmin(cur.lo[1], r->view_lo[1]), c, center, gu, gv, gn))
-            draw_grid(r, cam, center, gu, gv, gn, spacing, ext, true, fog);
+            draw_grid(r, cam, center, gu, gv, gn, spacing, ext, true, fog, &sr);
     }
 
     /* solids, then the surfaces pushed back a little so links on them stay visible */

@@ -69,6 +69,9 @@ for s in $SCENES; do
     first=0
 done
 scene "$BUILD/wobble" contacts 0 contacts_off contacts=0   # issue 8: what contacts add
+echo
+echo "== recording (tests/bench/record.lua: the demo scene at 1280x720, 4x MSAA, to MP4; wall clock)"
+scene "$BUILD/wobble" record 1
 if [ -n "$FLOAT" ]; then
     echo
     echo "== WB_FLOAT ($FLOAT): the cloth scenes (Bullet's figures as above)"
@@ -151,6 +154,10 @@ aim "self128: self-colliding / not" "$(row self128 ratio_off)" 1.3
 aim "loose128: hand-built, contacts / none" "$(row loose128 ratio_off)" 1.3
 aim "heap128: self-colliding heap / not" "$(row heap128 ratio_off)" 3
 aim "drape128: self-colliding, draped / not" "$(row drape128 ratio_off)" 1.3
+# the recording's goal (larger is better): drawing and encoding, the simulation taken out
+echo
+echo "== the goal of recording (tests/bench/record.lua; wall clock)"
+goal "record: frames a second of a 1280x720 recording" "$(row record fps_recording)" 30
 echo
 echo "JSON lines: $JSON"
 exit 0
