@@ -201,6 +201,9 @@ static int w_cloth(lua_State *L)
         d.mass = mat->density * t * d.size[0] * d.size[1];
         d.link.compliance = 1 / (mat->young * t);
         d.link.damping = mat->viscosity * t;
+        /* the plate's bending stiffness D = E t^3 / 12 (N m) as each hinge's: a hinge of a
+         * square grid spans about as much sheet as it is long */
+        d.bend = 12 / (mat->young * t * t * t);
     }
     const bool auto_radius = read_mass_radius(L, &d.mass, &d.radius);
     wbl_contact_opts co;
