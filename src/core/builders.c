@@ -136,19 +136,6 @@ static void link(wb_world *w, int32_t a, int32_t b, const wb_distance_def *def)
     wb_distance_add(w, a, b, def, NULL);
 }
 
-/* A Neo-Hookean body's damping: a dashpot along a tet edge a-b, a link whose spring is
- * DASH_SOFT of the edge's own stiffness E L (so E stays E to about 1e-4 per link) and
- * whose damping beta acts in full: with alpha~ >> 1/m the XPBD damping of eq. 26 becomes
- * a dashpot of beta N s/m whatever alpha is (distance.c, gamma / alpha~ = beta h). */
-#define DASH_SOFT ((wb_real)1e-4)
-wb_distance_def wb__dashpot_def(const wb_distance_def *link, wb_real young, wb_real length)
-{
-    wb_distance_def d = *link;
-    d.compliance = 1 / (DASH_SOFT * young * length);
-    d.yield = d.creep = d.break_strain = d.break_force = 0;
-    return d;
-}
-
 static void dashpot(wb_world *w, int32_t a, int32_t b, const wb_distance_def *def, wb_real young)
 {
     wb_real xa[3], xb[3];
