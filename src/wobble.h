@@ -659,4 +659,20 @@ typedef struct wb_rigid_contact {
 int32_t wb_world_rigid_contact_count(const wb_world *w);
 wb_rigid_contact wb_world_rigid_contact_at(const wb_world *w, int32_t i);
 
+/* ---- material presets (material.c) -------------------------------------------------------
+ * Named measured materials (README "Materials" gives the sources): builders take their
+ * figures as the defaults of young, poisson, mass (density x volume), damping, friction */
+typedef struct wb_material {
+    const char *name;     /* lower_snake: "rubber", "jelly", "foam", "cloth", "leather", "steel_cable" */
+    wb_real young;        /* Young's modulus, Pa */
+    wb_real poisson;      /* Poisson's ratio */
+    wb_real density;      /* kg/m^3 */
+    wb_real viscosity;    /* Kelvin-Voigt damping, Pa s (stress = E strain + viscosity strain rate) */
+    wb_real friction;     /* Coulomb coefficient of its particles' contacts */
+    wb_real thickness;    /* m: a sheet's thickness (cloth), a rope's diameter (rope) */
+} wb_material;
+int32_t wb_material_count(void);
+const wb_material *wb_material_at(int32_t i);                 /* NULL out of [0, count) */
+const wb_material *wb_material_preset(const char *name);      /* NULL for an unknown name */
+
 #endif

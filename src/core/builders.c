@@ -136,6 +136,17 @@ static void link(wb_world *w, int32_t a, int32_t b, const wb_distance_def *def)
     wb_distance_add(w, a, b, def, NULL);
 }
 
+static void dashpot(wb_world *w, int32_t a, int32_t b, const wb_distance_def *def, wb_real young)
+{
+    wb_real xa[3], xb[3];
+    wb_particle_position(w, a, xa);
+    wb_particle_position(w, b, xb);
+    const wb_real len = sqrt((xb[0] - xa[0]) * (xb[0] - xa[0]) + (xb[1] - xa[1]) * (xb[1] - xa[1]) +
+                             (xb[2] - xa[2]) * (xb[2] - xa[2]));
+    const wb_distance_def d = wb__dashpot_def(def, young, len);
+    wb_distance_add(w, a, b, &d, NULL);
+}
+
 wb_status wb_cloth(wb_world *w, const wb_cloth_def *d, wb_body *out)
 {
     wb_status st = check_common(d->mass, d->radius, &d->link);
@@ -261,15 +272,16 @@ wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
     if (d->tets && !(d->volume_compliance >= 0 && isfinite(d->volume_compliance)))
         return bad("volume_compliance must be >= 0");
     if (d->tets && 6 * cells > WB_MAX_CONSTRAINTS) return bad("res is too large for tets");
-    /* young: Neo-Hookean tets and no links (E means E: links would add their stiffness) */
-    const bool neo = d->young != 0;
+    /* young: Neo-Hookean tets and no links (E means E: links would add their stiffness);
+     * with damping, dashpot links (nearly no spring) on the same pairs */
+    const bool neo = d->young != 0, dash = neo && d->link.damping > 0;
     if (neo && !d->tets) return bad("young needs tets = true");
     if (neo) {
         const wb_tet_def td = { d->young, d->poisson, 0, 0 };
         const char *e = wb_tet_def_check(&td);
         if (e) return bad(e);
     }
-    if ((st = wb__reserve(w, np, neo ? 0 : nd)) != WB_OK || (st = wb__surface_reserve(w, (int32_t)ntri)) != WB_OK ||
+    if ((st = wb__reserve(w, np, neo && !dash ? 0 : nd)) != WB_OK || (st = wb__surface_reserve(w, (int32_t)ntri)) != WB_OK ||
         (d->tets && (st = neo ? wb__tet_reserve(w, 6 * cells) : wb__volume_reserve(w, 6 * cells)) != WB_OK))
         return st;
     const int32_t first = w->m.np, first_vol = wb_volume_count(w), first_tet = wb_tet_count(w);
@@ -290,8 +302,9 @@ wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
                 if (neo) {
                     if (ex && ey && ez)
                         wb__kuhn_tets(w, a, ID(i + 1, j, k) - a, ID(i, j + 1, k) - a, ID(i, j, k + 1) - a, 0, d->young, d->poisson);
-                    continue;
+                    if (!dash) continue;
                 }
+#define link(w, a, b, def) (dash ? dashpot(w, a, b, def, d->young) : link(w, a, b, def))
                 if (ex) link(w, a, ID(i + 1, j, k), &d->link);
                 if (ey) link(w, a, ID(i, j + 1, k), &d->link);
                 if (ez) link(w, a, ID(i, j, k + 1), &d->link);
@@ -303,10 +316,11 @@ wb_status wb_lattice(wb_world *w, const wb_lattice_def *d, wb_body *out)
                     link(w, ID(i + 1, j, k), ID(i, j + 1, k + 1), &d->link);
                     link(w, ID(i, j + 1, k), ID(i + 1, j, k + 1), &d->link);
                     link(w, ID(i, j, k + 1), ID(i + 1, j + 1, k), &d->link);
-                    if (d->tets) wb__kuhn_tets(w, ID(i, j, k), ID(i + 1, j, k) - ID(i, j, k), ID(i, j + 1, k) - ID(i, j, k),
+                    if (d->tets && !neo) wb__kuhn_tets(w, ID(i, j, k), ID(i + 1, j, k) - ID(i, j, k), ID(i, j + 1, k) - ID(i, j, k),
                                                ID(i, j, k + 1) - ID(i, j, k), d->volume_compliance, 0, 0);
                 }
             }
+#undef link
     /* the hull: each of the six faces as a grid of quads, wound outwards */
     int32_t *tri = malloc(sizeof *tri * 3 * (size_t)ntri);
     if (tri) {

@@ -685,6 +685,18 @@ void wb__contacts_friction(wb_world *w, wb_real h);
 void wb__tricontacts_load(wb_world *w, wb_real h, wb_real *load);
 void wb__tricontacts_static(wb_world *w, wb_real *load);
 wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra); /* world.c */
+/* A Neo-Hookean body's damping (builders.c, tets.c): a dashpot along a tet edge of rest
+ * length `length`, a link whose spring is 1e-4 of the edge's own stiffness E L (so E stays
+ * E to about 1e-4 per link) and whose damping beta acts in full: with alpha~ >> 1/m the
+ * XPBD damping of eq. 26 is a dashpot of beta N s/m whatever alpha is (distance.c: gamma /
+ * alpha~ = beta h). Inline: both builders use it and neither calls the other's file. */
+static inline wb_distance_def wb__dashpot_def(const wb_distance_def *link, wb_real young, wb_real length)
+{
+    wb_distance_def d = *link;
+    d.compliance = 1 / ((wb_real)1e-4 * young * length);
+    d.yield = d.creep = d.break_strain = d.break_force = 0;
+    return d;
+}
 wb_status wb__surface_reserve(wb_world *w, int32_t ntri);
 /* world.c: the world's pool for its current thread count (NULL: one thread); created
  * lazily, the same pool from call to call. A cache: callable on a const world */

@@ -207,7 +207,9 @@ wb_status wb_tet_body(wb_world *w, const wb_real *v, int32_t nv, const int32_t *
     }
     /* everything reserved first: after this nothing can fail */
     /* Neo-Hookean: the tets alone make the solid (links would stiffen it past E) */
-    if (neo) ne = 0;
+    /* ... but with damping, dashpots on the edges (builders.c's wb__dashpot_def) */
+    const bool dash = neo && d->link.damping > 0;
+    if (neo && !dash) ne = 0;
     if (st == WB_OK) st = wb__reserve(w, nv, ne);
     if (st == WB_OK) st = wb__surface_reserve(w, ntri);
     if (st == WB_OK) st = neo ? wb__tet_reserve(w, nt) : wb__volume_reserve(w, nt);
@@ -220,7 +222,15 @@ wb_status wb_tet_body(wb_world *w, const wb_real *v, int32_t nv, const int32_t *
         }
         for (int32_t i = 0; i < ne; i++) {
             wb_status s2;
-            wb_distance_add(w, first + (int32_t)(ek[i] >> 32), first + (int32_t)(ek[i] & 0xffffffffu), &d->link, &s2);
+            const int32_t a = (int32_t)(ek[i] >> 32), b = (int32_t)(ek[i] & 0xffffffffu);
+            wb_distance_def ld = d->link;
+            if (dash) {
+                const wb_real *va = &v[3 * a], *vb = &v[3 * b];
+                ld = wb__dashpot_def(&d->link, d->young, sqrt((va[0] - vb[0]) * (va[0] - vb[0]) +
+                                                              (va[1] - vb[1]) * (va[1] - vb[1]) +
+                                                              (va[2] - vb[2]) * (va[2] - vb[2])));
+            }
+            wb_distance_add(w, first + a, first + b, &ld, &s2);
         }
         for (int32_t t = 0; t < nt; t++) {
             int32_t p[4];

@@ -180,7 +180,8 @@ static void check_link(lua_State *L, const wb_distance_def *d)
 
 static const char *const cloth_keys[] = {
     "origin", "size", "res", "mass", "radius", "shear", "bend", "bend_links",
-    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
+    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction",
+    "material", NULL
 };
 
 static int w_cloth(lua_State *L)
@@ -192,9 +193,22 @@ static int w_cloth(lua_State *L)
     if (wbl_optvec(L, 2, "size", 2, d.size) && !(d.size[0] > 0 && d.size[1] > 0))
         return wbl_fielderror(L, 2, "size", "both sizes must be > 0");
     wbl_optivec(L, 2, "res", 2, 2, WB_MAX_PARTICLES, d.res);
+    /* a preset: a sheet of its thickness t: mass rho t A, links of stiffness E t and
+     * dashpots eta t (a square grid's links along one axis carry E t per unit width) */
+    const wb_material *mat = wbl_opt_material(L, 2);
+    if (mat) {
+        const wb_real t = mat->thickness;
+        d.mass = mat->density * t * d.size[0] * d.size[1];
+        d.link.compliance = 1 / (mat->young * t);
+        d.link.damping = mat->viscosity * t;
+        /* the plate's bending stiffness D = E t^3 / 12 (N m) as each hinge's: a hinge of a
+         * square grid spans about as much sheet as it is long */
+        d.bend = 12 / (mat->young * t * t * t);
+    }
     const bool auto_radius = read_mass_radius(L, &d.mass, &d.radius);
     wbl_contact_opts co;
     wbl_read_contact_opts(L, 2, &co);
+    wbl_material_friction(L, 2, mat, &co);
     wbl_optbool(L, 2, "shear", &d.shear);
     wbl_read_link(L, 2, &d.link);
     /* bend (dihedral, per interior edge): nil/false = none, true = rigid (0), a number =
@@ -221,7 +235,8 @@ static int w_cloth(lua_State *L)
 
 static const char *const rope_keys[] = {
     "from", "to", "segments", "mass", "radius",
-    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
+    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction",
+    "material", NULL
 };
 
 static int w_rope(lua_State *L)
@@ -232,9 +247,23 @@ static int w_rope(lua_State *L)
     wbl_optvec(L, 2, "from", 3, d.from);
     wbl_optvec(L, 2, "to", 3, d.to);
     wbl_optint(L, 2, "segments", 1, WB_MAX_PARTICLES - 1, &d.segments);
+    /* a preset: a rod of its diameter (area A), segments of length l: mass rho A L, links
+     * of stiffness E A / l and dashpots eta A / l */
+    const wb_material *mat = wbl_opt_material(L, 2);
+    if (mat) {
+        const wb_real dx = d.to[0] - d.from[0], dy = d.to[1] - d.from[1], dz = d.to[2] - d.from[2];
+        const wb_real len = sqrt(dx * dx + dy * dy + dz * dz), l = len / d.segments;
+        const wb_real area = 3.14159265358979323846 / 4 * mat->thickness * mat->thickness;
+        if (len > 0) d.mass = mat->density * area * len;
+        if (l > 0) {
+            d.link.compliance = l / (mat->young * area);
+            d.link.damping = mat->viscosity * area / l;
+        }
+    }
     const bool auto_radius = read_mass_radius(L, &d.mass, &d.radius);
     wbl_contact_opts co;
     wbl_read_contact_opts(L, 2, &co);
+    wbl_material_friction(L, 2, mat, &co);
     wbl_read_link(L, 2, &d.link);
     check_link(L, &d.link);
     BUILD(L, w, wb_rope, "rope", (int64_t)d.segments + 1);
@@ -242,7 +271,8 @@ static int w_rope(lua_State *L)
 
 static const char *const lattice_keys[] = {
     "min", "max", "res", "mass", "radius", "tets", "volume_compliance", "young", "poisson",
-    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
+    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction",
+    "material", NULL
 };
 
 static int w_lattice(lua_State *L)
@@ -255,12 +285,32 @@ static int w_lattice(lua_State *L)
     if (!(d.min[0] < d.max[0] && d.min[1] < d.max[1] && d.min[2] < d.max[2]))
         return luaL_argerror(L, 2, "min must be below max on every axis");
     wbl_optivec(L, 2, "res", 3, 2, WB_MAX_PARTICLES, d.res);
-    const bool auto_radius = read_mass_radius(L, &d.mass, &d.radius);
-    wbl_contact_opts co;
-    wbl_read_contact_opts(L, 2, &co);
+    /* a preset: mass rho x the box's volume; Neo-Hookean tets of its E and nu (tets on
+     * unless the options say false) with dashpots eta a on the cell's links (a the mean
+     * cell edge: a cubic grid's edge dashpots alone give a viscosity eta, the diagonals
+     * add to it); with tets = false links of stiffness E a */
+    const wb_material *mat = wbl_opt_material(L, 2);
+    if (mat) d.tets = true;
     /* tets: 6 per cell, each with a volume constraint of compliance volume_compliance
      * (m^3/Pa, default 0: incompressible; `compliance` stays the links' own, in m/N) */
     wbl_optbool(L, 2, "tets", &d.tets);
+    if (mat) {
+        wb_real vol = 1, a = 0;
+        for (int k = 0; k < 3; k++) {
+            vol *= d.max[k] - d.min[k];
+            a += (d.max[k] - d.min[k]) / (d.res[k] - 1) / 3;
+        }
+        d.mass = mat->density * vol;
+        if (d.tets) {
+            d.young = mat->young;
+            d.poisson = mat->poisson;
+        } else d.link.compliance = 1 / (mat->young * a);
+        d.link.damping = mat->viscosity * a;
+    }
+    const bool auto_radius = read_mass_radius(L, &d.mass, &d.radius);
+    wbl_contact_opts co;
+    wbl_read_contact_opts(L, 2, &co);
+    wbl_material_friction(L, 2, mat, &co);
     if (wbl_optreal(L, 2, "volume_compliance", &d.volume_compliance) && d.volume_compliance < 0)
         return wbl_fielderror(L, 2, "volume_compliance", "must be >= 0");
     /* young (Pa): Neo-Hookean tets (lua/volume.c's w:tet) and no links, so that E means E */

@@ -104,10 +104,12 @@ static int w_load_particles(lua_State *L)
     char path[PATH_MAX], err[1024];
     /* contact options for the whole body; without them the file's own settings stay
      * (radius: every particle's contact radius, e.g. a file made before contacts) */
-    static const char *const keys[] = { "collide", "self_collide", "friction", "radius", NULL };
+    static const char *const keys[] = { "collide", "self_collide", "friction", "radius", "material", NULL };
     const bool given = wbl_checkopts(L, 3, keys, true);
     wbl_contact_opts co;
     wbl_read_contact_opts(L, 3, &co);
+    /* a preset: its friction only (the file gives masses and constraints) */
+    wbl_material_friction(L, 3, wbl_opt_material(L, 3), &co);
     wb_real radius = -1;
     if (given && wbl_optreal(L, 3, "radius", &radius) && !(radius >= 0 && isfinite(radius)))
         return wbl_fielderror(L, 3, "radius", "must be finite and >= 0");

@@ -334,7 +334,8 @@ static int m_tostring(lua_State *L)
 /* ---- w:from_mesh(m, {tets = true, ...}): filled with tets by tetgen (io/tets.c), lua/volume.c builds */
 static const char *const from_mesh_tets_keys[] = {
     "tets", "max_volume", "quality", "keep_surface", "timeout", "mass", "radius", "volume_compliance", "young", "poisson",
-    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
+    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction",
+    "material", NULL
 };
 
 /* the volume a closed mesh encloses (divergence theorem over its triangles), m^3 */
@@ -360,9 +361,15 @@ static int from_mesh_tets(lua_State *L)
     const wb_mesh *m = wbl_checkmesh(L, 2);
     wbl_checkopts(L, 3, from_mesh_tets_keys, false);
     wb_tet_body_def d = wb_tet_body_default_def();
+    const wb_material *mat = wbl_opt_material(L, 3);
+    if (mat) {
+        d.young = mat->young;
+        d.poisson = mat->poisson;
+    }
     const bool auto_radius = wbl_read_tet_body(L, 3, &d);
     wbl_contact_opts co;
     wbl_read_contact_opts(L, 3, &co);
+    wbl_material_friction(L, 3, mat, &co);
     wbio_tetgen_opts o = { 0, 2, -1, false, 0, false };
     wb_real x;
     if (wbl_optreal(L, 3, "max_volume", &x)) {
@@ -410,6 +417,21 @@ static int from_mesh_tets(lua_State *L)
         }
         return luaL_argerror(L, 2, err);
     }
+    /* a preset: mass rho x the tets' volume, dashpots eta x the mean tet edge (as w:lattice) */
+    if (mat) {
+        double vol = 0, edges = 0;
+        for (int32_t i = 0; i < t->nt; i++) {
+            const int32_t *p = &t->tet[4 * i];
+            vol += fabs(wb_tet_signed_volume(&t->v[3 * p[0]], &t->v[3 * p[1]], &t->v[3 * p[2]], &t->v[3 * p[3]]));
+            for (int a = 0; a < 4; a++)
+                for (int c = a + 1; c < 4; c++) {
+                    const wb_real *u = &t->v[3 * p[a]], *q = &t->v[3 * p[c]];
+                    edges += sqrt((u[0] - q[0]) * (u[0] - q[0]) + (u[1] - q[1]) * (u[1] - q[1]) + (u[2] - q[2]) * (u[2] - q[2]));
+                }
+        }
+        if (!wbl_given(L, 3, "mass") && vol > 0) d.mass = mat->density * vol;
+        if (!wbl_given(L, 3, "damping") && t->nt > 0) d.link.damping = mat->viscosity * edges / (6.0 * t->nt);
+    }
     /* with the surface kept, the mesh's vertices are tetgen's first nodes: its triangles are
      * the body's surface, as they were; else the tets' boundary (tetgen split it) */
     keep = o.kept && t->nv >= m->nv;
@@ -423,7 +445,8 @@ static int from_mesh_tets(lua_State *L)
 /* ---- w:from_mesh(m, {...}) --------------------------------------------------------------------- */
 static const char *const from_mesh_keys[] = {
     "mass", "radius", "target", "neighbours", "surface", "tets",
-    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
+    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction",
+    "material", NULL
 };
 
 static int w_from_mesh(lua_State *L)
@@ -441,15 +464,24 @@ static int w_from_mesh(lua_State *L)
     /* the tet options mean nothing for a body of links: say what they need, not just "unknown" */
     static const char *const tet_only[] = { "volume_compliance", "max_volume", "quality", "keep_surface", "timeout",
                                             "young", "poisson", NULL };
+    /* a preset on a body of links: its friction, and its mass from the enclosed volume of a
+     * closed mesh; the links stay as given (a surface of links has no Young's modulus) */
+    const wb_material *mat = wbl_opt_material(L, 3);
     for (int i = 0; tet_only[i] && lua_type(L, 3) == LUA_TTABLE; i++) {
         const int given = lua_getfield(L, 3, tet_only[i]) != LUA_TNIL;
         lua_pop(L, 1);
         if (given) return wbl_fielderror(L, 3, tet_only[i], "needs tets = true");
     }
     wb_from_mesh_def d = wb_from_mesh_default_def();
+    int32_t ea, eb;
+    if (mat && wb_mesh_open_edges(m, &ea, &eb) == 0) {
+        const double vol = enclosed_volume(m);
+        if (vol > 0) d.mass = mat->density * vol;
+    }
     bool auto_radius = true; /* half the spacing, set after building */
     wbl_contact_opts co;
     wbl_read_contact_opts(L, 3, &co);
+    wbl_material_friction(L, 3, mat, &co);
     if (wbl_checkopts(L, 3, from_mesh_keys, true)) {
         if (wbl_optreal(L, 3, "mass", &d.mass) && !(d.mass > 0)) return wbl_fielderror(L, 3, "mass", "must be > 0");
         if (wbl_optreal(L, 3, "radius", &d.radius)) {

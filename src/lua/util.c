@@ -405,7 +405,7 @@ void wbl_read_neo(lua_State *L, int arg, wb_real *young, wb_real *poisson)
     if (has_young && !(*young > 0)) wbl_fielderror(L, arg, "young", "must be > 0 (Pa)");
     if (wbl_optreal(L, arg, "poisson", poisson)) {
         if (!(*poisson >= 0 && *poisson < 0.5)) wbl_fielderror(L, arg, "poisson", "must be in [0, 0.5)");
-        if (!has_young) wbl_fielderror(L, arg, "poisson", "needs young");
+        if (!has_young && !(*young > 0)) wbl_fielderror(L, arg, "poisson", "needs young"); /* or a material */
     }
 }
 

@@ -119,6 +119,14 @@ void wbl_apply_contact_opts(wb_world *w, wb_body b, const wbl_contact_opts *o);
 /* the builders' default radius: half the spacing of the body's particles, so that
  * neighbouring particles' contact spheres touch and other bodies cannot pass between */
 void wbl_default_radius(wb_world *w, wb_body b);
+/* the preset's friction into co unless the options at arg give one (m may be NULL) */
+void wbl_material_friction(lua_State *L, int arg, const wb_material *m, wbl_contact_opts *co);
+
+/* material presets (material.c): the one named by field 'material' at arg (NULL when
+ * absent; raises for an unknown name), and wobble.materials into the table on top */
+const wb_material *wbl_opt_material(lua_State *L, int arg);
+void wbl_open_materials(lua_State *L);
+bool wbl_given(lua_State *L, int arg, const char *key);       /* field key of the table at arg is not nil */
 
 /* a PNG of rgb written whole to path (a temporary renamed into place, a link at path
  * replaced, not followed); false with "cannot write path: reason" */

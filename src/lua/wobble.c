@@ -30,6 +30,7 @@ int luaopen_wobble(lua_State *L)
     wbl_open_io(L);         /* wobble.load; w:load_particles, w:save, recorders (after skin) */
     wbl_open_renderer(L);   /* wobble.renderer, wobble.probe, wobble.read_png; w:run's plot */
     wbl_open_result(L);     /* wobble.result */
+    wbl_open_materials(L);  /* wobble.materials */
     lua_pushliteral(L, WB_VERSION);
     lua_setfield(L, -2, "version");
     /* the core's hard limits, so scripts can size things without trial and error */

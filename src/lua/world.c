@@ -220,6 +220,14 @@ static int w_radius(lua_State *L)
     return 1;
 }
 
+/* w:friction(p) -> the contact friction of particle p (a builder's, or its preset's) */
+static int w_friction(lua_State *L)
+{
+    wb_world *w = toworld(L);
+    lua_pushnumber(L, (lua_Number)wb_particle_friction(w, wbl_checkparticle(L, w, 2)));
+    return 1;
+}
+
 static int w_pin(lua_State *L)
 {
     wb_world *w = toworld(L);
@@ -580,6 +588,7 @@ static const luaL_Reg world_methods[] = {
     { "set_velocity", w_set_velocity },
     { "mass", w_mass },
     { "radius", w_radius },
+    { "friction", w_friction },
     { "group", w_group },
     { "set_self_collide", w_set_self_collide },
     { "pin", w_pin },

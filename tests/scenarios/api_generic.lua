@@ -151,6 +151,7 @@ local CASES = {
   ["world:velocity"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.w:velocity(...) end },
   ["world:mass"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.w:mass(...) end },
   ["world:radius"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.w:radius(...) end },
+  ["world:friction"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.w:friction(...) end },
   ["world:group"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.w:group(...) end },
   ["world:set_self_collide"] = { args = { 1, true }, nums = { 1 }, call = function(f, ...) return f.w:set_self_collide(...) end },
   ["world:set_dt"] = { args = { 0.01 }, nums = { 1 }, call = function(f, ...) return f.w:set_dt(...) end },
