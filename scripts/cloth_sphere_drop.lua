@@ -12,8 +12,8 @@
 -- friction on the sphere, the floor and the cloth holds the drape; air drag (world
 -- damping 0.5 /s) lets it settle.
 -- The summary line gives the lowest and highest particle, the footprint, the closest
--- two particles that may collide (over their contact distance r_i + r_j: 1 or more means
--- apart) and the mean ms per frame (w:stats().step_ms).
+-- two particles in contact (over their contact distance r_i + r_j) and the mean ms per
+-- frame (w:stats().step_ms).
 -- tests/validation/cloth_sphere_drop.lua checks the claim at res = 48.
 -- Try --set self_collide=0 to watch the folds pass through each other.
 -- Run: build/wobble run scripts/cloth_sphere_drop.lua [--record out/drop/] [--set png=1]
@@ -64,47 +64,22 @@ w:run{ seconds = seconds, on_frame = function(w, f)
   end
 end }
 
--- pairs that may collide: every pair but those a constraint joins (links, bends: each
--- bend's four particles); the closest of them now, over r_i + r_j, from a spatial hash of
--- cells 2 r wide (every pair closer than 2 r lies in neighbouring cells)
-local joined = {}
-local function join(a, b) joined[math.min(a, b) * 1048576 + math.max(a, b)] = true end
-for _, c in ipairs(w:distances()) do join(c:particles()) end
-for _, b in ipairs(w:bends()) do
-  local q = { b:particles() }
-  for i = 1, 4 do for j = i + 1, 4 do join(q[i], q[j]) end end
-end
-local cell, grid, pos = 2 * r, {}, {}
-local function key(i, j, k) return (i * 4096 + j) * 4096 + k end
-for _, p in ipairs(cloth.particles) do
-  local x, y, z = w:position(p)
-  pos[p] = { x, y, z }
-  local kk = key(x // cell, y // cell, z // cell)
-  local list = grid[kk]
-  if not list then list = {}; grid[kk] = list end
-  list[#list + 1] = p
-end
+-- the closest two particles in contact (the last substep's pairs), over r_i + r_j: below 1
+-- by the substep's slack at most; tests/validation/cloth_sphere_drop.lua checks every pair
+-- that may collide on its own, without the engine's list
 local closest = math.huge
-for _, p in ipairs(cloth.particles) do
-  local a = pos[p]
-  local i, j, k = a[1] // cell, a[2] // cell, a[3] // cell
-  for di = -1, 1 do for dj = -1, 1 do for dk = -1, 1 do
-    local list = grid[key(i + di, j + dj, k + dk)]
-    if list then
-      for _, q in ipairs(list) do
-        if q > p and not joined[p * 1048576 + q] then
-          local b = pos[q]
-          local d = math.sqrt((a[1] - b[1]) ^ 2 + (a[2] - b[2]) ^ 2 + (a[3] - b[3]) ^ 2)
-          closest = math.min(closest, d / (w:radius(p) + w:radius(q)))
-        end
-      end
-    end
-  end end end
+for _, c in ipairs(w:contacts()) do
+  if c.kind == "particle" then
+    local ax, ay, az = w:position(c.a)
+    local bx, by, bz = w:position(c.b)
+    local d = math.sqrt((ax - bx) ^ 2 + (ay - by) ^ 2 + (az - bz) ^ 2)
+    closest = math.min(closest, d / (w:radius(c.a) + w:radius(c.b)))
+  end
 end
 
 local minx, miny, minz, maxx, maxy, maxz = w:bounds()
 print(string.format("cloth sphere drop: %d x %d particles (r = %.4f m), %.3f to %.3f m above the floor (sphere top %.2f), "
-                    .. "footprint %.2f x %.2f m; closest non-neighbours %.3f of r_i + r_j (%s); "
+                    .. "footprint %.2f x %.2f m; closest contact %.3f of r_i + r_j (%s); "
                     .. "%d particle contacts; %.0f ms/frame over %d frames",
                     res, res, r, miny, maxy, 2 * R, maxx - minx, maxz - minz, closest,
                     closest < 1 and "overlapping by the substep's slack" or "apart", w:stats().particle_contacts, ms / math.max(frames, 1),

@@ -134,7 +134,9 @@ local columns = {
   { "bullet_ratio_cpu", "%9s", "%9.2f", "cpu ratio" },
 }
 
-function M.report(r, note)
+-- cols: the columns (as `columns` above) of a scene with figures of its own (record.lua);
+-- nil: the usual ones
+function M.report(r, note, cols)
   -- --set row=NAME: the row's name instead of the scene's (make bench runs a scene again
   -- beside a busy core as another row)
   if args.row ~= nil and args.row ~= "" then r.scene = tostring(args.row) end
@@ -148,7 +150,7 @@ function M.report(r, note)
     return
   end
   local head, row = {}, {}
-  for _, c in ipairs(columns) do
+  for _, c in ipairs(cols or columns) do
     local key, hfmt, vfmt, label = c[1], c[2], c[3], c[4] or c[1]
     head[#head + 1] = string.format(hfmt, label)
     local v = r[key]

@@ -753,26 +753,13 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
         b->list.n = 0;
         b->lgrid = 0;
         /* keep's rules applied in the search (the list is rebuilt when they change); a list
-         * without a skin serves this call alone, with no distances to test again */
+         * without a skin serves this call alone (its distance test below passes every pair) */
         b->bare = !skin;
         if (broad(b, &b->list, x, b->vr, skip, n, pool, keep, ud) < 0) return -1;
         b->lgrid = 1;
         b->vn = n;
         b->vgen = gen;
         b->rebuilds++;
-        if (b->bare) {
-            if (!grow((void **)&c->ij, &c->cap, 2 * ((int64_t)c->n + b->list.n), sizeof *c->ij)) return -1;
-            int32_t *out = c->ij, at = c->n;
-            for (int32_t k = 0; k < b->list.n; k++) {
-                const int32_t i = b->list.ij[2 * k], j = b->list.ij[2 * k + 1];
-                if (keep_now && !keep_now(ud, i, j)) continue;
-                out[2 * at] = i;
-                out[2 * at + 1] = j;
-                at++;
-            }
-            c->n = at;
-            return c->n;
-        }
     }
     if (!grow((void **)&c->ij, &c->cap, 2 * ((int64_t)c->n + b->list.n), sizeof *c->ij)) return -1;
     int32_t *out = c->ij, at = c->n;
@@ -1502,17 +1489,25 @@ int wb__contacts_recheck(wb_world *w, wb_real h)
      * list was made */
     const ref_step rs = ref_at(w, sub + 1 - c->ref_k0, h);
     const wb_real *rad = m->radius;
-    int moved = 0;
-    for (int32_t i = 0; i < m->np; i++) moved |= strays(c, x, rad, &rs, i);
-    if (!moved) return 0;
-    const double t0 = now_ms();
+    /* one pass: those off their paths (soft) and those past their reach (mv; counted past
+     * REPAIR_MAX, kept up to it) */
     int32_t *soft = wb__grow(c->soft, &c->cap_soft, m->np, sizeof *soft), ns = 0;
-    if (!soft) { c->n = 0; c->check = 0; return -1; }
-    c->soft = soft;
-    if (!(moved & 2)) { /* off their paths alone */
-        for (int32_t i = 0; i < m->np; i++)
-            if (strays(c, x, rad, &rs, i)) soft[ns++] = i;
-        const int r = repair(w, NULL, 0, soft, ns, 0, 0, &rs);
+    int32_t *mv = wb__grow(c->fix, &c->cap_fix, REPAIR_MAX, sizeof *mv), nm = 0, r;
+    if (soft) c->soft = soft;
+    if (mv) c->fix = mv;
+    if (!soft || !mv) { c->n = 0; c->check = 0; return -1; }
+    for (int32_t i = 0; i < m->np; i++) {
+        const int k = strays(c, x, rad, &rs, i);
+        if (k == 1) soft[ns++] = i;
+        else if (k == 2) {
+            if (nm < REPAIR_MAX) mv[nm] = i;
+            nm++;
+        }
+    }
+    if (ns == 0 && nm == 0) return 0;
+    const double t0 = now_ms();
+    if (nm == 0) { /* off their paths alone */
+        r = repair(w, NULL, 0, soft, ns, 0, 0, &rs);
         c->broad_ms += now_ms() - t0;
         if (!r) { c->n = 0; c->check = 0; return -1; }
         return 2;
@@ -1524,19 +1519,7 @@ int wb__contacts_recheck(wb_world *w, wb_real h)
      * much each time, so a frame makes the list again a few times at most */
     const wb_real left = m->def.dt - (wb_real)sub * h, t = left > h ? left : h;
     const wb_real margin = (wb_real)0.25 * (wb_real)(1 << (c->remakes_frame < 4 ? c->remakes_frame : 4));
-    int32_t nm = 0, r;
-    int32_t *mv = wb__grow(c->fix, &c->cap_fix, REPAIR_MAX, sizeof *mv);
-    if (mv) {
-        c->fix = mv;
-        for (int32_t i = 0; i < m->np && nm <= REPAIR_MAX; i++) {
-            const int k = strays(c, x, rad, &rs, i);
-            if (k == 1) soft[ns++] = i;
-            if (k < 2) continue;
-            if (nm < REPAIR_MAX) mv[nm] = i;
-            nm++;
-        }
-    }
-    if (mv && nm <= REPAIR_MAX) {
+    if (nm <= REPAIR_MAX) {
         r = repair(w, mv, nm, soft, ns, t, margin, &rs);
         c->broad_ms += now_ms() - t0;
         if (!r) { c->n = 0; c->check = 0; return -1; }

@@ -57,23 +57,13 @@ local total = wobble.clock() - t0
 local rec_s = total - rec_step
 
 local out = {
-  scene = "record", width = width, height = height, frames = recorded, samples = select(2, r:info()),
+  scene = "record", width = width, height = height, size = width .. "x" .. height, frames = recorded, samples = select(2, r:info()),
   ms_per_draw = draw_ms / frames, ms_per_step = step_ms / frames, ms_per_frame = 1000 * rec_s / recorded,
   fps_recording = recorded / rec_s, fps_with_step = recorded / total,
 }
-if args.row ~= nil and args.row ~= "" then out.scene = tostring(args.row) end
-if args.json_file then
-  local f = assert(io.open(args.json_file, "a"))
-  f:write(bench.json(out), "\n")
-  f:close()
-end
-if args.json then
-  print(bench.json(out))
-else
-  if args.header ~= 0 then
-    print(string.format("%-12s %9s %7s %6s %9s %9s %9s %9s", "scene", "size", "samples", "frames", "ms/draw",
-      "ms/step", "rec fps", "all fps"))
-  end
-  print(string.format("%-12s %9s %7d %6d %9.2f %9.2f %9.1f %9.1f", out.scene, width .. "x" .. height, out.samples,
-    out.frames, out.ms_per_draw, out.ms_per_step, out.fps_recording, out.fps_with_step))
-end
+-- its own columns, the rest of the reporting as every scene's
+bench.report(out, nil, {
+  { "scene", "%-12s", "%-12s" }, { "size", "%9s", "%9s" }, { "samples", "%7s", "%7d" }, { "frames", "%6s", "%6d" },
+  { "ms_per_draw", "%9s", "%9.2f", "ms/draw" }, { "ms_per_step", "%9s", "%9.2f", "ms/step" },
+  { "fps_recording", "%9s", "%9.1f", "rec fps" }, { "fps_with_step", "%9s", "%9.1f", "all fps" },
+})
