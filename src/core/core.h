@@ -257,6 +257,10 @@ typedef struct wb_contacts {
     int32_t *made_ab;      /* (nmade x 2) the body pairs (groups a < b) contact.c moved apart this
                               substep for a made overlap: tricontact.c leaves theirs to it */
     int32_t nmade, cap_made;
+    /* (nbm x 3) body pairs (groups a < b) asked whether they were made overlapping, and
+     * the answer: derived from x0, so kept until the rules are rebuilt (bm_gen) */
+    int32_t *bm, nbm, cap_bm;
+    uint64_t bm_gen;
 } wb_contacts;
 
 /* rest neighbours (DESIGN.md §2) include pairs made in touch: created r_i + r_j apart, to
