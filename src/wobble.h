@@ -660,8 +660,9 @@ int32_t wb_world_rigid_contact_count(const wb_world *w);
 wb_rigid_contact wb_world_rigid_contact_at(const wb_world *w, int32_t i);
 
 /* ---- material presets (material.c) -------------------------------------------------------
- * Named measured materials (README "Materials" gives the sources): builders take their
- * figures as the defaults of young, poisson, mass (density x volume), damping, friction */
+ * Named measured materials (docs/physics.md, "Material presets", gives the sources):
+ * builders take their figures as the defaults of young, poisson, mass (density x volume),
+ * damping, friction */
 typedef struct wb_material {
     const char *name;     /* lower_snake: "rubber", "jelly", "foam", "cloth", "leather", "steel_cable" */
     wb_real young;        /* Young's modulus, Pa */

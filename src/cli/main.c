@@ -50,7 +50,7 @@ static const char usage_text[] =
     "  wobble test [PATH...] [options] run scenario tests (.lua files, folders searched\n"
     "                                  recursively; default tests/); TAP 13 on stdout,\n"
     "                                  last line \"N passed, N failed\"\n"
-    "  wobble view SCENE.lua [options] the scene live in a window (README, \"Live viewer\")\n"
+    "  wobble view SCENE.lua [options] the scene live in a window (docs/cli.md, \"Live viewer\")\n"
     "  wobble bench [--json]           run the benchmark scenes (tests/bench/*.lua, or\n"
     "                                  share/wobble/bench of an installed wobble)\n"
     "  wobble sweep SCENE.lua --grid key=a,b,c ... --out DIR   one run per combination: jobs\n"
