@@ -22,7 +22,7 @@ LDFLAGS += -pthread $(EXTRA_LDFLAGS)
 PC_CFLAGS = $(shell pkg-config --cflags $(PCMODS) 2>/dev/null)
 PC_LIBS   = $(shell pkg-config --libs $(PCMODS) 2>/dev/null)
 
-# one folder per layer (DESIGN.md §1): cli -> lua -> {render, io} -> core -> wobble.h
+# one folder per layer (docs/architecture.md, "Layers"): cli -> lua -> {render, io} -> core -> wobble.h
 LAYERS   := core io render lua cli
 # the core: no Lua, no GL, no file formats, no command line
 CORE_SRC := $(wildcard src/core/*.c)
@@ -110,7 +110,7 @@ asan: check-deps
 mutate: check-deps
 	@sh tests/mutate/run.sh $(MUTATIONS)
 
-# the benchmark (README, "Benchmark"; tests/bench/run.sh): the double build, a WB_FLOAT
+# the benchmark (docs/benchmark.md; tests/bench/run.sh): the double build, a WB_FLOAT
 # build beside it and the Bullet peer, each scene in a process of its own; BENCH_PKGS are
 # installed by it alone. JSON=FILE: every row as a JSON line too
 BENCH_OPT := -O3 -march=native
@@ -146,7 +146,7 @@ install: all
 clean:
 	rm -rf build build-asan build-bench build-bench-float build-fuzz $(BUILD)
 
-# ---- fuzzing (README, "Fuzzing"): `make fuzz` runs each libFuzzer target FUZZ_TIME
+# ---- fuzzing (docs/testing.md, "Fuzzing"): `make fuzz` runs each libFuzzer target FUZZ_TIME
 # seconds; FUZZ_PKGS are installed by it alone, never by `make test`
 FUZZ_PKGS    := clang libclang-rt-14-dev
 FUZZ_TIME    ?= 60
@@ -206,7 +206,7 @@ $(BUILD)/input_driver: tests/cli/input_driver.c $(DRIVER_OBJ) $(BUILD)/libwobble
 build: $(BUILD)/treepeak
 $(BUILD)/treepeak: tests/cli/treepeak.c
 	$(call quiet,CCLD,$@)$(CC) $(CFLAGS) -o $@ $< $(LDFLAGS)
-# ---- a one-node Slurm (README, "Sweeps"): `make test-cluster` starts munged, slurmctld and
+# ---- a one-node Slurm (docs/cli.md, "Sweeps"): `make test-cluster` starts munged, slurmctld and
 # slurmd in a temporary folder, runs a sweep's job array through sbatch and collects it;
 # CLUSTER_PKGS are installed by it alone, never by `make test`; needs root
 test-cluster: check-deps

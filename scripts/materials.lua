@@ -1,4 +1,4 @@
--- materials.lua: the material presets side by side (README "Materials"). Left to right:
+-- materials.lua: the material presets side by side (docs/physics.md, "Material presets"). Left to right:
 -- blocks of rubber, jelly and foam dropped on the ground, each with the same 4 kg rigid
 -- box dropped on it; sheets of cloth and leather dropped over a ball; a 10 mm steel cable
 -- slung between two pins. Each body is built with `material = "name"` and nothing else

@@ -1,6 +1,6 @@
 /* wobble.h: the public C API of the wobble core (libwobble.a).
  *
- * One line per function, grouped as the Lua API is (DESIGN.md §3): the Lua name
+ * One line per function, grouped as the Lua API is (docs/lua-api.md): the Lua name
  * w:foo(...) maps to wb_world_foo(w, ...), c:foo() to wb_distance_foo(w, c, ...).
  * The core has no Lua, no GL and no I/O side effects.
  *
@@ -344,7 +344,7 @@ wb_distance_id wb_world_break_at(const wb_world *w, int32_t i);
 
 const char *wb_last_error(void);   /* message of the last WB_ERR_ARG in this thread */
 
-/* ==== meshes, particle graphs from meshes, skinning, snapshots (issue 3) ================== */
+/* ==== meshes, particle graphs from meshes, skinning, snapshots ============================ */
 
 /* ---- meshes (mesh.c): triangle meshes in memory; file formats live outside the core ---- */
 typedef struct wb_mesh {
@@ -444,7 +444,7 @@ wb_real wb_mesh_weld_tolerance(const wb_mesh *m);
 wb_world *wb_world_clone(const wb_world *w);
 
 
-/* ==== volume constraints and tetrahedral solids (issue 9: volume.c, tets.c) ================ */
+/* ==== volume constraints and tetrahedral solids (volume.c, tets.c) ========================= */
 /* A volume constraint keeps the signed volume of the tetrahedron p0 p1 p2 p3,
  * V = (p1-p0) . ((p2-p0) x (p3-p0)) / 6, at its rest value (XPBD, gradients of V, mass
  * weighted): a tet pushed inside out is pushed back to the sign it was made with.
@@ -556,7 +556,7 @@ wb_real wb_pressure_volume(const wb_world *w, int32_t i);      /* enclosed now, 
 wb_real wb_pressure_rest_volume(const wb_world *w, int32_t i); /* V0, m^3 */
 int32_t wb_pressure_surface(const wb_world *w, int32_t i);
 
-/* ---- attachments and grabs (attach.c, grab.c; issue 10) ---------------------------------- */
+/* ---- attachments and grabs (attach.c, grab.c) -------------------------------------------- */
 /* XPBD constraints C = x_p - target (a vector, zero rest length): compliance alpha in m/N
  * (0 = exactly there at the end of every substep; else a spring of stiffness 1/alpha,
  * F = -C/alpha, U = |C|^2 / (2 alpha)). force() is the force on the particle, lambda/h^2
@@ -592,7 +592,7 @@ int32_t wb_grab_count(const wb_world *w);
 wb_grab_id wb_grab_at(const wb_world *w, int32_t i);
 int32_t wb_grab_list(const wb_world *w, wb_grab_id *out, int32_t cap); /* as wb_attach_list */
 
-/* ---- rigid bodies (rigid.c, issue 10): XPBD rigid bodies (Müller et al. 2020) --------- */
+/* ---- rigid bodies (rigid.c): XPBD rigid bodies (Müller et al. 2020) ------------------- */
 #define WB_MAX_RIGIDS (1 << 20)
 typedef struct wb_rigid_id { uint32_t index; uint32_t gen; } wb_rigid_id; /* odd gen = live */
 typedef struct wb_rigid_def {
@@ -660,8 +660,9 @@ int32_t wb_world_rigid_contact_count(const wb_world *w);
 wb_rigid_contact wb_world_rigid_contact_at(const wb_world *w, int32_t i);
 
 /* ---- material presets (material.c) -------------------------------------------------------
- * Named measured materials (README "Materials" gives the sources): builders take their
- * figures as the defaults of young, poisson, mass (density x volume), damping, friction */
+ * Named measured materials (docs/physics.md, "Material presets", gives the sources):
+ * builders take their figures as the defaults of young, poisson, mass (density x volume),
+ * damping, friction */
 typedef struct wb_material {
     const char *name;     /* lower_snake: "rubber", "jelly", "foam", "cloth", "leather", "steel_cable" */
     wb_real young;        /* Young's modulus, Pa */

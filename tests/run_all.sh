@@ -12,12 +12,14 @@
 #       tests/cli/budget.sh                     --memory-limit with no time limit: the process tree's peak RSS
 #       tests/cli/kill.sh                       writers killed mid-write: the old file or a complete new one
 #   (e) tests/render/run.sh                     wobble run --record, encoders that fail
-#   (f) tests/layers.sh                         the layers of DESIGN §1: no upward call, no circle
+#   (f) tests/layers.sh                         the layers (docs/architecture.md): no upward call, no circle
 #   (g) tests/cli/firstrun.sh                   what a new user meets: make deps, bench --frames, print
 #   (h) tests/cli/watchdog.sh                   --time-limit in finalizers, C calls, helper programs
 #   (i) tests/fuzz/replay.sh                    the fuzz corpus and past crashes, once each
 #   (j) tests/cli/sweep.sh                      wobble sweep run by GNU parallel, result.json, collect
 #   (k) tests/cli/bench.sh                      wobble bench --json on a tiny configuration
+#   (l) tests/docs.sh                           the manual: README length, every src/ file in
+#                                               docs/architecture.md, relative links lead somewhere
 # Each part prints its output and ends with "N passed, N failed"; a part that crashes
 # or prints no such line counts as a failure, never as zero tests. The last line is
 # the sum, "N passed, N failed"; the exit status is 1 when anything failed.
@@ -129,6 +131,7 @@ part "memory budgets without a time limit (tests/cli/budget.sh)" sh tests/cli/bu
 part "writers killed mid-write (tests/cli/kill.sh)" sh tests/cli/kill.sh "$BUILD"
 part "recording from the command line (tests/render/run.sh)" sh tests/render/run.sh "$BUILD"
 part "layers (tests/layers.sh)" sh tests/layers.sh "$BUILD"
+part "the manual (tests/docs.sh)" sh tests/docs.sh "$BUILD"
 part "first run (tests/cli/firstrun.sh)" sh tests/cli/firstrun.sh "$BUILD"
 part "--time-limit watchdog (tests/cli/watchdog.sh)" sh tests/cli/watchdog.sh "$BUILD"
 part "fuzz corpus replay (tests/fuzz/replay.sh)" sh tests/fuzz/replay.sh "$BUILD"

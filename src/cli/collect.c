@@ -1,5 +1,5 @@
 /* collect.c: `wobble collect DIR [--csv | --json] [--plot X,Y[,COLOUR] OUT.png]`
- * (DESIGN §4): one row per run of a sweep (DIR/sweep.json), read from its
+ * (docs/cli.md, "Sweeps"): one row per run of a sweep (DIR/sweep.json), read from its
  * runs/NNNN/result.json: its --set values, status, exit code, wall time, frames,
  * warnings, final hash and wobble.result values. A run whose folder is not there never
  * started ("missing"); one that started and left no finished result.json was ended from

@@ -1,4 +1,4 @@
-/* main.c: the `wobble` command line (DESIGN §4): run a scene, run scenario tests as
+/* main.c: the `wobble` command line (docs/cli.md): run a scene, run scenario tests as
  * TAP 13, run the benchmark scenes. Exit codes: 0 ok, 1 a test or expectation
  * failed, 2 script or input error, 3 a budget was exceeded. */
 #include "io/io.h"
@@ -50,7 +50,7 @@ static const char usage_text[] =
     "  wobble test [PATH...] [options] run scenario tests (.lua files, folders searched\n"
     "                                  recursively; default tests/); TAP 13 on stdout,\n"
     "                                  last line \"N passed, N failed\"\n"
-    "  wobble view SCENE.lua [options] the scene live in a window (README, \"Live viewer\")\n"
+    "  wobble view SCENE.lua [options] the scene live in a window (docs/cli.md, \"Live viewer\")\n"
     "  wobble bench [--json]           run the benchmark scenes (tests/bench/*.lua, or\n"
     "                                  share/wobble/bench of an installed wobble)\n"
     "  wobble sweep SCENE.lua --grid key=a,b,c ... --out DIR   one run per combination: jobs\n"
@@ -804,7 +804,7 @@ static int run_scene(const opts *o, const char *path, run_report *rep) {
     return code;
 }
 
-/* wobble run: the scene, then OUTDIR/result.json (DESIGN §4 collect) when --out names
+/* wobble run: the scene, then OUTDIR/result.json (for `wobble collect`) when --out names
  * the folder (a sweep's runs always do): a run typed by hand leaves no file it did not
  * ask for. The file is first written saying "running", so a run ended from outside (a
  * signal, the watchdog past --time-limit, the OOM killer, Slurm) leaves a run that

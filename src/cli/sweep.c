@@ -1,9 +1,9 @@
-/* sweep.c: `wobble sweep SCENE.lua --grid key=a,b,c ... --out DIR` (DESIGN §4). The
- * cartesian product of the grids, each combination `--repeat` times, becomes one
- * `wobble run` command line per run in DIR/jobs.txt (for GNU parallel, locally or over
- * ssh), a Slurm job array over the same lines (DIR/sweep.slurm) and DIR/sweep.json,
- * which `wobble collect` reads. wobble schedules nothing itself: those engines do; only
- * `--run` starts GNU parallel on this machine. */
+/* sweep.c: `wobble sweep SCENE.lua --grid key=a,b,c ... --out DIR`. The cartesian product
+ * of the grids, each combination `--repeat` times, becomes one `wobble run` command line
+ * per run in DIR/jobs.txt (for GNU parallel, locally or over ssh), a Slurm job array over
+ * the same lines (DIR/sweep.slurm) and DIR/sweep.json, which `wobble collect` reads. wobble
+ * schedules nothing itself: those engines do; only `--run` starts GNU parallel on this
+ * machine. */
 #include "sweep.h"
 #include "io/io.h"
 

@@ -1,5 +1,5 @@
-/* sweep.h: `wobble sweep` and `wobble collect` (DESIGN §4), called by main.c with the
- * whole command line (argv[1] is the command); both return the exit code. */
+/* sweep.h: `wobble sweep` and `wobble collect` (docs/cli.md, "Sweeps"), called by main.c
+ * with the whole command line (argv[1] is the command); both return the exit code. */
 #ifndef WOBBLE_CLI_SWEEP_H
 #define WOBBLE_CLI_SWEEP_H
 

@@ -1,10 +1,10 @@
-/* view.c: `wobble view SCENE.lua` (issue 11): the scene live in a window. Like
- * `run --record`, the script needs no change: a frame hook draws every frame of
- * w:run / w:step through the same renderer (glfw.c's window backend), paces it to the
- * world's dt and polls the window's events. Esc, closing the window, R and a saved file
- * (--watch) cut the script short with an error whose value is a marker (stop_key) that
- * the viewer treats as a normal end; a restart is a new Lua state with the camera kept.
- * Grabs go through lua/input.h so --record-input can save them for `run --replay`. */
+/* view.c: `wobble view SCENE.lua`: the scene live in a window. Like `run --record`, the
+ * script needs no change: a frame hook draws every frame of w:run / w:step through the same
+ * renderer (glfw.c's window backend), paces it to the world's dt and polls the window's
+ * events. Esc, closing the window, R and a saved file (--watch) cut the script short with
+ * an error whose value is a marker (stop_key) that the viewer treats as a normal end; a
+ * restart is a new Lua state with the camera kept. Grabs go through lua/input.h so
+ * --record-input can save them for `run --replay`. */
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 

@@ -1,6 +1,6 @@
-/* view.h: `wobble view SCENE.lua` (DESIGN §4, issue 11), the scene live in a window.
- * main.c parses the options and gives the viewer the means to open a scene's state
- * (the same runtime and wobble.args as `wobble run`) as callbacks. */
+/* view.h: `wobble view SCENE.lua`, the scene live in a window. main.c parses the options
+ * and gives the viewer the means to open a scene's state (the same runtime and wobble.args
+ * as `wobble run`) as callbacks. */
 #ifndef WB_CLI_VIEW_H
 #define WB_CLI_VIEW_H
 

@@ -1,4 +1,4 @@
-/* attach.c: attachments (DESIGN.md §2, one file per constraint type; issue 10 part 3).
+/* attach.c: attachments (a type of the table in ctype.c, so all of it is here).
  *
  * A particle is kept at a point fixed in a target's frame: the point `local` is stored
  * in that frame when it is made, and every substep the target is where the target is

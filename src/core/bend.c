@@ -14,8 +14,8 @@
  * Jacobi solver bends are still projected Gauss-Seidel (their batches are conflict-free,
  * so this needs no accumulator and stays deterministic). What the projection reads is
  * packed in its order at colour time; on a CPU with AVX2 a conflict-free batch goes 4
- * bends at a time (project_range_avx2), with the scalar loop's bits (issue 12: about 2x
- * less CPU per bend, see README, Benchmark). */
+ * bends at a time (project_range_avx2), with the scalar loop's bits (about 2x
+ * less CPU per bend than the scalar loop: docs/benchmark.md, "Bends"). */
 #include <assert.h>
 #include <stdlib.h>
 

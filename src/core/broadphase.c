@@ -1,5 +1,5 @@
 /* broadphase.c: the candidate pairs of particle-particle contacts, once per frame
- * (DESIGN.md §2, issue 8; Macklin et al. 2019 "Small steps" §4: swept bounds plus a
+ * (Macklin et al. 2019 "Small steps" §4: swept bounds plus a
  * margin, then every substep projects the same list).
  *
  * wb__contacts_begin works out each particle's reach (its radius with a margin, plus how
@@ -978,10 +978,10 @@ int wb__joined(const wb_contacts *c, int32_t i, int32_t j)
     return lo < c->key_row[a + 1] && c->keys[lo] == key;
 }
 
-/* DESIGN.md §2: particles of two bodies (or graphs) touch when both collide, unless a
- * constraint joins them; of one, only when it collides with itself (a loose graph
- * always does), and never rest neighbours: joined, or made closer than r_i + r_j (or
- * in touch: WB_REST_TOUCH) */
+/* The contact rule (docs/physics.md, "Contacts"): particles of two bodies (or graphs)
+ * touch when both collide, unless a constraint joins them; of one, only when it collides
+ * with itself (a loose graph always does), and never rest neighbours: joined, or made
+ * closer than r_i + r_j (or in touch: WB_REST_TOUCH) */
 static int may_touch_rules(void *ud, int32_t i, int32_t j)
 {
     const wb_world *w = ud;

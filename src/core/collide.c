@@ -669,20 +669,21 @@ typedef struct collide_job {
     _Atomic int32_t bad;        /* scan: the first non-finite particle, INT32_MAX none */
 } collide_job;
 
-/* Made overlap (DESIGN.md §2). A contact's overlap ov is corrected as contact.c corrects
- * a pair's (wb__contact_depth): what of d0, the overlap the particle began the substep
- * with (at x_prev, against the collider's start pose), it kept from substep to substep
- * (`left`: bodies made resting on the ground, half inside it) goes at no more than
- * max_depenetration x h per substep; what the substep drove in goes in full, and so does
- * the rest of d0 (what other contacts' repairs carried into the collider by moving
- * x_prev: a heap's upper layers pressing a made overlap down, which must not sink). All
- * of d0 that goes moves x_prev with x (*shift, Macklin et al. 2014 §4.2): a position
- * change, no speed. This pass is the substep's last to move particles, so where it left
- * a particle is where the next substep starts: one `left` per particle, the most any of
- * its contacts kept (a particle in a corner keeps each overlap below it). At a frame's
- * first substep `left` comes from the state alone, contact.c's rule: an overlap one
- * substep would not take counts as kept; a resting contact (pushed out in full) starts
- * each substep at none. *lmax: the particle's new `left` so far; returns the correction */
+/* Made overlap (a position error, not a collision). A contact's overlap ov is corrected
+ * as contact.c corrects a pair's (wb__contact_depth): what of d0, the overlap the
+ * particle began the substep with (at x_prev, against the collider's start pose), it kept
+ * from substep to substep (`left`: bodies made resting on the ground, half inside it)
+ * goes at no more than max_depenetration x h per substep; what the substep drove in goes
+ * in full, and so does the rest of d0 (what other contacts' repairs carried into the
+ * collider by moving x_prev: a heap's upper layers pressing a made overlap down, which
+ * must not sink). All of d0 that goes moves x_prev with x (*shift, Macklin et al. 2014
+ * §4.2): a position change, no speed. This pass is the substep's last to move particles,
+ * so where it left a particle is where the next substep starts: one `left` per particle,
+ * the most any of its contacts kept (a particle in a corner keeps each overlap below it).
+ * At a frame's first substep `left` comes from the state alone, contact.c's rule: an
+ * overlap one substep would not take counts as kept; a resting contact (pushed out in
+ * full) starts each substep at none. *lmax: the particle's new `left` so far; returns the
+ * correction */
 static inline wb_real made_contact(wb_real ov, wb_real d0, wb_real left, int fresh, wb_real step, wb_real *lmax,
                                    wb_real *shift)
 {

@@ -1,4 +1,4 @@
-/* contact.c: particle-particle contacts (DESIGN.md §2, issue 8).
+/* contact.c: particle-particle contacts (docs/physics.md, "Contacts").
  *
  * Once per frame a broad phase (broadphase.c: a sorted grid over the frame's swept bounds
  * plus a margin, Macklin et al. 2019 "Small steps" §4) lists the candidate pairs; every

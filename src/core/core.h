@@ -263,9 +263,9 @@ typedef struct wb_contacts {
     uint64_t bm_gen;
 } wb_contacts;
 
-/* rest neighbours (DESIGN.md §2) include pairs made in touch: created r_i + r_j apart, to
- * round-off (a rope of spacing s and radius 2 s: its particles four apart), they would
- * touch at its slightest bend */
+/* rest neighbours (never a contact pair) include pairs made in touch: created r_i + r_j
+ * apart, to round-off (a rope of spacing s and radius 2 s: its particles four apart), they
+ * would touch at its slightest bend */
 #define WB_REST_TOUCH ((wb_real)(1 + 1e-9))
 /* broadphase.c: the contact rules' data (keys, graph, cross) brought up to date with the
  * constraints and groups; 0 when out of memory. wb__joined: a constraint joins i and j */

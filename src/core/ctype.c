@@ -2,8 +2,8 @@
  * step (solver.c) and the contact rules (broadphase.c) both walk it. */
 #include "ctype.h"
 
-/* the constraint types the step walks, in projection order (ctype.h; DESIGN.md §2):
- * adding a type adds its line here. */
+/* the constraint types the step walks, in projection order (ctype.h; docs/architecture.md,
+ * "The constraint-type table"): adding a type adds its line here. */
 const wb_ctype *const wb__ctypes[] = {
     &wb__distance_type,
     &wb__bend_type,

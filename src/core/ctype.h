@@ -1,5 +1,5 @@
-/* ctype.h: the constraint-type table (DESIGN.md §2). One file per type in src/core/;
- * the step walks wb__ctypes[] in order. */
+/* ctype.h: the constraint-type table, so the step need not know each type. One file per
+ * type in src/core/; the step walks wb__ctypes[] in order. */
 #ifndef WB_CTYPE_H
 #define WB_CTYPE_H
 #include "core.h"
@@ -17,8 +17,9 @@ typedef struct wb_ctype {
                                                           (plastic flow, breaking); may be NULL */
     wb_real (*energy)(const wb_world *w);              /* elastic potential energy, J; may be NULL */
     /* the particle pairs its constraints join, for the contact rules (broadphase.c): each
-     * through fn(ud, a, b, joined); joined = 1: a and b never touch (DESIGN.md §2, rest
-     * neighbours); 0: they are one graph only (a cluster's chain). May be NULL: none */
+     * through fn(ud, a, b, joined); joined = 1: a and b never touch (rest neighbours:
+     * docs/physics.md, "Contacts"); 0: they are one graph only (a cluster's chain).
+     * May be NULL: none */
     void (*links)(const wb_world *w, wb_link_fn fn, void *ud);
 } wb_ctype;
 
@@ -33,7 +34,7 @@ static inline void wb__link_quads(const int32_t *q, int32_t n, wb_link_fn fn, vo
 
 extern const wb_ctype wb__distance_type, wb__bend_type, wb__volume_type,
                       wb__shape_type, wb__pressure_type, wb__tet_type;
-extern const wb_ctype wb__attach_type, wb__grab_type; /* attach.c, grab.c (issue 10) */
+extern const wb_ctype wb__attach_type, wb__grab_type; /* attach.c, grab.c */
 
 /* the table the step walks (solver.c), in projection order, and its length */
 extern const wb_ctype *const wb__ctypes[];

@@ -1,8 +1,8 @@
-/* distance.c: the distance constraint type (DESIGN.md §2): packing and colouring of
- * the live links into batches, their XPBD projection (Gauss-Seidel batch by batch or
- * Jacobi), plastic flow and breaking once per frame, and their elastic energy. The
- * slot arrays and the C API (wb_distance_*) live in world.c with the other model
- * arrays; this file owns the solver cache built from them (wb_cache's s_* arrays). */
+/* distance.c: the distance constraint type (the first of ctype.c's table): packing and
+ * colouring of the live links into batches, their XPBD projection (Gauss-Seidel batch by
+ * batch or Jacobi), plastic flow and breaking once per frame, and their elastic energy. The
+ * slot arrays and the C API (wb_distance_*) live in world.c with the other model arrays;
+ * this file owns the solver cache built from them (wb_cache's s_* arrays). */
 #include <stdlib.h>
 
 #include "ctype.h"

@@ -1,4 +1,4 @@
-/* grab.c: grabs (DESIGN.md §2, one file per constraint type; issue 10 part 4).
+/* grab.c: grabs (a type of the table in ctype.c, so all of it is here).
  *
  * The scripted form of dragging a particle with the mouse: particle p is pulled to a
  * target point the script moves. A rigid body is grabbed at a point fixed in its frame

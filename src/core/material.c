@@ -1,6 +1,6 @@
 /* material.c: named material presets (wb_material_preset): measured figures a builder
  * turns into its constraints' parameters (the conversions are the binding's and the
- * builders', README "Materials"). Sources per row; `damping` is a Kelvin-Voigt viscosity
+ * builders', docs/physics.md "Material presets"). Sources per row; `damping` is a Kelvin-Voigt viscosity
  * eta = tan(delta) E / omega at omega = 2 pi 10 Hz (the wobble of a scene-sized body),
  * tan(delta) the loss factor quoted in the row's comment. */
 #include <string.h>

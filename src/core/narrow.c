@@ -1,5 +1,5 @@
-/* narrow.c: the contact manifold between two shapes at poses (issue 10). Pure geometry:
- * no world, no allocation.
+/* narrow.c: the contact manifold between two shapes at poses, for rigid bodies. Pure
+ * geometry: no world, no allocation.
  *
  * Shapes are sorted plane < mesh < box < round (sphere and capsule are one kind: a
  * segment with a radius, a sphere's segment being a point); a pair given the other way

@@ -1,4 +1,4 @@
-/* narrow.h: contact manifolds between two shapes at poses (issue 10). Pure geometry. */
+/* narrow.h: contact manifolds between two shapes at poses for rigid bodies. Pure geometry. */
 #ifndef WB_NARROW_H
 #define WB_NARROW_H
 #include "core.h"

@@ -15,14 +15,14 @@
  * A surface is closed when every edge is shared by exactly two triangles that run it in
  * opposite directions (an oriented 2-manifold without border); it must face outwards
  * (V0 > 0). The constraints are projected one after another, serially: deterministic for
- * any thread count. Why not in parallel (DESIGN.md §2): one projection is a sum over the
- * triangles (V and the gradients, a scatter per triangle) and one update per particle;
- * measured on a 20^3 lattice's hull (4332 triangles, 10 substeps, -O3) it costs 1.5 ms of a
- * 38 ms frame (4%). A parallel version would gather per particle over its triangles and
- * sum V in fixed chunks combined in a fixed order (so that the bits do not depend on the
- * thread count); with two threads it could save about 2% of such a frame: not worth its
- * code. A scene of many pressure bodies is the case to revisit (bodies that share no
- * particle could then run side by side). */
+ * any thread count. Why not in parallel, as the batched types are: one projection is a sum
+ * over the triangles (V and the gradients, a scatter per triangle) and one update per
+ * particle; measured on a 20^3 lattice's hull (4332 triangles, 10 substeps, -O3) it costs
+ * 1.5 ms of a 38 ms frame (4%). A parallel version would gather per particle over its
+ * triangles and sum V in fixed chunks combined in a fixed order (so that the bits do not
+ * depend on the thread count); with two threads it could save about 2% of such a frame:
+ * not worth its code. A scene of many pressure bodies is the case to revisit (bodies that
+ * share no particle could then run side by side). */
 #include <assert.h>
 #include <stdio.h>
 #include <stdlib.h>

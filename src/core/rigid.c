@@ -1,5 +1,5 @@
 /* rigid.c: XPBD rigid bodies (Müller, Macklin, Chentanez, Jeschke, Kim 2020, "Detailed
- * rigid body simulation with extended position based dynamics"), issue 10.
+ * rigid body simulation with extended position based dynamics").
  *
  * Per substep (the paper's Algorithm 2), beside the particles: predict the pose from the
  * velocities (gravity, the gyroscopic term), correct positions at contacts with the
@@ -598,17 +598,17 @@ static void static_friction_pairs(wb_world *w)
 }
 
 /* ---- made overlap ---------------------------------------------------------------------------- */
-/* A manifold's made overlap (DESIGN.md §2: bodies made inside each other or a collider)
- * is kept as contact.c keeps a pair's: `left`, what of the overlap it started with its
- * own last solve left, goes at no more than max_depenetration; what the substep drove in
- * since goes in full, and so does what the other manifolds pushed back after its solve
- * (the bodies of a stack sink into each other by a little every sweep, which the next
- * substep finds at its start: counted as made, that repair, capped, let a stack of 10
- * boxes sink into itself at 1 cm/s). A manifold is known by its two sides, one table per
- * frame; at its first solve of a frame its overlap at the substep's start counts as made
- * when one substep would not take it (contact.c's rule), so a world loaded from a
- * snapshot goes on as the one saved. The speed the capped repair makes needs nothing
- * more: the velocity pass sets the points' normal speed (wb__rigids_velocity). */
+/* A manifold's made overlap (bodies made inside each other or a collider: a position error,
+ * not a collision) is kept as contact.c keeps a pair's: `left`, what of the overlap it
+ * started with its own last solve left, goes at no more than max_depenetration; what the
+ * substep drove in since goes in full, and so does what the other manifolds pushed back
+ * after its solve (the bodies of a stack sink into each other by a little every sweep,
+ * which the next substep finds at its start: counted as made, that repair, capped, let a
+ * stack of 10 boxes sink into itself at 1 cm/s). A manifold is known by its two sides, one
+ * table per frame; at its first solve of a frame its overlap at the substep's start counts
+ * as made when one substep would not take it (contact.c's rule), so a world loaded from a
+ * snapshot goes on as the one saved. The speed the capped repair makes needs nothing more:
+ * the velocity pass sets the points' normal speed (wb__rigids_velocity). */
 #define MADE_NONE UINT64_MAX
 
 static uint64_t made_key(int32_t a, int32_t b) { return (uint64_t)(uint32_t)a << 32 | (uint32_t)b; }

@@ -1,5 +1,5 @@
 /* rigid.h: XPBD rigid bodies (Müller, Macklin, Chentanez, Jeschke, Kim 2020, "Detailed
- * rigid body simulation with extended position based dynamics"), issue 10.
+ * rigid body simulation with extended position based dynamics").
  *
  * Bodies live in slots with generations (odd = live), as colliders do. Model: shape,
  * inverse mass, body-frame inertia and its inverse. State: pose (centre of mass, unit

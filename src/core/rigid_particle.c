@@ -1,4 +1,4 @@
-/* rigid_particle.c: two-way contacts between particles and rigid bodies (issue 10 part 2).
+/* rigid_particle.c: two-way contacts between particles and rigid bodies.
  *
  * A particle (its sphere of contact radius) against a body's shape: C = dist - radius >= 0,
  * dist and the outward normal n from wb__shape_distance at the body's current pose. Each

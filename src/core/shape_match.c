@@ -30,17 +30,17 @@
  * part of the strain past yield at min(1, creep dt) per frame (as distance links do,
  * solver.c), and is re-centred.
  *
- * Clusters are projected one after another, serially, in creation order: deterministic
- * for any thread count. Why not in parallel (DESIGN.md §2 asks every type to be free of
- * write conflicts or argue): a projection is two reductions over the cluster (mass centre,
- * A_pq) and one per-particle update, ~75 ns a particle; measured on a 20^3 lattice (8000
+ * Clusters are projected one after another, serially, in creation order: deterministic for
+ * any thread count. Why not in parallel, as the batched types are (their batches are free
+ * of write conflicts): a projection is two reductions over the cluster (mass centre, A_pq)
+ * and one per-particle update, ~75 ns a particle; measured on a 20^3 lattice (8000
  * particles, 10 substeps, -O3), one cluster over all of it costs 6 ms of a 42 ms frame
  * whose links (already parallel) take the rest, and eight 1000-particle clusters the same.
  * Two threads would save at most ~3 ms there (7%), less in the usual scenes (a few
  * clusters of tens to hundreds of particles: well under 1%), and a parallel version must
  * make its reductions thread-count independent (fixed chunks summed in a fixed order) and
- * colour the clusters by shared particles; not worth its code today. Revisit if a scene
- * is dominated by shape matching (many large clusters). */
+ * colour the clusters by shared particles; not worth its code today. Revisit if a scene is
+ * dominated by shape matching (many large clusters). */
 #include <assert.h>
 #include <stdlib.h>
 

@@ -1,4 +1,4 @@
-/* tet.c: Neo-Hookean tetrahedra (DESIGN.md §2, one file per constraint type).
+/* tet.c: Neo-Hookean tetrahedra (a type of the table in ctype.c, so all of it is here).
  *
  * Macklin & Müller 2021, "A constraint-based formulation of stable Neo-Hookean materials":
  * with F = Ds Dm^-1 (Ds = [x1-x0, x2-x0, x3-x0], Dm the same at rest) the energy

@@ -1,5 +1,6 @@
-/* tribroad.c: the broad phase of particle-triangle contacts, once per frame (DESIGN.md §2,
- * issue 8); tricontact.c projects the candidates it finds every substep.
+/* tribroad.c: the broad phase of particle-triangle contacts, once per frame, so that
+ * each substep tests only pairs that can meet; tricontact.c projects the candidates it
+ * finds every substep.
  *
  * A candidate is a point p and a triangle t such that
  *  - p may collide (reach_p >= 0: radius + a quarter of it + how far velocity and gravity

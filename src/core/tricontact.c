@@ -1,4 +1,4 @@
-/* tricontact.c: particle-triangle contacts (DESIGN.md §2, issue 8).
+/* tricontact.c: particle-triangle contacts (docs/physics.md, "Contacts").
  *
  * The surfaces builders register (a cloth's sheet, a lattice's hull, from_mesh's surface,
  * a JSON config's surfaces) are collision geometry: a particle keeps its radius r_p away

@@ -1,4 +1,4 @@
-/* volume.c: volume constraints (DESIGN.md §2, one file per constraint type).
+/* volume.c: volume constraints (a type of the table in ctype.c, so all of it is here).
  *
  * C = V - V0 with V the signed volume of the tetrahedron (p0 p1 p2 p3),
  * V = (p1-p0) . ((p2-p0) x (p3-p0)) / 6, projected with XPBD (Macklin et al. 2016):

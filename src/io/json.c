@@ -1,5 +1,5 @@
 /* json.c: JSON particle configs (the reference thesis's second import method) and
- * snapshots, through cJSON. The schema is in the README ("Particle configs"); in short:
+ * snapshots, through cJSON. The schema is in docs/formats.md ("Particle configs"); in short:
  *
  *   { "format": "wobble-particles", "version": 1,
  *     "particles": [ {"position": [x,y,z], "mass": 1, "pinned": false}, ... ],

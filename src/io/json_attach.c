@@ -1,5 +1,5 @@
-/* json_attach.c: the "attachments" and "grabs" sections of a particle config (README,
- * "Attachments and grabs"):
+/* json_attach.c: the "attachments" and "grabs" sections of a particle config (docs/formats.md,
+ * "Particle configs"):
  *
  *   "attachments": [ {"particle": 3, "collider": 0 | "rigid": 0, "point": [x,y,z], "compliance": 0}, ... ]
  *   "grabs": [ {"particle": 7 | "rigid": 0, "at": [x,y,z], "target": [x,y,z], "from": [x,y,z],

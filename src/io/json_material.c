@@ -1,5 +1,5 @@
 /* json_material.c: the "shape_matches" and "pressures" sections of a particle config
- * (README, "Particle configs"):
+ * (docs/formats.md, "Particle configs"):
  *
  *   "shape_matches": [ {"particles": [0, 1, 2, ...], "stiffness": 1, "yield": 0, "creep": 1,
  *                       "rest": [x,y,z, ...], "rotation": [w,x,y,z]}, ... ]

@@ -1,4 +1,4 @@
-/* json_rigid.c: the "rigids" section of a particle config (issue 10):
+/* json_rigid.c: the "rigids" section of a particle config:
  *
  *   "rigids": [ {"shape": "box", "half": [x,y,z], "mass": 1, "pos": [x,y,z],
  *                "rotation": [w,x,y,z], "vel": [..], "angular_velocity": [..],

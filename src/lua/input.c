@@ -1,7 +1,7 @@
-/* input.c: live input as a test (input.h, issue 11). The recorder does each grab, move and
- * release on the world and logs it with the frame it came after; the replay reads such a
- * log back and applies its events from a frame hook after the same frames, so that a
- * headless run reproduces the live one bit for bit (the same w:hash()). */
+/* input.c: live input as a test (input.h): a poke replays headless. The recorder does each
+ * grab, move and release on the world and logs it with the frame it came after; the replay
+ * reads such a log back and applies its events from a frame hook after the same frames, so
+ * that a headless run reproduces the live one bit for bit (the same w:hash()). */
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>

@@ -1,8 +1,8 @@
-/* input.h: live input as a test (issue 11). The viewer (cli/view.c) does every grab, move
- * and release through these functions, so each one is both done on the world and logged
- * with the frame it happened after; `--record-input FILE` saves the log as JSON and
- * `wobble run --replay FILE` applies it headless at the same frames (a frame hook), so the
- * run ends with the same w:hash() as the live one.
+/* input.h: live input as a test. The viewer (cli/view.c) does every grab, move and release
+ * through these functions, so each one is both done on the world and logged with the frame
+ * it happened after; `--record-input FILE` saves the log as JSON and `wobble run --replay
+ * FILE` applies it headless at the same frames (a frame hook), so the run ends with the
+ * same w:hash() as the live one.
  *
  * Frames: an event logged with frame F was done after the world's frame F finished (in an
  * after-frame hook, wb_rt_after_frame), before frame F+1 starts; F >= 1. Worlds: `world` is

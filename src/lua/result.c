@@ -1,6 +1,6 @@
-/* result.c: what one run reports for `wobble collect` (DESIGN §3 wobble.result, §4
- * sweep): the values a scene gives wobble.result{}, the frames stepped, and the last
- * world stepped (its hash and warnings, kept even when the script closes it), written
+/* result.c: what one run reports for `wobble collect`, so a sweep's runs can be gathered
+ * into one table: the values a scene gives wobble.result{}, the frames stepped, and the
+ * last world stepped (its hash and warnings, kept even when the script closes it), written
  * by the command line as OUTDIR/result.json. */
 #include "util.h"
 #include "io/io.h"

@@ -1,5 +1,5 @@
-/* rigid.c: rigid bodies (issue 10): w:rigid{shape = ...} and the body handle (id +
- * generation, the world's userdata as its user value), w:rigids(). */
+/* rigid.c: rigid bodies: w:rigid{shape = ...} and the body handle (id + generation, the
+ * world's userdata as its user value), w:rigids(). */
 #include <math.h>
 
 #include "util.h"

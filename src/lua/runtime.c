@@ -1,8 +1,8 @@
-/* runtime.c: what runs around a scene script. The sandbox of DESIGN §4 (no
- * process control, no bytecode, no debug library, file access through path rules),
- * the budgets (memory through the allocator, wall time through a count hook, after
- * every frame and a watchdog thread for what hooks never see) and the discovery of
- * the Lua library folder. */
+/* runtime.c: what runs around a scene script. The sandbox, so that a scene from anywhere is
+ * safe to run (no process control, no bytecode, no debug library, file access through path
+ * rules), the budgets (memory through the allocator, wall time through a count hook, after
+ * every frame and a watchdog thread for what hooks never see) and the discovery of the Lua
+ * library folder. */
 #include "wobble_lua.h"
 #include "sandbox.h"
 #include "io/io.h"
@@ -291,7 +291,7 @@ static _Noreturn void end_process(watchdog *wd, const char *msg) {
     }
     say(STDOUT_FILENO, wd->words);
     say(STDERR_FILENO, msg);
-    _exit(3);  /* DESIGN §4: a budget was exceeded */
+    _exit(3);  /* exit code 3: a budget was exceeded */
 }
 
 /* The state whose hook the deadline re-arms. At the deadline the watchdog signals the

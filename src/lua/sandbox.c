@@ -1,13 +1,13 @@
-/* sandbox.c: the file rules of DESIGN §4. Every path a script names is made absolute
- * and canonical (no ".." or symlink can leave a folder unnoticed); reads are allowed
- * under the scene, assets and output folders, writes only under the output folder.
- * A write through a symbolic link that leads nowhere is refused (its target would be
- * created wherever it points), and the files themselves are opened without following a
- * link at their name (io.open here; wobble's writers through io/file.c), so a link
- * placed in the output folder cannot take a write elsewhere. Refusals name the path as
- * the script gave it, never where it resolves. The standard libraries are opened
- * without process control, bytecode or debug, and their file functions are wrapped to
- * go through the same rules. */
+/* sandbox.c: the file rules of the sandbox (a scene writes only under its output folder).
+ * Every path a script names is made absolute and canonical (no ".." or symlink can leave a
+ * folder unnoticed); reads are allowed under the scene, assets and output folders, writes
+ * only under the output folder. A write through a symbolic link that leads nowhere is
+ * refused (its target would be created wherever it points), and the files themselves are
+ * opened without following a link at their name (io.open here; wobble's writers through
+ * io/file.c), so a link placed in the output folder cannot take a write elsewhere. Refusals
+ * name the path as the script gave it, never where it resolves. The standard libraries are
+ * opened without process control, bytecode or debug, and their file functions are wrapped
+ * to go through the same rules. */
 #include "sandbox.h"
 
 #include <lauxlib.h>

@@ -1,4 +1,4 @@
-/* sandbox.h: the file rules of DESIGN §4 for a script (lua/sandbox.c). The runtime owns
+/* sandbox.h: the sandbox's file rules for a script (lua/sandbox.c). The runtime owns
  * a wb_sandbox and opens it on its state; the binding resolves every path a script names
  * through wb_sandbox_path (or wbl_path / wbl_allow). */
 #ifndef WB_LUA_SANDBOX_H

@@ -44,7 +44,8 @@ void wb_rt_interrupt(lua_State *L, int (**fn)(void *), void **ud);
 /* raise the budget error that is due (time or memory), if any */
 void wb_rt_check_budgets(lua_State *L);
 
-/* raise a budget error: the command line exits with code 3 (DESIGN §4) */
+/* raise a budget error: the command line exits with code 3, which tells a sweep's collect
+ * (and the user) that a limit, not the scene, ended the run */
 int wb_rt_budget_error(lua_State *L, const char *fmt, ...);
 
 /* called by the binding after every simulated frame (w:step, each frame of w:run):
@@ -83,7 +84,7 @@ void wb_progress_update(lua_State *L, int64_t done);
 void wb_progress_end(lua_State *L);
 void wb_progress_note(lua_State *L, const char *note);   /* shown after every bar's label; NULL clears */
 
-/* ---- result.json of a run (result.c; DESIGN §4 collect) --------------------------------- */
+/* ---- result.json of a run (result.c), what `wobble collect` reads ----------------------- */
 typedef struct wbl_run_info {
     const char *out_dir;             /* the run's --out folder (exists) */
     const char *scene;

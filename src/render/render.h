@@ -1,4 +1,4 @@
-/* render.h: rendering and media (DESIGN §3, issue 4). Not part of the core: the
+/* render.h: rendering and media. Not part of the core, so the core stays free of GL: the
  * renderer reads a world through the public API of wobble.h only.
  *
  *   wb_renderer   an OpenGL 3.3 core pipeline (render.c, gl.c) behind a

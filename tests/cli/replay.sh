@@ -1,5 +1,5 @@
 #!/bin/sh
-# tests/cli/replay.sh BUILD_DIR: input as a test (issue 11, README "Replaying input").
+# tests/cli/replay.sh BUILD_DIR: input as a test (docs/cli.md, "Replaying input").
 #   (a) `wobble run SCENE --replay LOG` = the same grabs done by the script at the same
 #       frames: the same w:hash(); a log one frame off gives another hash; worlds are
 #       named by the order in which they first finish a frame;

@@ -215,18 +215,18 @@ check "test: folders are searched, sorted, fixtures and _files skipped" 0 \
 run test $F/tapdir/a.lua $F/missing_dir
 check "test: a missing path fails" 2 out "cannot open $F/missing_dir" out "1 passed, 1 failed"
 
-# ---- the README's examples, taken from README.md as they are printed there
-# readme_block MARKER: the ```lua block of README.md whose first line is MARKER
+# ---- the manual's examples, taken from README.md and docs/ as they are printed there
+# readme_block MARKER [FILE]: the ```lua block of FILE (README.md) whose first line is MARKER
 readme_block() {
-    awk -v m="$1" 'on && /^```/ {exit} on {print} prev == "```lua" && $0 == m {on = 1; print} {prev = $0}' README.md
+    awk -v m="$1" 'on && /^```/ {exit} on {print} prev == "```lua" && $0 == m {on = 1; print} {prev = $0}' "${2:-README.md}"
 }
 mkdir -p "$TMP/readme"
-readme_block "-- tests/scenarios/rope_hangs.lua" >"$TMP/readme/rope_hangs.lua"
+readme_block "-- tests/scenarios/rope_hangs.lua" docs/testing.md >"$TMP/readme/rope_hangs.lua"
 run test "$TMP/readme/rope_hangs.lua" --out "$TMP/readme/out"
-check "README: the scene test example runs as printed" 0 out "ok 1 - " out "1 passed, 0 failed"
+check "docs/testing.md: the scene test example runs as printed" 0 out "ok 1 - " out "1 passed, 0 failed"
 [ "$(grep -c . "$TMP/readme/rope_hangs.lua")" -ge 5 ]
 code=$?
-check "README: the scene test example was found" 0
+check "docs/testing.md: the scene test example was found" 0
 readme_block "-- drape.lua" >"$TMP/readme/drape.lua"
 run run "$TMP/readme/drape.lua" --frames 5 --out "$TMP/readme/out"
 check "README: the first scene runs as printed" 0 !err ""

@@ -1,5 +1,5 @@
 -- api_generic.lua: one table of every function of the Lua API, driven by one test each
--- for two promises of the README: an options table refuses a key it does not know
+-- for two promises of docs/lua-api.md: an options table refuses a key it does not know
 -- (naming it), and every number a function takes, positional, in an option or inside a
 -- vector, refuses NaN and both infinities (naming the argument or field); a refused
 -- call changes nothing (w:hash()). The table is checked against the metatables'

@@ -24,7 +24,7 @@
 -- 1e-6 m/N, one frame, which the end-of-frame check does not count) or 22-70 m/s (6 x 6 x
 -- 6, links of 1e-4 and 1e-6). One projection now gives a compressed link of a solid (its
 -- ends on volume constraints) back at most a quarter of its length (distance.c,
--- STRETCH_FREE; README "Crushed links").
+-- STRETCH_FREE; docs/physics.md "Crushed links").
 --
 -- Bounds: the press moves at 0.2 m/s and the bulge it drives at ~0.1 m/s (incompressible:
 -- a^2 h kept, da/dt = a/(2h) dh/dt); a quasi-static squeeze moves nothing much faster than

@@ -5,7 +5,7 @@ local N, SPACING, Y0 = 50, 0.01, 1.0          -- 50 links: a 0.5 m rope
 local L = N * SPACING
 
 local function build()
-  -- 40 substeps x 4 iterations: rigid links converge only with enough of them (README,
+  -- 40 substeps x 4 iterations: rigid links converge only with enough of them (docs/physics.md,
   -- "Convergence"); at the default 10 x 1 this rope stretches to 99% while it swings
   local w = wobble.world{ substeps = 40, iterations = 4 }
   local ids, links = {}, {}

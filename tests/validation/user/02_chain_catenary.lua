@@ -24,7 +24,7 @@ local T_support = wlen * (a + sag)               -- |T| at a support = w y(D/2)
 local function build()
   -- damping: a drag (1/s) so that the chain comes to rest within the run; a user wanting
   -- the static shape would add it. A drag changes no static equilibrium.
-  -- 40 substeps: rigid links converge only with enough of them (README, "Convergence");
+  -- 40 substeps: rigid links converge only with enough of them (docs/physics.md, "Convergence");
   -- at the default 10 x 1 this chain settles 11.7% too low
   local w = wobble.world{ damping = 2, substeps = 40 }
   local ids, links = {}, {}

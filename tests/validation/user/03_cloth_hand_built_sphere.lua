@@ -8,7 +8,7 @@ local R, C = 0.3, { 0, 0.5, 0 }          -- the sphere
 local H0 = 1.0                           -- the cloth's height when let go
 
 local function build()
-  -- 40 substeps: rigid links converge only with enough of them (README, "Convergence");
+  -- 40 substeps: rigid links converge only with enough of them (docs/physics.md, "Convergence");
   -- at the default 10 x 1 this cloth stretches 18% as it lands
   local w = wobble.world{ substeps = 40 }
   w:collider{ shape = "plane", normal = { 0, 1, 0 }, offset = 0, friction = 0.5 }

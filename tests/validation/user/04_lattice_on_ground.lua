@@ -1,6 +1,6 @@
 -- A builder body made resting on the ground the way a user writes it: a lattice block
 -- from y = 0 on the ground plane y = 0. Its particles have the default contact radius
--- (half the spacing, README "Builders and bodies"), so its bottom layer starts r inside
+-- (half the spacing, docs/lua-api.md "Builders"), so its bottom layer starts r inside
 -- the ground. Physically nothing should happen beyond the block settling onto its
 -- bottom layer: it must not be launched, and comes to rest on the ground.
 local S, RES = 0.5, 5               -- a 0.5 m cube, 5 x 5 x 5 particles: spacing 0.125, r = 0.0625

@@ -1,7 +1,7 @@
 -- Two lattice blocks stacked the obvious way: the upper block's bottom at the lower
 -- block's top. With default radii (half the spacing) the two touching layers overlap by
 -- 2r; physically the stack should stay a stack: the upper block pushed up by at most
--- that overlap, never thrown, nor slid off. Friction 0.5 on both blocks: the README says
+-- that overlap, never thrown, nor slid off. Friction 0.5 on both blocks: docs/physics.md says
 -- "Frictionless bodies never quite stop sliding on each other's particle bumps: give
 -- stacked bodies some friction", so a user reading it does.
 local S, RES = 0.4, 5                  -- 0.4 m cubes, spacing 0.1, r = 0.05

@@ -2,14 +2,14 @@
 -- substeps) laid horizontal and pinned at the two corners of one edge, let go to hang.
 -- Physics: pins do no work and the cloth's links only store or lose energy, so the total
 -- energy (kinetic + gravity + elastic) may only fall; it hangs below the pins; rigid
--- links barely stretch. The README gives no strain figure for a default cloth; it says
+-- links barely stretch. The manual gives no strain figure for a default cloth; it says
 -- compliance 0 is rigid, so 5% (the order of what the examples print for their cloths,
 -- e.g. the clothesline's few %) is the bound a user would expect.
 local S, RES, Y0, M = 1.0, 21, 1.5, 0.5
 local g = 9.81
 
 local function build(damping)
-  -- 40 substeps: rigid links converge only with enough of them (README, "Convergence");
+  -- 40 substeps: rigid links converge only with enough of them (docs/physics.md, "Convergence");
   -- at the default 10 x 1 this cloth stretches 40% while it swings, 12% at rest
   local w = wobble.world{ damping = damping, substeps = 40 }
   local c = w:cloth{ origin = { -S / 2, Y0, -S / 2 }, size = { S, S }, res = { RES, RES }, mass = M }

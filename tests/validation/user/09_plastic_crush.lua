@@ -2,7 +2,7 @@
 -- Physics: past its yield strain a plastic material flows, so after release it keeps
 -- (nearly all of) the imposed deformation, springing back by about its yield strain at
 -- most; nothing is given speed by the release, so it stays where it is, at rest.
--- Two ways the README offers: plastic links (w:lattice{yield, creep}) and a plastic
+-- Two ways docs/lua-api.md offers: plastic links (w:lattice{yield, creep}) and a plastic
 -- shape-matching cluster (w:shape_match{yield, creep}, as scripts/jelly_shape.lua).
 -- Block placed r above the ground as the README advises.
 local S, RES = 0.4, 5                    -- 0.4 m cube, spacing 0.1, default radius r = 0.05
@@ -75,7 +75,7 @@ end)
 -- the test's point. At 0.9 (kappa = 32400 /s^2) its own weight strains it 0.3%.
 test("plastic shape matching (stiffness 0.9, yield 0.02, creep 10/s) crushed and released keeps the dent", function()
   crush("plastic shape match", function(w, o)
-    o.compliance = 1                               -- soft links: the cluster shapes it (README)
+    o.compliance = 1                               -- soft links: the cluster shapes it (docs/lua-api.md, "Shape matching")
     local b = w:lattice(o)
     w:shape_match(b, { stiffness = 0.9, yield = YIELD, creep = 10 })
     return b

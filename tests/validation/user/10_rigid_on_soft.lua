@@ -5,7 +5,7 @@
 -- at rest the ground carries everything, so the momentum goes to ~0.
 -- The block is placed r above the ground (README placement); default radius.
 -- RES 6 (no particle on the mirror planes) and 7 (a column on each: the links meeting
--- there are projected together, README "Solvers"; before that the box turned at 0.69 rad/s)
+-- there are projected together, docs/physics.md "Solvers"; before that the box turned at 0.69 rad/s)
 local S = 0.6                            -- 0.6 m square block, 0.3 m tall; RES 6: spacing 0.12, r = 0.06
 local H = 0.3
 local M, HALF = 2, { 0.2, 0.1, 0.2 }

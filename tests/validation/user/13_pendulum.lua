@@ -5,7 +5,7 @@
 local L, g, TH = 1.0, 9.81, math.rad(10)
 
 local function swing()
-  -- 100 substeps: position-based steps damp a swing at O(h) (README, "Convergence"); at
+  -- 100 substeps: position-based steps damp a swing at O(h) (docs/physics.md, "Convergence"); at
   -- the default 10 it loses 14% of its amplitude in 9 periods, at 100 1.5%
   local w = wobble.world{ substeps = 100 }
   local pin = w:particle{ pos = { 0, 2, 0 } }
@@ -41,7 +41,7 @@ end)
 
 test("hand-built pendulum: amplitude kept over 9 periods", function()
   local _, _, amp_late, amp0 = swing()
-  -- no damping anywhere, and the README promises no numerical damping: the amplitude is
+  -- no damping anywhere, and the manual promises no numerical damping: the amplitude is
   -- kept within 2% over 18 s. (Measured: position-based projection loses energy at O(h):
   -- 14% of the amplitude at the default 10 substeps, 3.7% at 40, 1.5% at 100.)
   expect.rel(amp_late, amp0, 0.02, "amplitude kept")

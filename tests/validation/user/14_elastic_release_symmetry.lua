@@ -5,7 +5,7 @@
 -- Block placed r above the ground (README placement); links compliance 1e-3 (a springy
 -- block; the default rigid links cannot be pressed at all).
 -- RES 6 (no particle on the mirror planes) and 5 (a column on each: the links meeting
--- there are projected together, README "Solvers"; before that the block drifted 0.11 m)
+-- there are projected together, docs/physics.md "Solvers"; before that the block drifted 0.11 m)
 local S = 0.4
 local SPEED, TARGET = 0.1, 0.6
 
