@@ -70,10 +70,13 @@ deps:
 	  rm -f $(DEPS_LOG).rc; echo "installed:$$missing"; \
 	else rm -f $(DEPS_LOG).rc; echo "apt-get failed; the end of its output ($(DEPS_LOG)):" >&2; tail -n 20 $(DEPS_LOG) >&2; exit 1; fi
 
-# short build lines (CC src/core/bend.c, LD build/wobble); `make V=1` shows the commands
+# short build lines (CC src/core/bend.c, LD build/wobble); `make V=1` shows the commands;
+# `make -s` neither (its flag letters are MAKEFLAGS' first word)
 V ?= 0
 ifeq ($(V),1)
   quiet =
+else ifneq ($(findstring s,$(firstword -$(MAKEFLAGS))),)
+  quiet = @
 else
   quiet = @printf '  %-4s %s\n' $(1) $(2);
 endif

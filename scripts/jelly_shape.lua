@@ -2,8 +2,8 @@
 -- matching (w:shape_match, Müller et al. 2005) instead of stiff links: each cube's links
 -- are very soft, and one cluster over all its particles pulls them towards the rest
 -- shape, turned and moved with the cube. Left: stiffness 1, a rigid block that lands
--- without a dent (it lands on an edge, rocks onto a corner and back, outwards, away from
--- the others). Middle: stiffness 0.4, a jelly that squashes on impact and springs back.
+-- without a dent (it lands on an edge and tips flat a few cm outwards, as a rigid body of
+-- its shape does: tests/validation/shape_match.lua). Middle: stiffness 0.4, a jelly that squashes on impact and springs back.
 -- Right: stiffness 0.4 with yield = 0.04, a plastic one that keeps the dent of its
 -- landing (its rest shape flows towards the squashed one past a strain of 0.04).
 -- Try --set stiffness=0.2 for a softer jelly in the middle (it sags by a tenth of its
@@ -26,7 +26,7 @@ local function cube(x, opts, tilt)
   end
   return b, w:shape_match(b, opts)
 end
--- 1.4 m apart, each tilted so that its landing throws it outwards: they never meet
+-- 1.4 m apart, each tilted so that its landing moves it outwards: they never meet
 local rigid, rs = cube(-1.4, { stiffness = 1 }, -0.3)
 local jelly, js = cube(0, { stiffness = args.stiffness or 0.4 }, 0.3)
 local dent, ds = cube(1.4, { stiffness = args.stiffness or 0.4, yield = 0.04, creep = 10 }, 0.3)

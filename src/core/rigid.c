@@ -347,6 +347,11 @@ wb_real wb__rigid_w(const wb_world *w, int32_t r, const wb_real x[3], const wb_r
     return rb->inv_mass[r] + v3_dot(l, il);
 }
 
+void wb__rigid_inv_inertia(const wb_world *w, int32_t r, const wb_real v[3], wb_real out[3])
+{
+    inv_inertia_world(w->rb, r, v, out);
+}
+
 void wb__rigid_apply(wb_world *w, int32_t r, const wb_real x[3], const wb_real dp[3])
 {
     wb_rigids *rb = w->rb;

@@ -68,6 +68,8 @@ typedef struct wb_rigids {
     wb_real *pc_sph; int32_t cap_sph; /* bodies' swept spheres (scratch) */
     int32_t *pc_slot, cap_slot;    /* their slots (scratch) */
     int32_t *pc_cnt, cap_cnt;      /* (n) contacts per body in the substep */
+    wb_real *pc_bd; int32_t cap_bd; /* (n x 6) a body's move (or velocity) and turn of the
+                                       pass's joint solve so far (scratch) */
     struct wb_rpcontact *pct;
     int32_t npct, cap_pct;
     int32_t free_hint;     /* no dead slot below it (wb_rigid_add's search starts there) */
@@ -81,6 +83,8 @@ typedef struct wb_rpcontact {
                               (slow) or in full with its speed taken out (err): wb__contact_depth */
     wb_real lslow;         /* the positional impulse of slow (N s^2) */
     wb_real vn_pre;        /* normal relative velocity (particle - body) before the solve */
+    wb_real x0[3];         /* the particle at the pass's start (the joint solve's reference) */
+    wb_real wb;            /* the body's generalized inverse mass along n at the contact */
     wb_real arm[3];        /* where the body takes the impulses: offset from its centre */
     wb_real dp[3];         /* the body's impulse of the pass (scratch) */
 } wb_rpcontact;
@@ -88,6 +92,8 @@ typedef struct wb_rpcontact {
 /* generalized inverse mass of body r for a positional correction along unit n at world point x
  * (Müller 2020 eq. 2): 1/m + (r x n)^T I^-1 (r x n), r = x - centre */
 wb_real wb__rigid_w(const wb_world *w, int32_t r, const wb_real x[3], const wb_real n[3]);
+/* I^-1 v in the world frame, at body r's current rotation */
+void wb__rigid_inv_inertia(const wb_world *w, int32_t r, const wb_real v[3], wb_real out[3]);
 /* apply positional impulse dp (= lambda n, world) at world point x: p += dp/m, q += 0.5 [I^-1 (r x dp), 0] q */
 void wb__rigid_apply(wb_world *w, int32_t r, const wb_real x[3], const wb_real dp[3]);
 /* K (3 x 3, row-major, symmetric): how world point x of body r moves per unit positional
@@ -160,7 +166,7 @@ static inline void wb__rigids_free(wb_world *w, wb_rigids *rb)
     if (w->m.def.memory) w->m.def.memory->used -= rb->charged;
     void *p[] = { rb->shape, rb->mass, rb->inv_mass, rb->inertia, rb->inv_inertia, rb->bound, rb->gen, rb->x, rb->q,
                   rb->v, rb->om, rb->x_prev, rb->q_prev, rb->q_pred, rb->save, rb->mk, rb->ml, rb->ct, rb->fr, rb->moved, rb->cpose, rb->box, rb->ord, rb->pair,
-                  rb->pc, rb->pc_left, rb->pc_sph, rb->pc_slot, rb->pc_cnt, rb->pct };
+                  rb->pc, rb->pc_left, rb->pc_sph, rb->pc_slot, rb->pc_cnt, rb->pc_bd, rb->pct };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     free(rb);
 }

@@ -156,12 +156,48 @@ static void body_velocity(const wb_rigids *rb, int32_t r, const wb_real x[3], wb
     v3_add(out, out, &rb->v[3 * r]);
 }
 
-/* Every contact of a body is worked out against the body's pose at the pass's start and
- * the body then takes the sum (Jacobi on the body's side, Gauss-Seidel would let the first
- * corner of a box landing flat tilt it for all the others: a box dropped square on a
- * block drifted off it); with N contacts each sees the body N times heavier (mass
- * splitting, Tonge et al. 2012), so that N light particles under a light body do not push
- * it N times too far. Particles move at once. */
+/* The contacts' normal corrections are solved together (projected Gauss-Seidel, sweeps
+ * alternately forward and backward, against the bodies' poses at the pass's start, each
+ * body's move and turn so far kept aside and applied once at the end): a body resting on
+ * several particles comes out of all of them at once, and heavy particles (or immovable
+ * ones) under a body are not pushed out one by one as if each held it alone. With one
+ * Jacobi pass that saw the body N times heavier for N contacts (mass splitting), a box
+ * landing flat on immovable particles came out by less than its overlap (an edge
+ * particle's share also turned it), kept the rest to the next substep, and was pushed out
+ * of it there in full: it rebounded at 12% of its impact speed with restitution 0. The
+ * symmetric sweeps leave no corner first (one forward Gauss-Seidel pass tilted a box
+ * landing flat: it drifted off a block). Friction stays per contact, split among a
+ * body's contacts. Particles move at once. */
+#define JOINT_SWEEPS 64
+#define JOINT_TOL_X ((wb_real)1e-9)  /* m: a sweep that moves nothing more ends the solve */
+#define JOINT_TOL_V ((wb_real)1e-7)  /* m/s */
+
+/* body r's move so far at arm a (bd: move, turn) */
+static void joint_point(const wb_real *bd, const wb_real a[3], wb_real out[3])
+{
+    v3_cross(out, &bd[3], a);
+    v3_add(out, out, bd);
+}
+
+/* body r takes -dl n at arm a into bd */
+static void joint_take(const wb_world *w, int32_t r, wb_real *bd, const wb_real a[3], const wb_real n[3], wb_real dl)
+{
+    wb_real t[3];
+    v3_madd(bd, n, -dl * w->rb->inv_mass[r]);
+    v3_cross(t, a, n);
+    wb__rigid_inv_inertia(w, r, t, t);
+    v3_madd(&bd[3], t, -dl);
+}
+
+static wb_real *joint_scratch(wb_rigids *rb)
+{
+    wb_real *bd = wb__grow(rb->pc_bd, &rb->cap_bd, 6 * rb->n, sizeof *bd);
+    if (!bd) return NULL;
+    rb->pc_bd = bd;
+    memset(bd, 0, sizeof *bd * 6 * (size_t)rb->n);
+    return bd;
+}
+
 void wb__rigid_particles_solve(wb_world *w)
 {
     wb_rigids *rb = w->rb;
@@ -200,9 +236,14 @@ void wb__rigid_particles_solve(wb_world *w)
         ct->depth = depth;
         ct->slow = slow;
         ct->err = err;
+        ct->lambda = 0;
+        v3_copy(ct->x0, &x[3 * i]);
         /* where the positional impulses act on the body: the particle's offset from the
          * centre at the substep's start (see the file's head) */
         v3_sub(ct->arm, &xp[3 * i], &rb->x_prev[3 * r]);
+        wb_real at[3];
+        v3_add(at, ct->arm, &rb->x[3 * r]);
+        ct->wb = wb__rigid_w(w, r, at, n);
         /* the normal velocity they came in with, for restitution */
         wb_real vb[3], rel[3];
         body_velocity(rb, r, &x[3 * i], vb);
@@ -210,18 +251,37 @@ void wb__rigid_particles_solve(wb_world *w)
         ct->vn_pre = v3_dot(rel, n);
         cnt[r]++;
     }
+    if (rb->npct == 0) return;
+    wb_real *bd = joint_scratch(rb);
+    if (!bd) goto nomem;
+    for (int sweep = 0, more = 1; sweep < JOINT_SWEEPS && more; sweep++) {
+        more = 0;
+        for (int32_t j = 0; j < rb->npct; j++) {
+            wb_rpcontact *ct = &rb->pct[sweep & 1 ? rb->npct - 1 - j : j];
+            const int32_t i = ct->i, r = ct->r;
+            const wb_real *n = ct->n, wp = m->w[i], den = wp + ct->wb;
+            if (!(den > 0)) continue;
+            wb_real d[3], mv[3];
+            joint_point(&bd[6 * r], ct->arm, d);
+            v3_sub(mv, &x[3 * i], ct->x0);
+            const wb_real res = ct->depth - v3_dot(n, mv) + v3_dot(n, d);
+            const wb_real lam = fmax(ct->lambda + res / den, 0), dl = lam - ct->lambda;
+            if (dl == 0) continue;
+            more |= fabs(dl) * den > JOINT_TOL_X;
+            ct->lambda = lam;
+            v3_madd(&x[3 * i], n, wp * dl);
+            joint_take(w, r, &bd[6 * r], ct->arm, n, dl);
+        }
+    }
     for (int32_t k = 0; k < rb->npct; k++) {
         wb_rpcontact *ct = &rb->pct[k];
         const int32_t i = ct->i, r = ct->r;
-        const wb_real *n = ct->n, mu = rb->shape[r].friction, wp = m->w[i], split = cnt[r];
+        const wb_real *n = ct->n, mu = rb->shape[r].friction, wp = m->w[i], split = cnt[r], lam = ct->lambda;
         wb_real *xi = &x[3 * i], at[3];
         v3_add(at, ct->arm, &rb->x[3 * r]);
-        const wb_real wsum = wp + split * wb__rigid_w(w, r, at, n);
-        const wb_real lam = wsum > 0 ? ct->depth / wsum : 0;
-        ct->lambda = lam;
-        ct->lslow = wsum > 0 ? ct->slow / wsum : 0;
+        /* of the correction, the made overlap's slow part moves the start poses too */
+        ct->lslow = ct->slow > 0 ? lam * ct->slow / ct->depth : 0;
         v3_scale(ct->dp, n, -lam);
-        v3_madd(xi, n, wp * lam);
         if (ct->lslow > 0) v3_madd(&xp[3 * i], n, wp * ct->lslow);
         /* static friction (§3.5): undo the relative tangential slip of the substep when the
          * impulse it takes stays inside the cone, mu x lambda */
@@ -260,11 +320,14 @@ nomem:
     wb__warn(w, "out of memory in particle-rigid contacts; they are skipped this substep");
 }
 
-/* Dynamic friction and restitution (§3.6) on the velocities the poses gave, split and
- * summed over a body's contacts as the positions are: the tangential relative velocity
- * loses at most mu lambda / h, then an approaching normal relative velocity becomes -e
- * times the one it came in with (none below 2 |g| h, so that resting contact does not
- * jitter). Impulses act at the particle's centre */
+/* Dynamic friction (§3.6) on the velocities the poses gave, split among a body's contacts:
+ * the tangential relative velocity loses at most mu lambda / h. Then the normal relative
+ * velocity of every contact of the substep is set to -e times the one it came in with (0
+ * below 2 |g| h, so that resting contact does not jitter; Müller et al. 2020 eq. 34),
+ * solved together as the positions are: an approach left by the pass is stopped, and a
+ * separating speed the pass made (pushing out an overlap the substep began with, which
+ * is not a bounce) is taken out, by a pull no larger than the push the contact gave this
+ * substep (lambda / h). Impulses act at the particle's centre */
 void wb__rigid_particles_velocity(wb_world *w, wb_real h)
 {
     wb_rigids *rb = w->rb;
@@ -278,43 +341,64 @@ void wb__rigid_particles_velocity(wb_world *w, wb_real h)
         const wb_real *xi = &w->s.x[3 * i], *n = ct->n, wp = m->w[i], split = rb->pc_cnt[r];
         wb_real *vi = &w->s.v[3 * i], vb[3], u[3];
         v3_set(ct->dp, 0, 0, 0);
+        ct->wb = wb__rigid_w(w, r, xi, n);
+        if (!(s->friction > 0)) continue;
         body_velocity(rb, r, xi, vb);
         v3_sub(u, vi, vb);
-        wb_real un = v3_dot(u, n);
-        /* no separating speed made of old overlap pushed out in full (err), at most the
-         * speed there is (contact.c) */
-        const wb_real se = fmin(ct->err / h, un);
-        if (se > 0) {
-            const wb_real dl = se / (wp + split * wb__rigid_w(w, r, xi, n));
-            v3_madd(ct->dp, n, dl);
-            v3_madd(vi, n, -wp * dl);
-            un -= se;
+        const wb_real un = v3_dot(u, n);
+        wb_real ut[3];
+        v3_copy(ut, u);
+        v3_madd(ut, n, -un);
+        const wb_real vt = v3_len(ut);
+        if (!(vt > 0)) continue;
+        wb_real t[3];
+        v3_scale(t, ut, 1 / vt);
+        /* the normal impulse that stayed speed: without err's, as contact.c */
+        const wb_real ln = ct->err > 0 ? ct->lambda * (ct->depth - ct->err) / ct->depth : ct->lambda;
+        const wb_real P = fmin(s->friction * ln / h, vt / (wp + split * wb__rigid_w(w, r, xi, t)));
+        v3_madd(ct->dp, t, P);
+        v3_madd(vi, t, -wp * P);
+    }
+    wb_real *bd = joint_scratch(rb);
+    if (!bd) {
+        wb__warn(w, "out of memory in particle-rigid contacts; their velocities are left this substep");
+        return;
+    }
+    /* ct->x0 holds the normal impulse so far (x0[0]), its floor (x0[1]) and target (x0[2]) */
+    for (int32_t k = 0; k < rb->npct; k++) {
+        wb_rpcontact *ct = &rb->pct[k];
+        const wb_real e = fabs(ct->vn_pre) > 2 * g * h ? rb->shape[ct->r].restitution : 0;
+        wb_real vb[3], u[3], target = fmax(-e * ct->vn_pre, 0);
+        body_velocity(rb, ct->r, &w->s.x[3 * ct->i], vb);
+        v3_sub(u, &w->s.v[3 * ct->i], vb);
+        const wb_real un = v3_dot(u, ct->n);
+        if (un > target) target = fmax(target, un - ct->err / h);
+        v3_set(ct->x0, 0, -(ct->lambda - ct->lslow) / h, target);
+    }
+    for (int sweep = 0, more = 1; sweep < JOINT_SWEEPS && more; sweep++) {
+        more = 0;
+        for (int32_t j = 0; j < rb->npct; j++) {
+            wb_rpcontact *ct = &rb->pct[sweep & 1 ? rb->npct - 1 - j : j];
+            const int32_t i = ct->i, r = ct->r;
+            const wb_real *n = ct->n, wp = m->w[i], den = wp + ct->wb;
+            if (!(den > 0)) continue;
+            wb_real *vi = &w->s.v[3 * i], vb[3], a[3], d[3], u[3];
+            body_velocity(rb, r, &w->s.x[3 * i], vb);
+            v3_sub(a, &w->s.x[3 * i], &rb->x[3 * r]);
+            joint_point(&bd[6 * r], a, d);
+            v3_add(vb, vb, d);
+            v3_sub(u, vi, vb);
+            const wb_real p = fmax(ct->x0[0] + (ct->x0[2] - v3_dot(u, n)) / den, ct->x0[1]), dl = p - ct->x0[0];
+            if (dl == 0) continue;
+            more |= fabs(dl) * den > JOINT_TOL_V;
+            ct->x0[0] = p;
+            v3_madd(vi, n, wp * dl);
+            joint_take(w, r, &bd[6 * r], a, n, dl);
         }
-        if (s->friction > 0) {
-            wb_real ut[3];
-            v3_copy(ut, u);
-            v3_madd(ut, n, -un);
-            const wb_real vt = v3_len(ut);
-            if (vt > 0) {
-                wb_real t[3];
-                v3_scale(t, ut, 1 / vt);
-                /* the normal impulse that stayed speed: without err's, as contact.c */
-                const wb_real ln = ct->err > 0 ? ct->lambda * (ct->depth - ct->err) / ct->depth : ct->lambda;
-                const wb_real P = fmin(s->friction * ln / h, vt / (wp + split * wb__rigid_w(w, r, xi, t)));
-                v3_madd(ct->dp, t, P);
-                v3_madd(vi, t, -wp * P);
-                v3_madd(u, t, -wp * P - P * wb__rigid_w(w, r, xi, t)); /* (its normal part: none) */
-            }
-        }
-        const wb_real e = fabs(ct->vn_pre) > 2 * g * h ? s->restitution : 0;
-        const wb_real target = fmax(-e * ct->vn_pre, 0);
-        if (!(un < target)) continue;
-        const wb_real dl = (target - un) / (wp + split * wb__rigid_w(w, r, xi, n));
-        v3_madd(ct->dp, n, -dl);
-        v3_madd(vi, n, wp * dl);
     }
     for (int32_t k = 0; k < rb->npct; k++) {
-        const wb_rpcontact *ct = &rb->pct[k];
+        wb_rpcontact *ct = &rb->pct[k];
+        v3_madd(ct->dp, ct->n, -ct->x0[0]);
         wb__rigid_impulse(w, ct->r, &w->s.x[3 * ct->i], ct->dp);
     }
 }

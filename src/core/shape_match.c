@@ -95,10 +95,10 @@ static wb_status reserve(wb_world *w, int64_t n_extra, int64_t ids_extra)
 /* ---- the fit ------------------------------------------------------------------------------ */
 /* mass centre c of cluster k's particles at x and the rotation q (warm start in, fit out)
  * of its rest shape onto them; particles without mass (inv_mass 0) take no part */
-static void fit(const wb_world *w, int32_t k, wb_real q[4], wb_real c[3])
+static void fit_at(const wb_world *w, int32_t k, const wb_real *x, wb_real q[4], wb_real c[3])
 {
     const wb_smatch *sm = &w->sm;
-    const wb_real *x = w->s.x, *im = w->m.inv_mass;
+    const wb_real *im = w->m.inv_mass;
     wb_real M = 0, A[9] = { 0 };
     v3_set(c, 0, 0, 0);
     for (int32_t j = sm->start[k]; j < sm->start[k + 1]; j++) {
@@ -120,6 +120,8 @@ static void fit(const wb_world *w, int32_t k, wb_real q[4], wb_real c[3])
     }
     wb_extract_rotation(A, q, ROT_ITER);
 }
+
+static void fit(const wb_world *w, int32_t k, wb_real q[4], wb_real c[3]) { fit_at(w, k, w->s.x, q, c); }
 
 static void goal(const wb_real R[9], const wb_real c[3], const wb_real r[3], wb_real g[3])
 {
@@ -156,9 +158,40 @@ static wb_status sm_prepare(wb_world *w)
     return WB_OK;
 }
 
+/* A rigid cluster (stiffness 1) leaves each substep rigid but for what the contacts after
+ * it moved (the collisions are the substep's last pass): the ground pushes the particles
+ * it meets, and only those. Fitted again from there, the cluster would spread that push
+ * over itself as speed while moving those particles back into the ground by the rest,
+ * which the ground then pushes out again as a new collision: every push counted twice. A
+ * cube of 5^3 particles dropped flat at 4.3 m/s on a floor of restitution 0 rebounded at
+ * 1.7 m/s, and landing on an edge it sprang off it spinning and was thrown 0.6 m (a rigid
+ * body of its shape: 0.07 m). So at the substep's start a rigid cluster is fitted to where
+ * the last one left it and put there, x and x_prev moved alike: the contacts' pushes
+ * become the whole cluster's move, with no speed; what that puts back into the ground is
+ * an overlap the substep begins with, which the collisions take out with x_prev too.
+ * Velocities (x - x_prev) do not change, so neither do momentum and angular momentum.
+ * A compliant cluster's deformation is its elastic state: it keeps it. */
 static void sm_substep_begin(wb_world *w)
 {
-    if (w->sm.nids > 0) memset(w->sm.lambda, 0, 3 * sizeof(wb_real) * (size_t)w->sm.nids);
+    wb_smatch *sm = &w->sm;
+    if (sm->nids > 0) memset(sm->lambda, 0, 3 * sizeof(wb_real) * (size_t)sm->nids);
+    const wb_real *wv = w->m.w;
+    wb_real *x = w->s.x, *xp = w->s.x_prev;
+    for (int32_t k = 0; k < sm->n; k++) {
+        if (!(sm->stiff[k] >= 1)) continue;
+        wb_real c[3], R[9], *q = &sm->qk[4 * k];
+        fit_at(w, k, xp, q, c);
+        wb_quat_to_matrix(q, R);
+        for (int32_t j = sm->start[k]; j < sm->start[k + 1]; j++) {
+            const int32_t i = sm->ids[j];
+            if (wv[i] == 0) continue;
+            wb_real g[3], d[3];
+            goal(R, c, &sm->rest[3 * j], g);
+            v3_sub(d, g, &xp[3 * i]);
+            v3_add(&xp[3 * i], &xp[3 * i], d);
+            v3_add(&x[3 * i], &x[3 * i], d);
+        }
+    }
 }
 
 static void sm_project(wb_world *w, wb_real h)

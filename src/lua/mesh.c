@@ -417,21 +417,7 @@ static int from_mesh_tets(lua_State *L)
         }
         return luaL_argerror(L, 2, err);
     }
-    /* a preset: mass rho x the tets' volume, dashpots eta x the mean tet edge (as w:lattice) */
-    if (mat) {
-        double vol = 0, edges = 0;
-        for (int32_t i = 0; i < t->nt; i++) {
-            const int32_t *p = &t->tet[4 * i];
-            vol += fabs(wb_tet_signed_volume(&t->v[3 * p[0]], &t->v[3 * p[1]], &t->v[3 * p[2]], &t->v[3 * p[3]]));
-            for (int a = 0; a < 4; a++)
-                for (int c = a + 1; c < 4; c++) {
-                    const wb_real *u = &t->v[3 * p[a]], *q = &t->v[3 * p[c]];
-                    edges += sqrt((u[0] - q[0]) * (u[0] - q[0]) + (u[1] - q[1]) * (u[1] - q[1]) + (u[2] - q[2]) * (u[2] - q[2]));
-                }
-        }
-        if (!wbl_given(L, 3, "mass") && vol > 0) d.mass = mat->density * vol;
-        if (!wbl_given(L, 3, "damping") && t->nt > 0) d.link.damping = mat->viscosity * edges / (6.0 * t->nt);
-    }
+    wbl_tet_preset(L, 3, mat, t, &d);
     /* with the surface kept, the mesh's vertices are tetgen's first nodes: its triangles are
      * the body's surface, as they were; else the tets' boundary (tetgen split it) */
     keep = o.kept && t->nv >= m->nv;

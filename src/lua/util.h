@@ -111,6 +111,9 @@ bool wbl_read_tet_body(lua_State *L, int arg, wb_tet_body_def *d);
 void wbl_read_neo(lua_State *L, int arg, wb_real *young, wb_real *poisson);
 int wbl_push_tet_body(lua_State *L, wb_world *w, const struct wbio_tets *t, const int32_t *tri, int32_t ntri,
                       const wb_tet_body_def *d, bool auto_radius, const struct wbl_contact_opts *co, const char *what);
+/* a preset's mass (rho x the tets' volume) and dashpots (eta x the mean tet edge) into d,
+ * unless the options at arg give mass or damping (m may be NULL) */
+void wbl_tet_preset(lua_State *L, int arg, const wb_material *m, const struct wbio_tets *t, wb_tet_body_def *d);
 /* a builder's contact options (collide = true, self_collide = false, friction = 0) from
  * the options table at arg, and their application to the body it made */
 typedef struct wbl_contact_opts { bool collide, self_collide; wb_real friction; } wbl_contact_opts;

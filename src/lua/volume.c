@@ -175,6 +175,23 @@ int wbl_push_tet_body(lua_State *L, wb_world *w, const wbio_tets *t, const int32
     return 1;
 }
 
+void wbl_tet_preset(lua_State *L, int arg, const wb_material *m, const wbio_tets *t, wb_tet_body_def *d)
+{
+    if (!m) return;
+    double vol = 0, edges = 0;
+    for (int32_t i = 0; i < t->nt; i++) {
+        const int32_t *p = &t->tet[4 * i];
+        vol += fabs(wb_tet_signed_volume(&t->v[3 * p[0]], &t->v[3 * p[1]], &t->v[3 * p[2]], &t->v[3 * p[3]]));
+        for (int a = 0; a < 4; a++)
+            for (int c = a + 1; c < 4; c++) {
+                const wb_real *u = &t->v[3 * p[a]], *q = &t->v[3 * p[c]];
+                edges += sqrt((u[0] - q[0]) * (u[0] - q[0]) + (u[1] - q[1]) * (u[1] - q[1]) + (u[2] - q[2]) * (u[2] - q[2]));
+            }
+    }
+    if (!wbl_given(L, arg, "mass") && vol > 0) d->mass = m->density * vol;
+    if (!wbl_given(L, arg, "damping") && t->nt > 0) d->link.damping = m->viscosity * edges / (6.0 * t->nt);
+}
+
 /* "solid", "solid.node" or "solid.ele" -> the two paths through the sandbox */
 static void tet_paths(lua_State *L, const char *name, int write, char *node, char *ele, char *node_shown,
                       char *ele_shown)
@@ -191,19 +208,28 @@ static void tet_paths(lua_State *L, const char *name, int write, char *node, cha
 
 static const char *const load_tets_keys[] = {
     "mass", "radius", "volume_compliance", "young", "poisson",
-    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction", NULL
+    "compliance", "damping", "yield", "creep", "break_strain", "break_force", "collide", "self_collide", "friction",
+    "material", NULL
 };
 
-/* w:load_tets(path, {...}) -> body, or nil and "file:line: reason" */
+/* w:load_tets(path, {...}) -> body, or nil and "file:line: reason"; a preset as
+ * w:from_mesh{tets = true} takes it: Neo-Hookean tets of its E and nu, rho x the tets'
+ * volume, its dashpots and friction */
 static int w_load_tets(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
     const char *name = wbl_checkfilename(L, 2);
     wbl_checkopts(L, 3, load_tets_keys, true);
     wb_tet_body_def d = wb_tet_body_default_def();
+    const wb_material *mat = lua_istable(L, 3) ? wbl_opt_material(L, 3) : NULL;
+    if (mat) {
+        d.young = mat->young;
+        d.poisson = mat->poisson;
+    }
     const bool auto_radius = wbl_read_tet_body(L, 3, &d);
     wbl_contact_opts co;
     wbl_read_contact_opts(L, 3, &co);
+    wbl_material_friction(L, 3, mat, &co);
     char node[PATH_MAX], ele[PATH_MAX], node_shown[PATH_MAX], ele_shown[PATH_MAX], err[1024];
     tet_paths(L, name, 0, node, ele, node_shown, ele_shown);
     lua_settop(L, 3);
@@ -213,6 +239,7 @@ static int w_load_tets(lua_State *L)
         lua_pushstring(L, err);
         return 2;
     }
+    wbl_tet_preset(L, 3, mat, t, &d);
     /* a file's tets that the core refuses (flat ones): an expected failure as well */
     /* tet_count: volume constraints, or Neo-Hookean tets with young */
     const int32_t nd0 = wb_distance_count(w), nv0 = wb_volume_count(w) + wb_tet_count(w);
