@@ -6,12 +6,12 @@
  * neighbour across the edge by how far it is from the nearer end (a staircase's step
  * becomes a ramp), or by how much it stands out alone (a pixel-wide feature is softened).
  *
- * Only pixels next to something drawn as geometry are looked at: the ground and the sky
- * write alpha 0 (the ground's grid lines are anti-aliased by its shader already, and
- * long straight lines are FXAA's most expensive edges), so a pixel is skipped unless it
- * or one of its four neighbours has alpha. On llvmpipe a fragment pass costs several ms
- * a 720p frame of fixed work per pixel; here a pixel away from edges costs a few
- * comparisons. */
+ * Only pixels next to something drawn as geometry (alpha 255) are looked at: the ground
+ * writes alpha 128 (its grid lines are anti-aliased by its shader already, and long
+ * straight lines are FXAA's most expensive edges) and the sky is where nothing was drawn
+ * (alpha 0, filled in here), so a pixel is skipped unless it or one of its four
+ * neighbours is geometry. On llvmpipe a fragment pass costs several ms a 720p frame of
+ * fixed work per pixel; here a pixel away from edges costs a few comparisons. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -92,7 +92,14 @@ static float edge_blend(const uint8_t *lu, int w, int h, int x, int y, int range
     return off > sub ? off : sub;
 }
 
-bool wb_fxaa(const uint8_t *rgba, int w, int h, uint8_t *rgb, uint8_t **scratch, size_t *scratch_cap)
+/* pixel i of row y as drawn: the sky's colour where nothing was */
+static inline const uint8_t *drawn(const uint8_t *rgba, const uint8_t *sky, size_t i, size_t y)
+{
+    return sky && !rgba[4 * i + 3] ? sky + 3 * y : rgba + 4 * i;
+}
+
+bool wb_fxaa(const uint8_t *rgba, int w, int h, const uint8_t *sky, uint8_t *rgb, uint8_t **scratch,
+             size_t *scratch_cap)
 {
     const size_t n = (size_t)w * (size_t)h;
     if (*scratch_cap < 2 * n) {
@@ -104,18 +111,26 @@ bool wb_fxaa(const uint8_t *rgba, int w, int h, uint8_t *rgb, uint8_t **scratch,
     uint8_t *lu = *scratch, *geo = *scratch + n;
     /* the frame as RGB, its luma (Rec. 601 weights on the stored, gamma-encoded values, as
      * FXAA takes them) and where geometry was drawn */
-    for (size_t i = 0; i < n; i++) {
-        const uint8_t *p = rgba + 4 * i;
-        uint8_t *o = rgb + 3 * i;
-        o[0] = p[0], o[1] = p[1], o[2] = p[2];
-        lu[i] = (uint8_t)((77 * p[0] + 150 * p[1] + 29 * p[2] + 128) >> 8);
-        geo[i] = p[3];
-    }
+    for (size_t y = 0, i = 0; y < (size_t)h; y++)
+        for (int x = 0; x < w; x++, i++) {
+            const uint8_t *p = drawn(rgba, sky, i, y);
+            uint8_t *o = rgb + 3 * i;
+            o[0] = p[0], o[1] = p[1], o[2] = p[2];
+            lu[i] = (uint8_t)((77 * p[0] + 150 * p[1] + 29 * p[2] + 128) >> 8);
+            geo[i] = rgba[4 * i + 3] == 255;
+        }
     for (int y = 0; y < h; y++) {
         const size_t r = (size_t)y * w;
         const uint8_t *gm = geo + r, *gu = geo + (y > 0 ? r - w : r), *gd = geo + (y < h - 1 ? r + w : r);
         const uint8_t *row = lu + r, *lup = lu + (y > 0 ? r - w : r), *ldn = lu + (y < h - 1 ? r + w : r);
         for (int x = 0; x < w; x++) {
+            /* eight pixels at a time far from geometry (the most of a frame) */
+            uint64_t a8, b8, c8;
+            if (x + 9 <= w && (memcpy(&a8, gm + x, 8), memcpy(&b8, gu + x, 8), memcpy(&c8, gd + x, 8),
+                               !(a8 | b8 | c8 | gm[x + 8] | gm[x > 0 ? x - 1 : 0]))) {
+                x += 7;
+                continue;
+            }
             const int xl = x > 0 ? x - 1 : 0, xr = x < w - 1 ? x + 1 : x;
             if (!(gm[x] | gu[x] | gd[x] | gm[xl] | gm[xr])) continue;
             const int M = row[x], N = lup[x], S = ldn[x], W = row[xl], E = row[xr];
@@ -125,7 +140,7 @@ bool wb_fxaa(const uint8_t *rgba, int w, int h, uint8_t *rgb, uint8_t **scratch,
             size_t nb;
             const float a = edge_blend(lu, w, h, x, y, range, &nb);
             if (!(a > 0)) continue;
-            const uint8_t *p = rgba + 4 * (r + x), *q = rgba + 4 * nb;
+            const uint8_t *p = drawn(rgba, sky, r + x, (size_t)y), *q = drawn(rgba, sky, nb, nb / (size_t)w);
             uint8_t *o = rgb + 3 * (r + x);
             for (int c = 0; c < 3; c++) o[c] = (uint8_t)(p[c] + (q[c] - p[c]) * a + 0.5f);
         }

@@ -42,6 +42,9 @@ static const char light_fs[] =
     "uniform sampler2DShadow u_smap;\n"
     "uniform float u_bias;\n"
     "uniform int u_shadows;\n"
+    "uniform vec3 u_amb_down;\n"   /* the ambient light of a surface facing down and up (linear) */
+    "uniform vec3 u_amb_up;\n"
+    "uniform vec3 u_key;\n"        /* the key light's colour */
     /* the lookup moves off the surface along its normal by u_bias (a few texels), more
      * the more the light grazes (slope-scaled: a texel spans more depth there), up to 8
      * times. The slope is the larger of the smooth normal's and the triangle's own (ng,
@@ -70,27 +73,21 @@ static const char light_fs[] =
     "  float ndl = dot(n, u_light);\n"
     "  float sh = ndl > 0.0 ? shadow_at(p, n, ng) : 0.0;\n"
     "  vec3 h = normalize(u_light + v);\n"
-    "  float spec = shine * pow(max(dot(n, h), 0.0), 40.0);\n"
-    "  vec3 amb = mix(vec3(0.16, 0.14, 0.13), vec3(0.30, 0.34, 0.42), n.y * 0.5 + 0.5);\n"
+    /* the 40th power by squaring: pow is a log and an exp on llvmpipe */
+    "  float s2 = max(dot(n, h), 0.0);\n"
+    "  s2 *= s2;\n"
+    "  float s8 = s2 * s2;\n"
+    "  s8 *= s8;\n"
+    "  float s32 = s8 * s8;\n"
+    "  s32 *= s32;\n"
+    "  float spec = shine * s32 * s8;\n"
+    "  vec3 amb = mix(u_amb_down, u_amb_up, n.y * 0.5 + 0.5);\n"
     "  float rim = 1.0 - max(dot(n, v), 0.0);\n"
     "  rim = rim * rim * rim * 0.12;\n"
-    "  return base * (amb + vec3(1.0, 0.96, 0.9) * max(ndl, 0.0) * sh) + vec3(spec * sh + rim);\n"
+    "  return base * (amb + u_key * max(ndl, 0.0) * sh) + vec3(spec * sh + rim);\n"
     "}\n"
     /* gamma 2 instead of 2.2: a square root is much cheaper than pow on llvmpipe */
-    "vec4 to_srgb(vec3 c, float a) { return vec4(sqrt(clamp(c, 0.0, 1.0)), a); }\n"
-    /* the ground: diffuse only, its cost is most of the frame's. llvmpipe runs both
-     * sides of a branch (masked), so a lookup skipped at run time costs as much as one
-     * made: the ground has two programs, with the shadow map (SHADOWED, drawn where a
-     * shadow can fall; `near`: inside the map's box) and without (everywhere else) */
-    "vec3 lit_matte(vec3 base, vec3 n, vec3 p, bool near) {\n"
-    "  float ndl = dot(n, u_light);\n"
-    "  float sh = ndl > 0.0 ? 1.0 : 0.0;\n"
-    "#ifdef SHADOWED\n"
-    "  if (near && ndl > 0.0) sh = shadow_at(p, n, n);\n"
-    "#endif\n"
-    "  vec3 amb = mix(vec3(0.16, 0.14, 0.13), vec3(0.30, 0.34, 0.42), n.y * 0.5 + 0.5);\n"
-    "  return base * (amb + vec3(1.0, 0.96, 0.9) * max(ndl, 0.0) * sh);\n"
-    "}\n";
+    "vec4 to_srgb(vec3 c, float a) { return vec4(sqrt(clamp(c, 0.0, 1.0)), a); }\n";
 
 static const char mesh_fs[] =
     "in vec3 v_pos;\n"
@@ -167,16 +164,20 @@ static const char grid_fs[] =
     "uniform vec3 u_center;\n"
     "uniform vec3 u_gu;\n"
     "uniform vec3 u_gv;\n"
-    "uniform vec3 u_gn;\n"
     "uniform float u_spacing;\n"
     "uniform float u_extent;\n"
-    "uniform float u_fog;\n"
+    "uniform float u_fog2;\n"    /* 1 / the fog length squared */
     "uniform int u_floor;\n"
-    "uniform vec3 u_base;\n"
     "out vec4 o_col;\n"
     "uniform vec3 u_top;\n"
     "uniform vec3 u_bottom;\n"
     "uniform float u_height;\n"
+    /* the plane's colour in sRGB, unshadowed (render.c: the ground's colour lit from the
+     * side seen, whose normal is u_nrm) and, for the shadow, its linear parts */
+    "uniform vec3 u_lit;\n"
+    "uniform vec3 u_base_amb;\n"
+    "uniform vec3 u_base_key;\n"
+    "uniform vec3 u_nrm;\n"
     "uniform vec3 u_sc;\n"    /* beyond sqrt(u_sr2) of u_sc, outside the shadow map's box: no shadow */
     "uniform float u_sr2;\n"
     "float grid(vec2 uv, vec2 fw) {\n"
@@ -185,26 +186,32 @@ static const char grid_fs[] =
     "  return (1.0 - min(min(g.x, g.y), 1.0)) * fade;\n"
     "}\n"
     "void main() {\n"
-    "  vec3 p = v_p;\n"
-    "  vec3 d = p - u_center;\n"
-    "  float f = length(p - u_eye) / u_fog;\n"  /* the distance, in fog lengths */
-    "  float a = u_floor != 0 ? exp(-f * f)\n"
+    "  vec3 p = v_p, d = p - u_center, e = p - u_eye;\n"
+    "  float a = u_floor != 0 ? exp(-dot(e, e) * u_fog2)\n"   /* the distance in fog lengths, squared */
     "                         : 1.0 - smoothstep(0.45, 1.0, length(d) / u_extent);\n"
     "  if (a <= 0.002) discard;\n"
     "  vec2 uv = vec2(dot(d, u_gu), dot(d, u_gv)) / u_spacing;\n"
-    "  vec3 base = u_base;\n"
     "  vec2 fw = fwidth(uv);\n"
-    /* the lines have faded out where a major cell is under 2.5 pixels (grid's fade) */
-    "  if (max(fw.x, fw.y) < 2.0) {\n"
-    "    base = mix(base, base * 0.62, grid(uv, fw) * 0.7);\n"
-    "    base = mix(base, base * 0.45, grid(uv / 5.0, fw / 5.0));\n"
-    "  }\n"
-    "  vec3 n = dot(u_eye - p, u_gn) >= 0.0 ? u_gn : -u_gn;\n"  /* the side seen */
+    /* the lines darken the colour (linear) by m; they have faded out where a major cell
+     * is under 2.5 pixels (grid's fade) */
+    "  float m = 1.0;\n"
+    "  if (max(fw.x, fw.y) < 2.0) m = (1.0 - 0.266 * grid(uv, fw)) * (1.0 - 0.55 * grid(uv / 5.0, fw / 5.0));\n"
+    /* diffuse only, its cost is most of the frame's. llvmpipe runs both sides of a branch
+     * (masked), so a lookup skipped at run time costs as much as one made: the ground has
+     * two programs, with the shadow map (SHADOWED, drawn where a shadow can fall; inside
+     * the map's box) and without (everywhere else). sqrt(c m) = sqrt(c) sqrt(m): gamma 2,
+     * as to_srgb */
+    "#ifdef SHADOWED\n"
+    "  float sh = dot(p - u_sc, p - u_sc) < u_sr2 ? shadow_at(p, u_nrm, u_nrm) : 1.0;\n"
+    "  vec3 c = sqrt(u_base_amb + u_base_key * sh);\n"
+    "#else\n"
+    "  vec3 c = u_lit;\n"
+    "#endif\n"
     /* opaque: faded into the sky's colour here, so the sky is drawn last and only
-     * where nothing else is (the cheapest pixels are those never shaded). Alpha 0: not
-     * geometry, which FXAA looks at alone (fxaa.c) */
+     * where nothing else is (the cheapest pixels are those never shaded). Alpha 1/2: not
+     * geometry (alpha 1), which FXAA looks at alone, nor the sky (fxaa.c) */
     "  vec3 sky = mix(u_bottom, u_top, clamp(gl_FragCoord.y / u_height, 0.0, 1.0));\n"
-    "  o_col = vec4(mix(sky, to_srgb(lit_matte(base, n, p, dot(p - u_sc, p - u_sc) < u_sr2), 1.0).rgb, a), 0.0);\n"
+    "  o_col = vec4(mix(sky, min(c * sqrt(m), 1.0), a), 0.5);\n"
     "}\n";
 
 /* the sky: a vertical gradient over a full-screen triangle (alpha 0, as the ground) */

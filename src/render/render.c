@@ -29,6 +29,7 @@ struct wb_renderer {
     bool fxaa;                    /* antialiased after drawing (fxaa.c) */
     uint8_t *luma;                /* its scratch */
     size_t luma_cap;
+    uint8_t *sky;                 /* with one sample: the sky's colour of each row (sky_rows) */
     /* camera: fixed by the script, or framing everything shown since the reset */
     bool fixed;
     double eye[3], target[3], up[3], fov;
@@ -90,6 +91,10 @@ static const float col_ground[3] = { 0.80f, 0.80f, 0.78f };
 static const float col_sky_top[3] = { 0.50f, 0.61f, 0.75f };
 static const float col_sky_bottom[3] = { 0.89f, 0.90f, 0.92f };
 static const double light_dir[3] = { -0.40, 0.80, 0.45 };   /* towards the light: upper left, in front */
+/* the light (linear): ambient on a surface facing down and up (mixed by the normal's y),
+ * the key light's colour */
+static const float amb_down[3] = { 0.16f, 0.14f, 0.13f }, amb_up[3] = { 0.30f, 0.34f, 0.42f };
+static const float key_col[3] = { 1.0f, 0.96f, 0.9f };
 /* the default camera's box shrinks by this part of the way per draw: about half a
  * second to settle at 60 draws a second */
 static const double box_shrink = 0.03;
@@ -207,6 +212,7 @@ void wb_renderer_destroy(wb_renderer *r)
     }
     free(r->rgb);
     free(r->luma);
+    free(r->sky);
     wb_layers_free(&r->layers);
     const bool gl = r->be->gl;
     free(r);
@@ -733,6 +739,20 @@ static void draw_grid(wb_renderer *r, const double cam[3][3], const double cente
         corner[4 * slot + 2] = (float)(i < nnear ? fmin(z, zmax) : zmax), corner[4 * slot + 3] = (float)t;
         for (int k = 0; k < 3; k++) wpos[3 * slot + k] = (float)(r->cam_eye[k] + t * d[k]);
     }
+    /* its light, the same over the plane: the side seen (normal n) lit by the ambient and
+     * the key light (the ground's colour times each, linear), and unshadowed in sRGB */
+    double n[3], L[3] = { light_dir[0], light_dir[1], light_dir[2] };
+    norm3(L);
+    const double side = s <= 0 ? 1 : -1;   /* the eye above the plane (along gn): gn */
+    for (int k = 0; k < 3; k++) n[k] = side * gn[k];
+    const double ndl = fmax(dot3(n, L), 0), up = n[1] * 0.5 + 0.5;
+    float g[3], lit[3], base_amb[3], base_key[3];
+    wb_lin3(col_ground, g);
+    for (int k = 0; k < 3; k++) {
+        base_amb[k] = (float)(g[k] * (amb_down[k] + (amb_up[k] - amb_down[k]) * up));
+        base_key[k] = (float)(g[k] * key_col[k] * ndl);
+        lit[k] = (float)sqrt(fmin(base_amb[k] + base_key[k], 1));
+    }
     const int tw = (r->w + SHADOW_TILE - 1) / SHADOW_TILE, th = (r->h + SHADOW_TILE - 1) / SHADOW_TILE;
     const size_t nt = (size_t)tw * (size_t)th;
     /* the tiles, then the rectangles of each program and a row's open runs */
@@ -759,14 +779,14 @@ static void draw_grid(wb_renderer *r, const double cam[3][3], const double cente
         set_vec(p, "u_center", center[0], center[1], center[2]);
         set_vec(p, "u_gu", gu[0], gu[1], gu[2]);
         set_vec(p, "u_gv", gv[0], gv[1], gv[2]);
-        set_vec(p, "u_gn", gn[0], gn[1], gn[2]);
+        set_vec(p, "u_nrm", n[0], n[1], n[2]);
         glUniform1f(glGetUniformLocation(p, "u_spacing"), (float)spacing);
         glUniform1f(glGetUniformLocation(p, "u_extent"), (float)ext);
-        glUniform1f(glGetUniformLocation(p, "u_fog"), (float)fog);
+        glUniform1f(glGetUniformLocation(p, "u_fog2"), (float)(1 / (fog * fog)));
         glUniform1i(glGetUniformLocation(p, "u_floor"), floor);
-        float g[3];
-        wb_lin3(col_ground, g);
-        glUniform3f(glGetUniformLocation(p, "u_base"), g[0], g[1], g[2]);
+        glUniform3fv(glGetUniformLocation(p, "u_lit"), 1, lit);
+        glUniform3fv(glGetUniformLocation(p, "u_base_amb"), 1, base_amb);
+        glUniform3fv(glGetUniformLocation(p, "u_base_key"), 1, base_key);
         for (int k = 0; k < nrect[pass]; k++) {
             /* untold (or out of memory for the tiles): all of it with the shadow map */
             const int *q = tiled ? rects[pass * nt + k] : whole;
@@ -808,6 +828,22 @@ static void light_uniforms(GLuint p, const double vp[16], const double lvp[16], 
     glUniform1f(glGetUniformLocation(p, "u_bias"), (float)bias);
     glUniform1i(glGetUniformLocation(p, "u_shadows"), shadows);
     glUniform1i(glGetUniformLocation(p, "u_smap"), 0);
+    glUniform3fv(glGetUniformLocation(p, "u_amb_down"), 1, amb_down);
+    glUniform3fv(glGetUniformLocation(p, "u_amb_up"), 1, amb_up);
+    glUniform3fv(glGetUniformLocation(p, "u_key"), 1, key_col);
+}
+
+/* the sky's colour of each row, top first, as the sky's shader would draw it (bg_fs:
+ * the gradient at the pixel's centre, rounded to 8 bits); NULL: out of memory */
+static const uint8_t *sky_rows(wb_renderer *r)
+{
+    if (r->sky) return r->sky;
+    r->sky = malloc(3 * (size_t)r->h);
+    for (int y = 0; r->sky && y < r->h; y++) {
+        const float t = ((float)(r->h - y) - 0.5f) / (float)r->h;
+        for (int k = 0; k < 3; k++) r->sky[3 * y + k] = (uint8_t)lrintf(255 * (col_sky_bottom[k] + (col_sky_top[k] - col_sky_bottom[k]) * t));
+    }
+    return r->sky;
 }
 
 static void background_cpu(wb_renderer *r)
@@ -970,10 +1006,14 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     glDisable(GL_POLYGON_OFFSET_FILL);
     pass_mark(r, PASS_SHADOW);
 
-    /* the picture */
+    /* the picture. With one sample the sky is the CPU's (wb_fxaa, sky_copy): where nothing
+     * was drawn, alpha 0 from the clear (a pass over the uncovered pixels took 2-3 ms at
+     * 720p); samples would mix the clear's black into the edges */
+    const uint8_t *sky = r->samples == 1 ? sky_rows(r) : NULL;
     glBindFramebuffer(GL_FRAMEBUFFER, g->fbo_ms);
     glViewport(0, 0, r->w, r->h);
-    glClear(GL_DEPTH_BUFFER_BIT);
+    glClearColor(0, 0, 0, 0);
+    glClear(sky ? GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT : GL_DEPTH_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, g->tex_shadow);
@@ -1041,15 +1081,17 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     }
     pass_mark(r, PASS_LINES);
     /* the sky last, behind everything: only uncovered pixels pass the depth test */
-    glDepthFunc(GL_LEQUAL);
-    glDepthMask(GL_FALSE);
-    glUseProgram(g->prog_bg);
-    glUniform3f(glGetUniformLocation(g->prog_bg, "u_top"), col_sky_top[0], col_sky_top[1], col_sky_top[2]);
-    glUniform3f(glGetUniformLocation(g->prog_bg, "u_bottom"), col_sky_bottom[0], col_sky_bottom[1], col_sky_bottom[2]);
-    glBindVertexArray(g->vao_empty);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
+    if (!sky) {
+        glDepthFunc(GL_LEQUAL);
+        glDepthMask(GL_FALSE);
+        glUseProgram(g->prog_bg);
+        glUniform3f(glGetUniformLocation(g->prog_bg, "u_top"), col_sky_top[0], col_sky_top[1], col_sky_top[2]);
+        glUniform3f(glGetUniformLocation(g->prog_bg, "u_bottom"), col_sky_bottom[0], col_sky_bottom[1], col_sky_bottom[2]);
+        glBindVertexArray(g->vao_empty);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glDepthFunc(GL_LESS);
+        glDepthMask(GL_TRUE);
+    }
 
     pass_mark(r, PASS_SKY);
     /* resolve into the backend's buffer (unless drawn there) and keep the frame */
@@ -1069,8 +1111,12 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     pass_mark(r, PASS_RESOLVE);
     const uint8_t *px = r->be->pixels(r->ctx);
     size_t npx = (size_t)r->w * r->h;
-    if (!r->fxaa || !wb_fxaa(px, r->w, r->h, r->rgb, &r->luma, &r->luma_cap))   /* out of memory: as drawn */
+    if (!r->fxaa || !wb_fxaa(px, r->w, r->h, sky, r->rgb, &r->luma, &r->luma_cap)) {   /* out of memory: as drawn */
         for (size_t i = 0; i < npx; i++) memcpy(r->rgb + 3 * i, px + 4 * i, 3);
+        for (int y = 0; sky && y < r->h; y++)
+            for (int x = 0; x < r->w; x++)
+                if (!px[4 * ((size_t)y * r->w + x) + 3]) memcpy(r->rgb + 3 * ((size_t)y * r->w + x), sky + 3 * y, 3);
+    }
     if (o->legend && l->strain_shown) draw_legend(r, l->scale);
     pass_mark(r, PASS_COPY);
     return true;
