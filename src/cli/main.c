@@ -62,6 +62,8 @@ static const char usage_text[] =
     "  --frames N          w:run stops after N frames; bench: each scene runs N frames\n"
     "  --record OUT        (run) draw every frame into OUT: .mp4, .gif or a folder of PNGs\n"
     "  --size WxH          (run) --record's frame size (default 1280x720; a .gif 640x360)\n"
+    "  --samples N         (run) --record's antialiasing: N samples a pixel (1: none, 4:\n"
+    "                      the renderer's default, slower); default one sample and FXAA\n"
     "  --replay INPUT.json (run) apply the grabs of an input log after their frames; exit\n"
     "                      code 1 when some were not applied (the scene ended or differs)\n"
     "  --out DIR           output folder, the only place a script writes (default out);\n"
@@ -89,6 +91,7 @@ typedef struct opts {
     const char **sets, **pos;  /* --set values, positional arguments */
     const char *record;        /* run --record OUT, or NULL */
     const char *replay;        /* run --replay INPUT.json, or NULL */
+    int samples;               /* run --samples N (--record's antialiasing), 0: the default */
     int nsets, npos;
     int json;                  /* bench --json */
     int out_given;             /* --out named: run writes result.json there */
@@ -186,8 +189,9 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
         }
         if (strcmp(name, "--frames") && strcmp(name, "--out") && strcmp(name, "--set") && strcmp(name, "--threads") &&
             strcmp(name, "--time-limit") && strcmp(name, "--memory-limit") && strcmp(name, "--record") &&
-            strcmp(name, "--replay"))
+            strcmp(name, "--replay") && strcmp(name, "--samples"))
             return usage_error("unknown option %s", a);
+        if (!strcmp(name, "--samples") && strcmp(cmd, "run")) return usage_error("%s is an option of run", name);
         if (!strcmp(name, "--record") && strcmp(cmd, "run")) return usage_error("%s is an option of run", name);
         if (!strcmp(name, "--replay") && strcmp(cmd, "run")) return usage_error("%s is an option of run", name);
         if (eq) val = eq + 1;
@@ -211,6 +215,10 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
         } else if (!strcmp(name, "--record")) {
             if (!*val) return usage_error("%s", "--record expects a file (.mp4, .gif) or a folder");
             o->record = val;
+        } else if (!strcmp(name, "--samples")) {
+            if (parse_number(val, 1, 16, &v) || v != (int)v)
+                return usage_error("--samples expects a whole number from 1 to 16, got '%s'", val);
+            o->samples = (int)v;
         } else if (!strcmp(name, "--replay")) {
             if (!*val) return usage_error("%s", "--replay expects an input log (.json)");
             o->replay = val;
@@ -741,7 +749,7 @@ static int run_scene(const opts *o, const char *path, run_report *rep) {
         wb_rt_close(L);
         return EXIT_SCRIPT;
     }
-    if (o->record && !wbl_record_begin(L, o->record, o->view.width, o->view.height, rerr, sizeof rerr)) {
+    if (o->record && !wbl_record_begin(L, o->record, o->view.width, o->view.height, o->samples, rerr, sizeof rerr)) {
         fprintf(stderr, "wobble: %s\n", rerr);
         report_error(rep, rerr);
         report_take(rep, L);
@@ -940,6 +948,7 @@ int main(int argc, char **argv) {
             if (o.npos != 1) code = usage_error("%s", o.npos ? "run takes one scene script" : "run needs a scene script");
             /* run draws nothing else: a --size alone would be silently ignored */
             else if (o.view.width && !o.record) code = usage_error("%s", "--size sets --record's frame size: give --record OUT too");
+            else if (o.samples && !o.record) code = usage_error("%s", "--samples sets --record's antialiasing: give --record OUT too");
             else code = cmd_run(&o, o.pos[0]);
         } else if (!strcmp(cmd, "view")) {
             code = cmd_view(&o);

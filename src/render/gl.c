@@ -42,6 +42,9 @@ static const char light_fs[] =
     "uniform sampler2DShadow u_smap;\n"
     "uniform float u_bias;\n"
     "uniform int u_shadows;\n"
+    "uniform vec3 u_amb_down;\n"   /* the ambient light of a surface facing down and up (linear) */
+    "uniform vec3 u_amb_up;\n"
+    "uniform vec3 u_key;\n"        /* the key light's colour */
     /* the lookup moves off the surface along its normal by u_bias (a few texels), more
      * the more the light grazes (slope-scaled: a texel spans more depth there), up to 8
      * times. The slope is the larger of the smooth normal's and the triangle's own (ng,
@@ -70,27 +73,21 @@ static const char light_fs[] =
     "  float ndl = dot(n, u_light);\n"
     "  float sh = ndl > 0.0 ? shadow_at(p, n, ng) : 0.0;\n"
     "  vec3 h = normalize(u_light + v);\n"
-    "  float spec = shine * pow(max(dot(n, h), 0.0), 40.0);\n"
-    "  vec3 amb = mix(vec3(0.16, 0.14, 0.13), vec3(0.30, 0.34, 0.42), n.y * 0.5 + 0.5);\n"
+    /* the 40th power by squaring: pow is a log and an exp on llvmpipe */
+    "  float s2 = max(dot(n, h), 0.0);\n"
+    "  s2 *= s2;\n"
+    "  float s8 = s2 * s2;\n"
+    "  s8 *= s8;\n"
+    "  float s32 = s8 * s8;\n"
+    "  s32 *= s32;\n"
+    "  float spec = shine * s32 * s8;\n"
+    "  vec3 amb = mix(u_amb_down, u_amb_up, n.y * 0.5 + 0.5);\n"
     "  float rim = 1.0 - max(dot(n, v), 0.0);\n"
     "  rim = rim * rim * rim * 0.12;\n"
-    "  return base * (amb + vec3(1.0, 0.96, 0.9) * max(ndl, 0.0) * sh) + vec3(spec * sh + rim);\n"
+    "  return base * (amb + u_key * max(ndl, 0.0) * sh) + vec3(spec * sh + rim);\n"
     "}\n"
     /* gamma 2 instead of 2.2: a square root is much cheaper than pow on llvmpipe */
-    "vec4 to_srgb(vec3 c, float a) { return vec4(sqrt(clamp(c, 0.0, 1.0)), a); }\n"
-    /* the ground: diffuse only, its cost is most of the frame's. llvmpipe runs both
-     * sides of a branch (masked), so a lookup skipped at run time costs as much as one
-     * made: the ground has two programs, with the shadow map (SHADOWED, drawn where a
-     * shadow can fall; `near`: inside the map's box) and without (everywhere else) */
-    "vec3 lit_matte(vec3 base, vec3 n, vec3 p, bool near) {\n"
-    "  float ndl = dot(n, u_light);\n"
-    "  float sh = ndl > 0.0 ? 1.0 : 0.0;\n"
-    "#ifdef SHADOWED\n"
-    "  if (near && ndl > 0.0) sh = shadow_at(p, n, n);\n"
-    "#endif\n"
-    "  vec3 amb = mix(vec3(0.16, 0.14, 0.13), vec3(0.30, 0.34, 0.42), n.y * 0.5 + 0.5);\n"
-    "  return base * (amb + vec3(1.0, 0.96, 0.9) * max(ndl, 0.0) * sh);\n"
-    "}\n";
+    "vec4 to_srgb(vec3 c, float a) { return vec4(sqrt(clamp(c, 0.0, 1.0)), a); }\n";
 
 static const char mesh_fs[] =
     "in vec3 v_pos;\n"
@@ -139,41 +136,48 @@ static const char line_fs[] =
     "out vec4 o_col;\n"
     "void main() { o_col = vec4(sqrt(v_col.rgb), 1.0); }\n";
 
-/* the ground: the part of the screen below the plane's horizon (render.c clips the
- * frame's square to it, a fan of up to 5 corners in NDC); each pixel's view ray meets
- * the plane (grid_fs). Pixels above the horizon would only be discarded */
+/* the ground: the part of the screen below the plane's horizon and nearer than where
+ * it has faded out (render.c clips the frame's square to that, fans of up to 7 corners,
+ * the second from u_poly[8]); a corner's NDC x, y and depth and its clip w, and the
+ * plane's point there, interpolated in perspective to each pixel */
 static const char grid_vs[] =
     "#version 330 core\n"
-    "uniform vec2 u_poly[5];\n"
-    "void main() { gl_Position = vec4(u_poly[gl_VertexID], 0.0, 1.0); }\n";
+    "uniform vec4 u_poly[16];\n"
+    "uniform vec3 u_wpos[16];\n"
+    "out vec3 v_p;\n"
+    "void main() {\n"
+    "  vec4 c = u_poly[gl_VertexID];\n"
+    "  gl_Position = vec4(c.xyz * c.w, c.w);\n"
+    "  v_p = u_wpos[gl_VertexID];\n"
+    "}\n";
 
-/* the ground where each pixel's view ray meets the plane (n.x = u_offset): a floor
- * reaches the horizon, fogged with distance into the sky's colour at that row (the sky
- * is a screen gradient: the far ground meets it without a seam); any other plane is a
- * disc of radius u_extent fading out, as before. Anti-aliased minor and major lines
- * (fwidth) that fade where a cell shrinks to a few pixels (they would only shimmer).
- * The depth is the hit point's, so bodies stand on the ground and beyond the far plane
- * it is kept just in front of the sky. */
+/* the ground at the plane's point each pixel sees: a floor reaches the
+ * horizon, fogged with distance into the sky's colour at that row (the sky is a screen
+ * gradient: the far ground meets it without a seam); any other plane is a disc of
+ * radius u_extent fading out, as before. Anti-aliased minor and major lines (fwidth)
+ * that fade where a cell shrinks to a few pixels (they would only shimmer). The depth is
+ * the point's (render.c gives the corners theirs: a plane's is affine on the screen),
+ * so bodies stand on the ground; beyond the far plane it is kept just in front of the
+ * sky. */
 static const char grid_fs[] =
-    "uniform mat4 u_vp;\n"
-    "uniform vec3 u_cf;\n"   /* the camera's forward, right and up, scaled to the frame's edges */
-    "uniform vec3 u_cr;\n"
-    "uniform vec3 u_cu;\n"
-    "uniform vec2 u_size;\n"
+    "in vec3 v_p;\n"
     "uniform vec3 u_center;\n"
     "uniform vec3 u_gu;\n"
     "uniform vec3 u_gv;\n"
-    "uniform vec3 u_gn;\n"
-    "uniform float u_offset;\n"
     "uniform float u_spacing;\n"
     "uniform float u_extent;\n"
-    "uniform float u_fog;\n"
+    "uniform float u_fog2;\n"    /* 1 / the fog length squared */
     "uniform int u_floor;\n"
-    "uniform vec3 u_base;\n"
     "out vec4 o_col;\n"
     "uniform vec3 u_top;\n"
     "uniform vec3 u_bottom;\n"
     "uniform float u_height;\n"
+    /* the plane's colour in sRGB, unshadowed (render.c: the ground's colour lit from the
+     * side seen, whose normal is u_nrm) and, for the shadow, its linear parts */
+    "uniform vec3 u_lit;\n"
+    "uniform vec3 u_base_amb;\n"
+    "uniform vec3 u_base_key;\n"
+    "uniform vec3 u_nrm;\n"
     "uniform vec3 u_sc;\n"    /* beyond sqrt(u_sr2) of u_sc, outside the shadow map's box: no shadow */
     "uniform float u_sr2;\n"
     "float grid(vec2 uv, vec2 fw) {\n"
@@ -182,36 +186,35 @@ static const char grid_fs[] =
     "  return (1.0 - min(min(g.x, g.y), 1.0)) * fade;\n"
     "}\n"
     "void main() {\n"
-    "  vec2 ndc = gl_FragCoord.xy / u_size * 2.0 - 1.0;\n"
-    "  vec3 dir = u_cf + ndc.x * u_cr + ndc.y * u_cu;\n"
-    "  float den = dot(u_gn, dir);\n"
-    "  float t = abs(den) > 1e-12 ? (u_offset - dot(u_gn, u_eye)) / den : -1.0;\n"
-    "  if (!(t > 0.0)) discard;\n"
-    "  vec3 p = u_eye + t * dir;\n"
-    "  vec4 clip = u_vp * vec4(p, 1.0);\n"
-    "  if (clip.w <= 0.0) discard;\n"
-    "  gl_FragDepth = min(clip.z / clip.w * 0.5 + 0.5, 0.99999);\n"
-    "  vec3 d = p - u_center;\n"
-    "  float f = t * length(dir) / u_fog;\n"  /* the distance, in fog lengths */
-    "  float a = u_floor != 0 ? exp(-f * f)\n"
+    "  vec3 p = v_p, d = p - u_center, e = p - u_eye;\n"
+    "  float a = u_floor != 0 ? exp(-dot(e, e) * u_fog2)\n"   /* the distance in fog lengths, squared */
     "                         : 1.0 - smoothstep(0.45, 1.0, length(d) / u_extent);\n"
     "  if (a <= 0.002) discard;\n"
     "  vec2 uv = vec2(dot(d, u_gu), dot(d, u_gv)) / u_spacing;\n"
-    "  vec3 base = u_base;\n"
     "  vec2 fw = fwidth(uv);\n"
-    /* the lines have faded out where a major cell is under 2.5 pixels (grid's fade) */
-    "  if (max(fw.x, fw.y) < 2.0) {\n"
-    "    base = mix(base, base * 0.62, grid(uv, fw) * 0.7);\n"
-    "    base = mix(base, base * 0.45, grid(uv / 5.0, fw / 5.0));\n"
-    "  }\n"
-    "  vec3 n = dot(u_eye - p, u_gn) >= 0.0 ? u_gn : -u_gn;\n"  /* the side seen */
+    /* the lines darken the colour (linear) by m; they have faded out where a major cell
+     * is under 2.5 pixels (grid's fade) */
+    "  float m = 1.0;\n"
+    "  if (max(fw.x, fw.y) < 2.0) m = (1.0 - 0.266 * grid(uv, fw)) * (1.0 - 0.55 * grid(uv / 5.0, fw / 5.0));\n"
+    /* diffuse only, its cost is most of the frame's. llvmpipe runs both sides of a branch
+     * (masked), so a lookup skipped at run time costs as much as one made: the ground has
+     * two programs, with the shadow map (SHADOWED, drawn where a shadow can fall; inside
+     * the map's box) and without (everywhere else). sqrt(c m) = sqrt(c) sqrt(m): gamma 2,
+     * as to_srgb */
+    "#ifdef SHADOWED\n"
+    "  float sh = dot(p - u_sc, p - u_sc) < u_sr2 ? shadow_at(p, u_nrm, u_nrm) : 1.0;\n"
+    "  vec3 c = sqrt(u_base_amb + u_base_key * sh);\n"
+    "#else\n"
+    "  vec3 c = u_lit;\n"
+    "#endif\n"
     /* opaque: faded into the sky's colour here, so the sky is drawn last and only
-     * where nothing else is (the cheapest pixels are those never shaded) */
+     * where nothing else is (the cheapest pixels are those never shaded). Alpha 1/2: not
+     * geometry (alpha 1), which FXAA looks at alone, nor the sky (fxaa.c) */
     "  vec3 sky = mix(u_bottom, u_top, clamp(gl_FragCoord.y / u_height, 0.0, 1.0));\n"
-    "  o_col = vec4(mix(sky, to_srgb(lit_matte(base, n, p, dot(p - u_sc, p - u_sc) < u_sr2), 1.0).rgb, a), 1.0);\n"
+    "  o_col = vec4(mix(sky, min(c * sqrt(m), 1.0), a), 0.5);\n"
     "}\n";
 
-/* the sky: a vertical gradient over a full-screen triangle */
+/* the sky: a vertical gradient over a full-screen triangle (alpha 0, as the ground) */
 static const char bg_vs[] =
     "#version 330 core\n"
     "out float v_t;\n"
@@ -227,7 +230,7 @@ static const char bg_fs[] =
     "uniform vec3 u_top;\n"
     "uniform vec3 u_bottom;\n"
     "out vec4 o_col;\n"
-    "void main() { o_col = vec4(mix(u_bottom, u_top, clamp(v_t, 0.0, 1.0)), 1.0); }\n";
+    "void main() { o_col = vec4(mix(u_bottom, u_top, clamp(v_t, 0.0, 1.0)), 0.0); }\n";
 
 static GLuint compile(GLenum type, const char *const *src, int nsrc, char *err, size_t n)
 {
@@ -408,26 +411,34 @@ void wb_gl_inst_attribs(const wb_gl *g, size_t first)
     glVertexAttribPointer(9, 4, GL_FLOAT, GL_FALSE, sizeof(wb_inst), (const void *)(base + offsetof(wb_inst, c)));
 }
 
-static bool targets(wb_gl *g, int w, int h, int *samples, char *err, size_t n)
+/* the frame's own colour and depth (multisample when samples > 1) */
+static bool frame_target(wb_gl *g, int w, int h, int samples, char *err, size_t n)
 {
-    GLint max = 1;
-    glGetIntegerv(GL_MAX_SAMPLES, &max);
-    if (*samples > max) *samples = max;
-    if (*samples < 1) *samples = 1;
     glGenFramebuffers(1, &g->fbo_ms);
     glGenRenderbuffers(1, &g->rb_color);
     glGenRenderbuffers(1, &g->rb_depth);
     glBindFramebuffer(GL_FRAMEBUFFER, g->fbo_ms);
     glBindRenderbuffer(GL_RENDERBUFFER, g->rb_color);
-    glRenderbufferStorageMultisample(GL_RENDERBUFFER, *samples > 1 ? *samples : 0, GL_RGBA8, w, h);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples > 1 ? samples : 0, GL_RGBA8, w, h);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, g->rb_color);
     glBindRenderbuffer(GL_RENDERBUFFER, g->rb_depth);
-    glRenderbufferStorageMultisample(GL_RENDERBUFFER, *samples > 1 ? *samples : 0, GL_DEPTH_COMPONENT24, w, h);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples > 1 ? samples : 0, GL_DEPTH_COMPONENT24, w, h);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, g->rb_depth);
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-        snprintf(err, n, "the %dx%d framebuffer with %d samples is not supported", w, h, *samples);
+        snprintf(err, n, "the %dx%d framebuffer with %d samples is not supported", w, h, samples);
         return false;
     }
+    return true;
+}
+
+static bool targets(wb_gl *g, int w, int h, int *samples, bool direct, char *err, size_t n)
+{
+    GLint max = 1;
+    glGetIntegerv(GL_MAX_SAMPLES, &max);
+    if (*samples > max) *samples = max;
+    if (*samples < 1) *samples = 1;
+    /* one sample into the default framebuffer: a copy of the frame less (5 ms at 720p) */
+    if (!(*samples == 1 && direct) && !frame_target(g, w, h, *samples, err, n)) return false;
     /* the shadow map: 1024 texels over the scene's sphere is a few mm for a room-sized
      * scene; 2048 costs a tenth of a 720p frame */
     g->shadow_size = w * h > 1920 * 1080 ? 2048 : 1024;
@@ -454,7 +465,7 @@ static bool targets(wb_gl *g, int w, int h, int *samples, char *err, size_t n)
     return true;
 }
 
-bool wb_gl_init(wb_gl *g, int w, int h, int *samples, char *err, size_t n)
+bool wb_gl_init(wb_gl *g, int w, int h, int *samples, bool direct, char *err, size_t n)
 {
     memset(g, 0, sizeof *g);
     if (!(g->prog_mesh = program(mesh_vs, mesh_fs, true, NULL, err, n)) ||
@@ -527,7 +538,7 @@ bool wb_gl_init(wb_gl *g, int w, int h, int *samples, char *err, size_t n)
     glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, sizeof(wb_seg), (const void *)offsetof(wb_seg, c));
     glBindVertexArray(0);
 
-    if (!targets(g, w, h, samples, err, n)) return false;
+    if (!targets(g, w, h, samples, direct, err, n)) return false;
     GLenum e = glGetError();
     if (e != GL_NO_ERROR) {
         snprintf(err, n, "OpenGL error 0x%04x while setting up the renderer", (unsigned)e);

@@ -82,15 +82,16 @@ typedef struct wb_gl {
     GLuint vao_mesh, vao_surf, vao_line, vao_empty;
     GLuint vbo_mesh, ebo_mesh, vbo_inst, vbo_surf, ebo_surf, vbo_seg;
     GLint mesh_first[MESH_COUNT], mesh_count[MESH_COUNT];   /* index ranges */
-    GLuint fbo_ms, rb_color, rb_depth;                        /* the (multisample) target */
+    GLuint fbo_ms, rb_color, rb_depth;                        /* the (multisample) target; 0: the default */
     GLuint fbo_shadow, tex_shadow;
     int shadow_size;
     size_t inst_cap, surf_cap, surf_idx_cap, seg_cap;         /* buffer sizes in bytes */
 } wb_gl;
 
 /* build programs, meshes and framebuffers for a w x h target with `samples` (clamped
- * to what GL offers, written back); false with a message */
-bool wb_gl_init(wb_gl *g, int w, int h, int *samples, char *err, size_t n);
+ * to what GL offers, written back); `direct`: with one sample, draw into the default
+ * framebuffer (it has a depth buffer), fbo_ms 0. false with a message */
+bool wb_gl_init(wb_gl *g, int w, int h, int *samples, bool direct, char *err, size_t n);
 void wb_gl_free(wb_gl *g);
 /* make buffer `buf` (of `target`) hold `bytes` from data, growing it when needed */
 void wb_gl_upload(GLenum target, GLuint buf, size_t *cap, const void *data, size_t bytes);

@@ -145,7 +145,7 @@ static const uint8_t *win_pixels(void *p)
 }
 
 const wb_backend wb_backend_glfw = {
-    "glfw", true, win_create, win_current, win_pixels, win_destroy,
+    "glfw", true, win_create, win_current, win_pixels, win_destroy, false,
 };
 
 void *wb_window_handle(void)

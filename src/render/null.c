@@ -28,7 +28,7 @@ static void null_destroy(void *ctx)
     (void)ctx;
 }
 
-const wb_backend wb_backend_null = { "null", false, null_create, null_current, null_pixels, null_destroy };
+const wb_backend wb_backend_null = { "null", false, null_create, null_current, null_pixels, null_destroy, false };
 
 const wb_backend *wb_backend_find(const char *name)
 {

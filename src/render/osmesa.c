@@ -69,5 +69,5 @@ static const uint8_t *osm_pixels(void *p)
 }
 
 const wb_backend wb_backend_osmesa = {
-    "osmesa", true, osm_create, osm_current, osm_pixels, osm_destroy,
+    "osmesa", true, osm_create, osm_current, osm_pixels, osm_destroy, true,
 };

@@ -7,9 +7,15 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "render.h"
+#include "fxaa.h"
 #include "gl.h"
+
+/* the passes a draw is timed by (pass_mark) */
+enum { PASS_LAYERS, PASS_UPLOAD, PASS_SHADOW, PASS_GROUND, PASS_SOLIDS, PASS_LINES, PASS_SKY, PASS_RESOLVE,
+       PASS_COPY, PASS_COUNT };
 
 struct wb_renderer {
     const wb_backend *be;
@@ -20,6 +26,10 @@ struct wb_renderer {
     char info[192];
     uint8_t *rgb;                 /* the last frame */
     bool drawn;
+    bool fxaa;                    /* antialiased after drawing (fxaa.c) */
+    uint8_t *luma;                /* its scratch */
+    size_t luma_cap;
+    uint8_t *sky;                 /* with one sample: the sky's colour of each row (sky_rows) */
     /* camera: fixed by the script, or framing everything shown since the reset */
     bool fixed;
     double eye[3], target[3], up[3], fov;
@@ -31,13 +41,60 @@ struct wb_renderer {
     double cam_eye[3], cam_target[3], cam_up[3], cam_fov, vp[16];
     wb_layers layers;             /* what the layers draw, rebuilt every frame */
     size_t hi_small;              /* its fine spheres drawn coarse (small_spheres_first) */
+    bool timed;                   /* WOBBLE_PASS_TIMES (pass_mark) */
+    double pass_s[PASS_COUNT], pass_t;
+    int64_t pass_frames;
 };
+
+/* WOBBLE_PASS_TIMES=1 in the environment: each pass of a draw is finished (glFinish) and
+ * timed in the process's CPU time (llvmpipe's threads included, the encoder's not), and
+ * the means a frame are printed when the renderer is closed: what README's Recording
+ * figures are. Without it nothing is finished early or timed */
+static const char *const pass_names[PASS_COUNT] = { "layers", "upload", "shadow", "ground", "solids", "links",
+                                                    "sky", "resolve", "copy" };
+
+static double cpu_seconds(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* pass done (-1: a frame begins; the first, which compiles llvmpipe's shaders, is not
+ * counted) */
+static void pass_mark(wb_renderer *r, int pass)
+{
+    if (!r->timed) return;
+    if (pass >= 0) glFinish();
+    const double t = cpu_seconds();
+    if (pass >= 0) r->pass_s[pass] += t - r->pass_t;
+    else if (r->pass_frames++ == 1) memset(r->pass_s, 0, sizeof r->pass_s);
+    r->pass_t = t;
+}
+
+static void pass_report(const wb_renderer *r)
+{
+    if (!r->timed || r->pass_frames < 2) return;
+    const double frames = (double)(r->pass_frames - 1);
+    double sum = 0;
+    fprintf(stderr, "wobble: renderer %dx%d, %d sample%s%s, %lld frames, CPU ms a frame:", r->w, r->h, r->samples,
+            r->samples > 1 ? "s" : "", r->fxaa ? " and FXAA" : "", (long long)r->pass_frames - 1);
+    for (int k = 0; k < PASS_COUNT; k++) {
+        fprintf(stderr, " %s %.2f", pass_names[k], 1000 * r->pass_s[k] / frames);
+        sum += r->pass_s[k];
+    }
+    fprintf(stderr, "; total %.2f\n", 1000 * sum / frames);
+}
 
 /* colours, sRGB (the layers' own are in layers.c) */
 static const float col_ground[3] = { 0.80f, 0.80f, 0.78f };
 static const float col_sky_top[3] = { 0.50f, 0.61f, 0.75f };
 static const float col_sky_bottom[3] = { 0.89f, 0.90f, 0.92f };
 static const double light_dir[3] = { -0.40, 0.80, 0.45 };   /* towards the light: upper left, in front */
+/* the light (linear): ambient on a surface facing down and up (mixed by the normal's y),
+ * the key light's colour */
+static const float amb_down[3] = { 0.16f, 0.14f, 0.13f }, amb_up[3] = { 0.30f, 0.34f, 0.42f };
+static const float key_col[3] = { 1.0f, 0.96f, 0.9f };
 /* the default camera's box shrinks by this part of the way per draw: about half a
  * second to settle at 60 draws a second */
 static const double box_shrink = 0.03;
@@ -67,13 +124,15 @@ wb_renderer *wb_renderer_create(const wb_backend *be, int width, int height, int
     r->samples = samples;
     r->up[1] = 1;
     r->fov = 40;
+    const char *timed = getenv("WOBBLE_PASS_TIMES");
+    r->timed = be->gl && timed && *timed && strcmp(timed, "0") != 0;
     r->ctx = be->create(width, height, err, n);
     if (!r->ctx) {
         wb_renderer_destroy(r);
         return NULL;
     }
     if (be->gl) {
-        if (!wb_gl_init(&r->gl, width, height, &r->samples, err, n)) {
+        if (!wb_gl_init(&r->gl, width, height, &r->samples, be->depth, err, n)) {
             wb_renderer_destroy(r);
             return NULL;
         }
@@ -100,8 +159,10 @@ size_t wb_renderer_bytes(const wb_backend *be, int width, int height, int sample
      * (RGBA and 24-bit depth, which OSMesa allocates at the first draw), colour and depth
      * per sample; then the depth shadow map and the context. Within 5% of the RSS growth
      * measured per renderer (the old sum without the default framebuffer and the context
-     * was 40% of it for small frames) */
-    return px * (3 + 4 + 8 + 8 * (size_t)(samples > 1 ? samples : 1)) + 4 * shadow * shadow + GL_CONTEXT_BYTES;
+     * was 40% of it for small frames). One sample is drawn into the default framebuffer
+     * when it has depth (no target of its own), with FXAA's two bytes a pixel */
+    const size_t target = samples > 1 ? 8 * (size_t)samples : be->depth ? 2 : 8 + 2;
+    return px * (3 + 4 + 8 + target) + 4 * shadow * shadow + GL_CONTEXT_BYTES;
 }
 
 /* the layers (CPU) and the GL buffers they are copied to, which llvmpipe keeps in
@@ -144,11 +205,14 @@ size_t wb_renderer_draw_bytes(const wb_renderer *r, const wb_world *w, const wb_
 void wb_renderer_destroy(wb_renderer *r)
 {
     if (!r) return;
+    pass_report(r);
     if (r->ctx) {
         if (r->gl_ready && r->be->make_current(r->ctx)) wb_gl_free(&r->gl);
         r->be->destroy(r->ctx);
     }
     free(r->rgb);
+    free(r->luma);
+    free(r->sky);
     wb_layers_free(&r->layers);
     const bool gl = r->be->gl;
     free(r);
@@ -165,6 +229,8 @@ void wb_renderer_size(const wb_renderer *r, int *width, int *height)
 }
 
 int wb_renderer_samples(const wb_renderer *r) { return r->samples; }
+void wb_renderer_set_fxaa(wb_renderer *r, bool on) { r->fxaa = on; }
+bool wb_renderer_fxaa(const wb_renderer *r) { return r->fxaa; }
 const char *wb_renderer_info(const wb_renderer *r) { return r->info; }
 const uint8_t *wb_renderer_pixels(const wb_renderer *r) { return r->rgb; }
 
@@ -593,6 +659,44 @@ static int tile_rects(const uint8_t *tiles, int tw, int th, uint8_t v, int w, in
     return n;
 }
 
+/* the plane's depth (NDC z) at NDC (x, y) is a + b x + c y: a point's NDC z is affine
+ * in 1 / t along its view ray (the eye has clip w 0, and a ray's clip z and w do not
+ * depend on x and y: r and u are square to the view axis), and 1 / t = gn.dir / s is
+ * affine in x and y. Exact up to rounding, at the horizon too (its limit) */
+static void plane_depth(const wb_renderer *r, const double gn[3], double s, const double cam[3][3], double abc[3])
+{
+    const double *vp = r->vp, *e = r->cam_eye;
+    const double ez = vp[8] * e[0] + vp[9] * e[1] + vp[10] * e[2] + vp[11];
+    const double ew = vp[12] * e[0] + vp[13] * e[1] + vp[14] * e[2] + vp[15];
+    double z[3];
+    for (int k = 0; k < 3; k++) {
+        const double x = k == 1, y = k == 2;
+        double d[3];
+        for (int i = 0; i < 3; i++) d[i] = cam[0][i] + x * cam[1][i] + y * cam[2][i];
+        const double it = dot3(gn, d) / s, dz = vp[8] * d[0] + vp[9] * d[1] + vp[10] * d[2];
+        const double dw = vp[12] * d[0] + vp[13] * d[1] + vp[14] * d[2];
+        z[k] = (ez * it + dz) / (ew * it + dw);
+    }
+    abc[0] = z[0], abc[1] = z[1] - z[0], abc[2] = z[2] - z[0];
+}
+
+/* the part of a convex polygon (n corners x, y) where f = a + b x + c y <= 0 (sign 1) or
+ * >= 0 (sign -1), into out (n + 1 corners at most); its corner count, 0 when nothing */
+static int clip_poly(const double *poly, int n, const double abc[3], double sign, double *out)
+{
+    int k = 0;
+    for (int i = 0; i < n; i++) {
+        const double *p = poly + 2 * i, *q = poly + 2 * ((i + 1) % n);
+        const double fp = sign * (abc[0] + abc[1] * p[0] + abc[2] * p[1]), fq = sign * (abc[0] + abc[1] * q[0] + abc[2] * q[1]);
+        if (fp <= 0) out[2 * k] = p[0], out[2 * k + 1] = p[1], k++;
+        if ((fp <= 0) != (fq <= 0)) {
+            const double t = fp / (fp - fq);
+            out[2 * k] = p[0] + t * (q[0] - p[0]), out[2 * k + 1] = p[1] + t * (q[1] - p[1]), k++;
+        }
+    }
+    return k >= 3 ? k : 0;
+}
+
 /* a plane (n.x = offset) over the part of the screen below its horizon; a floor reaches
  * the horizon, fogged over `fog`; any other plane is a disc of radius ext around center.
  * cam: the view rays' axes (camera_rays). Two programs draw it: the one that looks up
@@ -602,9 +706,53 @@ static void draw_grid(wb_renderer *r, const double cam[3][3], const double cente
                       const double gv[3], const double gn[3], double spacing, double ext, bool floor, double fog,
                       const shadow_reach *sr)
 {
-    float poly[10];
-    const int np = below_horizon(gn, dot3(gn, center) - dot3(gn, r->cam_eye), cam, poly);
+    float flat[10];
+    const double s = dot3(gn, center) - dot3(gn, r->cam_eye);
+    const int nflat = below_horizon(gn, s, cam, flat);
+    if (!nflat) return;
+    /* the view rays meet the plane at t = s / gn.dir (a view depth: dir's forward part is
+     * 1), 1 / t affine on the screen: nearer than where the ground has faded out (a floor:
+     * 2.5 fog lengths, its alpha under 0.002, which grid_fs discards; a disc: its edge) */
+    double corners[10], poly[12], near[14], far[14], toc[3];
+    for (int i = 0; i < 2 * nflat; i++) corners[i] = flat[i];
+    for (int k = 0; k < 3; k++) toc[k] = center[k] - r->cam_eye[k];
+    const double tmax = floor ? 2.5 * fog : sqrt(dot3(toc, toc)) + ext;
+    const double inv_t[3] = { 1 / tmax - dot3(gn, cam[0]) / s, -dot3(gn, cam[1]) / s, -dot3(gn, cam[2]) / s };
+    const int np = clip_poly(corners, nflat, inv_t, 1, poly);
     if (!np) return;
+    /* the depth from the corners (a fragment shader writing its depth would test it late,
+     * at a third of the ground's cost), kept just in front of the sky beyond the far plane:
+     * the polygon cut where the plane's depth reaches that, the part beyond at that depth */
+    double abc[3];
+    const double zmax = 2 * 0.99999 - 1;
+    plane_depth(r, gn, s, cam, abc);
+    const double cut[3] = { abc[0] - zmax, abc[1], abc[2] };
+    const int nnear = clip_poly(poly, np, cut, 1, near), nfar = clip_poly(poly, np, cut, -1, far);
+    float corner[64], wpos[48];
+    for (int i = 0; i < nnear + nfar; i++) {
+        const double *q = i < nnear ? near + 2 * i : far + 2 * (i - nnear);
+        double d[3];
+        for (int k = 0; k < 3; k++) d[k] = cam[0][k] + q[0] * cam[1][k] + q[1] * cam[2][k];
+        const double t = s / dot3(gn, d), z = abc[0] + abc[1] * q[0] + abc[2] * q[1];
+        const int slot = i < nnear ? i : 8 + i - nnear;
+        corner[4 * slot] = (float)q[0], corner[4 * slot + 1] = (float)q[1];
+        corner[4 * slot + 2] = (float)(i < nnear ? fmin(z, zmax) : zmax), corner[4 * slot + 3] = (float)t;
+        for (int k = 0; k < 3; k++) wpos[3 * slot + k] = (float)(r->cam_eye[k] + t * d[k]);
+    }
+    /* its light, the same over the plane: the side seen (normal n) lit by the ambient and
+     * the key light (the ground's colour times each, linear), and unshadowed in sRGB */
+    double n[3], L[3] = { light_dir[0], light_dir[1], light_dir[2] };
+    norm3(L);
+    const double side = s <= 0 ? 1 : -1;   /* the eye above the plane (along gn): gn */
+    for (int k = 0; k < 3; k++) n[k] = side * gn[k];
+    const double ndl = fmax(dot3(n, L), 0), up = n[1] * 0.5 + 0.5;
+    float g[3], lit[3], base_amb[3], base_key[3];
+    wb_lin3(col_ground, g);
+    for (int k = 0; k < 3; k++) {
+        base_amb[k] = (float)(g[k] * (amb_down[k] + (amb_up[k] - amb_down[k]) * up));
+        base_key[k] = (float)(g[k] * key_col[k] * ndl);
+        lit[k] = (float)sqrt(fmin(base_amb[k] + base_key[k], 1));
+    }
     const int tw = (r->w + SHADOW_TILE - 1) / SHADOW_TILE, th = (r->h + SHADOW_TILE - 1) / SHADOW_TILE;
     const size_t nt = (size_t)tw * (size_t)th;
     /* the tiles, then the rectangles of each program and a row's open runs */
@@ -620,39 +768,43 @@ static void draw_grid(wb_renderer *r, const double cam[3][3], const double cente
     }
     glBindVertexArray(r->gl.vao_empty);
     glEnable(GL_SCISSOR_TEST);
+    /* ground nearer than the near plane is drawn at depth 0, as a written depth was */
+    glEnable(GL_DEPTH_CLAMP);
     for (int pass = 0; pass < 2; pass++) {
         if (!nrect[pass]) continue;
         GLuint p = pass == 0 ? r->gl.prog_grid : r->gl.prog_grid_plain;
         glUseProgram(p);
-        glUniform2fv(glGetUniformLocation(p, "u_poly"), 5, poly);
+        glUniform4fv(glGetUniformLocation(p, "u_poly"), 16, corner);
+        glUniform3fv(glGetUniformLocation(p, "u_wpos"), 16, wpos);
         set_vec(p, "u_center", center[0], center[1], center[2]);
         set_vec(p, "u_gu", gu[0], gu[1], gu[2]);
         set_vec(p, "u_gv", gv[0], gv[1], gv[2]);
-        set_vec(p, "u_gn", gn[0], gn[1], gn[2]);
-        glUniform1f(glGetUniformLocation(p, "u_offset"), (float)dot3(gn, center));
+        set_vec(p, "u_nrm", n[0], n[1], n[2]);
         glUniform1f(glGetUniformLocation(p, "u_spacing"), (float)spacing);
         glUniform1f(glGetUniformLocation(p, "u_extent"), (float)ext);
-        glUniform1f(glGetUniformLocation(p, "u_fog"), (float)fog);
+        glUniform1f(glGetUniformLocation(p, "u_fog2"), (float)(1 / (fog * fog)));
         glUniform1i(glGetUniformLocation(p, "u_floor"), floor);
-        float g[3];
-        wb_lin3(col_ground, g);
-        glUniform3f(glGetUniformLocation(p, "u_base"), g[0], g[1], g[2]);
+        glUniform3fv(glGetUniformLocation(p, "u_lit"), 1, lit);
+        glUniform3fv(glGetUniformLocation(p, "u_base_amb"), 1, base_amb);
+        glUniform3fv(glGetUniformLocation(p, "u_base_key"), 1, base_key);
         for (int k = 0; k < nrect[pass]; k++) {
             /* untold (or out of memory for the tiles): all of it with the shadow map */
             const int *q = tiled ? rects[pass * nt + k] : whole;
             glScissor(q[0], q[1], q[2], q[3]);
-            glDrawArrays(GL_TRIANGLE_FAN, 0, np);
+            if (nnear) glDrawArrays(GL_TRIANGLE_FAN, 0, nnear);
+            if (nfar) glDrawArrays(GL_TRIANGLE_FAN, 8, nfar);
         }
     }
     glDisable(GL_SCISSOR_TEST);
+    glDisable(GL_DEPTH_CLAMP);
     free(open);
     free(rects);
     free(tiles);
 }
 
 /* the camera's axes for the ground's view rays: forward, and right and up scaled to
- * the frame's edges (a pixel's ray is f + x r + y u, x and y in -1..1), also in cam */
-static void camera_rays(const wb_renderer *r, GLuint p, double cam[3][3])
+ * the frame's edges (a pixel's ray is f + x r + y u, x and y in NDC, -1..1) */
+static void camera_rays(const wb_renderer *r, double cam[3][3])
 {
     double f[3], s[3], u[3];
     for (int k = 0; k < 3; k++) f[k] = r->cam_target[k] - r->cam_eye[k];
@@ -661,12 +813,7 @@ static void camera_rays(const wb_renderer *r, GLuint p, double cam[3][3])
     norm3(s);
     cross3(s, f, u);
     const double ty = tan(r->cam_fov * M_PI / 360), tx = ty * r->w / r->h;
-    set_vec(p, "u_cf", f[0], f[1], f[2]);
-    set_vec(p, "u_cr", tx * s[0], tx * s[1], tx * s[2]);
-    set_vec(p, "u_cu", ty * u[0], ty * u[1], ty * u[2]);
     for (int k = 0; k < 3; k++) cam[0][k] = f[k], cam[1][k] = tx * s[k], cam[2][k] = ty * u[k];
-    glUniform2f(glGetUniformLocation(p, "u_size"), (float)r->w, (float)r->h);
-    set_mat(p, "u_vp", r->vp);
 }
 
 /* uniforms of the lit programs */
@@ -681,6 +828,22 @@ static void light_uniforms(GLuint p, const double vp[16], const double lvp[16], 
     glUniform1f(glGetUniformLocation(p, "u_bias"), (float)bias);
     glUniform1i(glGetUniformLocation(p, "u_shadows"), shadows);
     glUniform1i(glGetUniformLocation(p, "u_smap"), 0);
+    glUniform3fv(glGetUniformLocation(p, "u_amb_down"), 1, amb_down);
+    glUniform3fv(glGetUniformLocation(p, "u_amb_up"), 1, amb_up);
+    glUniform3fv(glGetUniformLocation(p, "u_key"), 1, key_col);
+}
+
+/* the sky's colour of each row, top first, as the sky's shader would draw it (bg_fs:
+ * the gradient at the pixel's centre, rounded to 8 bits); NULL: out of memory */
+static const uint8_t *sky_rows(wb_renderer *r)
+{
+    if (r->sky) return r->sky;
+    r->sky = malloc(3 * (size_t)r->h);
+    for (int y = 0; r->sky && y < r->h; y++) {
+        const float t = ((float)(r->h - y) - 0.5f) / (float)r->h;
+        for (int k = 0; k < 3; k++) r->sky[3 * y + k] = (uint8_t)lrintf(255 * (col_sky_bottom[k] + (col_sky_top[k] - col_sky_bottom[k]) * t));
+    }
+    return r->sky;
 }
 
 static void background_cpu(wb_renderer *r)
@@ -760,6 +923,7 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
                       int nskins, char *err, size_t n)
 {
     /* camera and extent */
+    pass_mark(r, -1);
     box cur = scene_box(w);
     follow_box(r, w, &cur);
     if (r->fixed) {
@@ -801,6 +965,7 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
         snprintf(err, n, "out of memory drawing %d particles", (int)wb_particle_count(w));
         return false;
     }
+    pass_mark(r, PASS_LAYERS);
     wb_gl *g = &r->gl;
     r->hi_small = small_spheres_first(l, r->vp, r->cam_fov, r->h);
     size_t ninst = l->first[WB_G_COUNT - 1] + l->count[WB_G_COUNT - 1];
@@ -817,6 +982,7 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     size_t nseg = l->nseg;
     if (nseg) wb_gl_upload(GL_ARRAY_BUFFER, g->vbo_seg, &g->seg_cap, l->seg, nseg * sizeof *l->seg);
 
+    pass_mark(r, PASS_UPLOAD);
     /* the shadow map: an orthographic view along the light over the scene's sphere */
     double L[3] = { light_dir[0], light_dir[1], light_dir[2] }, lvp[16], lview[16], lproj[16];
     norm3(L);
@@ -838,11 +1004,16 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     draw_meshes(r);
     if (surfaces) draw_surfaces(r);
     glDisable(GL_POLYGON_OFFSET_FILL);
+    pass_mark(r, PASS_SHADOW);
 
-    /* the picture */
+    /* the picture. With one sample the sky is the CPU's (wb_fxaa, sky_copy): where nothing
+     * was drawn, alpha 0 from the clear (a pass over the uncovered pixels took 2-3 ms at
+     * 720p); samples would mix the clear's black into the edges */
+    const uint8_t *sky = r->samples == 1 ? sky_rows(r) : NULL;
     glBindFramebuffer(GL_FRAMEBUFFER, g->fbo_ms);
     glViewport(0, 0, r->w, r->h);
-    glClear(GL_DEPTH_BUFFER_BIT);
+    glClearColor(0, 0, 0, 0);
+    glClear(sky ? GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT : GL_DEPTH_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, g->tex_shadow);
@@ -850,13 +1021,13 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
     /* the ground: every plane collider, or a floor under the scene; its two programs
      * (draw_grid) take the same uniforms */
     double cam[3][3];
+    camera_rays(r, cam);
     for (int k = 0; k < 2; k++) {
         const GLuint p = k ? g->prog_grid_plain : g->prog_grid;
         light_uniforms(p, r->vp, lvp, r->cam_eye, L, bias, true);
         glUniform3f(glGetUniformLocation(p, "u_top"), col_sky_top[0], col_sky_top[1], col_sky_top[2]);
         glUniform3f(glGetUniformLocation(p, "u_bottom"), col_sky_bottom[0], col_sky_bottom[1], col_sky_bottom[2]);
         glUniform1f(glGetUniformLocation(p, "u_height"), (float)r->h);
-        camera_rays(r, p, cam);
         /* the shadow map's box (ortho, below) lies within sqrt(6) R of c: no shadow beyond */
         set_vec(p, "u_sc", c[0], c[1], c[2]);
         glUniform1f(glGetUniformLocation(p, "u_sr2"), (float)(6.05 * R * R));
@@ -887,6 +1058,7 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
             draw_grid(r, cam, center, gu, gv, gn, spacing, ext, true, fog, &sr);
     }
 
+    pass_mark(r, PASS_GROUND);
     /* solids, then the surfaces pushed back a little so links on them stay visible */
     light_uniforms(g->prog_mesh, r->vp, lvp, r->cam_eye, L, bias, true);
     glUniform1i(glGetUniformLocation(g->prog_mesh, "u_two_sided"), 0);
@@ -898,6 +1070,7 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
         draw_surfaces(r);
         glDisable(GL_POLYGON_OFFSET_FILL);
     }
+    pass_mark(r, PASS_SOLIDS);
     if (nseg) {
         glUseProgram(g->prog_line);
         set_mat(g->prog_line, "u_vp", r->vp);
@@ -906,21 +1079,27 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
         glBindVertexArray(g->vao_line);
         glDrawArraysInstanced(GL_TRIANGLES, 0, 6, (GLsizei)nseg);
     }
+    pass_mark(r, PASS_LINES);
     /* the sky last, behind everything: only uncovered pixels pass the depth test */
-    glDepthFunc(GL_LEQUAL);
-    glDepthMask(GL_FALSE);
-    glUseProgram(g->prog_bg);
-    glUniform3f(glGetUniformLocation(g->prog_bg, "u_top"), col_sky_top[0], col_sky_top[1], col_sky_top[2]);
-    glUniform3f(glGetUniformLocation(g->prog_bg, "u_bottom"), col_sky_bottom[0], col_sky_bottom[1], col_sky_bottom[2]);
-    glBindVertexArray(g->vao_empty);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
+    if (!sky) {
+        glDepthFunc(GL_LEQUAL);
+        glDepthMask(GL_FALSE);
+        glUseProgram(g->prog_bg);
+        glUniform3f(glGetUniformLocation(g->prog_bg, "u_top"), col_sky_top[0], col_sky_top[1], col_sky_top[2]);
+        glUniform3f(glGetUniformLocation(g->prog_bg, "u_bottom"), col_sky_bottom[0], col_sky_bottom[1], col_sky_bottom[2]);
+        glBindVertexArray(g->vao_empty);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glDepthFunc(GL_LESS);
+        glDepthMask(GL_TRUE);
+    }
 
-    /* resolve into the backend's buffer and keep the frame */
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, g->fbo_ms);
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-    glBlitFramebuffer(0, 0, r->w, r->h, 0, 0, r->w, r->h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    pass_mark(r, PASS_SKY);
+    /* resolve into the backend's buffer (unless drawn there) and keep the frame */
+    if (g->fbo_ms) {
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, g->fbo_ms);
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+        glBlitFramebuffer(0, 0, r->w, r->h, 0, 0, r->w, r->h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glBindVertexArray(0);
     glFinish();
@@ -929,9 +1108,16 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
         snprintf(err, n, "OpenGL error 0x%04x while drawing", (unsigned)e);
         return false;
     }
+    pass_mark(r, PASS_RESOLVE);
     const uint8_t *px = r->be->pixels(r->ctx);
     size_t npx = (size_t)r->w * r->h;
-    for (size_t i = 0; i < npx; i++) memcpy(r->rgb + 3 * i, px + 4 * i, 3);
+    if (!r->fxaa || !wb_fxaa(px, r->w, r->h, sky, r->rgb, &r->luma, &r->luma_cap)) {   /* out of memory: as drawn */
+        for (size_t i = 0; i < npx; i++) memcpy(r->rgb + 3 * i, px + 4 * i, 3);
+        for (int y = 0; sky && y < r->h; y++)
+            for (int x = 0; x < r->w; x++)
+                if (!px[4 * ((size_t)y * r->w + x) + 3]) memcpy(r->rgb + 3 * ((size_t)y * r->w + x), sky + 3 * y, 3);
+    }
     if (o->legend && l->strain_shown) draw_legend(r, l->scale);
+    pass_mark(r, PASS_COPY);
     return true;
 }

@@ -33,6 +33,9 @@ typedef struct wb_backend {
     /* after glFinish: the default framebuffer, RGBA8, top row first (stride w*4) */
     const uint8_t *(*pixels)(void *ctx);
     void (*destroy)(void *ctx);
+    /* the default framebuffer has a depth buffer: with one sample the renderer draws
+     * into it (no framebuffer of its own to copy from) */
+    bool depth;
 } wb_backend;
 
 extern const wb_backend wb_backend_osmesa;
@@ -77,6 +80,10 @@ void wb_renderer_destroy(wb_renderer *r);
 size_t wb_renderer_bytes(const wb_backend *be, int width, int height, int samples);
 void wb_renderer_size(const wb_renderer *r, int *width, int *height);
 int wb_renderer_samples(const wb_renderer *r);            /* MSAA samples in use (1 = none) */
+/* FXAA on the frame drawn (fxaa.c): the cheap antialiasing of one sample, for recordings
+ * (about 2 ms a 720p frame on the CPU against 20 for 4 samples on llvmpipe); off by default */
+void wb_renderer_set_fxaa(wb_renderer *r, bool on);
+bool wb_renderer_fxaa(const wb_renderer *r);
 const char *wb_renderer_info(const wb_renderer *r);       /* "OpenGL 4.5 (Core Profile) Mesa ..., llvmpipe" */
 /* a fixed camera (fov: vertical, degrees); wb_renderer_auto_camera goes back to the
  * default, which keeps all of the world drawn in the frame: its box grows with the
@@ -216,12 +223,14 @@ typedef struct lua_State lua_State;
 void wbl_open_renderer(lua_State *L);   /* wobble.renderer, probe, read_png, read_frame, clock */
 /* `wobble run --record OUT`: every frame any w:run / w:step makes is drawn (the scene's
  * camera, every layer) and added to OUT, a path of the user's choice; frames of w x h
- * pixels (--size), or with w = 0 the default: 1280x720, a .gif 640x360 (for the web) */
+ * pixels (--size), or with w = 0 the default: 1280x720, a .gif 640x360 (for the web);
+ * drawn with `samples` (--samples; 1: no antialiasing), or with 0 the default: one
+ * sample and FXAA */
 #define WB_RECORD_WIDTH 1280
 #define WB_RECORD_HEIGHT 720
 #define WB_RECORD_GIF_WIDTH 640
 #define WB_RECORD_GIF_HEIGHT 360
-bool wbl_record_begin(lua_State *L, const char *path, int w, int h, char *err, size_t n);
+bool wbl_record_begin(lua_State *L, const char *path, int w, int h, int samples, char *err, size_t n);
 bool wbl_record_end(lua_State *L, char *err, size_t n);   /* finish the file; prints where it went */
 /* the camera the scene set with wobble.camera{...}; false when it left the framing automatic */
 bool wbl_scene_camera(lua_State *L, double eye[3], double target[3], double up[3], double *fov);

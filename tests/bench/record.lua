@@ -1,7 +1,8 @@
 -- record.lua: the recording benchmark (`make bench`'s row `record`). The demo scene
 -- (scripts/cloth_clothesline.lua's set-up: a 30x30 cloth pegged to a line over the
--- ground, settled for a second) drawn at 1280x720 with 4x multisampling and every layer
--- through OSMesa (llvmpipe on the CPU), as `wobble run --record` draws it.
+-- ground, settled for a second) drawn at 1280x720 with one sample and FXAA and every
+-- layer through OSMesa (llvmpipe on the CPU), as `wobble run --record` draws it
+-- (--set samples=4: with 4x multisampling instead, as `--record --samples 4`).
 -- Figures, wall clock (wobble.clock; os.clock would add up llvmpipe's threads):
 --   ms/draw   r:draw alone (shadow map, scene, resolve, read back)
 --   ms/step   one simulated frame
@@ -28,7 +29,8 @@ cloth:pin_where(function(x, y, z)
 end)
 for _ = 1, 60 do w:step() end   -- swinging, not falling: the frames the demo shows most
 
-local r = wobble.renderer{ width = width, height = height, samples = 4 }
+local samples = args.samples or 1
+local r = wobble.renderer{ width = width, height = height, samples = samples, fxaa = samples == 1 }
 r:draw(w)   -- the first frame compiles the shaders: not counted
 
 local step_ms, draw_ms = 0, 0
@@ -57,13 +59,15 @@ local total = wobble.clock() - t0
 local rec_s = total - rec_step
 
 local out = {
-  scene = "record", width = width, height = height, size = width .. "x" .. height, frames = recorded, samples = select(2, r:info()),
+  scene = "record", width = width, height = height, size = width .. "x" .. height, frames = recorded,
+  samples = select(2, r:info()), fxaa = select(3, r:info()),
   ms_per_draw = draw_ms / frames, ms_per_step = step_ms / frames, ms_per_frame = 1000 * rec_s / recorded,
   fps_recording = recorded / rec_s, fps_with_step = recorded / total,
 }
 -- its own columns, the rest of the reporting as every scene's
 bench.report(out, nil, {
-  { "scene", "%-12s", "%-12s" }, { "size", "%9s", "%9s" }, { "samples", "%7s", "%7d" }, { "frames", "%6s", "%6d" },
+  { "scene", "%-12s", "%-12s" }, { "size", "%9s", "%9s" }, { "samples", "%7s", "%7d" }, { "fxaa", "%5s", "%5s" },
+  { "frames", "%6s", "%6d" },
   { "ms_per_draw", "%9s", "%9.2f", "ms/draw" }, { "ms_per_step", "%9s", "%9.2f", "ms/step" },
   { "fps_recording", "%9s", "%9.1f", "rec fps" }, { "fps_with_step", "%9s", "%9.1f", "all fps" },
 })

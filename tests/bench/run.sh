@@ -70,7 +70,7 @@ for s in $SCENES; do
 done
 scene "$BUILD/wobble" contacts 0 contacts_off contacts=0   # issue 8: what contacts add
 echo
-echo "== recording (tests/bench/record.lua: the demo scene at 1280x720, 4x MSAA, to MP4; wall clock)"
+echo "== recording (tests/bench/record.lua: the demo scene at 1280x720 as --record draws it, to MP4; wall clock)"
 scene "$BUILD/wobble" record 1
 if [ -n "$FLOAT" ]; then
     echo

@@ -117,6 +117,15 @@ run "$W" run $F/record.lua --quiet --out "$TMP/link" --set name=v.mp4
 # draws itself with that camera, byte for byte, and not the automatic framing's
 run "$W" run $F/camera.lua --quiet --out "$TMP/cam" --set own=1 --record "$TMP/camrec/"
 [ "$code" = 0 ] && cmp -s "$TMP/cam/own.png" "$TMP/camrec/frame_000002.png"; ok "--record uses the scene's camera (wobble.camera)" $?
+# ... and its antialiasing: one sample and FXAA unless --samples N asks for N samples
+run "$W" run $F/camera.lua --quiet --out "$TMP/cam4" --set own=1 --set samples=4 --samples 4 --record "$TMP/camrec4/"
+[ "$code" = 0 ] && cmp -s "$TMP/cam4/own.png" "$TMP/camrec4/frame_000002.png" && ! cmp -s "$TMP/camrec4/frame_000002.png" "$TMP/camrec/frame_000002.png"; ok "--record --samples 4: 4x multisampling, as wobble.renderer{samples = 4}" $?
+run "$W" run $F/camera.lua --quiet --out "$TMP/cam1" --samples 1 --record "$TMP/camrec1/"
+[ "$code" = 0 ] && ! cmp -s "$TMP/camrec1/frame_000002.png" "$TMP/camrec/frame_000002.png"; ok "--record --samples 1: no FXAA (the default's frame differs)" $?
+run "$W" run $F/camera.lua --samples 4
+[ "$code" = 2 ] && grep -q "give --record OUT too" "$TMP/err"; ok "--samples without --record: exit 2" $?
+run "$W" run $F/camera.lua --samples 0 --record "$TMP/x0/"
+[ "$code" = 2 ] && grep -q "from 1 to 16" "$TMP/err"; ok "--samples 0: exit 2, the range said" $?
 run "$W" run $F/camera.lua --quiet --out "$TMP/cam2" --set auto=1 --record "$TMP/camauto/"
 [ "$code" = 0 ] && [ -s "$TMP/camauto/frame_000002.png" ] && ! cmp -s "$TMP/camauto/frame_000002.png" "$TMP/camrec/frame_000002.png"; ok "... and the automatic framing when the scene sets none" $?
 # MP4 colours: converted with the BT.709 matrix in limited range and tagged so. A player
