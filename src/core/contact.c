@@ -354,10 +354,86 @@ static int made_shift(wb_world *w, made *mb, const wb_real *left, wb_real step, 
     return 1;
 }
 
+/* Later sweeps over the pairs in touch. One Gauss-Seidel pass leaves a dense contact set
+ * overlapping: where a fold's crease jams, a particle pushed out of one pair is pushed back
+ * into another by the pairs after it, and the links squeeze the crease again each substep
+ * (a 56 x 56 cloth dropped onto a sphere at 10 substeps: pairs at 0.86 of r_i + r_j after
+ * the pass, 0.88 at the frame's end; tests/validation/cloth_sphere_drop.lua). The pairs in
+ * touch after the pass (in overlap, in touch, or within NEAR x r_i + r_j) are swept again
+ * in list order, each pushed back to the overlap its pass left it with (left: a made
+ * overlap going out at max_depenetration keeps its part), up to SWEEPS passes in all, fewer
+ * once a sweep's largest correction is below SWEEP_TOL x r_i + r_j; and again after the
+ * static friction (wb__contacts_settle), whose slips undone push the neighbouring pairs
+ * back into overlap (0.97 after the sweeps, 0.92 after the friction). A sweep's push is
+ * speed, as the pass's depth beyond the old overlap, and counts in the normal force read
+ * out, but not in the depth the friction takes its bound from: in a heap that is the
+ * repair of folds the links keep pressing shut, and as budget it lent friction that
+ * stirred the heap (a 64 x 64 heap at rest: 0.007-0.022 m/s rms with it, 0.005-0.009
+ * without, against 0.045-0.12 before the sweeps). Bodies being moved apart whole
+ * (made_shift) are not swept. Returns how many pairs the pass counted in touch the sweeps
+ * made contacts. */
+#define SWEEPS 4
+#define NEAR ((wb_real)1.1)
+#define SWEEP_TOL ((wb_real)1e-3)
+static int32_t sweep(wb_world *w, wb_real h, int32_t *near, int32_t nn)
+{
+    wb_contacts *c = &w->k.pc;
+    const wb_model *m = &w->m;
+    wb_real *x = w->s.x, *nds = c->act_nd;
+    const wb_real *wv = m->w, *rad = m->radius, *left = c->left;
+    int32_t was_touching = 0;
+    for (int s = 1; s < SWEEPS; s++) {
+        wb_real worst = 0;
+        for (int32_t q = 0; q < nn; q++) {
+            const int32_t e = near[q], k = e >= 0 ? c->act[e] : (-e - 1) >> 1;
+            const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];
+            const wb_real wi = wv[i], wj = wv[j], wsum = wi + wj;
+            if (wsum == 0) continue;
+            wb_real *xi = &x[3 * i], *xj = &x[3 * j], d[3];
+            v3_sub(d, xj, xi);
+            const wb_real r = rad[i] + rad[j], to = r - left[k], d2 = v3_dot(d, d);
+            if (!(d2 < to * to)) continue;
+            const wb_real len = sqrt(d2), depth = to - len;
+            wb_real n[3];
+            if (len > r * (wb_real)1e-9) v3_scale(n, d, 1 / len);
+            else v3_set(n, 0, 1, 0);
+            if (wi > 0) v3_madd(xi, n, -depth * wi / wsum);
+            if (wj > 0) v3_madd(xj, n, depth * wj / wsum);
+            if (depth > worst * r) worst = depth / r;
+            if (e >= 0) {
+                nds[ND * e + 4] += depth / wsum / (h * h);
+                continue;
+            }
+            /* a pair in touch after the pass made a contact */
+            const int32_t a = c->nact++;
+            was_touching += (-e - 1) & 1;
+            near[q] = a;
+            c->act[a] = k;
+            v3_copy(&nds[ND * a], n);
+            nds[ND * a + 3] = depth;
+            nds[ND * a + 4] = depth / wsum / (h * h);
+            nds[ND * a + 5] = 0;
+            nds[ND * a + 6] = 0;
+        }
+        if (worst < SWEEP_TOL) break;
+    }
+    return was_touching;
+}
+
+/* after the static friction: the pairs in touch swept again (above) */
+void wb__contacts_settle(wb_world *w, wb_real h)
+{
+    wb_contacts *c = &w->k.pc;
+    if (c->nnear == 0) return;
+    c->touching -= sweep(w, h, c->near, c->nnear);
+    c->last = c->nact + c->touching;
+}
+
 void wb__contacts_project(wb_world *w, wb_real h)
 {
     wb_contacts *c = &w->k.pc;
     c->nact = 0;
+    c->nnear = 0;
     /* the body pairs moved in the last substep, within the frame only: a frame's start
      * works them out from the state alone (a snapshot's future is the same) */
     const int32_t nprev = c->fresh ? 0 : c->nmade;
@@ -387,6 +463,9 @@ void wb__contacts_project(wb_world *w, wb_real h)
     wb_real *left = wb__grow(c->left, &c->cap_left, c->n, sizeof *left);
     if (!left) goto nomem;
     c->left = left;
+    int32_t *near = wb__grow(c->near, &c->cap_near, c->n, sizeof *near), nn = 0;
+    if (!near) goto nomem;
+    c->near = near;
     /* a new candidate list (each frame): what each pair was left with is not known; the
      * overlap it has now counts as kept, unless one step would take it all anyway (a
      * resting contact's g h^2: then its repair is taken out of the speed as within a
@@ -423,9 +502,11 @@ void wb__contacts_project(wb_world *w, wb_real h)
         if (!(d2 < r * r)) {
             /* in touch (left at r_i + r_j by the last substep, to round-off): a contact
              * for the count, with nothing to correct */
-            const wb_real rt = r * (1 + (wb_real)1e-9);
-            if (d2 <= rt * rt) touching++;
+            const wb_real rt = r * (1 + (wb_real)1e-9), rn = r * NEAR;
+            const int t = d2 <= rt * rt;
+            touching += t;
             left[k] = 0;
+            if (d2 < rn * rn && !(shifted && moving(&mb, m->group[i], m->group[j]))) near[nn++] = -(2 * k + t) - 1;
             continue;
         }
         wb_real n[3], dp[3], slow, err, depth;
@@ -450,7 +531,11 @@ void wb__contacts_project(wb_world *w, wb_real h)
         } else {
             depth = wb__contact_depth(r - len, r - v3_len(dp), &left[k], vmax * h, &slow, &err);
         }
-        if (!(depth > 0)) { touching++; continue; }
+        if (!(depth > 0)) {
+            touching++;
+            if (!mp) near[nn++] = -(2 * k + 1) - 1;
+            continue;
+        }
         if (mp && (mp->fa == 0 || mp->fa == 1)) {
             /* one of the two stays (above): the other takes all of it */
             const int i_stays = (mp->fa == 0) == (mp->a == m->group[i]);
@@ -472,9 +557,13 @@ void wb__contacts_project(wb_world *w, wb_real h)
         nds[ND * c->nact + 4] = depth / wsum / (h * h);
         nds[ND * c->nact + 5] = err;
         nds[ND * c->nact + 6] = 0; /* the friction pass sets it */
+        if (!mp) near[nn++] = c->nact;
         c->nact++;
     }
     made_free(&mb);
+    touching -= sweep(w, h, near, nn);
+    c->nnear = nn;
+    c->touching = touching;
     c->last = c->nact + touching;
     return;
 nomem:
