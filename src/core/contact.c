@@ -380,7 +380,7 @@ static int32_t sweep(wb_world *w, wb_real h, int32_t *near, int32_t nn)
     wb_contacts *c = &w->k.pc;
     const wb_model *m = &w->m;
     wb_real *x = w->s.x, *nds = c->act_nd;
-    const wb_real *wv = m->w, *rad = m->radius, *left = c->left;
+    const wb_real *xp = w->s.x_prev, *wv = m->w, *rad = m->radius, *left = c->left;
     int32_t was_touching = 0;
     for (int s = 1; s < SWEEPS; s++) {
         wb_real worst = 0;
@@ -400,10 +400,20 @@ static int32_t sweep(wb_world *w, wb_real h, int32_t *near, int32_t nn)
             if (wi > 0) v3_madd(xi, n, -depth * wi / wsum);
             if (wj > 0) v3_madd(xj, n, depth * wj / wsum);
             if (depth > worst * r) worst = depth / r;
+            /* old overlap: what the pair overlaps by at x_prev beyond its kept part, which
+             * the made overlap of others, pushed out with x_prev since the pass, adds to */
+            wb_real dp[3];
+            v3_sub(dp, &xp[3 * j], &xp[3 * i]);
+            wb_real old = to - v3_len(dp);
             if (e >= 0) {
+                old -= nds[ND * e + 5];
+                old = !(old > 0) ? 0 : old < depth ? old : depth;
+                nds[ND * e + 3] += old;
                 nds[ND * e + 4] += depth / wsum / (h * h);
+                nds[ND * e + 5] += old;
                 continue;
             }
+            old = !(old > 0) ? 0 : old < depth ? old : depth;
             /* a pair in touch after the pass made a contact */
             const int32_t a = c->nact++;
             was_touching += (-e - 1) & 1;
@@ -412,7 +422,7 @@ static int32_t sweep(wb_world *w, wb_real h, int32_t *near, int32_t nn)
             v3_copy(&nds[ND * a], n);
             nds[ND * a + 3] = depth;
             nds[ND * a + 4] = depth / wsum / (h * h);
-            nds[ND * a + 5] = 0;
+            nds[ND * a + 5] = old;
             nds[ND * a + 6] = 0;
         }
         if (worst < SWEEP_TOL) break;
