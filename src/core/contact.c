@@ -437,7 +437,7 @@ static int32_t sweep(wb_world *w, wb_real h, int32_t *near, int32_t nn)
 void wb__contacts_settle(wb_world *w, wb_real h)
 {
     wb_contacts *c = &w->k.pc;
-    if (c->nnear == 0) return;
+    if (c->nnear == 0 || (c->nact == 0 && w->k.tc.nact == 0)) return; /* (no friction ran) */
     c->touching -= sweep(w, h, c->near, c->nnear);
     c->last = c->nact + c->touching;
 }
@@ -574,6 +574,8 @@ void wb__contacts_project(wb_world *w, wb_real h)
         c->nact++;
     }
     made_free(&mb);
+    /* (no correction: nothing moved since any pair's projection) */
+    if (c->nact == 0) nn = 0;
     touching -= sweep(w, h, near, nn);
     c->nnear = nn;
     c->touching = touching;
