@@ -437,7 +437,7 @@ static int32_t sweep(wb_world *w, wb_real h, int32_t *near, int32_t nn)
 void wb__contacts_settle(wb_world *w, wb_real h)
 {
     wb_contacts *c = &w->k.pc;
-    if (c->nnear == 0 || (c->nact == 0 && w->k.tc.nact == 0)) return; /* (no friction ran) */
+    if (c->nnear == 0 || (!c->fmoved && w->k.tc.nact == 0)) return; /* (the friction moved nothing) */
     c->touching -= sweep(w, h, c->near, c->nnear);
     c->last = c->nact + c->touching;
 }
@@ -623,6 +623,7 @@ nomem:
 void wb__contacts_friction(wb_world *w, wb_real h)
 {
     wb_contacts *c = &w->k.pc;
+    c->fmoved = 0;
     if (c->nact == 0 && w->k.tc.nact == 0) return;
     const wb_model *m = &w->m;
     wb_real *load = wb__grow(c->load, &c->cap_load, m->np, sizeof *load);
@@ -659,6 +660,7 @@ void wb__contacts_friction(wb_world *w, wb_real h)
         if (wi > 0 && load[i] < tau) tau = load[i];
         if (wj > 0 && load[j] < tau) tau = load[j];
         if (!(tau > 0)) continue;
+        c->fmoved = 1;
         load[i] -= tau;
         load[j] -= tau;
         const wb_real f = tau / need / wsum;

@@ -211,6 +211,7 @@ typedef struct wb_contacts {
     int32_t *near;         /* (n) the substep's pairs in touch, for its later sweeps
                               (contact.c): an act index, or -(2 k + touching) - 1 */
     int32_t cap_near, nnear, touching;
+    int fmoved;            /* the substep's static friction moved a pair (contact.c) */
     wb_real *load;         /* (np) static friction budget of the substep, mu x normal impulse
                               (contact.c's friction pass; pairs' and triangles' together) */
     int32_t cap_load;
