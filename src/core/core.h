@@ -208,6 +208,10 @@ typedef struct wb_contacts {
     int32_t last;          /* contacts in the last substep */
     int fresh;             /* a new candidate list: `left` not known yet */
     double broad_ms;       /* broad phase of the last step */
+    int32_t *near;         /* (n) the substep's pairs in touch, for its later sweeps
+                              (contact.c): an act index, or -(2 k + touching) - 1 */
+    int32_t cap_near, nnear, touching;
+    int fmoved;            /* the substep's static friction moved a pair (contact.c) */
     wb_real *load;         /* (np) static friction budget of the substep, mu x normal impulse
                               (contact.c's friction pass; pairs' and triangles' together) */
     int32_t cap_load;
@@ -686,6 +690,8 @@ void wb__contacts_velocity(wb_world *w, wb_real h);
  * projections (per particle: its contacts' normal corrections bound what it may stick
  * with); tricontact.c: the triangle contacts' part of it */
 void wb__contacts_friction(wb_world *w, wb_real h);
+/* after it, the pairs in touch swept again (contact.c) */
+void wb__contacts_settle(wb_world *w, wb_real h);
 void wb__tricontacts_load(wb_world *w, wb_real h, wb_real *load);
 void wb__tricontacts_static(wb_world *w, wb_real *load);
 wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra); /* world.c */

@@ -1,8 +1,9 @@
 /* solver.c: the step (Macklin et al. 2019, "Small steps in physics simulation").
  *
  * Per frame, `substeps` times: predict, project the constraints `iterations` times
- * (XPBD, Gauss-Seidel over colour batches or Jacobi), project collisions (static
- * friction at position level), update velocities, then dynamic friction and restitution
+ * (XPBD, Gauss-Seidel over colour batches or Jacobi), project collisions (the particle
+ * pairs in touch swept a few times, static friction at position level, the pairs swept
+ * again: contact.c), update velocities, then dynamic friction and restitution
  * at velocity level (each substep's prediction but the first runs inside the previous
  * substep's collision pass when nothing between them moves particles: fusable()).
  * Plastic flow, breaking and the finiteness check run once per frame. The constraints
@@ -459,6 +460,7 @@ wb_status wb_world_step(wb_world *w)
         wb__contacts_project(w, h);
         wb__tricontacts_project(w, h);
         wb__contacts_friction(w, h);
+        wb__contacts_settle(w, h);
         wb__rigids_solve(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps);
         wb__rigid_particles_solve(w);
         const int last = sub + 1 == d->substeps, fuse = fusable(w);

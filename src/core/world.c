@@ -188,7 +188,7 @@ void wb_world_destroy(wb_world *w)
                      k->colour_start, k->comp_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda, k->s_jac,
                      k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->c_sub, k->c_left, k->c_save,
                      k->breaks, m->group, m->cflags, m->cfric, m->x0, k->pc.ij, k->pc.act, k->pc.act_nd,
-                     k->pc.left, k->pc.reach, k->pc.keys, k->pc.graph, k->pc.tcov, k->pc.load, k->pc.made_ab, k->pc.bm,
+                     k->pc.left, k->pc.reach, k->pc.keys, k->pc.graph, k->pc.tcov, k->pc.near, k->pc.load, k->pc.made_ab, k->pc.bm,
                      /* shape matching and pressure (freed here: a call into their files
                       * would close a circle, as they call this one) */
                      w->sm.start, w->sm.stiff, w->sm.yield, w->sm.creep, w->sm.ids, w->sm.rest, w->sm.q,

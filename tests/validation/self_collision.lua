@@ -102,8 +102,8 @@ end)
 -- pushed the heap about, and it kept moving at 0.30 m/s rms (contact.c's friction pass
 -- now takes it from the corrections that hold the pair apart, as the dynamic friction
 -- does: 0.020 m/s).
-test("a cloth fallen into a heap on itself comes to rest", function()
-  local n = 32
+-- the heap of an n x n cloth: its rms speed over the last 2 of 6 s and its highest particle
+local function heap(n)
   local w = wobble.world{ damping = 0.5 }
   w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.8 }
   local c = w:cloth{ origin = {-0.75, 0, 0}, size = {1.5, 1.5}, res = {n, n}, mass = 1, self_collide = true,
@@ -127,6 +127,24 @@ test("a cloth fallen into a heap on itself comes to rest", function()
     end
   end
   for _, p in ipairs(c.particles) do top = math.max(top, select(2, w:position(p))) end
+  return math.sqrt(sum / k), top
+end
+
+test("a cloth fallen into a heap on itself comes to rest", function()
+  local rms, top = heap(32)
   expect.lt(top, 0.5, "it fell into a heap (its highest particle, m)")
-  expect.lt(math.sqrt(sum / k), 0.057, "rms speed over the last 2 s (m/s)")
+  expect.lt(rms, 0.057, "rms speed over the last 2 s (m/s)")
+end)
+
+-- The same heap of a 64 x 64 cloth, whose folds jam harder. Its contacts projected in one
+-- pass left its pairs overlapping, and the static friction, bounded by corrections that
+-- were the repair of folds the links keep pressing shut, stirred it in bursts: 0.045 m/s
+-- rms over the last 2 s (0.009-0.12 over eight variants of its initial swirl), single
+-- particles at 3 m/s; without friction 0.006. With the pairs in touch swept again
+-- (contact.c): 0.020 (0.005-0.020). Bounded at 0.8% of the landing speed, 0.03 m/s.
+test("a 64 x 64 cloth fallen into a heap on itself comes to rest", function()
+  local rms, top = heap(64)
+  print(string.format("64 x 64 heap: rms speed over the last 2 s %.4f m/s, highest particle %.3f m", rms, top))
+  expect.lt(top, 0.5, "it fell into a heap (its highest particle, m)")
+  expect.lt(rms, 0.03, "rms speed over the last 2 s (m/s)")
 end)
