@@ -269,13 +269,13 @@ if command -v make >/dev/null 2>&1; then
     done
     # the build lines (a dry run of one object: -n prints even the silent recipe lines)
     obj="$BUILD/obj/core/bend.o"
-    make -n -B --no-print-directory "$obj" >"$TMP/out" 2>"$TMP/err"
+    make -n -B --no-print-directory BUILD="$BUILD" "$obj" >"$TMP/out" 2>"$TMP/err"
     code=$?
     check "make: a short build line per file" 0 out "printf '  %-4s %s" out "src/core/bend.c"
-    make -s -n -B --no-print-directory "$obj" >"$TMP/out" 2>"$TMP/err"
+    make -s -n -B --no-print-directory BUILD="$BUILD" "$obj" >"$TMP/out" 2>"$TMP/err"
     code=$?
     check "make -s: no build lines" 0 !out "printf" out "src/core/bend.c"
-    make -n -B --no-print-directory V=1 "$obj" >"$TMP/out" 2>"$TMP/err"
+    make -n -B --no-print-directory BUILD="$BUILD" V=1 "$obj" >"$TMP/out" 2>"$TMP/err"
     code=$?
     check "make V=1: the whole commands" 0 !out "printf" out "-Werror"
     # make clean: the build folders go, the user's out/ stays
