@@ -448,5 +448,10 @@ static wb_real att_energy(const wb_world *w)
 }
 
 const wb_ctype wb__attach_type = {
-    "attach", att_count, att_prepare, att_substep_begin, att_project, NULL, att_energy, NULL,
+    .name = "attach",
+    .count = att_count,
+    .prepare = att_prepare,
+    .substep_begin = att_substep_begin,
+    .project = att_project,
+    .energy = att_energy,
 };

@@ -430,5 +430,11 @@ static wb_real grab_energy(const wb_world *w)
 }
 
 const wb_ctype wb__grab_type = {
-    "grab", grab_count, grab_prepare, grab_substep_begin, grab_project, grab_frame_end, grab_energy, NULL,
+    .name = "grab",
+    .count = grab_count,
+    .prepare = grab_prepare,
+    .substep_begin = grab_substep_begin,
+    .project = grab_project,
+    .frame_end = grab_frame_end,
+    .energy = grab_energy,
 };

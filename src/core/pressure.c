@@ -233,7 +233,14 @@ static wb_real pr_energy(const wb_world *w)
     return u;
 }
 
-const wb_ctype wb__pressure_type = { "pressure", pr_count, pr_prepare, pr_substep_begin, pr_project, NULL, pr_energy, NULL };
+const wb_ctype wb__pressure_type = {
+    .name = "pressure",
+    .count = pr_count,
+    .prepare = pr_prepare,
+    .substep_begin = pr_substep_begin,
+    .project = pr_project,
+    .energy = pr_energy,
+};
 
 /* ---- API ------------------------------------------------------------------------------------ */
 wb_pressure_def wb_pressure_default_def(void)

@@ -148,9 +148,7 @@ uint64_t wb_world_hash(const wb_world *w)
         if (!(m->c_gen[c] & 1u)) continue;
         h = fnv(h, &s->c_pose[c], sizeof s->c_pose[c]); /* pose, sweep start, velocities */
     }
-    /* broken bends (state): their slots, so worlds without one hash as they always did */
-    for (int32_t i = 0; i < w->bend.n; i++)
-        if (w->bend.broken[i]) h = fnv(h, &i, sizeof i);
+    h = wb__bend_type.hash(w, h);
     /* shape matching and pressure: their parameters and state (rest shapes, rotations) */
     const wb_smatch *sm = &w->sm;
     if (sm->n > 0) { /* (worlds without any hash as they always did) */

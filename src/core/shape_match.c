@@ -261,8 +261,16 @@ static void sm_links(const wb_world *w, wb_link_fn fn, void *ud)
         for (int32_t i = sm->start[c] + 1; i < sm->start[c + 1]; i++) fn(ud, sm->ids[i - 1], sm->ids[i], 0);
 }
 
-const wb_ctype wb__shape_type = { "shape_match", sm_count, sm_prepare, sm_substep_begin, sm_project, sm_frame_end,
-                                  sm_energy, sm_links };
+const wb_ctype wb__shape_type = {
+    .name = "shape_match",
+    .count = sm_count,
+    .prepare = sm_prepare,
+    .substep_begin = sm_substep_begin,
+    .project = sm_project,
+    .frame_end = sm_frame_end,
+    .energy = sm_energy,
+    .links = sm_links,
+};
 
 /* ---- API ------------------------------------------------------------------------------------ */
 wb_shape_match_def wb_shape_match_default_def(void)

@@ -8,7 +8,7 @@
  * step, as after any topology edit. */
 #include <stdlib.h>
 
-#include "core.h"
+#include "ctype.h"
 #include "bvh.h"
 #include "snapshot.h"
 #include "volume.h"
@@ -67,23 +67,6 @@ wb_status wb_image_alloc(wb_image *g, int32_t np, int32_t nd, int32_t nfree, int
     return WB_OK;
 }
 
-wb_status wb_image_alloc_bends(wb_image *g, int32_t nb)
-{
-    free(g->b_ij); free(g->b_alpha); free(g->b_beta); free(g->b_rest); free(g->b_btorque); free(g->b_broken);
-    g->nb = nb;
-    g->b_ij = zalloc(4 * (int64_t)nb, sizeof *g->b_ij);
-    g->b_alpha = zalloc(nb, sizeof(wb_real));
-    g->b_beta = zalloc(nb, sizeof(wb_real));
-    g->b_rest = zalloc(nb, sizeof(wb_real));
-    g->b_btorque = zalloc(nb, sizeof(wb_real));
-    g->b_broken = zalloc(nb, 1);
-    if (!g->b_ij || !g->b_alpha || !g->b_beta || !g->b_rest || !g->b_btorque || !g->b_broken) {
-        wb_image_free(g);
-        return WB_ERR_NOMEM;
-    }
-    return WB_OK;
-}
-
 wb_status wb_image_alloc_volumes(wb_image *g, int32_t n)
 {
     free(g->vol_ijkl);
@@ -124,9 +107,10 @@ void wb_image_free(wb_image *g)
     }
     void *p[] = { g->x, g->v, g->inv_mass, g->radius, g->pinned, g->d_ij, g->d_alpha, g->d_beta, g->d_yield,
                   g->d_creep, g->d_break, g->d_rest, g->d_broken, g->d_gen, g->d_free, g->c, g->c_gen,
-                  g->surf_start, g->tri, g->group, g->cflags, g->cfric, g->x0, g->d_bforce,
-                  g->b_ij, g->b_alpha, g->b_beta, g->b_rest, g->b_btorque, g->b_broken };
+                  g->surf_start, g->tri, g->group, g->cflags, g->cfric, g->x0, g->d_bforce };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    for (int i = 0; i < wb__nctypes; i++)
+        if (wb__ctypes[i]->image_free) wb__ctypes[i]->image_free(g);
     wb__smatch_image_free(g);
     wb__pressure_image_free(g);
     wb__attach_image_free(g);
@@ -167,16 +151,6 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
         memcpy(g->d_gen, m->d_gen, nd * sizeof *g->d_gen);
     }
     if (m->nfree) memcpy(g->d_free, m->d_free, (size_t)m->nfree * sizeof *g->d_free);
-    const wb_bends *bd = &w->bend;
-    if (bd->n > 0) {
-        if ((st = wb_image_alloc_bends(g, bd->n)) != WB_OK) return st;
-        memcpy(g->b_ij, bd->ij, 4 * (size_t)bd->n * sizeof *g->b_ij);
-        memcpy(g->b_alpha, bd->alpha, (size_t)bd->n * sizeof(wb_real));
-        memcpy(g->b_beta, bd->beta, (size_t)bd->n * sizeof(wb_real));
-        memcpy(g->b_rest, bd->rest, (size_t)bd->n * sizeof(wb_real));
-        memcpy(g->b_btorque, bd->btorque, (size_t)bd->n * sizeof(wb_real));
-        memcpy(g->b_broken, bd->broken, (size_t)bd->n);
-    }
     for (int32_t i = 0; i < m->nc; i++) {
         const wb_cshape *cs = &m->c_shape[i];
         const wb_collider_pose *cp = &s->c_pose[i];
@@ -236,7 +210,10 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
         wb_image_free(g);
         return st;
     }
-    return WB_OK;
+    for (int i = 0; i < wb__nctypes && st == WB_OK; i++)
+        if (wb__ctypes[i]->image_save) st = wb__ctypes[i]->image_save(w, g);
+    if (st != WB_OK) wb_image_free(g);
+    return st;
 }
 
 /* ---- checks ---------------------------------------------------------------------------- */
@@ -300,18 +277,6 @@ const char *wb_image_check(const wb_image *g)
         v3_sub(dx, &g->x[3 * b], &g->x[3 * a]);
         if (!isfinite(v3_dot(dx, dx))) return "constraint particles are too far apart (their distance squared overflows)";
     }
-    if (g->nb < 0 || g->nb > WB_MAX_CONSTRAINTS) return "too many bends";
-    for (int32_t i = 0; i < g->nb; i++) {
-        const int32_t *p = &g->b_ij[4 * i];
-        for (int a = 0; a < 4; a++) {
-            if (p[a] < 0 || p[a] >= g->np) return "bend particle out of range";
-            for (int b = 0; b < a; b++)
-                if (p[a] == p[b]) return "a bend needs four distinct particles";
-        }
-        wb_bend_def bd = { g->b_alpha[i], g->b_beta[i], g->b_rest[i], g->b_btorque[i] };
-        if (isnan(g->b_rest[i])) return "bend rest must be an angle in [-pi, pi] (radians)";
-        if ((e = wb_bend_def_check(&bd))) return e;
-    }
     /* the free list is exactly the dead slots, each once (a mark per slot: linear) */
     if (g->nfree != dead) return "the free constraint slots do not match the dead ones";
     if (g->nfree > 0) {
@@ -347,9 +312,11 @@ const char *wb_image_check(const wb_image *g)
         if ((e = wb_volume_def_check(&d))) return e;
     }
     if ((e = wb__tet_image_check(g)) || (e = wb__smatch_image_check(g)) || (e = wb__pressure_image_check(g)) ||
-        (e = wb__attach_image_check(g)) || (e = wb__grab_image_check(g)) || (e = wb__rigid_image_check(g)))
+        (e = wb__attach_image_check(g)) || (e = wb__grab_image_check(g)))
         return e;
-    return NULL;
+    for (int i = 0; i < wb__nctypes; i++)
+        if (wb__ctypes[i]->image_check && (e = wb__ctypes[i]->image_check(g))) return e;
+    return wb__rigid_image_check(g);
 }
 
 /* the image's volume constraints after w's, particles shifted by `shift` (reserved) */
@@ -361,6 +328,21 @@ static void put_volumes(wb_world *w, const wb_image *g, int32_t shift)
         wb__volume_put(w, p, g->vol_alpha[i], g->vol_rest[i]);
         wb__volume_plastic(w, w->vol->n - 1, g->vol_plastic[2 * i], g->vol_plastic[2 * i + 1]);
     }
+}
+
+/* every type's section of the image: room for it in w, then (nothing can fail) put */
+static wb_status reserve_types(wb_world *w, const wb_image *g, const wb_image_at *at)
+{
+    wb_status st = WB_OK;
+    for (int i = 0; i < wb__nctypes && st == WB_OK; i++)
+        if (wb__ctypes[i]->image_reserve) st = wb__ctypes[i]->image_reserve(w, g, at);
+    return st;
+}
+
+static void put_types(wb_world *w, const wb_image *g, const wb_image_at *at)
+{
+    for (int i = 0; i < wb__nctypes; i++)
+        if (wb__ctypes[i]->image_put) wb__ctypes[i]->image_put(w, g, at);
 }
 
 /* ---- exact restore ----------------------------------------------------------------------- */
@@ -462,8 +444,8 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     }
     wb_world *w = wb_world_create(&g->def);
     wb_colmesh **cms = calloc((size_t)(g->nc > 0 ? g->nc : 1), sizeof *cms);
+    const wb_image_at at = { 1, 0, 0, NULL, NULL };
     wb_status st = w && cms ? wb__reserve(w, g->np, g->nd) : WB_ERR_NOMEM;
-    if (st == WB_OK) st = wb__bend_reserve(w, g->nb);
     if (st == WB_OK) st = grow_colliders(w, g->nc);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
     if (st == WB_OK && g->nvol > 0) st = wb__volume_reserve(w, g->nvol);
@@ -473,6 +455,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     if (st == WB_OK) st = wb__attach_image_reserve(w, g);
     if (st == WB_OK) st = wb__grab_image_reserve(w, g);
     if (st == WB_OK) st = wb__rigid_reserve(w, g, 1);
+    if (st == WB_OK) st = reserve_types(w, g, &at);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
@@ -518,17 +501,6 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     }
     m->nfree = g->nfree;
     if (g->nfree) memcpy(m->d_free, g->d_free, (size_t)g->nfree * sizeof *m->d_free);
-    wb_bends *bd = &w->bend;
-    bd->n = g->nb;
-    if (g->nb > 0) {
-        memcpy(bd->ij, g->b_ij, 4 * (size_t)g->nb * sizeof *bd->ij);
-        memcpy(bd->alpha, g->b_alpha, (size_t)g->nb * sizeof(wb_real));
-        memcpy(bd->beta, g->b_beta, (size_t)g->nb * sizeof(wb_real));
-        memcpy(bd->rest, g->b_rest, (size_t)g->nb * sizeof(wb_real));
-        memcpy(bd->btorque, g->b_btorque, (size_t)g->nb * sizeof(wb_real));
-        memcpy(bd->broken, g->b_broken, (size_t)g->nb);
-        bd->dirty = 1;
-    }
     m->nc = g->nc;
     for (int32_t i = 0; i < g->nc; i++) {
         put_collider(w, i, &g->c[i], cms[i]);
@@ -543,6 +515,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     wb__rigid_put(w, g, 1, NULL);
     wb__attach_image_put(w, g, 0, NULL, NULL);
     wb__grab_image_put(w, g, 0, NULL);
+    put_types(w, g, &at);
     s->time = g->time;
     s->frame = g->frame;
     s->warnings = g->warnings;
@@ -589,8 +562,8 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     int32_t *cmap = calloc((size_t)(g->nc > 0 ? g->nc : 1), sizeof *cmap); /* image slot -> w's */
     int32_t *rmap = calloc((size_t)(g->nrb > 0 ? g->nrb : 1), sizeof *rmap); /* the same for rigid bodies */
     if (!cms || !cmap || !rmap) { free(cms); free(cmap); free(rmap); return WB_ERR_NOMEM; }
+    const wb_image_at at = { 0, m->np, m->nsurf, cmap, rmap };
     wb_status st = wb__reserve(w, g->np, live_d);
-    if (st == WB_OK) st = wb__bend_reserve(w, g->nb);
     if (st == WB_OK) st = grow_colliders(w, m->nc + new_c);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
     if (st == WB_OK && g->nvol > 0) st = wb__volume_reserve(w, g->nvol);
@@ -600,6 +573,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     if (st == WB_OK) st = wb__attach_image_reserve(w, g);
     if (st == WB_OK) st = wb__grab_image_reserve(w, g);
     if (st == WB_OK) st = wb__rigid_reserve(w, g, 0);
+    if (st == WB_OK) st = reserve_types(w, g, &at);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
@@ -631,13 +605,6 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
         wb_distance_id id = wb_distance_add(w, first + g->d_ij[2 * i], first + g->d_ij[2 * i + 1], &d, NULL);
         w->s.d_broken[id.index - 1] = g->d_broken[i];
     }
-    for (int32_t i = 0; i < g->nb; i++) {
-        const int32_t p[4] = { first + g->b_ij[4 * i], first + g->b_ij[4 * i + 1], first + g->b_ij[4 * i + 2],
-                               first + g->b_ij[4 * i + 3] };
-        wb_bend_def bd = { g->b_alpha[i], g->b_beta[i], g->b_rest[i], g->b_btorque[i] };
-        wb_bend_id id = wb_bend_add(w, p, &bd, NULL); /* checked and reserved: cannot fail */
-        w->bend.broken[id.index - 1] = g->b_broken[i];
-    }
     int32_t scan = 0; /* dead slots are taken lowest first: the scan never goes back */
     for (int32_t i = 0; i < g->nc; i++) {
         if (!(g->c_gen[i] & 1u)) continue;
@@ -662,6 +629,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     wb__rigid_put(w, g, 0, rmap);
     wb__attach_image_put(w, g, first, cmap, rmap);
     wb__grab_image_put(w, g, first, rmap);
+    put_types(w, g, &at);
     free(rmap);
     free(cmap);
     m->topology_dirty = 1;

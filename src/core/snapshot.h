@@ -6,6 +6,7 @@
 #define WB_SNAPSHOT_H
 
 #include "wobble.h"
+#include "bend.h"
 
 /* a collider: its shape in its own frame and its full pose */
 typedef struct wb_image_collider {
@@ -89,12 +90,7 @@ typedef struct wb_image {
     int32_t nfree;
     int32_t *d_free;       /* (nfree) free slots, in stack order */
 
-    /* bending constraints in creation order (wb_image_alloc_bends) */
-    int32_t nb;
-    int32_t *b_ij;         /* (nb x 4) hinge p1 p2, wings p3 p4 */
-    wb_real *b_alpha, *b_beta, *b_rest; /* (nb) compliance, damping, rest angle */
-    wb_real *b_btorque;    /* (nb) break_torque, N m (0: never) */
-    uint8_t *b_broken;     /* (nb) broken by it */
+    wb_image_bend bend;    /* bend.h: empty unless wb_image_alloc_bends */
 
     int32_t nc;
     wb_image_collider *c;  /* (nc) by slot */
@@ -132,7 +128,8 @@ typedef struct wb_image {
 /* allocate the arrays for these counts (zeroed; generations 1, i.e. live; particles collide);
  * WB_ERR_NOMEM */
 wb_status wb_image_alloc(wb_image *img, int32_t np, int32_t nd, int32_t nfree, int32_t nc, int32_t nsurf, int32_t ntri);
-/* the bend arrays for nb bends (zeroed), after wb_image_alloc; WB_ERR_NOMEM */
+/* bend.c: the bend arrays for nb bends (zeroed), after wb_image_alloc; WB_ERR_NOMEM (the
+ * section left empty) */
 wb_status wb_image_alloc_bends(wb_image *img, int32_t nb);
 /* the volume constraints' arrays for n of them (zeroed); WB_ERR_NOMEM */
 wb_status wb_image_alloc_volumes(wb_image *img, int32_t n);

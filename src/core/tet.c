@@ -858,5 +858,12 @@ static void tet_links(const wb_world *w, wb_link_fn fn, void *ud)
 }
 
 const wb_ctype wb__tet_type = {
-    "tet", tet_count, tet_prepare, tet_substep_begin, tet_project, tet_frame_end, tet_energy, tet_links,
+    .name = "tet",
+    .count = tet_count,
+    .prepare = tet_prepare,
+    .substep_begin = tet_substep_begin,
+    .project = tet_project,
+    .frame_end = tet_frame_end,
+    .energy = tet_energy,
+    .links = tet_links,
 };

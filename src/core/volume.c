@@ -282,5 +282,12 @@ static void vol_links(const wb_world *w, wb_link_fn fn, void *ud)
 }
 
 const wb_ctype wb__volume_type = {
-    "volume", vol_count, vol_prepare, vol_substep_begin, vol_project, vol_frame_end, vol_energy, vol_links,
+    .name = "volume",
+    .count = vol_count,
+    .prepare = vol_prepare,
+    .substep_begin = vol_substep_begin,
+    .project = vol_project,
+    .frame_end = vol_frame_end,
+    .energy = vol_energy,
+    .links = vol_links,
 };

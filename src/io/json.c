@@ -261,7 +261,7 @@ static int read_bend(rd *r, const cJSON *c, const kp *p, wb_image *g, int32_t i)
     int32_t n;
     if (jv_get_array(r, f[1], &pp, 16, &n)) return -1;
     if (n != 4) return jv_fail(r, f[1], 0, &pp, "a bend joins 4 particles (hinge p1 p2, wings p3 p4), got %d", n);
-    int32_t *q = &g->b_ij[4 * i];
+    int32_t *q = &g->bend.ij[4 * i];
     int k = 0;
     for (const cJSON *e = f[1]->child; e; e = e->next, k++) {
         kp ep = { &pp, NULL, k };
@@ -288,11 +288,11 @@ static int read_bend(rd *r, const cJSON *c, const kp *p, wb_image *g, int32_t i)
     } else if (!wb_dihedral_angle(&g->x[3 * q[0]], &g->x[3 * q[1]], &g->x[3 * q[2]], &g->x[3 * q[3]], &d.rest)) {
         return jv_fail(r, f[1], 0, &pp, "the two triangles are degenerate (a wing on the hinge line): no angle to keep");
     }
-    g->b_alpha[i] = d.compliance;
-    g->b_beta[i] = d.damping;
-    g->b_rest[i] = d.rest;
-    g->b_btorque[i] = d.break_torque;
-    g->b_broken[i] = broken;
+    g->bend.alpha[i] = d.compliance;
+    g->bend.beta[i] = d.damping;
+    g->bend.rest[i] = d.rest;
+    g->bend.btorque[i] = d.break_torque;
+    g->bend.broken[i] = broken;
     return 0;
 }
 

@@ -137,21 +137,21 @@ static void write_constraints(out *o, const wb_image *g)
         }
         fprintf(f, ", \"broken\": %s}", g->d_broken[i] ? "true" : "false");
     }
-    for (int32_t i = 0; i < g->nb; i++) {
-        const int32_t *p = &g->b_ij[4 * i];
+    for (int32_t i = 0; i < g->bend.n; i++) {
+        const int32_t *p = &g->bend.ij[4 * i];
         fprintf(f, "%s    {\"type\": \"bend\", \"particles\": [%d, %d, %d, %d], \"rest\": ", first ? "\n" : ",\n", p[0],
                 p[1], p[2], p[3]);
         first = 0;
-        num(o, g->b_rest[i]);
+        num(o, g->bend.rest[i]);
         fputs(", \"compliance\": ", f);
-        num(o, g->b_alpha[i]);
+        num(o, g->bend.alpha[i]);
         fputs(", \"damping\": ", f);
-        num(o, g->b_beta[i]);
-        if (g->b_btorque[i] > 0) { /* only when set: configs without it read as before */
+        num(o, g->bend.beta[i]);
+        if (g->bend.btorque[i] > 0) { /* only when set: configs without it read as before */
             fputs(", \"break_torque\": ", f);
-            num(o, g->b_btorque[i]);
+            num(o, g->bend.btorque[i]);
         }
-        if (g->b_broken[i]) fputs(", \"broken\": true", f);
+        if (g->bend.broken[i]) fputs(", \"broken\": true", f);
         fputc('}', f);
     }
     fputs(first ? "],\n" : "\n  ],\n", f);
