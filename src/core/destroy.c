@@ -4,25 +4,17 @@
  * a circle between the files. */
 #include "ctype.h"
 #include "bvh.h"
-#include "volume.h"
-#include "tet.h"
-#include "attach.h"
-#include "grab.h"
 #include "rigid.h"
 
 void wb_world_destroy(wb_world *w)
 {
     if (!w) return;
-    wb__volume_free(w);
-    wb__tet_free(w);
-    wb__attach_free(w);
-    wb__grab_free(w);
     wb__rigids_free(w, w->rb);
     wb__pool_destroy(w->pool);
     wb_model *m = &w->m;
     for (int32_t i = 0; i < m->nc; i++) wb__colmesh_free(m->c_shape[i].mesh); /* mesh colliders' copies */
     /* each type's arrays and what it charged to the budget */
-    size_t charged = w->charged_self + m->charged + m->charged_mesh + w->sm.charged + w->pr.charged;
+    size_t charged = w->charged_self + m->charged + m->charged_mesh;
     for (int i = 0; i < wb__nctypes; i++) {
         const wb_ctype *t = wb__ctypes[i];
         if (t->charged) charged += t->charged(w);
@@ -33,19 +25,11 @@ void wb_world_destroy(wb_world *w)
     wb_cache *k = &w->k;
     wb__broadphase_free(&k->pc);
     wb__tribroad_free(&k->tc);
-    void *ptrs[] = { m->inv_mass, m->w, m->radius, m->pinned, m->d_ij, m->d_alpha, m->d_beta,
-                     m->d_yield, m->d_creep, m->d_break, m->d_bforce, m->d_gen, m->d_free, m->c_shape, m->c_gen, m->surf_start, m->tri,
-                     s->x, s->x_prev, s->v, s->d_rest, s->d_broken, s->c_pose,
-                     k->colour_start, k->comp_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda, k->s_jac,
-                     k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->c_sub, k->c_left, k->c_save,
-                     k->breaks, m->group, m->cflags, m->cfric, m->x0, k->pc.ij, k->pc.act, k->pc.act_nd,
-                     k->pc.left, k->pc.reach, k->pc.keys, k->pc.graph, k->pc.tcov, k->pc.load, k->pc.made_ab,
-                     /* shape matching and pressure (freed here: a call into their files
-                      * would close a circle, as they call this one) */
-                     w->sm.start, w->sm.stiff, w->sm.yield, w->sm.creep, w->sm.ids, w->sm.rest, w->sm.q,
-                     w->sm.qk, w->sm.lambda, w->pr.surface, w->pr.pressure, w->pr.alpha, w->pr.v0, w->pr.vstart,
-                     w->pr.tstart, w->pr.verts, w->pr.tri, w->pr.lambda, w->pr.grad,
-                     k->tc.pt, k->tc.act, k->tc.act_d, k->tc.left, k->mc_body, k->mc_root, k->mc_acc, k->mc_pinned, k->mc_end };
+    void *ptrs[] = { m->inv_mass, m->w, m->radius, m->pinned, m->group, m->cflags, m->cfric, m->x0, m->c_shape,
+                     m->c_gen, m->surf_start, m->tri, s->x, s->x_prev, s->v, s->c_pose, k->dx, k->ncount, k->x_save,
+                     k->v_save, k->c_sub, k->c_left, k->c_save, k->pc.ij, k->pc.act, k->pc.act_nd, k->pc.left,
+                     k->pc.reach, k->pc.keys, k->pc.graph, k->pc.tcov, k->pc.load, k->pc.made_ab, k->tc.pt, k->tc.act,
+                     k->tc.act_d, k->tc.left, k->mc_body, k->mc_root, k->mc_acc, k->mc_pinned, k->mc_end };
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
     free(w);
 }

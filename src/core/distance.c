@@ -746,6 +746,33 @@ static void distance_links(const wb_world *w, wb_link_fn fn, void *ud)
         if (m->d_gen[s] & 1u) fn(ud, m->d_ij[2 * s], m->d_ij[2 * s + 1], 1);
 }
 
+/* ---- teardown and hash (ctype.h) ----------------------------------------------------------- */
+/* its model and state arrays live in the world's (core.h: they grow with the particles'
+ * budget, world.c), its cache in the solver cache */
+static void distance_destroy(wb_world *w)
+{
+    wb_model *m = &w->m;
+    wb_state *s = &w->s;
+    wb_cache *k = &w->k;
+    void *p[] = { m->d_ij, m->d_alpha, m->d_beta, m->d_yield, m->d_creep, m->d_break, m->d_bforce, m->d_gen,
+                  m->d_free, s->d_rest, s->d_broken, k->colour_start, k->comp_start, k->s_a, k->s_b, k->s_rest,
+                  k->s_alpha, k->s_beta, k->s_lambda, k->s_jac, k->s_slot, k->slot_pack, k->breaks };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+}
+
+/* the live ones' state (rest lengths, broken flags) in slot order */
+static uint64_t distance_hash(const wb_world *w, uint64_t h)
+{
+    const wb_model *m = &w->m;
+    const wb_state *s = &w->s;
+    for (int32_t i = 0; i < m->nd; i++) {
+        if (!(m->d_gen[i] & 1u)) continue;
+        h = wb__fnv(h, &s->d_rest[i], sizeof s->d_rest[i]);
+        h = wb__fnv(h, &s->d_broken[i], 1);
+    }
+    return h;
+}
+
 const wb_ctype wb__distance_type = {
     .name = "distance",
     .count = distance_count,
@@ -755,4 +782,6 @@ const wb_ctype wb__distance_type = {
     .frame_end = distance_frame_end,
     .energy = distance_energy,
     .links = distance_links,
+    .destroy = distance_destroy,
+    .hash = distance_hash,
 };

@@ -261,16 +261,6 @@ static void sm_links(const wb_world *w, wb_link_fn fn, void *ud)
         for (int32_t i = sm->start[c] + 1; i < sm->start[c + 1]; i++) fn(ud, sm->ids[i - 1], sm->ids[i], 0);
 }
 
-const wb_ctype wb__shape_type = {
-    .name = "shape_match",
-    .count = sm_count,
-    .prepare = sm_prepare,
-    .substep_begin = sm_substep_begin,
-    .project = sm_project,
-    .frame_end = sm_frame_end,
-    .energy = sm_energy,
-    .links = sm_links,
-};
 
 /* ---- API ------------------------------------------------------------------------------------ */
 wb_shape_match_def wb_shape_match_default_def(void)
@@ -386,6 +376,8 @@ wb_real wb_shape_match_strain(const wb_world *w, int32_t s)
 }
 
 /* ---- snapshots -------------------------------------------------------------------------------- */
+static void sm_image_free(wb_image *g);
+
 wb_status wb_image_alloc_smatch(wb_image *g, int32_t n, int32_t nids)
 {
     wb_image_smatch *s = &g->sm;
@@ -399,14 +391,14 @@ wb_status wb_image_alloc_smatch(wb_image *g, int32_t n, int32_t nids)
     s->rest = calloc(3 * (size_t)(nids > 0 ? nids : 1), sizeof(wb_real));
     s->q = calloc(4 * (size_t)(n > 0 ? n : 1), sizeof(wb_real));
     if (!s->start || !s->ids || !s->stiff || !s->yield || !s->creep || !s->rest || !s->q) {
-        wb__smatch_image_free(g);
+        sm_image_free(g);
         return WB_ERR_NOMEM;
     }
     for (int32_t k = 0; k < n; k++) s->q[4 * k] = 1;
     return WB_OK;
 }
 
-void wb__smatch_image_free(wb_image *g)
+static void sm_image_free(wb_image *g)
 {
     wb_image_smatch *s = &g->sm;
     void *p[] = { s->start, s->ids, s->stiff, s->yield, s->creep, s->rest, s->q };
@@ -414,7 +406,7 @@ void wb__smatch_image_free(wb_image *g)
     memset(s, 0, sizeof *s);
 }
 
-wb_status wb__smatch_image_of(const wb_world *w, wb_image *g)
+static wb_status sm_image_save(const wb_world *w, wb_image *g)
 {
     const wb_smatch *sm = &w->sm;
     if (sm->n == 0) return WB_OK;
@@ -431,7 +423,7 @@ wb_status wb__smatch_image_of(const wb_world *w, wb_image *g)
     return WB_OK;
 }
 
-const char *wb__smatch_image_check(const wb_image *g)
+static const char *sm_image_check(const wb_image *g)
 {
     const wb_image_smatch *s = &g->sm;
     if (s->n < 0 || s->nids < 0 || s->n > WB_MAX_CONSTRAINTS || s->nids > WB_MAX_CONSTRAINTS) return "too many shape-matching clusters";
@@ -460,10 +452,15 @@ const char *wb__smatch_image_check(const wb_image *g)
     return e;
 }
 
-wb_status wb__smatch_reserve(wb_world *w, const wb_image *g) { return reserve(w, g->sm.n, g->sm.nids); }
-
-void wb__smatch_put(wb_world *w, const wb_image *g, int32_t pshift)
+static wb_status sm_image_reserve(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
+    (void)at;
+    return reserve(w, g->sm.n, g->sm.nids);
+}
+
+static void sm_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
+{
+    const int32_t pshift = at->pshift;
     wb_smatch *sm = &w->sm;
     const wb_image_smatch *s = &g->sm;
     for (int32_t k = 0; k < s->n; k++) {
@@ -479,3 +476,47 @@ void wb__smatch_put(wb_world *w, const wb_image *g, int32_t pshift)
     sm->n += s->n;
     sm->nids += s->nids;
 }
+
+/* ---- teardown and hash (ctype.h) --------------------------------------------------------- */
+static void sm_destroy(wb_world *w)
+{
+    wb_smatch *sm = &w->sm;
+    void *p[] = { sm->start, sm->stiff, sm->yield, sm->creep, sm->ids, sm->rest, sm->q, sm->qk, sm->lambda };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+}
+
+static size_t sm_charged(const wb_world *w) { return w->sm.charged; }
+
+/* parameters and state (rest shapes, rotations); a world without any adds nothing */
+static uint64_t sm_hash(const wb_world *w, uint64_t h)
+{
+    const wb_smatch *sm = &w->sm;
+    if (sm->n == 0) return h;
+    h = wb__fnv(h, &sm->n, sizeof sm->n);
+    h = wb__fnv(h, sm->start, sizeof(int32_t) * ((size_t)sm->n + 1));
+    h = wb__fnv(h, sm->ids, sizeof(int32_t) * (size_t)sm->nids);
+    h = wb__fnv(h, sm->stiff, sizeof(wb_real) * (size_t)sm->n);
+    h = wb__fnv(h, sm->yield, sizeof(wb_real) * (size_t)sm->n);
+    h = wb__fnv(h, sm->creep, sizeof(wb_real) * (size_t)sm->n);
+    h = wb__fnv(h, sm->rest, sizeof(wb_real) * 3 * (size_t)sm->nids);
+    return wb__fnv(h, sm->q, sizeof(wb_real) * 4 * (size_t)sm->n);
+}
+
+const wb_ctype wb__shape_type = {
+    .name = "shape_match",
+    .count = sm_count,
+    .prepare = sm_prepare,
+    .substep_begin = sm_substep_begin,
+    .project = sm_project,
+    .frame_end = sm_frame_end,
+    .energy = sm_energy,
+    .links = sm_links,
+    .destroy = sm_destroy,
+    .charged = sm_charged,
+    .hash = sm_hash,
+    .image_free = sm_image_free,
+    .image_save = sm_image_save,
+    .image_check = sm_image_check,
+    .image_reserve = sm_image_reserve,
+    .image_put = sm_image_put,
+};

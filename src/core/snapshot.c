@@ -11,7 +11,6 @@
 #include "ctype.h"
 #include "bvh.h"
 #include "snapshot.h"
-#include "volume.h"
 
 static int fin3(const wb_real *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
 
@@ -67,40 +66,8 @@ wb_status wb_image_alloc(wb_image *g, int32_t np, int32_t nd, int32_t nfree, int
     return WB_OK;
 }
 
-wb_status wb_image_alloc_volumes(wb_image *g, int32_t n)
-{
-    free(g->vol_ijkl);
-    free(g->vol_alpha);
-    free(g->vol_rest);
-    free(g->vol_plastic);
-    g->nvol = n;
-    g->vol_ijkl = zalloc(4 * (int64_t)n, sizeof *g->vol_ijkl);
-    g->vol_alpha = zalloc(n, sizeof *g->vol_alpha);
-    g->vol_rest = zalloc(n, sizeof *g->vol_rest);
-    g->vol_plastic = zalloc(2 * (int64_t)n, sizeof *g->vol_plastic);
-    if (g->vol_ijkl && g->vol_alpha && g->vol_rest && g->vol_plastic) return WB_OK;
-    free(g->vol_ijkl);
-    free(g->vol_alpha);
-    free(g->vol_rest);
-    free(g->vol_plastic);
-    g->vol_ijkl = NULL;
-    g->vol_alpha = g->vol_rest = g->vol_plastic = NULL;
-    g->nvol = 0;
-    return WB_ERR_NOMEM;
-}
-
 void wb_image_free(wb_image *g)
 {
-    free(g->tet_ijkl);
-    free(g->tet_dminv);
-    free(g->tet_v0);
-    free(g->tet_young);
-    free(g->tet_poisson);
-    free(g->tet_plastic);
-    free(g->vol_ijkl);
-    free(g->vol_alpha);
-    free(g->vol_rest);
-    free(g->vol_plastic);
     for (int32_t i = 0; g->c && i < g->nc; i++) {
         free(g->c[i].mv);
         free(g->c[i].mt);
@@ -111,10 +78,6 @@ void wb_image_free(wb_image *g)
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     for (int i = 0; i < wb__nctypes; i++)
         if (wb__ctypes[i]->image_free) wb__ctypes[i]->image_free(g);
-    wb__smatch_image_free(g);
-    wb__pressure_image_free(g);
-    wb__attach_image_free(g);
-    wb__grab_image_free(g);
     wb__rigid_image_free(g);
     memset(g, 0, sizeof *g);
 }
@@ -190,23 +153,7 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
     g->frame = s->frame;
     g->warnings = s->warnings;
     memcpy(g->last_warning, s->last_warning, sizeof g->last_warning);
-    const int32_t nvol = wb_volume_count(w);
-    if (wb_image_alloc_volumes(g, nvol) != WB_OK) {
-        wb_image_free(g);
-        return WB_ERR_NOMEM;
-    }
-    if (nvol) {
-        memcpy(g->vol_ijkl, w->vol->ijkl, 4 * (size_t)nvol * sizeof *g->vol_ijkl);
-        memcpy(g->vol_alpha, w->vol->alpha, (size_t)nvol * sizeof *g->vol_alpha);
-        memcpy(g->vol_rest, w->vol->rest, (size_t)nvol * sizeof *g->vol_rest);
-        for (int32_t i = 0; i < nvol; i++) {
-            g->vol_plastic[2 * i] = w->vol->yield[i];
-            g->vol_plastic[2 * i + 1] = w->vol->creep[i];
-        }
-    }
-    if ((st = wb__tet_image_of(w, g)) != WB_OK || (st = wb__smatch_image_of(w, g)) != WB_OK ||
-        (st = wb__pressure_image_of(w, g)) != WB_OK || (st = wb__attach_image_of(w, g)) != WB_OK ||
-        (st = wb__grab_image_of(w, g)) != WB_OK || (st = wb__rigid_image_of(w, g)) != WB_OK) {
+    if ((st = wb__rigid_image_of(w, g)) != WB_OK) {
         wb_image_free(g);
         return st;
     }
@@ -300,34 +247,9 @@ const char *wb_image_check(const wb_image *g)
     for (int64_t i = 0; i < 3 * (int64_t)g->ntri; i++)
         if (g->tri[i] < 0 || g->tri[i] >= g->np) return "surface corner out of range";
     if (!(g->time >= 0) || !isfinite(g->time) || g->frame < 0 || g->warnings < 0) return "time, frame and warnings must be finite and >= 0";
-    if (g->nvol < 0 || g->nvol > WB_MAX_CONSTRAINTS) return "too many volume constraints";
-    for (int32_t i = 0; i < g->nvol; i++) {
-        const int32_t *p = &g->vol_ijkl[4 * i];
-        for (int k = 0; k < 4; k++) {
-            if (p[k] < 0 || p[k] >= g->np) return "volume constraint particle out of range";
-            for (int j = 0; j < k; j++)
-                if (p[j] == p[k]) return "a volume constraint needs four distinct particles";
-        }
-        const wb_volume_def d = { g->vol_alpha[i], true, g->vol_rest[i], g->vol_plastic[2 * i], g->vol_plastic[2 * i + 1] };
-        if ((e = wb_volume_def_check(&d))) return e;
-    }
-    if ((e = wb__tet_image_check(g)) || (e = wb__smatch_image_check(g)) || (e = wb__pressure_image_check(g)) ||
-        (e = wb__attach_image_check(g)) || (e = wb__grab_image_check(g)))
-        return e;
     for (int i = 0; i < wb__nctypes; i++)
         if (wb__ctypes[i]->image_check && (e = wb__ctypes[i]->image_check(g))) return e;
     return wb__rigid_image_check(g);
-}
-
-/* the image's volume constraints after w's, particles shifted by `shift` (reserved) */
-static void put_volumes(wb_world *w, const wb_image *g, int32_t shift)
-{
-    for (int32_t i = 0; i < g->nvol; i++) {
-        int32_t p[4];
-        for (int k = 0; k < 4; k++) p[k] = g->vol_ijkl[4 * i + k] + shift;
-        wb__volume_put(w, p, g->vol_alpha[i], g->vol_rest[i]);
-        wb__volume_plastic(w, w->vol->n - 1, g->vol_plastic[2 * i], g->vol_plastic[2 * i + 1]);
-    }
 }
 
 /* every type's section of the image: room for it in w, then (nothing can fail) put */
@@ -448,12 +370,6 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     wb_status st = w && cms ? wb__reserve(w, g->np, g->nd) : WB_ERR_NOMEM;
     if (st == WB_OK) st = grow_colliders(w, g->nc);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
-    if (st == WB_OK && g->nvol > 0) st = wb__volume_reserve(w, g->nvol);
-    if (st == WB_OK) st = wb__tet_image_reserve(w, g);
-    if (st == WB_OK) st = wb__smatch_reserve(w, g);
-    if (st == WB_OK) st = wb__pressure_reserve(w, g);
-    if (st == WB_OK) st = wb__attach_image_reserve(w, g);
-    if (st == WB_OK) st = wb__grab_image_reserve(w, g);
     if (st == WB_OK) st = wb__rigid_reserve(w, g, 1);
     if (st == WB_OK) st = reserve_types(w, g, &at);
     if (st == WB_OK) st = build_meshes(w, g, cms);
@@ -508,13 +424,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     }
     free(cms);
     put_surfaces(w, g, 0);
-    put_volumes(w, g, 0);
-    wb__tet_image_put(w, g, 0);
-    wb__smatch_put(w, g, 0);
-    wb__pressure_put(w, g, 0);
-    wb__rigid_put(w, g, 1, NULL);
-    wb__attach_image_put(w, g, 0, NULL, NULL);
-    wb__grab_image_put(w, g, 0, NULL);
+    wb__rigid_put(w, g, 1, NULL); /* before the types: attachments and grabs name bodies */
     put_types(w, g, &at);
     s->time = g->time;
     s->frame = g->frame;
@@ -566,12 +476,6 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     wb_status st = wb__reserve(w, g->np, live_d);
     if (st == WB_OK) st = grow_colliders(w, m->nc + new_c);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
-    if (st == WB_OK && g->nvol > 0) st = wb__volume_reserve(w, g->nvol);
-    if (st == WB_OK) st = wb__tet_image_reserve(w, g);
-    if (st == WB_OK) st = wb__smatch_reserve(w, g);
-    if (st == WB_OK) st = wb__pressure_reserve(w, g);
-    if (st == WB_OK) st = wb__attach_image_reserve(w, g);
-    if (st == WB_OK) st = wb__grab_image_reserve(w, g);
     if (st == WB_OK) st = wb__rigid_reserve(w, g, 0);
     if (st == WB_OK) st = reserve_types(w, g, &at);
     if (st == WB_OK) st = build_meshes(w, g, cms);
@@ -581,7 +485,6 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
         free(rmap);
         return st;
     }
-    const int32_t first_surface = m->nsurf;
 
     const int32_t first = m->np;
     for (int32_t i = 0; i < g->np; i++) {
@@ -621,14 +524,8 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     }
     free(cms);
     put_surfaces(w, g, first);
-    put_volumes(w, g, first);
-    wb__tet_image_put(w, g, first);
-    wb__smatch_put(w, g, first);
-    wb__pressure_put(w, g, first_surface);
     /* the image's rigid bodies go to free or new slots: the attachments follow them */
     wb__rigid_put(w, g, 0, rmap);
-    wb__attach_image_put(w, g, first, cmap, rmap);
-    wb__grab_image_put(w, g, first, rmap);
     put_types(w, g, &at);
     free(rmap);
     free(cmap);

@@ -131,17 +131,12 @@ wb_status wb_image_alloc(wb_image *img, int32_t np, int32_t nd, int32_t nfree, i
 /* bend.c: the bend arrays for nb bends (zeroed), after wb_image_alloc; WB_ERR_NOMEM (the
  * section left empty) */
 wb_status wb_image_alloc_bends(wb_image *img, int32_t nb);
-/* the volume constraints' arrays for n of them (zeroed); WB_ERR_NOMEM */
+/* the volume constraints' arrays for n of them (zeroed; volume.c); WB_ERR_NOMEM */
 wb_status wb_image_alloc_volumes(wb_image *img, int32_t n);
 /* the Neo-Hookean tets' arrays for n of them (zeroed; tet.c); WB_ERR_NOMEM */
 wb_status wb_image_alloc_tets(wb_image *img, int32_t n);
-/* tet.c: copy w's tets into the image, check an image's, and add them after w's (reserved
- * by wb__tet_image_reserve), particles shifted by `shift` */
-wb_status wb__tet_image_of(const wb_world *w, wb_image *img);
-const char *wb__tet_image_check(const wb_image *img);
-wb_status wb__tet_image_reserve(wb_world *w, const wb_image *img);
-void wb__tet_image_put(wb_world *w, const wb_image *img, int32_t shift);
-/* the materials' sections (after wb_image_alloc; zeroed, rotations identity); WB_ERR_NOMEM */
+/* the materials' sections (after wb_image_alloc; zeroed, rotations identity; shape_match.c,
+ * pressure.c); WB_ERR_NOMEM */
 wb_status wb_image_alloc_smatch(wb_image *img, int32_t n, int32_t nids);
 wb_status wb_image_alloc_pressure(wb_image *img, int32_t n);
 void wb_image_free(wb_image *img);                     /* and zero it (mesh colliders' arrays too); fine on a zeroed image */
@@ -157,35 +152,10 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *img, wb_body *out);
 /* the collider w:collider{...} would make from a world-frame def, in its own frame + pose */
 wb_status wb_image_collider_from_def(const wb_collider_def *d, wb_image_collider *out);
 
-/* core-internal: each material type's part of the functions above (shape_match.c,
- * pressure.c). _of copies the world's; _check is the image's last line of defence (its
- * particle ids and surfaces already checked); _reserve makes room in w for the image's
- * (adding nothing); _put then adds them, particle ids shifted by pshift and surface
- * indices by sshift, and cannot fail */
-void wb__smatch_image_free(wb_image *g);
-wb_status wb__smatch_image_of(const wb_world *w, wb_image *g);
-const char *wb__smatch_image_check(const wb_image *g);
-wb_status wb__smatch_reserve(wb_world *w, const wb_image *g);
-void wb__smatch_put(wb_world *w, const wb_image *g, int32_t pshift);
-void wb__pressure_image_free(wb_image *g);
-wb_status wb__pressure_image_of(const wb_world *w, wb_image *g);
-const char *wb__pressure_image_check(const wb_image *g);
-wb_status wb__pressure_reserve(wb_world *w, const wb_image *g);
-void wb__pressure_put(wb_world *w, const wb_image *g, int32_t sshift);
-/* attach.c and grab.c, the same way; cmap and rmap map the image's collider and rigid slots to w's (NULL:
- * the same slots) */
+/* attach.c and grab.c, the same way. Each constraint type's part of the functions above
+ * (save, check, put) is its own, reached through its hooks (ctype.h) */
 wb_status wb_image_alloc_attach(wb_image *g, int32_t n);
 wb_status wb_image_alloc_grab(wb_image *g, int32_t n);
-void wb__attach_image_free(wb_image *g);
-wb_status wb__attach_image_of(const wb_world *w, wb_image *g);
-const char *wb__attach_image_check(const wb_image *g);
-wb_status wb__attach_image_reserve(wb_world *w, const wb_image *g);
-void wb__attach_image_put(wb_world *w, const wb_image *g, int32_t pshift, const int32_t *cmap, const int32_t *rmap);
-void wb__grab_image_free(wb_image *g);
-wb_status wb__grab_image_of(const wb_world *w, wb_image *g);
-const char *wb__grab_image_check(const wb_image *g);
-wb_status wb__grab_image_reserve(wb_world *w, const wb_image *g);
-void wb__grab_image_put(wb_world *w, const wb_image *g, int32_t pshift, const int32_t *rmap);
 
 /* rigid bodies (rigid_image.c): n slots, zeroed, generations 1 (live); WB_ERR_NOMEM */
 wb_status wb_image_alloc_rigids(wb_image *img, int32_t n);

@@ -274,6 +274,15 @@ void wb_tet_material(const wb_world *w, int32_t i, wb_real *young, wb_real *pois
 }
 
 /* ---- snapshots (snapshot.h): the model as it is, so a restored world has the same future */
+static void tet_image_free(wb_image *g)
+{
+    void *a[] = { g->tet_ijkl, g->tet_dminv, g->tet_v0, g->tet_young, g->tet_poisson, g->tet_plastic };
+    for (size_t k = 0; k < sizeof a / sizeof a[0]; k++) free(a[k]);
+    g->tet_ijkl = NULL;
+    g->tet_dminv = g->tet_v0 = g->tet_young = g->tet_poisson = g->tet_plastic = NULL;
+    g->ntet = 0;
+}
+
 wb_status wb_image_alloc_tets(wb_image *g, int32_t n)
 {
     void **a[] = { (void **)&g->tet_ijkl, (void **)&g->tet_dminv, (void **)&g->tet_v0, (void **)&g->tet_young,
@@ -293,7 +302,7 @@ wb_status wb_image_alloc_tets(wb_image *g, int32_t n)
     return WB_ERR_NOMEM;
 }
 
-wb_status wb__tet_image_of(const wb_world *w, wb_image *g)
+static wb_status tet_image_save(const wb_world *w, wb_image *g)
 {
     const int32_t n = wb_tet_count(w);
     if (wb_image_alloc_tets(g, n) != WB_OK) return WB_ERR_NOMEM;
@@ -311,7 +320,7 @@ wb_status wb__tet_image_of(const wb_world *w, wb_image *g)
     return WB_OK;
 }
 
-const char *wb__tet_image_check(const wb_image *g)
+static const char *tet_image_check(const wb_image *g)
 {
     if (g->ntet < 0 || g->ntet > WB_MAX_CONSTRAINTS) return "too many tets";
     for (int32_t i = 0; i < g->ntet; i++) {
@@ -337,13 +346,15 @@ const char *wb__tet_image_check(const wb_image *g)
     return NULL;
 }
 
-wb_status wb__tet_image_reserve(wb_world *w, const wb_image *g)
+static wb_status tet_image_reserve(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
+    (void)at;
     return g->ntet > 0 ? wb__tet_reserve(w, g->ntet) : WB_OK;
 }
 
-void wb__tet_image_put(wb_world *w, const wb_image *g, int32_t shift)
+static void tet_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
+    const int32_t shift = at->pshift;
     for (int32_t i = 0; i < g->ntet; i++) {
         int32_t p[4];
         for (int k = 0; k < 4; k++) p[k] = g->tet_ijkl[4 * i + k] + shift;
@@ -857,6 +868,31 @@ static void tet_links(const wb_world *w, wb_link_fn fn, void *ud)
     if (w->neo) wb__link_quads(w->neo->ijkl, w->neo->n, fn, ud);
 }
 
+/* ---- teardown and hash (ctype.h) --------------------------------------------------------- */
+static void tet_destroy(wb_world *w)
+{
+    wb_neos *v = w->neo;
+    if (!v) return;
+    void *a[] = { v->ijkl, v->dminv, v->v0, v->young, v->poisson, v->mu, v->lam, v->ld, v->lh, v->order, v->pk, v->pd,
+                  v->yield, v->creep };
+    for (size_t i = 0; i < sizeof a / sizeof a[0]; i++) free(a[i]);
+    free(v);
+    w->neo = NULL;
+}
+
+static size_t tet_charged(const wb_world *w) { return w->neo ? w->neo->charged : 0; }
+
+/* plastic tets' rest state flows (state), and how; elastic ones add nothing */
+static uint64_t tet_hash(const wb_world *w, uint64_t h)
+{
+    const wb_neos *ne = w->neo;
+    if (!ne || !ne->plastic) return h;
+    h = wb__fnv(h, ne->dminv, sizeof(wb_real) * 9 * (size_t)ne->n);
+    h = wb__fnv(h, ne->v0, sizeof(wb_real) * (size_t)ne->n);
+    h = wb__fnv(h, ne->yield, sizeof(wb_real) * (size_t)ne->n);
+    return wb__fnv(h, ne->creep, sizeof(wb_real) * (size_t)ne->n);
+}
+
 const wb_ctype wb__tet_type = {
     .name = "tet",
     .count = tet_count,
@@ -866,4 +902,12 @@ const wb_ctype wb__tet_type = {
     .frame_end = tet_frame_end,
     .energy = tet_energy,
     .links = tet_links,
+    .destroy = tet_destroy,
+    .charged = tet_charged,
+    .hash = tet_hash,
+    .image_free = tet_image_free,
+    .image_save = tet_image_save,
+    .image_check = tet_image_check,
+    .image_reserve = tet_image_reserve,
+    .image_put = tet_image_put,
 };

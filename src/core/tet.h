@@ -43,17 +43,4 @@ bool wb__tet_put_current(wb_world *w, const int32_t p[4], wb_real young, wb_real
  * its links' options */
 void wb__tet_plastic(wb_world *w, int32_t first, wb_real yield, wb_real creep);
 
-/* world.c's destroy (inline so that world.c and tet.c do not call each other) */
-static inline void wb__tet_free(wb_world *w)
-{
-    wb_neos *v = w->neo;
-    if (!v) return;
-    if (w->m.def.memory) w->m.def.memory->used -= v->charged;
-    void *a[] = { v->ijkl, v->dminv, v->v0, v->young, v->poisson, v->mu, v->lam, v->ld, v->lh, v->order, v->pk, v->pd,
-                  v->yield, v->creep };
-    for (size_t i = 0; i < sizeof a / sizeof a[0]; i++) free(a[i]);
-    free(v);
-    w->neo = NULL;
-}
-
 #endif

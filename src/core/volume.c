@@ -19,6 +19,7 @@
 #include "core.h"
 #include "ctype.h"
 #include "volume.h"
+#include "snapshot.h"
 
 
 #define VOLUME_BYTES (10 * sizeof(int32_t) + 7 * sizeof(wb_real))
@@ -281,6 +282,106 @@ static void vol_links(const wb_world *w, wb_link_fn fn, void *ud)
     if (w->vol) wb__link_quads(w->vol->ijkl, w->vol->n, fn, ud);
 }
 
+/* ---- teardown, hash, snapshots (ctype.h) -------------------------------------------------- */
+static void vol_destroy(wb_world *w)
+{
+    wb_volumes *v = w->vol;
+    if (!v) return;
+    void *p[] = { v->ijkl, v->alpha, v->rest, v->yield, v->creep, v->lambda, v->order, v->pos, v->pk, v->pa };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    free(v);
+    w->vol = NULL;
+}
+
+static size_t vol_charged(const wb_world *w) { return w->vol ? w->vol->charged : 0; }
+
+/* plastic ones' rest volumes flow (state), and how; elastic ones add nothing */
+static uint64_t vol_hash(const wb_world *w, uint64_t h)
+{
+    const wb_volumes *vo = w->vol;
+    if (!vo || !vo->plastic) return h;
+    h = wb__fnv(h, vo->rest, sizeof(wb_real) * (size_t)vo->n);
+    h = wb__fnv(h, vo->yield, sizeof(wb_real) * (size_t)vo->n);
+    return wb__fnv(h, vo->creep, sizeof(wb_real) * (size_t)vo->n);
+}
+
+static void vol_image_free(wb_image *g)
+{
+    free(g->vol_ijkl);
+    free(g->vol_alpha);
+    free(g->vol_rest);
+    free(g->vol_plastic);
+    g->vol_ijkl = NULL;
+    g->vol_alpha = g->vol_rest = g->vol_plastic = NULL;
+    g->nvol = 0;
+}
+
+/* calloc of n elements, never of 0 bytes (so NULL always means out of memory) */
+static void *zalloc(int64_t n, size_t elem) { return calloc((size_t)(n > 0 ? n : 1), elem); }
+
+wb_status wb_image_alloc_volumes(wb_image *g, int32_t n)
+{
+    vol_image_free(g);
+    g->nvol = n;
+    g->vol_ijkl = zalloc(4 * (int64_t)n, sizeof *g->vol_ijkl);
+    g->vol_alpha = zalloc(n, sizeof *g->vol_alpha);
+    g->vol_rest = zalloc(n, sizeof *g->vol_rest);
+    g->vol_plastic = zalloc(2 * (int64_t)n, sizeof *g->vol_plastic);
+    if (g->vol_ijkl && g->vol_alpha && g->vol_rest && g->vol_plastic) return WB_OK;
+    vol_image_free(g);
+    return WB_ERR_NOMEM;
+}
+
+static wb_status vol_image_save(const wb_world *w, wb_image *g)
+{
+    const int32_t n = wb_volume_count(w);
+    if (wb_image_alloc_volumes(g, n) != WB_OK) return WB_ERR_NOMEM;
+    if (n == 0) return WB_OK;
+    const wb_volumes *v = w->vol;
+    memcpy(g->vol_ijkl, v->ijkl, 4 * (size_t)n * sizeof *g->vol_ijkl);
+    memcpy(g->vol_alpha, v->alpha, (size_t)n * sizeof *g->vol_alpha);
+    memcpy(g->vol_rest, v->rest, (size_t)n * sizeof *g->vol_rest);
+    for (int32_t i = 0; i < n; i++) {
+        g->vol_plastic[2 * i] = v->yield[i];
+        g->vol_plastic[2 * i + 1] = v->creep[i];
+    }
+    return WB_OK;
+}
+
+static const char *vol_image_check(const wb_image *g)
+{
+    if (g->nvol < 0 || g->nvol > WB_MAX_CONSTRAINTS) return "too many volume constraints";
+    for (int32_t i = 0; i < g->nvol; i++) {
+        const int32_t *p = &g->vol_ijkl[4 * i];
+        for (int k = 0; k < 4; k++) {
+            if (p[k] < 0 || p[k] >= g->np) return "volume constraint particle out of range";
+            for (int j = 0; j < k; j++)
+                if (p[j] == p[k]) return "a volume constraint needs four distinct particles";
+        }
+        const wb_volume_def d = { g->vol_alpha[i], true, g->vol_rest[i], g->vol_plastic[2 * i], g->vol_plastic[2 * i + 1] };
+        const char *e = wb_volume_def_check(&d);
+        if (e) return e;
+    }
+    return NULL;
+}
+
+static wb_status vol_image_reserve(wb_world *w, const wb_image *g, const wb_image_at *at)
+{
+    (void)at;
+    return g->nvol > 0 ? wb__volume_reserve(w, g->nvol) : WB_OK;
+}
+
+/* after w's, particles shifted (reserved: cannot fail) */
+static void vol_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
+{
+    for (int32_t i = 0; i < g->nvol; i++) {
+        int32_t p[4];
+        for (int k = 0; k < 4; k++) p[k] = g->vol_ijkl[4 * i + k] + at->pshift;
+        wb__volume_put(w, p, g->vol_alpha[i], g->vol_rest[i]);
+        wb__volume_plastic(w, w->vol->n - 1, g->vol_plastic[2 * i], g->vol_plastic[2 * i + 1]);
+    }
+}
+
 const wb_ctype wb__volume_type = {
     .name = "volume",
     .count = vol_count,
@@ -290,4 +391,12 @@ const wb_ctype wb__volume_type = {
     .frame_end = vol_frame_end,
     .energy = vol_energy,
     .links = vol_links,
+    .destroy = vol_destroy,
+    .charged = vol_charged,
+    .hash = vol_hash,
+    .image_free = vol_image_free,
+    .image_save = vol_image_save,
+    .image_check = vol_image_check,
+    .image_reserve = vol_image_reserve,
+    .image_put = vol_image_put,
 };

@@ -35,25 +35,4 @@ void wb__volume_plastic(wb_world *w, int32_t first, wb_real yield, wb_real creep
 void wb__kuhn_tets(wb_world *w, int32_t base, int32_t sx, int32_t sy, int32_t sz, wb_real alpha,
                    wb_real young, wb_real poisson);
 
-/* world.c's destroy: the arrays freed and the budget given back (inline, so that world.c
- * and volume.c do not call each other) */
-static inline void wb__volume_free(wb_world *w)
-{
-    wb_volumes *v = w->vol;
-    if (!v) return;
-    if (w->m.def.memory) w->m.def.memory->used -= v->charged;
-    free(v->ijkl);
-    free(v->alpha);
-    free(v->rest);
-    free(v->yield);
-    free(v->creep);
-    free(v->lambda);
-    free(v->order);
-    free(v->pos);
-    free(v->pk);
-    free(v->pa);
-    free(v);
-    w->vol = NULL;
-}
-
 #endif
