@@ -6,7 +6,11 @@
 #define WB_SNAPSHOT_H
 
 #include "wobble.h"
+/* the constraint types' own sections of an image, declared by their owners */
 #include "bend.h"
+#include "shape_match.h"
+#include "tet.h"
+#include "volume.h"
 
 /* a collider: its shape in its own frame and its full pose */
 typedef struct wb_image_collider {
@@ -23,23 +27,6 @@ typedef struct wb_image_collider {
     wb_real *mv;           /* mesh: (mnv x 3) vertices in the collider frame (malloc'd, the image owns it) */
     int32_t *mt;           /* mesh: (mnt x 3) corners (malloc'd, the image owns it) */
 } wb_image_collider;
-
-/* shape-matching clusters (shape_match.c): model and state by cluster */
-typedef struct wb_image_smatch {
-    int32_t n, nids;
-    int32_t *start;        /* (n + 1) ranges into ids */
-    int32_t *ids;          /* (nids) particles */
-    wb_real *stiff, *yield, *creep; /* (n) */
-    wb_real *rest;         /* (nids x 3) rest shape about its mass centre */
-    wb_real *q;            /* (n x 4) rotation at the end of the last frame */
-} wb_image_smatch;
-
-/* pressure constraints (pressure.c): each over one of the image's surfaces */
-typedef struct wb_image_pressure {
-    int32_t n;
-    int32_t *surface;      /* (n) */
-    wb_real *pressure, *alpha, *v0; /* (n) factor, compliance, rest volume */
-} wb_image_pressure;
 
 /* attachments (attach.c) and grabs (grab.c): the live ones, in slot order */
 typedef struct wb_image_attach {
@@ -105,19 +92,10 @@ typedef struct wb_image {
     int64_t frame, warnings;
     char last_warning[160];
 
-    /* volume constraints (volume.c), in creation order: allocated by wb_image_alloc_volumes */
-    int32_t nvol;
-    int32_t *vol_ijkl;     /* (nvol x 4) */
-    wb_real *vol_alpha, *vol_rest; /* (nvol) compliance, signed rest volume */
-    wb_real *vol_plastic;  /* (nvol x 2) yield, creep (0: none) */
-    /* Neo-Hookean tets (tet.c), in creation order: allocated by wb_image_alloc_tets */
-    int32_t ntet;
-    int32_t *tet_ijkl;     /* (ntet x 4) */
-    wb_real *tet_dminv;    /* (ntet x 9) rest edge matrix inverse, row-major */
-    wb_real *tet_v0, *tet_young, *tet_poisson; /* (ntet) rest volume (> 0), E, nu */
-    wb_real *tet_plastic;  /* (ntet x 2) yield, creep (0: none) */
-    wb_image_smatch sm;    /* empty unless wb_image_alloc_smatch */
-    wb_image_pressure pr;  /* empty unless wb_image_alloc_pressure */
+    wb_image_volume vol;   /* volume.h: empty unless wb_image_alloc_volumes */
+    wb_image_tet tet;      /* tet.h: empty unless wb_image_alloc_tets */
+    wb_image_smatch sm;    /* shape_match.h: empty unless wb_image_alloc_smatch */
+    wb_image_pressure pr;  /* shape_match.h: empty unless wb_image_alloc_pressure */
     wb_image_attach att;   /* empty unless wb_image_alloc_attach */
     wb_image_grab grab;    /* empty unless wb_image_alloc_grab */
     int32_t nrb;           /* rigid bodies by slot: empty unless wb_image_alloc_rigids */

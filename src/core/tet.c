@@ -276,29 +276,27 @@ void wb_tet_material(const wb_world *w, int32_t i, wb_real *young, wb_real *pois
 /* ---- snapshots (snapshot.h): the model as it is, so a restored world has the same future */
 static void tet_image_free(wb_image *g)
 {
-    void *a[] = { g->tet_ijkl, g->tet_dminv, g->tet_v0, g->tet_young, g->tet_poisson, g->tet_plastic };
-    for (size_t k = 0; k < sizeof a / sizeof a[0]; k++) free(a[k]);
-    g->tet_ijkl = NULL;
-    g->tet_dminv = g->tet_v0 = g->tet_young = g->tet_poisson = g->tet_plastic = NULL;
-    g->ntet = 0;
+    wb_image_tet *t = &g->tet;
+    free(t->ijkl); free(t->dminv); free(t->v0); free(t->young); free(t->poisson); free(t->plastic);
+    memset(t, 0, sizeof *t);
 }
+
+/* calloc of n elements, never of 0 bytes (so NULL always means out of memory) */
+static void *zalloc(int64_t n, size_t elem) { return calloc((size_t)(n > 0 ? n : 1), elem); }
 
 wb_status wb_image_alloc_tets(wb_image *g, int32_t n)
 {
-    void **a[] = { (void **)&g->tet_ijkl, (void **)&g->tet_dminv, (void **)&g->tet_v0, (void **)&g->tet_young,
-                   (void **)&g->tet_poisson, (void **)&g->tet_plastic };
-    const size_t el[] = { 4 * sizeof(int32_t), 9 * sizeof(wb_real), sizeof(wb_real), sizeof(wb_real), sizeof(wb_real),
-                          2 * sizeof(wb_real) };
-    bool ok = true;
-    for (int k = 0; k < 6; k++) {
-        free(*a[k]);
-        *a[k] = calloc(n > 0 ? (size_t)n : 1, el[k]);
-        ok = ok && *a[k];
-    }
-    g->ntet = n;
-    if (ok) return WB_OK;
-    for (int k = 0; k < 6; k++) { free(*a[k]); *a[k] = NULL; }
-    g->ntet = 0;
+    tet_image_free(g);
+    wb_image_tet *t = &g->tet;
+    t->n = n;
+    t->ijkl = zalloc(4 * (int64_t)n, sizeof *t->ijkl);
+    t->dminv = zalloc(9 * (int64_t)n, sizeof *t->dminv);
+    t->v0 = zalloc(n, sizeof *t->v0);
+    t->young = zalloc(n, sizeof *t->young);
+    t->poisson = zalloc(n, sizeof *t->poisson);
+    t->plastic = zalloc(2 * (int64_t)n, sizeof *t->plastic);
+    if (t->ijkl && t->dminv && t->v0 && t->young && t->poisson && t->plastic) return WB_OK;
+    tet_image_free(g);
     return WB_ERR_NOMEM;
 }
 
@@ -308,39 +306,39 @@ static wb_status tet_image_save(const wb_world *w, wb_image *g)
     if (wb_image_alloc_tets(g, n) != WB_OK) return WB_ERR_NOMEM;
     if (n == 0) return WB_OK;
     const wb_neos *v = w->neo;
-    memcpy(g->tet_ijkl, v->ijkl, 4 * sizeof(int32_t) * (size_t)n);
-    memcpy(g->tet_dminv, v->dminv, 9 * sizeof(wb_real) * (size_t)n);
-    memcpy(g->tet_v0, v->v0, sizeof(wb_real) * (size_t)n);
-    memcpy(g->tet_young, v->young, sizeof(wb_real) * (size_t)n);
-    memcpy(g->tet_poisson, v->poisson, sizeof(wb_real) * (size_t)n);
+    memcpy(g->tet.ijkl, v->ijkl, 4 * sizeof(int32_t) * (size_t)n);
+    memcpy(g->tet.dminv, v->dminv, 9 * sizeof(wb_real) * (size_t)n);
+    memcpy(g->tet.v0, v->v0, sizeof(wb_real) * (size_t)n);
+    memcpy(g->tet.young, v->young, sizeof(wb_real) * (size_t)n);
+    memcpy(g->tet.poisson, v->poisson, sizeof(wb_real) * (size_t)n);
     for (int32_t i = 0; i < n; i++) {
-        g->tet_plastic[2 * i] = v->yield[i];
-        g->tet_plastic[2 * i + 1] = v->creep[i];
+        g->tet.plastic[2 * i] = v->yield[i];
+        g->tet.plastic[2 * i + 1] = v->creep[i];
     }
     return WB_OK;
 }
 
 static const char *tet_image_check(const wb_image *g)
 {
-    if (g->ntet < 0 || g->ntet > WB_MAX_CONSTRAINTS) return "too many tets";
-    for (int32_t i = 0; i < g->ntet; i++) {
-        const int32_t *p = &g->tet_ijkl[4 * i];
+    if (g->tet.n < 0 || g->tet.n > WB_MAX_CONSTRAINTS) return "too many tets";
+    for (int32_t i = 0; i < g->tet.n; i++) {
+        const int32_t *p = &g->tet.ijkl[4 * i];
         for (int k = 0; k < 4; k++) {
             if (p[k] < 0 || p[k] >= g->np) return "tet particle out of range";
             for (int j = 0; j < k; j++)
                 if (p[j] == p[k]) return "a tet needs four distinct particles";
         }
-        const wb_tet_def d = { g->tet_young[i], g->tet_poisson[i], g->tet_plastic[2 * i], g->tet_plastic[2 * i + 1] };
+        const wb_tet_def d = { g->tet.young[i], g->tet.poisson[i], g->tet.plastic[2 * i], g->tet.plastic[2 * i + 1] };
         const char *e = wb_tet_def_check(&d);
         if (e) return e;
-        if (!(g->tet_v0[i] > 0) || !isfinite(g->tet_v0[i])) return "a tet's rest volume must be > 0";
-        const wb_real *dm = &g->tet_dminv[9 * i];
+        if (!(g->tet.v0[i] > 0) || !isfinite(g->tet.v0[i])) return "a tet's rest volume must be > 0";
+        const wb_real *dm = &g->tet.dminv[9 * i];
         for (int k = 0; k < 9; k++)
             if (!isfinite(dm[k]) || fabs(dm[k]) > 1e150) return "a tet's rest shape must be finite";
         /* Dm^-1 and V0 describe one rest tet (V0 = 1 / (6 |det Dm^-1|)); a singular or
          * mismatched pair from a hand-edited file would make F and the energy NaN */
         const wb_real det = det3(dm);
-        if (!(fabs(6 * g->tet_v0[i] * det - 1) <= 1e-6) && !(fabs(6 * g->tet_v0[i] * det + 1) <= 1e-6))
+        if (!(fabs(6 * g->tet.v0[i] * det - 1) <= 1e-6) && !(fabs(6 * g->tet.v0[i] * det + 1) <= 1e-6))
             return "a tet's rest_inverse and rest_volume disagree (V0 = 1 / (6 |det|))";
     }
     return NULL;
@@ -349,17 +347,17 @@ static const char *tet_image_check(const wb_image *g)
 static wb_status tet_image_reserve(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
     (void)at;
-    return g->ntet > 0 ? wb__tet_reserve(w, g->ntet) : WB_OK;
+    return g->tet.n > 0 ? wb__tet_reserve(w, g->tet.n) : WB_OK;
 }
 
 static void tet_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
     const int32_t shift = at->pshift;
-    for (int32_t i = 0; i < g->ntet; i++) {
+    for (int32_t i = 0; i < g->tet.n; i++) {
         int32_t p[4];
-        for (int k = 0; k < 4; k++) p[k] = g->tet_ijkl[4 * i + k] + shift;
-        wb__tet_put(w, p, &g->tet_dminv[9 * i], g->tet_v0[i], g->tet_young[i], g->tet_poisson[i]);
-        wb__tet_plastic(w, w->neo->n - 1, g->tet_plastic[2 * i], g->tet_plastic[2 * i + 1]);
+        for (int k = 0; k < 4; k++) p[k] = g->tet.ijkl[4 * i + k] + shift;
+        wb__tet_put(w, p, &g->tet.dminv[9 * i], g->tet.v0[i], g->tet.young[i], g->tet.poisson[i]);
+        wb__tet_plastic(w, w->neo->n - 1, g->tet.plastic[2 * i], g->tet.plastic[2 * i + 1]);
     }
 }
 

@@ -33,6 +33,15 @@ typedef struct wb_neos {
     int inverted_warned;   /* the inverted-tets warning was given */
 } wb_neos;
 
+/* a snapshot image's Neo-Hookean tets (snapshot.h), in creation order */
+typedef struct wb_image_tet {
+    int32_t n;
+    int32_t *ijkl;         /* (n x 4) */
+    wb_real *dminv;        /* (n x 9) rest edge matrix inverse, row-major */
+    wb_real *v0, *young, *poisson; /* (n) rest volume (> 0), E, nu */
+    wb_real *plastic;      /* (n x 2) yield, creep (0: none) */
+} wb_image_tet;
+
 /* room for `extra` more, charged to the memory budget; after it wb__tet_put cannot fail */
 wb_status wb__tet_reserve(wb_world *w, int64_t extra);
 /* append one with its rest state (dminv row-major, v0 > 0) */

@@ -307,13 +307,9 @@ static uint64_t vol_hash(const wb_world *w, uint64_t h)
 
 static void vol_image_free(wb_image *g)
 {
-    free(g->vol_ijkl);
-    free(g->vol_alpha);
-    free(g->vol_rest);
-    free(g->vol_plastic);
-    g->vol_ijkl = NULL;
-    g->vol_alpha = g->vol_rest = g->vol_plastic = NULL;
-    g->nvol = 0;
+    wb_image_volume *v = &g->vol;
+    free(v->ijkl); free(v->alpha); free(v->rest); free(v->plastic);
+    memset(v, 0, sizeof *v);
 }
 
 /* calloc of n elements, never of 0 bytes (so NULL always means out of memory) */
@@ -322,12 +318,13 @@ static void *zalloc(int64_t n, size_t elem) { return calloc((size_t)(n > 0 ? n :
 wb_status wb_image_alloc_volumes(wb_image *g, int32_t n)
 {
     vol_image_free(g);
-    g->nvol = n;
-    g->vol_ijkl = zalloc(4 * (int64_t)n, sizeof *g->vol_ijkl);
-    g->vol_alpha = zalloc(n, sizeof *g->vol_alpha);
-    g->vol_rest = zalloc(n, sizeof *g->vol_rest);
-    g->vol_plastic = zalloc(2 * (int64_t)n, sizeof *g->vol_plastic);
-    if (g->vol_ijkl && g->vol_alpha && g->vol_rest && g->vol_plastic) return WB_OK;
+    wb_image_volume *v = &g->vol;
+    v->n = n;
+    v->ijkl = zalloc(4 * (int64_t)n, sizeof *v->ijkl);
+    v->alpha = zalloc(n, sizeof *v->alpha);
+    v->rest = zalloc(n, sizeof *v->rest);
+    v->plastic = zalloc(2 * (int64_t)n, sizeof *v->plastic);
+    if (v->ijkl && v->alpha && v->rest && v->plastic) return WB_OK;
     vol_image_free(g);
     return WB_ERR_NOMEM;
 }
@@ -338,27 +335,27 @@ static wb_status vol_image_save(const wb_world *w, wb_image *g)
     if (wb_image_alloc_volumes(g, n) != WB_OK) return WB_ERR_NOMEM;
     if (n == 0) return WB_OK;
     const wb_volumes *v = w->vol;
-    memcpy(g->vol_ijkl, v->ijkl, 4 * (size_t)n * sizeof *g->vol_ijkl);
-    memcpy(g->vol_alpha, v->alpha, (size_t)n * sizeof *g->vol_alpha);
-    memcpy(g->vol_rest, v->rest, (size_t)n * sizeof *g->vol_rest);
+    memcpy(g->vol.ijkl, v->ijkl, 4 * (size_t)n * sizeof *g->vol.ijkl);
+    memcpy(g->vol.alpha, v->alpha, (size_t)n * sizeof *g->vol.alpha);
+    memcpy(g->vol.rest, v->rest, (size_t)n * sizeof *g->vol.rest);
     for (int32_t i = 0; i < n; i++) {
-        g->vol_plastic[2 * i] = v->yield[i];
-        g->vol_plastic[2 * i + 1] = v->creep[i];
+        g->vol.plastic[2 * i] = v->yield[i];
+        g->vol.plastic[2 * i + 1] = v->creep[i];
     }
     return WB_OK;
 }
 
 static const char *vol_image_check(const wb_image *g)
 {
-    if (g->nvol < 0 || g->nvol > WB_MAX_CONSTRAINTS) return "too many volume constraints";
-    for (int32_t i = 0; i < g->nvol; i++) {
-        const int32_t *p = &g->vol_ijkl[4 * i];
+    if (g->vol.n < 0 || g->vol.n > WB_MAX_CONSTRAINTS) return "too many volume constraints";
+    for (int32_t i = 0; i < g->vol.n; i++) {
+        const int32_t *p = &g->vol.ijkl[4 * i];
         for (int k = 0; k < 4; k++) {
             if (p[k] < 0 || p[k] >= g->np) return "volume constraint particle out of range";
             for (int j = 0; j < k; j++)
                 if (p[j] == p[k]) return "a volume constraint needs four distinct particles";
         }
-        const wb_volume_def d = { g->vol_alpha[i], true, g->vol_rest[i], g->vol_plastic[2 * i], g->vol_plastic[2 * i + 1] };
+        const wb_volume_def d = { g->vol.alpha[i], true, g->vol.rest[i], g->vol.plastic[2 * i], g->vol.plastic[2 * i + 1] };
         const char *e = wb_volume_def_check(&d);
         if (e) return e;
     }
@@ -368,17 +365,17 @@ static const char *vol_image_check(const wb_image *g)
 static wb_status vol_image_reserve(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
     (void)at;
-    return g->nvol > 0 ? wb__volume_reserve(w, g->nvol) : WB_OK;
+    return g->vol.n > 0 ? wb__volume_reserve(w, g->vol.n) : WB_OK;
 }
 
 /* after w's, particles shifted (reserved: cannot fail) */
 static void vol_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
-    for (int32_t i = 0; i < g->nvol; i++) {
+    for (int32_t i = 0; i < g->vol.n; i++) {
         int32_t p[4];
-        for (int k = 0; k < 4; k++) p[k] = g->vol_ijkl[4 * i + k] + at->pshift;
-        wb__volume_put(w, p, g->vol_alpha[i], g->vol_rest[i]);
-        wb__volume_plastic(w, w->vol->n - 1, g->vol_plastic[2 * i], g->vol_plastic[2 * i + 1]);
+        for (int k = 0; k < 4; k++) p[k] = g->vol.ijkl[4 * i + k] + at->pshift;
+        wb__volume_put(w, p, g->vol.alpha[i], g->vol.rest[i]);
+        wb__volume_plastic(w, w->vol->n - 1, g->vol.plastic[2 * i], g->vol.plastic[2 * i + 1]);
     }
 }
 

@@ -24,6 +24,14 @@ typedef struct wb_volumes {
     size_t charged;        /* bytes charged to def.memory */
 } wb_volumes;
 
+/* a snapshot image's volume constraints (snapshot.h), in creation order */
+typedef struct wb_image_volume {
+    int32_t n;
+    int32_t *ijkl;         /* (n x 4) */
+    wb_real *alpha, *rest; /* (n) compliance, signed rest volume */
+    wb_real *plastic;      /* (n x 2) yield, creep (0: none) */
+} wb_image_volume;
+
 /* room for `extra` more, charged to the memory budget; after it wb__volume_put cannot fail */
 wb_status wb__volume_reserve(wb_world *w, int64_t extra);
 void wb__volume_put(wb_world *w, const int32_t p[4], wb_real alpha, wb_real rest);

@@ -385,7 +385,7 @@ static int read_volumes(rd *r, const cJSON *arr, const defaults *d, wb_image *g)
         int32_t n;
         if (jv_get_array(r, f[0], &pp, 16, &n)) return -1;
         if (n != 4) return jv_fail(r, f[0], 0, &pp, "a volume constraint joins 4 particles, got %d", n);
-        int32_t *ijkl = &g->vol_ijkl[4 * i];
+        int32_t *ijkl = &g->vol.ijkl[4 * i];
         int k = 0;
         for (const cJSON *e = f[0]->child; e; e = e->next, k++) {
             kp q = { &pp, NULL, k };
@@ -397,14 +397,14 @@ static int read_volumes(rd *r, const cJSON *arr, const defaults *d, wb_image *g)
                 if (ijkl[j] == ijkl[k]) return jv_fail(r, f[0], 0, &pp, "a volume constraint needs four distinct particles");
         }
         const wb_real *x = g->x;
-        g->vol_rest[i] = wb_tet_signed_volume(&x[3 * ijkl[0]], &x[3 * ijkl[1]], &x[3 * ijkl[2]], &x[3 * ijkl[3]]);
-        g->vol_alpha[i] = 0;
-        g->vol_plastic[2 * i] = g->vol_plastic[2 * i + 1] = 0;
-        if (jv_opt_real(r, f[1], &p, "rest", &g->vol_rest[i]) || jv_opt_nonneg(r, f[2], &p, "compliance", &g->vol_alpha[i]) ||
-            jv_opt_nonneg(r, f[3], &p, "yield", &g->vol_plastic[2 * i]) ||
-            jv_opt_nonneg(r, f[4], &p, "creep", &g->vol_plastic[2 * i + 1]))
+        g->vol.rest[i] = wb_tet_signed_volume(&x[3 * ijkl[0]], &x[3 * ijkl[1]], &x[3 * ijkl[2]], &x[3 * ijkl[3]]);
+        g->vol.alpha[i] = 0;
+        g->vol.plastic[2 * i] = g->vol.plastic[2 * i + 1] = 0;
+        if (jv_opt_real(r, f[1], &p, "rest", &g->vol.rest[i]) || jv_opt_nonneg(r, f[2], &p, "compliance", &g->vol.alpha[i]) ||
+            jv_opt_nonneg(r, f[3], &p, "yield", &g->vol.plastic[2 * i]) ||
+            jv_opt_nonneg(r, f[4], &p, "creep", &g->vol.plastic[2 * i + 1]))
             return -1;
-        if (!isfinite(g->vol_rest[i])) return jv_fail(r, f[0], 0, &pp, "the particles are too far apart (their volume overflows)");
+        if (!isfinite(g->vol.rest[i])) return jv_fail(r, f[0], 0, &pp, "the particles are too far apart (their volume overflows)");
     }
     return 0;
 }

@@ -171,15 +171,15 @@ static void plastic(out *o, const wb_real yc[2])
 static void write_volumes(out *o, const wb_image *g)
 {
     FILE *f = o->f;
-    if (g->nvol == 0) return;
+    if (g->vol.n == 0) return;
     fputs("  \"volumes\": [", f);
-    for (int32_t i = 0; i < g->nvol; i++) {
-        const int32_t *p = &g->vol_ijkl[4 * i];
+    for (int32_t i = 0; i < g->vol.n; i++) {
+        const int32_t *p = &g->vol.ijkl[4 * i];
         fprintf(f, "%s    {\"particles\": [%d, %d, %d, %d], \"rest\": ", i ? ",\n" : "\n", p[0], p[1], p[2], p[3]);
-        num(o, g->vol_rest[i]);
+        num(o, g->vol.rest[i]);
         fputs(", \"compliance\": ", f);
-        num(o, g->vol_alpha[i]);
-        plastic(o, &g->vol_plastic[2 * i]);
+        num(o, g->vol.alpha[i]);
+        plastic(o, &g->vol.plastic[2 * i]);
         fputc('}', f);
     }
     fputs("\n  ],\n", f);
@@ -189,19 +189,19 @@ static void write_volumes(out *o, const wb_image *g)
 static void write_tets(out *o, const wb_image *g)
 {
     FILE *f = o->f;
-    if (g->ntet == 0) return;
+    if (g->tet.n == 0) return;
     fputs("  \"tets\": [", f);
-    for (int32_t i = 0; i < g->ntet; i++) {
-        const int32_t *p = &g->tet_ijkl[4 * i];
+    for (int32_t i = 0; i < g->tet.n; i++) {
+        const int32_t *p = &g->tet.ijkl[4 * i];
         fprintf(f, "%s    {\"particles\": [%d, %d, %d, %d], \"young\": ", i ? ",\n" : "\n", p[0], p[1], p[2], p[3]);
-        num(o, g->tet_young[i]);
+        num(o, g->tet.young[i]);
         fputs(", \"poisson\": ", f);
-        num(o, g->tet_poisson[i]);
+        num(o, g->tet.poisson[i]);
         fputs(", \"rest_volume\": ", f);
-        num(o, g->tet_v0[i]);
+        num(o, g->tet.v0[i]);
         fputs(", \"rest_inverse\": ", f);
-        vec(o, &g->tet_dminv[9 * i], 9);
-        plastic(o, &g->tet_plastic[2 * i]);
+        vec(o, &g->tet.dminv[9 * i], 9);
+        plastic(o, &g->tet.plastic[2 * i]);
         fputc('}', f);
     }
     fputs("\n  ],\n", f);
