@@ -22,8 +22,6 @@ wb_status wb_image_alloc(wb_image *g, int32_t np, int32_t nd, int32_t nfree, int
     memset(g, 0, sizeof *g);
     g->def = wb_world_default_def();
     g->np = np;
-    g->nd = nd;
-    g->nfree = nfree;
     g->nc = nc;
     g->nsurf = nsurf;
     g->ntri = ntri;
@@ -36,28 +34,15 @@ wb_status wb_image_alloc(wb_image *g, int32_t np, int32_t nd, int32_t nfree, int
     g->cflags = zalloc(np, 1);
     g->cfric = zalloc(np, sizeof *g->cfric);
     g->x0 = zalloc(3 * (int64_t)np, sizeof *g->x0);
-    g->d_ij = zalloc(2 * (int64_t)nd, sizeof *g->d_ij);
-    g->d_alpha = zalloc(nd, sizeof(wb_real));
-    g->d_beta = zalloc(nd, sizeof(wb_real));
-    g->d_yield = zalloc(nd, sizeof(wb_real));
-    g->d_creep = zalloc(nd, sizeof(wb_real));
-    g->d_break = zalloc(nd, sizeof(wb_real));
-    g->d_bforce = zalloc(nd, sizeof(wb_real));
-    g->d_rest = zalloc(nd, sizeof(wb_real));
-    g->d_broken = zalloc(nd, 1);
-    g->d_gen = zalloc(nd, sizeof *g->d_gen);
-    g->d_free = zalloc(nfree, sizeof *g->d_free);
     g->c = zalloc(nc, sizeof *g->c);
     g->c_gen = zalloc(nc, sizeof *g->c_gen);
     g->surf_start = zalloc((int64_t)nsurf + 1, sizeof *g->surf_start);
     g->tri = zalloc(3 * (int64_t)ntri, sizeof *g->tri);
-    if (!g->x || !g->v || !g->inv_mass || !g->radius || !g->pinned || !g->d_ij || !g->d_alpha || !g->d_beta ||
-        !g->d_yield || !g->d_creep || !g->d_break || !g->d_bforce || !g->d_rest || !g->d_broken || !g->d_gen || !g->d_free ||
-        !g->c || !g->c_gen || !g->surf_start || !g->tri || !g->group || !g->cflags || !g->cfric || !g->x0) {
+    if (!g->x || !g->v || !g->inv_mass || !g->radius || !g->pinned || !g->c || !g->c_gen || !g->surf_start ||
+        !g->tri || !g->group || !g->cflags || !g->cfric || !g->x0 || wb_image_alloc_distances(g, nd, nfree) != WB_OK) {
         wb_image_free(g);
         return WB_ERR_NOMEM;
     }
-    for (int32_t i = 0; i < nd; i++) g->d_gen[i] = 1;
     memset(g->cflags, WB_CF_COLLIDE, (size_t)np);
     for (int32_t i = 0; i < nc; i++) {
         g->c_gen[i] = 1;
@@ -72,9 +57,8 @@ void wb_image_free(wb_image *g)
         free(g->c[i].mv);
         free(g->c[i].mt);
     }
-    void *p[] = { g->x, g->v, g->inv_mass, g->radius, g->pinned, g->d_ij, g->d_alpha, g->d_beta, g->d_yield,
-                  g->d_creep, g->d_break, g->d_rest, g->d_broken, g->d_gen, g->d_free, g->c, g->c_gen,
-                  g->surf_start, g->tri, g->group, g->cflags, g->cfric, g->x0, g->d_bforce };
+    void *p[] = { g->x, g->v, g->inv_mass, g->radius, g->pinned, g->c, g->c_gen, g->surf_start, g->tri, g->group,
+                  g->cflags, g->cfric, g->x0 };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     for (int i = 0; i < wb__nctypes; i++)
         if (wb__ctypes[i]->image_free) wb__ctypes[i]->image_free(g);
@@ -86,10 +70,10 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
 {
     const wb_model *m = &w->m;
     const wb_state *s = &w->s;
-    wb_status st = wb_image_alloc(g, m->np, m->nd, m->nfree, m->nc, m->nsurf, m->ntri);
+    wb_status st = wb_image_alloc(g, m->np, 0, 0, m->nc, m->nsurf, m->ntri); /* the types' sections: below */
     if (st != WB_OK) return st;
     g->def = m->def;
-    const size_t np = (size_t)m->np, nd = (size_t)m->nd;
+    const size_t np = (size_t)m->np;
     if (np) {
         memcpy(g->x, s->x, 3 * np * sizeof *g->x);
         memcpy(g->v, s->v, 3 * np * sizeof *g->v);
@@ -101,19 +85,6 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
         memcpy(g->cfric, m->cfric, np * sizeof *g->cfric);
         memcpy(g->x0, m->x0, 3 * np * sizeof *g->x0);
     }
-    if (nd) {
-        memcpy(g->d_ij, m->d_ij, 2 * nd * sizeof *g->d_ij);
-        memcpy(g->d_alpha, m->d_alpha, nd * sizeof(wb_real));
-        memcpy(g->d_beta, m->d_beta, nd * sizeof(wb_real));
-        memcpy(g->d_yield, m->d_yield, nd * sizeof(wb_real));
-        memcpy(g->d_creep, m->d_creep, nd * sizeof(wb_real));
-        memcpy(g->d_break, m->d_break, nd * sizeof(wb_real));
-        memcpy(g->d_bforce, m->d_bforce, nd * sizeof(wb_real));
-        memcpy(g->d_rest, s->d_rest, nd * sizeof(wb_real));
-        memcpy(g->d_broken, s->d_broken, nd);
-        memcpy(g->d_gen, m->d_gen, nd * sizeof *g->d_gen);
-    }
-    if (m->nfree) memcpy(g->d_free, m->d_free, (size_t)m->nfree * sizeof *g->d_free);
     for (int32_t i = 0; i < m->nc; i++) {
         const wb_cshape *cs = &m->c_shape[i];
         const wb_collider_pose *cp = &s->c_pose[i];
@@ -198,7 +169,6 @@ const char *wb_image_check(const wb_image *g)
     const char *e = wb_world_def_check(&g->def);
     if (e) return e;
     if (g->np < 0 || g->np > WB_MAX_PARTICLES) return "too many particles";
-    if (g->nd < 0 || g->nd > WB_MAX_CONSTRAINTS) return "too many constraints";
     if (g->nc < 0 || g->nc > WB_MAX_COLLIDERS) return "too many colliders";
     if (g->nsurf < 0 || g->ntri < 0 || g->ntri > WB_MAX_CONSTRAINTS) return "too many triangles";
     for (int32_t i = 0; i < g->np; i++) {
@@ -209,34 +179,6 @@ const char *wb_image_check(const wb_image *g)
         if (g->cflags[i] > (WB_CF_COLLIDE | WB_CF_SELF)) return "particle contact flags out of range";
         if (!(g->cfric[i] >= 0) || !isfinite(g->cfric[i])) return "particle friction must be >= 0";
         if (!fin3(&g->x0[3 * i])) return "particle rest position must be finite";
-    }
-    int32_t dead = 0;
-    for (int32_t i = 0; i < g->nd; i++) {
-        if (!(g->d_gen[i] & 1u)) { dead++; continue; }
-        const int32_t a = g->d_ij[2 * i], b = g->d_ij[2 * i + 1];
-        if (a < 0 || b < 0 || a >= g->np || b >= g->np) return "constraint particle out of range";
-        if (a == b) return "a constraint needs two distinct particles";
-        wb_distance_def d = { g->d_alpha[i], g->d_beta[i], g->d_rest[i], g->d_yield[i], g->d_creep[i], g->d_break[i],
-                              g->d_bforce[i] };
-        if ((e = wb_distance_def_check(&d))) return e;
-        if (!(g->d_rest[i] >= 0)) return "rest length must be >= 0";
-        wb_real dx[3];
-        v3_sub(dx, &g->x[3 * b], &g->x[3 * a]);
-        if (!isfinite(v3_dot(dx, dx))) return "constraint particles are too far apart (their distance squared overflows)";
-    }
-    /* the free list is exactly the dead slots, each once (a mark per slot: linear) */
-    if (g->nfree != dead) return "the free constraint slots do not match the dead ones";
-    if (g->nfree > 0) {
-        uint8_t *seen = calloc((size_t)g->nd, 1);
-        if (!seen) return "out of memory checking the free constraint slots";
-        const char *fe = NULL;
-        for (int32_t i = 0; i < g->nfree && !fe; i++) {
-            const int32_t s = g->d_free[i];
-            if (s < 0 || s >= g->nd || (g->d_gen[s] & 1u)) fe = "a free constraint slot is not a dead one";
-            else if (seen[s]++) fe = "a free constraint slot is listed twice";
-        }
-        free(seen);
-        if (fe) return fe;
     }
     for (int32_t i = 0; i < g->nc; i++)
         if ((g->c_gen[i] & 1u) && (e = check_collider(&g->c[i]))) return e;
@@ -367,7 +309,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     wb_world *w = wb_world_create(&g->def);
     wb_colmesh **cms = calloc((size_t)(g->nc > 0 ? g->nc : 1), sizeof *cms);
     const wb_image_at at = { 1, 0, 0, NULL, NULL };
-    wb_status st = w && cms ? wb__reserve(w, g->np, g->nd) : WB_ERR_NOMEM;
+    wb_status st = w && cms ? wb__reserve(w, g->np, 0) : WB_ERR_NOMEM;
     if (st == WB_OK) st = grow_colliders(w, g->nc);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
     if (st == WB_OK) st = wb__rigid_reserve(w, g, 1);
@@ -381,7 +323,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     }
     wb_model *m = &w->m;
     wb_state *s = &w->s;
-    const size_t np = (size_t)g->np, nd = (size_t)g->nd;
+    const size_t np = (size_t)g->np;
     m->np = g->np;
     if (np) {
         memcpy(s->x, g->x, 3 * np * sizeof *s->x);
@@ -397,26 +339,6 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     }
     for (size_t i = 0; i < np; i++) m->w[i] = g->pinned[i] ? 0 : g->inv_mass[i];
     m->w_gen++;
-    m->nd = g->nd;
-    m->nd_live = 0;
-    if (nd) {
-        memcpy(m->d_ij, g->d_ij, 2 * nd * sizeof *m->d_ij);
-        memcpy(m->d_alpha, g->d_alpha, nd * sizeof(wb_real));
-        memcpy(m->d_beta, g->d_beta, nd * sizeof(wb_real));
-        memcpy(m->d_yield, g->d_yield, nd * sizeof(wb_real));
-        memcpy(m->d_creep, g->d_creep, nd * sizeof(wb_real));
-        memcpy(m->d_break, g->d_break, nd * sizeof(wb_real));
-        memcpy(m->d_bforce, g->d_bforce, nd * sizeof(wb_real));
-        memcpy(s->d_rest, g->d_rest, nd * sizeof(wb_real));
-        memcpy(s->d_broken, g->d_broken, nd);
-        memcpy(m->d_gen, g->d_gen, nd * sizeof *m->d_gen);
-    }
-    for (size_t i = 0; i < nd; i++) {
-        w->k.slot_pack[i] = -1;
-        m->nd_live += (int32_t)(g->d_gen[i] & 1u);
-    }
-    m->nfree = g->nfree;
-    if (g->nfree) memcpy(m->d_free, g->d_free, (size_t)g->nfree * sizeof *m->d_free);
     m->nc = g->nc;
     for (int32_t i = 0; i < g->nc; i++) {
         put_collider(w, i, &g->c[i], cms[i]);
@@ -454,8 +376,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
         return WB_ERR_ARG;
     }
     wb_model *m = &w->m;
-    int32_t live_d = 0, live_c = 0, dead_c = 0;
-    for (int32_t i = 0; i < g->nd; i++) live_d += (int32_t)(g->d_gen[i] & 1u);
+    int32_t live_c = 0, dead_c = 0;
     for (int32_t i = 0; i < g->nc; i++) live_c += (int32_t)(g->c_gen[i] & 1u);
     for (int32_t i = 0; i < m->nc; i++) dead_c += !(m->c_gen[i] & 1u);
     const int32_t new_c = live_c > dead_c ? live_c - dead_c : 0;
@@ -473,7 +394,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     int32_t *rmap = calloc((size_t)(g->nrb > 0 ? g->nrb : 1), sizeof *rmap); /* the same for rigid bodies */
     if (!cms || !cmap || !rmap) { free(cms); free(cmap); free(rmap); return WB_ERR_NOMEM; }
     const wb_image_at at = { 0, m->np, m->nsurf, cmap, rmap };
-    wb_status st = wb__reserve(w, g->np, live_d);
+    wb_status st = wb__reserve(w, g->np, 0);
     if (st == WB_OK) st = grow_colliders(w, m->nc + new_c);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
     if (st == WB_OK) st = wb__rigid_reserve(w, g, 0);
@@ -501,13 +422,6 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
         memcpy(&m->x0[3 * (first + i)], &g->x0[3 * i], 3 * sizeof(wb_real));
     }
     w->k.pc.scan_dirty = 1;
-    for (int32_t i = 0; i < g->nd; i++) {
-        if (!(g->d_gen[i] & 1u)) continue;
-        wb_distance_def d = { g->d_alpha[i], g->d_beta[i], g->d_rest[i], g->d_yield[i], g->d_creep[i], g->d_break[i],
-                              g->d_bforce[i] };
-        wb_distance_id id = wb_distance_add(w, first + g->d_ij[2 * i], first + g->d_ij[2 * i + 1], &d, NULL);
-        w->s.d_broken[id.index - 1] = g->d_broken[i];
-    }
     int32_t scan = 0; /* dead slots are taken lowest first: the scan never goes back */
     for (int32_t i = 0; i < g->nc; i++) {
         if (!(g->c_gen[i] & 1u)) continue;

@@ -8,6 +8,7 @@
 #include "wobble.h"
 /* the constraint types' own sections of an image, declared by their owners */
 #include "bend.h"
+#include "distance.h"
 #include "shape_match.h"
 #include "tet.h"
 #include "volume.h"
@@ -67,15 +68,7 @@ typedef struct wb_image {
     wb_real *cfric;        /* (np) contact friction */
     wb_real *x0;           /* (np x 3) where created (the self-collision rest rule) */
 
-    /* distance constraints by slot: a slot is live while its generation is odd */
-    int32_t nd;
-    int32_t *d_ij;         /* (nd x 2) */
-    wb_real *d_alpha, *d_beta, *d_yield, *d_creep, *d_break, *d_rest; /* (nd) */
-    wb_real *d_bforce;     /* (nd) break_force, N (0 = none) */
-    uint8_t *d_broken;     /* (nd) */
-    uint32_t *d_gen;       /* (nd) */
-    int32_t nfree;
-    int32_t *d_free;       /* (nfree) free slots, in stack order */
+    wb_image_distance dist; /* distance.h */
 
     wb_image_bend bend;    /* bend.h: empty unless wb_image_alloc_bends */
 
@@ -106,6 +99,9 @@ typedef struct wb_image {
 /* allocate the arrays for these counts (zeroed; generations 1, i.e. live; particles collide);
  * WB_ERR_NOMEM */
 wb_status wb_image_alloc(wb_image *img, int32_t np, int32_t nd, int32_t nfree, int32_t nc, int32_t nsurf, int32_t ntri);
+/* distance.c: the distance section for nd slots (generations 1) and nfree free ones (zeroed);
+ * WB_ERR_NOMEM (the section left empty) */
+wb_status wb_image_alloc_distances(wb_image *img, int32_t nd, int32_t nfree);
 /* bend.c: the bend arrays for nb bends (zeroed), after wb_image_alloc; WB_ERR_NOMEM (the
  * section left empty) */
 wb_status wb_image_alloc_bends(wb_image *img, int32_t nb);

@@ -165,7 +165,7 @@ static int read_snapshot(rd *r, const sections *s, wb_image *g)
     if (s->dgen) {
         kp a = { &ds, "generations", 0 }, b = { &ds, "free", 0 };
         int32_t live;
-        if (read_generations(r, s->dgen, &a, s->nd, g->d_gen, &live)) return -1;
+        if (read_generations(r, s->dgen, &a, s->nd, g->dist.gen, &live)) return -1;
         if (live != s->ncons)
             return jv_fail(r, s->dgen, 0, &a, "%d live slots, but \"constraints\" has %d entries", live, s->ncons);
         int32_t k = 0;
@@ -177,9 +177,9 @@ static int read_snapshot(rd *r, const sections *s, wb_image *g)
             kp e = { &b, NULL, k };
             int64_t slot;
             if (jv_get_int(r, c, &e, 0, s->nd > 0 ? s->nd - 1 : 0, &slot)) bad = -1;
-            else if (s->nd == 0 || (g->d_gen[slot] & 1u)) bad = jv_fail(r, c, 0, &e, "slot %lld is live, not free", (long long)slot);
+            else if (s->nd == 0 || (g->dist.gen[slot] & 1u)) bad = jv_fail(r, c, 0, &e, "slot %lld is live, not free", (long long)slot);
             else if (seen[slot]++) bad = jv_fail(r, c, 0, &e, "slot %lld is listed twice", (long long)slot);
-            else g->d_free[k] = (int32_t)slot;
+            else g->dist.free_slots[k] = (int32_t)slot;
         }
         free(seen);
         if (bad) return -1;
@@ -330,7 +330,7 @@ static int read_constraints(rd *r, const sections *s, const defaults *d, wb_imag
         }
         if (ab[0] == ab[1]) return jv_fail(r, f[1], 0, &pp, "a constraint needs two distinct particles");
         /* the i-th live slot (all slots are live in a plain config) */
-        do slot++; while (!(g->d_gen[slot] & 1u));
+        do slot++; while (!(g->dist.gen[slot] & 1u));
         wb_distance_def l = d->link;
         const wb_real *xa = &g->x[3 * ab[0]], *xb = &g->x[3 * ab[1]];
         wb_real dx[3] = { xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2] };
@@ -353,16 +353,16 @@ static int read_constraints(rd *r, const sections *s, const defaults *d, wb_imag
             kp q = { &p, "broken", 0 };
             if (jv_get_bool(r, f[8], &q, &broken)) return -1;
         }
-        g->d_ij[2 * slot] = (int32_t)ab[0];
-        g->d_ij[2 * slot + 1] = (int32_t)ab[1];
-        g->d_alpha[slot] = l.compliance;
-        g->d_beta[slot] = l.damping;
-        g->d_yield[slot] = l.yield;
-        g->d_creep[slot] = l.creep;
-        g->d_break[slot] = l.break_strain;
-        g->d_bforce[slot] = l.break_force;
-        g->d_rest[slot] = l.rest;
-        g->d_broken[slot] = broken;
+        g->dist.ij[2 * slot] = (int32_t)ab[0];
+        g->dist.ij[2 * slot + 1] = (int32_t)ab[1];
+        g->dist.alpha[slot] = l.compliance;
+        g->dist.beta[slot] = l.damping;
+        g->dist.yield[slot] = l.yield;
+        g->dist.creep[slot] = l.creep;
+        g->dist.break_strain[slot] = l.break_strain;
+        g->dist.bforce[slot] = l.break_force;
+        g->dist.rest[slot] = l.rest;
+        g->dist.broken[slot] = broken;
     }
     return 0;
 }

@@ -76,9 +76,9 @@ static void write_snapshot(out *o, const wb_image *g)
     fprintf(f, ", \"frame\": %lld, \"warnings\": %lld, \"last_warning\": ", (long long)g->frame, (long long)g->warnings);
     str(f, g->last_warning);
     fputs(",\n    \"distance_slots\": {\"generations\": ", f);
-    ints(f, "      ", g->d_gen, NULL, g->nd);
+    ints(f, "      ", g->dist.gen, NULL, g->dist.n);
     fputs(", \"free\": ", f);
-    ints(f, "      ", NULL, g->d_free, g->nfree);
+    ints(f, "      ", NULL, g->dist.free_slots, g->dist.nfree);
     fputs("},\n    \"collider_slots\": {\"generations\": ", f);
     ints(f, "      ", g->c_gen, NULL, g->nc);
     fputs("}\n  },\n", f);
@@ -115,27 +115,27 @@ static void write_constraints(out *o, const wb_image *g)
     FILE *f = o->f;
     int first = 1;
     fputs("  \"constraints\": [", f);
-    for (int32_t i = 0; i < g->nd; i++) {
-        if (!(g->d_gen[i] & 1u)) continue;
+    for (int32_t i = 0; i < g->dist.n; i++) {
+        if (!(g->dist.gen[i] & 1u)) continue;
         fprintf(f, "%s    {\"type\": \"distance\", \"particles\": [%d, %d], \"rest\": ", first ? "\n" : ",\n",
-                g->d_ij[2 * i], g->d_ij[2 * i + 1]);
+                g->dist.ij[2 * i], g->dist.ij[2 * i + 1]);
         first = 0;
-        num(o, g->d_rest[i]);
+        num(o, g->dist.rest[i]);
         fputs(", \"compliance\": ", f);
-        num(o, g->d_alpha[i]);
+        num(o, g->dist.alpha[i]);
         fputs(", \"damping\": ", f);
-        num(o, g->d_beta[i]);
+        num(o, g->dist.beta[i]);
         fputs(", \"yield\": ", f);
-        num(o, g->d_yield[i]);
+        num(o, g->dist.yield[i]);
         fputs(", \"creep\": ", f);
-        num(o, g->d_creep[i]);
+        num(o, g->dist.creep[i]);
         fputs(", \"break_strain\": ", f);
-        num(o, g->d_break[i]);
-        if (g->d_bforce[i] > 0) { /* only when set: configs without it read as before */
+        num(o, g->dist.break_strain[i]);
+        if (g->dist.bforce[i] > 0) { /* only when set: configs without it read as before */
             fputs(", \"break_force\": ", f);
-            num(o, g->d_bforce[i]);
+            num(o, g->dist.bforce[i]);
         }
-        fprintf(f, ", \"broken\": %s}", g->d_broken[i] ? "true" : "false");
+        fprintf(f, ", \"broken\": %s}", g->dist.broken[i] ? "true" : "false");
     }
     for (int32_t i = 0; i < g->bend.n; i++) {
         const int32_t *p = &g->bend.ij[4 * i];
