@@ -479,6 +479,11 @@ static uint64_t att_hash(const wb_world *w, uint64_t h)
     return h;
 }
 
+static void att_stats(const wb_world *w, wb_stats *st)
+{
+    st->attachments = wb_attach_count(w);
+}
+
 const wb_ctype wb__attach_type = {
     .name = "attach",
     .count = att_count,
@@ -488,6 +493,7 @@ const wb_ctype wb__attach_type = {
     .energy = att_energy,
     .destroy = att_destroy,
     .charged = att_charged,
+    .stats = att_stats,
     .hash = att_hash,
     .image_free = att_image_free,
     .image_save = att_image_save,

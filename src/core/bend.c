@@ -771,6 +771,11 @@ static void bend_image_put(wb_world *w, const wb_image *g, const wb_image_at *at
     }
 }
 
+static void bend_stats(const wb_world *w, wb_stats *st)
+{
+    st->bends = wb_bend_count(w);
+}
+
 const wb_ctype wb__bend_type = {
     .name = "bend",
     .count = bend_count,
@@ -782,6 +787,7 @@ const wb_ctype wb__bend_type = {
     .links = bend_links,
     .destroy = bend_destroy,
     .charged = bend_charged,
+    .stats = bend_stats,
     .hash = bend_hash,
     .image_free = bend_image_free,
     .image_save = bend_image_save,

@@ -45,6 +45,8 @@ typedef struct wb_ctype {
     /* bytes it has charged to def.memory (given back at teardown); may be NULL: its bytes
      * are charged with the particles' */
     size_t (*charged)(const wb_world *w);
+    /* its counts in w:stats() (its fields of wb_stats) */
+    void (*stats)(const wb_world *w, wb_stats *st);
     /* its part of w:hash(), fed into h: the bytes and order the hash has always had, so
      * that saved hashes still compare (a world without any of the type adds nothing) */
     uint64_t (*hash)(const wb_world *w, uint64_t h);

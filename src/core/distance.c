@@ -933,6 +933,13 @@ static void distance_image_put(wb_world *w, const wb_image *g, const wb_image_at
     }
 }
 
+static void distance_stats(const wb_world *w, wb_stats *st)
+{
+    st->distances = w->m.nd_live;
+    for (int32_t s = 0; s < w->m.nd; s++)
+        if ((w->m.d_gen[s] & 1u) && w->s.d_broken[s]) st->broken++;
+}
+
 const wb_ctype wb__distance_type = {
     .name = "distance",
     .count = distance_count,
@@ -943,6 +950,7 @@ const wb_ctype wb__distance_type = {
     .energy = distance_energy,
     .links = distance_links,
     .destroy = distance_destroy,
+    .stats = distance_stats,
     .hash = distance_hash,
     .image_free = distance_image_free,
     .image_save = distance_image_save,

@@ -462,6 +462,11 @@ static uint64_t grab_hash(const wb_world *w, uint64_t h)
     return h;
 }
 
+static void grab_stats(const wb_world *w, wb_stats *st)
+{
+    st->grabs = wb_grab_count(w);
+}
+
 const wb_ctype wb__grab_type = {
     .name = "grab",
     .count = grab_count,
@@ -472,6 +477,7 @@ const wb_ctype wb__grab_type = {
     .energy = grab_energy,
     .destroy = grab_destroy,
     .charged = grab_charged,
+    .stats = grab_stats,
     .hash = grab_hash,
     .image_free = grab_image_free,
     .image_save = grab_image_save,

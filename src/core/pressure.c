@@ -421,6 +421,11 @@ static uint64_t pr_hash(const wb_world *w, uint64_t h)
     return wb__fnv(h, pr->v0, sizeof(wb_real) * (size_t)pr->n);
 }
 
+static void pr_stats(const wb_world *w, wb_stats *st)
+{
+    st->pressures = wb_pressure_count(w);
+}
+
 const wb_ctype wb__pressure_type = {
     .name = "pressure",
     .count = pr_count,
@@ -430,6 +435,7 @@ const wb_ctype wb__pressure_type = {
     .energy = pr_energy,
     .destroy = pr_destroy,
     .charged = pr_charged,
+    .stats = pr_stats,
     .hash = pr_hash,
     .image_free = pr_image_free,
     .image_save = pr_image_save,

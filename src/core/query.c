@@ -1,10 +1,6 @@
 /* query.c: read-only measures of a world: energy, momenta, bounds, strain, hash, stats. */
 #include "ctype.h"
-#include "attach.h"
-#include "grab.h"
 #include "rigid.h"
-#include "tet.h"
-#include "volume.h"
 
 static wb_real mass_of(const wb_world *w, int32_t i) { return w->m.w[i] > 0 ? 1 / w->m.w[i] : 0; }
 
@@ -171,15 +167,8 @@ wb_stats wb_world_stats(const wb_world *w)
     wb_stats st;
     memset(&st, 0, sizeof st);
     st.particles = w->m.np;
-    st.distances = w->m.nd_live;
-    for (int32_t s = 0; s < w->m.nd; s++)
-        if ((w->m.d_gen[s] & 1u) && w->s.d_broken[s]) st.broken++;
+    for (int i = 0; i < wb__nctypes; i++) wb__ctypes[i]->stats(w, &st);
     st.colliders = wb_collider_count(w);
-    st.bends = wb_bend_count(w);
-    st.volumes = wb_volume_count(w);
-    st.tets = wb_tet_count(w);
-    st.shape_matches = wb_shape_match_count(w);
-    st.pressures = wb_pressure_count(w);
     st.colours = w->k.ncolours;
     st.contacts = w->k.last_contacts;
     st.particle_contacts = w->k.pc.last + w->k.tc.last;
@@ -189,8 +178,6 @@ wb_stats wb_world_stats(const wb_world *w)
     st.step_ms = w->k.step_ms;
     st.solve_ms = w->k.solve_ms;
     st.warnings = w->s.warnings;
-    st.attachments = wb_attach_count(w);
-    st.grabs = wb_grab_count(w);
     st.rigids = wb_rigid_count(w);
     st.rigid_contacts = wb_world_rigid_contact_count(w);
     return st;

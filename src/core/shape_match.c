@@ -502,6 +502,11 @@ static uint64_t sm_hash(const wb_world *w, uint64_t h)
     return wb__fnv(h, sm->q, sizeof(wb_real) * 4 * (size_t)sm->n);
 }
 
+static void sm_stats(const wb_world *w, wb_stats *st)
+{
+    st->shape_matches = wb_shape_match_count(w);
+}
+
 const wb_ctype wb__shape_type = {
     .name = "shape_match",
     .count = sm_count,
@@ -513,6 +518,7 @@ const wb_ctype wb__shape_type = {
     .links = sm_links,
     .destroy = sm_destroy,
     .charged = sm_charged,
+    .stats = sm_stats,
     .hash = sm_hash,
     .image_free = sm_image_free,
     .image_save = sm_image_save,

@@ -891,6 +891,11 @@ static uint64_t tet_hash(const wb_world *w, uint64_t h)
     return wb__fnv(h, ne->creep, sizeof(wb_real) * (size_t)ne->n);
 }
 
+static void tet_stats(const wb_world *w, wb_stats *st)
+{
+    st->tets = wb_tet_count(w);
+}
+
 const wb_ctype wb__tet_type = {
     .name = "tet",
     .count = tet_count,
@@ -902,6 +907,7 @@ const wb_ctype wb__tet_type = {
     .links = tet_links,
     .destroy = tet_destroy,
     .charged = tet_charged,
+    .stats = tet_stats,
     .hash = tet_hash,
     .image_free = tet_image_free,
     .image_save = tet_image_save,

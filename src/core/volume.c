@@ -379,6 +379,11 @@ static void vol_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
     }
 }
 
+static void vol_stats(const wb_world *w, wb_stats *st)
+{
+    st->volumes = wb_volume_count(w);
+}
+
 const wb_ctype wb__volume_type = {
     .name = "volume",
     .count = vol_count,
@@ -390,6 +395,7 @@ const wb_ctype wb__volume_type = {
     .links = vol_links,
     .destroy = vol_destroy,
     .charged = vol_charged,
+    .stats = vol_stats,
     .hash = vol_hash,
     .image_free = vol_image_free,
     .image_save = vol_image_save,
