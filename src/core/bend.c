@@ -155,11 +155,8 @@ wb_bend_id wb_bend_add(wb_world *w, const int32_t p[4], const wb_bend_def *def, 
     wb_status dummy;
     if (!status) status = &dummy;
     const char *err = wb_bend_def_check(def);
-    for (int i = 0; i < 4 && !err; i++) {
-        if (p[i] < 0 || p[i] >= w->m.np) err = "particle out of range";
-        for (int j = 0; j < i && !err; j++)
-            if (p[i] == p[j]) err = "a bend needs four distinct particles";
-    }
+    const int q = err ? 0 : wb__quad_check(p, w->m.np);
+    if (q) err = q == 1 ? "particle out of range" : "a bend needs four distinct particles";
     int ok = 1;
     wb_real rest = def->rest;
     if (!err && isnan(rest)) {
@@ -723,12 +720,8 @@ static const char *bend_image_check(const wb_image *g)
     const wb_image_bend *b = &g->bend;
     if (b->n < 0 || b->n > WB_MAX_CONSTRAINTS) return "too many bends";
     for (int32_t i = 0; i < b->n; i++) {
-        const int32_t *p = &b->ij[4 * i];
-        for (int a = 0; a < 4; a++) {
-            if (p[a] < 0 || p[a] >= g->np) return "bend particle out of range";
-            for (int c = 0; c < a; c++)
-                if (p[a] == p[c]) return "a bend needs four distinct particles";
-        }
+        const int q = wb__quad_check(&b->ij[4 * i], g->np);
+        if (q) return q == 1 ? "bend particle out of range" : "a bend needs four distinct particles";
         const wb_bend_def d = { b->alpha[i], b->beta[i], b->rest[i], b->btorque[i] };
         if (isnan(b->rest[i])) return "bend rest must be an angle in [-pi, pi] (radians)";
         const char *e = wb_bend_def_check(&d);

@@ -70,6 +70,19 @@ static inline void wb__link_quads(const int32_t *q, int32_t n, wb_link_fn fn, vo
             for (int b = a + 1; b < 4; b++) fn(ud, q[4 * e + a], q[4 * e + b], 1);
 }
 
+/* the four corners of an element (a bend, a volume, a tet): 0 when each is a particle of
+ * [0, np) and no two are one; else, at the first corner that is not, 1 (out of range) or
+ * 2 (repeated). The API and the snapshot checks share it */
+static inline int wb__quad_check(const int32_t p[4], int32_t np)
+{
+    for (int k = 0; k < 4; k++) {
+        if (p[k] < 0 || p[k] >= np) return 1;
+        for (int j = 0; j < k; j++)
+            if (p[j] == p[k]) return 2;
+    }
+    return 0;
+}
+
 extern const wb_ctype wb__distance_type, wb__bend_type, wb__volume_type,
                       wb__shape_type, wb__pressure_type, wb__tet_type;
 extern const wb_ctype wb__attach_type, wb__grab_type; /* attach.c, grab.c */

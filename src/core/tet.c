@@ -166,11 +166,8 @@ bool wb__tet_put_current(wb_world *w, const int32_t p[4], wb_real young, wb_real
 int32_t wb_tet_add(wb_world *w, const int32_t p[4], const wb_tet_def *def)
 {
     const char *err = wb_tet_def_check(def);
-    for (int k = 0; k < 4 && !err; k++) {
-        if (p[k] < 0 || p[k] >= w->m.np) err = "particle out of range";
-        for (int j = 0; j < k && !err; j++)
-            if (p[j] == p[k]) err = "a tet needs four distinct particles";
-    }
+    const int q = err ? 0 : wb__quad_check(p, w->m.np);
+    if (q) err = q == 1 ? "particle out of range" : "a tet needs four distinct particles";
     wb_real inv[9], vol;
     if (!err && !rest_of(w->s.x, p, inv, &vol)) err = "the four particles lie in a plane (a flat tet has no rest shape)";
     if (err) {
@@ -322,12 +319,8 @@ static const char *tet_image_check(const wb_image *g)
 {
     if (g->tet.n < 0 || g->tet.n > WB_MAX_CONSTRAINTS) return "too many tets";
     for (int32_t i = 0; i < g->tet.n; i++) {
-        const int32_t *p = &g->tet.ijkl[4 * i];
-        for (int k = 0; k < 4; k++) {
-            if (p[k] < 0 || p[k] >= g->np) return "tet particle out of range";
-            for (int j = 0; j < k; j++)
-                if (p[j] == p[k]) return "a tet needs four distinct particles";
-        }
+        const int q = wb__quad_check(&g->tet.ijkl[4 * i], g->np);
+        if (q) return q == 1 ? "tet particle out of range" : "a tet needs four distinct particles";
         const wb_tet_def d = { g->tet.young[i], g->tet.poisson[i], g->tet.plastic[2 * i], g->tet.plastic[2 * i + 1] };
         const char *e = wb_tet_def_check(&d);
         if (e) return e;

@@ -104,11 +104,8 @@ void wb__volume_plastic(wb_world *w, int32_t first, wb_real yield, wb_real creep
 int32_t wb_volume_add(wb_world *w, const int32_t p[4], const wb_volume_def *def)
 {
     const char *err = wb_volume_def_check(def);
-    for (int k = 0; k < 4 && !err; k++) {
-        if (p[k] < 0 || p[k] >= w->m.np) err = "particle out of range";
-        for (int j = 0; j < k && !err; j++)
-            if (p[j] == p[k]) err = "a volume constraint needs four distinct particles";
-    }
+    const int q = err ? 0 : wb__quad_check(p, w->m.np);
+    if (q) err = q == 1 ? "particle out of range" : "a volume constraint needs four distinct particles";
     const wb_real *x = w->s.x;
     const wb_real rest = def->has_rest ? def->rest
                        : err ? 0 : wb_tet_signed_volume(&x[3 * p[0]], &x[3 * p[1]], &x[3 * p[2]], &x[3 * p[3]]);
@@ -349,12 +346,8 @@ static const char *vol_image_check(const wb_image *g)
 {
     if (g->vol.n < 0 || g->vol.n > WB_MAX_CONSTRAINTS) return "too many volume constraints";
     for (int32_t i = 0; i < g->vol.n; i++) {
-        const int32_t *p = &g->vol.ijkl[4 * i];
-        for (int k = 0; k < 4; k++) {
-            if (p[k] < 0 || p[k] >= g->np) return "volume constraint particle out of range";
-            for (int j = 0; j < k; j++)
-                if (p[j] == p[k]) return "a volume constraint needs four distinct particles";
-        }
+        const int q = wb__quad_check(&g->vol.ijkl[4 * i], g->np);
+        if (q) return q == 1 ? "volume constraint particle out of range" : "a volume constraint needs four distinct particles";
         const wb_volume_def d = { g->vol.alpha[i], true, g->vol.rest[i], g->vol.plastic[2 * i], g->vol.plastic[2 * i + 1] };
         const char *e = wb_volume_def_check(&d);
         if (e) return e;
