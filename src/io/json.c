@@ -370,13 +370,14 @@ static int read_constraints(rd *r, const sections *s, const defaults *d, wb_imag
 /* "volumes": [ {"particles": [a, b, c, d], "rest": V, "compliance": alpha, "yield": y,
  * "creep": c}, ... ]: volume constraints (the tet's signed volume kept at rest, default the
  * particles' current one; yield and creep: plastic flow of the rest volume, 0 by default) */
-static int read_volumes(rd *r, const cJSON *arr, const defaults *d, wb_image *g)
+static int read_volumes(rd *r, const cJSON *arr, wb_image *g)
 {
     static const char *const keys[] = { "particles", "rest", "compliance", "yield", "creep", NULL };
     kp top = { NULL, "volumes", 0 };
-    int32_t i = 0;
-    (void)d;
+    int32_t i = 0, n;
     if (!arr) return 0;
+    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
+    if (wb_image_alloc_volumes(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
     for (const cJSON *c = arr->child; c; c = c->next, i++) {
         const cJSON *f[6];
         kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
@@ -408,6 +409,36 @@ static int read_volumes(rd *r, const cJSON *arr, const defaults *d, wb_image *g)
     }
     return 0;
 }
+
+/* "volumes" (only when there are any: a config without stays as it was) */
+static void write_volumes(jw_out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    if (g->vol.n == 0) return;
+    fputs("  \"volumes\": [", f);
+    for (int32_t i = 0; i < g->vol.n; i++) {
+        const int32_t *p = &g->vol.ijkl[4 * i];
+        fprintf(f, "%s    {\"particles\": [%d, %d, %d, %d], \"rest\": ", i ? ",\n" : "\n", p[0], p[1], p[2], p[3]);
+        jw_num(o, g->vol.rest[i]);
+        fputs(", \"compliance\": ", f);
+        jw_num(o, g->vol.alpha[i]);
+        jw_plastic(o, &g->vol.plastic[2 * i]);
+        fputc('}', f);
+    }
+    fputs("\n  ],\n", f);
+}
+
+/* the constraint types with a section of their own (json.h), in the order w:save writes
+ * them; each reads and writes its own */
+const jtype jtypes[] = {
+    { "volumes", read_volumes, write_volumes },
+    { "tets", jm_read_tets, jm_write_tets },
+    { "shape_matches", jm_read_shape_matches, jm_write_shape_matches },
+    { "pressures", jm_read_pressures, jm_write_pressures },
+    { "attachments", ja_read_attachments, ja_write_attachments },
+    { "grabs", ja_read_grabs, ja_write_grabs },
+};
+const int njtypes = (int)(sizeof jtypes / sizeof jtypes[0]);
 
 static const char *const shape_names[] = { "plane", "sphere", "box", "capsule", "mesh", NULL };
 
@@ -694,6 +725,14 @@ static int read_skins(rd *r, const sections *s, wbio_config *cfg)
 }
 
 /* ---- the file ---------------------------------------------------------------------------------- */
+/* each type's own section (jtypes), after the rigid bodies that attachments and grabs name */
+static int read_sections(rd *r, const cJSON *root, wb_image *g)
+{
+    for (int i = 0; i < njtypes; i++)
+        if (jtypes[i].read(r, cJSON_GetObjectItemCaseSensitive(root, jtypes[i].key), g)) return -1;
+    return 0;
+}
+
 static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
 {
     static const char *const keys[] = { "format", "version", "description", "defaults", "particles", "constraints",
@@ -747,25 +786,18 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
     }
     s.ncons -= s.nbend;
     s.snapshot = f[10];
-    int32_t nvol = 0;
-    kp volp = { NULL, "volumes", 0 };
-    if (f[11] && jv_get_array(r, f[11], &volp, WB_MAX_CONSTRAINTS, &nvol)) return -1;
     if (scan_snapshot(r, &s) || read_surfaces(r, &s, NULL, &s.ntri)) return -1;
     if (wb_image_alloc(&cfg->img, s.np, s.nd, s.nfree, s.nc, s.nsurf, s.ntri) != WB_OK ||
         (s.nbend > 0 && wb_image_alloc_bends(&cfg->img, s.nbend) != WB_OK) ||
         !(cfg->parts = calloc((size_t)s.nparts + 1, sizeof *cfg->parts)) ||
-        !(cfg->skins = calloc((size_t)s.nskins + 1, sizeof *cfg->skins)) ||
-        wb_image_alloc_volumes(&cfg->img, nvol) != WB_OK)
+        !(cfg->skins = calloc((size_t)s.nskins + 1, sizeof *cfg->skins)))
         return jv_fail(r, NULL, 0, NULL, "out of memory");
     cfg->snapshot = s.snapshot != NULL;
     /* the snapshot first: its slot tables say where the constraints and colliders go */
     if ((s.snapshot && read_snapshot(r, &s, &cfg->img)) || read_particles(r, &s, &d, &cfg->img) ||
         read_constraints(r, &s, &d, &cfg->img) || read_colliders(r, &s, &cfg->img) ||
         read_surfaces(r, &s, &cfg->img, &s.ntri) || read_parts(r, &s, cfg) || read_skins(r, &s, cfg) ||
-        read_volumes(r, f[11], &d, &cfg->img) || jm_read_shape_matches(r, f[12], &cfg->img) ||
-        jm_read_pressures(r, f[13], &cfg->img) || jm_read_tets(r, f[14], &cfg->img) ||
-        jr_read_rigids(r, f[17], &cfg->img) || /* before the attachments that name them */
-        ja_read_attachments(r, f[15], &cfg->img) || ja_read_grabs(r, f[16], &cfg->img))
+        jr_read_rigids(r, f[17], &cfg->img) || read_sections(r, root, &cfg->img))
         return -1;
     /* every value was checked where it was read: this is the last line of defence */
     const char *e = wb_image_check(&cfg->img);

@@ -186,3 +186,66 @@ int jm_read_tets(rd *r, const cJSON *arr, wb_image *g)
     }
     return 0;
 }
+
+/* ---- writing (w:save) ------------------------------------------------------------------------ */
+/* "tets": Neo-Hookean tets with their rest state (only when present) */
+void jm_write_tets(jw_out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    if (g->tet.n == 0) return;
+    fputs("  \"tets\": [", f);
+    for (int32_t i = 0; i < g->tet.n; i++) {
+        const int32_t *p = &g->tet.ijkl[4 * i];
+        fprintf(f, "%s    {\"particles\": [%d, %d, %d, %d], \"young\": ", i ? ",\n" : "\n", p[0], p[1], p[2], p[3]);
+        jw_num(o, g->tet.young[i]);
+        fputs(", \"poisson\": ", f);
+        jw_num(o, g->tet.poisson[i]);
+        fputs(", \"rest_volume\": ", f);
+        jw_num(o, g->tet.v0[i]);
+        fputs(", \"rest_inverse\": ", f);
+        jw_vec(o, &g->tet.dminv[9 * i], 9);
+        jw_plastic(o, &g->tet.plastic[2 * i]);
+        fputc('}', f);
+    }
+    fputs("\n  ],\n", f);
+}
+
+/* "shape_matches": only when present, with the rest shapes and rotations (the exact restore) */
+void jm_write_shape_matches(jw_out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    const wb_image_smatch *s = &g->sm;
+    for (int32_t k = 0; k < s->n; k++) {
+        const int32_t a = s->start[k], b = s->start[k + 1];
+        fputs(k ? ",\n    {\"particles\": " : "  \"shape_matches\": [\n    {\"particles\": ", f);
+        jw_ints(f, "      ", NULL, &s->ids[a], b - a);
+        fputs(", \"stiffness\": ", f);
+        jw_num(o, s->stiff[k]);
+        fputs(", \"yield\": ", f);
+        jw_num(o, s->yield[k]);
+        fputs(", \"creep\": ", f);
+        jw_num(o, s->creep[k]);
+        fputs(",\n     \"rest\": ", f);
+        jw_vec(o, &s->rest[3 * (int64_t)a], 3 * (b - a));
+        fputs(", \"rotation\": ", f);
+        jw_vec(o, &s->q[4 * k], 4);
+        fputc('}', f);
+    }
+    if (s->n) fputs("\n  ],\n", f);
+}
+
+/* "pressures": only when present, with the rest volumes */
+void jm_write_pressures(jw_out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    for (int32_t k = 0; k < g->pr.n; k++) {
+        fprintf(f, "%s    {\"surface\": %d, \"pressure\": ", k ? ",\n" : "  \"pressures\": [\n", g->pr.surface[k]);
+        jw_num(o, g->pr.pressure[k]);
+        fputs(", \"compliance\": ", f);
+        jw_num(o, g->pr.alpha[k]);
+        fputs(", \"rest_volume\": ", f);
+        jw_num(o, g->pr.v0[k]);
+        fputc('}', f);
+    }
+    if (g->pr.n) fputs("\n  ],\n", f);
+}
