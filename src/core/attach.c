@@ -54,7 +54,7 @@ wb_status wb__attach_reserve(wb_world *w, int64_t extra)
     if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     if (need <= a->cap) return WB_OK;
     const int32_t cap = wb__grown_cap(a->cap, need, 16);
-    if (!wb__material_charge(w, &a->charged, (size_t)cap * ATTACH_BYTES)) return WB_ERR_NOMEM;
+    if (!wb__charge(w, &a->charged, (size_t)cap * ATTACH_BYTES)) return WB_ERR_NOMEM;
     const wb_soa arr[] = {
         { (void **)&a->p, sizeof(int32_t) }, { (void **)&a->kind, 1 }, { (void **)&a->tindex, sizeof(int32_t) },
         { (void **)&a->tgen, sizeof(uint32_t) }, { (void **)&a->local, 3 * sizeof(wb_real) },
@@ -356,7 +356,7 @@ static wb_status att_prepare(wb_world *w)
     a->skip_col = col;
     /* charged like the attachments (a million particles make it 4 MB); past the budget
      * the step fails and the table stays built-but-unused until the world goes */
-    if (!wb__material_charge(w, &a->skip_charged, sizeof(int32_t) * ((size_t)a->cap_start + (size_t)a->cap_col))) {
+    if (!wb__charge(w, &a->skip_charged, sizeof(int32_t) * ((size_t)a->cap_start + (size_t)a->cap_col))) {
         a->skip_np = 0;
         return WB_ERR_NOMEM;
     }

@@ -79,18 +79,7 @@ static wb_real wrap(wb_real d)
 }
 
 /* ---- memory --------------------------------------------------------------------------------- */
-static int charge(wb_world *w, int32_t cap)
-{
-    wb_memory *mem = w->m.def.memory;
-    wb_bends *b = &w->bend;
-    if (!mem) return 1;
-    const double want = (double)cap * BEND_BYTES;
-    const double used = (double)mem->used - (double)b->charged + want;
-    if (mem->limit > 0 && used > (double)mem->limit) return 0;
-    mem->used = (size_t)used;
-    b->charged = (size_t)want;
-    return 1;
-}
+static int charge(wb_world *w, int32_t cap) { return wb__charge(w, &w->bend.charged, (size_t)cap * BEND_BYTES); }
 
 static wb_status grow(wb_world *w, int32_t need)
 {

@@ -39,7 +39,7 @@ wb_status wb__grab_reserve(wb_world *w, int64_t extra)
     if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     if (need <= g->cap) return WB_OK;
     const int32_t cap = wb__grown_cap(g->cap, need, 16);
-    if (!wb__material_charge(w, &g->charged, (size_t)cap * GRAB_BYTES)) return WB_ERR_NOMEM;
+    if (!wb__charge(w, &g->charged, (size_t)cap * GRAB_BYTES)) return WB_ERR_NOMEM;
     const wb_soa arr[] = {
         { (void **)&g->p, sizeof(int32_t) }, { (void **)&g->alpha, sizeof(wb_real) },
         { (void **)&g->kind, 1 }, { (void **)&g->tgen, sizeof(uint32_t) }, { (void **)&g->local, 3 * sizeof(wb_real) },

@@ -45,7 +45,7 @@ static wb_status reserve(wb_world *w, int64_t n_extra, int64_t nv_extra, int64_t
     const int32_t cn = n <= p->cap ? p->cap : wb__grown_cap(p->cap, n, 16);
     const int32_t cv = nv <= p->cap_verts ? p->cap_verts : wb__grown_cap(p->cap_verts, nv, 16);
     const int32_t ct = nt <= p->cap_tri ? p->cap_tri : wb__grown_cap(p->cap_tri, nt, 16);
-    if (!wb__material_charge(w, &p->charged, (size_t)cn * BYTES_P + (size_t)cv * BYTES_V + (size_t)ct * BYTES_T))
+    if (!wb__charge(w, &p->charged, (size_t)cn * BYTES_P + (size_t)cv * BYTES_V + (size_t)ct * BYTES_T))
         return WB_ERR_NOMEM;
     const wb_soa per[] = {
         { (void **)&p->surface, sizeof(int32_t) }, { (void **)&p->pressure, sizeof(wb_real) },

@@ -53,18 +53,6 @@
 #define BYTES_CLUSTER (4 + 11 * sizeof(wb_real))
 #define BYTES_ID (4 + 6 * sizeof(wb_real))
 
-int wb__material_charge(wb_world *w, size_t *charged, size_t want)
-{
-    wb_memory *mem = w->m.def.memory;
-    if (mem) {
-        const double used = (double)mem->used - (double)*charged + (double)want;
-        if (mem->limit > 0 && used > (double)mem->limit) return 0;
-        mem->used = (size_t)used;
-    }
-    *charged = want;
-    return 1;
-}
-
 /* room for n_extra more clusters of ids_extra particles in all; after it, adding them
  * cannot fail */
 static wb_status reserve(wb_world *w, int64_t n_extra, int64_t ids_extra)
@@ -75,7 +63,7 @@ static wb_status reserve(wb_world *w, int64_t n_extra, int64_t ids_extra)
     if (nc + 1 <= sm->cap && ni <= sm->cap_ids) return WB_OK;
     const int32_t cc = nc + 1 <= sm->cap ? sm->cap : wb__grown_cap(sm->cap, nc + 1, 16);
     const int32_t ci = ni <= sm->cap_ids ? sm->cap_ids : wb__grown_cap(sm->cap_ids, ni, 16);
-    if (!wb__material_charge(w, &sm->charged, (size_t)cc * BYTES_CLUSTER + (size_t)ci * BYTES_ID)) return WB_ERR_NOMEM;
+    if (!wb__charge(w, &sm->charged, (size_t)cc * BYTES_CLUSTER + (size_t)ci * BYTES_ID)) return WB_ERR_NOMEM;
     const wb_soa clusters[] = {
         { (void **)&sm->start, sizeof(int32_t) }, { (void **)&sm->stiff, sizeof(wb_real) },
         { (void **)&sm->yield, sizeof(wb_real) }, { (void **)&sm->creep, sizeof(wb_real) },

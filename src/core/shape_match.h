@@ -62,8 +62,5 @@ typedef struct wb_image_pressure {
     wb_real *pressure, *alpha, *v0; /* (n) factor, compliance, rest volume */
 } wb_image_pressure;
 
-/* charge `want` bytes in place of *charged to the world's budget; 0 (nothing charged)
- * when it would pass the limit */
-int wb__material_charge(struct wb_world *w, size_t *charged, size_t want);
 
 #endif

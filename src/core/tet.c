@@ -77,7 +77,7 @@ wb_status wb__tet_reserve(wb_world *w, int64_t extra)
     if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     if (need <= v->cap) return WB_OK;
     const int32_t cap = wb__grown_cap(v->cap, need, 64);
-    if (!wb__material_charge(w, &v->charged, (size_t)cap * TET_BYTES)) return WB_ERR_NOMEM;
+    if (!wb__charge(w, &v->charged, (size_t)cap * TET_BYTES)) return WB_ERR_NOMEM;
     const wb_soa arr[] = {
         { (void **)&v->ijkl, 4 * sizeof(int32_t) }, { (void **)&v->dminv, 9 * sizeof(wb_real) },
         { (void **)&v->v0, sizeof(wb_real) }, { (void **)&v->young, sizeof(wb_real) },

@@ -51,7 +51,7 @@ const char *wb_volume_def_check(const wb_volume_def *d)
 
 /* room for `extra` more constraints, charged to the memory budget: refused, nothing made,
  * when it would pass the budget (a failed allocation leaves the larger charge until the
- * next reserve, as wb__material_charge's other users do) */
+ * next reserve, as wb__charge's other users do) */
 wb_status wb__volume_reserve(wb_world *w, int64_t extra)
 {
     wb_volumes *v = w->vol;
@@ -64,7 +64,7 @@ wb_status wb__volume_reserve(wb_world *w, int64_t extra)
     if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     if (need <= v->cap) return WB_OK;
     const int32_t cap = wb__grown_cap(v->cap, need, 64);
-    if (!wb__material_charge(w, &v->charged, (size_t)cap * VOLUME_BYTES)) return WB_ERR_NOMEM;
+    if (!wb__charge(w, &v->charged, (size_t)cap * VOLUME_BYTES)) return WB_ERR_NOMEM;
     const wb_soa arr[] = {
         { (void **)&v->ijkl, 4 * sizeof(int32_t) }, { (void **)&v->alpha, sizeof(wb_real) },
         { (void **)&v->rest, sizeof(wb_real) }, { (void **)&v->lambda, sizeof(wb_real) },

@@ -188,18 +188,22 @@ int64_t wb_world_frame(const wb_world *w) { return w->s.frame; }
 #define PARTICLE_BYTES (25 * sizeof(wb_real) + 5 + 8 + 5)
 #define CONSTRAINT_BYTES (14 * sizeof(wb_real) + 42)
 
-/* charge the arrays at capacities (cap_p, cap_d) to the budget; 0 when it would pass
- * the limit (nothing charged then) */
-static int charge(wb_world *w, int64_t cap_p, int64_t cap_d)
+int wb__charge(wb_world *w, size_t *charged, size_t want)
 {
     wb_memory *mem = w->m.def.memory;
-    if (!mem) return 1;
-    const double want = (double)cap_p * PARTICLE_BYTES + (double)cap_d * CONSTRAINT_BYTES;
-    const double used = (double)mem->used - (double)w->m.charged + want;
-    if (mem->limit > 0 && used > (double)mem->limit) return 0;
-    mem->used = (size_t)used;
-    w->m.charged = (size_t)want;
+    if (mem) {
+        const double used = (double)mem->used - (double)*charged + (double)want;
+        if (mem->limit > 0 && used > (double)mem->limit) return 0;
+        mem->used = (size_t)used;
+    }
+    *charged = want;
     return 1;
+}
+
+/* the particles' and distances' arrays at capacities (cap_p, cap_d), charged together */
+static int charge(wb_world *w, int64_t cap_p, int64_t cap_d)
+{
+    return wb__charge(w, &w->m.charged, (size_t)cap_p * PARTICLE_BYTES + (size_t)cap_d * CONSTRAINT_BYTES);
 }
 
 /* every per-particle array grows together; on failure nothing is lost */
