@@ -6,12 +6,6 @@
 #include <stdlib.h>
 
 #include "core.h"
-#include "bvh.h"
-#include "volume.h"
-#include "tet.h"
-#include "attach.h"
-#include "grab.h"
-#include "rigid.h"
 
 static _Thread_local char wb_err[256];
 
