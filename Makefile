@@ -81,8 +81,14 @@ else
   quiet = @printf '  %-4s %s\n' $(1) $(2);
 endif
 
-$(BUILD)/obj/%.o: src/%.c $(HEADERS) | $(addprefix $(BUILD)/obj/,$(LAYERS))
-	$(call quiet,CC,$<)$(CC) $(CFLAGS) $(PC_CFLAGS) -c $< -o $@
+# each object lists the headers it really includes in its .d (-MMD; -MP: a deleted header
+# is no error), so touching a header rebuilds its dependents only. An object without its
+# .d (a build from before) is rebuilt once: the empty rule makes a missing .d a new one
+$(BUILD)/obj/%.o: src/%.c $(BUILD)/obj/%.d | $(addprefix $(BUILD)/obj/,$(LAYERS))
+	$(call quiet,CC,$<)$(CC) $(CFLAGS) $(PC_CFLAGS) -MMD -MP -c $< -o $@
+DEPS := $(CORE_OBJ:.o=.d) $(APP_OBJ:.o=.d)
+$(DEPS):
+include $(wildcard $(DEPS))
 
 $(addprefix $(BUILD)/obj/,$(LAYERS)):
 	@mkdir -p $@
@@ -171,9 +177,12 @@ $(BUILD)/fuzz_%_replay: tests/fuzz/fuzz_json.c tests/fuzz/fuzz_mesh.c tests/fuzz
 	$(call quiet,CCLD,$@)$(CC) $(CFLAGS) $(PC_CFLAGS) $(call fuzz_def,$*) -o $@ $(call fuzz_src,$*) tests/fuzz/replay.c \
 	  $(IO_OBJ) $(BUILD)/libwobble.a $(LDFLAGS) $(PC_LIBS) -lm
 
-$(FUZZ_BUILD)/obj/%.o: src/%.c $(HEADERS)
+$(FUZZ_BUILD)/obj/%.o: src/%.c $(FUZZ_BUILD)/obj/%.d
 	@mkdir -p $(dir $@)
-	$(call quiet,CC,$<)$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link $(FUZZ_SAN) $(PC_CFLAGS) -c $< -o $@
+	$(call quiet,CC,$<)$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link $(FUZZ_SAN) $(PC_CFLAGS) -MMD -MP -c $< -o $@
+FUZZ_DEPS := $(FUZZ_OBJ:.o=.d)
+$(FUZZ_DEPS):
+include $(wildcard $(FUZZ_DEPS))
 
 $(FUZZ_BUILD)/fuzz_%: tests/fuzz/fuzz_json.c tests/fuzz/fuzz_mesh.c $(FUZZ_OBJ)
 	$(call quiet,CCLD,$@)$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer $(FUZZ_SAN) $(PC_CFLAGS) $(call fuzz_def,$*) -o $@ \

@@ -54,7 +54,7 @@ wb_status wb__attach_reserve(wb_world *w, int64_t extra)
     if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     if (need <= a->cap) return WB_OK;
     const int32_t cap = wb__grown_cap(a->cap, need, 16);
-    if (!wb__material_charge(w, &a->charged, (size_t)cap * ATTACH_BYTES)) return WB_ERR_NOMEM;
+    if (!wb__charge(w, &a->charged, (size_t)cap * ATTACH_BYTES)) return WB_ERR_NOMEM;
     const wb_soa arr[] = {
         { (void **)&a->p, sizeof(int32_t) }, { (void **)&a->kind, 1 }, { (void **)&a->tindex, sizeof(int32_t) },
         { (void **)&a->tgen, sizeof(uint32_t) }, { (void **)&a->local, 3 * sizeof(wb_real) },
@@ -248,7 +248,7 @@ int32_t wb_attach_list(const wb_world *w, wb_attach_id *out, int32_t cap)
 /* ---- images (snapshot.h) ------------------------------------------------------------- */
 static void *zalloc(int64_t n, size_t elem) { return calloc((size_t)(n > 0 ? n : 1), elem); }
 
-void wb__attach_image_free(wb_image *g)
+static void att_image_free(wb_image *g)
 {
     wb_image_attach *a = &g->att;
     free(a->p); free(a->kind); free(a->target); free(a->local); free(a->alpha);
@@ -257,7 +257,7 @@ void wb__attach_image_free(wb_image *g)
 
 wb_status wb_image_alloc_attach(wb_image *g, int32_t n)
 {
-    wb__attach_image_free(g);
+    att_image_free(g);
     wb_image_attach *a = &g->att;
     a->n = n;
     a->p = zalloc(n, sizeof *a->p);
@@ -266,11 +266,11 @@ wb_status wb_image_alloc_attach(wb_image *g, int32_t n)
     a->local = zalloc(3 * (int64_t)n, sizeof *a->local);
     a->alpha = zalloc(n, sizeof *a->alpha);
     if (a->p && a->kind && a->target && a->local && a->alpha) return WB_OK;
-    wb__attach_image_free(g);
+    att_image_free(g);
     return WB_ERR_NOMEM;
 }
 
-wb_status wb__attach_image_of(const wb_world *w, wb_image *g)
+static wb_status att_image_save(const wb_world *w, wb_image *g)
 {
     wb_status st = wb_image_alloc_attach(g, wb_attach_count(w));
     if (st != WB_OK) return st;
@@ -288,7 +288,7 @@ wb_status wb__attach_image_of(const wb_world *w, wb_image *g)
     return WB_OK;
 }
 
-const char *wb__attach_image_check(const wb_image *g)
+static const char *att_image_check(const wb_image *g)
 {
     const wb_image_attach *a = &g->att;
     if (a->n < 0 || a->n > WB_MAX_CONSTRAINTS) return "too many attachments";
@@ -309,13 +309,15 @@ const char *wb__attach_image_check(const wb_image *g)
     return NULL;
 }
 
-wb_status wb__attach_image_reserve(wb_world *w, const wb_image *g)
+static wb_status att_image_reserve(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
+    (void)at;
     return g->att.n > 0 ? wb__attach_reserve(w, g->att.n) : WB_OK;
 }
 
-void wb__attach_image_put(wb_world *w, const wb_image *g, int32_t pshift, const int32_t *cmap, const int32_t *rmap)
+static void att_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
+    const int32_t pshift = at->pshift, *cmap = at->cmap, *rmap = at->rmap;
     const wb_image_attach *a = &g->att;
     for (int32_t k = 0; k < a->n; k++) {
         const int rigid = a->kind[k] == WB_TARGET_RIGID;
@@ -354,7 +356,7 @@ static wb_status att_prepare(wb_world *w)
     a->skip_col = col;
     /* charged like the attachments (a million particles make it 4 MB); past the budget
      * the step fails and the table stays built-but-unused until the world goes */
-    if (!wb__material_charge(w, &a->skip_charged, sizeof(int32_t) * ((size_t)a->cap_start + (size_t)a->cap_col))) {
+    if (!wb__charge(w, &a->skip_charged, sizeof(int32_t) * ((size_t)a->cap_start + (size_t)a->cap_col))) {
         a->skip_np = 0;
         return WB_ERR_NOMEM;
     }
@@ -447,6 +449,55 @@ static wb_real att_energy(const wb_world *w)
     return e;
 }
 
+/* ---- teardown and hash (ctype.h) --------------------------------------------------------- */
+static void att_destroy(wb_world *w)
+{
+    wb_attaches *a = w->att;
+    if (!a) return;
+    void *p[] = { a->p, a->kind, a->tindex, a->tgen, a->local, a->alpha, a->gen, a->lambda,
+                  a->skip_start, a->skip_col };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    free(a);
+    w->att = NULL;
+}
+
+static size_t att_charged(const wb_world *w) { return w->att ? w->att->charged + w->att->skip_charged : 0; }
+
+/* the live ones in slot order (a snapshot keeps that order; it drops an attachment whose
+ * collider was removed, so the hash does too) */
+static uint64_t att_hash(const wb_world *w, uint64_t h)
+{
+    const wb_attaches *a = w->att;
+    for (int32_t i = 0; a && i < a->n; i++) {
+        if (!wb__attach_active(w, a, i)) continue;
+        h = wb__fnv(h, &a->p[i], sizeof a->p[i]);
+        h = wb__fnv(h, &a->kind[i], 1);
+        h = wb__fnv(h, &a->tindex[i], sizeof a->tindex[i]);
+        h = wb__fnv(h, &a->local[3 * i], 3 * sizeof(wb_real));
+        h = wb__fnv(h, &a->alpha[i], sizeof(wb_real));
+    }
+    return h;
+}
+
+static void att_stats(const wb_world *w, wb_stats *st)
+{
+    st->attachments = wb_attach_count(w);
+}
+
 const wb_ctype wb__attach_type = {
-    "attach", att_count, att_prepare, att_substep_begin, att_project, NULL, att_energy, NULL,
+    .name = "attach",
+    .count = att_count,
+    .prepare = att_prepare,
+    .substep_begin = att_substep_begin,
+    .project = att_project,
+    .energy = att_energy,
+    .destroy = att_destroy,
+    .charged = att_charged,
+    .stats = att_stats,
+    .hash = att_hash,
+    .image_free = att_image_free,
+    .image_save = att_image_save,
+    .image_check = att_image_check,
+    .image_reserve = att_image_reserve,
+    .image_put = att_image_put,
 };

@@ -59,19 +59,6 @@ static inline int wb__attach_skip(const wb_attaches *a, int32_t i, int32_t c)
     return 0;
 }
 
-/* world.c's destroy: arrays freed, budget given back (inline: no call between the files) */
-static inline void wb__attach_free(wb_world *w)
-{
-    wb_attaches *a = w->att;
-    if (!a) return;
-    if (w->m.def.memory) w->m.def.memory->used -= a->charged + a->skip_charged;
-    void *p[] = { a->p, a->kind, a->tindex, a->tgen, a->local, a->alpha, a->gen, a->lambda,
-                  a->skip_start, a->skip_col };
-    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
-    free(a);
-    w->att = NULL;
-}
-
 /* snapshot.c: room for `extra` more (charged), then put one (cannot fail after reserving) */
 wb_status wb__attach_reserve(wb_world *w, int64_t extra);
 void wb__attach_put(wb_world *w, int32_t p, int kind, int32_t tindex, uint32_t tgen, const wb_real local[3],

@@ -5,7 +5,12 @@
 #ifndef WB_BATCH_H
 #define WB_BATCH_H
 
-#include "core.h"
+#include "wobble.h"
+#include "bend.h" /* WB_MAX_COLOURS */
+
+/* no more of the core than names (core.h): volume.h and tet.h, which snapshot.h includes
+ * for their image sections, stay plain data for the file formats */
+typedef struct wb_model wb_model;
 
 typedef struct wb_batches {
     int32_t n;                                 /* constraints when coloured (-1: never) */

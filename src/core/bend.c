@@ -20,6 +20,7 @@
 #include <stdlib.h>
 
 #include "ctype.h"
+#include "snapshot.h"
 
 #define PI_R ((wb_real)3.14159265358979323846)
 
@@ -78,18 +79,7 @@ static wb_real wrap(wb_real d)
 }
 
 /* ---- memory --------------------------------------------------------------------------------- */
-static int charge(wb_world *w, int32_t cap)
-{
-    wb_memory *mem = w->m.def.memory;
-    wb_bends *b = &w->bend;
-    if (!mem) return 1;
-    const double want = (double)cap * BEND_BYTES;
-    const double used = (double)mem->used - (double)b->charged + want;
-    if (mem->limit > 0 && used > (double)mem->limit) return 0;
-    mem->used = (size_t)used;
-    b->charged = (size_t)want;
-    return 1;
-}
+static int charge(wb_world *w, int32_t cap) { return wb__charge(w, &w->bend.charged, (size_t)cap * BEND_BYTES); }
 
 static wb_status grow(wb_world *w, int32_t need)
 {
@@ -154,11 +144,8 @@ wb_bend_id wb_bend_add(wb_world *w, const int32_t p[4], const wb_bend_def *def, 
     wb_status dummy;
     if (!status) status = &dummy;
     const char *err = wb_bend_def_check(def);
-    for (int i = 0; i < 4 && !err; i++) {
-        if (p[i] < 0 || p[i] >= w->m.np) err = "particle out of range";
-        for (int j = 0; j < i && !err; j++)
-            if (p[i] == p[j]) err = "a bend needs four distinct particles";
-    }
+    const int q = err ? 0 : wb__quad_check(p, w->m.np);
+    if (q) err = q == 1 ? "particle out of range" : "a bend needs four distinct particles";
     int ok = 1;
     wb_real rest = def->rest;
     if (!err && isnan(rest)) {
@@ -655,6 +642,122 @@ static void bend_frame_end(wb_world *w)
 
 static void bend_links(const wb_world *w, wb_link_fn fn, void *ud) { wb__link_quads(w->bend.ij, w->bend.n, fn, ud); }
 
+/* ---- teardown, hash, snapshots (ctype.h) ------------------------------------------------ */
+static void bend_destroy(wb_world *w)
+{
+    wb_bends *b = &w->bend;
+    void *p[] = { b->ij, b->alpha, b->beta, b->rest, b->s_ij, b->s_slot, b->pack, b->lambda, b->btorque,
+                  b->broken, b->breaks };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+}
+
+static size_t bend_charged(const wb_world *w) { return w->bend.charged; }
+
+/* the broken ones' slots (state): a world without one adds nothing */
+static uint64_t bend_hash(const wb_world *w, uint64_t h)
+{
+    for (int32_t i = 0; i < w->bend.n; i++)
+        if (w->bend.broken[i]) h = wb__fnv(h, &i, sizeof i);
+    return h;
+}
+
+static void bend_image_free(wb_image *g)
+{
+    wb_image_bend *b = &g->bend;
+    free(b->ij); free(b->alpha); free(b->beta); free(b->rest); free(b->btorque); free(b->broken);
+    memset(b, 0, sizeof *b);
+}
+
+/* calloc of n elements, never of 0 bytes (so NULL always means out of memory) */
+static void *zalloc(int64_t n, size_t elem) { return calloc((size_t)(n > 0 ? n : 1), elem); }
+
+wb_status wb_image_alloc_bends(wb_image *g, int32_t n)
+{
+    bend_image_free(g);
+    wb_image_bend *b = &g->bend;
+    b->n = n;
+    b->ij = zalloc(4 * (int64_t)n, sizeof *b->ij);
+    b->alpha = zalloc(n, sizeof(wb_real));
+    b->beta = zalloc(n, sizeof(wb_real));
+    b->rest = zalloc(n, sizeof(wb_real));
+    b->btorque = zalloc(n, sizeof(wb_real));
+    b->broken = zalloc(n, 1);
+    if (b->ij && b->alpha && b->beta && b->rest && b->btorque && b->broken) return WB_OK;
+    bend_image_free(g);
+    return WB_ERR_NOMEM;
+}
+
+static wb_status bend_image_save(const wb_world *w, wb_image *g)
+{
+    const wb_bends *bd = &w->bend;
+    const size_t n = (size_t)bd->n;
+    if (n == 0) return WB_OK;
+    wb_status st = wb_image_alloc_bends(g, bd->n);
+    if (st != WB_OK) return st;
+    wb_image_bend *b = &g->bend;
+    memcpy(b->ij, bd->ij, 4 * n * sizeof *b->ij);
+    memcpy(b->alpha, bd->alpha, n * sizeof(wb_real));
+    memcpy(b->beta, bd->beta, n * sizeof(wb_real));
+    memcpy(b->rest, bd->rest, n * sizeof(wb_real));
+    memcpy(b->btorque, bd->btorque, n * sizeof(wb_real));
+    memcpy(b->broken, bd->broken, n);
+    return WB_OK;
+}
+
+static const char *bend_image_check(const wb_image *g)
+{
+    const wb_image_bend *b = &g->bend;
+    if (b->n < 0 || b->n > WB_MAX_CONSTRAINTS) return "too many bends";
+    for (int32_t i = 0; i < b->n; i++) {
+        const int q = wb__quad_check(&b->ij[4 * i], g->np);
+        if (q) return q == 1 ? "bend particle out of range" : "a bend needs four distinct particles";
+        const wb_bend_def d = { b->alpha[i], b->beta[i], b->rest[i], b->btorque[i] };
+        if (isnan(b->rest[i])) return "bend rest must be an angle in [-pi, pi] (radians)";
+        const char *e = wb_bend_def_check(&d);
+        if (e) return e;
+    }
+    return NULL;
+}
+
+static wb_status bend_image_reserve(wb_world *w, const wb_image *g, const wb_image_at *at)
+{
+    (void)at;
+    return wb__bend_reserve(w, g->bend.n);
+}
+
+/* a new world takes the arrays as they are; an appended image's bends are added one by
+ * one after w's (checked and reserved: that cannot fail) */
+static void bend_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
+{
+    const wb_image_bend *b = &g->bend;
+    wb_bends *bd = &w->bend;
+    const size_t n = (size_t)b->n;
+    if (n == 0) return;
+    if (at->exact) {
+        bd->n = b->n;
+        memcpy(bd->ij, b->ij, 4 * n * sizeof *bd->ij);
+        memcpy(bd->alpha, b->alpha, n * sizeof(wb_real));
+        memcpy(bd->beta, b->beta, n * sizeof(wb_real));
+        memcpy(bd->rest, b->rest, n * sizeof(wb_real));
+        memcpy(bd->btorque, b->btorque, n * sizeof(wb_real));
+        memcpy(bd->broken, b->broken, n);
+        bd->dirty = 1;
+        return;
+    }
+    for (int32_t i = 0; i < b->n; i++) {
+        int32_t p[4];
+        for (int k = 0; k < 4; k++) p[k] = b->ij[4 * i + k] + at->pshift;
+        const wb_bend_def d = { b->alpha[i], b->beta[i], b->rest[i], b->btorque[i] };
+        const wb_bend_id id = wb_bend_add(w, p, &d, NULL);
+        bd->broken[id.index - 1] = b->broken[i];
+    }
+}
+
+static void bend_stats(const wb_world *w, wb_stats *st)
+{
+    st->bends = wb_bend_count(w);
+}
+
 const wb_ctype wb__bend_type = {
     .name = "bend",
     .count = bend_count,
@@ -664,6 +767,15 @@ const wb_ctype wb__bend_type = {
     .frame_end = bend_frame_end,
     .energy = bend_energy,
     .links = bend_links,
+    .destroy = bend_destroy,
+    .charged = bend_charged,
+    .stats = bend_stats,
+    .hash = bend_hash,
+    .image_free = bend_image_free,
+    .image_save = bend_image_save,
+    .image_check = bend_image_check,
+    .image_reserve = bend_image_reserve,
+    .image_put = bend_image_put,
 };
 
 /* ---- hinges of a triangle list ----------------------------------------------------------------- */

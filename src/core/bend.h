@@ -1,4 +1,5 @@
-/* bend.h: the bending constraints' arrays (bend.c), one member of struct wb_world. */
+/* bend.h: the bending constraints' arrays (bend.c), one member of struct wb_world, and
+ * their section of a snapshot image (snapshot.h). */
 #ifndef WB_BEND_H
 #define WB_BEND_H
 
@@ -37,5 +38,15 @@ typedef struct wb_bends {
     int32_t *pack;         /* (n) packed index of each slot */
     wb_real *lambda;       /* (n) multipliers of the current substep, by packed index */
 } wb_bends;
+
+/* a snapshot image's bends, in creation order: plain data (the JSON files read and write
+ * it); allocated by wb_image_alloc_bends */
+typedef struct wb_image_bend {
+    int32_t n;
+    int32_t *ij;           /* (n x 4) hinge p1 p2, wings p3 p4 */
+    wb_real *alpha, *beta, *rest; /* (n) compliance, damping, rest angle */
+    wb_real *btorque;      /* (n) break_torque, N m (0: never) */
+    uint8_t *broken;       /* (n) broken by it */
+} wb_image_bend;
 
 #endif

@@ -27,6 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core.h"
 #include "batch.h"
 
 /* the visiting order: 0 creation order (tests: the colouring before mirror keys), 1 keys */

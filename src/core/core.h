@@ -712,6 +712,9 @@ wb_status wb__surface_reserve(wb_world *w, int32_t ntri);
  * lazily, the same pool from call to call. A cache: callable on a const world */
 wb_pool *wb__world_pool(const wb_world *w);
 void *wb__grow(void *ptr, int32_t *cap, int32_t need, size_t elem); /* world.c: realloc helper */
+/* world.c, the one budget routine: charge `want` bytes in place of *charged to the world's
+ * memory budget (def.memory); 0 (nothing charged) when it would pass the limit */
+int wb__charge(wb_world *w, size_t *charged, size_t want);
 /* one array of a structure of arrays: where its pointer is, the bytes of an element */
 typedef struct { void **p; size_t elem; } wb_soa;
 /* world.c: each of the n arrays reallocated to cap elements; WB_ERR_NOMEM when one fails

@@ -1,5 +1,6 @@
-/* ctype.c: the table of constraint types (ctype.h). It is a file of its own because the
- * step (solver.c) and the contact rules (broadphase.c) both walk it. */
+/* ctype.c: the tables of constraint types (ctype.h). A file of its own because the step
+ * (solver.c), the contact rules (broadphase.c), the teardown (destroy.c), the hash
+ * (query.c) and the snapshots (snapshot.c) all walk them. */
 #include "ctype.h"
 
 /* the constraint types the step walks, in projection order (ctype.h; docs/architecture.md,
@@ -15,3 +16,19 @@ const wb_ctype *const wb__ctypes[] = {
     &wb__grab_type,
 };
 const int wb__nctypes = (int)(sizeof wb__ctypes / sizeof wb__ctypes[0]);
+
+/* the order w:hash() has always fed the types in (query.c): saved hashes compare only
+ * while it stays, so it is not the projection order. NULL: the colliders' poses */
+const wb_ctype *const wb__ctypes_hashed[] = {
+    &wb__distance_type,
+    NULL,
+    &wb__bend_type,
+    &wb__shape_type,
+    &wb__pressure_type,
+    &wb__volume_type,
+    &wb__tet_type,
+    &wb__attach_type,
+    &wb__grab_type,
+};
+_Static_assert(sizeof wb__ctypes_hashed / sizeof wb__ctypes_hashed[0] == sizeof wb__ctypes / sizeof wb__ctypes[0] + 1,
+               "every type has its place in the hash");

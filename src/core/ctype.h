@@ -1,10 +1,29 @@
-/* ctype.h: the constraint-type table, so the step need not know each type. One file per
- * type in src/core/; the step walks wb__ctypes[] in order. */
+/* ctype.h: the constraint-type table (docs/architecture.md). One file per type in src/core/;
+ * the step walks wb__ctypes[] in order, and so do the world's teardown (destroy.c), its
+ * hash (query.c) and its snapshots (snapshot.c): a type's file is the one place that
+ * names its arrays. */
 #ifndef WB_CTYPE_H
 #define WB_CTYPE_H
 #include "core.h"
 
 typedef void (*wb_link_fn)(void *ud, int32_t a, int32_t b, int joined);
+typedef struct wb_image wb_image; /* snapshot.h */
+
+/* where an image's items go in the world they are put into (snapshot.c) */
+typedef struct wb_image_at {
+    int exact;                  /* 1: a new world, the image's slots as they are; 0: appended */
+    int32_t pshift, sshift;     /* added to the image's particle and surface indices */
+    const int32_t *cmap, *rmap; /* the image's collider and rigid slots -> the world's (NULL:
+                                   the same slots) */
+} wb_image_at;
+
+/* FNV-1a over n bytes: w:hash() and each type's part of it */
+static inline uint64_t wb__fnv(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++) { h ^= b[i]; h *= 1099511628211ull; }
+    return h;
+}
 
 typedef struct wb_ctype {
     const char *name;                                  /* "distance", "bend", "volume", ... */
@@ -21,6 +40,26 @@ typedef struct wb_ctype {
      * docs/physics.md, "Contacts"); 0: they are one graph only (a cluster's chain).
      * May be NULL: none */
     void (*links)(const wb_world *w, wb_link_fn fn, void *ud);
+
+    /* the world's teardown: free the type's arrays (the world is freed after) */
+    void (*destroy)(wb_world *w);
+    /* bytes it has charged to def.memory (given back at teardown); may be NULL: its bytes
+     * are charged with the particles' */
+    size_t (*charged)(const wb_world *w);
+    /* its counts in w:stats() (its fields of wb_stats) */
+    void (*stats)(const wb_world *w, wb_stats *st);
+    /* its part of w:hash(), fed into h: the bytes and order the hash has always had, so
+     * that saved hashes still compare (a world without any of the type adds nothing) */
+    uint64_t (*hash)(const wb_world *w, uint64_t h);
+    /* its section of a snapshot image (snapshot.h): free it (fine when empty), copy the
+     * world's into it, check it (the image's particles, colliders, surfaces and rigid
+     * bodies already checked: NULL or what is wrong), make room in w for it (adding
+     * nothing), then put it (after reserving: cannot fail) */
+    void (*image_free)(wb_image *g);
+    wb_status (*image_save)(const wb_world *w, wb_image *g);
+    const char *(*image_check)(const wb_image *g);
+    wb_status (*image_reserve)(wb_world *w, const wb_image *g, const wb_image_at *at);
+    void (*image_put)(wb_world *w, const wb_image *g, const wb_image_at *at);
 } wb_ctype;
 
 /* the links of n elements of four particles each (q: n x 4): every pair of an element's
@@ -32,6 +71,19 @@ static inline void wb__link_quads(const int32_t *q, int32_t n, wb_link_fn fn, vo
             for (int b = a + 1; b < 4; b++) fn(ud, q[4 * e + a], q[4 * e + b], 1);
 }
 
+/* the four corners of an element (a bend, a volume, a tet): 0 when each is a particle of
+ * [0, np) and no two are one; else, at the first corner that is not, 1 (out of range) or
+ * 2 (repeated). The API and the snapshot checks share it */
+static inline int wb__quad_check(const int32_t p[4], int32_t np)
+{
+    for (int k = 0; k < 4; k++) {
+        if (p[k] < 0 || p[k] >= np) return 1;
+        for (int j = 0; j < k; j++)
+            if (p[j] == p[k]) return 2;
+    }
+    return 0;
+}
+
 extern const wb_ctype wb__distance_type, wb__bend_type, wb__volume_type,
                       wb__shape_type, wb__pressure_type, wb__tet_type;
 extern const wb_ctype wb__attach_type, wb__grab_type; /* attach.c, grab.c */
@@ -39,4 +91,7 @@ extern const wb_ctype wb__attach_type, wb__grab_type; /* attach.c, grab.c */
 /* the table the step walks (solver.c), in projection order, and its length */
 extern const wb_ctype *const wb__ctypes[];
 extern const int wb__nctypes;
+/* the same types in the order w:hash() feeds them in (query.c), wb__nctypes + 1 entries:
+ * NULL stands for the colliders' poses */
+extern const wb_ctype *const wb__ctypes_hashed[];
 #endif

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 
 #include "ctype.h"
+#include "snapshot.h"
 #include "tet.h"
 #include "volume.h"
 
@@ -746,6 +747,199 @@ static void distance_links(const wb_world *w, wb_link_fn fn, void *ud)
         if (m->d_gen[s] & 1u) fn(ud, m->d_ij[2 * s], m->d_ij[2 * s + 1], 1);
 }
 
+/* ---- teardown and hash (ctype.h) ----------------------------------------------------------- */
+/* its model and state arrays live in the world's (core.h: they grow with the particles'
+ * budget, world.c), its cache in the solver cache */
+static void distance_destroy(wb_world *w)
+{
+    wb_model *m = &w->m;
+    wb_state *s = &w->s;
+    wb_cache *k = &w->k;
+    void *p[] = { m->d_ij, m->d_alpha, m->d_beta, m->d_yield, m->d_creep, m->d_break, m->d_bforce, m->d_gen,
+                  m->d_free, s->d_rest, s->d_broken, k->colour_start, k->comp_start, k->s_a, k->s_b, k->s_rest,
+                  k->s_alpha, k->s_beta, k->s_lambda, k->s_jac, k->s_slot, k->slot_pack, k->breaks };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+}
+
+/* the live ones' state (rest lengths, broken flags) in slot order */
+static uint64_t distance_hash(const wb_world *w, uint64_t h)
+{
+    const wb_model *m = &w->m;
+    const wb_state *s = &w->s;
+    for (int32_t i = 0; i < m->nd; i++) {
+        if (!(m->d_gen[i] & 1u)) continue;
+        h = wb__fnv(h, &s->d_rest[i], sizeof s->d_rest[i]);
+        h = wb__fnv(h, &s->d_broken[i], 1);
+    }
+    return h;
+}
+
+static void distance_image_free(wb_image *g)
+{
+    wb_image_distance *d = &g->dist;
+    void *p[] = { d->ij, d->alpha, d->beta, d->yield, d->creep, d->break_strain, d->rest, d->bforce, d->broken,
+                  d->gen, d->free_slots };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    memset(d, 0, sizeof *d);
+}
+
+/* calloc of n elements, never of 0 bytes (so NULL always means out of memory) */
+static void *zalloc(int64_t n, size_t elem) { return calloc((size_t)(n > 0 ? n : 1), elem); }
+
+wb_status wb_image_alloc_distances(wb_image *g, int32_t nd, int32_t nfree)
+{
+    distance_image_free(g);
+    wb_image_distance *d = &g->dist;
+    d->n = nd;
+    d->nfree = nfree;
+    d->ij = zalloc(2 * (int64_t)nd, sizeof *d->ij);
+    wb_real **r[] = { &d->alpha, &d->beta, &d->yield, &d->creep, &d->break_strain, &d->rest, &d->bforce };
+    int ok = d->ij != NULL;
+    for (size_t k = 0; k < sizeof r / sizeof r[0]; k++) ok &= (*r[k] = zalloc(nd, sizeof(wb_real))) != NULL;
+    d->broken = zalloc(nd, 1);
+    d->gen = zalloc(nd, sizeof *d->gen);
+    d->free_slots = zalloc(nfree, sizeof *d->free_slots);
+    if (!ok || !d->broken || !d->gen || !d->free_slots) {
+        distance_image_free(g);
+        return WB_ERR_NOMEM;
+    }
+    for (int32_t i = 0; i < nd; i++) d->gen[i] = 1;
+    return WB_OK;
+}
+
+static wb_status distance_image_save(const wb_world *w, wb_image *g)
+{
+    const wb_model *m = &w->m;
+    const wb_state *s = &w->s;
+    wb_status st = wb_image_alloc_distances(g, m->nd, m->nfree);
+    if (st != WB_OK || m->nd == 0) return st;
+    wb_image_distance *d = &g->dist;
+    const size_t n = (size_t)m->nd;
+    memcpy(d->ij, m->d_ij, 2 * n * sizeof *d->ij);
+    memcpy(d->alpha, m->d_alpha, n * sizeof(wb_real));
+    memcpy(d->beta, m->d_beta, n * sizeof(wb_real));
+    memcpy(d->yield, m->d_yield, n * sizeof(wb_real));
+    memcpy(d->creep, m->d_creep, n * sizeof(wb_real));
+    memcpy(d->break_strain, m->d_break, n * sizeof(wb_real));
+    memcpy(d->bforce, m->d_bforce, n * sizeof(wb_real));
+    memcpy(d->rest, s->d_rest, n * sizeof(wb_real));
+    memcpy(d->broken, s->d_broken, n);
+    memcpy(d->gen, m->d_gen, n * sizeof *d->gen);
+    if (m->nfree) memcpy(d->free_slots, m->d_free, (size_t)m->nfree * sizeof *d->free_slots);
+    return WB_OK;
+}
+
+static wb_distance_def image_def(const wb_image_distance *d, int32_t i)
+{
+    const wb_distance_def def = { d->alpha[i], d->beta[i], d->rest[i], d->yield[i], d->creep[i], d->break_strain[i],
+                                  d->bforce[i] };
+    return def;
+}
+
+/* the live slots' constraints; *dead counts the others */
+static const char *check_live(const wb_image *g, int32_t *dead)
+{
+    const wb_image_distance *d = &g->dist;
+    for (int32_t i = 0; i < d->n; i++) {
+        if (!(d->gen[i] & 1u)) { ++*dead; continue; }
+        const int32_t a = d->ij[2 * i], b = d->ij[2 * i + 1];
+        if (a < 0 || b < 0 || a >= g->np || b >= g->np) return "constraint particle out of range";
+        if (a == b) return "a constraint needs two distinct particles";
+        const wb_distance_def def = image_def(d, i);
+        const char *e = wb_distance_def_check(&def);
+        if (e) return e;
+        if (!(d->rest[i] >= 0)) return "rest length must be >= 0";
+        wb_real dx[3];
+        v3_sub(dx, &g->x[3 * b], &g->x[3 * a]);
+        if (!isfinite(v3_dot(dx, dx))) return "constraint particles are too far apart (their distance squared overflows)";
+    }
+    return NULL;
+}
+
+static const char *distance_image_check(const wb_image *g)
+{
+    const wb_image_distance *d = &g->dist;
+    if (d->n < 0 || d->n > WB_MAX_CONSTRAINTS) return "too many constraints";
+    int32_t dead = 0;
+    const char *e = check_live(g, &dead);
+    if (e) return e;
+    /* the free list is exactly the dead slots, each once (a mark per slot: linear) */
+    if (d->nfree != dead) return "the free constraint slots do not match the dead ones";
+    if (d->nfree == 0) return NULL;
+    uint8_t *seen = calloc((size_t)d->n, 1);
+    if (!seen) return "out of memory checking the free constraint slots";
+    for (int32_t i = 0; i < d->nfree && !e; i++) {
+        const int32_t s = d->free_slots[i];
+        if (s < 0 || s >= d->n || (d->gen[s] & 1u)) e = "a free constraint slot is not a dead one";
+        else if (seen[s]++) e = "a free constraint slot is listed twice";
+    }
+    free(seen);
+    return e;
+}
+
+/* a new world: every slot; appended: the live ones */
+static wb_status distance_image_reserve(wb_world *w, const wb_image *g, const wb_image_at *at)
+{
+    const wb_image_distance *d = &g->dist;
+    int32_t n = d->n;
+    if (!at->exact) {
+        n = 0;
+        for (int32_t i = 0; i < d->n; i++) n += (int32_t)(d->gen[i] & 1u);
+    }
+    return wb__reserve(w, 0, n);
+}
+
+/* a new world takes the slots as they are (generations, free list: the same future) */
+static void put_exact(wb_world *w, const wb_image_distance *d)
+{
+    wb_model *m = &w->m;
+    wb_state *s = &w->s;
+    const size_t n = (size_t)d->n;
+    m->nd = d->n;
+    m->nd_live = 0;
+    if (n) {
+        memcpy(m->d_ij, d->ij, 2 * n * sizeof *m->d_ij);
+        memcpy(m->d_alpha, d->alpha, n * sizeof(wb_real));
+        memcpy(m->d_beta, d->beta, n * sizeof(wb_real));
+        memcpy(m->d_yield, d->yield, n * sizeof(wb_real));
+        memcpy(m->d_creep, d->creep, n * sizeof(wb_real));
+        memcpy(m->d_break, d->break_strain, n * sizeof(wb_real));
+        memcpy(m->d_bforce, d->bforce, n * sizeof(wb_real));
+        memcpy(s->d_rest, d->rest, n * sizeof(wb_real));
+        memcpy(s->d_broken, d->broken, n);
+        memcpy(m->d_gen, d->gen, n * sizeof *m->d_gen);
+    }
+    for (size_t i = 0; i < n; i++) {
+        w->k.slot_pack[i] = -1;
+        m->nd_live += (int32_t)(d->gen[i] & 1u);
+    }
+    m->nfree = d->nfree;
+    if (d->nfree) memcpy(m->d_free, d->free_slots, (size_t)d->nfree * sizeof *m->d_free);
+}
+
+/* appended: the live ones added after w's (checked and reserved: cannot fail) */
+static void distance_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
+{
+    const wb_image_distance *d = &g->dist;
+    if (at->exact) {
+        put_exact(w, d);
+        return;
+    }
+    for (int32_t i = 0; i < d->n; i++) {
+        if (!(d->gen[i] & 1u)) continue;
+        const wb_distance_def def = image_def(d, i);
+        const wb_distance_id id = wb_distance_add(w, at->pshift + d->ij[2 * i], at->pshift + d->ij[2 * i + 1], &def, NULL);
+        w->s.d_broken[id.index - 1] = d->broken[i];
+    }
+}
+
+static void distance_stats(const wb_world *w, wb_stats *st)
+{
+    st->distances = w->m.nd_live;
+    for (int32_t s = 0; s < w->m.nd; s++)
+        if ((w->m.d_gen[s] & 1u) && w->s.d_broken[s]) st->broken++;
+}
+
 const wb_ctype wb__distance_type = {
     .name = "distance",
     .count = distance_count,
@@ -755,4 +949,12 @@ const wb_ctype wb__distance_type = {
     .frame_end = distance_frame_end,
     .energy = distance_energy,
     .links = distance_links,
+    .destroy = distance_destroy,
+    .stats = distance_stats,
+    .hash = distance_hash,
+    .image_free = distance_image_free,
+    .image_save = distance_image_save,
+    .image_check = distance_image_check,
+    .image_reserve = distance_image_reserve,
+    .image_put = distance_image_put,
 };

@@ -39,7 +39,7 @@ wb_status wb__grab_reserve(wb_world *w, int64_t extra)
     if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     if (need <= g->cap) return WB_OK;
     const int32_t cap = wb__grown_cap(g->cap, need, 16);
-    if (!wb__material_charge(w, &g->charged, (size_t)cap * GRAB_BYTES)) return WB_ERR_NOMEM;
+    if (!wb__charge(w, &g->charged, (size_t)cap * GRAB_BYTES)) return WB_ERR_NOMEM;
     const wb_soa arr[] = {
         { (void **)&g->p, sizeof(int32_t) }, { (void **)&g->alpha, sizeof(wb_real) },
         { (void **)&g->kind, 1 }, { (void **)&g->tgen, sizeof(uint32_t) }, { (void **)&g->local, 3 * sizeof(wb_real) },
@@ -249,7 +249,7 @@ int32_t wb_grab_list(const wb_world *w, wb_grab_id *out, int32_t cap)
 /* ---- images (snapshot.h) ------------------------------------------------------------- */
 static void *zalloc(int64_t n, size_t elem) { return calloc((size_t)(n > 0 ? n : 1), elem); }
 
-void wb__grab_image_free(wb_image *g)
+static void grab_image_free(wb_image *g)
 {
     wb_image_grab *a = &g->grab;
     free(a->p); free(a->kind); free(a->local); free(a->target); free(a->from); free(a->alpha);
@@ -258,7 +258,7 @@ void wb__grab_image_free(wb_image *g)
 
 wb_status wb_image_alloc_grab(wb_image *g, int32_t n)
 {
-    wb__grab_image_free(g);
+    grab_image_free(g);
     wb_image_grab *a = &g->grab;
     a->n = n;
     a->p = zalloc(n, sizeof *a->p);
@@ -268,11 +268,11 @@ wb_status wb_image_alloc_grab(wb_image *g, int32_t n)
     a->from = zalloc(3 * (int64_t)n, sizeof *a->from);
     a->alpha = zalloc(n, sizeof *a->alpha);
     if (a->p && a->kind && a->local && a->target && a->from && a->alpha) return WB_OK;
-    wb__grab_image_free(g);
+    grab_image_free(g);
     return WB_ERR_NOMEM;
 }
 
-wb_status wb__grab_image_of(const wb_world *w, wb_image *img)
+static wb_status grab_image_save(const wb_world *w, wb_image *img)
 {
     wb_status st = wb_image_alloc_grab(img, wb_grab_count(w));
     if (st != WB_OK) return st;
@@ -291,7 +291,7 @@ wb_status wb__grab_image_of(const wb_world *w, wb_image *img)
     return WB_OK;
 }
 
-const char *wb__grab_image_check(const wb_image *img)
+static const char *grab_image_check(const wb_image *img)
 {
     const wb_image_grab *g = &img->grab;
     if (g->n < 0 || g->n > WB_MAX_CONSTRAINTS) return "too many grabs";
@@ -311,13 +311,15 @@ const char *wb__grab_image_check(const wb_image *img)
     return NULL;
 }
 
-wb_status wb__grab_image_reserve(wb_world *w, const wb_image *img)
+static wb_status grab_image_reserve(wb_world *w, const wb_image *img, const wb_image_at *at)
 {
+    (void)at;
     return img->grab.n > 0 ? wb__grab_reserve(w, img->grab.n) : WB_OK;
 }
 
-void wb__grab_image_put(wb_world *w, const wb_image *img, int32_t pshift, const int32_t *rmap)
+static void grab_image_put(wb_world *w, const wb_image *img, const wb_image_at *at)
 {
+    const int32_t pshift = at->pshift, *rmap = at->rmap;
     const wb_image_grab *g = &img->grab;
     for (int32_t k = 0; k < g->n; k++) {
         const int rigid = g->kind[k] == WB_GRAB_RIGID;
@@ -429,6 +431,57 @@ static wb_real grab_energy(const wb_world *w)
     return e;
 }
 
+/* ---- teardown and hash (ctype.h) --------------------------------------------------------- */
+static void grab_destroy(wb_world *w)
+{
+    wb_grabs *g = w->grab;
+    if (!g) return;
+    void *p[] = { g->p, g->kind, g->tgen, g->local, g->alpha, g->gen, g->target, g->from, g->lambda };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    free(g);
+    w->grab = NULL;
+}
+
+static size_t grab_charged(const wb_world *w) { return w->grab ? w->grab->charged : 0; }
+
+/* the live ones in slot order, as a snapshot keeps them */
+static uint64_t grab_hash(const wb_world *w, uint64_t h)
+{
+    const wb_grabs *g = w->grab;
+    for (int32_t i = 0; g && i < g->n; i++) {
+        if (!wb__grab_active(w, g, i)) continue;
+        h = wb__fnv(h, &g->p[i], sizeof g->p[i]);
+        if (g->kind[i] == WB_GRAB_RIGID) { /* (particle grabs hash as they always did) */
+            h = wb__fnv(h, &g->kind[i], 1);
+            h = wb__fnv(h, &g->local[3 * i], 3 * sizeof(wb_real));
+        }
+        h = wb__fnv(h, &g->target[3 * i], 3 * sizeof(wb_real));
+        h = wb__fnv(h, &g->from[3 * i], 3 * sizeof(wb_real));
+        h = wb__fnv(h, &g->alpha[i], sizeof(wb_real));
+    }
+    return h;
+}
+
+static void grab_stats(const wb_world *w, wb_stats *st)
+{
+    st->grabs = wb_grab_count(w);
+}
+
 const wb_ctype wb__grab_type = {
-    "grab", grab_count, grab_prepare, grab_substep_begin, grab_project, grab_frame_end, grab_energy, NULL,
+    .name = "grab",
+    .count = grab_count,
+    .prepare = grab_prepare,
+    .substep_begin = grab_substep_begin,
+    .project = grab_project,
+    .frame_end = grab_frame_end,
+    .energy = grab_energy,
+    .destroy = grab_destroy,
+    .charged = grab_charged,
+    .stats = grab_stats,
+    .hash = grab_hash,
+    .image_free = grab_image_free,
+    .image_save = grab_image_save,
+    .image_check = grab_image_check,
+    .image_reserve = grab_image_reserve,
+    .image_put = grab_image_put,
 };

@@ -29,17 +29,6 @@ typedef struct wb_grabs {
     int32_t free_hint;      /* no dead slot below it: a new grab's search starts there */
 } wb_grabs;
 
-static inline void wb__grab_free(wb_world *w)
-{
-    wb_grabs *g = w->grab;
-    if (!g) return;
-    if (w->m.def.memory) w->m.def.memory->used -= g->charged;
-    void *p[] = { g->p, g->kind, g->tgen, g->local, g->alpha, g->gen, g->target, g->from, g->lambda };
-    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
-    free(g);
-    w->grab = NULL;
-}
-
 /* slot s is live and, for a rigid body's grab, the body still is (a removed body leaves
  * its grabs inert until the next step's prepare retires them; the hash and images skip them) */
 static inline int wb__grab_active(const wb_world *w, const wb_grabs *g, int32_t s)

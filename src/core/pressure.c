@@ -45,7 +45,7 @@ static wb_status reserve(wb_world *w, int64_t n_extra, int64_t nv_extra, int64_t
     const int32_t cn = n <= p->cap ? p->cap : wb__grown_cap(p->cap, n, 16);
     const int32_t cv = nv <= p->cap_verts ? p->cap_verts : wb__grown_cap(p->cap_verts, nv, 16);
     const int32_t ct = nt <= p->cap_tri ? p->cap_tri : wb__grown_cap(p->cap_tri, nt, 16);
-    if (!wb__material_charge(w, &p->charged, (size_t)cn * BYTES_P + (size_t)cv * BYTES_V + (size_t)ct * BYTES_T))
+    if (!wb__charge(w, &p->charged, (size_t)cn * BYTES_P + (size_t)cv * BYTES_V + (size_t)ct * BYTES_T))
         return WB_ERR_NOMEM;
     const wb_soa per[] = {
         { (void **)&p->surface, sizeof(int32_t) }, { (void **)&p->pressure, sizeof(wb_real) },
@@ -233,7 +233,6 @@ static wb_real pr_energy(const wb_world *w)
     return u;
 }
 
-const wb_ctype wb__pressure_type = { "pressure", pr_count, pr_prepare, pr_substep_begin, pr_project, NULL, pr_energy, NULL };
 
 /* ---- API ------------------------------------------------------------------------------------ */
 wb_pressure_def wb_pressure_default_def(void)
@@ -306,6 +305,8 @@ wb_real wb_pressure_rest_volume(const wb_world *w, int32_t k) { CHECK_K(w, k); r
 int32_t wb_pressure_surface(const wb_world *w, int32_t k) { CHECK_K(w, k); return w->pr.surface[k]; }
 
 /* ---- snapshots -------------------------------------------------------------------------------- */
+static void pr_image_free(wb_image *g);
+
 wb_status wb_image_alloc_pressure(wb_image *g, int32_t n)
 {
     wb_image_pressure *p = &g->pr;
@@ -316,13 +317,13 @@ wb_status wb_image_alloc_pressure(wb_image *g, int32_t n)
     p->alpha = calloc(c, sizeof(wb_real));
     p->v0 = calloc(c, sizeof(wb_real));
     if (!p->surface || !p->pressure || !p->alpha || !p->v0) {
-        wb__pressure_image_free(g);
+        pr_image_free(g);
         return WB_ERR_NOMEM;
     }
     return WB_OK;
 }
 
-void wb__pressure_image_free(wb_image *g)
+static void pr_image_free(wb_image *g)
 {
     wb_image_pressure *p = &g->pr;
     free(p->surface);
@@ -332,7 +333,7 @@ void wb__pressure_image_free(wb_image *g)
     memset(p, 0, sizeof *p);
 }
 
-wb_status wb__pressure_image_of(const wb_world *w, wb_image *g)
+static wb_status pr_image_save(const wb_world *w, wb_image *g)
 {
     const wb_pressures *p = &w->pr;
     if (p->n == 0) return WB_OK;
@@ -363,7 +364,7 @@ static wb_real image_volume(const wb_image *g, int32_t s)
     return V / 6;
 }
 
-const char *wb__pressure_image_check(const wb_image *g)
+static const char *pr_image_check(const wb_image *g)
 {
     static _Thread_local char msg[160];
     const wb_image_pressure *p = &g->pr;
@@ -382,15 +383,63 @@ const char *wb__pressure_image_check(const wb_image *g)
     return NULL;
 }
 
-wb_status wb__pressure_reserve(wb_world *w, const wb_image *g)
+static wb_status pr_image_reserve(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
+    (void)at;
     int64_t nt = 0;
     for (int32_t k = 0; k < g->pr.n; k++) nt += g->surf_start[g->pr.surface[k] + 1] - g->surf_start[g->pr.surface[k]];
     return reserve(w, g->pr.n, 3 * nt, nt);
 }
 
-void wb__pressure_put(wb_world *w, const wb_image *g, int32_t sshift)
+static void pr_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
+    const int32_t sshift = at->sshift;
     const wb_image_pressure *p = &g->pr;
     for (int32_t k = 0; k < p->n; k++) build(w, p->surface[k] + sshift, p->pressure[k], p->alpha[k], p->v0[k]);
 }
+
+/* ---- teardown and hash (ctype.h) --------------------------------------------------------- */
+static void pr_destroy(wb_world *w)
+{
+    wb_pressures *pr = &w->pr;
+    void *p[] = { pr->surface, pr->pressure, pr->alpha, pr->v0, pr->vstart, pr->tstart, pr->verts, pr->tri,
+                  pr->lambda, pr->grad };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+}
+
+static size_t pr_charged(const wb_world *w) { return w->pr.charged; }
+
+/* parameters and rest volumes; a world without any adds nothing */
+static uint64_t pr_hash(const wb_world *w, uint64_t h)
+{
+    const wb_pressures *pr = &w->pr;
+    if (pr->n == 0) return h;
+    h = wb__fnv(h, &pr->n, sizeof pr->n);
+    h = wb__fnv(h, pr->surface, sizeof(int32_t) * (size_t)pr->n);
+    h = wb__fnv(h, pr->pressure, sizeof(wb_real) * (size_t)pr->n);
+    h = wb__fnv(h, pr->alpha, sizeof(wb_real) * (size_t)pr->n);
+    return wb__fnv(h, pr->v0, sizeof(wb_real) * (size_t)pr->n);
+}
+
+static void pr_stats(const wb_world *w, wb_stats *st)
+{
+    st->pressures = wb_pressure_count(w);
+}
+
+const wb_ctype wb__pressure_type = {
+    .name = "pressure",
+    .count = pr_count,
+    .prepare = pr_prepare,
+    .substep_begin = pr_substep_begin,
+    .project = pr_project,
+    .energy = pr_energy,
+    .destroy = pr_destroy,
+    .charged = pr_charged,
+    .stats = pr_stats,
+    .hash = pr_hash,
+    .image_free = pr_image_free,
+    .image_save = pr_image_save,
+    .image_check = pr_image_check,
+    .image_reserve = pr_image_reserve,
+    .image_put = pr_image_put,
+};

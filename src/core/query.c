@@ -1,10 +1,6 @@
 /* query.c: read-only measures of a world: energy, momenta, bounds, strain, hash, stats. */
 #include "ctype.h"
-#include "attach.h"
-#include "grab.h"
 #include "rigid.h"
-#include "tet.h"
-#include "volume.h"
 
 static wb_real mass_of(const wb_world *w, int32_t i) { return w->m.w[i] > 0 ? 1 / w->m.w[i] : 0; }
 
@@ -117,120 +113,52 @@ int32_t wb_world_distance_pairs(const wb_world *w, int32_t *ij, wb_real *strain)
 }
 
 /* FNV-1a over the bytes of the state: bit-identical states, identical hashes */
-static uint64_t fnv(uint64_t h, const void *p, size_t n)
-{
-    const unsigned char *b = p;
-    for (size_t i = 0; i < n; i++) { h ^= b[i]; h *= 1099511628211ull; }
-    return h;
-}
-
 uint64_t wb_world_hash(const wb_world *w)
 {
     const wb_model *m = &w->m;
     const wb_state *s = &w->s;
     uint64_t h = 14695981039346656037ull;
-    h = fnv(h, &m->np, sizeof m->np);
-    h = fnv(h, s->x, sizeof(wb_real) * 3 * (size_t)m->np);
-    h = fnv(h, s->v, sizeof(wb_real) * 3 * (size_t)m->np);
-    h = fnv(h, m->pinned, (size_t)m->np);
-    h = fnv(h, m->inv_mass, sizeof(wb_real) * (size_t)m->np);
-    h = fnv(h, m->radius, sizeof(wb_real) * (size_t)m->np);
-    h = fnv(h, m->group, sizeof(int32_t) * (size_t)m->np);
-    h = fnv(h, m->cflags, (size_t)m->np);
-    h = fnv(h, m->cfric, sizeof(wb_real) * (size_t)m->np);
-    h = fnv(h, m->x0, sizeof(wb_real) * 3 * (size_t)m->np);
-    for (int32_t i = 0; i < m->nd; i++) {
-        if (!(m->d_gen[i] & 1u)) continue;
-        h = fnv(h, &s->d_rest[i], sizeof s->d_rest[i]);
-        h = fnv(h, &s->d_broken[i], 1);
-    }
-    for (int32_t c = 0; c < m->nc; c++) {
-        if (!(m->c_gen[c] & 1u)) continue;
-        h = fnv(h, &s->c_pose[c], sizeof s->c_pose[c]); /* pose, sweep start, velocities */
-    }
-    /* broken bends (state): their slots, so worlds without one hash as they always did */
-    for (int32_t i = 0; i < w->bend.n; i++)
-        if (w->bend.broken[i]) h = fnv(h, &i, sizeof i);
-    /* shape matching and pressure: their parameters and state (rest shapes, rotations) */
-    const wb_smatch *sm = &w->sm;
-    if (sm->n > 0) { /* (worlds without any hash as they always did) */
-        h = fnv(h, &sm->n, sizeof sm->n);
-        h = fnv(h, sm->start, sizeof(int32_t) * ((size_t)sm->n + 1));
-        h = fnv(h, sm->ids, sizeof(int32_t) * (size_t)sm->nids);
-        h = fnv(h, sm->stiff, sizeof(wb_real) * (size_t)sm->n);
-        h = fnv(h, sm->yield, sizeof(wb_real) * (size_t)sm->n);
-        h = fnv(h, sm->creep, sizeof(wb_real) * (size_t)sm->n);
-        h = fnv(h, sm->rest, sizeof(wb_real) * 3 * (size_t)sm->nids);
-        h = fnv(h, sm->q, sizeof(wb_real) * 4 * (size_t)sm->n);
-    }
-    const wb_pressures *pr = &w->pr;
-    if (pr->n > 0) {
-        h = fnv(h, &pr->n, sizeof pr->n);
-        h = fnv(h, pr->surface, sizeof(int32_t) * (size_t)pr->n);
-        h = fnv(h, pr->pressure, sizeof(wb_real) * (size_t)pr->n);
-        h = fnv(h, pr->alpha, sizeof(wb_real) * (size_t)pr->n);
-        h = fnv(h, pr->v0, sizeof(wb_real) * (size_t)pr->n);
-    }
-    /* plastic volume constraints and tets: their rest state flows (state), and how (worlds
-     * without any hash as they always did) */
-    const wb_volumes *vo = w->vol;
-    if (vo && vo->plastic) {
-        h = fnv(h, vo->rest, sizeof(wb_real) * (size_t)vo->n);
-        h = fnv(h, vo->yield, sizeof(wb_real) * (size_t)vo->n);
-        h = fnv(h, vo->creep, sizeof(wb_real) * (size_t)vo->n);
-    }
-    const wb_neos *ne = w->neo;
-    if (ne && ne->plastic) {
-        h = fnv(h, ne->dminv, sizeof(wb_real) * 9 * (size_t)ne->n);
-        h = fnv(h, ne->v0, sizeof(wb_real) * (size_t)ne->n);
-        h = fnv(h, ne->yield, sizeof(wb_real) * (size_t)ne->n);
-        h = fnv(h, ne->creep, sizeof(wb_real) * (size_t)ne->n);
-    }
-    /* attachments and grabs: the live ones in slot order (a snapshot keeps that order;
-     * it drops an attachment whose collider was removed, so the hash does too) */
-    const wb_attaches *at = w->att;
-    for (int32_t i = 0; at && i < at->n; i++) {
-        if (!wb__attach_active(w, at, i)) continue;
-        h = fnv(h, &at->p[i], sizeof at->p[i]);
-        h = fnv(h, &at->kind[i], 1);
-        h = fnv(h, &at->tindex[i], sizeof at->tindex[i]);
-        h = fnv(h, &at->local[3 * i], 3 * sizeof(wb_real));
-        h = fnv(h, &at->alpha[i], sizeof(wb_real));
-    }
-    const wb_grabs *gr = w->grab;
-    for (int32_t i = 0; gr && i < gr->n; i++) {
-        if (!wb__grab_active(w, gr, i)) continue;
-        h = fnv(h, &gr->p[i], sizeof gr->p[i]);
-        if (gr->kind[i] == WB_GRAB_RIGID) { /* (particle grabs hash as they always did) */
-            h = fnv(h, &gr->kind[i], 1);
-            h = fnv(h, &gr->local[3 * i], 3 * sizeof(wb_real));
+    h = wb__fnv(h, &m->np, sizeof m->np);
+    h = wb__fnv(h, s->x, sizeof(wb_real) * 3 * (size_t)m->np);
+    h = wb__fnv(h, s->v, sizeof(wb_real) * 3 * (size_t)m->np);
+    h = wb__fnv(h, m->pinned, (size_t)m->np);
+    h = wb__fnv(h, m->inv_mass, sizeof(wb_real) * (size_t)m->np);
+    h = wb__fnv(h, m->radius, sizeof(wb_real) * (size_t)m->np);
+    h = wb__fnv(h, m->group, sizeof(int32_t) * (size_t)m->np);
+    h = wb__fnv(h, m->cflags, (size_t)m->np);
+    h = wb__fnv(h, m->cfric, sizeof(wb_real) * (size_t)m->np);
+    h = wb__fnv(h, m->x0, sizeof(wb_real) * 3 * (size_t)m->np);
+    /* the types' state in the hash's own order, the colliders' poses at their place (NULL) */
+    for (int t = 0; t <= wb__nctypes; t++) {
+        const wb_ctype *ct = wb__ctypes_hashed[t];
+        if (ct) { h = ct->hash(w, h); continue; }
+        for (int32_t c = 0; c < m->nc; c++) {
+            if (!(m->c_gen[c] & 1u)) continue;
+            h = wb__fnv(h, &s->c_pose[c], sizeof s->c_pose[c]); /* pose, sweep start, velocities */
         }
-        h = fnv(h, &gr->target[3 * i], 3 * sizeof(wb_real));
-        h = fnv(h, &gr->from[3 * i], 3 * sizeof(wb_real));
-        h = fnv(h, &gr->alpha[i], sizeof(wb_real));
     }
     const wb_rigids *rb = w->rb;
     for (int32_t r = 0; rb && r < rb->n; r++) { /* (worlds without any hash as they always did) */
         if (!(rb->gen[r] & 1u)) continue;
         const wb_cshape *sh = &rb->shape[r];
         const int32_t shape = (int32_t)sh->shape;
-        h = fnv(h, &r, sizeof r);
-        h = fnv(h, &rb->gen[r], sizeof rb->gen[r]);
-        h = fnv(h, &shape, sizeof shape);
-        h = fnv(h, &sh->radius, sizeof sh->radius);
-        h = fnv(h, sh->half, sizeof sh->half);
-        h = fnv(h, sh->a, sizeof sh->a);
-        h = fnv(h, sh->b, sizeof sh->b);
-        h = fnv(h, &sh->friction, sizeof sh->friction);
-        h = fnv(h, &sh->restitution, sizeof sh->restitution);
-        h = fnv(h, &rb->mass[r], sizeof(wb_real));
-        h = fnv(h, &rb->x[3 * r], 3 * sizeof(wb_real));
-        h = fnv(h, &rb->q[4 * r], 4 * sizeof(wb_real));
-        h = fnv(h, &rb->v[3 * r], 3 * sizeof(wb_real));
-        h = fnv(h, &rb->om[3 * r], 3 * sizeof(wb_real));
+        h = wb__fnv(h, &r, sizeof r);
+        h = wb__fnv(h, &rb->gen[r], sizeof rb->gen[r]);
+        h = wb__fnv(h, &shape, sizeof shape);
+        h = wb__fnv(h, &sh->radius, sizeof sh->radius);
+        h = wb__fnv(h, sh->half, sizeof sh->half);
+        h = wb__fnv(h, sh->a, sizeof sh->a);
+        h = wb__fnv(h, sh->b, sizeof sh->b);
+        h = wb__fnv(h, &sh->friction, sizeof sh->friction);
+        h = wb__fnv(h, &sh->restitution, sizeof sh->restitution);
+        h = wb__fnv(h, &rb->mass[r], sizeof(wb_real));
+        h = wb__fnv(h, &rb->x[3 * r], 3 * sizeof(wb_real));
+        h = wb__fnv(h, &rb->q[4 * r], 4 * sizeof(wb_real));
+        h = wb__fnv(h, &rb->v[3 * r], 3 * sizeof(wb_real));
+        h = wb__fnv(h, &rb->om[3 * r], 3 * sizeof(wb_real));
     }
-    h = fnv(h, &s->time, sizeof s->time);
-    h = fnv(h, &s->frame, sizeof s->frame);
+    h = wb__fnv(h, &s->time, sizeof s->time);
+    h = wb__fnv(h, &s->frame, sizeof s->frame);
     return h;
 }
 
@@ -239,15 +167,8 @@ wb_stats wb_world_stats(const wb_world *w)
     wb_stats st;
     memset(&st, 0, sizeof st);
     st.particles = w->m.np;
-    st.distances = w->m.nd_live;
-    for (int32_t s = 0; s < w->m.nd; s++)
-        if ((w->m.d_gen[s] & 1u) && w->s.d_broken[s]) st.broken++;
+    for (int i = 0; i < wb__nctypes; i++) wb__ctypes[i]->stats(w, &st);
     st.colliders = wb_collider_count(w);
-    st.bends = wb_bend_count(w);
-    st.volumes = wb_volume_count(w);
-    st.tets = wb_tet_count(w);
-    st.shape_matches = wb_shape_match_count(w);
-    st.pressures = wb_pressure_count(w);
     st.colours = w->k.ncolours;
     st.contacts = w->k.last_contacts;
     st.particle_contacts = w->k.pc.last + w->k.tc.last;
@@ -257,8 +178,6 @@ wb_stats wb_world_stats(const wb_world *w)
     st.step_ms = w->k.step_ms;
     st.solve_ms = w->k.solve_ms;
     st.warnings = w->s.warnings;
-    st.attachments = wb_attach_count(w);
-    st.grabs = wb_grab_count(w);
     st.rigids = wb_rigid_count(w);
     st.rigid_contacts = wb_world_rigid_contact_count(w);
     return st;

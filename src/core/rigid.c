@@ -148,7 +148,7 @@ static int grow(wb_world *w, wb_rigids *rb, int32_t need)
     int32_t c = rb->cap, cap = rb->cap;
     int64_t want = cap ? cap : 16;
     while (want < need) want *= 2;
-    if (!wb__material_charge(w, &rb->charged, (size_t)want * SLOT_BYTES)) return 0;
+    if (!wb__charge(w, &rb->charged, (size_t)want * SLOT_BYTES)) return 0;
 #define G(ptr, k)                                                          \
     do {                                                                   \
         c = cap;                                                           \

@@ -53,18 +53,6 @@
 #define BYTES_CLUSTER (4 + 11 * sizeof(wb_real))
 #define BYTES_ID (4 + 6 * sizeof(wb_real))
 
-int wb__material_charge(wb_world *w, size_t *charged, size_t want)
-{
-    wb_memory *mem = w->m.def.memory;
-    if (mem) {
-        const double used = (double)mem->used - (double)*charged + (double)want;
-        if (mem->limit > 0 && used > (double)mem->limit) return 0;
-        mem->used = (size_t)used;
-    }
-    *charged = want;
-    return 1;
-}
-
 /* room for n_extra more clusters of ids_extra particles in all; after it, adding them
  * cannot fail */
 static wb_status reserve(wb_world *w, int64_t n_extra, int64_t ids_extra)
@@ -75,7 +63,7 @@ static wb_status reserve(wb_world *w, int64_t n_extra, int64_t ids_extra)
     if (nc + 1 <= sm->cap && ni <= sm->cap_ids) return WB_OK;
     const int32_t cc = nc + 1 <= sm->cap ? sm->cap : wb__grown_cap(sm->cap, nc + 1, 16);
     const int32_t ci = ni <= sm->cap_ids ? sm->cap_ids : wb__grown_cap(sm->cap_ids, ni, 16);
-    if (!wb__material_charge(w, &sm->charged, (size_t)cc * BYTES_CLUSTER + (size_t)ci * BYTES_ID)) return WB_ERR_NOMEM;
+    if (!wb__charge(w, &sm->charged, (size_t)cc * BYTES_CLUSTER + (size_t)ci * BYTES_ID)) return WB_ERR_NOMEM;
     const wb_soa clusters[] = {
         { (void **)&sm->start, sizeof(int32_t) }, { (void **)&sm->stiff, sizeof(wb_real) },
         { (void **)&sm->yield, sizeof(wb_real) }, { (void **)&sm->creep, sizeof(wb_real) },
@@ -294,8 +282,6 @@ static void sm_links(const wb_world *w, wb_link_fn fn, void *ud)
         for (int32_t i = sm->start[c] + 1; i < sm->start[c + 1]; i++) fn(ud, sm->ids[i - 1], sm->ids[i], 0);
 }
 
-const wb_ctype wb__shape_type = { "shape_match", sm_count, sm_prepare, sm_substep_begin, sm_project, sm_frame_end,
-                                  sm_energy, sm_links };
 
 /* ---- API ------------------------------------------------------------------------------------ */
 wb_shape_match_def wb_shape_match_default_def(void)
@@ -411,6 +397,8 @@ wb_real wb_shape_match_strain(const wb_world *w, int32_t s)
 }
 
 /* ---- snapshots -------------------------------------------------------------------------------- */
+static void sm_image_free(wb_image *g);
+
 wb_status wb_image_alloc_smatch(wb_image *g, int32_t n, int32_t nids)
 {
     wb_image_smatch *s = &g->sm;
@@ -424,14 +412,14 @@ wb_status wb_image_alloc_smatch(wb_image *g, int32_t n, int32_t nids)
     s->rest = calloc(3 * (size_t)(nids > 0 ? nids : 1), sizeof(wb_real));
     s->q = calloc(4 * (size_t)(n > 0 ? n : 1), sizeof(wb_real));
     if (!s->start || !s->ids || !s->stiff || !s->yield || !s->creep || !s->rest || !s->q) {
-        wb__smatch_image_free(g);
+        sm_image_free(g);
         return WB_ERR_NOMEM;
     }
     for (int32_t k = 0; k < n; k++) s->q[4 * k] = 1;
     return WB_OK;
 }
 
-void wb__smatch_image_free(wb_image *g)
+static void sm_image_free(wb_image *g)
 {
     wb_image_smatch *s = &g->sm;
     void *p[] = { s->start, s->ids, s->stiff, s->yield, s->creep, s->rest, s->q };
@@ -439,7 +427,7 @@ void wb__smatch_image_free(wb_image *g)
     memset(s, 0, sizeof *s);
 }
 
-wb_status wb__smatch_image_of(const wb_world *w, wb_image *g)
+static wb_status sm_image_save(const wb_world *w, wb_image *g)
 {
     const wb_smatch *sm = &w->sm;
     if (sm->n == 0) return WB_OK;
@@ -456,7 +444,7 @@ wb_status wb__smatch_image_of(const wb_world *w, wb_image *g)
     return WB_OK;
 }
 
-const char *wb__smatch_image_check(const wb_image *g)
+static const char *sm_image_check(const wb_image *g)
 {
     const wb_image_smatch *s = &g->sm;
     if (s->n < 0 || s->nids < 0 || s->n > WB_MAX_CONSTRAINTS || s->nids > WB_MAX_CONSTRAINTS) return "too many shape-matching clusters";
@@ -485,10 +473,15 @@ const char *wb__smatch_image_check(const wb_image *g)
     return e;
 }
 
-wb_status wb__smatch_reserve(wb_world *w, const wb_image *g) { return reserve(w, g->sm.n, g->sm.nids); }
-
-void wb__smatch_put(wb_world *w, const wb_image *g, int32_t pshift)
+static wb_status sm_image_reserve(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
+    (void)at;
+    return reserve(w, g->sm.n, g->sm.nids);
+}
+
+static void sm_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
+{
+    const int32_t pshift = at->pshift;
     wb_smatch *sm = &w->sm;
     const wb_image_smatch *s = &g->sm;
     for (int32_t k = 0; k < s->n; k++) {
@@ -504,3 +497,53 @@ void wb__smatch_put(wb_world *w, const wb_image *g, int32_t pshift)
     sm->n += s->n;
     sm->nids += s->nids;
 }
+
+/* ---- teardown and hash (ctype.h) --------------------------------------------------------- */
+static void sm_destroy(wb_world *w)
+{
+    wb_smatch *sm = &w->sm;
+    void *p[] = { sm->start, sm->stiff, sm->yield, sm->creep, sm->ids, sm->rest, sm->q, sm->qk, sm->lambda };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+}
+
+static size_t sm_charged(const wb_world *w) { return w->sm.charged; }
+
+/* parameters and state (rest shapes, rotations); a world without any adds nothing */
+static uint64_t sm_hash(const wb_world *w, uint64_t h)
+{
+    const wb_smatch *sm = &w->sm;
+    if (sm->n == 0) return h;
+    h = wb__fnv(h, &sm->n, sizeof sm->n);
+    h = wb__fnv(h, sm->start, sizeof(int32_t) * ((size_t)sm->n + 1));
+    h = wb__fnv(h, sm->ids, sizeof(int32_t) * (size_t)sm->nids);
+    h = wb__fnv(h, sm->stiff, sizeof(wb_real) * (size_t)sm->n);
+    h = wb__fnv(h, sm->yield, sizeof(wb_real) * (size_t)sm->n);
+    h = wb__fnv(h, sm->creep, sizeof(wb_real) * (size_t)sm->n);
+    h = wb__fnv(h, sm->rest, sizeof(wb_real) * 3 * (size_t)sm->nids);
+    return wb__fnv(h, sm->q, sizeof(wb_real) * 4 * (size_t)sm->n);
+}
+
+static void sm_stats(const wb_world *w, wb_stats *st)
+{
+    st->shape_matches = wb_shape_match_count(w);
+}
+
+const wb_ctype wb__shape_type = {
+    .name = "shape_match",
+    .count = sm_count,
+    .prepare = sm_prepare,
+    .substep_begin = sm_substep_begin,
+    .project = sm_project,
+    .frame_end = sm_frame_end,
+    .energy = sm_energy,
+    .links = sm_links,
+    .destroy = sm_destroy,
+    .charged = sm_charged,
+    .stats = sm_stats,
+    .hash = sm_hash,
+    .image_free = sm_image_free,
+    .image_save = sm_image_save,
+    .image_check = sm_image_check,
+    .image_reserve = sm_image_reserve,
+    .image_put = sm_image_put,
+};

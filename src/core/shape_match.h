@@ -1,5 +1,6 @@
 /* shape_match.h: the data of shape-matching clusters (shape_match.c) and of pressure
- * constraints (pressure.c), one member each of struct wb_world. */
+ * constraints (pressure.c), one member each of struct wb_world, and their sections of a
+ * snapshot image (snapshot.h). */
 #ifndef WB_SHAPE_MATCH_H
 #define WB_SHAPE_MATCH_H
 
@@ -44,8 +45,22 @@ typedef struct wb_pressures {
 
 /* (world.c's wb_world_destroy frees both structs' arrays and gives their charge back) */
 struct wb_world;
-/* charge `want` bytes in place of *charged to the world's budget; 0 (nothing charged)
- * when it would pass the limit */
-int wb__material_charge(struct wb_world *w, size_t *charged, size_t want);
+/* a snapshot image's shape-matching clusters (snapshot.h): model and state by cluster */
+typedef struct wb_image_smatch {
+    int32_t n, nids;
+    int32_t *start;        /* (n + 1) ranges into ids */
+    int32_t *ids;          /* (nids) particles */
+    wb_real *stiff, *yield, *creep; /* (n) */
+    wb_real *rest;         /* (nids x 3) rest shape about its mass centre */
+    wb_real *q;            /* (n x 4) rotation at the end of the last frame */
+} wb_image_smatch;
+
+/* a snapshot image's pressure constraints, each over one of the image's surfaces */
+typedef struct wb_image_pressure {
+    int32_t n;
+    int32_t *surface;      /* (n) */
+    wb_real *pressure, *alpha, *v0; /* (n) factor, compliance, rest volume */
+} wb_image_pressure;
+
 
 #endif

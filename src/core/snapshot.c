@@ -8,10 +8,9 @@
  * step, as after any topology edit. */
 #include <stdlib.h>
 
-#include "core.h"
+#include "ctype.h"
 #include "bvh.h"
 #include "snapshot.h"
-#include "volume.h"
 
 static int fin3(const wb_real *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
 
@@ -23,8 +22,6 @@ wb_status wb_image_alloc(wb_image *g, int32_t np, int32_t nd, int32_t nfree, int
     memset(g, 0, sizeof *g);
     g->def = wb_world_default_def();
     g->np = np;
-    g->nd = nd;
-    g->nfree = nfree;
     g->nc = nc;
     g->nsurf = nsurf;
     g->ntri = ntri;
@@ -37,28 +34,15 @@ wb_status wb_image_alloc(wb_image *g, int32_t np, int32_t nd, int32_t nfree, int
     g->cflags = zalloc(np, 1);
     g->cfric = zalloc(np, sizeof *g->cfric);
     g->x0 = zalloc(3 * (int64_t)np, sizeof *g->x0);
-    g->d_ij = zalloc(2 * (int64_t)nd, sizeof *g->d_ij);
-    g->d_alpha = zalloc(nd, sizeof(wb_real));
-    g->d_beta = zalloc(nd, sizeof(wb_real));
-    g->d_yield = zalloc(nd, sizeof(wb_real));
-    g->d_creep = zalloc(nd, sizeof(wb_real));
-    g->d_break = zalloc(nd, sizeof(wb_real));
-    g->d_bforce = zalloc(nd, sizeof(wb_real));
-    g->d_rest = zalloc(nd, sizeof(wb_real));
-    g->d_broken = zalloc(nd, 1);
-    g->d_gen = zalloc(nd, sizeof *g->d_gen);
-    g->d_free = zalloc(nfree, sizeof *g->d_free);
     g->c = zalloc(nc, sizeof *g->c);
     g->c_gen = zalloc(nc, sizeof *g->c_gen);
     g->surf_start = zalloc((int64_t)nsurf + 1, sizeof *g->surf_start);
     g->tri = zalloc(3 * (int64_t)ntri, sizeof *g->tri);
-    if (!g->x || !g->v || !g->inv_mass || !g->radius || !g->pinned || !g->d_ij || !g->d_alpha || !g->d_beta ||
-        !g->d_yield || !g->d_creep || !g->d_break || !g->d_bforce || !g->d_rest || !g->d_broken || !g->d_gen || !g->d_free ||
-        !g->c || !g->c_gen || !g->surf_start || !g->tri || !g->group || !g->cflags || !g->cfric || !g->x0) {
+    if (!g->x || !g->v || !g->inv_mass || !g->radius || !g->pinned || !g->c || !g->c_gen || !g->surf_start ||
+        !g->tri || !g->group || !g->cflags || !g->cfric || !g->x0 || wb_image_alloc_distances(g, nd, nfree) != WB_OK) {
         wb_image_free(g);
         return WB_ERR_NOMEM;
     }
-    for (int32_t i = 0; i < nd; i++) g->d_gen[i] = 1;
     memset(g->cflags, WB_CF_COLLIDE, (size_t)np);
     for (int32_t i = 0; i < nc; i++) {
         g->c_gen[i] = 1;
@@ -67,70 +51,17 @@ wb_status wb_image_alloc(wb_image *g, int32_t np, int32_t nd, int32_t nfree, int
     return WB_OK;
 }
 
-wb_status wb_image_alloc_bends(wb_image *g, int32_t nb)
-{
-    free(g->b_ij); free(g->b_alpha); free(g->b_beta); free(g->b_rest); free(g->b_btorque); free(g->b_broken);
-    g->nb = nb;
-    g->b_ij = zalloc(4 * (int64_t)nb, sizeof *g->b_ij);
-    g->b_alpha = zalloc(nb, sizeof(wb_real));
-    g->b_beta = zalloc(nb, sizeof(wb_real));
-    g->b_rest = zalloc(nb, sizeof(wb_real));
-    g->b_btorque = zalloc(nb, sizeof(wb_real));
-    g->b_broken = zalloc(nb, 1);
-    if (!g->b_ij || !g->b_alpha || !g->b_beta || !g->b_rest || !g->b_btorque || !g->b_broken) {
-        wb_image_free(g);
-        return WB_ERR_NOMEM;
-    }
-    return WB_OK;
-}
-
-wb_status wb_image_alloc_volumes(wb_image *g, int32_t n)
-{
-    free(g->vol_ijkl);
-    free(g->vol_alpha);
-    free(g->vol_rest);
-    free(g->vol_plastic);
-    g->nvol = n;
-    g->vol_ijkl = zalloc(4 * (int64_t)n, sizeof *g->vol_ijkl);
-    g->vol_alpha = zalloc(n, sizeof *g->vol_alpha);
-    g->vol_rest = zalloc(n, sizeof *g->vol_rest);
-    g->vol_plastic = zalloc(2 * (int64_t)n, sizeof *g->vol_plastic);
-    if (g->vol_ijkl && g->vol_alpha && g->vol_rest && g->vol_plastic) return WB_OK;
-    free(g->vol_ijkl);
-    free(g->vol_alpha);
-    free(g->vol_rest);
-    free(g->vol_plastic);
-    g->vol_ijkl = NULL;
-    g->vol_alpha = g->vol_rest = g->vol_plastic = NULL;
-    g->nvol = 0;
-    return WB_ERR_NOMEM;
-}
-
 void wb_image_free(wb_image *g)
 {
-    free(g->tet_ijkl);
-    free(g->tet_dminv);
-    free(g->tet_v0);
-    free(g->tet_young);
-    free(g->tet_poisson);
-    free(g->tet_plastic);
-    free(g->vol_ijkl);
-    free(g->vol_alpha);
-    free(g->vol_rest);
-    free(g->vol_plastic);
     for (int32_t i = 0; g->c && i < g->nc; i++) {
         free(g->c[i].mv);
         free(g->c[i].mt);
     }
-    void *p[] = { g->x, g->v, g->inv_mass, g->radius, g->pinned, g->d_ij, g->d_alpha, g->d_beta, g->d_yield,
-                  g->d_creep, g->d_break, g->d_rest, g->d_broken, g->d_gen, g->d_free, g->c, g->c_gen,
-                  g->surf_start, g->tri, g->group, g->cflags, g->cfric, g->x0, g->d_bforce,
-                  g->b_ij, g->b_alpha, g->b_beta, g->b_rest, g->b_btorque, g->b_broken };
+    void *p[] = { g->x, g->v, g->inv_mass, g->radius, g->pinned, g->c, g->c_gen, g->surf_start, g->tri, g->group,
+                  g->cflags, g->cfric, g->x0 };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
-    wb__smatch_image_free(g);
-    wb__pressure_image_free(g);
-    wb__attach_image_free(g);
-    wb__grab_image_free(g);
+    for (int i = 0; i < wb__nctypes; i++)
+        if (wb__ctypes[i]->image_free) wb__ctypes[i]->image_free(g);
     wb__rigid_image_free(g);
     memset(g, 0, sizeof *g);
 }
@@ -139,10 +70,10 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
 {
     const wb_model *m = &w->m;
     const wb_state *s = &w->s;
-    wb_status st = wb_image_alloc(g, m->np, m->nd, m->nfree, m->nc, m->nsurf, m->ntri);
+    wb_status st = wb_image_alloc(g, m->np, 0, 0, m->nc, m->nsurf, m->ntri); /* the types' sections: below */
     if (st != WB_OK) return st;
     g->def = m->def;
-    const size_t np = (size_t)m->np, nd = (size_t)m->nd;
+    const size_t np = (size_t)m->np;
     if (np) {
         memcpy(g->x, s->x, 3 * np * sizeof *g->x);
         memcpy(g->v, s->v, 3 * np * sizeof *g->v);
@@ -153,29 +84,6 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
         memcpy(g->cflags, m->cflags, np);
         memcpy(g->cfric, m->cfric, np * sizeof *g->cfric);
         memcpy(g->x0, m->x0, 3 * np * sizeof *g->x0);
-    }
-    if (nd) {
-        memcpy(g->d_ij, m->d_ij, 2 * nd * sizeof *g->d_ij);
-        memcpy(g->d_alpha, m->d_alpha, nd * sizeof(wb_real));
-        memcpy(g->d_beta, m->d_beta, nd * sizeof(wb_real));
-        memcpy(g->d_yield, m->d_yield, nd * sizeof(wb_real));
-        memcpy(g->d_creep, m->d_creep, nd * sizeof(wb_real));
-        memcpy(g->d_break, m->d_break, nd * sizeof(wb_real));
-        memcpy(g->d_bforce, m->d_bforce, nd * sizeof(wb_real));
-        memcpy(g->d_rest, s->d_rest, nd * sizeof(wb_real));
-        memcpy(g->d_broken, s->d_broken, nd);
-        memcpy(g->d_gen, m->d_gen, nd * sizeof *g->d_gen);
-    }
-    if (m->nfree) memcpy(g->d_free, m->d_free, (size_t)m->nfree * sizeof *g->d_free);
-    const wb_bends *bd = &w->bend;
-    if (bd->n > 0) {
-        if ((st = wb_image_alloc_bends(g, bd->n)) != WB_OK) return st;
-        memcpy(g->b_ij, bd->ij, 4 * (size_t)bd->n * sizeof *g->b_ij);
-        memcpy(g->b_alpha, bd->alpha, (size_t)bd->n * sizeof(wb_real));
-        memcpy(g->b_beta, bd->beta, (size_t)bd->n * sizeof(wb_real));
-        memcpy(g->b_rest, bd->rest, (size_t)bd->n * sizeof(wb_real));
-        memcpy(g->b_btorque, bd->btorque, (size_t)bd->n * sizeof(wb_real));
-        memcpy(g->b_broken, bd->broken, (size_t)bd->n);
     }
     for (int32_t i = 0; i < m->nc; i++) {
         const wb_cshape *cs = &m->c_shape[i];
@@ -216,27 +124,14 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
     g->frame = s->frame;
     g->warnings = s->warnings;
     memcpy(g->last_warning, s->last_warning, sizeof g->last_warning);
-    const int32_t nvol = wb_volume_count(w);
-    if (wb_image_alloc_volumes(g, nvol) != WB_OK) {
-        wb_image_free(g);
-        return WB_ERR_NOMEM;
-    }
-    if (nvol) {
-        memcpy(g->vol_ijkl, w->vol->ijkl, 4 * (size_t)nvol * sizeof *g->vol_ijkl);
-        memcpy(g->vol_alpha, w->vol->alpha, (size_t)nvol * sizeof *g->vol_alpha);
-        memcpy(g->vol_rest, w->vol->rest, (size_t)nvol * sizeof *g->vol_rest);
-        for (int32_t i = 0; i < nvol; i++) {
-            g->vol_plastic[2 * i] = w->vol->yield[i];
-            g->vol_plastic[2 * i + 1] = w->vol->creep[i];
-        }
-    }
-    if ((st = wb__tet_image_of(w, g)) != WB_OK || (st = wb__smatch_image_of(w, g)) != WB_OK ||
-        (st = wb__pressure_image_of(w, g)) != WB_OK || (st = wb__attach_image_of(w, g)) != WB_OK ||
-        (st = wb__grab_image_of(w, g)) != WB_OK || (st = wb__rigid_image_of(w, g)) != WB_OK) {
+    if ((st = wb__rigid_image_of(w, g)) != WB_OK) {
         wb_image_free(g);
         return st;
     }
-    return WB_OK;
+    for (int i = 0; i < wb__nctypes && st == WB_OK; i++)
+        if (wb__ctypes[i]->image_save) st = wb__ctypes[i]->image_save(w, g);
+    if (st != WB_OK) wb_image_free(g);
+    return st;
 }
 
 /* ---- checks ---------------------------------------------------------------------------- */
@@ -274,7 +169,6 @@ const char *wb_image_check(const wb_image *g)
     const char *e = wb_world_def_check(&g->def);
     if (e) return e;
     if (g->np < 0 || g->np > WB_MAX_PARTICLES) return "too many particles";
-    if (g->nd < 0 || g->nd > WB_MAX_CONSTRAINTS) return "too many constraints";
     if (g->nc < 0 || g->nc > WB_MAX_COLLIDERS) return "too many colliders";
     if (g->nsurf < 0 || g->ntri < 0 || g->ntri > WB_MAX_CONSTRAINTS) return "too many triangles";
     for (int32_t i = 0; i < g->np; i++) {
@@ -286,46 +180,6 @@ const char *wb_image_check(const wb_image *g)
         if (!(g->cfric[i] >= 0) || !isfinite(g->cfric[i])) return "particle friction must be >= 0";
         if (!fin3(&g->x0[3 * i])) return "particle rest position must be finite";
     }
-    int32_t dead = 0;
-    for (int32_t i = 0; i < g->nd; i++) {
-        if (!(g->d_gen[i] & 1u)) { dead++; continue; }
-        const int32_t a = g->d_ij[2 * i], b = g->d_ij[2 * i + 1];
-        if (a < 0 || b < 0 || a >= g->np || b >= g->np) return "constraint particle out of range";
-        if (a == b) return "a constraint needs two distinct particles";
-        wb_distance_def d = { g->d_alpha[i], g->d_beta[i], g->d_rest[i], g->d_yield[i], g->d_creep[i], g->d_break[i],
-                              g->d_bforce[i] };
-        if ((e = wb_distance_def_check(&d))) return e;
-        if (!(g->d_rest[i] >= 0)) return "rest length must be >= 0";
-        wb_real dx[3];
-        v3_sub(dx, &g->x[3 * b], &g->x[3 * a]);
-        if (!isfinite(v3_dot(dx, dx))) return "constraint particles are too far apart (their distance squared overflows)";
-    }
-    if (g->nb < 0 || g->nb > WB_MAX_CONSTRAINTS) return "too many bends";
-    for (int32_t i = 0; i < g->nb; i++) {
-        const int32_t *p = &g->b_ij[4 * i];
-        for (int a = 0; a < 4; a++) {
-            if (p[a] < 0 || p[a] >= g->np) return "bend particle out of range";
-            for (int b = 0; b < a; b++)
-                if (p[a] == p[b]) return "a bend needs four distinct particles";
-        }
-        wb_bend_def bd = { g->b_alpha[i], g->b_beta[i], g->b_rest[i], g->b_btorque[i] };
-        if (isnan(g->b_rest[i])) return "bend rest must be an angle in [-pi, pi] (radians)";
-        if ((e = wb_bend_def_check(&bd))) return e;
-    }
-    /* the free list is exactly the dead slots, each once (a mark per slot: linear) */
-    if (g->nfree != dead) return "the free constraint slots do not match the dead ones";
-    if (g->nfree > 0) {
-        uint8_t *seen = calloc((size_t)g->nd, 1);
-        if (!seen) return "out of memory checking the free constraint slots";
-        const char *fe = NULL;
-        for (int32_t i = 0; i < g->nfree && !fe; i++) {
-            const int32_t s = g->d_free[i];
-            if (s < 0 || s >= g->nd || (g->d_gen[s] & 1u)) fe = "a free constraint slot is not a dead one";
-            else if (seen[s]++) fe = "a free constraint slot is listed twice";
-        }
-        free(seen);
-        if (fe) return fe;
-    }
     for (int32_t i = 0; i < g->nc; i++)
         if ((g->c_gen[i] & 1u) && (e = check_collider(&g->c[i]))) return e;
     if (g->nsurf > 0 && (g->surf_start[0] != 0 || g->surf_start[g->nsurf] != g->ntri)) return "surface ranges do not cover the triangles";
@@ -335,32 +189,24 @@ const char *wb_image_check(const wb_image *g)
     for (int64_t i = 0; i < 3 * (int64_t)g->ntri; i++)
         if (g->tri[i] < 0 || g->tri[i] >= g->np) return "surface corner out of range";
     if (!(g->time >= 0) || !isfinite(g->time) || g->frame < 0 || g->warnings < 0) return "time, frame and warnings must be finite and >= 0";
-    if (g->nvol < 0 || g->nvol > WB_MAX_CONSTRAINTS) return "too many volume constraints";
-    for (int32_t i = 0; i < g->nvol; i++) {
-        const int32_t *p = &g->vol_ijkl[4 * i];
-        for (int k = 0; k < 4; k++) {
-            if (p[k] < 0 || p[k] >= g->np) return "volume constraint particle out of range";
-            for (int j = 0; j < k; j++)
-                if (p[j] == p[k]) return "a volume constraint needs four distinct particles";
-        }
-        const wb_volume_def d = { g->vol_alpha[i], true, g->vol_rest[i], g->vol_plastic[2 * i], g->vol_plastic[2 * i + 1] };
-        if ((e = wb_volume_def_check(&d))) return e;
-    }
-    if ((e = wb__tet_image_check(g)) || (e = wb__smatch_image_check(g)) || (e = wb__pressure_image_check(g)) ||
-        (e = wb__attach_image_check(g)) || (e = wb__grab_image_check(g)) || (e = wb__rigid_image_check(g)))
-        return e;
-    return NULL;
+    for (int i = 0; i < wb__nctypes; i++)
+        if (wb__ctypes[i]->image_check && (e = wb__ctypes[i]->image_check(g))) return e;
+    return wb__rigid_image_check(g);
 }
 
-/* the image's volume constraints after w's, particles shifted by `shift` (reserved) */
-static void put_volumes(wb_world *w, const wb_image *g, int32_t shift)
+/* every type's section of the image: room for it in w, then (nothing can fail) put */
+static wb_status reserve_types(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
-    for (int32_t i = 0; i < g->nvol; i++) {
-        int32_t p[4];
-        for (int k = 0; k < 4; k++) p[k] = g->vol_ijkl[4 * i + k] + shift;
-        wb__volume_put(w, p, g->vol_alpha[i], g->vol_rest[i]);
-        wb__volume_plastic(w, w->vol->n - 1, g->vol_plastic[2 * i], g->vol_plastic[2 * i + 1]);
-    }
+    wb_status st = WB_OK;
+    for (int i = 0; i < wb__nctypes && st == WB_OK; i++)
+        if (wb__ctypes[i]->image_reserve) st = wb__ctypes[i]->image_reserve(w, g, at);
+    return st;
+}
+
+static void put_types(wb_world *w, const wb_image *g, const wb_image_at *at)
+{
+    for (int i = 0; i < wb__nctypes; i++)
+        if (wb__ctypes[i]->image_put) wb__ctypes[i]->image_put(w, g, at);
 }
 
 /* ---- exact restore ----------------------------------------------------------------------- */
@@ -462,17 +308,12 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     }
     wb_world *w = wb_world_create(&g->def);
     wb_colmesh **cms = calloc((size_t)(g->nc > 0 ? g->nc : 1), sizeof *cms);
-    wb_status st = w && cms ? wb__reserve(w, g->np, g->nd) : WB_ERR_NOMEM;
-    if (st == WB_OK) st = wb__bend_reserve(w, g->nb);
+    const wb_image_at at = { 1, 0, 0, NULL, NULL };
+    wb_status st = w && cms ? wb__reserve(w, g->np, 0) : WB_ERR_NOMEM;
     if (st == WB_OK) st = grow_colliders(w, g->nc);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
-    if (st == WB_OK && g->nvol > 0) st = wb__volume_reserve(w, g->nvol);
-    if (st == WB_OK) st = wb__tet_image_reserve(w, g);
-    if (st == WB_OK) st = wb__smatch_reserve(w, g);
-    if (st == WB_OK) st = wb__pressure_reserve(w, g);
-    if (st == WB_OK) st = wb__attach_image_reserve(w, g);
-    if (st == WB_OK) st = wb__grab_image_reserve(w, g);
     if (st == WB_OK) st = wb__rigid_reserve(w, g, 1);
+    if (st == WB_OK) st = reserve_types(w, g, &at);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
@@ -482,7 +323,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     }
     wb_model *m = &w->m;
     wb_state *s = &w->s;
-    const size_t np = (size_t)g->np, nd = (size_t)g->nd;
+    const size_t np = (size_t)g->np;
     m->np = g->np;
     if (np) {
         memcpy(s->x, g->x, 3 * np * sizeof *s->x);
@@ -498,37 +339,6 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     }
     for (size_t i = 0; i < np; i++) m->w[i] = g->pinned[i] ? 0 : g->inv_mass[i];
     m->w_gen++;
-    m->nd = g->nd;
-    m->nd_live = 0;
-    if (nd) {
-        memcpy(m->d_ij, g->d_ij, 2 * nd * sizeof *m->d_ij);
-        memcpy(m->d_alpha, g->d_alpha, nd * sizeof(wb_real));
-        memcpy(m->d_beta, g->d_beta, nd * sizeof(wb_real));
-        memcpy(m->d_yield, g->d_yield, nd * sizeof(wb_real));
-        memcpy(m->d_creep, g->d_creep, nd * sizeof(wb_real));
-        memcpy(m->d_break, g->d_break, nd * sizeof(wb_real));
-        memcpy(m->d_bforce, g->d_bforce, nd * sizeof(wb_real));
-        memcpy(s->d_rest, g->d_rest, nd * sizeof(wb_real));
-        memcpy(s->d_broken, g->d_broken, nd);
-        memcpy(m->d_gen, g->d_gen, nd * sizeof *m->d_gen);
-    }
-    for (size_t i = 0; i < nd; i++) {
-        w->k.slot_pack[i] = -1;
-        m->nd_live += (int32_t)(g->d_gen[i] & 1u);
-    }
-    m->nfree = g->nfree;
-    if (g->nfree) memcpy(m->d_free, g->d_free, (size_t)g->nfree * sizeof *m->d_free);
-    wb_bends *bd = &w->bend;
-    bd->n = g->nb;
-    if (g->nb > 0) {
-        memcpy(bd->ij, g->b_ij, 4 * (size_t)g->nb * sizeof *bd->ij);
-        memcpy(bd->alpha, g->b_alpha, (size_t)g->nb * sizeof(wb_real));
-        memcpy(bd->beta, g->b_beta, (size_t)g->nb * sizeof(wb_real));
-        memcpy(bd->rest, g->b_rest, (size_t)g->nb * sizeof(wb_real));
-        memcpy(bd->btorque, g->b_btorque, (size_t)g->nb * sizeof(wb_real));
-        memcpy(bd->broken, g->b_broken, (size_t)g->nb);
-        bd->dirty = 1;
-    }
     m->nc = g->nc;
     for (int32_t i = 0; i < g->nc; i++) {
         put_collider(w, i, &g->c[i], cms[i]);
@@ -536,13 +346,8 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     }
     free(cms);
     put_surfaces(w, g, 0);
-    put_volumes(w, g, 0);
-    wb__tet_image_put(w, g, 0);
-    wb__smatch_put(w, g, 0);
-    wb__pressure_put(w, g, 0);
-    wb__rigid_put(w, g, 1, NULL);
-    wb__attach_image_put(w, g, 0, NULL, NULL);
-    wb__grab_image_put(w, g, 0, NULL);
+    wb__rigid_put(w, g, 1, NULL); /* before the types: attachments and grabs name bodies */
+    put_types(w, g, &at);
     s->time = g->time;
     s->frame = g->frame;
     s->warnings = g->warnings;
@@ -571,8 +376,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
         return WB_ERR_ARG;
     }
     wb_model *m = &w->m;
-    int32_t live_d = 0, live_c = 0, dead_c = 0;
-    for (int32_t i = 0; i < g->nd; i++) live_d += (int32_t)(g->d_gen[i] & 1u);
+    int32_t live_c = 0, dead_c = 0;
     for (int32_t i = 0; i < g->nc; i++) live_c += (int32_t)(g->c_gen[i] & 1u);
     for (int32_t i = 0; i < m->nc; i++) dead_c += !(m->c_gen[i] & 1u);
     const int32_t new_c = live_c > dead_c ? live_c - dead_c : 0;
@@ -589,17 +393,12 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     int32_t *cmap = calloc((size_t)(g->nc > 0 ? g->nc : 1), sizeof *cmap); /* image slot -> w's */
     int32_t *rmap = calloc((size_t)(g->nrb > 0 ? g->nrb : 1), sizeof *rmap); /* the same for rigid bodies */
     if (!cms || !cmap || !rmap) { free(cms); free(cmap); free(rmap); return WB_ERR_NOMEM; }
-    wb_status st = wb__reserve(w, g->np, live_d);
-    if (st == WB_OK) st = wb__bend_reserve(w, g->nb);
+    const wb_image_at at = { 0, m->np, m->nsurf, cmap, rmap };
+    wb_status st = wb__reserve(w, g->np, 0);
     if (st == WB_OK) st = grow_colliders(w, m->nc + new_c);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
-    if (st == WB_OK && g->nvol > 0) st = wb__volume_reserve(w, g->nvol);
-    if (st == WB_OK) st = wb__tet_image_reserve(w, g);
-    if (st == WB_OK) st = wb__smatch_reserve(w, g);
-    if (st == WB_OK) st = wb__pressure_reserve(w, g);
-    if (st == WB_OK) st = wb__attach_image_reserve(w, g);
-    if (st == WB_OK) st = wb__grab_image_reserve(w, g);
     if (st == WB_OK) st = wb__rigid_reserve(w, g, 0);
+    if (st == WB_OK) st = reserve_types(w, g, &at);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);
@@ -607,7 +406,6 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
         free(rmap);
         return st;
     }
-    const int32_t first_surface = m->nsurf;
 
     const int32_t first = m->np;
     for (int32_t i = 0; i < g->np; i++) {
@@ -624,20 +422,6 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
         memcpy(&m->x0[3 * (first + i)], &g->x0[3 * i], 3 * sizeof(wb_real));
     }
     w->k.pc.scan_dirty = 1;
-    for (int32_t i = 0; i < g->nd; i++) {
-        if (!(g->d_gen[i] & 1u)) continue;
-        wb_distance_def d = { g->d_alpha[i], g->d_beta[i], g->d_rest[i], g->d_yield[i], g->d_creep[i], g->d_break[i],
-                              g->d_bforce[i] };
-        wb_distance_id id = wb_distance_add(w, first + g->d_ij[2 * i], first + g->d_ij[2 * i + 1], &d, NULL);
-        w->s.d_broken[id.index - 1] = g->d_broken[i];
-    }
-    for (int32_t i = 0; i < g->nb; i++) {
-        const int32_t p[4] = { first + g->b_ij[4 * i], first + g->b_ij[4 * i + 1], first + g->b_ij[4 * i + 2],
-                               first + g->b_ij[4 * i + 3] };
-        wb_bend_def bd = { g->b_alpha[i], g->b_beta[i], g->b_rest[i], g->b_btorque[i] };
-        wb_bend_id id = wb_bend_add(w, p, &bd, NULL); /* checked and reserved: cannot fail */
-        w->bend.broken[id.index - 1] = g->b_broken[i];
-    }
     int32_t scan = 0; /* dead slots are taken lowest first: the scan never goes back */
     for (int32_t i = 0; i < g->nc; i++) {
         if (!(g->c_gen[i] & 1u)) continue;
@@ -654,14 +438,9 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     }
     free(cms);
     put_surfaces(w, g, first);
-    put_volumes(w, g, first);
-    wb__tet_image_put(w, g, first);
-    wb__smatch_put(w, g, first);
-    wb__pressure_put(w, g, first_surface);
     /* the image's rigid bodies go to free or new slots: the attachments follow them */
     wb__rigid_put(w, g, 0, rmap);
-    wb__attach_image_put(w, g, first, cmap, rmap);
-    wb__grab_image_put(w, g, first, rmap);
+    put_types(w, g, &at);
     free(rmap);
     free(cmap);
     m->topology_dirty = 1;

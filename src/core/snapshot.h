@@ -6,6 +6,12 @@
 #define WB_SNAPSHOT_H
 
 #include "wobble.h"
+/* the constraint types' own sections of an image, declared by their owners */
+#include "bend.h"
+#include "distance.h"
+#include "shape_match.h"
+#include "tet.h"
+#include "volume.h"
 
 /* a collider: its shape in its own frame and its full pose */
 typedef struct wb_image_collider {
@@ -22,23 +28,6 @@ typedef struct wb_image_collider {
     wb_real *mv;           /* mesh: (mnv x 3) vertices in the collider frame (malloc'd, the image owns it) */
     int32_t *mt;           /* mesh: (mnt x 3) corners (malloc'd, the image owns it) */
 } wb_image_collider;
-
-/* shape-matching clusters (shape_match.c): model and state by cluster */
-typedef struct wb_image_smatch {
-    int32_t n, nids;
-    int32_t *start;        /* (n + 1) ranges into ids */
-    int32_t *ids;          /* (nids) particles */
-    wb_real *stiff, *yield, *creep; /* (n) */
-    wb_real *rest;         /* (nids x 3) rest shape about its mass centre */
-    wb_real *q;            /* (n x 4) rotation at the end of the last frame */
-} wb_image_smatch;
-
-/* pressure constraints (pressure.c): each over one of the image's surfaces */
-typedef struct wb_image_pressure {
-    int32_t n;
-    int32_t *surface;      /* (n) */
-    wb_real *pressure, *alpha, *v0; /* (n) factor, compliance, rest volume */
-} wb_image_pressure;
 
 /* attachments (attach.c) and grabs (grab.c): the live ones, in slot order */
 typedef struct wb_image_attach {
@@ -79,22 +68,9 @@ typedef struct wb_image {
     wb_real *cfric;        /* (np) contact friction */
     wb_real *x0;           /* (np x 3) where created (the self-collision rest rule) */
 
-    /* distance constraints by slot: a slot is live while its generation is odd */
-    int32_t nd;
-    int32_t *d_ij;         /* (nd x 2) */
-    wb_real *d_alpha, *d_beta, *d_yield, *d_creep, *d_break, *d_rest; /* (nd) */
-    wb_real *d_bforce;     /* (nd) break_force, N (0 = none) */
-    uint8_t *d_broken;     /* (nd) */
-    uint32_t *d_gen;       /* (nd) */
-    int32_t nfree;
-    int32_t *d_free;       /* (nfree) free slots, in stack order */
+    wb_image_distance dist; /* distance.h */
 
-    /* bending constraints in creation order (wb_image_alloc_bends) */
-    int32_t nb;
-    int32_t *b_ij;         /* (nb x 4) hinge p1 p2, wings p3 p4 */
-    wb_real *b_alpha, *b_beta, *b_rest; /* (nb) compliance, damping, rest angle */
-    wb_real *b_btorque;    /* (nb) break_torque, N m (0: never) */
-    uint8_t *b_broken;     /* (nb) broken by it */
+    wb_image_bend bend;    /* bend.h: empty unless wb_image_alloc_bends */
 
     int32_t nc;
     wb_image_collider *c;  /* (nc) by slot */
@@ -109,19 +85,10 @@ typedef struct wb_image {
     int64_t frame, warnings;
     char last_warning[160];
 
-    /* volume constraints (volume.c), in creation order: allocated by wb_image_alloc_volumes */
-    int32_t nvol;
-    int32_t *vol_ijkl;     /* (nvol x 4) */
-    wb_real *vol_alpha, *vol_rest; /* (nvol) compliance, signed rest volume */
-    wb_real *vol_plastic;  /* (nvol x 2) yield, creep (0: none) */
-    /* Neo-Hookean tets (tet.c), in creation order: allocated by wb_image_alloc_tets */
-    int32_t ntet;
-    int32_t *tet_ijkl;     /* (ntet x 4) */
-    wb_real *tet_dminv;    /* (ntet x 9) rest edge matrix inverse, row-major */
-    wb_real *tet_v0, *tet_young, *tet_poisson; /* (ntet) rest volume (> 0), E, nu */
-    wb_real *tet_plastic;  /* (ntet x 2) yield, creep (0: none) */
-    wb_image_smatch sm;    /* empty unless wb_image_alloc_smatch */
-    wb_image_pressure pr;  /* empty unless wb_image_alloc_pressure */
+    wb_image_volume vol;   /* volume.h: empty unless wb_image_alloc_volumes */
+    wb_image_tet tet;      /* tet.h: empty unless wb_image_alloc_tets */
+    wb_image_smatch sm;    /* shape_match.h: empty unless wb_image_alloc_smatch */
+    wb_image_pressure pr;  /* shape_match.h: empty unless wb_image_alloc_pressure */
     wb_image_attach att;   /* empty unless wb_image_alloc_attach */
     wb_image_grab grab;    /* empty unless wb_image_alloc_grab */
     int32_t nrb;           /* rigid bodies by slot: empty unless wb_image_alloc_rigids */
@@ -132,19 +99,18 @@ typedef struct wb_image {
 /* allocate the arrays for these counts (zeroed; generations 1, i.e. live; particles collide);
  * WB_ERR_NOMEM */
 wb_status wb_image_alloc(wb_image *img, int32_t np, int32_t nd, int32_t nfree, int32_t nc, int32_t nsurf, int32_t ntri);
-/* the bend arrays for nb bends (zeroed), after wb_image_alloc; WB_ERR_NOMEM */
+/* distance.c: the distance section for nd slots (generations 1) and nfree free ones (zeroed);
+ * WB_ERR_NOMEM (the section left empty) */
+wb_status wb_image_alloc_distances(wb_image *img, int32_t nd, int32_t nfree);
+/* bend.c: the bend arrays for nb bends (zeroed), after wb_image_alloc; WB_ERR_NOMEM (the
+ * section left empty) */
 wb_status wb_image_alloc_bends(wb_image *img, int32_t nb);
-/* the volume constraints' arrays for n of them (zeroed); WB_ERR_NOMEM */
+/* the volume constraints' arrays for n of them (zeroed; volume.c); WB_ERR_NOMEM */
 wb_status wb_image_alloc_volumes(wb_image *img, int32_t n);
 /* the Neo-Hookean tets' arrays for n of them (zeroed; tet.c); WB_ERR_NOMEM */
 wb_status wb_image_alloc_tets(wb_image *img, int32_t n);
-/* tet.c: copy w's tets into the image, check an image's, and add them after w's (reserved
- * by wb__tet_image_reserve), particles shifted by `shift` */
-wb_status wb__tet_image_of(const wb_world *w, wb_image *img);
-const char *wb__tet_image_check(const wb_image *img);
-wb_status wb__tet_image_reserve(wb_world *w, const wb_image *img);
-void wb__tet_image_put(wb_world *w, const wb_image *img, int32_t shift);
-/* the materials' sections (after wb_image_alloc; zeroed, rotations identity); WB_ERR_NOMEM */
+/* the materials' sections (after wb_image_alloc; zeroed, rotations identity; shape_match.c,
+ * pressure.c); WB_ERR_NOMEM */
 wb_status wb_image_alloc_smatch(wb_image *img, int32_t n, int32_t nids);
 wb_status wb_image_alloc_pressure(wb_image *img, int32_t n);
 void wb_image_free(wb_image *img);                     /* and zero it (mesh colliders' arrays too); fine on a zeroed image */
@@ -160,35 +126,10 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *img, wb_body *out);
 /* the collider w:collider{...} would make from a world-frame def, in its own frame + pose */
 wb_status wb_image_collider_from_def(const wb_collider_def *d, wb_image_collider *out);
 
-/* core-internal: each material type's part of the functions above (shape_match.c,
- * pressure.c). _of copies the world's; _check is the image's last line of defence (its
- * particle ids and surfaces already checked); _reserve makes room in w for the image's
- * (adding nothing); _put then adds them, particle ids shifted by pshift and surface
- * indices by sshift, and cannot fail */
-void wb__smatch_image_free(wb_image *g);
-wb_status wb__smatch_image_of(const wb_world *w, wb_image *g);
-const char *wb__smatch_image_check(const wb_image *g);
-wb_status wb__smatch_reserve(wb_world *w, const wb_image *g);
-void wb__smatch_put(wb_world *w, const wb_image *g, int32_t pshift);
-void wb__pressure_image_free(wb_image *g);
-wb_status wb__pressure_image_of(const wb_world *w, wb_image *g);
-const char *wb__pressure_image_check(const wb_image *g);
-wb_status wb__pressure_reserve(wb_world *w, const wb_image *g);
-void wb__pressure_put(wb_world *w, const wb_image *g, int32_t sshift);
-/* attach.c and grab.c, the same way; cmap and rmap map the image's collider and rigid slots to w's (NULL:
- * the same slots) */
+/* attach.c and grab.c, the same way. Each constraint type's part of the functions above
+ * (save, check, put) is its own, reached through its hooks (ctype.h) */
 wb_status wb_image_alloc_attach(wb_image *g, int32_t n);
 wb_status wb_image_alloc_grab(wb_image *g, int32_t n);
-void wb__attach_image_free(wb_image *g);
-wb_status wb__attach_image_of(const wb_world *w, wb_image *g);
-const char *wb__attach_image_check(const wb_image *g);
-wb_status wb__attach_image_reserve(wb_world *w, const wb_image *g);
-void wb__attach_image_put(wb_world *w, const wb_image *g, int32_t pshift, const int32_t *cmap, const int32_t *rmap);
-void wb__grab_image_free(wb_image *g);
-wb_status wb__grab_image_of(const wb_world *w, wb_image *g);
-const char *wb__grab_image_check(const wb_image *g);
-wb_status wb__grab_image_reserve(wb_world *w, const wb_image *g);
-void wb__grab_image_put(wb_world *w, const wb_image *g, int32_t pshift, const int32_t *rmap);
 
 /* rigid bodies (rigid_image.c): n slots, zeroed, generations 1 (live); WB_ERR_NOMEM */
 wb_status wb_image_alloc_rigids(wb_image *img, int32_t n);

@@ -77,7 +77,7 @@ wb_status wb__tet_reserve(wb_world *w, int64_t extra)
     if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     if (need <= v->cap) return WB_OK;
     const int32_t cap = wb__grown_cap(v->cap, need, 64);
-    if (!wb__material_charge(w, &v->charged, (size_t)cap * TET_BYTES)) return WB_ERR_NOMEM;
+    if (!wb__charge(w, &v->charged, (size_t)cap * TET_BYTES)) return WB_ERR_NOMEM;
     const wb_soa arr[] = {
         { (void **)&v->ijkl, 4 * sizeof(int32_t) }, { (void **)&v->dminv, 9 * sizeof(wb_real) },
         { (void **)&v->v0, sizeof(wb_real) }, { (void **)&v->young, sizeof(wb_real) },
@@ -166,11 +166,8 @@ bool wb__tet_put_current(wb_world *w, const int32_t p[4], wb_real young, wb_real
 int32_t wb_tet_add(wb_world *w, const int32_t p[4], const wb_tet_def *def)
 {
     const char *err = wb_tet_def_check(def);
-    for (int k = 0; k < 4 && !err; k++) {
-        if (p[k] < 0 || p[k] >= w->m.np) err = "particle out of range";
-        for (int j = 0; j < k && !err; j++)
-            if (p[j] == p[k]) err = "a tet needs four distinct particles";
-    }
+    const int q = err ? 0 : wb__quad_check(p, w->m.np);
+    if (q) err = q == 1 ? "particle out of range" : "a tet needs four distinct particles";
     wb_real inv[9], vol;
     if (!err && !rest_of(w->s.x, p, inv, &vol)) err = "the four particles lie in a plane (a flat tet has no rest shape)";
     if (err) {
@@ -274,81 +271,86 @@ void wb_tet_material(const wb_world *w, int32_t i, wb_real *young, wb_real *pois
 }
 
 /* ---- snapshots (snapshot.h): the model as it is, so a restored world has the same future */
+static void tet_image_free(wb_image *g)
+{
+    wb_image_tet *t = &g->tet;
+    free(t->ijkl); free(t->dminv); free(t->v0); free(t->young); free(t->poisson); free(t->plastic);
+    memset(t, 0, sizeof *t);
+}
+
+/* calloc of n elements, never of 0 bytes (so NULL always means out of memory) */
+static void *zalloc(int64_t n, size_t elem) { return calloc((size_t)(n > 0 ? n : 1), elem); }
+
 wb_status wb_image_alloc_tets(wb_image *g, int32_t n)
 {
-    void **a[] = { (void **)&g->tet_ijkl, (void **)&g->tet_dminv, (void **)&g->tet_v0, (void **)&g->tet_young,
-                   (void **)&g->tet_poisson, (void **)&g->tet_plastic };
-    const size_t el[] = { 4 * sizeof(int32_t), 9 * sizeof(wb_real), sizeof(wb_real), sizeof(wb_real), sizeof(wb_real),
-                          2 * sizeof(wb_real) };
-    bool ok = true;
-    for (int k = 0; k < 6; k++) {
-        free(*a[k]);
-        *a[k] = calloc(n > 0 ? (size_t)n : 1, el[k]);
-        ok = ok && *a[k];
-    }
-    g->ntet = n;
-    if (ok) return WB_OK;
-    for (int k = 0; k < 6; k++) { free(*a[k]); *a[k] = NULL; }
-    g->ntet = 0;
+    tet_image_free(g);
+    wb_image_tet *t = &g->tet;
+    t->n = n;
+    t->ijkl = zalloc(4 * (int64_t)n, sizeof *t->ijkl);
+    t->dminv = zalloc(9 * (int64_t)n, sizeof *t->dminv);
+    t->v0 = zalloc(n, sizeof *t->v0);
+    t->young = zalloc(n, sizeof *t->young);
+    t->poisson = zalloc(n, sizeof *t->poisson);
+    t->plastic = zalloc(2 * (int64_t)n, sizeof *t->plastic);
+    if (t->ijkl && t->dminv && t->v0 && t->young && t->poisson && t->plastic) return WB_OK;
+    tet_image_free(g);
     return WB_ERR_NOMEM;
 }
 
-wb_status wb__tet_image_of(const wb_world *w, wb_image *g)
+static wb_status tet_image_save(const wb_world *w, wb_image *g)
 {
     const int32_t n = wb_tet_count(w);
     if (wb_image_alloc_tets(g, n) != WB_OK) return WB_ERR_NOMEM;
     if (n == 0) return WB_OK;
     const wb_neos *v = w->neo;
-    memcpy(g->tet_ijkl, v->ijkl, 4 * sizeof(int32_t) * (size_t)n);
-    memcpy(g->tet_dminv, v->dminv, 9 * sizeof(wb_real) * (size_t)n);
-    memcpy(g->tet_v0, v->v0, sizeof(wb_real) * (size_t)n);
-    memcpy(g->tet_young, v->young, sizeof(wb_real) * (size_t)n);
-    memcpy(g->tet_poisson, v->poisson, sizeof(wb_real) * (size_t)n);
+    memcpy(g->tet.ijkl, v->ijkl, 4 * sizeof(int32_t) * (size_t)n);
+    memcpy(g->tet.dminv, v->dminv, 9 * sizeof(wb_real) * (size_t)n);
+    memcpy(g->tet.v0, v->v0, sizeof(wb_real) * (size_t)n);
+    memcpy(g->tet.young, v->young, sizeof(wb_real) * (size_t)n);
+    memcpy(g->tet.poisson, v->poisson, sizeof(wb_real) * (size_t)n);
     for (int32_t i = 0; i < n; i++) {
-        g->tet_plastic[2 * i] = v->yield[i];
-        g->tet_plastic[2 * i + 1] = v->creep[i];
+        g->tet.plastic[2 * i] = v->yield[i];
+        g->tet.plastic[2 * i + 1] = v->creep[i];
     }
     return WB_OK;
 }
 
-const char *wb__tet_image_check(const wb_image *g)
+static const char *tet_image_check(const wb_image *g)
 {
-    if (g->ntet < 0 || g->ntet > WB_MAX_CONSTRAINTS) return "too many tets";
-    for (int32_t i = 0; i < g->ntet; i++) {
-        const int32_t *p = &g->tet_ijkl[4 * i];
-        for (int k = 0; k < 4; k++) {
-            if (p[k] < 0 || p[k] >= g->np) return "tet particle out of range";
-            for (int j = 0; j < k; j++)
-                if (p[j] == p[k]) return "a tet needs four distinct particles";
-        }
-        const wb_tet_def d = { g->tet_young[i], g->tet_poisson[i], g->tet_plastic[2 * i], g->tet_plastic[2 * i + 1] };
+    if (g->tet.n < 0 || g->tet.n > WB_MAX_CONSTRAINTS) return "too many tets";
+    for (int32_t i = 0; i < g->tet.n; i++) {
+        const int q = wb__quad_check(&g->tet.ijkl[4 * i], g->np);
+        if (q) return q == 1 ? "tet particle out of range" : "a tet needs four distinct particles";
+        const wb_tet_def d = { g->tet.young[i], g->tet.poisson[i], g->tet.plastic[2 * i], g->tet.plastic[2 * i + 1] };
         const char *e = wb_tet_def_check(&d);
         if (e) return e;
-        if (!(g->tet_v0[i] > 0) || !isfinite(g->tet_v0[i])) return "a tet's rest volume must be > 0";
-        const wb_real *dm = &g->tet_dminv[9 * i];
+        if (!(g->tet.v0[i] > 0) || !isfinite(g->tet.v0[i])) return "a tet's rest volume must be > 0";
+        const wb_real *dm = &g->tet.dminv[9 * i];
         for (int k = 0; k < 9; k++)
             if (!isfinite(dm[k]) || fabs(dm[k]) > 1e150) return "a tet's rest shape must be finite";
         /* Dm^-1 and V0 describe one rest tet (V0 = 1 / (6 |det Dm^-1|)); a singular or
          * mismatched pair from a hand-edited file would make F and the energy NaN */
         const wb_real det = det3(dm);
-        if (!(fabs(6 * g->tet_v0[i] * det - 1) <= 1e-6) && !(fabs(6 * g->tet_v0[i] * det + 1) <= 1e-6))
+        if (!(fabs(6 * g->tet.v0[i] * det - 1) <= 1e-6) && !(fabs(6 * g->tet.v0[i] * det + 1) <= 1e-6))
             return "a tet's rest_inverse and rest_volume disagree (V0 = 1 / (6 |det|))";
     }
     return NULL;
 }
 
-wb_status wb__tet_image_reserve(wb_world *w, const wb_image *g)
+static wb_status tet_image_reserve(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
-    return g->ntet > 0 ? wb__tet_reserve(w, g->ntet) : WB_OK;
+    (void)at;
+    return g->tet.n > 0 ? wb__tet_reserve(w, g->tet.n) : WB_OK;
 }
 
-void wb__tet_image_put(wb_world *w, const wb_image *g, int32_t shift)
+static void tet_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
-    for (int32_t i = 0; i < g->ntet; i++) {
+    const int32_t shift = at->pshift;
+    for (int32_t i = 0; i < g->tet.n; i++) {
         int32_t p[4];
-        for (int k = 0; k < 4; k++) p[k] = g->tet_ijkl[4 * i + k] + shift;
-        wb__tet_put(w, p, &g->tet_dminv[9 * i], g->tet_v0[i], g->tet_young[i], g->tet_poisson[i]);
-        wb__tet_plastic(w, w->neo->n - 1, g->tet_plastic[2 * i], g->tet_plastic[2 * i + 1]);
+        for (int k = 0; k < 4; k++) p[k] = g->tet.ijkl[4 * i + k] + shift;
+        wb__tet_put(w, p, &g->tet.dminv[9 * i], g->tet.v0[i], g->tet.young[i], g->tet.poisson[i]);
+        wb__tet_plastic(w, w->neo->n - 1, g->tet.plastic[2 * i], g->tet.plastic[2 * i + 1]);
     }
 }
 
@@ -857,6 +859,52 @@ static void tet_links(const wb_world *w, wb_link_fn fn, void *ud)
     if (w->neo) wb__link_quads(w->neo->ijkl, w->neo->n, fn, ud);
 }
 
+/* ---- teardown and hash (ctype.h) --------------------------------------------------------- */
+static void tet_destroy(wb_world *w)
+{
+    wb_neos *v = w->neo;
+    if (!v) return;
+    void *a[] = { v->ijkl, v->dminv, v->v0, v->young, v->poisson, v->mu, v->lam, v->ld, v->lh, v->order, v->pk, v->pd,
+                  v->yield, v->creep };
+    for (size_t i = 0; i < sizeof a / sizeof a[0]; i++) free(a[i]);
+    free(v);
+    w->neo = NULL;
+}
+
+static size_t tet_charged(const wb_world *w) { return w->neo ? w->neo->charged : 0; }
+
+/* plastic tets' rest state flows (state), and how; elastic ones add nothing */
+static uint64_t tet_hash(const wb_world *w, uint64_t h)
+{
+    const wb_neos *ne = w->neo;
+    if (!ne || !ne->plastic) return h;
+    h = wb__fnv(h, ne->dminv, sizeof(wb_real) * 9 * (size_t)ne->n);
+    h = wb__fnv(h, ne->v0, sizeof(wb_real) * (size_t)ne->n);
+    h = wb__fnv(h, ne->yield, sizeof(wb_real) * (size_t)ne->n);
+    return wb__fnv(h, ne->creep, sizeof(wb_real) * (size_t)ne->n);
+}
+
+static void tet_stats(const wb_world *w, wb_stats *st)
+{
+    st->tets = wb_tet_count(w);
+}
+
 const wb_ctype wb__tet_type = {
-    "tet", tet_count, tet_prepare, tet_substep_begin, tet_project, tet_frame_end, tet_energy, tet_links,
+    .name = "tet",
+    .count = tet_count,
+    .prepare = tet_prepare,
+    .substep_begin = tet_substep_begin,
+    .project = tet_project,
+    .frame_end = tet_frame_end,
+    .energy = tet_energy,
+    .links = tet_links,
+    .destroy = tet_destroy,
+    .charged = tet_charged,
+    .stats = tet_stats,
+    .hash = tet_hash,
+    .image_free = tet_image_free,
+    .image_save = tet_image_save,
+    .image_check = tet_image_check,
+    .image_reserve = tet_image_reserve,
+    .image_put = tet_image_put,
 };

@@ -33,6 +33,15 @@ typedef struct wb_neos {
     int inverted_warned;   /* the inverted-tets warning was given */
 } wb_neos;
 
+/* a snapshot image's Neo-Hookean tets (snapshot.h), in creation order */
+typedef struct wb_image_tet {
+    int32_t n;
+    int32_t *ijkl;         /* (n x 4) */
+    wb_real *dminv;        /* (n x 9) rest edge matrix inverse, row-major */
+    wb_real *v0, *young, *poisson; /* (n) rest volume (> 0), E, nu */
+    wb_real *plastic;      /* (n x 2) yield, creep (0: none) */
+} wb_image_tet;
+
 /* room for `extra` more, charged to the memory budget; after it wb__tet_put cannot fail */
 wb_status wb__tet_reserve(wb_world *w, int64_t extra);
 /* append one with its rest state (dminv row-major, v0 > 0) */
@@ -42,18 +51,5 @@ bool wb__tet_put_current(wb_world *w, const int32_t p[4], wb_real young, wb_real
 /* plastic flow (yield, creep) for the tets from `first` on: a body's builder gives them
  * its links' options */
 void wb__tet_plastic(wb_world *w, int32_t first, wb_real yield, wb_real creep);
-
-/* world.c's destroy (inline so that world.c and tet.c do not call each other) */
-static inline void wb__tet_free(wb_world *w)
-{
-    wb_neos *v = w->neo;
-    if (!v) return;
-    if (w->m.def.memory) w->m.def.memory->used -= v->charged;
-    void *a[] = { v->ijkl, v->dminv, v->v0, v->young, v->poisson, v->mu, v->lam, v->ld, v->lh, v->order, v->pk, v->pd,
-                  v->yield, v->creep };
-    for (size_t i = 0; i < sizeof a / sizeof a[0]; i++) free(a[i]);
-    free(v);
-    w->neo = NULL;
-}
 
 #endif

@@ -19,6 +19,7 @@
 #include "core.h"
 #include "ctype.h"
 #include "volume.h"
+#include "snapshot.h"
 
 
 #define VOLUME_BYTES (10 * sizeof(int32_t) + 7 * sizeof(wb_real))
@@ -50,7 +51,7 @@ const char *wb_volume_def_check(const wb_volume_def *d)
 
 /* room for `extra` more constraints, charged to the memory budget: refused, nothing made,
  * when it would pass the budget (a failed allocation leaves the larger charge until the
- * next reserve, as wb__material_charge's other users do) */
+ * next reserve, as wb__charge's other users do) */
 wb_status wb__volume_reserve(wb_world *w, int64_t extra)
 {
     wb_volumes *v = w->vol;
@@ -63,7 +64,7 @@ wb_status wb__volume_reserve(wb_world *w, int64_t extra)
     if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     if (need <= v->cap) return WB_OK;
     const int32_t cap = wb__grown_cap(v->cap, need, 64);
-    if (!wb__material_charge(w, &v->charged, (size_t)cap * VOLUME_BYTES)) return WB_ERR_NOMEM;
+    if (!wb__charge(w, &v->charged, (size_t)cap * VOLUME_BYTES)) return WB_ERR_NOMEM;
     const wb_soa arr[] = {
         { (void **)&v->ijkl, 4 * sizeof(int32_t) }, { (void **)&v->alpha, sizeof(wb_real) },
         { (void **)&v->rest, sizeof(wb_real) }, { (void **)&v->lambda, sizeof(wb_real) },
@@ -103,11 +104,8 @@ void wb__volume_plastic(wb_world *w, int32_t first, wb_real yield, wb_real creep
 int32_t wb_volume_add(wb_world *w, const int32_t p[4], const wb_volume_def *def)
 {
     const char *err = wb_volume_def_check(def);
-    for (int k = 0; k < 4 && !err; k++) {
-        if (p[k] < 0 || p[k] >= w->m.np) err = "particle out of range";
-        for (int j = 0; j < k && !err; j++)
-            if (p[j] == p[k]) err = "a volume constraint needs four distinct particles";
-    }
+    const int q = err ? 0 : wb__quad_check(p, w->m.np);
+    if (q) err = q == 1 ? "particle out of range" : "a volume constraint needs four distinct particles";
     const wb_real *x = w->s.x;
     const wb_real rest = def->has_rest ? def->rest
                        : err ? 0 : wb_tet_signed_volume(&x[3 * p[0]], &x[3 * p[1]], &x[3 * p[2]], &x[3 * p[3]]);
@@ -281,6 +279,120 @@ static void vol_links(const wb_world *w, wb_link_fn fn, void *ud)
     if (w->vol) wb__link_quads(w->vol->ijkl, w->vol->n, fn, ud);
 }
 
+/* ---- teardown, hash, snapshots (ctype.h) -------------------------------------------------- */
+static void vol_destroy(wb_world *w)
+{
+    wb_volumes *v = w->vol;
+    if (!v) return;
+    void *p[] = { v->ijkl, v->alpha, v->rest, v->yield, v->creep, v->lambda, v->order, v->pos, v->pk, v->pa };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    free(v);
+    w->vol = NULL;
+}
+
+static size_t vol_charged(const wb_world *w) { return w->vol ? w->vol->charged : 0; }
+
+/* plastic ones' rest volumes flow (state), and how; elastic ones add nothing */
+static uint64_t vol_hash(const wb_world *w, uint64_t h)
+{
+    const wb_volumes *vo = w->vol;
+    if (!vo || !vo->plastic) return h;
+    h = wb__fnv(h, vo->rest, sizeof(wb_real) * (size_t)vo->n);
+    h = wb__fnv(h, vo->yield, sizeof(wb_real) * (size_t)vo->n);
+    return wb__fnv(h, vo->creep, sizeof(wb_real) * (size_t)vo->n);
+}
+
+static void vol_image_free(wb_image *g)
+{
+    wb_image_volume *v = &g->vol;
+    free(v->ijkl); free(v->alpha); free(v->rest); free(v->plastic);
+    memset(v, 0, sizeof *v);
+}
+
+/* calloc of n elements, never of 0 bytes (so NULL always means out of memory) */
+static void *zalloc(int64_t n, size_t elem) { return calloc((size_t)(n > 0 ? n : 1), elem); }
+
+wb_status wb_image_alloc_volumes(wb_image *g, int32_t n)
+{
+    vol_image_free(g);
+    wb_image_volume *v = &g->vol;
+    v->n = n;
+    v->ijkl = zalloc(4 * (int64_t)n, sizeof *v->ijkl);
+    v->alpha = zalloc(n, sizeof *v->alpha);
+    v->rest = zalloc(n, sizeof *v->rest);
+    v->plastic = zalloc(2 * (int64_t)n, sizeof *v->plastic);
+    if (v->ijkl && v->alpha && v->rest && v->plastic) return WB_OK;
+    vol_image_free(g);
+    return WB_ERR_NOMEM;
+}
+
+static wb_status vol_image_save(const wb_world *w, wb_image *g)
+{
+    const int32_t n = wb_volume_count(w);
+    if (wb_image_alloc_volumes(g, n) != WB_OK) return WB_ERR_NOMEM;
+    if (n == 0) return WB_OK;
+    const wb_volumes *v = w->vol;
+    memcpy(g->vol.ijkl, v->ijkl, 4 * (size_t)n * sizeof *g->vol.ijkl);
+    memcpy(g->vol.alpha, v->alpha, (size_t)n * sizeof *g->vol.alpha);
+    memcpy(g->vol.rest, v->rest, (size_t)n * sizeof *g->vol.rest);
+    for (int32_t i = 0; i < n; i++) {
+        g->vol.plastic[2 * i] = v->yield[i];
+        g->vol.plastic[2 * i + 1] = v->creep[i];
+    }
+    return WB_OK;
+}
+
+static const char *vol_image_check(const wb_image *g)
+{
+    if (g->vol.n < 0 || g->vol.n > WB_MAX_CONSTRAINTS) return "too many volume constraints";
+    for (int32_t i = 0; i < g->vol.n; i++) {
+        const int q = wb__quad_check(&g->vol.ijkl[4 * i], g->np);
+        if (q) return q == 1 ? "volume constraint particle out of range" : "a volume constraint needs four distinct particles";
+        const wb_volume_def d = { g->vol.alpha[i], true, g->vol.rest[i], g->vol.plastic[2 * i], g->vol.plastic[2 * i + 1] };
+        const char *e = wb_volume_def_check(&d);
+        if (e) return e;
+    }
+    return NULL;
+}
+
+static wb_status vol_image_reserve(wb_world *w, const wb_image *g, const wb_image_at *at)
+{
+    (void)at;
+    return g->vol.n > 0 ? wb__volume_reserve(w, g->vol.n) : WB_OK;
+}
+
+/* after w's, particles shifted (reserved: cannot fail) */
+static void vol_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
+{
+    for (int32_t i = 0; i < g->vol.n; i++) {
+        int32_t p[4];
+        for (int k = 0; k < 4; k++) p[k] = g->vol.ijkl[4 * i + k] + at->pshift;
+        wb__volume_put(w, p, g->vol.alpha[i], g->vol.rest[i]);
+        wb__volume_plastic(w, w->vol->n - 1, g->vol.plastic[2 * i], g->vol.plastic[2 * i + 1]);
+    }
+}
+
+static void vol_stats(const wb_world *w, wb_stats *st)
+{
+    st->volumes = wb_volume_count(w);
+}
+
 const wb_ctype wb__volume_type = {
-    "volume", vol_count, vol_prepare, vol_substep_begin, vol_project, vol_frame_end, vol_energy, vol_links,
+    .name = "volume",
+    .count = vol_count,
+    .prepare = vol_prepare,
+    .substep_begin = vol_substep_begin,
+    .project = vol_project,
+    .frame_end = vol_frame_end,
+    .energy = vol_energy,
+    .links = vol_links,
+    .destroy = vol_destroy,
+    .charged = vol_charged,
+    .stats = vol_stats,
+    .hash = vol_hash,
+    .image_free = vol_image_free,
+    .image_save = vol_image_save,
+    .image_check = vol_image_check,
+    .image_reserve = vol_image_reserve,
+    .image_put = vol_image_put,
 };

@@ -24,6 +24,14 @@ typedef struct wb_volumes {
     size_t charged;        /* bytes charged to def.memory */
 } wb_volumes;
 
+/* a snapshot image's volume constraints (snapshot.h), in creation order */
+typedef struct wb_image_volume {
+    int32_t n;
+    int32_t *ijkl;         /* (n x 4) */
+    wb_real *alpha, *rest; /* (n) compliance, signed rest volume */
+    wb_real *plastic;      /* (n x 2) yield, creep (0: none) */
+} wb_image_volume;
+
 /* room for `extra` more, charged to the memory budget; after it wb__volume_put cannot fail */
 wb_status wb__volume_reserve(wb_world *w, int64_t extra);
 void wb__volume_put(wb_world *w, const int32_t p[4], wb_real alpha, wb_real rest);
@@ -34,26 +42,5 @@ void wb__volume_plastic(wb_world *w, int32_t first, wb_real yield, wb_real creep
  * volume constraints of compliance alpha, or Neo-Hookean tets (tet.h) when young > 0 */
 void wb__kuhn_tets(wb_world *w, int32_t base, int32_t sx, int32_t sy, int32_t sz, wb_real alpha,
                    wb_real young, wb_real poisson);
-
-/* world.c's destroy: the arrays freed and the budget given back (inline, so that world.c
- * and volume.c do not call each other) */
-static inline void wb__volume_free(wb_world *w)
-{
-    wb_volumes *v = w->vol;
-    if (!v) return;
-    if (w->m.def.memory) w->m.def.memory->used -= v->charged;
-    free(v->ijkl);
-    free(v->alpha);
-    free(v->rest);
-    free(v->yield);
-    free(v->creep);
-    free(v->lambda);
-    free(v->order);
-    free(v->pos);
-    free(v->pk);
-    free(v->pa);
-    free(v);
-    w->vol = NULL;
-}
 
 #endif

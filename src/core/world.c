@@ -6,12 +6,6 @@
 #include <stdlib.h>
 
 #include "core.h"
-#include "bvh.h"
-#include "volume.h"
-#include "tet.h"
-#include "attach.h"
-#include "grab.h"
-#include "rigid.h"
 
 static _Thread_local char wb_err[256];
 
@@ -160,45 +154,6 @@ wb_pool *wb__world_pool(const wb_world *w)
     return p;
 }
 
-void wb_world_destroy(wb_world *w)
-{
-    if (!w) return;
-    wb__volume_free(w);
-    wb__tet_free(w);
-    wb__attach_free(w);
-    wb__grab_free(w);
-    wb__rigids_free(w, w->rb);
-    wb__pool_destroy(w->pool);
-    wb_model *m = &w->m;
-    for (int32_t i = 0; i < m->nc; i++) wb__colmesh_free(m->c_shape[i].mesh); /* mesh colliders' copies */
-    /* the bends' arrays (bend.c owns their use; freed here so that no circle joins the files) */
-    wb_bends *bd = &w->bend;
-    if (m->def.memory) m->def.memory->used -= bd->charged + w->charged_self;
-    void *bp[] = { bd->ij, bd->alpha, bd->beta, bd->rest, bd->s_ij, bd->s_slot, bd->pack, bd->lambda, bd->btorque,
-                   bd->broken, bd->breaks };
-    for (size_t i = 0; i < sizeof bp / sizeof bp[0]; i++) free(bp[i]);
-    if (m->def.memory) m->def.memory->used -= m->charged + m->charged_mesh + w->sm.charged + w->pr.charged;
-    wb_state *s = &w->s;
-    wb_cache *k = &w->k;
-    wb__broadphase_free(&k->pc);
-    wb__tribroad_free(&k->tc);
-    void *ptrs[] = { m->inv_mass, m->w, m->radius, m->pinned, m->d_ij, m->d_alpha, m->d_beta,
-                     m->d_yield, m->d_creep, m->d_break, m->d_bforce, m->d_gen, m->d_free, m->c_shape, m->c_gen, m->surf_start, m->tri,
-                     s->x, s->x_prev, s->v, s->d_rest, s->d_broken, s->c_pose,
-                     k->colour_start, k->comp_start, k->s_a, k->s_b, k->s_rest, k->s_alpha, k->s_beta, k->s_lambda, k->s_jac,
-                     k->s_slot, k->slot_pack, k->dx, k->ncount, k->x_save, k->v_save, k->c_sub, k->c_left, k->c_save,
-                     k->breaks, m->group, m->cflags, m->cfric, m->x0, k->pc.ij, k->pc.act, k->pc.act_nd,
-                     k->pc.left, k->pc.reach, k->pc.keys, k->pc.graph, k->pc.tcov, k->pc.near, k->pc.load, k->pc.made_ab, k->pc.bm,
-                     /* shape matching and pressure (freed here: a call into their files
-                      * would close a circle, as they call this one) */
-                     w->sm.start, w->sm.stiff, w->sm.yield, w->sm.creep, w->sm.ids, w->sm.rest, w->sm.q,
-                     w->sm.qk, w->sm.lambda, w->pr.surface, w->pr.pressure, w->pr.alpha, w->pr.v0, w->pr.vstart,
-                     w->pr.tstart, w->pr.verts, w->pr.tri, w->pr.lambda, w->pr.grad,
-                     k->tc.pt, k->tc.act, k->tc.act_d, k->tc.left, k->mc_body, k->mc_root, k->mc_acc, k->mc_pinned, k->mc_end };
-    for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
-    free(w);
-}
-
 wb_world_def wb_world_get_def(const wb_world *w) { return w->m.def; }
 
 wb_status wb_world_set_def(wb_world *w, const wb_world_def *def)
@@ -227,18 +182,22 @@ int64_t wb_world_frame(const wb_world *w) { return w->s.frame; }
 #define PARTICLE_BYTES (25 * sizeof(wb_real) + 5 + 8 + 5)
 #define CONSTRAINT_BYTES (14 * sizeof(wb_real) + 42)
 
-/* charge the arrays at capacities (cap_p, cap_d) to the budget; 0 when it would pass
- * the limit (nothing charged then) */
-static int charge(wb_world *w, int64_t cap_p, int64_t cap_d)
+int wb__charge(wb_world *w, size_t *charged, size_t want)
 {
     wb_memory *mem = w->m.def.memory;
-    if (!mem) return 1;
-    const double want = (double)cap_p * PARTICLE_BYTES + (double)cap_d * CONSTRAINT_BYTES;
-    const double used = (double)mem->used - (double)w->m.charged + want;
-    if (mem->limit > 0 && used > (double)mem->limit) return 0;
-    mem->used = (size_t)used;
-    w->m.charged = (size_t)want;
+    if (mem) {
+        const double used = (double)mem->used - (double)*charged + (double)want;
+        if (mem->limit > 0 && used > (double)mem->limit) return 0;
+        mem->used = (size_t)used;
+    }
+    *charged = want;
     return 1;
+}
+
+/* the particles' and distances' arrays at capacities (cap_p, cap_d), charged together */
+static int charge(wb_world *w, int64_t cap_p, int64_t cap_d)
+{
+    return wb__charge(w, &w->m.charged, (size_t)cap_p * PARTICLE_BYTES + (size_t)cap_d * CONSTRAINT_BYTES);
 }
 
 /* every per-particle array grows together; on failure nothing is lost */

@@ -165,7 +165,7 @@ static int read_snapshot(rd *r, const sections *s, wb_image *g)
     if (s->dgen) {
         kp a = { &ds, "generations", 0 }, b = { &ds, "free", 0 };
         int32_t live;
-        if (read_generations(r, s->dgen, &a, s->nd, g->d_gen, &live)) return -1;
+        if (read_generations(r, s->dgen, &a, s->nd, g->dist.gen, &live)) return -1;
         if (live != s->ncons)
             return jv_fail(r, s->dgen, 0, &a, "%d live slots, but \"constraints\" has %d entries", live, s->ncons);
         int32_t k = 0;
@@ -177,9 +177,9 @@ static int read_snapshot(rd *r, const sections *s, wb_image *g)
             kp e = { &b, NULL, k };
             int64_t slot;
             if (jv_get_int(r, c, &e, 0, s->nd > 0 ? s->nd - 1 : 0, &slot)) bad = -1;
-            else if (s->nd == 0 || (g->d_gen[slot] & 1u)) bad = jv_fail(r, c, 0, &e, "slot %lld is live, not free", (long long)slot);
+            else if (s->nd == 0 || (g->dist.gen[slot] & 1u)) bad = jv_fail(r, c, 0, &e, "slot %lld is live, not free", (long long)slot);
             else if (seen[slot]++) bad = jv_fail(r, c, 0, &e, "slot %lld is listed twice", (long long)slot);
-            else g->d_free[k] = (int32_t)slot;
+            else g->dist.free_slots[k] = (int32_t)slot;
         }
         free(seen);
         if (bad) return -1;
@@ -261,7 +261,7 @@ static int read_bend(rd *r, const cJSON *c, const kp *p, wb_image *g, int32_t i)
     int32_t n;
     if (jv_get_array(r, f[1], &pp, 16, &n)) return -1;
     if (n != 4) return jv_fail(r, f[1], 0, &pp, "a bend joins 4 particles (hinge p1 p2, wings p3 p4), got %d", n);
-    int32_t *q = &g->b_ij[4 * i];
+    int32_t *q = &g->bend.ij[4 * i];
     int k = 0;
     for (const cJSON *e = f[1]->child; e; e = e->next, k++) {
         kp ep = { &pp, NULL, k };
@@ -288,11 +288,11 @@ static int read_bend(rd *r, const cJSON *c, const kp *p, wb_image *g, int32_t i)
     } else if (!wb_dihedral_angle(&g->x[3 * q[0]], &g->x[3 * q[1]], &g->x[3 * q[2]], &g->x[3 * q[3]], &d.rest)) {
         return jv_fail(r, f[1], 0, &pp, "the two triangles are degenerate (a wing on the hinge line): no angle to keep");
     }
-    g->b_alpha[i] = d.compliance;
-    g->b_beta[i] = d.damping;
-    g->b_rest[i] = d.rest;
-    g->b_btorque[i] = d.break_torque;
-    g->b_broken[i] = broken;
+    g->bend.alpha[i] = d.compliance;
+    g->bend.beta[i] = d.damping;
+    g->bend.rest[i] = d.rest;
+    g->bend.btorque[i] = d.break_torque;
+    g->bend.broken[i] = broken;
     return 0;
 }
 
@@ -330,7 +330,7 @@ static int read_constraints(rd *r, const sections *s, const defaults *d, wb_imag
         }
         if (ab[0] == ab[1]) return jv_fail(r, f[1], 0, &pp, "a constraint needs two distinct particles");
         /* the i-th live slot (all slots are live in a plain config) */
-        do slot++; while (!(g->d_gen[slot] & 1u));
+        do slot++; while (!(g->dist.gen[slot] & 1u));
         wb_distance_def l = d->link;
         const wb_real *xa = &g->x[3 * ab[0]], *xb = &g->x[3 * ab[1]];
         wb_real dx[3] = { xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2] };
@@ -353,16 +353,16 @@ static int read_constraints(rd *r, const sections *s, const defaults *d, wb_imag
             kp q = { &p, "broken", 0 };
             if (jv_get_bool(r, f[8], &q, &broken)) return -1;
         }
-        g->d_ij[2 * slot] = (int32_t)ab[0];
-        g->d_ij[2 * slot + 1] = (int32_t)ab[1];
-        g->d_alpha[slot] = l.compliance;
-        g->d_beta[slot] = l.damping;
-        g->d_yield[slot] = l.yield;
-        g->d_creep[slot] = l.creep;
-        g->d_break[slot] = l.break_strain;
-        g->d_bforce[slot] = l.break_force;
-        g->d_rest[slot] = l.rest;
-        g->d_broken[slot] = broken;
+        g->dist.ij[2 * slot] = (int32_t)ab[0];
+        g->dist.ij[2 * slot + 1] = (int32_t)ab[1];
+        g->dist.alpha[slot] = l.compliance;
+        g->dist.beta[slot] = l.damping;
+        g->dist.yield[slot] = l.yield;
+        g->dist.creep[slot] = l.creep;
+        g->dist.break_strain[slot] = l.break_strain;
+        g->dist.bforce[slot] = l.break_force;
+        g->dist.rest[slot] = l.rest;
+        g->dist.broken[slot] = broken;
     }
     return 0;
 }
@@ -370,13 +370,14 @@ static int read_constraints(rd *r, const sections *s, const defaults *d, wb_imag
 /* "volumes": [ {"particles": [a, b, c, d], "rest": V, "compliance": alpha, "yield": y,
  * "creep": c}, ... ]: volume constraints (the tet's signed volume kept at rest, default the
  * particles' current one; yield and creep: plastic flow of the rest volume, 0 by default) */
-static int read_volumes(rd *r, const cJSON *arr, const defaults *d, wb_image *g)
+static int read_volumes(rd *r, const cJSON *arr, wb_image *g)
 {
     static const char *const keys[] = { "particles", "rest", "compliance", "yield", "creep", NULL };
     kp top = { NULL, "volumes", 0 };
-    int32_t i = 0;
-    (void)d;
+    int32_t i = 0, n;
     if (!arr) return 0;
+    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
+    if (wb_image_alloc_volumes(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
     for (const cJSON *c = arr->child; c; c = c->next, i++) {
         const cJSON *f[6];
         kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
@@ -385,7 +386,7 @@ static int read_volumes(rd *r, const cJSON *arr, const defaults *d, wb_image *g)
         int32_t n;
         if (jv_get_array(r, f[0], &pp, 16, &n)) return -1;
         if (n != 4) return jv_fail(r, f[0], 0, &pp, "a volume constraint joins 4 particles, got %d", n);
-        int32_t *ijkl = &g->vol_ijkl[4 * i];
+        int32_t *ijkl = &g->vol.ijkl[4 * i];
         int k = 0;
         for (const cJSON *e = f[0]->child; e; e = e->next, k++) {
             kp q = { &pp, NULL, k };
@@ -397,17 +398,47 @@ static int read_volumes(rd *r, const cJSON *arr, const defaults *d, wb_image *g)
                 if (ijkl[j] == ijkl[k]) return jv_fail(r, f[0], 0, &pp, "a volume constraint needs four distinct particles");
         }
         const wb_real *x = g->x;
-        g->vol_rest[i] = wb_tet_signed_volume(&x[3 * ijkl[0]], &x[3 * ijkl[1]], &x[3 * ijkl[2]], &x[3 * ijkl[3]]);
-        g->vol_alpha[i] = 0;
-        g->vol_plastic[2 * i] = g->vol_plastic[2 * i + 1] = 0;
-        if (jv_opt_real(r, f[1], &p, "rest", &g->vol_rest[i]) || jv_opt_nonneg(r, f[2], &p, "compliance", &g->vol_alpha[i]) ||
-            jv_opt_nonneg(r, f[3], &p, "yield", &g->vol_plastic[2 * i]) ||
-            jv_opt_nonneg(r, f[4], &p, "creep", &g->vol_plastic[2 * i + 1]))
+        g->vol.rest[i] = wb_tet_signed_volume(&x[3 * ijkl[0]], &x[3 * ijkl[1]], &x[3 * ijkl[2]], &x[3 * ijkl[3]]);
+        g->vol.alpha[i] = 0;
+        g->vol.plastic[2 * i] = g->vol.plastic[2 * i + 1] = 0;
+        if (jv_opt_real(r, f[1], &p, "rest", &g->vol.rest[i]) || jv_opt_nonneg(r, f[2], &p, "compliance", &g->vol.alpha[i]) ||
+            jv_opt_nonneg(r, f[3], &p, "yield", &g->vol.plastic[2 * i]) ||
+            jv_opt_nonneg(r, f[4], &p, "creep", &g->vol.plastic[2 * i + 1]))
             return -1;
-        if (!isfinite(g->vol_rest[i])) return jv_fail(r, f[0], 0, &pp, "the particles are too far apart (their volume overflows)");
+        if (!isfinite(g->vol.rest[i])) return jv_fail(r, f[0], 0, &pp, "the particles are too far apart (their volume overflows)");
     }
     return 0;
 }
+
+/* "volumes" (only when there are any: a config without stays as it was) */
+static void write_volumes(jw_out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    if (g->vol.n == 0) return;
+    fputs("  \"volumes\": [", f);
+    for (int32_t i = 0; i < g->vol.n; i++) {
+        const int32_t *p = &g->vol.ijkl[4 * i];
+        fprintf(f, "%s    {\"particles\": [%d, %d, %d, %d], \"rest\": ", i ? ",\n" : "\n", p[0], p[1], p[2], p[3]);
+        jw_num(o, g->vol.rest[i]);
+        fputs(", \"compliance\": ", f);
+        jw_num(o, g->vol.alpha[i]);
+        jw_plastic(o, &g->vol.plastic[2 * i]);
+        fputc('}', f);
+    }
+    fputs("\n  ],\n", f);
+}
+
+/* the constraint types with a section of their own (json.h), in the order w:save writes
+ * them; each reads and writes its own */
+const jtype jtypes[] = {
+    { "volumes", read_volumes, write_volumes },
+    { "tets", jm_read_tets, jm_write_tets },
+    { "shape_matches", jm_read_shape_matches, jm_write_shape_matches },
+    { "pressures", jm_read_pressures, jm_write_pressures },
+    { "attachments", ja_read_attachments, ja_write_attachments },
+    { "grabs", ja_read_grabs, ja_write_grabs },
+};
+const int njtypes = (int)(sizeof jtypes / sizeof jtypes[0]);
 
 static const char *const shape_names[] = { "plane", "sphere", "box", "capsule", "mesh", NULL };
 
@@ -694,6 +725,14 @@ static int read_skins(rd *r, const sections *s, wbio_config *cfg)
 }
 
 /* ---- the file ---------------------------------------------------------------------------------- */
+/* each type's own section (jtypes), after the rigid bodies that attachments and grabs name */
+static int read_sections(rd *r, const cJSON *root, wb_image *g)
+{
+    for (int i = 0; i < njtypes; i++)
+        if (jtypes[i].read(r, cJSON_GetObjectItemCaseSensitive(root, jtypes[i].key), g)) return -1;
+    return 0;
+}
+
 static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
 {
     static const char *const keys[] = { "format", "version", "description", "defaults", "particles", "constraints",
@@ -747,25 +786,18 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
     }
     s.ncons -= s.nbend;
     s.snapshot = f[10];
-    int32_t nvol = 0;
-    kp volp = { NULL, "volumes", 0 };
-    if (f[11] && jv_get_array(r, f[11], &volp, WB_MAX_CONSTRAINTS, &nvol)) return -1;
     if (scan_snapshot(r, &s) || read_surfaces(r, &s, NULL, &s.ntri)) return -1;
     if (wb_image_alloc(&cfg->img, s.np, s.nd, s.nfree, s.nc, s.nsurf, s.ntri) != WB_OK ||
         (s.nbend > 0 && wb_image_alloc_bends(&cfg->img, s.nbend) != WB_OK) ||
         !(cfg->parts = calloc((size_t)s.nparts + 1, sizeof *cfg->parts)) ||
-        !(cfg->skins = calloc((size_t)s.nskins + 1, sizeof *cfg->skins)) ||
-        wb_image_alloc_volumes(&cfg->img, nvol) != WB_OK)
+        !(cfg->skins = calloc((size_t)s.nskins + 1, sizeof *cfg->skins)))
         return jv_fail(r, NULL, 0, NULL, "out of memory");
     cfg->snapshot = s.snapshot != NULL;
     /* the snapshot first: its slot tables say where the constraints and colliders go */
     if ((s.snapshot && read_snapshot(r, &s, &cfg->img)) || read_particles(r, &s, &d, &cfg->img) ||
         read_constraints(r, &s, &d, &cfg->img) || read_colliders(r, &s, &cfg->img) ||
         read_surfaces(r, &s, &cfg->img, &s.ntri) || read_parts(r, &s, cfg) || read_skins(r, &s, cfg) ||
-        read_volumes(r, f[11], &d, &cfg->img) || jm_read_shape_matches(r, f[12], &cfg->img) ||
-        jm_read_pressures(r, f[13], &cfg->img) || jm_read_tets(r, f[14], &cfg->img) ||
-        jr_read_rigids(r, f[17], &cfg->img) || /* before the attachments that name them */
-        ja_read_attachments(r, f[15], &cfg->img) || ja_read_grabs(r, f[16], &cfg->img))
+        jr_read_rigids(r, f[17], &cfg->img) || read_sections(r, root, &cfg->img))
         return -1;
     /* every value was checked where it was read: this is the last line of defence */
     const char *e = wb_image_check(&cfg->img);

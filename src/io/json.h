@@ -73,14 +73,44 @@ int jv_opt_nonneg(rd *r, const cJSON *f, const kp *up, const char *key, wb_real 
 int jv_opt_int(rd *r, const cJSON *f, const kp *up, const char *key, int64_t lo, int64_t hi, int64_t *out);
 int jv_opt_vec(rd *r, const cJSON *f, const kp *up, const char *key, int n, wb_real *out);
 
-/* json_material.c: the "shape_matches" and "pressures" sections (arr may be NULL) into
- * the image, after its particles and surfaces */
+/* writing (json_value.c): numbers as "%.17g", which round-trips every double through
+ * strtod (cJSON's reader); a non-finite one is written as 0 and marks the output bad */
+typedef struct jw_out {
+    FILE *f;
+    int bad;               /* a non-finite number was met */
+    int nomem;             /* a scratch table could not be had */
+} jw_out;
+void jw_num(jw_out *o, double x);
+void jw_vec(jw_out *o, const wb_real *v, int n);
+/* n integers (u, or s when u is NULL), 24 a line, continued lines indented */
+void jw_ints(FILE *f, const char *indent, const uint32_t *u, const int32_t *s, int32_t n);
+/* ", yield, creep" when either is set (files without stay as they were) */
+void jw_plastic(jw_out *o, const wb_real yc[2]);
+
+/* A constraint type with a section of its own in a particle config: its key, its reader
+ * (arr may be NULL: none) into the image after the particles, surfaces, colliders and
+ * rigid bodies, and its writer (nothing when the image has none). The table (json.c) is
+ * in the order w:save writes the sections; distances and bends share "constraints"
+ * (json.c, json_write.c) */
+typedef struct jtype {
+    const char *key;
+    int (*read)(rd *r, const cJSON *arr, wb_image *g);
+    void (*write)(jw_out *o, const wb_image *g);
+} jtype;
+extern const jtype jtypes[];
+extern const int njtypes;
+/* json_material.c: "tets", "shape_matches" and "pressures" */
 int jm_read_shape_matches(rd *r, const cJSON *arr, wb_image *g);
 int jm_read_pressures(rd *r, const cJSON *arr, wb_image *g);
 int jm_read_tets(rd *r, const cJSON *arr, wb_image *g);
-/* json_attach.c: the "attachments" and "grabs" sections, after particles and colliders */
+void jm_write_tets(jw_out *o, const wb_image *g);
+void jm_write_shape_matches(jw_out *o, const wb_image *g);
+void jm_write_pressures(jw_out *o, const wb_image *g);
+/* json_attach.c: "attachments" and "grabs" */
 int ja_read_attachments(rd *r, const cJSON *arr, wb_image *g);
 int ja_read_grabs(rd *r, const cJSON *arr, wb_image *g);
+void ja_write_attachments(jw_out *o, const wb_image *g);
+void ja_write_grabs(jw_out *o, const wb_image *g);
 /* json_rigid.c: the "rigids" section (arr may be NULL) into the image */
 int jr_read_rigids(rd *r, const cJSON *arr, wb_image *g);
 

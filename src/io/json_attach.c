@@ -147,3 +147,59 @@ int ja_read_grabs(rd *r, const cJSON *arr, wb_image *g)
     }
     return 0;
 }
+
+/* ---- writing (w:save) ------------------------------------------------------------------------ */
+/* "attachments": only when present. An attachment names its collider by its place among
+ * the written (live) colliders */
+void ja_write_attachments(jw_out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    const wb_image_attach *a = &g->att;
+    /* slot -> its place among the live ones, once (a count per attachment is na x nc) */
+    int32_t *rank = a->n ? malloc(sizeof *rank * (size_t)(g->nc > 0 ? g->nc : 1)) : NULL;
+    if (a->n && !rank) {
+        o->nomem = 1;
+        return;
+    }
+    for (int32_t s = 0, r = 0; rank && s < g->nc; s++) {
+        rank[s] = r;
+        r += (int32_t)(g->c_gen[s] & 1u);
+    }
+    for (int32_t k = 0; k < a->n; k++) {
+        /* a rigid body by its slot: w:save writes every slot of "rigids" */
+        const int rigid = a->kind[k] == 1;
+        fprintf(f, "%s    {\"particle\": %d, \"%s\": %d, \"point\": ", k ? ",\n" : "  \"attachments\": [\n",
+                a->p[k], rigid ? "rigid" : "collider", rigid ? a->target[k] : rank[a->target[k]]);
+        jw_vec(o, &a->local[3 * k], 3);
+        fputs(", \"compliance\": ", f);
+        jw_num(o, a->alpha[k]);
+        fputc('}', f);
+    }
+    if (a->n) fputs("\n  ],\n", f);
+    free(rank);
+}
+
+/* "grabs": only when present */
+void ja_write_grabs(jw_out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    const wb_image_grab *gr = &g->grab;
+    for (int32_t k = 0; k < gr->n; k++) {
+        /* a rigid body by its slot, as attachments name theirs */
+        const int rigid = gr->kind[k] == 1;
+        fprintf(f, "%s    {\"%s\": %d, ", k ? ",\n" : "  \"grabs\": [\n", rigid ? "rigid" : "particle", gr->p[k]);
+        if (rigid) {
+            fputs("\"at\": ", f);
+            jw_vec(o, &gr->local[3 * k], 3);
+            fputs(", ", f);
+        }
+        fputs("\"target\": ", f);
+        jw_vec(o, &gr->target[3 * k], 3);
+        fputs(", \"from\": ", f);
+        jw_vec(o, &gr->from[3 * k], 3);
+        fputs(", \"compliance\": ", f);
+        jw_num(o, gr->alpha[k]);
+        fputc('}', f);
+    }
+    if (gr->n) fputs("\n  ],\n", f);
+}

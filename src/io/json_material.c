@@ -148,7 +148,7 @@ int jm_read_tets(rd *r, const cJSON *arr, wb_image *g)
         int32_t m;
         if (jv_get_array(r, f[0], &pp, 16, &m)) return -1;
         if (m != 4) return jv_fail(r, f[0], 0, &pp, "a tet joins 4 particles, got %d", m);
-        int32_t *q4 = &g->tet_ijkl[4 * i];
+        int32_t *q4 = &g->tet.ijkl[4 * i];
         int k = 0;
         for (const cJSON *e = f[0]->child; e; e = e->next, k++) {
             kp q = { &pp, NULL, k };
@@ -164,25 +164,88 @@ int jm_read_tets(rd *r, const cJSON *arr, wb_image *g)
         kp yq = { &p, "young", 0 }, nq = { &p, "poisson", 0 };
         if (!(y > 0) || !isfinite(y)) return jv_fail(r, f[1], 0, &yq, "must be > 0 (Pa)");
         if (!(nu >= 0 && nu < 0.5)) return jv_fail(r, f[2], 0, &nq, "must be in [0, 0.5)");
-        g->tet_young[i] = y;
-        g->tet_poisson[i] = nu;
-        g->tet_plastic[2 * i] = g->tet_plastic[2 * i + 1] = 0;
-        if (jv_opt_nonneg(r, f[5], &p, "yield", &g->tet_plastic[2 * i]) ||
-            jv_opt_nonneg(r, f[6], &p, "creep", &g->tet_plastic[2 * i + 1]))
+        g->tet.young[i] = y;
+        g->tet.poisson[i] = nu;
+        g->tet.plastic[2 * i] = g->tet.plastic[2 * i + 1] = 0;
+        if (jv_opt_nonneg(r, f[5], &p, "yield", &g->tet.plastic[2 * i]) ||
+            jv_opt_nonneg(r, f[6], &p, "creep", &g->tet.plastic[2 * i + 1]))
             return -1;
         if (!f[3] != !f[4]) return jv_fail(r, c, 0, &p, "rest_inverse and rest_volume go together");
         if (f[3]) {
             kp vq = { &p, "rest_volume", 0 };
-            if (jv_opt_vec(r, f[3], &p, "rest_inverse", 9, &g->tet_dminv[9 * i]) ||
-                jv_opt_real(r, f[4], &p, "rest_volume", &g->tet_v0[i]))
+            if (jv_opt_vec(r, f[3], &p, "rest_inverse", 9, &g->tet.dminv[9 * i]) ||
+                jv_opt_real(r, f[4], &p, "rest_volume", &g->tet.v0[i]))
                 return -1;
-            if (!(g->tet_v0[i] > 0) || !isfinite(g->tet_v0[i])) return jv_fail(r, f[4], 0, &vq, "must be > 0");
+            if (!(g->tet.v0[i] > 0) || !isfinite(g->tet.v0[i])) return jv_fail(r, f[4], 0, &vq, "must be > 0");
         } else {
             const wb_real *x = g->x;
-            if (!wb_tet_rest_shape(&x[3 * q4[0]], &x[3 * q4[1]], &x[3 * q4[2]], &x[3 * q4[3]], &g->tet_dminv[9 * i],
-                                   &g->tet_v0[i]))
+            if (!wb_tet_rest_shape(&x[3 * q4[0]], &x[3 * q4[1]], &x[3 * q4[2]], &x[3 * q4[3]], &g->tet.dminv[9 * i],
+                                   &g->tet.v0[i]))
                 return jv_fail(r, f[0], 0, &pp, "the four particles lie in a plane (a flat tet has no rest shape)");
         }
     }
     return 0;
+}
+
+/* ---- writing (w:save) ------------------------------------------------------------------------ */
+/* "tets": Neo-Hookean tets with their rest state (only when present) */
+void jm_write_tets(jw_out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    if (g->tet.n == 0) return;
+    fputs("  \"tets\": [", f);
+    for (int32_t i = 0; i < g->tet.n; i++) {
+        const int32_t *p = &g->tet.ijkl[4 * i];
+        fprintf(f, "%s    {\"particles\": [%d, %d, %d, %d], \"young\": ", i ? ",\n" : "\n", p[0], p[1], p[2], p[3]);
+        jw_num(o, g->tet.young[i]);
+        fputs(", \"poisson\": ", f);
+        jw_num(o, g->tet.poisson[i]);
+        fputs(", \"rest_volume\": ", f);
+        jw_num(o, g->tet.v0[i]);
+        fputs(", \"rest_inverse\": ", f);
+        jw_vec(o, &g->tet.dminv[9 * i], 9);
+        jw_plastic(o, &g->tet.plastic[2 * i]);
+        fputc('}', f);
+    }
+    fputs("\n  ],\n", f);
+}
+
+/* "shape_matches": only when present, with the rest shapes and rotations (the exact restore) */
+void jm_write_shape_matches(jw_out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    const wb_image_smatch *s = &g->sm;
+    for (int32_t k = 0; k < s->n; k++) {
+        const int32_t a = s->start[k], b = s->start[k + 1];
+        fputs(k ? ",\n    {\"particles\": " : "  \"shape_matches\": [\n    {\"particles\": ", f);
+        jw_ints(f, "      ", NULL, &s->ids[a], b - a);
+        fputs(", \"stiffness\": ", f);
+        jw_num(o, s->stiff[k]);
+        fputs(", \"yield\": ", f);
+        jw_num(o, s->yield[k]);
+        fputs(", \"creep\": ", f);
+        jw_num(o, s->creep[k]);
+        fputs(",\n     \"rest\": ", f);
+        jw_vec(o, &s->rest[3 * (int64_t)a], 3 * (b - a));
+        fputs(", \"rotation\": ", f);
+        jw_vec(o, &s->q[4 * k], 4);
+        fputc('}', f);
+    }
+    if (s->n) fputs("\n  ],\n", f);
+}
+
+/* "pressures": only when present, with the rest volumes */
+void jm_write_pressures(jw_out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    for (int32_t k = 0; k < g->pr.n; k++) {
+        fprintf(f, "%s    {\"surface\": %d, \"pressure\": ", k ? ",\n" : "  \"pressures\": [\n", g->pr.surface[k]);
+        jw_num(o, g->pr.pressure[k]);
+        fputs(", \"compliance\": ", f);
+        jw_num(o, g->pr.alpha[k]);
+        fputs(", \"rest_volume\": ", f);
+        jw_num(o, g->pr.v0[k]);
+        fputc('}', f);
+    }
+    if (g->pr.n) fputs("\n  ],\n", f);
 }

@@ -299,3 +299,41 @@ int jv_opt_vec(rd *r, const cJSON *f, const kp *up, const char *key, int n, wb_r
     return jv_get_vec(r, f, &p, n, out);
 }
 
+/* ---- writing (json_write.c and the sections' writers) ------------------------------------ */
+void jw_num(jw_out *o, double x)
+{
+    if (!isfinite(x)) { o->bad = 1; x = 0; }
+    fprintf(o->f, "%.17g", x);
+}
+
+void jw_vec(jw_out *o, const wb_real *v, int n)
+{
+    fputc('[', o->f);
+    for (int i = 0; i < n; i++) {
+        if (i) fputs(", ", o->f);
+        jw_num(o, (double)v[i]);
+    }
+    fputc(']', o->f);
+}
+
+void jw_ints(FILE *f, const char *indent, const uint32_t *u, const int32_t *s, int32_t n)
+{
+    fputc('[', f);
+    for (int32_t i = 0; i < n; i++) {
+        if (i) fputs(i % 24 ? ", " : ",\n", f);
+        if (i && i % 24 == 0) fputs(indent, f);
+        if (u) fprintf(f, "%u", u[i]);
+        else fprintf(f, "%d", s[i]);
+    }
+    fputc(']', f);
+}
+
+/* a volume's or a tet's plastic flow, only when it has one (files without stay as they were) */
+void jw_plastic(jw_out *o, const wb_real yc[2])
+{
+    if (!(yc[0] > 0) && !(yc[1] > 0)) return;
+    fputs(", \"yield\": ", o->f);
+    jw_num(o, yc[0]);
+    fputs(", \"creep\": ", o->f);
+    jw_num(o, yc[1]);
+}

@@ -124,7 +124,7 @@ static int w_load_particles(lua_State *L)
         return 2;
     }
     int32_t live = 0;
-    for (int32_t i = 0; i < c->img.nd; i++) live += (int32_t)(c->img.d_gen[i] & 1u);
+    for (int32_t i = 0; i < c->img.dist.n; i++) live += (int32_t)(c->img.dist.gen[i] & 1u);
     /* 5: the collider slots live before, so the new ones can be told apart after */
     uint32_t top = 0;
     for (int32_t i = 0; i < wb_collider_count(w); i++)

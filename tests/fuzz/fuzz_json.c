@@ -88,7 +88,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     round_trip(w);
     /* step only what is cheap: a fuzzer wants thousands of runs a second */
     const wb_world_def wd = wb_world_get_def(w);
-    const int64_t cost = (int64_t)wd.substeps * wd.iterations * (g->np + g->nd + 1);
+    const int64_t cost = (int64_t)wd.substeps * wd.iterations * (g->np + g->dist.n + 1);
     if (cost <= 200000) {
         for (int f = 0; f < 3; f++) {
             CHECK(wb_world_step(w) == WB_OK);

@@ -1,0 +1,35 @@
+/* destroy.c: a world's teardown. Every owner's arrays are freed here, each constraint
+ * type's through its hook (ctype.h). A file of its own, above the types: they call the
+ * world's leaf helpers (world.c), so a teardown there that called them back would close
+ * a circle between the files. */
+#include "ctype.h"
+#include "bvh.h"
+#include "rigid.h"
+
+void wb_world_destroy(wb_world *w)
+{
+    if (!w) return;
+    wb__rigids_free(w, w->rb);
+    wb__pool_destroy(w->pool);
+    wb_model *m = &w->m;
+    for (int32_t i = 0; i < m->nc; i++) wb__colmesh_free(m->c_shape[i].mesh); /* mesh colliders' copies */
+    /* each type's arrays and what it charged to the budget */
+    size_t charged = w->charged_self + m->charged + m->charged_mesh;
+    for (int i = 0; i < wb__nctypes; i++) {
+        const wb_ctype *t = wb__ctypes[i];
+        if (t->charged) charged += t->charged(w);
+        if (t->destroy) t->destroy(w);
+    }
+    if (m->def.memory) m->def.memory->used -= charged;
+    wb_state *s = &w->s;
+    wb_cache *k = &w->k;
+    wb__broadphase_free(&k->pc);
+    wb__tribroad_free(&k->tc);
+    void *ptrs[] = { m->inv_mass, m->w, m->radius, m->pinned, m->group, m->cflags, m->cfric, m->x0, m->c_shape,
+                     m->c_gen, m->surf_start, m->tri, s->x, s->x_prev, s->v, s->c_pose, k->dx, k->ncount, k->x_save,
+                     k->v_save, k->c_sub, k->c_left, k->c_save, k->pc.ij, k->pc.act, k->pc.act_nd, k->pc.left,
+                     k->pc.reach, k->pc.keys, k->pc.graph, k->pc.tcov, k->pc.near, k->pc.load, k->pc.made_ab, k->pc.bm, k->tc.pt, k->tc.act,
+                     k->tc.act_d, k->tc.left, k->mc_body, k->mc_root, k->mc_acc, k->mc_pinned, k->mc_end };
+    for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
+    free(w);
+}
