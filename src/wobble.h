@@ -74,6 +74,8 @@ typedef struct wb_world_def {
     bool contacts;        /* particle-particle contacts, default true */
     wb_real max_depenetration; /* m/s: how fast contacts push out an overlap a pair already had
                                   (bodies made inside each other), default 0.25; >= 0 */
+    wb_real tolerance;    /* m: iterations stop once the constraints' residual is at most this
+                             (wb_world_residual); 0 (default): always `iterations` */
     wb_memory *memory;    /* budget the world, its worker threads and its arrays are charged to; NULL =
                              none (not copied by set_def) */
 } wb_world_def;
@@ -332,6 +334,11 @@ typedef struct wb_stats {
     int32_t rigid_contacts;   /* particle-rigid contacts that corrected positions in the last substep */
 } wb_stats;
 wb_stats wb_world_stats(const wb_world *w);
+/* the constraints' residual, m: the largest of every constraint's |C + alpha~ lambda| over
+ * the RMS of its corners' gradients (how far they are from meeting it), after the last
+ * substep's iterations. Measured by each step from the first call on (a pass over every
+ * constraint); that first call measures the positions as they are; 0 before any step */
+wb_real wb_world_residual(wb_world *w);
 
 /* numerical trouble: counted, the last message kept; the step restores the previous
  * frame's particles when a position or velocity turns non-finite */

@@ -536,6 +536,8 @@ typedef struct wb_cache {
     wb_real *c_save;       /* (nc x 7) collider poses at the frame's start, for undo */
     int32_t cap_c_save;
     wb_real h_last;        /* substep length of the last step (force readback) */
+    int residual_on;       /* the residual was asked for: each step measures it (query.c) */
+    wb_real residual;      /* ... after the last substep's iterations (-1: not yet) */
     int (*interrupt)(void *);
     void *interrupt_ud;
     int32_t last_contacts;

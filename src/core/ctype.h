@@ -59,7 +59,21 @@ typedef struct wb_ctype {
     const char *(*image_check)(const wb_image *g);
     wb_status (*image_reserve)(wb_world *w, const wb_image *g, const wb_image_at *at);
     void (*image_put)(wb_world *w, const wb_image *g, const wb_image_at *at);
+    /* its largest residual at the positions as they are, with the multipliers of the last
+     * projection (h: its substep), in metres (wb__residual); may be NULL: none */
+    wb_real (*residual)(const wb_world *w, wb_real h);
 } wb_ctype;
+
+/* A constraint's residual in metres: what XPBD drives to zero, |C + alpha~ lambda| (C
+ * alone for a hard one), over the root mean square of its corners' gradients (g2: the sum
+ * of their squares over n corners), so an angle or a volume reads as how far its corners
+ * are from meeting it. 0 where it has no direction (a flat tet's volume, coincident ends) */
+/* every type's largest (query.c), for the iterations' early stop (solver.c) */
+wb_real wb__residual_all(const wb_world *w, wb_real h);
+static inline wb_real wb__residual(wb_real c, wb_real g2, int n)
+{
+    return g2 > 0 && isfinite(g2) ? fabs(c) / sqrt(g2 / n) : 0;
+}
 
 /* the links of n elements of four particles each (q: n x 4): every pair of an element's
  * corners is joined (a bend's hinge and wings, a tet's or volume's edges) */

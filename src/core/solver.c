@@ -24,11 +24,20 @@ static double now_ms(void)
 
 /* one pass of every type, `iterations` times: the types run one after the other (Gauss-
  * Seidel between types; inside one, as the type projects: batches or Jacobi) */
-static void solve_constraints(wb_world *w, wb_real h)
+/* the residual after the iterations when it is measured (tolerance, or asked for in
+ * the last substep: measure), else -1 */
+static wb_real solve_constraints(wb_world *w, wb_real h, int measure)
 {
     const int iterations = w->m.def.iterations;
-    for (int it = 0; it < iterations; it++)
+    const wb_real tol = w->m.def.tolerance;
+    wb_real r = -1;
+    for (int it = 0; it < iterations; it++) {
         for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->project(w, h);
+        /* (a pass over every constraint: only when asked for) */
+        if (tol > 0 || (measure && it + 1 == iterations)) r = wb__residual_all(w, h);
+        if (tol > 0 && r <= tol) break;
+    }
+    return r;
 }
 
 static wb_predict predict_of(const wb_world *w, wb_real h)
@@ -453,7 +462,8 @@ wb_status wb_world_step(wb_world *w)
         double t0 = now_ms();
         /* TYPE HOOK: the constraint types, walked from the table (wb__ctypes) */
         for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->substep_begin(w);
-        solve_constraints(w, h);
+        const wb_real r = solve_constraints(w, h, k->residual_on && sub + 1 == d->substeps);
+        if (sub + 1 == d->substeps) k->residual = r;
         wb__momentum_restore(w, h);
         solve += now_ms() - t0;
         wb__contacts_project(w, h);

@@ -102,6 +102,7 @@ const char *wb_world_def_check(const wb_world_def *d)
     if (!(d->relaxation > 0 && d->relaxation < 2)) return "relaxation must be in (0, 2)";
     if (d->threads < 1 || d->threads > WB_MAX_THREADS) return "threads must be in 1..256";
     if (!(d->max_depenetration >= 0) || !isfinite(d->max_depenetration)) return "max_depenetration must be finite and >= 0 (m/s)";
+    if (!(d->tolerance >= 0) || !isfinite(d->tolerance)) return "tolerance must be finite and >= 0 (m)";
     return NULL;
 }
 

@@ -57,8 +57,8 @@ static const char *const solver_names[] = { "gauss-seidel", "jacobi" };
 static int read_world(rd *r, const cJSON *it, const kp *up, wb_world_def *d)
 {
     static const char *const keys[] = { "gravity", "dt", "substeps", "iterations", "damping", "solver", "relaxation", "threads",
-                                        "contacts", "max_depenetration", NULL };
-    const cJSON *f[11];
+                                        "contacts", "max_depenetration", "tolerance", NULL };
+    const cJSON *f[12];
     kp p = { up, "world", 0 };
     int64_t i;
     if (jv_get_object(r, it, &p, keys, f)) return -1;
@@ -81,6 +81,7 @@ static int read_world(rd *r, const cJSON *it, const kp *up, wb_world_def *d)
         if (jv_get_bool(r, f[8], &q, &d->contacts)) return -1;
     }
     if (jv_opt_real(r, f[9], &p, "max_depenetration", &d->max_depenetration)) return -1;
+    if (jv_opt_real(r, f[10], &p, "tolerance", &d->tolerance)) return -1;
     const char *e = wb_world_def_check(d);
     return e ? jv_fail(r, it, 0, &p, "%s", e) : 0;
 }

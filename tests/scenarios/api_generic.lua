@@ -51,8 +51,8 @@ local function plus(t, extra) local r = {} for _, v in ipairs(t) do r[#r + 1] = 
 local CASES = {
   -- ---- wobble.*
   ["wobble.world"] = { opts = { gravity = {0, -9.81, 0}, dt = 1 / 60, substeps = 2, iterations = 1, damping = 0,
-                                relaxation = 1, threads = 1, contacts = true },
-                       nums = { "gravity", "dt", "substeps", "iterations", "damping", "relaxation", "threads" },
+                                relaxation = 1, threads = 1, contacts = true, tolerance = 0 },
+                       nums = { "gravity", "dt", "substeps", "iterations", "damping", "relaxation", "threads", "tolerance" },
                        call = function(_, o) return wobble.world(o) end },
   ["wobble.renderer"] = { opts = { width = 8, height = 8, samples = 1, backend = "null" },
                           nums = { "width", "height", "samples" },
@@ -155,6 +155,7 @@ local CASES = {
   ["world:group"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.w:group(...) end },
   ["world:set_self_collide"] = { args = { 1, true }, nums = { 1 }, call = function(f, ...) return f.w:set_self_collide(...) end },
   ["world:set_dt"] = { args = { 0.01 }, nums = { 1 }, call = function(f, ...) return f.w:set_dt(...) end },
+  ["world:set_tolerance"] = { args = { 1e-4 }, nums = { 1 }, call = function(f, ...) return f.w:set_tolerance(...) end },
   ["world:set_substeps"] = { args = { 2 }, nums = { 1 }, call = function(f, ...) return f.w:set_substeps(...) end },
   ["world:set_iterations"] = { args = { 2 }, nums = { 1 }, call = function(f, ...) return f.w:set_iterations(...) end },
   ["world:set_damping"] = { args = { 0 }, nums = { 1 }, call = function(f, ...) return f.w:set_damping(...) end },
@@ -189,7 +190,8 @@ local CASES = {
 }
 for _, name in ipairs{ "angular_momentum", "bend_breaks", "bends", "bounds", "breaks", "closed", "colliders", "contacts", "damping", "distances", "dt",
                        "energy", "frame", "gravity", "hash", "iterations", "max_strain", "momentum", "particle_count",
-                       "relaxation", "rigid_contacts", "rigids", "skins", "solver", "stats", "step", "substeps", "threads", "time", "warnings" } do
+                       "relaxation", "rigid_contacts", "rigids", "skins", "solver", "stats", "step", "substeps", "threads", "time", "tolerance",
+                       "warnings" } do
   CASES["world:" .. name] = { none = "a getter or step: no arguments" }
 end
 
