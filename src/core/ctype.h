@@ -99,7 +99,7 @@ static inline int wb__quad_check(const int32_t p[4], int32_t np)
 
 extern const wb_ctype wb__distance_type, wb__bend_type, wb__volume_type,
                       wb__shape_type, wb__pressure_type, wb__tet_type;
-extern const wb_ctype wb__attach_type, wb__grab_type; /* attach.c, grab.c */
+extern const wb_ctype wb__attach_type, wb__grab_type, wb__tether_type; /* attach.c, grab.c, tether.c */
 
 /* the table the step walks (solver.c), in projection order, and its length */
 extern const wb_ctype *const wb__ctypes[];

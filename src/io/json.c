@@ -429,6 +429,61 @@ static void write_volumes(jw_out *o, const wb_image *g)
     fputs("\n  ],\n", f);
 }
 
+/* "tethers": [ {"particles": [p, q], "length": l, "compliance": alpha}, ... ]: long-range
+ * attachments (length: the particles' distance by default; compliance 0 by default) */
+static int read_tethers(rd *r, const cJSON *arr, wb_image *g)
+{
+    static const char *const keys[] = { "particles", "length", "compliance", NULL };
+    kp top = { NULL, "tethers", 0 };
+    int32_t i = 0, n;
+    if (!arr) return 0;
+    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
+    if (wb_image_alloc_tethers(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
+    for (const cJSON *c = arr->child; c; c = c->next, i++) {
+        const cJSON *f[3];
+        kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "particles");
+        int32_t m;
+        if (jv_get_array(r, f[0], &pp, 16, &m)) return -1;
+        if (m != 2) return jv_fail(r, f[0], 0, &pp, "a tether joins 2 particles, got %d", m);
+        int32_t *ij = &g->teth.ij[2 * i];
+        int k = 0;
+        for (const cJSON *e = f[0]->child; e; e = e->next, k++) {
+            kp q = { &pp, NULL, k };
+            int64_t v;
+            if (g->np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
+            if (jv_get_int(r, e, &q, 0, g->np - 1, &v)) return -1;
+            ij[k] = (int32_t)v;
+        }
+        if (ij[0] == ij[1]) return jv_fail(r, f[0], 0, &pp, "a tether needs two distinct particles");
+        const wb_real *x = g->x;
+        wb_real d[3];
+        v3_sub(d, &x[3 * ij[0]], &x[3 * ij[1]]);
+        g->teth.len[i] = v3_len(d);
+        g->teth.alpha[i] = 0;
+        if (jv_opt_nonneg(r, f[1], &p, "length", &g->teth.len[i]) || jv_opt_nonneg(r, f[2], &p, "compliance", &g->teth.alpha[i]))
+            return -1;
+    }
+    return 0;
+}
+
+/* "tethers" (only when there are any) */
+static void write_tethers(jw_out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    if (g->teth.n == 0) return;
+    fputs("  \"tethers\": [", f);
+    for (int32_t i = 0; i < g->teth.n; i++) {
+        fprintf(f, "%s    {\"particles\": [%d, %d], \"length\": ", i ? ",\n" : "\n", g->teth.ij[2 * i], g->teth.ij[2 * i + 1]);
+        jw_num(o, g->teth.len[i]);
+        fputs(", \"compliance\": ", f);
+        jw_num(o, g->teth.alpha[i]);
+        fputc('}', f);
+    }
+    fputs("\n  ],\n", f);
+}
+
 /* the constraint types with a section of their own (json.h), in the order w:save writes
  * them; each reads and writes its own */
 const jtype jtypes[] = {
@@ -438,6 +493,7 @@ const jtype jtypes[] = {
     { "pressures", jm_read_pressures, jm_write_pressures },
     { "attachments", ja_read_attachments, ja_write_attachments },
     { "grabs", ja_read_grabs, ja_write_grabs },
+    { "tethers", read_tethers, write_tethers },
 };
 const int njtypes = (int)(sizeof jtypes / sizeof jtypes[0]);
 
@@ -738,8 +794,9 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
 {
     static const char *const keys[] = { "format", "version", "description", "defaults", "particles", "constraints",
                                         "colliders", "surfaces", "parts", "skins", "snapshot", "volumes",
-                                        "shape_matches", "pressures", "tets", "attachments", "grabs", "rigids", NULL };
-    const cJSON *f[19];
+                                        "shape_matches", "pressures", "tets", "attachments", "grabs", "rigids", "tethers",
+                                        NULL };
+    const cJSON *f[20];
     sections s;
     defaults d;
     memset(&s, 0, sizeof s);

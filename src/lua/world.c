@@ -472,6 +472,7 @@ static int w_stats(lua_State *L)
     SETI("particle_contacts", s.particle_contacts);
     SETI("rigids", s.rigids);
     SETI("rigid_contacts", s.rigid_contacts);
+    SETI("tethers", s.tethers);
     SETN("broad_ms", s.broad_ms);
     SETN("broad_remakes", s.broad_remakes);
     SETI("projections", s.projections);

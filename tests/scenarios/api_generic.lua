@@ -171,6 +171,13 @@ local CASES = {
                        call = function(f, o) local b = f.body.first
                          return f.w:volume(b, b + 1, b + 2, b + 4, o) end },
   ["world:volume_info"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.w:volume_info(...) end },
+  -- tethers (lua/tether.c): tethers.lua
+  ["world:tether"] = { opts = { length = 1, compliance = 0 }, opts_arg = 4, nums = { "length", "compliance" },
+                       call = function(f, o) local b = f.body.first return f.w:tether(b, b + 1, o) end },
+  ["world:tether_info"] = { args = { 1 }, nums = { 1 }, call = function(f, ...)
+                              if f.w:tether_count() == 0 then f.w:tether(f.body.first, f.body.first + 1) end
+                              return f.w:tether_info(...) end },
+  ["world:tether_count"] = { none = "a getter: no arguments" },
   ["world:load_tets"] = { opts = link{ mass = 1, radius = 0.02, volume_compliance = 0 }, opts_arg = 2,
                           nums = plus(link_nums, { "mass", "radius", "volume_compliance", "friction" }),
                           call = function(f, o) assert(f.w:save_tets("api_generic/tets", f.body))
@@ -255,6 +262,8 @@ end
 CASES["body:pin_where"] = { none = "a predicate function" }
 CASES["body:pin_all"] = { none = "no arguments" }
 CASES["body:unpin_all"] = { none = "no arguments" }
+CASES["body:tether_to_pins"] = { opts = { compliance = 0 }, opts_arg = 2, nums = { "compliance" },
+                                 call = function(f, o) return f.body:tether_to_pins(o) end }
 
 -- ---- meshes and skins
 CASES["mesh:transform"] = { opts = { scale = 2, translate = {0, 1, 0} }, nums = { "scale", "translate" },
