@@ -115,3 +115,26 @@ test("every constraint type has a residual, which falls with the iterations", fu
     expect.lt(r30, 0.1 * r1, kind .. ": 30 iterations leave under a tenth")
   end
 end)
+
+-- 6. Attachments and grabs: a particle hanging from a compliant attachment (to a sphere
+-- collider) and one held by a compliant grab are each met by their one
+-- projection, as the link of 1: residual round-off, while each hangs m g alpha off (the
+-- attachment holds the point where the particle was made, 2 m under its sphere).
+test("attachments and grabs report their residual", function()
+  for _, kind in ipairs{ "attach", "grab" } do
+    local w = wobble.world{ damping = 10, contacts = false }
+    local p = w:particle{ pos = { 0, 1, 0 }, mass = 2 }
+    if kind == "attach" then
+      local c = w:collider{ shape = "sphere", center = { 0, 3, 0 }, radius = 0.1 } -- (held 2 m below it)
+      w:attach(p, c, { compliance = 1e-3 })
+    else
+      w:grab(p, { 0, 1, 0 }, { compliance = 1e-3 })
+    end
+    local r0 = w:stats().residual
+    for _ = 1, 120 do w:step() end
+    local _, y = w:position(p)
+    expect.eq(r0, 0, kind .. ": nothing before the first step")
+    expect.near(1 - y, 2 * 9.81 * 1e-3, 0.01 * 2 * 9.81 * 1e-3, kind .. ": hangs m g alpha low")
+    expect.lt(w:stats().residual, 1e-9, kind .. ": its residual")
+  end
+end)
