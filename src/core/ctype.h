@@ -64,12 +64,12 @@ typedef struct wb_ctype {
     wb_real (*residual)(const wb_world *w, wb_real h);
 } wb_ctype;
 
+/* every type's largest residual (query.c), for the iterations' early stop (solver.c) */
+wb_real wb__residual_all(const wb_world *w, wb_real h);
 /* A constraint's residual in metres: what XPBD drives to zero, |C + alpha~ lambda| (C
  * alone for a hard one), over the root mean square of its corners' gradients (g2: the sum
  * of their squares over n corners), so an angle or a volume reads as how far its corners
  * are from meeting it. 0 where it has no direction (a flat tet's volume, coincident ends) */
-/* every type's largest (query.c), for the iterations' early stop (solver.c) */
-wb_real wb__residual_all(const wb_world *w, wb_real h);
 static inline wb_real wb__residual(wb_real c, wb_real g2, int n)
 {
     return g2 > 0 && isfinite(g2) ? fabs(c) / sqrt(g2 / n) : 0;
