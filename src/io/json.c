@@ -384,20 +384,8 @@ static int read_volumes(rd *r, const cJSON *arr, wb_image *g)
         kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
         if (jv_get_object(r, c, &p, keys, f)) return -1;
         if (!f[0]) return jv_missing(r, c, &p, "particles");
-        int32_t n;
-        if (jv_get_array(r, f[0], &pp, 16, &n)) return -1;
-        if (n != 4) return jv_fail(r, f[0], 0, &pp, "a volume constraint joins 4 particles, got %d", n);
         int32_t *ijkl = &g->vol.ijkl[4 * i];
-        int k = 0;
-        for (const cJSON *e = f[0]->child; e; e = e->next, k++) {
-            kp q = { &pp, NULL, k };
-            int64_t v;
-            if (g->np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
-            if (jv_get_int(r, e, &q, 0, g->np - 1, &v)) return -1;
-            ijkl[k] = (int32_t)v;
-            for (int j = 0; j < k; j++)
-                if (ijkl[j] == ijkl[k]) return jv_fail(r, f[0], 0, &pp, "a volume constraint needs four distinct particles");
-        }
+        if (jv_get_corners(r, f[0], &pp, g->np, 4, "a volume constraint", ijkl)) return -1;
         const wb_real *x = g->x;
         g->vol.rest[i] = wb_tet_signed_volume(&x[3 * ijkl[0]], &x[3 * ijkl[1]], &x[3 * ijkl[2]], &x[3 * ijkl[3]]);
         g->vol.alpha[i] = 0;
@@ -444,19 +432,8 @@ static int read_tethers(rd *r, const cJSON *arr, wb_image *g)
         kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
         if (jv_get_object(r, c, &p, keys, f)) return -1;
         if (!f[0]) return jv_missing(r, c, &p, "particles");
-        int32_t m;
-        if (jv_get_array(r, f[0], &pp, 16, &m)) return -1;
-        if (m != 2) return jv_fail(r, f[0], 0, &pp, "a tether joins 2 particles, got %d", m);
         int32_t *ij = &g->teth.ij[2 * i];
-        int k = 0;
-        for (const cJSON *e = f[0]->child; e; e = e->next, k++) {
-            kp q = { &pp, NULL, k };
-            int64_t v;
-            if (g->np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
-            if (jv_get_int(r, e, &q, 0, g->np - 1, &v)) return -1;
-            ij[k] = (int32_t)v;
-        }
-        if (ij[0] == ij[1]) return jv_fail(r, f[0], 0, &pp, "a tether needs two distinct particles");
+        if (jv_get_corners(r, f[0], &pp, g->np, 2, "a tether", ij)) return -1;
         const wb_real *x = g->x;
         wb_real d[3];
         v3_sub(d, &x[3 * ij[0]], &x[3 * ij[1]]);
