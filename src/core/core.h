@@ -597,6 +597,7 @@ struct wb_world {
     struct wb_attaches *att; /* attachments (attach.h), NULL until the first */
     struct wb_grabs *grab;  /* grabs (grab.h), NULL until the first */
     struct wb_rigids *rb;  /* rigid bodies (rigid.h), NULL until the first */
+    struct wb_vbd *vbd;    /* the VBD solver's cache (vbd.c), NULL until a step with it */
     wb_pool *pool;         /* the threads (pool.h), NULL until a step runs with threads > 1 */
     size_t charged_self;   /* the struct and its worker threads, charged to def.memory (world.c) */
 };

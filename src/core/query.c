@@ -4,6 +4,7 @@
 #include "grab.h"
 #include "rigid.h"
 #include "tet.h"
+#include "vbd.h"
 #include "volume.h"
 
 static wb_real mass_of(const wb_world *w, int32_t i) { return w->m.w[i] > 0 ? 1 / w->m.w[i] : 0; }
@@ -252,6 +253,7 @@ wb_stats wb_world_stats(const wb_world *w)
     st.contacts = w->k.last_contacts;
     st.particle_contacts = w->k.pc.last + w->k.tc.last;
     st.broad_ms = w->k.pc.broad_ms + w->k.tc.broad_ms;
+    st.residual = wb__vbd_residual(w);
     st.broad_remakes = w->k.pc.remakes_frame;
     st.projections = w->k.projections;
     st.step_ms = w->k.step_ms;

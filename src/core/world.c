@@ -12,6 +12,7 @@
 #include "attach.h"
 #include "grab.h"
 #include "rigid.h"
+#include "vbd.h"
 
 static _Thread_local char wb_err[256];
 
@@ -104,7 +105,7 @@ const char *wb_world_def_check(const wb_world_def *d)
     const wb_real h = d->dt / d->substeps;
     if (!(h * h >= h2_min)) return "dt/substeps is too short: h = dt/substeps must be >= 1.5e-154 s (h*h underflows)";
     if (!(d->damping >= 0) || !isfinite(d->damping)) return "damping must be >= 0";
-    if (d->solver != WB_SOLVER_GAUSS_SEIDEL && d->solver != WB_SOLVER_JACOBI) return "unknown solver";
+    if (d->solver != WB_SOLVER_GAUSS_SEIDEL && d->solver != WB_SOLVER_JACOBI && d->solver != WB_SOLVER_VBD) return "unknown solver";
     if (!(d->relaxation > 0 && d->relaxation < 2)) return "relaxation must be in (0, 2)";
     if (d->threads < 1 || d->threads > WB_MAX_THREADS) return "threads must be in 1..256";
     if (!(d->max_depenetration >= 0) || !isfinite(d->max_depenetration)) return "max_depenetration must be finite and >= 0 (m/s)";
@@ -168,6 +169,7 @@ void wb_world_destroy(wb_world *w)
     wb__attach_free(w);
     wb__grab_free(w);
     wb__rigids_free(w, w->rb);
+    wb__vbd_destroy(w);
     wb__pool_destroy(w->pool);
     wb_model *m = &w->m;
     for (int32_t i = 0; i < m->nc; i++) wb__colmesh_free(m->c_shape[i].mesh); /* mesh colliders' copies */

@@ -67,7 +67,7 @@ static void write_snapshot(out *o, const wb_image *g)
     num(o, d->dt);
     fprintf(f, ", \"substeps\": %d, \"iterations\": %d, \"damping\": ", d->substeps, d->iterations);
     num(o, d->damping);
-    fprintf(f, ", \"solver\": \"%s\", \"relaxation\": ", d->solver == WB_SOLVER_JACOBI ? "jacobi" : "gauss-seidel");
+    fprintf(f, ", \"solver\": \"%s\", \"relaxation\": ", d->solver == WB_SOLVER_VBD ? "vbd" : d->solver == WB_SOLVER_JACOBI ? "jacobi" : "gauss-seidel");
     num(o, d->relaxation);
     fprintf(f, ", \"threads\": %d, \"contacts\": %s, \"max_depenetration\": ", d->threads, d->contacts ? "true" : "false");
     num(o, d->max_depenetration);

@@ -9,7 +9,7 @@
 #include "util.h"
 #include "render/render.h"
 
-static const char *const solver_names[] = { "gauss-seidel", "jacobi", NULL };
+static const char *const solver_names[] = { "gauss-seidel", "jacobi", "vbd", NULL };
 
 #define toworld(L) wbl_checkworld(L, 1)
 
@@ -132,7 +132,7 @@ static int w_set_solver(lua_State *L)
 static int w_solver(lua_State *L)
 {
     wb_world_def d = wb_world_get_def(toworld(L));
-    lua_pushstring(L, solver_names[d.solver == WB_SOLVER_JACOBI]);
+    lua_pushstring(L, solver_names[d.solver]);
     return 1;
 }
 
@@ -463,12 +463,13 @@ static int w_stats(lua_State *L)
     SETI("projections", s.projections);
     SETN("step_ms", s.step_ms);
     SETN("solve_ms", s.solve_ms);
+    if (d.solver == WB_SOLVER_VBD) SETN("residual", s.residual);
     SETI("warnings", s.warnings);
     SETI("substeps", d.substeps);
     SETI("iterations", d.iterations);
     SETI("threads", d.threads);
     SETN("dt", d.dt);
-    lua_pushstring(L, solver_names[d.solver == WB_SOLVER_JACOBI]);
+    lua_pushstring(L, solver_names[d.solver]);
     lua_setfield(L, -2, "solver");
 #undef SETI
 #undef SETN
