@@ -19,16 +19,19 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bend.h"
 #include "pool.h"
 #include "tet.h"
 #include "vbd.h"
 
 struct wb_vbd {
-    int32_t np, nd, nt;    /* the model it was built for */
+    int32_t np, nd, nt, nb; /* the model it was built for */
     int32_t *adj_start;    /* (np + 1) each vertex's range of adj */
     int32_t *adj;          /* link slots touching each vertex */
     int32_t *tadj_start;   /* (np + 1) each vertex's range of tadj */
     int32_t *tadj;         /* 4 tet + corner of the Neo-Hookean tets touching each vertex */
+    int32_t *badj_start;   /* (np + 1) each vertex's range of badj */
+    int32_t *badj;         /* 4 bend + corner of the bends touching each vertex */
     int32_t *order;        /* (np) the vertices by colour */
     int32_t *colour_start; /* (ncolours + 1) ranges of order */
     int32_t ncolours;
@@ -68,6 +71,8 @@ void wb__vbd_destroy(wb_world *w)
     free(v->adj);
     free(v->tadj_start);
     free(v->tadj);
+    free(v->badj_start);
+    free(v->badj);
     free(v->order);
     free(v->colour_start);
     free(v->y);
@@ -79,9 +84,31 @@ void wb__vbd_destroy(wb_world *w)
     w->vbd = NULL;
 }
 
-int wb__vbd_serves(const wb_ctype *t) { return t == &wb__distance_type || t == &wb__tet_type; }
+int wb__vbd_serves(const wb_ctype *t) { return t == &wb__distance_type || t == &wb__tet_type || t == &wb__bend_type; }
 
 static int link_live(const wb_world *w, int32_t s) { return (w->m.d_gen[s] & 1u) && !w->s.d_broken[s]; }
+
+/* each vertex's elements of four corners q (n x 4), as 4 element + corner (CSR) */
+static int quads(int32_t np, const int32_t *q, int32_t n, int32_t **start_out, int32_t **adj_out)
+{
+    int32_t *ts = calloc((size_t)np + 1, sizeof *ts);
+    if (!ts) return 0;
+    for (int64_t k = 0; k < 4 * (int64_t)n; k++) ts[q[k] + 1]++;
+    for (int32_t i = 0; i < np; i++) ts[i + 1] += ts[i];
+    int32_t *ta = malloc(sizeof *ta * (size_t)(ts[np] > 0 ? ts[np] : 1)), *tf = malloc(sizeof *tf * (size_t)(np > 0 ? np : 1));
+    if (!ta || !tf) {
+        free(ts), free(ta), free(tf);
+        return 0;
+    }
+    memcpy(tf, ts, sizeof *tf * (size_t)np);
+    for (int32_t k = 0; k < 4 * n; k++) ta[tf[q[k]]++] = k;
+    free(tf);
+    free(*start_out);
+    free(*adj_out);
+    *start_out = ts;
+    *adj_out = ta;
+    return 1;
+}
 
 /* each vertex's links (CSR) */
 static int build_adjacency(wb_world *w, struct wb_vbd *v)
@@ -107,25 +134,8 @@ static int build_adjacency(wb_world *w, struct wb_vbd *v)
     free(v->adj);
     v->adj_start = start;
     v->adj = adj;
-    /* the tets' corners */
-    const int32_t nt = w->neo ? w->neo->n : 0;
-    int32_t *ts = calloc((size_t)np + 1, sizeof *ts);
-    if (!ts) return 0;
-    for (int64_t q = 0; q < 4 * (int64_t)nt; q++) ts[w->neo->ijkl[q] + 1]++;
-    for (int32_t i = 0; i < np; i++) ts[i + 1] += ts[i];
-    int32_t *ta = malloc(sizeof *ta * (size_t)(ts[np] > 0 ? ts[np] : 1)), *tf = malloc(sizeof *tf * (size_t)(np > 0 ? np : 1));
-    if (!ta || !tf) {
-        free(ts), free(ta), free(tf);
-        return 0;
-    }
-    memcpy(tf, ts, sizeof *tf * (size_t)np);
-    for (int32_t q = 0; q < 4 * nt; q++) ta[tf[w->neo->ijkl[q]]++] = q; /* 4 tet + corner */
-    free(tf);
-    free(v->tadj_start);
-    free(v->tadj);
-    v->tadj_start = ts;
-    v->tadj = ta;
-    return 1;
+    return quads(np, w->neo ? w->neo->ijkl : NULL, w->neo ? w->neo->n : 0, &v->tadj_start, &v->tadj) &&
+           quads(np, w->bend.ij, w->bend.n, &v->badj_start, &v->badj);
 }
 
 static int32_t other_end(const wb_model *m, int32_t s, int32_t i) { return m->d_ij[2 * s] == i ? m->d_ij[2 * s + 1] : m->d_ij[2 * s]; }
@@ -152,6 +162,11 @@ static int build_colours(wb_world *w, struct wb_vbd *v)
         }
         for (int32_t e = v->tadj_start[i]; e < v->tadj_start[i + 1]; e++) {
             const int32_t *c = &w->neo->ijkl[4 * (v->tadj[e] / 4)];
+            for (int k = 0; k < 4; k++)
+                if (c[k] < i) used |= (uint64_t)1 << col[c[k]];
+        }
+        for (int32_t e = v->badj_start[i]; e < v->badj_start[i + 1]; e++) {
+            const int32_t *c = &w->bend.ij[4 * (v->badj[e] / 4)];
             for (int k = 0; k < 4; k++)
                 if (c[k] < i) used |= (uint64_t)1 << col[c[k]];
         }
@@ -188,7 +203,7 @@ int wb__vbd_prepare(wb_world *w)
     }
     const wb_model *m = &w->m;
     const int32_t nt = w->neo ? w->neo->n : 0;
-    if (m->topology_dirty || v->np != m->np || v->nd != m->nd || v->nt != nt) {
+    if (m->topology_dirty || v->np != m->np || v->nd != m->nd || v->nt != nt || v->nb != w->bend.n) {
         if (!build_adjacency(w, v) || !build_colours(w, v)) return 0;
         const int32_t np0 = v->np > 0 ? v->np : 0;
         wb_real *y = realloc(v->y, sizeof *y * 3 * (size_t)(m->np > 0 ? m->np : 1));
@@ -213,6 +228,7 @@ int wb__vbd_prepare(wb_world *w)
         v->np = m->np;
         v->nd = m->nd;
         v->nt = nt;
+        v->nb = w->bend.n;
     }
     return 1;
 }
@@ -294,6 +310,21 @@ static void tet_block(const wb_world *w, int32_t q, wb_real f[3], wb_real H[6])
     H[3] += kh * g[0] * g[1], H[4] += kh * g[0] * g[2], H[5] += kh * g[1] * g[2];
 }
 
+/* a bend's energy off / (2 alpha) on corner k: Gauss-Newton, k g g^T (a rigid one, alpha
+ * 0, as a penalty of VBD_KBEND: no multiplier for bends yet) */
+#define VBD_KBEND ((wb_real)1e6)
+static void bend_block(const wb_world *w, int32_t q, wb_real f[3], wb_real H[6])
+{
+    const int32_t b = q / 4, k = q % 4;
+    if (w->bend.broken[b]) return;
+    wb_real off, g[4][3];
+    if (!wb__bend_off(w, b, &off, g)) return;
+    const wb_real a = w->bend.alpha[b], kb = a > 0 ? 1 / a : VBD_KBEND, *gk = g[k];
+    v3_madd(f, gk, -kb * off);
+    H[0] += kb * gk[0] * gk[0], H[1] += kb * gk[1] * gk[1], H[2] += kb * gk[2] * gk[2];
+    H[3] += kb * gk[0] * gk[1], H[4] += kb * gk[0] * gk[2], H[5] += kb * gk[1] * gk[2];
+}
+
 static void sweep_part(void *ctx, int32_t lo, int32_t hi)
 {
     sweep_job *j = ctx;
@@ -311,6 +342,7 @@ static void sweep_part(void *ctx, int32_t lo, int32_t hi)
         v3_scale(f, f, mh);
         for (int32_t e = v->adj_start[i]; e < v->adj_start[i + 1]; e++) link_block(w, v, v->adj[e], i, f, H);
         for (int32_t e = v->tadj_start[i]; e < v->tadj_start[i + 1]; e++) tet_block(w, v->tadj[e], f, H);
+        for (int32_t e = v->badj_start[i]; e < v->badj_start[i + 1]; e++) bend_block(w, v->badj[e], f, H);
         if (!solve3(H, f, d)) continue;
         v3_add(&x[3 * i], &x[3 * i], d);
         const wb_real dd = v3_dot(d, d);
