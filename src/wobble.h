@@ -44,7 +44,7 @@ typedef enum wb_status {
     WB_ERR_INTERRUPTED = -4, /* the interrupt callback stopped a step: the frame was undone */
 } wb_status;
 
-typedef enum wb_solver { WB_SOLVER_GAUSS_SEIDEL = 0, WB_SOLVER_JACOBI = 1 } wb_solver;
+typedef enum wb_solver { WB_SOLVER_GAUSS_SEIDEL = 0, WB_SOLVER_JACOBI = 1, WB_SOLVER_VBD = 2 } wb_solver;
 
 typedef enum wb_shape {
     WB_SHAPE_PLANE = 0, WB_SHAPE_SPHERE, WB_SHAPE_BOX, WB_SHAPE_CAPSULE, WB_SHAPE_MESH, WB_SHAPE_COUNT

@@ -257,6 +257,10 @@ typedef struct wb_contacts {
     int32_t *made_ab;      /* (nmade x 2) the body pairs (groups a < b) contact.c moved apart this
                               substep for a made overlap: tricontact.c leaves theirs to it */
     int32_t nmade, cap_made;
+    /* (nbm x 3) body pairs (groups a < b) asked whether they were made overlapping, and
+     * the answer: derived from x0, so kept until the rules are rebuilt (bm_gen) */
+    int32_t *bm, nbm, cap_bm;
+    uint64_t bm_gen;
 } wb_contacts;
 
 /* rest neighbours (DESIGN.md §2) include pairs made in touch: created r_i + r_j apart, to
@@ -596,6 +600,7 @@ struct wb_world {
     struct wb_grabs *grab;  /* grabs (grab.h), NULL until the first */
     struct wb_tethers *teth; /* tethers (tether.h), NULL until the first */
     struct wb_rigids *rb;  /* rigid bodies (rigid.h), NULL until the first */
+    struct wb_vbd *vbd;    /* the VBD solver's cache (vbd.c), NULL until a step with it */
     wb_pool *pool;         /* the threads (pool.h), NULL until a step runs with threads > 1 */
     size_t charged_self;   /* the struct and its worker threads, charged to def.memory (world.c) */
 };

@@ -1,6 +1,7 @@
 /* query.c: read-only measures of a world: energy, momenta, bounds, strain, hash, stats. */
 #include "ctype.h"
 #include "rigid.h"
+#include "vbd.h"
 
 static wb_real mass_of(const wb_world *w, int32_t i) { return w->m.w[i] > 0 ? 1 / w->m.w[i] : 0; }
 
@@ -180,6 +181,7 @@ wb_real wb_world_residual(wb_world *w)
     const int was = k->residual_on;
     k->residual_on = 1;
     if (was && k->residual >= 0) return k->residual;
+    if (w->m.def.solver == WB_SOLVER_VBD) return wb__vbd_residual(w); /* (its last sweep's) */
     return k->h_last > 0 ? wb__residual_all(w, k->h_last) : 0;
 }
 

@@ -14,6 +14,7 @@
 #include "ctype.h"
 #include "grab.h"
 #include "rigid.h"
+#include "vbd.h"
 
 static double now_ms(void)
 {
@@ -419,6 +420,7 @@ wb_status wb_world_step(wb_world *w)
     wb_cache *k = &w->k;
     wb_status prep = WB_OK;
     wb__momentum_prepare(w); /* (first: the types' prepare clears the topology flag it reads) */
+    if (!wb__vbd_prepare(w)) prep = WB_ERR_NOMEM; /* (as well) */
     for (int t = 0; t < wb__nctypes && prep == WB_OK; t++) prep = wb__ctypes[t]->prepare(w);
     if (prep != WB_OK || !save_colliders(w)) {
         wb__warn(w, "frame %lld: out of memory preparing the step; frame skipped", (long long)w->s.frame + 1);
@@ -462,7 +464,8 @@ wb_status wb_world_step(wb_world *w)
         double t0 = now_ms();
         /* TYPE HOOK: the constraint types, walked from the table (wb__ctypes) */
         for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->substep_begin(w);
-        const wb_real r = solve_constraints(w, h, k->residual_on && sub + 1 == d->substeps);
+        const int measure = k->residual_on && sub + 1 == d->substeps;
+        const wb_real r = d->solver == WB_SOLVER_VBD ? wb__vbd_solve(w, h, measure) : solve_constraints(w, h, measure);
         if (sub + 1 == d->substeps) k->residual = r;
         wb__momentum_restore(w, h);
         solve += now_ms() - t0;

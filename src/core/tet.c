@@ -418,7 +418,8 @@ static wb_status tet_prepare(wb_world *w)
     /* stable up to about 2 (a hanging lattice bar: whole at 2.3, collapsed at 3.2); once per
      * substep length and tet count, not per step */
     wb_neos *v = w->neo;
-    if (r > WAVE_LIMIT && (h != v->warned_h || v->n != v->warned_n)) {
+    /* (VBD's Newton steps are stable at any stiffness: the limit is XPBD's) */
+    if (r > WAVE_LIMIT && w->m.def.solver != WB_SOLVER_VBD && (h != v->warned_h || v->n != v->warned_n)) {
         const wb_real m = corner_mass(w, at);
         const double need = ceil(w->m.def.substeps * r / WAVE_LIMIT);
         v->advised = need < 1e9 ? (int32_t)need : 1000000000;

@@ -51,7 +51,7 @@ static int read_defaults(rd *r, const cJSON *it, defaults *d)
            jv_opt_nonneg(r, f[7], &p, "break_force", &d->link.break_force) ? -1 : 0;
 }
 
-static const char *const solver_names[] = { "gauss-seidel", "jacobi" };
+static const char *const solver_names[] = { "gauss-seidel", "jacobi", "vbd" };
 
 /* the "world" settings of a snapshot */
 static int read_world(rd *r, const cJSON *it, const kp *up, wb_world_def *d)
@@ -70,9 +70,10 @@ static int read_world(rd *r, const cJSON *it, const kp *up, wb_world_def *d)
         kp q = { &p, "solver", 0 };
         const char *s = "";
         if (jv_get_string(r, f[5], &q, &s)) return -1;
-        if (strcmp(s, solver_names[0]) && strcmp(s, solver_names[1]))
-            return jv_fail(r, f[5], 0, &q, "unknown solver '%s' (expected gauss-seidel or jacobi)", s);
-        d->solver = strcmp(s, solver_names[0]) ? WB_SOLVER_JACOBI : WB_SOLVER_GAUSS_SEIDEL;
+        int k = 0;
+        while (k < 3 && strcmp(s, solver_names[k])) k++;
+        if (k == 3) return jv_fail(r, f[5], 0, &q, "unknown solver '%s' (expected gauss-seidel, jacobi or vbd)", s);
+        d->solver = (wb_solver)k;
     }
     if (jv_opt_real(r, f[6], &p, "relaxation", &d->relaxation)) return -1;
     if (f[7]) { if (jv_opt_int(r, f[7], &p, "threads", 1, WB_MAX_THREADS, &i)) return -1; d->threads = (int)i; }

@@ -9,7 +9,7 @@
 #include "util.h"
 #include "render/render.h"
 
-static const char *const solver_names[] = { "gauss-seidel", "jacobi", NULL };
+static const char *const solver_names[] = { "gauss-seidel", "jacobi", "vbd", NULL };
 
 #define toworld(L) wbl_checkworld(L, 1)
 
@@ -134,7 +134,7 @@ static int w_set_solver(lua_State *L)
 static int w_solver(lua_State *L)
 {
     wb_world_def d = wb_world_get_def(toworld(L));
-    lua_pushstring(L, solver_names[d.solver == WB_SOLVER_JACOBI]);
+    lua_pushstring(L, solver_names[d.solver]);
     return 1;
 }
 
@@ -483,7 +483,7 @@ static int w_stats(lua_State *L)
     SETI("iterations", d.iterations);
     SETI("threads", d.threads);
     SETN("dt", d.dt);
-    lua_pushstring(L, solver_names[d.solver == WB_SOLVER_JACOBI]);
+    lua_pushstring(L, solver_names[d.solver]);
     lua_setfield(L, -2, "solver");
     lua_createtable(L, 0, 1);
     lua_pushvalue(L, 1);
