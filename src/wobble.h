@@ -44,7 +44,7 @@ typedef enum wb_status {
     WB_ERR_INTERRUPTED = -4, /* the interrupt callback stopped a step: the frame was undone */
 } wb_status;
 
-typedef enum wb_solver { WB_SOLVER_GAUSS_SEIDEL = 0, WB_SOLVER_JACOBI = 1 } wb_solver;
+typedef enum wb_solver { WB_SOLVER_GAUSS_SEIDEL = 0, WB_SOLVER_JACOBI = 1, WB_SOLVER_VBD = 2 } wb_solver;
 
 typedef enum wb_shape {
     WB_SHAPE_PLANE = 0, WB_SHAPE_SPHERE, WB_SHAPE_BOX, WB_SHAPE_CAPSULE, WB_SHAPE_MESH, WB_SHAPE_COUNT
@@ -74,6 +74,8 @@ typedef struct wb_world_def {
     bool contacts;        /* particle-particle contacts, default true */
     wb_real max_depenetration; /* m/s: how fast contacts push out an overlap a pair already had
                                   (bodies made inside each other), default 0.25; >= 0 */
+    wb_real tolerance;    /* m: iterations stop once the constraints' residual is at most this
+                             (wb_world_residual); 0 (default): always `iterations` */
     wb_memory *memory;    /* budget the world, its worker threads and its arrays are charged to; NULL =
                              none (not copied by set_def) */
 } wb_world_def;
@@ -301,6 +303,27 @@ int32_t wb_surface_add(wb_world *w, const int32_t *tri, int32_t ntri);
 int32_t wb_surface_count(const wb_world *w);
 const int32_t *wb_surface_triangles(const wb_world *w, int32_t s, int32_t *ntri); /* valid until the next add */
 
+/* ---- tethers (long-range attachments, tether.c) ------------------------------------------- */
+/* Kim, Chentanez, Müller 2012: |x_p - x_q| <= length, a one-sided constraint that pulls and
+ * never pushes, so a particle far down a chain of links from its pin stays within its rest
+ * distance of it at any iteration count. Numbered 0.. in the order made; never removed. */
+typedef struct wb_tether_def {
+    bool has_length;      /* false: their distance now */
+    wb_real length;       /* m, >= 0 */
+    wb_real compliance;   /* m/N; 0 = inextensible past length */
+} wb_tether_def;
+wb_tether_def wb_tether_default_def(void);
+const char *wb_tether_def_check(const wb_tether_def *def);   /* NULL or what is wrong */
+/* returns the tether's index, or a negative wb_status (WB_ERR_ARG: see wb_last_error) */
+int32_t wb_tether_add(wb_world *w, int32_t p, int32_t q, const wb_tether_def *def);
+/* a tether from each of ids' particles that is not pinned to the nearest pinned one among
+ * them where they were made, that far: how many were made (0 without a pin), or a status */
+int32_t wb_tether_to_pins(wb_world *w, const int32_t *ids, int32_t n, wb_real compliance);
+int32_t wb_tether_count(const wb_world *w);
+void wb_tether_particles(const wb_world *w, int32_t i, int32_t pq[2]);
+wb_real wb_tether_length(const wb_world *w, int32_t i);        /* m */
+wb_real wb_tether_force(const wb_world *w, int32_t i);         /* N, |lambda|/h^2 of the last substep */
+
 /* ---- queries ---------------------------------------------------------------------- */
 void wb_world_energy(const wb_world *w, wb_real *kinetic, wb_real *potential); /* J; potential = gravity + elastic */
 void wb_world_momentum(const wb_world *w, wb_real out[3]);          /* movable particles */
@@ -330,8 +353,14 @@ typedef struct wb_stats {
     int32_t attachments, grabs; /* live ones (attach.c, grab.c) */
     int32_t rigids;           /* live rigid bodies */
     int32_t rigid_contacts;   /* particle-rigid contacts that corrected positions in the last substep */
+    int32_t tethers;          /* tethers (wb_tether_add) */
 } wb_stats;
 wb_stats wb_world_stats(const wb_world *w);
+/* the constraints' residual, m: the largest of every constraint's |C + alpha~ lambda| over
+ * the RMS of its corners' gradients (how far they are from meeting it), after the last
+ * substep's iterations. Measured by each step from the first call on (a pass over every
+ * constraint); that first call measures the positions as they are; 0 before any step */
+wb_real wb_world_residual(wb_world *w);
 
 /* numerical trouble: counted, the last message kept; the step restores the previous
  * frame's particles when a position or velocity turns non-finite */

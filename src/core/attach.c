@@ -435,6 +435,29 @@ static void att_project(wb_world *w, wb_real h)
     }
 }
 
+/* |x - t + alpha~ lambda| (C = x - t, a point: its gradients are the identity), the
+ * target where this substep's projection put it */
+static wb_real att_residual(const wb_world *w, wb_real h)
+{
+    const wb_attaches *a = w->att;
+    if (!a) return 0;
+    const wb_real f = (wb_real)a->sub / w->m.def.substeps, inv_h2 = 1 / (h * h);
+    wb_real r = 0;
+    for (int32_t s = 0; s < a->n; s++) {
+        if (!target_live(w, a, s)) continue;
+        const int32_t p = a->p[s];
+        const wb_real at = a->alpha[s] * inv_h2;
+        if ((w->m.w[p] == 0 && a->kind[s] != WB_TARGET_RIGID) || isinf(at)) continue;
+        wb_real t[3], c[3];
+        point_at(w, a, s, f, t);
+        v3_sub(c, &w->s.x[3 * p], t);
+        v3_madd(c, &a->lambda[3 * s], at);
+        const wb_real ri = v3_len(c);
+        r = ri > r ? ri : r;
+    }
+    return r;
+}
+
 static wb_real att_energy(const wb_world *w)
 {
     const wb_attaches *a = w->att;
@@ -500,4 +523,5 @@ const wb_ctype wb__attach_type = {
     .image_check = att_image_check,
     .image_reserve = att_image_reserve,
     .image_put = att_image_put,
+    .residual = att_residual,
 };

@@ -78,6 +78,16 @@ static wb_real wrap(wb_real d)
     return d;
 }
 
+int wb__bend_off(const wb_world *w, int32_t b, wb_real *off, wb_real g[4][3])
+{
+    const int32_t *p = &w->bend.ij[4 * b];
+    const wb_real *x = w->s.x;
+    wb_real th;
+    if (!dihedral(&x[3 * p[0]], &x[3 * p[1]], &x[3 * p[2]], &x[3 * p[3]], &th, g)) return 0;
+    *off = wrap(th - w->bend.rest[b]);
+    return 1;
+}
+
 /* ---- memory --------------------------------------------------------------------------------- */
 static int charge(wb_world *w, int32_t cap) { return wb__charge(w, &w->bend.charged, (size_t)cap * BEND_BYTES); }
 
@@ -654,6 +664,26 @@ static void bend_destroy(wb_world *w)
 static size_t bend_charged(const wb_world *w) { return w->bend.charged; }
 
 /* the broken ones' slots (state): a world without one adds nothing */
+static wb_real bend_residual(const wb_world *w, wb_real h)
+{
+    const wb_bends *b = &w->bend;
+    const wb_real *x = w->s.x, *wv = w->m.w, inv_h2 = 1 / (h * h);
+    wb_real r = 0;
+    if (b->dirty) return 0; /* made since the last step: not packed, never projected */
+    for (int32_t i = 0; i < b->n; i++) {
+        const int32_t s = b->s_slot[i], *p = &b->s_ij[4 * i];
+        const wb_real at = b->alpha[s] * inv_h2;
+        if (b->broken[s] || isinf(at) || wv[p[0]] + wv[p[1]] + wv[p[2]] + wv[p[3]] == 0) continue;
+        wb_real g[4][3], th;
+        if (!dihedral(&x[3 * p[0]], &x[3 * p[1]], &x[3 * p[2]], &x[3 * p[3]], &th, g)) continue;
+        wb_real g2 = 0;
+        for (int k = 0; k < 4; k++) g2 += v3_dot(g[k], g[k]);
+        const wb_real ri = wb__residual(wrap(th - b->s_rest[i]) + at * b->lambda[i], g2, 4);
+        r = ri > r ? ri : r;
+    }
+    return r;
+}
+
 static uint64_t bend_hash(const wb_world *w, uint64_t h)
 {
     for (int32_t i = 0; i < w->bend.n; i++)
@@ -776,6 +806,7 @@ const wb_ctype wb__bend_type = {
     .image_check = bend_image_check,
     .image_reserve = bend_image_reserve,
     .image_put = bend_image_put,
+    .residual = bend_residual,
 };
 
 /* ---- hinges of a triangle list ----------------------------------------------------------------- */

@@ -49,4 +49,8 @@ typedef struct wb_image_bend {
     uint8_t *broken;       /* (n) broken by it */
 } wb_image_bend;
 
+/* bend b's angle off its rest (the short way round) and its gradient on its four corners
+ * (vbd.c's energies); 0 when degenerate */
+int wb__bend_off(const wb_world *w, int32_t b, wb_real *off, wb_real g[4][3]);
+
 #endif

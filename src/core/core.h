@@ -544,6 +544,8 @@ typedef struct wb_cache {
     wb_real *c_save;       /* (nc x 7) collider poses at the frame's start, for undo */
     int32_t cap_c_save;
     wb_real h_last;        /* substep length of the last step (force readback) */
+    int residual_on;       /* the residual was asked for: each step measures it (query.c) */
+    wb_real residual;      /* ... after the last substep's iterations (-1: not yet) */
     int (*interrupt)(void *);
     void *interrupt_ud;
     int32_t last_contacts;
@@ -600,7 +602,9 @@ struct wb_world {
     wb_pressures pr;       /* pressure constraints (pressure.c) */
     struct wb_attaches *att; /* attachments (attach.h), NULL until the first */
     struct wb_grabs *grab;  /* grabs (grab.h), NULL until the first */
+    struct wb_tethers *teth; /* tethers (tether.h), NULL until the first */
     struct wb_rigids *rb;  /* rigid bodies (rigid.h), NULL until the first */
+    struct wb_vbd *vbd;    /* the VBD solver's cache (vbd.c), NULL until a step with it */
     wb_pool *pool;         /* the threads (pool.h), NULL until a step runs with threads > 1 */
     size_t charged_self;   /* the struct and its worker threads, charged to def.memory (world.c) */
 };

@@ -14,6 +14,7 @@ const wb_ctype *const wb__ctypes[] = {
     &wb__pressure_type,
     &wb__attach_type,
     &wb__grab_type,
+    &wb__tether_type, /* last: the pull the links and the rest left a long chain short of */
 };
 const int wb__nctypes = (int)(sizeof wb__ctypes / sizeof wb__ctypes[0]);
 
@@ -29,6 +30,7 @@ const wb_ctype *const wb__ctypes_hashed[] = {
     &wb__tet_type,
     &wb__attach_type,
     &wb__grab_type,
+    &wb__tether_type,
 };
 _Static_assert(sizeof wb__ctypes_hashed / sizeof wb__ctypes_hashed[0] == sizeof wb__ctypes / sizeof wb__ctypes[0] + 1,
                "every type has its place in the hash");

@@ -60,7 +60,21 @@ typedef struct wb_ctype {
     const char *(*image_check)(const wb_image *g);
     wb_status (*image_reserve)(wb_world *w, const wb_image *g, const wb_image_at *at);
     void (*image_put)(wb_world *w, const wb_image *g, const wb_image_at *at);
+    /* its largest residual at the positions as they are, with the multipliers of the last
+     * projection (h: its substep), in metres (wb__residual); may be NULL: none */
+    wb_real (*residual)(const wb_world *w, wb_real h);
 } wb_ctype;
+
+/* every type's largest residual (query.c), for the iterations' early stop (solver.c) */
+wb_real wb__residual_all(const wb_world *w, wb_real h);
+/* A constraint's residual in metres: what XPBD drives to zero, |C + alpha~ lambda| (C
+ * alone for a hard one), over the root mean square of its corners' gradients (g2: the sum
+ * of their squares over n corners), so an angle or a volume reads as how far its corners
+ * are from meeting it. 0 where it has no direction (a flat tet's volume, coincident ends) */
+static inline wb_real wb__residual(wb_real c, wb_real g2, int n)
+{
+    return g2 > 0 && isfinite(g2) ? fabs(c) / sqrt(g2 / n) : 0;
+}
 
 /* the links of n elements of four particles each (q: n x 4): every pair of an element's
  * corners is joined (a bend's hinge and wings, a tet's or volume's edges) */
@@ -86,7 +100,7 @@ static inline int wb__quad_check(const int32_t p[4], int32_t np)
 
 extern const wb_ctype wb__distance_type, wb__bend_type, wb__volume_type,
                       wb__shape_type, wb__pressure_type, wb__tet_type;
-extern const wb_ctype wb__attach_type, wb__grab_type; /* attach.c, grab.c */
+extern const wb_ctype wb__attach_type, wb__grab_type, wb__tether_type; /* attach.c, grab.c, tether.c */
 
 /* the table the step walks (solver.c), in projection order, and its length */
 extern const wb_ctype *const wb__ctypes[];

@@ -5,11 +5,13 @@
 #include "ctype.h"
 #include "bvh.h"
 #include "rigid.h"
+#include "vbd.h"
 
 void wb_world_destroy(wb_world *w)
 {
     if (!w) return;
     wb__rigids_free(w, w->rb);
+    wb__vbd_destroy(w);
     wb__pool_destroy(w->pool);
     wb_model *m = &w->m;
     for (int32_t i = 0; i < m->nc; i++) wb__colmesh_free(m->c_shape[i].mesh); /* mesh colliders' copies */

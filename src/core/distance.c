@@ -762,6 +762,24 @@ static void distance_destroy(wb_world *w)
 }
 
 /* the live ones' state (rest lengths, broken flags) in slot order */
+/* the packed links' largest |len - rest + alpha~ lambda| (a link's two gradients are unit) */
+static wb_real distance_residual(const wb_world *w, wb_real h)
+{
+    const wb_cache *k = &w->k;
+    const wb_real *x = w->s.x, *wv = w->m.w, inv_h2 = 1 / (h * h);
+    wb_real r = 0;
+    for (int32_t i = 0; i < k->ns; i++) {
+        const int32_t a = k->s_a[i], b = k->s_b[i];
+        if (wv[a] + wv[b] == 0) continue;
+        wb_real d[3];
+        v3_sub(d, &x[3 * b], &x[3 * a]);
+        const wb_real at = k->s_alpha[i] * inv_h2, lam = k->s_lambda_stale ? 0 : k->s_lambda[i];
+        const wb_real ri = isinf(at) ? 0 : fabs(v3_len(d) - k->s_rest[i] + at * lam);
+        r = ri > r ? ri : r;
+    }
+    return r;
+}
+
 static uint64_t distance_hash(const wb_world *w, uint64_t h)
 {
     const wb_model *m = &w->m;
@@ -957,4 +975,5 @@ const wb_ctype wb__distance_type = {
     .image_check = distance_image_check,
     .image_reserve = distance_image_reserve,
     .image_put = distance_image_put,
+    .residual = distance_residual,
 };

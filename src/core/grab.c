@@ -417,6 +417,30 @@ static void grab_frame_end(wb_world *w)
     if (g && g->n > 0) memcpy(g->from, g->target, sizeof(wb_real) * 3 * (size_t)g->n);
 }
 
+/* |x - t + alpha~ lambda| (C = x - t), the target where this substep's projection put it */
+static wb_real grab_residual(const wb_world *w, wb_real h)
+{
+    const wb_grabs *g = w->grab;
+    if (!g) return 0;
+    const int32_t n_sub = w->m.def.substeps;
+    const wb_real f = (wb_real)g->sub / n_sub, inv_h2 = 1 / (h * h);
+    wb_real r = 0;
+    for (int32_t s = 0; s < g->n; s++) {
+        if (!wb__grab_active(w, g, s)) continue;
+        const wb_real at = g->alpha[s] * inv_h2;
+        if (isinf(at)) continue;
+        wb_real x[3], c[3];
+        if (g->kind[s] == WB_GRAB_RIGID) wb__rigid_to_world(w, g->p[s], &g->local[3 * s], x);
+        else if (w->m.w[g->p[s]] == 0) continue;
+        else v3_copy(x, &w->s.x[3 * g->p[s]]);
+        const wb_real *t1 = &g->target[3 * s], *t0 = &g->from[3 * s];
+        for (int k = 0; k < 3; k++) c[k] = x[k] - (g->sub >= n_sub ? t1[k] : t0[k] + (t1[k] - t0[k]) * f) + at * g->lambda[3 * s + k];
+        const wb_real ri = v3_len(c);
+        r = ri > r ? ri : r;
+    }
+    return r;
+}
+
 static wb_real grab_energy(const wb_world *w)
 {
     const wb_grabs *g = w->grab;
@@ -484,4 +508,5 @@ const wb_ctype wb__grab_type = {
     .image_check = grab_image_check,
     .image_reserve = grab_image_reserve,
     .image_put = grab_image_put,
+    .residual = grab_residual,
 };

@@ -221,6 +221,23 @@ static void pr_project(wb_world *w, wb_real h)
     }
 }
 
+static wb_real pr_residual(const wb_world *w, wb_real h)
+{
+    const wb_pressures *p = &w->pr;
+    wb_real r = 0, *g = p->grad; /* (scratch) */
+    for (int32_t k = 0; k < p->n; k++) {
+        const wb_real at = p->alpha[k] / (h * h);
+        if (isinf(at)) continue;
+        const int32_t nv = p->vstart[k + 1] - p->vstart[k];
+        const wb_real C = volume6(w, k, g) / 6 - p->pressure[k] * p->v0[k];
+        wb_real g2 = 0;
+        for (int32_t i = 0; i < nv; i++) g2 += v3_dot(&g[3 * i], &g[3 * i]) / 36;
+        const wb_real ri = wb__residual(C + at * p->lambda[k], g2, nv);
+        r = ri > r ? ri : r;
+    }
+    return r;
+}
+
 static wb_real pr_energy(const wb_world *w)
 {
     const wb_pressures *p = &w->pr;
@@ -442,4 +459,5 @@ const wb_ctype wb__pressure_type = {
     .image_check = pr_image_check,
     .image_reserve = pr_image_reserve,
     .image_put = pr_image_put,
+    .residual = pr_residual,
 };

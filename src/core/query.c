@@ -1,6 +1,7 @@
 /* query.c: read-only measures of a world: energy, momenta, bounds, strain, hash, stats. */
 #include "ctype.h"
 #include "rigid.h"
+#include "vbd.h"
 
 static wb_real mass_of(const wb_world *w, int32_t i) { return w->m.w[i] > 0 ? 1 / w->m.w[i] : 0; }
 
@@ -160,6 +161,28 @@ uint64_t wb_world_hash(const wb_world *w)
     h = wb__fnv(h, &s->time, sizeof s->time);
     h = wb__fnv(h, &s->frame, sizeof s->frame);
     return h;
+}
+
+wb_real wb__residual_all(const wb_world *w, wb_real h)
+{
+    wb_real r = 0;
+    for (int i = 0; i < wb__nctypes; i++) {
+        const wb_real ri = wb__ctypes[i]->residual ? wb__ctypes[i]->residual(w, h) : 0;
+        r = ri > r ? ri : r;
+    }
+    return r;
+}
+
+/* measured in the step from the first time it is asked for (solver.c); until a step has,
+ * at the positions as they are */
+wb_real wb_world_residual(wb_world *w)
+{
+    wb_cache *k = &w->k;
+    const int was = k->residual_on;
+    k->residual_on = 1;
+    if (was && k->residual >= 0) return k->residual;
+    if (w->m.def.solver == WB_SOLVER_VBD) return wb__vbd_residual(w); /* (its last sweep's) */
+    return k->h_last > 0 ? wb__residual_all(w, k->h_last) : 0;
 }
 
 wb_stats wb_world_stats(const wb_world *w)

@@ -257,6 +257,35 @@ static void sm_frame_end(wb_world *w)
 }
 
 /* U = sum 1/2 m kappa |x - g|^2 over the compliant clusters (rigid ones store none) */
+/* each member's distance from its goal (less what its compliance allows), the goals from
+ * a fit of the positions as they are (from a copy of the cluster's rotation) */
+static wb_real sm_residual(const wb_world *w, wb_real h)
+{
+    const wb_smatch *sm = &w->sm;
+    const wb_real *x = w->s.x, *wv = w->m.w, *im = w->m.inv_mass;
+    wb_real r = 0;
+    for (int32_t k = 0; k < sm->n; k++) {
+        const wb_real s = sm->stiff[k];
+        if (s <= 0) continue;
+        const wb_real kh2 = s >= 1 ? 0 : s / (1 - s) * (h * h) / (H_REF * H_REF);
+        wb_real q[4], c[3], R[9];
+        memcpy(q, &sm->qk[4 * k], sizeof q);
+        fit(w, k, q, c);
+        wb_quat_to_matrix(q, R);
+        for (int32_t j = sm->start[k]; j < sm->start[k + 1]; j++) {
+            const int32_t i = sm->ids[j];
+            if (wv[i] == 0) continue;
+            wb_real g[3], d[3];
+            goal(R, c, &sm->rest[3 * j], g);
+            v3_sub(d, &x[3 * i], g);
+            if (kh2 > 0) v3_madd(d, &sm->lambda[3 * j], im[i] / kh2); /* C = x - g */
+            const wb_real ri = v3_len(d);
+            r = ri > r ? ri : r;
+        }
+    }
+    return r;
+}
+
 static wb_real sm_energy(const wb_world *w)
 {
     const wb_smatch *sm = &w->sm;
@@ -546,4 +575,5 @@ const wb_ctype wb__shape_type = {
     .image_check = sm_image_check,
     .image_reserve = sm_image_reserve,
     .image_put = sm_image_put,
+    .residual = sm_residual,
 };

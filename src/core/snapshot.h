@@ -11,6 +11,7 @@
 #include "distance.h"
 #include "shape_match.h"
 #include "tet.h"
+#include "tether.h"
 #include "volume.h"
 
 /* a collider: its shape in its own frame and its full pose */
@@ -91,6 +92,7 @@ typedef struct wb_image {
     wb_image_pressure pr;  /* shape_match.h: empty unless wb_image_alloc_pressure */
     wb_image_attach att;   /* empty unless wb_image_alloc_attach */
     wb_image_grab grab;    /* empty unless wb_image_alloc_grab */
+    wb_image_tether teth;  /* tether.h: empty unless wb_image_alloc_tethers */
     int32_t nrb;           /* rigid bodies by slot: empty unless wb_image_alloc_rigids */
     wb_image_rigid *rb;    /* (nrb) */
     uint32_t *rb_gen;      /* (nrb) odd = live */

@@ -15,6 +15,7 @@
 #include "ctype.h"
 #include "grab.h"
 #include "rigid.h"
+#include "vbd.h"
 
 static double now_ms(void)
 {
@@ -25,11 +26,20 @@ static double now_ms(void)
 
 /* one pass of every type, `iterations` times: the types run one after the other (Gauss-
  * Seidel between types; inside one, as the type projects: batches or Jacobi) */
-static void solve_constraints(wb_world *w, wb_real h)
+/* the residual after the iterations when it is measured (tolerance, or asked for in
+ * the last substep: measure), else -1 */
+static wb_real solve_constraints(wb_world *w, wb_real h, int measure)
 {
     const int iterations = w->m.def.iterations;
-    for (int it = 0; it < iterations; it++)
+    const wb_real tol = w->m.def.tolerance;
+    wb_real r = -1;
+    for (int it = 0; it < iterations; it++) {
         for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->project(w, h);
+        /* (a pass over every constraint: only when asked for) */
+        if (tol > 0 || (measure && it + 1 == iterations)) r = wb__residual_all(w, h);
+        if (tol > 0 && r <= tol) break;
+    }
+    return r;
 }
 
 static wb_predict predict_of(const wb_world *w, wb_real h)
@@ -411,6 +421,7 @@ wb_status wb_world_step(wb_world *w)
     wb_cache *k = &w->k;
     wb_status prep = WB_OK;
     wb__momentum_prepare(w); /* (first: the types' prepare clears the topology flag it reads) */
+    if (!wb__vbd_prepare(w)) prep = WB_ERR_NOMEM; /* (as well) */
     for (int t = 0; t < wb__nctypes && prep == WB_OK; t++) prep = wb__ctypes[t]->prepare(w);
     if (prep != WB_OK || !save_colliders(w)) {
         wb__warn(w, "frame %lld: out of memory preparing the step; frame skipped", (long long)w->s.frame + 1);
@@ -454,7 +465,9 @@ wb_status wb_world_step(wb_world *w)
         double t0 = now_ms();
         /* TYPE HOOK: the constraint types, walked from the table (wb__ctypes) */
         for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->substep_begin(w);
-        solve_constraints(w, h);
+        const int measure = k->residual_on && sub + 1 == d->substeps;
+        const wb_real r = d->solver == WB_SOLVER_VBD ? wb__vbd_solve(w, h, measure) : solve_constraints(w, h, measure);
+        if (sub + 1 == d->substeps) k->residual = r;
         wb__momentum_restore(w, h);
         solve += now_ms() - t0;
         wb__contacts_project(w, h);

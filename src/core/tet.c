@@ -418,7 +418,8 @@ static wb_status tet_prepare(wb_world *w)
     /* stable up to about 2 (a hanging lattice bar: whole at 2.3, collapsed at 3.2); once per
      * substep length and tet count, not per step */
     wb_neos *v = w->neo;
-    if (r > WAVE_LIMIT && (h != v->warned_h || v->n != v->warned_n)) {
+    /* (VBD's Newton steps are stable at any stiffness: the limit is XPBD's) */
+    if (r > WAVE_LIMIT && w->m.def.solver != WB_SOLVER_VBD && (h != v->warned_h || v->n != v->warned_n)) {
         const wb_real m = corner_mass(w, at);
         const double need = ceil(w->m.def.substeps * r / WAVE_LIMIT);
         v->advised = need < 1e9 ? (int32_t)need : 1000000000;
@@ -847,6 +848,42 @@ static void tet_project(wb_world *w, wb_real h)
     w->k.projections += v->n; /* a tet (both of its constraints) is one projection */
 }
 
+/* both constraints of each coloured tet (as project_scalar forms them) */
+static wb_real tet_residual(const wb_world *w, wb_real h)
+{
+    const wb_neos *v = w->neo;
+    if (!v || v->bt.n <= 0 || !(v->pd_h > 0)) return 0;
+    const wb_real *x = w->s.x, *wv = w->m.w, s2 = (v->pd_h / h) * (v->pd_h / h);
+    wb_real r = 0;
+    for (int32_t j = 0; j < v->bt.n; j++) {
+        const int32_t *p = &v->pk[4 * j];
+        if (wv[p[0]] + wv[p[1]] + wv[p[2]] + wv[p[3]] == 0) continue;
+        const wb_real *dm = &v->pd[PD * j];
+        wb_real F[9], G[9], g[4][3], ic = 0;
+        deformation_of(p, dm, x, F);
+        for (int k = 0; k < 9; k++) ic += F[k] * F[k];
+        const wb_real cd = sqrt(ic);
+        if (cd > (wb_real)1e-12) {
+            for (int k = 0; k < 9; k++) G[k] = F[k] / cd;
+            grads(dm, G, g);
+            const wb_real ones[4] = { 1, 1, 1, 1 }, ri = wb__residual(cd + dm[PD_AD] * s2 * v->ld[j], wdot(ones, g, g), 4);
+            r = ri > r ? ri : r;
+        }
+        const wb_real f0[3] = { F[0], F[3], F[6] }, f1[3] = { F[1], F[4], F[7] }, f2[3] = { F[2], F[5], F[8] };
+        wb_real c[3][3];
+        v3_cross(c[0], f1, f2);
+        v3_cross(c[1], f2, f0);
+        v3_cross(c[2], f0, f1);
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++) G[3 * a + b] = c[b][a];
+        grads(dm, G, g);
+        const wb_real ones[4] = { 1, 1, 1, 1 };
+        const wb_real ri = wb__residual(v3_dot(f0, c[0]) - dm[PD_A] + dm[PD_AH] * s2 * v->lh[j], wdot(ones, g, g), 4);
+        r = ri > r ? ri : r;
+    }
+    return r;
+}
+
 static wb_real tet_energy(const wb_world *w)
 {
     wb_real e = 0;
@@ -907,4 +944,5 @@ const wb_ctype wb__tet_type = {
     .image_check = tet_image_check,
     .image_reserve = tet_image_reserve,
     .image_put = tet_image_put,
+    .residual = tet_residual,
 };

@@ -236,6 +236,32 @@ static void vol_project(wb_world *w, wb_real h)
 }
 
 /* U = C^2 / (2 alpha) for compliant constraints; incompressible ones store none */
+static wb_real vol_residual(const wb_world *w, wb_real h)
+{
+    const wb_volumes *v = w->vol;
+    if (!v || v->bt.n <= 0) return 0;
+    const wb_real *x = w->s.x, *wv = w->m.w, inv_h2 = 1 / (h * h);
+    wb_real r = 0;
+    for (int32_t j = 0; j < v->bt.n; j++) {
+        const int32_t *p = &v->pk[4 * j];
+        const wb_real at = v->pa[2 * j] * inv_h2;
+        if (isinf(at) || wv[p[0]] + wv[p[1]] + wv[p[2]] + wv[p[3]] == 0) continue;
+        wb_real e1[3], e2[3], e3[3], g[4][3];
+        v3_sub(e1, &x[3 * p[1]], &x[3 * p[0]]);
+        v3_sub(e2, &x[3 * p[2]], &x[3 * p[0]]);
+        v3_sub(e3, &x[3 * p[3]], &x[3 * p[0]]);
+        v3_cross(g[1], e2, e3);
+        v3_cross(g[2], e3, e1);
+        v3_cross(g[3], e1, e2);
+        for (int c = 0; c < 3; c++) g[0][c] = -(g[1][c] + g[2][c] + g[3][c]);
+        wb_real g2 = 0;
+        for (int k = 0; k < 4; k++) g2 += v3_dot(g[k], g[k]) / 36;
+        const wb_real ri = wb__residual(v3_dot(e1, g[1]) / 6 - v->pa[2 * j + 1] + at * v->lambda[j], g2, 4);
+        r = ri > r ? ri : r;
+    }
+    return r;
+}
+
 static wb_real vol_energy(const wb_world *w)
 {
     wb_real e = 0;
@@ -395,4 +421,5 @@ const wb_ctype wb__volume_type = {
     .image_check = vol_image_check,
     .image_reserve = vol_image_reserve,
     .image_put = vol_image_put,
+    .residual = vol_residual,
 };

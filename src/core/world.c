@@ -98,10 +98,11 @@ const char *wb_world_def_check(const wb_world_def *d)
     const wb_real h = d->dt / d->substeps;
     if (!(h * h >= h2_min)) return "dt/substeps is too short: h = dt/substeps must be >= 1.5e-154 s (h*h underflows)";
     if (!(d->damping >= 0) || !isfinite(d->damping)) return "damping must be >= 0";
-    if (d->solver != WB_SOLVER_GAUSS_SEIDEL && d->solver != WB_SOLVER_JACOBI) return "unknown solver";
+    if (d->solver != WB_SOLVER_GAUSS_SEIDEL && d->solver != WB_SOLVER_JACOBI && d->solver != WB_SOLVER_VBD) return "unknown solver";
     if (!(d->relaxation > 0 && d->relaxation < 2)) return "relaxation must be in (0, 2)";
     if (d->threads < 1 || d->threads > WB_MAX_THREADS) return "threads must be in 1..256";
     if (!(d->max_depenetration >= 0) || !isfinite(d->max_depenetration)) return "max_depenetration must be finite and >= 0 (m/s)";
+    if (!(d->tolerance >= 0) || !isfinite(d->tolerance)) return "tolerance must be finite and >= 0 (m)";
     return NULL;
 }
 

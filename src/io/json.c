@@ -51,14 +51,14 @@ static int read_defaults(rd *r, const cJSON *it, defaults *d)
            jv_opt_nonneg(r, f[7], &p, "break_force", &d->link.break_force) ? -1 : 0;
 }
 
-static const char *const solver_names[] = { "gauss-seidel", "jacobi" };
+static const char *const solver_names[] = { "gauss-seidel", "jacobi", "vbd" };
 
 /* the "world" settings of a snapshot */
 static int read_world(rd *r, const cJSON *it, const kp *up, wb_world_def *d)
 {
     static const char *const keys[] = { "gravity", "dt", "substeps", "iterations", "damping", "solver", "relaxation", "threads",
-                                        "contacts", "max_depenetration", NULL };
-    const cJSON *f[11];
+                                        "contacts", "max_depenetration", "tolerance", NULL };
+    const cJSON *f[12];
     kp p = { up, "world", 0 };
     int64_t i;
     if (jv_get_object(r, it, &p, keys, f)) return -1;
@@ -70,9 +70,10 @@ static int read_world(rd *r, const cJSON *it, const kp *up, wb_world_def *d)
         kp q = { &p, "solver", 0 };
         const char *s = "";
         if (jv_get_string(r, f[5], &q, &s)) return -1;
-        if (strcmp(s, solver_names[0]) && strcmp(s, solver_names[1]))
-            return jv_fail(r, f[5], 0, &q, "unknown solver '%s' (expected gauss-seidel or jacobi)", s);
-        d->solver = strcmp(s, solver_names[0]) ? WB_SOLVER_JACOBI : WB_SOLVER_GAUSS_SEIDEL;
+        int k = 0;
+        while (k < 3 && strcmp(s, solver_names[k])) k++;
+        if (k == 3) return jv_fail(r, f[5], 0, &q, "unknown solver '%s' (expected gauss-seidel, jacobi or vbd)", s);
+        d->solver = (wb_solver)k;
     }
     if (jv_opt_real(r, f[6], &p, "relaxation", &d->relaxation)) return -1;
     if (f[7]) { if (jv_opt_int(r, f[7], &p, "threads", 1, WB_MAX_THREADS, &i)) return -1; d->threads = (int)i; }
@@ -81,6 +82,7 @@ static int read_world(rd *r, const cJSON *it, const kp *up, wb_world_def *d)
         if (jv_get_bool(r, f[8], &q, &d->contacts)) return -1;
     }
     if (jv_opt_real(r, f[9], &p, "max_depenetration", &d->max_depenetration)) return -1;
+    if (jv_opt_real(r, f[10], &p, "tolerance", &d->tolerance)) return -1;
     const char *e = wb_world_def_check(d);
     return e ? jv_fail(r, it, 0, &p, "%s", e) : 0;
 }
@@ -383,20 +385,8 @@ static int read_volumes(rd *r, const cJSON *arr, wb_image *g)
         kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
         if (jv_get_object(r, c, &p, keys, f)) return -1;
         if (!f[0]) return jv_missing(r, c, &p, "particles");
-        int32_t n;
-        if (jv_get_array(r, f[0], &pp, 16, &n)) return -1;
-        if (n != 4) return jv_fail(r, f[0], 0, &pp, "a volume constraint joins 4 particles, got %d", n);
         int32_t *ijkl = &g->vol.ijkl[4 * i];
-        int k = 0;
-        for (const cJSON *e = f[0]->child; e; e = e->next, k++) {
-            kp q = { &pp, NULL, k };
-            int64_t v;
-            if (g->np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
-            if (jv_get_int(r, e, &q, 0, g->np - 1, &v)) return -1;
-            ijkl[k] = (int32_t)v;
-            for (int j = 0; j < k; j++)
-                if (ijkl[j] == ijkl[k]) return jv_fail(r, f[0], 0, &pp, "a volume constraint needs four distinct particles");
-        }
+        if (jv_get_corners(r, f[0], &pp, g->np, 4, "a volume constraint", ijkl)) return -1;
         const wb_real *x = g->x;
         g->vol.rest[i] = wb_tet_signed_volume(&x[3 * ijkl[0]], &x[3 * ijkl[1]], &x[3 * ijkl[2]], &x[3 * ijkl[3]]);
         g->vol.alpha[i] = 0;
@@ -428,6 +418,50 @@ static void write_volumes(jw_out *o, const wb_image *g)
     fputs("\n  ],\n", f);
 }
 
+/* "tethers": [ {"particles": [p, q], "length": l, "compliance": alpha}, ... ]: long-range
+ * attachments (length: the particles' distance by default; compliance 0 by default) */
+static int read_tethers(rd *r, const cJSON *arr, wb_image *g)
+{
+    static const char *const keys[] = { "particles", "length", "compliance", NULL };
+    kp top = { NULL, "tethers", 0 };
+    int32_t i = 0, n;
+    if (!arr) return 0;
+    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
+    if (wb_image_alloc_tethers(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
+    for (const cJSON *c = arr->child; c; c = c->next, i++) {
+        const cJSON *f[3];
+        kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
+        if (jv_get_object(r, c, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, c, &p, "particles");
+        int32_t *ij = &g->teth.ij[2 * i];
+        if (jv_get_corners(r, f[0], &pp, g->np, 2, "a tether", ij)) return -1;
+        const wb_real *x = g->x;
+        wb_real d[3];
+        v3_sub(d, &x[3 * ij[0]], &x[3 * ij[1]]);
+        g->teth.len[i] = v3_len(d);
+        g->teth.alpha[i] = 0;
+        if (jv_opt_nonneg(r, f[1], &p, "length", &g->teth.len[i]) || jv_opt_nonneg(r, f[2], &p, "compliance", &g->teth.alpha[i]))
+            return -1;
+    }
+    return 0;
+}
+
+/* "tethers" (only when there are any) */
+static void write_tethers(jw_out *o, const wb_image *g)
+{
+    FILE *f = o->f;
+    if (g->teth.n == 0) return;
+    fputs("  \"tethers\": [", f);
+    for (int32_t i = 0; i < g->teth.n; i++) {
+        fprintf(f, "%s    {\"particles\": [%d, %d], \"length\": ", i ? ",\n" : "\n", g->teth.ij[2 * i], g->teth.ij[2 * i + 1]);
+        jw_num(o, g->teth.len[i]);
+        fputs(", \"compliance\": ", f);
+        jw_num(o, g->teth.alpha[i]);
+        fputc('}', f);
+    }
+    fputs("\n  ],\n", f);
+}
+
 /* the constraint types with a section of their own (json.h), in the order w:save writes
  * them; each reads and writes its own */
 const jtype jtypes[] = {
@@ -437,6 +471,7 @@ const jtype jtypes[] = {
     { "pressures", jm_read_pressures, jm_write_pressures },
     { "attachments", ja_read_attachments, ja_write_attachments },
     { "grabs", ja_read_grabs, ja_write_grabs },
+    { "tethers", read_tethers, write_tethers },
 };
 const int njtypes = (int)(sizeof jtypes / sizeof jtypes[0]);
 
@@ -737,8 +772,9 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
 {
     static const char *const keys[] = { "format", "version", "description", "defaults", "particles", "constraints",
                                         "colliders", "surfaces", "parts", "skins", "snapshot", "volumes",
-                                        "shape_matches", "pressures", "tets", "attachments", "grabs", "rigids", NULL };
-    const cJSON *f[19];
+                                        "shape_matches", "pressures", "tets", "attachments", "grabs", "rigids", "tethers",
+                                        NULL };
+    const cJSON *f[20];
     sections s;
     defaults d;
     memset(&s, 0, sizeof s);

@@ -64,6 +64,9 @@ int jv_get_bool(rd *r, const cJSON *it, const kp *p, bool *out);
 int jv_get_string(rd *r, const cJSON *it, const kp *p, const char **out);
 int jv_get_array(rd *r, const cJSON *it, const kp *p, int64_t max, int32_t *count);
 int jv_get_vec(rd *r, const cJSON *it, const kp *p, int n, wb_real *out); /* exactly n numbers */
+/* an element's "particles": exactly k (2 or 4) distinct indices of the np particles, into
+ * out; `what` names the element in the messages ("a tet") */
+int jv_get_corners(rd *r, const cJSON *it, const kp *p, int32_t np, int k, const char *what, int32_t *out);
 /* an object whose keys are all in `keys` (NULL-terminated), none twice: found[i] = value */
 int jv_get_object(rd *r, const cJSON *obj, const kp *p, const char *const keys[], const cJSON **found);
 

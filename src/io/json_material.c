@@ -145,20 +145,8 @@ int jm_read_tets(rd *r, const cJSON *arr, wb_image *g)
         if (jv_get_object(r, c, &p, keys, f)) return -1;
         if (!f[0]) return jv_missing(r, c, &p, "particles");
         if (!f[1]) return jv_missing(r, c, &p, "young");
-        int32_t m;
-        if (jv_get_array(r, f[0], &pp, 16, &m)) return -1;
-        if (m != 4) return jv_fail(r, f[0], 0, &pp, "a tet joins 4 particles, got %d", m);
         int32_t *q4 = &g->tet.ijkl[4 * i];
-        int k = 0;
-        for (const cJSON *e = f[0]->child; e; e = e->next, k++) {
-            kp q = { &pp, NULL, k };
-            int64_t v;
-            if (g->np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
-            if (jv_get_int(r, e, &q, 0, g->np - 1, &v)) return -1;
-            q4[k] = (int32_t)v;
-            for (int j = 0; j < k; j++)
-                if (q4[j] == q4[k]) return jv_fail(r, f[0], 0, &pp, "a tet needs four distinct particles");
-        }
+        if (jv_get_corners(r, f[0], &pp, g->np, 4, "a tet", q4)) return -1;
         wb_real y = 0, nu = 0.3;
         if (jv_opt_real(r, f[1], &p, "young", &y) || jv_opt_real(r, f[2], &p, "poisson", &nu)) return -1;
         kp yq = { &p, "young", 0 }, nq = { &p, "poisson", 0 };

@@ -219,6 +219,24 @@ int jv_get_array(rd *r, const cJSON *it, const kp *p, int64_t max, int32_t *coun
     return 0;
 }
 
+int jv_get_corners(rd *r, const cJSON *it, const kp *p, int32_t np, int k, const char *what, int32_t *out)
+{
+    int32_t n;
+    if (jv_get_array(r, it, p, 16, &n)) return -1;
+    if (n != k) return jv_fail(r, it, 0, p, "%s joins %d particles, got %d", what, k, n);
+    int c = 0;
+    for (const cJSON *e = it->child; e; e = e->next, c++) {
+        kp q = { p, NULL, c };
+        int64_t v;
+        if (np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
+        if (jv_get_int(r, e, &q, 0, np - 1, &v)) return -1;
+        out[c] = (int32_t)v;
+        for (int j = 0; j < c; j++)
+            if (out[j] == out[c]) return jv_fail(r, it, 0, p, "%s needs %s distinct particles", what, k == 2 ? "two" : "four");
+    }
+    return 0;
+}
+
 /* an array of exactly n finite numbers */
 int jv_get_vec(rd *r, const cJSON *it, const kp *p, int n, wb_real *out)
 {

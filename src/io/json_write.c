@@ -33,10 +33,14 @@ static void write_snapshot(jw_out *o, const wb_image *g)
     jw_num(o, d->dt);
     fprintf(f, ", \"substeps\": %d, \"iterations\": %d, \"damping\": ", d->substeps, d->iterations);
     jw_num(o, d->damping);
-    fprintf(f, ", \"solver\": \"%s\", \"relaxation\": ", d->solver == WB_SOLVER_JACOBI ? "jacobi" : "gauss-seidel");
+    fprintf(f, ", \"solver\": \"%s\", \"relaxation\": ", d->solver == WB_SOLVER_VBD ? "vbd" : d->solver == WB_SOLVER_JACOBI ? "jacobi" : "gauss-seidel");
     jw_num(o, d->relaxation);
     fprintf(f, ", \"threads\": %d, \"contacts\": %s, \"max_depenetration\": ", d->threads, d->contacts ? "true" : "false");
     jw_num(o, d->max_depenetration);
+    if (d->tolerance > 0) { /* (left out when off: files of worlds without it as they were) */
+        fputs(", \"tolerance\": ", f);
+        jw_num(o, d->tolerance);
+    }
     fputs("},\n    \"time\": ", f);
     jw_num(o, g->time);
     fprintf(f, ", \"frame\": %lld, \"warnings\": %lld, \"last_warning\": ", (long long)g->frame, (long long)g->warnings);

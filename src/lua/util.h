@@ -38,6 +38,7 @@ void wbl_open_shape_match(lua_State *L); /* shape_match.c: w:shape_match and its
 void wbl_open_pressure(lua_State *L);  /* pressure.c: w:pressure and its handle */
 void wbl_open_attach(lua_State *L);    /* attach.c: w:attach, w:grab and their handles */
 void wbl_open_rigid(lua_State *L);     /* rigid.c: w:rigid and its handle */
+void wbl_open_tether(lua_State *L);    /* tether.c: w:tether, body:tether_to_pins (after body.c) */
 int wbl_world_new(lua_State *L);       /* wobble.world{...} */
 /* add methods to the world's method table (used by the per-type files) */
 void wbl_add_world_methods(lua_State *L, const luaL_Reg *l);

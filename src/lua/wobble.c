@@ -23,6 +23,7 @@ int luaopen_wobble(lua_State *L)
     wbl_open_pressure(L);
     wbl_open_attach(L);
     wbl_open_rigid(L);
+    wbl_open_tether(L);
 
     luaL_newlib(L, wobble_funcs);
     wbl_open_mesh(L);       /* wobble.mesh, wobble.load_mesh; w:from_mesh */

@@ -9,14 +9,14 @@
 #include "util.h"
 #include "render/render.h"
 
-static const char *const solver_names[] = { "gauss-seidel", "jacobi", NULL };
+static const char *const solver_names[] = { "gauss-seidel", "jacobi", "vbd", NULL };
 
 #define toworld(L) wbl_checkworld(L, 1)
 
 /* ---- settings --------------------------------------------------------------------- */
 static const char *const world_keys[] = {
     "gravity", "dt", "substeps", "iterations", "damping", "solver", "relaxation", "threads", "contacts",
-    "max_depenetration", NULL
+    "max_depenetration", "tolerance", NULL
 };
 
 /* read the settings table at arg over *d; the core's check gives the ranges */
@@ -33,6 +33,7 @@ static void read_world_def(lua_State *L, int arg, wb_world_def *d)
     wbl_optint(L, arg, "threads", INT32_MIN, INT32_MAX, &d->threads);
     wbl_optbool(L, arg, "contacts", &d->contacts);
     wbl_optreal(L, arg, "max_depenetration", &d->max_depenetration);
+    wbl_optreal(L, arg, "tolerance", &d->tolerance);
 }
 
 /* check *d and apply it: errors blame argument `arg` */
@@ -116,6 +117,7 @@ static int w_gravity(lua_State *L)
 REAL_SETTING(dt)
 REAL_SETTING(damping)
 REAL_SETTING(relaxation)
+REAL_SETTING(tolerance)
 INT_SETTING(substeps)
 INT_SETTING(iterations)
 INT_SETTING(threads)
@@ -132,7 +134,7 @@ static int w_set_solver(lua_State *L)
 static int w_solver(lua_State *L)
 {
     wb_world_def d = wb_world_get_def(toworld(L));
-    lua_pushstring(L, solver_names[d.solver == WB_SOLVER_JACOBI]);
+    lua_pushstring(L, solver_names[d.solver]);
     return 1;
 }
 
@@ -434,6 +436,18 @@ static int w_set_self_collide(lua_State *L)
     return 0;
 }
 
+/* the stats table's residual, worked out when read (a pass over every constraint: a
+ * script reading the step's time every frame does not pay for it) */
+static int stats_index(lua_State *L)
+{
+    const char *k = lua_tostring(L, 2);
+    if (k && !strcmp(k, "residual")) {
+        lua_pushnumber(L, (lua_Number)wb_world_residual(wbl_checkworld(L, lua_upvalueindex(1))));
+        return 1;
+    }
+    return 0;
+}
+
 static int w_stats(lua_State *L)
 {
     wb_world *w = toworld(L);
@@ -458,6 +472,7 @@ static int w_stats(lua_State *L)
     SETI("particle_contacts", s.particle_contacts);
     SETI("rigids", s.rigids);
     SETI("rigid_contacts", s.rigid_contacts);
+    SETI("tethers", s.tethers);
     SETN("broad_ms", s.broad_ms);
     SETN("broad_remakes", s.broad_remakes);
     SETI("projections", s.projections);
@@ -468,8 +483,13 @@ static int w_stats(lua_State *L)
     SETI("iterations", d.iterations);
     SETI("threads", d.threads);
     SETN("dt", d.dt);
-    lua_pushstring(L, solver_names[d.solver == WB_SOLVER_JACOBI]);
+    lua_pushstring(L, solver_names[d.solver]);
     lua_setfield(L, -2, "solver");
+    lua_createtable(L, 0, 1);
+    lua_pushvalue(L, 1);
+    lua_pushcclosure(L, stats_index, 1);
+    lua_setfield(L, -2, "__index");
+    lua_setmetatable(L, -2);
 #undef SETI
 #undef SETN
     return 1;
@@ -611,6 +631,8 @@ static const luaL_Reg world_methods[] = {
     { "set_gravity", w_set_gravity },
     { "dt", w_dt },
     { "set_dt", w_set_dt },
+    { "tolerance", w_tolerance },
+    { "set_tolerance", w_set_tolerance },
     { "substeps", w_substeps },
     { "set_substeps", w_set_substeps },
     { "iterations", w_iterations },

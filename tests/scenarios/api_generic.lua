@@ -51,8 +51,8 @@ local function plus(t, extra) local r = {} for _, v in ipairs(t) do r[#r + 1] = 
 local CASES = {
   -- ---- wobble.*
   ["wobble.world"] = { opts = { gravity = {0, -9.81, 0}, dt = 1 / 60, substeps = 2, iterations = 1, damping = 0,
-                                relaxation = 1, threads = 1, contacts = true },
-                       nums = { "gravity", "dt", "substeps", "iterations", "damping", "relaxation", "threads" },
+                                relaxation = 1, threads = 1, contacts = true, tolerance = 0 },
+                       nums = { "gravity", "dt", "substeps", "iterations", "damping", "relaxation", "threads", "tolerance" },
                        call = function(_, o) return wobble.world(o) end },
   ["wobble.renderer"] = { opts = { width = 8, height = 8, samples = 1, backend = "null" },
                           nums = { "width", "height", "samples" },
@@ -155,6 +155,7 @@ local CASES = {
   ["world:group"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.w:group(...) end },
   ["world:set_self_collide"] = { args = { 1, true }, nums = { 1 }, call = function(f, ...) return f.w:set_self_collide(...) end },
   ["world:set_dt"] = { args = { 0.01 }, nums = { 1 }, call = function(f, ...) return f.w:set_dt(...) end },
+  ["world:set_tolerance"] = { args = { 1e-4 }, nums = { 1 }, call = function(f, ...) return f.w:set_tolerance(...) end },
   ["world:set_substeps"] = { args = { 2 }, nums = { 1 }, call = function(f, ...) return f.w:set_substeps(...) end },
   ["world:set_iterations"] = { args = { 2 }, nums = { 1 }, call = function(f, ...) return f.w:set_iterations(...) end },
   ["world:set_damping"] = { args = { 0 }, nums = { 1 }, call = function(f, ...) return f.w:set_damping(...) end },
@@ -170,6 +171,13 @@ local CASES = {
                        call = function(f, o) local b = f.body.first
                          return f.w:volume(b, b + 1, b + 2, b + 4, o) end },
   ["world:volume_info"] = { args = { 1 }, nums = { 1 }, call = function(f, ...) return f.w:volume_info(...) end },
+  -- tethers (lua/tether.c): tethers.lua
+  ["world:tether"] = { opts = { length = 1, compliance = 0 }, opts_arg = 4, nums = { "length", "compliance" },
+                       call = function(f, o) local b = f.body.first return f.w:tether(b, b + 1, o) end },
+  ["world:tether_info"] = { args = { 1 }, nums = { 1 }, call = function(f, ...)
+                              if f.w:tether_count() == 0 then f.w:tether(f.body.first, f.body.first + 1) end
+                              return f.w:tether_info(...) end },
+  ["world:tether_count"] = { none = "a getter: no arguments" },
   ["world:load_tets"] = { opts = link{ mass = 1, radius = 0.02, volume_compliance = 0 }, opts_arg = 2,
                           nums = plus(link_nums, { "mass", "radius", "volume_compliance", "friction" }),
                           call = function(f, o) assert(f.w:save_tets("api_generic/tets", f.body))
@@ -189,7 +197,8 @@ local CASES = {
 }
 for _, name in ipairs{ "angular_momentum", "bend_breaks", "bends", "bounds", "breaks", "closed", "colliders", "contacts", "damping", "distances", "dt",
                        "energy", "frame", "gravity", "hash", "iterations", "max_strain", "momentum", "particle_count",
-                       "relaxation", "rigid_contacts", "rigids", "skins", "solver", "stats", "step", "substeps", "threads", "time", "warnings" } do
+                       "relaxation", "rigid_contacts", "rigids", "skins", "solver", "stats", "step", "substeps", "threads", "time", "tolerance",
+                       "warnings" } do
   CASES["world:" .. name] = { none = "a getter or step: no arguments" }
 end
 
@@ -253,6 +262,8 @@ end
 CASES["body:pin_where"] = { none = "a predicate function" }
 CASES["body:pin_all"] = { none = "no arguments" }
 CASES["body:unpin_all"] = { none = "no arguments" }
+CASES["body:tether_to_pins"] = { opts = { compliance = 0 }, opts_arg = 2, nums = { "compliance" },
+                                 call = function(f, o) return f.body:tether_to_pins(o) end }
 
 -- ---- meshes and skins
 CASES["mesh:transform"] = { opts = { scale = 2, translate = {0, 1, 0} }, nums = { "scale", "translate" },
