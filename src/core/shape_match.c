@@ -182,6 +182,10 @@ static void sm_substep_begin(wb_world *w)
     }
 }
 
+/* kappa h^2 of a cluster of stiffness s (0 for a rigid one, s >= 1): the XPBD spring per
+ * particle that removes the fraction s of the distance to the goal per H_REF */
+static wb_real kappa_h2(wb_real s, wb_real h) { return s >= 1 ? 0 : s / (1 - s) * (h * h) / (H_REF * H_REF); }
+
 static void sm_project(wb_world *w, wb_real h)
 {
     wb_smatch *sm = &w->sm;
@@ -192,7 +196,7 @@ static void sm_project(wb_world *w, wb_real h)
         const wb_real s = sm->stiff[k];
         if (s <= 0) continue;
         const int hard = s >= 1;
-        const wb_real kh2 = hard ? 0 : s / (1 - s) * (h * h) / (H_REF * H_REF); /* kappa h^2 */
+        const wb_real kh2 = kappa_h2(s, h);
         wb_real c[3], R[9], *q = &sm->qk[4 * k];
         fit(w, k, q, c);
         wb_quat_to_matrix(q, R);
@@ -267,7 +271,7 @@ static wb_real sm_residual(const wb_world *w, wb_real h)
     for (int32_t k = 0; k < sm->n; k++) {
         const wb_real s = sm->stiff[k];
         if (s <= 0) continue;
-        const wb_real kh2 = s >= 1 ? 0 : s / (1 - s) * (h * h) / (H_REF * H_REF);
+        const wb_real kh2 = kappa_h2(s, h);
         wb_real q[4], c[3], R[9];
         memcpy(q, &sm->qk[4 * k], sizeof q);
         fit(w, k, q, c);

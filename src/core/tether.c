@@ -217,7 +217,7 @@ static wb_real teth_energy(const wb_world *w)
     return e;
 }
 
-/* its two particles never touch (DESIGN.md §2: joined by a constraint) */
+/* its two particles never touch (joined by a constraint: docs/physics.md, "Contacts") */
 static void teth_links(const wb_world *w, wb_link_fn fn, void *ud)
 {
     for (int32_t i = 0; w->teth && i < w->teth->n; i++) fn(ud, w->teth->ij[2 * i], w->teth->ij[2 * i + 1], 1);

@@ -1,5 +1,5 @@
 /* vbd.c: Vertex Block Descent (Chen, Liu, Yang, Yuksel, "Vertex Block Descent", SIGGRAPH
- * 2024), the solver = "vbd" of DESIGN.md §2.
+ * 2024), the solver = "vbd" (docs/physics.md, "VBD").
  *
  * Each substep minimises the implicit-Euler energy
  *     sum_i m_i / (2 h^2) |x_i - y_i|^2 + sum_c E_c(x)
