@@ -221,7 +221,7 @@ int jv_get_array(rd *r, const cJSON *it, const kp *p, int64_t max, int32_t *coun
 
 int jv_get_corners(rd *r, const cJSON *it, const kp *p, int32_t np, int k, const char *what, int32_t *out)
 {
-    int32_t n;
+    int32_t n = 0;
     if (jv_get_array(r, it, p, 16, &n)) return -1;
     if (n != k) return jv_fail(r, it, 0, p, "%s joins %d particles, got %d", what, k, n);
     int c = 0;
