@@ -47,21 +47,17 @@ struct wb_vbd {
 };
 
 #define VBD_COLOURS 64
-#define VBD_WARM ((wb_real)0.99)     /* what a substep keeps of the last one's lambda and k */
-#ifndef VBD_RAMP
-#define VBD_RAMP ((wb_real)1e3)      /* k grows by k0 for each 1/VBD_RAMP of the rest length off */
-#endif
-#ifndef VBD_ETA
-#define VBD_ETA 1
-#endif
+/* A hard link's multiplier lambda is kept whole from substep to substep (decayed, a chain
+ * at rest kept a stretch of its decay over its penalty); its penalty k decays by VBD_WARM
+ * a substep down to k0 (the inertia of its ends: start_penalty), grows by k0 for each
+ * 1/VBD_RAMP of its rest length it is off after a sweep, up to VBD_KMAX k0. lambda grows
+ * by k0 C, not k C: with k's growth in it, a 100-link chain's multipliers overshot and it
+ * blew up. Of the error a link begins the substep with it keeps VBD_STAB (AVBD's
+ * stabilisation: the rest is corrected, without it the correction was all speed) */
+#define VBD_WARM ((wb_real)0.99)
+#define VBD_RAMP ((wb_real)1e3)
 #define VBD_KMAX ((wb_real)1e6)
-#ifndef VBD_KMIN
-#define VBD_KMIN 1
-#endif
-#ifndef VBD_LAMW
-#define VBD_LAMW 1
-#endif
-#define VBD_STAB ((wb_real)0.99)   /* of a hard link's error at the substep's start, what it keeps */
+#define VBD_STAB ((wb_real)0.99)
 
 void wb__vbd_destroy(wb_world *w)
 {
@@ -372,8 +368,7 @@ static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2)
         v3_sub(d, &xp[3 * m->d_ij[2 * s]], &xp[3 * m->d_ij[2 * s + 1]]);
         v->c0[s] = v3_len(d) - w->s.d_rest[s];
         const wb_real k0 = start_penalty(w, s, inv_h2);
-        v->lam[s] *= VBD_LAMW;
-        v->kpen[s] = v->kpen[s] * VBD_WARM > VBD_KMIN * k0 ? v->kpen[s] * VBD_WARM : VBD_KMIN * k0;
+        v->kpen[s] = v->kpen[s] * VBD_WARM > k0 ? v->kpen[s] * VBD_WARM : k0;
     }
 }
 
@@ -387,7 +382,7 @@ static void dual_update(wb_world *w, struct wb_vbd *v, wb_real inv_h2)
         wb_real d[3];
         v3_sub(d, &x[3 * a], &x[3 * b]);
         const wb_real L = w->s.d_rest[s], C = v3_len(d) - L - VBD_STAB * v->c0[s], k0 = start_penalty(w, s, inv_h2);
-        v->lam[s] += VBD_ETA * k0 * C;
+        v->lam[s] += k0 * C;
         const wb_real k = v->kpen[s] + k0 * VBD_RAMP * fabs(C) / (L > 0 ? L : 1);
         v->kpen[s] = k < VBD_KMAX * k0 ? k : VBD_KMAX * k0;
     }
