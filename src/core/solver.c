@@ -466,7 +466,7 @@ wb_status wb_world_step(wb_world *w)
         /* TYPE HOOK: the constraint types, walked from the table (wb__ctypes) */
         for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->substep_begin(w);
         const int measure = k->residual_on && sub + 1 == d->substeps;
-        const wb_real r = d->solver == WB_SOLVER_VBD ? wb__vbd_solve(w, h, measure) : solve_constraints(w, h, measure);
+        const wb_real r = d->solver == WB_SOLVER_VBD ? wb__vbd_solve(w, h) : solve_constraints(w, h, measure);
         if (sub + 1 == d->substeps) k->residual = r;
         wb__momentum_restore(w, h);
         solve += now_ms() - t0;

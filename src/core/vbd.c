@@ -410,9 +410,8 @@ static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h)
     }
 }
 
-wb_real wb__vbd_solve(wb_world *w, wb_real h, int measure)
+wb_real wb__vbd_solve(wb_world *w, wb_real h)
 {
-    (void)measure; /* (the sweeps measure their steps anyway) */
     struct wb_vbd *v = w->vbd;
     if (!v || v->np != w->m.np) return -1; /* (prepare failed: out of memory, warned there) */
     const wb_real inv_h2 = 1 / (h * h);

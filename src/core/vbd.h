@@ -6,7 +6,7 @@
 /* `iterations` sweeps of per-vertex Newton steps over the types it serves (the others
  * are projected as in XPBD after each sweep; fewer once the last sweep's largest step is
  * at most the tolerance); returns that step, the residual (m), or -1 */
-wb_real wb__vbd_solve(wb_world *w, wb_real h, int measure);
+wb_real wb__vbd_solve(wb_world *w, wb_real h);
 /* the types the solver minimises as energies itself */
 int wb__vbd_serves(const wb_ctype *t);
 /* once per step before the types' prepare: the adjacency and colouring when the topology
