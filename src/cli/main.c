@@ -70,6 +70,7 @@ static const char usage_text[] =
     "                      run --out DIR writes DIR/result.json (wobble collect)\n"
     "  --set key=value     wobble.args.key = value (numbers, true/false converted); repeatable\n"
     "  --threads N         default thread count of new worlds, 1 to 256 (default 1)\n"
+    "                      ($WOBBLE_SOLVER=vbd: the solver of new worlds that name none)\n"
     "  --unsafe            no sandbox: any path, os.execute, io.popen, C modules, debug\n"
     "  --quiet             no progress bar\n"
     "  --time-limit S      stop after S seconds of wall time (exit code 3)\n"
@@ -137,6 +138,14 @@ static int parse_opts(int argc, char **argv, const char *cmd, opts *o) {
     o->sets = calloc((size_t)argc + 2, sizeof *o->sets);  /* + bench's json and frames */
     o->pos = calloc((size_t)argc, sizeof *o->pos);
     if (!o->sets || !o->pos) return usage_error("%s", "out of memory");
+    /* the solver of worlds that name none: the suite runs the validation tests under VBD */
+    const char *solver = getenv("WOBBLE_SOLVER");
+    if (solver && *solver) {
+        static const char *const names[] = { "gauss-seidel", "jacobi", "vbd" };
+        for (int k = 0; k < 3 && !o->rt.solver; k++)
+            if (!strcmp(solver, names[k])) o->rt.solver = k + 1;
+        if (!o->rt.solver) return usage_error("WOBBLE_SOLVER must be gauss-seidel, jacobi or vbd, got '%s'", solver);
+    }
     int only_pos = 0;
     for (int i = 2; i < argc; i++) {
         char *a = argv[i], name[64];

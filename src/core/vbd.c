@@ -42,7 +42,10 @@ struct wb_vbd {
     wb_real *lam, *kpen;   /* (nd) a hard link's multiplier and penalty */
     wb_real *c0;           /* (nd) a hard link's error at the substep's start, which it keeps
                               but for 1 - VBD_STAB (AVBD's stabilisation) */
+    wb_real *fhard;        /* (nd) a hard link's force in the last sweep, lambda + k C (N) */
     int32_t cap_lam;
+    wb_real *blam, *bkpen; /* (nb, by slot) a hard bend's multiplier and penalty */
+    int32_t cap_blam;
     wb_real residual;      /* the last sweep's largest step, m */
 };
 
@@ -76,6 +79,9 @@ void wb__vbd_destroy(wb_world *w)
     free(v->lam);
     free(v->kpen);
     free(v->c0);
+    free(v->fhard);
+    free(v->blam);
+    free(v->bkpen);
     free(v);
     w->vbd = NULL;
 }
@@ -213,13 +219,25 @@ int wb__vbd_prepare(wb_world *w)
             wb_real *lam = realloc(v->lam, sizeof *lam * (size_t)m->nd), *kp = realloc(v->kpen, sizeof *kp * (size_t)m->nd);
             if (lam) v->lam = lam;
             if (kp) v->kpen = kp;
-            wb_real *c0 = realloc(v->c0, sizeof *c0 * (size_t)m->nd);
+            wb_real *c0 = realloc(v->c0, sizeof *c0 * (size_t)m->nd), *fh = realloc(v->fhard, sizeof *fh * (size_t)m->nd);
             if (c0) v->c0 = c0;
-            if (!lam || !kp || !c0) return 0;
+            if (fh) v->fhard = fh;
+            if (!lam || !kp || !c0 || !fh) return 0;
+            memset(v->fhard + v->cap_lam, 0, sizeof *fh * (size_t)(m->nd - v->cap_lam));
             /* new slots start with no multiplier and no penalty (set at their first use) */
             memset(v->lam + v->cap_lam, 0, sizeof *lam * (size_t)(m->nd - v->cap_lam));
             memset(v->kpen + v->cap_lam, 0, sizeof *kp * (size_t)(m->nd - v->cap_lam));
             v->cap_lam = m->nd;
+        }
+        if (w->bend.n > v->cap_blam) {
+            const size_t n = (size_t)w->bend.n;
+            wb_real *bl = realloc(v->blam, sizeof *bl * n), *bk = realloc(v->bkpen, sizeof *bk * n);
+            if (bl) v->blam = bl;
+            if (bk) v->bkpen = bk;
+            if (!bl || !bk) return 0;
+            memset(v->blam + v->cap_blam, 0, sizeof *bl * (n - (size_t)v->cap_blam));
+            memset(v->bkpen + v->cap_blam, 0, sizeof *bk * (n - (size_t)v->cap_blam));
+            v->cap_blam = w->bend.n;
         }
         v->np = m->np;
         v->nd = m->nd;
@@ -247,7 +265,7 @@ static int solve3(const wb_real H[6], const wb_real f[3], wb_real d[3])
 typedef struct sweep_job {
     wb_world *w;
     struct wb_vbd *v;
-    wb_real inv_h2;
+    wb_real inv_h2, inv_h;
     const int32_t *vert;   /* the colour's vertices */
     wb_real step;          /* the largest step taken (max_into) */
 } sweep_job;
@@ -256,7 +274,7 @@ typedef struct sweep_job {
  * C^2 / (2 alpha); a hard one's k C^2 / 2 + lambda C. The Hessian's part across n, the
  * force over l, is kept only while it pulls (a pushed link's is indefinite: left out, as
  * VBD does) */
-static void link_block(const wb_world *w, const struct wb_vbd *v, int32_t s, int32_t i, wb_real f[3], wb_real H[6])
+static void link_block(const wb_world *w, const struct wb_vbd *v, int32_t s, int32_t i, wb_real inv_h, wb_real f[3], wb_real H[6])
 {
     const wb_model *m = &w->m;
     const int32_t j = other_end(m, s, i);
@@ -269,7 +287,19 @@ static void link_block(const wb_world *w, const struct wb_vbd *v, int32_t s, int
     const wb_real alpha = m->d_alpha[s], C = l - w->s.d_rest[s] - (alpha > 0 ? 0 : VBD_STAB * v->c0[s]);
     const wb_real k = alpha > 0 ? 1 / alpha : v->kpen[s], fm = alpha > 0 ? k * C : k * C + v->lam[s];
     v3_madd(f, n, -fm);
-    const wb_real g = fm > 0 ? fm / l : 0, kn = k - g;
+    wb_real g = fm > 0 ? fm / l : 0, kn = k - g;
+    /* a soft link's damping beta (N s/m) on the speed it stretches at over the substep,
+     * as XPBD's (a hard link has none there either); its block is beta / h n n^T */
+    const wb_real beta = m->d_beta[s];
+    if (alpha > 0 && beta > 0) {
+        const wb_real *xp = w->s.x_prev;
+        wb_real u[3];
+        v3_sub(u, &x[3 * i], &xp[3 * i]);
+        v3_sub(u, u, &x[3 * j]);
+        v3_add(u, u, &xp[3 * j]);
+        v3_madd(f, n, -beta * v3_dot(n, u) * inv_h);
+        kn += beta * inv_h;
+    }
     H[0] += kn * n[0] * n[0] + g, H[1] += kn * n[1] * n[1] + g, H[2] += kn * n[2] * n[2] + g;
     H[3] += kn * n[0] * n[1], H[4] += kn * n[0] * n[2], H[5] += kn * n[1] * n[2];
 }
@@ -306,17 +336,31 @@ static void tet_block(const wb_world *w, int32_t q, wb_real f[3], wb_real H[6])
     H[3] += kh * g[0] * g[1], H[4] += kh * g[0] * g[2], H[5] += kh * g[1] * g[2];
 }
 
-/* a bend's energy off / (2 alpha) on corner k: Gauss-Newton, k g g^T (a rigid one, alpha
- * 0, as a penalty of VBD_KBEND: no multiplier for bends yet) */
-#define VBD_KBEND ((wb_real)1e6)
-static void bend_block(const wb_world *w, int32_t q, wb_real f[3], wb_real H[6])
+/* a bend's energy off^2 / (2 alpha) on corner k: Gauss-Newton, k g g^T; a rigid one (alpha
+ * 0) through the augmented Lagrangian, k off^2 / 2 + lambda off, as a hard link but with
+ * no stabilisation (a rigid bend set off its rest is turned there at once, as XPBD does).
+ * Its damping beta (N m s) on the angle's speed over the substep, as XPBD's */
+static void bend_block(const wb_world *w, const struct wb_vbd *v, int32_t q, wb_real inv_h, wb_real f[3], wb_real H[6])
 {
     const int32_t b = q / 4, k = q % 4;
     if (w->bend.broken[b]) return;
     wb_real off, g[4][3];
     if (!wb__bend_off(w, b, &off, g)) return;
-    const wb_real a = w->bend.alpha[b], kb = a > 0 ? 1 / a : VBD_KBEND, *gk = g[k];
-    v3_madd(f, gk, -kb * off);
+    const wb_real a = w->bend.alpha[b], *gk = g[k];
+    wb_real kb = a > 0 ? 1 / a : v->bkpen[b], fm = a > 0 ? kb * off : kb * off + v->blam[b];
+    const wb_real beta = w->bend.beta[b];
+    if (a > 0 && beta > 0) {
+        const int32_t *p = &w->bend.ij[4 * b];
+        wb_real rel = 0;
+        for (int c = 0; c < 4; c++) {
+            wb_real u[3];
+            v3_sub(u, &w->s.x[3 * p[c]], &w->s.x_prev[3 * p[c]]);
+            rel += v3_dot(g[c], u);
+        }
+        fm += beta * rel * inv_h;
+        kb += beta * inv_h;
+    }
+    v3_madd(f, gk, -fm);
     H[0] += kb * gk[0] * gk[0], H[1] += kb * gk[1] * gk[1], H[2] += kb * gk[2] * gk[2];
     H[3] += kb * gk[0] * gk[1], H[4] += kb * gk[0] * gk[2], H[5] += kb * gk[1] * gk[2];
 }
@@ -336,9 +380,9 @@ static void sweep_part(void *ctx, int32_t lo, int32_t hi)
         wb_real f[3], H[6] = { mh, mh, mh, 0, 0, 0 }, d[3];
         v3_sub(f, &v->y[3 * i], &x[3 * i]);
         v3_scale(f, f, mh);
-        for (int32_t e = v->adj_start[i]; e < v->adj_start[i + 1]; e++) link_block(w, v, v->adj[e], i, f, H);
+        for (int32_t e = v->adj_start[i]; e < v->adj_start[i + 1]; e++) link_block(w, v, v->adj[e], i, j->inv_h, f, H);
         for (int32_t e = v->tadj_start[i]; e < v->tadj_start[i + 1]; e++) tet_block(w, v->tadj[e], f, H);
-        for (int32_t e = v->badj_start[i]; e < v->badj_start[i + 1]; e++) bend_block(w, v->badj[e], f, H);
+        for (int32_t e = v->badj_start[i]; e < v->badj_start[i + 1]; e++) bend_block(w, v, v->badj[e], j->inv_h, f, H);
         if (!solve3(H, f, d)) continue;
         v3_add(&x[3 * i], &x[3 * i], d);
         const wb_real dd = v3_dot(d, d);
@@ -383,8 +427,78 @@ static void dual_update(wb_world *w, struct wb_vbd *v, wb_real inv_h2)
         v3_sub(d, &x[3 * a], &x[3 * b]);
         const wb_real L = w->s.d_rest[s], C = v3_len(d) - L - VBD_STAB * v->c0[s], k0 = start_penalty(w, s, inv_h2);
         v->lam[s] += k0 * C;
+        v->fhard[s] = v->lam[s];
         const wb_real k = v->kpen[s] + k0 * VBD_RAMP * fabs(C) / (L > 0 ? L : 1);
         v->kpen[s] = k < VBD_KMAX * k0 ? k : VBD_KMAX * k0;
+    }
+}
+
+/* a hard bend's penalty to start from: the inertia of its angle, 1 / (h^2 sum w |g|^2) */
+static wb_real bend_start_penalty(const wb_world *w, int32_t b, const wb_real g[4][3], wb_real inv_h2)
+{
+    const int32_t *p = &w->bend.ij[4 * b];
+    wb_real den = 0;
+    for (int c = 0; c < 4; c++) den += w->m.w[p[c]] * v3_dot(g[c], g[c]);
+    return den > 0 ? inv_h2 / den : 0;
+}
+
+static int hard_bend(const wb_world *w, int32_t b) { return !w->bend.broken[b] && !(w->bend.alpha[b] > 0); }
+
+static void bend_warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2)
+{
+    for (int32_t b = 0; b < w->bend.n; b++) {
+        wb_real off, g[4][3];
+        if (!hard_bend(w, b) || !wb__bend_off(w, b, &off, g)) continue;
+        const wb_real k0 = bend_start_penalty(w, b, g, inv_h2);
+        v->bkpen[b] = v->bkpen[b] * VBD_WARM > k0 ? v->bkpen[b] * VBD_WARM : k0;
+    }
+}
+
+/* a hard bend's multiplier and penalty after a sweep, as a hard link's (its error in
+ * radians: the penalty grows by k0 each 1/VBD_RAMP rad); its torque (what force() reads,
+ * XPBD's multiplier lambda = -torque h^2) is the sweep's, k off + lambda */
+static void bend_dual_update(wb_world *w, struct wb_vbd *v, wb_real h)
+{
+    wb_bends *bs = &w->bend;
+    const wb_real inv_h2 = 1 / (h * h);
+    for (int32_t b = 0; b < bs->n; b++) {
+        wb_real off, g[4][3];
+        if (!hard_bend(w, b) || !wb__bend_off(w, b, &off, g)) continue;
+        const wb_real k0 = bend_start_penalty(w, b, g, inv_h2);
+        if (!bs->dirty) bs->lambda[bs->pack[b]] = -(v->bkpen[b] * off + v->blam[b]) * h * h;
+        v->blam[b] += k0 * off;
+        const wb_real k = v->bkpen[b] + k0 * VBD_RAMP * fabs(off);
+        v->bkpen[b] = k < VBD_KMAX * k0 ? k : VBD_KMAX * k0;
+    }
+}
+
+/* What force() and break_force read, in XPBD's multipliers (lambda = -force h^2, a
+ * stretched link's negative): a soft link's C / alpha, a hard one's lambda + k C of the
+ * last sweep; a soft bend's off / alpha (a hard one's: bend_dual_update) */
+static void write_forces(wb_world *w, const struct wb_vbd *v, wb_real h)
+{
+    wb_cache *k = &w->k;
+    const wb_model *m = &w->m;
+    const wb_real h2 = h * h;
+    for (int32_t i = 0; i < k->ns; i++) {
+        const int32_t s = k->s_slot[i];
+        if (!link_live(w, s)) { k->s_lambda[i] = 0; continue; }
+        const wb_real alpha = m->d_alpha[s];
+        if (alpha > 0) {
+            wb_real d[3];
+            v3_sub(d, &w->s.x[3 * m->d_ij[2 * s]], &w->s.x[3 * m->d_ij[2 * s + 1]]);
+            k->s_lambda[i] = -(v3_len(d) - w->s.d_rest[s]) / alpha * h2;
+        } else {
+            k->s_lambda[i] = -v->fhard[s] * h2;
+        }
+    }
+    k->s_lambda_stale = 0;
+    wb_bends *bs = &w->bend;
+    if (bs->dirty) return;
+    for (int32_t b = 0; b < bs->n; b++) {
+        wb_real off, g[4][3];
+        if (bs->broken[b] || !(bs->alpha[b] > 0)) continue;
+        bs->lambda[bs->pack[b]] = wb__bend_off(w, b, &off, g) ? -off / bs->alpha[b] * h2 : 0;
     }
 }
 
@@ -418,9 +532,10 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     memcpy(v->y, w->s.x, sizeof *v->y * 3 * (size_t)w->m.np);
     start_guess(w, v, h);
     warm_start(w, v, inv_h2);
+    bend_warm_start(w, v, inv_h2);
     wb_pool *pool = wb__world_pool(w);
     for (int it = 0; it < w->m.def.iterations; it++) {
-        sweep_job j = { w, v, inv_h2, NULL, 0 };
+        sweep_job j = { w, v, inv_h2, 1 / h, NULL, 0 };
         for (int32_t c = 0; c < v->ncolours; c++) {
             const int32_t lo = v->colour_start[c], n = v->colour_start[c + 1] - lo;
             j.vert = v->order + lo;
@@ -429,10 +544,12 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
         }
         v->residual = sqrt(j.step);
         dual_update(w, v, inv_h2);
+        bend_dual_update(w, v, h);
         for (int t = 0; t < wb__nctypes; t++)
             if (!wb__vbd_serves(wb__ctypes[t])) wb__ctypes[t]->project(w, h);
         if (w->m.def.tolerance > 0 && v->residual <= w->m.def.tolerance) break;
     }
+    write_forces(w, v, h);
     return v->residual;
 }
 

@@ -193,6 +193,7 @@ static int l_load(lua_State *L)
         wb_runtime *rt = wb_rt_get(L);
         c->img.def = wb_world_default_def();
         if (rt && rt->threads > 0) c->img.def.threads = rt->threads;
+        if (rt && rt->solver > 0) c->img.def.solver = (wb_solver)(rt->solver - 1);
     }
     c->img.def.memory = &wb_rt_get(L)->memory; /* a loaded world is charged like any other */
     wbl_world *ud = (wbl_world *)lua_newuserdatauv(L, sizeof *ud, 0); /* 4 */

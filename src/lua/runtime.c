@@ -90,7 +90,7 @@ static rt_state *rt_from(lua_State *L) {
 wb_runtime *wb_rt_get(lua_State *L) {
     /* a state opened without the runtime (embedding, `require "wobble"` from lua) gets
      * permissive defaults so the binding never has to test for NULL */
-    static wb_runtime plain = { ".", "out", NULL, 1, 0, 0, -1, 0, 0, { 0, 0 }, NULL, NULL, NULL, NULL };
+    static wb_runtime plain = { ".", "out", NULL, 1, 0, 0, 0, -1, 0, 0, { 0, 0 }, NULL, NULL, NULL, NULL };
     rt_state *rt = rt_from(L);
     return rt ? &rt->pub : &plain;
 }

@@ -21,6 +21,7 @@ typedef struct wb_runtime {
     int unsafe;                /* --unsafe: no sandbox */
     int quiet;                 /* --quiet: no progress, no summaries */
     int threads;               /* --threads N, 0 when not given */
+    int solver;                /* $WOBBLE_SOLVER: 1 + the wb_solver of new worlds that name none, 0 when not set */
     int64_t frame_cap;         /* --frames N: w:run stops after N frames; -1 = none */
     double time_budget;        /* seconds of wall time; 0 = none */
     size_t memory_budget;      /* bytes the Lua heap and the worlds' arrays may use together; 0 = none */

@@ -52,6 +52,8 @@ int wbl_world_new(lua_State *L)
     /* --threads on the command line is the default a script can still override */
     wb_runtime *rt = wb_rt_get(L);
     if (rt && rt->threads > 0) d.threads = rt->threads;
+    /* $WOBBLE_SOLVER likewise (run the same tests under another solver) */
+    if (rt && rt->solver > 0) d.solver = (wb_solver)(rt->solver - 1);
     /* the world's arrays live outside the Lua heap: charge them to the same budget */
     if (rt) d.memory = &rt->memory;
     if (!lua_isnoneornil(L, 1)) read_world_def(L, 1, &d);
