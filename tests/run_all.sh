@@ -2,6 +2,7 @@
 # tests/run_all.sh BUILD_DIR: the whole suite behind `make test` and `make asan`.
 #   (a) BUILD_DIR/unit_tests                    C unit tests of the core
 #   (b) wobble test tests/scenarios tests/validation   Lua scenario and validation tests
+#       tests/validation_vbd.sh                 the validation tests again under solver = "vbd"
 #   (c) every scripts/*.lua for 5 frames        one test per example scene (pass = exit 0)
 #       the scenes that check their claim       run in full under wobble test
 #       the output of (b)                       no warning/assert/error line that no test announced
@@ -121,6 +122,7 @@ done
 part "scenario and validation tests" "$BUILD/wobble" test --out "$TMP/out-tests" $lua_dirs
 cp "$TMP/log" "$TMP/scenarios.log"
 part "expected stderr of the scenario tests is labelled" expected_noise "$TMP/scenarios.log"
+part "validation tests under VBD (tests/validation_vbd.sh)" sh tests/validation_vbd.sh "$BUILD"
 part "example scenes (scripts/*.lua, 5 frames)" examples
 part "example scenes that check their claim, in full" checked_examples
 part "command line (tests/cli/run.sh)" sh tests/cli/run.sh "$BUILD"

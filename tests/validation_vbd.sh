@@ -1,0 +1,55 @@
+#!/bin/sh
+# tests/validation_vbd.sh BUILD_DIR: the validation tests again under the second solver
+# (WOBBLE_SOLVER=vbd: every world that names no solver is a VBD world; docs/testing.md).
+# Every file of tests/validation runs but those listed below, each with its reason; a new
+# validation test runs here too unless it is added to a list. Last line "N passed, N failed".
+BUILD=${1:-build}
+cd "$(dirname "$0")/.." || exit 2
+
+# They do not apply to VBD:
+#   neo_stiff.lua      the warning that a tet is too stiff for its substep is XPBD's (a wave
+#                      faster than one substep); VBD is stable there and warns nothing
+#   residual.lua       XPBD's residual, |C + alpha~ lambda| by type, and its projection count;
+#                      VBD's residual is its last sweep's largest step (vbd.lua checks it)
+#   materials.lua      its foam's ringing (zeta 0.8 of Kelvin-Voigt's) is XPBD's one-iteration
+#                      figure: XPBD at 20 iterations rings down in fewer than 3 peaks too
+#                      (VBD 0.54, 3x Kelvin-Voigt); the rest of the file holds under VBD
+not_vbd="neo_stiff.lua residual.lua materials.lua"
+
+# They apply but fail under VBD today (docs/physics.md, "VBD": what it does not serve yet);
+# each is a bug of the solver, not of the test:
+#   hard links and bends in motion converge no faster than XPBD and carry multipliers that
+#   lag (a swinging chain stretches, a catenary's end link reads 3x its tension, a rigid
+#   link under load stretches past 1e-6, a rigid hinge is 6e-4 rad off after a frame):
+#     bending.lua hand_built.lua user/01_rope_hand_built.lua user/02_chain_catenary.lua
+#     user/03_cloth_hand_built_sphere.lua user/07_cloth_two_pins.lua attach_rigid.lua
+#     bend_break.lua tethers.lua
+#   a stiff body's translation is carried by the sweeps' start (the prediction less the
+#   gravity it did not follow): a block on a slope past tan = mu does not slide, blocks
+#   made overlapping part too fast, a box on a soft block spins, free momentum drifts:
+#     friction_block.lua user/11_slope_friction.lua contacts.lua contact_energy.lua
+#     contact_kinetic.lua made_overlapping.lua made_stack.lua symmetric_drop.lua
+#     user/10_rigid_on_soft.lua user/14_elastic_release_symmetry.lua user/06_projectile.lua
+#     rigid_particle.lua squeeze.lua pressure.lua shape_match.lua
+#   cloth falling on itself: self-contacts projected after the sweeps fight them (blow-ups):
+#     cloth_sphere_drop.lua self_collision.lua contact_triangles.lua contact_triangles_overlap.lua
+not_yet="bending.lua hand_built.lua user/01_rope_hand_built.lua user/02_chain_catenary.lua
+user/03_cloth_hand_built_sphere.lua user/07_cloth_two_pins.lua attach_rigid.lua bend_break.lua tethers.lua
+friction_block.lua user/11_slope_friction.lua contacts.lua contact_energy.lua contact_kinetic.lua
+made_overlapping.lua made_stack.lua symmetric_drop.lua user/10_rigid_on_soft.lua
+user/14_elastic_release_symmetry.lua user/06_projectile.lua rigid_particle.lua squeeze.lua pressure.lua
+shape_match.lua cloth_sphere_drop.lua self_collision.lua contact_triangles.lua contact_triangles_overlap.lua"
+
+set --
+for f in $(find tests/validation -name '*.lua' | sort); do
+    rel=${f#tests/validation/}
+    skip=0
+    for x in $not_vbd $not_yet; do [ "$rel" = "$x" ] && skip=1; done
+    [ $skip -eq 0 ] && set -- "$@" "$f"
+done
+for x in $not_vbd $not_yet; do
+    [ -f "tests/validation/$x" ] || { echo "not ok 1 - tests/validation_vbd.sh lists $x, which is gone"; echo "0 passed, 1 failed"; exit 1; }
+done
+TMP=$(mktemp -d "${TMPDIR:-/tmp}/wobble-vbd.XXXXXX") || exit 2
+trap 'rm -rf "$TMP"' EXIT INT TERM
+WOBBLE_SOLVER=vbd "$BUILD/wobble" test --out "$TMP/out" "$@"
