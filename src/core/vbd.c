@@ -24,10 +24,21 @@
 #include "tet.h"
 #include "vbd.h"
 
+/* a link as the sweep reads it (one load of 40 bytes instead of six arrays): its force
+ * along it is kk (l - tgt) + lm and its stiffness kk; dmp: a soft link's damping beta / h */
+typedef struct vbd_link {
+    wb_real tgt, kk, lm, dmp, k0;
+    wb_real kr, kmax;      /* a hard one's penalty growth per metre off, k0 VBD_RAMP / rest, and cap */
+} vbd_link;
+
 struct wb_vbd {
     int32_t np, nd, nt, nb; /* the model it was built for */
-    int32_t *adj_start;    /* (np + 1) each vertex's range of adj */
-    int32_t *adj;          /* link slots touching each vertex */
+    int32_t *adj_start;    /* (np + 1) each vertex's range of adj, padded to a multiple of 4 */
+    int32_t *adj;          /* link slots touching each vertex (-1: padding) */
+    int32_t *adjo;         /* the other end of each of them (padding: the vertex itself) */
+    wb_real *ekk, *etg, *elm, *edm; /* each entry's link as the sweep reads it (vbd_link's kk,
+                              tgt, lm, dmp; padding 0): 4 entries in one load each */
+    int32_t *epos;         /* (2 nd) the two entries of each link */
     int32_t *tadj_start;   /* (np + 1) each vertex's range of tadj */
     int32_t *tadj;         /* 4 tet + corner of the Neo-Hookean tets touching each vertex */
     int32_t *badj_start;   /* (np + 1) each vertex's range of badj */
@@ -42,7 +53,9 @@ struct wb_vbd {
     wb_real *lam, *kpen;   /* (nd) a hard link's multiplier and penalty */
     wb_real *c0;           /* (nd) a hard link's error at the substep's start, which it keeps
                               but for 1 - VBD_STAB (AVBD's stabilisation) */
-    wb_real *fhard;        /* (nd) a hard link's force in the last sweep, lambda + k C (N) */
+    vbd_link *lk;          /* (nd) what the sweep reads of each link, set each substep */
+    int32_t *hard;         /* the live hard links' slots, this substep */
+    int32_t nhard;
     int32_t cap_lam;
     wb_real *blam, *bkpen; /* (nb, by slot) a hard bend's multiplier and penalty */
     int32_t cap_blam;
@@ -68,6 +81,14 @@ void wb__vbd_destroy(wb_world *w)
     if (!v) return;
     free(v->adj_start);
     free(v->adj);
+    free(v->adjo);
+    free(v->ekk);
+    free(v->etg);
+    free(v->elm);
+    free(v->edm);
+    free(v->epos);
+    free(v->lk);
+    free(v->hard);
     free(v->tadj_start);
     free(v->tadj);
     free(v->badj_start);
@@ -79,7 +100,6 @@ void wb__vbd_destroy(wb_world *w)
     free(v->lam);
     free(v->kpen);
     free(v->c0);
-    free(v->fhard);
     free(v->blam);
     free(v->bkpen);
     free(v);
@@ -112,7 +132,7 @@ static int quads(int32_t np, const int32_t *q, int32_t n, int32_t **start_out, i
     return 1;
 }
 
-/* each vertex's links (CSR) */
+/* each vertex's links (CSR, each range padded to a multiple of 4 for the vector lanes) */
 static int build_adjacency(wb_world *w, struct wb_vbd *v)
 {
     const wb_model *m = &w->m;
@@ -121,26 +141,35 @@ static int build_adjacency(wb_world *w, struct wb_vbd *v)
     if (!start) return 0;
     for (int32_t s = 0; s < nd; s++)
         if (link_live(w, s)) start[m->d_ij[2 * s] + 1]++, start[m->d_ij[2 * s + 1] + 1]++;
-    for (int32_t i = 0; i < np; i++) start[i + 1] += start[i];
-    int32_t *adj = malloc(sizeof *adj * (size_t)(start[np] > 0 ? start[np] : 1));
+    for (int32_t i = 0; i < np; i++) start[i + 1] = start[i] + ((start[i + 1] + 3) & ~3);
+    const size_t ne = (size_t)(start[np] > 0 ? start[np] : 1);
+    int32_t *adj = malloc(sizeof *adj * ne), *adjo = malloc(sizeof *adjo * ne);
+    int32_t *epos = malloc(sizeof *epos * 2 * (size_t)(nd > 0 ? nd : 1));
     int32_t *fill = malloc(sizeof *fill * (size_t)(np > 0 ? np : 1));
-    if (!adj || !fill) {
-        free(start), free(adj), free(fill);
+    wb_real *ek[4];
+    for (int c = 0; c < 4; c++) ek[c] = calloc(ne, sizeof(wb_real));
+    if (!adj || !adjo || !epos || !fill || !ek[0] || !ek[1] || !ek[2] || !ek[3]) {
+        free(start), free(adj), free(adjo), free(epos), free(fill);
+        for (int c = 0; c < 4; c++) free(ek[c]);
         return 0;
     }
     memcpy(fill, start, sizeof *fill * (size_t)np);
-    for (int32_t s = 0; s < nd; s++)
-        if (link_live(w, s)) adj[fill[m->d_ij[2 * s]]++] = s, adj[fill[m->d_ij[2 * s + 1]]++] = s;
+    for (int32_t s = 0; s < nd; s++) {
+        if (!link_live(w, s)) continue;
+        const int32_t a = m->d_ij[2 * s], b = m->d_ij[2 * s + 1];
+        epos[2 * s] = fill[a], adjo[fill[a]] = b, adj[fill[a]++] = s;
+        epos[2 * s + 1] = fill[b], adjo[fill[b]] = a, adj[fill[b]++] = s;
+    }
+    for (int32_t i = 0; i < np; i++)
+        for (int32_t e = fill[i]; e < start[i + 1]; e++) adj[e] = -1, adjo[e] = i;
     free(fill);
-    free(v->adj_start);
-    free(v->adj);
-    v->adj_start = start;
-    v->adj = adj;
+    free(v->adj_start), free(v->adj), free(v->adjo), free(v->epos);
+    free(v->ekk), free(v->etg), free(v->elm), free(v->edm);
+    v->adj_start = start, v->adj = adj, v->adjo = adjo, v->epos = epos;
+    v->ekk = ek[0], v->etg = ek[1], v->elm = ek[2], v->edm = ek[3];
     return quads(np, w->neo ? w->neo->ijkl : NULL, w->neo ? w->neo->n : 0, &v->tadj_start, &v->tadj) &&
            quads(np, w->bend.ij, w->bend.n, &v->badj_start, &v->badj);
 }
-
-static int32_t other_end(const wb_model *m, int32_t s, int32_t i) { return m->d_ij[2 * s] == i ? m->d_ij[2 * s + 1] : m->d_ij[2 * s]; }
 
 /* greedy colouring in index order (deterministic): each vertex the least colour none of
  * its coloured neighbours has */
@@ -159,7 +188,8 @@ static int build_colours(wb_world *w, struct wb_vbd *v)
     for (int32_t i = 0; i < np; i++) {
         uint64_t used = 0;
         for (int32_t e = v->adj_start[i]; e < v->adj_start[i + 1]; e++) {
-            const int32_t j = other_end(m, v->adj[e], i);
+            if (v->adj[e] < 0) continue;
+            const int32_t j = v->adjo[e];
             if (j < i) used |= (uint64_t)1 << col[j];
         }
         for (int32_t e = v->tadj_start[i]; e < v->tadj_start[i + 1]; e++) {
@@ -219,11 +249,13 @@ int wb__vbd_prepare(wb_world *w)
             wb_real *lam = realloc(v->lam, sizeof *lam * (size_t)m->nd), *kp = realloc(v->kpen, sizeof *kp * (size_t)m->nd);
             if (lam) v->lam = lam;
             if (kp) v->kpen = kp;
-            wb_real *c0 = realloc(v->c0, sizeof *c0 * (size_t)m->nd), *fh = realloc(v->fhard, sizeof *fh * (size_t)m->nd);
+            wb_real *c0 = realloc(v->c0, sizeof *c0 * (size_t)m->nd);
             if (c0) v->c0 = c0;
-            if (fh) v->fhard = fh;
-            if (!lam || !kp || !c0 || !fh) return 0;
-            memset(v->fhard + v->cap_lam, 0, sizeof *fh * (size_t)(m->nd - v->cap_lam));
+            vbd_link *lk = realloc(v->lk, sizeof *lk * (size_t)m->nd);
+            if (lk) v->lk = lk;
+            int32_t *hd = realloc(v->hard, sizeof *hd * (size_t)m->nd);
+            if (hd) v->hard = hd;
+            if (!lam || !kp || !c0 || !lk || !hd) return 0;
             /* new slots start with no multiplier and no penalty (set at their first use) */
             memset(v->lam + v->cap_lam, 0, sizeof *lam * (size_t)(m->nd - v->cap_lam));
             memset(v->kpen + v->cap_lam, 0, sizeof *kp * (size_t)(m->nd - v->cap_lam));
@@ -271,37 +303,142 @@ typedef struct sweep_job {
 } sweep_job;
 
 /* A link's force on i along n = (x_i - x_j) / l and its stiffness: a soft one's energy
- * C^2 / (2 alpha); a hard one's k C^2 / 2 + lambda C. The Hessian's part across n, the
- * force over l, is kept only while it pulls (a pushed link's is indefinite: left out, as
- * VBD does) */
-static void link_block(const wb_world *w, const struct wb_vbd *v, int32_t s, int32_t i, wb_real inv_h, wb_real f[3], wb_real H[6])
+ * C^2 / (2 alpha); a hard one's k C^2 / 2 + lambda C (vbd_link: C = l - tgt). The
+ * Hessian's part across n, the force over l, is kept only while it pulls (a pushed link's
+ * is indefinite: left out, as VBD does). A soft link's damping beta (N s/m) acts on the
+ * speed it stretches at over the substep, as XPBD's (a hard link has none there either);
+ * its block is beta / h n n^T.
+ * A vertex's links are summed in 4 lanes (link q into lane q % 4, the lanes added as
+ * (0 + 1) + (2 + 3)): the AVX2 path below takes 4 links at once and gives these bits. */
+static void links_scalar(const wb_world *w, const struct wb_vbd *v, int32_t i, wb_real fs[3], wb_real hs[6])
 {
-    const wb_model *m = &w->m;
-    const int32_t j = other_end(m, s, i);
-    const wb_real *x = w->s.x;
-    wb_real n[3];
-    v3_sub(n, &x[3 * i], &x[3 * j]);
-    const wb_real l = v3_len(n);
-    if (!(l > 1e-12)) return;
-    v3_scale(n, n, 1 / l);
-    const wb_real alpha = m->d_alpha[s], C = l - w->s.d_rest[s] - (alpha > 0 ? 0 : VBD_STAB * v->c0[s]);
-    const wb_real k = alpha > 0 ? 1 / alpha : v->kpen[s], fm = alpha > 0 ? k * C : k * C + v->lam[s];
-    v3_madd(f, n, -fm);
-    wb_real g = fm > 0 ? fm / l : 0, kn = k - g;
-    /* a soft link's damping beta (N s/m) on the speed it stretches at over the substep,
-     * as XPBD's (a hard link has none there either); its block is beta / h n n^T */
-    const wb_real beta = m->d_beta[s];
-    if (alpha > 0 && beta > 0) {
-        const wb_real *xp = w->s.x_prev;
-        wb_real u[3];
-        v3_sub(u, &x[3 * i], &xp[3 * i]);
-        v3_sub(u, u, &x[3 * j]);
-        v3_add(u, u, &xp[3 * j]);
-        v3_madd(f, n, -beta * v3_dot(n, u) * inv_h);
-        kn += beta * inv_h;
+    wb_real F[3][4] = { { 0 } }, Hl[6][4] = { { 0 } };
+    const wb_real *x = w->s.x, *xp = w->s.x_prev;
+    const int32_t e0 = v->adj_start[i], n = v->adj_start[i + 1] - e0;
+    for (int32_t q = 0; q < n; q++) {
+        if (v->adj[e0 + q] < 0) continue;
+        const int32_t j = v->adjo[e0 + q], c = q & 3;
+        const vbd_link *L = &v->lk[v->adj[e0 + q]];
+        const wb_real d0 = x[3 * i] - x[3 * j], d1 = x[3 * i + 1] - x[3 * j + 1], d2 = x[3 * i + 2] - x[3 * j + 2];
+        const wb_real l2 = d0 * d0 + d1 * d1 + d2 * d2;
+        if (!(l2 > 1e-24)) continue;
+        const wb_real l = sqrt(l2), il = 1 / l;
+        wb_real fm = L->kk * (l - L->tgt) + L->lm, kn = L->kk;
+        if (L->dmp > 0) {
+            const wb_real u = d0 * (xp[3 * j] - xp[3 * i]) + d1 * (xp[3 * j + 1] - xp[3 * i + 1]) + d2 * (xp[3 * j + 2] - xp[3 * i + 2]);
+            fm = fm + L->dmp * (l + u * il);
+            kn = kn + L->dmp;
+        }
+        const wb_real g = fm > 0 ? fm * il : 0, a = (kn - g) * il * il, fl = fm * il;
+        F[0][c] -= fl * d0, F[1][c] -= fl * d1, F[2][c] -= fl * d2;
+        Hl[0][c] += a * d0 * d0 + g, Hl[1][c] += a * d1 * d1 + g, Hl[2][c] += a * d2 * d2 + g;
+        Hl[3][c] += a * d0 * d1, Hl[4][c] += a * d0 * d2, Hl[5][c] += a * d1 * d2;
     }
-    H[0] += kn * n[0] * n[0] + g, H[1] += kn * n[1] * n[1] + g, H[2] += kn * n[2] * n[2] + g;
-    H[3] += kn * n[0] * n[1], H[4] += kn * n[0] * n[2], H[5] += kn * n[1] * n[2];
+    for (int c = 0; c < 3; c++) fs[c] = (F[c][0] + F[c][1]) + (F[c][2] + F[c][3]);
+    for (int c = 0; c < 6; c++) hs[c] = (Hl[c][0] + Hl[c][1]) + (Hl[c][2] + Hl[c][3]);
+}
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(WB_FLOAT)
+#define WB_VBD_AVX2 1
+#include <immintrin.h>
+
+/* the x, y, z of 4 particles (offsets o) as 3 vectors of lanes, as distance.c's load4:
+ * rows loaded without their 4th double (maskload does not touch it), then transposed */
+static inline __attribute__((always_inline, target("avx2"))) void
+load4(const wb_real *p, const size_t o[4], __m256d *X, __m256d *Y, __m256d *Z)
+{
+    const __m256i m = _mm256_set_epi64x(0, -1, -1, -1);
+    const __m256d r0 = _mm256_maskload_pd(&p[o[0]], m), r1 = _mm256_maskload_pd(&p[o[1]], m);
+    const __m256d r2 = _mm256_maskload_pd(&p[o[2]], m), r3 = _mm256_maskload_pd(&p[o[3]], m);
+    const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
+    const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+    *X = _mm256_permute2f128_pd(t0, t2, 0x20);
+    *Y = _mm256_permute2f128_pd(t1, t3, 0x20);
+    *Z = _mm256_permute2f128_pd(t0, t2, 0x31);
+}
+
+/* the lanes of a and b added as (0 + 1) + (2 + 3): out[0] a's, out[1] b's */
+static inline __attribute__((always_inline, target("avx2"))) void sum2(__m256d a, __m256d b, wb_real out[2])
+{
+    const __m256d t = _mm256_hadd_pd(a, b); /* a0+a1, b0+b1, a2+a3, b2+b3 */
+    _mm_storeu_pd(out, _mm_add_pd(_mm256_castpd256_pd128(t), _mm256_extractf128_pd(t, 1)));
+}
+
+static __attribute__((target("avx2"))) void links_avx2(const wb_world *w, const struct wb_vbd *v, int32_t i, wb_real fs[3],
+                                                       wb_real hs[6])
+{
+    const wb_real *x = w->s.x, *xp = w->s.x_prev;
+    const int32_t e0 = v->adj_start[i], n = v->adj_start[i + 1] - e0;
+    __m256d f0 = _mm256_setzero_pd(), f1 = f0, f2 = f0, h0 = f0, h1 = f0, h2 = f0, h3 = f0, h4 = f0, h5 = f0;
+    const __m256d xi = _mm256_set1_pd(x[3 * i]), yi = _mm256_set1_pd(x[3 * i + 1]), zi = _mm256_set1_pd(x[3 * i + 2]);
+    const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1), tiny = _mm256_set1_pd(1e-24);
+    for (int32_t q = 0; q < n; q += 4) {
+        const int32_t e = e0 + q, *j = &v->adjo[e];
+        const size_t o[4] = { 3 * (size_t)j[0], 3 * (size_t)j[1], 3 * (size_t)j[2], 3 * (size_t)j[3] };
+        __m256d d0, d1, d2;
+        load4(x, o, &d0, &d1, &d2);
+        d0 = _mm256_sub_pd(xi, d0), d1 = _mm256_sub_pd(yi, d1), d2 = _mm256_sub_pd(zi, d2);
+        const __m256d l2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2));
+        const __m256d live = _mm256_cmp_pd(l2, tiny, _CMP_GT_OQ);
+        const __m256d l = _mm256_sqrt_pd(l2), il = _mm256_div_pd(one, l);
+        const __m256d K = _mm256_loadu_pd(&v->ekk[e]), D = _mm256_loadu_pd(&v->edm[e]);
+        __m256d fm = _mm256_add_pd(_mm256_mul_pd(K, _mm256_sub_pd(l, _mm256_loadu_pd(&v->etg[e]))), _mm256_loadu_pd(&v->elm[e]));
+        __m256d kn = K;
+        if (_mm256_movemask_pd(_mm256_cmp_pd(D, zero, _CMP_GT_OQ))) {
+            /* the damped lanes only (a lane of dmp 0 would add 0 times a finite number: the
+             * same fm, never -0, but the scalar loop does not add it) */
+            __m256d u0, u1, u2;
+            load4(xp, o, &u0, &u1, &u2);
+            u0 = _mm256_sub_pd(u0, _mm256_set1_pd(xp[3 * i]));
+            u1 = _mm256_sub_pd(u1, _mm256_set1_pd(xp[3 * i + 1]));
+            u2 = _mm256_sub_pd(u2, _mm256_set1_pd(xp[3 * i + 2]));
+            const __m256d u = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, u0), _mm256_mul_pd(d1, u1)), _mm256_mul_pd(d2, u2));
+            const __m256d dfm = _mm256_mul_pd(D, _mm256_add_pd(l, _mm256_mul_pd(u, il)));
+            fm = _mm256_blendv_pd(fm, _mm256_add_pd(fm, dfm), _mm256_cmp_pd(D, zero, _CMP_GT_OQ));
+            kn = _mm256_blendv_pd(kn, _mm256_add_pd(kn, D), _mm256_cmp_pd(D, zero, _CMP_GT_OQ));
+        }
+        const __m256d g = _mm256_and_pd(_mm256_mul_pd(fm, il), _mm256_cmp_pd(fm, zero, _CMP_GT_OQ));
+        const __m256d a = _mm256_mul_pd(_mm256_mul_pd(_mm256_sub_pd(kn, g), il), il), fl = _mm256_mul_pd(fm, il);
+        const __m256d ad0 = _mm256_mul_pd(a, d0), ad1 = _mm256_mul_pd(a, d1);
+        f0 = _mm256_sub_pd(f0, _mm256_and_pd(_mm256_mul_pd(fl, d0), live));
+        f1 = _mm256_sub_pd(f1, _mm256_and_pd(_mm256_mul_pd(fl, d1), live));
+        f2 = _mm256_sub_pd(f2, _mm256_and_pd(_mm256_mul_pd(fl, d2), live));
+        h0 = _mm256_add_pd(h0, _mm256_and_pd(_mm256_add_pd(_mm256_mul_pd(ad0, d0), g), live));
+        h1 = _mm256_add_pd(h1, _mm256_and_pd(_mm256_add_pd(_mm256_mul_pd(ad1, d1), g), live));
+        h2 = _mm256_add_pd(h2, _mm256_and_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_mul_pd(a, d2), d2), g), live));
+        h3 = _mm256_add_pd(h3, _mm256_and_pd(_mm256_mul_pd(ad0, d1), live));
+        h4 = _mm256_add_pd(h4, _mm256_and_pd(_mm256_mul_pd(ad0, d2), live));
+        h5 = _mm256_add_pd(h5, _mm256_and_pd(_mm256_mul_pd(ad1, d2), live));
+    }
+    wb_real t[2];
+    sum2(f0, f1, fs);
+    sum2(f2, h0, t);
+    fs[2] = t[0], hs[0] = t[1];
+    sum2(h1, h2, hs + 1);
+    sum2(h3, h4, hs + 3);
+    sum2(h5, h5, t);
+    hs[5] = t[0];
+}
+#endif
+
+/* the vector path: -1 not yet decided, 0 off (no AVX2, or turned off), 1 on */
+static int simd_state = -1;
+
+/* Internal switch for tests, as wb__distance_simd: on = 0 forces the scalar loop */
+int wb__vbd_simd(int on);
+int wb__vbd_simd(int on) { return wb__simd_set(&simd_state, on); }
+
+static inline void link_lanes(const wb_world *w, const struct wb_vbd *v, int32_t i, wb_real F[3], wb_real Hl[6])
+{
+#ifdef WB_VBD_AVX2
+    int s = __atomic_load_n(&simd_state, __ATOMIC_RELAXED);
+    if (s < 0) s = wb__vbd_simd(1);
+    if (s) {
+        links_avx2(w, v, i, F, Hl);
+        return;
+    }
+#endif
+    links_scalar(w, v, i, F, Hl);
 }
 
 /* A Neo-Hookean tet's energy on corner k, in its constraint form (tet.c): V0 (mu/2 |F|^2 +
@@ -377,10 +514,9 @@ static void sweep_part(void *ctx, int32_t lo, int32_t hi)
         const int32_t i = j->vert[q];
         if (!(wv[i] > 0)) continue;
         const wb_real mh = j->inv_h2 / wv[i];
-        wb_real f[3], H[6] = { mh, mh, mh, 0, 0, 0 }, d[3];
-        v3_sub(f, &v->y[3 * i], &x[3 * i]);
-        v3_scale(f, f, mh);
-        for (int32_t e = v->adj_start[i]; e < v->adj_start[i + 1]; e++) link_block(w, v, v->adj[e], i, j->inv_h, f, H);
+        wb_real f[3], H[6], d[3];
+        link_lanes(w, v, i, f, H);
+        for (int c = 0; c < 3; c++) f[c] += mh * (v->y[3 * i + c] - x[3 * i + c]), H[c] += mh;
         for (int32_t e = v->tadj_start[i]; e < v->tadj_start[i + 1]; e++) tet_block(w, v->tadj[e], f, H);
         for (int32_t e = v->badj_start[i]; e < v->badj_start[i + 1]; e++) bend_block(w, v, v->badj[e], j->inv_h, f, H);
         if (!solve3(H, f, d)) continue;
@@ -402,34 +538,66 @@ static wb_real start_penalty(const wb_world *w, int32_t s, wb_real inv_h2)
     return wsum > 0 ? inv_h2 / wsum : 0;
 }
 
-static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2)
+/* link s's two entries of the vertex lists, as the vector lanes read them */
+static void put_entries(struct wb_vbd *v, int32_t s, const vbd_link *L)
 {
-    const wb_model *m = &w->m;
-    const wb_real *xp = w->s.x_prev;
-    for (int32_t s = 0; s < m->nd; s++) {
-        if (!link_live(w, s) || m->d_alpha[s] > 0) continue;
-        wb_real d[3];
-        v3_sub(d, &xp[3 * m->d_ij[2 * s]], &xp[3 * m->d_ij[2 * s + 1]]);
-        v->c0[s] = v3_len(d) - w->s.d_rest[s];
-        const wb_real k0 = start_penalty(w, s, inv_h2);
-        v->kpen[s] = v->kpen[s] * VBD_WARM > k0 ? v->kpen[s] * VBD_WARM : k0;
+    for (int c = 0; c < 2; c++) {
+        const int32_t e = v->epos[2 * s + c];
+        v->ekk[e] = L->kk, v->etg[e] = L->tgt, v->elm[e] = L->lm, v->edm[e] = L->dmp;
     }
 }
 
-static void dual_update(wb_world *w, struct wb_vbd *v, wb_real inv_h2)
+/* each link as the sweeps read it this substep (vbd_link), and the hard links' list */
+static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2, wb_real inv_h)
+{
+    const wb_model *m = &w->m;
+    const wb_real *xp = w->s.x_prev;
+    v->nhard = 0;
+    for (int32_t s = 0; s < m->nd; s++) {
+        if (!link_live(w, s)) continue;
+        vbd_link *L = &v->lk[s];
+        const wb_real alpha = m->d_alpha[s], rest = w->s.d_rest[s];
+        if (alpha > 0) {
+            L->tgt = rest, L->kk = 1 / alpha, L->lm = 0, L->k0 = 0;
+            L->dmp = m->d_beta[s] > 0 ? m->d_beta[s] * inv_h : 0;
+            put_entries(v, s, L);
+            continue;
+        }
+        wb_real d[3];
+        v3_sub(d, &xp[3 * m->d_ij[2 * s]], &xp[3 * m->d_ij[2 * s + 1]]);
+        v->c0[s] = v3_len(d) - rest;
+        const wb_real k0 = start_penalty(w, s, inv_h2);
+        v->kpen[s] = v->kpen[s] * VBD_WARM > k0 ? v->kpen[s] * VBD_WARM : k0;
+        L->tgt = rest + VBD_STAB * v->c0[s], L->kk = v->kpen[s], L->lm = v->lam[s], L->dmp = 0, L->k0 = k0;
+        L->kr = k0 * VBD_RAMP / (rest > 0 ? rest : 1), L->kmax = VBD_KMAX * k0;
+        put_entries(v, s, L);
+        v->hard[v->nhard++] = s;
+    }
+}
+
+static void dual_update(wb_world *w, struct wb_vbd *v)
 {
     const wb_model *m = &w->m;
     const wb_real *x = w->s.x;
-    for (int32_t s = 0; s < m->nd; s++) {
-        if (!link_live(w, s) || m->d_alpha[s] > 0) continue;
-        const int32_t a = m->d_ij[2 * s], b = m->d_ij[2 * s + 1];
+    for (int32_t q = 0; q < v->nhard; q++) {
+        const int32_t s = v->hard[q], a = m->d_ij[2 * s], b = m->d_ij[2 * s + 1];
+        vbd_link *L = &v->lk[s];
         wb_real d[3];
         v3_sub(d, &x[3 * a], &x[3 * b]);
-        const wb_real L = w->s.d_rest[s], C = v3_len(d) - L - VBD_STAB * v->c0[s], k0 = start_penalty(w, s, inv_h2);
-        v->lam[s] += k0 * C;
-        v->fhard[s] = v->lam[s];
-        const wb_real k = v->kpen[s] + k0 * VBD_RAMP * fabs(C) / (L > 0 ? L : 1);
-        v->kpen[s] = k < VBD_KMAX * k0 ? k : VBD_KMAX * k0;
+        const wb_real C = v3_len(d) - L->tgt, k = L->kk + L->kr * fabs(C);
+        L->lm += L->k0 * C;
+        L->kk = k < L->kmax ? k : L->kmax;
+        const int32_t e = v->epos[2 * s], f = v->epos[2 * s + 1];
+        v->ekk[e] = v->ekk[f] = L->kk, v->elm[e] = v->elm[f] = L->lm;
+    }
+}
+
+/* the hard links' multipliers and penalties carried to the next substep */
+static void keep_multipliers(struct wb_vbd *v)
+{
+    for (int32_t q = 0; q < v->nhard; q++) {
+        const int32_t s = v->hard[q];
+        v->lam[s] = v->lk[s].lm, v->kpen[s] = v->lk[s].kk;
     }
 }
 
@@ -489,7 +657,7 @@ static void write_forces(wb_world *w, const struct wb_vbd *v, wb_real h)
             v3_sub(d, &w->s.x[3 * m->d_ij[2 * s]], &w->s.x[3 * m->d_ij[2 * s + 1]]);
             k->s_lambda[i] = -(v3_len(d) - w->s.d_rest[s]) / alpha * h2;
         } else {
-            k->s_lambda[i] = -v->fhard[s] * h2;
+            k->s_lambda[i] = -v->lam[s] * h2;
         }
     }
     k->s_lambda_stale = 0;
@@ -531,7 +699,7 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     const wb_real inv_h2 = 1 / (h * h);
     memcpy(v->y, w->s.x, sizeof *v->y * 3 * (size_t)w->m.np);
     start_guess(w, v, h);
-    warm_start(w, v, inv_h2);
+    warm_start(w, v, inv_h2, 1 / h);
     bend_warm_start(w, v, inv_h2);
     wb_pool *pool = wb__world_pool(w);
     for (int it = 0; it < w->m.def.iterations; it++) {
@@ -543,12 +711,13 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
             wb__pool_for(serial ? NULL : pool, n, 1024, sweep_part, &j);
         }
         v->residual = sqrt(j.step);
-        dual_update(w, v, inv_h2);
+        dual_update(w, v);
         bend_dual_update(w, v, h);
         for (int t = 0; t < wb__nctypes; t++)
             if (!wb__vbd_serves(wb__ctypes[t])) wb__ctypes[t]->project(w, h);
         if (w->m.def.tolerance > 0 && v->residual <= w->m.def.tolerance) break;
     }
+    keep_multipliers(v);
     write_forces(w, v, h);
     return v->residual;
 }

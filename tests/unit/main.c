@@ -202,6 +202,7 @@
     RIGID_TESTS(X)                               \
     NARROW_TESTS(X)                              \
     X(distance_simd_bit_identical_to_scalar)     \
+    X(vbd_simd_bit_identical_to_scalar)          \
     X(momentum_simd_bit_identical_to_scalar)     \
     POOL_TESTS(X)                                \
     FUSED_TESTS(X)
