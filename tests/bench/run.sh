@@ -23,6 +23,7 @@ FLOAT_SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2"
 SCENES="$SCENES bend"   # the bending scene (tests/bench/bend.lua)
 SCENES="$SCENES self128 loose128 heap128 drape128"   # self-collision against none (tests/bench/self_collide.lua)
 SCENES="$SCENES self32 self64 self128_30 self256"   # ... per size (the cost per particle: flat)
+SCENES="$SCENES convergence"   # XPBD and VBD: error against CPU time (tests/bench/convergence.lua)
 
 # scene EXE NAME HEADER(1/0) [ROW [SET]]: one row (and the header when asked); with ROW the row
 # is named ROW and has no Bullet figures (the busy-core rows: Bullet ran without the spinner);
