@@ -22,7 +22,7 @@ if not bench.want("convergence") then return end
 local quick = args.quick == 1 or args.frames ~= nil
 local ITERS = quick and { 1, 2 } or { 1, 2, 4, 8, 16, 32 }
 local CLOTH_ITERS = quick and { 1, 2 } or { 1, 2, 4, 8 }
-local function frames(n) return quick and 2 or n end
+local function frames(n) return args.frames ~= nil and bench.frames(n) or quick and 2 or n end
 local G = 9.81
 
 -- the median of the frames' solve times (a busy machine's hiccups left out)
@@ -77,7 +77,8 @@ local function cloth(solver, iters, n)
   w:pin(c.particles[128])
   w:step() -- (the first step colours the constraints: not timed)
   local ms = solve_ms(w, n)
-  return w:max_strain(), ms, w:stats().substeps
+  local st = w:stats()
+  return w:max_strain(), ms, st.substeps, st.distances
 end
 
 local series = {} -- { name, solver, points = { {ms, err, iters} } }
@@ -102,8 +103,9 @@ for _, solver in ipairs(SOLVERS) do
     add("bar", solver, ms2, math.min(10, math.abs(e - want_bar) / want_bar), it)
   end
   for _, it in ipairs(CLOTH_ITERS) do
-    local s, ms = cloth(solver, it, frames(60))
+    local s, ms, _, links = cloth(solver, it, frames(60))
     add("cloth", solver, ms, s, it)
+    series.links = links
   end
 end
 
@@ -116,14 +118,16 @@ for _, solver in ipairs(SOLVERS) do
   per_iter[solver] = (t9 - t1) / (8 * sub)
 end
 
+-- (--json: the row alone, one JSON object a line)
+local say = args.json and function() end or print
 for _, s in ipairs(series) do
   local row = {}
   for _, p in ipairs(s.points) do row[#row + 1] = string.format("%dx: %.3g ms %.3g", p[3], p[1], p[2]) end
-  print(string.format("# %-5s %-12s %s", s.name, s.solver, table.concat(row, " | ")))
+  say(string.format("# %-5s %-12s %s", s.name, s.solver, table.concat(row, " | ")))
 end
-print(string.format("# strip converged droop %.4f m (XPBD 10 x 100); bar's analytic elongation %.4f mm", ref, 1e3 * want_bar))
+say(string.format("# strip converged droop %.4f m (XPBD 10 x 100); bar's analytic elongation %.4f mm", ref, 1e3 * want_bar))
 local ratio = per_iter.vbd / per_iter["gauss-seidel"]
-print(string.format("# cloth 128 x 128: one iteration of a substep %.3f ms XPBD, %.3f ms VBD (%.2fx)", per_iter["gauss-seidel"],
+say(string.format("# cloth 128 x 128: one iteration of a substep %.3f ms XPBD, %.3f ms VBD (%.2fx)", per_iter["gauss-seidel"],
                     per_iter.vbd, ratio))
 
 -- ---- the plot: a PPM drawn here, made a PNG by ffmpeg ----------------------------------------
@@ -202,16 +206,18 @@ local function plot(path)
   f:close()
   assert(os.execute(string.format("ffmpeg -loglevel error -y -i '%s' '%s'", ppm, path)), "ffmpeg failed")
   os.remove(ppm)
-  print(string.format("# plot: %s (x: solve ms per frame, 10^%d to 10^%d; y: error, 10^%d to 10^%d)", path, xmin, xmax,
+  say(string.format("# plot: %s (x: solve ms per frame, 10^%d to 10^%d; y: error, 10^%d to 10^%d)", path, xmin, xmax,
                       ymin, ymax))
 end
 if args.plot then plot(tostring(args.plot)) end
 
-local v1 = series["strip vbd"].points[1]
+-- the row: the cloth under VBD at 10 x 1 (ns per projection: per link and iteration, the
+-- solver's time alone, so both columns are the same)
+local v1, cms = series["strip vbd"].points[1], series["cloth vbd"].points[1][1]
+local ns = cms * 1e6 / (10 * series.links)
 bench.report({
-  scene = "convergence", particles = 128 * 128, constraints = bench.null, substeps = 10, iterations = 1, threads = 1,
-  frames = frames(60), ms_per_frame = series["cloth vbd"].points[1][1], ns_per_projection = bench.null,
-  ns_per_projection_solve = bench.null, bytes_per_particle = bench.null,
+  scene = "convergence", particles = 128 * 128, constraints = series.links, substeps = 10, iterations = 1, threads = 1,
+  frames = frames(60), ms_per_frame = cms, ns_per_projection = ns, ns_per_projection_solve = ns, bytes_per_particle = bench.null,
   vbd_iteration_ms = per_iter.vbd, xpbd_iteration_ms = per_iter["gauss-seidel"], vbd_over_xpbd_iteration = ratio,
   strip_vbd_error_10x1 = v1[2], strip_xpbd_error_10x1 = series["strip gauss-seidel"].points[1][2],
 }, string.format("cloth VBD 10 x 1; one VBD iteration %.2fx one XPBD's; strip at 10 x 1 %.0f%% off (XPBD %.0f%%)", ratio,
