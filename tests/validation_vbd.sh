@@ -52,4 +52,12 @@ for x in $not_vbd $not_yet; do
 done
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/wobble-vbd.XXXXXX") || exit 2
 trap 'rm -rf "$TMP"' EXIT INT TERM
+# the switch itself: a world that names no solver is a VBD world, one that names one keeps it
+printf 'print(wobble.world{}:solver(), wobble.world{solver = "jacobi"}:solver())\n' >"$TMP/switch.lua"
+got=$(WOBBLE_SOLVER=vbd "$BUILD/wobble" run "$TMP/switch.lua" --quiet --out "$TMP/out" 2>&1)
+if [ "$got" != "$(printf 'vbd\tjacobi')" ]; then
+    echo "not ok 1 - WOBBLE_SOLVER=vbd makes worlds that name no solver VBD worlds (got: $got)"
+    echo "0 passed, 1 failed"
+    exit 1
+fi
 WOBBLE_SOLVER=vbd "$BUILD/wobble" test --out "$TMP/out" "$@"
