@@ -628,7 +628,8 @@ static void bend_warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2)
 
 /* a hard bend's multiplier and penalty after a sweep, as a hard link's (its error in
  * radians: the penalty grows by k0 each 1/VBD_RAMP rad); its torque (what force() reads,
- * XPBD's multiplier lambda = -torque h^2) is the sweep's, k off + lambda */
+ * XPBD's multiplier lambda = -torque h^2) is the multiplier, as a hard link's: k off
+ * overshot it (k is large, off noisy) */
 static void bend_dual_update(wb_world *w, struct wb_vbd *v, wb_real h)
 {
     wb_bends *bs = &w->bend;
@@ -637,8 +638,8 @@ static void bend_dual_update(wb_world *w, struct wb_vbd *v, wb_real h)
         wb_real off, g[4][3];
         if (!hard_bend(w, b) || !wb__bend_off(w, b, &off, g)) continue;
         const wb_real k0 = bend_start_penalty(w, b, g, inv_h2);
-        if (!bs->dirty) bs->lambda[bs->pack[b]] = -(v->bkpen[b] * off + v->blam[b]) * h * h;
         v->blam[b] += k0 * off;
+        if (!bs->dirty) bs->lambda[bs->pack[b]] = -v->blam[b] * h * h;
         const wb_real k = v->bkpen[b] + k0 * VBD_RAMP * fabs(off);
         v->bkpen[b] = k < VBD_KMAX * k0 ? k : VBD_KMAX * k0;
     }
