@@ -13,6 +13,19 @@
 
 enum { WB_TARGET_COLLIDER = 0, WB_TARGET_RIGID = 1 };
 
+/* a snapshot image's attachments (snapshot.h): the live ones, in slot order */
+typedef struct wb_image_attach {
+    int32_t n;
+    int32_t *p;            /* (n) particle */
+    int32_t *kind;         /* (n) target kind: 0 = collider */
+    int32_t *target;       /* (n) the target's slot (a live collider slot of the image) */
+    wb_real *local;        /* (n x 3) the point in the target's frame */
+    wb_real *alpha;        /* (n) compliance, m/N */
+} wb_image_attach;
+struct wb_image;
+/* the image's attachment arrays for n of them (zeroed), after wb_image_alloc; WB_ERR_NOMEM */
+wb_status wb_image_alloc_attach(struct wb_image *g, int32_t n);
+
 /* w->att: NULL until the first attachment */
 typedef struct wb_attaches {
     int32_t n, cap, nlive;  /* slots, capacity, live ones */

@@ -10,6 +10,19 @@
 
 enum { WB_GRAB_PARTICLE = 0, WB_GRAB_RIGID = 1 };
 
+/* a snapshot image's grabs (snapshot.h): the live ones, in slot order */
+typedef struct wb_image_grab {
+    int32_t n;
+    int32_t *p;            /* (n) particle, or the rigid slot (kind 1) */
+    int32_t *kind;         /* (n) 0 = particle, 1 = rigid body */
+    wb_real *local;        /* (n x 3) a body's grabbed point in its frame (kind 1) */
+    wb_real *target, *from; /* (n x 3) target now, and where the next step's sweep starts */
+    wb_real *alpha;        /* (n) compliance, m/N */
+} wb_image_grab;
+struct wb_image;
+/* the image's grab arrays for n of them (zeroed), after wb_image_alloc; WB_ERR_NOMEM */
+wb_status wb_image_alloc_grab(struct wb_image *g, int32_t n);
+
 /* w->grab: NULL until the first grab */
 typedef struct wb_grabs {
     int32_t n, cap, nlive;  /* slots, capacity, live ones */

@@ -7,8 +7,10 @@
 
 #include "wobble.h"
 /* the constraint types' own sections of an image, declared by their owners */
+#include "attach.h"
 #include "bend.h"
 #include "distance.h"
+#include "grab.h"
 #include "shape_match.h"
 #include "tet.h"
 #include "tether.h"
@@ -30,23 +32,6 @@ typedef struct wb_image_collider {
     int32_t *mt;           /* mesh: (mnt x 3) corners (malloc'd, the image owns it) */
 } wb_image_collider;
 
-/* attachments (attach.c) and grabs (grab.c): the live ones, in slot order */
-typedef struct wb_image_attach {
-    int32_t n;
-    int32_t *p;            /* (n) particle */
-    int32_t *kind;         /* (n) target kind: 0 = collider */
-    int32_t *target;       /* (n) the target's slot (a live collider slot of the image) */
-    wb_real *local;        /* (n x 3) the point in the target's frame */
-    wb_real *alpha;        /* (n) compliance, m/N */
-} wb_image_attach;
-typedef struct wb_image_grab {
-    int32_t n;
-    int32_t *p;            /* (n) particle, or the rigid slot (kind 1) */
-    int32_t *kind;         /* (n) 0 = particle, 1 = rigid body */
-    wb_real *local;        /* (n x 3) a body's grabbed point in its frame (kind 1) */
-    wb_real *target, *from; /* (n x 3) target now, and where the next step's sweep starts */
-    wb_real *alpha;        /* (n) compliance, m/N */
-} wb_image_grab;
 /* a rigid body (rigid.c): its shape in its own frame, mass, pose and velocities, raw (a
  * capsule's a and b about its centre of mass, the rotation unit) */
 typedef struct wb_image_rigid {
@@ -90,8 +75,8 @@ typedef struct wb_image {
     wb_image_tet tet;      /* tet.h: empty unless wb_image_alloc_tets */
     wb_image_smatch sm;    /* shape_match.h: empty unless wb_image_alloc_smatch */
     wb_image_pressure pr;  /* shape_match.h: empty unless wb_image_alloc_pressure */
-    wb_image_attach att;   /* empty unless wb_image_alloc_attach */
-    wb_image_grab grab;    /* empty unless wb_image_alloc_grab */
+    wb_image_attach att;   /* attach.h: empty unless wb_image_alloc_attach */
+    wb_image_grab grab;    /* grab.h: empty unless wb_image_alloc_grab */
     wb_image_tether teth;  /* tether.h: empty unless wb_image_alloc_tethers */
     int32_t nrb;           /* rigid bodies by slot: empty unless wb_image_alloc_rigids */
     wb_image_rigid *rb;    /* (nrb) */
@@ -128,10 +113,8 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *img, wb_body *out);
 /* the collider w:collider{...} would make from a world-frame def, in its own frame + pose */
 wb_status wb_image_collider_from_def(const wb_collider_def *d, wb_image_collider *out);
 
-/* attach.c and grab.c, the same way. Each constraint type's part of the functions above
- * (save, check, put) is its own, reached through its hooks (ctype.h) */
-wb_status wb_image_alloc_attach(wb_image *g, int32_t n);
-wb_status wb_image_alloc_grab(wb_image *g, int32_t n);
+/* Each constraint type's part of the functions above (save, check, put) is its own,
+ * reached through its hooks (ctype.h) */
 
 /* rigid bodies (rigid_image.c): n slots, zeroed, generations 1 (live); WB_ERR_NOMEM */
 wb_status wb_image_alloc_rigids(wb_image *img, int32_t n);
