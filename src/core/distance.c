@@ -287,34 +287,14 @@ project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const w
 #define WB_DISTANCE_AVX2 1
 #include <immintrin.h>
 
-/* the x, y, z of 4 particles as 3 vectors of lanes: rows loaded without the 4th double
- * (maskload does not touch it: the last particle ends the array), then transposed */
-static inline __attribute__((always_inline, target("avx2"))) void
-load4(const wb_real *p, const size_t o[4], __m256d *X, __m256d *Y, __m256d *Z)
-{
-    const __m256i m = _mm256_set_epi64x(0, -1, -1, -1);
-    const __m256d r0 = _mm256_maskload_pd(&p[o[0]], m), r1 = _mm256_maskload_pd(&p[o[1]], m);
-    const __m256d r2 = _mm256_maskload_pd(&p[o[2]], m), r3 = _mm256_maskload_pd(&p[o[3]], m);
-    const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1); /* x0 x1 z0 z1, y0 y1 . . */
-    const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
-    *X = _mm256_permute2f128_pd(t0, t2, 0x20);
-    *Y = _mm256_permute2f128_pd(t1, t3, 0x20);
-    *Z = _mm256_permute2f128_pd(t0, t2, 0x31);
-}
+#include "simd.h"
 
 /* load4 on 4 row pointers, and its inverse (the corrections' pass: each row's address
  * made once for its load and its two stores) */
 static inline __attribute__((always_inline, target("avx2"))) void
 load4p(wb_real *const r[4], __m256d *X, __m256d *Y, __m256d *Z)
 {
-    const __m256i m = _mm256_set_epi64x(0, -1, -1, -1);
-    const __m256d r0 = _mm256_maskload_pd(r[0], m), r1 = _mm256_maskload_pd(r[1], m);
-    const __m256d r2 = _mm256_maskload_pd(r[2], m), r3 = _mm256_maskload_pd(r[3], m);
-    const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
-    const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
-    *X = _mm256_permute2f128_pd(t0, t2, 0x20);
-    *Y = _mm256_permute2f128_pd(t1, t3, 0x20);
-    *Z = _mm256_permute2f128_pd(t0, t2, 0x31);
+    wb__transpose4(wb__load3(r[0]), wb__load3(r[1]), wb__load3(r[2]), wb__load3(r[3]), X, Y, Z);
 }
 
 static inline __attribute__((always_inline, target("avx2"))) void
@@ -397,8 +377,8 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
             size_t ia[4], ic[4];
             offsets(&soa[j], &soc[j], ia, ic);
             __m256d xa0, xa1, xa2, xc0, xc1, xc2;
-            load4(x, ia, &xa0, &xa1, &xa2);
-            load4(x, ic, &xc0, &xc1, &xc2);
+            wb__load4(x, ia, &xa0, &xa1, &xa2);
+            wb__load4(x, ic, &xc0, &xc1, &xc2);
             const __m256d d0 = _mm256_sub_pd(xc0, xa0), d1 = _mm256_sub_pd(xc1, xa1), d2 = _mm256_sub_pd(xc2, xa2);
             const __m256d len2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)),
                                                _mm256_mul_pd(d2, d2));
@@ -422,8 +402,8 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
             _mm256_store_pd(&lv[g], _mm256_sqrt_pd(len2));
             if (damped) {
                 __m256d pa0, pa1, pa2, pc0, pc1, pc2;
-                load4(xp, ia, &pa0, &pa1, &pa2);
-                load4(xp, ic, &pc0, &pc1, &pc2);
+                wb__load4(xp, ia, &pa0, &pa1, &pa2);
+                wb__load4(xp, ic, &pc0, &pc1, &pc2);
                 const __m256d r0 = _mm256_mul_pd(_mm256_sub_pd(_mm256_sub_pd(xc0, pc0), _mm256_sub_pd(xa0, pa0)), d0);
                 const __m256d r1 = _mm256_mul_pd(_mm256_sub_pd(_mm256_sub_pd(xc1, pc1), _mm256_sub_pd(xa1, pa1)), d1);
                 const __m256d r2 = _mm256_mul_pd(_mm256_sub_pd(_mm256_sub_pd(xc2, pc2), _mm256_sub_pd(xa2, pa2)), d2);
@@ -483,8 +463,8 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
             if (jacobi) {
                 size_t ia[4], ic[4];
                 offsets(&soa[j], &soc[j], ia, ic);
-                load4(x, ia, &xa0, &xa1, &xa2);
-                load4(x, ic, &xc0, &xc1, &xc2);
+                wb__load4(x, ia, &xa0, &xa1, &xa2);
+                wb__load4(x, ic, &xc0, &xc1, &xc2);
             } else { /* out is x */
                 load4p(ra, &xa0, &xa1, &xa2);
                 load4p(rc, &xc0, &xc1, &xc2);

@@ -346,20 +346,7 @@ static void links_scalar(const wb_world *w, const struct wb_vbd *v, int32_t i, w
 #define WB_VBD_AVX2 1
 #include <immintrin.h>
 
-/* the x, y, z of 4 particles (offsets o) as 3 vectors of lanes, as distance.c's load4:
- * rows loaded without their 4th double (maskload does not touch it), then transposed */
-static inline __attribute__((always_inline, target("avx2"))) void
-load4(const wb_real *p, const size_t o[4], __m256d *X, __m256d *Y, __m256d *Z)
-{
-    const __m256i m = _mm256_set_epi64x(0, -1, -1, -1);
-    const __m256d r0 = _mm256_maskload_pd(&p[o[0]], m), r1 = _mm256_maskload_pd(&p[o[1]], m);
-    const __m256d r2 = _mm256_maskload_pd(&p[o[2]], m), r3 = _mm256_maskload_pd(&p[o[3]], m);
-    const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
-    const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
-    *X = _mm256_permute2f128_pd(t0, t2, 0x20);
-    *Y = _mm256_permute2f128_pd(t1, t3, 0x20);
-    *Z = _mm256_permute2f128_pd(t0, t2, 0x31);
-}
+#include "simd.h"
 
 /* the lanes of a and b added as (0 + 1) + (2 + 3): out[0] a's, out[1] b's */
 static inline __attribute__((always_inline, target("avx2"))) void sum2(__m256d a, __m256d b, wb_real out[2])
@@ -380,7 +367,7 @@ static __attribute__((target("avx2"))) void links_avx2(const wb_world *w, const 
         const int32_t e = e0 + q, *j = &v->adjo[e];
         const size_t o[4] = { 3 * (size_t)j[0], 3 * (size_t)j[1], 3 * (size_t)j[2], 3 * (size_t)j[3] };
         __m256d d0, d1, d2;
-        load4(x, o, &d0, &d1, &d2);
+        wb__load4(x, o, &d0, &d1, &d2);
         d0 = _mm256_sub_pd(xi, d0), d1 = _mm256_sub_pd(yi, d1), d2 = _mm256_sub_pd(zi, d2);
         const __m256d l2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2));
         const __m256d live = _mm256_cmp_pd(l2, tiny, _CMP_GT_OQ);
@@ -392,7 +379,7 @@ static __attribute__((target("avx2"))) void links_avx2(const wb_world *w, const 
             /* the damped lanes only (a lane of dmp 0 would add 0 times a finite number: the
              * same fm, never -0, but the scalar loop does not add it) */
             __m256d u0, u1, u2;
-            load4(xp, o, &u0, &u1, &u2);
+            wb__load4(xp, o, &u0, &u1, &u2);
             u0 = _mm256_sub_pd(u0, _mm256_set1_pd(xp[3 * i]));
             u1 = _mm256_sub_pd(u1, _mm256_set1_pd(xp[3 * i + 1]));
             u2 = _mm256_sub_pd(u2, _mm256_set1_pd(xp[3 * i + 2]));
