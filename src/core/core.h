@@ -13,39 +13,10 @@
 #include <string.h>
 
 #include "wobble.h"
+#include "vec.h"
 #include "bend.h"
 #include "shape_match.h"
 #include "pool.h"
-
-/* ---- small vector helpers ---------------------------------------------------------- */
-static inline void v3_set(wb_real *o, wb_real x, wb_real y, wb_real z) { o[0] = x; o[1] = y; o[2] = z; }
-static inline void v3_copy(wb_real *o, const wb_real *a) { o[0] = a[0]; o[1] = a[1]; o[2] = a[2]; }
-static inline void v3_add(wb_real *o, const wb_real *a, const wb_real *b) { o[0] = a[0] + b[0]; o[1] = a[1] + b[1]; o[2] = a[2] + b[2]; }
-static inline void v3_sub(wb_real *o, const wb_real *a, const wb_real *b) { o[0] = a[0] - b[0]; o[1] = a[1] - b[1]; o[2] = a[2] - b[2]; }
-static inline void v3_scale(wb_real *o, const wb_real *a, wb_real s) { o[0] = a[0] * s; o[1] = a[1] * s; o[2] = a[2] * s; }
-static inline void v3_madd(wb_real *o, const wb_real *a, wb_real s) { o[0] += a[0] * s; o[1] += a[1] * s; o[2] += a[2] * s; }
-static inline wb_real v3_dot(const wb_real *a, const wb_real *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-static inline wb_real v3_len(const wb_real *a) { return sqrt(v3_dot(a, a)); }
-/* |a| without overflow for huge components (1e300 squared is inf) */
-static inline wb_real v3_len_safe(const wb_real *a)
-{
-    wb_real m = fmax(fabs(a[0]), fmax(fabs(a[1]), fabs(a[2])));
-    if (m == 0 || !isfinite(m)) return m;
-    wb_real b[3] = { a[0] / m, a[1] / m, a[2] / m };
-    return m * v3_len(b);
-}
-/* the same, the quick way while the square cannot overflow (the broad phases' speeds) */
-static inline wb_real v3_len_fast(const wb_real *a)
-{
-    const wb_real s = v3_dot(a, a);
-    return s < 1e300 ? sqrt(s) : v3_len_safe(a);
-}
-static inline void v3_cross(wb_real *o, const wb_real *a, const wb_real *b)
-{
-    wb_real x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2], z = a[0] * b[1] - a[1] * b[0];
-    o[0] = x; o[1] = y; o[2] = z;
-}
-static inline wb_real clampr(wb_real x, wb_real lo, wb_real hi) { return x < lo ? lo : x > hi ? hi : x; }
 
 /* a substep's prediction, per particle: damping, gravity, x += h v (x_prev = x first; a
  * particle with w = 0 stays). solver.c's pass and collide.c's fused one share it, so
@@ -62,13 +33,6 @@ static inline void wb__predict_one(const wb_predict *p, wb_real w, wb_real *rest
     v[0] = v[0] * p->keep + p->g[0]; v[1] = v[1] * p->keep + p->g[1]; v[2] = v[2] * p->keep + p->g[2];
     x[0] += p->h * v[0]; x[1] += p->h * v[1]; x[2] += p->h * v[2];
 }
-
-/* quaternions (w, x, y, z) */
-void q_normalize(wb_real q[4]);
-void q_rotate(const wb_real q[4], const wb_real v[3], wb_real out[3]);      /* q v q* */
-void q_rotate_inv(const wb_real q[4], const wb_real v[3], wb_real out[3]);  /* q* v q */
-void q_slerp(const wb_real a[4], const wb_real b[4], wb_real t, wb_real out[4]);
-void q_integrate(const wb_real q[4], const wb_real om[3], wb_real h, wb_real out[4]);
 
 /* ---- model ----------------------------------------------------------------------- */
 typedef struct wb_cshape {
