@@ -14,6 +14,7 @@
 
 #include "wobble.h"
 #include "vec.h"
+#include "shape.h"
 #include "bend.h"
 #include "shape_match.h"
 #include "pool.h"
@@ -35,16 +36,6 @@ static inline void wb__predict_one(const wb_predict *p, wb_real w, wb_real *rest
 }
 
 /* ---- model ----------------------------------------------------------------------- */
-typedef struct wb_cshape {
-    wb_shape shape;
-    wb_real n[3];          /* plane: unit normal in the collider frame */
-    wb_real radius;        /* sphere, capsule */
-    wb_real half[3];       /* box */
-    wb_real a[3], b[3];    /* capsule segment in the collider frame */
-    wb_real friction, restitution;
-    struct wb_colmesh *mesh; /* mesh: owned triangles and tree (bvh.h); NULL otherwise */
-} wb_cshape;
-
 typedef struct wb_model {
     wb_world_def def;
 
@@ -641,8 +632,6 @@ int32_t wb__bend_hinges(const int32_t *tri, int32_t ntri, int32_t *out);
  * the finiteness check of x and v into k.nonfinite. 0 when out of memory (nothing done) */
 int wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1, const wb_predict *next, int scan);
 void wb__collider_pose_at(const wb_collider_pose *cp, wb_real t, wb_real p[3], wb_real q[4]);
-wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real q[4],
-                           const wb_real x[3], wb_real n[3]);
 /* collide.c: a mesh collider's copy charged to / given back to the memory budget (and freed) */
 int wb__mesh_charge(wb_world *w, const struct wb_colmesh *cm);
 void wb__mesh_release(wb_world *w, wb_cshape *s);

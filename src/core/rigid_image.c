@@ -32,23 +32,17 @@ wb_status wb_image_rigid_from_def(const wb_rigid_def *d, wb_image_rigid *o)
     if (e) { wb__set_error("%s", e); return WB_ERR_ARG; }
     memset(o, 0, sizeof *o);
     o->shape = d->shape;
-    if (d->shape != WB_SHAPE_BOX) o->radius = d->radius;
     o->friction = d->friction;
     o->restitution = d->restitution;
     o->mass = d->mass;
-    memcpy(o->q, d->rotation, sizeof o->q);
-    q_normalize(o->q);
-    v3_copy(o->x, d->pos);
     v3_copy(o->v, d->vel);
     v3_copy(o->om, d->angular_velocity);
-    if (d->shape == WB_SHAPE_BOX) v3_copy(o->half, d->half);
-    if (d->shape == WB_SHAPE_CAPSULE) { /* as wb_rigid_add: about the midpoint */
-        wb_real c[3] = { d->a[0] / 2 + d->b[0] / 2, d->a[1] / 2 + d->b[1] / 2, d->a[2] / 2 + d->b[2] / 2 }, cw[3];
-        v3_sub(o->a, d->a, c);
-        v3_sub(o->b, d->b, c);
-        q_rotate(o->q, c, cw);
-        v3_add(o->x, o->x, cw);
-    }
+    wb_cshape s;
+    wb__rigid_shape_of(d, &s, o->x, o->q); /* as wb_rigid_add */
+    o->radius = s.radius;
+    v3_copy(o->half, s.half);
+    v3_copy(o->a, s.a);
+    v3_copy(o->b, s.b);
     return WB_OK;
 }
 
