@@ -140,6 +140,12 @@ int32_t wb_collider_mesh(const wb_world *w, wb_collider_id c, const wb_real **v,
     return cm->nv;
 }
 
+int wb_collider_solids(const wb_world *w, wb_collider_id c, wb_solid out[WB_MAX_SOLIDS])
+{
+    const int32_t i = CSLOT(w, c);
+    return wb__shape_solids(&w->m.c_shape[i], w->s.c_pose[i].p, w->s.c_pose[i].q, out);
+}
+
 bool wb_collider_mesh_closed(const wb_world *w, wb_collider_id c)
 {
     const wb_colmesh *cm = w->m.c_shape[CSLOT(w, c)].mesh;

@@ -215,6 +215,14 @@ wb_rigid_id wb_rigid_at(const wb_world *w, int32_t i)
     return none;
 }
 
+int wb_rigid_solids(const wb_world *w, wb_rigid_id r, wb_solid out[WB_MAX_SOLIDS])
+{
+    const int32_t i = RSLOT(w, r);
+    return wb__shape_solids(&w->rb->shape[i], &w->rb->x[3 * i], &w->rb->q[4 * i], out);
+}
+
+wb_real wb_rigid_bound(const wb_world *w, wb_rigid_id r) { return w->rb->bound[RSLOT(w, r)]; }
+
 void wb_rigid_get_def(const wb_world *w, wb_rigid_id r, wb_rigid_def *out)
 {
     const int32_t i = RSLOT(w, r);

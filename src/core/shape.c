@@ -33,6 +33,12 @@ wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real
     return dist;
 }
 
+int wb__shape_solids(const wb_cshape *s, const wb_real p[3], const wb_real q[4], wb_solid out[WB_MAX_SOLIDS])
+{
+    const wb_shape_class *k = wb__shape(s->shape);
+    return k && k->solids ? k->solids(s, p, q, out) : 0;
+}
+
 wb_real wb__shape_bound(const wb_cshape *s)
 {
     const wb_shape_class *k = wb__shape(s->shape);

@@ -48,6 +48,8 @@ typedef struct wb_shape_class {
     /* a round shape (a segment swept by a ball of s->radius): the segment's ends in the
      * world at pose (p, q); NULL for the others */
     void (*segment)(const wb_cshape *s, const wb_real p[3], const wb_real q[4], wb_real a[3], wb_real b[3]);
+    /* what a renderer draws of it at pose (p, q) (wobble.h's wb_solid); NULL: nothing */
+    int (*solids)(const wb_cshape *s, const wb_real p[3], const wb_real q[4], wb_solid out[WB_MAX_SOLIDS]);
     /* rigid bodies: NULL for a shape that cannot be one. A rigid def's shape fields:
      * NULL when valid (its mass given: the inertia must stay finite) */
     const char *(*rigid_check)(const wb_rigid_def *d);
@@ -68,6 +70,8 @@ wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real
                            wb_real n[3]);
 /* the class's bound (-1: none) */
 wb_real wb__shape_bound(const wb_cshape *s);
+/* the class's solids at pose (p, q) (0 when it has none) */
+int wb__shape_solids(const wb_cshape *s, const wb_real p[3], const wb_real q[4], wb_solid out[WB_MAX_SOLIDS]);
 
 /* what the shapes' checks share */
 static inline int wb__fin3(const wb_real *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }

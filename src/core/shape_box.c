@@ -45,6 +45,19 @@ static wb_real distance(const wb_cshape *s, const wb_real l[3], wb_real nl[3])
 
 static wb_real bound(const wb_cshape *s) { return v3_len(s->half); }
 
+static int solids(const wb_cshape *s, const wb_real p[3], const wb_real q[4], wb_solid out[WB_MAX_SOLIDS])
+{
+    memset(out, 0, sizeof *out);
+    out->kind = WB_SOLID_BOX;
+    v3_copy(out->c, p);
+    for (int k = 0; k < 3; k++) {
+        wb_real e[3] = { 0, 0, 0 };
+        e[k] = s->half[k];
+        q_rotate(q, e, out->axes[k]);
+    }
+    return 1;
+}
+
 static const char *rigid_check(const wb_rigid_def *d)
 {
     if (!(d->half[0] > 0 && d->half[1] > 0 && d->half[2] > 0) || !wb__fin3(d->half)) return "half extents must be > 0";
@@ -68,6 +81,6 @@ static void inertia(const wb_cshape *s, wb_real m, wb_real I[9])
 }
 
 const wb_shape_class wb__shape_box = {
-    .name = "box", .check = check, .make = make, .check_shape = check_shape, .distance = distance, .bound = bound,
+    .name = "box", .check = check, .make = make, .check_shape = check_shape, .distance = distance, .bound = bound, .solids = solids,
     .rigid_check = rigid_check, .rigid_make = rigid_make, .inertia = inertia,
 };

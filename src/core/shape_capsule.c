@@ -55,6 +55,22 @@ static void segment(const wb_cshape *s, const wb_real p[3], const wb_real q[4], 
     v3_add(b, b, p);
 }
 
+/* a ball at each end and the cylinder between */
+static int solids(const wb_cshape *s, const wb_real p[3], const wb_real q[4], wb_solid out[WB_MAX_SOLIDS])
+{
+    wb_real a[3], b[3];
+    segment(s, p, q, a, b);
+    memset(out, 0, 3 * sizeof *out);
+    out[0].kind = out[1].kind = WB_SOLID_SPHERE;
+    out[2].kind = WB_SOLID_CYLINDER;
+    v3_copy(out[0].c, a);
+    v3_copy(out[1].c, b);
+    v3_copy(out[2].a, a);
+    v3_copy(out[2].b, b);
+    out[0].radius = out[1].radius = out[2].radius = s->radius;
+    return 3;
+}
+
 static const char *rigid_check(const wb_rigid_def *d)
 {
     if (!(d->radius > 0) || !isfinite(d->radius * d->radius * d->mass)) return "radius must be > 0 (and not huge)";
@@ -96,5 +112,5 @@ static void inertia(const wb_cshape *s, wb_real m, wb_real I[9])
 
 const wb_shape_class wb__shape_capsule = {
     .name = "capsule", .check = check, .make = make, .check_shape = check_shape, .distance = distance,
-    .bound = bound, .segment = segment, .rigid_check = rigid_check, .rigid_make = rigid_make, .inertia = inertia,
+    .bound = bound, .segment = segment, .solids = solids, .rigid_check = rigid_check, .rigid_make = rigid_make, .inertia = inertia,
 };

@@ -52,6 +52,16 @@ static void segment(const wb_cshape *s, const wb_real p[3], const wb_real q[4], 
     v3_copy(b, p);
 }
 
+static int solids(const wb_cshape *s, const wb_real p[3], const wb_real q[4], wb_solid out[WB_MAX_SOLIDS])
+{
+    (void)q;
+    memset(out, 0, sizeof *out);
+    out->kind = WB_SOLID_SPHERE;
+    v3_copy(out->c, p);
+    out->radius = s->radius;
+    return 1;
+}
+
 static const char *rigid_check(const wb_rigid_def *d)
 {
     if (!(d->radius > 0) || !isfinite(d->radius * d->radius * d->mass)) return "radius must be > 0 (and not huge)";
@@ -72,6 +82,6 @@ static void inertia(const wb_cshape *s, wb_real m, wb_real I[9])
 
 const wb_shape_class wb__shape_sphere = {
     .name = "sphere", .check = check, .make = make, .check_shape = check_shape, .distance = distance,
-    .distance_world = distance_world, .bound = bound, .segment = segment,
+    .distance_world = distance_world, .bound = bound, .segment = segment, .solids = solids,
     .rigid_check = rigid_check, .rigid_make = rigid_make, .inertia = inertia,
 };
