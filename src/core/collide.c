@@ -261,7 +261,7 @@ static wb_real mesh_depth(const sub_pose *sp, const wb_real x[3], const wb_real 
     q_rotate_inv(sp->q1, u, l);
     /* far from the tree's box: no contact, and no query */
     const wb_bvh_node *root = &cm->nodes[0];
-    wb_real lp[3], mv = 0;
+    wb_real lp[3] = { 0, 0, 0 }, mv = 0; /* set and read only for an open mesh (gcc -O3 cannot tell) */
     if (!cm->closed) {
         v3_sub(u, xprev, sp->p0);
         q_rotate_inv(sp->q0, u, lp);
