@@ -49,6 +49,13 @@ typedef enum wb_solver { WB_SOLVER_GAUSS_SEIDEL = 0, WB_SOLVER_JACOBI = 1, WB_SO
 typedef enum wb_shape {
     WB_SHAPE_PLANE = 0, WB_SHAPE_SPHERE, WB_SHAPE_BOX, WB_SHAPE_CAPSULE, WB_SHAPE_MESH, WB_SHAPE_COUNT
 } wb_shape;
+/* what scripts and files call a shape, and the fields it takes as words separated by
+ * spaces (its file, src/core/shape_NAME.c, gives them): of wb_collider_def (`mesh`: the
+ * wb_mesh), of a collider in its own frame as w:save writes it (in that order), of
+ * wb_rigid_def (in w:save's order; NULL: no rigid body has the shape) */
+typedef struct wb_shape_info { const char *name, *fields, *own_fields, *rigid_fields; } wb_shape_info;
+const wb_shape_info *wb_shape_info_of(wb_shape s); /* NULL when s is not a shape */
+bool wb_shape_takes(const char *fields, const char *key); /* fields (a list above) has the word key */
 
 typedef struct wb_world wb_world;
 

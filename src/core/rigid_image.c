@@ -96,12 +96,14 @@ const char *wb_image_rigid_check(const wb_image_rigid *o)
     if (e) return e;
     if (!fin(o->q, 4) || fabs(o->q[0] * o->q[0] + v3_dot(&o->q[1], &o->q[1]) - 1) > 1e-9)
         return "rigid body rotation must be a unit quaternion";
-    /* the capsule about its centre of mass */
-    if (o->shape == WB_SHAPE_CAPSULE)
-        for (int i = 0; i < 3; i++)
-            if (fabs(o->a[i] + o->b[i]) > 1e-9 * (1 + fabs(o->a[i]) + fabs(o->b[i])))
-                return "rigid capsule a and b must be about its centre (a = -b)";
-    return NULL;
+    /* the shape about its centre of mass */
+    const wb_shape_class *k = wb__shape(o->shape);
+    if (!k->rigid_check_shape) return NULL;
+    wb_cshape s = { .shape = o->shape, .radius = o->radius };
+    v3_copy(s.half, o->half);
+    v3_copy(s.a, o->a);
+    v3_copy(s.b, o->b);
+    return k->rigid_check_shape(&s);
 }
 
 const char *wb__rigid_image_check(const wb_image *g)

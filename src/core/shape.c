@@ -15,6 +15,25 @@ const wb_shape_class *wb__shape(wb_shape s)
     return (unsigned)s < WB_SHAPE_COUNT ? shapes[s] : NULL;
 }
 
+const wb_shape_info *wb_shape_info_of(wb_shape s)
+{
+    const wb_shape_class *k = wb__shape(s);
+    return k ? &k->info : NULL;
+}
+
+bool wb_shape_takes(const char *fields, const char *key)
+{
+    const size_t n = strlen(key);
+    for (const char *p = fields; p && *p;) {
+        while (*p == ' ') p++;
+        const char *e = p;
+        while (*e && *e != ' ') e++;
+        if ((size_t)(e - p) == n && n > 0 && !strncmp(p, key, n)) return true;
+        p = e;
+    }
+    return false;
+}
+
 wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real q[4], const wb_real x[3],
                            wb_real n[3])
 {

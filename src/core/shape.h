@@ -26,7 +26,7 @@ typedef struct wb_cshape {
 } wb_cshape;
 
 typedef struct wb_shape_class {
-    const char *name;
+    wb_shape_info info;    /* its names and fields (wobble.h) */
     int has_mesh;          /* keeps a copy of a def's mesh (bvh.h's wb_colmesh) */
     /* a collider def's shape fields: NULL when valid, else what is wrong */
     const char *(*check)(const wb_collider_def *d);
@@ -59,6 +59,9 @@ typedef struct wb_shape_class {
     /* the inertia tensor of mass m about the centre of mass, in the body frame, into I
      * (row-major, zero on entry) */
     void (*inertia)(const wb_cshape *s, wb_real m, wb_real I[9]);
+    /* a restored rigid shape (an image's) about its centre of mass: NULL when it is, else
+     * what is wrong; NULL: always */
+    const char *(*rigid_check_shape)(const wb_cshape *s);
 } wb_shape_class;
 
 extern const wb_shape_class wb__shape_plane, wb__shape_sphere, wb__shape_box, wb__shape_capsule, wb__shape_mesh;

@@ -81,6 +81,6 @@ static void inertia(const wb_cshape *s, wb_real m, wb_real I[9])
 }
 
 const wb_shape_class wb__shape_box = {
-    .name = "box", .check = check, .make = make, .check_shape = check_shape, .distance = distance, .bound = bound, .solids = solids,
+    .info = { "box", "center half rotation", "half", "half" }, .check = check, .make = make, .check_shape = check_shape, .distance = distance, .bound = bound, .solids = solids,
     .rigid_check = rigid_check, .rigid_make = rigid_make, .inertia = inertia,
 };

@@ -90,6 +90,14 @@ static int rigid_make(const wb_rigid_def *d, wb_cshape *s, wb_real c[3])
     return 1;
 }
 
+static const char *rigid_check_shape(const wb_cshape *s)
+{
+    for (int i = 0; i < 3; i++)
+        if (fabs(s->a[i] + s->b[i]) > 1e-9 * (1 + fabs(s->a[i]) + fabs(s->b[i])))
+            return "rigid capsule a and b must be about its centre (a = -b)";
+    return NULL;
+}
+
 static void inertia(const wb_cshape *s, wb_real m, wb_real I[9])
 {
     /* a cylinder of length L and two hemispheres (together a ball), mass by volume */
@@ -111,6 +119,7 @@ static void inertia(const wb_cshape *s, wb_real m, wb_real I[9])
 }
 
 const wb_shape_class wb__shape_capsule = {
-    .name = "capsule", .check = check, .make = make, .check_shape = check_shape, .distance = distance,
+    .info = { "capsule", "a b radius", "a b radius", "radius a b" }, .check = check, .make = make, .check_shape = check_shape, .distance = distance,
     .bound = bound, .segment = segment, .solids = solids, .rigid_check = rigid_check, .rigid_make = rigid_make, .inertia = inertia,
+    .rigid_check_shape = rigid_check_shape,
 };

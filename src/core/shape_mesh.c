@@ -35,5 +35,5 @@ static wb_real distance(const wb_cshape *s, const wb_real l[3], wb_real nl[3])
 static wb_real bound(const wb_cshape *s) { (void)s; return -1; }
 
 const wb_shape_class wb__shape_mesh = {
-    .name = "mesh", .has_mesh = 1, .check = check, .make = make, .distance = distance, .bound = bound,
+    .info = { "mesh", "mesh center rotation scale", "vertices triangles", NULL }, .has_mesh = 1, .check = check, .make = make, .distance = distance, .bound = bound,
 };

@@ -33,5 +33,5 @@ static wb_real distance(const wb_cshape *s, const wb_real l[3], wb_real nl[3])
 static wb_real bound(const wb_cshape *s) { (void)s; return -1; }
 
 const wb_shape_class wb__shape_plane = {
-    .name = "plane", .check = check, .make = make, .check_shape = check_shape, .distance = distance, .bound = bound,
+    .info = { "plane", "normal offset", "normal", NULL }, .check = check, .make = make, .check_shape = check_shape, .distance = distance, .bound = bound,
 };

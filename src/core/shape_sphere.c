@@ -81,7 +81,7 @@ static void inertia(const wb_cshape *s, wb_real m, wb_real I[9])
 }
 
 const wb_shape_class wb__shape_sphere = {
-    .name = "sphere", .check = check, .make = make, .check_shape = check_shape, .distance = distance,
+    .info = { "sphere", "center radius", "radius", "radius" }, .check = check, .make = make, .check_shape = check_shape, .distance = distance,
     .distance_world = distance_world, .bound = bound, .segment = segment, .solids = solids,
     .rigid_check = rigid_check, .rigid_make = rigid_make, .inertia = inertia,
 };
