@@ -49,6 +49,13 @@ typedef enum wb_solver { WB_SOLVER_GAUSS_SEIDEL = 0, WB_SOLVER_JACOBI = 1, WB_SO
 typedef enum wb_shape {
     WB_SHAPE_PLANE = 0, WB_SHAPE_SPHERE, WB_SHAPE_BOX, WB_SHAPE_CAPSULE, WB_SHAPE_MESH, WB_SHAPE_COUNT
 } wb_shape;
+/* what scripts and files call a shape, and the fields it takes as words separated by
+ * spaces (its file, src/core/shape_NAME.c, gives them): of wb_collider_def (`mesh`: the
+ * wb_mesh), of a collider in its own frame as w:save writes it (in that order), of
+ * wb_rigid_def (in w:save's order; NULL: no rigid body has the shape) */
+typedef struct wb_shape_info { const char *name, *fields, *own_fields, *rigid_fields; } wb_shape_info;
+const wb_shape_info *wb_shape_info_of(wb_shape s); /* NULL when s is not a shape */
+bool wb_shape_takes(const char *fields, const char *key); /* fields (a list above) has the word key */
 
 typedef struct wb_world wb_world;
 
@@ -213,6 +220,19 @@ wb_real wb_collider_distance(const wb_world *w, wb_collider_id c, const wb_real 
  * returns the vertex count, 0 for other shapes; pointers valid until it is removed */
 int32_t wb_collider_mesh(const wb_world *w, wb_collider_id c, const wb_real **v, const int32_t **tri, int32_t *nt);
 bool wb_collider_mesh_closed(const wb_world *w, wb_collider_id c);
+/* what a renderer draws of a shape: spheres, cylinders (capped by spheres) and boxes in the
+ * world at the current pose; a plane and a mesh have none (the ground; wb_collider_mesh) */
+typedef enum wb_solid_kind { WB_SOLID_SPHERE, WB_SOLID_CYLINDER, WB_SOLID_BOX } wb_solid_kind;
+typedef struct wb_solid {
+    wb_solid_kind kind;
+    wb_real c[3];                 /* sphere, box: centre */
+    wb_real a[3], b[3];           /* cylinder: its axis' ends */
+    wb_real radius;               /* sphere, cylinder */
+    wb_real axes[3][3];           /* box: axes[k] is its k-th half axis in the world */
+} wb_solid;
+#define WB_MAX_SOLIDS 3
+/* the collider's solids into out (room for WB_MAX_SOLIDS); returns how many */
+int wb_collider_solids(const wb_world *w, wb_collider_id c, wb_solid out[WB_MAX_SOLIDS]);
 
 /* ---- builders: particles are contiguous [first, first+count) --------------------------- */
 typedef struct wb_body { int32_t first, count, group; } wb_body; /* group: its contact group */
@@ -649,6 +669,10 @@ wb_rigid_id wb_rigid_at(const wb_world *w, int32_t i);       /* 0 <= i < count, 
  * returns how many were written (rigid_image.c) */
 int32_t wb_rigid_list(const wb_world *w, wb_rigid_id *out, int32_t cap);
 void wb_rigid_get_def(const wb_world *w, wb_rigid_id r, wb_rigid_def *out); /* shape + state now */
+/* the body's solids as wb_collider_solids; the radius of a ball about its centre of mass
+ * holding it */
+int wb_rigid_solids(const wb_world *w, wb_rigid_id r, wb_solid out[WB_MAX_SOLIDS]);
+wb_real wb_rigid_bound(const wb_world *w, wb_rigid_id r);
 void wb_rigid_position(const wb_world *w, wb_rigid_id r, wb_real out[3]);
 void wb_rigid_rotation(const wb_world *w, wb_rigid_id r, wb_real out[4]);
 void wb_rigid_velocity(const wb_world *w, wb_rigid_id r, wb_real out[3]);

@@ -15,71 +15,6 @@
 #include "bvh.h"
 #include "attach.h"
 
-/* ---- quaternions ------------------------------------------------------------------- */
-void q_normalize(wb_real q[4])
-{
-    /* scaled first: components of 1e200 must not overflow to inf when squared */
-    wb_real m = fmax(fmax(fabs(q[0]), fabs(q[1])), fmax(fabs(q[2]), fabs(q[3])));
-    if (m == 0 || !isfinite(m)) { q[0] = 1; q[1] = q[2] = q[3] = 0; return; }
-    for (int i = 0; i < 4; i++) q[i] /= m;
-    wb_real n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    for (int i = 0; i < 4; i++) q[i] /= n;
-}
-
-void q_rotate(const wb_real q[4], const wb_real v[3], wb_real out[3])
-{
-    /* v + 2 u x (u x v + w v), u = (x, y, z) */
-    const wb_real *u = &q[1];
-    wb_real t[3], c[3];
-    v3_cross(t, u, v);
-    v3_madd(t, v, q[0]);
-    v3_cross(c, u, t);
-    wb_real r[3] = { v[0] + 2 * c[0], v[1] + 2 * c[1], v[2] + 2 * c[2] };
-    v3_copy(out, r);
-}
-
-void q_rotate_inv(const wb_real q[4], const wb_real v[3], wb_real out[3])
-{
-    wb_real c[4] = { q[0], -q[1], -q[2], -q[3] };
-    q_rotate(c, v, out);
-}
-
-void q_slerp(const wb_real a[4], const wb_real b[4], wb_real t, wb_real out[4])
-{
-    wb_real d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3], s = 1;
-    if (d < 0) { d = -d; s = -1; } /* the short way round */
-    wb_real wa, wb;
-    if (d > (wb_real)0.9995) {
-        wa = 1 - t;
-        wb = t;
-    } else {
-        wb_real th = acos(d), sn = sin(th);
-        wa = sin((1 - t) * th) / sn;
-        wb = sin(t * th) / sn;
-    }
-    wb_real r[4];
-    for (int i = 0; i < 4; i++) r[i] = wa * a[i] + s * wb * b[i];
-    q_normalize(r);
-    memcpy(out, r, sizeof r);
-}
-
-void q_integrate(const wb_real q[4], const wb_real om[3], wb_real h, wb_real out[4])
-{
-    wb_real n = v3_len_safe(om);
-    if (n == 0) { if (out != q) memcpy(out, q, 4 * sizeof(wb_real)); return; }
-    /* exact rotation by |om| h about om: dq * q */
-    wb_real half = n * h / 2, s = sin(half) / n;
-    wb_real dq[4] = { cos(half), om[0] * s, om[1] * s, om[2] * s };
-    wb_real r[4] = {
-        dq[0] * q[0] - dq[1] * q[1] - dq[2] * q[2] - dq[3] * q[3],
-        dq[0] * q[1] + dq[1] * q[0] + dq[2] * q[3] - dq[3] * q[2],
-        dq[0] * q[2] - dq[1] * q[3] + dq[2] * q[0] + dq[3] * q[1],
-        dq[0] * q[3] + dq[1] * q[2] - dq[2] * q[1] + dq[3] * q[0],
-    };
-    q_normalize(r);
-    memcpy(out, r, sizeof r);
-}
-
 /* ---- collider API -------------------------------------------------------------------- */
 wb_collider_def wb_collider_default_def(wb_shape shape)
 {
@@ -96,55 +31,13 @@ wb_collider_def wb_collider_default_def(wb_shape shape)
     return d;
 }
 
-static int fin3(const wb_real *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
-
 const char *wb_collider_def_check(const wb_collider_def *d)
 {
-    if ((unsigned)d->shape >= WB_SHAPE_COUNT) return "unknown shape";
+    const wb_shape_class *k = wb__shape(d->shape);
+    if (!k) return "unknown shape";
     if (!(d->friction >= 0) || !isfinite(d->friction)) return "friction must be >= 0";
     if (!(d->restitution >= 0 && d->restitution <= 1)) return "restitution must be in [0, 1]";
-    switch (d->shape) {
-    case WB_SHAPE_PLANE:
-        if (!fin3(d->normal) || !isfinite(d->offset)) return "normal and offset must be finite";
-        if (!(v3_len_safe(d->normal) > 1e-12)) return "normal must not be zero";
-        /* the plane's point is offset/|normal| along it */
-        if (!isfinite(d->offset / v3_len_safe(d->normal))) return "offset / |normal| overflows: offset must be finite over a unit normal";
-        break;
-    case WB_SHAPE_SPHERE:
-        if (!fin3(d->center)) return "center must be finite";
-        if (!(d->radius > 0) || !isfinite(d->radius)) return "radius must be > 0";
-        break;
-    case WB_SHAPE_BOX:
-        if (!fin3(d->center)) return "center must be finite";
-        if (!(d->half[0] > 0 && d->half[1] > 0 && d->half[2] > 0) || !fin3(d->half)) return "half extents must be > 0";
-        if (!fin3(&d->rotation[1]) || !isfinite(d->rotation[0])) return "rotation must be finite";
-        if (!(fmax(fabs(d->rotation[0]), v3_len_safe(&d->rotation[1])) > 1e-12)) return "rotation must not be zero";
-        break;
-    case WB_SHAPE_CAPSULE:
-        if (!fin3(d->a) || !fin3(d->b)) return "a and b must be finite";
-        {
-            /* distances to the segment square b - a */
-            const wb_real ab[3] = { d->b[0] - d->a[0], d->b[1] - d->a[1], d->b[2] - d->a[2] };
-            if (!isfinite(v3_dot(ab, ab))) return "a and b are too far apart (|b - a| squared overflows)";
-        }
-        if (!(d->radius > 0) || !isfinite(d->radius)) return "radius must be > 0";
-        break;
-    case WB_SHAPE_MESH:
-        if (!d->mesh) return "mesh is missing";
-        if (d->mesh->nt <= 0) return "mesh is empty (no triangles)";
-        if (!(d->scale > 0) || !isfinite(d->scale)) return "scale must be > 0";
-        if (!fin3(d->center)) return "center must be finite";
-        if (!fin3(&d->rotation[1]) || !isfinite(d->rotation[0])) return "rotation must be finite";
-        if (!(fmax(fabs(d->rotation[0]), v3_len_safe(&d->rotation[1])) > 1e-12)) return "rotation must not be zero";
-        for (int64_t i = 0; i < 3 * (int64_t)d->mesh->nv; i++)
-            if (!isfinite(d->mesh->v[i] * d->scale)) return "mesh vertices x scale must be finite";
-        for (int64_t i = 0; i < 3 * (int64_t)d->mesh->nt; i++)
-            if (d->mesh->tri[i] < 0 || d->mesh->tri[i] >= d->mesh->nv) return "mesh corner out of range";
-        break;
-    default:
-        break;
-    }
-    return NULL;
+    return k->check(d);
 }
 
 /* a mesh collider's copy against the world's memory budget: 0 when it would pass the limit */
@@ -178,7 +71,7 @@ wb_collider_id wb_collider_add(wb_world *w, const wb_collider_def *def, wb_statu
     wb_model *m = &w->m;
     /* the mesh's copy first: when it fails nothing has changed */
     wb_colmesh *cm = NULL;
-    if (def->shape == WB_SHAPE_MESH) {
+    if (wb__shape(def->shape)->has_mesh) {
         cm = wb__colmesh_build(def->mesh->v, def->mesh->nv, def->mesh->tri, def->mesh->nt, def->scale);
         if (!cm) { *status = WB_ERR_NOMEM; return none; }
         if (!wb__mesh_charge(w, cm)) { wb__colmesh_free(cm); *status = WB_ERR_NOMEM; return none; }
@@ -211,41 +104,8 @@ wb_collider_id wb_collider_add(wb_world *w, const wb_collider_def *def, wb_statu
     s->friction = def->friction;
     s->restitution = def->restitution;
     p->q[0] = 1;
-    switch (def->shape) {
-    case WB_SHAPE_PLANE: {
-        wb_real n = v3_len_safe(def->normal);
-        v3_scale(s->n, def->normal, 1 / n);
-        v3_scale(p->p, s->n, def->offset / n); /* the plane passes through its position */
-        break;
-    }
-    case WB_SHAPE_SPHERE:
-        s->radius = def->radius;
-        v3_copy(p->p, def->center);
-        break;
-    case WB_SHAPE_MESH:
-        s->mesh = cm;
-        v3_copy(p->p, def->center);
-        memcpy(p->q, def->rotation, sizeof p->q);
-        q_normalize(p->q);
-        break;
-    case WB_SHAPE_BOX:
-        v3_copy(s->half, def->half);
-        v3_copy(p->p, def->center);
-        memcpy(p->q, def->rotation, sizeof p->q);
-        q_normalize(p->q);
-        break;
-    case WB_SHAPE_CAPSULE: {
-        s->radius = def->radius;
-        /* halves first: a + b overflows for a = b = 1e308 */
-        wb_real c[3] = { def->a[0] / 2 + def->b[0] / 2, def->a[1] / 2 + def->b[1] / 2, def->a[2] / 2 + def->b[2] / 2 };
-        v3_copy(p->p, c);
-        v3_sub(s->a, def->a, c);
-        v3_sub(s->b, def->b, c);
-        break;
-    }
-    default:
-        break;
-    }
+    wb__shape(def->shape)->make(def, s, p->p, p->q);
+    s->mesh = cm;
     v3_copy(p->p0, p->p);
     memcpy(p->q0, p->q, sizeof p->q);
     m->c_gen[slot]++;
@@ -278,6 +138,12 @@ int32_t wb_collider_mesh(const wb_world *w, wb_collider_id c, const wb_real **v,
     *tri = cm->tri;
     *nt = cm->nt;
     return cm->nv;
+}
+
+int wb_collider_solids(const wb_world *w, wb_collider_id c, wb_solid out[WB_MAX_SOLIDS])
+{
+    const int32_t i = CSLOT(w, c);
+    return wb__shape_solids(&w->m.c_shape[i], w->s.c_pose[i].p, w->s.c_pose[i].q, out);
 }
 
 bool wb_collider_mesh_closed(const wb_world *w, wb_collider_id c)
@@ -338,82 +204,6 @@ wb_collider_id wb_collider_at(const wb_world *w, int32_t i)
     return none;
 }
 
-/* ---- signed distances ------------------------------------------------------------------ */
-/* distance from x (world) to the surface of shape s at pose (p, q); n: outward unit normal */
-wb_real wb__shape_distance(const wb_cshape *s, const wb_real p[3], const wb_real q[4],
-                           const wb_real x[3], wb_real n[3])
-{
-    wb_real r[3], l[3], nl[3];
-    v3_sub(r, x, p);
-    if (s->shape == WB_SHAPE_SPHERE) {
-        /* round: no turn into its frame and back (two quaternion rotations a contact) */
-        const wb_real len = v3_len(r);
-        if (len > 0) v3_scale(n, r, 1 / len);
-        else {
-            v3_set(nl, 0, 1, 0);
-            q_rotate(q, nl, n);
-        }
-        return len - s->radius;
-    }
-    q_rotate_inv(q, r, l);
-    wb_real dist;
-    switch (s->shape) {
-    case WB_SHAPE_PLANE:
-        v3_copy(nl, s->n);
-        dist = v3_dot(l, s->n);
-        break;
-    case WB_SHAPE_SPHERE: {
-        wb_real len = v3_len(l);
-        if (len > 0) v3_scale(nl, l, 1 / len);
-        else v3_set(nl, 0, 1, 0);
-        dist = len - s->radius;
-        break;
-    }
-    case WB_SHAPE_CAPSULE: {
-        wb_real ab[3], al[3], c[3];
-        v3_sub(ab, s->b, s->a);
-        v3_sub(al, l, s->a);
-        wb_real ll = v3_dot(ab, ab), t = ll > 0 ? clampr(v3_dot(al, ab) / ll, 0, 1) : 0;
-        v3_copy(c, s->a);
-        v3_madd(c, ab, t);
-        v3_sub(c, l, c);
-        wb_real len = v3_len(c);
-        if (len > 0) v3_scale(nl, c, 1 / len);
-        else v3_set(nl, 0, 1, 0);
-        dist = len - s->radius;
-        break;
-    }
-    case WB_SHAPE_BOX: {
-        wb_real d[3], o[3] = { 0, 0, 0 };
-        int inside = 1;
-        for (int i = 0; i < 3; i++) {
-            d[i] = fabs(l[i]) - s->half[i];
-            if (d[i] > 0) { o[i] = l[i] > 0 ? d[i] : -d[i]; inside = 0; }
-        }
-        if (!inside) {
-            dist = v3_len(o);
-            v3_scale(nl, o, 1 / dist);
-        } else {
-            /* nearest face */
-            int k = d[0] > d[1] ? (d[0] > d[2] ? 0 : 2) : (d[1] > d[2] ? 1 : 2);
-            v3_set(nl, 0, 0, 0);
-            nl[k] = l[k] >= 0 ? 1 : -1;
-            dist = d[k];
-        }
-        break;
-    }
-    case WB_SHAPE_MESH:
-        dist = wb__colmesh_distance(s->mesh, l, nl, NULL, NULL);
-        break;
-    default:
-        v3_set(nl, 0, 1, 0);
-        dist = INFINITY;
-        break;
-    }
-    q_rotate(q, nl, n);
-    return dist;
-}
-
 void wb__collider_pose_at(const wb_collider_pose *cp, wb_real t, wb_real p[3], wb_real q[4])
 {
     if (t >= 1) { /* exactly the pose the script set, not p0 + (p - p0) rounded */
@@ -471,7 +261,7 @@ static wb_real mesh_depth(const sub_pose *sp, const wb_real x[3], const wb_real 
     q_rotate_inv(sp->q1, u, l);
     /* far from the tree's box: no contact, and no query */
     const wb_bvh_node *root = &cm->nodes[0];
-    wb_real lp[3], mv = 0;
+    wb_real lp[3] = { 0, 0, 0 }, mv = 0; /* set and read only for an open mesh (gcc -O3 cannot tell) */
     if (!cm->closed) {
         v3_sub(u, xprev, sp->p0);
         q_rotate_inv(sp->q0, u, lp);

@@ -1,9 +1,10 @@
 /* narrow.c: the contact manifold between two shapes at poses, for rigid bodies. Pure
  * geometry: no world, no allocation.
  *
- * Shapes are sorted plane < mesh < box < round (sphere and capsule are one kind: a
- * segment with a radius, a sphere's segment being a point); a pair given the other way
- * round is worked out swapped and flipped (normal negated, pa and pb exchanged).
+ * The pair table pairs[][] gives each ordered pair of shapes its routine. Shapes are
+ * ranked plane < mesh < box < round (sphere and capsule are one kind: a segment with a
+ * radius, shape.h's segment, a sphere's being a point); a pair given the other way round
+ * is worked out swapped and flipped (normal negated, pa and pb exchanged).
  *   round-round  closest points of the two segments; parallel capsules give the two ends
  *                of their overlap, so a capsule lies on another without rocking
  *   box-round    the segment's point of least signed distance to the box (the box's
@@ -172,15 +173,7 @@ typedef struct round_s { wb_real a[3], b[3], r; } round_s; /* world segment, rad
 
 static void round_make(const wb_cshape *s, const wb_real p[3], const wb_real q[4], round_s *o)
 {
-    if (s->shape == WB_SHAPE_CAPSULE) {
-        q_rotate(q, s->a, o->a);
-        v3_add(o->a, o->a, p);
-        q_rotate(q, s->b, o->b);
-        v3_add(o->b, o->b, p);
-    } else {
-        v3_copy(o->a, p);
-        v3_copy(o->b, p);
-    }
+    wb__shape(s->shape)->segment(s, p, q, o->a, o->b);
     o->r = s->radius;
 }
 
@@ -857,7 +850,7 @@ static void mesh_box(const meshq *M, const obox *B, wb_real margin, mcands *cs)
 }
 
 static void mesh_shape(const wb_colmesh *cm, const wb_real p[3], const wb_real q[4], const wb_cshape *b,
-                       const wb_real pb[3], const wb_real qb[4], wb_real margin, wb_manifold *m)
+                       const wb_real pb[3], const wb_real qb[4], wb_real margin, wb_manifold *m, int box)
 {
     if (cm->nt <= 0 || !cm->nodes) return;
     meshq M = { cm, p, q, 1, 0 };
@@ -878,7 +871,7 @@ static void mesh_shape(const wb_colmesh *cm, const wb_real p[3], const wb_real q
     round_s rs;
     obox bx;
     wb_real size;
-    if (b->shape == WB_SHAPE_BOX) {
+    if (box) {
         box_make(b, pb, qb, &bx);
         size = v3_len(bx.h);
     } else {
@@ -889,7 +882,7 @@ static void mesh_shape(const wb_colmesh *cm, const wb_real p[3], const wb_real q
     }
     cs.eps2 = 1e-18 * size * size;
     if (!cm->closed) M.behind = 2 * size;
-    if (b->shape == WB_SHAPE_BOX) mesh_box(&M, &bx, margin, &cs);
+    if (box) mesh_box(&M, &bx, margin, &cs);
     else mesh_round(&M, &rs, margin, &cs);
     if (cs.n == 0) return;
     /* the deepest gives the normal; the others are measured along it */
@@ -913,17 +906,95 @@ static void mesh_shape(const wb_colmesh *cm, const wb_real p[3], const wb_real q
     for (int j = 0; j < nk; j++) m->pt[m->n++] = pts[k[j]];
 }
 
-/* ---- dispatch ------------------------------------------------------------------------------- */
-static int rank(wb_shape s)
+/* ---- the pair table ------------------------------------------------------------------------- */
+typedef void (*pair_fn)(const wb_cshape *a, const wb_real pa[3], const wb_real qa[4], const wb_cshape *b,
+                        const wb_real pb[3], const wb_real qb[4], wb_real margin, wb_manifold *m);
+
+static void plane_box_pair(const wb_cshape *a, const wb_real pa[3], const wb_real qa[4], const wb_cshape *b,
+                           const wb_real pb[3], const wb_real qb[4], wb_real margin, wb_manifold *m)
 {
-    switch (s) {
-    case WB_SHAPE_PLANE: return 0;
-    case WB_SHAPE_MESH: return 1;
-    case WB_SHAPE_BOX: return 2;
-    case WB_SHAPE_SPHERE: case WB_SHAPE_CAPSULE: return 3;
-    default: return -1;
-    }
+    obox bb;
+    plane_normal(a, qa, m->normal);
+    box_make(b, pb, qb, &bb);
+    plane_box(pa, &bb, margin, m);
 }
+
+static void plane_round_pair(const wb_cshape *a, const wb_real pa[3], const wb_real qa[4], const wb_cshape *b,
+                             const wb_real pb[3], const wb_real qb[4], wb_real margin, wb_manifold *m)
+{
+    round_s rs;
+    plane_normal(a, qa, m->normal);
+    round_make(b, pb, qb, &rs);
+    plane_round(pa, &rs, margin, m);
+}
+
+static void mesh_box_pair(const wb_cshape *a, const wb_real pa[3], const wb_real qa[4], const wb_cshape *b,
+                          const wb_real pb[3], const wb_real qb[4], wb_real margin, wb_manifold *m)
+{
+    if (a->mesh) mesh_shape(a->mesh, pa, qa, b, pb, qb, margin, m, 1);
+}
+
+static void mesh_round_pair(const wb_cshape *a, const wb_real pa[3], const wb_real qa[4], const wb_cshape *b,
+                            const wb_real pb[3], const wb_real qb[4], wb_real margin, wb_manifold *m)
+{
+    if (a->mesh) mesh_shape(a->mesh, pa, qa, b, pb, qb, margin, m, 0);
+}
+
+static void box_box_pair(const wb_cshape *a, const wb_real pa[3], const wb_real qa[4], const wb_cshape *b,
+                         const wb_real pb[3], const wb_real qb[4], wb_real margin, wb_manifold *m)
+{
+    obox ba, bb;
+    box_make(a, pa, qa, &ba);
+    box_make(b, pb, qb, &bb);
+    box_box(&ba, &bb, margin, m);
+}
+
+static void box_round_pair(const wb_cshape *a, const wb_real pa[3], const wb_real qa[4], const wb_cshape *b,
+                           const wb_real pb[3], const wb_real qb[4], wb_real margin, wb_manifold *m)
+{
+    obox ba;
+    round_s rs;
+    box_make(a, pa, qa, &ba);
+    round_make(b, pb, qb, &rs);
+    box_round(&ba, &rs, margin, m);
+}
+
+static void round_round_pair(const wb_cshape *a, const wb_real pa[3], const wb_real qa[4], const wb_cshape *b,
+                             const wb_real pb[3], const wb_real qb[4], wb_real margin, wb_manifold *m)
+{
+    round_s r1, r2;
+    round_make(a, pa, qa, &r1);
+    round_make(b, pb, qb, &r2);
+    round_round(&r1, &r2, margin, m);
+}
+
+/* pairs[A][B]: the routine for A against B, or swap: B against A, flipped. Plane-plane,
+ * plane-mesh and mesh-mesh have none (colliders never touch each other) */
+typedef struct pair { pair_fn fn; int swap; } pair;
+#define SWAP { NULL, 1 }
+static const pair pairs[WB_SHAPE_COUNT][WB_SHAPE_COUNT] = {
+    [WB_SHAPE_PLANE] = {
+        [WB_SHAPE_SPHERE] = { plane_round_pair, 0 }, [WB_SHAPE_BOX] = { plane_box_pair, 0 },
+        [WB_SHAPE_CAPSULE] = { plane_round_pair, 0 },
+    },
+    [WB_SHAPE_SPHERE] = {
+        [WB_SHAPE_PLANE] = SWAP, [WB_SHAPE_SPHERE] = { round_round_pair, 0 }, [WB_SHAPE_BOX] = SWAP,
+        [WB_SHAPE_CAPSULE] = { round_round_pair, 0 }, [WB_SHAPE_MESH] = SWAP,
+    },
+    [WB_SHAPE_BOX] = {
+        [WB_SHAPE_PLANE] = SWAP, [WB_SHAPE_SPHERE] = { box_round_pair, 0 }, [WB_SHAPE_BOX] = { box_box_pair, 0 },
+        [WB_SHAPE_CAPSULE] = { box_round_pair, 0 }, [WB_SHAPE_MESH] = SWAP,
+    },
+    [WB_SHAPE_CAPSULE] = {
+        [WB_SHAPE_PLANE] = SWAP, [WB_SHAPE_SPHERE] = { round_round_pair, 0 }, [WB_SHAPE_BOX] = SWAP,
+        [WB_SHAPE_CAPSULE] = { round_round_pair, 0 }, [WB_SHAPE_MESH] = SWAP,
+    },
+    [WB_SHAPE_MESH] = {
+        [WB_SHAPE_PLANE] = SWAP, [WB_SHAPE_SPHERE] = { mesh_round_pair, 0 }, [WB_SHAPE_BOX] = { mesh_box_pair, 0 },
+        [WB_SHAPE_CAPSULE] = { mesh_round_pair, 0 },
+    },
+};
+#undef SWAP
 
 static int finite_manifold(const wb_manifold *m)
 {
@@ -941,50 +1012,15 @@ int wb__narrow(const wb_cshape *a, const wb_real pa[3], const wb_real qa[4],
 {
     out->n = 0;
     v3_set(out->normal, 0, 1, 0);
-    const int ra = rank(a->shape), rb = rank(b->shape);
-    if (ra < 0 || rb < 0) return 0;
-    if (ra > rb) {
+    if ((unsigned)a->shape >= WB_SHAPE_COUNT || (unsigned)b->shape >= WB_SHAPE_COUNT) return 0;
+    const pair *e = &pairs[a->shape][b->shape];
+    if (e->swap) {
         wb__narrow(b, pb, qb, a, pa, qa, margin, out);
         flip(out);
         return out->n;
     }
     if (isnan(margin)) margin = 0;
-    round_s rs;
-    obox ba, bb;
-    switch (ra * 4 + rb) {
-    case 0 * 4 + 2:
-        plane_normal(a, qa, out->normal);
-        box_make(b, pb, qb, &bb);
-        plane_box(pa, &bb, margin, out);
-        break;
-    case 0 * 4 + 3:
-        plane_normal(a, qa, out->normal);
-        round_make(b, pb, qb, &rs);
-        plane_round(pa, &rs, margin, out);
-        break;
-    case 1 * 4 + 2: case 1 * 4 + 3:
-        if (a->mesh) mesh_shape(a->mesh, pa, qa, b, pb, qb, margin, out);
-        break;
-    case 2 * 4 + 2:
-        box_make(a, pa, qa, &ba);
-        box_make(b, pb, qb, &bb);
-        box_box(&ba, &bb, margin, out);
-        break;
-    case 2 * 4 + 3:
-        box_make(a, pa, qa, &ba);
-        round_make(b, pb, qb, &rs);
-        box_round(&ba, &rs, margin, out);
-        break;
-    case 3 * 4 + 3: {
-        round_s r2;
-        round_make(a, pa, qa, &rs);
-        round_make(b, pb, qb, &r2);
-        round_round(&rs, &r2, margin, out);
-        break;
-    }
-    default: /* plane-plane, plane-mesh, mesh-mesh: nothing */
-        break;
-    }
+    if (e->fn) e->fn(a, pa, qa, b, pb, qb, margin, out);
     int k = 0; /* support points off the closest pair may fall a little short */
     for (int i = 0; i < out->n; i++)
         if (out->pt[i].depth > -margin) out->pt[k++] = out->pt[i];

@@ -39,39 +39,8 @@ static int m3_inverse(const wb_real M[9], wb_real out[9])
 void wb__rigid_inertia(const wb_cshape *s, wb_real m, wb_real I[9])
 {
     memset(I, 0, 9 * sizeof(wb_real));
-    switch (s->shape) {
-    case WB_SHAPE_SPHERE:
-        I[0] = I[4] = I[8] = (wb_real)0.4 * m * s->radius * s->radius;
-        break;
-    case WB_SHAPE_BOX: {
-        const wb_real x = s->half[0] * s->half[0], y = s->half[1] * s->half[1], z = s->half[2] * s->half[2];
-        I[0] = m * (y + z) / 3;
-        I[4] = m * (x + z) / 3;
-        I[8] = m * (x + y) / 3;
-        break;
-    }
-    case WB_SHAPE_CAPSULE: {
-        /* a cylinder of length L and two hemispheres (together a ball), mass by volume */
-        wb_real u[3];
-        v3_sub(u, s->b, s->a);
-        const wb_real L = v3_len(u), r = s->radius, r2 = r * r;
-        const wb_real vc = M_PI * r2 * L, vs = (wb_real)4 / 3 * M_PI * r2 * r;
-        const wb_real mc = m * vc / (vc + vs), ms = m * vs / (vc + vs);
-        /* axial: the cylinder's m r^2/2, the ball's 2/5 m r^2 */
-        const wb_real ia = mc * r2 / 2 + ms * r2 * (wb_real)0.4;
-        /* transverse: the cylinder's m (L^2/12 + r^2/4); each hemisphere about its own centroid
-         * (83/320 m r^2) shifted by the parallel-axis term to L/2 + 3r/8 from the centre:
-         * together ms (2/5 r^2 + L^2/4 + 3 L r/8) */
-        const wb_real it = mc * (L * L / 12 + r2 / 4) + ms * ((wb_real)0.4 * r2 + L * L / 4 + 3 * L * r / 8);
-        if (L > 0) v3_scale(u, u, 1 / L);
-        else v3_set(u, 0, 1, 0);
-        for (int i = 0; i < 3; i++)
-            for (int j = 0; j < 3; j++) I[3 * i + j] = (i == j ? it : 0) + (ia - it) * u[i] * u[j];
-        break;
-    }
-    default:
-        break;
-    }
+    const wb_shape_class *k = wb__shape(s->shape);
+    if (k && k->inertia) k->inertia(s, m, I);
 }
 
 /* ---- bodies ----------------------------------------------------------------------------- */
@@ -91,28 +60,16 @@ wb_rigid_def wb_rigid_default_def(wb_shape shape)
 
 const char *wb_rigid_def_check(const wb_rigid_def *d)
 {
-    if (d->shape != WB_SHAPE_SPHERE && d->shape != WB_SHAPE_BOX && d->shape != WB_SHAPE_CAPSULE)
-        return "shape must be sphere, box or capsule";
+    const wb_shape_class *k = wb__shape(d->shape);
+    if (!k || !k->inertia) return "shape must be sphere, box or capsule";
     if (!(d->mass > 0) || !isfinite(d->mass)) return "mass must be > 0";
     if (!(d->friction >= 0) || !isfinite(d->friction)) return "friction must be >= 0";
     if (!(d->restitution >= 0 && d->restitution <= 1)) return "restitution must be in [0, 1]";
     if (!fin3(d->pos)) return "pos must be finite";
     if (!fin3(d->vel)) return "vel must be finite";
     if (!fin3(d->angular_velocity)) return "angular_velocity must be finite";
-    if (!fin3(&d->rotation[1]) || !isfinite(d->rotation[0])) return "rotation must be finite";
-    if (!(fmax(fabs(d->rotation[0]), v3_len_safe(&d->rotation[1])) > 1e-12)) return "rotation must not be zero";
-    if (d->shape == WB_SHAPE_BOX) {
-        if (!(d->half[0] > 0 && d->half[1] > 0 && d->half[2] > 0) || !fin3(d->half)) return "half extents must be > 0";
-        if (!isfinite(v3_dot(d->half, d->half) * d->mass)) return "half extents are too large";
-    } else {
-        if (!(d->radius > 0) || !isfinite(d->radius * d->radius * d->mass)) return "radius must be > 0 (and not huge)";
-    }
-    if (d->shape == WB_SHAPE_CAPSULE) {
-        if (!fin3(d->a) || !fin3(d->b)) return "a and b must be finite";
-        const wb_real ab[3] = { d->b[0] - d->a[0], d->b[1] - d->a[1], d->b[2] - d->a[2] };
-        if (!isfinite(v3_dot(ab, ab) * d->mass)) return "a and b are too far apart";
-    }
-    return NULL;
+    const char *e = wb__rotation_check(d->rotation);
+    return e ? e : k->rigid_check(d);
 }
 
 int wb__rigid_set_slot(wb_world *w, int32_t r, const wb_cshape *s, wb_real mass, const wb_real x[3],
@@ -128,9 +85,7 @@ int wb__rigid_set_slot(wb_world *w, int32_t r, const wb_cshape *s, wb_real mass,
     rb->inv_mass[r] = 1 / mass;
     memcpy(&rb->inertia[9 * r], I, sizeof I);
     memcpy(&rb->inv_inertia[9 * r], Ii, sizeof Ii);
-    rb->bound[r] = s->shape == WB_SHAPE_BOX ? v3_len(s->half)
-                 : s->shape == WB_SHAPE_SPHERE ? s->radius
-                 : fmax(v3_len(s->a), v3_len(s->b)) + s->radius;
+    rb->bound[r] = wb__shape_bound(s);
     v3_copy(&rb->x[3 * r], x);
     memcpy(&rb->q[4 * r], q, 4 * sizeof(wb_real));
     v3_copy(&rb->v[3 * r], v);
@@ -169,6 +124,22 @@ int wb__rigids_reserve(wb_world *w, int32_t need)
     return grow(w, w->rb, need);
 }
 
+void wb__rigid_shape_of(const wb_rigid_def *d, wb_cshape *s, wb_real x[3], wb_real q[4])
+{
+    memset(s, 0, sizeof *s);
+    s->shape = d->shape;
+    s->friction = d->friction;
+    s->restitution = d->restitution;
+    memcpy(q, d->rotation, 4 * sizeof(wb_real));
+    q_normalize(q);
+    v3_copy(x, d->pos);
+    wb_real c[3], cw[3];
+    if (wb__shape(d->shape)->rigid_make(d, s, c)) {
+        q_rotate(q, c, cw);
+        v3_add(x, x, cw);
+    }
+}
+
 wb_rigid_id wb_rigid_add(wb_world *w, const wb_rigid_def *def, wb_status *status)
 {
     wb_rigid_id none = { 0, 0 };
@@ -194,24 +165,8 @@ wb_rigid_id wb_rigid_add(wb_world *w, const wb_rigid_def *def, wb_status *status
         rb->gen[slot] = 0;
     }
     wb_cshape s;
-    memset(&s, 0, sizeof s);
-    s.shape = def->shape;
-    s.friction = def->friction;
-    s.restitution = def->restitution;
-    if (def->shape != WB_SHAPE_BOX) s.radius = def->radius;
     wb_real x[3], q[4];
-    memcpy(q, def->rotation, sizeof q);
-    q_normalize(q);
-    v3_copy(x, def->pos);
-    if (def->shape == WB_SHAPE_BOX) v3_copy(s.half, def->half);
-    if (def->shape == WB_SHAPE_CAPSULE) {
-        /* the segment about its midpoint, the centre of mass */
-        wb_real c[3] = { def->a[0] / 2 + def->b[0] / 2, def->a[1] / 2 + def->b[1] / 2, def->a[2] / 2 + def->b[2] / 2 }, cw[3];
-        v3_sub(s.a, def->a, c);
-        v3_sub(s.b, def->b, c);
-        q_rotate(q, c, cw);
-        v3_add(x, x, cw);
-    }
+    wb__rigid_shape_of(def, &s, x, q);
     if (!wb__rigid_set_slot(w, slot, &s, def->mass, x, q, def->vel, def->angular_velocity)) {
         wb__set_error("the inertia tensor is singular (shape too small for its mass)");
         *status = WB_ERR_ARG;
@@ -259,6 +214,14 @@ wb_rigid_id wb_rigid_at(const wb_world *w, int32_t i)
     wb_rigid_id none = { 0, 0 };
     return none;
 }
+
+int wb_rigid_solids(const wb_world *w, wb_rigid_id r, wb_solid out[WB_MAX_SOLIDS])
+{
+    const int32_t i = RSLOT(w, r);
+    return wb__shape_solids(&w->rb->shape[i], &w->rb->x[3 * i], &w->rb->q[4 * i], out);
+}
+
+wb_real wb_rigid_bound(const wb_world *w, wb_rigid_id r) { return w->rb->bound[RSLOT(w, r)]; }
 
 void wb_rigid_get_def(const wb_world *w, wb_rigid_id r, wb_rigid_def *out)
 {
@@ -841,10 +804,7 @@ static int collider_poses(wb_world *w, wb_real f0, wb_real f1)
         wb_real *e = &cp[15 * c];
         wb__collider_pose_at(&w->s.c_pose[c], f0, e, e + 3);
         wb__collider_pose_at(&w->s.c_pose[c], f1, e + 7, e + 10);
-        const wb_cshape *s = &m->c_shape[c];
-        e[14] = s->shape == WB_SHAPE_SPHERE ? s->radius
-              : s->shape == WB_SHAPE_BOX ? v3_len(s->half)
-              : s->shape == WB_SHAPE_CAPSULE ? fmax(v3_len(s->a), v3_len(s->b)) + s->radius : -1;
+        e[14] = wb__shape_bound(&m->c_shape[c]);
     }
     return 1;
 }

@@ -158,6 +158,9 @@ int wb__rigid_set_slot(wb_world *w, int32_t r, const wb_cshape *s, wb_real mass,
 
 /* body-frame inertia tensor (row-major 3 x 3) of a shape of mass m about its centre */
 void wb__rigid_inertia(const wb_cshape *s, wb_real m, wb_real I[9]);
+/* a valid def's shape (about its centre of mass), that centre x and the unit rotation q:
+ * what wb_rigid_add and a def's image keep */
+void wb__rigid_shape_of(const wb_rigid_def *d, wb_cshape *s, wb_real x[3], wb_real q[4]);
 
 /* freed by world.c (an inline: a call into rigid.c would close a circle) */
 static inline void wb__rigids_free(wb_world *w, wb_rigids *rb)

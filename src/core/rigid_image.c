@@ -32,23 +32,17 @@ wb_status wb_image_rigid_from_def(const wb_rigid_def *d, wb_image_rigid *o)
     if (e) { wb__set_error("%s", e); return WB_ERR_ARG; }
     memset(o, 0, sizeof *o);
     o->shape = d->shape;
-    if (d->shape != WB_SHAPE_BOX) o->radius = d->radius;
     o->friction = d->friction;
     o->restitution = d->restitution;
     o->mass = d->mass;
-    memcpy(o->q, d->rotation, sizeof o->q);
-    q_normalize(o->q);
-    v3_copy(o->x, d->pos);
     v3_copy(o->v, d->vel);
     v3_copy(o->om, d->angular_velocity);
-    if (d->shape == WB_SHAPE_BOX) v3_copy(o->half, d->half);
-    if (d->shape == WB_SHAPE_CAPSULE) { /* as wb_rigid_add: about the midpoint */
-        wb_real c[3] = { d->a[0] / 2 + d->b[0] / 2, d->a[1] / 2 + d->b[1] / 2, d->a[2] / 2 + d->b[2] / 2 }, cw[3];
-        v3_sub(o->a, d->a, c);
-        v3_sub(o->b, d->b, c);
-        q_rotate(o->q, c, cw);
-        v3_add(o->x, o->x, cw);
-    }
+    wb_cshape s;
+    wb__rigid_shape_of(d, &s, o->x, o->q); /* as wb_rigid_add */
+    o->radius = s.radius;
+    v3_copy(o->half, s.half);
+    v3_copy(o->a, s.a);
+    v3_copy(o->b, s.b);
     return WB_OK;
 }
 
@@ -102,12 +96,14 @@ const char *wb_image_rigid_check(const wb_image_rigid *o)
     if (e) return e;
     if (!fin(o->q, 4) || fabs(o->q[0] * o->q[0] + v3_dot(&o->q[1], &o->q[1]) - 1) > 1e-9)
         return "rigid body rotation must be a unit quaternion";
-    /* the capsule about its centre of mass */
-    if (o->shape == WB_SHAPE_CAPSULE)
-        for (int i = 0; i < 3; i++)
-            if (fabs(o->a[i] + o->b[i]) > 1e-9 * (1 + fabs(o->a[i]) + fabs(o->b[i])))
-                return "rigid capsule a and b must be about its centre (a = -b)";
-    return NULL;
+    /* the shape about its centre of mass */
+    const wb_shape_class *k = wb__shape(o->shape);
+    if (!k->rigid_check_shape) return NULL;
+    wb_cshape s = { .shape = o->shape, .radius = o->radius };
+    v3_copy(s.half, o->half);
+    v3_copy(s.a, o->a);
+    v3_copy(s.b, o->b);
+    return k->rigid_check_shape(&s);
 }
 
 const char *wb__rigid_image_check(const wb_image *g)

@@ -137,7 +137,7 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
 /* ---- checks ---------------------------------------------------------------------------- */
 static const char *check_collider(const wb_image_collider *c)
 {
-    if ((unsigned)c->shape >= WB_SHAPE_COUNT) return "unknown collider shape";
+    if (!wb__shape(c->shape)) return "unknown collider shape";
     if (!(c->friction >= 0) || !isfinite(c->friction)) return "collider friction must be >= 0";
     if (!(c->restitution >= 0 && c->restitution <= 1)) return "collider restitution must be in [0, 1]";
     if (!fin3(c->n) || !fin3(c->half) || !fin3(c->a) || !fin3(c->b) || !isfinite(c->radius)) return "collider shape must be finite";
@@ -146,15 +146,17 @@ static const char *check_collider(const wb_image_collider *c)
         if (!isfinite(c->q[i]) || !isfinite(c->q0[i])) return "collider rotation must be finite";
     if (c->q[0] * c->q[0] + v3_dot(&c->q[1], &c->q[1]) < 1e-24) return "collider rotation must not be zero";
     if (c->q0[0] * c->q0[0] + v3_dot(&c->q0[1], &c->q0[1]) < 1e-24) return "collider rotation must not be zero";
-    if ((c->shape == WB_SHAPE_SPHERE || c->shape == WB_SHAPE_CAPSULE) && !(c->radius > 0)) return "collider radius must be > 0";
-    if (c->shape == WB_SHAPE_BOX && !(c->half[0] > 0 && c->half[1] > 0 && c->half[2] > 0)) return "box half extents must be > 0";
-    if (c->shape == WB_SHAPE_CAPSULE) {
-        wb_real ab[3];
-        v3_sub(ab, c->b, c->a);
-        if (!isfinite(v3_dot(ab, ab))) return "capsule ends are too far apart (|b - a| squared overflows)";
+    const wb_shape_class *k = wb__shape(c->shape);
+    if (k->check_shape) {
+        wb_cshape t = { .shape = c->shape, .radius = c->radius };
+        v3_copy(t.n, c->n);
+        v3_copy(t.half, c->half);
+        v3_copy(t.a, c->a);
+        v3_copy(t.b, c->b);
+        const char *e = k->check_shape(&t);
+        if (e) return e;
     }
-    if (c->shape == WB_SHAPE_PLANE && !(v3_len(c->n) > 1e-12)) return "plane normal must not be zero";
-    if (c->shape == WB_SHAPE_MESH) {
+    if (k->has_mesh) {
         if (!c->mv || !c->mt || c->mnt <= 0 || c->mnv <= 0) return "mesh collider has no triangles";
         for (int64_t i = 0; i < 3 * (int64_t)c->mnv; i++)
             if (!isfinite(c->mv[i])) return "mesh collider vertices must be finite";
@@ -236,7 +238,7 @@ static wb_status build_meshes(wb_world *w, const wb_image *g, wb_colmesh **cms)
     for (int32_t i = 0; i < g->nc; i++) {
         const wb_image_collider *c = &g->c[i];
         cms[i] = NULL;
-        if (!(g->c_gen[i] & 1u) || c->shape != WB_SHAPE_MESH) continue;
+        if (!(g->c_gen[i] & 1u) || !wb__shape(c->shape) || !wb__shape(c->shape)->has_mesh) continue;
         cms[i] = wb__colmesh_build(c->mv, c->mnv, c->mt, c->mnt, 1);
         if (!cms[i] || !wb__mesh_charge(w, cms[i])) {
             wb__colmesh_free(cms[i]);

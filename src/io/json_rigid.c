@@ -18,7 +18,6 @@ int jr_read_rigids(rd *r, const cJSON *arr, wb_image *g)
 {
     static const char *const keys[] = { "shape", "radius", "half", "a", "b", "mass", "pos", "rotation", "vel",
                                         "angular_velocity", "friction", "restitution", "generation", NULL };
-    static const char *const names[] = { "plane", "sphere", "box", "capsule", "mesh", NULL };
     kp top = { NULL, "rigids", 0 };
     int32_t n = 0, i = 0;
     if (!arr) return 0;
@@ -44,19 +43,17 @@ int jr_read_rigids(rd *r, const cJSON *arr, wb_image *g)
         const char *str;
         if (jv_get_string(r, f[0], &sp, &str)) return -1;
         int shape = -1;
-        for (int k = 0; names[k]; k++)
-            if (!strcmp(str, names[k])) shape = k;
-        if (shape != WB_SHAPE_SPHERE && shape != WB_SHAPE_BOX && shape != WB_SHAPE_CAPSULE)
+        for (int k = 0; wb_shape_info_of((wb_shape)k); k++)
+            if (!strcmp(str, wb_shape_info_of((wb_shape)k)->name)) shape = k;
+        const wb_shape_info *in = shape >= 0 ? wb_shape_info_of((wb_shape)shape) : NULL;
+        if (!in || !in->rigid_fields)
             return jv_fail(r, f[0], 0, &sp, "'%s' is not a rigid body shape (box, sphere or capsule)", str);
         /* a key of another shape is an error, as in w:rigid */
-        const int has[3] = { shape != WB_SHAPE_BOX, shape == WB_SHAPE_BOX, shape == WB_SHAPE_CAPSULE };
-        for (int k = 0; k < 4; k++) {
-            const int ok = k == 0 ? has[0] : k == 1 ? has[1] : has[2];
-            if (f[1 + k] && !ok) {
-                kp q = { &p, keys[1 + k], 0 };
-                return jv_fail(r, f[1 + k], 1, &q, "is not a key of a %s", names[shape]);
+        for (int k = 1; k <= 4; k++)
+            if (f[k] && !wb_shape_takes(in->rigid_fields, keys[k])) {
+                kp q = { &p, keys[k], 0 };
+                return jv_fail(r, f[k], 1, &q, "is not a key of a %s", in->name);
             }
-        }
         wb_rigid_def d = wb_rigid_default_def((wb_shape)shape);
         if (jv_opt_real(r, f[1], &p, "radius", &d.radius) || jv_opt_vec(r, f[2], &p, "half", 3, d.half) ||
             jv_opt_vec(r, f[3], &p, "a", 3, d.a) || jv_opt_vec(r, f[4], &p, "b", 3, d.b) ||
@@ -71,12 +68,11 @@ int jr_read_rigids(rd *r, const cJSON *arr, wb_image *g)
         if (f[12]) { /* as saved: raw */
             memset(o, 0, sizeof *o);
             o->shape = d.shape;
-            if (shape != WB_SHAPE_BOX) o->radius = d.radius;
-            if (shape == WB_SHAPE_BOX) memcpy(o->half, d.half, sizeof o->half);
-            if (shape == WB_SHAPE_CAPSULE) {
-                memcpy(o->a, d.a, sizeof o->a);
-                memcpy(o->b, d.b, sizeof o->b);
-            }
+            /* the shape's own fields only (the others stay zero, as saved) */
+            if (wb_shape_takes(in->rigid_fields, "radius")) o->radius = d.radius;
+            if (wb_shape_takes(in->rigid_fields, "half")) memcpy(o->half, d.half, sizeof o->half);
+            if (wb_shape_takes(in->rigid_fields, "a")) memcpy(o->a, d.a, sizeof o->a);
+            if (wb_shape_takes(in->rigid_fields, "b")) memcpy(o->b, d.b, sizeof o->b);
             o->friction = d.friction;
             o->restitution = d.restitution;
             o->mass = d.mass;

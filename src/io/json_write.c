@@ -127,36 +127,56 @@ static void write_constraints(jw_out *o, const wb_image *g)
     fputs(first ? "],\n" : "\n  ],\n", f);
 }
 
+/* one field of a shape (wobble.h's wb_shape_info lists) as "key": value: a collider's in its
+ * own frame (c) or a rigid body's (b) */
+static void write_field(jw_out *o, const char *k, size_t n, const wb_image_collider *c, const wb_image_rigid *b)
+{
+    FILE *f = o->f;
+    fprintf(f, "\"%.*s\": ", (int)n, k);
+#define IS(name) (n == sizeof name - 1 && !strncmp(k, name, n))
+    if (IS("radius")) jw_num(o, c ? c->radius : b->radius);
+    else if (IS("normal")) jw_vec(o, c->n, 3);
+    else if (IS("half")) jw_vec(o, c ? c->half : b->half, 3);
+    else if (IS("a")) jw_vec(o, c ? c->a : b->a, 3);
+    else if (IS("b")) jw_vec(o, c ? c->b : b->b, 3);
+    else if (IS("vertices")) jw_vec(o, c->mv, 3 * c->mnv); /* its own copy, scale applied: exact */
+    else if (IS("triangles")) {
+        fputc('[', f);
+        for (int64_t i = 0; i < 3 * (int64_t)c->mnt; i++) fprintf(f, "%s%d", i ? ", " : "", (int)c->mt[i]);
+        fputc(']', f);
+    }
+#undef IS
+}
+
+/* a shape's fields, in its list's order: ", " between them (a mesh's triangles on a line
+ * of their own) */
+static void write_fields(jw_out *o, const char *fields, const wb_image_collider *c, const wb_image_rigid *b)
+{
+    int first = 1;
+    for (const char *p = fields; *p;) {
+        while (*p == ' ') p++;
+        const char *e = p;
+        while (*e && *e != ' ') e++;
+        if (e == p) break;
+        if (!first) fputs(e - p == 9 && !strncmp(p, "triangles", 9) ? ",\n     " : ", ", o->f);
+        write_field(o, p, (size_t)(e - p), c, b);
+        first = 0;
+        p = e;
+    }
+}
+
 static void write_colliders(jw_out *o, const wb_image *g)
 {
-    static const char *const names[] = { "plane", "sphere", "box", "capsule", "mesh" };
     FILE *f = o->f;
     int first = 1;
     fputs("  \"colliders\": [", f);
     for (int32_t i = 0; i < g->nc; i++) {
         if (!(g->c_gen[i] & 1u)) continue;
         const wb_image_collider *c = &g->c[i];
-        fprintf(f, "%s    {\"shape\": \"%s\", ", first ? "\n" : ",\n", names[c->shape]);
+        fprintf(f, "%s    {\"shape\": \"%s\", ", first ? "\n" : ",\n", wb_shape_info_of(c->shape)->name);
         first = 0;
         /* the shape in the collider's own frame: what the pose carries */
-        switch (c->shape) {
-        case WB_SHAPE_PLANE: fputs("\"normal\": ", f); jw_vec(o, c->n, 3); break;
-        case WB_SHAPE_SPHERE: fputs("\"radius\": ", f); jw_num(o, c->radius); break;
-        case WB_SHAPE_BOX: fputs("\"half\": ", f); jw_vec(o, c->half, 3); break;
-        case WB_SHAPE_MESH:
-            /* its own copy, in its own frame with the scale applied: exact */
-            fputs("\"vertices\": ", f);
-            jw_vec(o, c->mv, 3 * c->mnv);
-            fputs(",\n     \"triangles\": [", f);
-            for (int64_t k = 0; k < 3 * (int64_t)c->mnt; k++) fprintf(f, "%s%d", k ? ", " : "", (int)c->mt[k]);
-            fputc(']', f);
-            break;
-        default:
-            fputs("\"a\": ", f); jw_vec(o, c->a, 3);
-            fputs(", \"b\": ", f); jw_vec(o, c->b, 3);
-            fputs(", \"radius\": ", f); jw_num(o, c->radius);
-            break;
-        }
+        write_fields(o, wb_shape_info_of(c->shape)->own_fields, c, NULL);
         fputs(", \"friction\": ", f);
         jw_num(o, c->friction);
         fputs(", \"restitution\": ", f);
@@ -181,19 +201,14 @@ static void write_colliders(jw_out *o, const wb_image *g)
 /* rigid bodies by slot, raw, with their generations (json_rigid.c reads them) */
 static void write_rigids(jw_out *o, const wb_image *g)
 {
-    static const char *const names[] = { "plane", "sphere", "box", "capsule", "mesh" };
     FILE *f = o->f;
     for (int32_t i = 0; i < g->nrb; i++) {
         const wb_image_rigid *b = &g->rb[i];
         fputs(i ? ",\n    {" : "  \"rigids\": [\n    {", f);
         if (!(g->rb_gen[i] & 1u)) { fprintf(f, "\"generation\": %u}", (unsigned)g->rb_gen[i]); continue; }
-        fprintf(f, "\"shape\": \"%s\", ", names[b->shape]);
-        if (b->shape == WB_SHAPE_BOX) { fputs("\"half\": ", f); jw_vec(o, b->half, 3); }
-        else { fputs("\"radius\": ", f); jw_num(o, b->radius); }
-        if (b->shape == WB_SHAPE_CAPSULE) {
-            fputs(", \"a\": ", f); jw_vec(o, b->a, 3);
-            fputs(", \"b\": ", f); jw_vec(o, b->b, 3);
-        }
+        const wb_shape_info *in = wb_shape_info_of(b->shape);
+        fprintf(f, "\"shape\": \"%s\", ", in->name);
+        write_fields(o, in->rigid_fields, NULL, b);
         fputs(", \"mass\": ", f); jw_num(o, b->mass);
         fputs(", \"friction\": ", f); jw_num(o, b->friction);
         fputs(", \"restitution\": ", f); jw_num(o, b->restitution);

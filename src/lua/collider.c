@@ -5,16 +5,10 @@
 
 typedef struct wbl_collider { wb_collider_id id; } wbl_collider;
 
-static const char *const shape_names[] = { "plane", "sphere", "box", "capsule", "mesh", NULL };
-
-/* the keys each shape accepts: a key of another shape is an error, not ignored */
-static const char *const shape_keys[WB_SHAPE_COUNT][8] = {
-    [WB_SHAPE_PLANE] = { "shape", "normal", "offset", "friction", "restitution", NULL },
-    [WB_SHAPE_SPHERE] = { "shape", "center", "radius", "friction", "restitution", NULL },
-    [WB_SHAPE_BOX] = { "shape", "center", "half", "rotation", "friction", "restitution", NULL },
-    [WB_SHAPE_CAPSULE] = { "shape", "a", "b", "radius", "friction", "restitution", NULL },
-    [WB_SHAPE_MESH] = { "shape", "mesh", "center", "rotation", "scale", "friction", "restitution", NULL },
-};
+/* the keys every shape takes around its own fields (wb_shape_info): a key of another shape
+ * is an error, not ignored */
+static const char *const keys_first[] = { "shape", NULL };
+static const char *const keys_last[] = { "friction", "restitution", NULL };
 
 wb_collider_id *wbl_push_collider(lua_State *L, int world_index, wb_collider_id id)
 {
@@ -40,9 +34,13 @@ static int w_collider(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
     luaL_checktype(L, 2, LUA_TTABLE);
-    int shape = wbl_optenum(L, 2, "shape", "shape", shape_names);
+    const char *names[WB_SHAPE_COUNT + 1];
+    int shape = wbl_optenum(L, 2, "shape", "shape", wbl_shape_names(names));
     if (shape < 0) return wbl_fielderror(L, 2, "shape", "missing (plane, sphere, box, capsule or mesh)");
-    wbl_checkopts(L, 2, shape_keys[shape], false);
+    const char *keys[24];
+    char kbuf[128];
+    wbl_shape_keys(keys_first, wb_shape_info_of((wb_shape)shape)->fields, NULL, keys_last, keys, kbuf);
+    wbl_checkopts(L, 2, keys, false);
     wb_collider_def d = wb_collider_default_def((wb_shape)shape);
     wbl_optvec(L, 2, "normal", 3, d.normal);
     wbl_optreal(L, 2, "offset", &d.offset);
@@ -54,7 +52,7 @@ static int w_collider(lua_State *L)
     wbl_optvec(L, 2, "b", 3, d.b);
     wbl_optreal(L, 2, "friction", &d.friction);
     wbl_optreal(L, 2, "restitution", &d.restitution);
-    if (shape == WB_SHAPE_MESH) {
+    if (wb_shape_takes(wb_shape_info_of((wb_shape)shape)->fields, "mesh")) {
         wbl_optreal(L, 2, "scale", &d.scale);
         lua_getfield(L, 2, "mesh");
         if (lua_isnil(L, -1)) return wbl_fielderror(L, 2, "mesh", "missing (a mesh from wobble.load_mesh or wobble.mesh)");
@@ -151,7 +149,7 @@ static int col_shape(lua_State *L)
     wb_collider_id id;
     wb_world *w = checkcollider(L, 1, &id);
     wb_shape s = wb_collider_shape(w, id);
-    lua_pushstring(L, s >= 0 && s < WB_SHAPE_COUNT ? shape_names[s] : "?");
+    lua_pushstring(L, wb_shape_info_of(s) ? wb_shape_info_of(s)->name : "?");
     return 1;
 }
 
@@ -210,7 +208,7 @@ static int col_tostring(lua_State *L)
     }
     wb_shape s = wb_collider_shape(w, c->id);
     lua_pushfstring(L, "wobble.collider: %p (%s)", (void *)c,
-                    s >= 0 && s < WB_SHAPE_COUNT ? shape_names[s] : "?");
+                    wb_shape_info_of(s) ? wb_shape_info_of(s)->name : "?");
     return 1;
 }
 

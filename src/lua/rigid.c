@@ -6,13 +6,12 @@
 
 typedef struct wbl_rigid { wb_rigid_id id; } wbl_rigid;
 
-static const char *const shape_names[] = { "plane", "sphere", "box", "capsule", "mesh", NULL };
-
-/* the keys each shape accepts: a key of another shape is an error, not ignored */
-#define COMMON "shape", "mass", "pos", "rotation", "vel", "angular_velocity", "friction", "restitution"
-static const char *const sphere_keys[] = { COMMON, "radius", NULL };
-static const char *const box_keys[] = { COMMON, "half", NULL };
-static const char *const capsule_keys[] = { COMMON, "a", "b", "radius", NULL };
+/* the keys every body takes, then its shape's fields (wb_shape_info: those of a collider's
+ * def that a rigid def has too, in that order): a key of another shape is an error, not
+ * ignored */
+static const char *const keys_first[] = { "shape", "mass", "pos", "rotation", "vel", "angular_velocity", "friction",
+                                          "restitution", NULL };
+static const char *const keys_last[] = { NULL };
 
 static wb_rigid_id *push_rigid(lua_State *L, int world_index, wb_rigid_id id)
 {
@@ -40,11 +39,16 @@ static int w_rigid(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
     luaL_checktype(L, 2, LUA_TTABLE);
-    int shape = wbl_optenum(L, 2, "shape", "shape", shape_names);
+    const char *names[WB_SHAPE_COUNT + 1];
+    int shape = wbl_optenum(L, 2, "shape", "shape", wbl_shape_names(names));
     if (shape < 0) return wbl_fielderror(L, 2, "shape", "missing (box, sphere or capsule)");
-    if (shape != WB_SHAPE_SPHERE && shape != WB_SHAPE_BOX && shape != WB_SHAPE_CAPSULE)
-        return wbl_fielderror(L, 2, "shape", "must be box, sphere or capsule (a %s is a collider)", shape_names[shape]);
-    wbl_checkopts(L, 2, shape == WB_SHAPE_SPHERE ? sphere_keys : shape == WB_SHAPE_BOX ? box_keys : capsule_keys, false);
+    const wb_shape_info *in = wb_shape_info_of((wb_shape)shape);
+    if (!in->rigid_fields)
+        return wbl_fielderror(L, 2, "shape", "must be box, sphere or capsule (a %s is a collider)", in->name);
+    const char *keys[24];
+    char kbuf[128];
+    wbl_shape_keys(keys_first, in->fields, in->rigid_fields, keys_last, keys, kbuf);
+    wbl_checkopts(L, 2, keys, false);
     wb_rigid_def d = wb_rigid_default_def((wb_shape)shape);
     wbl_optreal(L, 2, "radius", &d.radius);
     wbl_optvec(L, 2, "half", 3, d.half);
@@ -160,7 +164,7 @@ static int rb_shape(lua_State *L)
     wb_world *w = checkrigid(L, 1, &id);
     wb_rigid_def d;
     wb_rigid_get_def(w, id, &d);
-    lua_pushstring(L, shape_names[d.shape]);
+    lua_pushstring(L, wb_shape_info_of(d.shape)->name);
     return 1;
 }
 
@@ -208,7 +212,7 @@ static int rb_tostring(lua_State *L)
     }
     wb_rigid_def d;
     wb_rigid_get_def(w, r->id, &d);
-    lua_pushfstring(L, "wobble.rigid: %p (%s)", (void *)r, shape_names[d.shape]);
+    lua_pushfstring(L, "wobble.rigid: %p (%s)", (void *)r, wb_shape_info_of(d.shape)->name);
     return 1;
 }
 

@@ -424,3 +424,34 @@ bool wbl_write_png(const char *path, const uint8_t *rgb, int w, int h, char *err
     if (!ok) snprintf(err, n, "cannot write %s", e);
     return ok;
 }
+
+const char *const *wbl_shape_names(const char *names[WB_SHAPE_COUNT + 1])
+{
+    for (int s = 0; s < WB_SHAPE_COUNT; s++) names[s] = wb_shape_info_of((wb_shape)s)->name;
+    names[WB_SHAPE_COUNT] = NULL;
+    return names;
+}
+
+void wbl_shape_keys(const char *const first[], const char *fields, const char *only, const char *const last[],
+                    const char *keys[24], char buf[128])
+{
+    int n = 0;
+    size_t used = 0;
+    for (int i = 0; first[i] && n < 23; i++) keys[n++] = first[i];
+    for (const char *p = fields; p && *p && n < 23;) {
+        while (*p == ' ') p++;
+        const char *e = p;
+        while (*e && *e != ' ') e++;
+        const size_t len = (size_t)(e - p);
+        if (len == 0 || used + len + 1 > 128) break;
+        memcpy(buf + used, p, len);
+        buf[used + len] = 0;
+        if (!only || wb_shape_takes(only, buf + used)) {
+            keys[n++] = buf + used;
+            used += len + 1;
+        }
+        p = e;
+    }
+    for (int i = 0; last[i] && n < 23; i++) keys[n++] = last[i];
+    keys[n] = NULL;
+}

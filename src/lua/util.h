@@ -83,6 +83,14 @@ bool wbl_optivec(lua_State *L, int arg, const char *key, int n, lua_Integer lo, 
 int wbl_optenum(lua_State *L, int arg, const char *key, const char *what, const char *const names[]);
 int wbl_enum_index(lua_State *L, int arg, const char *s, const char *what, const char *const names[]);
 int wbl_fielderror(lua_State *L, int arg, const char *key, const char *fmt, ...);
+/* the shapes' names in wb_shape's order, NULL-terminated (wb_shape_info), into names, for
+ * wbl_optenum; returns names */
+const char *const *wbl_shape_names(const char *names[WB_SHAPE_COUNT + 1]);
+/* the keys a shape takes: those of `first` (NULL-terminated), the words of fields (a
+ * wb_shape_info list) that `only` also has (only NULL: every one), those of `last`; into
+ * keys (room for 24 with the NULL), the words copied into buf (128 bytes) */
+void wbl_shape_keys(const char *const first[], const char *fields, const char *only, const char *const last[],
+                    const char *keys[24], char buf[128]);
 
 /* distance constraint options shared by w:distance and the builders (rest excluded) */
 extern const char *const wbl_link_keys[];   /* compliance, damping, yield, creep, break_strain */

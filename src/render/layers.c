@@ -85,6 +85,34 @@ static void inst_cylinder(wb_inst *in, const double a[3], const double b[3], dou
     inst_set(in, a, cols, rgb, 0.35f);
 }
 
+/* a shape's solid (wobble.h) as an instance when it is of group g's kind, with the
+ * colour and shine of its owner (spheres in the fine group, under its cylinders' caps);
+ * returns the instances written (0 or 1). One that is not finite is not drawn */
+static int inst_solid(wb_inst *in, const wb_solid *s, int g, const float rgb[3], float shine)
+{
+    const double c[3] = { s->c[0], s->c[1], s->c[2] };
+    if (g == WB_G_HI && s->kind == WB_SOLID_SPHERE) {
+        if (!isfinite(c[0] + c[1] + c[2])) return 0;
+        inst_sphere(in, c, s->radius, rgb, shine);
+        return 1;
+    }
+    if (g == WB_G_CYL && s->kind == WB_SOLID_CYLINDER) {
+        const double a[3] = { s->a[0], s->a[1], s->a[2] }, b[3] = { s->b[0], s->b[1], s->b[2] };
+        if (!isfinite(a[0] + a[1] + a[2] + b[0] + b[1] + b[2])) return 0;
+        inst_cylinder(in, a, b, s->radius, rgb);
+        return 1;
+    }
+    if (g == WB_G_BOX && s->kind == WB_SOLID_BOX) {
+        double cols[3][3];
+        for (int cc = 0; cc < 3; cc++)
+            for (int rr = 0; rr < 3; rr++) cols[cc][rr] = s->axes[cc][rr];
+        if (!isfinite(c[0] + c[1] + c[2])) return 0;
+        inst_set(in, c, cols, rgb, shine);
+        return 1;
+    }
+    return 0;
+}
+
 /* instances grouped by mesh: particle spheres, collider spheres and capsule caps,
  * capsule bodies, boxes. Particles of a drawn surface are shown by the surface (a
  * sphere per cloth vertex hides the cloth), those under a skin by the skin. */
@@ -140,49 +168,15 @@ static bool build_instances(wb_layers *l, const wb_world *w, const wb_draw_opts 
     for (int g = WB_G_HI; g < WB_G_COUNT; g++) {
         l->first[g] = k;
         for (int32_t i = 0; o->colliders && i < nc; i++) {
-            wb_collider_def d;
-            wb_collider_get_def(w, wb_collider_at(w, i), &d);
-            double c[3] = { d.center[0], d.center[1], d.center[2] };
-            double a[3] = { d.a[0], d.a[1], d.a[2] }, b[3] = { d.b[0], d.b[1], d.b[2] };
-            if (g == WB_G_HI && d.shape == WB_SHAPE_SPHERE) {
-                inst_sphere(&l->inst[k++], c, d.radius, col_collider, 0.35f);
-            } else if (g == WB_G_HI && d.shape == WB_SHAPE_CAPSULE) {
-                inst_sphere(&l->inst[k++], a, d.radius, col_collider, 0.35f);
-                inst_sphere(&l->inst[k++], b, d.radius, col_collider, 0.35f);
-            } else if (g == WB_G_CYL && d.shape == WB_SHAPE_CAPSULE) {
-                inst_cylinder(&l->inst[k++], a, b, d.radius, col_collider);
-            } else if (g == WB_G_BOX && d.shape == WB_SHAPE_BOX) {
-                double m[9], cols[3][3];
-                quat_mat(d.rotation, m);
-                for (int cc = 0; cc < 3; cc++)
-                    for (int rr = 0; rr < 3; rr++) cols[cc][rr] = m[rr * 3 + cc] * d.half[cc];
-                inst_set(&l->inst[k++], c, cols, col_collider, 0.35f);
-            }
+            wb_solid sol[WB_MAX_SOLIDS];
+            const int ns = wb_collider_solids(w, wb_collider_at(w, i), sol);
+            for (int j = 0; j < ns; j++) k += inst_solid(&l->inst[k], &sol[j], g, col_collider, 0.35f);
         }
-        /* rigid bodies: the same solids at their poses (a capsule's ends are body-frame) */
+        /* rigid bodies: the same solids at their poses */
         for (int32_t i = 0; i < nr; i++) {
-            wb_rigid_def d;
-            wb_rigid_get_def(w, wb_rigid_at(w, i), &d);
-            double c[3] = { d.pos[0], d.pos[1], d.pos[2] }, m[9], cols[3][3];
-            if (!isfinite(c[0] + c[1] + c[2])) continue;
-            quat_mat(d.rotation, m);
-            double a[3], b[3];
-            for (int rr = 0; rr < 3; rr++) {
-                a[rr] = c[rr] + m[rr * 3] * d.a[0] + m[rr * 3 + 1] * d.a[1] + m[rr * 3 + 2] * d.a[2];
-                b[rr] = c[rr] + m[rr * 3] * d.b[0] + m[rr * 3 + 1] * d.b[1] + m[rr * 3 + 2] * d.b[2];
-            }
-            if (g == WB_G_HI && d.shape == WB_SHAPE_SPHERE) {
-                inst_sphere(&l->inst[k++], c, d.radius, col_rigid, 0.45f);
-            } else if (g == WB_G_HI && d.shape == WB_SHAPE_CAPSULE) {
-                inst_sphere(&l->inst[k++], a, d.radius, col_rigid, 0.45f);
-                inst_sphere(&l->inst[k++], b, d.radius, col_rigid, 0.45f);
-            } else if (g == WB_G_CYL && d.shape == WB_SHAPE_CAPSULE) {
-                inst_cylinder(&l->inst[k++], a, b, d.radius, col_rigid);
-            } else if (g == WB_G_BOX && d.shape == WB_SHAPE_BOX) {
-                for (int cc = 0; cc < 3; cc++)
-                    for (int rr = 0; rr < 3; rr++) cols[cc][rr] = m[rr * 3 + cc] * d.half[cc];
-                inst_set(&l->inst[k++], c, cols, col_rigid, 0.45f);
-            }
+            wb_solid sol[WB_MAX_SOLIDS];
+            const int ns = wb_rigid_solids(w, wb_rigid_at(w, i), sol);
+            for (int j = 0; j < ns; j++) k += inst_solid(&l->inst[k], &sol[j], g, col_rigid, 0.45f);
         }
         l->count[g] = k - l->first[g];
     }

@@ -297,6 +297,27 @@ static bool floor_height(const wb_collider_def *d, double *height)
     return true;
 }
 
+/* a shape's solid (wobble.h): a sphere, a cylinder's two ends with its radius, a box's
+ * corners */
+static void solid_add(box *b, const wb_solid *s)
+{
+    const double c[3] = { s->c[0], s->c[1], s->c[2] };
+    if (s->kind == WB_SOLID_SPHERE) box_add(b, c, s->radius);
+    else if (s->kind == WB_SOLID_CYLINDER) {
+        const double a[3] = { s->a[0], s->a[1], s->a[2] }, e[3] = { s->b[0], s->b[1], s->b[2] };
+        box_add(b, a, s->radius);
+        box_add(b, e, s->radius);
+    } else {
+        for (int k = 0; k < 8; k++) {
+            double p[3];
+            for (int r = 0; r < 3; r++)
+                p[r] = c[r] + (k & 1 ? 1 : -1) * s->axes[0][r] + (k & 2 ? 1 : -1) * s->axes[1][r] +
+                       (k & 4 ? 1 : -1) * s->axes[2][r];
+            box_add(b, p, 0);
+        }
+    }
+}
+
 /* particles and the finite colliders; an upward plane below is pulled in when it is
  * near, so the ground the scene rests on is in the picture */
 static box scene_box(const wb_world *w)
@@ -313,26 +334,13 @@ static box scene_box(const wb_world *w)
         wb_collider_def d;
         wb_collider_get_def(w, wb_collider_at(w, i), &d);
         double c[3] = { d.center[0], d.center[1], d.center[2] };
-        if (d.shape == WB_SHAPE_SPHERE) {
-            box_add(&b, c, d.radius);
-        } else if (d.shape == WB_SHAPE_BOX) {
-            double m[9];
-            quat_mat(d.rotation, m);
-            for (int k = 0; k < 8; k++) {
-                double s[3] = { k & 1 ? d.half[0] : -d.half[0], k & 2 ? d.half[1] : -d.half[1],
-                                k & 4 ? d.half[2] : -d.half[2] };
-                double p[3];
-                for (int r = 0; r < 3; r++) p[r] = c[r] + m[r * 3] * s[0] + m[r * 3 + 1] * s[1] + m[r * 3 + 2] * s[2];
-                box_add(&b, p, 0);
-            }
-        } else if (d.shape == WB_SHAPE_CAPSULE) {
-            double a[3] = { d.a[0], d.a[1], d.a[2] }, e[3] = { d.b[0], d.b[1], d.b[2] };
-            box_add(&b, a, d.radius);
-            box_add(&b, e, d.radius);
-        } else if (d.shape == WB_SHAPE_MESH) {
-            const wb_real *v;
-            const int32_t *t;
-            int32_t nt = 0, nv = wb_collider_mesh(w, wb_collider_at(w, i), &v, &t, &nt);
+        wb_solid sol[WB_MAX_SOLIDS];
+        const int ns = wb_collider_solids(w, wb_collider_at(w, i), sol);
+        for (int j = 0; j < ns; j++) solid_add(&b, &sol[j]);
+        const wb_real *v;
+        const int32_t *t;
+        int32_t nt = 0, nv = wb_collider_mesh(w, wb_collider_at(w, i), &v, &t, &nt); /* 0: not a mesh */
+        if (nv > 0) {
             double m[9];
             quat_mat(d.rotation, m);
             for (int32_t k = 0; k < nv; k++) {
@@ -347,9 +355,7 @@ static box scene_box(const wb_world *w)
         wb_rigid_def d;
         wb_rigid_get_def(w, wb_rigid_at(w, i), &d);
         double c[3] = { d.pos[0], d.pos[1], d.pos[2] };
-        const double r = d.shape == WB_SHAPE_BOX ? sqrt(d.half[0] * d.half[0] + d.half[1] * d.half[1] + d.half[2] * d.half[2])
-                       : d.shape == WB_SHAPE_SPHERE ? d.radius
-                       : sqrt(d.a[0] * d.a[0] + d.a[1] * d.a[1] + d.a[2] * d.a[2]) + d.radius;
+        const double r = wb_rigid_bound(w, wb_rigid_at(w, i));
         if (isfinite(c[0] + c[1] + c[2] + r)) box_add(&b, c, r);
     }
     if (!b.any) {

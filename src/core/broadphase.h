@@ -1,0 +1,113 @@
+/* broadphase.h: the particle pairs' broad phase (broadphase.c): its entry points, the
+ * contact rules, and its scratch kept from frame to frame (defined here, its free inline,
+ * so that the world frees it without calling back into broadphase.c). */
+#ifndef WB_BROADPHASE_H
+#define WB_BROADPHASE_H
+
+#include <stdlib.h>
+
+#include "contact.h"
+#include "grid.h"
+#include "pool.h"
+
+/* broadphase.c: the contact rules' data (keys, graph, cross) brought up to date with the
+ * constraints and groups; 0 when out of memory. wb__joined: a constraint joins i and j */
+int wb__contact_rules(wb_world *w);
+int wb__joined(const wb_contacts *c, int32_t i, int32_t j);
+/* at a substep (the frame's sub-th, step h): 0 when the list holds; when some particle
+ * moved past what its reach allowed, 2 when its pairs were added to the list in place
+ * (with left NaN, and the rest of left moved along when the list had it), 1 when the
+ * list was made again for the rest of the frame (the old one in ij_old, n_old); -1 when
+ * out of memory (the list is then empty).
+ * wb__contacts_brute: the tests' count of touching pairs the list lacks (brute) */
+int wb__contacts_recheck(wb_world *w, wb_real h);
+void wb__contacts_brute(wb_world *w);
+/* broadphase.c: every pair i < j with |x_i - x_j| < reach_i + reach_j (particles with
+ * reach < 0 or a non-finite position left out; pairs with one nonzero skip key too,
+ * skip may be NULL), each once, in (i, j) order (so the same for any thread count);
+ * keep(ud, i, j) filters them (NULL: all; called from several threads
+ * at once). A sorted grid, linear in n. Appends to c->ij; -1 when out of memory */
+typedef struct wb_broad wb_broad;
+int32_t wb__broadphase(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
+                       int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), void *ud);
+/* the same pairs from a neighbour list kept from call to call in c->bp and rebuilt (by
+ * wb__broadphase) only when some particle moved past its skin (from the motion they
+ * share), the particles' reach >= 0 or skip keys changed, or keep's rules did (gen: a
+ * number that changes with them; keep is applied when the list is built); keep_now
+ * (NULL: none) filters each call's pairs (broadphase.c) */
+int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *reach, const int32_t *skip,
+                            int32_t n, wb_pool *pool, int (*keep)(void *ud, int32_t i, int32_t j), uint64_t gen,
+                            int (*keep_now)(void *ud, int32_t i, int32_t j), void *ud);
+/* a rigid motion X -> c + Q (X - C) (Q row-major) */
+typedef struct wb_motion { wb_real Q[9], C[3], c[3]; } wb_motion;
+struct wb_broad {
+    int32_t *cand; int32_t cap_cand;   /* candidates in index order, then the survivors */
+    int32_t *cell; int32_t cap_cell;   /* cell of each survivor */
+    int32_t *start; int32_t cap_start; /* (cells + 1) counting-sort offsets */
+    wb_real *p; int32_t cap_p;         /* sorted: x, y, z, reach */
+    int32_t *id; int32_t cap_id;       /* sorted: particle */
+    int32_t *key; int32_t cap_key;     /* sorted: skip key */
+    struct wb_broad_run *runs; int32_t cap_runs;
+    wb_real *boxes; int32_t cap_boxes; /* (lo, hi) of runs' overlaps */
+    wb_pairbuf *out; int nout;         /* one per thread */
+    int32_t *first; int32_t cap_first; /* (n + 1) sorting the pairs by i */
+    /* the kept list (wb__broadphase_kept): positions, reaches with the skin (-1: left
+     * out) and skip keys it was built with, its pairs (keep not applied) */
+    int32_t vn;                        /* particles it was built for; 0: none */
+    wb_real *vx, *vr; int32_t cap_vx, cap_vr;
+    int32_t *vskip; int32_t cap_vskip;
+    wb_pairbuf list;
+    int64_t rebuilds;                  /* for the tests */
+    int bare;                          /* the list was built without a skin, keep applied */
+    wb_motion mo;                      /* the motion it was last used under (list_valid) */
+    uint64_t vgen;                     /* keep's rules it was built with */
+    int used;                          /* it was used again since it was built */
+    /* particles whose list position and reach were made again since it was built (the
+     * grid has them where it was built), a flag each; scratch for the mends */
+    int32_t *moved, nmoved, cap_moved;
+    uint8_t *is_moved; int32_t cap_is_moved;
+    int32_t *bad, cap_bad;
+    wb_pairbuf mend;
+    int64_t mends;                     /* for the tests */
+    int bare_left, bare_run;           /* lists still to build without a skin; how many
+                                          the last run had */
+    wb_real mq[4];                     /* its rotation, the next fit's start */
+    /* the grid of the last search (cand, start, p, id), when it is the kept list's
+     * (lgrid): its shape, particles, whether they are all the candidates (none culled),
+     * and their largest reach */
+    int lgrid, lfull;
+    wb_grid lg;
+    int32_t lm;
+    wb_real lrmax;
+};
+static inline void wb__broadphase_free(wb_contacts *c)
+{
+    wb_broad *b = c->bp;
+    free(c->skip);
+    c->skip = NULL;
+    c->cap_skip = 0;
+    free(c->key_row); free(c->path); free(c->dorm); free(c->dorm_row); free(c->dorm_at); free(c->dorm_on);
+    free(c->off_path); free(c->soft); free(c->qs);
+    c->key_row = c->dorm = c->dorm_row = c->dorm_at = c->soft = c->qs = NULL;
+    c->cap_qs = 0;
+    c->path = NULL;
+    c->dorm_on = c->off_path = NULL;
+    c->cap_key_row = c->cap_path = c->cap_dorm = c->cap_dorm_row = c->cap_dorm_at = c->cap_dorm_on = 0;
+    c->cap_off_path = c->cap_soft = 0;
+    c->nd = 0;
+    free(c->xf); free(c->ij_old); free(c->left_old); free(c->fix); free(c->add); free(c->fixed);
+    c->xf = c->left_old = NULL;
+    c->ij_old = c->fix = c->add = c->fixed = NULL;
+    c->cap_xf = c->cap_old = c->cap_left_old = c->cap_fix = c->cap_add = c->cap_fixed = 0;
+    if (!b) return;
+    free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key);
+    free(b->runs); free(b->boxes); free(b->first);
+    free(b->vx); free(b->vr); free(b->vskip); free(b->list.ij); free(b->list.hit);
+    free(b->moved); free(b->is_moved); free(b->bad); free(b->mend.ij); free(b->mend.hit);
+    for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
+    free(b->out);
+    free(b);
+    c->bp = NULL;
+}
+
+#endif
