@@ -103,7 +103,7 @@ expected_noise() {
         echo "0 passed, 1 failed"
         return 1
     fi
-    echo "ok 1 - every warning, assertion or error line of the scenario tests was announced as expected"
+    echo "ok 1 - every warning, assertion or error line was announced as expected"
     echo "1 passed, 0 failed"
 }
 
@@ -123,6 +123,8 @@ cp "$TMP/log" "$TMP/scenarios.log"
 part "expected stderr of the scenario tests is labelled" expected_noise "$TMP/scenarios.log"
 part "example scenes (scripts/*.lua, 5 frames)" examples
 part "example scenes that check their claim, in full" checked_examples
+cp "$TMP/log" "$TMP/checked.log"
+part "expected stderr of the checked example scenes is labelled" expected_noise "$TMP/checked.log"
 part "command line (tests/cli/run.sh)" sh tests/cli/run.sh "$BUILD"
 part "sandbox escapes (tests/cli/sandbox.sh)" sh tests/cli/sandbox.sh "$BUILD"
 part "extreme input from the command line (tests/cli/extreme.sh)" sh tests/cli/extreme.sh "$BUILD"
