@@ -4,7 +4,7 @@
 #   (b) wobble test tests/scenarios tests/validation   Lua scenario and validation tests
 #   (c) every scripts/*.lua for 5 frames        one test per example scene (pass = exit 0)
 #       the scenes that check their claim       run in full under wobble test
-#       the output of (b)                       no warning/assert/error line that no test announced
+#       the output of (b) and of those scenes   no warning/assert/error line that no test announced
 #   (d) tests/cli/run.sh                        the command line in separate processes
 #       tests/cli/sandbox.sh                    escapes from the file rules, in separate processes
 #       tests/cli/extreme.sh                    extreme input (overflowing builders, rest lengths, KNN ties)
