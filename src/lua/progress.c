@@ -50,9 +50,10 @@ static void draw(double t) {
     bar.last = t;
 }
 
-void wb_progress_begin(lua_State *L, const char *what, int64_t total) {
+void wb_progress_begin(lua_State *L, const char *what, int64_t total, int quiet) {
+    (void)L;
     if (bar.depth++ > 0) return;
-    bar.on = !wb_rt_get(L)->quiet && isatty(STDERR_FILENO);
+    bar.on = !quiet && isatty(STDERR_FILENO);
     bar.drawn = bar.shown = 0;
     snprintf(bar.what, sizeof bar.what, "%s", what ? what : "frames");
     bar.total = total;
