@@ -9,6 +9,8 @@ local args = wobble.args
 local n = args.res or 48
 local w = wobble.world{ damping = 1 } -- (a light drag: they come to rest in a few seconds)
 wobble.camera{ eye = { 0, 1.4, 3.6 }, target = { 0, 1.4, 0 }, fov = 45 }
+-- the ground, 0.9 m under the hanging cloths: in the picture they hang, they do not stand
+w:collider{ shape = "plane", normal = { 0, 1, 0 }, offset = 0 }
 
 local function hang(x0, tethers)
   local c = w:cloth{ origin = { x0, 2, 0 }, size = { 1, 1 }, res = { n, n }, mass = 0.1 }

@@ -84,9 +84,12 @@ end }
 for _, r in ipairs(recorders) do r:close() end
 
 local x0, y0, z0, x1, y1, z1 = skin:bounds()
-print(string.format("skinned cube: %d vertices on %d particles; lands at frame %s, settles at frame %s, "
-                    .. "rests %.3f x %.3f x %.3f m; its lowest vertex went %.1f mm into the ground",
-                    skin:vertex_count(), #cage.particles, tostring(landed), tostring(settled), x1 - x0, y1 - y0,
+-- (a run too short to settle says so, rather than "settles at frame nil")
+local settles = settled and string.format("settles at frame %d", settled)
+                or string.format("still moving at the end (kinetic %.2g J)", w:energy())
+print(string.format("skinned cube: %d vertices on %d particles; lands at frame %s, %s, "
+                    .. "ends %.3f x %.3f x %.3f m; its lowest vertex went %.1f mm into the ground",
+                    skin:vertex_count(), #cage.particles, tostring(landed), settles, x1 - x0, y1 - y0,
                     z1 - z0, -1000 * deepest))
 
 if test then

@@ -46,6 +46,17 @@ wobble.result{ sag = finite and sag or 0 / 0, max_strain = strain, centre_y = cy
                warnings = (w:warnings()) }
 print(string.format("compliance %g, %d substeps: sag %.3f m, max strain %.1f %%, %s", compliance, substeps, sag,
   100 * strain, stable and "stable" or "NOT stable"))
+if test then -- under `wobble test`: at the defaults the cloth drapes, stable
+  test("at the defaults the cloth drapes over the sphere: its centre on the top, its corners hanging", function()
+    expect.truthy(stable, "stable")
+    local r = w:radius(centre)
+    -- resting on the sphere, a particle's centre is its radius r above the top (measured:
+    -- 0.11 r lower, the sheet's weight on the contact)
+    expect.near(cy, top + r, 0.25 * r, "the centre rests on the sphere's top")
+    -- flat, the corners would be 0.2 m above the top; draped they hang well below it
+    expect.gt(sag, 0.3, "the corners hang below the sphere's top (m)")
+  end)
+end
 if not stable then
   error(string.format("unstable: max strain %.0f %%, centre at y = %.2f", 100 * strain, cy))
 end

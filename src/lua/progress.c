@@ -14,7 +14,8 @@
 static struct {
     int depth;          /* begin/end nesting; only the outermost draws */
     int on;             /* drawing at all (terminal, not quiet) */
-    int drawn;          /* something is on the line: end it with a newline */
+    int drawn;          /* the bar is on the line now */
+    int shown;          /* drawn at least once: the end draws it once more, then a newline */
     char what[32];
     int64_t total, done;
     double t0, last;
@@ -45,14 +46,15 @@ static void draw(double t) {
     }
     fputs("\033[K", stderr);  /* clear what a longer line left behind */
     fflush(stderr);
-    bar.drawn = 1;
+    bar.drawn = bar.shown = 1;
     bar.last = t;
 }
 
-void wb_progress_begin(lua_State *L, const char *what, int64_t total) {
+void wb_progress_begin(lua_State *L, const char *what, int64_t total, int quiet) {
+    (void)L;
     if (bar.depth++ > 0) return;
-    bar.on = !wb_rt_get(L)->quiet && isatty(STDERR_FILENO);
-    bar.drawn = 0;
+    bar.on = !quiet && isatty(STDERR_FILENO);
+    bar.drawn = bar.shown = 0;
     snprintf(bar.what, sizeof bar.what, "%s", what ? what : "frames");
     bar.total = total;
     bar.done = 0;
@@ -70,11 +72,35 @@ void wb_progress_update(lua_State *L, int64_t done) {
 void wb_progress_end(lua_State *L) {
     (void)L;
     if (bar.depth == 0 || --bar.depth > 0) return;
-    if (bar.on && bar.drawn) {
+    if (bar.on && bar.shown) {
         draw(now());
         fputc('\n', stderr);
     }
-    bar.on = bar.drawn = 0;
+    bar.on = bar.drawn = bar.shown = 0;
+}
+
+/* the scene's print: the bar leaves its line first (else a printed line starts at the
+ * bar's end, on the same terminal line) and is drawn again by the next update */
+static int progress_print(lua_State *L) {
+    if (bar.on && bar.drawn) {
+        fputs("\r\033[K", stderr);
+        fflush(stderr);
+        bar.drawn = 0;
+    }
+    lua_pushvalue(L, lua_upvalueindex(1));
+    lua_insert(L, 1);
+    lua_call(L, lua_gettop(L) - 1, LUA_MULTRET);
+    return lua_gettop(L);
+}
+
+void wb_progress_wrap_print(lua_State *L) {
+    lua_getglobal(L, "print");
+    if (!lua_isfunction(L, -1)) {
+        lua_pop(L, 1);
+        return;
+    }
+    lua_pushcclosure(L, progress_print, 1);
+    lua_setglobal(L, "print");
 }
 
 void wb_progress_note(lua_State *L, const char *note) {

@@ -574,6 +574,7 @@ static int rt_init(lua_State *L) {
     lua_pushlightuserdata(L, rt);  /* for code that looks for it by name */
     lua_setfield(L, LUA_REGISTRYINDEX, "wobble.runtime");
     wb_sandbox_open(L, &rt->sb);
+    wb_progress_wrap_print(L);
     /* require: the library folder, then the scene's folder */
     lua_getglobal(L, LUA_LOADLIBNAME);
     luaL_Buffer b;

@@ -80,10 +80,11 @@ const char *wb_rt_lib_dir(void);              /* the folder holding wobble/test.
 const char *wb_rt_project_root(void);         /* the source tree (tests/bench, assets), or NULL */
 
 /* ---- progress (progress.c): a bar on a terminal, silent otherwise or with --quiet ---- */
-void wb_progress_begin(lua_State *L, const char *what, int64_t total);
+void wb_progress_begin(lua_State *L, const char *what, int64_t total, int quiet);  /* quiet: --quiet */
 void wb_progress_update(lua_State *L, int64_t done);
 void wb_progress_end(lua_State *L);
 void wb_progress_note(lua_State *L, const char *note);   /* shown after every bar's label; NULL clears */
+void wb_progress_wrap_print(lua_State *L);  /* the global print takes the bar off its line first */
 
 /* ---- result.json of a run (result.c), what `wobble collect` reads ----------------------- */
 typedef struct wbl_run_info {

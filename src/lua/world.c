@@ -359,7 +359,7 @@ static int w_run(lua_State *L)
     r->has_fn = has_fn;
     wbl_plot_push(L, 2, "plot", 1);   /* slot 5: the plot's sampler, or nil */
     r->active = 1;
-    wb_progress_begin(L, "run", n);
+    wb_progress_begin(L, "run", n, wb_rt_get(L)->quiet);
     return run_loop(L, LUA_OK, 0);
 }
 

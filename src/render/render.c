@@ -1058,9 +1058,12 @@ bool wb_renderer_draw(wb_renderer *r, const wb_world *w, const wb_draw_opts *o, 
             planes++;
         }
     }
-    if (!planes && o->grid) {
+    /* the floor under the scene, only below the eye: bodies made above it (a cloth hung
+     * flat at the start) would put it overhead, a ceiling hiding them */
+    const double floor_h = fmin(cur.lo[1], r->view_lo[1]);
+    if (!planes && o->grid && floor_h < r->cam_eye[1]) {
         wb_real up[3] = { 0, 1, 0 };
-        if (plane_frame(up, fmin(cur.lo[1], r->view_lo[1]), c, center, gu, gv, gn))
+        if (plane_frame(up, floor_h, c, center, gu, gv, gn))
             draw_grid(r, cam, center, gu, gv, gn, spacing, ext, true, fog, &sr);
     }
 

@@ -37,7 +37,7 @@ start() {
 stop() {
     sleep "$2"
     kill -s "$1" "$pid" 2>/dev/null
-    wait "$pid"
+    wait "$pid" 2>/dev/null
     code=$?
     pid=""
 }

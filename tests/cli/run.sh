@@ -165,6 +165,13 @@ if command -v script >/dev/null 2>&1; then
     script -qec "$W run $F/slow_run.lua --quiet" /dev/null >"$TMP/out" 2>&1
     code=$?
     check "--quiet: no progress bar on a terminal" 0 !out "60/60"
+    # a line the scene prints starts a line of its own: the bar leaves its line first
+    script -qec "$W run $F/slow_print.lua" /dev/null >"$TMP/out" 2>&1
+    code=$?
+    check "print during a progress bar: on its own line" 0 out "tick 45" out "60/60"
+    tr '\r' '\n' <"$TMP/out" | grep -q "fps.*tick 45" &&
+        result "print during a progress bar: not after the bar's text" "a printed line begins at the bar's end" ||
+        result "print during a progress bar: not after the bar's text" ""
 fi
 
 # symlinks cannot lead out of an allowed folder

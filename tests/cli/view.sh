@@ -342,13 +342,21 @@ if window && wait_for "$TMP/out" "frame 30" 1 20; then
     xdotool mouseup 1
     sleep 0.3
     xdotool key --window "$wid" r
+    sleep 0.3
+    # R keeps the pause (docs/cli.md): Space runs the new run on to its frame 30
+    xdotool key --window "$wid" space
     wait_for "$TMP/out" "frame 30" 2 20 || why="R did not restart the scene"
     xdotool key --window "$wid" Escape 2>/dev/null
 else
     why="no window"
 fi
 finish 20
-check "a grab while paused, then R: the log holds the new run alone" 0 err "recorded 0 input events"
+# (check starts its own why: a reason found above is reported by result instead)
+if [ -n "$why" ]; then
+    result "a grab while paused, then R: the log holds the new run alone" "$why"
+else
+    check "a grab while paused, then R: the log holds the new run alone" 0 err "recorded 0 input events"
+fi
 
 # ---- os.exit (--unsafe) closes the viewer with its code; the input log and the
 # screenshot are still written (the process used to exit on the spot)
