@@ -50,8 +50,8 @@ for k, p in ipairs(cloth.particles) do
 end
 
 -- the camera `--record` draws with and `wobble view` starts with: from above at a slant,
--- the drape over the sphere in the middle and the folds of the skirt around it
-wobble.camera{ eye = {1.6, 1.45, 2.1}, target = {0, 0.17, 0} }
+-- far enough back to hold the sheet where it starts (1.1-1.4 m up) and the drape below
+wobble.camera{ eye = {2.3, 2.4, 3.3}, target = {0, 0.65, 0} }
 
 local seconds = args.seconds or 4
 local ms, frames = 0, 0

@@ -17,7 +17,7 @@ local ball = w:collider{ shape = "sphere", center = {0.1, 0.35, 0}, radius = 0.3
 
 -- the camera `--record` draws with and `wobble view` starts with: from the front and above,
 -- across the way it slides off, so that its bend over the ball shows
-wobble.camera{ eye = {-0.1, 1.5, 2.7}, target = {-0.3, 0.35, 0} }
+wobble.camera{ eye = {-0.1, 1.7, 3.3}, target = {-0.3, 0.55, 0} }
 
 local torus = assert(wobble.load_mesh("../assets/torus.ply")) -- relative to this file's folder
 torus:transform{ translate = {0, 1.2, 0} }
