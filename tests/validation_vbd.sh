@@ -24,21 +24,24 @@ not_vbd="neo_stiff.lua residual.lua materials.lua"
 #     bending.lua hand_built.lua user/01_rope_hand_built.lua user/02_chain_catenary.lua
 #     user/03_cloth_hand_built_sphere.lua user/07_cloth_two_pins.lua attach_rigid.lua
 #     bend_break.lua tethers.lua
-#   a stiff body's translation is carried by the sweeps' start (the prediction less the
-#   gravity it did not follow): a block on a slope past tan = mu does not slide, blocks
-#   made overlapping part too fast, a box on a soft block spins, free momentum drifts:
-#     friction_block.lua user/11_slope_friction.lua contacts.lua contact_energy.lua
-#     contact_kinetic.lua made_overlapping.lua made_stack.lua symmetric_drop.lua
-#     user/10_rigid_on_soft.lua user/14_elastic_release_symmetry.lua user/06_projectile.lua
-#     rigid_particle.lua squeeze.lua pressure.lua shape_match.lua
+#   a stiff body touching particles or a rigid body keeps the translation of the sweeps'
+#   start (the prediction less the gravity it did not follow; a free one is moved to keep
+#   its momentum, docs/physics.md): blocks made overlapping part too fast, a box on a soft
+#   block spins, a block on another creeps below tan = mu, stacked blocks sink:
+#     contacts.lua contact_energy.lua contact_kinetic.lua made_overlapping.lua made_stack.lua
+#     symmetric_drop.lua user/10_rigid_on_soft.lua user/14_elastic_release_symmetry.lua
+#     rigid_particle.lua squeeze.lua shape_match.lua
+#   penetration.lua: its rotated box's "something rests on it" (the contacts of the last
+#     step) is chance: its lattice slides off as under XPBD, and of the rain 0 particles
+#     stay at the defaults, 1-4 at 8 or 12 substeps or 2 iterations (XPBD 2-7); its other
+#     tests pass
 #   cloth falling on itself: self-contacts projected after the sweeps fight them (blow-ups):
 #     cloth_sphere_drop.lua self_collision.lua contact_triangles.lua contact_triangles_overlap.lua
 not_yet="bending.lua hand_built.lua user/01_rope_hand_built.lua user/02_chain_catenary.lua
 user/03_cloth_hand_built_sphere.lua user/07_cloth_two_pins.lua attach_rigid.lua bend_break.lua tethers.lua
-friction_block.lua user/11_slope_friction.lua contacts.lua contact_energy.lua contact_kinetic.lua
+contacts.lua contact_energy.lua contact_kinetic.lua
 made_overlapping.lua made_stack.lua symmetric_drop.lua user/10_rigid_on_soft.lua
-user/14_elastic_release_symmetry.lua user/06_projectile.lua rigid_particle.lua squeeze.lua pressure.lua
-shape_match.lua cloth_sphere_drop.lua self_collision.lua contact_triangles.lua contact_triangles_overlap.lua"
+user/14_elastic_release_symmetry.lua rigid_particle.lua squeeze.lua shape_match.lua penetration.lua cloth_sphere_drop.lua self_collision.lua contact_triangles.lua contact_triangles_overlap.lua"
 
 set --
 for f in $(find tests/validation -name '*.lua' | sort); do

@@ -21,7 +21,9 @@
 
 #include "bend.h"
 #include "pool.h"
+#include "rigid.h"
 #include "tet.h"
+#include "volume.h"
 #include "vbd.h"
 
 /* a link as the sweep reads it (one load of 40 bytes instead of six arrays): its force
@@ -51,8 +53,8 @@ struct wb_vbd {
     wb_real *y;            /* (np x 3) the substep's prediction */
     wb_real *vlast;        /* (np x 3) each vertex's velocity before gravity, last substep */
     wb_real *lam, *kpen;   /* (nd) a hard link's multiplier and penalty */
-    wb_real *c0;           /* (nd) a hard link's error at the substep's start, which it keeps
-                              but for 1 - VBD_STAB (AVBD's stabilisation) */
+    wb_real *c0;           /* (nd) a hard link's error as the last solve left it (NaN: not
+                              known), of which it keeps VBD_STAB (AVBD's stabilisation) */
     vbd_link *lk;          /* (nd) what the sweep reads of each link, set each substep */
     int32_t *hard;         /* the live hard links' slots, this substep */
     int32_t nhard;
@@ -62,6 +64,8 @@ struct wb_vbd {
     wb_real residual;      /* the last sweep's largest step, m */
     wb_real *cheb[2];      /* (np x 3, while Chebyshev is on) the positions two and one
                               iterations back */
+    double *tsum;          /* (bodies x 4) each free body's mass and sum m (x - y) */
+    int32_t cap_tsum;
 };
 
 #define VBD_COLOURS 64
@@ -106,6 +110,7 @@ void wb__vbd_destroy(wb_world *w)
     free(v->bkpen);
     free(v->cheb[0]);
     free(v->cheb[1]);
+    free(v->tsum);
     free(v);
     w->vbd = NULL;
 }
@@ -275,6 +280,8 @@ int wb__vbd_prepare(wb_world *w)
             memset(v->bkpen + v->cap_blam, 0, sizeof *bk * (n - (size_t)v->cap_blam));
             v->cap_blam = w->bend.n;
         }
+        /* (a slot may hold another link now: its error is the one it starts with) */
+        for (int32_t q = 0; q < m->nd; q++) v->c0[q] = (wb_real)NAN;
         v->np = m->np;
         v->nd = m->nd;
         v->nt = nt;
@@ -544,6 +551,11 @@ static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2, wb_real in
     const wb_model *m = &w->m;
     const wb_real *xp = w->s.x_prev;
     v->nhard = 0;
+    /* volume constraints are projected after the sweeps: with rigid links they may hold
+     * a body over-constrained (rigid links and incompressible tets under a press), and a
+     * link that took back what the press pushed into it each substep fought them (a
+     * lattice with tets squeezed to 60% blew up at 55 m/s): there every error is kept */
+    const int keep_all = wb_volume_count(w) > 0;
     for (int32_t s = 0; s < m->nd; s++) {
         if (!link_live(w, s)) continue;
         vbd_link *L = &v->lk[s];
@@ -556,10 +568,15 @@ static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2, wb_real in
         }
         wb_real d[3];
         v3_sub(d, &xp[3 * m->d_ij[2 * s]], &xp[3 * m->d_ij[2 * s + 1]]);
-        v->c0[s] = v3_len(d) - rest;
+        /* the error kept is no more than the solve itself left: what the contacts and
+         * colliders did to the link since (pushing a body's bottom up into it) is a load
+         * it takes, not a drift to stabilise, or a block on the ground sags by 100 g h^2
+         * a link (a 4 x 4 x 4 lattice's lowest links 17% short on a slope) */
+        const wb_real c = v3_len(d) - rest, ce = v->c0[s];
+        const wb_real c0 = keep_all || !isfinite(ce) ? c : c * ce <= 0 ? 0 : fabs(c) < fabs(ce) ? c : ce;
         const wb_real k0 = start_penalty(w, s, inv_h2);
         v->kpen[s] = v->kpen[s] * VBD_WARM > k0 ? v->kpen[s] * VBD_WARM : k0;
-        L->tgt = rest + VBD_STAB * v->c0[s], L->kk = v->kpen[s], L->lm = v->lam[s], L->dmp = 0, L->k0 = k0;
+        L->tgt = rest + VBD_STAB * c0, L->kk = v->kpen[s], L->lm = v->lam[s], L->dmp = 0, L->k0 = k0;
         L->kr = k0 * VBD_RAMP / (rest > 0 ? rest : 1), L->kmax = VBD_KMAX * k0;
         put_entries(v, s, L);
         v->hard[v->nhard++] = s;
@@ -583,12 +600,17 @@ static void dual_update(wb_world *w, struct wb_vbd *v)
     }
 }
 
-/* the hard links' multipliers and penalties carried to the next substep */
-static void keep_multipliers(struct wb_vbd *v)
+/* the hard links' multipliers, penalties and errors carried to the next substep */
+static void keep_multipliers(wb_world *w, struct wb_vbd *v)
 {
+    const wb_model *m = &w->m;
+    const wb_real *x = w->s.x;
     for (int32_t q = 0; q < v->nhard; q++) {
         const int32_t s = v->hard[q];
         v->lam[s] = v->lk[s].lm, v->kpen[s] = v->lk[s].kk;
+        wb_real d[3];
+        v3_sub(d, &x[3 * m->d_ij[2 * s]], &x[3 * m->d_ij[2 * s + 1]]);
+        v->c0[s] = v3_len(d) - w->s.d_rest[s];
     }
 }
 
@@ -709,6 +731,62 @@ static void chebyshev(wb_world *w, struct wb_vbd *v, int it, wb_real *omega)
     memcpy(v->cheb[1], x, sizeof *x * n3);
 }
 
+/* Each free body (momentum.c's: nothing outside the solve holds it) moved rigidly so that
+ * the solve keeps its momentum, sum m (x - y) = 0. Its energies do not change under a
+ * translation, so the move only lowers the inertia term: it is the exact step of the
+ * substep's energy along the body's translation, which the vertex steps cannot take for
+ * a stiff body (a vertex's own block is its stiffness, which one translating with its
+ * neighbours does not feel: each sweep moves the body by m / (h^2 k) of what is left,
+ * and the start (start_guess) would carry it). Serial, in particle order: the same bits
+ * on any thread count */
+static void keep_momentum(wb_world *w, struct wb_vbd *v)
+{
+    const wb_cache *k = &w->k;
+    if (!k->mc_built || k->mc_nbody == 0) return;
+    const int32_t nb = k->mc_nbody, *body = k->mc_body;
+    if (nb > v->cap_tsum) {
+        double *t = realloc(v->tsum, sizeof *t * 4 * (size_t)nb);
+        if (!t) return;
+        v->tsum = t, v->cap_tsum = nb;
+    }
+    double *T = v->tsum;
+    memset(T, 0, sizeof *T * 4 * (size_t)nb);
+    /* a body that may touch particles or a rigid body this frame is left as the sweeps
+     * leave it: the particle contacts projected after the solve would take the step back
+     * from one side only (measured: two stacked lattices crept 3 cm off centre, a cloth
+     * under falling particles slid off a sphere) */
+    const wb_contacts *pc = &k->pc;
+    for (int32_t c = 0; c < pc->n; c++)
+        for (int e = 0; e < 2; e++)
+            if (body[pc->ij[2 * c + e]] >= 0) T[4 * body[pc->ij[2 * c + e]]] = -1;
+    const wb_tricontacts *tc = &k->tc;
+    for (int32_t c = 0; c < tc->n; c++) {
+        const int32_t t = tc->pt[2 * c + 1], pts[4] = { tc->pt[2 * c], w->m.tri[3 * t], w->m.tri[3 * t + 1], w->m.tri[3 * t + 2] };
+        for (int e = 0; e < 4; e++)
+            if (body[pts[e]] >= 0) T[4 * body[pts[e]]] = -1;
+    }
+    if (w->rb)
+        for (int32_t c = 0; c < w->rb->npct; c++)
+            if (body[w->rb->pc[2 * c]] >= 0) T[4 * body[w->rb->pc[2 * c]]] = -1;
+    const wb_real *wv = w->m.w, *y = v->y;
+    wb_real *x = w->s.x;
+    for (int32_t i = 0; i < w->m.np; i++) {
+        const int32_t b = body[i];
+        if (b < 0 || k->mc_acc[16 * b] < 0 || T[4 * b] < 0 || !(wv[i] > 0)) continue;
+        const double m = 1 / (double)wv[i];
+        T[4 * b] += m;
+        for (int c = 0; c < 3; c++) T[4 * b + 1 + c] += m * ((double)x[3 * i + c] - (double)y[3 * i + c]);
+    }
+    for (int32_t b = 0; b < nb; b++)
+        if (T[4 * b] > 0)
+            for (int c = 1; c < 4; c++) T[4 * b + c] /= T[4 * b];
+    for (int32_t i = 0; i < w->m.np; i++) {
+        const int32_t b = body[i];
+        if (b < 0 || !(T[4 * b] > 0) || !(wv[i] > 0)) continue;
+        for (int c = 0; c < 3; c++) x[3 * i + c] -= (wb_real)T[4 * b + 1 + c];
+    }
+}
+
 wb_real wb__vbd_solve(wb_world *w, wb_real h)
 {
     struct wb_vbd *v = w->vbd;
@@ -746,7 +824,8 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
             if (!wb__vbd_serves(wb__ctypes[t])) wb__ctypes[t]->project(w, h);
         if (w->m.def.tolerance > 0 && v->residual <= w->m.def.tolerance) break;
     }
-    keep_multipliers(v);
+    keep_momentum(w, v);
+    keep_multipliers(w, v);
     write_forces(w, v, h);
     return v->residual;
 }
