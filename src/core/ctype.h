@@ -98,6 +98,24 @@ static inline int wb__quad_check(const int32_t p[4], int32_t np)
     return 0;
 }
 
+/* a type's check's faults (wb_fault): an option's, with its key (a string literal), and
+ * the particles' (corner: the one at fault, -1: together) */
+#define WB_FAULT_KEY(k, why_) ((wb_fault){ k " " why_, k, why_, -1 })
+#define WB_FAULT_AT(c, msg_, why_) ((wb_fault){ msg_, NULL, why_, c })
+#define WB_NO_FAULT ((wb_fault){ NULL, NULL, NULL, -1 })
+
+/* the four corners' fault (wb__quad_check), in the type's words: range ("bend particle
+ * out of range"), distinct ("a bend needs four distinct particles") */
+static inline wb_fault wb__quad_fault(const int32_t p[4], int32_t np, const char *range, const char *distinct)
+{
+    for (int k = 0; k < 4; k++) {
+        if (p[k] < 0 || p[k] >= np) return WB_FAULT_AT(k, range, "out of range");
+        for (int j = 0; j < k; j++)
+            if (p[j] == p[k]) return WB_FAULT_AT(k, distinct, distinct);
+    }
+    return WB_NO_FAULT;
+}
+
 extern const wb_ctype wb__distance_type, wb__bend_type, wb__volume_type,
                       wb__shape_type, wb__pressure_type, wb__tet_type;
 extern const wb_ctype wb__attach_type, wb__grab_type, wb__tether_type; /* attach.c, grab.c, tether.c */
