@@ -351,6 +351,8 @@ typedef struct wb_tether_def {
 } wb_tether_def;
 wb_tether_def wb_tether_default_def(void);
 const char *wb_tether_def_check(const wb_tether_def *def);   /* NULL or what is wrong */
+/* what wb_tether_add would refuse (x: the positions, or NULL to leave out their distance) */
+wb_fault wb_tether_check(int32_t np, const wb_real *x, int32_t p, int32_t q, const wb_tether_def *def);
 /* returns the tether's index, or a negative wb_status (WB_ERR_ARG: see wb_last_error) */
 int32_t wb_tether_add(wb_world *w, int32_t p, int32_t q, const wb_tether_def *def);
 /* a tether from each of ids' particles that is not pinned to the nearest pinned one among
@@ -525,6 +527,8 @@ typedef struct wb_volume_def {
 
 wb_volume_def wb_volume_default_def(void);                    /* incompressible, rest = current */
 const char *wb_volume_def_check(const wb_volume_def *def);    /* NULL or what is wrong */
+/* what wb_volume_add would refuse (x: the positions, or NULL to leave out their volume) */
+wb_fault wb_volume_check(int32_t np, const wb_real *x, const int32_t p[4], const wb_volume_def *def);
 /* returns the constraint's index, or a negative wb_status (WB_ERR_ARG: see wb_last_error) */
 int32_t wb_volume_add(wb_world *w, const int32_t p[4], const wb_volume_def *def);
 int32_t wb_volume_count(const wb_world *w);
@@ -545,6 +549,8 @@ typedef struct wb_tet_def {
 } wb_tet_def;
 wb_tet_def wb_tet_default_def(void);
 const char *wb_tet_def_check(const wb_tet_def *def);          /* NULL or what is wrong */
+/* what wb_tet_add would refuse (x: the positions, or NULL to leave out their rest shape) */
+wb_fault wb_tet_check(int32_t np, const wb_real *x, const int32_t p[4], const wb_tet_def *def);
 /* index, or WB_ERR_ARG (see wb_last_error: a particle twice, a flat tet) */
 int32_t wb_tet_add(wb_world *w, const int32_t p[4], const wb_tet_def *def);
 int32_t wb_tet_count(const wb_world *w);

@@ -368,16 +368,21 @@ static int read_volumes(rd *r, const cJSON *arr, wb_image *g)
         if (jv_get_object(r, c, &p, keys, f)) return -1;
         if (!f[0]) return jv_missing(r, c, &p, "particles");
         int32_t *ijkl = &g->vol.ijkl[4 * i];
-        if (jv_get_corners(r, f[0], &pp, g->np, 4, "a volume constraint", ijkl)) return -1;
-        const wb_real *x = g->x;
-        g->vol.rest[i] = wb_tet_signed_volume(&x[3 * ijkl[0]], &x[3 * ijkl[1]], &x[3 * ijkl[2]], &x[3 * ijkl[3]]);
-        g->vol.alpha[i] = 0;
-        g->vol.plastic[2 * i] = g->vol.plastic[2 * i + 1] = 0;
-        if (jv_opt_real(r, f[1], &p, "rest", &g->vol.rest[i]) || jv_opt_nonneg(r, f[2], &p, "compliance", &g->vol.alpha[i]) ||
-            jv_opt_nonneg(r, f[3], &p, "yield", &g->vol.plastic[2 * i]) ||
-            jv_opt_nonneg(r, f[4], &p, "creep", &g->vol.plastic[2 * i + 1]))
+        if (jv_get_ids(r, f[0], &pp, g->np, 4, "a volume constraint", ijkl)) return -1;
+        wb_volume_def d = wb_volume_default_def();
+        d.has_rest = f[1] != NULL;
+        if (jv_opt_real(r, f[1], &p, "rest", &d.rest) || jv_opt_real(r, f[2], &p, "compliance", &d.compliance) ||
+            jv_opt_real(r, f[3], &p, "yield", &d.yield) || jv_opt_real(r, f[4], &p, "creep", &d.creep))
             return -1;
-        if (!isfinite(g->vol.rest[i])) return jv_fail(r, f[0], 0, &pp, "the particles are too far apart (their volume overflows)");
+        /* the core decides what a volume constraint may be (volume.c) */
+        const wb_fault ft = wb_volume_check(g->np, g->x, ijkl, &d);
+        if (jv_fault(r, &ft, &p, keys, f, 0)) return -1;
+        const wb_real *x = g->x;
+        g->vol.rest[i] = d.has_rest ? d.rest
+                       : wb_tet_signed_volume(&x[3 * ijkl[0]], &x[3 * ijkl[1]], &x[3 * ijkl[2]], &x[3 * ijkl[3]]);
+        g->vol.alpha[i] = d.compliance;
+        g->vol.plastic[2 * i] = d.yield;
+        g->vol.plastic[2 * i + 1] = d.creep;
     }
     return 0;
 }
@@ -416,14 +421,19 @@ static int read_tethers(rd *r, const cJSON *arr, wb_image *g)
         if (jv_get_object(r, c, &p, keys, f)) return -1;
         if (!f[0]) return jv_missing(r, c, &p, "particles");
         int32_t *ij = &g->teth.ij[2 * i];
-        if (jv_get_corners(r, f[0], &pp, g->np, 2, "a tether", ij)) return -1;
+        if (jv_get_ids(r, f[0], &pp, g->np, 2, "a tether", ij)) return -1;
+        wb_tether_def td = wb_tether_default_def();
+        td.has_length = f[1] != NULL;
+        if (jv_opt_real(r, f[1], &p, "length", &td.length) || jv_opt_real(r, f[2], &p, "compliance", &td.compliance))
+            return -1;
+        /* the core decides what a tether may be (tether.c) */
+        const wb_fault ft = wb_tether_check(g->np, g->x, ij[0], ij[1], &td);
+        if (jv_fault(r, &ft, &p, keys, f, 0)) return -1;
         const wb_real *x = g->x;
         wb_real d[3];
         v3_sub(d, &x[3 * ij[0]], &x[3 * ij[1]]);
-        g->teth.len[i] = v3_len(d);
-        g->teth.alpha[i] = 0;
-        if (jv_opt_nonneg(r, f[1], &p, "length", &g->teth.len[i]) || jv_opt_nonneg(r, f[2], &p, "compliance", &g->teth.alpha[i]))
-            return -1;
+        g->teth.len[i] = td.has_length ? td.length : v3_len(d);
+        g->teth.alpha[i] = td.compliance;
     }
     return 0;
 }

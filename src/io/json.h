@@ -66,9 +66,8 @@ int jv_get_array(rd *r, const cJSON *it, const kp *p, int64_t max, int32_t *coun
 int jv_get_vec(rd *r, const cJSON *it, const kp *p, int n, wb_real *out); /* exactly n numbers */
 /* an element's "particles": exactly k (2 or 4) indices of the np particles, into out;
  * `what` names the element in the messages ("a tet"). Whether they may repeat is the
- * type's check's to say (jv_fault); jv_get_corners also refuses a repeat itself */
+ * type's check's to say (jv_fault) */
 int jv_get_ids(rd *r, const cJSON *it, const kp *p, int32_t np, int k, const char *what, int32_t *out);
-int jv_get_corners(rd *r, const cJSON *it, const kp *p, int32_t np, int k, const char *what, int32_t *out);
 /* fail with what a type's check found (wb_fault; returns 0 when nothing): an option's at
  * its value (keys: the element's keys, f: their values, up: its path), the particles' at
  * their array, f[parts] (and there an option's whose value the file does not give) */

@@ -146,18 +146,19 @@ int jm_read_tets(rd *r, const cJSON *arr, wb_image *g)
         if (!f[0]) return jv_missing(r, c, &p, "particles");
         if (!f[1]) return jv_missing(r, c, &p, "young");
         int32_t *q4 = &g->tet.ijkl[4 * i];
-        if (jv_get_corners(r, f[0], &pp, g->np, 4, "a tet", q4)) return -1;
-        wb_real y = 0, nu = 0.3;
-        if (jv_opt_real(r, f[1], &p, "young", &y) || jv_opt_real(r, f[2], &p, "poisson", &nu)) return -1;
-        kp yq = { &p, "young", 0 }, nq = { &p, "poisson", 0 };
-        if (!(y > 0) || !isfinite(y)) return jv_fail(r, f[1], 0, &yq, "must be > 0 (Pa)");
-        if (!(nu >= 0 && nu < 0.5)) return jv_fail(r, f[2], 0, &nq, "must be in [0, 0.5)");
-        g->tet.young[i] = y;
-        g->tet.poisson[i] = nu;
-        g->tet.plastic[2 * i] = g->tet.plastic[2 * i + 1] = 0;
-        if (jv_opt_nonneg(r, f[5], &p, "yield", &g->tet.plastic[2 * i]) ||
-            jv_opt_nonneg(r, f[6], &p, "creep", &g->tet.plastic[2 * i + 1]))
+        if (jv_get_ids(r, f[0], &pp, g->np, 4, "a tet", q4)) return -1;
+        wb_tet_def d = wb_tet_default_def();
+        if (jv_opt_real(r, f[1], &p, "young", &d.young) || jv_opt_real(r, f[2], &p, "poisson", &d.poisson) ||
+            jv_opt_real(r, f[5], &p, "yield", &d.yield) || jv_opt_real(r, f[6], &p, "creep", &d.creep))
             return -1;
+        /* the core decides what a tet may be (tet.c); its rest shape from the positions
+         * only when the file does not give it */
+        const wb_fault ft = wb_tet_check(g->np, f[3] ? NULL : g->x, q4, &d);
+        if (jv_fault(r, &ft, &p, keys, f, 0)) return -1;
+        g->tet.young[i] = d.young;
+        g->tet.poisson[i] = d.poisson;
+        g->tet.plastic[2 * i] = d.yield;
+        g->tet.plastic[2 * i + 1] = d.creep;
         if (!f[3] != !f[4]) return jv_fail(r, c, 0, &p, "rest_inverse and rest_volume go together");
         if (f[3]) {
             kp vq = { &p, "rest_volume", 0 };
@@ -167,9 +168,8 @@ int jm_read_tets(rd *r, const cJSON *arr, wb_image *g)
             if (!(g->tet.v0[i] > 0) || !isfinite(g->tet.v0[i])) return jv_fail(r, f[4], 0, &vq, "must be > 0");
         } else {
             const wb_real *x = g->x;
-            if (!wb_tet_rest_shape(&x[3 * q4[0]], &x[3 * q4[1]], &x[3 * q4[2]], &x[3 * q4[3]], &g->tet.dminv[9 * i],
-                                   &g->tet.v0[i]))
-                return jv_fail(r, f[0], 0, &pp, "the four particles lie in a plane (a flat tet has no rest shape)");
+            wb_tet_rest_shape(&x[3 * q4[0]], &x[3 * q4[1]], &x[3 * q4[2]], &x[3 * q4[3]], &g->tet.dminv[9 * i],
+                              &g->tet.v0[i]); /* checked above: not flat */
         }
     }
     return 0;

@@ -235,15 +235,6 @@ int jv_get_ids(rd *r, const cJSON *it, const kp *p, int32_t np, int k, const cha
     return 0;
 }
 
-int jv_get_corners(rd *r, const cJSON *it, const kp *p, int32_t np, int k, const char *what, int32_t *out)
-{
-    if (jv_get_ids(r, it, p, np, k, what, out)) return -1;
-    for (int c = 0; c < k; c++)
-        for (int j = 0; j < c; j++)
-            if (out[j] == out[c]) return jv_fail(r, it, 0, p, "%s needs %s distinct particles", what, k == 2 ? "two" : "four");
-    return 0;
-}
-
 int jv_fault(rd *r, const wb_fault *ft, const kp *up, const char *const keys[], const cJSON *const f[], int parts)
 {
     if (!ft->msg) return 0;
