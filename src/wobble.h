@@ -594,6 +594,8 @@ typedef struct wb_shape_match_def {
 
 wb_shape_match_def wb_shape_match_default_def(void);          /* rigid, elastic */
 const char *wb_shape_match_def_check(const wb_shape_match_def *def); /* NULL or what is wrong */
+/* the options' fault as wb_shape_match_def_check finds it, by key (wb_fault) */
+wb_fault wb_shape_match_def_fault(const wb_shape_match_def *def);
 /* a cluster of n >= 2 distinct particles, some with mass, their rest shape as they are now;
  * returns its index (clusters are never removed) or a negative wb_status */
 int32_t wb_shape_match_add(wb_world *w, const int32_t *ids, int32_t n, const wb_shape_match_def *def);
@@ -614,6 +616,8 @@ typedef struct wb_pressure_def {
 
 wb_pressure_def wb_pressure_default_def(void);
 const char *wb_pressure_def_check(const wb_pressure_def *def);
+/* the options' fault as wb_pressure_def_check finds it, by key (wb_fault) */
+wb_fault wb_pressure_def_fault(const wb_pressure_def *def);
 /* the first surface whose corners all lie in the body's particles; -1 when none */
 int32_t wb_body_surface(const wb_world *w, wb_body b);
 /* over surface s, which must be closed (every edge shared by exactly two triangles,
