@@ -95,9 +95,11 @@ static int p_set_pressure(lua_State *L)
 {
     int32_t k;
     wb_world *w = checkpr(L, 1, &k);
-    const wb_real p = wbl_checkreal(L, 2);
-    if (!(p > 0)) return luaL_argerror(L, 2, "pressure must be > 0");
-    wb_pressure_set(w, k, p);
+    wb_pressure_def d = wb_pressure_get_def(w, k);
+    d.pressure = wbl_checkreal(L, 2);
+    const wb_fault f = wb_pressure_def_fault(&d); /* the core decides (pressure.c) */
+    if (f.msg) return luaL_argerror(L, 2, f.msg);
+    wb_pressure_set(w, k, d.pressure);
     return 0;
 }
 
