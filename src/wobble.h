@@ -44,6 +44,17 @@ typedef enum wb_status {
     WB_ERR_INTERRUPTED = -4, /* the interrupt callback stopped a step: the frame was undone */
 } wb_status;
 
+/* what is wrong with a constraint's arguments, as its type's check (wb_distance_check,
+ * wb_bend_check, ...) finds it: the type's file is the one place that decides, and a
+ * binding or a file reader says it in its own terms (the option's key, the particle's
+ * argument or the file's line). msg NULL: nothing is wrong */
+typedef struct wb_fault {
+    const char *msg;    /* the whole sentence ("compliance must be >= 0") */
+    const char *key;    /* the option at fault, as scripts and files name it; NULL: the particles */
+    const char *why;    /* msg without its subject ("must be >= 0") */
+    int corner;         /* key NULL: the particle at fault (0-based); -1: the particles together */
+} wb_fault;
+
 typedef enum wb_solver { WB_SOLVER_GAUSS_SEIDEL = 0, WB_SOLVER_JACOBI = 1, WB_SOLVER_VBD = 2 } wb_solver;
 
 typedef enum wb_shape {
@@ -133,6 +144,9 @@ typedef struct wb_distance_def {
 
 wb_distance_def wb_distance_default_def(void);                /* rigid, rest = current, elastic, unbreakable */
 const char *wb_distance_def_check(const wb_distance_def *def); /* NULL or what is wrong */
+/* what wb_distance_add would refuse of these arguments (np particles; x: their positions,
+ * or NULL to leave out the check of their distance) */
+wb_fault wb_distance_check(int32_t np, const wb_real *x, int32_t a, int32_t b, const wb_distance_def *def);
 /* connect two distinct particles; returns the handle, or index 0 / gen 0 with *status set */
 wb_distance_id wb_distance_add(wb_world *w, int32_t a, int32_t b, const wb_distance_def *def, wb_status *status);
 bool wb_distance_valid(const wb_world *w, wb_distance_id c);  /* false for stale or removed handles */
@@ -162,6 +176,9 @@ typedef struct wb_bend_def {
 
 wb_bend_def wb_bend_default_def(void);                        /* rigid, undamped, rest = current */
 const char *wb_bend_def_check(const wb_bend_def *def);        /* NULL or what is wrong */
+/* what wb_bend_add would refuse of these arguments (np particles; x: their positions, or
+ * NULL to leave out the check that the triangles have an angle) */
+wb_fault wb_bend_check(int32_t np, const wb_real *x, const int32_t p[4], const wb_bend_def *def);
 /* four distinct particles whose triangles are not degenerate; index 0 / gen 0 and
  * *status set on failure. Bends are never removed */
 wb_bend_id wb_bend_add(wb_world *w, const int32_t p[4], const wb_bend_def *def, wb_status *status);
@@ -334,6 +351,8 @@ typedef struct wb_tether_def {
 } wb_tether_def;
 wb_tether_def wb_tether_default_def(void);
 const char *wb_tether_def_check(const wb_tether_def *def);   /* NULL or what is wrong */
+/* what wb_tether_add would refuse (x: the positions, or NULL to leave out their distance) */
+wb_fault wb_tether_check(int32_t np, const wb_real *x, int32_t p, int32_t q, const wb_tether_def *def);
 /* returns the tether's index, or a negative wb_status (WB_ERR_ARG: see wb_last_error) */
 int32_t wb_tether_add(wb_world *w, int32_t p, int32_t q, const wb_tether_def *def);
 /* a tether from each of ids' particles that is not pinned to the nearest pinned one among
@@ -508,6 +527,8 @@ typedef struct wb_volume_def {
 
 wb_volume_def wb_volume_default_def(void);                    /* incompressible, rest = current */
 const char *wb_volume_def_check(const wb_volume_def *def);    /* NULL or what is wrong */
+/* what wb_volume_add would refuse (x: the positions, or NULL to leave out their volume) */
+wb_fault wb_volume_check(int32_t np, const wb_real *x, const int32_t p[4], const wb_volume_def *def);
 /* returns the constraint's index, or a negative wb_status (WB_ERR_ARG: see wb_last_error) */
 int32_t wb_volume_add(wb_world *w, const int32_t p[4], const wb_volume_def *def);
 int32_t wb_volume_count(const wb_world *w);
@@ -528,6 +549,8 @@ typedef struct wb_tet_def {
 } wb_tet_def;
 wb_tet_def wb_tet_default_def(void);
 const char *wb_tet_def_check(const wb_tet_def *def);          /* NULL or what is wrong */
+/* what wb_tet_add would refuse (x: the positions, or NULL to leave out their rest shape) */
+wb_fault wb_tet_check(int32_t np, const wb_real *x, const int32_t p[4], const wb_tet_def *def);
 /* index, or WB_ERR_ARG (see wb_last_error: a particle twice, a flat tet) */
 int32_t wb_tet_add(wb_world *w, const int32_t p[4], const wb_tet_def *def);
 int32_t wb_tet_count(const wb_world *w);
@@ -571,6 +594,8 @@ typedef struct wb_shape_match_def {
 
 wb_shape_match_def wb_shape_match_default_def(void);          /* rigid, elastic */
 const char *wb_shape_match_def_check(const wb_shape_match_def *def); /* NULL or what is wrong */
+/* the options' fault as wb_shape_match_def_check finds it, by key (wb_fault) */
+wb_fault wb_shape_match_def_fault(const wb_shape_match_def *def);
 /* a cluster of n >= 2 distinct particles, some with mass, their rest shape as they are now;
  * returns its index (clusters are never removed) or a negative wb_status */
 int32_t wb_shape_match_add(wb_world *w, const int32_t *ids, int32_t n, const wb_shape_match_def *def);
@@ -591,6 +616,8 @@ typedef struct wb_pressure_def {
 
 wb_pressure_def wb_pressure_default_def(void);
 const char *wb_pressure_def_check(const wb_pressure_def *def);
+/* the options' fault as wb_pressure_def_check finds it, by key (wb_fault) */
+wb_fault wb_pressure_def_fault(const wb_pressure_def *def);
 /* the first surface whose corners all lie in the body's particles; -1 when none */
 int32_t wb_body_surface(const wb_world *w, wb_body b);
 /* over surface s, which must be closed (every edge shared by exactly two triangles,

@@ -127,13 +127,34 @@ wb_bend_def wb_bend_default_def(void)
     return d;
 }
 
+/* the options' rules: the one place they are decided (the binding and the JSON reader
+ * print what this finds) */
+static wb_fault def_fault(const wb_bend_def *d)
+{
+    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return WB_FAULT_KEY("compliance", "must be >= 0");
+    if (!(d->damping >= 0) || !isfinite(d->damping)) return WB_FAULT_KEY("damping", "must be >= 0");
+    if (!isnan(d->rest) && !(d->rest >= -PI_R && d->rest <= PI_R))
+        return WB_FAULT_KEY("rest", "must be an angle in [-pi, pi] (radians)");
+    if (!(d->break_torque >= 0) || !isfinite(d->break_torque))
+        return WB_FAULT_KEY("break_torque", "must be >= 0 (N m; 0: never breaks)");
+    return WB_NO_FAULT;
+}
+
 const char *wb_bend_def_check(const wb_bend_def *d)
 {
-    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return "compliance must be >= 0";
-    if (!(d->damping >= 0) || !isfinite(d->damping)) return "damping must be >= 0";
-    if (!isnan(d->rest) && !(d->rest >= -PI_R && d->rest <= PI_R)) return "rest must be an angle in [-pi, pi] (radians)";
-    if (!(d->break_torque >= 0) || !isfinite(d->break_torque)) return "break_torque must be >= 0 (N m)";
-    return NULL;
+    return def_fault(d).msg;
+}
+
+/* the particles first (what it joins), then the options, then whether the triangles have
+ * an angle to keep when the rest is theirs */
+wb_fault wb_bend_check(int32_t np, const wb_real *x, const int32_t p[4], const wb_bend_def *d)
+{
+    wb_fault f = wb__quad_fault(p, np, "bend particle out of range", "a bend needs four distinct particles");
+    if (!f.msg) f = def_fault(d);
+    if (!f.msg && x && isnan(d->rest) && !dihedral(&x[3 * p[0]], &x[3 * p[1]], &x[3 * p[2]], &x[3 * p[3]], &(wb_real){ 0 }, NULL))
+        f = WB_FAULT_AT(-1, "the two triangles are degenerate (a wing on the hinge line): no angle to keep",
+                        "the two triangles are degenerate (a wing on the hinge line): no angle to keep");
+    return f;
 }
 
 bool wb_dihedral_angle(const wb_real x1[3], const wb_real x2[3], const wb_real x3[3], const wb_real x4[3], wb_real *theta)
@@ -153,20 +174,15 @@ wb_bend_id wb_bend_add(wb_world *w, const int32_t p[4], const wb_bend_def *def, 
     wb_bend_id none = { 0, 0 };
     wb_status dummy;
     if (!status) status = &dummy;
-    const char *err = wb_bend_def_check(def);
-    const int q = err ? 0 : wb__quad_check(p, w->m.np);
-    if (q) err = q == 1 ? "particle out of range" : "a bend needs four distinct particles";
-    int ok = 1;
-    wb_real rest = def->rest;
-    if (!err && isnan(rest)) {
-        rest = wb__bend_angle_of(w->s.x, p, &ok);
-        if (!ok) err = "the two triangles are degenerate (a wing on the hinge line): no angle to keep";
-    }
-    if (err) {
-        wb__set_error("%s", err);
+    const wb_fault f = wb_bend_check(w->m.np, w->s.x, p, def);
+    if (f.msg) {
+        wb__set_error("%s", f.msg);
         *status = WB_ERR_ARG;
         return none;
     }
+    int ok = 1;
+    wb_real rest = def->rest;
+    if (isnan(rest)) rest = wb__bend_angle_of(w->s.x, p, &ok);
     wb_status st = grow(w, w->bend.n + 1);
     if (st != WB_OK) { *status = st; return none; }
     wb_bends *b = &w->bend;
@@ -739,12 +755,12 @@ static const char *bend_image_check(const wb_image *g)
     const wb_image_bend *b = &g->bend;
     if (b->n < 0 || b->n > WB_MAX_CONSTRAINTS) return "too many bends";
     for (int32_t i = 0; i < b->n; i++) {
-        const int q = wb__quad_check(&b->ij[4 * i], g->np);
-        if (q) return q == 1 ? "bend particle out of range" : "a bend needs four distinct particles";
+        /* an image keeps the angle (never NaN, the API's "current"), and a broken bend's
+         * triangles may have none: no positions */
         const wb_bend_def d = { b->alpha[i], b->beta[i], b->rest[i], b->btorque[i] };
         if (isnan(b->rest[i])) return "bend rest must be an angle in [-pi, pi] (radians)";
-        const char *e = wb_bend_def_check(&d);
-        if (e) return e;
+        const wb_fault f = wb_bend_check(g->np, NULL, &b->ij[4 * i], &d);
+        if (f.msg) return f.msg;
     }
     return NULL;
 }

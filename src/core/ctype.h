@@ -85,17 +85,24 @@ static inline void wb__link_quads(const int32_t *q, int32_t n, wb_link_fn fn, vo
             for (int b = a + 1; b < 4; b++) fn(ud, q[4 * e + a], q[4 * e + b], 1);
 }
 
-/* the four corners of an element (a bend, a volume, a tet): 0 when each is a particle of
- * [0, np) and no two are one; else, at the first corner that is not, 1 (out of range) or
- * 2 (repeated). The API and the snapshot checks share it */
-static inline int wb__quad_check(const int32_t p[4], int32_t np)
+/* a type's check's faults (wb_fault): an option's, with its key (a string literal), and
+ * the particles' (corner: the one at fault, -1: together) */
+#define WB_FAULT_KEY(k, why_) ((wb_fault){ k " " why_, k, why_, -1 })
+#define WB_FAULT_AT(c, msg_, why_) ((wb_fault){ msg_, NULL, why_, c })
+#define WB_NO_FAULT ((wb_fault){ NULL, NULL, NULL, -1 })
+
+/* the four corners of an element (a bend, a volume, a tet): no fault when each is a
+ * particle of [0, np) and no two are one; else the first corner that is not, in the
+ * type's words: range ("bend particle out of range"), distinct ("a bend needs four
+ * distinct particles"). The API and the snapshot checks share it */
+static inline wb_fault wb__quad_fault(const int32_t p[4], int32_t np, const char *range, const char *distinct)
 {
     for (int k = 0; k < 4; k++) {
-        if (p[k] < 0 || p[k] >= np) return 1;
+        if (p[k] < 0 || p[k] >= np) return WB_FAULT_AT(k, range, "out of range");
         for (int j = 0; j < k; j++)
-            if (p[j] == p[k]) return 2;
+            if (p[j] == p[k]) return WB_FAULT_AT(k, distinct, distinct);
     }
-    return 0;
+    return WB_NO_FAULT;
 }
 
 extern const wb_ctype wb__distance_type, wb__bend_type, wb__volume_type,

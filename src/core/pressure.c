@@ -258,11 +258,18 @@ wb_pressure_def wb_pressure_default_def(void)
     return d;
 }
 
+/* the options' rules: the one place they are decided (the binding and the JSON reader
+ * print what this finds; the surface is wb_pressure_add's to judge) */
+wb_fault wb_pressure_def_fault(const wb_pressure_def *d)
+{
+    if (!(d->pressure > 0) || !isfinite(d->pressure)) return WB_FAULT_KEY("pressure", "must be > 0");
+    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return WB_FAULT_KEY("compliance", "must be >= 0");
+    return WB_NO_FAULT;
+}
+
 const char *wb_pressure_def_check(const wb_pressure_def *d)
 {
-    if (!(d->pressure > 0) || !isfinite(d->pressure)) return "pressure must be a finite number > 0";
-    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return "compliance must be >= 0";
-    return NULL;
+    return wb_pressure_def_fault(d).msg;
 }
 
 /* what is wrong with surface s (of nsurf, ranges ss, corners tri) for a pressure, or NULL */

@@ -323,12 +323,19 @@ wb_shape_match_def wb_shape_match_default_def(void)
     return d;
 }
 
+/* the options' rules: the one place they are decided (the binding and the JSON reader
+ * print what this finds; the cluster's particles are wb_shape_match_add's to judge) */
+wb_fault wb_shape_match_def_fault(const wb_shape_match_def *d)
+{
+    if (!(d->stiffness >= 0 && d->stiffness <= 1)) return WB_FAULT_KEY("stiffness", "must be in [0, 1]");
+    if (!(d->yield >= 0) || !isfinite(d->yield)) return WB_FAULT_KEY("yield", "must be >= 0");
+    if (!(d->creep >= 0) || !isfinite(d->creep)) return WB_FAULT_KEY("creep", "must be >= 0");
+    return WB_NO_FAULT;
+}
+
 const char *wb_shape_match_def_check(const wb_shape_match_def *d)
 {
-    if (!(d->stiffness >= 0 && d->stiffness <= 1)) return "stiffness must be in [0, 1]";
-    if (!(d->yield >= 0) || !isfinite(d->yield)) return "yield must be >= 0";
-    if (!(d->creep >= 0) || !isfinite(d->creep)) return "creep must be >= 0";
-    return NULL;
+    return wb_shape_match_def_fault(d).msg;
 }
 
 static int cmp_i32(const void *a, const void *b)

@@ -49,14 +49,21 @@ wb_tet_def wb_tet_default_def(void)
     return d;
 }
 
-const char *wb_tet_def_check(const wb_tet_def *d)
+/* the options' rules: the one place they are decided (the binding and the JSON reader
+ * print what this finds) */
+static wb_fault def_fault(const wb_tet_def *d)
 {
     /* the bound: 100x diamond's modulus; far past it mu V0 and the energy overflow */
-    if (!(d->young > 0) || !(d->young <= 1e14)) return "young must be in (0, 1e14] (Pa)";
-    if (!(d->poisson >= 0 && d->poisson < 0.5)) return "poisson must be in [0, 0.5)";
-    if (!(d->yield >= 0) || !isfinite(d->yield)) return "yield must be >= 0";
-    if (!(d->creep >= 0) || !isfinite(d->creep)) return "creep must be >= 0";
-    return NULL;
+    if (!(d->young > 0) || !(d->young <= 1e14)) return WB_FAULT_KEY("young", "must be in (0, 1e14] (Pa)");
+    if (!(d->poisson >= 0 && d->poisson < 0.5)) return WB_FAULT_KEY("poisson", "must be in [0, 0.5)");
+    if (!(d->yield >= 0) || !isfinite(d->yield)) return WB_FAULT_KEY("yield", "must be >= 0");
+    if (!(d->creep >= 0) || !isfinite(d->creep)) return WB_FAULT_KEY("creep", "must be >= 0");
+    return WB_NO_FAULT;
+}
+
+const char *wb_tet_def_check(const wb_tet_def *d)
+{
+    return def_fault(d).msg;
 }
 
 static void lame(wb_real young, wb_real poisson, wb_real *mu, wb_real *lam)
@@ -163,17 +170,27 @@ bool wb__tet_put_current(wb_world *w, const int32_t p[4], wb_real young, wb_real
     return true;
 }
 
+/* the particles first, then the options, then whether they make a rest shape */
+wb_fault wb_tet_check(int32_t np, const wb_real *x, const int32_t p[4], const wb_tet_def *d)
+{
+    wb_fault f = wb__quad_fault(p, np, "tet particle out of range", "a tet needs four distinct particles");
+    if (!f.msg) f = def_fault(d);
+    wb_real inv[9], vol;
+    if (!f.msg && x && !rest_of(x, p, inv, &vol))
+        f = WB_FAULT_AT(-1, "the four particles lie in a plane (a flat tet has no rest shape)",
+                        "the four particles lie in a plane (a flat tet has no rest shape)");
+    return f;
+}
+
 int32_t wb_tet_add(wb_world *w, const int32_t p[4], const wb_tet_def *def)
 {
-    const char *err = wb_tet_def_check(def);
-    const int q = err ? 0 : wb__quad_check(p, w->m.np);
-    if (q) err = q == 1 ? "particle out of range" : "a tet needs four distinct particles";
-    wb_real inv[9], vol;
-    if (!err && !rest_of(w->s.x, p, inv, &vol)) err = "the four particles lie in a plane (a flat tet has no rest shape)";
-    if (err) {
-        wb__set_error("%s", err);
+    const wb_fault f = wb_tet_check(w->m.np, w->s.x, p, def);
+    if (f.msg) {
+        wb__set_error("%s", f.msg);
         return WB_ERR_ARG;
     }
+    wb_real inv[9], vol;
+    rest_of(w->s.x, p, inv, &vol);
     wb_status st = wb__tet_reserve(w, 1);
     if (st != WB_OK) return st;
     wb__tet_put(w, p, inv, fabs(vol), def->young, def->poisson);
@@ -319,11 +336,9 @@ static const char *tet_image_check(const wb_image *g)
 {
     if (g->tet.n < 0 || g->tet.n > WB_MAX_CONSTRAINTS) return "too many tets";
     for (int32_t i = 0; i < g->tet.n; i++) {
-        const int q = wb__quad_check(&g->tet.ijkl[4 * i], g->np);
-        if (q) return q == 1 ? "tet particle out of range" : "a tet needs four distinct particles";
         const wb_tet_def d = { g->tet.young[i], g->tet.poisson[i], g->tet.plastic[2 * i], g->tet.plastic[2 * i + 1] };
-        const char *e = wb_tet_def_check(&d);
-        if (e) return e;
+        const wb_fault f = wb_tet_check(g->np, NULL, &g->tet.ijkl[4 * i], &d);
+        if (f.msg) return f.msg;
         if (!(g->tet.v0[i] > 0) || !isfinite(g->tet.v0[i])) return "a tet's rest volume must be > 0";
         const wb_real *dm = &g->tet.dminv[9 * i];
         for (int k = 0; k < 9; k++)

@@ -25,11 +25,18 @@ wb_tether_def wb_tether_default_def(void)
     return d;
 }
 
+/* the options' rules: the one place they are decided (the binding and the JSON reader
+ * print what this finds) */
+static wb_fault def_fault(const wb_tether_def *d)
+{
+    if (d->has_length && !(d->length >= 0 && isfinite(d->length))) return WB_FAULT_KEY("length", "must be finite and >= 0");
+    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return WB_FAULT_KEY("compliance", "must be >= 0");
+    return WB_NO_FAULT;
+}
+
 const char *wb_tether_def_check(const wb_tether_def *d)
 {
-    if (d->has_length && !(d->length >= 0 && isfinite(d->length))) return "length must be finite and >= 0";
-    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return "compliance must be >= 0";
-    return NULL;
+    return def_fault(d).msg;
 }
 
 /* room for `extra` more, charged to the memory budget */
@@ -74,17 +81,27 @@ static wb_real dist(const wb_real *x, int32_t p, int32_t q)
     return v3_len(d);
 }
 
+/* the particles first, then the options, then (without a length) whether their
+ * distance is finite */
+wb_fault wb_tether_check(int32_t np, const wb_real *x, int32_t p, int32_t q, const wb_tether_def *d)
+{
+    if (p < 0 || p >= np) return WB_FAULT_AT(0, "tether particle out of range", "out of range");
+    if (q < 0 || q >= np) return WB_FAULT_AT(1, "tether particle out of range", "out of range");
+    if (p == q) return WB_FAULT_AT(1, "a tether needs two distinct particles", "a tether needs two distinct particles");
+    const wb_fault f = def_fault(d);
+    if (f.msg || !x || d->has_length || isfinite(dist(x, p, q))) return f;
+    return WB_FAULT_AT(-1, "the particles are too far apart (their distance overflows)",
+                       "the particles are too far apart (their distance overflows)");
+}
+
 int32_t wb_tether_add(wb_world *w, int32_t p, int32_t q, const wb_tether_def *def)
 {
-    const char *err = wb_tether_def_check(def);
-    if (!err && (p < 0 || p >= w->m.np || q < 0 || q >= w->m.np)) err = "particle out of range";
-    if (!err && p == q) err = "a tether needs two distinct particles";
-    const wb_real len = def->has_length ? def->length : err ? 0 : dist(w->s.x, p, q);
-    if (!err && !isfinite(len)) err = "the particles are too far apart (their distance overflows)";
-    if (err) {
-        wb__set_error("%s", err);
+    const wb_fault f = wb_tether_check(w->m.np, w->s.x, p, q, def);
+    if (f.msg) {
+        wb__set_error("%s", f.msg);
         return WB_ERR_ARG;
     }
+    const wb_real len = def->has_length ? def->length : dist(w->s.x, p, q);
     const wb_status st = reserve(w, 1);
     if (st != WB_OK) return st;
     put(w, p, q, len, def->compliance);
@@ -285,12 +302,9 @@ static const char *teth_image_check(const wb_image *g)
     const wb_image_tether *t = &g->teth;
     if (t->n < 0 || t->n > WB_MAX_CONSTRAINTS) return "too many tethers";
     for (int32_t i = 0; i < t->n; i++) {
-        const int32_t p = t->ij[2 * i], q = t->ij[2 * i + 1];
-        if (p < 0 || p >= g->np || q < 0 || q >= g->np) return "tether particle out of range";
-        if (p == q) return "a tether needs two distinct particles";
         const wb_tether_def d = { true, t->len[i], t->alpha[i] };
-        const char *e = wb_tether_def_check(&d);
-        if (e) return e;
+        const wb_fault f = wb_tether_check(g->np, NULL, t->ij[2 * i], t->ij[2 * i + 1], &d);
+        if (f.msg) return f.msg;
     }
     return NULL;
 }

@@ -40,13 +40,34 @@ wb_volume_def wb_volume_default_def(void)
     return d;
 }
 
+/* the options' rules: the one place they are decided (the binding and the JSON reader
+ * print what this finds) */
+static wb_fault def_fault(const wb_volume_def *d)
+{
+    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return WB_FAULT_KEY("compliance", "must be >= 0");
+    if (d->has_rest && !isfinite(d->rest)) return WB_FAULT_KEY("rest", "must be finite");
+    if (!(d->yield >= 0) || !isfinite(d->yield)) return WB_FAULT_KEY("yield", "must be >= 0");
+    if (!(d->creep >= 0) || !isfinite(d->creep)) return WB_FAULT_KEY("creep", "must be >= 0");
+    return WB_NO_FAULT;
+}
+
 const char *wb_volume_def_check(const wb_volume_def *d)
 {
-    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return "compliance must be >= 0";
-    if (d->has_rest && !isfinite(d->rest)) return "rest must be finite";
-    if (!(d->yield >= 0) || !isfinite(d->yield)) return "yield must be >= 0";
-    if (!(d->creep >= 0) || !isfinite(d->creep)) return "creep must be >= 0";
-    return NULL;
+    return def_fault(d).msg;
+}
+
+/* the particles first, then the options, then (without a rest) whether their volume is
+ * finite */
+wb_fault wb_volume_check(int32_t np, const wb_real *x, const int32_t p[4], const wb_volume_def *d)
+{
+    wb_fault f = wb__quad_fault(p, np, "volume constraint particle out of range",
+                                "a volume constraint needs four distinct particles");
+    if (!f.msg) f = def_fault(d);
+    if (!f.msg && x && !d->has_rest &&
+        !isfinite(wb_tet_signed_volume(&x[3 * p[0]], &x[3 * p[1]], &x[3 * p[2]], &x[3 * p[3]])))
+        f = WB_FAULT_AT(-1, "the particles are too far apart (their volume overflows)",
+                        "the particles are too far apart (their volume overflows)");
+    return f;
 }
 
 /* room for `extra` more constraints, charged to the memory budget: refused, nothing made,
@@ -103,17 +124,14 @@ void wb__volume_plastic(wb_world *w, int32_t first, wb_real yield, wb_real creep
 
 int32_t wb_volume_add(wb_world *w, const int32_t p[4], const wb_volume_def *def)
 {
-    const char *err = wb_volume_def_check(def);
-    const int q = err ? 0 : wb__quad_check(p, w->m.np);
-    if (q) err = q == 1 ? "particle out of range" : "a volume constraint needs four distinct particles";
-    const wb_real *x = w->s.x;
-    const wb_real rest = def->has_rest ? def->rest
-                       : err ? 0 : wb_tet_signed_volume(&x[3 * p[0]], &x[3 * p[1]], &x[3 * p[2]], &x[3 * p[3]]);
-    if (!err && !isfinite(rest)) err = "the particles are too far apart (their volume overflows)";
-    if (err) {
-        wb__set_error("%s", err);
+    const wb_fault f = wb_volume_check(w->m.np, w->s.x, p, def);
+    if (f.msg) {
+        wb__set_error("%s", f.msg);
         return WB_ERR_ARG;
     }
+    const wb_real *x = w->s.x;
+    const wb_real rest = def->has_rest ? def->rest
+                       : wb_tet_signed_volume(&x[3 * p[0]], &x[3 * p[1]], &x[3 * p[2]], &x[3 * p[3]]);
     wb_status st = wb__volume_reserve(w, 1);
     if (st != WB_OK) return st;
     wb__volume_put(w, p, def->compliance, rest);
@@ -372,11 +390,9 @@ static const char *vol_image_check(const wb_image *g)
 {
     if (g->vol.n < 0 || g->vol.n > WB_MAX_CONSTRAINTS) return "too many volume constraints";
     for (int32_t i = 0; i < g->vol.n; i++) {
-        const int q = wb__quad_check(&g->vol.ijkl[4 * i], g->np);
-        if (q) return q == 1 ? "volume constraint particle out of range" : "a volume constraint needs four distinct particles";
         const wb_volume_def d = { g->vol.alpha[i], true, g->vol.rest[i], g->vol.plastic[2 * i], g->vol.plastic[2 * i + 1] };
-        const char *e = wb_volume_def_check(&d);
-        if (e) return e;
+        const wb_fault f = wb_volume_check(g->np, NULL, &g->vol.ijkl[4 * i], &d);
+        if (f.msg) return f.msg;
     }
     return NULL;
 }

@@ -5,7 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "core.h"
+#include "ctype.h"
 
 static _Thread_local char wb_err[256];
 
@@ -306,17 +306,43 @@ wb_distance_def wb_distance_default_def(void)
     return d;
 }
 
+/* the options' rules: the one place they are decided (the binding and the JSON reader
+ * print what this finds) */
+static wb_fault distance_def_fault(const wb_distance_def *d)
+{
+    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return WB_FAULT_KEY("compliance", "must be >= 0");
+    if (!(d->damping >= 0) || !isfinite(d->damping)) return WB_FAULT_KEY("damping", "must be >= 0");
+    /* the solver works with squared lengths: a rest whose square overflows can never be met */
+    if (!isfinite(d->rest) || !isfinite(d->rest * d->rest))
+        return WB_FAULT_KEY("rest", "must be finite and below 1e154 (its square overflows)");
+    if (!(d->yield >= 0) || !isfinite(d->yield)) return WB_FAULT_KEY("yield", "must be >= 0");
+    if (!(d->creep >= 0) || !isfinite(d->creep)) return WB_FAULT_KEY("creep", "must be >= 0");
+    if (!(d->break_strain >= 0) || !isfinite(d->break_strain)) return WB_FAULT_KEY("break_strain", "must be >= 0");
+    if (!(d->break_force >= 0) || !isfinite(d->break_force)) return WB_FAULT_KEY("break_force", "must be >= 0");
+    return WB_NO_FAULT;
+}
+
 const char *wb_distance_def_check(const wb_distance_def *d)
 {
-    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return "compliance must be >= 0";
-    if (!(d->damping >= 0) || !isfinite(d->damping)) return "damping must be >= 0";
-    /* the solver works with squared lengths: a rest whose square overflows can never be met */
-    if (!isfinite(d->rest) || !isfinite(d->rest * d->rest)) return "rest must be finite (and below 1e154)";
-    if (!(d->yield >= 0) || !isfinite(d->yield)) return "yield must be >= 0";
-    if (!(d->creep >= 0) || !isfinite(d->creep)) return "creep must be >= 0";
-    if (!(d->break_strain >= 0) || !isfinite(d->break_strain)) return "break_strain must be >= 0";
-    if (!(d->break_force >= 0) || !isfinite(d->break_force)) return "break_force must be >= 0";
-    return NULL;
+    return distance_def_fault(d).msg;
+}
+
+/* the particles first (what it joins), then the options, then whether their distance has
+ * a finite square (the rest it derives obeys the rule a given one does) */
+wb_fault wb_distance_check(int32_t np, const wb_real *x, int32_t a, int32_t b, const wb_distance_def *d)
+{
+    if (a < 0 || a >= np) return WB_FAULT_AT(0, "particle out of range", "out of range");
+    if (b < 0 || b >= np) return WB_FAULT_AT(1, "particle out of range", "out of range");
+    if (a == b)
+        return WB_FAULT_AT(1, "a constraint needs two distinct particles", "a constraint needs two distinct particles");
+    const wb_fault f = distance_def_fault(d);
+    if (f.msg || !x) return f;
+    wb_real dx[3];
+    v3_sub(dx, &x[3 * b], &x[3 * a]);
+    if (!isfinite(v3_dot(dx, dx)))
+        return WB_FAULT_AT(-1, "the particles are too far apart (their distance squared overflows)",
+                           "too far apart (their distance squared overflows)");
+    return WB_NO_FAULT;
 }
 
 static int slot_live(uint32_t gen) { return gen & 1u; }
@@ -361,23 +387,16 @@ wb_distance_id wb_distance_add(wb_world *w, int32_t a, int32_t b, const wb_dista
     wb_distance_id none = { 0, 0 };
     wb_status dummy;
     if (!status) status = &dummy;
-    const char *err = wb_distance_def_check(def);
-    if (err || a < 0 || b < 0 || a >= w->m.np || b >= w->m.np || a == b) {
-        wb__set_error("%s", err ? err : a == b ? "a constraint needs two distinct particles" : "particle out of range");
+    const wb_fault f = wb_distance_check(w->m.np, w->s.x, a, b, def);
+    if (f.msg) {
+        if (!f.key && f.corner < 0) wb__set_error("particles %d and %d are %s", a + 1, b + 1, f.why);
+        else wb__set_error("%s", f.msg);
         *status = WB_ERR_ARG;
         return none;
     }
-    /* the rest it derives obeys the same rule as a given one: particles so far apart that
-     * their distance squared overflows would give an infinite rest and freeze the world */
-    const wb_real *xa = &w->s.x[3 * a], *xb = &w->s.x[3 * b];
     wb_real d[3];
-    v3_sub(d, xb, xa);
+    v3_sub(d, &w->s.x[3 * b], &w->s.x[3 * a]);
     const wb_real rest = def->rest >= 0 ? def->rest : v3_len(d);
-    if (!isfinite(v3_dot(d, d))) {
-        wb__set_error("particles %d and %d are too far apart (their distance squared overflows)", a + 1, b + 1);
-        *status = WB_ERR_ARG;
-        return none;
-    }
     wb_model *m = &w->m;
     int32_t slot;
     if (m->nfree > 0) {

@@ -44,11 +44,16 @@ static int read_defaults(rd *r, const cJSON *it, defaults *d)
         kp mp = { &p, "mass", 0 };
         return jv_fail(r, f[0], 0, &mp, "%g is too small (its inverse overflows)", (double)d->mass);
     }
-    return jv_opt_nonneg(r, f[1], &p, "radius", &d->radius) ||
-           jv_opt_nonneg(r, f[2], &p, "compliance", &d->link.compliance) || jv_opt_nonneg(r, f[3], &p, "damping", &d->link.damping) ||
-           jv_opt_nonneg(r, f[4], &p, "yield", &d->link.yield) || jv_opt_nonneg(r, f[5], &p, "creep", &d->link.creep) ||
-           jv_opt_nonneg(r, f[6], &p, "break_strain", &d->link.break_strain) ||
-           jv_opt_nonneg(r, f[7], &p, "break_force", &d->link.break_force) ? -1 : 0;
+    if (jv_opt_nonneg(r, f[1], &p, "radius", &d->radius) ||
+        jv_opt_real(r, f[2], &p, "compliance", &d->link.compliance) || jv_opt_real(r, f[3], &p, "damping", &d->link.damping) ||
+        jv_opt_real(r, f[4], &p, "yield", &d->link.yield) || jv_opt_real(r, f[5], &p, "creep", &d->link.creep) ||
+        jv_opt_real(r, f[6], &p, "break_strain", &d->link.break_strain) ||
+        jv_opt_real(r, f[7], &p, "break_force", &d->link.break_force))
+        return -1;
+    /* the link's options as the core decides them (wb_distance_check, of two particles:
+     * the options alone) */
+    const wb_fault ft = wb_distance_check(2, NULL, 0, 1, &d->link);
+    return jv_fault(r, &ft, &p, keys, f, 0);
 }
 
 static const char *const solver_names[] = { "gauss-seidel", "jacobi", "vbd" };
@@ -259,37 +264,25 @@ static int read_bend(rd *r, const cJSON *c, const kp *p, wb_image *g, int32_t i)
     const cJSON *f[8];
     if (jv_get_object(r, c, p, keys, f)) return -1;
     if (!f[1]) return jv_missing(r, c, p, "particles");
-    kp pp = { p, "particles", 0 }, rp = { p, "rest", 0 };
+    kp pp = { p, "particles", 0 };
     int32_t n;
     if (jv_get_array(r, f[1], &pp, 16, &n)) return -1;
     if (n != 4) return jv_fail(r, f[1], 0, &pp, "a bend joins 4 particles (hinge p1 p2, wings p3 p4), got %d", n);
     int32_t *q = &g->bend.ij[4 * i];
-    int k = 0;
-    for (const cJSON *e = f[1]->child; e; e = e->next, k++) {
-        kp ep = { &pp, NULL, k };
-        int64_t v;
-        if (g->np == 0) return jv_fail(r, e, 0, &ep, "there are no particles");
-        if (jv_get_int(r, e, &ep, 0, g->np - 1, &v)) return -1;
-        q[k] = (int32_t)v;
-        for (int j = 0; j < k; j++)
-            if (q[j] == q[k]) return jv_fail(r, f[1], 0, &pp, "a bend needs four distinct particles");
-    }
+    if (jv_get_ids(r, f[1], &pp, g->np, 4, "a bend", q)) return -1;
     wb_bend_def d = wb_bend_default_def();
-    if (jv_opt_nonneg(r, f[3], p, "compliance", &d.compliance) || jv_opt_nonneg(r, f[4], p, "damping", &d.damping) ||
-        jv_opt_nonneg(r, f[5], p, "break_torque", &d.break_torque))
+    if (jv_opt_real(r, f[2], p, "rest", &d.rest) || jv_opt_real(r, f[3], p, "compliance", &d.compliance) ||
+        jv_opt_real(r, f[4], p, "damping", &d.damping) || jv_opt_real(r, f[5], p, "break_torque", &d.break_torque))
         return -1;
     bool broken = false;
     if (f[6]) {
-        kp q = { p, "broken", 0 };
-        if (jv_get_bool(r, f[6], &q, &broken)) return -1;
+        kp bp = { p, "broken", 0 };
+        if (jv_get_bool(r, f[6], &bp, &broken)) return -1;
     }
-    if (f[2]) {
-        if (!cJSON_IsNumber(f[2])) return jv_fail(r, f[2], 0, &rp, "number expected, got %s", jv_type_name(f[2]));
-        d.rest = (wb_real)f[2]->valuedouble;
-        if (!(fabs(d.rest) <= 3.14159265358979323846)) return jv_fail(r, f[2], 0, &rp, "must be an angle in [-pi, pi] (radians)");
-    } else if (!wb_dihedral_angle(&g->x[3 * q[0]], &g->x[3 * q[1]], &g->x[3 * q[2]], &g->x[3 * q[3]], &d.rest)) {
-        return jv_fail(r, f[1], 0, &pp, "the two triangles are degenerate (a wing on the hinge line): no angle to keep");
-    }
+    /* the core decides what a bend may be (bend.c) */
+    const wb_fault ft = wb_bend_check(g->np, g->x, q, &d);
+    if (jv_fault(r, &ft, p, keys, f, 1)) return -1;
+    if (isnan(d.rest)) wb_dihedral_angle(&g->x[3 * q[0]], &g->x[3 * q[1]], &g->x[3 * q[2]], &g->x[3 * q[3]], &d.rest);
     g->bend.alpha[i] = d.compliance;
     g->bend.beta[i] = d.damping;
     g->bend.rest[i] = d.rest;
@@ -320,40 +313,29 @@ static int read_constraints(rd *r, const sections *s, const defaults *d, wb_imag
         const char *type = "";
         if (jv_get_string(r, f[0], &tp, &type)) return -1;
         if (strcmp(type, "distance") != 0) return jv_fail(r, f[0], 0, &tp, "unknown constraint type '%s' (expected distance or bend)", type);
-        int32_t n;
-        if (jv_get_array(r, f[1], &pp, 16, &n)) return -1;
-        if (n != 2) return jv_fail(r, f[1], 0, &pp, "a distance constraint joins 2 particles, got %d", n);
-        int64_t ab[2];
-        int k = 0;
-        for (const cJSON *e = f[1]->child; e; e = e->next, k++) {
-            kp q = { &pp, NULL, k };
-            if (g->np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
-            if (jv_get_int(r, e, &q, 0, g->np - 1, &ab[k])) return -1;
-        }
-        if (ab[0] == ab[1]) return jv_fail(r, f[1], 0, &pp, "a constraint needs two distinct particles");
+        int32_t ab[2];
+        if (jv_get_ids(r, f[1], &pp, g->np, 2, "a distance constraint", ab)) return -1;
         /* the i-th live slot (all slots are live in a plain config) */
         do slot++; while (!(g->dist.gen[slot] & 1u));
         wb_distance_def l = d->link;
-        const wb_real *xa = &g->x[3 * ab[0]], *xb = &g->x[3 * ab[1]];
-        wb_real dx[3] = { xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2] };
-        l.rest = sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
         bool broken = false;
-        if (jv_opt_nonneg(r, f[2], &p, "rest", &l.rest) || jv_opt_nonneg(r, f[3], &p, "compliance", &l.compliance) ||
-            jv_opt_nonneg(r, f[4], &p, "damping", &l.damping) || jv_opt_nonneg(r, f[5], &p, "yield", &l.yield) ||
-            jv_opt_nonneg(r, f[6], &p, "creep", &l.creep) || jv_opt_nonneg(r, f[7], &p, "break_strain", &l.break_strain) ||
-            jv_opt_nonneg(r, f[9], &p, "break_force", &l.break_force))
+        /* a rest the file gives is >= 0: a negative one would read as "their distance" */
+        if (jv_opt_nonneg(r, f[2], &p, "rest", &l.rest) || jv_opt_real(r, f[3], &p, "compliance", &l.compliance) ||
+            jv_opt_real(r, f[4], &p, "damping", &l.damping) || jv_opt_real(r, f[5], &p, "yield", &l.yield) ||
+            jv_opt_real(r, f[6], &p, "creep", &l.creep) || jv_opt_real(r, f[7], &p, "break_strain", &l.break_strain) ||
+            jv_opt_real(r, f[9], &p, "break_force", &l.break_force))
             return -1;
-        /* the solver squares lengths (wb_distance_add's rule): the particles' distance and
-         * the rest must have finite squares */
-        if (!isfinite(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]))
-            return jv_fail(r, f[1], 0, &pp, "the particles are too far apart (their distance squared overflows)");
-        if (!isfinite(l.rest * l.rest)) {
-            kp q = { &p, "rest", 0 };
-            return jv_fail(r, f[2] ? f[2] : f[1], 0, f[2] ? &q : &pp, "rest must be below 1e154 (its square overflows)");
-        }
         if (f[8]) {
             kp q = { &p, "broken", 0 };
             if (jv_get_bool(r, f[8], &q, &broken)) return -1;
+        }
+        /* the core decides what a distance constraint may be (wb_distance_check) */
+        const wb_fault ft = wb_distance_check(g->np, g->x, ab[0], ab[1], &l);
+        if (jv_fault(r, &ft, &p, keys, f, 1)) return -1;
+        if (l.rest < 0) {
+            const wb_real *xa = &g->x[3 * ab[0]], *xb = &g->x[3 * ab[1]];
+            wb_real dx[3] = { xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2] };
+            l.rest = sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
         }
         g->dist.ij[2 * slot] = (int32_t)ab[0];
         g->dist.ij[2 * slot + 1] = (int32_t)ab[1];
@@ -386,16 +368,21 @@ static int read_volumes(rd *r, const cJSON *arr, wb_image *g)
         if (jv_get_object(r, c, &p, keys, f)) return -1;
         if (!f[0]) return jv_missing(r, c, &p, "particles");
         int32_t *ijkl = &g->vol.ijkl[4 * i];
-        if (jv_get_corners(r, f[0], &pp, g->np, 4, "a volume constraint", ijkl)) return -1;
-        const wb_real *x = g->x;
-        g->vol.rest[i] = wb_tet_signed_volume(&x[3 * ijkl[0]], &x[3 * ijkl[1]], &x[3 * ijkl[2]], &x[3 * ijkl[3]]);
-        g->vol.alpha[i] = 0;
-        g->vol.plastic[2 * i] = g->vol.plastic[2 * i + 1] = 0;
-        if (jv_opt_real(r, f[1], &p, "rest", &g->vol.rest[i]) || jv_opt_nonneg(r, f[2], &p, "compliance", &g->vol.alpha[i]) ||
-            jv_opt_nonneg(r, f[3], &p, "yield", &g->vol.plastic[2 * i]) ||
-            jv_opt_nonneg(r, f[4], &p, "creep", &g->vol.plastic[2 * i + 1]))
+        if (jv_get_ids(r, f[0], &pp, g->np, 4, "a volume constraint", ijkl)) return -1;
+        wb_volume_def d = wb_volume_default_def();
+        d.has_rest = f[1] != NULL;
+        if (jv_opt_real(r, f[1], &p, "rest", &d.rest) || jv_opt_real(r, f[2], &p, "compliance", &d.compliance) ||
+            jv_opt_real(r, f[3], &p, "yield", &d.yield) || jv_opt_real(r, f[4], &p, "creep", &d.creep))
             return -1;
-        if (!isfinite(g->vol.rest[i])) return jv_fail(r, f[0], 0, &pp, "the particles are too far apart (their volume overflows)");
+        /* the core decides what a volume constraint may be (volume.c) */
+        const wb_fault ft = wb_volume_check(g->np, g->x, ijkl, &d);
+        if (jv_fault(r, &ft, &p, keys, f, 0)) return -1;
+        const wb_real *x = g->x;
+        g->vol.rest[i] = d.has_rest ? d.rest
+                       : wb_tet_signed_volume(&x[3 * ijkl[0]], &x[3 * ijkl[1]], &x[3 * ijkl[2]], &x[3 * ijkl[3]]);
+        g->vol.alpha[i] = d.compliance;
+        g->vol.plastic[2 * i] = d.yield;
+        g->vol.plastic[2 * i + 1] = d.creep;
     }
     return 0;
 }
@@ -434,14 +421,19 @@ static int read_tethers(rd *r, const cJSON *arr, wb_image *g)
         if (jv_get_object(r, c, &p, keys, f)) return -1;
         if (!f[0]) return jv_missing(r, c, &p, "particles");
         int32_t *ij = &g->teth.ij[2 * i];
-        if (jv_get_corners(r, f[0], &pp, g->np, 2, "a tether", ij)) return -1;
+        if (jv_get_ids(r, f[0], &pp, g->np, 2, "a tether", ij)) return -1;
+        wb_tether_def td = wb_tether_default_def();
+        td.has_length = f[1] != NULL;
+        if (jv_opt_real(r, f[1], &p, "length", &td.length) || jv_opt_real(r, f[2], &p, "compliance", &td.compliance))
+            return -1;
+        /* the core decides what a tether may be (tether.c) */
+        const wb_fault ft = wb_tether_check(g->np, g->x, ij[0], ij[1], &td);
+        if (jv_fault(r, &ft, &p, keys, f, 0)) return -1;
         const wb_real *x = g->x;
         wb_real d[3];
         v3_sub(d, &x[3 * ij[0]], &x[3 * ij[1]]);
-        g->teth.len[i] = v3_len(d);
-        g->teth.alpha[i] = 0;
-        if (jv_opt_nonneg(r, f[1], &p, "length", &g->teth.len[i]) || jv_opt_nonneg(r, f[2], &p, "compliance", &g->teth.alpha[i]))
-            return -1;
+        g->teth.len[i] = td.has_length ? td.length : v3_len(d);
+        g->teth.alpha[i] = td.compliance;
     }
     return 0;
 }

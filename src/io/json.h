@@ -64,9 +64,14 @@ int jv_get_bool(rd *r, const cJSON *it, const kp *p, bool *out);
 int jv_get_string(rd *r, const cJSON *it, const kp *p, const char **out);
 int jv_get_array(rd *r, const cJSON *it, const kp *p, int64_t max, int32_t *count);
 int jv_get_vec(rd *r, const cJSON *it, const kp *p, int n, wb_real *out); /* exactly n numbers */
-/* an element's "particles": exactly k (2 or 4) distinct indices of the np particles, into
- * out; `what` names the element in the messages ("a tet") */
-int jv_get_corners(rd *r, const cJSON *it, const kp *p, int32_t np, int k, const char *what, int32_t *out);
+/* an element's "particles": exactly k (2 or 4) indices of the np particles, into out;
+ * `what` names the element in the messages ("a tet"). Whether they may repeat is the
+ * type's check's to say (jv_fault) */
+int jv_get_ids(rd *r, const cJSON *it, const kp *p, int32_t np, int k, const char *what, int32_t *out);
+/* fail with what a type's check found (wb_fault; returns 0 when nothing): an option's at
+ * its value (keys: the element's keys, f: their values, up: its path), the particles' at
+ * their array, f[parts] (and there an option's whose value the file does not give) */
+int jv_fault(rd *r, const wb_fault *ft, const kp *up, const char *const keys[], const cJSON *const f[], int parts);
 /* an object whose keys are all in `keys` (NULL-terminated), none twice: found[i] = value */
 int jv_get_object(rd *r, const cJSON *obj, const kp *p, const char *const keys[], const cJSON **found);
 

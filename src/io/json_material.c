@@ -53,18 +53,17 @@ int jm_read_shape_matches(rd *r, const cJSON *arr, wb_image *g)
             s->ids[at++] = (int32_t)v;
         }
         s->start[i + 1] = at;
-        wb_real st = 1, y = 0, cr = 0;
-        if (jv_opt_nonneg(r, f[1], &p, "stiffness", &st) || jv_opt_nonneg(r, f[2], &p, "yield", &y) ||
-            jv_opt_nonneg(r, f[3], &p, "creep", &cr) || jv_opt_vec(r, f[5], &p, "rotation", 4, &s->q[4 * i]))
+        wb_shape_match_def d = { 1, 0, 0 };
+        if (jv_opt_real(r, f[1], &p, "stiffness", &d.stiffness) || jv_opt_real(r, f[2], &p, "yield", &d.yield) ||
+            jv_opt_real(r, f[3], &p, "creep", &d.creep) || jv_opt_vec(r, f[5], &p, "rotation", 4, &s->q[4 * i]))
             return -1;
-        if (st > 1) {
-            kp q = { &p, "stiffness", 0 };
-            return jv_fail(r, f[1], 0, &q, "must be in [0, 1]");
-        }
-        if (!f[3] && y > 0) cr = 1;
-        s->stiff[i] = st;
-        s->yield[i] = y;
-        s->creep[i] = cr;
+        /* the core decides the options (shape_match.c) */
+        const wb_fault ft = wb_shape_match_def_fault(&d);
+        if (jv_fault(r, &ft, &p, keys, f, 0)) return -1;
+        if (!f[3] && d.yield > 0) d.creep = 1;
+        s->stiff[i] = d.stiffness;
+        s->yield[i] = d.yield;
+        s->creep[i] = d.creep;
         if (f[4]) {
             kp q = { &p, "rest", 0 };
             int32_t m;
@@ -111,16 +110,19 @@ int jm_read_pressures(rd *r, const cJSON *arr, wb_image *g)
             kp q = { &p, "surface", 0 };
             return jv_fail(r, f[0], 0, &q, "there are no surfaces");
         }
-        wb_real pr = 1, a = 0, v0 = -1;
-        if (jv_opt_int(r, f[0], &p, "surface", 0, g->nsurf - 1, &s) || jv_opt_real(r, f[1], &p, "pressure", &pr) ||
-            jv_opt_nonneg(r, f[2], &p, "compliance", &a) || jv_opt_real(r, f[3], &p, "rest_volume", &v0))
+        wb_pressure_def d = { 1, 0 };
+        wb_real v0 = -1;
+        if (jv_opt_int(r, f[0], &p, "surface", 0, g->nsurf - 1, &s) || jv_opt_real(r, f[1], &p, "pressure", &d.pressure) ||
+            jv_opt_real(r, f[2], &p, "compliance", &d.compliance) || jv_opt_real(r, f[3], &p, "rest_volume", &v0))
             return -1;
-        kp pq = { &p, "pressure", 0 }, vq = { &p, "rest_volume", 0 };
-        if (!(pr > 0)) return jv_fail(r, f[1], 0, &pq, "must be > 0");
+        /* the core decides the options (pressure.c); the rest volume is the file's state */
+        const wb_fault ft = wb_pressure_def_fault(&d);
+        if (jv_fault(r, &ft, &p, keys, f, 0)) return -1;
+        kp vq = { &p, "rest_volume", 0 };
         if (f[3] && !(v0 > 0)) return jv_fail(r, f[3], 0, &vq, "must be > 0");
         g->pr.surface[i] = (int32_t)s;
-        g->pr.pressure[i] = pr;
-        g->pr.alpha[i] = a;
+        g->pr.pressure[i] = d.pressure;
+        g->pr.alpha[i] = d.compliance;
         g->pr.v0[i] = v0; /* < 0: the volume at load */
     }
     return 0;
@@ -146,18 +148,19 @@ int jm_read_tets(rd *r, const cJSON *arr, wb_image *g)
         if (!f[0]) return jv_missing(r, c, &p, "particles");
         if (!f[1]) return jv_missing(r, c, &p, "young");
         int32_t *q4 = &g->tet.ijkl[4 * i];
-        if (jv_get_corners(r, f[0], &pp, g->np, 4, "a tet", q4)) return -1;
-        wb_real y = 0, nu = 0.3;
-        if (jv_opt_real(r, f[1], &p, "young", &y) || jv_opt_real(r, f[2], &p, "poisson", &nu)) return -1;
-        kp yq = { &p, "young", 0 }, nq = { &p, "poisson", 0 };
-        if (!(y > 0) || !isfinite(y)) return jv_fail(r, f[1], 0, &yq, "must be > 0 (Pa)");
-        if (!(nu >= 0 && nu < 0.5)) return jv_fail(r, f[2], 0, &nq, "must be in [0, 0.5)");
-        g->tet.young[i] = y;
-        g->tet.poisson[i] = nu;
-        g->tet.plastic[2 * i] = g->tet.plastic[2 * i + 1] = 0;
-        if (jv_opt_nonneg(r, f[5], &p, "yield", &g->tet.plastic[2 * i]) ||
-            jv_opt_nonneg(r, f[6], &p, "creep", &g->tet.plastic[2 * i + 1]))
+        if (jv_get_ids(r, f[0], &pp, g->np, 4, "a tet", q4)) return -1;
+        wb_tet_def d = wb_tet_default_def();
+        if (jv_opt_real(r, f[1], &p, "young", &d.young) || jv_opt_real(r, f[2], &p, "poisson", &d.poisson) ||
+            jv_opt_real(r, f[5], &p, "yield", &d.yield) || jv_opt_real(r, f[6], &p, "creep", &d.creep))
             return -1;
+        /* the core decides what a tet may be (tet.c); its rest shape from the positions
+         * only when the file does not give it */
+        const wb_fault ft = wb_tet_check(g->np, f[3] ? NULL : g->x, q4, &d);
+        if (jv_fault(r, &ft, &p, keys, f, 0)) return -1;
+        g->tet.young[i] = d.young;
+        g->tet.poisson[i] = d.poisson;
+        g->tet.plastic[2 * i] = d.yield;
+        g->tet.plastic[2 * i + 1] = d.creep;
         if (!f[3] != !f[4]) return jv_fail(r, c, 0, &p, "rest_inverse and rest_volume go together");
         if (f[3]) {
             kp vq = { &p, "rest_volume", 0 };
@@ -167,9 +170,8 @@ int jm_read_tets(rd *r, const cJSON *arr, wb_image *g)
             if (!(g->tet.v0[i] > 0) || !isfinite(g->tet.v0[i])) return jv_fail(r, f[4], 0, &vq, "must be > 0");
         } else {
             const wb_real *x = g->x;
-            if (!wb_tet_rest_shape(&x[3 * q4[0]], &x[3 * q4[1]], &x[3 * q4[2]], &x[3 * q4[3]], &g->tet.dminv[9 * i],
-                                   &g->tet.v0[i]))
-                return jv_fail(r, f[0], 0, &pp, "the four particles lie in a plane (a flat tet has no rest shape)");
+            wb_tet_rest_shape(&x[3 * q4[0]], &x[3 * q4[1]], &x[3 * q4[2]], &x[3 * q4[3]], &g->tet.dminv[9 * i],
+                              &g->tet.v0[i]); /* checked above: not flat */
         }
     }
     return 0;

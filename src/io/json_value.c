@@ -219,7 +219,7 @@ int jv_get_array(rd *r, const cJSON *it, const kp *p, int64_t max, int32_t *coun
     return 0;
 }
 
-int jv_get_corners(rd *r, const cJSON *it, const kp *p, int32_t np, int k, const char *what, int32_t *out)
+int jv_get_ids(rd *r, const cJSON *it, const kp *p, int32_t np, int k, const char *what, int32_t *out)
 {
     int32_t n = 0;
     if (jv_get_array(r, it, p, 16, &n)) return -1;
@@ -231,10 +231,21 @@ int jv_get_corners(rd *r, const cJSON *it, const kp *p, int32_t np, int k, const
         if (np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
         if (jv_get_int(r, e, &q, 0, np - 1, &v)) return -1;
         out[c] = (int32_t)v;
-        for (int j = 0; j < c; j++)
-            if (out[j] == out[c]) return jv_fail(r, it, 0, p, "%s needs %s distinct particles", what, k == 2 ? "two" : "four");
     }
     return 0;
+}
+
+int jv_fault(rd *r, const wb_fault *ft, const kp *up, const char *const keys[], const cJSON *const f[], int parts)
+{
+    if (!ft->msg) return 0;
+    if (ft->key)
+        for (int i = 0; keys[i]; i++)
+            if (f[i] && strcmp(keys[i], ft->key) == 0) {
+                kp q = { up, keys[i], 0 };
+                return jv_fail(r, f[i], 0, &q, "%s", ft->why);
+            }
+    kp q = { up, keys[parts], 0 };
+    return jv_fail(r, f[parts], 0, &q, "%s", ft->msg);
 }
 
 /* an array of exactly n finite numbers */

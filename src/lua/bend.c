@@ -1,8 +1,6 @@
 /* bend.c: dihedral bending constraints: w:bend(p1, p2, p3, p4, {...}), w:bends() and
  * the bend handle. As a distance handle: the core's id plus its world's userdata as
  * the user value, so the world outlives every handle. */
-#include <math.h>
-
 #include "util.h"
 
 #define WBL_BEND "wobble.bend"
@@ -38,23 +36,18 @@ static int w_bend(lua_State *L)
     for (int i = 0; i < 4; i++) p[i] = wbl_checkparticle(L, w, 2 + i);
     wb_bend_def d = wb_bend_default_def();
     if (wbl_checkopts(L, 6, bend_keys, true)) {
-        if (wbl_optreal(L, 6, "compliance", &d.compliance) && d.compliance < 0)
-            return wbl_fielderror(L, 6, "compliance", "must be >= 0");
-        if (wbl_optreal(L, 6, "damping", &d.damping) && d.damping < 0)
-            return wbl_fielderror(L, 6, "damping", "must be >= 0");
-        if (wbl_optreal(L, 6, "rest", &d.rest) && !(fabs(d.rest) <= 3.14159265358979323846))
-            return wbl_fielderror(L, 6, "rest", "must be an angle in [-pi, pi] (radians)");
-        if (wbl_optreal(L, 6, "break_torque", &d.break_torque) && !(d.break_torque >= 0 && isfinite(d.break_torque)))
-            return wbl_fielderror(L, 6, "break_torque", "must be >= 0 (N m; 0: never breaks)");
+        wbl_optreal(L, 6, "compliance", &d.compliance);
+        wbl_optreal(L, 6, "damping", &d.damping);
+        wbl_optreal(L, 6, "rest", &d.rest);
+        wbl_optreal(L, 6, "break_torque", &d.break_torque);
     }
-    for (int i = 0; i < 4; i++)
-        for (int j = 0; j < i; j++)
-            if (p[i] == p[j]) return luaL_argerror(L, 2 + i, "a bend needs four distinct particles");
+    /* the core decides (bend.c); an error names the option or the particle at fault */
+    const wb_fault f = wb_bend_check(wb_particle_count(w), wb_particle_positions(w), p, &d);
+    wbl_fault_error(L, &f, 2, 2, 6);
     push_bend(L, 1, (wb_bend_id){ 0, 0 }); /* first: Lua may run out of memory */
     wb_status st = WB_OK;
     wb_bend_id id = wb_bend_add(w, p, &d, &st);
-    /* the options and particles were checked: an argument error is the geometry */
-    if (st != WB_OK) return wbl_status_error(L, st == WB_ERR_ARG ? 2 : 6, st, "bend constraint");
+    if (st != WB_OK) return wbl_status_error(L, 6, st, "bend constraint");
     ((wbl_bend *)lua_touserdata(L, -1))->id = id;
     return 1;
 }

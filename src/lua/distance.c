@@ -42,14 +42,14 @@ static int w_distance(lua_State *L)
         if (wbl_optreal(L, 4, "rest", &d.rest) && d.rest < 0)
             return wbl_fielderror(L, 4, "rest", "must be >= 0");
     }
-    const char *err = wb_distance_def_check(&d);
-    if (err) return luaL_argerror(L, 4, err);
+    /* the core decides (wb_distance_check); an error names the option or the particle at
+     * fault. Without positions: the message of their distance names the particles */
+    const wb_fault f = wb_distance_check(wb_particle_count(w), NULL, a, b, &d);
+    wbl_fault_error(L, &f, 2, 3, 4);
     wb_distance_id none = { 0, 0 };
     wb_distance_id *id = wbl_push_distance(L, 1, none); /* first: Lua may run out of memory */
     wb_status st = WB_OK;
     *id = wb_distance_add(w, a, b, &d, &st);
-    /* the options were checked above: an argument error now is about the particles
-     * (the same particle twice, or too far apart for a finite squared length) */
     if (st != WB_OK) return wbl_status_error(L, st == WB_ERR_ARG ? 3 : 4, st, "distance constraint");
     return 1;
 }

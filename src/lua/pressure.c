@@ -35,10 +35,12 @@ static int w_pressure(lua_State *L)
     luaL_checktype(L, 2, LUA_TTABLE);
     wb_pressure_def d = wb_pressure_default_def();
     if (wbl_checkopts(L, 3, pr_keys, true)) {
-        if (wbl_optreal(L, 3, "pressure", &d.pressure) && !(d.pressure > 0)) return wbl_fielderror(L, 3, "pressure", "must be > 0");
-        if (wbl_optreal(L, 3, "compliance", &d.compliance) && !(d.compliance >= 0))
-            return wbl_fielderror(L, 3, "compliance", "must be >= 0");
+        wbl_optreal(L, 3, "pressure", &d.pressure);
+        wbl_optreal(L, 3, "compliance", &d.compliance);
     }
+    /* the core decides (pressure.c); an error names the option */
+    const wb_fault f = wb_pressure_def_fault(&d);
+    wbl_fault_error(L, &f, 2, 2, 3);
     /* a body names its world: another world's body has a range that means other particles here */
     if (lua_getfield(L, 2, "world") != LUA_TNIL) {
         const wbl_world *bw = (const wbl_world *)luaL_testudata(L, -1, WBL_WORLD);
@@ -93,9 +95,11 @@ static int p_set_pressure(lua_State *L)
 {
     int32_t k;
     wb_world *w = checkpr(L, 1, &k);
-    const wb_real p = wbl_checkreal(L, 2);
-    if (!(p > 0)) return luaL_argerror(L, 2, "pressure must be > 0");
-    wb_pressure_set(w, k, p);
+    wb_pressure_def d = wb_pressure_get_def(w, k);
+    d.pressure = wbl_checkreal(L, 2);
+    const wb_fault f = wb_pressure_def_fault(&d); /* the core decides (pressure.c) */
+    if (f.msg) return luaL_argerror(L, 2, f.msg);
+    wb_pressure_set(w, k, d.pressure);
     return 0;
 }
 

@@ -23,15 +23,14 @@ static int w_shape_match(lua_State *L)
     wb_world *w = wbl_checkworld(L, 1);
     wb_shape_match_def d = wb_shape_match_default_def();
     if (wbl_checkopts(L, 3, sm_keys, true)) {
-        if (wbl_optreal(L, 3, "stiffness", &d.stiffness) && !(d.stiffness >= 0 && d.stiffness <= 1))
-            return wbl_fielderror(L, 3, "stiffness", "must be in [0, 1]");
-        if (wbl_optreal(L, 3, "yield", &d.yield) && !(d.yield >= 0)) return wbl_fielderror(L, 3, "yield", "must be >= 0");
-        if (wbl_optreal(L, 3, "creep", &d.creep) && !(d.creep >= 0)) return wbl_fielderror(L, 3, "creep", "must be >= 0");
+        wbl_optreal(L, 3, "stiffness", &d.stiffness);
+        wbl_optreal(L, 3, "yield", &d.yield);
         /* plastic when yield is set: flow at creep per second, 1/s by default */
-        lua_getfield(L, 3, "creep");
-        if (lua_isnil(L, -1) && d.yield > 0) d.creep = 1;
-        lua_pop(L, 1);
+        if (!wbl_optreal(L, 3, "creep", &d.creep) && d.yield > 0) d.creep = 1;
     }
+    /* the core decides (shape_match.c); an error names the option */
+    const wb_fault f = wb_shape_match_def_fault(&d);
+    wbl_fault_error(L, &f, 2, 2, 3);
     int32_t n;
     const int32_t *ids = wbl_checkids(L, 2, w, &n); /* a userdata on the stack: freed by Lua */
     wbl_smatch *h = (wbl_smatch *)lua_newuserdatauv(L, sizeof *h, 1); /* first: Lua may run out of memory */

@@ -22,12 +22,13 @@ static int w_tether(lua_State *L)
     wb_tether_def d = wb_tether_default_def();
     if (wbl_checkopts(L, 4, tether_keys, true)) {
         d.has_length = wbl_optreal(L, 4, "length", &d.length);
-        if (d.has_length && !(d.length >= 0)) return wbl_fielderror(L, 4, "length", "must be >= 0");
-        read_compliance(L, 4, &d.compliance);
+        wbl_optreal(L, 4, "compliance", &d.compliance);
     }
+    /* the core decides (tether.c); an error names the option or the particle at fault */
+    const wb_fault f = wb_tether_check(wb_particle_count(w), wb_particle_positions(w), p, q, &d);
+    wbl_fault_error(L, &f, 2, 3, 4);
     const int32_t i = wb_tether_add(w, p, q, &d);
-    /* the options were checked: an argument error is about the particles (one twice) */
-    if (i < 0) return wbl_status_error(L, i == WB_ERR_ARG ? 3 : 4, (wb_status)i, "tether");
+    if (i < 0) return wbl_status_error(L, 4, (wb_status)i, "tether");
     lua_pushinteger(L, (lua_Integer)i + 1);
     return 1;
 }

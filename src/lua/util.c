@@ -319,6 +319,13 @@ void wbl_read_link(lua_State *L, int arg, wb_distance_def *d)
     wbl_optreal(L, arg, "break_force", &d->break_force);
 }
 
+int wbl_fault_error(lua_State *L, const wb_fault *f, int first, int together, int opts)
+{
+    if (!f->msg) return 0;
+    if (f->key) return wbl_fielderror(L, opts, f->key, "%s", f->why);
+    return luaL_argerror(L, f->corner >= 0 ? first + f->corner : together, f->msg);
+}
+
 int wbl_status_error(lua_State *L, int arg, wb_status st, const char *what)
 {
     switch (st) {

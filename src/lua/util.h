@@ -96,6 +96,11 @@ void wbl_shape_keys(const char *const first[], const char *fields, const char *o
 extern const char *const wbl_link_keys[];   /* compliance, damping, yield, creep, break_strain */
 void wbl_read_link(lua_State *L, int arg, wb_distance_def *d);
 
+/* what a type's check found (wb_fault), raised as the script wrote it: an option's as
+ * "field 'key': why" at opts, a particle's at its argument (first + corner; at together
+ * when the particles are at fault together). Returns only when f has no fault */
+int wbl_fault_error(lua_State *L, const wb_fault *f, int first, int together, int opts);
+
 /* a failed core call: WB_ERR_ARG / WB_ERR_LIMIT -> argument error, NOMEM -> budget error */
 int wbl_status_error(lua_State *L, int arg, wb_status st, const char *what);
 

@@ -17,13 +17,6 @@
 
 static const char *const volume_keys[] = { "compliance", "rest", "yield", "creep", NULL };
 
-/* yield and creep (plastic flow, as a distance's) of the options at arg 6 */
-static void read_plastic(lua_State *L, wb_real *yield, wb_real *creep)
-{
-    if (wbl_optreal(L, 6, "yield", yield) && !(*yield >= 0)) wbl_fielderror(L, 6, "yield", "must be >= 0");
-    if (wbl_optreal(L, 6, "creep", creep) && !(*creep >= 0)) wbl_fielderror(L, 6, "creep", "must be >= 0");
-}
-
 static int w_volume(lua_State *L)
 {
     wb_world *w = wbl_checkworld(L, 1);
@@ -31,14 +24,16 @@ static int w_volume(lua_State *L)
     for (int k = 0; k < 4; k++) p[k] = wbl_checkparticle(L, w, 2 + k);
     wb_volume_def d = wb_volume_default_def();
     if (wbl_checkopts(L, 6, volume_keys, true)) {
-        if (wbl_optreal(L, 6, "compliance", &d.compliance) && d.compliance < 0)
-            return wbl_fielderror(L, 6, "compliance", "must be >= 0");
+        wbl_optreal(L, 6, "compliance", &d.compliance);
         d.has_rest = wbl_optreal(L, 6, "rest", &d.rest);
-        read_plastic(L, &d.yield, &d.creep);
+        wbl_optreal(L, 6, "yield", &d.yield);
+        wbl_optreal(L, 6, "creep", &d.creep);
     }
+    /* the core decides (volume.c); an error names the option or the particle at fault */
+    const wb_fault f = wb_volume_check(wb_particle_count(w), wb_particle_positions(w), p, &d);
+    wbl_fault_error(L, &f, 2, 5, 6);
     const int32_t i = wb_volume_add(w, p, &d);
-    /* the options were checked: an argument error is about the particles (one twice) */
-    if (i < 0) return wbl_status_error(L, i == WB_ERR_ARG ? 5 : 6, (wb_status)i, "volume constraint");
+    if (i < 0) return wbl_status_error(L, 6, (wb_status)i, "volume constraint");
     lua_pushinteger(L, (lua_Integer)i + 1);
     return 1;
 }
@@ -89,13 +84,15 @@ static int w_tet(lua_State *L)
     for (int k = 0; k < 4; k++) p[k] = wbl_checkparticle(L, w, 2 + k);
     wb_tet_def d = wb_tet_default_def();
     if (wbl_checkopts(L, 6, tet_keys, true)) {
-        if (wbl_optreal(L, 6, "young", &d.young) && !(d.young > 0)) return wbl_fielderror(L, 6, "young", "must be > 0 (Pa)");
-        if (wbl_optreal(L, 6, "poisson", &d.poisson) && !(d.poisson >= 0 && d.poisson < 0.5))
-            return wbl_fielderror(L, 6, "poisson", "must be in [0, 0.5)");
-        read_plastic(L, &d.yield, &d.creep);
+        wbl_optreal(L, 6, "young", &d.young);
+        wbl_optreal(L, 6, "poisson", &d.poisson);
+        wbl_optreal(L, 6, "yield", &d.yield);
+        wbl_optreal(L, 6, "creep", &d.creep);
     }
+    /* the core decides (tet.c); an error names the option or the particle at fault */
+    const wb_fault f = wb_tet_check(wb_particle_count(w), wb_particle_positions(w), p, &d);
+    wbl_fault_error(L, &f, 2, 5, 6);
     const int32_t i = wb_tet_add(w, p, &d);
-    if (i == WB_ERR_ARG) return luaL_argerror(L, 5, wb_last_error());
     if (i < 0) return wbl_status_error(L, 6, (wb_status)i, "tet");
     lua_pushinteger(L, (lua_Integer)i + 1);
     return 1;

@@ -114,6 +114,7 @@
     X(world_def_defaults)                        \
     X(world_def_check_messages)                  \
     X(distance_and_collider_def_check_messages)  \
+    X(constraint_check_faults)                   \
     X(particle_add_get_set)                      \
     X(particle_immovable_and_pin)                \
     X(distance_handles)                          \

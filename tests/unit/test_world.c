@@ -1,5 +1,6 @@
 /* test_world.c: world, particle and distance-constraint API of the core. */
 #include <stdint.h>
+#include <string.h>
 
 #include "test.h"
 #include "wobble.h"
@@ -116,6 +117,84 @@ TEST(world_def_check_messages)
     CHECK_EQ(wb_world_set_def(w, &good), WB_OK);
     CHECK_EQ(wb_world_get_def(w).substeps, 3);
     CHECK_NEAR(wb_world_get_def(w).gravity[0], 1, 0);
+    wb_world_destroy(w);
+}
+
+/* a type's check names what is at fault the way a binding or a reader needs it: the key
+ * of an option (and its reason alone), or the particle (0-based corner), or the particles
+ * together; the add refuses exactly what the check refuses */
+TEST(constraint_check_faults)
+{
+    const wb_real x[15] = { 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 2, 0, 0 };
+    wb_distance_def dd = wb_distance_default_def();
+    wb_fault f = wb_distance_check(5, x, 0, 1, &dd);
+    CHECK(f.msg == NULL);
+    f = wb_distance_check(5, x, 0, 0, &dd);
+    CHECK(f.key == NULL); CHECK_EQ(f.corner, 1); CHECK_HAS(f.msg, "two distinct");
+    f = wb_distance_check(5, x, 0, 7, &dd);
+    CHECK_EQ(f.corner, 1); CHECK_HAS(f.msg, "out of range");
+    dd.break_force = -1;
+    f = wb_distance_check(5, x, 0, 1, &dd);
+    REQUIRE(f.key); CHECK(strcmp(f.key, "break_force") == 0); CHECK(strcmp(f.why, "must be >= 0") == 0);
+    CHECK(strcmp(f.msg, wb_distance_def_check(&dd)) == 0);
+    const wb_real far[6] = { -1e200, 0, 0, 1e200, 0, 0 };
+    dd = wb_distance_default_def();
+    f = wb_distance_check(2, far, 0, 1, &dd);
+    CHECK(f.key == NULL); CHECK_EQ(f.corner, -1); CHECK_HAS(f.msg, "too far apart");
+    CHECK(wb_distance_check(2, NULL, 0, 1, &dd).msg == NULL); /* without positions: not checked */
+
+    wb_bend_def bd = wb_bend_default_def();
+    const int32_t ok[4] = { 0, 1, 2, 3 }, twice[4] = { 0, 1, 2, 1 }, flat[4] = { 0, 1, 2, 4 };
+    CHECK(wb_bend_check(5, x, ok, &bd).msg == NULL);
+    f = wb_bend_check(5, x, twice, &bd);
+    CHECK(f.key == NULL); CHECK_EQ(f.corner, 3); CHECK_HAS(f.msg, "four distinct");
+    f = wb_bend_check(5, x, flat, &bd);
+    CHECK(f.key == NULL); CHECK_EQ(f.corner, -1); CHECK_HAS(f.msg, "degenerate");
+    bd.rest = 4;
+    f = wb_bend_check(5, x, ok, &bd);
+    REQUIRE(f.key); CHECK(strcmp(f.key, "rest") == 0); CHECK_HAS(f.why, "[-pi, pi]");
+
+    wb_tet_def td = wb_tet_default_def();
+    CHECK(wb_tet_check(5, x, ok, &td).msg == NULL);
+    CHECK_EQ(wb_tet_check(5, x, flat, &td).corner, -1);
+    CHECK(wb_tet_check(5, NULL, flat, &td).msg == NULL);
+    td.young = 1e15;
+    f = wb_tet_check(5, x, ok, &td);
+    REQUIRE(f.key); CHECK(strcmp(f.key, "young") == 0);
+
+    wb_volume_def vd = wb_volume_default_def();
+    vd.creep = -1;
+    f = wb_volume_check(5, x, twice, &vd); /* the particles come first */
+    CHECK(f.key == NULL); CHECK_EQ(f.corner, 3);
+    f = wb_volume_check(5, x, ok, &vd);
+    REQUIRE(f.key); CHECK(strcmp(f.key, "creep") == 0);
+
+    wb_tether_def hd = wb_tether_default_def();
+    hd.has_length = true; hd.length = -1;
+    f = wb_tether_check(5, x, 0, 1, &hd);
+    REQUIRE(f.key); CHECK(strcmp(f.key, "length") == 0);
+
+    wb_shape_match_def sd = wb_shape_match_default_def();
+    sd.stiffness = 2;
+    f = wb_shape_match_def_fault(&sd);
+    REQUIRE(f.key); CHECK(strcmp(f.key, "stiffness") == 0); CHECK(strcmp(f.why, "must be in [0, 1]") == 0);
+    wb_pressure_def pd = wb_pressure_default_def();
+    pd.pressure = 0;
+    f = wb_pressure_def_fault(&pd);
+    REQUIRE(f.key); CHECK(strcmp(f.key, "pressure") == 0);
+
+    /* the add refuses what the check refuses, with its message */
+    wb_world *w = new_world();
+    REQUIRE(w);
+    const wb_real v0[3] = { 0, 0, 0 };
+    for (int i = 0; i < 5; i++) wb_particle_add(w, &x[3 * i], v0, 1, 0.01);
+    wb_status st = WB_OK;
+    bd = wb_bend_default_def();
+    wb_bend_add(w, flat, &bd, &st);
+    CHECK_EQ(st, WB_ERR_ARG); CHECK_HAS(wb_last_error(), "degenerate");
+    CHECK_EQ(wb_bend_count(w), 0);
+    wb_bend_add(w, ok, &bd, &st);
+    CHECK_EQ(st, WB_OK); CHECK_EQ(wb_bend_count(w), 1);
     wb_world_destroy(w);
 }
 
