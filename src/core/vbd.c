@@ -792,7 +792,7 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     struct wb_vbd *v = w->vbd;
     if (!v || v->np != w->m.np) return -1; /* (prepare failed: out of memory, warned there) */
     const wb_real inv_h2 = 1 / (h * h);
-    memcpy(v->y, w->s.x, sizeof *v->y * 3 * (size_t)w->m.np);
+    if (w->m.np > 0) memcpy(v->y, w->s.x, sizeof *v->y * 3 * (size_t)w->m.np); /* none: rigid bodies alone */
     start_guess(w, v, h);
     warm_start(w, v, inv_h2, 1 / h);
     bend_warm_start(w, v, inv_h2);
@@ -806,7 +806,7 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
             if (!c) return -1;
             v->cheb[k] = c;
         }
-        memcpy(v->cheb[1], w->s.x, sizeof *w->s.x * 3 * (size_t)w->m.np);
+        if (w->m.np > 0) memcpy(v->cheb[1], w->s.x, sizeof *w->s.x * 3 * (size_t)w->m.np);
     }
     for (int it = 0; it < w->m.def.iterations; it++) {
         sweep_job j = { w, v, inv_h2, 1 / h, NULL, 0 };
