@@ -62,8 +62,6 @@ struct wb_vbd {
     wb_real *blam, *bkpen; /* (nb, by slot) a hard bend's multiplier and penalty */
     int32_t cap_blam;
     wb_real residual;      /* the last sweep's largest step, m */
-    wb_real *cheb[2];      /* (np x 3, while Chebyshev is on) the positions two and one
-                              iterations back */
     double *tsum;          /* (bodies x 4) each free body's mass and sum m (x - y) */
     int32_t cap_tsum;
 };
@@ -108,8 +106,6 @@ void wb__vbd_destroy(wb_world *w)
     free(v->c0);
     free(v->blam);
     free(v->bkpen);
-    free(v->cheb[0]);
-    free(v->cheb[1]);
     free(v->tsum);
     free(v);
     w->vbd = NULL;
@@ -706,31 +702,6 @@ static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h)
     }
 }
 
-/* Chebyshev acceleration of the iterations (Chen et al. 2024, after Wang 2015): iteration
- * n >= 2 ends at omega_n (x~ - x_{n-2}) + x_{n-2}, omega_2 = 2 / (2 - rho^2), omega_n =
- * 4 / (4 - rho^2 omega_{n-1}), rho the estimated spectral radius. The first iteration is
- * never changed (omega_1 = 1): at one iteration a substep it does nothing. An internal
- * switch for measurements (rho 0: off, the default); not thread-safe: between steps. */
-static double cheb_rho;
-void wb__vbd_chebyshev(double rho);
-void wb__vbd_chebyshev(double rho) { cheb_rho = rho; }
-
-static void chebyshev(wb_world *w, struct wb_vbd *v, int it, wb_real *omega)
-{
-    const size_t n3 = 3 * (size_t)w->m.np;
-    wb_real *x = w->s.x;
-    if (it >= 1) {
-        const wb_real r2 = (wb_real)(cheb_rho * cheb_rho), *a = v->cheb[0], *wv = w->m.w;
-        *omega = it == 1 ? 2 / (2 - r2) : 4 / (4 - r2 * *omega);
-        for (int32_t i = 0; i < w->m.np; i++)
-            if (wv[i] > 0)
-                for (int c = 0; c < 3; c++) x[3 * i + c] = *omega * (x[3 * i + c] - a[3 * i + c]) + a[3 * i + c];
-    }
-    wb_real *t = v->cheb[0];
-    v->cheb[0] = v->cheb[1], v->cheb[1] = t;
-    memcpy(v->cheb[1], x, sizeof *x * n3);
-}
-
 /* Each free body (momentum.c's: nothing outside the solve holds it) moved rigidly so that
  * the solve keeps its momentum, sum m (x - y) = 0. Its energies do not change under a
  * translation, so the move only lowers the inertia term: it is the exact step of the
@@ -797,17 +768,6 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     warm_start(w, v, inv_h2, 1 / h);
     bend_warm_start(w, v, inv_h2);
     wb_pool *pool = wb__world_pool(w);
-    const int cheb = cheb_rho > 0 && w->m.def.iterations > 1;
-    wb_real omega = 1;
-    if (cheb) {
-        const size_t n3 = 3 * (size_t)(w->m.np > 0 ? w->m.np : 1);
-        for (int k = 0; k < 2; k++) {
-            wb_real *c = realloc(v->cheb[k], sizeof *c * n3);
-            if (!c) return -1;
-            v->cheb[k] = c;
-        }
-        if (w->m.np > 0) memcpy(v->cheb[1], w->s.x, sizeof *w->s.x * 3 * (size_t)w->m.np);
-    }
     for (int it = 0; it < w->m.def.iterations; it++) {
         sweep_job j = { w, v, inv_h2, 1 / h, NULL, 0 };
         for (int32_t c = 0; c < v->ncolours; c++) {
@@ -817,7 +777,6 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
             wb__pool_for(serial ? NULL : pool, n, 1024, sweep_part, &j);
         }
         v->residual = sqrt(j.step);
-        if (cheb) chebyshev(w, v, it, &omega);
         dual_update(w, v);
         bend_dual_update(w, v, h);
         for (int t = 0; t < wb__nctypes; t++)

@@ -227,7 +227,7 @@ int jv_get_ids(rd *r, const cJSON *it, const kp *p, int32_t np, int k, const cha
     int c = 0;
     for (const cJSON *e = it->child; e; e = e->next, c++) {
         kp q = { p, NULL, c };
-        int64_t v;
+        int64_t v = 0;
         if (np == 0) return jv_fail(r, e, 0, &q, "there are no particles");
         if (jv_get_int(r, e, &q, 0, np - 1, &v)) return -1;
         out[c] = (int32_t)v;
