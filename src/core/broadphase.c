@@ -1204,11 +1204,30 @@ static int split_dormant(wb_contacts *c, const wb_model *m, int32_t r)
     return 1;
 }
 
-/* the candidate list for the next t seconds (k0 substeps of h into the frame) from where
- * the particles are: each one's reach is how far it can get from the reference motion in
- * that time, plus a quarter of its radius for what the constraints move it; kept in c->xf
- * for the substeps' checks. Returns the pairs, or -1 when out of memory */
-static int32_t make_list(wb_world *w, wb_real t, wb_real margin, int32_t k0)
+/* How many substeps one list covers: the frame's, or half of them where the particles get
+ * more than SPAN_R radii farther than their radii from the reference motion in a frame
+ * (the mean of (|u| dt + |g| dt^2) / r). A list's reaches grow with that and the pairs it
+ * holds with their square on a sheet, their cube in a heap, so where it is large two
+ * lists of half the span cost less than one; where it is small the second list is the
+ * grid, the reference and the paths made again for little. Measured with callgrind
+ * (instructions; docs/benchmark.md) with one, two or three lists in every frame: a 128 x
+ * 128 cloth swinging from two corners, 60 frames, 15.67 / 11.79 / 11.88 G (three where it
+ * moves more than 2 radii); a 64 x 64 cloth falling into a heap 6.33 / 4.81 / 4.87 G; 27
+ * soft blocks falling into a box (the contacts bench, radii of 8 cm) 4.50 / 4.65 G. From
+ * the state alone (the velocities and the reference), so a step run again makes the same
+ * lists. */
+#define SPAN_R 0.5
+static int32_t list_span(int32_t substeps, double motion)
+{
+    return motion > SPAN_R && substeps >= 6 ? (substeps + 1) / 2 : substeps;
+}
+
+/* the candidate list for the next substeps of h, at most kmax (k0 substeps into the
+ * frame; list_span picks how many) from where the particles are: each one's reach is how
+ * far it can get from the reference motion in that time, plus a quarter of its radius for
+ * what the constraints move it (margin); kept in c->xf for the substeps' checks. Sets
+ * c->span at a frame's start. Returns the pairs, or -1 when out of memory */
+static int32_t make_list(wb_world *w, wb_real h, int32_t kmax, wb_real margin, int32_t k0)
 {
     wb_model *m = &w->m;
     wb_contacts *c = &w->k.pc;
@@ -1223,7 +1242,7 @@ static int32_t make_list(wb_world *w, wb_real t, wb_real margin, int32_t k0)
     wb_real *path = wb__grow(c->path, &c->cap_path, 8 * m->np, sizeof *path);
     if (path) c->path = path;
     if (!reach || !skip || !xf || !path) return -1;
-    const wb_real gt2 = v3_len(m->def.gravity) * t * t, *v = w->s.v;
+    const wb_real *v = w->s.v;
     for (int32_t i = 0; i < m->np; i++) {
         const uint8_t f = m->cflags[i];
         const int32_t gi = m->group[i];
@@ -1231,18 +1250,31 @@ static int32_t make_list(wb_world *w, wb_real t, wb_real margin, int32_t k0)
         reach[i] = (f & WB_CF_COLLIDE) || (gi > 0 && (f & WB_CF_SELF)) ? 0 : -1;
         skip[i] = gi > 0 && !(f & WB_CF_SELF) ? gi : 0;
     }
-    fit_reference(w, reach, t);
+    fit_reference(w, reach, h * kmax);
     c->ref_k0 = k0;
-    c->path_t = t;
     const ref_step rs0 = { 0, 1 };
+    /* each candidate's speed from the reference (in reach for now), and their mean motion
+     * over kmax substeps in radii, for the span */
+    double motion = 0;
+    int32_t nmov = 0; /* (the span is the frame's: worked out at its start) */
+    const wb_real g = v3_len(m->def.gravity);
+    for (int32_t i = 0; i < m->np; i++) {
+        if (reach[i] < 0) continue;
+        wb_real u[3];
+        ref_rel(c, &rs0, &w->s.x[3 * i], &v[3 * i], m->w[i] > 0, u);
+        reach[i] = v3_len_fast(u);
+        if (m->radius[i] > 0) motion += (reach[i] * h * kmax + g * h * h * kmax * kmax) / m->radius[i], nmov++;
+    }
+    if (k0 == 0) c->span = list_span(kmax, nmov > 0 ? motion / nmov : 0);
+    const int32_t span = k0 == 0 ? c->span : kmax;
+    const wb_real t = h * span, gt2 = g * t * t;
+    c->path_t = t;
     static const wb_real still[3] = { 0, 0, 0 };
     for (int32_t i = 0; i < m->np; i++) {
         if (reach[i] < 0) continue;
         const wb_real *p = &w->s.x[3 * i], eps = m->radius[i] * margin + gt2;
         const int movable = m->w[i] > 0;
-        wb_real u[3];
-        ref_rel(c, &rs0, p, &v[3 * i], movable, u);
-        reach[i] = m->radius[i] + eps + v3_len_fast(u) * t;
+        reach[i] = m->radius[i] + eps + reach[i] * t;
         if (!isfinite(reach[i] + p[0] + p[1] + p[2])) reach[i] = -1;
         set_path(c, i, p, movable ? &v[3 * i] : still, eps);
     }
@@ -1266,6 +1298,7 @@ void wb__contacts_begin(wb_world *w)
     c->broad_ms = 0;
     c->check = 0;
     c->sub = 0;
+    c->span = m->def.substeps;
     c->remakes_frame = 0;
     if (!m->def.contacts || m->np < 2) return;
     if (!wb__contact_rules(w)) {
@@ -1280,7 +1313,7 @@ void wb__contacts_begin(wb_world *w)
     }
     if (!c->possible) return;
     const double t0 = now_ms();
-    if (make_list(w, m->def.dt, (wb_real)0.25, 0) < 0) {
+    if (make_list(w, m->def.dt / m->def.substeps, m->def.substeps, (wb_real)0.25, 0) < 0) {
         c->n = 0;
         wb__warn(w, "out of memory in the contact broad phase; contacts skipped");
     }
@@ -1504,22 +1537,30 @@ int wb__contacts_recheck(wb_world *w, wb_real h)
             nm++;
         }
     }
-    if (ns == 0 && nm == 0) return 0;
+    /* a span ends here (list_span): the list for the next */
+    const int due = sub > 0 && sub % c->span == 0;
+    if (ns == 0 && nm == 0 && !due) return 0;
     const double t0 = now_ms();
-    if (nm == 0) { /* off their paths alone */
+    if (nm == 0 && !due) { /* off their paths alone */
         r = repair(w, NULL, 0, soft, ns, 0, 0, &rs);
         c->broad_ms += now_ms() - t0;
         if (!r) { c->n = 0; c->check = 0; return -1; }
         return 2;
     }
-    c->remakes++;
-    c->remakes_frame++;
-    /* what is left of the frame, this substep included; the constraints moved some
-     * particle farther than its margin allowed: the rest of the frame allows twice as
-     * much each time, so a frame makes the list again a few times at most */
-    const wb_real left = m->def.dt - (wb_real)sub * h, t = left > h ? left : h;
-    const wb_real margin = (wb_real)0.25 * (wb_real)(1 << (c->remakes_frame < 4 ? c->remakes_frame : 4));
-    if (nm <= REPAIR_MAX) {
+    if (!due) {
+        c->remakes++;
+        c->remakes_frame++;
+    }
+    /* due: for the next span; else what is left of the frame, this substep included (the
+     * constraints moved some particle farther than its margin allowed: the rest of the
+     * frame allows twice as much each time, so a frame makes the list again a few times
+     * at most) */
+    const int32_t kleft = due ? (c->span < m->def.substeps - sub ? c->span : m->def.substeps - sub)
+                              : m->def.substeps - sub;
+    const wb_real t = (wb_real)kleft * h;
+    const wb_real margin = due ? (wb_real)0.25
+                               : (wb_real)0.25 * (wb_real)(1 << (c->remakes_frame < 4 ? c->remakes_frame : 4));
+    if (!due && nm <= REPAIR_MAX) {
         r = repair(w, mv, nm, soft, ns, t, margin, &rs);
         c->broad_ms += now_ms() - t0;
         if (!r) { c->n = 0; c->check = 0; return -1; }
@@ -1531,7 +1572,7 @@ int wb__contacts_recheck(wb_world *w, wb_real h)
     c->ij_old = io;
     if (c->n > 0) memcpy(io, c->ij, sizeof *io * 2 * (size_t)c->n);
     c->n_old = c->n;
-    r = make_list(w, t, margin, sub + 1);
+    r = make_list(w, h, kleft, margin, sub + 1);
     c->broad_ms += now_ms() - t0;
     if (r < 0) { c->n = 0; c->check = 0; return -1; }
     return 1;

@@ -81,6 +81,7 @@ typedef struct wb_contacts {
      * list was made (broadphase.c: wb__contacts_recheck), else the list is made again */
     int check;             /* a list was made this frame: check it */
     int32_t sub;           /* substeps of the frame checked so far */
+    int32_t span;          /* substeps one list of this frame covers (broadphase.c: list_span) */
     wb_real *xf;           /* (np x 3) where the list's reaches were measured from (a particle
                               mended within the frame: where the reference motion below takes
                               to where it was then) */

@@ -46,12 +46,16 @@ static wb_world *heap(int n)
 TEST(contact_list_complete_every_substep)
 {
     int64_t missed[2], remakes[2];
+    int split = 0;
     for (int on = 0; on < 2; on++) {
         wb_world *w = heap(32);
         REQUIRE(w);
         w->k.pc.brute = 1;
         w->k.pc.no_recheck = !on;
-        for (int f = 0; f < 90; f++) wb_world_step(w);
+        for (int f = 0; f < 90; f++) {
+            wb_world_step(w);
+            split += on && w->k.pc.span < w->m.def.substeps; /* two lists that frame */
+        }
         missed[on] = w->k.pc.missed;
         remakes[on] = w->k.pc.remakes;
         wb_world_destroy(w);
@@ -61,6 +65,7 @@ TEST(contact_list_complete_every_substep)
     CHECK(missed[0] > 0);  /* the scene does outrun the frame's reach */
     CHECK_EQ(missed[1], 0);
     CHECK(remakes[1] > 0);
+    CHECK(split > 0);      /* and some frames' lists were made for half of them each */
 }
 
 /* The reaches are measured against a reference motion fitted to the particles (a
@@ -113,8 +118,10 @@ TEST(contact_list_complete_with_reference_motion)
         REQUIRE(w);
         w->k.pc.brute = 1;
         wb_real turned = 0;
+        int split = 0;
         for (int f = 0; f < 60; f++) {
             wb_world_step(w);
+            split += w->k.pc.span < w->m.def.substeps;
             const wb_real *om = w->k.pc.ref_om;
             turned = fmax(turned, sqrt(om[0] * om[0] + om[1] * om[1] + om[2] * om[2]));
         }
@@ -122,6 +129,7 @@ TEST(contact_list_complete_with_reference_motion)
                spin ? "tumbling cloth" : "swinging cloth", (long long)w->k.pc.missed,
                (long long)w->k.pc.remakes, turned);
         CHECK(turned > 0.5); /* the reference did turn with the cloth */
+        CHECK(split > 0);    /* frames of two lists, each for half the substeps */
         CHECK_EQ(w->k.pc.missed, 0);
         wb_world_destroy(w);
     }
