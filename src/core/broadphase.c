@@ -1211,8 +1211,9 @@ static int split_dormant(wb_contacts *c, const wb_model *m, int32_t r)
  * lists of half the span cost less than one; where it is small the second list is the
  * grid, the reference and the paths made again for little. Measured with callgrind
  * (instructions; docs/benchmark.md) with one, two or three lists in every frame: a 128 x
- * 128 cloth swinging from two corners, 60 frames, 15.67 / 11.79 / 11.88 G (three where it
- * moves more than 2 radii); a 64 x 64 cloth falling into a heap 6.33 / 4.81 / 4.87 G; 27
+ * 128 cloth swinging from two corners, 60 frames, 15.67 / 11.79 G (and 11.88 G with one
+ * list below a radius of motion, two to 2 radii, three above); a 64 x 64 cloth falling
+ * into a heap 6.33 / 4.81 / 4.87 G; 27
  * soft blocks falling into a box (the contacts bench, radii of 8 cm) 4.50 / 4.65 G. From
  * the state alone (the velocities and the reference), so a step run again makes the same
  * lists. */
