@@ -244,7 +244,7 @@ static void scan(const wb_broad *b, const grid *g, int32_t lo, int32_t hi, int32
                  int (*keep)(void *ud, int32_t i, int32_t j), void *ud)
 {
     const int32_t *restrict start = b->start, *restrict key = b->key;
-    const wb_real *restrict P = b->p, T = g->big;
+    const wb_real *restrict P = b->p, *restrict rowr = b->rowr, T = g->big;
     const wb_grid *G = &g->g;
     const int64_t nx = G->nc[0], ny = G->nc[1], nz = G->nc[2];
     const wb_real ox = G->o[0], oy = G->o[1], oz = G->o[2], inv = G->inv;
@@ -256,19 +256,34 @@ static void scan(const wb_broad *b, const grid *g, int32_t lo, int32_t hi, int32
         int32_t nh = 0;
         if (!G->wrap && !big) {
             /* rows wholly before s in the sorted order hold no partner of it: from its
-             * own row on (its own from s + 1) */
-            const int64_t x0 = cell_of(p[0] - e, ox, inv), x1r = cell_of(p[0] + e, ox, inv),
-                          y1r = cell_of(p[1] + e, oy, inv), z1r = cell_of(p[2] + e, oz, inv);
-            const int64_t x1 = x1r < nx - 1 ? x1r : nx - 1, y1 = y1r < ny - 1 ? y1r : ny - 1,
-                          z1 = z1r < nz - 1 ? z1r : nz - 1;
+             * own row on (its own from s + 1). Each row is searched to rs + its own
+             * largest reach (rowr) and skipped where its cells lie farther than that in y
+             * and z (the gap in cells, less a millionth of a cell for round-off) */
+            const int64_t x1r = cell_of(p[0] + e, ox, inv), y1r = cell_of(p[1] + e, oy, inv),
+                          z1r = cell_of(p[2] + e, oz, inv);
+            const int64_t y1 = y1r < ny - 1 ? y1r : ny - 1, z1 = z1r < nz - 1 ? z1r : nz - 1;
             const int64_t y0 = cell_of(p[1], oy, inv), z0 = cell_of(p[2], oz, inv), ylo = cell_of(p[1] - e, oy, inv);
+            const wb_real sy = (p[1] - oy) * inv, sz = (p[2] - oz) * inv, cs = 1 / inv;
             int64_t row = nx * (y0 + ny * z0);
-            nh = gather(P, key, p, ks, kz, s + 1, start[row + x1 + 1], hit, nh);
-            for (int64_t z = z0; z <= z1; z++)
+            {
+                const wb_real er = rs + rowr[y0 + ny * z0];
+                const int64_t xr = cell_of(p[0] + er, ox, inv), x1 = xr < x1r ? xr : x1r;
+                nh = gather(P, key, p, ks, kz, s + 1, start[row + (x1 < nx - 1 ? x1 : nx - 1) + 1], hit, nh);
+            }
+            for (int64_t z = z0; z <= z1; z++) {
+                const wb_real gz = z > z0 ? ((wb_real)z - sz - (wb_real)1e-6) * cs : 0, gz2 = gz > 0 ? gz * gz : 0;
                 for (int64_t y = z == z0 ? y0 + 1 : ylo; y <= y1; y++) {
+                    const wb_real rr = rowr[y + ny * z];
+                    if (rr < 0) continue;
+                    const wb_real er = rs + rr;
+                    const wb_real gy = y > y0 ? ((wb_real)y - sy - (wb_real)1e-6) * cs
+                                     : y < y0 ? (sy - (wb_real)(y + 1) - (wb_real)1e-6) * cs : 0;
+                    if ((gy > 0 ? gy * gy : 0) + gz2 >= er * er) continue;
+                    const int64_t xa = cell_of(p[0] - er, ox, inv), xb = cell_of(p[0] + er, ox, inv);
                     row = nx * (y + ny * z);
-                    nh = gather(P, key, p, ks, kz, start[row + x0], start[row + x1 + 1], hit, nh);
+                    nh = gather(P, key, p, ks, kz, start[row + xa], start[row + (xb < nx - 1 ? xb : nx - 1) + 1], hit, nh);
                 }
+            }
             emit(b, g, s, 0, hit, nh, o, keep, ud);
             continue;
         }
@@ -366,6 +381,15 @@ static int32_t broad(wb_broad *b, wb_pairbuf *o, const wb_real *x, const wb_real
     }
     for (int64_t q = ncell; q > 0; q--) start[q] = start[q - 1]; /* back to starts */
     start[0] = 0;
+    /* each x-row's largest ordinary reach (the search of an ordinary particle, scan) */
+    const int64_t nrow = g.g.nc[1] * g.g.nc[2];
+    if (!grow((void **)&b->rowr, &b->cap_rowr, nrow, sizeof *b->rowr)) return -1;
+    for (int64_t q = 0; q < nrow; q++) b->rowr[q] = -1;
+    for (int32_t k = 0; k < m; k++) {
+        const wb_real r = reach[b->cand[k]];
+        wb_real *rr = &b->rowr[b->cell[k] / g.g.nc[0]];
+        if (r <= g.big && r > *rr) *rr = r;
+    }
     /* the grid stays for the kept list's mends (wb__contacts_recheck): whether it holds
      * every candidate, its shape and its largest reach */
     b->lg = g.g;

@@ -45,6 +45,7 @@ struct wb_broad {
     int32_t *cell; int32_t cap_cell;   /* cell of each survivor */
     int32_t *start; int32_t cap_start; /* (cells + 1) counting-sort offsets */
     wb_real *p; int32_t cap_p;         /* sorted: x, y, z, reach */
+    wb_real *rowr; int32_t cap_rowr;   /* (rows) each x-row's largest ordinary reach, -1: none */
     int32_t *id; int32_t cap_id;       /* sorted: particle */
     int32_t *key; int32_t cap_key;     /* sorted: skip key */
     struct wb_broad_run *runs; int32_t cap_runs;
@@ -101,7 +102,7 @@ static inline void wb__broadphase_free(wb_contacts *c)
     c->cap_xf = c->cap_old = c->cap_left_old = c->cap_fix = c->cap_add = c->cap_fixed = 0;
     if (!b) return;
     free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key);
-    free(b->runs); free(b->boxes); free(b->first);
+    free(b->runs); free(b->boxes); free(b->first); free(b->rowr);
     free(b->vx); free(b->vr); free(b->vskip); free(b->list.ij); free(b->list.hit);
     free(b->moved); free(b->is_moved); free(b->bad); free(b->mend.ij); free(b->mend.hit);
     for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
