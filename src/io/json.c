@@ -23,12 +23,7 @@
 #define MAX_FILE (1ll << 31) /* 2 GiB: a snapshot of WB_MAX_PARTICLES fits; larger is not ours */
 
 /* ---- sections --------------------------------------------------------------------------------- */
-typedef struct defaults {
-    wb_real mass, radius;
-    wb_distance_def link;
-} defaults;
-
-static int read_defaults(rd *r, const cJSON *it, defaults *d)
+static int read_defaults(rd *r, const cJSON *it, jdefaults *d)
 {
     static const char *const keys[] = { "mass", "radius", "compliance", "damping", "yield", "creep", "break_strain",
                                         "break_force", NULL };
@@ -112,7 +107,7 @@ typedef struct sections {      /* the top-level values, checked for type */
     const cJSON *particles, *constraints, *colliders, *surfaces, *parts, *skins, *snapshot;
     const cJSON *world, *dgen, *dfree, *cgen, *clock[4];
     int32_t np, ncons, ncol, nsurf, ntri, nparts, nskins, nd, nfree, nc;
-    int32_t nbend;             /* "constraints" entries of type "bend" (ncons counts the others) */
+    int32_t nentries[JT_MAX];  /* "constraints" entries of each type (ncons: the distance slots') */
 } sections;
 
 /* the snapshot section's shape (its values are read once the image exists) */
@@ -202,7 +197,7 @@ static int read_snapshot(rd *r, const sections *s, wb_image *g)
     return 0;
 }
 
-static int read_particles(rd *r, const sections *s, const defaults *d, wb_image *g)
+static int read_particles(rd *r, const sections *s, const jdefaults *d, wb_image *g)
 {
     static const char *const keys[] = { "position", "velocity", "mass", "inv_mass", "radius", "pinned",
                                         "group", "friction", "collide", "self_collide", "created_at", NULL };
@@ -256,216 +251,67 @@ static int read_particles(rd *r, const sections *s, const defaults *d, wb_image 
     return 0;
 }
 
-/* {"type": "bend", "particles": [p1, p2, p3, p4], "rest": angle, "compliance": 0, "damping": 0}:
- * the i-th bend; rest defaults to the angle the particles make */
-static int read_bend(rd *r, const cJSON *c, const kp *p, wb_image *g, int32_t i)
+/* the type a "constraints" entry is read as (jtypes): the one its "type" names; without a
+ * string there, the first, whose reader says what is wrong. -1: a type none reads */
+static int entry_type(const cJSON *c)
 {
-    static const char *const keys[] = { "type", "particles", "rest", "compliance", "damping", "break_torque", "broken", NULL };
-    const cJSON *f[8];
-    if (jv_get_object(r, c, p, keys, f)) return -1;
-    if (!f[1]) return jv_missing(r, c, p, "particles");
-    kp pp = { p, "particles", 0 };
-    int32_t n;
-    if (jv_get_array(r, f[1], &pp, 16, &n)) return -1;
-    if (n != 4) return jv_fail(r, f[1], 0, &pp, "a bend joins 4 particles (hinge p1 p2, wings p3 p4), got %d", n);
-    int32_t *q = &g->bend.ij[4 * i];
-    if (jv_get_ids(r, f[1], &pp, g->np, 4, "a bend", q)) return -1;
-    wb_bend_def d = wb_bend_default_def();
-    if (jv_opt_real(r, f[2], p, "rest", &d.rest) || jv_opt_real(r, f[3], p, "compliance", &d.compliance) ||
-        jv_opt_real(r, f[4], p, "damping", &d.damping) || jv_opt_real(r, f[5], p, "break_torque", &d.break_torque))
-        return -1;
-    bool broken = false;
-    if (f[6]) {
-        kp bp = { p, "broken", 0 };
-        if (jv_get_bool(r, f[6], &bp, &broken)) return -1;
+    const cJSON *t = cJSON_IsObject(c) ? cJSON_GetObjectItemCaseSensitive(c, "type") : NULL;
+    int first = -1;
+    for (int k = 0; k < njtypes; k++) {
+        if (!jtypes[k]->entry) continue;
+        if (cJSON_IsString(t) && !strcmp(t->valuestring, jtypes[k]->entry)) return k;
+        if (first < 0) first = k;
     }
-    /* the core decides what a bend may be (bend.c) */
-    const wb_fault ft = wb_bend_check(g->np, g->x, q, &d);
-    if (jv_fault(r, &ft, p, keys, f, 1)) return -1;
-    if (isnan(d.rest)) wb_dihedral_angle(&g->x[3 * q[0]], &g->x[3 * q[1]], &g->x[3 * q[2]], &g->x[3 * q[3]], &d.rest);
-    g->bend.alpha[i] = d.compliance;
-    g->bend.beta[i] = d.damping;
-    g->bend.rest[i] = d.rest;
-    g->bend.btorque[i] = d.break_torque;
-    g->bend.broken[i] = broken;
+    return cJSON_IsString(t) ? -1 : first;
+}
+
+/* count the entries of each type (before the image is made), or name the one no type reads */
+static int count_entries(rd *r, sections *s)
+{
+    int64_t i = 0;
+    for (const cJSON *c = s->constraints ? s->constraints->child : NULL; c; c = c->next, i++) {
+        const int k = entry_type(c);
+        if (k >= 0) { s->nentries[k]++; continue; }
+        char list[200] = "";
+        size_t len = 0;
+        int n = 0, m = 0;
+        for (int j = 0; j < njtypes; j++) n += jtypes[j]->entry != NULL;
+        for (int j = 0; j < njtypes && len < sizeof list; j++)
+            if (jtypes[j]->entry)
+                len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", m++ == 0 ? "" : m == n ? " or " : ", ",
+                                        jtypes[j]->entry);
+        kp top = { NULL, "constraints", 0 }, p = { &top, NULL, i }, tp = { &p, "type", 0 };
+        const cJSON *t = cJSON_GetObjectItemCaseSensitive(c, "type");
+        return jv_fail(r, t, 0, &tp, "unknown constraint type '%s' (expected %s)", t->valuestring, list);
+    }
+    /* the entries without arrays of their own fill the distance slots */
+    s->ncons = 0;
+    for (int k = 0; k < njtypes; k++)
+        if (jtypes[k]->entry && !jtypes[k]->alloc) s->ncons += s->nentries[k];
     return 0;
 }
 
-static int read_constraints(rd *r, const sections *s, const defaults *d, wb_image *g)
+/* room in the image for the entries of the types with arrays of their own */
+static wb_status alloc_entries(const sections *s, wb_image *g)
 {
-    static const char *const keys[] = { "type", "particles", "rest", "compliance", "damping", "yield", "creep",
-                                        "break_strain", "broken", "break_force", NULL };
+    for (int k = 0; k < njtypes; k++)
+        if (jtypes[k]->alloc && s->nentries[k] > 0 && jtypes[k]->alloc(g, s->nentries[k]) != WB_OK) return WB_ERR_NOMEM;
+    return WB_OK;
+}
+
+/* every entry of "constraints" by its type's reader */
+static int read_constraints(rd *r, const sections *s, const jdefaults *d, wb_image *g)
+{
     kp top = { NULL, "constraints", 0 };
-    int32_t i = 0, slot = -1, nb = 0;
-    if (!s->constraints) return 0;
-    for (const cJSON *c = s->constraints->child; c; c = c->next, i++) {
-        const cJSON *f[11];
+    int32_t i = 0, at[JT_MAX];
+    for (int k = 0; k < njtypes; k++) at[k] = -1;
+    for (const cJSON *c = s->constraints ? s->constraints->child : NULL; c; c = c->next, i++) {
         kp p = { &top, NULL, i };
-        const cJSON *t = cJSON_IsObject(c) ? cJSON_GetObjectItemCaseSensitive(c, "type") : NULL;
-        if (cJSON_IsString(t) && strcmp(t->valuestring, "bend") == 0) {
-            if (read_bend(r, c, &p, g, nb++)) return -1;
-            continue;
-        }
-        if (jv_get_object(r, c, &p, keys, f)) return -1;
-        if (!f[0]) return jv_missing(r, c, &p, "type");
-        if (!f[1]) return jv_missing(r, c, &p, "particles");
-        kp tp = { &p, "type", 0 }, pp = { &p, "particles", 0 };
-        const char *type = "";
-        if (jv_get_string(r, f[0], &tp, &type)) return -1;
-        if (strcmp(type, "distance") != 0) return jv_fail(r, f[0], 0, &tp, "unknown constraint type '%s' (expected distance or bend)", type);
-        int32_t ab[2];
-        if (jv_get_ids(r, f[1], &pp, g->np, 2, "a distance constraint", ab)) return -1;
-        /* the i-th live slot (all slots are live in a plain config) */
-        do slot++; while (!(g->dist.gen[slot] & 1u));
-        wb_distance_def l = d->link;
-        bool broken = false;
-        /* a rest the file gives is >= 0: a negative one would read as "their distance" */
-        if (jv_opt_nonneg(r, f[2], &p, "rest", &l.rest) || jv_opt_real(r, f[3], &p, "compliance", &l.compliance) ||
-            jv_opt_real(r, f[4], &p, "damping", &l.damping) || jv_opt_real(r, f[5], &p, "yield", &l.yield) ||
-            jv_opt_real(r, f[6], &p, "creep", &l.creep) || jv_opt_real(r, f[7], &p, "break_strain", &l.break_strain) ||
-            jv_opt_real(r, f[9], &p, "break_force", &l.break_force))
-            return -1;
-        if (f[8]) {
-            kp q = { &p, "broken", 0 };
-            if (jv_get_bool(r, f[8], &q, &broken)) return -1;
-        }
-        /* the core decides what a distance constraint may be (wb_distance_check) */
-        const wb_fault ft = wb_distance_check(g->np, g->x, ab[0], ab[1], &l);
-        if (jv_fault(r, &ft, &p, keys, f, 1)) return -1;
-        if (l.rest < 0) {
-            const wb_real *xa = &g->x[3 * ab[0]], *xb = &g->x[3 * ab[1]];
-            wb_real dx[3] = { xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2] };
-            l.rest = sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
-        }
-        g->dist.ij[2 * slot] = (int32_t)ab[0];
-        g->dist.ij[2 * slot + 1] = (int32_t)ab[1];
-        g->dist.alpha[slot] = l.compliance;
-        g->dist.beta[slot] = l.damping;
-        g->dist.yield[slot] = l.yield;
-        g->dist.creep[slot] = l.creep;
-        g->dist.break_strain[slot] = l.break_strain;
-        g->dist.bforce[slot] = l.break_force;
-        g->dist.rest[slot] = l.rest;
-        g->dist.broken[slot] = broken;
+        const int k = entry_type(c); /* counted before: one of them */
+        if (jtypes[k]->read_entry(r, c, &p, d, g, &at[k])) return -1;
     }
     return 0;
 }
-
-/* "volumes": [ {"particles": [a, b, c, d], "rest": V, "compliance": alpha, "yield": y,
- * "creep": c}, ... ]: volume constraints (the tet's signed volume kept at rest, default the
- * particles' current one; yield and creep: plastic flow of the rest volume, 0 by default) */
-static int read_volumes(rd *r, const cJSON *arr, wb_image *g)
-{
-    static const char *const keys[] = { "particles", "rest", "compliance", "yield", "creep", NULL };
-    kp top = { NULL, "volumes", 0 };
-    int32_t i = 0, n;
-    if (!arr) return 0;
-    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
-    if (wb_image_alloc_volumes(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
-    for (const cJSON *c = arr->child; c; c = c->next, i++) {
-        const cJSON *f[6];
-        kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
-        if (jv_get_object(r, c, &p, keys, f)) return -1;
-        if (!f[0]) return jv_missing(r, c, &p, "particles");
-        int32_t *ijkl = &g->vol.ijkl[4 * i];
-        if (jv_get_ids(r, f[0], &pp, g->np, 4, "a volume constraint", ijkl)) return -1;
-        wb_volume_def d = wb_volume_default_def();
-        d.has_rest = f[1] != NULL;
-        if (jv_opt_real(r, f[1], &p, "rest", &d.rest) || jv_opt_real(r, f[2], &p, "compliance", &d.compliance) ||
-            jv_opt_real(r, f[3], &p, "yield", &d.yield) || jv_opt_real(r, f[4], &p, "creep", &d.creep))
-            return -1;
-        /* the core decides what a volume constraint may be (volume.c) */
-        const wb_fault ft = wb_volume_check(g->np, g->x, ijkl, &d);
-        if (jv_fault(r, &ft, &p, keys, f, 0)) return -1;
-        const wb_real *x = g->x;
-        g->vol.rest[i] = d.has_rest ? d.rest
-                       : wb_tet_signed_volume(&x[3 * ijkl[0]], &x[3 * ijkl[1]], &x[3 * ijkl[2]], &x[3 * ijkl[3]]);
-        g->vol.alpha[i] = d.compliance;
-        g->vol.plastic[2 * i] = d.yield;
-        g->vol.plastic[2 * i + 1] = d.creep;
-    }
-    return 0;
-}
-
-/* "volumes" (only when there are any: a config without stays as it was) */
-static void write_volumes(jw_out *o, const wb_image *g)
-{
-    FILE *f = o->f;
-    if (g->vol.n == 0) return;
-    fputs("  \"volumes\": [", f);
-    for (int32_t i = 0; i < g->vol.n; i++) {
-        const int32_t *p = &g->vol.ijkl[4 * i];
-        fprintf(f, "%s    {\"particles\": [%d, %d, %d, %d], \"rest\": ", i ? ",\n" : "\n", p[0], p[1], p[2], p[3]);
-        jw_num(o, g->vol.rest[i]);
-        fputs(", \"compliance\": ", f);
-        jw_num(o, g->vol.alpha[i]);
-        jw_plastic(o, &g->vol.plastic[2 * i]);
-        fputc('}', f);
-    }
-    fputs("\n  ],\n", f);
-}
-
-/* "tethers": [ {"particles": [p, q], "length": l, "compliance": alpha}, ... ]: long-range
- * attachments (length: the particles' distance by default; compliance 0 by default) */
-static int read_tethers(rd *r, const cJSON *arr, wb_image *g)
-{
-    static const char *const keys[] = { "particles", "length", "compliance", NULL };
-    kp top = { NULL, "tethers", 0 };
-    int32_t i = 0, n;
-    if (!arr) return 0;
-    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
-    if (wb_image_alloc_tethers(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
-    for (const cJSON *c = arr->child; c; c = c->next, i++) {
-        const cJSON *f[3];
-        kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
-        if (jv_get_object(r, c, &p, keys, f)) return -1;
-        if (!f[0]) return jv_missing(r, c, &p, "particles");
-        int32_t *ij = &g->teth.ij[2 * i];
-        if (jv_get_ids(r, f[0], &pp, g->np, 2, "a tether", ij)) return -1;
-        wb_tether_def td = wb_tether_default_def();
-        td.has_length = f[1] != NULL;
-        if (jv_opt_real(r, f[1], &p, "length", &td.length) || jv_opt_real(r, f[2], &p, "compliance", &td.compliance))
-            return -1;
-        /* the core decides what a tether may be (tether.c) */
-        const wb_fault ft = wb_tether_check(g->np, g->x, ij[0], ij[1], &td);
-        if (jv_fault(r, &ft, &p, keys, f, 0)) return -1;
-        const wb_real *x = g->x;
-        wb_real d[3];
-        v3_sub(d, &x[3 * ij[0]], &x[3 * ij[1]]);
-        g->teth.len[i] = td.has_length ? td.length : v3_len(d);
-        g->teth.alpha[i] = td.compliance;
-    }
-    return 0;
-}
-
-/* "tethers" (only when there are any) */
-static void write_tethers(jw_out *o, const wb_image *g)
-{
-    FILE *f = o->f;
-    if (g->teth.n == 0) return;
-    fputs("  \"tethers\": [", f);
-    for (int32_t i = 0; i < g->teth.n; i++) {
-        fprintf(f, "%s    {\"particles\": [%d, %d], \"length\": ", i ? ",\n" : "\n", g->teth.ij[2 * i], g->teth.ij[2 * i + 1]);
-        jw_num(o, g->teth.len[i]);
-        fputs(", \"compliance\": ", f);
-        jw_num(o, g->teth.alpha[i]);
-        fputc('}', f);
-    }
-    fputs("\n  ],\n", f);
-}
-
-/* the constraint types with a section of their own (json.h), in the order w:save writes
- * them; each reads and writes its own */
-const jtype jtypes[] = {
-    { "volumes", read_volumes, write_volumes },
-    { "tets", jm_read_tets, jm_write_tets },
-    { "shape_matches", jm_read_shape_matches, jm_write_shape_matches },
-    { "pressures", jm_read_pressures, jm_write_pressures },
-    { "attachments", ja_read_attachments, ja_write_attachments },
-    { "grabs", ja_read_grabs, ja_write_grabs },
-    { "tethers", read_tethers, write_tethers },
-};
-const int njtypes = (int)(sizeof jtypes / sizeof jtypes[0]);
 
 static const char *const shape_names[] = { "plane", "sphere", "box", "capsule", "mesh", NULL };
 
@@ -756,20 +602,30 @@ static int read_skins(rd *r, const sections *s, wbio_config *cfg)
 static int read_sections(rd *r, const cJSON *root, wb_image *g)
 {
     for (int i = 0; i < njtypes; i++)
-        if (jtypes[i].read(r, cJSON_GetObjectItemCaseSensitive(root, jtypes[i].key), g)) return -1;
+        if (jtypes[i]->key && jtypes[i]->read(r, cJSON_GetObjectItemCaseSensitive(root, jtypes[i]->key), g)) return -1;
     return 0;
+}
+
+/* the root's keys: the file's own, then the types' sections (jtypes) */
+static void root_keys(const char *keys[])
+{
+    static const char *const own[] = { "format", "version", "description", "defaults", "particles", "constraints",
+                                       "colliders", "surfaces", "parts", "skins", "snapshot", "rigids", NULL };
+    int n = 0;
+    for (; own[n]; n++) keys[n] = own[n];
+    for (int k = 0; k < njtypes; k++)
+        if (jtypes[k]->key) keys[n++] = jtypes[k]->key;
+    keys[n] = NULL;
 }
 
 static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
 {
-    static const char *const keys[] = { "format", "version", "description", "defaults", "particles", "constraints",
-                                        "colliders", "surfaces", "parts", "skins", "snapshot", "volumes",
-                                        "shape_matches", "pressures", "tets", "attachments", "grabs", "rigids", "tethers",
-                                        NULL };
-    const cJSON *f[20];
+    const char *keys[13 + JT_MAX];
+    const cJSON *f[13 + JT_MAX];
     sections s;
-    defaults d;
+    jdefaults d;
     memset(&s, 0, sizeof s);
+    root_keys(keys);
     if (!cJSON_IsObject(root)) return jv_fail(r, root, 0, NULL, "a particle config is a JSON object, got %s", jv_type_name(root));
     if (jv_get_object(r, root, NULL, keys, f)) return -1;
     kp fp = { NULL, "format", 0 }, vp = { NULL, "version", 0 };
@@ -800,23 +656,13 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
         *arrays[i].dst = it;
         if (it && jv_get_array(r, it, &ap, arrays[i].max, arrays[i].n)) return -1;
     }
-    /* bends have no slots: the distance slot tables count the other entries. A type
-     * neither counts is named here, before a slot count that would miss it blames the
+    /* a type none reads is named here, before a slot count that would miss it blames the
      * slot tables instead */
-    int64_t ci = 0;
-    for (const cJSON *c = s.constraints ? s.constraints->child : NULL; c; c = c->next, ci++) {
-        const cJSON *t = cJSON_IsObject(c) ? cJSON_GetObjectItemCaseSensitive(c, "type") : NULL;
-        if (cJSON_IsString(t) && strcmp(t->valuestring, "bend") == 0) s.nbend++;
-        else if (cJSON_IsString(t) && strcmp(t->valuestring, "distance") != 0) {
-            kp top = { NULL, "constraints", 0 }, p = { &top, NULL, ci }, tp = { &p, "type", 0 };
-            return jv_fail(r, t, 0, &tp, "unknown constraint type '%s' (expected distance or bend)", t->valuestring);
-        }
-    }
-    s.ncons -= s.nbend;
+    if (count_entries(r, &s)) return -1;
     s.snapshot = f[10];
     if (scan_snapshot(r, &s) || read_surfaces(r, &s, NULL, &s.ntri)) return -1;
     if (wb_image_alloc(&cfg->img, s.np, s.nd, s.nfree, s.nc, s.nsurf, s.ntri) != WB_OK ||
-        (s.nbend > 0 && wb_image_alloc_bends(&cfg->img, s.nbend) != WB_OK) ||
+        alloc_entries(&s, &cfg->img) != WB_OK ||
         !(cfg->parts = calloc((size_t)s.nparts + 1, sizeof *cfg->parts)) ||
         !(cfg->skins = calloc((size_t)s.nskins + 1, sizeof *cfg->skins)))
         return jv_fail(r, NULL, 0, NULL, "out of memory");
@@ -825,7 +671,7 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
     if ((s.snapshot && read_snapshot(r, &s, &cfg->img)) || read_particles(r, &s, &d, &cfg->img) ||
         read_constraints(r, &s, &d, &cfg->img) || read_colliders(r, &s, &cfg->img) ||
         read_surfaces(r, &s, &cfg->img, &s.ntri) || read_parts(r, &s, cfg) || read_skins(r, &s, cfg) ||
-        jr_read_rigids(r, f[17], &cfg->img) || read_sections(r, root, &cfg->img))
+        jr_read_rigids(r, f[11], &cfg->img) || read_sections(r, root, &cfg->img))
         return -1;
     /* every value was checked where it was read: this is the last line of defence */
     const char *e = wb_image_check(&cfg->img);

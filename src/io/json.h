@@ -95,30 +95,37 @@ void jw_ints(FILE *f, const char *indent, const uint32_t *u, const int32_t *s, i
 /* ", yield, creep" when either is set (files without stay as they were) */
 void jw_plastic(jw_out *o, const wb_real yc[2]);
 
-/* A constraint type with a section of its own in a particle config: its key, its reader
- * (arr may be NULL: none) into the image after the particles, surfaces, colliders and
- * rigid bodies, and its writer (nothing when the image has none). The table (json.c) is
- * in the order w:save writes the sections; distances and bends share "constraints"
- * (json.c, json_write.c) */
+/* the file's "defaults": a particle's mass and radius, a link's options (json.c) */
+typedef struct jdefaults {
+    wb_real mass, radius;
+    wb_distance_def link;
+} jdefaults;
+
+/* A constraint type in a particle config: its reader and writer, in its own file
+ * (json_NAME.c, beside core/NAME.c). Either it has an array of its own at the root (key),
+ * or its entries are in "constraints" with its "type" (entry).
+ * - An array of its own: read (arr may be NULL: none) into the image after the particles,
+ *   colliders, surfaces and rigid bodies; write (nothing when the image has none).
+ * - Entries of "constraints": alloc makes room for n in the image (NULL: they fill the
+ *   distance slots the image is made with, which the snapshot's "distance_slots" describe);
+ *   read_entry reads one at c, path p (*at: the type's own cursor across its entries, -1
+ *   before the first); write_entries writes all of them after those of the types before
+ *   it (first: none written yet; returns whether still none).
+ * The table (json_types.c) is in the order w:save writes them and the reader reads them;
+ * the root's keys and the entries' "type" names come from it */
 typedef struct jtype {
-    const char *key;
+    const char *key, *entry;
     int (*read)(rd *r, const cJSON *arr, wb_image *g);
     void (*write)(jw_out *o, const wb_image *g);
+    wb_status (*alloc)(wb_image *g, int32_t n);
+    int (*read_entry)(rd *r, const cJSON *c, const kp *p, const jdefaults *d, wb_image *g, int32_t *at);
+    int (*write_entries)(jw_out *o, const wb_image *g, int first);
 } jtype;
-extern const jtype jtypes[];
+#define JT_MAX 16 /* the table's room */
+extern const jtype *const jtypes[];
 extern const int njtypes;
-/* json_material.c: "tets", "shape_matches" and "pressures" */
-int jm_read_shape_matches(rd *r, const cJSON *arr, wb_image *g);
-int jm_read_pressures(rd *r, const cJSON *arr, wb_image *g);
-int jm_read_tets(rd *r, const cJSON *arr, wb_image *g);
-void jm_write_tets(jw_out *o, const wb_image *g);
-void jm_write_shape_matches(jw_out *o, const wb_image *g);
-void jm_write_pressures(jw_out *o, const wb_image *g);
-/* json_attach.c: "attachments" and "grabs" */
-int ja_read_attachments(rd *r, const cJSON *arr, wb_image *g);
-int ja_read_grabs(rd *r, const cJSON *arr, wb_image *g);
-void ja_write_attachments(jw_out *o, const wb_image *g);
-void ja_write_grabs(jw_out *o, const wb_image *g);
+/* each in its file: json_distance.c, json_bend.c, ... */
+extern const jtype jt_distance, jt_bend, jt_volume, jt_tet, jt_shape_match, jt_pressure, jt_attach, jt_grab, jt_tether;
 /* json_rigid.c: the "rigids" section (arr may be NULL) into the image */
 int jr_read_rigids(rd *r, const cJSON *arr, wb_image *g);
 

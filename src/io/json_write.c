@@ -80,51 +80,14 @@ static void write_particles(jw_out *o, const wb_image *g)
     fputs(g->np ? "\n  ],\n" : "],\n", f);
 }
 
+/* "constraints": the entries of every type that has them (jtypes), in the table's order */
 static void write_constraints(jw_out *o, const wb_image *g)
 {
-    FILE *f = o->f;
     int first = 1;
-    fputs("  \"constraints\": [", f);
-    for (int32_t i = 0; i < g->dist.n; i++) {
-        if (!(g->dist.gen[i] & 1u)) continue;
-        fprintf(f, "%s    {\"type\": \"distance\", \"particles\": [%d, %d], \"rest\": ", first ? "\n" : ",\n",
-                g->dist.ij[2 * i], g->dist.ij[2 * i + 1]);
-        first = 0;
-        jw_num(o, g->dist.rest[i]);
-        fputs(", \"compliance\": ", f);
-        jw_num(o, g->dist.alpha[i]);
-        fputs(", \"damping\": ", f);
-        jw_num(o, g->dist.beta[i]);
-        fputs(", \"yield\": ", f);
-        jw_num(o, g->dist.yield[i]);
-        fputs(", \"creep\": ", f);
-        jw_num(o, g->dist.creep[i]);
-        fputs(", \"break_strain\": ", f);
-        jw_num(o, g->dist.break_strain[i]);
-        if (g->dist.bforce[i] > 0) { /* only when set: configs without it read as before */
-            fputs(", \"break_force\": ", f);
-            jw_num(o, g->dist.bforce[i]);
-        }
-        fprintf(f, ", \"broken\": %s}", g->dist.broken[i] ? "true" : "false");
-    }
-    for (int32_t i = 0; i < g->bend.n; i++) {
-        const int32_t *p = &g->bend.ij[4 * i];
-        fprintf(f, "%s    {\"type\": \"bend\", \"particles\": [%d, %d, %d, %d], \"rest\": ", first ? "\n" : ",\n", p[0],
-                p[1], p[2], p[3]);
-        first = 0;
-        jw_num(o, g->bend.rest[i]);
-        fputs(", \"compliance\": ", f);
-        jw_num(o, g->bend.alpha[i]);
-        fputs(", \"damping\": ", f);
-        jw_num(o, g->bend.beta[i]);
-        if (g->bend.btorque[i] > 0) { /* only when set: configs without it read as before */
-            fputs(", \"break_torque\": ", f);
-            jw_num(o, g->bend.btorque[i]);
-        }
-        if (g->bend.broken[i]) fputs(", \"broken\": true", f);
-        fputc('}', f);
-    }
-    fputs(first ? "],\n" : "\n  ],\n", f);
+    fputs("  \"constraints\": [", o->f);
+    for (int i = 0; i < njtypes; i++)
+        if (jtypes[i]->write_entries) first = jtypes[i]->write_entries(o, g, first);
+    fputs(first ? "],\n" : "\n  ],\n", o->f);
 }
 
 /* one field of a shape (wobble.h's wb_shape_info lists) as "key": value: a collider's in its
@@ -255,7 +218,7 @@ int wbio_write_snapshot(const wb_world *w, const char *path, const char *shown, 
     write_particles(&o, &g);
     write_constraints(&o, &g);
     for (int i = 0; i < njtypes; i++)
-        if (jtypes[i].write) jtypes[i].write(&o, &g);
+        if (jtypes[i]->write) jtypes[i]->write(&o, &g);
     write_rigids(&o, &g);
     write_colliders(&o, &g);
     write_surfaces(&o, &g);

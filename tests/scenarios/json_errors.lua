@@ -78,7 +78,7 @@ end)
 
 test("unknown, miscased and repeated keys are pointed at", function()
   bad(HEAD .. ' "particle": []}', NAME .. ":2:2: particle: unknown key 'particle' (expected one of: format, version, "
-      .. "description, defaults, particles, constraints, colliders, surfaces, parts, skins, snapshot, volumes, shape_matches, pressures, tets, attachments, grabs, rigids, tethers)")
+      .. "description, defaults, particles, constraints, colliders, surfaces, parts, skins, snapshot, rigids, volumes, tets, shape_matches, pressures, attachments, grabs, tethers)")
   bad(HEAD .. ' "Particles": []}', NAME .. ":2:2: Particles: unknown key 'Particles' (keys are case-sensitive: 'particles')")
   local t = HEAD .. ' "particles": [],\n "version": 1}'
   bad_at(t, '"version"', "version: duplicate key 'version' (first at line 1, column 32)", 40)
