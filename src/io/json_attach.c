@@ -70,8 +70,11 @@ static int read_attach_items(rd *r, const cJSON *arr, const kp *parent, const ch
         if (ntarget == 0) return jv_fail(r, tf, 0, &tq, rigid ? "there are no rigid bodies" : "there are no colliders");
         wb_real a = 0;
         if (jv_opt_int(r, f[0], &p, "particle", 0, g->np - 1, &pid) ||
-            jv_opt_int(r, tf, &p, tkey, 0, ntarget - 1, &cid) || jv_opt_nonneg(r, f[3], &p, "compliance", &a))
+            jv_opt_int(r, tf, &p, tkey, 0, ntarget - 1, &cid) || jv_opt_real(r, f[3], &p, "compliance", &a))
             return -1;
+        /* the core decides the compliance (attach.c) */
+        const wb_fault ft = wb_attach_def_fault(a);
+        if (jv_fault(r, &ft, &p, keys, f, 0)) return -1;
         /* a collider: the cid-th live slot; a rigid body: the cid-th entry of "rigids" */
         const int32_t slot = rigid ? (int32_t)cid : live[cid];
         if (rigid && !(g->rb_gen[slot] & 1u)) return jv_fail(r, tf, 0, &tq, "that rigid body was removed");

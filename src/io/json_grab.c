@@ -43,8 +43,11 @@ static int read_grabs(rd *r, const cJSON *arr, wb_image *g)
         }
         wb_real a = 0, *t = &g->grab.target[3 * i], *fr = &g->grab.from[3 * i];
         if ((!rigid && jv_opt_int(r, f[0], &p, "particle", 0, g->np - 1, &pid)) || jv_opt_vec(r, f[1], &p, "target", 3, t) ||
-            jv_opt_nonneg(r, f[3], &p, "compliance", &a))
+            jv_opt_real(r, f[3], &p, "compliance", &a))
             return -1;
+        /* the core decides the compliance (grab.c) */
+        const wb_fault ft = wb_grab_def_fault(a);
+        if (jv_fault(r, &ft, &p, keys, f, 0)) return -1;
         if (f[2]) {
             if (jv_opt_vec(r, f[2], &p, "from", 3, fr)) return -1;
         } else {
