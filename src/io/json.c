@@ -313,8 +313,6 @@ static int read_constraints(rd *r, const sections *s, const jdefaults *d, wb_ima
     return 0;
 }
 
-static const char *const shape_names[] = { "plane", "sphere", "box", "capsule", "mesh", NULL };
-
 /* a mesh collider's "vertices" (flat x,y,z, ...) and "triangles" (flat, 0-based corners) */
 static int read_mesh_arrays(rd *r, const cJSON *it, const kp *p, const cJSON *fv, const cJSON *ft, wb_image_collider *c)
 {
@@ -379,38 +377,66 @@ static int read_pose(rd *r, const cJSON *it, const kp *up, wb_image_collider *c)
     return 0;
 }
 
+/* the shape "name" names (wobble.h's wb_shape_info), or -1 after failing with the names */
+static int find_shape(rd *r, const cJSON *it, const kp *p, const char *name)
+{
+    int n = 0;
+    while (wb_shape_info_of((wb_shape)n)) n++;
+    for (int k = 0; k < n; k++)
+        if (!strcmp(name, wb_shape_info_of((wb_shape)k)->name)) return k;
+    char list[200] = "";
+    size_t len = 0;
+    for (int k = 0; k < n && len < sizeof list; k++)
+        len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", k == 0 ? "" : k == n - 1 ? " or " : ", ",
+                                wb_shape_info_of((wb_shape)k)->name);
+    jv_fail(r, it, 0, p, "unknown shape '%s' (expected %s)", name, list);
+    return -1;
+}
+
+/* the keys of a shape's def in the world form: its fields (wb_shape_info), a mesh given by
+ * its arrays ("vertices triangles") where a script gives a mesh object */
+static const char *world_keys(const wb_shape_info *in, char buf[160])
+{
+    size_t n = 0;
+    buf[0] = '\0';
+    for (const char *q = in->fields; *q && n < 150;) {
+        while (*q == ' ') q++;
+        const char *e = q;
+        while (*e && *e != ' ') e++;
+        if (e == q) break;
+        const int mesh = e - q == 4 && !strncmp(q, "mesh", 4);
+        n += (size_t)snprintf(buf + n, 160 - n, "%s%.*s", n ? " " : "", mesh ? 18 : (int)(e - q),
+                              mesh ? "vertices triangles" : q);
+        q = e;
+    }
+    return buf;
+}
+
 /* Two forms: as w:collider{...} takes it (world frame), or, with "pose", the shape in the
- * collider's own frame plus its full pose (what w:save writes, exact) */
+ * collider's own frame plus its full pose (what w:save writes, exact). Which keys a shape
+ * takes, what it keeps in its own frame and what must hold there are its file's
+ * (core/shape_NAME.c, through wb_shape_info and wb_image_collider_shape_check) */
 static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider *c)
 {
     static const char *const keys[] = { "shape", "normal", "offset", "center", "radius", "half", "rotation", "a", "b",
                                         "friction", "restitution", "pose", "vertices", "triangles", "scale", NULL };
-    /* which keys each shape takes, world form / own-frame form (pose) */
-    static const char *const world_keys[WB_SHAPE_COUNT] = { "normal offset", "center radius", "center half rotation", "a b radius",
-                                                            "center rotation vertices triangles scale" };
-    static const char *const local_keys[WB_SHAPE_COUNT] = { "normal", "radius", "half", "a b radius", "vertices triangles" };
     const cJSON *f[16];
     if (jv_get_object(r, it, p, keys, f)) return -1;
     if (!f[0]) return jv_missing(r, it, p, "shape");
     kp sp = { p, "shape", 0 };
     const char *name = "";
     if (jv_get_string(r, f[0], &sp, &name)) return -1;
-    int shape = 0;
-    while (shape_names[shape] && strcmp(name, shape_names[shape])) shape++;
-    if (!shape_names[shape]) return jv_fail(r, f[0], 0, &sp, "unknown shape '%s' (expected plane, sphere, box, capsule or mesh)", name);
-    const int local = f[11] != NULL;
-    const char *allowed = (local ? local_keys : world_keys)[shape];
+    const int shape = find_shape(r, f[0], &sp, name);
+    if (shape < 0) return -1;
+    const wb_shape_info *in = wb_shape_info_of((wb_shape)shape);
+    const int local = f[11] != NULL, has_mesh = wb_shape_takes(in->fields, "mesh");
+    char wbuf[160];
+    const char *allowed = local ? in->own_fields : world_keys(in, wbuf);
     for (int i = 1; i <= 14; i++) {
-        if (!f[i] || (i >= 9 && i <= 11)) continue;
-        const char *k = keys[i], *hit = strstr(allowed, k);
-        const size_t kl = strlen(k);
-        /* a whole word of the list */
-        while (hit && ((hit > allowed && hit[-1] != ' ') || (hit[kl] && hit[kl] != ' '))) hit = strstr(hit + 1, k);
-        if (!hit) {
-            kp kk = { p, k, 0 };
-            if (local) return jv_fail(r, f[i], 1, &kk, "a %s with a pose takes %s in its own frame, not '%s'", name, allowed, k);
-            return jv_fail(r, f[i], 1, &kk, "a %s takes %s (and friction, restitution, pose), not '%s'", name, allowed, k);
-        }
+        if (!f[i] || (i >= 9 && i <= 11) || wb_shape_takes(allowed, keys[i])) continue;
+        kp kk = { p, keys[i], 0 };
+        if (local) return jv_fail(r, f[i], 1, &kk, "a %s with a pose takes %s in its own frame, not '%s'", name, allowed, keys[i]);
+        return jv_fail(r, f[i], 1, &kk, "a %s takes %s (and friction, restitution, pose), not '%s'", name, allowed, keys[i]);
     }
     wb_collider_def d = wb_collider_default_def((wb_shape)shape);
     if (jv_opt_vec(r, f[1], p, "normal", 3, d.normal) || jv_opt_real(r, f[2], p, "offset", &d.offset) ||
@@ -422,12 +448,12 @@ static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider 
         kp q = { p, "rotation", 0 };
         if (get_quat(r, f[6], &q, d.rotation)) return -1;
     }
-    if (shape == WB_SHAPE_MESH) {
+    if (has_mesh) {
         kp sc = { p, "scale", 0 };
         if (f[14] && jv_get_real(r, f[14], &sc, &d.scale)) return -1;
         if (read_mesh_arrays(r, it, p, f[12], f[13], c)) return -1;
     }
-    if (!local && shape == WB_SHAPE_MESH) {
+    if (!local && has_mesh) {
         /* the arrays just read are the mesh the def copies (scaled) into the collider */
         wb_mesh mesh = { c->mnv, c->mnt, c->mv, NULL, c->mt };
         d.mesh = &mesh;
@@ -445,7 +471,8 @@ static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider 
         if (st == WB_ERR_NOMEM) return jv_fail(r, it, 0, p, "out of memory");
         return st != WB_OK ? jv_fail(r, it, 0, p, "%s", wb_last_error()) : 0;
     }
-    /* own frame: the values are the collider's internals, as w:save wrote them */
+    /* own frame: the values are the collider's internals, as w:save wrote them: the
+     * shape's own fields, the others zero */
     wb_real *mv = c->mv;
     int32_t *mt = c->mt, mnv = c->mnv, mnt = c->mnt;
     memset(c, 0, sizeof *c);
@@ -456,26 +483,18 @@ static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider 
     c->shape = (wb_shape)shape;
     c->friction = d.friction;
     c->restitution = d.restitution;
-    switch (c->shape) {
-    case WB_SHAPE_PLANE: {
+    if (wb_shape_takes(in->own_fields, "normal")) {
         wb_real n2 = d.normal[0] * d.normal[0] + d.normal[1] * d.normal[1] + d.normal[2] * d.normal[2];
         if (!(n2 > 1e-24)) return jv_fail(r, f[1] ? f[1] : it, 0, p, "normal must not be zero");
         for (int i = 0; i < 3; i++) c->n[i] = fabs(n2 - 1) > 1e-12 ? d.normal[i] / sqrt(n2) : d.normal[i];
-        break;
     }
-    case WB_SHAPE_BOX: memcpy(c->half, d.half, sizeof c->half); break;
-    case WB_SHAPE_CAPSULE:
-        memcpy(c->a, d.a, sizeof c->a);
-        memcpy(c->b, d.b, sizeof c->b);
-        c->radius = d.radius;
-        break;
-    default: c->radius = d.radius; break;
-    }
+    if (wb_shape_takes(in->own_fields, "half")) memcpy(c->half, d.half, sizeof c->half);
+    if (wb_shape_takes(in->own_fields, "a")) memcpy(c->a, d.a, sizeof c->a);
+    if (wb_shape_takes(in->own_fields, "b")) memcpy(c->b, d.b, sizeof c->b);
+    if (wb_shape_takes(in->own_fields, "radius")) c->radius = d.radius;
     if (read_pose(r, f[11], p, c)) return -1;
-    if (c->shape == WB_SHAPE_BOX && !(c->half[0] > 0 && c->half[1] > 0 && c->half[2] > 0))
-        return jv_fail(r, it, 0, p, "half extents must be > 0");
-    if ((c->shape == WB_SHAPE_SPHERE || c->shape == WB_SHAPE_CAPSULE) && !(c->radius > 0))
-        return jv_fail(r, it, 0, p, "radius must be > 0");
+    const char *e = wb_image_collider_shape_check(c);
+    if (e) return jv_fail(r, it, 0, p, "%s", e);
     if (c->restitution > 1) return jv_fail(r, f[10], 0, p, "restitution must be in [0, 1]");
     return 0;
 }
