@@ -308,7 +308,7 @@ static int read_constraints(rd *r, const sections *s, const jdefaults *d, wb_ima
     for (const cJSON *c = s->constraints ? s->constraints->child : NULL; c; c = c->next, i++) {
         kp p = { &top, NULL, i };
         const int k = entry_type(c); /* counted before: one of them */
-        if (jtypes[k]->read_entry(r, c, &p, d, g, &at[k])) return -1;
+        if (jtypes[k]->read_item(r, c, &p, d, g, &at[k])) return -1;
     }
     return 0;
 }
@@ -617,11 +617,28 @@ static int read_skins(rd *r, const sections *s, wbio_config *cfg)
 }
 
 /* ---- the file ---------------------------------------------------------------------------------- */
-/* each type's own section (jtypes), after the rigid bodies that attachments and grabs name */
-static int read_sections(rd *r, const cJSON *root, wb_image *g)
+/* a type's array of its own (arr may be NULL: none) */
+static int read_section(rd *r, const jtype *t, const cJSON *arr, const jdefaults *d, wb_image *g)
+{
+    if (t->read) return t->read(r, arr, g);
+    kp top = { NULL, t->key, 0 };
+    int32_t n, i = 0, at = -1;
+    if (!arr) return 0;
+    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
+    if (t->alloc(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
+    for (const cJSON *c = arr->child; c; c = c->next, i++) {
+        kp p = { &top, NULL, i };
+        if (t->read_item(r, c, &p, d, g, &at)) return -1;
+    }
+    return 0;
+}
+
+/* each type's array of its own (jtypes), after the rigid bodies that attachments and grabs name */
+static int read_sections(rd *r, const cJSON *root, const jdefaults *d, wb_image *g)
 {
     for (int i = 0; i < njtypes; i++)
-        if (jtypes[i]->key && jtypes[i]->read(r, cJSON_GetObjectItemCaseSensitive(root, jtypes[i]->key), g)) return -1;
+        if (jtypes[i]->key && read_section(r, jtypes[i], cJSON_GetObjectItemCaseSensitive(root, jtypes[i]->key), d, g))
+            return -1;
     return 0;
 }
 
@@ -690,7 +707,7 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
     if ((s.snapshot && read_snapshot(r, &s, &cfg->img)) || read_particles(r, &s, &d, &cfg->img) ||
         read_constraints(r, &s, &d, &cfg->img) || read_colliders(r, &s, &cfg->img) ||
         read_surfaces(r, &s, &cfg->img, &s.ntri) || read_parts(r, &s, cfg) || read_skins(r, &s, cfg) ||
-        jr_read_rigids(r, f[11], &cfg->img) || read_sections(r, root, &cfg->img))
+        jr_read_rigids(r, f[11], &cfg->img) || read_sections(r, root, &d, &cfg->img))
         return -1;
     /* every value was checked where it was read: this is the last line of defence */
     const char *e = wb_image_check(&cfg->img);

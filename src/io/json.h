@@ -87,11 +87,17 @@ typedef struct jw_out {
     FILE *f;
     int bad;               /* a non-finite number was met */
     int nomem;             /* a scratch table could not be had */
+    const char *head;      /* the opening of the array being written, not yet written (NULL: none) */
 } jw_out;
 void jw_num(jw_out *o, double x);
+/* ', "key": x' */
+void jw_key(jw_out *o, const char *key, double x);
 void jw_vec(jw_out *o, const wb_real *v, int n);
 /* n integers (u, or s when u is NULL), 24 a line, continued lines indented */
 void jw_ints(FILE *f, const char *indent, const uint32_t *u, const int32_t *s, int32_t n);
+/* before an element of an array: "\n" before the first (after o->head, once), ",\n" before
+ * the others */
+void jw_next(jw_out *o, int *first);
 /* ", yield, creep" when either is set (files without stay as they were) */
 void jw_plastic(jw_out *o, const wb_real yc[2]);
 
@@ -102,24 +108,25 @@ typedef struct jdefaults {
 } jdefaults;
 
 /* A constraint type in a particle config: its reader and writer, in its own file
- * (json_NAME.c, beside core/NAME.c). Either it has an array of its own at the root (key),
- * or its entries are in "constraints" with its "type" (entry).
- * - An array of its own: read (arr may be NULL: none) into the image after the particles,
- *   colliders, surfaces and rigid bodies; write (nothing when the image has none).
- * - Entries of "constraints": alloc makes room for n in the image (NULL: they fill the
- *   distance slots the image is made with, which the snapshot's "distance_slots" describe);
- *   read_entry reads one at c, path p (*at: the type's own cursor across its entries, -1
- *   before the first); write_entries writes all of them after those of the types before
- *   it (first: none written yet; returns whether still none).
+ * (json_NAME.c, beside core/NAME.c). Its elements are either an array of their own at the
+ * root (key: "volumes") or entries of "constraints" with its "type" (entry: "bend").
+ * - alloc: room in the image for n elements (NULL for distances: they fill the slots the
+ *   image is made with, which the snapshot's "distance_slots" describe);
+ * - read_item: the element at c (path p) into the image; *at: the type's own cursor, -1
+ *   before its first. The array of its own is read after the particles, colliders,
+ *   surfaces and rigid bodies; "constraints" after the particles;
+ * - read: for a type that reads its own array otherwise (arr may be NULL: none), in place
+ *   of alloc and read_item;
+ * - write: w:save's elements, each after jw_next (first: none written yet in the array;
+ *   returns whether still none). An array of its own is left out when it has none.
  * The table (json_types.c) is in the order w:save writes them and the reader reads them;
  * the root's keys and the entries' "type" names come from it */
 typedef struct jtype {
     const char *key, *entry;
-    int (*read)(rd *r, const cJSON *arr, wb_image *g);
-    void (*write)(jw_out *o, const wb_image *g);
     wb_status (*alloc)(wb_image *g, int32_t n);
-    int (*read_entry)(rd *r, const cJSON *c, const kp *p, const jdefaults *d, wb_image *g, int32_t *at);
-    int (*write_entries)(jw_out *o, const wb_image *g, int first);
+    int (*read_item)(rd *r, const cJSON *c, const kp *p, const jdefaults *d, wb_image *g, int32_t *at);
+    int (*read)(rd *r, const cJSON *arr, wb_image *g);
+    int (*write)(jw_out *o, const wb_image *g, int first);
 } jtype;
 #define JT_MAX 16 /* the table's room */
 extern const jtype *const jtypes[];

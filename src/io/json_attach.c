@@ -104,9 +104,8 @@ static int read_attach_items(rd *r, const cJSON *arr, const kp *parent, const ch
 }
 
 /* ---- writing (w:save) ------------------------------------------------------------------------ */
-/* "attachments": only when present. An attachment names its collider by its place among
- * the written (live) colliders */
-static void write_attachments(jw_out *o, const wb_image *g)
+/* An attachment names its collider by its place among the written (live) colliders */
+static int write_attachments(jw_out *o, const wb_image *g, int first)
 {
     FILE *f = o->f;
     const wb_image_attach *a = &g->att;
@@ -114,7 +113,7 @@ static void write_attachments(jw_out *o, const wb_image *g)
     int32_t *rank = a->n ? malloc(sizeof *rank * (size_t)(g->nc > 0 ? g->nc : 1)) : NULL;
     if (a->n && !rank) {
         o->nomem = 1;
-        return;
+        return first;
     }
     for (int32_t s = 0, r = 0; rank && s < g->nc; s++) {
         rank[s] = r;
@@ -123,15 +122,15 @@ static void write_attachments(jw_out *o, const wb_image *g)
     for (int32_t k = 0; k < a->n; k++) {
         /* a rigid body by its slot: w:save writes every slot of "rigids" */
         const int rigid = a->kind[k] == 1;
-        fprintf(f, "%s    {\"particle\": %d, \"%s\": %d, \"point\": ", k ? ",\n" : "  \"attachments\": [\n",
-                a->p[k], rigid ? "rigid" : "collider", rigid ? a->target[k] : rank[a->target[k]]);
+        jw_next(o, &first);
+        fprintf(f, "    {\"particle\": %d, \"%s\": %d, \"point\": ", a->p[k], rigid ? "rigid" : "collider",
+                rigid ? a->target[k] : rank[a->target[k]]);
         jw_vec(o, &a->local[3 * k], 3);
-        fputs(", \"compliance\": ", f);
-        jw_num(o, a->alpha[k]);
+        jw_key(o, "compliance", a->alpha[k]);
         fputc('}', f);
     }
-    if (a->n) fputs("\n  ],\n", f);
     free(rank);
+    return first;
 }
 
 const jtype jt_attach = { .key = "attachments", .read = read_attachments, .write = write_attachments };

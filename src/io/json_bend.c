@@ -51,17 +51,13 @@ static int write_bends(jw_out *o, const wb_image *g, int first)
     FILE *f = o->f;
     for (int32_t i = 0; i < g->bend.n; i++) {
         const int32_t *p = &g->bend.ij[4 * i];
-        fprintf(f, "%s    {\"type\": \"bend\", \"particles\": [%d, %d, %d, %d], \"rest\": ", first ? "\n" : ",\n", p[0],
-                p[1], p[2], p[3]);
-        first = 0;
+        jw_next(o, &first);
+        fprintf(f, "    {\"type\": \"bend\", \"particles\": [%d, %d, %d, %d], \"rest\": ", p[0], p[1], p[2], p[3]);
         jw_num(o, g->bend.rest[i]);
-        fputs(", \"compliance\": ", f);
-        jw_num(o, g->bend.alpha[i]);
-        fputs(", \"damping\": ", f);
-        jw_num(o, g->bend.beta[i]);
+        jw_key(o, "compliance", g->bend.alpha[i]);
+        jw_key(o, "damping", g->bend.beta[i]);
         if (g->bend.btorque[i] > 0) { /* only when set: configs without it read as before */
-            fputs(", \"break_torque\": ", f);
-            jw_num(o, g->bend.btorque[i]);
+            jw_key(o, "break_torque", g->bend.btorque[i]);
         }
         if (g->bend.broken[i]) fputs(", \"broken\": true", f);
         fputc('}', f);
@@ -69,4 +65,4 @@ static int write_bends(jw_out *o, const wb_image *g, int first)
     return first;
 }
 
-const jtype jt_bend = { .entry = "bend", .alloc = wb_image_alloc_bends, .read_entry = read_bend, .write_entries = write_bends };
+const jtype jt_bend = { .entry = "bend", .alloc = wb_image_alloc_bends, .read_item = read_bend, .write = write_bends };

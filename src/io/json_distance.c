@@ -70,23 +70,17 @@ static int write_distances(jw_out *o, const wb_image *g, int first)
     FILE *f = o->f;
     for (int32_t i = 0; i < g->dist.n; i++) {
         if (!(g->dist.gen[i] & 1u)) continue;
-        fprintf(f, "%s    {\"type\": \"distance\", \"particles\": [%d, %d], \"rest\": ", first ? "\n" : ",\n",
-                g->dist.ij[2 * i], g->dist.ij[2 * i + 1]);
-        first = 0;
+        jw_next(o, &first);
+        fprintf(f, "    {\"type\": \"distance\", \"particles\": [%d, %d], \"rest\": ", g->dist.ij[2 * i],
+                g->dist.ij[2 * i + 1]);
         jw_num(o, g->dist.rest[i]);
-        fputs(", \"compliance\": ", f);
-        jw_num(o, g->dist.alpha[i]);
-        fputs(", \"damping\": ", f);
-        jw_num(o, g->dist.beta[i]);
-        fputs(", \"yield\": ", f);
-        jw_num(o, g->dist.yield[i]);
-        fputs(", \"creep\": ", f);
-        jw_num(o, g->dist.creep[i]);
-        fputs(", \"break_strain\": ", f);
-        jw_num(o, g->dist.break_strain[i]);
+        jw_key(o, "compliance", g->dist.alpha[i]);
+        jw_key(o, "damping", g->dist.beta[i]);
+        jw_key(o, "yield", g->dist.yield[i]);
+        jw_key(o, "creep", g->dist.creep[i]);
+        jw_key(o, "break_strain", g->dist.break_strain[i]);
         if (g->dist.bforce[i] > 0) { /* only when set: configs without it read as before */
-            fputs(", \"break_force\": ", f);
-            jw_num(o, g->dist.bforce[i]);
+            jw_key(o, "break_force", g->dist.bforce[i]);
         }
         fprintf(f, ", \"broken\": %s}", g->dist.broken[i] ? "true" : "false");
     }
@@ -94,4 +88,4 @@ static int write_distances(jw_out *o, const wb_image *g, int first)
 }
 
 /* no alloc: its arrays are the image's distance slots (wb_image_alloc) */
-const jtype jt_distance = { .entry = "distance", .read_entry = read_distance, .write_entries = write_distances };
+const jtype jt_distance = { .entry = "distance", .read_item = read_distance, .write = write_distances };

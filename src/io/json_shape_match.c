@@ -87,28 +87,26 @@ static int read_shape_matches(rd *r, const cJSON *arr, wb_image *g)
 }
 
 /* ---- writing (w:save) ------------------------------------------------------------------------ */
-/* "shape_matches": only when present, with the rest shapes and rotations (the exact restore) */
-static void write_shape_matches(jw_out *o, const wb_image *g)
+/* with the rest shapes and rotations (the exact restore) */
+static int write_shape_matches(jw_out *o, const wb_image *g, int first)
 {
     FILE *f = o->f;
     const wb_image_smatch *s = &g->sm;
     for (int32_t k = 0; k < s->n; k++) {
         const int32_t a = s->start[k], b = s->start[k + 1];
-        fputs(k ? ",\n    {\"particles\": " : "  \"shape_matches\": [\n    {\"particles\": ", f);
+        jw_next(o, &first);
+        fputs("    {\"particles\": ", f);
         jw_ints(f, "      ", NULL, &s->ids[a], b - a);
-        fputs(", \"stiffness\": ", f);
-        jw_num(o, s->stiff[k]);
-        fputs(", \"yield\": ", f);
-        jw_num(o, s->yield[k]);
-        fputs(", \"creep\": ", f);
-        jw_num(o, s->creep[k]);
+        jw_key(o, "stiffness", s->stiff[k]);
+        jw_key(o, "yield", s->yield[k]);
+        jw_key(o, "creep", s->creep[k]);
         fputs(",\n     \"rest\": ", f);
         jw_vec(o, &s->rest[3 * (int64_t)a], 3 * (b - a));
         fputs(", \"rotation\": ", f);
         jw_vec(o, &s->q[4 * k], 4);
         fputc('}', f);
     }
-    if (s->n) fputs("\n  ],\n", f);
+    return first;
 }
 
 const jtype jt_shape_match = { .key = "shape_matches", .read = read_shape_matches, .write = write_shape_matches };
