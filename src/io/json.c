@@ -9,7 +9,9 @@
  *
  * Errors name the file, line and column and the key path ("logo.json:12:7:
  * particles[3].mass: number expected, got string"; how, in json_value.c). The whole
- * file is read and checked into a wb_image before anything is built. */
+ * file is read and checked into a wb_image before anything is built. Each constraint
+ * type's elements ("constraints" entries, "volumes", ...) are read by its own file through
+ * the jtypes table (json.h, json_types.c). */
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>

@@ -1,6 +1,8 @@
-/* json.h: the JSON machinery shared by the particle-config reader (json.c) and its
- * value layer (json_value.c): where each value of the text is, key paths, and typed
- * reads that fail with "file:line:col: key.path: reason". Private to io_json*.c. */
+/* json.h: the JSON machinery shared by the particle-config reader (json.c), its value layer
+ * (json_value.c), its writer (json_write.c) and the constraint types' files (json_NAME.c,
+ * the jtype table): where each value of the text is, key paths, typed reads that fail with
+ * "file:line:col: key.path: reason", and the writer's numbers. Private to io/json*.c (and
+ * the input log, lua/input.c). */
 #ifndef WB_IO_JSON_H
 #define WB_IO_JSON_H
 

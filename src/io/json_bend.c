@@ -65,4 +65,6 @@ static int write_bends(jw_out *o, const wb_image *g, int first)
     return first;
 }
 
-const jtype jt_bend = { .entry = "bend", .alloc = wb_image_alloc_bends, .read_item = read_bend, .write = write_bends };
+const jtype jt_bend = {
+    .entry = "bend", .alloc = wb_image_alloc_bends, .read_item = read_bend, .write = write_bends,
+};

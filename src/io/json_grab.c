@@ -79,4 +79,6 @@ static int write_grabs(jw_out *o, const wb_image *g, int first)
     return first;
 }
 
-const jtype jt_grab = { .key = "grabs", .alloc = wb_image_alloc_grab, .read_item = read_grabs, .write = write_grabs };
+const jtype jt_grab = {
+    .key = "grabs", .alloc = wb_image_alloc_grab, .read_item = read_grabs, .write = write_grabs,
+};

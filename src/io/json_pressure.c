@@ -53,4 +53,7 @@ static int write_pressures(jw_out *o, const wb_image *g, int first)
     return first;
 }
 
-const jtype jt_pressure = { .key = "pressures", .alloc = wb_image_alloc_pressure, .read_item = read_pressures, .write = write_pressures };
+const jtype jt_pressure = {
+    .key = "pressures", .alloc = wb_image_alloc_pressure,
+    .read_item = read_pressures, .write = write_pressures,
+};

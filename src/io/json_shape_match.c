@@ -109,4 +109,6 @@ static int write_shape_matches(jw_out *o, const wb_image *g, int first)
     return first;
 }
 
-const jtype jt_shape_match = { .key = "shape_matches", .read = read_shape_matches, .write = write_shape_matches };
+const jtype jt_shape_match = {
+    .key = "shape_matches", .read = read_shape_matches, .write = write_shape_matches,
+};

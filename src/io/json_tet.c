@@ -68,4 +68,6 @@ static int write_tets(jw_out *o, const wb_image *g, int first)
     return first;
 }
 
-const jtype jt_tet = { .key = "tets", .alloc = wb_image_alloc_tets, .read_item = read_tets, .write = write_tets };
+const jtype jt_tet = {
+    .key = "tets", .alloc = wb_image_alloc_tets, .read_item = read_tets, .write = write_tets,
+};

@@ -43,4 +43,6 @@ static int write_tethers(jw_out *o, const wb_image *g, int first)
     return first;
 }
 
-const jtype jt_tether = { .key = "tethers", .alloc = wb_image_alloc_tethers, .read_item = read_tethers, .write = write_tethers };
+const jtype jt_tether = {
+    .key = "tethers", .alloc = wb_image_alloc_tethers, .read_item = read_tethers, .write = write_tethers,
+};

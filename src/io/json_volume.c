@@ -48,4 +48,6 @@ static int write_volumes(jw_out *o, const wb_image *g, int first)
     return first;
 }
 
-const jtype jt_volume = { .key = "volumes", .alloc = wb_image_alloc_volumes, .read_item = read_volumes, .write = write_volumes };
+const jtype jt_volume = {
+    .key = "volumes", .alloc = wb_image_alloc_volumes, .read_item = read_volumes, .write = write_volumes,
+};
