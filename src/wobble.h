@@ -639,6 +639,11 @@ int32_t wb_pressure_surface(const wb_world *w, int32_t i);
  * of the last substep, pointing to the target; it returns |F|. */
 typedef struct wb_attach_id { uint32_t index; uint32_t gen; } wb_attach_id;
 typedef struct wb_grab_id { uint32_t index; uint32_t gen; } wb_grab_id;
+/* their option as the core decides it (wb_fault by key): a compliance, finite and >= 0;
+ * attach.c and grab.c each say it for their own (the particle, target and pose are the
+ * caller's to check, as it numbers them) */
+wb_fault wb_attach_def_fault(wb_real compliance);
+wb_fault wb_grab_def_fault(wb_real compliance);
 
 /* particle p kept where it is now in collider c's frame: it rides the collider as the
  * collider moves and turns, and no longer collides with it */

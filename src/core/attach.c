@@ -124,10 +124,15 @@ static wb_attach_id attach_new(wb_world *w, int32_t p, int kind, int32_t slot, u
     return id;
 }
 
+wb_fault wb_attach_def_fault(wb_real compliance)
+{
+    return !(compliance >= 0) || !isfinite(compliance) ? WB_FAULT_KEY("compliance", "must be >= 0 (m/N)") : WB_NO_FAULT;
+}
+
 static const char *check_new(const wb_world *w, int32_t p, wb_real compliance)
 {
-    return !(compliance >= 0) || !isfinite(compliance) ? "compliance must be >= 0"
-         : p < 0 || p >= w->m.np ? "particle out of range" : NULL;
+    const char *e = wb_attach_def_fault(compliance).msg;
+    return e ? e : p < 0 || p >= w->m.np ? "particle out of range" : NULL;
 }
 
 wb_attach_id wb_attach_collider(wb_world *w, int32_t p, wb_collider_id c, wb_real compliance, wb_status *status)
@@ -304,7 +309,7 @@ static const char *att_image_check(const wb_image *g)
         }
         if (!isfinite(a->local[3 * k]) || !isfinite(a->local[3 * k + 1]) || !isfinite(a->local[3 * k + 2]))
             return "attachment point must be finite";
-        if (!(a->alpha[k] >= 0) || !isfinite(a->alpha[k])) return "attachment compliance must be >= 0";
+        if (wb_attach_def_fault(a->alpha[k]).msg) return "attachment compliance must be >= 0 (m/N)";
     }
     return NULL;
 }

@@ -105,13 +105,18 @@ static wb_grab_id grab_new(wb_world *w, int32_t p, int kind, const wb_real local
     return id;
 }
 
+wb_fault wb_grab_def_fault(wb_real compliance)
+{
+    return !(compliance >= 0) || !isfinite(compliance) ? WB_FAULT_KEY("compliance", "must be >= 0 (m/N)") : WB_NO_FAULT;
+}
+
 wb_grab_id wb_grab_add(wb_world *w, int32_t p, const wb_real target[3], wb_real compliance, wb_status *status)
 {
     wb_grab_id none = { 0, 0 };
     wb_status dummy;
     if (!status) status = &dummy;
-    const char *err = !(compliance >= 0) || !isfinite(compliance) ? "compliance must be >= 0"
-                    : p < 0 || p >= w->m.np ? "particle out of range"
+    const char *err = wb_grab_def_fault(compliance).msg;
+    if (!err) err = p < 0 || p >= w->m.np ? "particle out of range"
                     : !fin3(target) ? "target must be finite" : NULL;
     if (err) {
         wb__set_error("%s", err);
@@ -129,8 +134,8 @@ wb_grab_id wb_grab_rigid(wb_world *w, wb_rigid_id r, const wb_real local[3], con
     if (!status) status = &dummy;
     static const wb_real centre[3] = { 0, 0, 0 };
     if (!local) local = centre;
-    const char *err = !(compliance >= 0) || !isfinite(compliance) ? "compliance must be >= 0"
-                    : !wb_rigid_valid(w, r) ? "rigid body removed"
+    const char *err = wb_grab_def_fault(compliance).msg;
+    if (!err) err = !wb_rigid_valid(w, r) ? "rigid body removed"
                     : !fin3(local) ? "at must be finite"
                     : !fin3(target) ? "target must be finite" : NULL;
     if (err) {
@@ -306,7 +311,7 @@ static const char *grab_image_check(const wb_image *img)
             return "grab particle out of range";
         }
         if (!fin3(&g->target[3 * k]) || !fin3(&g->from[3 * k])) return "grab target must be finite";
-        if (!(g->alpha[k] >= 0) || !isfinite(g->alpha[k])) return "grab compliance must be >= 0";
+        if (wb_grab_def_fault(g->alpha[k]).msg) return "grab compliance must be >= 0 (m/N)";
     }
     return NULL;
 }

@@ -135,6 +135,19 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
 }
 
 /* ---- checks ---------------------------------------------------------------------------- */
+const char *wb_image_collider_shape_check(const wb_image_collider *c)
+{
+    const wb_shape_class *k = wb__shape(c->shape);
+    if (!k) return "unknown collider shape";
+    if (!k->check_shape) return NULL;
+    wb_cshape t = { .shape = c->shape, .radius = c->radius };
+    v3_copy(t.n, c->n);
+    v3_copy(t.half, c->half);
+    v3_copy(t.a, c->a);
+    v3_copy(t.b, c->b);
+    return k->check_shape(&t);
+}
+
 static const char *check_collider(const wb_image_collider *c)
 {
     if (!wb__shape(c->shape)) return "unknown collider shape";
@@ -146,17 +159,9 @@ static const char *check_collider(const wb_image_collider *c)
         if (!isfinite(c->q[i]) || !isfinite(c->q0[i])) return "collider rotation must be finite";
     if (c->q[0] * c->q[0] + v3_dot(&c->q[1], &c->q[1]) < 1e-24) return "collider rotation must not be zero";
     if (c->q0[0] * c->q0[0] + v3_dot(&c->q0[1], &c->q0[1]) < 1e-24) return "collider rotation must not be zero";
-    const wb_shape_class *k = wb__shape(c->shape);
-    if (k->check_shape) {
-        wb_cshape t = { .shape = c->shape, .radius = c->radius };
-        v3_copy(t.n, c->n);
-        v3_copy(t.half, c->half);
-        v3_copy(t.a, c->a);
-        v3_copy(t.b, c->b);
-        const char *e = k->check_shape(&t);
-        if (e) return e;
-    }
-    if (k->has_mesh) {
+    const char *e = wb_image_collider_shape_check(c);
+    if (e) return e;
+    if (wb__shape(c->shape)->has_mesh) {
         if (!c->mv || !c->mt || c->mnt <= 0 || c->mnv <= 0) return "mesh collider has no triangles";
         for (int64_t i = 0; i < 3 * (int64_t)c->mnv; i++)
             if (!isfinite(c->mv[i])) return "mesh collider vertices must be finite";

@@ -112,6 +112,9 @@ wb_world *wb_world_from_image(const wb_image *img, wb_status *status);
 wb_status wb_world_append_image(wb_world *w, const wb_image *img, wb_body *out);
 /* the collider w:collider{...} would make from a world-frame def, in its own frame + pose */
 wb_status wb_image_collider_from_def(const wb_collider_def *d, wb_image_collider *out);
+/* a collider's shape fields in its own frame as its shape's file judges them (wb_image_check
+ * asks it too): NULL, or what is wrong */
+const char *wb_image_collider_shape_check(const wb_image_collider *c);
 
 /* Each constraint type's part of the functions above (save, check, put) is its own,
  * reached through its hooks (ctype.h) */

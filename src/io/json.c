@@ -9,7 +9,9 @@
  *
  * Errors name the file, line and column and the key path ("logo.json:12:7:
  * particles[3].mass: number expected, got string"; how, in json_value.c). The whole
- * file is read and checked into a wb_image before anything is built. */
+ * file is read and checked into a wb_image before anything is built. Each constraint
+ * type's elements ("constraints" entries, "volumes", ...) are read by its own file through
+ * the jtypes table (json.h, json_types.c). */
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -23,12 +25,7 @@
 #define MAX_FILE (1ll << 31) /* 2 GiB: a snapshot of WB_MAX_PARTICLES fits; larger is not ours */
 
 /* ---- sections --------------------------------------------------------------------------------- */
-typedef struct defaults {
-    wb_real mass, radius;
-    wb_distance_def link;
-} defaults;
-
-static int read_defaults(rd *r, const cJSON *it, defaults *d)
+static int read_defaults(rd *r, const cJSON *it, jdefaults *d)
 {
     static const char *const keys[] = { "mass", "radius", "compliance", "damping", "yield", "creep", "break_strain",
                                         "break_force", NULL };
@@ -112,7 +109,7 @@ typedef struct sections {      /* the top-level values, checked for type */
     const cJSON *particles, *constraints, *colliders, *surfaces, *parts, *skins, *snapshot;
     const cJSON *world, *dgen, *dfree, *cgen, *clock[4];
     int32_t np, ncons, ncol, nsurf, ntri, nparts, nskins, nd, nfree, nc;
-    int32_t nbend;             /* "constraints" entries of type "bend" (ncons counts the others) */
+    int32_t nentries[JT_MAX];  /* "constraints" entries of each type (ncons: the distance slots') */
 } sections;
 
 /* the snapshot section's shape (its values are read once the image exists) */
@@ -202,7 +199,7 @@ static int read_snapshot(rd *r, const sections *s, wb_image *g)
     return 0;
 }
 
-static int read_particles(rd *r, const sections *s, const defaults *d, wb_image *g)
+static int read_particles(rd *r, const sections *s, const jdefaults *d, wb_image *g)
 {
     static const char *const keys[] = { "position", "velocity", "mass", "inv_mass", "radius", "pinned",
                                         "group", "friction", "collide", "self_collide", "created_at", NULL };
@@ -256,218 +253,67 @@ static int read_particles(rd *r, const sections *s, const defaults *d, wb_image 
     return 0;
 }
 
-/* {"type": "bend", "particles": [p1, p2, p3, p4], "rest": angle, "compliance": 0, "damping": 0}:
- * the i-th bend; rest defaults to the angle the particles make */
-static int read_bend(rd *r, const cJSON *c, const kp *p, wb_image *g, int32_t i)
+/* the type a "constraints" entry is read as (jtypes): the one its "type" names; without a
+ * string there, the first, whose reader says what is wrong. -1: a type none reads */
+static int entry_type(const cJSON *c)
 {
-    static const char *const keys[] = { "type", "particles", "rest", "compliance", "damping", "break_torque", "broken", NULL };
-    const cJSON *f[8];
-    if (jv_get_object(r, c, p, keys, f)) return -1;
-    if (!f[1]) return jv_missing(r, c, p, "particles");
-    kp pp = { p, "particles", 0 };
-    int32_t n;
-    if (jv_get_array(r, f[1], &pp, 16, &n)) return -1;
-    if (n != 4) return jv_fail(r, f[1], 0, &pp, "a bend joins 4 particles (hinge p1 p2, wings p3 p4), got %d", n);
-    int32_t *q = &g->bend.ij[4 * i];
-    if (jv_get_ids(r, f[1], &pp, g->np, 4, "a bend", q)) return -1;
-    wb_bend_def d = wb_bend_default_def();
-    if (jv_opt_real(r, f[2], p, "rest", &d.rest) || jv_opt_real(r, f[3], p, "compliance", &d.compliance) ||
-        jv_opt_real(r, f[4], p, "damping", &d.damping) || jv_opt_real(r, f[5], p, "break_torque", &d.break_torque))
-        return -1;
-    bool broken = false;
-    if (f[6]) {
-        kp bp = { p, "broken", 0 };
-        if (jv_get_bool(r, f[6], &bp, &broken)) return -1;
+    const cJSON *t = cJSON_IsObject(c) ? cJSON_GetObjectItemCaseSensitive(c, "type") : NULL;
+    int first = -1;
+    for (int k = 0; k < njtypes; k++) {
+        if (!jtypes[k]->entry) continue;
+        if (cJSON_IsString(t) && !strcmp(t->valuestring, jtypes[k]->entry)) return k;
+        if (first < 0) first = k;
     }
-    /* the core decides what a bend may be (bend.c) */
-    const wb_fault ft = wb_bend_check(g->np, g->x, q, &d);
-    if (jv_fault(r, &ft, p, keys, f, 1)) return -1;
-    if (isnan(d.rest)) wb_dihedral_angle(&g->x[3 * q[0]], &g->x[3 * q[1]], &g->x[3 * q[2]], &g->x[3 * q[3]], &d.rest);
-    g->bend.alpha[i] = d.compliance;
-    g->bend.beta[i] = d.damping;
-    g->bend.rest[i] = d.rest;
-    g->bend.btorque[i] = d.break_torque;
-    g->bend.broken[i] = broken;
+    return cJSON_IsString(t) ? -1 : first;
+}
+
+/* count the entries of each type (before the image is made), or name the one no type reads */
+static int count_entries(rd *r, sections *s)
+{
+    int64_t i = 0;
+    for (const cJSON *c = s->constraints ? s->constraints->child : NULL; c; c = c->next, i++) {
+        const int k = entry_type(c);
+        if (k >= 0) { s->nentries[k]++; continue; }
+        char list[200] = "";
+        size_t len = 0;
+        int n = 0, m = 0;
+        for (int j = 0; j < njtypes; j++) n += jtypes[j]->entry != NULL;
+        for (int j = 0; j < njtypes && len < sizeof list; j++)
+            if (jtypes[j]->entry)
+                len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", m++ == 0 ? "" : m == n ? " or " : ", ",
+                                        jtypes[j]->entry);
+        kp top = { NULL, "constraints", 0 }, p = { &top, NULL, i }, tp = { &p, "type", 0 };
+        const cJSON *t = cJSON_GetObjectItemCaseSensitive(c, "type");
+        return jv_fail(r, t, 0, &tp, "unknown constraint type '%s' (expected %s)", t->valuestring, list);
+    }
+    /* the entries without arrays of their own fill the distance slots */
+    s->ncons = 0;
+    for (int k = 0; k < njtypes; k++)
+        if (jtypes[k]->entry && !jtypes[k]->alloc) s->ncons += s->nentries[k];
     return 0;
 }
 
-static int read_constraints(rd *r, const sections *s, const defaults *d, wb_image *g)
+/* room in the image for the entries of the types with arrays of their own */
+static wb_status alloc_entries(const sections *s, wb_image *g)
 {
-    static const char *const keys[] = { "type", "particles", "rest", "compliance", "damping", "yield", "creep",
-                                        "break_strain", "broken", "break_force", NULL };
+    for (int k = 0; k < njtypes; k++)
+        if (jtypes[k]->alloc && s->nentries[k] > 0 && jtypes[k]->alloc(g, s->nentries[k]) != WB_OK) return WB_ERR_NOMEM;
+    return WB_OK;
+}
+
+/* every entry of "constraints" by its type's reader */
+static int read_constraints(rd *r, const sections *s, const jdefaults *d, wb_image *g)
+{
     kp top = { NULL, "constraints", 0 };
-    int32_t i = 0, slot = -1, nb = 0;
-    if (!s->constraints) return 0;
-    for (const cJSON *c = s->constraints->child; c; c = c->next, i++) {
-        const cJSON *f[11];
+    int32_t i = 0, at[JT_MAX];
+    for (int k = 0; k < njtypes; k++) at[k] = -1;
+    for (const cJSON *c = s->constraints ? s->constraints->child : NULL; c; c = c->next, i++) {
         kp p = { &top, NULL, i };
-        const cJSON *t = cJSON_IsObject(c) ? cJSON_GetObjectItemCaseSensitive(c, "type") : NULL;
-        if (cJSON_IsString(t) && strcmp(t->valuestring, "bend") == 0) {
-            if (read_bend(r, c, &p, g, nb++)) return -1;
-            continue;
-        }
-        if (jv_get_object(r, c, &p, keys, f)) return -1;
-        if (!f[0]) return jv_missing(r, c, &p, "type");
-        if (!f[1]) return jv_missing(r, c, &p, "particles");
-        kp tp = { &p, "type", 0 }, pp = { &p, "particles", 0 };
-        const char *type = "";
-        if (jv_get_string(r, f[0], &tp, &type)) return -1;
-        if (strcmp(type, "distance") != 0) return jv_fail(r, f[0], 0, &tp, "unknown constraint type '%s' (expected distance or bend)", type);
-        int32_t ab[2];
-        if (jv_get_ids(r, f[1], &pp, g->np, 2, "a distance constraint", ab)) return -1;
-        /* the i-th live slot (all slots are live in a plain config) */
-        do slot++; while (!(g->dist.gen[slot] & 1u));
-        wb_distance_def l = d->link;
-        bool broken = false;
-        /* a rest the file gives is >= 0: a negative one would read as "their distance" */
-        if (jv_opt_nonneg(r, f[2], &p, "rest", &l.rest) || jv_opt_real(r, f[3], &p, "compliance", &l.compliance) ||
-            jv_opt_real(r, f[4], &p, "damping", &l.damping) || jv_opt_real(r, f[5], &p, "yield", &l.yield) ||
-            jv_opt_real(r, f[6], &p, "creep", &l.creep) || jv_opt_real(r, f[7], &p, "break_strain", &l.break_strain) ||
-            jv_opt_real(r, f[9], &p, "break_force", &l.break_force))
-            return -1;
-        if (f[8]) {
-            kp q = { &p, "broken", 0 };
-            if (jv_get_bool(r, f[8], &q, &broken)) return -1;
-        }
-        /* the core decides what a distance constraint may be (wb_distance_check) */
-        const wb_fault ft = wb_distance_check(g->np, g->x, ab[0], ab[1], &l);
-        if (jv_fault(r, &ft, &p, keys, f, 1)) return -1;
-        if (l.rest < 0) {
-            const wb_real *xa = &g->x[3 * ab[0]], *xb = &g->x[3 * ab[1]];
-            wb_real dx[3] = { xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2] };
-            l.rest = sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
-        }
-        g->dist.ij[2 * slot] = (int32_t)ab[0];
-        g->dist.ij[2 * slot + 1] = (int32_t)ab[1];
-        g->dist.alpha[slot] = l.compliance;
-        g->dist.beta[slot] = l.damping;
-        g->dist.yield[slot] = l.yield;
-        g->dist.creep[slot] = l.creep;
-        g->dist.break_strain[slot] = l.break_strain;
-        g->dist.bforce[slot] = l.break_force;
-        g->dist.rest[slot] = l.rest;
-        g->dist.broken[slot] = broken;
+        const int k = entry_type(c); /* counted before: one of them */
+        if (jtypes[k]->read_item(r, c, &p, d, g, &at[k])) return -1;
     }
     return 0;
 }
-
-/* "volumes": [ {"particles": [a, b, c, d], "rest": V, "compliance": alpha, "yield": y,
- * "creep": c}, ... ]: volume constraints (the tet's signed volume kept at rest, default the
- * particles' current one; yield and creep: plastic flow of the rest volume, 0 by default) */
-static int read_volumes(rd *r, const cJSON *arr, wb_image *g)
-{
-    static const char *const keys[] = { "particles", "rest", "compliance", "yield", "creep", NULL };
-    kp top = { NULL, "volumes", 0 };
-    int32_t i = 0, n;
-    if (!arr) return 0;
-    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
-    if (wb_image_alloc_volumes(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
-    for (const cJSON *c = arr->child; c; c = c->next, i++) {
-        const cJSON *f[6];
-        kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
-        if (jv_get_object(r, c, &p, keys, f)) return -1;
-        if (!f[0]) return jv_missing(r, c, &p, "particles");
-        int32_t *ijkl = &g->vol.ijkl[4 * i];
-        if (jv_get_ids(r, f[0], &pp, g->np, 4, "a volume constraint", ijkl)) return -1;
-        wb_volume_def d = wb_volume_default_def();
-        d.has_rest = f[1] != NULL;
-        if (jv_opt_real(r, f[1], &p, "rest", &d.rest) || jv_opt_real(r, f[2], &p, "compliance", &d.compliance) ||
-            jv_opt_real(r, f[3], &p, "yield", &d.yield) || jv_opt_real(r, f[4], &p, "creep", &d.creep))
-            return -1;
-        /* the core decides what a volume constraint may be (volume.c) */
-        const wb_fault ft = wb_volume_check(g->np, g->x, ijkl, &d);
-        if (jv_fault(r, &ft, &p, keys, f, 0)) return -1;
-        const wb_real *x = g->x;
-        g->vol.rest[i] = d.has_rest ? d.rest
-                       : wb_tet_signed_volume(&x[3 * ijkl[0]], &x[3 * ijkl[1]], &x[3 * ijkl[2]], &x[3 * ijkl[3]]);
-        g->vol.alpha[i] = d.compliance;
-        g->vol.plastic[2 * i] = d.yield;
-        g->vol.plastic[2 * i + 1] = d.creep;
-    }
-    return 0;
-}
-
-/* "volumes" (only when there are any: a config without stays as it was) */
-static void write_volumes(jw_out *o, const wb_image *g)
-{
-    FILE *f = o->f;
-    if (g->vol.n == 0) return;
-    fputs("  \"volumes\": [", f);
-    for (int32_t i = 0; i < g->vol.n; i++) {
-        const int32_t *p = &g->vol.ijkl[4 * i];
-        fprintf(f, "%s    {\"particles\": [%d, %d, %d, %d], \"rest\": ", i ? ",\n" : "\n", p[0], p[1], p[2], p[3]);
-        jw_num(o, g->vol.rest[i]);
-        fputs(", \"compliance\": ", f);
-        jw_num(o, g->vol.alpha[i]);
-        jw_plastic(o, &g->vol.plastic[2 * i]);
-        fputc('}', f);
-    }
-    fputs("\n  ],\n", f);
-}
-
-/* "tethers": [ {"particles": [p, q], "length": l, "compliance": alpha}, ... ]: long-range
- * attachments (length: the particles' distance by default; compliance 0 by default) */
-static int read_tethers(rd *r, const cJSON *arr, wb_image *g)
-{
-    static const char *const keys[] = { "particles", "length", "compliance", NULL };
-    kp top = { NULL, "tethers", 0 };
-    int32_t i = 0, n;
-    if (!arr) return 0;
-    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
-    if (wb_image_alloc_tethers(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
-    for (const cJSON *c = arr->child; c; c = c->next, i++) {
-        const cJSON *f[3];
-        kp p = { &top, NULL, i }, pp = { &p, "particles", 0 };
-        if (jv_get_object(r, c, &p, keys, f)) return -1;
-        if (!f[0]) return jv_missing(r, c, &p, "particles");
-        int32_t *ij = &g->teth.ij[2 * i];
-        if (jv_get_ids(r, f[0], &pp, g->np, 2, "a tether", ij)) return -1;
-        wb_tether_def td = wb_tether_default_def();
-        td.has_length = f[1] != NULL;
-        if (jv_opt_real(r, f[1], &p, "length", &td.length) || jv_opt_real(r, f[2], &p, "compliance", &td.compliance))
-            return -1;
-        /* the core decides what a tether may be (tether.c) */
-        const wb_fault ft = wb_tether_check(g->np, g->x, ij[0], ij[1], &td);
-        if (jv_fault(r, &ft, &p, keys, f, 0)) return -1;
-        const wb_real *x = g->x;
-        wb_real d[3];
-        v3_sub(d, &x[3 * ij[0]], &x[3 * ij[1]]);
-        g->teth.len[i] = td.has_length ? td.length : v3_len(d);
-        g->teth.alpha[i] = td.compliance;
-    }
-    return 0;
-}
-
-/* "tethers" (only when there are any) */
-static void write_tethers(jw_out *o, const wb_image *g)
-{
-    FILE *f = o->f;
-    if (g->teth.n == 0) return;
-    fputs("  \"tethers\": [", f);
-    for (int32_t i = 0; i < g->teth.n; i++) {
-        fprintf(f, "%s    {\"particles\": [%d, %d], \"length\": ", i ? ",\n" : "\n", g->teth.ij[2 * i], g->teth.ij[2 * i + 1]);
-        jw_num(o, g->teth.len[i]);
-        fputs(", \"compliance\": ", f);
-        jw_num(o, g->teth.alpha[i]);
-        fputc('}', f);
-    }
-    fputs("\n  ],\n", f);
-}
-
-/* the constraint types with a section of their own (json.h), in the order w:save writes
- * them; each reads and writes its own */
-const jtype jtypes[] = {
-    { "volumes", read_volumes, write_volumes },
-    { "tets", jm_read_tets, jm_write_tets },
-    { "shape_matches", jm_read_shape_matches, jm_write_shape_matches },
-    { "pressures", jm_read_pressures, jm_write_pressures },
-    { "attachments", ja_read_attachments, ja_write_attachments },
-    { "grabs", ja_read_grabs, ja_write_grabs },
-    { "tethers", read_tethers, write_tethers },
-};
-const int njtypes = (int)(sizeof jtypes / sizeof jtypes[0]);
-
-static const char *const shape_names[] = { "plane", "sphere", "box", "capsule", "mesh", NULL };
 
 /* a mesh collider's "vertices" (flat x,y,z, ...) and "triangles" (flat, 0-based corners) */
 static int read_mesh_arrays(rd *r, const cJSON *it, const kp *p, const cJSON *fv, const cJSON *ft, wb_image_collider *c)
@@ -533,38 +379,66 @@ static int read_pose(rd *r, const cJSON *it, const kp *up, wb_image_collider *c)
     return 0;
 }
 
+/* the shape "name" names (wobble.h's wb_shape_info), or -1 after failing with the names */
+static int find_shape(rd *r, const cJSON *it, const kp *p, const char *name)
+{
+    int n = 0;
+    while (wb_shape_info_of((wb_shape)n)) n++;
+    for (int k = 0; k < n; k++)
+        if (!strcmp(name, wb_shape_info_of((wb_shape)k)->name)) return k;
+    char list[200] = "";
+    size_t len = 0;
+    for (int k = 0; k < n && len < sizeof list; k++)
+        len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", k == 0 ? "" : k == n - 1 ? " or " : ", ",
+                                wb_shape_info_of((wb_shape)k)->name);
+    jv_fail(r, it, 0, p, "unknown shape '%s' (expected %s)", name, list);
+    return -1;
+}
+
+/* the keys of a shape's def in the world form: its fields (wb_shape_info), a mesh given by
+ * its arrays ("vertices triangles") where a script gives a mesh object */
+static const char *world_keys(const wb_shape_info *in, char buf[160])
+{
+    size_t n = 0;
+    buf[0] = '\0';
+    for (const char *q = in->fields; *q && n < 150;) {
+        while (*q == ' ') q++;
+        const char *e = q;
+        while (*e && *e != ' ') e++;
+        if (e == q) break;
+        const int mesh = e - q == 4 && !strncmp(q, "mesh", 4);
+        n += (size_t)snprintf(buf + n, 160 - n, "%s%.*s", n ? " " : "", mesh ? 18 : (int)(e - q),
+                              mesh ? "vertices triangles" : q);
+        q = e;
+    }
+    return buf;
+}
+
 /* Two forms: as w:collider{...} takes it (world frame), or, with "pose", the shape in the
- * collider's own frame plus its full pose (what w:save writes, exact) */
+ * collider's own frame plus its full pose (what w:save writes, exact). Which keys a shape
+ * takes, what it keeps in its own frame and what must hold there are its file's
+ * (core/shape_NAME.c, through wb_shape_info and wb_image_collider_shape_check) */
 static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider *c)
 {
     static const char *const keys[] = { "shape", "normal", "offset", "center", "radius", "half", "rotation", "a", "b",
                                         "friction", "restitution", "pose", "vertices", "triangles", "scale", NULL };
-    /* which keys each shape takes, world form / own-frame form (pose) */
-    static const char *const world_keys[WB_SHAPE_COUNT] = { "normal offset", "center radius", "center half rotation", "a b radius",
-                                                            "center rotation vertices triangles scale" };
-    static const char *const local_keys[WB_SHAPE_COUNT] = { "normal", "radius", "half", "a b radius", "vertices triangles" };
     const cJSON *f[16];
     if (jv_get_object(r, it, p, keys, f)) return -1;
     if (!f[0]) return jv_missing(r, it, p, "shape");
     kp sp = { p, "shape", 0 };
     const char *name = "";
     if (jv_get_string(r, f[0], &sp, &name)) return -1;
-    int shape = 0;
-    while (shape_names[shape] && strcmp(name, shape_names[shape])) shape++;
-    if (!shape_names[shape]) return jv_fail(r, f[0], 0, &sp, "unknown shape '%s' (expected plane, sphere, box, capsule or mesh)", name);
-    const int local = f[11] != NULL;
-    const char *allowed = (local ? local_keys : world_keys)[shape];
+    const int shape = find_shape(r, f[0], &sp, name);
+    if (shape < 0) return -1;
+    const wb_shape_info *in = wb_shape_info_of((wb_shape)shape);
+    const int local = f[11] != NULL, has_mesh = wb_shape_takes(in->fields, "mesh");
+    char wbuf[160];
+    const char *allowed = local ? in->own_fields : world_keys(in, wbuf);
     for (int i = 1; i <= 14; i++) {
-        if (!f[i] || (i >= 9 && i <= 11)) continue;
-        const char *k = keys[i], *hit = strstr(allowed, k);
-        const size_t kl = strlen(k);
-        /* a whole word of the list */
-        while (hit && ((hit > allowed && hit[-1] != ' ') || (hit[kl] && hit[kl] != ' '))) hit = strstr(hit + 1, k);
-        if (!hit) {
-            kp kk = { p, k, 0 };
-            if (local) return jv_fail(r, f[i], 1, &kk, "a %s with a pose takes %s in its own frame, not '%s'", name, allowed, k);
-            return jv_fail(r, f[i], 1, &kk, "a %s takes %s (and friction, restitution, pose), not '%s'", name, allowed, k);
-        }
+        if (!f[i] || (i >= 9 && i <= 11) || wb_shape_takes(allowed, keys[i])) continue;
+        kp kk = { p, keys[i], 0 };
+        if (local) return jv_fail(r, f[i], 1, &kk, "a %s with a pose takes %s in its own frame, not '%s'", name, allowed, keys[i]);
+        return jv_fail(r, f[i], 1, &kk, "a %s takes %s (and friction, restitution, pose), not '%s'", name, allowed, keys[i]);
     }
     wb_collider_def d = wb_collider_default_def((wb_shape)shape);
     if (jv_opt_vec(r, f[1], p, "normal", 3, d.normal) || jv_opt_real(r, f[2], p, "offset", &d.offset) ||
@@ -576,12 +450,12 @@ static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider 
         kp q = { p, "rotation", 0 };
         if (get_quat(r, f[6], &q, d.rotation)) return -1;
     }
-    if (shape == WB_SHAPE_MESH) {
+    if (has_mesh) {
         kp sc = { p, "scale", 0 };
         if (f[14] && jv_get_real(r, f[14], &sc, &d.scale)) return -1;
         if (read_mesh_arrays(r, it, p, f[12], f[13], c)) return -1;
     }
-    if (!local && shape == WB_SHAPE_MESH) {
+    if (!local && has_mesh) {
         /* the arrays just read are the mesh the def copies (scaled) into the collider */
         wb_mesh mesh = { c->mnv, c->mnt, c->mv, NULL, c->mt };
         d.mesh = &mesh;
@@ -599,7 +473,8 @@ static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider 
         if (st == WB_ERR_NOMEM) return jv_fail(r, it, 0, p, "out of memory");
         return st != WB_OK ? jv_fail(r, it, 0, p, "%s", wb_last_error()) : 0;
     }
-    /* own frame: the values are the collider's internals, as w:save wrote them */
+    /* own frame: the values are the collider's internals, as w:save wrote them: the
+     * shape's own fields, the others zero */
     wb_real *mv = c->mv;
     int32_t *mt = c->mt, mnv = c->mnv, mnt = c->mnt;
     memset(c, 0, sizeof *c);
@@ -610,26 +485,18 @@ static int read_collider(rd *r, const cJSON *it, const kp *p, wb_image_collider 
     c->shape = (wb_shape)shape;
     c->friction = d.friction;
     c->restitution = d.restitution;
-    switch (c->shape) {
-    case WB_SHAPE_PLANE: {
+    if (wb_shape_takes(in->own_fields, "normal")) {
         wb_real n2 = d.normal[0] * d.normal[0] + d.normal[1] * d.normal[1] + d.normal[2] * d.normal[2];
         if (!(n2 > 1e-24)) return jv_fail(r, f[1] ? f[1] : it, 0, p, "normal must not be zero");
         for (int i = 0; i < 3; i++) c->n[i] = fabs(n2 - 1) > 1e-12 ? d.normal[i] / sqrt(n2) : d.normal[i];
-        break;
     }
-    case WB_SHAPE_BOX: memcpy(c->half, d.half, sizeof c->half); break;
-    case WB_SHAPE_CAPSULE:
-        memcpy(c->a, d.a, sizeof c->a);
-        memcpy(c->b, d.b, sizeof c->b);
-        c->radius = d.radius;
-        break;
-    default: c->radius = d.radius; break;
-    }
+    if (wb_shape_takes(in->own_fields, "half")) memcpy(c->half, d.half, sizeof c->half);
+    if (wb_shape_takes(in->own_fields, "a")) memcpy(c->a, d.a, sizeof c->a);
+    if (wb_shape_takes(in->own_fields, "b")) memcpy(c->b, d.b, sizeof c->b);
+    if (wb_shape_takes(in->own_fields, "radius")) c->radius = d.radius;
     if (read_pose(r, f[11], p, c)) return -1;
-    if (c->shape == WB_SHAPE_BOX && !(c->half[0] > 0 && c->half[1] > 0 && c->half[2] > 0))
-        return jv_fail(r, it, 0, p, "half extents must be > 0");
-    if ((c->shape == WB_SHAPE_SPHERE || c->shape == WB_SHAPE_CAPSULE) && !(c->radius > 0))
-        return jv_fail(r, it, 0, p, "radius must be > 0");
+    const char *e = wb_image_collider_shape_check(c);
+    if (e) return jv_fail(r, it, 0, p, "%s", e);
     if (c->restitution > 1) return jv_fail(r, f[10], 0, p, "restitution must be in [0, 1]");
     return 0;
 }
@@ -752,24 +619,51 @@ static int read_skins(rd *r, const sections *s, wbio_config *cfg)
 }
 
 /* ---- the file ---------------------------------------------------------------------------------- */
-/* each type's own section (jtypes), after the rigid bodies that attachments and grabs name */
-static int read_sections(rd *r, const cJSON *root, wb_image *g)
+/* a type's array of its own (arr may be NULL: none) */
+static int read_section(rd *r, const jtype *t, const cJSON *arr, const jdefaults *d, wb_image *g)
+{
+    if (t->read) return t->read(r, arr, g);
+    kp top = { NULL, t->key, 0 };
+    int32_t n, i = 0, at = -1;
+    if (!arr) return 0;
+    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
+    if (t->alloc(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
+    for (const cJSON *c = arr->child; c; c = c->next, i++) {
+        kp p = { &top, NULL, i };
+        if (t->read_item(r, c, &p, d, g, &at)) return -1;
+    }
+    return 0;
+}
+
+/* each type's array of its own (jtypes), after the rigid bodies that attachments and grabs name */
+static int read_sections(rd *r, const cJSON *root, const jdefaults *d, wb_image *g)
 {
     for (int i = 0; i < njtypes; i++)
-        if (jtypes[i].read(r, cJSON_GetObjectItemCaseSensitive(root, jtypes[i].key), g)) return -1;
+        if (jtypes[i]->key && read_section(r, jtypes[i], cJSON_GetObjectItemCaseSensitive(root, jtypes[i]->key), d, g))
+            return -1;
     return 0;
+}
+
+/* the root's keys: the file's own, then the types' sections (jtypes) */
+static void root_keys(const char *keys[])
+{
+    static const char *const own[] = { "format", "version", "description", "defaults", "particles", "constraints",
+                                       "colliders", "surfaces", "parts", "skins", "snapshot", "rigids", NULL };
+    int n = 0;
+    for (; own[n]; n++) keys[n] = own[n];
+    for (int k = 0; k < njtypes; k++)
+        if (jtypes[k]->key) keys[n++] = jtypes[k]->key;
+    keys[n] = NULL;
 }
 
 static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
 {
-    static const char *const keys[] = { "format", "version", "description", "defaults", "particles", "constraints",
-                                        "colliders", "surfaces", "parts", "skins", "snapshot", "volumes",
-                                        "shape_matches", "pressures", "tets", "attachments", "grabs", "rigids", "tethers",
-                                        NULL };
-    const cJSON *f[20];
+    const char *keys[13 + JT_MAX];
+    const cJSON *f[13 + JT_MAX];
     sections s;
-    defaults d;
+    jdefaults d;
     memset(&s, 0, sizeof s);
+    root_keys(keys);
     if (!cJSON_IsObject(root)) return jv_fail(r, root, 0, NULL, "a particle config is a JSON object, got %s", jv_type_name(root));
     if (jv_get_object(r, root, NULL, keys, f)) return -1;
     kp fp = { NULL, "format", 0 }, vp = { NULL, "version", 0 };
@@ -800,23 +694,13 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
         *arrays[i].dst = it;
         if (it && jv_get_array(r, it, &ap, arrays[i].max, arrays[i].n)) return -1;
     }
-    /* bends have no slots: the distance slot tables count the other entries. A type
-     * neither counts is named here, before a slot count that would miss it blames the
+    /* a type none reads is named here, before a slot count that would miss it blames the
      * slot tables instead */
-    int64_t ci = 0;
-    for (const cJSON *c = s.constraints ? s.constraints->child : NULL; c; c = c->next, ci++) {
-        const cJSON *t = cJSON_IsObject(c) ? cJSON_GetObjectItemCaseSensitive(c, "type") : NULL;
-        if (cJSON_IsString(t) && strcmp(t->valuestring, "bend") == 0) s.nbend++;
-        else if (cJSON_IsString(t) && strcmp(t->valuestring, "distance") != 0) {
-            kp top = { NULL, "constraints", 0 }, p = { &top, NULL, ci }, tp = { &p, "type", 0 };
-            return jv_fail(r, t, 0, &tp, "unknown constraint type '%s' (expected distance or bend)", t->valuestring);
-        }
-    }
-    s.ncons -= s.nbend;
+    if (count_entries(r, &s)) return -1;
     s.snapshot = f[10];
     if (scan_snapshot(r, &s) || read_surfaces(r, &s, NULL, &s.ntri)) return -1;
     if (wb_image_alloc(&cfg->img, s.np, s.nd, s.nfree, s.nc, s.nsurf, s.ntri) != WB_OK ||
-        (s.nbend > 0 && wb_image_alloc_bends(&cfg->img, s.nbend) != WB_OK) ||
+        alloc_entries(&s, &cfg->img) != WB_OK ||
         !(cfg->parts = calloc((size_t)s.nparts + 1, sizeof *cfg->parts)) ||
         !(cfg->skins = calloc((size_t)s.nskins + 1, sizeof *cfg->skins)))
         return jv_fail(r, NULL, 0, NULL, "out of memory");
@@ -825,7 +709,7 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
     if ((s.snapshot && read_snapshot(r, &s, &cfg->img)) || read_particles(r, &s, &d, &cfg->img) ||
         read_constraints(r, &s, &d, &cfg->img) || read_colliders(r, &s, &cfg->img) ||
         read_surfaces(r, &s, &cfg->img, &s.ntri) || read_parts(r, &s, cfg) || read_skins(r, &s, cfg) ||
-        jr_read_rigids(r, f[17], &cfg->img) || read_sections(r, root, &cfg->img))
+        jr_read_rigids(r, f[11], &cfg->img) || read_sections(r, root, &d, &cfg->img))
         return -1;
     /* every value was checked where it was read: this is the last line of defence */
     const char *e = wb_image_check(&cfg->img);

@@ -1,6 +1,8 @@
-/* json.h: the JSON machinery shared by the particle-config reader (json.c) and its
- * value layer (json_value.c): where each value of the text is, key paths, and typed
- * reads that fail with "file:line:col: key.path: reason". Private to io_json*.c. */
+/* json.h: the JSON machinery shared by the particle-config reader (json.c), its value layer
+ * (json_value.c), its writer (json_write.c) and the constraint types' files (json_NAME.c,
+ * the jtype table): where each value of the text is, key paths, typed reads that fail with
+ * "file:line:col: key.path: reason", and the writer's numbers. Private to io/json*.c (and
+ * the input log, lua/input.c). */
 #ifndef WB_IO_JSON_H
 #define WB_IO_JSON_H
 
@@ -87,38 +89,52 @@ typedef struct jw_out {
     FILE *f;
     int bad;               /* a non-finite number was met */
     int nomem;             /* a scratch table could not be had */
+    const char *head;      /* the opening of the array being written, not yet written (NULL: none) */
 } jw_out;
 void jw_num(jw_out *o, double x);
+/* ', "key": x' */
+void jw_key(jw_out *o, const char *key, double x);
 void jw_vec(jw_out *o, const wb_real *v, int n);
 /* n integers (u, or s when u is NULL), 24 a line, continued lines indented */
 void jw_ints(FILE *f, const char *indent, const uint32_t *u, const int32_t *s, int32_t n);
+/* before an element of an array: "\n" before the first (after o->head, once), ",\n" before
+ * the others */
+void jw_next(jw_out *o, int *first);
 /* ", yield, creep" when either is set (files without stay as they were) */
 void jw_plastic(jw_out *o, const wb_real yc[2]);
 
-/* A constraint type with a section of its own in a particle config: its key, its reader
- * (arr may be NULL: none) into the image after the particles, surfaces, colliders and
- * rigid bodies, and its writer (nothing when the image has none). The table (json.c) is
- * in the order w:save writes the sections; distances and bends share "constraints"
- * (json.c, json_write.c) */
+/* the file's "defaults": a particle's mass and radius, a link's options (json.c) */
+typedef struct jdefaults {
+    wb_real mass, radius;
+    wb_distance_def link;
+} jdefaults;
+
+/* A constraint type in a particle config: its reader and writer, in its own file
+ * (json_NAME.c, beside core/NAME.c). Its elements are either an array of their own at the
+ * root (key: "volumes") or entries of "constraints" with its "type" (entry: "bend").
+ * - alloc: room in the image for n elements (NULL for distances: they fill the slots the
+ *   image is made with, which the snapshot's "distance_slots" describe);
+ * - read_item: the element at c (path p) into the image; *at: the type's own cursor, -1
+ *   before its first. The array of its own is read after the particles, colliders,
+ *   surfaces and rigid bodies; "constraints" after the particles;
+ * - read: for a type that reads its own array otherwise (arr may be NULL: none), in place
+ *   of alloc and read_item;
+ * - write: w:save's elements, each after jw_next (first: none written yet in the array;
+ *   returns whether still none). An array of its own is left out when it has none.
+ * The table (json_types.c) is in the order w:save writes them and the reader reads them;
+ * the root's keys and the entries' "type" names come from it */
 typedef struct jtype {
-    const char *key;
+    const char *key, *entry;
+    wb_status (*alloc)(wb_image *g, int32_t n);
+    int (*read_item)(rd *r, const cJSON *c, const kp *p, const jdefaults *d, wb_image *g, int32_t *at);
     int (*read)(rd *r, const cJSON *arr, wb_image *g);
-    void (*write)(jw_out *o, const wb_image *g);
+    int (*write)(jw_out *o, const wb_image *g, int first);
 } jtype;
-extern const jtype jtypes[];
+#define JT_MAX 16 /* the table's room */
+extern const jtype *const jtypes[];
 extern const int njtypes;
-/* json_material.c: "tets", "shape_matches" and "pressures" */
-int jm_read_shape_matches(rd *r, const cJSON *arr, wb_image *g);
-int jm_read_pressures(rd *r, const cJSON *arr, wb_image *g);
-int jm_read_tets(rd *r, const cJSON *arr, wb_image *g);
-void jm_write_tets(jw_out *o, const wb_image *g);
-void jm_write_shape_matches(jw_out *o, const wb_image *g);
-void jm_write_pressures(jw_out *o, const wb_image *g);
-/* json_attach.c: "attachments" and "grabs" */
-int ja_read_attachments(rd *r, const cJSON *arr, wb_image *g);
-int ja_read_grabs(rd *r, const cJSON *arr, wb_image *g);
-void ja_write_attachments(jw_out *o, const wb_image *g);
-void ja_write_grabs(jw_out *o, const wb_image *g);
+/* each in its file: json_distance.c, json_bend.c, ... */
+extern const jtype jt_distance, jt_bend, jt_volume, jt_tet, jt_shape_match, jt_pressure, jt_attach, jt_grab, jt_tether;
 /* json_rigid.c: the "rigids" section (arr may be NULL) into the image */
 int jr_read_rigids(rd *r, const cJSON *arr, wb_image *g);
 

@@ -1,14 +1,11 @@
-/* json_attach.c: the "attachments" and "grabs" sections of a particle config (docs/formats.md,
- * "Particle configs"):
+/* json_attach.c: attachments (core/attach.c) in a particle config: their "attachments"
+ * section (docs/formats.md, "Particle configs"):
  *
  *   "attachments": [ {"particle": 3, "collider": 0 | "rigid": 0, "point": [x,y,z], "compliance": 0}, ... ]
- *   "grabs": [ {"particle": 7 | "rigid": 0, "at": [x,y,z], "target": [x,y,z], "from": [x,y,z],
- *                "compliance": 0}, ... ]
  *
  * "collider" counts the file's "colliders" entries from 0, "rigid" its "rigids" entries
- * (removed slots included, as w:save writes them). "point" (in the target's frame) defaults to where the particle is, as w:attach does; "from" (where the next
- * step's sweep of the target starts) defaults to the target. w:save writes both. A rigid
- * body's grab names its body as attachments do; "at" (its frame) defaults to the centre. */
+ * (removed slots included, as w:save writes them). "point" (in the target's frame)
+ * defaults to where the particle is, as w:attach does; w:save writes it. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -30,7 +27,7 @@ static void rotate_inv(const wb_real q[4], const wb_real v[3], wb_real out[3])
 static int read_attach_items(rd *r, const cJSON *arr, const kp *parent, const char *const *keys, wb_image *g,
                      const int32_t *live, int32_t ncol);
 
-int ja_read_attachments(rd *r, const cJSON *arr, wb_image *g)
+static int read_attachments(rd *r, const cJSON *arr, wb_image *g)
 {
     static const char *const keys[] = { "particle", "collider", "point", "compliance", "rigid", NULL };
     kp top = { NULL, "attachments", 0 };
@@ -73,8 +70,11 @@ static int read_attach_items(rd *r, const cJSON *arr, const kp *parent, const ch
         if (ntarget == 0) return jv_fail(r, tf, 0, &tq, rigid ? "there are no rigid bodies" : "there are no colliders");
         wb_real a = 0;
         if (jv_opt_int(r, f[0], &p, "particle", 0, g->np - 1, &pid) ||
-            jv_opt_int(r, tf, &p, tkey, 0, ntarget - 1, &cid) || jv_opt_nonneg(r, f[3], &p, "compliance", &a))
+            jv_opt_int(r, tf, &p, tkey, 0, ntarget - 1, &cid) || jv_opt_real(r, f[3], &p, "compliance", &a))
             return -1;
+        /* the core decides the compliance (attach.c) */
+        const wb_fault ft = wb_attach_def_fault(a);
+        if (jv_fault(r, &ft, &p, keys, f, 0)) return -1;
         /* a collider: the cid-th live slot; a rigid body: the cid-th entry of "rigids" */
         const int32_t slot = rigid ? (int32_t)cid : live[cid];
         if (rigid && !(g->rb_gen[slot] & 1u)) return jv_fail(r, tf, 0, &tq, "that rigid body was removed");
@@ -103,55 +103,9 @@ static int read_attach_items(rd *r, const cJSON *arr, const kp *parent, const ch
     return 0;
 }
 
-int ja_read_grabs(rd *r, const cJSON *arr, wb_image *g)
-{
-    static const char *const keys[] = { "particle", "target", "from", "compliance", "rigid", "at", NULL };
-    kp top = { NULL, "grabs", 0 };
-    int32_t n = 0, i = 0;
-    if (!arr) return 0;
-    if (jv_get_array(r, arr, &top, WB_MAX_CONSTRAINTS, &n)) return -1;
-    if (wb_image_alloc_grab(g, n) != WB_OK) return jv_fail(r, arr, 0, &top, "out of memory");
-    for (const cJSON *c = arr->child; c; c = c->next, i++) {
-        const cJSON *f[6];
-        kp p = { &top, NULL, i };
-        int64_t pid;
-        if (jv_get_object(r, c, &p, keys, f)) return -1;
-        const int rigid = f[4] != NULL;
-        kp rq = { &p, "rigid", 0 }, aq = { &p, "at", 0 };
-        if (rigid && f[0]) return jv_fail(r, f[4], 0, &rq, "give particle or rigid, not both");
-        if (!rigid && f[5]) return jv_fail(r, f[5], 0, &aq, "is for a rigid body's grab (with \"rigid\")");
-        if (!f[0] && !rigid) return jv_fail(r, c, 0, &p, "missing key 'particle' (or 'rigid')");
-        if (!f[1]) return jv_missing(r, c, &p, "target");
-        wb_real *loc = &g->grab.local[3 * i];
-        if (rigid) {
-            if (g->nrb == 0) return jv_fail(r, f[4], 0, &rq, "there are no rigid bodies");
-            if (jv_opt_int(r, f[4], &p, "rigid", 0, g->nrb - 1, &pid)) return -1;
-            if (!(g->rb_gen[pid] & 1u)) return jv_fail(r, f[4], 0, &rq, "that rigid body was removed");
-            if (f[5] && jv_opt_vec(r, f[5], &p, "at", 3, loc)) return -1;
-        } else if (g->np == 0) {
-            kp q = { &p, "particle", 0 };
-            return jv_fail(r, f[0], 0, &q, "there are no particles");
-        }
-        wb_real a = 0, *t = &g->grab.target[3 * i], *fr = &g->grab.from[3 * i];
-        if ((!rigid && jv_opt_int(r, f[0], &p, "particle", 0, g->np - 1, &pid)) || jv_opt_vec(r, f[1], &p, "target", 3, t) ||
-            jv_opt_nonneg(r, f[3], &p, "compliance", &a))
-            return -1;
-        if (f[2]) {
-            if (jv_opt_vec(r, f[2], &p, "from", 3, fr)) return -1;
-        } else {
-            memcpy(fr, t, 3 * sizeof *fr);
-        }
-        g->grab.p[i] = (int32_t)pid;
-        g->grab.kind[i] = rigid; /* WB_GRAB_PARTICLE = 0, WB_GRAB_RIGID = 1 (grab.h) */
-        g->grab.alpha[i] = a;
-    }
-    return 0;
-}
-
 /* ---- writing (w:save) ------------------------------------------------------------------------ */
-/* "attachments": only when present. An attachment names its collider by its place among
- * the written (live) colliders */
-void ja_write_attachments(jw_out *o, const wb_image *g)
+/* An attachment names its collider by its place among the written (live) colliders */
+static int write_attachments(jw_out *o, const wb_image *g, int first)
 {
     FILE *f = o->f;
     const wb_image_attach *a = &g->att;
@@ -159,7 +113,7 @@ void ja_write_attachments(jw_out *o, const wb_image *g)
     int32_t *rank = a->n ? malloc(sizeof *rank * (size_t)(g->nc > 0 ? g->nc : 1)) : NULL;
     if (a->n && !rank) {
         o->nomem = 1;
-        return;
+        return first;
     }
     for (int32_t s = 0, r = 0; rank && s < g->nc; s++) {
         rank[s] = r;
@@ -168,38 +122,15 @@ void ja_write_attachments(jw_out *o, const wb_image *g)
     for (int32_t k = 0; k < a->n; k++) {
         /* a rigid body by its slot: w:save writes every slot of "rigids" */
         const int rigid = a->kind[k] == 1;
-        fprintf(f, "%s    {\"particle\": %d, \"%s\": %d, \"point\": ", k ? ",\n" : "  \"attachments\": [\n",
-                a->p[k], rigid ? "rigid" : "collider", rigid ? a->target[k] : rank[a->target[k]]);
+        jw_next(o, &first);
+        fprintf(f, "    {\"particle\": %d, \"%s\": %d, \"point\": ", a->p[k], rigid ? "rigid" : "collider",
+                rigid ? a->target[k] : rank[a->target[k]]);
         jw_vec(o, &a->local[3 * k], 3);
-        fputs(", \"compliance\": ", f);
-        jw_num(o, a->alpha[k]);
+        jw_key(o, "compliance", a->alpha[k]);
         fputc('}', f);
     }
-    if (a->n) fputs("\n  ],\n", f);
     free(rank);
+    return first;
 }
 
-/* "grabs": only when present */
-void ja_write_grabs(jw_out *o, const wb_image *g)
-{
-    FILE *f = o->f;
-    const wb_image_grab *gr = &g->grab;
-    for (int32_t k = 0; k < gr->n; k++) {
-        /* a rigid body by its slot, as attachments name theirs */
-        const int rigid = gr->kind[k] == 1;
-        fprintf(f, "%s    {\"%s\": %d, ", k ? ",\n" : "  \"grabs\": [\n", rigid ? "rigid" : "particle", gr->p[k]);
-        if (rigid) {
-            fputs("\"at\": ", f);
-            jw_vec(o, &gr->local[3 * k], 3);
-            fputs(", ", f);
-        }
-        fputs("\"target\": ", f);
-        jw_vec(o, &gr->target[3 * k], 3);
-        fputs(", \"from\": ", f);
-        jw_vec(o, &gr->from[3 * k], 3);
-        fputs(", \"compliance\": ", f);
-        jw_num(o, gr->alpha[k]);
-        fputc('}', f);
-    }
-    if (gr->n) fputs("\n  ],\n", f);
-}
+const jtype jt_attach = { .key = "attachments", .read = read_attachments, .write = write_attachments };

@@ -357,6 +357,20 @@ void jw_ints(FILE *f, const char *indent, const uint32_t *u, const int32_t *s, i
     fputc(']', f);
 }
 
+void jw_key(jw_out *o, const char *key, double x)
+{
+    fprintf(o->f, ", \"%s\": ", key);
+    jw_num(o, x);
+}
+
+void jw_next(jw_out *o, int *first)
+{
+    if (*first && o->head) fputs(o->head, o->f);
+    if (*first) o->head = NULL;
+    fputs(*first ? "\n" : ",\n", o->f);
+    *first = 0;
+}
+
 /* a volume's or a tet's plastic flow, only when it has one (files without stay as they were) */
 void jw_plastic(jw_out *o, const wb_real yc[2])
 {

@@ -29,8 +29,7 @@ static void write_snapshot(jw_out *o, const wb_image *g)
     const wb_world_def *d = &g->def;
     fputs("  \"snapshot\": {\n    \"world\": {\"gravity\": ", f);
     jw_vec(o, d->gravity, 3);
-    fputs(", \"dt\": ", f);
-    jw_num(o, d->dt);
+    jw_key(o, "dt", d->dt);
     fprintf(f, ", \"substeps\": %d, \"iterations\": %d, \"damping\": ", d->substeps, d->iterations);
     jw_num(o, d->damping);
     fprintf(f, ", \"solver\": \"%s\", \"relaxation\": ", d->solver == WB_SOLVER_VBD ? "vbd" : d->solver == WB_SOLVER_JACOBI ? "jacobi" : "gauss-seidel");
@@ -38,8 +37,7 @@ static void write_snapshot(jw_out *o, const wb_image *g)
     fprintf(f, ", \"threads\": %d, \"contacts\": %s, \"max_depenetration\": ", d->threads, d->contacts ? "true" : "false");
     jw_num(o, d->max_depenetration);
     if (d->tolerance > 0) { /* (left out when off: files of worlds without it as they were) */
-        fputs(", \"tolerance\": ", f);
-        jw_num(o, d->tolerance);
+        jw_key(o, "tolerance", d->tolerance);
     }
     fputs("},\n    \"time\": ", f);
     jw_num(o, g->time);
@@ -64,12 +62,9 @@ static void write_particles(jw_out *o, const wb_image *g)
         fputs(", \"velocity\": ", f);
         jw_vec(o, &g->v[3 * i], 3);
         /* mass for people, inv_mass for the exact restore */
-        fputs(", \"mass\": ", f);
-        jw_num(o, g->inv_mass[i] > 0 ? 1 / g->inv_mass[i] : 0);
-        fputs(", \"inv_mass\": ", f);
-        jw_num(o, g->inv_mass[i]);
-        fputs(", \"radius\": ", f);
-        jw_num(o, g->radius[i]);
+        jw_key(o, "mass", g->inv_mass[i] > 0 ? 1 / g->inv_mass[i] : 0);
+        jw_key(o, "inv_mass", g->inv_mass[i]);
+        jw_key(o, "radius", g->radius[i]);
         fprintf(f, ", \"pinned\": %s, \"group\": %d, \"friction\": ", g->pinned[i] ? "true" : "false", g->group[i]);
         jw_num(o, g->cfric[i]);
         fprintf(f, ", \"collide\": %s, \"self_collide\": %s, \"created_at\": ", (g->cflags[i] & 1) ? "true" : "false",
@@ -80,51 +75,27 @@ static void write_particles(jw_out *o, const wb_image *g)
     fputs(g->np ? "\n  ],\n" : "],\n", f);
 }
 
+/* "constraints": the entries of every type that has them (jtypes), in the table's order */
 static void write_constraints(jw_out *o, const wb_image *g)
 {
-    FILE *f = o->f;
     int first = 1;
-    fputs("  \"constraints\": [", f);
-    for (int32_t i = 0; i < g->dist.n; i++) {
-        if (!(g->dist.gen[i] & 1u)) continue;
-        fprintf(f, "%s    {\"type\": \"distance\", \"particles\": [%d, %d], \"rest\": ", first ? "\n" : ",\n",
-                g->dist.ij[2 * i], g->dist.ij[2 * i + 1]);
-        first = 0;
-        jw_num(o, g->dist.rest[i]);
-        fputs(", \"compliance\": ", f);
-        jw_num(o, g->dist.alpha[i]);
-        fputs(", \"damping\": ", f);
-        jw_num(o, g->dist.beta[i]);
-        fputs(", \"yield\": ", f);
-        jw_num(o, g->dist.yield[i]);
-        fputs(", \"creep\": ", f);
-        jw_num(o, g->dist.creep[i]);
-        fputs(", \"break_strain\": ", f);
-        jw_num(o, g->dist.break_strain[i]);
-        if (g->dist.bforce[i] > 0) { /* only when set: configs without it read as before */
-            fputs(", \"break_force\": ", f);
-            jw_num(o, g->dist.bforce[i]);
-        }
-        fprintf(f, ", \"broken\": %s}", g->dist.broken[i] ? "true" : "false");
+    fputs("  \"constraints\": [", o->f);
+    for (int i = 0; i < njtypes; i++)
+        if (jtypes[i]->entry) first = jtypes[i]->write(o, g, first);
+    fputs(first ? "],\n" : "\n  ],\n", o->f);
+}
+
+/* the types' arrays of their own, those that have elements (a file without stays as it was) */
+static void write_sections(jw_out *o, const wb_image *g)
+{
+    for (int i = 0; i < njtypes; i++) {
+        if (!jtypes[i]->key) continue;
+        char head[64];
+        snprintf(head, sizeof head, "  \"%s\": [", jtypes[i]->key);
+        o->head = head;
+        if (!jtypes[i]->write(o, g, 1)) fputs("\n  ],\n", o->f);
+        o->head = NULL;
     }
-    for (int32_t i = 0; i < g->bend.n; i++) {
-        const int32_t *p = &g->bend.ij[4 * i];
-        fprintf(f, "%s    {\"type\": \"bend\", \"particles\": [%d, %d, %d, %d], \"rest\": ", first ? "\n" : ",\n", p[0],
-                p[1], p[2], p[3]);
-        first = 0;
-        jw_num(o, g->bend.rest[i]);
-        fputs(", \"compliance\": ", f);
-        jw_num(o, g->bend.alpha[i]);
-        fputs(", \"damping\": ", f);
-        jw_num(o, g->bend.beta[i]);
-        if (g->bend.btorque[i] > 0) { /* only when set: configs without it read as before */
-            fputs(", \"break_torque\": ", f);
-            jw_num(o, g->bend.btorque[i]);
-        }
-        if (g->bend.broken[i]) fputs(", \"broken\": true", f);
-        fputc('}', f);
-    }
-    fputs(first ? "],\n" : "\n  ],\n", f);
 }
 
 /* one field of a shape (wobble.h's wb_shape_info lists) as "key": value: a collider's in its
@@ -177,10 +148,8 @@ static void write_colliders(jw_out *o, const wb_image *g)
         first = 0;
         /* the shape in the collider's own frame: what the pose carries */
         write_fields(o, wb_shape_info_of(c->shape)->own_fields, c, NULL);
-        fputs(", \"friction\": ", f);
-        jw_num(o, c->friction);
-        fputs(", \"restitution\": ", f);
-        jw_num(o, c->restitution);
+        jw_key(o, "friction", c->friction);
+        jw_key(o, "restitution", c->restitution);
         fputs(",\n     \"pose\": {\"position\": ", f);
         jw_vec(o, c->p, 3);
         fputs(", \"rotation\": ", f);
@@ -247,15 +216,14 @@ int wbio_write_snapshot(const wb_world *w, const char *path, const char *shown, 
         wb_image_free(&g);
         return -1;
     }
-    jw_out o = { file.f, 0, 0 };
+    jw_out o = { file.f, 0, 0, NULL };
     setvbuf(o.f, NULL, _IOFBF, 1 << 20);
     fprintf(o.f, "{\n  \"format\": \"%s\",\n  \"version\": %d,\n  \"description\": \"wobble %s snapshot at frame %lld\",\n",
             WBIO_FORMAT, WBIO_VERSION, WB_VERSION, (long long)g.frame);
     write_snapshot(&o, &g);
     write_particles(&o, &g);
     write_constraints(&o, &g);
-    for (int i = 0; i < njtypes; i++)
-        if (jtypes[i].write) jtypes[i].write(&o, &g);
+    write_sections(&o, &g);
     write_rigids(&o, &g);
     write_colliders(&o, &g);
     write_surfaces(&o, &g);

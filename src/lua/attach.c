@@ -13,16 +13,17 @@ typedef struct wbl_grab { wb_grab_id id; } wbl_grab;
 static const char *const keys[] = { "compliance", NULL };
 static const char *const grab_keys[] = { "compliance", "at", NULL };
 
-/* the compliance option at arg (absent: 0) */
-static wb_real read_compliance_keys(lua_State *L, int arg, const char *const *k)
+/* the compliance option at arg (absent: 0), as the type's core rule (fault) allows it */
+static wb_real read_compliance_keys(lua_State *L, int arg, const char *const *k, wb_fault (*fault)(wb_real))
 {
     wb_real a = 0;
-    if (wbl_checkopts(L, arg, k, true) && wbl_optreal(L, arg, "compliance", &a) && !(a >= 0))
-        wbl_fielderror(L, arg, "compliance", "must be >= 0 (m/N)");
+    if (wbl_checkopts(L, arg, k, true)) wbl_optreal(L, arg, "compliance", &a);
+    const wb_fault f = fault(a);
+    wbl_fault_error(L, &f, arg, arg, arg);
     return a;
 }
 
-static wb_real read_compliance(lua_State *L, int arg) { return read_compliance_keys(L, arg, keys); }
+static wb_real read_compliance(lua_State *L, int arg) { return read_compliance_keys(L, arg, keys, wb_attach_def_fault); }
 
 /* ---- attachments ------------------------------------------------------------------ */
 static wb_attach_id *push_attach(lua_State *L, int world_index)
@@ -178,7 +179,7 @@ static int w_grab(lua_State *L)
         if (!wb_rigid_valid(w, r)) return luaL_argerror(L, 2, "the rigid body was removed");
         wb_real t[3], at[3] = { 0, 0, 0 };
         wbl_checkvec(L, 3, 3, t);
-        const wb_real alpha = read_compliance_keys(L, 4, grab_keys);
+        const wb_real alpha = read_compliance_keys(L, 4, grab_keys, wb_grab_def_fault);
         if (!lua_isnoneornil(L, 4)) wbl_optvec(L, 4, "at", 3, at);
         wb_grab_id *id = push_grab(L, 1);
         wb_status st = WB_OK;
@@ -190,7 +191,7 @@ static int w_grab(lua_State *L)
     const int32_t p = wbl_checkparticle(L, w, 2);
     wb_real t[3];
     wbl_checkvec(L, 3, 3, t);
-    const wb_real alpha = read_compliance_keys(L, 4, grab_keys);
+    const wb_real alpha = read_compliance_keys(L, 4, grab_keys, wb_grab_def_fault);
     if (lua_istable(L, 4) && lua_getfield(L, 4, "at") != LUA_TNIL)
         return wbl_fielderror(L, 4, "at", "is for a rigid body's grab (a particle is grabbed where it is)");
     lua_settop(L, 4);

@@ -112,9 +112,13 @@ bool wbl_input_grab(wbl_input_log *log, wb_world *w, int world, int32_t particle
         snprintf(err, n, "grab: particle %lld out of range (the world has %d)", (long long)particle + 1, (int)np);
         return false;
     }
-    if (!isfinite(target[0]) || !isfinite(target[1]) || !isfinite(target[2]) || !(compliance >= 0) ||
-        !isfinite(compliance)) {
-        snprintf(err, n, "grab: the target must be finite and the compliance finite and >= 0");
+    if (!isfinite(target[0]) || !isfinite(target[1]) || !isfinite(target[2])) {
+        snprintf(err, n, "grab: the target must be finite");
+        return false;
+    }
+    const wb_fault f = wb_grab_def_fault(compliance); /* the core's rule (grab.c) */
+    if (f.msg) {
+        snprintf(err, n, "grab: %s", f.msg);
         return false;
     }
     /* room first, so that a grab done is a grab logged */
@@ -378,8 +382,10 @@ static int read_event(rd *r, const cJSON *it, const kp *p, int64_t i, fgrab **fg
         x->particle = (int32_t)(v - 1);
         item_pos(r, f[3], cur, &x->line, &x->col);
         if (!f[4]) return jv_missing(r, it, p, "target");
-        if (jv_opt_vec(r, f[4], p, "target", 3, x->target) || jv_opt_nonneg(r, f[5], p, "compliance", &x->compliance))
+        if (jv_opt_vec(r, f[4], p, "target", 3, x->target) || jv_opt_real(r, f[5], p, "compliance", &x->compliance))
             return -1;
+        const wb_fault ft = wb_grab_def_fault(x->compliance); /* the core's rule (grab.c) */
+        if (jv_fault(r, &ft, p, ev_keys[type], f, 3)) return -1;
         if ((*nfg & (*nfg - 1)) == 0) {  /* doubled at each power of two: one more each time copies n^2 */
             fgrab *n = realloc(*fg, (size_t)(*nfg ? 2 * *nfg : 1) * sizeof *n);
             if (!n) return jv_fail(r, it, 0, p, "out of memory");

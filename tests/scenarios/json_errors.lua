@@ -78,7 +78,7 @@ end)
 
 test("unknown, miscased and repeated keys are pointed at", function()
   bad(HEAD .. ' "particle": []}', NAME .. ":2:2: particle: unknown key 'particle' (expected one of: format, version, "
-      .. "description, defaults, particles, constraints, colliders, surfaces, parts, skins, snapshot, volumes, shape_matches, pressures, tets, attachments, grabs, rigids, tethers)")
+      .. "description, defaults, particles, constraints, colliders, surfaces, parts, skins, snapshot, rigids, volumes, tets, shape_matches, pressures, attachments, grabs, tethers)")
   bad(HEAD .. ' "Particles": []}', NAME .. ":2:2: Particles: unknown key 'Particles' (keys are case-sensitive: 'particles')")
   local t = HEAD .. ' "particles": [],\n "version": 1}'
   bad_at(t, '"version"', "version: duplicate key 'version' (first at line 1, column 32)", 40)
@@ -133,6 +133,13 @@ test("colliders: shapes and their keys", function()
       "colliders[0].pose: missing key 'rotation'")
   bad(TWO .. ' "colliders": [{"shape": "sphere", "center": [0,0,0], "pose": {"position": [0,0,0], "rotation": [1,0,0,0]}}]}',
       "a sphere with a pose takes radius in its own frame, not 'center'")
+  -- a shape in its own frame is judged by its shape's file, at the collider (not the file's root)
+  local POSE = '"pose": {"position": [0,0,0], "rotation": [1,0,0,0]}'
+  bad(TWO .. ' "colliders": [{"shape": "capsule", "a": [-1e200,0,0], "b": [1e200,0,0], "radius": 0.1, ' .. POSE .. '}]}',
+      "colliders[0]: capsule ends are too far apart")
+  bad(TWO .. ' "colliders": [{"shape": "box", "half": [1, 0, 1], ' .. POSE .. '}]}', "colliders[0]: box half extents must be > 0")
+  bad(TWO .. ' "colliders": [{"shape": "mesh", "radius": 1, "vertices": [0,0,0, 1,0,0, 0,1,0], "triangles": [0,1,2]}]}',
+      "colliders[0].radius: a mesh takes vertices triangles center rotation scale (and friction, restitution, pose), not 'radius'")
 end)
 
 test("surfaces, parts and skins", function()

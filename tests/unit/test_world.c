@@ -182,6 +182,16 @@ TEST(constraint_check_faults)
     pd.pressure = 0;
     f = wb_pressure_def_fault(&pd);
     REQUIRE(f.key); CHECK(strcmp(f.key, "pressure") == 0);
+    /* attachments and grabs: their compliance (m/N), finite and >= 0 */
+    wb_fault (*const point_faults[2])(wb_real) = { wb_attach_def_fault, wb_grab_def_fault };
+    for (int k = 0; k < 2; k++) {
+        CHECK(point_faults[k](0).msg == NULL);
+        CHECK(point_faults[k](1e-3).msg == NULL);
+        f = point_faults[k](-1e-9);
+        REQUIRE(f.key); CHECK(strcmp(f.key, "compliance") == 0); CHECK(strcmp(f.why, "must be >= 0 (m/N)") == 0);
+        CHECK(point_faults[k](NAN).msg != NULL);
+        CHECK(point_faults[k](INFINITY).msg != NULL);
+    }
 
     /* the add refuses what the check refuses, with its message */
     wb_world *w = new_world();
@@ -195,6 +205,14 @@ TEST(constraint_check_faults)
     CHECK_EQ(wb_bend_count(w), 0);
     wb_bend_add(w, ok, &bd, &st);
     CHECK_EQ(st, WB_OK); CHECK_EQ(wb_bend_count(w), 1);
+    wb_collider_def cd = wb_collider_default_def(WB_SHAPE_SPHERE);
+    const wb_collider_id c = wb_collider_add(w, &cd, &st);
+    REQUIRE(st == WB_OK);
+    wb_attach_collider(w, 0, c, -1, &st);
+    CHECK_EQ(st, WB_ERR_ARG); CHECK_HAS(wb_last_error(), "compliance must be >= 0");
+    wb_grab_add(w, 0, x, NAN, &st);
+    CHECK_EQ(st, WB_ERR_ARG); CHECK_HAS(wb_last_error(), "compliance must be >= 0");
+    CHECK_EQ(wb_attach_count(w), 0); CHECK_EQ(wb_grab_count(w), 0);
     wb_world_destroy(w);
 }
 
