@@ -71,15 +71,15 @@ struct wb_vbd {
  * (the augmented Lagrangian's own update). Its penalty k is fixed, VBD_LINK_K times the
  * inertia of its ends over the substep (start_penalty): a penalty that grew while a link
  * was stretched and decayed while it was not pumped energy into swinging chains (a rope
- * swinging at 40 x 4 gained twice its energy), and one below the inertia of a chain's
- * modes, with the multiplier carried over, made them grow (measured: 4 k0 let a 100-link
- * chain hang 6% long, 64 k0 let a two-pin cloth gain 3x its energy). Of the error a link
+ * swinging at 40 x 4 gained twice its energy); measured: 4 k0 let a 100-link chain hang 6%
+ * long, 16 k0 threw a lattice stacked on another, 64 k0 let a two-pin cloth gain 3x its
+ * energy. Of the error a link
  * begins the substep with it keeps VBD_STAB (AVBD's stabilisation): carried over, a
  * multiplier that also took in the error it had already corrected fed it back as speed
  * (0.99 let the clamped strip swing up again within 10 s at 10 x 1, 0.995 at 40 x 1).
  * A hard bend's penalty decays by VBD_WARM a substep down to its k0, grows by k0 for each
  * 1/VBD_RAMP rad it is off after a sweep, up to VBD_KMAX k0, its multiplier by k0 off */
-#define VBD_LINK_K ((wb_real)16)
+#define VBD_LINK_K ((wb_real)8)
 #define VBD_STAB ((wb_real)0.999)
 #define VBD_WARM ((wb_real)0.99)
 #define VBD_RAMP ((wb_real)1e3)
