@@ -81,6 +81,11 @@ struct wb_vbd {
  * 1/VBD_RAMP rad it is off after a sweep, up to VBD_KMAX k0, its multiplier by k0 off */
 #define VBD_LINK_K ((wb_real)8)
 #define VBD_STAB ((wb_real)0.999)
+/* in a world with volume constraints (projected after the sweeps) a body of rigid links
+ * and incompressible tets is over-constrained under a press: a link that takes its error
+ * back faster fights the tets (0.99: a block squeezed to 60% blew up 3 s on at 10 m/s), a
+ * slower one holds the squeeze after the press lets go (0.999: back to 0.87 of its height) */
+#define VBD_STAB_VOL ((wb_real)0.995)
 #define VBD_WARM ((wb_real)0.99)
 #define VBD_RAMP ((wb_real)1e3)
 #define VBD_KMAX ((wb_real)1e6)
@@ -566,7 +571,7 @@ static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2, wb_real in
          * a link (a 4 x 4 x 4 lattice's lowest links 17% short on a slope) */
         const wb_real c = v3_len(d) - rest, ce = v->c0[s];
         const wb_real c0 = keep_all || !isfinite(ce) ? c : c * ce <= 0 ? 0 : fabs(c) < fabs(ce) ? c : ce;
-        L->tgt = rest + VBD_STAB * c0, L->kk = VBD_LINK_K * start_penalty(w, s, inv_h2), L->lm = v->lam[s], L->dmp = 0;
+        L->tgt = rest + (keep_all ? VBD_STAB_VOL : VBD_STAB) * c0, L->kk = VBD_LINK_K * start_penalty(w, s, inv_h2), L->lm = v->lam[s], L->dmp = 0;
         put_entries(v, s, L);
         v->hard[v->nhard++] = s;
     }
@@ -666,22 +671,64 @@ static void write_forces(wb_world *w, const struct wb_vbd *v, wb_real h)
     }
 }
 
+/* v->tsum (bodies x 4) zeroed, with [4 b] = -1 for each body b that may touch particles
+ * or a rigid body this frame (the contacts found for the frame); 0 when there are no
+ * bodies (or no memory) */
+static int touching(wb_world *w, struct wb_vbd *v)
+{
+    const wb_cache *k = &w->k;
+    if (!k->mc_built || k->mc_nbody == 0) return 0;
+    const int32_t nb = k->mc_nbody, *body = k->mc_body;
+    if (nb > v->cap_tsum) {
+        double *t = realloc(v->tsum, sizeof *t * 4 * (size_t)nb);
+        if (!t) return 0;
+        v->tsum = t, v->cap_tsum = nb;
+    }
+    double *T = v->tsum;
+    memset(T, 0, sizeof *T * 4 * (size_t)nb);
+    const wb_contacts *pc = &k->pc;
+    for (int32_t c = 0; c < pc->n; c++)
+        for (int e = 0; e < 2; e++)
+            if (body[pc->ij[2 * c + e]] >= 0) T[4 * body[pc->ij[2 * c + e]]] = -1;
+    const wb_tricontacts *tc = &k->tc;
+    for (int32_t c = 0; c < tc->n; c++) {
+        const int32_t t = tc->pt[2 * c + 1], pts[4] = { tc->pt[2 * c], w->m.tri[3 * t], w->m.tri[3 * t + 1], w->m.tri[3 * t + 2] };
+        for (int e = 0; e < 4; e++)
+            if (body[pts[e]] >= 0) T[4 * body[pts[e]]] = -1;
+    }
+    if (w->rb)
+        for (int32_t c = 0; c < w->rb->npct; c++)
+            if (body[w->rb->pc[2 * c]] >= 0) T[4 * body[w->rb->pc[2 * c]]] = -1;
+    return 1;
+}
+
 /* The sweeps start from where its speed alone takes a vertex held by a constraint, the
  * prediction less this substep's gravity (x + h v; Chen et al. 2024 list it among their
- * starts), and a free vertex from the prediction, its minimum. A body at rest is then a
- * fixed point of a single sweep (from y itself, one sweep a substep never reaches it: a
- * bar of E = 1e7 hung at 18.6 mm where it stretches 0.049 mm). Their adaptive start, the
- * prediction less the part of gravity a vertex did not follow last substep, fed a
- * vertex's swing back into its next start: the clamped strip swung on at 10 x 1 (0.63 m
- * against 0.29) and the bar crept to 0.8 mm at 10 x 1 */
-static void start_guess(wb_world *w, const struct wb_vbd *v, wb_real h)
+ * starts), and a free vertex from the prediction, its minimum. A body held by pins or
+ * its own links is then at rest a fixed point of a single sweep (from y itself, one sweep
+ * a substep never reaches it: a bar of E = 1e7 hung at 18.6 mm where it stretches 0.049
+ * mm). Chen et al.'s adaptive start, the prediction less the part of gravity a vertex did
+ * not follow last substep, fed the swing of such a body back into its next start (the
+ * clamped strip swung on at 10 x 1, 0.63 m against 0.29; the bar crept to 0.8 mm at
+ * 10 x 1). A body that nothing holds (no pin, attachment or grab) but that may touch
+ * particles or a rigid body starts from the prediction: the contacts projected after the
+ * sweeps carry it and keep_momentum leaves it alone, so the gravity it follows is the one
+ * its start has (from x + h v, a lattice made overlapping another was lifted 0.25 m
+ * instead of 0.15; from the adaptive start, a stack still moved after 4 s). A held one
+ * touching itself keeps x + h v (from y, a pinned rope folding onto itself as it swung
+ * gained energy) */
+static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h)
 {
     const wb_real *g = w->m.def.gravity, *wv = w->m.w;
     wb_real *x = w->s.x;
+    const int touch = touching(w, v);
+    const int32_t *body = w->k.mc_body;
     for (int32_t i = 0; i < w->m.np; i++) {
         const int held = v->adj_start[i + 1] > v->adj_start[i] || v->tadj_start[i + 1] > v->tadj_start[i] ||
                          v->badj_start[i + 1] > v->badj_start[i];
-        if (wv[i] > 0 && held) v3_madd(&x[3 * i], g, -h * h);
+        const int32_t b = body ? body[i] : -1;
+        if (!(wv[i] > 0) || !held || (touch && b >= 0 && v->tsum[4 * b] < 0 && !(w->k.mc_acc[16 * b] < 0))) continue;
+        v3_madd(&x[3 * i], g, -h * h);
     }
 }
 
@@ -696,32 +743,13 @@ static void start_guess(wb_world *w, const struct wb_vbd *v, wb_real h)
 static void keep_momentum(wb_world *w, struct wb_vbd *v)
 {
     const wb_cache *k = &w->k;
-    if (!k->mc_built || k->mc_nbody == 0) return;
-    const int32_t nb = k->mc_nbody, *body = k->mc_body;
-    if (nb > v->cap_tsum) {
-        double *t = realloc(v->tsum, sizeof *t * 4 * (size_t)nb);
-        if (!t) return;
-        v->tsum = t, v->cap_tsum = nb;
-    }
-    double *T = v->tsum;
-    memset(T, 0, sizeof *T * 4 * (size_t)nb);
     /* a body that may touch particles or a rigid body this frame is left as the sweeps
      * leave it: the particle contacts projected after the solve would take the step back
      * from one side only (measured: two stacked lattices crept 3 cm off centre, a cloth
      * under falling particles slid off a sphere) */
-    const wb_contacts *pc = &k->pc;
-    for (int32_t c = 0; c < pc->n; c++)
-        for (int e = 0; e < 2; e++)
-            if (body[pc->ij[2 * c + e]] >= 0) T[4 * body[pc->ij[2 * c + e]]] = -1;
-    const wb_tricontacts *tc = &k->tc;
-    for (int32_t c = 0; c < tc->n; c++) {
-        const int32_t t = tc->pt[2 * c + 1], pts[4] = { tc->pt[2 * c], w->m.tri[3 * t], w->m.tri[3 * t + 1], w->m.tri[3 * t + 2] };
-        for (int e = 0; e < 4; e++)
-            if (body[pts[e]] >= 0) T[4 * body[pts[e]]] = -1;
-    }
-    if (w->rb)
-        for (int32_t c = 0; c < w->rb->npct; c++)
-            if (body[w->rb->pc[2 * c]] >= 0) T[4 * body[w->rb->pc[2 * c]]] = -1;
+    if (!touching(w, v)) return;
+    const int32_t nb = k->mc_nbody, *body = k->mc_body;
+    double *T = v->tsum;
     const wb_real *wv = w->m.w, *y = v->y;
     wb_real *x = w->s.x;
     for (int32_t i = 0; i < w->m.np; i++) {
