@@ -18,15 +18,21 @@ not_vbd="neo_stiff.lua residual.lua materials.lua"
 
 # They apply but fail under VBD today (docs/physics.md, "VBD": what it does not serve yet);
 # each is a bug of the solver, not of the test:
-#   hard links and bends in motion converge no faster than XPBD and carry multipliers that
-#   lag (a swinging chain stretches, a catenary's end link reads 3x its tension, a rigid
-#   link under load stretches past 1e-6, a rigid hinge is 6e-4 rad off after a frame):
-#     bending.lua hand_built.lua user/01_rope_hand_built.lua user/02_chain_catenary.lua
-#     user/03_cloth_hand_built_sphere.lua user/07_cloth_two_pins.lua attach_rigid.lua
-#     bend_break.lua tethers.lua
+#   rigid bends still ramp their penalty and correct their whole error each substep (with a
+#   fixed penalty and the multiplier carried over as rigid links have it, the clamped strip
+#   with rigid bends blew up): a rigid hinge is 6e-4 rad off after a frame, a bend reads
+#   more than its torque and breaks below it; a rigid link keeps 0.999 of its error a
+#   substep (vbd.c), so the first substep's stretch of one suddenly loaded (3e-6 of 0.5 m)
+#   trips a break_strain of 1e-6; VBD's multipliers are not in snapshots (a loaded world
+#   steps on differently: bending, bend_break, tethers); hand_built: its rope's "free end
+#   swung down" samples one instant (0.9 s) of XPBD's rope, 30% stretched, where VBD's (1%)
+#   has already whipped up past the pin, and a rope draped on another rests 2.2 mm low
+#   (contacts after the sweeps); tethers.lua's first test wants the cloth to stretch
+#   without tethers, which under VBD it does not (-1.6%: that check is XPBD's):
+#     bending.lua hand_built.lua bend_break.lua tethers.lua
 #   a stiff body touching particles or a rigid body keeps the translation of the sweeps'
-#   start (the prediction less the gravity it did not follow; a free one is moved to keep
-#   its momentum, docs/physics.md): blocks made overlapping part too fast, a box on a soft
+#   start (the prediction; a free one is moved to keep its momentum, docs/physics.md):
+#   blocks made overlapping part too fast, a box on a soft
 #   block spins, a block on another creeps below tan = mu, stacked blocks sink:
 #     contacts.lua contact_energy.lua contact_kinetic.lua made_overlapping.lua made_stack.lua
 #     symmetric_drop.lua user/10_rigid_on_soft.lua user/14_elastic_release_symmetry.lua
@@ -37,8 +43,7 @@ not_vbd="neo_stiff.lua residual.lua materials.lua"
 #     tests pass
 #   cloth falling on itself: self-contacts projected after the sweeps fight them (blow-ups):
 #     cloth_sphere_drop.lua self_collision.lua contact_triangles.lua contact_triangles_overlap.lua
-not_yet="bending.lua hand_built.lua user/01_rope_hand_built.lua user/02_chain_catenary.lua
-user/03_cloth_hand_built_sphere.lua user/07_cloth_two_pins.lua attach_rigid.lua bend_break.lua tethers.lua
+not_yet="bending.lua hand_built.lua bend_break.lua tethers.lua
 contacts.lua contact_energy.lua contact_kinetic.lua
 made_overlapping.lua made_stack.lua symmetric_drop.lua user/10_rigid_on_soft.lua
 user/14_elastic_release_symmetry.lua rigid_particle.lua squeeze.lua shape_match.lua penetration.lua cloth_sphere_drop.lua self_collision.lua contact_triangles.lua contact_triangles_overlap.lua"

@@ -10,9 +10,9 @@
  * A constraint of compliance alpha is the energy C^2 / (2 alpha), as in XPBD, so a material
  * means the same in both solvers. A hard one (alpha = 0) has no finite energy: it goes
  * through the augmented Lagrangian of Giles, Diaz, Yuksel ("Augmented Vertex Block
- * Descent", SIGGRAPH 2025), k C^2 / 2 + lambda C, lambda growing by k C and the penalty k
- * by how far C is off after each sweep, both carried from substep to substep (warm start)
- * so a hanging chain holds its tension instead of finding it again every substep.
+ * Descent", SIGGRAPH 2025), k C^2 / 2 + lambda C, lambda growing by k C after each sweep
+ * and carried from substep to substep (warm start) so a hanging chain holds its tension
+ * instead of finding it again every substep.
  *
  * Served: distance links. The other types are projected as in XPBD after each sweep, and
  * contacts, colliders and rigid bodies follow the sweeps as in the XPBD step (solver.c). */
@@ -26,11 +26,10 @@
 #include "volume.h"
 #include "vbd.h"
 
-/* a link as the sweep reads it (one load of 40 bytes instead of six arrays): its force
- * along it is kk (l - tgt) + lm and its stiffness kk; dmp: a soft link's damping beta / h */
+/* a link as the sweep reads it: its force along it is kk (l - tgt) + lm and its stiffness
+ * kk; dmp: a soft link's damping beta / h */
 typedef struct vbd_link {
-    wb_real tgt, kk, lm, dmp, k0;
-    wb_real kr, kmax;      /* a hard one's penalty growth per metre off, k0 VBD_RAMP / rest, and cap */
+    wb_real tgt, kk, lm, dmp;
 } vbd_link;
 
 struct wb_vbd {
@@ -51,10 +50,10 @@ struct wb_vbd {
     int serial_last;       /* the last colour holds vertices that may share a link (more
                               colours than a mask holds): it runs on one thread */
     wb_real *y;            /* (np x 3) the substep's prediction */
-    wb_real *vlast;        /* (np x 3) each vertex's velocity before gravity, last substep */
-    wb_real *lam, *kpen;   /* (nd) a hard link's multiplier and penalty */
-    wb_real *c0;           /* (nd) a hard link's error as the last solve left it (NaN: not
-                              known), of which it keeps VBD_STAB (AVBD's stabilisation) */
+    wb_real *lam;          /* (nd) a hard link's multiplier */
+    wb_real *c0;           /* (nd) a hard link's error as the last sweep left it, before the
+                              types projected after it (NaN: not known), of which it keeps
+                              VBD_STAB (AVBD's stabilisation) */
     vbd_link *lk;          /* (nd) what the sweep reads of each link, set each substep */
     int32_t *hard;         /* the live hard links' slots, this substep */
     int32_t nhard;
@@ -68,16 +67,28 @@ struct wb_vbd {
 
 #define VBD_COLOURS 64
 /* A hard link's multiplier lambda is kept whole from substep to substep (decayed, a chain
- * at rest kept a stretch of its decay over its penalty); its penalty k decays by VBD_WARM
- * a substep down to k0 (the inertia of its ends: start_penalty), grows by k0 for each
- * 1/VBD_RAMP of its rest length it is off after a sweep, up to VBD_KMAX k0. lambda grows
- * by k0 C, not k C: with k's growth in it, a 100-link chain's multipliers overshot and it
- * blew up. Of the error a link begins the substep with it keeps VBD_STAB (AVBD's
- * stabilisation: the rest is corrected, without it the correction was all speed) */
+ * at rest kept a stretch of its decay over its penalty) and grows by k C after each sweep
+ * (the augmented Lagrangian's own update). Its penalty k is fixed, VBD_LINK_K times the
+ * inertia of its ends over the substep (start_penalty): a penalty that grew while a link
+ * was stretched and decayed while it was not pumped energy into swinging chains (a rope
+ * swinging at 40 x 4 gained twice its energy); measured: 4 k0 let a 100-link chain hang 6%
+ * long, 16 k0 threw a lattice stacked on another, 64 k0 let a two-pin cloth gain 3x its
+ * energy. Of the error a link begins the substep with it keeps VBD_STAB (AVBD's
+ * stabilisation): carried over, a multiplier that also took in the error it had already
+ * corrected fed it back as speed (0.995: the clamped strip at 40 x 1 swung 0.15 m off its
+ * droop; all of it corrected, a 1-D chain's modes grew 15% a substep).
+ * A hard bend's penalty decays by VBD_WARM a substep down to its k0, grows by k0 for each
+ * 1/VBD_RAMP rad it is off after a sweep, up to VBD_KMAX k0, its multiplier by k0 off */
+#define VBD_LINK_K ((wb_real)8)
+#define VBD_STAB ((wb_real)0.999)
+/* in a world with volume constraints (projected after the sweeps) a body of rigid links
+ * and incompressible tets is over-constrained under a press: a link that takes its error
+ * back faster fights the tets (0.99: a block squeezed to 60% blew up 3 s on at 10 m/s), a
+ * slower one holds the squeeze after the press lets go (0.999: back to 0.87 of its height) */
+#define VBD_STAB_VOL ((wb_real)0.995)
 #define VBD_WARM ((wb_real)0.99)
 #define VBD_RAMP ((wb_real)1e3)
 #define VBD_KMAX ((wb_real)1e6)
-#define VBD_STAB ((wb_real)0.99)
 
 void wb__vbd_destroy(wb_world *w)
 {
@@ -100,9 +111,7 @@ void wb__vbd_destroy(wb_world *w)
     free(v->order);
     free(v->colour_start);
     free(v->y);
-    free(v->vlast);
     free(v->lam);
-    free(v->kpen);
     free(v->c0);
     free(v->blam);
     free(v->bkpen);
@@ -242,28 +251,21 @@ int wb__vbd_prepare(wb_world *w)
     const int32_t nt = w->neo ? w->neo->n : 0;
     if (m->topology_dirty || v->np != m->np || v->nd != m->nd || v->nt != nt || v->nb != w->bend.n) {
         if (!build_adjacency(w, v) || !build_colours(w, v)) return 0;
-        const int32_t np0 = v->np > 0 ? v->np : 0;
         wb_real *y = realloc(v->y, sizeof *y * 3 * (size_t)(m->np > 0 ? m->np : 1));
         if (!y) return 0;
         v->y = y;
-        wb_real *vl = realloc(v->vlast, sizeof *vl * 3 * (size_t)(m->np > 0 ? m->np : 1));
-        if (!vl) return 0;
-        v->vlast = vl;
-        if (m->np > np0) memset(vl + 3 * np0, 0, sizeof *vl * 3 * (size_t)(m->np - np0));
         if (m->nd > v->cap_lam) {
-            wb_real *lam = realloc(v->lam, sizeof *lam * (size_t)m->nd), *kp = realloc(v->kpen, sizeof *kp * (size_t)m->nd);
+            wb_real *lam = realloc(v->lam, sizeof *lam * (size_t)m->nd);
             if (lam) v->lam = lam;
-            if (kp) v->kpen = kp;
             wb_real *c0 = realloc(v->c0, sizeof *c0 * (size_t)m->nd);
             if (c0) v->c0 = c0;
             vbd_link *lk = realloc(v->lk, sizeof *lk * (size_t)m->nd);
             if (lk) v->lk = lk;
             int32_t *hd = realloc(v->hard, sizeof *hd * (size_t)m->nd);
             if (hd) v->hard = hd;
-            if (!lam || !kp || !c0 || !lk || !hd) return 0;
-            /* new slots start with no multiplier and no penalty (set at their first use) */
+            if (!lam || !c0 || !lk || !hd) return 0;
+            /* new slots start with no multiplier */
             memset(v->lam + v->cap_lam, 0, sizeof *lam * (size_t)(m->nd - v->cap_lam));
-            memset(v->kpen + v->cap_lam, 0, sizeof *kp * (size_t)(m->nd - v->cap_lam));
             v->cap_lam = m->nd;
         }
         if (w->bend.n > v->cap_blam) {
@@ -524,8 +526,7 @@ static void sweep_part(void *ctx, int32_t lo, int32_t hi)
 }
 
 /* ---- the hard links' multipliers ------------------------------------------------------------ */
-/* the penalty a hard link starts from, the inertia of its ends over the substep (a
- * stiffer start overshoots, a softer one needs more sweeps), and its cap */
+/* the inertia of a hard link's ends over the substep, 1 / (h^2 (w_i + w_j)) */
 static wb_real start_penalty(const wb_world *w, int32_t s, wb_real inv_h2)
 {
     const wb_real wsum = w->m.w[w->m.d_ij[2 * s]] + w->m.w[w->m.d_ij[2 * s + 1]];
@@ -557,7 +558,7 @@ static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2, wb_real in
         vbd_link *L = &v->lk[s];
         const wb_real alpha = m->d_alpha[s], rest = w->s.d_rest[s];
         if (alpha > 0) {
-            L->tgt = rest, L->kk = 1 / alpha, L->lm = 0, L->k0 = 0;
+            L->tgt = rest, L->kk = 1 / alpha, L->lm = 0;
             L->dmp = m->d_beta[s] > 0 ? m->d_beta[s] * inv_h : 0;
             put_entries(v, s, L);
             continue;
@@ -570,10 +571,8 @@ static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2, wb_real in
          * a link (a 4 x 4 x 4 lattice's lowest links 17% short on a slope) */
         const wb_real c = v3_len(d) - rest, ce = v->c0[s];
         const wb_real c0 = keep_all || !isfinite(ce) ? c : c * ce <= 0 ? 0 : fabs(c) < fabs(ce) ? c : ce;
-        const wb_real k0 = start_penalty(w, s, inv_h2);
-        v->kpen[s] = v->kpen[s] * VBD_WARM > k0 ? v->kpen[s] * VBD_WARM : k0;
-        L->tgt = rest + VBD_STAB * c0, L->kk = v->kpen[s], L->lm = v->lam[s], L->dmp = 0, L->k0 = k0;
-        L->kr = k0 * VBD_RAMP / (rest > 0 ? rest : 1), L->kmax = VBD_KMAX * k0;
+        L->tgt = rest + (keep_all ? VBD_STAB_VOL : VBD_STAB) * c0;
+        L->kk = VBD_LINK_K * start_penalty(w, s, inv_h2), L->lm = v->lam[s], L->dmp = 0;
         put_entries(v, s, L);
         v->hard[v->nhard++] = s;
     }
@@ -588,26 +587,18 @@ static void dual_update(wb_world *w, struct wb_vbd *v)
         vbd_link *L = &v->lk[s];
         wb_real d[3];
         v3_sub(d, &x[3 * a], &x[3 * b]);
-        const wb_real C = v3_len(d) - L->tgt, k = L->kk + L->kr * fabs(C);
-        L->lm += L->k0 * C;
-        L->kk = k < L->kmax ? k : L->kmax;
+        const wb_real l = v3_len(d);
+        L->lm += L->kk * (l - L->tgt);
+        v->c0[s] = l - w->s.d_rest[s]; /* (before the types projected after the sweep) */
         const int32_t e = v->epos[2 * s], f = v->epos[2 * s + 1];
-        v->ekk[e] = v->ekk[f] = L->kk, v->elm[e] = v->elm[f] = L->lm;
+        v->elm[e] = v->elm[f] = L->lm;
     }
 }
 
-/* the hard links' multipliers, penalties and errors carried to the next substep */
-static void keep_multipliers(wb_world *w, struct wb_vbd *v)
+/* the hard links' multipliers carried to the next substep */
+static void keep_multipliers(struct wb_vbd *v)
 {
-    const wb_model *m = &w->m;
-    const wb_real *x = w->s.x;
-    for (int32_t q = 0; q < v->nhard; q++) {
-        const int32_t s = v->hard[q];
-        v->lam[s] = v->lk[s].lm, v->kpen[s] = v->lk[s].kk;
-        wb_real d[3];
-        v3_sub(d, &x[3 * m->d_ij[2 * s]], &x[3 * m->d_ij[2 * s + 1]]);
-        v->c0[s] = v3_len(d) - w->s.d_rest[s];
-    }
+    for (int32_t q = 0; q < v->nhard; q++) v->lam[v->hard[q]] = v->lk[v->hard[q]].lm;
 }
 
 /* a hard bend's penalty to start from: the inertia of its angle, 1 / (h^2 sum w |g|^2) */
@@ -680,25 +671,64 @@ static void write_forces(wb_world *w, const struct wb_vbd *v, wb_real h)
     }
 }
 
-/* The sweeps start from the prediction less the part of gravity's pull the vertex did not
- * follow last substep (Chen et al. 2024's adaptive initialisation): from y itself, one
- * sweep a substep never reaches a body at rest, whose substep minimum is where it was (a
- * bar of E = 1e7 hung at 18.6 mm where it stretches 0.049 mm) */
+/* v->tsum (bodies x 4) zeroed, with [4 b] = -1 for each body b that may touch particles
+ * or a rigid body this frame (the contacts found for the frame); 0 when there are no
+ * bodies (or no memory) */
+static int touching(wb_world *w, struct wb_vbd *v)
+{
+    const wb_cache *k = &w->k;
+    if (!k->mc_built || k->mc_nbody == 0) return 0;
+    const int32_t nb = k->mc_nbody, *body = k->mc_body;
+    if (nb > v->cap_tsum) {
+        double *t = realloc(v->tsum, sizeof *t * 4 * (size_t)nb);
+        if (!t) return 0;
+        v->tsum = t, v->cap_tsum = nb;
+    }
+    double *T = v->tsum;
+    memset(T, 0, sizeof *T * 4 * (size_t)nb);
+    const wb_contacts *pc = &k->pc;
+    for (int32_t c = 0; c < pc->n; c++)
+        for (int e = 0; e < 2; e++)
+            if (body[pc->ij[2 * c + e]] >= 0) T[4 * body[pc->ij[2 * c + e]]] = -1;
+    const wb_tricontacts *tc = &k->tc;
+    for (int32_t c = 0; c < tc->n; c++) {
+        const int32_t t = tc->pt[2 * c + 1], pts[4] = { tc->pt[2 * c], w->m.tri[3 * t], w->m.tri[3 * t + 1], w->m.tri[3 * t + 2] };
+        for (int e = 0; e < 4; e++)
+            if (body[pts[e]] >= 0) T[4 * body[pts[e]]] = -1;
+    }
+    if (w->rb)
+        for (int32_t c = 0; c < w->rb->npct; c++)
+            if (body[w->rb->pc[2 * c]] >= 0) T[4 * body[w->rb->pc[2 * c]]] = -1;
+    return 1;
+}
+
+/* The sweeps start from where its speed alone takes a vertex held by a constraint, the
+ * prediction less this substep's gravity (x + h v; Chen et al. 2024 list it among their
+ * starts), and a free vertex from the prediction, its minimum. A body held by pins or
+ * its own links is then at rest a fixed point of a single sweep (from y itself, one sweep
+ * a substep never reaches it: a bar of E = 1e7 hung at 18.6 mm where it stretches 0.049
+ * mm). Chen et al.'s adaptive start, the prediction less the part of gravity a vertex did
+ * not follow last substep, fed the swing of such a body back into its next start (the
+ * clamped strip swung on at 10 x 1, 0.63 m against 0.29; the bar crept to 0.8 mm at
+ * 10 x 1). A body that nothing holds (no pin, attachment or grab) but that may touch
+ * particles or a rigid body starts from the prediction: the contacts projected after the
+ * sweeps carry it and keep_momentum leaves it alone, so the gravity it follows is the one
+ * its start has (from x + h v, a lattice made overlapping another was lifted 0.25 m
+ * instead of 0.15; from the adaptive start, a stack still moved after 4 s). A held one
+ * touching itself keeps x + h v (from y, a pinned rope folding onto itself as it swung
+ * gained energy) */
 static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h)
 {
-    const wb_real *g = w->m.def.gravity, gl = v3_len(g), *wv = w->m.w;
-    wb_real *x = w->s.x, *vel = w->s.v;
+    const wb_real *g = w->m.def.gravity, *wv = w->m.w;
+    wb_real *x = w->s.x;
+    const int touch = touching(w, v);
+    const int32_t *body = w->k.mc_body;
     for (int32_t i = 0; i < w->m.np; i++) {
-        if (!(wv[i] > 0)) continue;
-        wb_real u[3], a[3];
-        v3_copy(u, &vel[3 * i]);
-        v3_madd(u, g, -h);              /* its velocity before this substep's gravity */
-        v3_sub(a, u, &v->vlast[3 * i]);
-        v3_copy(&v->vlast[3 * i], u);
-        if (!(gl > 0)) continue;
-        wb_real k = v3_dot(a, g) / (gl * gl * h); /* how much of g it fell with */
-        k = k < 0 ? 0 : k > 1 ? 1 : k;
-        v3_madd(&x[3 * i], g, -(1 - k) * h * h);
+        const int held = v->adj_start[i + 1] > v->adj_start[i] || v->tadj_start[i + 1] > v->tadj_start[i] ||
+                         v->badj_start[i + 1] > v->badj_start[i];
+        const int32_t b = body ? body[i] : -1;
+        if (!(wv[i] > 0) || !held || (touch && b >= 0 && v->tsum[4 * b] < 0 && !(w->k.mc_acc[16 * b] < 0))) continue;
+        v3_madd(&x[3 * i], g, -h * h);
     }
 }
 
@@ -713,32 +743,13 @@ static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h)
 static void keep_momentum(wb_world *w, struct wb_vbd *v)
 {
     const wb_cache *k = &w->k;
-    if (!k->mc_built || k->mc_nbody == 0) return;
-    const int32_t nb = k->mc_nbody, *body = k->mc_body;
-    if (nb > v->cap_tsum) {
-        double *t = realloc(v->tsum, sizeof *t * 4 * (size_t)nb);
-        if (!t) return;
-        v->tsum = t, v->cap_tsum = nb;
-    }
-    double *T = v->tsum;
-    memset(T, 0, sizeof *T * 4 * (size_t)nb);
     /* a body that may touch particles or a rigid body this frame is left as the sweeps
      * leave it: the particle contacts projected after the solve would take the step back
      * from one side only (measured: two stacked lattices crept 3 cm off centre, a cloth
      * under falling particles slid off a sphere) */
-    const wb_contacts *pc = &k->pc;
-    for (int32_t c = 0; c < pc->n; c++)
-        for (int e = 0; e < 2; e++)
-            if (body[pc->ij[2 * c + e]] >= 0) T[4 * body[pc->ij[2 * c + e]]] = -1;
-    const wb_tricontacts *tc = &k->tc;
-    for (int32_t c = 0; c < tc->n; c++) {
-        const int32_t t = tc->pt[2 * c + 1], pts[4] = { tc->pt[2 * c], w->m.tri[3 * t], w->m.tri[3 * t + 1], w->m.tri[3 * t + 2] };
-        for (int e = 0; e < 4; e++)
-            if (body[pts[e]] >= 0) T[4 * body[pts[e]]] = -1;
-    }
-    if (w->rb)
-        for (int32_t c = 0; c < w->rb->npct; c++)
-            if (body[w->rb->pc[2 * c]] >= 0) T[4 * body[w->rb->pc[2 * c]]] = -1;
+    if (!touching(w, v)) return;
+    const int32_t nb = k->mc_nbody, *body = k->mc_body;
+    double *T = v->tsum;
     const wb_real *wv = w->m.w, *y = v->y;
     wb_real *x = w->s.x;
     for (int32_t i = 0; i < w->m.np; i++) {
@@ -784,7 +795,7 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
         if (w->m.def.tolerance > 0 && v->residual <= w->m.def.tolerance) break;
     }
     keep_momentum(w, v);
-    keep_multipliers(w, v);
+    keep_multipliers(v);
     write_forces(w, v, h);
     return v->residual;
 }

@@ -9,20 +9,20 @@
 -- leave it. The scenes carry a drag (world damping) so that they come to rest in the time
 -- they run; the drag changes no resting position (it acts on velocities only).
 --  1. A Neo-Hookean bar, E = 1e7 Pa (nu 0.3), 1 m x 0.1 x 0.1, 1 kg (rho = 100), hung from
---     its top face: it stretches rho g L^2 / (2E) = 0.049 mm under its weight. At 5
---     substeps x 1 iteration VBD within 15% and no tet inverted; XPBD (the same 5 x 1)
---     inverts tets and collapses.
+--     its top face: it stretches rho g L^2 / (2E) = 0.049 mm under its weight. At 5 and at
+--     10 substeps x 1 iteration VBD within 15% and no tet inverted (more substeps must not
+--     make it worse); XPBD (the same 5 x 1) inverts tets and collapses.
 --  2. A hand-built chain of 100 rigid links (1 cm, 10 g beads) hanging from a pin: its
 --     length within 1% at 5 x 1; XPBD more than 10% long.
 --  3. The 1 m strip of 21 x 3 (rigid links, bends 0.2 rad/(N m)) clamped at one end droops
---     within 10% of its converged droop (XPBD at 10 x 100) at 40 x 1.
+--     within 10% of its converged droop (XPBD at 10 x 100) at the default 10 x 1 and at 40 x 1.
 --  4. Free fall is the same as XPBD's (no constraint: the Newton step is the prediction),
 --     and the result is the same on 1 and 2 threads.
 
 local G = 9.81
 
-local function bar(solver)
-  local w = wobble.world{ solver = solver, substeps = 5, damping = 20 }
+local function bar(solver, substeps)
+  local w = wobble.world{ solver = solver, substeps = substeps or 5, damping = 20 }
   local b = w:lattice{ min = { 0, 0, 0 }, max = { 0.1, 1, 0.1 }, res = { 3, 21, 3 }, mass = 1, tets = true, young = 1e7,
                        poisson = 0.3 }
   local bottom = {}
@@ -43,9 +43,13 @@ local function bar(solver)
   return -s, inverted
 end
 
-test("a stiff Neo-Hookean bar hangs stretched by rho g L^2 / 2E at 5 x 1", function()
+test("a stiff Neo-Hookean bar hangs stretched by rho g L^2 / 2E at 5 x 1 and 10 x 1", function()
   local want = 100 * G / (2 * 1e7)
   local e, inv = bar("vbd")
+  local e10, inv10 = bar("vbd", 10)
+  print(string.format("# bar at 10 x 1: VBD %.4f mm (%d inverted)", 1e3 * e10, inv10))
+  expect.near(e10, want, 0.15 * want, "VBD's stretch at 10 x 1")
+  expect.eq(inv10, 0, "VBD at 10 x 1: no tet inverted")
   print("expected on stderr: a warning that Neo-Hookean tets are inverted (XPBD's twin, on purpose)")
   local ex, invx = bar("gauss-seidel")
   print(string.format("# bar: VBD %.4f mm (%d inverted), XPBD %.4f mm (%d inverted), analytic %.4f mm", 1e3 * e, inv, 1e3 * ex,
@@ -93,10 +97,11 @@ local function strip(solver, substeps, iterations)
   return 1 - low
 end
 
-test("the clamped strip droops within 10% of its converged droop at 40 x 1", function()
+test("the clamped strip droops within 10% of its converged droop at 10 x 1 and 40 x 1", function()
   print("expected on stderr: a blow-up warning from the converged XPBD reference (10 x 100, its clamped end)")
-  local ref, v40, x40 = strip("gauss-seidel", 10, 100), strip("vbd", 40, 1), strip("gauss-seidel", 40, 1)
-  print(string.format("# strip: converged %.4f m; at 40 x 1 VBD %.4f, XPBD %.4f", ref, v40, x40))
+  local ref, v10, v40, x40 = strip("gauss-seidel", 10, 100), strip("vbd", 10, 1), strip("vbd", 40, 1), strip("gauss-seidel", 40, 1)
+  print(string.format("# strip: converged %.4f m; VBD %.4f at 10 x 1, %.4f at 40 x 1; XPBD %.4f at 40 x 1", ref, v10, v40, x40))
+  expect.near(v10, ref, 0.1 * ref, "VBD at 10 x 1")
   expect.near(v40, ref, 0.1 * ref, "VBD at 40 x 1")
   expect.gt(math.abs(x40 - ref), 0.1 * ref, "XPBD at 40 x 1 is not")
 end)
