@@ -24,10 +24,17 @@ not_vbd="neo_stiff.lua residual.lua materials.lua"
 #     bending.lua hand_built.lua user/01_rope_hand_built.lua user/02_chain_catenary.lua
 #     user/03_cloth_hand_built_sphere.lua user/07_cloth_two_pins.lua attach_rigid.lua
 #     bend_break.lua tethers.lua
-#   a stiff body touching particles or a rigid body keeps the translation of the sweeps'
-#   start (the prediction less the gravity it did not follow; a free one is moved to keep
-#   its momentum, docs/physics.md): blocks made overlapping part too fast, a box on a soft
-#   block spins, a block on another creeps below tan = mu, stacked blocks sink:
+#   a stiff body touching a movable particle of another body or a rigid body is not moved
+#   to keep its momentum (docs/physics.md, "VBD"): its translation is its sweeps' start's
+#   (the prediction less the gravity it did not follow). Stacked blocks jiggle 1-2 cm
+#   (contacts.lua) and a block on a pinned slab creeps 3.8 mm in 1 s at 0.95 of tan = mu
+#   (contacts.lua; bound 1 mm), blocks made overlapping part too fast (made_overlapping,
+#   made_stack, contact_energy), a box on a soft block spins (symmetric_drop, user/10), two
+#   free bodies sliding on each other lose momentum (contact_kinetic), a box falling on a
+#   cloth trampoline leaves it (rigid_particle), a block released from a press drifts
+#   sideways (user/14), a stiff block under a press runs at 8 m/s (squeeze); shape matching
+#   is projected after each sweep, so at 4 iterations it sags 11.65 where the test allows
+#   0.049 (its spring of 2 g / kappa at 1 iteration, shape_match):
 #     contacts.lua contact_energy.lua contact_kinetic.lua made_overlapping.lua made_stack.lua
 #     symmetric_drop.lua user/10_rigid_on_soft.lua user/14_elastic_release_symmetry.lua
 #     rigid_particle.lua squeeze.lua shape_match.lua
@@ -35,13 +42,15 @@ not_vbd="neo_stiff.lua residual.lua materials.lua"
 #     step) is chance: its lattice slides off as under XPBD, and of the rain 0 particles
 #     stay at the defaults, 1-4 at 8 or 12 substeps or 2 iterations (XPBD 2-7); its other
 #     tests pass
-#   cloth falling on itself: self-contacts projected after the sweeps fight them (blow-ups):
-#     cloth_sphere_drop.lua self_collision.lua contact_triangles.lua contact_triangles_overlap.lua
+#   cloth falling on itself: self-contacts projected after the sweeps fight them (blow-ups;
+#   contact_triangles.lua: a cloth folded onto itself passes through its sheet, a small
+#   body sinks into a soft block's hull; its 4 other tests pass):
+#     cloth_sphere_drop.lua self_collision.lua contact_triangles.lua
 not_yet="bending.lua hand_built.lua user/01_rope_hand_built.lua user/02_chain_catenary.lua
 user/03_cloth_hand_built_sphere.lua user/07_cloth_two_pins.lua attach_rigid.lua bend_break.lua tethers.lua
 contacts.lua contact_energy.lua contact_kinetic.lua
 made_overlapping.lua made_stack.lua symmetric_drop.lua user/10_rigid_on_soft.lua
-user/14_elastic_release_symmetry.lua rigid_particle.lua squeeze.lua shape_match.lua penetration.lua cloth_sphere_drop.lua self_collision.lua contact_triangles.lua contact_triangles_overlap.lua"
+user/14_elastic_release_symmetry.lua rigid_particle.lua squeeze.lua shape_match.lua penetration.lua cloth_sphere_drop.lua self_collision.lua contact_triangles.lua"
 
 set --
 for f in $(find tests/validation -name '*.lua' | sort); do

@@ -63,8 +63,8 @@ struct wb_vbd {
     int32_t cap_blam;
     wb_real residual;      /* the last sweep's largest step, m */
     double *tsum;          /* (bodies x 4) each free body's mass and sum m (x - y) */
-    uint8_t *touch;        /* (bodies) 1: may touch a movable particle of another body, a loose
-                              one or a rigid body this frame (touching()) */
+    uint8_t *touch;        /* (bodies) 1: may touch a movable particle of another body or a
+                              rigid body this frame (touching()) */
     int32_t cap_touch;
     int32_t cap_tsum;
 };
@@ -684,15 +684,12 @@ static void write_forces(wb_world *w, const struct wb_vbd *v, wb_real h)
     }
 }
 
-/* What each body may touch this frame outside itself (its contact candidates; a body's
- * own folds and loose particles do not count): TOUCH_MOVING, a movable particle of another
- * body or a rigid body; TOUCH_FIXED, an immovable particle of another body (a pinned slab,
- * as a collider). The contacts are projected after the sweeps: a body touching either
- * starts its sweeps from the prediction, not the adaptive guess (below), and one touching
- * something movable is not moved to keep its momentum (keep_momentum). 0 when there are no
- * bodies (or out of memory: then none is marked) */
-#define TOUCH_MOVING 1
-#define TOUCH_FIXED 2
+/* Which bodies may touch something movable outside themselves this frame (its contact
+ * candidates): a movable particle of another body or a rigid body. Those contacts are
+ * projected after the sweeps and move both sides, so such a body is not moved to keep its
+ * momentum (keep_momentum). A body's own folds, loose particles and immovable particles (a
+ * pinned slab, as a collider) do not count: the contacts with them keep the momentum the
+ * move keeps. 0 when there are no bodies (or out of memory: then none is marked) */
 static int touching(wb_world *w, struct wb_vbd *v)
 {
     const wb_cache *k = &w->k;
@@ -710,20 +707,20 @@ static int touching(wb_world *w, struct wb_vbd *v)
     for (int32_t c = 0; c < pc->n; c++) {
         const int32_t i = pc->ij[2 * c], j = pc->ij[2 * c + 1], a = body[i], b = body[j];
         if (a < 0 || b < 0 || a == b) continue;
-        T[a] |= wv[j] > 0 ? TOUCH_MOVING : TOUCH_FIXED;
-        T[b] |= wv[i] > 0 ? TOUCH_MOVING : TOUCH_FIXED;
+        T[a] |= wv[j] > 0;
+        T[b] |= wv[i] > 0;
     }
     const wb_tricontacts *tc = &k->tc;
     for (int32_t c = 0; c < tc->n; c++) {
         const int32_t t = tc->pt[2 * c + 1], p[4] = { tc->pt[2 * c], w->m.tri[3 * t], w->m.tri[3 * t + 1], w->m.tri[3 * t + 2] };
         const int32_t a = body[p[0]], b = body[p[1]];
         if (a < 0 || b < 0 || a == b) continue;
-        T[a] |= wv[p[1]] > 0 || wv[p[2]] > 0 || wv[p[3]] > 0 ? TOUCH_MOVING : TOUCH_FIXED;
-        T[b] |= wv[p[0]] > 0 ? TOUCH_MOVING : TOUCH_FIXED;
+        T[a] |= wv[p[1]] > 0 || wv[p[2]] > 0 || wv[p[3]] > 0;
+        T[b] |= wv[p[0]] > 0;
     }
     if (w->rb)
         for (int32_t c = 0; c < w->rb->npct; c++)
-            if (body[w->rb->pc[2 * c]] >= 0) T[body[w->rb->pc[2 * c]]] |= TOUCH_MOVING;
+            if (body[w->rb->pc[2 * c]] >= 0) T[body[w->rb->pc[2 * c]]] = 1;
     return 1;
 }
 
@@ -731,9 +728,8 @@ static int touching(wb_world *w, struct wb_vbd *v)
  * follow last substep (Chen et al. 2024's adaptive initialisation): from y itself, one
  * sweep a substep never reaches a body at rest, whose substep minimum is where it was (a
  * bar of E = 1e7 hung at 18.6 mm where it stretches 0.049 mm) */
-static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h, int touch)
+static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h)
 {
-    const int32_t *body = w->k.mc_body;
     const wb_real *g = w->m.def.gravity, gl = v3_len(g), *wv = w->m.w;
     wb_real *x = w->s.x, *vel = w->s.v;
     for (int32_t i = 0; i < w->m.np; i++) {
@@ -743,7 +739,7 @@ static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h, int touch)
         v3_madd(u, g, -h);              /* its velocity before this substep's gravity */
         v3_sub(a, u, &v->vlast[3 * i]);
         v3_copy(&v->vlast[3 * i], u);
-        if (!(gl > 0) || (touch && body[i] >= 0 && v->touch[body[i]])) continue;
+        if (!(gl > 0)) continue;
         wb_real k = v3_dot(a, g) / (gl * gl * h); /* how much of g it fell with */
         k = k < 0 ? 0 : k > 1 ? 1 : k;
         v3_madd(&x[3 * i], g, -(1 - k) * h * h);
@@ -772,11 +768,12 @@ static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch)
     memset(T, 0, sizeof *T * 4 * (size_t)nb);
     /* a body touching something movable (touching()) is left as the sweeps leave it: the
      * particle contacts projected after the solve would take the step back from one side
-     * only (measured: two stacked lattices crept 3 cm off centre, a cloth under falling
-     * particles slid off a sphere; two stacked blocks moved as one fell through each other) */
+     * only (measured: two stacked lattices crept 3 cm off centre; moved as one, two stacked
+     * lattices fell through each other, the floor pushing the lower back only after their
+     * contacts) */
     if (touch)
         for (int32_t b = 0; b < nb; b++)
-            if (v->touch[b] & TOUCH_MOVING) T[4 * b] = -1;
+            if (v->touch[b]) T[4 * b] = -1;
     const wb_real *wv = w->m.w, *y = v->y;
     wb_real *x = w->s.x;
     for (int32_t i = 0; i < w->m.np; i++) {
@@ -802,8 +799,7 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     if (!v || v->np != w->m.np) return -1; /* (prepare failed: out of memory, warned there) */
     const wb_real inv_h2 = 1 / (h * h);
     if (w->m.np > 0) memcpy(v->y, w->s.x, sizeof *v->y * 3 * (size_t)w->m.np); /* none: rigid bodies alone */
-    const int touch = touching(w, v);
-    start_guess(w, v, h, touch);
+    start_guess(w, v, h);
     warm_start(w, v, inv_h2, 1 / h);
     bend_warm_start(w, v, inv_h2);
     wb_pool *pool = wb__world_pool(w);
@@ -822,7 +818,7 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
             if (!wb__vbd_serves(wb__ctypes[t])) wb__ctypes[t]->project(w, h);
         if (w->m.def.tolerance > 0 && v->residual <= w->m.def.tolerance) break;
     }
-    keep_momentum(w, v, touch);
+    keep_momentum(w, v, touching(w, v));
     keep_multipliers(w, v);
     write_forces(w, v, h);
     return v->residual;
