@@ -30,10 +30,16 @@ not_vbd="neo_stiff.lua residual.lua materials.lua"
 #   (contacts after the sweeps); tethers.lua's first test wants the cloth to stretch
 #   without tethers, which under VBD it does not (-1.6%: that check is XPBD's):
 #     bending.lua hand_built.lua bend_break.lua tethers.lua
-#   a stiff body touching particles or a rigid body keeps the translation of the sweeps'
-#   start (the prediction; a free one is moved to keep its momentum, docs/physics.md):
-#   blocks made overlapping part too fast, a box on a soft
-#   block spins, a block on another creeps below tan = mu, stacked blocks sink:
+#   a stiff body touching a movable particle of another body or a rigid body is not moved
+#   to keep its momentum (docs/physics.md, "VBD"): its translation is its sweeps' start's.
+#   A block on a pinned slab creeps 1.03 mm in 1 s at 0.95 of tan = mu (contacts.lua, bound
+#   1 mm; its other 8 tests pass), blocks made overlapping part too fast (made_overlapping,
+#   made_stack, contact_energy), a box on a soft block spins (symmetric_drop, user/10), two
+#   free bodies sliding on each other lose momentum (contact_kinetic), a box falling on a
+#   cloth trampoline leaves it (rigid_particle), a block released from a press drifts
+#   sideways (user/14), a stiff block under a press runs at 8 m/s (squeeze); shape matching
+#   is projected after each sweep, so at 4 iterations it sags 11.65 where the test allows
+#   0.049 (its spring of 2 g / kappa at 1 iteration, shape_match):
 #     contacts.lua contact_energy.lua contact_kinetic.lua made_overlapping.lua made_stack.lua
 #     symmetric_drop.lua user/10_rigid_on_soft.lua user/14_elastic_release_symmetry.lua
 #     rigid_particle.lua squeeze.lua shape_match.lua
@@ -41,12 +47,14 @@ not_vbd="neo_stiff.lua residual.lua materials.lua"
 #     step) is chance: its lattice slides off as under XPBD, and of the rain 0 particles
 #     stay at the defaults, 1-4 at 8 or 12 substeps or 2 iterations (XPBD 2-7); its other
 #     tests pass
-#   cloth falling on itself: self-contacts projected after the sweeps fight them (blow-ups):
-#     cloth_sphere_drop.lua self_collision.lua contact_triangles.lua contact_triangles_overlap.lua
+#   cloth falling on itself: self-contacts projected after the sweeps fight them (blow-ups;
+#   contact_triangles.lua: a coarse cloth folded onto itself passes through its sheet
+#   (378 particles); its 5 other tests pass):
+#     cloth_sphere_drop.lua self_collision.lua contact_triangles.lua
 not_yet="bending.lua hand_built.lua bend_break.lua tethers.lua
 contacts.lua contact_energy.lua contact_kinetic.lua
 made_overlapping.lua made_stack.lua symmetric_drop.lua user/10_rigid_on_soft.lua
-user/14_elastic_release_symmetry.lua rigid_particle.lua squeeze.lua shape_match.lua penetration.lua cloth_sphere_drop.lua self_collision.lua contact_triangles.lua contact_triangles_overlap.lua"
+user/14_elastic_release_symmetry.lua rigid_particle.lua squeeze.lua shape_match.lua penetration.lua cloth_sphere_drop.lua self_collision.lua contact_triangles.lua"
 
 set --
 for f in $(find tests/validation -name '*.lua' | sort); do
