@@ -1288,7 +1288,8 @@ static int32_t make_list(wb_world *w, wb_real h, int32_t kmax, wb_real margin, i
         wb_real u[3];
         ref_rel(c, &rs0, &w->s.x[3 * i], &v[3 * i], m->w[i] > 0, u);
         reach[i] = v3_len_fast(u);
-        if (m->radius[i] > 0) motion += (reach[i] * h * kmax + g * h * h * kmax * kmax) / m->radius[i], nmov++;
+        if (k0 == 0 && m->radius[i] > 0) /* (a remake within the frame keeps its span) */
+            motion += (reach[i] * h * kmax + g * h * h * kmax * kmax) / m->radius[i], nmov++;
     }
     if (k0 == 0) c->span = list_span(kmax, nmov > 0 ? motion / nmov : 0);
     const int32_t span = k0 == 0 ? c->span : kmax;

@@ -727,11 +727,10 @@ static int touching(wb_world *w, struct wb_vbd *v)
  * instead of 0.15; from the adaptive start, a stack still moved after 4 s). A held one
  * touching itself keeps x + h v (from y, a pinned rope folding onto itself as it swung
  * gained energy) */
-static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h)
+static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h, int touch)
 {
     const wb_real *g = w->m.def.gravity, *wv = w->m.w;
     wb_real *x = w->s.x;
-    const int touch = touching(w, v);
     const int32_t *body = w->k.mc_body;
     for (int32_t i = 0; i < w->m.np; i++) {
         const int held = v->adj_start[i + 1] > v->adj_start[i] || v->tadj_start[i + 1] > v->tadj_start[i] ||
@@ -749,15 +748,15 @@ static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h)
  * a stiff body (a vertex's own block is its stiffness, which one translating with its
  * neighbours does not feel: each sweep moves the body by m / (h^2 k) of what is left,
  * and the start (start_guess) would carry it). Serial, in particle order: the same bits
- * on any thread count */
-static void keep_momentum(wb_world *w, struct wb_vbd *v)
+ * on any thread count. touch: touching() ran this substep (v->tsum holds its flags) */
+static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch)
 {
     const wb_cache *k = &w->k;
     /* a body that may touch another body's movable particle or a rigid body this frame is
      * left as the sweeps leave it (touching()): the particle contacts projected after the
      * solve would take the step back from one side only (measured: two stacked lattices
      * crept 3 cm off centre) */
-    if (!touching(w, v)) return;
+    if (!touch) return;
     const int32_t nb = k->mc_nbody, *body = k->mc_body;
     double *T = v->tsum;
     const wb_real *wv = w->m.w, *y = v->y;
@@ -785,7 +784,10 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     if (!v || v->np != w->m.np) return -1; /* (prepare failed: out of memory, warned there) */
     const wb_real inv_h2 = 1 / (h * h);
     if (w->m.np > 0) memcpy(v->y, w->s.x, sizeof *v->y * 3 * (size_t)w->m.np); /* none: rigid bodies alone */
-    start_guess(w, v, h);
+    /* which bodies touch another's movable particle or a rigid body: the contacts are the
+     * frame's list, the same for the start and the momentum step (one pass, not two) */
+    const int touch = touching(w, v);
+    start_guess(w, v, h, touch);
     warm_start(w, v, inv_h2, 1 / h);
     bend_warm_start(w, v, inv_h2);
     wb_pool *pool = wb__world_pool(w);
@@ -804,7 +806,7 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
             if (!wb__vbd_serves(wb__ctypes[t])) wb__ctypes[t]->project(w, h);
         if (w->m.def.tolerance > 0 && v->residual <= w->m.def.tolerance) break;
     }
-    keep_momentum(w, v);
+    keep_momentum(w, v, touch);
     keep_multipliers(v);
     write_forces(w, v, h);
     return v->residual;
