@@ -13,8 +13,9 @@
  *     body's box, so it is kept only if its box meets one of its body's overlaps with
  *     the other bodies' boxes. The others (deep inside a body, or every particle of a
  *     body that touches nothing) never enter the grid.
- *  2. A sorted grid: the rest are counting-sorted by cell, row-major (x fastest), so the
- *     cells of one x-row are one contiguous range of the sorted array. The cell is the
+ *  2. A sorted grid: the rest are counting-sorted by cell, row-major (x fastest), and
+ *     each cell's by x, so an x-row is one contiguous range of the sorted array, in x
+ *     order (a cloth lying across a row: a stretch of it, not whole cells). The cell is the
  *     typical reach (a median of sampled reaches), grown until the grid has at most ~2
  *     cells per particle; one fast particle does not enlarge the cells of all the
  *     others. Past that (particles spread over an enormous volume) the cell coordinates
@@ -22,7 +23,9 @@
  *  3. The search. A particle whose reach is at most twice the typical one (ordinary)
  *     finds its pairs with the ordinary particles after it in the sorted array, within
  *     its reach + the largest ordinary reach (rows wholly before it are skipped: half
- *     the neighbourhood). A big (fast) one finds its pairs with every particle of a
+ *     the neighbourhood; of each row only the x-window where that sphere crosses the
+ *     row's nearest edge in y and z, so grid cells much larger than the reach, as in a
+ *     sheet spread over a large box, cost no more tests). A big (fast) one finds its pairs with every particle of a
  *     smaller reach (ties: the higher index) within twice its reach, since reach_i +
  *     reach_j <= 2 reach_i. Each pair is found once. Pairs of one skip key are dropped
  *     after the distance test, before the group rules (keep).
@@ -207,11 +210,12 @@ static inline int axis_ranges(const wb_grid *g, int a, wb_real v, wb_real e, int
  * of its skip key ks (kz: it has none), appended to hit from nh. Branch-free: most fail,
  * and a branch per test mispredicts */
 static inline int32_t gather(const wb_real *restrict P, const int32_t *restrict key, const wb_real *restrict p,
-                             int32_t ks, int kz, int32_t q0, int32_t q1, int32_t *restrict hit, int32_t nh)
+                             int32_t ks, int kz, int32_t q0, int32_t q1, wb_real xmax, int32_t *restrict hit, int32_t nh)
 {
     const wb_real px = p[0], py = p[1], pz = p[2], rs = p[3];
     for (int32_t t = q0; t < q1; t++) {
         const wb_real *q = &P[4 * t];
+        if (q[0] >= xmax) break; /* the row is sorted by x (sort_cells) */
         const wb_real d0 = q[0] - px, d1 = q[1] - py, d2 = q[2] - pz, r = rs + q[3];
         hit[nh] = t;
         nh += (d0 * d0 + d1 * d1 + d2 * d2 < r * r) & ((key[t] != ks) | kz);
@@ -233,6 +237,38 @@ static void emit(const wb_broad *b, const grid *g, int32_t s, int big, const int
         if (keep && !keep(ud, i < j ? i : j, i < j ? j : i)) continue;
         push(o, i, j);
     }
+}
+
+/* each cell's slots [start[c], start[c + 1]) sorted by x, stably (an insertion sort: a
+ * cell holds a handful) */
+static void sort_cells(wb_broad *b, const int32_t *start, int64_t ncell)
+{
+    wb_real *P = b->p;
+    int32_t *id = b->id, *key = b->key;
+    for (int64_t c = 0; c < ncell; c++) {
+        const int32_t lo = start[c], hi = start[c + 1];
+        for (int32_t k = lo + 1; k < hi; k++) {
+            if (!(P[4 * k] < P[4 * (k - 1)])) continue;
+            wb_real t[4];
+            memcpy(t, &P[4 * k], sizeof t);
+            const int32_t ti = id[k], tk = key[k];
+            int32_t q = k;
+            for (; q > lo && t[0] < P[4 * (q - 1)]; q--) {
+                memcpy(&P[4 * q], &P[4 * (q - 1)], sizeof t);
+                id[q] = id[q - 1], key[q] = key[q - 1];
+            }
+            memcpy(&P[4 * q], t, sizeof t);
+            id[q] = ti, key[q] = tk;
+        }
+    }
+}
+
+/* the first of the sorted slots [lo, hi) of one x-row whose x is not below v (a cell or
+ * so of them: a linear skip costs less than a bisection) */
+static inline int32_t x_from(const wb_real *P, int32_t lo, int32_t hi, wb_real v)
+{
+    while (lo < hi && P[4 * lo] < v) lo++;
+    return lo;
 }
 
 /* pass 3 over the sorted positions [lo, hi) (hit: scratch for hi - lo ... at most every
@@ -264,11 +300,14 @@ static void scan(const wb_broad *b, const grid *g, int32_t lo, int32_t hi, int32
             const int64_t y1 = y1r < ny - 1 ? y1r : ny - 1, z1 = z1r < nz - 1 ? z1r : nz - 1;
             const int64_t y0 = cell_of(p[1], oy, inv), z0 = cell_of(p[2], oz, inv), ylo = cell_of(p[1] - e, oy, inv);
             const wb_real sy = (p[1] - oy) * inv, sz = (p[2] - oz) * inv, cs = 1 / inv;
+            /* round-off in the x window: a millionth of a cell, as the gaps */
+            const wb_real tol = (wb_real)1e-6 * cs;
             int64_t row = nx * (y0 + ny * z0);
             {
                 const wb_real er = rs + rowr[y0 + ny * z0];
                 const int64_t xr = cell_of(p[0] + er, ox, inv), x1 = xr < x1r ? xr : x1r;
-                nh = gather(P, key, p, ks, kz, s + 1, start[row + (x1 < nx - 1 ? x1 : nx - 1) + 1], hit, nh);
+                const int32_t q1 = start[row + (x1 < nx - 1 ? x1 : nx - 1) + 1];
+                nh = gather(P, key, p, ks, kz, s + 1, q1, p[0] + er + tol, hit, nh);
             }
             for (int64_t z = z0; z <= z1; z++) {
                 const wb_real gz = z > z0 ? ((wb_real)z - sz - (wb_real)1e-6) * cs : 0, gz2 = gz > 0 ? gz * gz : 0;
@@ -278,10 +317,15 @@ static void scan(const wb_broad *b, const grid *g, int32_t lo, int32_t hi, int32
                     const wb_real er = rs + rr;
                     const wb_real gy = y > y0 ? ((wb_real)y - sy - (wb_real)1e-6) * cs
                                      : y < y0 ? (sy - (wb_real)(y + 1) - (wb_real)1e-6) * cs : 0;
-                    if ((gy > 0 ? gy * gy : 0) + gz2 >= er * er) continue;
-                    const int64_t xa = cell_of(p[0] - er, ox, inv), xb = cell_of(p[0] + er, ox, inv);
+                    const wb_real gap2 = (gy > 0 ? gy * gy : 0) + gz2;
+                    if (gap2 >= er * er) continue;
+                    /* a partner lies within the chord of the sphere er across the row's
+                     * nearest y and z: no farther in x than sqrt(er^2 - gap^2) */
+                    const wb_real cw = sqrt(er * er - gap2) + tol;
+                    const int64_t xa = cell_of(p[0] - cw, ox, inv), xb = cell_of(p[0] + cw, ox, inv);
                     row = nx * (y + ny * z);
-                    nh = gather(P, key, p, ks, kz, start[row + xa], start[row + (xb < nx - 1 ? xb : nx - 1) + 1], hit, nh);
+                    const int32_t q1 = start[row + (xb < nx - 1 ? xb : nx - 1) + 1];
+                    nh = gather(P, key, p, ks, kz, x_from(P, start[row + xa], q1, p[0] - cw), q1, p[0] + cw, hit, nh);
                 }
             }
             emit(b, g, s, 0, hit, nh, o, keep, ud);
@@ -302,7 +346,7 @@ static void scan(const wb_broad *b, const grid *g, int32_t lo, int32_t hi, int32
                                 if (q1 <= s + 1) continue;
                                 if (q0 < s + 1) q0 = s + 1;
                             }
-                            nh = gather(P, key, p, ks, kz, q0, q1, hit, nh);
+                            nh = gather(P, key, p, ks, kz, q0, q1, INFINITY, hit, nh);
                         }
                     }
         emit(b, g, s, big, hit, nh, o, keep, ud);
@@ -381,6 +425,9 @@ static int32_t broad(wb_broad *b, wb_pairbuf *o, const wb_real *x, const wb_real
     }
     for (int64_t q = ncell; q > 0; q--) start[q] = start[q - 1]; /* back to starts */
     start[0] = 0;
+    /* each cell's particles by x (ties: index order), so that an x-row is sorted by x and
+     * the search takes from a row only the stretch within reach in x (scan) */
+    sort_cells(b, start, ncell);
     /* each x-row's largest ordinary reach (the search of an ordinary particle, scan) */
     const int64_t nrow = g.g.nc[1] * g.g.nc[2];
     if (!grow((void **)&b->rowr, &b->cap_rowr, nrow, sizeof *b->rowr)) return -1;
