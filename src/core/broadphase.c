@@ -1040,13 +1040,16 @@ int wb__joined(const wb_contacts *c, int32_t i, int32_t j)
     if (c->nkeys == 0) return 0;
     const uint64_t key = pair_key(i, j);
     const int32_t a = i < j ? i : j;
-    int32_t lo = c->key_row[a], hi = c->key_row[a + 1];
-    while (lo < hi) {
-        const int32_t mid = lo + (hi - lo) / 2;
-        if (c->keys[mid] < key) lo = mid + 1;
+    /* a row holds the handful of links, bends, ... from a: a linear scan beats a bisection
+     * there; a hub's long row is bisected down to such a stretch first */
+    const uint64_t *k = &c->keys[c->key_row[a]], *end = &c->keys[c->key_row[a + 1]];
+    for (const uint64_t *hi = end; hi - k > 16;) {
+        const uint64_t *mid = k + (hi - k) / 2;
+        if (*mid < key) k = mid + 1;
         else hi = mid;
     }
-    return lo < c->key_row[a + 1] && c->keys[lo] == key;
+    while (k < end && *k < key) k++;
+    return k < end && *k == key;
 }
 
 /* The contact rule (docs/physics.md, "Contacts"): particles of two bodies (or graphs)
