@@ -2,7 +2,12 @@
  * colouring of the live links into batches, their XPBD projection (Gauss-Seidel batch by
  * batch or Jacobi), plastic flow and breaking once per frame, and their elastic energy. The
  * slot arrays and the C API (wb_distance_*) live in world.c with the other model arrays;
- * this file owns the solver cache built from them (wb_cache's s_* arrays). */
+ * this file owns the solver cache built from them (wb_cache's s_* arrays).
+ *
+ * The batches are this file's own, not batch.h's: links are removed (slots freed, links
+ * broken), so they are packed live ones only, the links meeting on a mirror plane are
+ * split out as compounds projected together from the same positions (wb_split: a
+ * symmetric scene stays symmetric), and the Jacobi solver runs over the same packing. */
 #include <stdlib.h>
 
 #include "ctype.h"
