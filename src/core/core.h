@@ -16,9 +16,6 @@
 #include "vec.h"
 #include "shape.h"
 #include "pool.h"
-#include "contact.h"
-#include "broadphase.h"
-#include "tricontact.h"
 
 /* a substep's prediction, per particle: damping, gravity, x += h v (x_prev = x first; a
  * particle with w = 0 stays). solver.c's pass and collide.c's fused one share it, so
@@ -100,13 +97,6 @@ typedef struct wb_state {
 #define WB_CF_COLLIDE 1u     /* collides with other bodies and loose particles */
 #define WB_CF_SELF 2u        /* collides with its own body (group > 0) */
 
-/* the body a particle is in for the contact rules: its group, or for a loose particle its
- * graph (the loose particles its constraints reach), as -1 - the graph's least particle */
-static inline int32_t wb__graph_of(const wb_contacts *c, const wb_model *m, int32_t i)
-{
-    return m->group[i] > 0 ? m->group[i] : -1 - c->graph[i];
-}
-
 
 /* ---- solver cache: packed colour batches and per-step scratch ------------------------ */
 typedef struct wb_cache {
@@ -157,8 +147,11 @@ typedef struct wb_cache {
     int (*interrupt)(void *);
     void *interrupt_ud;
     int32_t last_contacts;
-    wb_contacts pc;        /* particle-particle contacts (contact.c) */
-    wb_tricontacts tc;     /* particle-triangle contacts (tricontact.c) */
+    /* the contacts' scratch, made by their files at the first step (NULL before it; a file
+     * that reads them outside a step checks): particle pairs (contact.h, contact.c) and
+     * particle-triangle pairs (tricontact.h, tribroad.c and tricontact.c) */
+    struct wb_contacts *pc;
+    struct wb_tricontacts *tc;
     int64_t projections;
     double step_ms, solve_ms;
     int no_fuse;           /* tests: the plain order, the next substep's prediction never
@@ -257,6 +250,14 @@ void wb__collider_pose_at(const wb_collider_pose *cp, wb_real t, wb_real p[3], w
 /* collide.c: a mesh collider's copy charged to / given back to the memory budget (and freed) */
 int wb__mesh_charge(wb_world *w, const struct wb_colmesh *cm);
 void wb__mesh_release(wb_world *w, wb_cshape *s);
+/* contact.c, tribroad.c: the contacts' scratch (k.pc, k.tc) made when there is none
+ * (each step, first: 0 when out of memory), and freed with the world */
+int wb__contacts_make(wb_world *w);
+int wb__tricontacts_make(wb_world *w);
+void wb__contacts_destroy(wb_world *w);
+void wb__tricontacts_destroy(wb_world *w);
+/* contact.c: the contacts' counts in w:stats() (nothing before the first step) */
+void wb__contacts_stats(const wb_world *w, wb_stats *st);
 /* contact.c: broad phase once per frame, projection per substep, velocity pass after
  * the velocities are updated */
 void wb__contacts_begin(wb_world *w);

@@ -14,6 +14,7 @@
 #include "snapshot.h"
 #include "tet.h"
 #include "volume.h"
+#include "contact.h"
 
 static int realloc_n(void **p, int32_t n, size_t elem)
 {
@@ -101,7 +102,7 @@ static wb_status colour(wb_world *w)
 {
     wb_model *m = &w->m;
     wb_cache *k = &w->k;
-    k->pc.keys_dirty = 1; /* the constraint pairs that self-collision skips */
+    if (k->pc) k->pc->keys_dirty = 1; /* the constraint pairs that self-collision skips */
 
     int32_t ns = 0;
     for (int32_t s = 0; s < m->nd; s++) ns += packable(w, s);

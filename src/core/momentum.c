@@ -43,6 +43,8 @@
 #include "shape_match.h"
 #include "tet.h"
 #include "volume.h"
+#include "contact.h"
+#include "tricontact.h"
 
 /* per body: 0 mass, 1-3 sum m r, 4-6 sum m r x d, 7-9 sum m d, 10-15 sum m r r^T
  * (xx yy zz xy xz yz), r about the body's first particle (no cancellation far from the
@@ -432,13 +434,13 @@ void wb__momentum_restore(wb_world *w, wb_real h)
      * parts against each other, and a rigid turn of the whole would slip at every contact,
      * which friction then takes back as a twist of the body (a self-colliding cloth heap,
      * turned so, never comes to rest). So is one touching a rigid body. */
-    const wb_contacts *pc = &k->pc;
+    const wb_contacts *pc = k->pc;
     for (int32_t c = 0; c < pc->n; c++)
         for (int e = 0; e < 2; e++) {
             const int32_t b = body[pc->ij[2 * c + e]];
             if (b >= 0 && acc[ACC * b] >= 0) acc[ACC * b] = -2;
         }
-    const wb_tricontacts *tc = &k->tc;
+    const wb_tricontacts *tc = k->tc;
     for (int32_t c = 0; c < tc->n; c++) {
         const int32_t t = tc->pt[2 * c + 1], pts[4] = { tc->pt[2 * c], w->m.tri[3 * t], w->m.tri[3 * t + 1], w->m.tri[3 * t + 2] };
         for (int e = 0; e < 4; e++)

@@ -25,6 +25,8 @@
 #include "tet.h"
 #include "volume.h"
 #include "vbd.h"
+#include "contact.h"
+#include "tricontact.h"
 
 /* a link as the sweep reads it: its force along it is kk (l - tgt) + lm and its stiffness
  * kk; dmp: a soft link's damping beta / h */
@@ -690,14 +692,14 @@ static int touching(wb_world *w, struct wb_vbd *v)
      * immovable particles (a pinned slab, as a collider) keep the momentum the move keeps
      * (a block on a pinned slab at 0.95 of its sticking angle crept 26 mm in 1 s, now 1.03) */
     const wb_real *wv = w->m.w;
-    const wb_contacts *pc = &k->pc;
+    const wb_contacts *pc = k->pc;
     for (int32_t c = 0; c < pc->n; c++) {
         const int32_t i = pc->ij[2 * c], j = pc->ij[2 * c + 1], a = body[i], b = body[j];
         if (a < 0 || b < 0 || a == b) continue;
         if (wv[j] > 0) T[4 * a] = -1;
         if (wv[i] > 0) T[4 * b] = -1;
     }
-    const wb_tricontacts *tc = &k->tc;
+    const wb_tricontacts *tc = k->tc;
     for (int32_t c = 0; c < tc->n; c++) {
         const int32_t t = tc->pt[2 * c + 1], p[4] = { tc->pt[2 * c], w->m.tri[3 * t], w->m.tri[3 * t + 1], w->m.tri[3 * t + 2] };
         const int32_t a = body[p[0]], b = body[p[1]];
