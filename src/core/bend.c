@@ -19,6 +19,7 @@
 #include <assert.h>
 #include <stdlib.h>
 
+#include "bend.h"
 #include "ctype.h"
 #include "snapshot.h"
 
@@ -80,22 +81,30 @@ static wb_real wrap(wb_real d)
 
 int wb__bend_off(const wb_world *w, int32_t b, wb_real *off, wb_real g[4][3])
 {
-    const int32_t *p = &w->bend.ij[4 * b];
+    const int32_t *p = &w->bend->ij[4 * b];
     const wb_real *x = w->s.x;
     wb_real th;
     if (!dihedral(&x[3 * p[0]], &x[3 * p[1]], &x[3 * p[2]], &x[3 * p[3]], &th, g)) return 0;
-    *off = wrap(th - w->bend.rest[b]);
+    *off = wrap(th - w->bend->rest[b]);
     return 1;
 }
 
 /* ---- memory --------------------------------------------------------------------------------- */
-static int charge(wb_world *w, int32_t cap) { return wb__charge(w, &w->bend.charged, (size_t)cap * BEND_BYTES); }
+static int charge(wb_world *w, int32_t cap) { return wb__charge(w, &w->bend->charged, (size_t)cap * BEND_BYTES); }
 
+/* room for need bends; the struct is made with the first (w->bend: NULL until then) */
 static wb_status grow(wb_world *w, int32_t need)
 {
-    wb_bends *b = &w->bend;
-    if (need <= b->cap) return WB_OK;
     if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    if (!w->bend) {
+        if (need <= 0) return WB_OK;
+        wb_bends *b = calloc(1, sizeof *b);
+        if (!b) return WB_ERR_NOMEM;
+        b->bt.n = -1; /* never coloured */
+        w->bend = b;
+    }
+    wb_bends *b = w->bend;
+    if (need <= b->cap) return WB_OK;
     int32_t cap = b->cap ? b->cap : 64;
     while (cap < need) cap = cap > WB_MAX_CONSTRAINTS / 2 ? WB_MAX_CONSTRAINTS : cap * 2;
     if (!charge(w, cap)) {
@@ -116,8 +125,9 @@ static wb_status grow(wb_world *w, int32_t need)
 
 wb_status wb__bend_reserve(wb_world *w, int64_t extra)
 {
-    if (w->bend.n + extra > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
-    return grow(w, w->bend.n + (int32_t)extra);
+    const int32_t n = wb_bend_count(w);
+    if (n + extra > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    return grow(w, n + (int32_t)extra);
 }
 
 /* ---- the C API -------------------------------------------------------------------------------- */
@@ -183,9 +193,9 @@ wb_bend_id wb_bend_add(wb_world *w, const int32_t p[4], const wb_bend_def *def, 
     int ok = 1;
     wb_real rest = def->rest;
     if (isnan(rest)) rest = wb__bend_angle_of(w->s.x, p, &ok);
-    wb_status st = grow(w, w->bend.n + 1);
+    wb_status st = grow(w, wb_bend_count(w) + 1);
     if (st != WB_OK) { *status = st; return none; }
-    wb_bends *b = &w->bend;
+    wb_bends *b = w->bend;
     const int32_t s = b->n++;
     memcpy(&b->ij[4 * s], p, 4 * sizeof *p);
     b->alpha[s] = def->compliance;
@@ -200,47 +210,45 @@ wb_bend_id wb_bend_add(wb_world *w, const int32_t p[4], const wb_bend_def *def, 
     return id;
 }
 
-bool wb_bend_valid(const wb_world *w, wb_bend_id c) { return c.gen == 1 && c.index >= 1 && c.index <= (uint32_t)w->bend.n; }
+bool wb_bend_valid(const wb_world *w, wb_bend_id c) { return c.gen == 1 && c.index >= 1 && c.index <= (uint32_t)wb_bend_count(w); }
 
 #define BSLOT(w, c) (assert(wb_bend_valid((w), (c))), (int32_t)(c).index - 1)
 
 wb_real wb_bend_angle(const wb_world *w, wb_bend_id c)
 {
     int ok;
-    wb_real th = wb__bend_angle_of(w->s.x, &w->bend.ij[4 * BSLOT(w, c)], &ok);
+    wb_real th = wb__bend_angle_of(w->s.x, &w->bend->ij[4 * BSLOT(w, c)], &ok);
     return ok ? th : NAN;
 }
 
-wb_real wb_bend_rest(const wb_world *w, wb_bend_id c) { return w->bend.rest[BSLOT(w, c)]; }
+wb_real wb_bend_rest(const wb_world *w, wb_bend_id c) { return w->bend->rest[BSLOT(w, c)]; }
 
 wb_real wb_bend_force(const wb_world *w, wb_bend_id c)
 {
-    const int32_t s = BSLOT(w, c), i = w->bend.pack[s];
-    if (w->bend.dirty || i < 0 || w->bend.broken[s]) return 0; /* not stepped since it was made, or broken */
+    const int32_t s = BSLOT(w, c), i = w->bend->pack[s];
+    if (w->bend->dirty || i < 0 || w->bend->broken[s]) return 0; /* not stepped since it was made, or broken */
     const wb_real h = w->k.h_last;
-    return fabs(w->bend.lambda[i]) / (h * h);
+    return fabs(w->bend->lambda[i]) / (h * h);
 }
 
-void wb_bend_particles(const wb_world *w, wb_bend_id c, int32_t p[4]) { memcpy(p, &w->bend.ij[4 * BSLOT(w, c)], 4 * sizeof *p); }
-int32_t wb_bend_count(const wb_world *w) { return w->bend.n; }
-bool wb_bend_broken(const wb_world *w, wb_bend_id c) { return w->bend.broken[BSLOT(w, c)] != 0; }
-int32_t wb_world_bend_break_count(const wb_world *w) { return w->bend.nbreaks; }
+void wb_bend_particles(const wb_world *w, wb_bend_id c, int32_t p[4]) { memcpy(p, &w->bend->ij[4 * BSLOT(w, c)], 4 * sizeof *p); }
+int32_t wb_bend_count(const wb_world *w) { return w->bend ? w->bend->n : 0; }
+bool wb_bend_broken(const wb_world *w, wb_bend_id c) { return w->bend->broken[BSLOT(w, c)] != 0; }
+int32_t wb_world_bend_break_count(const wb_world *w) { return w->bend ? w->bend->nbreaks : 0; }
 wb_bend_id wb_world_bend_break_at(const wb_world *w, int32_t i)
 {
-    assert(i >= 0 && i < w->bend.nbreaks);
-    return w->bend.breaks[i];
+    assert(i >= 0 && i < w->bend->nbreaks);
+    return w->bend->breaks[i];
 }
 wb_bend_id wb_bend_at(const wb_world *w, int32_t i)
 {
-    assert(i >= 0 && i < w->bend.n);
+    assert(i >= 0 && i < wb_bend_count(w));
     wb_bend_id id = { (uint32_t)i + 1, 1 };
     return id;
 }
 
 /* ---- the type ---------------------------------------------------------------------------- */
-static int32_t bend_count(const wb_world *w) { return w->bend.n; }
-
-static int always(const void *ud, int32_t i) { (void)ud; (void)i; return 1; }
+static int32_t bend_count(const wb_world *w) { return wb_bend_count(w); }
 
 /* the packed block for n entries: one allocation (bend.h), grown only */
 static int pack_alloc(wb_bends *b, int32_t n)
@@ -259,28 +267,23 @@ static int pack_alloc(wb_bends *b, int32_t n)
     return 1;
 }
 
+/* colour batches (batch.h) when bends were made since, and what the projection reads
+ * copied in batch order */
 static wb_status bend_prepare(wb_world *w)
 {
-    wb_bends *b = &w->bend;
+    wb_bends *b = w->bend;
+    if (!b) return WB_OK;
     b->nbreaks = 0; /* the list reports the step about to run */
     if (!b->dirty) return WB_OK;
-    uint8_t *colour = malloc((size_t)(b->n > 0 ? b->n : 1));
-    int32_t count[WB_MAX_COLOURS + 1], start[WB_MAX_COLOURS + 1];
-    if (!colour || !pack_alloc(b, b->n) ||
-        !wb__colour_greedy(&w->m, b->ij, 4, b->n, always, NULL, colour, count, NULL)) {
-        free(colour);
+    if (!pack_alloc(b, b->n) || !wb__batches_build(&b->bt, &w->m, b->ij, 4, b->n, b->s_slot))
         return WB_ERR_NOMEM;
-    }
-    wb__colour_ranges(count, b->colour_start, &b->ncolours, &b->serial_start, start);
-    for (int32_t s = 0; s < b->n; s++) {
-        const int32_t i = start[colour[s]]++;
+    for (int32_t i = 0; i < b->n; i++) {
+        const int32_t s = b->s_slot[i];
         memcpy(&b->s_ij[4 * i], &b->ij[4 * s], 4 * sizeof(int32_t));
         b->s_rest[i] = b->rest[s];
-        b->s_slot[i] = s;
         b->pack[s] = i;
         b->lambda[i] = 0;
     }
-    free(colour);
     b->h_at = NAN; /* s_at, s_gamma, s_flag: at the next projection */
     b->dirty = 0;
     return WB_OK;
@@ -288,7 +291,7 @@ static wb_status bend_prepare(wb_world *w)
 
 static void bend_substep_begin(wb_world *w)
 {
-    if (w->bend.n > 0) memset(w->bend.lambda, 0, sizeof(wb_real) * (size_t)w->bend.n);
+    if (wb_bend_count(w) > 0) memset(w->bend->lambda, 0, sizeof(wb_real) * (size_t)w->bend->n);
 }
 
 /* the per-constraint constants of a substep h, in the packed order: computed as the
@@ -585,11 +588,15 @@ static int simd_state = -1;
 int wb__bend_simd(int on);
 int wb__bend_simd(int on) { return wb__simd_set(&simd_state, on); }
 
-/* [lo, hi) of one batch; apart: it shares no movable particle (not the serial tail) */
-static void project_batch(wb_world *w, int32_t lo, int32_t hi, int apart)
+/* packed [lo, hi) of one batch, or of a chunk of one (batch.h); the serial tail's
+ * bends may share a movable particle, so only the others take the vector path */
+static void project_batch(wb_world *w, const int32_t *order, int32_t lo, int32_t hi, wb_real h)
 {
-    wb_bends *b = &w->bend;
+    (void)order; /* the packed copies are in batch order already */
+    (void)h;     /* ... and hold the substep's constants (pack_constants) */
+    wb_bends *b = w->bend;
 #ifdef WB_BEND_AVX2
+    const int apart = hi <= b->bt.colour_start[b->bt.serial_start];
     if (apart && hi - lo >= 4) {
         /* decided once, possibly by several threads at once (the same answer) */
         int v = __atomic_load_n(&simd_state, __ATOMIC_RELAXED);
@@ -599,44 +606,27 @@ static void project_batch(wb_world *w, int32_t lo, int32_t hi, int apart)
             return;
         }
     }
-#else
-    (void)apart;
 #endif
     project_range(b, w->m.w, w->s.x, w->s.x_prev, lo, hi);
 }
 
-typedef struct bend_job { wb_world *w; int32_t lo; } bend_job;
-
-static void bend_part(void *ctx, int32_t lo, int32_t hi)
-{
-    const bend_job *j = ctx;
-    project_batch(j->w, j->lo + lo, j->lo + hi, 1);
-}
-
+/* batch after batch in colour order, a batch of 256 or more in parallel chunks (batch.h):
+ * the same bits for any thread count */
 static void bend_project(wb_world *w, wb_real h)
 {
-    wb_bends *b = &w->bend;
+    wb_bends *b = w->bend;
+    if (!b) return;
     w->k.projections += b->n;
     if (!(h == b->h_at)) pack_constants(b, h, 1 / (h * h));
-    for (int32_t c = 0; c < b->ncolours; c++) {
-        const int32_t lo = b->colour_start[c], hi = b->colour_start[c + 1];
-        wb_pool *pool = c < b->serial_start && hi - lo >= 256 ? wb__world_pool(w) : NULL;
-        if (!pool) {
-            project_batch(w, lo, hi, c < b->serial_start);
-            continue;
-        }
-        /* contiguous chunks on the pool: a batch shares no movable particle */
-        bend_job j = { w, lo };
-        wb__pool_for(pool, hi - lo, 128, bend_part, &j);
-    }
+    wb__batches_run(&b->bt, w, 256, project_batch, b->s_slot, h);
 }
 
 /* U = C^2 / (2 alpha) for compliant bends (alpha = 1/k, k in N m / rad) */
 static wb_real bend_energy(const wb_world *w)
 {
-    const wb_bends *b = &w->bend;
+    const wb_bends *b = w->bend;
     wb_real e = 0;
-    for (int32_t s = 0; s < b->n; s++) {
+    for (int32_t s = 0; s < wb_bend_count(w); s++) {
         int ok;
         if (b->alpha[s] <= 0 || b->broken[s]) continue;
         const wb_real th = wb__bend_angle_of(w->s.x, &b->ij[4 * s], &ok);
@@ -652,8 +642,8 @@ static wb_real bend_energy(const wb_world *w)
  * force; a broken bend stays (its slot is its handle) and is skipped from then on */
 static void bend_frame_end(wb_world *w)
 {
-    wb_bends *b = &w->bend;
-    if (b->dirty || !(w->k.h_last > 0)) return;
+    wb_bends *b = w->bend;
+    if (!b || b->dirty || !(w->k.h_last > 0)) return;
     const wb_real inv_h2 = 1 / (w->k.h_last * w->k.h_last);
     for (int32_t i = 0; i < b->n; i++) {
         const int32_t s = b->s_slot[i];
@@ -666,26 +656,31 @@ static void bend_frame_end(wb_world *w)
     }
 }
 
-static void bend_links(const wb_world *w, wb_link_fn fn, void *ud) { wb__link_quads(w->bend.ij, w->bend.n, fn, ud); }
+static void bend_links(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    if (w->bend) wb__link_quads(w->bend->ij, w->bend->n, fn, ud);
+}
 
 /* ---- teardown, hash, snapshots (ctype.h) ------------------------------------------------ */
 static void bend_destroy(wb_world *w)
 {
-    wb_bends *b = &w->bend;
+    wb_bends *b = w->bend;
+    if (!b) return;
     void *p[] = { b->ij, b->alpha, b->beta, b->rest, b->s_ij, b->s_slot, b->pack, b->lambda, b->btorque,
                   b->broken, b->breaks };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    free(b);
+    w->bend = NULL;
 }
 
-static size_t bend_charged(const wb_world *w) { return w->bend.charged; }
+static size_t bend_charged(const wb_world *w) { return w->bend ? w->bend->charged : 0; }
 
-/* the broken ones' slots (state): a world without one adds nothing */
 static wb_real bend_residual(const wb_world *w, wb_real h)
 {
-    const wb_bends *b = &w->bend;
+    const wb_bends *b = w->bend;
     const wb_real *x = w->s.x, *wv = w->m.w, inv_h2 = 1 / (h * h);
     wb_real r = 0;
-    if (b->dirty) return 0; /* made since the last step: not packed, never projected */
+    if (!b || b->dirty) return 0; /* made since the last step: not packed, never projected */
     for (int32_t i = 0; i < b->n; i++) {
         const int32_t s = b->s_slot[i], *p = &b->s_ij[4 * i];
         const wb_real at = b->alpha[s] * inv_h2;
@@ -700,10 +695,11 @@ static wb_real bend_residual(const wb_world *w, wb_real h)
     return r;
 }
 
+/* the broken ones' slots (state): a world without one adds nothing */
 static uint64_t bend_hash(const wb_world *w, uint64_t h)
 {
-    for (int32_t i = 0; i < w->bend.n; i++)
-        if (w->bend.broken[i]) h = wb__fnv(h, &i, sizeof i);
+    for (int32_t i = 0; i < wb_bend_count(w); i++)
+        if (w->bend->broken[i]) h = wb__fnv(h, &i, sizeof i);
     return h;
 }
 
@@ -735,8 +731,8 @@ wb_status wb_image_alloc_bends(wb_image *g, int32_t n)
 
 static wb_status bend_image_save(const wb_world *w, wb_image *g)
 {
-    const wb_bends *bd = &w->bend;
-    const size_t n = (size_t)bd->n;
+    const wb_bends *bd = w->bend;
+    const size_t n = (size_t)wb_bend_count(w);
     if (n == 0) return WB_OK;
     wb_status st = wb_image_alloc_bends(g, bd->n);
     if (st != WB_OK) return st;
@@ -776,7 +772,7 @@ static wb_status bend_image_reserve(wb_world *w, const wb_image *g, const wb_ima
 static void bend_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
     const wb_image_bend *b = &g->bend;
-    wb_bends *bd = &w->bend;
+    wb_bends *bd = w->bend;
     const size_t n = (size_t)b->n;
     if (n == 0) return;
     if (at->exact) {

@@ -1,12 +1,11 @@
-/* bend.h: the bending constraints' arrays (bend.c), one member of struct wb_world, and
- * their section of a snapshot image (snapshot.h). */
+/* bend.h: the bending constraints' arrays (bend.c), and their section of a snapshot image
+ * (snapshot.h). */
 #ifndef WB_BEND_H
 #define WB_BEND_H
 
-#include "wobble.h"
+#include "batch.h"
 
-#define WB_MAX_COLOURS 64  /* one bit each in a per-particle mask; the rest go to a serial batch */
-
+/* w->bend: NULL until the first one is made */
 typedef struct wb_bends {
     /* model: what a step does not change */
     int32_t n, cap;        /* constraints (never removed: the slot is the handle) */
@@ -20,12 +19,11 @@ typedef struct wb_bends {
     wb_bend_id *breaks;    /* broken in the last step (reported after it) */
     int32_t nbreaks, cap_breaks;
     size_t charged;        /* bytes charged to def.memory */
-    /* cache: packed by colour, rebuilt when dirty */
+    /* cache: packed by colour (batch.h), rebuilt when dirty */
     int dirty;
-    int32_t ncolours, serial_start;
-    int32_t colour_start[WB_MAX_COLOURS + 2];
+    wb_batches bt;         /* the batches, ranges into the packed order */
     /* what the projection reads, packed in its order at colour time: one allocation
-     * starting at s_ij (world.c frees it), cap_s entries; s_at, s_gamma and the skip
+     * starting at s_ij (bend_destroy frees it), cap_s entries; s_at, s_gamma and the skip
      * flag hold for the substep h_at (recomputed when h changes: NaN = not yet) */
     int32_t *s_ij;         /* (n x 4) packed particles */
     wb_real *s_rest;       /* (n) rest angle */
@@ -34,7 +32,7 @@ typedef struct wb_bends {
     uint8_t *s_flag;       /* (n) 1: skipped (broken, or alpha / h^2 = inf); 2: damped */
     wb_real h_at;
     int32_t cap_s;
-    int32_t *s_slot;       /* (n) slot of each packed entry */
+    int32_t *s_slot;       /* (n) slot of each packed entry (the batches' order) */
     int32_t *pack;         /* (n) packed index of each slot */
     wb_real *lambda;       /* (n) multipliers of the current substep, by packed index */
 } wb_bends;
@@ -48,6 +46,15 @@ typedef struct wb_image_bend {
     wb_real *btorque;      /* (n) break_torque, N m (0: never) */
     uint8_t *broken;       /* (n) broken by it */
 } wb_image_bend;
+
+/* after it, extra bends add without failing (charged to the memory budget) */
+wb_status wb__bend_reserve(wb_world *w, int64_t extra);
+/* the dihedral angle of the bend over particles p[0..3] at positions x; *ok = 0
+ * when a triangle is degenerate */
+wb_real wb__bend_angle_of(const wb_real *x, const int32_t *p, int *ok);
+/* the interior edges of a triangle list (each shared by exactly two triangles), as
+ * hinges p1 p2 p3 p4 into out (room for 3 ntri / 2 x 4), in edge order; -1 when out of memory */
+int32_t wb__bend_hinges(const int32_t *tri, int32_t ntri, int32_t *out);
 
 /* bend b's angle off its rest (the short way round) and its gradient on its four corners
  * (vbd.c's energies); 0 when degenerate */

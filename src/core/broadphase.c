@@ -38,6 +38,8 @@
 
 #include "core.h"
 #include "ctype.h"
+#include "broadphase.h"
+#include "tricontact.h"
 
 static double now_ms(void)
 {
@@ -919,7 +921,7 @@ static void add_link(void *ud, int32_t a, int32_t b, int joined)
  * each once, and the loose particles' graphs; 0 when out of memory */
 static int build_rules(wb_world *w)
 {
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     const wb_model *m = &w->m;
     int32_t *g = wb__grow(c->graph, &c->cap_graph, m->np > 0 ? m->np : 1, sizeof *g);
     if (!g) return 0;
@@ -973,7 +975,7 @@ static int cmp_group_radius(const void *a, const void *b)
 
 static int build_cover(wb_world *w)
 {
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     const wb_model *m = &w->m;
     uint8_t *cov = wb__grow(c->tcov, &c->cap_tcov, m->ntri > 0 ? m->ntri : 1, sizeof *cov);
     if (!cov) return 0;
@@ -1026,7 +1028,7 @@ static uint64_t rules_sig(const wb_world *w)
 
 int wb__contact_rules(wb_world *w)
 {
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     const uint64_t sig = rules_sig(w);
     if (!c->keys_dirty && !c->scan_dirty && c->keys_sig == sig && c->graph) return 1;
     if (!build_rules(w) || !build_cover(w)) return 0;
@@ -1060,7 +1062,7 @@ static int may_touch_rules(void *ud, int32_t i, int32_t j)
 {
     const wb_world *w = ud;
     const wb_model *m = &w->m;
-    const wb_contacts *c = &w->k.pc;
+    const wb_contacts *c = w->k.pc;
     if (wb__graph_of(c, m, i) != wb__graph_of(c, m, j))
         return (m->cflags[i] & m->cflags[j] & WB_CF_COLLIDE) && !(c->cross && wb__joined(c, i, j));
     if (m->group[i] > 0 && !(m->cflags[i] & m->cflags[j] & WB_CF_SELF)) return 0;
@@ -1154,7 +1156,7 @@ static inline void ref_rel(const wb_contacts *c, const ref_step *rs, const wb_re
  * where it shrinks the volume their reaches search (below) */
 static void fit_reference(wb_world *w, const wb_real *reach, wb_real t)
 {
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     const wb_model *m = &w->m;
     const wb_real *x = w->s.x, *v = w->s.v, *wv = m->w;
     for (int a = 0; a < 3; a++) c->ref_v[a] = c->ref_om[a] = c->ref_c[a] = 0;
@@ -1305,7 +1307,7 @@ static int32_t list_span(int32_t substeps, double motion)
 static int32_t make_list(wb_world *w, wb_real h, int32_t kmax, wb_real margin, int32_t k0)
 {
     wb_model *m = &w->m;
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     c->check = 0;
     c->nfixed = 0; /* every particle's xf and reach from here */
     wb_real *reach = wb__grow(c->reach, &c->cap_reach, m->np, sizeof *reach);
@@ -1363,10 +1365,40 @@ static int32_t make_list(wb_world *w, wb_real h, int32_t kmax, wb_real margin, i
     return r;
 }
 
+void wb__broadphase_free(wb_contacts *c)
+{
+    wb_broad *b = c->bp;
+    free(c->skip);
+    c->skip = NULL;
+    c->cap_skip = 0;
+    free(c->key_row); free(c->path); free(c->dorm); free(c->dorm_row); free(c->dorm_at); free(c->dorm_on);
+    free(c->off_path); free(c->soft); free(c->qs);
+    c->key_row = c->dorm = c->dorm_row = c->dorm_at = c->soft = c->qs = NULL;
+    c->cap_qs = 0;
+    c->path = NULL;
+    c->dorm_on = c->off_path = NULL;
+    c->cap_key_row = c->cap_path = c->cap_dorm = c->cap_dorm_row = c->cap_dorm_at = c->cap_dorm_on = 0;
+    c->cap_off_path = c->cap_soft = 0;
+    c->nd = 0;
+    free(c->xf); free(c->ij_old); free(c->left_old); free(c->fix); free(c->add); free(c->fixed);
+    c->xf = c->left_old = NULL;
+    c->ij_old = c->fix = c->add = c->fixed = NULL;
+    c->cap_xf = c->cap_old = c->cap_left_old = c->cap_fix = c->cap_add = c->cap_fixed = 0;
+    if (!b) return;
+    free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key);
+    free(b->runs); free(b->boxes); free(b->first); free(b->rowr);
+    free(b->vx); free(b->vr); free(b->vskip); free(b->list.ij); free(b->list.hit);
+    free(b->moved); free(b->is_moved); free(b->bad); free(b->mend.ij); free(b->mend.hit);
+    for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
+    free(b->out);
+    free(b);
+    c->bp = NULL;
+}
+
 void wb__contacts_begin(wb_world *w)
 {
     wb_model *m = &w->m;
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     c->n = 0;
     c->nact = 0;
     c->last = 0;
@@ -1415,7 +1447,7 @@ void wb__contacts_begin(wb_world *w)
 
 static int add_pair(wb_world *w, int32_t i, int32_t j, int32_t *na)
 {
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     const wb_real *xf = c->xf, *reach = c->reach, *p = &xf[3 * i];
     if (j == i || reach[j] < 0) return 1;
     const wb_real d0 = xf[3 * j] - p[0], d1 = xf[3 * j + 1] - p[1], d2 = xf[3 * j + 2] - p[2];
@@ -1446,7 +1478,7 @@ static int grid_pairs(wb_world *w, const wb_broad *b, int32_t i, wb_real e, int3
     const wb_grid *G = &b->lg;
     /* the grid holds the list's positions X: where M^-1 takes xf_i (each xf_j is within
      * its skin of M(X_j)) */
-    const wb_real *xi = &w->k.pc.xf[3 * i], *Q = b->mo.Q;
+    const wb_real *xi = &w->k.pc->xf[3 * i], *Q = b->mo.Q;
     const wb_real r0 = xi[0] - b->mo.c[0], r1 = xi[1] - b->mo.c[1], r2 = xi[2] - b->mo.c[2];
     wb_real p[3];
     for (int a = 0; a < 3; a++) p[a] = b->mo.C[a] + Q[a] * r0 + Q[3 + a] * r1 + Q[6 + a] * r2;
@@ -1460,7 +1492,7 @@ static int repair(wb_world *w, const int32_t *moved, int32_t nm, const int32_t *
                   wb_real margin, const ref_step *rs)
 {
     wb_model *m = &w->m;
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     const wb_broad *b = c->bp;
     wb_real *xf = c->xf, *reach = c->reach;
     const wb_real *x = w->s.x, *v = w->s.v, gt2 = v3_len(m->def.gravity) * t * t;
@@ -1590,7 +1622,7 @@ static inline int strays(const wb_contacts *c, const wb_real *x, const wb_real *
 int wb__contacts_recheck(wb_world *w, wb_real h)
 {
     wb_model *m = &w->m;
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     if (!c->check || c->no_recheck) return 0;
     const int32_t sub = c->sub++;
     const wb_real *x = w->s.x;
@@ -1657,7 +1689,7 @@ int wb__contacts_recheck(wb_world *w, wb_real h)
 void wb__contacts_brute(wb_world *w)
 {
     const wb_model *m = &w->m;
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     const wb_real *x = w->s.x;
     if (!m->def.contacts) return;
     for (int32_t i = 0; i < m->np; i++)

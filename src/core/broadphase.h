@@ -1,6 +1,5 @@
 /* broadphase.h: the particle pairs' broad phase (broadphase.c): its entry points, the
- * contact rules, and its scratch kept from frame to frame (defined here, its free inline,
- * so that the world frees it without calling back into broadphase.c). */
+ * contact rules, and its scratch kept from frame to frame. */
 #ifndef WB_BROADPHASE_H
 #define WB_BROADPHASE_H
 
@@ -81,34 +80,7 @@ struct wb_broad {
     int32_t lm;
     wb_real lrmax;
 };
-static inline void wb__broadphase_free(wb_contacts *c)
-{
-    wb_broad *b = c->bp;
-    free(c->skip);
-    c->skip = NULL;
-    c->cap_skip = 0;
-    free(c->key_row); free(c->path); free(c->dorm); free(c->dorm_row); free(c->dorm_at); free(c->dorm_on);
-    free(c->off_path); free(c->soft); free(c->qs);
-    c->key_row = c->dorm = c->dorm_row = c->dorm_at = c->soft = c->qs = NULL;
-    c->cap_qs = 0;
-    c->path = NULL;
-    c->dorm_on = c->off_path = NULL;
-    c->cap_key_row = c->cap_path = c->cap_dorm = c->cap_dorm_row = c->cap_dorm_at = c->cap_dorm_on = 0;
-    c->cap_off_path = c->cap_soft = 0;
-    c->nd = 0;
-    free(c->xf); free(c->ij_old); free(c->left_old); free(c->fix); free(c->add); free(c->fixed);
-    c->xf = c->left_old = NULL;
-    c->ij_old = c->fix = c->add = c->fixed = NULL;
-    c->cap_xf = c->cap_old = c->cap_left_old = c->cap_fix = c->cap_add = c->cap_fixed = 0;
-    if (!b) return;
-    free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key);
-    free(b->runs); free(b->boxes); free(b->first); free(b->rowr);
-    free(b->vx); free(b->vr); free(b->vskip); free(b->list.ij); free(b->list.hit);
-    free(b->moved); free(b->is_moved); free(b->bad); free(b->mend.ij); free(b->mend.hit);
-    for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
-    free(b->out);
-    free(b);
-    c->bp = NULL;
-}
+/* its scratch freed (contact.c's teardown; the tests' own lists) */
+void wb__broadphase_free(wb_contacts *c);
 
 #endif

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 
 #include "core.h"
+#include "bend.h"
 #include "volume.h"
 #include "tet.h"
 

@@ -14,6 +14,7 @@
 #include "core.h"
 #include "bvh.h"
 #include "attach.h"
+#include "contact.h"
 
 /* ---- collider API -------------------------------------------------------------------- */
 wb_collider_def wb_collider_default_def(wb_shape shape)

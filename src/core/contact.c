@@ -22,10 +22,31 @@
 
 #include "core.h"
 #include "ctype.h"
+#include "broadphase.h"
+#include "tricontact.h"
 
 /* a contact's record for the velocity pass and the readout (act_nd): normal (i -> j),
  * depth, normal force, old overlap pushed back in full (err), mu when sliding (else 0) */
 #define ND 7
+
+/* ---- the scratch (k.pc) -------------------------------------------------------------------- */
+int wb__contacts_make(wb_world *w)
+{
+    if (!w->k.pc) w->k.pc = calloc(1, sizeof *w->k.pc);
+    return w->k.pc != NULL;
+}
+
+void wb__contacts_destroy(wb_world *w)
+{
+    wb_contacts *c = w->k.pc;
+    if (!c) return;
+    wb__broadphase_free(c);
+    void *p[] = { c->ij, c->act, c->act_nd, c->left, c->reach, c->keys, c->graph, c->tcov, c->near, c->load,
+                  c->made_ab, c->bm };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    free(c);
+    w->k.pc = NULL;
+}
 
 /* ---- groups and settings ---------------------------------------------------------------- */
 int32_t wb_group_new(const wb_world *w)
@@ -43,7 +64,7 @@ bool wb_particle_collides(const wb_world *w, int32_t p) { return (w->m.cflags[p]
 void wb_particle_set_group(wb_world *w, int32_t p, int32_t group)
 {
     w->m.group[p] = group > 0 ? group : 0;
-    w->k.pc.scan_dirty = 1;
+    if (w->k.pc) w->k.pc->scan_dirty = 1;
 }
 
 void wb_particle_set_friction(wb_world *w, int32_t p, wb_real mu) { w->m.cfric[p] = mu; }
@@ -56,7 +77,7 @@ void wb_body_set_contacts(wb_world *w, wb_body b, bool collide, bool self_collid
         w->m.cflags[i] = f;
         w->m.cfric[i] = friction;
     }
-    w->k.pc.scan_dirty = 1;
+    if (w->k.pc) w->k.pc->scan_dirty = 1;
 }
 
 wb_status wb__body_finish(wb_world *w, int32_t first, int32_t count, wb_body *out)
@@ -75,7 +96,7 @@ void wb_group_set_self_collide(wb_world *w, int32_t group, bool on)
         if (on) w->m.cflags[i] |= WB_CF_SELF;
         else w->m.cflags[i] &= (uint8_t)~WB_CF_SELF;
     }
-    w->k.pc.scan_dirty = 1;
+    if (w->k.pc) w->k.pc->scan_dirty = 1;
 }
 
 bool wb_group_self_collide(const wb_world *w, int32_t group)
@@ -88,7 +109,7 @@ bool wb_group_self_collide(const wb_world *w, int32_t group)
 void wb_particle_set_radius(wb_world *w, int32_t p, wb_real r)
 {
     w->m.radius[p] = r;
-    w->k.pc.scan_dirty = 1; /* the triangles a body's spheres cover (wb__contact_rules) */
+    if (w->k.pc) w->k.pc->scan_dirty = 1; /* the triangles a body's spheres cover (wb__contact_rules) */
 }
 
 /* the body's links (any constraint type's: a Neo-Hookean lattice has tets and no
@@ -299,7 +320,7 @@ static int made_overlapping(const wb_model *m, int32_t a, int32_t b)
 /* groups a < b were made overlapping (above), from the cache when asked before */
 static int bodies_made(wb_world *w, int32_t a, int32_t b)
 {
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     if (c->bm_gen != c->rules_gen) c->nbm = 0, c->bm_gen = c->rules_gen;
     for (int32_t q = 0; q < c->nbm; q++)
         if (c->bm[3 * q] == a && c->bm[3 * q + 1] == b) return c->bm[3 * q + 2];
@@ -377,7 +398,7 @@ static const struct made_pair *moving(const made *mb, int32_t a, int32_t b)
 /* the bodies that keep a made overlap moved apart (above); 0 when none is */
 static int made_shift(wb_world *w, made *mb, const wb_real *left, wb_real step, int32_t nprev)
 {
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     const int32_t *g = w->m.group;
     const wb_real *xp = w->s.x_prev, *rad = w->m.radius;
     for (int32_t k = 0; k < c->n; k++) {
@@ -469,7 +490,7 @@ static int made_shift(wb_world *w, made *mb, const wb_real *left, wb_real step, 
 #define SWEEP_TOL ((wb_real)1e-3)
 static int32_t sweep(wb_world *w, wb_real h, int32_t *near, int32_t nn)
 {
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     const wb_model *m = &w->m;
     wb_real *x = w->s.x, *nds = c->act_nd;
     const wb_real *xp = w->s.x_prev, *wv = m->w, *rad = m->radius, *left = c->left;
@@ -525,15 +546,15 @@ static int32_t sweep(wb_world *w, wb_real h, int32_t *near, int32_t nn)
 /* after the static friction: the pairs in touch swept again (above) */
 void wb__contacts_settle(wb_world *w, wb_real h)
 {
-    wb_contacts *c = &w->k.pc;
-    if (c->nnear == 0 || (!c->fmoved && w->k.tc.nact == 0)) return; /* (the friction moved nothing) */
+    wb_contacts *c = w->k.pc;
+    if (c->nnear == 0 || (!c->fmoved && w->k.tc->nact == 0)) return; /* (the friction moved nothing) */
     c->touching -= sweep(w, h, c->near, c->nnear);
     c->last = c->nact + c->touching;
 }
 
 void wb__contacts_project(wb_world *w, wb_real h)
 {
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     c->nact = 0;
     c->nnear = 0;
     /* the body pairs moved in the last substep, within the frame only: a frame's start
@@ -593,8 +614,12 @@ void wb__contacts_project(wb_world *w, wb_real h)
         }
     }
     const int shifted = made_shift(w, &mb, left, vmax * h, nprev);
-    for (int32_t k = 0; k < c->n; k++) {
-        const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];
+    /* the list and the count in locals: the stores below (int32 act and near) could alias
+     * the scratch's fields for the compiler, which would then load them every pair */
+    const int32_t npairs = c->n, *ij = c->ij;
+    int32_t nact = 0;
+    for (int32_t k = 0; k < npairs; k++) {
+        const int32_t i = ij[2 * k], j = ij[2 * k + 1];
         const wb_real wi = wv[i], wj = wv[j], wsum = wi + wj;
         if (wsum == 0) continue;
         wb_real *xi = &x[3 * i], *xj = &x[3 * j], *pi = &xp[3 * i], *pj = &xp[3 * j];
@@ -653,15 +678,16 @@ void wb__contacts_project(wb_world *w, wb_real h)
         }
         /* normal and depth, kept for the velocity pass; the normal force for the readout
          * (XPBD multiplier of a zero-compliance contact, depth / (w_i + w_j), over h^2) */
-        act[c->nact] = k;
-        v3_copy(&nds[ND * c->nact], n);
-        nds[ND * c->nact + 3] = depth;
-        nds[ND * c->nact + 4] = depth / wsum / (h * h);
-        nds[ND * c->nact + 5] = err;
-        nds[ND * c->nact + 6] = 0; /* the friction pass sets it */
-        if (!mp) near[nn++] = c->nact;
-        c->nact++;
+        act[nact] = k;
+        v3_copy(&nds[ND * nact], n);
+        nds[ND * nact + 3] = depth;
+        nds[ND * nact + 4] = depth / wsum / (h * h);
+        nds[ND * nact + 5] = err;
+        nds[ND * nact + 6] = 0; /* the friction pass sets it */
+        if (!mp) near[nn++] = nact;
+        nact++;
     }
+    c->nact = nact;
     made_free(&mb);
     /* (no correction: nothing moved since any pair's projection) */
     if (c->nact == 0) nn = 0;
@@ -711,9 +737,9 @@ nomem:
  * An immovable particle has no budget to keep. */
 void wb__contacts_friction(wb_world *w, wb_real h)
 {
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     c->fmoved = 0;
-    if (c->nact == 0 && w->k.tc.nact == 0) return;
+    if (c->nact == 0 && w->k.tc->nact == 0) return;
     const wb_model *m = &w->m;
     wb_real *load = wb__grow(c->load, &c->cap_load, m->np, sizeof *load);
     if (!load) { wb__warn(w, "out of memory in contact friction; friction skipped this substep"); return; }
@@ -776,7 +802,7 @@ void wb__contacts_friction(wb_world *w, wb_real h)
  * fold the links keep pressing shut made friction that kept a cloth heap moving. */
 void wb__contacts_velocity(wb_world *w, wb_real h)
 {
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     const wb_model *m = &w->m;
     wb_real *v = w->s.v;
     for (int32_t a = 0; a < c->nact; a++) {
@@ -816,13 +842,23 @@ void wb__contacts_velocity(wb_world *w, wb_real h)
 }
 
 /* ---- readout of the last substep's contacts ------------------------------------------------ */
-int32_t wb_world_contact_count(const wb_world *w) { return w->k.pc.nact; }
+void wb__contacts_stats(const wb_world *w, wb_stats *st)
+{
+    const wb_contacts *pc = w->k.pc;
+    const wb_tricontacts *tc = w->k.tc;
+    if (!pc || !tc) return; /* never stepped */
+    st->particle_contacts = pc->last + tc->last;
+    st->broad_ms = pc->broad_ms + tc->broad_ms;
+    st->broad_remakes = pc->remakes_frame;
+}
+
+int32_t wb_world_contact_count(const wb_world *w) { return w->k.pc ? w->k.pc->nact : 0; }
 
 wb_contact wb_world_contact_at(const wb_world *w, int32_t i)
 {
-    const wb_contacts *c = &w->k.pc;
+    const wb_contacts *c = w->k.pc;
     wb_contact out = { -1, -1, 0, { 0, 0, 0 }, 0 };
-    if (i < 0 || i >= c->nact) return out;
+    if (i < 0 || i >= wb_world_contact_count(w)) return out;
     const int32_t k = c->act[i];
     const wb_real *nd = &c->act_nd[ND * i];
     out.a = c->ij[2 * k];

@@ -5,7 +5,7 @@
 
 #include <stdint.h>
 
-#include "wobble.h"
+#include "core.h"
 
 /* How much of a contact's overlap ov to correct this substep (contact.c explains why).
  * d0: the overlap it started the substep with (at x_prev, which earlier contacts of the
@@ -32,6 +32,7 @@ static inline wb_real wb__contact_depth(wb_real ov, wb_real d0, wb_real *left, w
     return ov - keep;
 }
 
+/* w->k.pc (core.h) */
 typedef struct wb_contacts {
     int32_t n, cap;        /* candidate pairs of this frame */
     int32_t *ij;           /* (n x 2) i < j, in the broad phase's fixed order */
@@ -134,5 +135,12 @@ typedef struct wb_contacts {
  * apart, to round-off (a rope of spacing s and radius 2 s: its particles four apart), they
  * would touch at its slightest bend */
 #define WB_REST_TOUCH ((wb_real)(1 + 1e-9))
+
+/* the body a particle is in for the contact rules: its group, or for a loose particle its
+ * graph (the loose particles its constraints reach), as -1 - the graph's least particle */
+static inline int32_t wb__graph_of(const wb_contacts *c, const wb_model *m, int32_t i)
+{
+    return m->group[i] > 0 ? m->group[i] : -1 - c->graph[i];
+}
 
 #endif

@@ -15,12 +15,7 @@
 #include "wobble.h"
 #include "vec.h"
 #include "shape.h"
-#include "bend.h"
-#include "shape_match.h"
 #include "pool.h"
-#include "contact.h"
-#include "broadphase.h"
-#include "tricontact.h"
 
 /* a substep's prediction, per particle: damping, gravity, x += h v (x_prev = x first; a
  * particle with w = 0 stays). solver.c's pass and collide.c's fused one share it, so
@@ -102,13 +97,6 @@ typedef struct wb_state {
 #define WB_CF_COLLIDE 1u     /* collides with other bodies and loose particles */
 #define WB_CF_SELF 2u        /* collides with its own body (group > 0) */
 
-/* the body a particle is in for the contact rules: its group, or for a loose particle its
- * graph (the loose particles its constraints reach), as -1 - the graph's least particle */
-static inline int32_t wb__graph_of(const wb_contacts *c, const wb_model *m, int32_t i)
-{
-    return m->group[i] > 0 ? m->group[i] : -1 - c->graph[i];
-}
-
 
 /* ---- solver cache: packed colour batches and per-step scratch ------------------------ */
 typedef struct wb_cache {
@@ -159,8 +147,11 @@ typedef struct wb_cache {
     int (*interrupt)(void *);
     void *interrupt_ud;
     int32_t last_contacts;
-    wb_contacts pc;        /* particle-particle contacts (contact.c) */
-    wb_tricontacts tc;     /* particle-triangle contacts (tricontact.c) */
+    /* the contacts' scratch, made by their files at the first step (NULL before it; a file
+     * that reads them outside a step checks): particle pairs (contact.h, contact.c) and
+     * particle-triangle pairs (tricontact.h, tribroad.c and tricontact.c) */
+    struct wb_contacts *pc;
+    struct wb_tricontacts *tc;
     int64_t projections;
     double step_ms, solve_ms;
     int no_fuse;           /* tests: the plain order, the next substep's prediction never
@@ -205,14 +196,17 @@ struct wb_world {
     wb_model m;
     wb_state s;
     wb_cache k;
-    wb_bends bend;         /* bending constraints (bend.c): model, state and cache */
-    struct wb_volumes *vol; /* volume constraints (volume.h), NULL until the first */
-    struct wb_neos *neo;    /* Neo-Hookean tets (tet.h), NULL until the first */
-    wb_smatch sm;          /* shape-matching clusters (shape_match.c) */
-    wb_pressures pr;       /* pressure constraints (pressure.c) */
-    struct wb_attaches *att; /* attachments (attach.h), NULL until the first */
-    struct wb_grabs *grab;  /* grabs (grab.h), NULL until the first */
-    struct wb_tethers *teth; /* tethers (tether.h), NULL until the first */
+    /* each constraint type but distance: its struct (model, state and cache) declared in
+     * its own header, made by its file with the first constraint, freed by its destroy
+     * hook (ctype.h); NULL until the first */
+    struct wb_bends *bend;  /* bends (bend.h) */
+    struct wb_volumes *vol; /* volume constraints (volume.h) */
+    struct wb_neos *neo;    /* Neo-Hookean tets (tet.h) */
+    struct wb_smatch *sm;   /* shape-matching clusters (shape_match.h) */
+    struct wb_pressures *pr; /* pressure constraints (pressure.h) */
+    struct wb_attaches *att; /* attachments (attach.h) */
+    struct wb_grabs *grab;  /* grabs (grab.h) */
+    struct wb_tethers *teth; /* tethers (tether.h) */
     struct wb_rigids *rb;  /* rigid bodies (rigid.h), NULL until the first */
     struct wb_vbd *vbd;    /* the VBD solver's cache (vbd.c), NULL until a step with it */
     wb_pool *pool;         /* the threads (pool.h), NULL until a step runs with threads > 1 */
@@ -248,40 +242,6 @@ void wb__momentum_restore(wb_world *w, wb_real h);
  * about their mass centre are S (xx yy zz xy xz yz): the turn that carries angular
  * momentum L; 0 when singular or not finite (broadphase.c's reference motion too) */
 void wb__turn_rate(const double S[6], const double L[3], double om[3]);
-/* colour.c: greedy colouring of n constraints of k particles each (constraint i joins
- * idx[k i .. k i + k - 1]), mirror images alike (colour.c's header); those live() refuses
- * get WB_NO_COLOUR, the others a colour in [0, WB_MAX_COLOURS] (WB_MAX_COLOURS: the serial
- * overflow batch), counted in count. 0 when out of memory */
-#define WB_NO_COLOUR 255
-/* With split (not NULL, mirror keys on): the groups of mirror images that share a movable
- * particle (links meeting on a mirror plane), which no colouring can keep alike, are not
- * coloured (WB_SPLIT_COLOUR, not counted) but returned as compounds: each a set of images
- * joined through shared particles, to be projected together from the same positions
- * (distance.c). split->member (n slots) gets them compound by compound in visiting order,
- * split->comp_start (n + 1 slots) the ncomp + 1 compound bounds into member. */
-#define WB_SPLIT_COLOUR 254
-typedef struct wb_split {
-    int32_t n, first, ncomp; /* members, coloured constraints (visit_order's), compounds */
-    int32_t *member, *comp_start;
-} wb_split;
-int wb__colour_greedy(const wb_model *m, const int32_t *idx, int k, int32_t n,
-                      int (*live)(const void *ud, int32_t i), const void *ud, uint8_t *colour,
-                      int32_t count[WB_MAX_COLOURS + 1], wb_split *split);
-/* colour.c, tests: on = 0 colours in creation order (as before mirror keys), 1 with mirror
- * keys (the default) from the next colouring on; returns the previous setting. Not
- * thread-safe: call it between steps */
-int wb__colour_symmetric(int on);
-/* batch ranges from the counts: colour_start (ncolours + 1), the first serial batch, and
- * start[c] the first packed index of colour c; returns the packed total */
-int32_t wb__colour_ranges(const int32_t count[WB_MAX_COLOURS + 1], int32_t *colour_start, int32_t *ncolours,
-                          int32_t *serial_start, int32_t start[WB_MAX_COLOURS + 1]);
-wb_status wb__bend_reserve(wb_world *w, int64_t extra); /* bend.c: after it, extra bends add without failing */
-/* bend.c: the dihedral angle of the bend over particles p[0..3] at positions x; *ok = 0
- * when a triangle is degenerate */
-wb_real wb__bend_angle_of(const wb_real *x, const int32_t *p, int *ok);
-/* bend.c: the interior edges of a triangle list (each shared by exactly two triangles), as
- * hinges p1 p2 p3 p4 into out (room for 3 ntri / 2 x 4), in edge order; -1 when out of memory */
-int32_t wb__bend_hinges(const int32_t *tri, int32_t ntri, int32_t *out);
 /* collide.c: collisions, then v = (x - x_prev)/h, friction and restitution; then, per
  * particle in the same pass, the next substep's prediction when next != NULL, or (scan)
  * the finiteness check of x and v into k.nonfinite. 0 when out of memory (nothing done) */
@@ -290,6 +250,14 @@ void wb__collider_pose_at(const wb_collider_pose *cp, wb_real t, wb_real p[3], w
 /* collide.c: a mesh collider's copy charged to / given back to the memory budget (and freed) */
 int wb__mesh_charge(wb_world *w, const struct wb_colmesh *cm);
 void wb__mesh_release(wb_world *w, wb_cshape *s);
+/* contact.c, tribroad.c: the contacts' scratch (k.pc, k.tc) made when there is none
+ * (each step, first: 0 when out of memory), and freed with the world */
+int wb__contacts_make(wb_world *w);
+int wb__tricontacts_make(wb_world *w);
+void wb__contacts_destroy(wb_world *w);
+void wb__tricontacts_destroy(wb_world *w);
+/* contact.c: the contacts' counts in w:stats() (nothing before the first step) */
+void wb__contacts_stats(const wb_world *w, wb_stats *st);
 /* contact.c: broad phase once per frame, projection per substep, velocity pass after
  * the velocities are updated */
 void wb__contacts_begin(wb_world *w);

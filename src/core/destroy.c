@@ -25,13 +25,12 @@ void wb_world_destroy(wb_world *w)
     if (m->def.memory) m->def.memory->used -= charged;
     wb_state *s = &w->s;
     wb_cache *k = &w->k;
-    wb__broadphase_free(&k->pc);
-    wb__tribroad_free(&k->tc);
+    wb__contacts_destroy(w);
+    wb__tricontacts_destroy(w);
     void *ptrs[] = { m->inv_mass, m->w, m->radius, m->pinned, m->group, m->cflags, m->cfric, m->x0, m->c_shape,
                      m->c_gen, m->surf_start, m->tri, s->x, s->x_prev, s->v, s->c_pose, k->dx, k->ncount, k->x_save,
-                     k->v_save, k->c_sub, k->c_left, k->c_save, k->pc.ij, k->pc.act, k->pc.act_nd, k->pc.left,
-                     k->pc.reach, k->pc.keys, k->pc.graph, k->pc.tcov, k->pc.near, k->pc.load, k->pc.made_ab, k->pc.bm, k->tc.pt, k->tc.act,
-                     k->tc.act_d, k->tc.left, k->mc_body, k->mc_root, k->mc_acc, k->mc_pinned, k->mc_end };
+                     k->v_save, k->c_sub, k->c_left, k->c_save, k->mc_body, k->mc_root, k->mc_acc, k->mc_pinned,
+                     k->mc_end };
     for (size_t i = 0; i < sizeof ptrs / sizeof ptrs[0]; i++) free(ptrs[i]);
     free(w);
 }

@@ -2,13 +2,19 @@
  * colouring of the live links into batches, their XPBD projection (Gauss-Seidel batch by
  * batch or Jacobi), plastic flow and breaking once per frame, and their elastic energy. The
  * slot arrays and the C API (wb_distance_*) live in world.c with the other model arrays;
- * this file owns the solver cache built from them (wb_cache's s_* arrays). */
+ * this file owns the solver cache built from them (wb_cache's s_* arrays).
+ *
+ * The batches are this file's own, not batch.h's: links are removed (slots freed, links
+ * broken), so they are packed live ones only, the links meeting on a mirror plane are
+ * split out as compounds projected together from the same positions (wb_split: a
+ * symmetric scene stays symmetric), and the Jacobi solver runs over the same packing. */
 #include <stdlib.h>
 
 #include "ctype.h"
 #include "snapshot.h"
 #include "tet.h"
 #include "volume.h"
+#include "contact.h"
 
 static int realloc_n(void **p, int32_t n, size_t elem)
 {
@@ -96,7 +102,7 @@ static wb_status colour(wb_world *w)
 {
     wb_model *m = &w->m;
     wb_cache *k = &w->k;
-    k->pc.keys_dirty = 1; /* the constraint pairs that self-collision skips */
+    if (k->pc) k->pc->keys_dirty = 1; /* the constraint pairs that self-collision skips */
 
     int32_t ns = 0;
     for (int32_t s = 0; s < m->nd; s++) ns += packable(w, s);

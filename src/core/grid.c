@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "core.h"
+#include "grid.h"
 
 static int cmp_real(const void *a, const void *b)
 {

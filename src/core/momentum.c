@@ -37,9 +37,14 @@
 
 #include "core.h"
 #include "attach.h"
+#include "bend.h"
 #include "grab.h"
+#include "pressure.h"
+#include "shape_match.h"
 #include "tet.h"
 #include "volume.h"
+#include "contact.h"
+#include "tricontact.h"
 
 /* per body: 0 mass, 1-3 sum m r, 4-6 sum m r x d, 7-9 sum m d, 10-15 sum m r r^T
  * (xx yy zz xy xz yz), r about the body's first particle (no cancellation far from the
@@ -86,13 +91,13 @@ static void unite_all(int32_t *parent, const int32_t *p, int k)
 static void signature(const wb_world *w, int64_t sig[8])
 {
     sig[0] = w->m.np;
-    sig[1] = w->bend.n;
+    sig[1] = wb_bend_count(w);
     sig[2] = wb_volume_count(w);
     sig[3] = wb_tet_count(w);
-    sig[4] = w->sm.n;
-    sig[5] = w->sm.nids;
-    sig[6] = w->pr.n;
-    sig[7] = w->pr.nverts;
+    sig[4] = wb_shape_match_count(w);
+    sig[5] = w->sm ? w->sm->nids : 0;
+    sig[6] = wb_pressure_count(w);
+    sig[7] = w->pr ? w->pr->nverts : 0;
 }
 
 static int build(wb_world *w)
@@ -106,13 +111,13 @@ static int build(wb_world *w)
     for (int32_t s = 0; s < m->nd; s++)
         if ((m->d_gen[s] & 1u) && !w->s.d_broken[s]) unite(parent, m->d_ij[2 * s], m->d_ij[2 * s + 1]);
     /* bends, broken or not: a body joined once too often is only kept a little less well */
-    for (int32_t i = 0; i < w->bend.n; i++) unite_all(parent, &w->bend.ij[4 * i], 4);
+    for (int32_t i = 0; i < wb_bend_count(w); i++) unite_all(parent, &w->bend->ij[4 * i], 4);
     for (int32_t i = 0; i < wb_volume_count(w); i++) unite_all(parent, &w->vol->ijkl[4 * i], 4);
     for (int32_t i = 0; i < wb_tet_count(w); i++) unite_all(parent, &w->neo->ijkl[4 * i], 4);
-    for (int32_t c = 0; c < w->sm.n; c++)
-        unite_all(parent, &w->sm.ids[w->sm.start[c]], w->sm.start[c + 1] - w->sm.start[c]);
-    for (int32_t c = 0; c < w->pr.n; c++)
-        unite_all(parent, &w->pr.verts[w->pr.vstart[c]], w->pr.vstart[c + 1] - w->pr.vstart[c]);
+    for (int32_t c = 0; c < wb_shape_match_count(w); c++)
+        unite_all(parent, &w->sm->ids[w->sm->start[c]], w->sm->start[c + 1] - w->sm->start[c]);
+    for (int32_t c = 0; c < wb_pressure_count(w); c++)
+        unite_all(parent, &w->pr->verts[w->pr->vstart[c]], w->pr->vstart[c + 1] - w->pr->vstart[c]);
     /* number the bodies of two or more particles in order of their first particle; a
      * particle alone (no constraint) is nobody's: -1 */
     int32_t nb = 0;
@@ -429,13 +434,13 @@ void wb__momentum_restore(wb_world *w, wb_real h)
      * parts against each other, and a rigid turn of the whole would slip at every contact,
      * which friction then takes back as a twist of the body (a self-colliding cloth heap,
      * turned so, never comes to rest). So is one touching a rigid body. */
-    const wb_contacts *pc = &k->pc;
+    const wb_contacts *pc = k->pc;
     for (int32_t c = 0; c < pc->n; c++)
         for (int e = 0; e < 2; e++) {
             const int32_t b = body[pc->ij[2 * c + e]];
             if (b >= 0 && acc[ACC * b] >= 0) acc[ACC * b] = -2;
         }
-    const wb_tricontacts *tc = &k->tc;
+    const wb_tricontacts *tc = k->tc;
     for (int32_t c = 0; c < tc->n; c++) {
         const int32_t t = tc->pt[2 * c + 1], pts[4] = { tc->pt[2 * c], w->m.tri[3 * t], w->m.tri[3 * t + 1], w->m.tri[3 * t + 2] };
         for (int e = 0; e < 4; e++)

@@ -29,16 +29,26 @@
 
 #include "core.h"
 #include "ctype.h"
+#include "pressure.h"
 #include "snapshot.h"
 
 #define BYTES_P (3 * sizeof(int32_t) + 4 * sizeof(wb_real))
 #define BYTES_V (sizeof(int32_t))
 #define BYTES_T (3 * sizeof(int32_t))
 
-/* room for n_extra constraints over nv_extra particles and nt_extra triangles in all */
+/* w->pr for reading: an empty one while there is none */
+static const wb_pressures no_pressures;
+#define PR(w) ((w)->pr ? (w)->pr : &no_pressures)
+
+/* room for n_extra constraints over nv_extra particles and nt_extra triangles in all; the
+ * struct is made with the first */
 static wb_status reserve(wb_world *w, int64_t n_extra, int64_t nv_extra, int64_t nt_extra)
 {
-    wb_pressures *p = &w->pr;
+    if (!w->pr) {
+        if (n_extra <= 0 && nv_extra <= 0 && nt_extra <= 0) return WB_OK;
+        if (!(w->pr = calloc(1, sizeof *w->pr))) return WB_ERR_NOMEM;
+    }
+    wb_pressures *p = w->pr;
     const int64_t n = p->n + n_extra + 1, nv = p->nverts + nv_extra, nt = p->ntri + nt_extra;
     if (n > WB_MAX_CONSTRAINTS || nv > WB_MAX_CONSTRAINTS || nt > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     if (n <= p->cap && nv <= p->cap_verts && nt <= p->cap_tri) return WB_OK;
@@ -124,7 +134,7 @@ int32_t wb_body_surface(const wb_world *w, wb_body b)
 /* the volume of constraint k and (when grad) its gradients, unscaled: 6 V and 6 grad V */
 static wb_real volume6(const wb_world *w, int32_t k, wb_real *grad)
 {
-    const wb_pressures *p = &w->pr;
+    const wb_pressures *p = PR(w);
     const int32_t *v = &p->verts[p->vstart[k]], nv = p->vstart[k + 1] - p->vstart[k];
     const wb_real *x = w->s.x;
     wb_real o[3], V = 0;
@@ -153,7 +163,7 @@ static wb_real volume6(const wb_world *w, int32_t k, wb_real *grad)
  * triangles, surface checked); v0 < 0: the volume now */
 static int32_t build(wb_world *w, int32_t s, wb_real pressure, wb_real alpha, wb_real v0)
 {
-    wb_pressures *p = &w->pr;
+    wb_pressures *p = w->pr;
     const wb_model *m = &w->m;
     const int32_t t0 = m->surf_start[s], nt = m->surf_start[s + 1] - t0, k = p->n;
     /* the surface's particles, ascending, made in place in the reserved room */
@@ -180,11 +190,12 @@ static int32_t build(wb_world *w, int32_t s, wb_real pressure, wb_real alpha, wb
 }
 
 /* ---- the type ------------------------------------------------------------------------------- */
-static int32_t pr_count(const wb_world *w) { return w->pr.n; }
+static int32_t pr_count(const wb_world *w) { return PR(w)->n; }
 
 static wb_status pr_prepare(wb_world *w)
 {
-    wb_pressures *p = &w->pr;
+    wb_pressures *p = w->pr;
+    if (!p) return WB_OK;
     int32_t most = 0;
     for (int32_t k = 0; k < p->n; k++)
         if (p->vstart[k + 1] - p->vstart[k] > most) most = p->vstart[k + 1] - p->vstart[k];
@@ -197,12 +208,13 @@ static wb_status pr_prepare(wb_world *w)
 
 static void pr_substep_begin(wb_world *w)
 {
-    if (w->pr.n > 0) memset(w->pr.lambda, 0, sizeof(wb_real) * (size_t)w->pr.n);
+    if (pr_count(w) > 0) memset(w->pr->lambda, 0, sizeof(wb_real) * (size_t)w->pr->n);
 }
 
 static void pr_project(wb_world *w, wb_real h)
 {
-    wb_pressures *p = &w->pr;
+    wb_pressures *p = w->pr;
+    if (!p) return;
     const wb_real *wv = w->m.w;
     wb_real *x = w->s.x, *g = p->grad;
     w->k.projections += p->n;
@@ -223,7 +235,7 @@ static void pr_project(wb_world *w, wb_real h)
 
 static wb_real pr_residual(const wb_world *w, wb_real h)
 {
-    const wb_pressures *p = &w->pr;
+    const wb_pressures *p = PR(w);
     wb_real r = 0, *g = p->grad; /* (scratch) */
     for (int32_t k = 0; k < p->n; k++) {
         const wb_real at = p->alpha[k] / (h * h);
@@ -240,7 +252,7 @@ static wb_real pr_residual(const wb_world *w, wb_real h)
 
 static wb_real pr_energy(const wb_world *w)
 {
-    const wb_pressures *p = &w->pr;
+    const wb_pressures *p = PR(w);
     wb_real u = 0;
     for (int32_t k = 0; k < p->n; k++) {
         if (p->alpha[k] <= 0) continue;
@@ -292,10 +304,10 @@ int32_t wb_pressure_add(wb_world *w, int32_t s, const wb_pressure_def *def)
     wb_status st = reserve(w, 1, 3 * (int64_t)nt, nt);
     if (st != WB_OK) return st;
     const int32_t k = build(w, s, def->pressure, def->compliance, -1);
-    const wb_real v0 = w->pr.v0[k];
+    const wb_real v0 = w->pr->v0[k];
     if (!(v0 > 0) || !isfinite(v0)) {
         /* undo: nothing else points at the arrays' tails */
-        wb_pressures *p = &w->pr;
+        wb_pressures *p = w->pr;
         p->n--;
         p->nverts = p->vstart[k];
         p->ntri = p->tstart[k];
@@ -306,14 +318,14 @@ int32_t wb_pressure_add(wb_world *w, int32_t s, const wb_pressure_def *def)
     return k;
 }
 
-#define CHECK_K(w, k) assert((k) >= 0 && (k) < (w)->pr.n)
+#define CHECK_K(w, k) assert((k) >= 0 && (k) < wb_pressure_count(w))
 
-int32_t wb_pressure_count(const wb_world *w) { return w->pr.n; }
+int32_t wb_pressure_count(const wb_world *w) { return PR(w)->n; }
 
 wb_pressure_def wb_pressure_get_def(const wb_world *w, int32_t k)
 {
     CHECK_K(w, k);
-    wb_pressure_def d = { w->pr.pressure[k], w->pr.alpha[k] };
+    wb_pressure_def d = { w->pr->pressure[k], w->pr->alpha[k] };
     return d;
 }
 
@@ -321,12 +333,12 @@ void wb_pressure_set(wb_world *w, int32_t k, wb_real pressure)
 {
     CHECK_K(w, k);
     assert(pressure > 0 && isfinite(pressure));
-    w->pr.pressure[k] = pressure;
+    w->pr->pressure[k] = pressure;
 }
 
 wb_real wb_pressure_volume(const wb_world *w, int32_t k) { CHECK_K(w, k); return volume6(w, k, NULL) / 6; }
-wb_real wb_pressure_rest_volume(const wb_world *w, int32_t k) { CHECK_K(w, k); return w->pr.v0[k]; }
-int32_t wb_pressure_surface(const wb_world *w, int32_t k) { CHECK_K(w, k); return w->pr.surface[k]; }
+wb_real wb_pressure_rest_volume(const wb_world *w, int32_t k) { CHECK_K(w, k); return w->pr->v0[k]; }
+int32_t wb_pressure_surface(const wb_world *w, int32_t k) { CHECK_K(w, k); return w->pr->surface[k]; }
 
 /* ---- snapshots -------------------------------------------------------------------------------- */
 static void pr_image_free(wb_image *g);
@@ -359,7 +371,7 @@ static void pr_image_free(wb_image *g)
 
 static wb_status pr_image_save(const wb_world *w, wb_image *g)
 {
-    const wb_pressures *p = &w->pr;
+    const wb_pressures *p = PR(w);
     if (p->n == 0) return WB_OK;
     wb_status st = wb_image_alloc_pressure(g, p->n);
     if (st != WB_OK) return st;
@@ -425,18 +437,21 @@ static void pr_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
 /* ---- teardown and hash (ctype.h) --------------------------------------------------------- */
 static void pr_destroy(wb_world *w)
 {
-    wb_pressures *pr = &w->pr;
+    wb_pressures *pr = w->pr;
+    if (!pr) return;
     void *p[] = { pr->surface, pr->pressure, pr->alpha, pr->v0, pr->vstart, pr->tstart, pr->verts, pr->tri,
                   pr->lambda, pr->grad };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    free(pr);
+    w->pr = NULL;
 }
 
-static size_t pr_charged(const wb_world *w) { return w->pr.charged; }
+static size_t pr_charged(const wb_world *w) { return PR(w)->charged; }
 
 /* parameters and rest volumes; a world without any adds nothing */
 static uint64_t pr_hash(const wb_world *w, uint64_t h)
 {
-    const wb_pressures *pr = &w->pr;
+    const wb_pressures *pr = PR(w);
     if (pr->n == 0) return h;
     h = wb__fnv(h, &pr->n, sizeof pr->n);
     h = wb__fnv(h, pr->surface, sizeof(int32_t) * (size_t)pr->n);

@@ -194,9 +194,7 @@ wb_stats wb_world_stats(const wb_world *w)
     st.colliders = wb_collider_count(w);
     st.colours = w->k.ncolours;
     st.contacts = w->k.last_contacts;
-    st.particle_contacts = w->k.pc.last + w->k.tc.last;
-    st.broad_ms = w->k.pc.broad_ms + w->k.tc.broad_ms;
-    st.broad_remakes = w->k.pc.remakes_frame;
+    wb__contacts_stats(w, &st);
     st.projections = w->k.projections;
     st.step_ms = w->k.step_ms;
     st.solve_ms = w->k.solve_ms;

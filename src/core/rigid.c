@@ -7,6 +7,7 @@
  * from the poses, then dynamic friction and restitution at velocity level. */
 #include <assert.h>
 
+#include "contact.h"
 #include "rigid.h"
 
 /* bytes per slot over the model, state and cache arrays, for the memory budget */

@@ -26,6 +26,7 @@
  * rigid bodies. The list is in particle order, then body slot order, and projected
  * serially: the same for any thread count. */
 #include "attach.h"
+#include "contact.h"
 #include "rigid.h"
 
 static int live(const wb_rigids *rb, int32_t r) { return rb->gen[r] & 1u; }

@@ -46,6 +46,7 @@
 
 #include "core.h"
 #include "ctype.h"
+#include "shape_match.h"
 #include "snapshot.h"
 
 #define H_REF ((wb_real)1 / 60)  /* the step at which `stiffness` is the fraction removed */
@@ -53,11 +54,19 @@
 #define BYTES_CLUSTER (4 + 11 * sizeof(wb_real))
 #define BYTES_ID (4 + 6 * sizeof(wb_real))
 
+/* w->sm for reading: an empty one while there is none */
+static const wb_smatch no_clusters;
+#define SM(w) ((w)->sm ? (w)->sm : &no_clusters)
+
 /* room for n_extra more clusters of ids_extra particles in all; after it, adding them
  * cannot fail */
 static wb_status reserve(wb_world *w, int64_t n_extra, int64_t ids_extra)
 {
-    wb_smatch *sm = &w->sm;
+    if (!w->sm) {
+        if (n_extra <= 0 && ids_extra <= 0) return WB_OK;
+        if (!(w->sm = calloc(1, sizeof *w->sm))) return WB_ERR_NOMEM;
+    }
+    wb_smatch *sm = w->sm;
     const int64_t nc = sm->n + n_extra, ni = sm->nids + ids_extra;
     if (nc + 1 > WB_MAX_CONSTRAINTS || ni > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     if (nc + 1 <= sm->cap && ni <= sm->cap_ids) return WB_OK;
@@ -85,7 +94,7 @@ static wb_status reserve(wb_world *w, int64_t n_extra, int64_t ids_extra)
  * of its rest shape onto them; particles without mass (inv_mass 0) take no part */
 static void fit_at(const wb_world *w, int32_t k, const wb_real *x, wb_real q[4], wb_real c[3])
 {
-    const wb_smatch *sm = &w->sm;
+    const wb_smatch *sm = SM(w);
     const wb_real *im = w->m.inv_mass;
     wb_real M = 0, A[9] = { 0 };
     v3_set(c, 0, 0, 0);
@@ -119,7 +128,7 @@ static void goal(const wb_real R[9], const wb_real c[3], const wb_real r[3], wb_
 /* sum m |x - g|^2 and sum m |r|^2 over cluster k for the fit (q, c) */
 static void deviation(const wb_world *w, int32_t k, const wb_real q[4], const wb_real c[3], wb_real *dev, wb_real *size)
 {
-    const wb_smatch *sm = &w->sm;
+    const wb_smatch *sm = SM(w);
     const wb_real *im = w->m.inv_mass;
     wb_real R[9];
     wb_quat_to_matrix(q, R);
@@ -137,11 +146,12 @@ static void deviation(const wb_world *w, int32_t k, const wb_real q[4], const wb
 }
 
 /* ---- the type ------------------------------------------------------------------------------- */
-static int32_t sm_count(const wb_world *w) { return w->sm.n; }
+static int32_t sm_count(const wb_world *w) { return SM(w)->n; }
 
 static wb_status sm_prepare(wb_world *w)
 {
-    wb_smatch *sm = &w->sm;
+    wb_smatch *sm = w->sm;
+    if (!sm) return WB_OK;
     if (sm->n > 0) memcpy(sm->qk, sm->q, 4 * sizeof(wb_real) * (size_t)sm->n);
     return WB_OK;
 }
@@ -161,7 +171,8 @@ static wb_status sm_prepare(wb_world *w)
  * A compliant cluster's deformation is its elastic state: it keeps it. */
 static void sm_substep_begin(wb_world *w)
 {
-    wb_smatch *sm = &w->sm;
+    wb_smatch *sm = w->sm;
+    if (!sm) return;
     if (sm->nids > 0) memset(sm->lambda, 0, 3 * sizeof(wb_real) * (size_t)sm->nids);
     const wb_real *wv = w->m.w;
     wb_real *x = w->s.x, *xp = w->s.x_prev;
@@ -188,7 +199,8 @@ static wb_real kappa_h2(wb_real s, wb_real h) { return s >= 1 ? 0 : s / (1 - s) 
 
 static void sm_project(wb_world *w, wb_real h)
 {
-    wb_smatch *sm = &w->sm;
+    wb_smatch *sm = w->sm;
+    if (!sm) return;
     const wb_real *wv = w->m.w, *im = w->m.inv_mass;
     wb_real *x = w->s.x;
     w->k.projections += sm->n;   /* a cluster is one projection */
@@ -226,7 +238,8 @@ static void sm_project(wb_world *w, wb_real h)
 
 static void sm_frame_end(wb_world *w)
 {
-    wb_smatch *sm = &w->sm;
+    wb_smatch *sm = w->sm;
+    if (!sm) return;
     const wb_real dt = w->m.def.dt, *im = w->m.inv_mass;
     for (int32_t k = 0; k < sm->n; k++) {
         wb_real *q = &sm->q[4 * k];
@@ -265,7 +278,7 @@ static void sm_frame_end(wb_world *w)
  * a fit of the positions as they are (from a copy of the cluster's rotation) */
 static wb_real sm_residual(const wb_world *w, wb_real h)
 {
-    const wb_smatch *sm = &w->sm;
+    const wb_smatch *sm = SM(w);
     const wb_real *x = w->s.x, *wv = w->m.w, *im = w->m.inv_mass;
     wb_real r = 0;
     for (int32_t k = 0; k < sm->n; k++) {
@@ -292,7 +305,7 @@ static wb_real sm_residual(const wb_world *w, wb_real h)
 
 static wb_real sm_energy(const wb_world *w)
 {
-    const wb_smatch *sm = &w->sm;
+    const wb_smatch *sm = SM(w);
     wb_real u = 0;
     for (int32_t k = 0; k < sm->n; k++) {
         const wb_real s = sm->stiff[k];
@@ -310,7 +323,7 @@ static wb_real sm_energy(const wb_world *w)
  * overlapping could touch, and the rest rule takes those): a chain through it */
 static void sm_links(const wb_world *w, wb_link_fn fn, void *ud)
 {
-    const wb_smatch *sm = &w->sm;
+    const wb_smatch *sm = SM(w);
     for (int32_t c = 0; c < sm->n; c++)
         for (int32_t i = sm->start[c] + 1; i < sm->start[c + 1]; i++) fn(ud, sm->ids[i - 1], sm->ids[i], 0);
 }
@@ -385,7 +398,7 @@ int32_t wb_shape_match_add(wb_world *w, const int32_t *ids, int32_t n, const wb_
     }
     wb_status st = reserve(w, 1, n);
     if (st != WB_OK) return st;
-    wb_smatch *sm = &w->sm;
+    wb_smatch *sm = w->sm;
     const int32_t k = sm->n++, first = sm->nids;
     sm->nids += n;
     sm->start[k + 1] = sm->nids;
@@ -401,36 +414,36 @@ int32_t wb_shape_match_add(wb_world *w, const int32_t *ids, int32_t n, const wb_
     return k;
 }
 
-int32_t wb_shape_match_count(const wb_world *w) { return w->sm.n; }
+int32_t wb_shape_match_count(const wb_world *w) { return SM(w)->n; }
 
-#define CHECK_S(w, s) assert((s) >= 0 && (s) < (w)->sm.n)
+#define CHECK_S(w, s) assert((s) >= 0 && (s) < wb_shape_match_count(w))
 
 wb_shape_match_def wb_shape_match_get_def(const wb_world *w, int32_t s)
 {
     CHECK_S(w, s);
-    wb_shape_match_def d = { w->sm.stiff[s], w->sm.yield[s], w->sm.creep[s] };
+    wb_shape_match_def d = { w->sm->stiff[s], w->sm->yield[s], w->sm->creep[s] };
     return d;
 }
 
-int32_t wb_shape_match_size(const wb_world *w, int32_t s) { CHECK_S(w, s); return w->sm.start[s + 1] - w->sm.start[s]; }
+int32_t wb_shape_match_size(const wb_world *w, int32_t s) { CHECK_S(w, s); return w->sm->start[s + 1] - w->sm->start[s]; }
 
 int32_t wb_shape_match_particle(const wb_world *w, int32_t s, int32_t i)
 {
     assert(i >= 0 && i < wb_shape_match_size(w, s));
-    return w->sm.ids[w->sm.start[s] + i];
+    return w->sm->ids[w->sm->start[s] + i];
 }
 
 void wb_shape_match_rest(const wb_world *w, int32_t s, int32_t i, wb_real out[3])
 {
     assert(i >= 0 && i < wb_shape_match_size(w, s));
-    v3_copy(out, &w->sm.rest[3 * (w->sm.start[s] + i)]);
+    v3_copy(out, &w->sm->rest[3 * (w->sm->start[s] + i)]);
 }
 
 wb_real wb_shape_match_strain(const wb_world *w, int32_t s)
 {
     CHECK_S(w, s);
     wb_real q[4], c[3], dev, size;
-    memcpy(q, &w->sm.q[4 * s], sizeof q);
+    memcpy(q, &w->sm->q[4 * s], sizeof q);
     fit(w, s, q, c);
     deviation(w, s, q, c, &dev, &size);
     return size > 0 ? sqrt(dev / size) : 0;
@@ -469,7 +482,7 @@ static void sm_image_free(wb_image *g)
 
 static wb_status sm_image_save(const wb_world *w, wb_image *g)
 {
-    const wb_smatch *sm = &w->sm;
+    const wb_smatch *sm = SM(w);
     if (sm->n == 0) return WB_OK;
     wb_status st = wb_image_alloc_smatch(g, sm->n, sm->nids);
     if (st != WB_OK) return st;
@@ -522,8 +535,9 @@ static wb_status sm_image_reserve(wb_world *w, const wb_image *g, const wb_image
 static void sm_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
 {
     const int32_t pshift = at->pshift;
-    wb_smatch *sm = &w->sm;
+    wb_smatch *sm = w->sm;
     const wb_image_smatch *s = &g->sm;
+    if (s->n == 0) return; /* (then it has no particles either: checked) */
     for (int32_t k = 0; k < s->n; k++) {
         const int32_t c = sm->n + k;
         sm->start[c + 1] = sm->nids + s->start[k + 1];
@@ -541,17 +555,20 @@ static void sm_image_put(wb_world *w, const wb_image *g, const wb_image_at *at)
 /* ---- teardown and hash (ctype.h) --------------------------------------------------------- */
 static void sm_destroy(wb_world *w)
 {
-    wb_smatch *sm = &w->sm;
+    wb_smatch *sm = w->sm;
+    if (!sm) return;
     void *p[] = { sm->start, sm->stiff, sm->yield, sm->creep, sm->ids, sm->rest, sm->q, sm->qk, sm->lambda };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    free(sm);
+    w->sm = NULL;
 }
 
-static size_t sm_charged(const wb_world *w) { return w->sm.charged; }
+static size_t sm_charged(const wb_world *w) { return SM(w)->charged; }
 
 /* parameters and state (rest shapes, rotations); a world without any adds nothing */
 static uint64_t sm_hash(const wb_world *w, uint64_t h)
 {
-    const wb_smatch *sm = &w->sm;
+    const wb_smatch *sm = SM(w);
     if (sm->n == 0) return h;
     h = wb__fnv(h, &sm->n, sizeof sm->n);
     h = wb__fnv(h, sm->start, sizeof(int32_t) * ((size_t)sm->n + 1));

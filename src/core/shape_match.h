@@ -1,6 +1,5 @@
-/* shape_match.h: the data of shape-matching clusters (shape_match.c) and of pressure
- * constraints (pressure.c), one member each of struct wb_world, and their sections of a
- * snapshot image (snapshot.h). */
+/* shape_match.h: the shape-matching clusters' arrays (shape_match.c), and their section of
+ * a snapshot image (snapshot.h). */
 #ifndef WB_SHAPE_MATCH_H
 #define WB_SHAPE_MATCH_H
 
@@ -8,7 +7,7 @@
 
 #include "wobble.h"
 
-/* shape-matching clusters (Müller et al. 2005) */
+/* shape-matching clusters (Müller et al. 2005); w->sm: NULL until the first */
 typedef struct wb_smatch {
     /* model */
     int32_t n, cap;                 /* clusters */
@@ -25,26 +24,6 @@ typedef struct wb_smatch {
     size_t charged;                 /* bytes charged to the memory budget */
 } wb_smatch;
 
-/* balloon constraints over closed surfaces (Müller et al. 2007, Macklin's XPBD form) */
-typedef struct wb_pressures {
-    /* model */
-    int32_t n, cap;
-    int32_t *surface;               /* (n) the surface it encloses */
-    wb_real *pressure, *alpha, *v0; /* (n) target factor, compliance (m^6/J), rest volume */
-    int32_t *vstart, *tstart;       /* (n + 1) ranges into verts and tri */
-    int32_t nverts, cap_verts;
-    int32_t *verts;                 /* (nverts) the surface's particles, ascending */
-    int32_t ntri, cap_tri;
-    int32_t *tri;                   /* (ntri x 3) corners as indices into its verts range */
-    /* cache */
-    wb_real *lambda;                /* (n) multipliers of the current substep */
-    wb_real *grad;                  /* (largest verts range x 3) scratch */
-    int32_t cap_grad;
-    size_t charged;
-} wb_pressures;
-
-/* (world.c's wb_world_destroy frees both structs' arrays and gives their charge back) */
-struct wb_world;
 /* a snapshot image's shape-matching clusters (snapshot.h): model and state by cluster */
 typedef struct wb_image_smatch {
     int32_t n, nids;
@@ -54,13 +33,5 @@ typedef struct wb_image_smatch {
     wb_real *rest;         /* (nids x 3) rest shape about its mass centre */
     wb_real *q;            /* (n x 4) rotation at the end of the last frame */
 } wb_image_smatch;
-
-/* a snapshot image's pressure constraints, each over one of the image's surfaces */
-typedef struct wb_image_pressure {
-    int32_t n;
-    int32_t *surface;      /* (n) */
-    wb_real *pressure, *alpha, *v0; /* (n) factor, compliance, rest volume */
-} wb_image_pressure;
-
 
 #endif

@@ -11,6 +11,7 @@
 #include "ctype.h"
 #include "bvh.h"
 #include "snapshot.h"
+#include "contact.h"
 
 static int fin3(const wb_real *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
 
@@ -428,7 +429,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
         m->cfric[first + i] = g->cfric[i];
         memcpy(&m->x0[3 * (first + i)], &g->x0[3 * i], 3 * sizeof(wb_real));
     }
-    w->k.pc.scan_dirty = 1;
+    if (w->k.pc) w->k.pc->scan_dirty = 1;
     int32_t scan = 0; /* dead slots are taken lowest first: the scan never goes back */
     for (int32_t i = 0; i < g->nc; i++) {
         if (!(g->c_gen[i] & 1u)) continue;

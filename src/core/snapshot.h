@@ -11,6 +11,7 @@
 #include "bend.h"
 #include "distance.h"
 #include "grab.h"
+#include "pressure.h"
 #include "shape_match.h"
 #include "tet.h"
 #include "tether.h"
@@ -74,7 +75,7 @@ typedef struct wb_image {
     wb_image_volume vol;   /* volume.h: empty unless wb_image_alloc_volumes */
     wb_image_tet tet;      /* tet.h: empty unless wb_image_alloc_tets */
     wb_image_smatch sm;    /* shape_match.h: empty unless wb_image_alloc_smatch */
-    wb_image_pressure pr;  /* shape_match.h: empty unless wb_image_alloc_pressure */
+    wb_image_pressure pr;  /* pressure.h: empty unless wb_image_alloc_pressure */
     wb_image_attach att;   /* attach.h: empty unless wb_image_alloc_attach */
     wb_image_grab grab;    /* grab.h: empty unless wb_image_alloc_grab */
     wb_image_tether teth;  /* tether.h: empty unless wb_image_alloc_tethers */

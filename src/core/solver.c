@@ -16,6 +16,8 @@
 #include "grab.h"
 #include "rigid.h"
 #include "vbd.h"
+#include "contact.h"
+#include "tricontact.h"
 
 static double now_ms(void)
 {
@@ -145,7 +147,7 @@ static void predict(wb_world *w, wb_real h, int save)
  * last substep. (wb_cache.no_fuse: the tests' switch to the unfused order.) */
 static int fusable(const wb_world *w)
 {
-    return !w->k.no_fuse && w->k.pc.nact == 0 && w->k.tc.nact == 0 && !(w->rb && w->rb->npct > 0);
+    return !w->k.no_fuse && w->k.pc->nact == 0 && w->k.tc->nact == 0 && !(w->rb && w->rb->npct > 0);
 }
 
 /* put the particles back as they were at the frame's start; the multipliers of the
@@ -419,7 +421,8 @@ wb_status wb_world_step(wb_world *w)
 {
     const double t_begin = now_ms();
     wb_cache *k = &w->k;
-    wb_status prep = WB_OK;
+    /* the contacts' scratch, made with the first step (so the step's passes find it) */
+    wb_status prep = wb__contacts_make(w) && wb__tricontacts_make(w) ? WB_OK : WB_ERR_NOMEM;
     wb__momentum_prepare(w); /* (first: the types' prepare clears the topology flag it reads) */
     if (!wb__vbd_prepare(w)) prep = WB_ERR_NOMEM; /* (as well) */
     for (int t = 0; t < wb__nctypes && prep == WB_OK; t++) prep = wb__ctypes[t]->prepare(w);

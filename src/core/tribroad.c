@@ -36,6 +36,8 @@
 #include <stdlib.h>
 
 #include "core.h"
+#include "broadphase.h"
+#include "tricontact.h"
 
 static double now_ms(void)
 {
@@ -137,7 +139,7 @@ static int candidate(const wb_world *w, const wb_real *tb, int32_t t, int32_t p,
     for (int k = 0; k < 3; k++) lo[k] = tb[k] - tb[6], hi[k] = tb[3 + k] + tb[6];
     if (!(box_dist2(&x[3 * p], lo, hi) < rp * rp)) return 0;
     const int32_t *v = &m->tri[3 * t];
-    const wb_contacts *pc = &w->k.pc;
+    const wb_contacts *pc = w->k.pc;
     int same;
     if (!rules_allow(m, pc, p, v, &same) || (pc->tcov[t] && m->group[p] == m->group[v[0]])) return 0;
     wb_real d[3];
@@ -704,7 +706,7 @@ static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, cons
         if (need && (b->qtrun[t] < 0 || !need[b->qtrun[t]])) continue;
         const wb_real e = tri_box(m, x, mvp, t, &b->tbox[TB * t]);
         if (e != e) continue;
-        b->tkey[t] = tri_key(m, &w->k.pc, t);
+        b->tkey[t] = tri_key(m, w->k.pc, t);
         b->tc[nt++] = t;
         sum += e;
     }
@@ -773,7 +775,7 @@ static int search(struct wb_tribroad *b, wb_world *w, const wb_real *reach, cons
 /* b->pt2 (total pairs by point) into c->pt in the projection's order (cell ocell) */
 static int finish(struct wb_tribroad *b, wb_world *w, int64_t total, wb_real ocell)
 {
-    wb_tricontacts *c = &w->k.tc;
+    wb_tricontacts *c = w->k.tc;
     if (!grow((void **)&c->pt, &c->cap, 2 * total, sizeof *c->pt)) return -1;
     if (!order_as_grid(b, w, ocell, total, c->pt)) return -1;
     c->n = (int32_t)total;
@@ -834,7 +836,7 @@ static int quick_runs(struct wb_tribroad *b, const wb_world *w)
 {
     const wb_model *m = &w->m;
     b->qvalid = 0;
-    if (!model_same(b, m, w->k.pc.tcov, 1) || !grow((void **)&b->qtrun, &b->cap_qtrun, m->ntri, sizeof *b->qtrun)) return 0;
+    if (!model_same(b, m, w->k.pc->tcov, 1) || !grow((void **)&b->qtrun, &b->cap_qtrun, m->ntri, sizeof *b->qtrun)) return 0;
     int32_t *rid = b->qtrun;
     int32_t keys[RUNS_MAX];
     run_picker pick = { 0, -1, -1, 0 };
@@ -843,7 +845,7 @@ static int quick_runs(struct wb_tribroad *b, const wb_world *w)
         const uint8_t f0 = m->cflags[tv[0]], f1 = m->cflags[tv[1]], f2 = m->cflags[tv[2]];
         rid[t] = -1;
         if (!((f0 | f1 | f2) & (WB_CF_COLLIDE | WB_CF_SELF))) continue;
-        const int32_t key = tri_key(m, &w->k.pc, t);
+        const int32_t key = tri_key(m, w->k.pc, t);
         int fresh;
         rid[t] = pick_run(&pick, key, &fresh);
         if (rid[t] < 0) { b->nq = -1; b->qvalid = 1; return 1; }
@@ -886,7 +888,7 @@ static int quick_empty(struct wb_tribroad *b, wb_world *w, int32_t na, wb_real r
     *tris = 0;
     const wb_model *m = &w->m;
     const wb_real *x = w->s.x, *mvp = b->mv;
-    if (!b->qvalid || !model_same(b, m, w->k.pc.tcov, 0)) {
+    if (!b->qvalid || !model_same(b, m, w->k.pc->tcov, 0)) {
         if (!quick_runs(b, w)) return -1;
     }
     if (b->nq < 0) return 0;
@@ -940,7 +942,7 @@ static int quick_empty(struct wb_tribroad *b, wb_world *w, int32_t na, wb_real r
 static int broadphase(wb_world *w)
 {
     wb_model *m = &w->m;
-    wb_tricontacts *c = &w->k.tc;
+    wb_tricontacts *c = w->k.tc;
     if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
     struct wb_tribroad *b = c->bp;
     const wb_real *x = w->s.x, *v = w->s.v;
@@ -994,10 +996,43 @@ static int broadphase(wb_world *w)
     return finish(b, w, total, ocell);
 }
 
+/* its scratch freed (the teardown below) */
+static void tribroad_free(wb_tricontacts *c)
+{
+    struct wb_tribroad *b = c->bp;
+    if (!b) return;
+    void *p[] = { b->reach, b->mv, b->tbox, b->tkey, b->pc, b->tc, b->prun, b->trun, b->tmp, b->runs, b->boxes,
+                  b->sp, b->sid, b->skey, b->scell, b->start, b->first, b->pt2, b->okey,
+                  b->qrun, b->qcorner, b->qtrun, b->kmodel };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
+    free(b->out);
+    free(b);
+    c->bp = NULL;
+}
+
+/* ---- the scratch (k.tc) -------------------------------------------------------------------------- */
+int wb__tricontacts_make(wb_world *w)
+{
+    if (!w->k.tc) w->k.tc = calloc(1, sizeof *w->k.tc);
+    return w->k.tc != NULL;
+}
+
+void wb__tricontacts_destroy(wb_world *w)
+{
+    wb_tricontacts *c = w->k.tc;
+    if (!c) return;
+    tribroad_free(c);
+    void *p[] = { c->pt, c->act, c->act_d, c->left };
+    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    free(c);
+    w->k.tc = NULL;
+}
+
 void wb__tricontacts_begin(wb_world *w)
 {
     const wb_model *m = &w->m;
-    wb_tricontacts *c = &w->k.tc;
+    wb_tricontacts *c = w->k.tc;
     c->n = 0;
     c->nact = 0;
     c->last = 0;
@@ -1005,7 +1040,7 @@ void wb__tricontacts_begin(wb_world *w)
     c->broad_ms = 0;
     /* contact.c's scan of this frame: no pair of particles may touch, so no point a
      * triangle either (its corners' rules are the pairs'); one body costs nothing */
-    if (!m->def.contacts || m->ntri == 0 || m->np < 4 || !w->k.pc.possible) return;
+    if (!m->def.contacts || m->ntri == 0 || m->np < 4 || !w->k.pc->possible) return;
     const double t0 = now_ms();
     if (broadphase(w) < 0) {
         c->n = 0;

@@ -40,6 +40,8 @@
 #include <stdlib.h>
 
 #include "core.h"
+#include "contact.h"
+#include "tricontact.h"
 
 /* a contact's record for the velocity pass and the readout (act_d): barycentrics, normal
  * (triangle -> point), depth, force, old overlap pushed back in full, mu when sliding */
@@ -118,7 +120,7 @@ wb_real wb__tri_closest(const wb_real p[3], const wb_real a[3], const wb_real b[
 /* p's body and the triangle's are a pair contact.c moves apart this substep */
 static int made_moving(const wb_world *w, int32_t p, int32_t corner)
 {
-    const wb_contacts *pc = &w->k.pc;
+    const wb_contacts *pc = w->k.pc;
     const int32_t g1 = w->m.group[p], g2 = w->m.group[corner];
     if (pc->nmade == 0 || g1 <= 0 || g2 <= 0 || g1 == g2) return 0;
     const int32_t a = g1 < g2 ? g1 : g2, b = g1 < g2 ? g2 : g1;
@@ -129,7 +131,7 @@ static int made_moving(const wb_world *w, int32_t p, int32_t corner)
 
 void wb__tricontacts_project(wb_world *w, wb_real h)
 {
-    wb_tricontacts *c = &w->k.tc;
+    wb_tricontacts *c = w->k.tc;
     c->nact = 0;
     if (c->n == 0) { c->last = 0; return; }
     const wb_model *m = &w->m;
@@ -268,7 +270,7 @@ static wb_real tri_mu(const wb_real *cf, int32_t p, const int32_t *v, const wb_r
  * weights */
 void wb__tricontacts_load(wb_world *w, wb_real h, wb_real *load)
 {
-    wb_tricontacts *c = &w->k.tc;
+    wb_tricontacts *c = w->k.tc;
     const wb_model *m = &w->m;
     const wb_real *wv = m->w, *vel = w->s.v;
     for (int32_t a = 0; a < c->nact; a++) {
@@ -296,7 +298,7 @@ void wb__tricontacts_load(wb_world *w, wb_real h, wb_real *load)
  * every movable particle's budget allows */
 void wb__tricontacts_static(wb_world *w, wb_real *load)
 {
-    const wb_tricontacts *c = &w->k.tc;
+    const wb_tricontacts *c = w->k.tc;
     const wb_model *m = &w->m;
     wb_real *x = w->s.x;
     const wb_real *xp = w->s.x_prev, *wv = m->w;
@@ -332,7 +334,7 @@ void wb__tricontacts_static(wb_world *w, wb_real *load)
  * correction */
 void wb__tricontacts_velocity(wb_world *w, wb_real h)
 {
-    wb_tricontacts *c = &w->k.tc;
+    wb_tricontacts *c = w->k.tc;
     const wb_model *m = &w->m;
     wb_real *vel = w->s.v;
     const wb_real *wv = m->w;
@@ -380,15 +382,15 @@ void wb__tricontacts_velocity(wb_world *w, wb_real h)
 }
 
 /* ---- readout -------------------------------------------------------------------------------------------- */
-int32_t wb_world_tri_contact_count(const wb_world *w) { return w->k.tc.nact; }
+int32_t wb_world_tri_contact_count(const wb_world *w) { return w->k.tc ? w->k.tc->nact : 0; }
 
 wb_tri_contact wb_world_tri_contact_at(const wb_world *w, int32_t i)
 {
-    const wb_tricontacts *c = &w->k.tc;
+    const wb_tricontacts *c = w->k.tc;
     wb_tri_contact out;
     memset(&out, 0, sizeof out);
     out.p = out.tri[0] = out.tri[1] = out.tri[2] = -1;
-    if (i < 0 || i >= c->nact) return out;
+    if (i < 0 || i >= wb_world_tri_contact_count(w)) return out;
     const int32_t k = c->act[i];
     const wb_real *d = &c->act_d[TD * i];
     out.p = c->pt[2 * k];

@@ -1,6 +1,6 @@
 /* tricontact.h: particle-triangle contacts (tricontact.c) and their broad phase
- * (tribroad.c): the per-frame scratch (its free inline, so that the world frees it
- * without calling into tribroad.c) and the step's passes. */
+ * (tribroad.c): the per-frame scratch (w->k.tc, made and freed by tribroad.c) and the
+ * step's passes. */
 #ifndef WB_TRICONTACT_H
 #define WB_TRICONTACT_H
 
@@ -24,8 +24,7 @@ typedef struct wb_tricontacts {
     double broad_ms;       /* its broad phase in the last step */
 } wb_tricontacts;
 
-/* tribroad.c's scratch, kept from frame to frame (defined here so that the world frees it
- * without calling into tribroad.c) */
+/* tribroad.c's scratch, kept from frame to frame */
 typedef struct wb_trilevel {
     wb_grid g;             /* its grid */
     wb_real rn;            /* the largest reach of its points */
@@ -62,25 +61,12 @@ struct wb_tribroad {
     int qback, qwait;                    /* frames the quick answer waits after it left many points */
     int64_t rebuilds;                    /* for the tests */
 };
-static inline void wb__tribroad_free(wb_tricontacts *c)
-{
-    struct wb_tribroad *b = c->bp;
-    if (!b) return;
-    void *p[] = { b->reach, b->mv, b->tbox, b->tkey, b->pc, b->tc, b->prun, b->trun, b->tmp, b->runs, b->boxes,
-                  b->sp, b->sid, b->skey, b->scell, b->start, b->first, b->pt2, b->okey,
-                  b->qrun, b->qcorner, b->qtrun, b->kmodel };
-    for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
-    for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
-    free(b->out);
-    free(b);
-    c->bp = NULL;
-}
 
 /* the closest point of triangle (a, b, c) to p as barycentrics bary (summing to 1) and the
  * point out; returns the squared distance (a degenerate triangle: its nearest edge) */
 wb_real wb__tri_closest(const wb_real p[3], const wb_real a[3], const wb_real b[3], const wb_real c[3],
                         wb_real bary[3], wb_real out[3]);
-/* the step's three passes, as contact.c's (world.c frees the scratch): the broad phase
+/* the step's three passes, as contact.c's: the broad phase
  * in tribroad.c, the projection and velocity pass in tricontact.c */
 void wb__tricontacts_begin(wb_world *w);
 void wb__tricontacts_project(wb_world *w, wb_real h);

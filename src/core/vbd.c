@@ -25,6 +25,8 @@
 #include "tet.h"
 #include "volume.h"
 #include "vbd.h"
+#include "contact.h"
+#include "tricontact.h"
 
 /* a link as the sweep reads it: its force along it is kk (l - tgt) + lm and its stiffness
  * kk; dmp: a soft link's damping beta / h */
@@ -182,7 +184,7 @@ static int build_adjacency(wb_world *w, struct wb_vbd *v)
     v->adj_start = start, v->adj = adj, v->adjo = adjo, v->epos = epos;
     v->ekk = ek[0], v->etg = ek[1], v->elm = ek[2], v->edm = ek[3];
     return quads(np, w->neo ? w->neo->ijkl : NULL, w->neo ? w->neo->n : 0, &v->tadj_start, &v->tadj) &&
-           quads(np, w->bend.ij, w->bend.n, &v->badj_start, &v->badj);
+           quads(np, w->bend ? w->bend->ij : NULL, wb_bend_count(w), &v->badj_start, &v->badj);
 }
 
 /* greedy colouring in index order (deterministic): each vertex the least colour none of
@@ -212,7 +214,7 @@ static int build_colours(wb_world *w, struct wb_vbd *v)
                 if (c[k] < i) used |= (uint64_t)1 << col[c[k]];
         }
         for (int32_t e = v->badj_start[i]; e < v->badj_start[i + 1]; e++) {
-            const int32_t *c = &w->bend.ij[4 * (v->badj[e] / 4)];
+            const int32_t *c = &w->bend->ij[4 * (v->badj[e] / 4)];
             for (int k = 0; k < 4; k++)
                 if (c[k] < i) used |= (uint64_t)1 << col[c[k]];
         }
@@ -249,7 +251,7 @@ int wb__vbd_prepare(wb_world *w)
     }
     const wb_model *m = &w->m;
     const int32_t nt = w->neo ? w->neo->n : 0;
-    if (m->topology_dirty || v->np != m->np || v->nd != m->nd || v->nt != nt || v->nb != w->bend.n) {
+    if (m->topology_dirty || v->np != m->np || v->nd != m->nd || v->nt != nt || v->nb != wb_bend_count(w)) {
         if (!build_adjacency(w, v) || !build_colours(w, v)) return 0;
         wb_real *y = realloc(v->y, sizeof *y * 3 * (size_t)(m->np > 0 ? m->np : 1));
         if (!y) return 0;
@@ -268,22 +270,22 @@ int wb__vbd_prepare(wb_world *w)
             memset(v->lam + v->cap_lam, 0, sizeof *lam * (size_t)(m->nd - v->cap_lam));
             v->cap_lam = m->nd;
         }
-        if (w->bend.n > v->cap_blam) {
-            const size_t n = (size_t)w->bend.n;
+        if (wb_bend_count(w) > v->cap_blam) {
+            const size_t n = (size_t)wb_bend_count(w);
             wb_real *bl = realloc(v->blam, sizeof *bl * n), *bk = realloc(v->bkpen, sizeof *bk * n);
             if (bl) v->blam = bl;
             if (bk) v->bkpen = bk;
             if (!bl || !bk) return 0;
             memset(v->blam + v->cap_blam, 0, sizeof *bl * (n - (size_t)v->cap_blam));
             memset(v->bkpen + v->cap_blam, 0, sizeof *bk * (n - (size_t)v->cap_blam));
-            v->cap_blam = w->bend.n;
+            v->cap_blam = wb_bend_count(w);
         }
         /* (a slot may hold another link now: its error is the one it starts with) */
         for (int32_t q = 0; q < m->nd; q++) v->c0[q] = (wb_real)NAN;
         v->np = m->np;
         v->nd = m->nd;
         v->nt = nt;
-        v->nb = w->bend.n;
+        v->nb = wb_bend_count(w);
     }
     return 1;
 }
@@ -476,14 +478,14 @@ static void tet_block(const wb_world *w, int32_t q, wb_real f[3], wb_real H[6])
 static void bend_block(const wb_world *w, const struct wb_vbd *v, int32_t q, wb_real inv_h, wb_real f[3], wb_real H[6])
 {
     const int32_t b = q / 4, k = q % 4;
-    if (w->bend.broken[b]) return;
+    if (w->bend->broken[b]) return;
     wb_real off, g[4][3];
     if (!wb__bend_off(w, b, &off, g)) return;
-    const wb_real a = w->bend.alpha[b], *gk = g[k];
+    const wb_real a = w->bend->alpha[b], *gk = g[k];
     wb_real kb = a > 0 ? 1 / a : v->bkpen[b], fm = a > 0 ? kb * off : kb * off + v->blam[b];
-    const wb_real beta = w->bend.beta[b];
+    const wb_real beta = w->bend->beta[b];
     if (a > 0 && beta > 0) {
-        const int32_t *p = &w->bend.ij[4 * b];
+        const int32_t *p = &w->bend->ij[4 * b];
         wb_real rel = 0;
         for (int c = 0; c < 4; c++) {
             wb_real u[3];
@@ -604,17 +606,17 @@ static void keep_multipliers(struct wb_vbd *v)
 /* a hard bend's penalty to start from: the inertia of its angle, 1 / (h^2 sum w |g|^2) */
 static wb_real bend_start_penalty(const wb_world *w, int32_t b, const wb_real g[4][3], wb_real inv_h2)
 {
-    const int32_t *p = &w->bend.ij[4 * b];
+    const int32_t *p = &w->bend->ij[4 * b];
     wb_real den = 0;
     for (int c = 0; c < 4; c++) den += w->m.w[p[c]] * v3_dot(g[c], g[c]);
     return den > 0 ? inv_h2 / den : 0;
 }
 
-static int hard_bend(const wb_world *w, int32_t b) { return !w->bend.broken[b] && !(w->bend.alpha[b] > 0); }
+static int hard_bend(const wb_world *w, int32_t b) { return !w->bend->broken[b] && !(w->bend->alpha[b] > 0); }
 
 static void bend_warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2)
 {
-    for (int32_t b = 0; b < w->bend.n; b++) {
+    for (int32_t b = 0; b < wb_bend_count(w); b++) {
         wb_real off, g[4][3];
         if (!hard_bend(w, b) || !wb__bend_off(w, b, &off, g)) continue;
         const wb_real k0 = bend_start_penalty(w, b, g, inv_h2);
@@ -628,9 +630,9 @@ static void bend_warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2)
  * overshot it (k is large, off noisy) */
 static void bend_dual_update(wb_world *w, struct wb_vbd *v, wb_real h)
 {
-    wb_bends *bs = &w->bend;
+    wb_bends *bs = w->bend;
     const wb_real inv_h2 = 1 / (h * h);
-    for (int32_t b = 0; b < bs->n; b++) {
+    for (int32_t b = 0; b < wb_bend_count(w); b++) {
         wb_real off, g[4][3];
         if (!hard_bend(w, b) || !wb__bend_off(w, b, &off, g)) continue;
         const wb_real k0 = bend_start_penalty(w, b, g, inv_h2);
@@ -662,8 +664,8 @@ static void write_forces(wb_world *w, const struct wb_vbd *v, wb_real h)
         }
     }
     k->s_lambda_stale = 0;
-    wb_bends *bs = &w->bend;
-    if (bs->dirty) return;
+    wb_bends *bs = w->bend;
+    if (!bs || bs->dirty) return;
     for (int32_t b = 0; b < bs->n; b++) {
         wb_real off, g[4][3];
         if (bs->broken[b] || !(bs->alpha[b] > 0)) continue;
@@ -690,14 +692,14 @@ static int touching(wb_world *w, struct wb_vbd *v)
      * immovable particles (a pinned slab, as a collider) keep the momentum the move keeps
      * (a block on a pinned slab at 0.95 of its sticking angle crept 26 mm in 1 s, now 1.03) */
     const wb_real *wv = w->m.w;
-    const wb_contacts *pc = &k->pc;
+    const wb_contacts *pc = k->pc;
     for (int32_t c = 0; c < pc->n; c++) {
         const int32_t i = pc->ij[2 * c], j = pc->ij[2 * c + 1], a = body[i], b = body[j];
         if (a < 0 || b < 0 || a == b) continue;
         if (wv[j] > 0) T[4 * a] = -1;
         if (wv[i] > 0) T[4 * b] = -1;
     }
-    const wb_tricontacts *tc = &k->tc;
+    const wb_tricontacts *tc = k->tc;
     for (int32_t c = 0; c < tc->n; c++) {
         const int32_t t = tc->pt[2 * c + 1], p[4] = { tc->pt[2 * c], w->m.tri[3 * t], w->m.tri[3 * t + 1], w->m.tri[3 * t + 2] };
         const int32_t a = body[p[0]], b = body[p[1]];

@@ -12,6 +12,7 @@
  * file is read and checked into a wb_image before anything is built. Each constraint
  * type's elements ("constraints" entries, "volumes", ...) are read by its own file through
  * the jtypes table (json.h, json_types.c). */
+#include <assert.h>
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -25,32 +26,37 @@
 #define MAX_FILE (1ll << 31) /* 2 GiB: a snapshot of WB_MAX_PARTICLES fits; larger is not ours */
 
 /* ---- sections --------------------------------------------------------------------------------- */
+#define MAX_DEFAULT_KEYS 32 /* the keys of "defaults": a particle's two and the types' */
+
+/* "defaults": a particle's mass and radius here, each type's options by its reader */
 static int read_defaults(rd *r, const cJSON *it, jdefaults *d)
 {
-    static const char *const keys[] = { "mass", "radius", "compliance", "damping", "yield", "creep", "break_strain",
-                                        "break_force", NULL };
-    const cJSON *f[9];
+    const char *keys[MAX_DEFAULT_KEYS + 1] = { "mass", "radius" };
+    const cJSON *f[MAX_DEFAULT_KEYS + 1] = { NULL };
+    int nk = 2, at[JT_MAX];
+    for (int k = 0; k < njtypes; k++) {
+        at[k] = nk;
+        for (const char *const *q = jtypes[k]->default_keys; q && *q; q++) {
+            assert(nk < MAX_DEFAULT_KEYS);
+            keys[nk++] = *q;
+        }
+    }
+    keys[nk] = NULL;
     kp p = { NULL, "defaults", 0 };
     d->mass = 1;
     d->radius = 0.02;
-    d->link = wb_distance_default_def();
-    if (!it) return 0;
-    if (jv_get_object(r, it, &p, keys, f)) return -1;
-    if (jv_opt_nonneg(r, f[0], &p, "mass", &d->mass)) return -1;
-    if (d->mass > 0 && !isfinite(1 / d->mass)) {
-        kp mp = { &p, "mass", 0 };
-        return jv_fail(r, f[0], 0, &mp, "%g is too small (its inverse overflows)", (double)d->mass);
+    if (it) {
+        if (jv_get_object(r, it, &p, keys, f)) return -1;
+        if (jv_opt_nonneg(r, f[0], &p, "mass", &d->mass)) return -1;
+        if (d->mass > 0 && !isfinite(1 / d->mass)) {
+            kp mp = { &p, "mass", 0 };
+            return jv_fail(r, f[0], 0, &mp, "%g is too small (its inverse overflows)", (double)d->mass);
+        }
+        if (jv_opt_nonneg(r, f[1], &p, "radius", &d->radius)) return -1;
     }
-    if (jv_opt_nonneg(r, f[1], &p, "radius", &d->radius) ||
-        jv_opt_real(r, f[2], &p, "compliance", &d->link.compliance) || jv_opt_real(r, f[3], &p, "damping", &d->link.damping) ||
-        jv_opt_real(r, f[4], &p, "yield", &d->link.yield) || jv_opt_real(r, f[5], &p, "creep", &d->link.creep) ||
-        jv_opt_real(r, f[6], &p, "break_strain", &d->link.break_strain) ||
-        jv_opt_real(r, f[7], &p, "break_force", &d->link.break_force))
-        return -1;
-    /* the link's options as the core decides them (wb_distance_check, of two particles:
-     * the options alone) */
-    const wb_fault ft = wb_distance_check(2, NULL, 0, 1, &d->link);
-    return jv_fault(r, &ft, &p, keys, f, 0);
+    for (int k = 0; k < njtypes; k++)
+        if (jtypes[k]->read_defaults && jtypes[k]->read_defaults(r, &f[at[k]], it ? &p : NULL, d)) return -1;
+    return 0;
 }
 
 static const char *const solver_names[] = { "gauss-seidel", "jacobi", "vbd" };
@@ -89,58 +95,41 @@ static int read_world(rd *r, const cJSON *it, const kp *up, wb_world_def *d)
     return e ? jv_fail(r, it, 0, &p, "%s", e) : 0;
 }
 
-/* "generations": [...] of a slot table; counts the live (odd) ones */
-static int read_generations(rd *r, const cJSON *it, const kp *p, int32_t n, uint32_t *gen, int32_t *live)
-{
-    int32_t i = 0;
-    *live = 0;
-    for (const cJSON *c = it->child; c; c = c->next, i++) {
-        kp e = { p, NULL, i };
-        int64_t g;
-        if (jv_get_int(r, c, &e, 0, UINT32_MAX, &g)) return -1;
-        gen[i] = (uint32_t)g;
-        *live += (int32_t)(g & 1);
-    }
-    (void)n;
-    return 0;
-}
-
 typedef struct sections {      /* the top-level values, checked for type */
     const cJSON *particles, *constraints, *colliders, *surfaces, *parts, *skins, *snapshot;
-    const cJSON *world, *dgen, *dfree, *cgen, *clock[4];
-    int32_t np, ncons, ncol, nsurf, ntri, nparts, nskins, nd, nfree, nc;
-    int32_t nentries[JT_MAX];  /* "constraints" entries of each type (ncons: the distance slots') */
+    const cJSON *world, *cgen, *clock[4];
+    int32_t np, ncons, ncol, nsurf, ntri, nparts, nskins, nc;
+    int32_t nentries[JT_MAX];  /* "constraints" entries of each type (ncons: the slotted type's) */
+    int slotted;               /* the type stored by slot (jtype.slots_key), -1 none */
+    jslots slots;              /* its slot table */
 } sections;
 
 /* the snapshot section's shape (its values are read once the image exists) */
 static int scan_snapshot(rd *r, sections *s)
 {
-    static const char *const keys[] = { "world", "time", "frame", "warnings", "last_warning", "distance_slots", "collider_slots", NULL };
-    static const char *const dkeys[] = { "generations", "free", NULL };
+    /* the clock, the slotted type's table, the colliders' */
+    const char *keys[] = { "world", "time", "frame", "warnings", "last_warning", NULL, "collider_slots", NULL };
     static const char *const ckeys[] = { "generations", NULL };
-    const cJSON *f[8], *g[3];
+    const cJSON *f[8] = { NULL }, *g[3];
     kp p = { NULL, "snapshot", 0 };
-    s->nd = s->ncons;
+    const jtype *st = s->slotted >= 0 ? jtypes[s->slotted] : NULL;
+    s->slots = (jslots){ NULL, NULL, 0, 0 };
+    if (st) keys[5] = st->slots_key;
+    else keys[5] = keys[6], keys[6] = NULL;
+    const int cf = st ? 6 : 5; /* the colliders' table */
     s->nc = s->ncol;
-    if (!s->snapshot) return 0;
-    if (jv_get_object(r, s->snapshot, &p, keys, f)) return -1;
-    if (!f[0]) return jv_missing(r, s->snapshot, &p, "world");
-    s->world = f[0];
-    for (int i = 0; i < 4; i++) s->clock[i] = f[1 + i];
-    if (f[5]) {
-        kp q = { &p, "distance_slots", 0 };
-        if (jv_get_object(r, f[5], &q, dkeys, g)) return -1;
-        if (!g[0]) return jv_missing(r, f[5], &q, "generations");
-        if (!g[1]) return jv_missing(r, f[5], &q, "free");
-        kp a = { &q, "generations", 0 }, b = { &q, "free", 0 };
-        if (jv_get_array(r, g[0], &a, WB_MAX_CONSTRAINTS, &s->nd) || jv_get_array(r, g[1], &b, WB_MAX_CONSTRAINTS, &s->nfree)) return -1;
-        s->dgen = g[0];
-        s->dfree = g[1];
+    if (s->snapshot) {
+        if (jv_get_object(r, s->snapshot, &p, keys, f)) return -1;
+        if (!f[0]) return jv_missing(r, s->snapshot, &p, "world");
+        s->world = f[0];
+        for (int i = 0; i < 4; i++) s->clock[i] = f[1 + i];
     }
-    if (f[6]) {
+    if (st && st->scan_slots(r, f[5], &p, s->ncons, &s->slots)) return -1;
+    if (!s->snapshot) return 0;
+    if (f[cf]) {
         kp q = { &p, "collider_slots", 0 };
-        if (jv_get_object(r, f[6], &q, ckeys, g)) return -1;
-        if (!g[0]) return jv_missing(r, f[6], &q, "generations");
+        if (jv_get_object(r, f[cf], &q, ckeys, g)) return -1;
+        if (!g[0]) return jv_missing(r, f[cf], &q, "generations");
         kp a = { &q, "generations", 0 };
         if (jv_get_array(r, g[0], &a, WB_MAX_COLLIDERS, &s->nc)) return -1;
         s->cgen = g[0];
@@ -165,35 +154,12 @@ static int read_snapshot(rd *r, const sections *s, wb_image *g)
         if (jv_get_string(r, s->clock[3], &q, &msg)) return -1;
         snprintf(g->last_warning, sizeof g->last_warning, "%s", msg);
     }
-    kp ds = { &p, "distance_slots", 0 }, cs = { &p, "collider_slots", 0 };
-    if (s->dgen) {
-        kp a = { &ds, "generations", 0 }, b = { &ds, "free", 0 };
-        int32_t live;
-        if (read_generations(r, s->dgen, &a, s->nd, g->dist.gen, &live)) return -1;
-        if (live != s->ncons)
-            return jv_fail(r, s->dgen, 0, &a, "%d live slots, but \"constraints\" has %d entries", live, s->ncons);
-        int32_t k = 0;
-        /* a mark per slot, so a long free list is checked for repeats in linear time */
-        uint8_t *seen = s->nfree > 0 ? calloc((size_t)(s->nd > 0 ? s->nd : 1), 1) : NULL;
-        if (s->nfree > 0 && !seen) return jv_fail(r, s->dfree, 0, &b, "out of memory");
-        int bad = 0;
-        for (const cJSON *c = s->dfree->child; c && !bad; c = c->next, k++) {
-            kp e = { &b, NULL, k };
-            int64_t slot;
-            if (jv_get_int(r, c, &e, 0, s->nd > 0 ? s->nd - 1 : 0, &slot)) bad = -1;
-            else if (s->nd == 0 || (g->dist.gen[slot] & 1u)) bad = jv_fail(r, c, 0, &e, "slot %lld is live, not free", (long long)slot);
-            else if (seen[slot]++) bad = jv_fail(r, c, 0, &e, "slot %lld is listed twice", (long long)slot);
-            else g->dist.free_slots[k] = (int32_t)slot;
-        }
-        free(seen);
-        if (bad) return -1;
-        if (s->nd - live != s->nfree)
-            return jv_fail(r, s->dfree, 0, &b, "%d free slots listed, but %d slots are dead", s->nfree, s->nd - live);
-    }
+    kp cs = { &p, "collider_slots", 0 };
+    if (s->slotted >= 0 && jtypes[s->slotted]->read_slots(r, &s->slots, &p, s->ncons, g)) return -1;
     if (s->cgen) {
         kp a = { &cs, "generations", 0 };
         int32_t live;
-        if (read_generations(r, s->cgen, &a, s->nc, g->c_gen, &live)) return -1;
+        if (jv_read_generations(r, s->cgen, &a, g->c_gen, &live)) return -1;
         if (live != s->ncol) return jv_fail(r, s->cgen, 0, &a, "%d live slots, but \"colliders\" has %d entries", live, s->ncol);
     }
     return 0;
@@ -286,10 +252,13 @@ static int count_entries(rd *r, sections *s)
         const cJSON *t = cJSON_GetObjectItemCaseSensitive(c, "type");
         return jv_fail(r, t, 0, &tp, "unknown constraint type '%s' (expected %s)", t->valuestring, list);
     }
-    /* the entries without arrays of their own fill the distance slots */
+    /* the entries without arrays of their own fill the slots of the type stored by slot */
     s->ncons = 0;
-    for (int k = 0; k < njtypes; k++)
+    s->slotted = -1;
+    for (int k = 0; k < njtypes; k++) {
         if (jtypes[k]->entry && !jtypes[k]->alloc) s->ncons += s->nentries[k];
+        if (jtypes[k]->slots_key) s->slotted = k;
+    }
     return 0;
 }
 
@@ -699,7 +668,7 @@ static int read_root(rd *r, const cJSON *root, wbio_config *cfg)
     if (count_entries(r, &s)) return -1;
     s.snapshot = f[10];
     if (scan_snapshot(r, &s) || read_surfaces(r, &s, NULL, &s.ntri)) return -1;
-    if (wb_image_alloc(&cfg->img, s.np, s.nd, s.nfree, s.nc, s.nsurf, s.ntri) != WB_OK ||
+    if (wb_image_alloc(&cfg->img, s.np, s.slots.n, s.slots.nfree, s.nc, s.nsurf, s.ntri) != WB_OK ||
         alloc_entries(&s, &cfg->img) != WB_OK ||
         !(cfg->parts = calloc((size_t)s.nparts + 1, sizeof *cfg->parts)) ||
         !(cfg->skins = calloc((size_t)s.nskins + 1, sizeof *cfg->skins)))

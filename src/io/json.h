@@ -103,11 +103,23 @@ void jw_next(jw_out *o, int *first);
 /* ", yield, creep" when either is set (files without stay as they were) */
 void jw_plastic(jw_out *o, const wb_real yc[2]);
 
-/* the file's "defaults": a particle's mass and radius, a link's options (json.c) */
+/* the file's "defaults": a particle's mass and radius (json.c), a link's options
+ * (json_distance.c) */
 typedef struct jdefaults {
     wb_real mass, radius;
     wb_distance_def link;
 } jdefaults;
+
+/* "generations": [...] of a slot table (its length checked), into gen; counts the live
+ * (odd) ones (json_value.c) */
+int jv_read_generations(rd *r, const cJSON *it, const kp *p, uint32_t *gen, int32_t *live);
+
+/* a snapshot's slot table (of a type stored by slot: "distance_slots"), as scanned before
+ * the image is made: the object, its arrays, and the image's slots and free slots */
+typedef struct jslots {
+    const cJSON *gen, *free;
+    int32_t n, nfree;
+} jslots;
 
 /* A constraint type in a particle config: its reader and writer, in its own file
  * (json_NAME.c, beside core/NAME.c). Its elements are either an array of their own at the
@@ -129,6 +141,20 @@ typedef struct jtype {
     int (*read_item)(rd *r, const cJSON *c, const kp *p, const jdefaults *d, wb_image *g, int32_t *at);
     int (*read)(rd *r, const cJSON *arr, wb_image *g);
     int (*write)(jw_out *o, const wb_image *g, int first);
+    /* its options in the file's "defaults" (may be NULL: none): their keys, and the reader
+     * of their values f (NULL where not given; p NULL: no "defaults"), which also sets
+     * them when none is given */
+    const char *const *default_keys;
+    int (*read_defaults)(rd *r, const cJSON *const f[], const kp *p, jdefaults *d);
+    /* a type stored by slot (the image's distance slots): its slot table in the snapshot
+     * (may be NULL: none) at slots_key. scan_slots: its shape, before the image is made
+     * (it: NULL when the file has none: then one slot per entry, nentries); read_slots:
+     * its values into the image (after the image is made, before the entries); write_slots:
+     * w:save's, after the clock */
+    const char *slots_key;
+    int (*scan_slots)(rd *r, const cJSON *it, const kp *p, int32_t nentries, jslots *s);
+    int (*read_slots)(rd *r, const jslots *s, const kp *p, int32_t nentries, wb_image *g);
+    void (*write_slots)(FILE *f, const wb_image *g);
 } jtype;
 #define JT_MAX 16 /* the table's room */
 extern const jtype *const jtypes[];

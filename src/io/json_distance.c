@@ -8,6 +8,7 @@
  * They fill the distance slots in order (the live ones of the snapshot's "distance_slots";
  * every slot in a plain config). */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "json.h"
@@ -87,5 +88,91 @@ static int write_distances(jw_out *o, const wb_image *g, int first)
     return first;
 }
 
-/* no alloc: its arrays are the image's distance slots (wb_image_alloc) */
-const jtype jt_distance = { .entry = "distance", .read_item = read_distance, .write = write_distances };
+/* ---- the file's "defaults": a link's options ------------------------------------------------ */
+static const char *const default_keys[] = { "compliance", "damping", "yield", "creep", "break_strain", "break_force",
+                                            NULL };
+
+static int read_defaults(rd *r, const cJSON *const f[], const kp *p, jdefaults *d)
+{
+    wb_distance_def *l = &d->link;
+    *l = wb_distance_default_def();
+    if (!p) return 0;
+    if (jv_opt_real(r, f[0], p, "compliance", &l->compliance) || jv_opt_real(r, f[1], p, "damping", &l->damping) ||
+        jv_opt_real(r, f[2], p, "yield", &l->yield) || jv_opt_real(r, f[3], p, "creep", &l->creep) ||
+        jv_opt_real(r, f[4], p, "break_strain", &l->break_strain) || jv_opt_real(r, f[5], p, "break_force", &l->break_force))
+        return -1;
+    /* the options as the core decides them (wb_distance_check, of two particles: the
+     * options alone, so the fault is an option's) */
+    const wb_fault ft = wb_distance_check(2, NULL, 0, 1, l);
+    return jv_fault(r, &ft, p, default_keys, f, 0);
+}
+
+/* ---- the snapshot's "distance_slots": generations and free slots ------------------------------ */
+static int scan_slots(rd *r, const cJSON *it, const kp *up, int32_t nentries, jslots *s)
+{
+    static const char *const keys[] = { "generations", "free", NULL };
+    const cJSON *g[3];
+    s->n = nentries; /* a plain config: a slot per entry, all live */
+    if (!it) return 0;
+    kp q = { up, "distance_slots", 0 };
+    if (jv_get_object(r, it, &q, keys, g)) return -1;
+    if (!g[0]) return jv_missing(r, it, &q, "generations");
+    if (!g[1]) return jv_missing(r, it, &q, "free");
+    kp a = { &q, "generations", 0 }, b = { &q, "free", 0 };
+    if (jv_get_array(r, g[0], &a, WB_MAX_CONSTRAINTS, &s->n) || jv_get_array(r, g[1], &b, WB_MAX_CONSTRAINTS, &s->nfree))
+        return -1;
+    s->gen = g[0];
+    s->free = g[1];
+    return 0;
+}
+
+static int read_slots(rd *r, const jslots *s, const kp *up, int32_t nentries, wb_image *g)
+{
+    if (!s->gen) return 0;
+    kp ds = { up, "distance_slots", 0 }, a = { &ds, "generations", 0 }, b = { &ds, "free", 0 };
+    int32_t live;
+    if (jv_read_generations(r, s->gen, &a, g->dist.gen, &live)) return -1;
+    if (live != nentries)
+        return jv_fail(r, s->gen, 0, &a, "%d live slots, but \"constraints\" has %d entries", live, nentries);
+    int32_t k = 0;
+    /* a mark per slot, so a long free list is checked for repeats in linear time */
+    uint8_t *seen = s->nfree > 0 ? calloc((size_t)(s->n > 0 ? s->n : 1), 1) : NULL;
+    if (s->nfree > 0 && !seen) return jv_fail(r, s->free, 0, &b, "out of memory");
+    int bad = 0;
+    for (const cJSON *c = s->free->child; c && !bad; c = c->next, k++) {
+        kp e = { &b, NULL, k };
+        int64_t slot;
+        if (jv_get_int(r, c, &e, 0, s->n > 0 ? s->n - 1 : 0, &slot)) bad = -1;
+        else if (s->n == 0 || (g->dist.gen[slot] & 1u)) bad = jv_fail(r, c, 0, &e, "slot %lld is live, not free", (long long)slot);
+        else if (seen[slot]++) bad = jv_fail(r, c, 0, &e, "slot %lld is listed twice", (long long)slot);
+        else g->dist.free_slots[k] = (int32_t)slot;
+    }
+    free(seen);
+    if (bad) return -1;
+    if (s->n - live != s->nfree)
+        return jv_fail(r, s->free, 0, &b, "%d free slots listed, but %d slots are dead", s->nfree, s->n - live);
+    return 0;
+}
+
+static void write_slots(FILE *f, const wb_image *g)
+{
+    fputs(",\n    \"distance_slots\": {\"generations\": ", f);
+    jw_ints(f, "      ", g->dist.gen, NULL, g->dist.n);
+    fputs(", \"free\": ", f);
+    jw_ints(f, "      ", NULL, g->dist.free_slots, g->dist.nfree);
+    fputs("}", f);
+}
+
+/* no alloc: its arrays are the image's distance slots (wb_image_alloc), which the
+ * snapshot's slot table describes */
+const jtype jt_distance = {
+    .entry = "distance",
+    .read_item = read_distance,
+    .write = write_distances,
+    .default_keys = default_keys,
+    .read_defaults = read_defaults,
+    .slots_key = "distance_slots",
+    .scan_slots = scan_slots,
+    .read_slots = read_slots,
+    .write_slots = write_slots,
+};

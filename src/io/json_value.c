@@ -248,6 +248,21 @@ int jv_fault(rd *r, const wb_fault *ft, const kp *up, const char *const keys[], 
     return jv_fail(r, f[parts], 0, &q, "%s", ft->msg);
 }
 
+/* a slot table's generations (json.h) */
+int jv_read_generations(rd *r, const cJSON *it, const kp *p, uint32_t *gen, int32_t *live)
+{
+    int32_t i = 0;
+    *live = 0;
+    for (const cJSON *c = it->child; c; c = c->next, i++) {
+        kp e = { p, NULL, i };
+        int64_t g;
+        if (jv_get_int(r, c, &e, 0, UINT32_MAX, &g)) return -1;
+        gen[i] = (uint32_t)g;
+        *live += (int32_t)(g & 1);
+    }
+    return 0;
+}
+
 /* an array of exactly n finite numbers */
 int jv_get_vec(rd *r, const cJSON *it, const kp *p, int n, wb_real *out)
 {

@@ -43,11 +43,9 @@ static void write_snapshot(jw_out *o, const wb_image *g)
     jw_num(o, g->time);
     fprintf(f, ", \"frame\": %lld, \"warnings\": %lld, \"last_warning\": ", (long long)g->frame, (long long)g->warnings);
     str(f, g->last_warning);
-    fputs(",\n    \"distance_slots\": {\"generations\": ", f);
-    jw_ints(f, "      ", g->dist.gen, NULL, g->dist.n);
-    fputs(", \"free\": ", f);
-    jw_ints(f, "      ", NULL, g->dist.free_slots, g->dist.nfree);
-    fputs("},\n    \"collider_slots\": {\"generations\": ", f);
+    for (int k = 0; k < njtypes; k++)
+        if (jtypes[k]->write_slots) jtypes[k]->write_slots(f, g);
+    fputs(",\n    \"collider_slots\": {\"generations\": ", f);
     jw_ints(f, "      ", g->c_gen, NULL, g->nc);
     fputs("}\n  },\n", f);
 }

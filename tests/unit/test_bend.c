@@ -3,6 +3,7 @@
 #include <stdlib.h>
 
 #include "core/core.h"
+#include "core/bend.h"
 #include "test.h"
 
 static wb_world *bent_cloth(int threads, wb_solver solver, int res)
@@ -30,18 +31,18 @@ TEST(bend_batches_valid)
     wb_world *w = bent_cloth(1, WB_SOLVER_GAUSS_SEIDEL, 33);
     REQUIRE(w);
     wb_world_step(w);
-    const wb_bends *b = &w->bend;
+    const wb_bends *b = w->bend;
     REQUIRE(!b->dirty);
     CHECK_EQ(b->n, 2 * 32 * 33 + 32 * 32 - 4 * 32); /* interior edges of a 32 x 32-cell sheet */
-    CHECK_EQ(b->colour_start[0], 0);
-    CHECK_EQ(b->colour_start[b->ncolours], b->n);
-    CHECK(b->ncolours >= 4); /* four particles each: a hinge, its two wings */
+    CHECK_EQ(b->bt.colour_start[0], 0);
+    CHECK_EQ(b->bt.colour_start[b->bt.ncolours], b->n);
+    CHECK(b->bt.ncolours >= 4); /* four particles each: a hinge, its two wings */
     int32_t *owner = malloc(sizeof(int32_t) * (size_t)w->m.np);
     REQUIRE(owner);
     for (int32_t i = 0; i < w->m.np; i++) owner[i] = -1;
     int conflicts = 0, bad = 0;
-    for (int32_t c = 0; c < b->serial_start; c++)
-        for (int32_t i = b->colour_start[c]; i < b->colour_start[c + 1]; i++)
+    for (int32_t c = 0; c < b->bt.serial_start; c++)
+        for (int32_t i = b->bt.colour_start[c]; i < b->bt.colour_start[c + 1]; i++)
             for (int e = 0; e < 4; e++) {
                 const int32_t p = b->s_ij[4 * i + e];
                 if (w->m.inv_mass[p] == 0) continue;
@@ -67,8 +68,8 @@ TEST(bend_threads_identical)
         REQUIRE(a && b);
         for (int f = 0; f < 20; f++) { wb_world_step(a); wb_world_step(b); }
         int32_t big = 0;
-        for (int32_t c = 0; c < b->bend.serial_start; c++)
-            if (b->bend.colour_start[c + 1] - b->bend.colour_start[c] >= 256) big++;
+        for (int32_t c = 0; c < b->bend->bt.serial_start; c++)
+            if (b->bend->bt.colour_start[c + 1] - b->bend->bt.colour_start[c] >= 256) big++;
         CHECK(big > 0);
         CHECK_EQ(wb_world_hash(a), wb_world_hash(b));
         CHECK_EQ(wb_world_warnings(b), 0);

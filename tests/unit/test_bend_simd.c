@@ -15,6 +15,7 @@
 #include <stdlib.h>
 
 #include "core/core.h"
+#include "core/bend.h"
 #include "test.h"
 
 int wb__bend_simd(int on); /* bend.c's internal switch */
@@ -112,11 +113,11 @@ static wb_world *scene(int threads, int damped)
 /* whether any position, multiplier or broken flag differs in its bits */
 static int differing(const wb_world *a, const wb_world *b)
 {
-    const int32_t n = wb_particle_count(a), nb = a->bend.n;
-    if (n != wb_particle_count(b) || nb != b->bend.n) return 1;
+    const int32_t n = wb_particle_count(a), nb = a->bend->n;
+    if (n != wb_particle_count(b) || nb != b->bend->n) return 1;
     return memcmp(wb_particle_positions(a), wb_particle_positions(b), sizeof(wb_real) * 3 * (size_t)n) != 0 ||
-           memcmp(a->bend.lambda, b->bend.lambda, sizeof(wb_real) * (size_t)nb) != 0 ||
-           memcmp(a->bend.broken, b->bend.broken, (size_t)nb) != 0;
+           memcmp(a->bend->lambda, b->bend->lambda, sizeof(wb_real) * (size_t)nb) != 0 ||
+           memcmp(a->bend->broken, b->bend->broken, (size_t)nb) != 0;
 }
 
 TEST(bend_simd_bit_identical_to_scalar)
@@ -139,8 +140,8 @@ TEST(bend_simd_bit_identical_to_scalar)
         }
         /* the scene reached what it is for: some bends broke, none of the loose ones blew up */
         int broken = 0;
-        for (int32_t i = 0; i < v->bend.n; i++) broken += v->bend.broken[i];
-        CHECK(broken > 0 && broken < v->bend.n / 10);
+        for (int32_t i = 0; i < v->bend->n; i++) broken += v->bend->broken[i];
+        CHECK(broken > 0 && broken < v->bend->n / 10);
         CHECK_EQ(wb_world_warnings(v), 0);
         wb_world_destroy(v);
         wb_world_destroy(s);
@@ -160,8 +161,8 @@ TEST(bend_simd_threads_identical)
         CHECK_EQ(wb_world_step(b), WB_OK);
         CHECK_EQ(wb_world_hash(a), wb_world_hash(b));
     }
-    for (int32_t c = 0; c < b->bend.serial_start; c++)
-        if (b->bend.colour_start[c + 1] - b->bend.colour_start[c] >= 256) big++;
+    for (int32_t c = 0; c < b->bend->bt.serial_start; c++)
+        if (b->bend->bt.colour_start[c + 1] - b->bend->bt.colour_start[c] >= 256) big++;
     CHECK(big > 0); /* batches that the pool splits */
     wb_world_destroy(a);
     wb_world_destroy(b);

@@ -9,6 +9,8 @@
 #include <stdlib.h>
 
 #include "core/core.h"
+#include "core/broadphase.h"
+#include "core/tricontact.h"
 #include "test.h"
 
 static uint64_t rng = 0x2545F4914F6CDD1Dull;

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 
 #include "core/core.h"
+#include "core/batch.h"
 #include "test.h"
 
 static void check_colouring(wb_world *w)

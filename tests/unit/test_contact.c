@@ -10,6 +10,8 @@
 #include <stdlib.h>
 
 #include "core/core.h"
+#include "core/broadphase.h"
+#include "core/tricontact.h"
 #include "test.h"
 
 /* a small LCG: the same input on every machine */
@@ -263,8 +265,8 @@ TEST(contact_self_collision_skips_rest_neighbours)
      * listed: never two linked neighbours */
     wb__contacts_begin(w);
     int found = 0;
-    for (int32_t k = 0; k < w->k.pc.n; k++) {
-        const int32_t i = w->k.pc.ij[2 * k], j = w->k.pc.ij[2 * k + 1];
+    for (int32_t k = 0; k < w->k.pc->n; k++) {
+        const int32_t i = w->k.pc->ij[2 * k], j = w->k.pc->ij[2 * k + 1];
         CHECK(j - i >= 2);
         if (i == b.first && j == b.first + 10) found = 1;
     }
@@ -283,8 +285,8 @@ TEST(contact_self_collision_skips_rest_neighbours)
     p1[0] += 0.05;
     wb_particle_set_position(w, b.first + 1, p1);
     wb_world_step(w);
-    for (int32_t k = 0; k < w->k.pc.n; k++) {
-        const int32_t i = w->k.pc.ij[2 * k], j = w->k.pc.ij[2 * k + 1];
+    for (int32_t k = 0; k < w->k.pc->n; k++) {
+        const int32_t i = w->k.pc->ij[2 * k], j = w->k.pc->ij[2 * k + 1];
         CHECK(j - i >= 2);
     }
     wb_world_destroy(w);

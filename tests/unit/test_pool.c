@@ -15,6 +15,8 @@
 #include <time.h>
 
 #include "core/core.h"
+#include "core/broadphase.h"
+#include "core/tricontact.h"
 #include "test.h"
 
 typedef struct cover {
@@ -319,7 +321,7 @@ TEST(pool_world_identical_for_1_2_3_threads)
     CHECK(w[1]->pool != NULL && w[2]->pool != NULL);
     CHECK(wb__pool_jobs(w[1]->pool) > 0); /* the pool really ran the loops */
     CHECK(wb_world_stats(w[0]).contacts > 0);
-    CHECK(w[0]->k.pc.n > 0); /* the cloths met: pairs from the broad phase */
+    CHECK(w[0]->k.pc->n > 0); /* the cloths met: pairs from the broad phase */
     CHECK(wb_world_hash(w[0]) == wb_world_hash(w[1]));
     CHECK(wb_world_hash(w[0]) == wb_world_hash(w[2]));
     CHECK(memcmp(w[0]->s.x, w[2]->s.x, sizeof(wb_real) * 3 * (size_t)w[0]->m.np) == 0);

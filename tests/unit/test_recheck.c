@@ -8,6 +8,8 @@
 
 #include "test.h"
 #include "core/core.h"
+#include "core/broadphase.h"
+#include "core/tricontact.h"
 
 static wb_world *heap(int n)
 {
@@ -50,14 +52,15 @@ TEST(contact_list_complete_every_substep)
     for (int on = 0; on < 2; on++) {
         wb_world *w = heap(32);
         REQUIRE(w);
-        w->k.pc.brute = 1;
-        w->k.pc.no_recheck = !on;
+        REQUIRE(wb__contacts_make(w)); /* (the first step's: the switches go in before it) */
+        w->k.pc->brute = 1;
+        w->k.pc->no_recheck = !on;
         for (int f = 0; f < 90; f++) {
             wb_world_step(w);
-            split += on && w->k.pc.span < w->m.def.substeps; /* two lists that frame */
+            split += on && w->k.pc->span < w->m.def.substeps; /* two lists that frame */
         }
-        missed[on] = w->k.pc.missed;
-        remakes[on] = w->k.pc.remakes;
+        missed[on] = w->k.pc->missed;
+        remakes[on] = w->k.pc->remakes;
         wb_world_destroy(w);
     }
     printf("# missed pairs without the check %lld, with it %lld (lists made again: %lld)\n",
@@ -116,21 +119,22 @@ TEST(contact_list_complete_with_reference_motion)
     for (int spin = 0; spin < 2; spin++) {
         wb_world *w = swinging(spin);
         REQUIRE(w);
-        w->k.pc.brute = 1;
+        REQUIRE(wb__contacts_make(w));
+        w->k.pc->brute = 1;
         wb_real turned = 0;
         int split = 0;
         for (int f = 0; f < 60; f++) {
             wb_world_step(w);
-            split += w->k.pc.span < w->m.def.substeps;
-            const wb_real *om = w->k.pc.ref_om;
+            split += w->k.pc->span < w->m.def.substeps;
+            const wb_real *om = w->k.pc->ref_om;
             turned = fmax(turned, sqrt(om[0] * om[0] + om[1] * om[1] + om[2] * om[2]));
         }
         printf("# %s: missed %lld, lists made again %lld, reference turn up to %.3g rad/s\n",
-               spin ? "tumbling cloth" : "swinging cloth", (long long)w->k.pc.missed,
-               (long long)w->k.pc.remakes, turned);
+               spin ? "tumbling cloth" : "swinging cloth", (long long)w->k.pc->missed,
+               (long long)w->k.pc->remakes, turned);
         CHECK(turned > 0.5); /* the reference did turn with the cloth */
         CHECK(split > 0);    /* frames of two lists, each for half the substeps */
-        CHECK_EQ(w->k.pc.missed, 0);
+        CHECK_EQ(w->k.pc->missed, 0);
         wb_world_destroy(w);
     }
 }
@@ -160,8 +164,9 @@ static int64_t folded_corner_missed(int check)
         v3_set(v, om * p[2], 0, -om * p[0]);
         wb_particle_set_velocity(w, i, v);
     }
+    if (!wb__contacts_make(w)) abort(); /* (a step's first act) */
     wb__contacts_begin(w);
-    wb_contacts *c = &w->k.pc;
+    wb_contacts *c = w->k.pc;
     CHECK(c->check);
     CHECK(fabs(c->ref_om[1]) > 1); /* the list was made with the turning reference */
     /* one substep on: each particle turned with the reference (S = h, no drag), the first

@@ -14,6 +14,8 @@
 #include <stdlib.h>
 
 #include "core/core.h"
+#include "core/broadphase.h"
+#include "core/tricontact.h"
 #include "test.h"
 
 static uint64_t rng = 0x9E3779B97F4A7C15ull;
@@ -154,12 +156,13 @@ static int32_t *broad_list(wb_world *w, int threads, int32_t *n)
     wb_world_def d = wb_world_get_def(w);
     d.threads = threads;
     CHECK(wb_world_set_def(w, &d) == WB_OK);
+    if (!wb__contacts_make(w) || !wb__tricontacts_make(w)) abort(); /* (a step's first act) */
     wb__contacts_begin(w);
     wb__tricontacts_begin(w);
-    *n = w->k.tc.n;
+    *n = w->k.tc->n;
     int32_t *l = malloc(sizeof *l * (size_t)(2 * *n + 1));
     if (!l) abort();
-    if (*n > 0) memcpy(l, w->k.tc.pt, sizeof *l * (size_t)(2 * *n)); /* (pt may be NULL when empty) */
+    if (*n > 0) memcpy(l, w->k.tc->pt, sizeof *l * (size_t)(2 * *n)); /* (pt may be NULL when empty) */
     return l;
 }
 
@@ -321,13 +324,13 @@ TEST(tribroad_matches_brute_force_sparse)
 static int32_t *quick_and_fresh(wb_world *w, int threads, int32_t *n, int32_t **fresh, int32_t *nf)
 {
     int32_t *l = broad_list(w, threads, n);
-    if (w->k.tc.bp) w->k.tc.bp->fresh_only = 1;
+    if (w->k.tc && w->k.tc->bp) w->k.tc->bp->fresh_only = 1;
     *fresh = broad_list(w, 1, nf);
-    if (w->k.tc.bp) w->k.tc.bp->fresh_only = 0;
+    if (w->k.tc && w->k.tc->bp) w->k.tc->bp->fresh_only = 0;
     return l;
 }
 
-static int64_t rebuilds(const wb_world *w) { return w->k.tc.bp ? w->k.tc.bp->rebuilds : 0; }
+static int64_t rebuilds(const wb_world *w) { return w->k.tc && w->k.tc->bp ? w->k.tc->bp->rebuilds : 0; }
 
 /* Every frame the list must be the search's, pair for pair in order (and now and then the
  * brute force's set on 1-3 threads), while soft blocks in a row close in on each other
@@ -409,7 +412,7 @@ TEST(tribroad_quick_answer_matches_search_over_frames)
             change = 0;
         } else change = 0;
         const int64_t r0 = rebuilds(w);
-        if (w->k.tc.bp) w->k.tc.bp->qwait = 0; /* the quick answer every frame, however many points it left */
+        if (w->k.tc && w->k.tc->bp) w->k.tc->bp->qwait = 0; /* the quick answer every frame, however many points it left */
         int32_t n, nf, *fresh;
         int32_t *l = quick_and_fresh(w, 1 + f % 3, &n, &fresh, &nf);
         /* f == 52: the frame before had a NaN (no quick answer, no look at the runs) */
@@ -499,9 +502,9 @@ TEST(tribroad_quick_answer_same_steps_as_search)
         }
         int64_t touching = 0;
         for (int f = 0; f < 120; f++) {
-            if (f == 1 && run % 2) w->k.tc.bp->fresh_only = 1;
+            if (f == 1 && run % 2) w->k.tc->bp->fresh_only = 1;
             REQUIRE(wb_world_step(w) == WB_OK);
-            touching += w->k.tc.n;
+            touching += w->k.tc->n;
         }
         CHECK(touching > 1000);
         h[run] = wb_world_hash(w);

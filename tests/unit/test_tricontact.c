@@ -8,6 +8,8 @@
 #include <stdlib.h>
 
 #include "core/core.h"
+#include "core/broadphase.h"
+#include "core/tricontact.h"
 #include "core/bvh.h"
 #include "test.h"
 
@@ -152,7 +154,7 @@ TEST(tricontact_who_may_touch)
     int32_t p;
     wb_world *w = scene(0, &p);
     REQUIRE(wb_world_step(w) == WB_OK);
-    CHECK_EQ(w->k.tc.n, 1); /* loose particles: the point and the triangle */
+    CHECK_EQ(w->k.tc->n, 1); /* loose particles: the point and the triangle */
     wb_world_destroy(w);
 
     /* one body, no self-collision: nothing; with it: the point (0.01 from the triangle
@@ -161,24 +163,24 @@ TEST(tricontact_who_may_touch)
     wb_body b = { 0, 4, 1 };
     wb_body_set_contacts(w, b, true, false, 0);
     REQUIRE(wb_world_step(w) == WB_OK);
-    CHECK_EQ(w->k.tc.n, 0);
+    CHECK_EQ(w->k.tc->n, 0);
     wb_group_set_self_collide(w, 1, true);
     REQUIRE(wb_world_step(w) == WB_OK);
-    CHECK_EQ(w->k.tc.n, 0);
+    CHECK_EQ(w->k.tc->n, 0);
     wb_world_destroy(w);
     /* ... created 0.2 away it may touch */
     w = scene(0, &p);
     w->m.x0[3 * p + 2] = 0.2;
     wb_body_set_contacts(w, b, true, true, 0);
     REQUIRE(wb_world_step(w) == WB_OK);
-    CHECK_EQ(w->k.tc.n, 1);
+    CHECK_EQ(w->k.tc->n, 1);
     wb_world_destroy(w);
 
     /* an immovable triangle stops the point */
     w = scene(0, &p);
     for (int32_t i = 0; i < 3; i++) wb_particle_pin(w, i, NULL);
     REQUIRE(wb_world_step(w) == WB_OK);
-    CHECK_EQ(w->k.tc.n, 1);
+    CHECK_EQ(w->k.tc->n, 1);
     CHECK_NEAR(wb_particle_positions(w)[3 * p + 2], 0.05, 1e-12);
     wb_world_destroy(w);
 
@@ -189,6 +191,6 @@ TEST(tricontact_who_may_touch)
     wb_world_def d2 = wb_world_get_def(w);
     CHECK(!d2.contacts);
     REQUIRE(wb_world_step(w) == WB_OK);
-    CHECK_EQ(w->k.tc.n, 0);
+    CHECK_EQ(w->k.tc->n, 0);
     wb_world_destroy(w);
 }
