@@ -52,5 +52,7 @@ typedef struct wb_image_bend {
 /* bend b's angle off its rest (the short way round) and its gradient on its four corners
  * (vbd.c's energies); 0 when degenerate */
 int wb__bend_off(const wb_world *w, int32_t b, wb_real *off, wb_real g[4][3]);
+/* the same at the positions x (np x 3) */
+int wb__bend_off_at(const wb_world *w, const wb_real *x, int32_t b, wb_real *off, wb_real g[4][3]);
 
 #endif

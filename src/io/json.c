@@ -107,7 +107,7 @@ static int read_generations(rd *r, const cJSON *it, const kp *p, int32_t n, uint
 
 typedef struct sections {      /* the top-level values, checked for type */
     const cJSON *particles, *constraints, *colliders, *surfaces, *parts, *skins, *snapshot;
-    const cJSON *world, *dgen, *dfree, *cgen, *clock[4];
+    const cJSON *world, *dgen, *dfree, *cgen, *clock[4], *vbd;
     int32_t np, ncons, ncol, nsurf, ntri, nparts, nskins, nd, nfree, nc;
     int32_t nentries[JT_MAX];  /* "constraints" entries of each type (ncons: the distance slots') */
 } sections;
@@ -115,10 +115,11 @@ typedef struct sections {      /* the top-level values, checked for type */
 /* the snapshot section's shape (its values are read once the image exists) */
 static int scan_snapshot(rd *r, sections *s)
 {
-    static const char *const keys[] = { "world", "time", "frame", "warnings", "last_warning", "distance_slots", "collider_slots", NULL };
+    static const char *const keys[] = { "world", "time", "frame", "warnings", "last_warning", "distance_slots", "collider_slots",
+                                        "vbd", NULL };
     static const char *const dkeys[] = { "generations", "free", NULL };
     static const char *const ckeys[] = { "generations", NULL };
-    const cJSON *f[8], *g[3];
+    const cJSON *f[9], *g[3];
     kp p = { NULL, "snapshot", 0 };
     s->nd = s->ncons;
     s->nc = s->ncol;
@@ -144,6 +145,35 @@ static int scan_snapshot(rd *r, sections *s)
         kp a = { &q, "generations", 0 };
         if (jv_get_array(r, g[0], &a, WB_MAX_COLLIDERS, &s->nc)) return -1;
         s->cgen = g[0];
+    }
+    s->vbd = f[7];
+    return 0;
+}
+
+/* the VBD solver's multipliers (json_write.c): one a distance slot, one a bend; an error
+ * not known is null */
+static int read_vbd(rd *r, const sections *s, const kp *up, wb_image *g)
+{
+    static const char *const keys[] = { "multipliers", "errors", "bend_multipliers", "bend_errors", NULL };
+    const cJSON *f[5];
+    kp p = { up, "vbd", 0 };
+    if (jv_get_object(r, s->vbd, &p, keys, f)) return -1;
+    for (int k = 0; k < 4; k++)
+        if (!f[k]) return jv_missing(r, s->vbd, &p, keys[k]);
+    const int32_t want[4] = { s->nd, s->nd, g->bend.n, g->bend.n };
+    if (wb_image_alloc_vbd(g, s->nd, g->bend.n) != WB_OK) return jv_fail(r, NULL, 0, NULL, "out of memory");
+    wb_real *dst[4] = { g->vbd_lam, g->vbd_c0, g->vbd_blam, g->vbd_bc0 };
+    for (int k = 0; k < 4; k++) {
+        kp a = { &p, keys[k], 0 };
+        int32_t n;
+        if (jv_get_array(r, f[k], &a, WB_MAX_CONSTRAINTS, &n)) return -1;
+        if (n != want[k]) return jv_fail(r, f[k], 0, &a, "%d numbers, but the world has %d %s", n, want[k], k < 2 ? "distance slots" : "bends");
+        int32_t i = 0;
+        for (const cJSON *c = f[k]->child; c; c = c->next, i++) {
+            kp e = { &a, NULL, i };
+            if (k % 2 && cJSON_IsNull(c)) dst[k][i] = (wb_real)NAN;
+            else if (jv_get_real(r, c, &e, &dst[k][i])) return -1;
+        }
     }
     return 0;
 }
@@ -196,7 +226,7 @@ static int read_snapshot(rd *r, const sections *s, wb_image *g)
         if (read_generations(r, s->cgen, &a, s->nc, g->c_gen, &live)) return -1;
         if (live != s->ncol) return jv_fail(r, s->cgen, 0, &a, "%d live slots, but \"colliders\" has %d entries", live, s->ncol);
     }
-    return 0;
+    return s->vbd ? read_vbd(r, s, &p, g) : 0;
 }
 
 static int read_particles(rd *r, const sections *s, const jdefaults *d, wb_image *g)
