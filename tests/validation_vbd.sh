@@ -18,12 +18,6 @@ not_vbd="neo_stiff.lua residual.lua materials.lua"
 
 # They apply but fail under VBD today (docs/physics.md, "VBD": what it does not serve yet);
 # each is a bug of the solver, not of the test:
-#   a rigid bend set far off its rest (a hinge turned by up to pi with set_position) is
-#   not back within a frame: its multiplier, carried from substep to substep as a rigid
-#   link's, takes the correction in and swings the wing past it (XPBD projects to 1e-9);
-#   a rigid link keeps 0.999 of its error a substep (vbd.c), so the first substep's
-#   stretch of one suddenly loaded (3e-6 of 0.5 m) trips a break_strain of 1e-6:
-#     bending.lua
 #   hand_built: a rope draped on another rests 2.2 mm low (contacts after the sweeps):
 #     hand_built.lua
 #   a stiff body touching a movable particle of another body or a rigid body is not moved
@@ -47,7 +41,7 @@ not_vbd="neo_stiff.lua residual.lua materials.lua"
 #   contact_triangles.lua: a coarse cloth folded onto itself passes through its sheet
 #   (378 particles); its 5 other tests pass):
 #     cloth_sphere_drop.lua self_collision.lua contact_triangles.lua
-not_yet="bending.lua hand_built.lua
+not_yet="hand_built.lua
 contacts.lua contact_energy.lua contact_kinetic.lua
 made_overlapping.lua made_stack.lua symmetric_drop.lua user/10_rigid_on_soft.lua
 user/14_elastic_release_symmetry.lua rigid_particle.lua squeeze.lua shape_match.lua penetration.lua cloth_sphere_drop.lua self_collision.lua contact_triangles.lua"

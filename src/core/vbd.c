@@ -85,10 +85,10 @@ struct wb_vbd {
  * corrected fed it back as speed (0.995: the clamped strip at 40 x 1 swung 0.15 m off its
  * droop; all of it corrected, a 1-D chain's modes grew 15% a substep).
  * A hard bend is held the same way (multiplier carried whole, VBD_STAB of its error kept)
- * with its penalty VBD_BEND_K times the inertia of its angle, 1 / (h^2 sum w |grad|^2) (rad,
+ * with its penalty VBD_BEND_K times the inertia of its angle (bend_start_penalty; rad,
  * not m: the gradient of a 5 cm wing is 20 /m). That is the stiffness the bend has until its
- * multiplier catches up: a clamped strip with rigid bends droops 0.45 m at 8, 11 mm at
- * 512 (10 x 1) before it straightens, 0.14 mm with 4096 */
+ * multiplier catches up: a clamped strip with rigid bends droops 0.55 m at 8, 12 mm at
+ * 512 and 1.4 mm at 4096 (10 x 1) before it straightens (512: what the suite ran with) */
 #define VBD_LINK_K ((wb_real)8)
 #define VBD_STAB ((wb_real)0.999)
 /* in a world with volume constraints (projected after the sweeps) a body of rigid links
@@ -97,6 +97,7 @@ struct wb_vbd {
  * slower one holds the squeeze after the press lets go (0.999: back to 0.87 of its height) */
 #define VBD_STAB_VOL ((wb_real)0.995)
 #define VBD_BEND_K ((wb_real)512)
+#define VBD_STAB_T ((wb_real)1 / 600) /* a bend's VBD_STAB is per this much time (the default substep) */
 
 void wb__vbd_destroy(wb_world *w)
 {
@@ -653,13 +654,20 @@ static void keep_multipliers(struct wb_vbd *v)
     for (int32_t q = 0; q < v->nhard; q++) v->lam[v->hard[q]] = v->lk[v->hard[q]].lm;
 }
 
-/* a hard bend's penalty to start from: the inertia of its angle, 1 / (h^2 sum w |g|^2) */
+/* a hard bend's penalty: the inertia of its angle, 1 / (h^2 w sum |g|^2), with w its
+ * lightest movable corner's inverse mass over all four corners. Over the movable corners
+ * alone (sum w |g|^2) it grew without bound where they barely turn the angle (a row of
+ * pins along a cloth's edge: a hinge corner's gradient near 0), and the multiplier with it:
+ * a 9 x 9 cloth hung by an edge blew up in 5 frames */
 static wb_real bend_start_penalty(const wb_world *w, int32_t b, const wb_real g[4][3], wb_real inv_h2)
 {
     const int32_t *p = &w->bend.ij[4 * b];
-    wb_real den = 0;
-    for (int c = 0; c < 4; c++) den += w->m.w[p[c]] * v3_dot(g[c], g[c]);
-    return den > 0 ? inv_h2 / den : 0;
+    wb_real wm = 0, gg = 0;
+    for (int c = 0; c < 4; c++) {
+        wm = w->m.w[p[c]] > wm ? w->m.w[p[c]] : wm;
+        gg += v3_dot(g[c], g[c]);
+    }
+    return wm * gg > 0 ? inv_h2 / (wm * gg) : 0;
 }
 
 static int hard_bend(const wb_world *w, int32_t b) { return !w->bend.broken[b] && !(w->bend.alpha[b] > 0); }
@@ -667,16 +675,24 @@ static int hard_bend(const wb_world *w, int32_t b) { return !w->bend.broken[b] &
 /* each hard bend's penalty and the error it keeps this substep, as warm_start's links:
  * measured where the substep starts (x_prev), not at the sweeps' start: kept from the
  * prediction, a bend took its swing in as error and the multiplier fed it back (the strip
- * with rigid bends blew up within 5 s at any penalty) */
-static void bend_warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2)
+ * with rigid bends blew up within 5 s at any penalty). It keeps VBD_STAB of it per
+ * VBD_STAB_T of time, not per substep: the multiplier integrates what is not kept, and at
+ * 0.999 a substep the strip at 40 x 1 (the rate 4 times the default's, 2.4 /s against
+ * its drag of 2 /s) swung up to 0.6 m in 50 s; so it held within 1.3 mm */
+static void bend_warm_start(wb_world *w, struct wb_vbd *v, wb_real h)
 {
+    const wb_real inv_h2 = 1 / (h * h), keep = pow(VBD_STAB, h / VBD_STAB_T);
     for (int32_t b = 0; b < w->bend.n; b++) {
         wb_real off, g[4][3];
-        if (!hard_bend(w, b) || !wb__bend_off_at(w, w->s.x_prev, b, &off, g)) continue;
+        if (!hard_bend(w, b)) continue;
+        if (!wb__bend_off_at(w, w->s.x_prev, b, &off, g)) { /* degenerate: no penalty this substep */
+            v->bkpen[b] = v->btg[b] = 0;
+            continue;
+        }
         v->bkpen[b] = VBD_BEND_K * bend_start_penalty(w, b, g, inv_h2);
         const wb_real ce = v->bc0[b];
         const wb_real c0 = !isfinite(ce) ? 0 : off * ce <= 0 ? 0 : fabs(off) < fabs(ce) ? off : ce;
-        v->btg[b] = VBD_STAB * c0;
+        v->btg[b] = keep * c0;
     }
 }
 
@@ -842,7 +858,7 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     const int touch = touching(w, v);
     start_guess(w, v, h, touch);
     warm_start(w, v, inv_h2, 1 / h);
-    bend_warm_start(w, v, inv_h2);
+    bend_warm_start(w, v, h);
     wb_pool *pool = wb__world_pool(w);
     for (int it = 0; it < w->m.def.iterations; it++) {
         sweep_job j = { w, v, inv_h2, 1 / h, NULL, 0 };
@@ -898,10 +914,11 @@ wb_status wb__vbd_image_of(const wb_world *w, wb_image *g)
     if (!v || w->m.def.solver != WB_SOLVER_VBD || (w->m.nd == 0 && w->bend.n == 0)) return WB_OK;
     const int32_t nd = w->m.nd, nb = w->bend.n;
     if (wb_image_alloc_vbd(g, nd, nb) != WB_OK) return WB_ERR_NOMEM;
-    const int fresh = rebuild_due(w, v) && !v->restored;
+    /* (a world just restored has its image's errors for every slot it held) */
+    const int32_t known = v->restored ? v->cap_lam : rebuild_due(w, v) ? 0 : v->nd;
     for (int32_t s = 0; s < nd; s++) {
         g->vbd_lam[s] = s < v->cap_lam ? v->lam[s] : 0;
-        g->vbd_c0[s] = !fresh && s < v->nd ? v->c0[s] : (wb_real)NAN;
+        g->vbd_c0[s] = s < known ? v->c0[s] : (wb_real)NAN;
     }
     for (int32_t b = 0; b < nb; b++) {
         g->vbd_blam[b] = b < v->cap_blam ? v->blam[b] : 0;
