@@ -18,18 +18,8 @@ not_vbd="neo_stiff.lua residual.lua materials.lua"
 
 # They apply but fail under VBD today (docs/physics.md, "VBD": what it does not serve yet);
 # each is a bug of the solver, not of the test:
-#   rigid bends still ramp their penalty and correct their whole error each substep (with a
-#   fixed penalty and the multiplier carried over as rigid links have it, the clamped strip
-#   with rigid bends blew up): a rigid hinge is 6e-4 rad off after a frame, a bend reads
-#   more than its torque and breaks below it; a rigid link keeps 0.999 of its error a
-#   substep (vbd.c), so the first substep's stretch of one suddenly loaded (3e-6 of 0.5 m)
-#   trips a break_strain of 1e-6; VBD's multipliers are not in snapshots (a loaded world
-#   steps on differently: bending, bend_break, tethers); hand_built: its rope's "free end
-#   swung down" samples one instant (0.9 s) of XPBD's rope, 30% stretched, where VBD's (1%)
-#   has already whipped up past the pin, and a rope draped on another rests 2.2 mm low
-#   (contacts after the sweeps); tethers.lua's first test wants the cloth to stretch
-#   without tethers, which under VBD it does not (-1.6%: that check is XPBD's):
-#     bending.lua hand_built.lua bend_break.lua tethers.lua
+#   hand_built: a rope draped on another rests 2.2 mm low (contacts after the sweeps):
+#     hand_built.lua
 #   a stiff body touching a movable particle of another body or a rigid body is not moved
 #   to keep its momentum (docs/physics.md, "VBD"): its translation is its sweeps' start's.
 #   A block on a pinned slab creeps 1.03 mm in 1 s at 0.95 of tan = mu (contacts.lua, bound
@@ -51,7 +41,7 @@ not_vbd="neo_stiff.lua residual.lua materials.lua"
 #   contact_triangles.lua: a coarse cloth folded onto itself passes through its sheet
 #   (378 particles); its 5 other tests pass):
 #     cloth_sphere_drop.lua self_collision.lua contact_triangles.lua
-not_yet="bending.lua hand_built.lua bend_break.lua tethers.lua
+not_yet="hand_built.lua
 contacts.lua contact_energy.lua contact_kinetic.lua
 made_overlapping.lua made_stack.lua symmetric_drop.lua user/10_rigid_on_soft.lua
 user/14_elastic_release_symmetry.lua rigid_particle.lua squeeze.lua shape_match.lua penetration.lua cloth_sphere_drop.lua self_collision.lua contact_triangles.lua"

@@ -79,10 +79,11 @@ static wb_real wrap(wb_real d)
     return d;
 }
 
-int wb__bend_off(const wb_world *w, int32_t b, wb_real *off, wb_real g[4][3])
+int wb__bend_off(const wb_world *w, int32_t b, wb_real *off, wb_real g[4][3]) { return wb__bend_off_at(w, w->s.x, b, off, g); }
+
+int wb__bend_off_at(const wb_world *w, const wb_real *x, int32_t b, wb_real *off, wb_real g[4][3])
 {
     const int32_t *p = &w->bend->ij[4 * b];
-    const wb_real *x = w->s.x;
     wb_real th;
     if (!dihedral(&x[3 * p[0]], &x[3 * p[1]], &x[3 * p[2]], &x[3 * p[3]], &th, g)) return 0;
     *off = wrap(th - w->bend->rest[b]);

@@ -64,6 +64,7 @@ void wb_image_free(wb_image *g)
     for (int i = 0; i < wb__nctypes; i++)
         if (wb__ctypes[i]->image_free) wb__ctypes[i]->image_free(g);
     wb__rigid_image_free(g);
+    wb__vbd_image_free(g);
     memset(g, 0, sizeof *g);
 }
 
@@ -131,6 +132,7 @@ wb_status wb_image_of(const wb_world *w, wb_image *g)
     }
     for (int i = 0; i < wb__nctypes && st == WB_OK; i++)
         if (wb__ctypes[i]->image_save) st = wb__ctypes[i]->image_save(w, g);
+    if (st == WB_OK) st = wb__vbd_image_of(w, g);
     if (st != WB_OK) wb_image_free(g);
     return st;
 }
@@ -199,6 +201,7 @@ const char *wb_image_check(const wb_image *g)
     if (!(g->time >= 0) || !isfinite(g->time) || g->frame < 0 || g->warnings < 0) return "time, frame and warnings must be finite and >= 0";
     for (int i = 0; i < wb__nctypes; i++)
         if (wb__ctypes[i]->image_check && (e = wb__ctypes[i]->image_check(g))) return e;
+    if ((e = wb__vbd_image_check(g))) return e;
     return wb__rigid_image_check(g);
 }
 
@@ -322,6 +325,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
     if (st == WB_OK) st = wb__rigid_reserve(w, g, 1);
     if (st == WB_OK) st = reserve_types(w, g, &at);
+    if (st == WB_OK) st = wb__vbd_image_put(w, g);
     if (st == WB_OK) st = build_meshes(w, g, cms);
     if (st != WB_OK) {
         free(cms);

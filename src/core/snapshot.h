@@ -82,7 +82,22 @@ typedef struct wb_image {
     int32_t nrb;           /* rigid bodies by slot: empty unless wb_image_alloc_rigids */
     wb_image_rigid *rb;    /* (nrb) */
     uint32_t *rb_gen;      /* (nrb) odd = live */
+    /* the VBD solver's multipliers (vbd.c), what its next substep starts from: empty (0, 0)
+     * in an XPBD world or a VBD world that has not stepped */
+    int32_t vbd_nd, vbd_nb;
+    wb_real *vbd_lam, *vbd_c0;   /* (vbd_nd) by distance slot: a rigid link's multiplier and its
+                                    error as the last sweep left it (NaN: not known) */
+    wb_real *vbd_blam, *vbd_bc0; /* (vbd_nb) the same of each rigid bend */
 } wb_image;
+/* vbd.c: the VBD section for nd distance slots and nb bends (uninitialised); WB_ERR_NOMEM
+ * (the section left empty) */
+wb_status wb_image_alloc_vbd(wb_image *img, int32_t nd, int32_t nb);
+/* vbd.c: the section above (free: fine when empty; put: into a world just made from the
+ * image, before its first step; check: NULL or what is wrong) */
+wb_status wb__vbd_image_of(const wb_world *w, wb_image *g);
+void wb__vbd_image_free(wb_image *g);
+const char *wb__vbd_image_check(const wb_image *g);
+wb_status wb__vbd_image_put(wb_world *w, const wb_image *g);
 
 /* allocate the arrays for these counts (zeroed; generations 1, i.e. live; particles collide);
  * WB_ERR_NOMEM */

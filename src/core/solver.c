@@ -162,6 +162,7 @@ static void undo_particles(wb_world *w)
     }
     for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->substep_begin(w);
     wb__rigids_undo(w);
+    wb__vbd_undo(w);
 }
 
 /* the colliders' poses at the frame's start, before their velocities move them */

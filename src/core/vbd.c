@@ -14,7 +14,7 @@
  * and carried from substep to substep (warm start) so a hanging chain holds its tension
  * instead of finding it again every substep.
  *
- * Served: distance links. The other types are projected as in XPBD after each sweep, and
+ * Served: distance links, bends, Neo-Hookean tets. The other types are projected as in XPBD after each sweep, and
  * contacts, colliders and rigid bodies follow the sweeps as in the XPBD step (solver.c). */
 #include <stdlib.h>
 #include <string.h>
@@ -22,6 +22,7 @@
 #include "bend.h"
 #include "pool.h"
 #include "rigid.h"
+#include "snapshot.h"
 #include "tet.h"
 #include "volume.h"
 #include "vbd.h"
@@ -61,7 +62,13 @@ struct wb_vbd {
     int32_t nhard;
     int32_t cap_lam;
     wb_real *blam, *bkpen; /* (nb, by slot) a hard bend's multiplier and penalty */
+    wb_real *btg, *bc0;    /* (nb) a hard bend's target (the error it keeps this substep) and
+                              its error as the last sweep left it (NaN: not known) */
     int32_t cap_blam;
+    wb_real *save;         /* (2 cap_lam + 2 cap_blam) lam, c0, blam, bc0 at the step's start:
+                              an undone frame puts them back (wb__vbd_undo) */
+    int restored;          /* made from a snapshot image: the next rebuild keeps c0 (the
+                              image holds what the saved world's next step starts from) */
     wb_real residual;      /* the last sweep's largest step, m */
     double *tsum;          /* (bodies x 4) each free body's mass and sum m (x - y) */
     int32_t cap_tsum;
@@ -79,8 +86,11 @@ struct wb_vbd {
  * stabilisation): carried over, a multiplier that also took in the error it had already
  * corrected fed it back as speed (0.995: the clamped strip at 40 x 1 swung 0.15 m off its
  * droop; all of it corrected, a 1-D chain's modes grew 15% a substep).
- * A hard bend's penalty decays by VBD_WARM a substep down to its k0, grows by k0 for each
- * 1/VBD_RAMP rad it is off after a sweep, up to VBD_KMAX k0, its multiplier by k0 off */
+ * A hard bend is held the same way (multiplier carried whole, VBD_STAB of its error kept)
+ * with its penalty VBD_BEND_K times the inertia of its angle (bend_start_penalty; rad,
+ * not m: the gradient of a 5 cm wing is 20 /m). That is the stiffness the bend has until its
+ * multiplier catches up: a clamped strip with rigid bends droops 0.55 m at 8, 12 mm at
+ * 512 and 1.4 mm at 4096 (10 x 1) before it straightens (512: what the suite ran with) */
 #define VBD_LINK_K ((wb_real)8)
 #define VBD_STAB ((wb_real)0.999)
 /* in a world with volume constraints (projected after the sweeps) a body of rigid links
@@ -88,9 +98,13 @@ struct wb_vbd {
  * back faster fights the tets (0.99: a block squeezed to 60% blew up 3 s on at 10 m/s), a
  * slower one holds the squeeze after the press lets go (0.999: back to 0.87 of its height) */
 #define VBD_STAB_VOL ((wb_real)0.995)
-#define VBD_WARM ((wb_real)0.99)
-#define VBD_RAMP ((wb_real)1e3)
-#define VBD_KMAX ((wb_real)1e6)
+#define VBD_BEND_K ((wb_real)512)
+/* a bend keeps VBD_STAB of its error per this much time (the default substep), a link per
+ * substep: per time, a rope of rigid links at 40 x 4 stretched 3.7% (3% allowed), the
+ * catenary at 40 x 1 read its tension 3.4% off and a hand-built cloth fell through its
+ * sphere (user/01-03); the clamped strip at 40 x 1 held its droop better (0.2873 m at
+ * frame 2400 against 0.2825, converged 0.2881) */
+#define VBD_STAB_T ((wb_real)1 / 600)
 
 void wb__vbd_destroy(wb_world *w)
 {
@@ -117,6 +131,9 @@ void wb__vbd_destroy(wb_world *w)
     free(v->c0);
     free(v->blam);
     free(v->bkpen);
+    free(v->btg);
+    free(v->bc0);
+    free(v->save);
     free(v->tsum);
     free(v);
     w->vbd = NULL;
@@ -239,6 +256,14 @@ static int build_colours(wb_world *w, struct wb_vbd *v)
     return 1;
 }
 
+/* the next prepare rebuilds the adjacency (and forgets the links' errors) */
+static int rebuild_due(const wb_world *w, const struct wb_vbd *v)
+{
+    const wb_model *m = &w->m;
+    const int32_t nt = w->neo ? w->neo->n : 0;
+    return m->topology_dirty || v->np != m->np || v->nd != m->nd || v->nt != nt || v->nb != wb_bend_count(w);
+}
+
 int wb__vbd_prepare(wb_world *w)
 {
     if (w->m.def.solver != WB_SOLVER_VBD) return 1;
@@ -251,7 +276,7 @@ int wb__vbd_prepare(wb_world *w)
     }
     const wb_model *m = &w->m;
     const int32_t nt = w->neo ? w->neo->n : 0;
-    if (m->topology_dirty || v->np != m->np || v->nd != m->nd || v->nt != nt || v->nb != wb_bend_count(w)) {
+    if (rebuild_due(w, v)) {
         if (!build_adjacency(w, v) || !build_colours(w, v)) return 0;
         wb_real *y = realloc(v->y, sizeof *y * 3 * (size_t)(m->np > 0 ? m->np : 1));
         if (!y) return 0;
@@ -275,19 +300,52 @@ int wb__vbd_prepare(wb_world *w)
             wb_real *bl = realloc(v->blam, sizeof *bl * n), *bk = realloc(v->bkpen, sizeof *bk * n);
             if (bl) v->blam = bl;
             if (bk) v->bkpen = bk;
-            if (!bl || !bk) return 0;
+            wb_real *bt = realloc(v->btg, sizeof *bt * n), *bc = realloc(v->bc0, sizeof *bc * n);
+            if (bt) v->btg = bt;
+            if (bc) v->bc0 = bc;
+            if (!bl || !bk || !bt || !bc) return 0;
             memset(v->blam + v->cap_blam, 0, sizeof *bl * (n - (size_t)v->cap_blam));
             memset(v->bkpen + v->cap_blam, 0, sizeof *bk * (n - (size_t)v->cap_blam));
+            for (int32_t b = v->cap_blam; b < wb_bend_count(w); b++) v->btg[b] = 0, v->bc0[b] = (wb_real)NAN;
             v->cap_blam = wb_bend_count(w);
         }
         /* (a slot may hold another link now: its error is the one it starts with) */
-        for (int32_t q = 0; q < m->nd; q++) v->c0[q] = (wb_real)NAN;
+        if (!v->restored)
+            for (int32_t q = 0; q < m->nd; q++) v->c0[q] = (wb_real)NAN;
+        v->restored = 0;
         v->np = m->np;
         v->nd = m->nd;
         v->nt = nt;
         v->nb = wb_bend_count(w);
+        wb_real *sv = realloc(v->save, sizeof *sv * (2 * (size_t)v->cap_lam + 2 * (size_t)v->cap_blam + 1));
+        if (!sv) return 0;
+        v->save = sv;
+    }
+    const size_t nl = (size_t)v->cap_lam, nb = (size_t)v->cap_blam;
+    if (nl) {
+        memcpy(v->save, v->lam, sizeof *v->save * nl);
+        memcpy(v->save + nl, v->c0, sizeof *v->save * nl);
+    }
+    if (nb) {
+        memcpy(v->save + 2 * nl, v->blam, sizeof *v->save * nb);
+        memcpy(v->save + 2 * nl + nb, v->bc0, sizeof *v->save * nb);
     }
     return 1;
+}
+
+void wb__vbd_undo(wb_world *w)
+{
+    struct wb_vbd *v = w->vbd;
+    if (!v || !v->save || v->np != w->m.np) return;
+    const size_t nl = (size_t)v->cap_lam, nb = (size_t)v->cap_blam;
+    if (nl) {
+        memcpy(v->lam, v->save, sizeof *v->save * nl);
+        memcpy(v->c0, v->save + nl, sizeof *v->save * nl);
+    }
+    if (nb) {
+        memcpy(v->blam, v->save + 2 * nl, sizeof *v->save * nb);
+        memcpy(v->bc0, v->save + 2 * nl + nb, sizeof *v->save * nb);
+    }
 }
 
 /* ---- the vertex step ------------------------------------------------------------------------ */
@@ -472,8 +530,8 @@ static void tet_block(const wb_world *w, int32_t q, wb_real f[3], wb_real H[6])
 }
 
 /* a bend's energy off^2 / (2 alpha) on corner k: Gauss-Newton, k g g^T; a rigid one (alpha
- * 0) through the augmented Lagrangian, k off^2 / 2 + lambda off, as a hard link but with
- * no stabilisation (a rigid bend set off its rest is turned there at once, as XPBD does).
+ * 0) through the augmented Lagrangian, k (off - t)^2 / 2 + lambda (off - t), as a hard link
+ * (t: the error it keeps this substep).
  * Its damping beta (N m s) on the angle's speed over the substep, as XPBD's */
 static void bend_block(const wb_world *w, const struct wb_vbd *v, int32_t q, wb_real inv_h, wb_real f[3], wb_real H[6])
 {
@@ -482,7 +540,7 @@ static void bend_block(const wb_world *w, const struct wb_vbd *v, int32_t q, wb_
     wb_real off, g[4][3];
     if (!wb__bend_off(w, b, &off, g)) return;
     const wb_real a = w->bend->alpha[b], *gk = g[k];
-    wb_real kb = a > 0 ? 1 / a : v->bkpen[b], fm = a > 0 ? kb * off : kb * off + v->blam[b];
+    wb_real kb = a > 0 ? 1 / a : v->bkpen[b], fm = a > 0 ? kb * off : kb * (off - v->btg[b]) + v->blam[b];
     const wb_real beta = w->bend->beta[b];
     if (a > 0 && beta > 0) {
         const int32_t *p = &w->bend->ij[4 * b];
@@ -603,43 +661,59 @@ static void keep_multipliers(struct wb_vbd *v)
     for (int32_t q = 0; q < v->nhard; q++) v->lam[v->hard[q]] = v->lk[v->hard[q]].lm;
 }
 
-/* a hard bend's penalty to start from: the inertia of its angle, 1 / (h^2 sum w |g|^2) */
+/* a hard bend's penalty: the inertia of its angle, 1 / (h^2 w sum |g|^2), with w its
+ * lightest movable corner's inverse mass over all four corners. Over the movable corners
+ * alone (sum w |g|^2) it grew without bound where they barely turn the angle (a row of
+ * pins along a cloth's edge: a hinge corner's gradient near 0), and the multiplier with it:
+ * a 9 x 9 cloth hung by an edge blew up in 5 frames */
 static wb_real bend_start_penalty(const wb_world *w, int32_t b, const wb_real g[4][3], wb_real inv_h2)
 {
     const int32_t *p = &w->bend->ij[4 * b];
-    wb_real den = 0;
-    for (int c = 0; c < 4; c++) den += w->m.w[p[c]] * v3_dot(g[c], g[c]);
-    return den > 0 ? inv_h2 / den : 0;
+    wb_real wm = 0, gg = 0;
+    for (int c = 0; c < 4; c++) {
+        wm = w->m.w[p[c]] > wm ? w->m.w[p[c]] : wm;
+        gg += v3_dot(g[c], g[c]);
+    }
+    return wm * gg > 0 ? inv_h2 / (wm * gg) : 0;
 }
 
 static int hard_bend(const wb_world *w, int32_t b) { return !w->bend->broken[b] && !(w->bend->alpha[b] > 0); }
 
-static void bend_warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2)
+/* each hard bend's penalty and the error it keeps this substep, as warm_start's links:
+ * measured where the substep starts (x_prev), not at the sweeps' start: kept from the
+ * prediction, a bend took its swing in as error and the multiplier fed it back (the strip
+ * with rigid bends blew up within 5 s at any penalty). It keeps VBD_STAB of it per
+ * VBD_STAB_T of time, not per substep: the multiplier integrates what is not kept, and at
+ * 0.999 a substep the strip at 40 x 1 (the rate 4 times the default's, 2.4 /s against
+ * its drag of 2 /s) swung up to 0.6 m in 50 s; so it held within 1.3 mm */
+static void bend_warm_start(wb_world *w, struct wb_vbd *v, wb_real h)
 {
+    const wb_real inv_h2 = 1 / (h * h), keep = pow(VBD_STAB, h / VBD_STAB_T);
     for (int32_t b = 0; b < wb_bend_count(w); b++) {
         wb_real off, g[4][3];
-        if (!hard_bend(w, b) || !wb__bend_off(w, b, &off, g)) continue;
-        const wb_real k0 = bend_start_penalty(w, b, g, inv_h2);
-        v->bkpen[b] = v->bkpen[b] * VBD_WARM > k0 ? v->bkpen[b] * VBD_WARM : k0;
+        if (!hard_bend(w, b)) continue;
+        if (!wb__bend_off_at(w, w->s.x_prev, b, &off, g)) { /* degenerate: no penalty this substep */
+            v->bkpen[b] = v->btg[b] = 0;
+            continue;
+        }
+        v->bkpen[b] = VBD_BEND_K * bend_start_penalty(w, b, g, inv_h2);
+        const wb_real ce = v->bc0[b];
+        const wb_real c0 = !isfinite(ce) ? 0 : off * ce <= 0 ? 0 : fabs(off) < fabs(ce) ? off : ce;
+        v->btg[b] = keep * c0;
     }
 }
 
-/* a hard bend's multiplier and penalty after a sweep, as a hard link's (its error in
- * radians: the penalty grows by k0 each 1/VBD_RAMP rad); its torque (what force() reads,
- * XPBD's multiplier lambda = -torque h^2) is the multiplier, as a hard link's: k off
- * overshot it (k is large, off noisy) */
+/* a hard bend's multiplier after a sweep, as a hard link's; its torque (what force() and
+ * break_torque read, XPBD's multiplier lambda = -torque h^2) is the multiplier */
 static void bend_dual_update(wb_world *w, struct wb_vbd *v, wb_real h)
 {
     wb_bends *bs = w->bend;
-    const wb_real inv_h2 = 1 / (h * h);
     for (int32_t b = 0; b < wb_bend_count(w); b++) {
         wb_real off, g[4][3];
         if (!hard_bend(w, b) || !wb__bend_off(w, b, &off, g)) continue;
-        const wb_real k0 = bend_start_penalty(w, b, g, inv_h2);
-        v->blam[b] += k0 * off;
+        v->blam[b] += v->bkpen[b] * (off - v->btg[b]);
+        v->bc0[b] = off;
         if (!bs->dirty) bs->lambda[bs->pack[b]] = -v->blam[b] * h * h;
-        const wb_real k = v->bkpen[b] + k0 * VBD_RAMP * fabs(off);
-        v->bkpen[b] = k < VBD_KMAX * k0 ? k : VBD_KMAX * k0;
     }
 }
 
@@ -791,7 +865,7 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     const int touch = touching(w, v);
     start_guess(w, v, h, touch);
     warm_start(w, v, inv_h2, 1 / h);
-    bend_warm_start(w, v, inv_h2);
+    bend_warm_start(w, v, h);
     wb_pool *pool = wb__world_pool(w);
     for (int it = 0; it < w->m.def.iterations; it++) {
         sweep_job j = { w, v, inv_h2, 1 / h, NULL, 0 };
@@ -815,3 +889,86 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
 }
 
 wb_real wb__vbd_residual(const wb_world *w) { return w->vbd ? w->vbd->residual : 0; }
+
+/* ---- snapshots ------------------------------------------------------------------------------- */
+void wb__vbd_image_free(wb_image *g)
+{
+    free(g->vbd_lam), free(g->vbd_c0), free(g->vbd_blam), free(g->vbd_bc0);
+    g->vbd_lam = g->vbd_c0 = g->vbd_blam = g->vbd_bc0 = NULL;
+    g->vbd_nd = g->vbd_nb = 0;
+}
+
+wb_status wb_image_alloc_vbd(wb_image *g, int32_t nd, int32_t nb)
+{
+    wb__vbd_image_free(g);
+    g->vbd_lam = malloc(sizeof(wb_real) * (size_t)(nd > 0 ? nd : 1));
+    g->vbd_c0 = malloc(sizeof(wb_real) * (size_t)(nd > 0 ? nd : 1));
+    g->vbd_blam = malloc(sizeof(wb_real) * (size_t)(nb > 0 ? nb : 1));
+    g->vbd_bc0 = malloc(sizeof(wb_real) * (size_t)(nb > 0 ? nb : 1));
+    if (!g->vbd_lam || !g->vbd_c0 || !g->vbd_blam || !g->vbd_bc0) {
+        wb__vbd_image_free(g);
+        return WB_ERR_NOMEM;
+    }
+    g->vbd_nd = nd, g->vbd_nb = nb;
+    return WB_OK;
+}
+
+/* what the world's next substep starts from: a slot the cache has not met yet starts
+ * with no multiplier, and the errors of a cache about to be rebuilt are forgotten */
+wb_status wb__vbd_image_of(const wb_world *w, wb_image *g)
+{
+    const struct wb_vbd *v = w->vbd;
+    if (!v || w->m.def.solver != WB_SOLVER_VBD || (w->m.nd == 0 && wb_bend_count(w) == 0)) return WB_OK;
+    const int32_t nd = w->m.nd, nb = wb_bend_count(w);
+    if (wb_image_alloc_vbd(g, nd, nb) != WB_OK) return WB_ERR_NOMEM;
+    /* (a world just restored has its image's errors for every slot it held) */
+    const int32_t known = v->restored ? v->cap_lam : rebuild_due(w, v) ? 0 : v->nd;
+    for (int32_t s = 0; s < nd; s++) {
+        g->vbd_lam[s] = s < v->cap_lam ? v->lam[s] : 0;
+        g->vbd_c0[s] = s < known ? v->c0[s] : (wb_real)NAN;
+    }
+    for (int32_t b = 0; b < nb; b++) {
+        g->vbd_blam[b] = b < v->cap_blam ? v->blam[b] : 0;
+        g->vbd_bc0[b] = b < v->cap_blam ? v->bc0[b] : (wb_real)NAN;
+    }
+    return WB_OK;
+}
+
+const char *wb__vbd_image_check(const wb_image *g)
+{
+    if (g->vbd_nd == 0 && g->vbd_nb == 0) return NULL;
+    if (g->def.solver != WB_SOLVER_VBD) return "VBD multipliers in a world of another solver";
+    if (g->vbd_nd != g->dist.n) return "VBD multipliers: one per distance slot";
+    if (g->vbd_nb != g->bend.n) return "VBD bend multipliers: one per bend";
+    for (int32_t s = 0; s < g->vbd_nd; s++)
+        if (!isfinite(g->vbd_lam[s]) || isinf(g->vbd_c0[s])) return "VBD multipliers must be finite";
+    for (int32_t b = 0; b < g->vbd_nb; b++)
+        if (!isfinite(g->vbd_blam[b]) || isinf(g->vbd_bc0[b])) return "VBD multipliers must be finite";
+    return NULL;
+}
+
+wb_status wb__vbd_image_put(wb_world *w, const wb_image *g)
+{
+    if (g->vbd_nd == 0 && g->vbd_nb == 0) return WB_OK;
+    struct wb_vbd *v = calloc(1, sizeof *v);
+    if (!v) return WB_ERR_NOMEM;
+    w->vbd = v;
+    v->np = -1;
+    const size_t nd = (size_t)(g->vbd_nd > 0 ? g->vbd_nd : 1), nb = (size_t)(g->vbd_nb > 0 ? g->vbd_nb : 1);
+    v->lam = malloc(sizeof *v->lam * nd), v->c0 = malloc(sizeof *v->c0 * nd);
+    v->lk = malloc(sizeof *v->lk * nd), v->hard = malloc(sizeof *v->hard * nd);
+    v->blam = malloc(sizeof *v->blam * nb), v->bkpen = calloc(nb, sizeof *v->bkpen);
+    v->btg = calloc(nb, sizeof *v->btg), v->bc0 = malloc(sizeof *v->bc0 * nb);
+    if (!v->lam || !v->c0 || !v->lk || !v->hard || !v->blam || !v->bkpen || !v->btg || !v->bc0) return WB_ERR_NOMEM;
+    if (g->vbd_nd) {
+        memcpy(v->lam, g->vbd_lam, sizeof *v->lam * (size_t)g->vbd_nd);
+        memcpy(v->c0, g->vbd_c0, sizeof *v->c0 * (size_t)g->vbd_nd);
+    }
+    if (g->vbd_nb) {
+        memcpy(v->blam, g->vbd_blam, sizeof *v->blam * (size_t)g->vbd_nb);
+        memcpy(v->bc0, g->vbd_bc0, sizeof *v->bc0 * (size_t)g->vbd_nb);
+    }
+    v->cap_lam = g->vbd_nd, v->cap_blam = g->vbd_nb;
+    v->restored = 1;
+    return WB_OK;
+}

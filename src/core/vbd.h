@@ -13,6 +13,8 @@ int wb__vbd_serves(const wb_ctype *t);
  * changed; 0 when out of memory */
 int wb__vbd_prepare(wb_world *w);
 void wb__vbd_destroy(wb_world *w);
+/* an undone frame: the multipliers back as the step found them */
+void wb__vbd_undo(wb_world *w);
 /* the last substep's residual: the largest Newton step of its last sweep, m */
 wb_real wb__vbd_residual(const wb_world *w);
 

@@ -97,7 +97,7 @@ static int read_world(rd *r, const cJSON *it, const kp *up, wb_world_def *d)
 
 typedef struct sections {      /* the top-level values, checked for type */
     const cJSON *particles, *constraints, *colliders, *surfaces, *parts, *skins, *snapshot;
-    const cJSON *world, *cgen, *clock[4];
+    const cJSON *world, *cgen, *clock[4], *vbd;
     int32_t np, ncons, ncol, nsurf, ntri, nparts, nskins, nc;
     int32_t nentries[JT_MAX];  /* "constraints" entries of each type (ncons: the slotted type's) */
     int slotted;               /* the type stored by slot (jtype.slots_key), -1 none */
@@ -107,15 +107,15 @@ typedef struct sections {      /* the top-level values, checked for type */
 /* the snapshot section's shape (its values are read once the image exists) */
 static int scan_snapshot(rd *r, sections *s)
 {
-    /* the clock, the slotted type's table, the colliders' */
-    const char *keys[] = { "world", "time", "frame", "warnings", "last_warning", NULL, "collider_slots", NULL };
+    /* the clock, the slotted type's table, the colliders', the VBD solver's multipliers */
+    const char *keys[] = { "world", "time", "frame", "warnings", "last_warning", NULL, "collider_slots", "vbd", NULL };
     static const char *const ckeys[] = { "generations", NULL };
-    const cJSON *f[8] = { NULL }, *g[3];
+    const cJSON *f[9] = { NULL }, *g[3];
     kp p = { NULL, "snapshot", 0 };
     const jtype *st = s->slotted >= 0 ? jtypes[s->slotted] : NULL;
     s->slots = (jslots){ NULL, NULL, 0, 0 };
     if (st) keys[5] = st->slots_key;
-    else keys[5] = keys[6], keys[6] = NULL;
+    else keys[5] = keys[6], keys[6] = keys[7], keys[7] = NULL;
     const int cf = st ? 6 : 5; /* the colliders' table */
     s->nc = s->ncol;
     if (s->snapshot) {
@@ -133,6 +133,35 @@ static int scan_snapshot(rd *r, sections *s)
         kp a = { &q, "generations", 0 };
         if (jv_get_array(r, g[0], &a, WB_MAX_COLLIDERS, &s->nc)) return -1;
         s->cgen = g[0];
+    }
+    s->vbd = f[cf + 1];
+    return 0;
+}
+
+/* the VBD solver's multipliers (json_write.c): one a distance slot, one a bend; an error
+ * not known is null */
+static int read_vbd(rd *r, const sections *s, const kp *up, wb_image *g)
+{
+    static const char *const keys[] = { "multipliers", "errors", "bend_multipliers", "bend_errors", NULL };
+    const cJSON *f[5];
+    kp p = { up, "vbd", 0 };
+    if (jv_get_object(r, s->vbd, &p, keys, f)) return -1;
+    for (int k = 0; k < 4; k++)
+        if (!f[k]) return jv_missing(r, s->vbd, &p, keys[k]);
+    const int32_t nd = g->dist.n, want[4] = { nd, nd, g->bend.n, g->bend.n };
+    if (wb_image_alloc_vbd(g, nd, g->bend.n) != WB_OK) return jv_fail(r, NULL, 0, NULL, "out of memory");
+    wb_real *dst[4] = { g->vbd_lam, g->vbd_c0, g->vbd_blam, g->vbd_bc0 };
+    for (int k = 0; k < 4; k++) {
+        kp a = { &p, keys[k], 0 };
+        int32_t n;
+        if (jv_get_array(r, f[k], &a, WB_MAX_CONSTRAINTS, &n)) return -1;
+        if (n != want[k]) return jv_fail(r, f[k], 0, &a, "%d numbers, but the world has %d %s", n, want[k], k < 2 ? "distance slots" : "bends");
+        int32_t i = 0;
+        for (const cJSON *c = f[k]->child; c; c = c->next, i++) {
+            kp e = { &a, NULL, i };
+            if (k % 2 && cJSON_IsNull(c)) dst[k][i] = (wb_real)NAN;
+            else if (jv_get_real(r, c, &e, &dst[k][i])) return -1;
+        }
     }
     return 0;
 }
@@ -162,7 +191,7 @@ static int read_snapshot(rd *r, const sections *s, wb_image *g)
         if (jv_read_generations(r, s->cgen, &a, g->c_gen, &live)) return -1;
         if (live != s->ncol) return jv_fail(r, s->cgen, 0, &a, "%d live slots, but \"colliders\" has %d entries", live, s->ncol);
     }
-    return 0;
+    return s->vbd ? read_vbd(r, s, &p, g) : 0;
 }
 
 static int read_particles(rd *r, const sections *s, const jdefaults *d, wb_image *g)

@@ -23,6 +23,18 @@ static void str(FILE *f, const char *s)
     fputc('"', f);
 }
 
+/* n numbers, 6 a line; NaN (not known) as null */
+static void reals(jw_out *o, const wb_real *x, int32_t n)
+{
+    fputc('[', o->f);
+    for (int32_t i = 0; i < n; i++) {
+        if (i) fputs(i % 6 ? ", " : ",\n        ", o->f);
+        if (isnan(x[i])) fputs("null", o->f);
+        else jw_num(o, x[i]);
+    }
+    fputc(']', o->f);
+}
+
 static void write_snapshot(jw_out *o, const wb_image *g)
 {
     FILE *f = o->f;
@@ -47,7 +59,19 @@ static void write_snapshot(jw_out *o, const wb_image *g)
         if (jtypes[k]->write_slots) jtypes[k]->write_slots(f, g);
     fputs(",\n    \"collider_slots\": {\"generations\": ", f);
     jw_ints(f, "      ", g->c_gen, NULL, g->nc);
-    fputs("}\n  },\n", f);
+    fputc('}', f);
+    if (g->vbd_nd || g->vbd_nb) { /* (a VBD world that has stepped: others' files as they were) */
+        fputs(",\n    \"vbd\": {\"multipliers\": ", f);
+        reals(o, g->vbd_lam, g->vbd_nd);
+        fputs(", \"errors\": ", f);
+        reals(o, g->vbd_c0, g->vbd_nd);
+        fputs(",\n      \"bend_multipliers\": ", f);
+        reals(o, g->vbd_blam, g->vbd_nb);
+        fputs(", \"bend_errors\": ", f);
+        reals(o, g->vbd_bc0, g->vbd_nb);
+        fputc('}', f);
+    }
+    fputs("\n  },\n", f);
 }
 
 static void write_particles(jw_out *o, const wb_image *g)

