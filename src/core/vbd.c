@@ -14,8 +14,10 @@
  * and carried from substep to substep (warm start) so a hanging chain holds its tension
  * instead of finding it again every substep.
  *
- * Served: distance links. The other types are projected as in XPBD after each sweep, and
- * contacts, colliders and rigid bodies follow the sweeps as in the XPBD step (solver.c). */
+ * Served: distance links, bends, Neo-Hookean tets, and particle pairs with one immovable
+ * end (vbd_contact.c). The other types are projected as in XPBD after each sweep, and
+ * contacts (all of them, again: what the sweeps left), colliders and rigid bodies follow
+ * the sweeps as in the XPBD step (solver.c). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -25,6 +27,7 @@
 #include "tet.h"
 #include "volume.h"
 #include "vbd.h"
+#include "vbd_contact.h"
 
 /* a link as the sweep reads it: its force along it is kk (l - tgt) + lm and its stiffness
  * kk; dmp: a soft link's damping beta / h */
@@ -63,6 +66,8 @@ struct wb_vbd {
     wb_real residual;      /* the last sweep's largest step, m */
     double *tsum;          /* (bodies x 4) each free body's mass and sum m (x - y) */
     int32_t cap_tsum;
+    wb_vbdc *ct;           /* the particle contacts in the vertex steps (vbd_contact.c) */
+    int ct_on;             /* ct holds this substep's */
 };
 
 #define VBD_COLOURS 64
@@ -116,6 +121,7 @@ void wb__vbd_destroy(wb_world *w)
     free(v->blam);
     free(v->bkpen);
     free(v->tsum);
+    wb__vbdc_destroy(v->ct);
     free(v);
     w->vbd = NULL;
 }
@@ -309,6 +315,7 @@ typedef struct sweep_job {
     wb_real inv_h2, inv_h;
     const int32_t *vert;   /* the colour's vertices */
     wb_real step;          /* the largest step taken (max_into) */
+    const wb_vbdc *ct;     /* the substep's contacts, NULL: none */
 } sweep_job;
 
 /* A link's force on i along n = (x_i - x_j) / l and its stiffness: a soft one's energy
@@ -498,7 +505,9 @@ static void bend_block(const wb_world *w, const struct wb_vbd *v, int32_t q, wb_
     H[3] += kb * gk[0] * gk[1], H[4] += kb * gk[0] * gk[2], H[5] += kb * gk[1] * gk[2];
 }
 
-static void sweep_part(void *ctx, int32_t lo, int32_t hi)
+/* con: the substep has contacts in the vertex steps (two copies: the loop without them
+ * stays as it was) */
+static inline __attribute__((always_inline)) void sweep_body(void *ctx, int32_t lo, int32_t hi, int con)
 {
     sweep_job *j = ctx;
     wb_world *w = j->w;
@@ -515,6 +524,7 @@ static void sweep_part(void *ctx, int32_t lo, int32_t hi)
         for (int c = 0; c < 3; c++) f[c] += mh * (v->y[3 * i + c] - x[3 * i + c]), H[c] += mh;
         for (int32_t e = v->tadj_start[i]; e < v->tadj_start[i + 1]; e++) tet_block(w, v->tadj[e], f, H);
         for (int32_t e = v->badj_start[i]; e < v->badj_start[i + 1]; e++) bend_block(w, v, v->badj[e], j->inv_h, f, H);
+        if (con) wb__vbdc_block(w, j->ct, i, f, H);
         if (!solve3(H, f, d)) continue;
         v3_add(&x[3 * i], &x[3 * i], d);
         const wb_real dd = v3_dot(d, d);
@@ -524,6 +534,9 @@ static void sweep_part(void *ctx, int32_t lo, int32_t hi)
     __atomic_load(&j->step, &cur, __ATOMIC_RELAXED);
     while (big > cur && !__atomic_compare_exchange(&j->step, &cur, &big, 1, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {}
 }
+
+static void sweep_part(void *ctx, int32_t lo, int32_t hi) { sweep_body(ctx, lo, hi, 0); }
+static void sweep_part_ct(void *ctx, int32_t lo, int32_t hi) { sweep_body(ctx, lo, hi, 1); }
 
 /* ---- the hard links' multipliers ------------------------------------------------------------ */
 /* the inertia of a hard link's ends over the substep, 1 / (h^2 (w_i + w_j)) */
@@ -790,16 +803,22 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     start_guess(w, v, h, touch);
     warm_start(w, v, inv_h2, 1 / h);
     bend_warm_start(w, v, inv_h2);
+    /* the contacts in the vertex steps (out of memory: left to the projection after) */
+    v->ct_on = wb__vbdc_begin(w, &v->ct, h, v->order, v->colour_start, v->ncolours) > 0;
+    wb_vbdc *ct = v->ct_on ? v->ct : NULL;
     wb_pool *pool = wb__world_pool(w);
     for (int it = 0; it < w->m.def.iterations; it++) {
-        sweep_job j = { w, v, inv_h2, 1 / h, NULL, 0 };
+        sweep_job j = { w, v, inv_h2, 1 / h, NULL, 0, ct };
+        if (ct && it > 0) wb__vbdc_refresh(w, ct, v->ncolours);
         for (int32_t c = 0; c < v->ncolours; c++) {
             const int32_t lo = v->colour_start[c], n = v->colour_start[c + 1] - lo;
             j.vert = v->order + lo;
             const int serial = v->serial_last && c == v->ncolours - 1;
-            wb__pool_for(serial ? NULL : pool, n, 1024, sweep_part, &j);
+            wb__pool_for(serial ? NULL : pool, n, 1024, ct ? sweep_part_ct : sweep_part, &j);
+            if (ct) wb__vbdc_colour_done(w, ct, c);
         }
         v->residual = sqrt(j.step);
+        if (ct) wb__vbdc_dual(w, ct);
         dual_update(w, v);
         bend_dual_update(w, v, h);
         for (int t = 0; t < wb__nctypes; t++)
@@ -810,6 +829,11 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     keep_multipliers(v);
     write_forces(w, v, h);
     return v->residual;
+}
+
+void wb__vbd_contacts_done(wb_world *w)
+{
+    if (w->vbd && w->vbd->ct_on) wb__vbdc_readout(w, w->vbd->ct);
 }
 
 wb_real wb__vbd_residual(const wb_world *w) { return w->vbd ? w->vbd->residual : 0; }
