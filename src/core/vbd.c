@@ -64,8 +64,12 @@ struct wb_vbd {
     wb_real *blam, *bkpen; /* (nb, by slot) a hard bend's multiplier and penalty */
     int32_t cap_blam;
     wb_real residual;      /* the last sweep's largest step, m */
-    double *tsum;          /* (bodies x 4) each free body's mass and sum m (x - y) */
+    double *tsum;          /* (bodies x 4) each free body's mass and sum m (x - y), then
+                              (bodies) 1: it may touch an immovable particle */
     int32_t cap_tsum;
+    double *csum;          /* (bodies x 17) a free body's contacts in the vertex steps
+                              (keep_momentum) */
+    uint8_t *bmove;        /* (bodies) 1: its friction goes in its momentum step */
     wb_vbdc *ct;           /* the particle contacts in the vertex steps (vbd_contact.c) */
     int ct_on;             /* ct holds this substep's */
 };
@@ -121,6 +125,8 @@ void wb__vbd_destroy(wb_world *w)
     free(v->blam);
     free(v->bkpen);
     free(v->tsum);
+    free(v->csum);
+    free(v->bmove);
     wb__vbdc_destroy(v->ct);
     free(v);
     w->vbd = NULL;
@@ -693,19 +699,34 @@ static int touching(wb_world *w, struct wb_vbd *v)
     if (!k->mc_built || k->mc_nbody == 0) return 0;
     const int32_t nb = k->mc_nbody, *body = k->mc_body;
     if (nb > v->cap_tsum) {
-        double *t = realloc(v->tsum, sizeof *t * 4 * (size_t)nb);
-        if (!t) return 0;
-        v->tsum = t, v->cap_tsum = nb;
+        double *t = realloc(v->tsum, sizeof *t * 5 * (size_t)nb), *e = realloc(v->csum, sizeof *e * 17 * (size_t)nb);
+        uint8_t *bm = realloc(v->bmove, (size_t)nb);
+        if (t) v->tsum = t;
+        if (e) v->csum = e;
+        if (bm) v->bmove = bm;
+        if (!t || !e || !bm) return 0;
+        v->cap_tsum = nb;
     }
     double *T = v->tsum;
-    memset(T, 0, sizeof *T * 4 * (size_t)nb);
+    memset(T, 0, sizeof *T * 5 * (size_t)nb);
     /* only what moves outside the body counts: its own folds, loose particles and
      * immovable particles (a pinned slab, as a collider) keep the momentum the move keeps
-     * (a block on a pinned slab at 0.95 of its sticking angle crept 26 mm in 1 s, now 1.03) */
+     * (a block on a pinned slab at 0.95 of its sticking angle crept 26 mm in 1 s, then
+     * 1.03). Immovable particles near it are flagged: they are contacts in the vertex
+     * steps (vbd_contact.c), the body starts from the prediction and its move takes them
+     * in (keep_momentum) */
     const wb_real *wv = w->m.w;
     const wb_contacts *pc = &k->pc;
+    const wb_real *xp = w->s.x_prev, *rad = w->m.radius;
     for (int32_t c = 0; c < pc->n; c++) {
         const int32_t i = pc->ij[2 * c], j = pc->ij[2 * c + 1], a = body[i], b = body[j];
+        /* [4 nb + b] = 1: b may touch an immovable particle (a contact in the vertex steps) */
+        if (!(wv[i] > 0) != !(wv[j] > 0) && body[wv[i] > 0 ? i : j] >= 0) {
+            wb_real d[3];
+            v3_sub(d, &xp[3 * i], &xp[3 * j]);
+            const wb_real rn = (rad[i] + rad[j]) * (wb_real)1.25;
+            if (v3_dot(d, d) < rn * rn) T[4 * nb + body[wv[i] > 0 ? i : j]] = 1;
+        }
         if (a < 0 || b < 0 || a == b) continue;
         if (wv[j] > 0) T[4 * a] = -1;
         if (wv[i] > 0) T[4 * b] = -1;
@@ -737,9 +758,11 @@ static int touching(wb_world *w, struct wb_vbd *v)
  * prediction: the contacts projected after the
  * sweeps carry it and keep_momentum leaves it alone, so the gravity it follows is the one
  * its start has (from x + h v, a lattice made overlapping another was lifted 0.25 m
- * instead of 0.15; from the adaptive start, a stack still moved after 4 s). A held one
- * touching itself keeps x + h v (from y, a pinned rope folding onto itself as it swung
- * gained energy) */
+ * instead of 0.15; from the adaptive start, a stack still moved after 4 s). So does a
+ * free body near an immovable particle: its contacts in the vertex steps then push from
+ * the start (from x + h v a Newton step did not see them, and their multipliers took 8
+ * times the weight after it). A held one touching itself keeps x + h v (from y, a pinned
+ * rope folding onto itself as it swung gained energy) */
 static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h, int touch)
 {
     const wb_real *g = w->m.def.gravity, *wv = w->m.w;
@@ -749,7 +772,8 @@ static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h, int touch)
         const int held = v->adj_start[i + 1] > v->adj_start[i] || v->tadj_start[i + 1] > v->tadj_start[i] ||
                          v->badj_start[i + 1] > v->badj_start[i];
         const int32_t b = body ? body[i] : -1;
-        if (!(wv[i] > 0) || !held || (touch && b >= 0 && v->tsum[4 * b] < 0 && !(w->k.mc_acc[16 * b] < 0))) continue;
+        const int from_y = touch && b >= 0 && !(w->k.mc_acc[16 * b] < 0) && (v->tsum[4 * b] < 0 || v->tsum[4 * w->k.mc_nbody + b] > 0);
+        if (!(wv[i] > 0) || !held || from_y) continue;
         v3_madd(&x[3 * i], g, -h * h);
     }
 }
@@ -762,7 +786,7 @@ static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h, int touch)
  * neighbours does not feel: each sweep moves the body by m / (h^2 k) of what is left,
  * and the start (start_guess) would carry it). Serial, in particle order: the same bits
  * on any thread count. touch: touching() ran this substep (v->tsum holds its flags) */
-static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch)
+static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch, wb_real inv_h2)
 {
     const wb_cache *k = &w->k;
     /* a body that may touch another body's movable particle or a rigid body this frame is
@@ -784,6 +808,57 @@ static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch)
     for (int32_t b = 0; b < nb; b++)
         if (T[4 * b] > 0)
             for (int c = 1; c < 4; c++) T[4 * b + c] /= T[4 * b];
+    /* A body with contacts in the vertex steps (their partners immovable: forces from
+     * outside it) takes the Newton step of the substep's energy along its translation t
+     * with their normal forces, (M / h^2 + sum H_c) t = -M / h^2 mean(x - y) + sum f_c,
+     * and then its friction exactly: the body's slip over the substep across the contacts'
+     * mean normal stopped if M / h^2 |slip| is within sum mu f_n (the lagged forces), else
+     * cut by that much. Without the step the move above took the contacts' net force back
+     * (a block on a pinned slab at 0.95 of its sticking angle moved 1.007 mm in 1 s); with
+     * the vertices' smoothed friction in it (one Newton step on |slip|) it fell short of
+     * the stop by half and the block crept 29 mm */
+    if (v->ct_on) {
+        int32_t nc;
+        const int32_t *cv = wb__vbdc_vertices(v->ct, v->ncolours, &nc);
+        double *E = v->csum; /* (bodies x 17): 1, sum f_c, sum H_c, friction, sum m (y - x_prev) */
+        memset(E, 0, sizeof *E * 17 * (size_t)nb);
+        for (int32_t q = 0; q < nc; q++) {
+            const int32_t b = body[cv[q]];
+            if (b < 0 || !(T[4 * b] > 0)) continue;
+            wb_real f[3] = { 0, 0, 0 }, H[6] = { 0, 0, 0, 0, 0, 0 }, fr[4] = { 0, 0, 0, 0 };
+            wb__vbdc_body(w, v->ct, cv[q], f, H, fr);
+            E[17 * b] = 1;
+            for (int c = 0; c < 3; c++) E[17 * b + 1 + c] += f[c];
+            for (int c = 0; c < 6; c++) E[17 * b + 4 + c] += H[c];
+            for (int c = 0; c < 4; c++) E[17 * b + 10 + c] += fr[c];
+        }
+        const wb_real *xp = w->s.x_prev;
+        for (int32_t i = 0; i < w->m.np; i++) {
+            const int32_t b = body[i];
+            if (b < 0 || !(E[17 * b] > 0) || !(wv[i] > 0)) continue;
+            const double m = 1 / (double)wv[i];
+            for (int c = 0; c < 3; c++) E[17 * b + 14 + c] += m * ((double)y[3 * i + c] - (double)xp[3 * i + c]);
+        }
+        for (int32_t b = 0; b < nb; b++) {
+            const double *e = &E[17 * b];
+            if (!(e[0] > 0)) continue;
+            const double mh = T[4 * b] * inv_h2;
+            wb_real Hb[6], fb[3], t[3];
+            for (int c = 0; c < 6; c++) Hb[c] = (wb_real)(e[4 + c] + (c < 3 ? mh : 0));
+            for (int c = 0; c < 3; c++) fb[c] = (wb_real)(e[1 + c] - mh * T[4 * b + 1 + c]);
+            if (!solve3(Hb, fb, t)) continue;
+            const double nl = sqrt(e[11] * e[11] + e[12] * e[12] + e[13] * e[13]);
+            if (v->bmove[b] && e[10] > 0 && nl > 0) {
+                double D[3], dn = 0;
+                for (int c = 0; c < 3; c++) D[c] = T[4 * b + 1 + c] + t[c] + e[14 + c] / T[4 * b], dn += D[c] * e[11 + c] / nl;
+                for (int c = 0; c < 3; c++) D[c] -= dn * e[11 + c] / nl;
+                const double sl = sqrt(D[0] * D[0] + D[1] * D[1] + D[2] * D[2]), need = mh * sl;
+                const double cut = need <= e[10] ? 1 : e[10] / need;
+                for (int c = 0; c < 3; c++) t[c] -= (wb_real)(D[c] * cut);
+            }
+            for (int c = 0; c < 3; c++) T[4 * b + 1 + c] = -t[c];
+        }
+    }
     for (int32_t i = 0; i < w->m.np; i++) {
         const int32_t b = body[i];
         if (b < 0 || !(T[4 * b] > 0) || !(wv[i] > 0)) continue;
@@ -804,7 +879,10 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     warm_start(w, v, inv_h2, 1 / h);
     bend_warm_start(w, v, inv_h2);
     /* the contacts in the vertex steps (out of memory: left to the projection after) */
-    v->ct_on = wb__vbdc_begin(w, &v->ct, h, v->order, v->colour_start, v->ncolours) > 0;
+    if (touch)
+        for (int32_t b = 0; b < w->k.mc_nbody; b++)
+            v->bmove[b] = v->tsum[4 * w->k.mc_nbody + b] > 0 && v->tsum[4 * b] >= 0 && !(w->k.mc_acc[16 * b] < 0);
+    v->ct_on = wb__vbdc_begin(w, &v->ct, h, v->order, v->colour_start, v->ncolours, touch ? v->bmove : NULL) > 0;
     wb_vbdc *ct = v->ct_on ? v->ct : NULL;
     wb_pool *pool = wb__world_pool(w);
     for (int it = 0; it < w->m.def.iterations; it++) {
@@ -825,7 +903,8 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
             if (!wb__vbd_serves(wb__ctypes[t])) wb__ctypes[t]->project(w, h);
         if (w->m.def.tolerance > 0 && v->residual <= w->m.def.tolerance) break;
     }
-    keep_momentum(w, v, touch);
+    keep_momentum(w, v, touch, inv_h2);
+    if (v->ct_on) wb__vbdc_end(w, v->ct);
     keep_multipliers(v);
     write_forces(w, v, h);
     return v->residual;

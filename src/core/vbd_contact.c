@@ -4,10 +4,12 @@
  * with a penalty k and a multiplier lambda >= 0, its force on i along the pair's normal
  * max(0, lambda - k C), Hessian k n n^T while it pushes; lambda grows by -k C after each
  * sweep, clamped at 0. Friction as Chen et al.'s VBD (after IPC, Li et al. 2020): mu
- * times a lagged normal force, the pair's force as the last substep's sweeps left it
- * (the force of the same evaluation, from the prediction, was 8 times the weight: a
+ * times a lagged normal force, the pair's force where the last substep's sweeps and
+ * momentum step left it (wb__vbdc_end; the force of the same evaluation, from the prediction, was 8 times the weight: a
  * particle sliding on a pinned one stopped in 0.012 m of 0.102), smoothed over a slip of
- * eps_v h, its Hessian the tangent plane times mu f_n f1(|u|) / |u|.
+ * eps_v h, its Hessian the tangent plane times mu f_n f1(|u|) / |u|. A free body's pairs
+ * leave their friction to its momentum step (vbd.c's keep_momentum, wb__vbdc_body),
+ * which holds it exactly within the cone, with the same lagged f_n.
  *
  * Served: pairs of one movable and one immovable particle (a body on a pinned slab).
  * Pairs of two movable particles stay with the projection after the sweeps: Gauss-Seidel
@@ -59,10 +61,14 @@ struct wb_vbdc {
                                 the last left it (the readout: what they corrected) */
     int32_t npair;
     int32_t *prev;           /* (nprev x 2) the last substep's pairs, with fend: prevf */
-    wb_real *fend, *prevf;   /* (npair) each pair's normal force as the sweeps left it */
+    wb_real *fend, *prevf;   /* (npair) each pair's normal force as the substep's solve left
+                                it (wb__vbdc_end) */
+    wb_real *lamp;           /* (npair) the multiplier before the last sweep's update */
+    uint8_t *sf;             /* (npair) 1: its friction acts in the vertex steps (0: in its
+                                body's momentum step, vbd.c) */
     wb_real *fl;             /* (npair) the normal force its friction takes: the last
-                                substep's sweeps' (lagged; the projection after them has
-                                its own friction for its own part) */
+                                substep's (lagged; the projection after the solve has its
+                                own friction for its own part) */
     int32_t nprev;
     int sorted;              /* pij in (i, j) order (0: not set up) */
     vbdc_key *ks;            /* (candidates) the near ones' keys, sorted */
@@ -78,7 +84,7 @@ void wb__vbdc_destroy(wb_vbdc *c)
 {
     if (!c) return;
     free(c->start), free(c->ent), free(c->pij), free(c->tgt), free(c->kk), free(c->lam), free(c->mu);
-    free(c->ov), free(c->ove), free(c->prev), free(c->fend), free(c->prevf), free(c->fl), free(c->ks), free(c->xc), free(c->cv), free(c->cvs);
+    free(c->ov), free(c->ove), free(c->prev), free(c->fend), free(c->prevf), free(c->fl), free(c->lamp), free(c->sf), free(c->ks), free(c->xc), free(c->cv), free(c->cvs);
     free(c);
 }
 
@@ -117,7 +123,11 @@ static int grow(wb_vbdc *c, int32_t np, int32_t npair, int32_t ncol)
         if (q[1]) c->prevf = q[1];
         q[2] = realloc(c->fl, sizeof(wb_real) * n);
         if (q[2]) c->fl = q[2];
-        if (!e || !p || !r[0] || !r[1] || !r[2] || !r[3] || !ov || !ove || !pv || !q[0] || !q[1] || !q[2]) return 0;
+        wb_real *lp = realloc(c->lamp, sizeof *lp * n);
+        if (lp) c->lamp = lp;
+        uint8_t *sf = realloc(c->sf, n);
+        if (sf) c->sf = sf;
+        if (!e || !p || !r[0] || !r[1] || !r[2] || !r[3] || !ov || !ove || !pv || !q[0] || !q[1] || !q[2] || !lp || !sf) return 0;
         c->cap_pair = npair;
     }
     if (ncol + 1 > c->cap_col) {
@@ -129,7 +139,7 @@ static int grow(wb_vbdc *c, int32_t np, int32_t npair, int32_t ncol)
 }
 
 int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, const int32_t *colour_start,
-                   int32_t ncolours)
+                   int32_t ncolours, const uint8_t *bmoved)
 {
     const wb_contacts *pc = &w->k.pc;
     wb_vbdc *c = *cp;
@@ -200,6 +210,8 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, c
         c->kk[q] = VBDC_K * inv_h2 / wsum;
         c->lam[q] = 0;
         c->mu[q] = (cf[i] + cf[j]) / 2;
+        const int32_t mv = wv[i] > 0 ? i : j, b = bmoved && w->k.mc_body ? w->k.mc_body[mv] : -1;
+        c->sf[q] = !(b >= 0 && bmoved[b]);
         if (wv[i] > 0) start[i + 1]++;
         if (wv[j] > 0) start[j + 1]++;
     }
@@ -239,7 +251,8 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, c
     return 1;
 }
 
-void wb__vbdc_block(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3], wb_real H[6])
+static inline __attribute__((always_inline)) void block(const wb_world *w, const wb_vbdc *c, const wb_real *lam, int32_t i,
+                                                        wb_real f[3], wb_real H[6], wb_real *fr)
 {
     const wb_real *x = w->s.x, *xp = w->s.x_prev, *xc = c->xc;
     for (int32_t e = c->start[i]; e < c->start[i + 1]; e++) {
@@ -248,14 +261,23 @@ void wb__vbdc_block(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3]
         v3_sub(d, &x[3 * i], &xc[3 * o]);
         const wb_real l2 = v3_dot(d, d);
         if (!(l2 > 1e-24)) continue;
-        const wb_real l = sqrt(l2), kk = c->kk[q], fn = c->lam[q] - kk * (l - c->tgt[q]);
-        if (!(fn > 0)) continue;
+        const wb_real l = sqrt(l2), kk = c->kk[q], fn = lam[q] - kk * (l - c->tgt[q]), mu = fr || !c->sf[q] ? 0 : c->mu[q] * c->fl[q];
+        if (!(fn > 0) && !(mu > 0)) continue;
         wb_real n[3];
         v3_scale(n, d, 1 / l);
-        v3_madd(f, n, fn);
-        H[0] += kk * n[0] * n[0], H[1] += kk * n[1] * n[1], H[2] += kk * n[2] * n[2];
-        H[3] += kk * n[0] * n[1], H[4] += kk * n[0] * n[2], H[5] += kk * n[1] * n[2];
-        const wb_real mu = c->mu[q] * c->fl[q];
+        if (fr) {
+            /* (the body's friction: its capacity and the direction it pushes along) */
+            const wb_real cap = c->mu[q] * c->fl[q];
+            fr[0] += cap;
+            v3_madd(&fr[1], n, c->fl[q]);
+        }
+        if (fn > 0) {
+            v3_madd(f, n, fn);
+            H[0] += kk * n[0] * n[0], H[1] += kk * n[1] * n[1], H[2] += kk * n[2] * n[2];
+            H[3] += kk * n[0] * n[1], H[4] += kk * n[0] * n[2], H[5] += kk * n[1] * n[2];
+        }
+        /* (friction on the lagged force: a pair that pushed last substep holds while the
+         * step starts it apart) */
         if (!(mu > 0)) continue;
         /* the pair's tangential slip over the substep, u, and the friction that opposes it,
          * mu fn f1(|u|) u / |u|: f1 rises from 0 as 2 s - s^2 (s = |u| / eps) to 1 */
@@ -267,6 +289,28 @@ void wb__vbdc_block(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3]
         v3_madd(f, u, -s);
         H[0] += s * (1 - n[0] * n[0]), H[1] += s * (1 - n[1] * n[1]), H[2] += s * (1 - n[2] * n[2]);
         H[3] -= s * n[0] * n[1], H[4] -= s * n[0] * n[2], H[5] -= s * n[1] * n[2];
+    }
+}
+
+void wb__vbdc_block(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3], wb_real H[6])
+{
+    block(w, c, c->lam, i, f, H, NULL);
+}
+
+void wb__vbdc_body(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3], wb_real H[6], wb_real fr[4])
+{
+    block(w, c, c->lamp, i, f, H, fr);
+}
+
+void wb__vbdc_end(const wb_world *w, wb_vbdc *c)
+{
+    const wb_real *x = w->s.x;
+    for (int32_t q = 0; q < c->npair; q++) {
+        wb_real d[3];
+        v3_sub(d, &x[3 * c->pij[2 * q]], &x[3 * c->pij[2 * q + 1]]);
+        const wb_real C = v3_len(d) - c->tgt[q], lm = c->lamp[q] - c->kk[q] * C;
+        c->lam[q] = c->fend[q] = lm > 0 ? lm : 0;
+        c->ove[q] = -C;
     }
 }
 
@@ -289,8 +333,8 @@ void wb__vbdc_dual(const wb_world *w, wb_vbdc *c)
         wb_real d[3];
         v3_sub(d, &x[3 * c->pij[2 * q]], &x[3 * c->pij[2 * q + 1]]);
         const wb_real C = v3_len(d) - c->tgt[q], lm = c->lam[q] - c->kk[q] * C;
-        c->lam[q] = c->fend[q] = lm > 0 ? lm : 0;
-        c->ove[q] = -C;
+        c->lamp[q] = c->lam[q];
+        c->lam[q] = lm > 0 ? lm : 0;
     }
 }
 
