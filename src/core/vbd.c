@@ -532,6 +532,12 @@ static inline __attribute__((always_inline)) void sweep_body(void *ctx, int32_t 
         for (int32_t e = v->badj_start[i]; e < v->badj_start[i + 1]; e++) bend_block(w, v, v->badj[e], j->inv_h, f, H);
         if (con) wb__vbdc_block(w, j->ct, i, f, H);
         if (!solve3(H, f, d)) continue;
+        if (con) {
+            wb_real xn[3];
+            v3_add(xn, &x[3 * i], d);
+            wb__vbdc_friction(w, j->ct, i, H, xn);
+            v3_sub(d, xn, &x[3 * i]);
+        }
         v3_add(&x[3 * i], &x[3 * i], d);
         const wb_real dd = v3_dot(d, d);
         big = dd > big ? dd : big;

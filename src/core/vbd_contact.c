@@ -3,13 +3,21 @@
  * Yuksel, SIGGRAPH 2025): each pair an inequality constraint C = |x_i - x_j| - target >= 0
  * with a penalty k and a multiplier lambda >= 0, its force on i along the pair's normal
  * max(0, lambda - k C), Hessian k n n^T while it pushes; lambda grows by -k C after each
- * sweep, clamped at 0. Friction as Chen et al.'s VBD (after IPC, Li et al. 2020): mu
- * times a lagged normal force, the pair's force where the last substep's sweeps and
- * momentum step left it (wb__vbdc_end; the force of the same evaluation, from the prediction, was 8 times the weight: a
- * particle sliding on a pinned one stopped in 0.012 m of 0.102), smoothed over a slip of
- * eps_v h, its Hessian the tangent plane times mu f_n f1(|u|) / |u|. A free body's pairs
- * leave their friction to its momentum step (vbd.c's keep_momentum, wb__vbdc_body),
- * which holds it exactly within the cone, with the same lagged f_n.
+ * sweep, clamped at 0 (not carried to the next substep: carried whole, a block on a
+ * slab chattered between 0 and 4 times its weight and crept 4.4 mm in 1 s; 0.9 of it,
+ * 1.2 mm).
+ *
+ * Friction: Coulomb's, mu times a lagged normal force (as IPC and Chen et al.'s VBD lag
+ * it), the pair's force where the last substep's solve left it (wb__vbdc_end; the force
+ * of the same evaluation, from the prediction, was 8 times the weight). Not as their
+ * smoothed energy (mu f_n f1(|u|), one Newton step on it): with one step a substep it
+ * stopped half of the slip it could (a block at 0.95 of its sticking angle crept 29 mm
+ * in 1 s, a particle on a pinned one slid 2.2% too far), but exactly within the cone,
+ * after the vertex's Newton step (wb__vbdc_friction): its slip over the substep across
+ * its contacts' mean normal undone if the force that takes, its Hessian times the slip,
+ * is within sum mu f_n, else cut by that much. A free body's pairs leave theirs to its
+ * momentum step (vbd.c's keep_momentum, wb__vbdc_body), which does the same for the
+ * body's translation.
  *
  * Served: pairs of one movable and one immovable particle (a body on a pinned slab).
  * Pairs of two movable particles stay with the projection after the sweeps: Gauss-Seidel
@@ -19,7 +27,7 @@
  *
  * The contacts projected after the sweeps (contact.c) still run and take what the
  * sweeps left (a penalty leaves 1 / (1 + VBDC_K) of a resting overlap); their friction
- * acts on that part, this file's on the sweeps' (the lag below). A made overlap parts no
+ * acts on that part, this file's on the solve's. A made overlap parts no
  * faster than max_depenetration because the target keeps what contact.c's rule keeps
  * (wb__contact_depth).
  *
@@ -37,9 +45,6 @@
 /* a candidate whose ends are closer than this times r_i + r_j at the sweeps' start is in
  * the substep's contacts (the ones farther apart are left to the projection after) */
 #define VBDC_NEAR ((wb_real)1.25)
-/* friction's slip speed below which it holds as a stiff spring (m/s): at the bound of the
- * cone a pair creeps at about 0.8 of it */
-#define VBDC_EPSV ((wb_real)1e-4)
 
 typedef struct vbdc_key {
     uint64_t key; /* i << 32 | j */
@@ -77,7 +82,6 @@ struct wb_vbdc {
     int32_t *cv;             /* the vertices with contacts, by colour */
     int32_t *cvs;            /* (ncolours + 1) ranges of cv */
     int32_t cap_np, cap_pair, cap_col;
-    wb_real eps;             /* friction's slip, eps_v h */
 };
 
 void wb__vbdc_destroy(wb_vbdc *c)
@@ -247,54 +251,69 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, c
     c->cvs[ncolours] = nv;
     /* every end's copy (the immovable ones are not refreshed: they do not move in the solve) */
     for (int32_t q = 0; q < 2 * n; q++) v3_copy(&c->xc[3 * c->pij[q]], &x[3 * c->pij[q]]);
-    c->eps = VBDC_EPSV * h;
     return 1;
 }
 
 static inline __attribute__((always_inline)) void block(const wb_world *w, const wb_vbdc *c, const wb_real *lam, int32_t i,
                                                         wb_real f[3], wb_real H[6], wb_real *fr)
 {
-    const wb_real *x = w->s.x, *xp = w->s.x_prev, *xc = c->xc;
+    const wb_real *x = w->s.x, *xc = c->xc;
     for (int32_t e = c->start[i]; e < c->start[i + 1]; e++) {
         const int32_t q = c->ent[e] >> 1, o = c->pij[2 * q + 1 - (c->ent[e] & 1)];
         wb_real d[3];
         v3_sub(d, &x[3 * i], &xc[3 * o]);
         const wb_real l2 = v3_dot(d, d);
         if (!(l2 > 1e-24)) continue;
-        const wb_real l = sqrt(l2), kk = c->kk[q], fn = lam[q] - kk * (l - c->tgt[q]), mu = fr || !c->sf[q] ? 0 : c->mu[q] * c->fl[q];
-        if (!(fn > 0) && !(mu > 0)) continue;
+        const wb_real l = sqrt(l2), kk = c->kk[q], fn = lam[q] - kk * (l - c->tgt[q]), fl = c->fl[q];
+        if (!(fn > 0) && !(fr && fl > 0)) continue;
         wb_real n[3];
         v3_scale(n, d, 1 / l);
-        if (fr) {
+        if (fr && fl > 0) {
             /* (the body's friction: its capacity and the direction it pushes along) */
-            const wb_real cap = c->mu[q] * c->fl[q];
-            fr[0] += cap;
-            v3_madd(&fr[1], n, c->fl[q]);
+            fr[0] += c->mu[q] * fl;
+            v3_madd(&fr[1], n, fl);
         }
-        if (fn > 0) {
-            v3_madd(f, n, fn);
-            H[0] += kk * n[0] * n[0], H[1] += kk * n[1] * n[1], H[2] += kk * n[2] * n[2];
-            H[3] += kk * n[0] * n[1], H[4] += kk * n[0] * n[2], H[5] += kk * n[1] * n[2];
-        }
-        /* (friction on the lagged force: a pair that pushed last substep holds while the
-         * step starts it apart) */
-        if (!(mu > 0)) continue;
-        /* the pair's tangential slip over the substep, u, and the friction that opposes it,
-         * mu fn f1(|u|) u / |u|: f1 rises from 0 as 2 s - s^2 (s = |u| / eps) to 1 */
-        wb_real u[3];
-        for (int k = 0; k < 3; k++) u[k] = (x[3 * i + k] - xp[3 * i + k]) - (xc[3 * o + k] - xp[3 * o + k]);
-        v3_madd(u, n, -v3_dot(u, n));
-        const wb_real ul = v3_len(u), eps = c->eps;
-        const wb_real s = mu * (ul < eps ? (2 - ul / eps) / eps : 1 / ul);
-        v3_madd(f, u, -s);
-        H[0] += s * (1 - n[0] * n[0]), H[1] += s * (1 - n[1] * n[1]), H[2] += s * (1 - n[2] * n[2]);
-        H[3] -= s * n[0] * n[1], H[4] -= s * n[0] * n[2], H[5] -= s * n[1] * n[2];
+        if (!(fn > 0)) continue;
+        v3_madd(f, n, fn);
+        H[0] += kk * n[0] * n[0], H[1] += kk * n[1] * n[1], H[2] += kk * n[2] * n[2];
+        H[3] += kk * n[0] * n[1], H[4] += kk * n[0] * n[2], H[5] += kk * n[1] * n[2];
     }
 }
 
 void wb__vbdc_block(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3], wb_real H[6])
 {
     block(w, c, c->lam, i, f, H, NULL);
+}
+
+void wb__vbdc_friction(const wb_world *w, const wb_vbdc *c, int32_t i, const wb_real H[6], wb_real xi[3])
+{
+    const wb_real *xc = c->xc, *xp = w->s.x_prev;
+    wb_real cap = 0, N[3] = { 0, 0, 0 };
+    for (int32_t e = c->start[i]; e < c->start[i + 1]; e++) {
+        const int32_t q = c->ent[e] >> 1, o = c->pij[2 * q + 1 - (c->ent[e] & 1)];
+        const wb_real fl = c->fl[q];
+        if (!c->sf[q] || !(c->mu[q] * fl > 0)) continue;
+        wb_real d[3];
+        v3_sub(d, xi, &xc[3 * o]);
+        const wb_real l = v3_len(d);
+        if (!(l > 0)) continue;
+        cap += c->mu[q] * fl;
+        v3_madd(N, d, fl / l);
+    }
+    const wb_real nl = v3_len(N);
+    if (!(cap > 0) || !(nl > 0)) return;
+    v3_scale(N, N, 1 / nl);
+    /* the slip over the substep across N (the partners are immovable) and the force that
+     * stops it, the vertex's Hessian times it */
+    wb_real u[3], Hu[3];
+    v3_sub(u, xi, &xp[3 * i]);
+    v3_madd(u, N, -v3_dot(u, N));
+    Hu[0] = H[0] * u[0] + H[3] * u[1] + H[4] * u[2];
+    Hu[1] = H[3] * u[0] + H[1] * u[1] + H[5] * u[2];
+    Hu[2] = H[4] * u[0] + H[5] * u[1] + H[2] * u[2];
+    v3_madd(Hu, N, -v3_dot(Hu, N));
+    const wb_real need = v3_len(Hu);
+    v3_madd(xi, u, -(need <= cap ? 1 : cap / need));
 }
 
 void wb__vbdc_body(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3], wb_real H[6], wb_real fr[4])
