@@ -489,6 +489,7 @@ wb_status wb_world_step(wb_world *w)
         wb__tricontacts_velocity(w, h);
         wb__rigids_velocity(w, h);
         wb__rigid_particles_velocity(w, h);
+        if (d->solver == WB_SOLVER_VBD) wb__vbd_contacts_done(w);
     }
 
     /* a frame gone non-finite is undone before it can bend or break anything; a blow-up is

@@ -14,8 +14,10 @@
  * and carried from substep to substep (warm start) so a hanging chain holds its tension
  * instead of finding it again every substep.
  *
- * Served: distance links, bends, Neo-Hookean tets. The other types are projected as in XPBD after each sweep, and
- * contacts, colliders and rigid bodies follow the sweeps as in the XPBD step (solver.c). */
+ * Served: distance links, bends, Neo-Hookean tets, and particle pairs with one immovable
+ * end (vbd_contact.c). The other types are projected as in XPBD after each sweep, and
+ * contacts (all of them, again: what the sweeps left), colliders and rigid bodies follow
+ * the sweeps as in the XPBD step (solver.c). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -28,6 +30,7 @@
 #include "vbd.h"
 #include "contact.h"
 #include "tricontact.h"
+#include "vbd_contact.h"
 
 /* a link as the sweep reads it: its force along it is kk (l - tgt) + lm and its stiffness
  * kk; dmp: a soft link's damping beta / h */
@@ -70,8 +73,14 @@ struct wb_vbd {
     int restored;          /* made from a snapshot image: the next rebuild keeps c0 (the
                               image holds what the saved world's next step starts from) */
     wb_real residual;      /* the last sweep's largest step, m */
-    double *tsum;          /* (bodies x 4) each free body's mass and sum m (x - y) */
+    double *tsum;          /* (bodies x 4) each free body's mass and sum m (x - y), then
+                              (bodies) 1: it may touch an immovable particle */
     int32_t cap_tsum;
+    double *csum;          /* (bodies x 17) a free body's contacts in the vertex steps
+                              (keep_momentum) */
+    uint8_t *bmove;        /* (bodies) 1: its friction goes in its momentum step */
+    wb_vbdc *ct;           /* the particle contacts in the vertex steps (vbd_contact.c) */
+    int ct_on;             /* ct holds this substep's */
 };
 
 #define VBD_COLOURS 64
@@ -135,6 +144,9 @@ void wb__vbd_destroy(wb_world *w)
     free(v->bc0);
     free(v->save);
     free(v->tsum);
+    free(v->csum);
+    free(v->bmove);
+    wb__vbdc_destroy(v->ct);
     free(v);
     w->vbd = NULL;
 }
@@ -369,6 +381,7 @@ typedef struct sweep_job {
     wb_real inv_h2, inv_h;
     const int32_t *vert;   /* the colour's vertices */
     wb_real step;          /* the largest step taken (max_into) */
+    const wb_vbdc *ct;     /* the substep's contacts, NULL: none */
 } sweep_job;
 
 /* A link's force on i along n = (x_i - x_j) / l and its stiffness: a soft one's energy
@@ -558,7 +571,9 @@ static void bend_block(const wb_world *w, const struct wb_vbd *v, int32_t q, wb_
     H[3] += kb * gk[0] * gk[1], H[4] += kb * gk[0] * gk[2], H[5] += kb * gk[1] * gk[2];
 }
 
-static void sweep_part(void *ctx, int32_t lo, int32_t hi)
+/* con: the substep has contacts in the vertex steps (two copies: the loop without them
+ * stays as it was) */
+static inline __attribute__((always_inline)) void sweep_body(void *ctx, int32_t lo, int32_t hi, int con)
 {
     sweep_job *j = ctx;
     wb_world *w = j->w;
@@ -575,7 +590,14 @@ static void sweep_part(void *ctx, int32_t lo, int32_t hi)
         for (int c = 0; c < 3; c++) f[c] += mh * (v->y[3 * i + c] - x[3 * i + c]), H[c] += mh;
         for (int32_t e = v->tadj_start[i]; e < v->tadj_start[i + 1]; e++) tet_block(w, v->tadj[e], f, H);
         for (int32_t e = v->badj_start[i]; e < v->badj_start[i + 1]; e++) bend_block(w, v, v->badj[e], j->inv_h, f, H);
+        if (con) wb__vbdc_block(w, j->ct, i, f, H);
         if (!solve3(H, f, d)) continue;
+        if (con) {
+            wb_real xn[3];
+            v3_add(xn, &x[3 * i], d);
+            wb__vbdc_friction(w, j->ct, i, H, xn);
+            v3_sub(d, xn, &x[3 * i]);
+        }
         v3_add(&x[3 * i], &x[3 * i], d);
         const wb_real dd = v3_dot(d, d);
         big = dd > big ? dd : big;
@@ -584,6 +606,9 @@ static void sweep_part(void *ctx, int32_t lo, int32_t hi)
     __atomic_load(&j->step, &cur, __ATOMIC_RELAXED);
     while (big > cur && !__atomic_compare_exchange(&j->step, &cur, &big, 1, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {}
 }
+
+static void sweep_part(void *ctx, int32_t lo, int32_t hi) { sweep_body(ctx, lo, hi, 0); }
+static void sweep_part_ct(void *ctx, int32_t lo, int32_t hi) { sweep_body(ctx, lo, hi, 1); }
 
 /* ---- the hard links' multipliers ------------------------------------------------------------ */
 /* the inertia of a hard link's ends over the substep, 1 / (h^2 (w_i + w_j)) */
@@ -756,19 +781,34 @@ static int touching(wb_world *w, struct wb_vbd *v)
     if (!k->mc_built || k->mc_nbody == 0) return 0;
     const int32_t nb = k->mc_nbody, *body = k->mc_body;
     if (nb > v->cap_tsum) {
-        double *t = realloc(v->tsum, sizeof *t * 4 * (size_t)nb);
-        if (!t) return 0;
-        v->tsum = t, v->cap_tsum = nb;
+        double *t = realloc(v->tsum, sizeof *t * 5 * (size_t)nb), *e = realloc(v->csum, sizeof *e * 17 * (size_t)nb);
+        uint8_t *bm = realloc(v->bmove, (size_t)nb);
+        if (t) v->tsum = t;
+        if (e) v->csum = e;
+        if (bm) v->bmove = bm;
+        if (!t || !e || !bm) return 0;
+        v->cap_tsum = nb;
     }
     double *T = v->tsum;
-    memset(T, 0, sizeof *T * 4 * (size_t)nb);
+    memset(T, 0, sizeof *T * 5 * (size_t)nb);
     /* only what moves outside the body counts: its own folds, loose particles and
      * immovable particles (a pinned slab, as a collider) keep the momentum the move keeps
-     * (a block on a pinned slab at 0.95 of its sticking angle crept 26 mm in 1 s, now 1.03) */
+     * (a block on a pinned slab at 0.95 of its sticking angle crept 26 mm in 1 s, then
+     * 1.03). Immovable particles near it are flagged: they are contacts in the vertex
+     * steps (vbd_contact.c), the body starts from the prediction and its move takes them
+     * in (keep_momentum) */
     const wb_real *wv = w->m.w;
     const wb_contacts *pc = k->pc;
+    const wb_real *xp = w->s.x_prev, *rad = w->m.radius;
     for (int32_t c = 0; c < pc->n; c++) {
         const int32_t i = pc->ij[2 * c], j = pc->ij[2 * c + 1], a = body[i], b = body[j];
+        /* [4 nb + b] = 1: b may touch an immovable particle (a contact in the vertex steps) */
+        if (!(wv[i] > 0) != !(wv[j] > 0) && body[wv[i] > 0 ? i : j] >= 0) {
+            wb_real d[3];
+            v3_sub(d, &xp[3 * i], &xp[3 * j]);
+            const wb_real rn = (rad[i] + rad[j]) * (wb_real)1.25;
+            if (v3_dot(d, d) < rn * rn) T[4 * nb + body[wv[i] > 0 ? i : j]] = 1;
+        }
         if (a < 0 || b < 0 || a == b) continue;
         if (wv[j] > 0) T[4 * a] = -1;
         if (wv[i] > 0) T[4 * b] = -1;
@@ -800,9 +840,11 @@ static int touching(wb_world *w, struct wb_vbd *v)
  * prediction: the contacts projected after the
  * sweeps carry it and keep_momentum leaves it alone, so the gravity it follows is the one
  * its start has (from x + h v, a lattice made overlapping another was lifted 0.25 m
- * instead of 0.15; from the adaptive start, a stack still moved after 4 s). A held one
- * touching itself keeps x + h v (from y, a pinned rope folding onto itself as it swung
- * gained energy) */
+ * instead of 0.15; from the adaptive start, a stack still moved after 4 s). So does a
+ * free body near an immovable particle: its contacts in the vertex steps then push from
+ * the start (from x + h v a Newton step did not see them, and their multipliers took 8
+ * times the weight after it). A held one touching itself keeps x + h v (from y, a pinned
+ * rope folding onto itself as it swung gained energy) */
 static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h, int touch)
 {
     const wb_real *g = w->m.def.gravity, *wv = w->m.w;
@@ -812,7 +854,8 @@ static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h, int touch)
         const int held = v->adj_start[i + 1] > v->adj_start[i] || v->tadj_start[i + 1] > v->tadj_start[i] ||
                          v->badj_start[i + 1] > v->badj_start[i];
         const int32_t b = body ? body[i] : -1;
-        if (!(wv[i] > 0) || !held || (touch && b >= 0 && v->tsum[4 * b] < 0 && !(w->k.mc_acc[16 * b] < 0))) continue;
+        const int from_y = touch && b >= 0 && !(w->k.mc_acc[16 * b] < 0) && (v->tsum[4 * b] < 0 || v->tsum[4 * w->k.mc_nbody + b] > 0);
+        if (!(wv[i] > 0) || !held || from_y) continue;
         v3_madd(&x[3 * i], g, -h * h);
     }
 }
@@ -825,7 +868,7 @@ static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h, int touch)
  * neighbours does not feel: each sweep moves the body by m / (h^2 k) of what is left,
  * and the start (start_guess) would carry it). Serial, in particle order: the same bits
  * on any thread count. touch: touching() ran this substep (v->tsum holds its flags) */
-static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch)
+static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch, wb_real inv_h2)
 {
     const wb_cache *k = &w->k;
     /* a body that may touch another body's movable particle or a rigid body this frame is
@@ -847,6 +890,57 @@ static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch)
     for (int32_t b = 0; b < nb; b++)
         if (T[4 * b] > 0)
             for (int c = 1; c < 4; c++) T[4 * b + c] /= T[4 * b];
+    /* A body with contacts in the vertex steps (their partners immovable: forces from
+     * outside it) takes the Newton step of the substep's energy along its translation t
+     * with their normal forces, (M / h^2 + sum H_c) t = -M / h^2 mean(x - y) + sum f_c,
+     * and then its friction exactly: the body's slip over the substep across the contacts'
+     * mean normal stopped if M / h^2 |slip| is within sum mu f_n (the lagged forces), else
+     * cut by that much. Without the step the move above took the contacts' net force back
+     * (a block on a pinned slab at 0.95 of its sticking angle moved 1.007 mm in 1 s); with
+     * the vertices' smoothed friction in it (one Newton step on |slip|) it fell short of
+     * the stop by half and the block crept 29 mm */
+    if (v->ct_on) {
+        int32_t nc;
+        const int32_t *cv = wb__vbdc_vertices(v->ct, v->ncolours, &nc);
+        double *E = v->csum; /* (bodies x 17): 1, sum f_c, sum H_c, friction, sum m (y - x_prev) */
+        memset(E, 0, sizeof *E * 17 * (size_t)nb);
+        for (int32_t q = 0; q < nc; q++) {
+            const int32_t b = body[cv[q]];
+            if (b < 0 || !(T[4 * b] > 0)) continue;
+            wb_real f[3] = { 0, 0, 0 }, H[6] = { 0, 0, 0, 0, 0, 0 }, fr[4] = { 0, 0, 0, 0 };
+            wb__vbdc_body(w, v->ct, cv[q], f, H, fr);
+            E[17 * b] = 1;
+            for (int c = 0; c < 3; c++) E[17 * b + 1 + c] += f[c];
+            for (int c = 0; c < 6; c++) E[17 * b + 4 + c] += H[c];
+            for (int c = 0; c < 4; c++) E[17 * b + 10 + c] += fr[c];
+        }
+        const wb_real *xp = w->s.x_prev;
+        for (int32_t i = 0; i < w->m.np; i++) {
+            const int32_t b = body[i];
+            if (b < 0 || !(E[17 * b] > 0) || !(wv[i] > 0)) continue;
+            const double m = 1 / (double)wv[i];
+            for (int c = 0; c < 3; c++) E[17 * b + 14 + c] += m * ((double)y[3 * i + c] - (double)xp[3 * i + c]);
+        }
+        for (int32_t b = 0; b < nb; b++) {
+            const double *e = &E[17 * b];
+            if (!(e[0] > 0)) continue;
+            const double mh = T[4 * b] * inv_h2;
+            wb_real Hb[6], fb[3], t[3];
+            for (int c = 0; c < 6; c++) Hb[c] = (wb_real)(e[4 + c] + (c < 3 ? mh : 0));
+            for (int c = 0; c < 3; c++) fb[c] = (wb_real)(e[1 + c] - mh * T[4 * b + 1 + c]);
+            if (!solve3(Hb, fb, t)) continue;
+            const double nl = sqrt(e[11] * e[11] + e[12] * e[12] + e[13] * e[13]);
+            if (v->bmove[b] && e[10] > 0 && nl > 0) {
+                double D[3], dn = 0;
+                for (int c = 0; c < 3; c++) D[c] = T[4 * b + 1 + c] + t[c] + e[14 + c] / T[4 * b], dn += D[c] * e[11 + c] / nl;
+                for (int c = 0; c < 3; c++) D[c] -= dn * e[11 + c] / nl;
+                const double sl = sqrt(D[0] * D[0] + D[1] * D[1] + D[2] * D[2]), need = mh * sl;
+                const double cut = need <= e[10] ? 1 : e[10] / need;
+                for (int c = 0; c < 3; c++) t[c] -= (wb_real)(D[c] * cut);
+            }
+            for (int c = 0; c < 3; c++) T[4 * b + 1 + c] = -t[c];
+        }
+    }
     for (int32_t i = 0; i < w->m.np; i++) {
         const int32_t b = body[i];
         if (b < 0 || !(T[4 * b] > 0) || !(wv[i] > 0)) continue;
@@ -866,26 +960,41 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     start_guess(w, v, h, touch);
     warm_start(w, v, inv_h2, 1 / h);
     bend_warm_start(w, v, h);
+    /* the contacts in the vertex steps (out of memory: left to the projection after) */
+    if (touch)
+        for (int32_t b = 0; b < w->k.mc_nbody; b++)
+            v->bmove[b] = v->tsum[4 * w->k.mc_nbody + b] > 0 && v->tsum[4 * b] >= 0 && !(w->k.mc_acc[16 * b] < 0);
+    v->ct_on = wb__vbdc_begin(w, &v->ct, h, v->order, v->colour_start, v->ncolours, touch ? v->bmove : NULL) > 0;
+    wb_vbdc *ct = v->ct_on ? v->ct : NULL;
     wb_pool *pool = wb__world_pool(w);
     for (int it = 0; it < w->m.def.iterations; it++) {
-        sweep_job j = { w, v, inv_h2, 1 / h, NULL, 0 };
+        sweep_job j = { w, v, inv_h2, 1 / h, NULL, 0, ct };
+        if (ct && it > 0) wb__vbdc_refresh(w, ct, v->ncolours);
         for (int32_t c = 0; c < v->ncolours; c++) {
             const int32_t lo = v->colour_start[c], n = v->colour_start[c + 1] - lo;
             j.vert = v->order + lo;
             const int serial = v->serial_last && c == v->ncolours - 1;
-            wb__pool_for(serial ? NULL : pool, n, 1024, sweep_part, &j);
+            wb__pool_for(serial ? NULL : pool, n, 1024, ct ? sweep_part_ct : sweep_part, &j);
+            if (ct) wb__vbdc_colour_done(w, ct, c);
         }
         v->residual = sqrt(j.step);
+        if (ct) wb__vbdc_dual(w, ct);
         dual_update(w, v);
         bend_dual_update(w, v, h);
         for (int t = 0; t < wb__nctypes; t++)
             if (!wb__vbd_serves(wb__ctypes[t])) wb__ctypes[t]->project(w, h);
         if (w->m.def.tolerance > 0 && v->residual <= w->m.def.tolerance) break;
     }
-    keep_momentum(w, v, touch);
+    keep_momentum(w, v, touch, inv_h2);
+    if (v->ct_on) wb__vbdc_end(w, v->ct);
     keep_multipliers(v);
     write_forces(w, v, h);
     return v->residual;
+}
+
+void wb__vbd_contacts_done(wb_world *w)
+{
+    if (w->vbd && w->vbd->ct_on) wb__vbdc_readout(w, w->vbd->ct);
 }
 
 wb_real wb__vbd_residual(const wb_world *w) { return w->vbd ? w->vbd->residual : 0; }

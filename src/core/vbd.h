@@ -15,6 +15,8 @@ int wb__vbd_prepare(wb_world *w);
 void wb__vbd_destroy(wb_world *w);
 /* an undone frame: the multipliers back as the step found them */
 void wb__vbd_undo(wb_world *w);
+/* at a substep's end: the particle contacts' readout takes in the sweeps' forces */
+void wb__vbd_contacts_done(wb_world *w);
 /* the last substep's residual: the largest Newton step of its last sweep, m */
 wb_real wb__vbd_residual(const wb_world *w);
 

@@ -1,0 +1,42 @@
+/* vbd_contact.h: the particle contacts as energies in VBD's vertex steps (vbd_contact.c) */
+#ifndef WB_VBD_CONTACT_H
+#define WB_VBD_CONTACT_H
+#include "core.h"
+
+typedef struct wb_vbdc wb_vbdc;
+
+/* Once a substep, after the sweeps' start: the frame's candidate pairs near enough to
+ * touch during it, each vertex's list of them, and the copy its partners are read from.
+ * order / colour_start / ncolours: the sweep's vertices by colour. Returns 1 when some
+ * vertex has a contact (then call the others), 0 when none, -1 when out of memory (the
+ * contacts after the sweeps still hold). *c is made on first use. bmoved (bodies, may be
+ * NULL): 1 for a body whose friction its momentum step takes (wb__vbdc_body), not the
+ * vertex steps. */
+int wb__vbdc_begin(wb_world *w, wb_vbdc **c, wb_real h, const int32_t *order, const int32_t *colour_start,
+                   int32_t ncolours, const uint8_t *bmoved);
+/* vertex i's contact forces and their Hessian added to f and H (H: xx, yy, zz, xy, xz, yz) */
+void wb__vbdc_block(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3], wb_real H[6]);
+/* after vertex i's Newton step to xi (H: its Hessian): its friction with its partners */
+void wb__vbdc_friction(const wb_world *w, const wb_vbdc *c, int32_t i, const wb_real H[6], wb_real xi[3]);
+/* vertex i's contact forces after the sweeps (the multipliers before the last update)
+ * without friction, added to f and H; fr[0] += its friction's capacity, sum mu f_n (the
+ * lagged forces), fr[1..3] += sum f_n n (the direction they push it): a body's momentum
+ * step's */
+void wb__vbdc_body(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3], wb_real H[6], wb_real fr[4]);
+/* after the sweeps and the momentum step: each pair's force where they left it (the
+ * readout's, and the next substep's friction's) */
+void wb__vbdc_end(const wb_world *w, wb_vbdc *c);
+/* the vertices with contacts this substep (*n of them) */
+const int32_t *wb__vbdc_vertices(const wb_vbdc *c, int32_t ncolours, int32_t *n);
+/* after colour col's vertices stepped: the copy of their positions brought up to date */
+void wb__vbdc_colour_done(const wb_world *w, wb_vbdc *c, int32_t col);
+/* after a sweep: each contact's multiplier grown by its penalty times its overlap */
+void wb__vbdc_dual(const wb_world *w, wb_vbdc *c);
+/* before a sweep after the first: the copy taken again (the types projected after a
+ * sweep move vertices) */
+void wb__vbdc_refresh(const wb_world *w, wb_vbdc *c, int32_t ncolours);
+/* after the contacts' projection (contact.c): their reported forces take in the sweeps' */
+void wb__vbdc_readout(wb_world *w, const wb_vbdc *c);
+void wb__vbdc_destroy(wb_vbdc *c);
+
+#endif
