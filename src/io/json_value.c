@@ -255,7 +255,7 @@ int jv_read_generations(rd *r, const cJSON *it, const kp *p, uint32_t *gen, int3
     *live = 0;
     for (const cJSON *c = it->child; c; c = c->next, i++) {
         kp e = { p, NULL, i };
-        int64_t g;
+        int64_t g = 0; /* (set when jv_get_int succeeds; -O3 cannot see it) */
         if (jv_get_int(r, c, &e, 0, UINT32_MAX, &g)) return -1;
         gen[i] = (uint32_t)g;
         *live += (int32_t)(g & 1);
