@@ -322,14 +322,22 @@ void wb__vbdc_body(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3],
     block(w, c, c->lamp, i, f, H, fr);
 }
 
+/* pair q's gap C from its target where the particles are, and the force a multiplier
+ * base gives it there, clamped at 0 (the dual update of wb__vbdc_dual and _end) */
+static inline wb_real pair_force(const wb_real *x, const wb_vbdc *c, int32_t q, wb_real base, wb_real *C)
+{
+    wb_real d[3];
+    v3_sub(d, &x[3 * c->pij[2 * q]], &x[3 * c->pij[2 * q + 1]]);
+    *C = v3_len(d) - c->tgt[q];
+    const wb_real lm = base - c->kk[q] * *C;
+    return lm > 0 ? lm : 0;
+}
+
 void wb__vbdc_end(const wb_world *w, wb_vbdc *c)
 {
-    const wb_real *x = w->s.x;
     for (int32_t q = 0; q < c->npair; q++) {
-        wb_real d[3];
-        v3_sub(d, &x[3 * c->pij[2 * q]], &x[3 * c->pij[2 * q + 1]]);
-        const wb_real C = v3_len(d) - c->tgt[q], lm = c->lamp[q] - c->kk[q] * C;
-        c->lam[q] = c->fend[q] = lm > 0 ? lm : 0;
+        wb_real C;
+        c->lam[q] = c->fend[q] = pair_force(w->s.x, c, q, c->lamp[q], &C);
         c->ove[q] = -C;
     }
 }
@@ -348,13 +356,11 @@ void wb__vbdc_colour_done(const wb_world *w, wb_vbdc *c, int32_t col)
 
 void wb__vbdc_dual(const wb_world *w, wb_vbdc *c)
 {
-    const wb_real *x = w->s.x;
     for (int32_t q = 0; q < c->npair; q++) {
-        wb_real d[3];
-        v3_sub(d, &x[3 * c->pij[2 * q]], &x[3 * c->pij[2 * q + 1]]);
-        const wb_real C = v3_len(d) - c->tgt[q], lm = c->lam[q] - c->kk[q] * C;
+        wb_real C;
+        const wb_real f = pair_force(w->s.x, c, q, c->lam[q], &C);
         c->lamp[q] = c->lam[q];
-        c->lam[q] = lm > 0 ? lm : 0;
+        c->lam[q] = f;
     }
 }
 
