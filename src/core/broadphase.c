@@ -25,10 +25,10 @@
  *     its reach + the largest ordinary reach (rows wholly before it are skipped: half
  *     the neighbourhood; of each row only the x-window where that sphere crosses the
  *     row's nearest edge in y and z, so grid cells much larger than the reach, as in a
- *     sheet spread over a large box, cost no more tests). A big (fast) one finds its pairs with every particle of a
- *     smaller reach (ties: the higher index) within twice its reach, since reach_i +
- *     reach_j <= 2 reach_i. Each pair is found once. Pairs of one skip key are dropped
- *     after the distance test, before the group rules (keep).
+ *     sheet spread over a large box, cost no more tests). A big (fast) one finds its
+ *     pairs with every particle of a smaller reach (ties: the higher index) within twice
+ *     its reach, since reach_i + reach_j <= 2 reach_i. Each pair is found once. Pairs of
+ *     one skip key are dropped after the distance test, before the group rules (keep).
  *
  * Determinism: threads take contiguous ranges of the sorted array, each with its own
  * pair buffer; the pairs are then counting-sorted into (i, j) order, so the list is the
@@ -208,9 +208,10 @@ static inline int axis_ranges(const wb_grid *g, int a, wb_real v, wb_real e, int
     return 2;
 }
 
-/* the sorted positions [q0, q1) closer to p (x, y, z, reach) than the two reaches and not
- * of its skip key ks (kz: it has none), appended to hit from nh. Branch-free: most fail,
- * and a branch per test mispredicts */
+/* the sorted positions [q0, q1) up to x = xmax (exclusive) closer to p (x, y, z, reach)
+ * than the two reaches and not of its skip key ks (kz: it has none), appended to hit from
+ * nh. Branch-free but for the row's end (taken once): most fail, and a branch per test
+ * mispredicts */
 static inline int32_t gather(const wb_real *restrict P, const int32_t *restrict key, const wb_real *restrict p,
                              int32_t ks, int kz, int32_t q0, int32_t q1, wb_real xmax, int32_t *restrict hit, int32_t nh)
 {
