@@ -303,8 +303,10 @@ int wb__vbd_prepare(wb_world *w)
             int32_t *hd = realloc(v->hard, sizeof *hd * (size_t)m->nd);
             if (hd) v->hard = hd;
             if (!lam || !c0 || !lk || !hd) return 0;
-            /* new slots start with no multiplier */
+            /* new slots start with no multiplier and no error known (also in a world just
+             * restored, whose image holds the errors of its own slots only) */
             memset(v->lam + v->cap_lam, 0, sizeof *lam * (size_t)(m->nd - v->cap_lam));
+            for (int32_t q = v->cap_lam; q < m->nd; q++) v->c0[q] = (wb_real)NAN;
             v->cap_lam = m->nd;
         }
         if (wb_bend_count(w) > v->cap_blam) {
