@@ -191,6 +191,36 @@ static void push(pairbuf *o, int32_t i, int32_t j)
     o->n++;
 }
 
+/* Pairs into (i, j) order by two counting sorts, by j and then stably by i: linear in the
+ * pairs and particles (a heap's particle can have a hundred pairs: sorting each one's
+ * handful by insertion took an eighth of a 128 x 128 heap's frame). The pairs of the nb
+ * buffers src (a thread's each), all of particles below np, written to dst (2 n ints);
+ * by_j (2 n) and cnt, first (np + 1) are scratch */
+static void order_pairs(const pairbuf *src, int nb, int32_t np, int32_t *by_j, int32_t *cnt, int32_t *first,
+                        int32_t *dst)
+{
+    memset(cnt, 0, sizeof *cnt * ((size_t)np + 1));
+    memset(first, 0, sizeof *first * ((size_t)np + 1));
+    for (int t = 0; t < nb; t++)
+        for (int32_t k = 0; k < src[t].n; k++) {
+            cnt[src[t].ij[2 * k + 1] + 1]++;
+            first[src[t].ij[2 * k] + 1]++;
+        }
+    for (int32_t i = 0; i < np; i++) cnt[i + 1] += cnt[i], first[i + 1] += first[i];
+    for (int t = 0; t < nb; t++)
+        for (int32_t k = 0; k < src[t].n; k++) {
+            const int32_t *e = &src[t].ij[2 * k], at = cnt[e[1]]++;
+            by_j[2 * at] = e[0];
+            by_j[2 * at + 1] = e[1];
+        }
+    const int32_t n = cnt[np];
+    for (int32_t k = 0; k < n; k++) {
+        const int32_t at = first[by_j[2 * k]]++;
+        dst[2 * at] = by_j[2 * k];
+        dst[2 * at + 1] = by_j[2 * k + 1];
+    }
+}
+
 /* an axis's search range [v - e, v + e] as at most two runs of grid cells */
 static inline int axis_ranges(const wb_grid *g, int a, wb_real v, wb_real e, int64_t r[4])
 {
@@ -464,30 +494,13 @@ static int32_t broad(wb_broad *b, wb_pairbuf *o, const wb_real *x, const wb_real
         total += b->out[t].n;
     }
     if (!grow((void **)&o->ij, &o->cap, 2 * total, sizeof *o->ij) ||
-        !grow((void **)&b->first, &b->cap_first, (int64_t)n + 1, sizeof *b->first))
+        !grow((void **)&b->first, &b->cap_first, (int64_t)n + 1, sizeof *b->first) ||
+        !grow((void **)&b->by_j, &b->cap_by_j, 2 * total, sizeof *b->by_j) ||
+        !grow((void **)&b->cnt, &b->cap_cnt, (int64_t)n + 1, sizeof *b->cnt))
         return -1;
-    /* in (i, j) order: a counting sort by i, then j sorted in each i's handful. The list
-     * is then the set of pairs alone, whatever the grid, the ranges or the threads */
-    int32_t *first = b->first, *ij = &o->ij[2 * o->n];
-    memset(first, 0, sizeof *first * ((size_t)n + 1));
-    for (int t = 0; t < nt; t++)
-        for (int32_t k = 0; k < b->out[t].n; k++) first[b->out[t].ij[2 * k] + 1]++;
-    for (int32_t i = 0; i < n; i++) first[i + 1] += first[i];
-    for (int t = 0; t < nt; t++)
-        for (int32_t k = 0; k < b->out[t].n; k++) {
-            const int32_t at = first[b->out[t].ij[2 * k]]++;
-            ij[2 * at] = b->out[t].ij[2 * k];
-            ij[2 * at + 1] = b->out[t].ij[2 * k + 1];
-        }
-    for (int32_t i = 0, at = 0; i < n; i++) { /* first[i] is now the end of i's pairs */
-        for (int32_t k = at + 1; k < first[i]; k++) {
-            const int32_t j = ij[2 * k + 1];
-            int32_t q = k;
-            for (; q > at && ij[2 * q - 1] > j; q--) ij[2 * q + 1] = ij[2 * q - 1];
-            ij[2 * q + 1] = j;
-        }
-        at = first[i];
-    }
+    /* in (i, j) order, so that the list is the set of pairs alone, whatever the grid, the
+     * ranges or the threads */
+    order_pairs(b->out, nt, n, b->by_j, b->cnt, b->first, &o->ij[2 * o->n]);
     o->n = (int32_t)total;
     return o->n;
 }
@@ -592,21 +605,37 @@ static int grid_each(const wb_broad *b, const wb_real *p, wb_real e, int (*fn)(v
     return 1;
 }
 
-/* the pairs of add (n, in any order) in (i, j) order, each once, less those of the sorted
- * list (nl) already; returns how many */
-static int32_t new_pairs(int32_t *add, int32_t n, const int32_t *list, int32_t nl)
+/* the pairs of add (n, in any order, of particles below np) in (i, j) order, each once,
+ * less those of the sorted list (nl) already; returns how many. Many pairs are put in
+ * order by counting (b's scratch; a comparison sort where that is out of memory), a few
+ * by comparison (the counts cost np) */
+static int32_t new_pairs(wb_broad *b, int32_t np, int32_t *add, int32_t n, const int32_t *list, int32_t nl)
 {
-    if (n > 1) qsort(add, (size_t)n, 2 * sizeof *add, cmp_pair);
-    int32_t nb = 0;
+    if (n > 1) {
+        if (b && n >= 64 && 16 * (int64_t)n >= np && grow((void **)&b->by_j, &b->cap_by_j, 2 * (int64_t)n, sizeof *b->by_j) &&
+            grow((void **)&b->cnt, &b->cap_cnt, (int64_t)np + 1, sizeof *b->cnt) &&
+            grow((void **)&b->first, &b->cap_first, (int64_t)np + 1, sizeof *b->first)) {
+            const pairbuf one = { add, n, n, 0, NULL, 0 };
+            order_pairs(&one, 1, np, b->by_j, b->cnt, b->first, add);
+        } else qsort(add, (size_t)n, 2 * sizeof *add, cmp_pair);
+    }
+    /* each looked for in the list from where the one before it was (both in order):
+     * galloping, then a bisection, so many pairs cost a merge and a few a search */
+    int32_t nb = 0, from = 0;
     for (int32_t q = 0; q < n; q++) {
         const int32_t *e = &add[2 * q];
         if (nb > 0 && cmp_pair(&add[2 * nb - 2], e) == 0) continue;
-        int32_t lo = 0, hi = nl;
+        int32_t lo = from, hi = from;
+        for (int32_t step = 1; hi < nl && cmp_pair(&list[2 * hi], e) < 0; step *= 2) {
+            lo = hi + 1;
+            hi = nl - hi > step ? hi + step : nl;
+        }
         while (lo < hi) {
             const int32_t mid = lo + (hi - lo) / 2;
             if (cmp_pair(&list[2 * mid], e) < 0) lo = mid + 1;
             else hi = mid;
         }
+        from = lo;
         if (lo < nl && cmp_pair(&list[2 * lo], e) == 0) continue;
         add[2 * nb] = e[0];
         add[2 * nb + 1] = e[1];
@@ -734,7 +763,7 @@ static int mend_list(wb_broad *b, const wb_real *x, const wb_real *reach, const 
     if (o->fail) return 0;
     if (o->n == 0) return 1;
     /* in order, each once, those the list lacks, merged in */
-    const int32_t na = new_pairs(o->ij, o->n, b->list.ij, b->list.n);
+    const int32_t na = new_pairs(b, n, o->ij, o->n, b->list.ij, b->list.n);
     if (!grow((void **)&b->list.ij, &b->list.cap, 2 * ((int64_t)b->list.n + na), sizeof *b->list.ij)) return 0;
     int32_t *ij = b->list.ij;
     for (int32_t p = b->list.n - 1, q = na - 1, w = b->list.n + na - 1; q >= 0; w--) {
@@ -1395,7 +1424,7 @@ void wb__broadphase_free(wb_contacts *c)
     c->cap_xf = c->cap_old = c->cap_left_old = c->cap_fix = c->cap_add = c->cap_fixed = 0;
     if (!b) return;
     free(b->cand); free(b->cell); free(b->start); free(b->p); free(b->id); free(b->key);
-    free(b->runs); free(b->boxes); free(b->first); free(b->rowr);
+    free(b->runs); free(b->boxes); free(b->first); free(b->by_j); free(b->cnt); free(b->rowr);
     free(b->vx); free(b->vr); free(b->vskip); free(b->list.ij); free(b->list.hit);
     free(b->moved); free(b->is_moved); free(b->bad); free(b->mend.ij); free(b->mend.hit);
     for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
@@ -1567,7 +1596,7 @@ static int repair(wb_world *w, const int32_t *moved, int32_t nm, const int32_t *
     for (int32_t k = 0; k < nq; k++) c->dorm_on[c->qs[k]] = 1;
     if (na == 0 && nq == 0) return 1;
     /* the new pairs in order, each once and not already listed */
-    int32_t nb = new_pairs(c->add, na, c->ij, c->n);
+    int32_t nb = new_pairs(c->bp, m->np, c->add, na, c->ij, c->n);
     /* with the dormant ones, in order as the dormant list is (merged from the back) */
     if (!grow((void **)&c->add, &c->cap_add, 2 * ((int64_t)nb + nq), sizeof *c->add)) return 0;
     for (int32_t o = nb + nq - 1, p = nb - 1, q = nq - 1; q >= 0; o--) {

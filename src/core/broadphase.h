@@ -51,6 +51,8 @@ struct wb_broad {
     wb_real *boxes; int32_t cap_boxes; /* (lo, hi) of runs' overlaps */
     wb_pairbuf *out; int nout;         /* one per thread */
     int32_t *first; int32_t cap_first; /* (n + 1) sorting the pairs by i */
+    int32_t *by_j; int32_t cap_by_j;   /* (2 pairs) the pairs sorted by j, then stably by i */
+    int32_t *cnt; int32_t cap_cnt;     /* (n + 1) counts for sorting by j */
     /* the kept list (wb__broadphase_kept): positions, reaches with the skin (-1: left
      * out) and skip keys it was built with, its pairs (keep not applied) */
     int32_t vn;                        /* particles it was built for; 0: none */
