@@ -1148,14 +1148,6 @@ static int any_possible(const wb_model *m)
  * before. */
 typedef struct ref_step { wb_real S, vf; } ref_step;
 
-/* how far gravity g takes a particle from its straight path in k substeps of h (the
- * prediction v <- v + g h, x <- x + v h: g h^2 (1 + 2 + ... + k) = g t^2 (1 + 1/k) / 2,
- * t = k h; the drag only shortens it). Gravity's part of every reach */
-static inline wb_real fall(wb_real g, wb_real h, int32_t k)
-{
-    return g * h * h * (wb_real)k * (wb_real)(k + 1) / 2;
-}
-
 /* after j substeps of h from the list's start: S_j, and the factor vf of the
  * reference's velocity there, vf (V + om x r) */
 static ref_step ref_at(const wb_world *w, int32_t j, wb_real h)
@@ -1379,11 +1371,11 @@ static int32_t make_list(wb_world *w, wb_real h, int32_t kmax, wb_real margin, i
         ref_rel(c, &rs0, &w->s.x[3 * i], &v[3 * i], m->w[i] > 0, u);
         reach[i] = v3_len_fast(u);
         if (k0 == 0 && m->radius[i] > 0) /* (a remake within the frame keeps its span) */
-            motion += (reach[i] * h * kmax + fall(g, h, kmax)) / m->radius[i], nmov++;
+            motion += (reach[i] * h * kmax + g * h * h * kmax * kmax) / m->radius[i], nmov++;
     }
     if (k0 == 0) c->span = list_span(kmax, nmov > 0 ? motion / nmov : 0);
     const int32_t span = k0 == 0 ? c->span : kmax;
-    const wb_real t = h * span, gt2 = fall(g, h, span);
+    const wb_real t = h * span, gt2 = g * t * t;
     c->path_t = t;
     static const wb_real still[3] = { 0, 0, 0 };
     for (int32_t i = 0; i < m->np; i++) {
@@ -1526,14 +1518,14 @@ static int grid_pairs(wb_world *w, const wb_broad *b, int32_t i, wb_real e, int3
     return 1;
 }
 
-static int repair(wb_world *w, const int32_t *moved, int32_t nm, const int32_t *soft, int32_t ns, wb_real h,
-                  int32_t kleft, wb_real margin, const ref_step *rs)
+static int repair(wb_world *w, const int32_t *moved, int32_t nm, const int32_t *soft, int32_t ns, wb_real t,
+                  wb_real margin, const ref_step *rs)
 {
     wb_model *m = &w->m;
     wb_contacts *c = w->k.pc;
     const wb_broad *b = c->bp;
     wb_real *xf = c->xf, *reach = c->reach;
-    const wb_real *x = w->s.x, *v = w->s.v, t = h * (wb_real)kleft, gt2 = fall(v3_len(m->def.gravity), h, kleft);
+    const wb_real *x = w->s.x, *v = w->s.v, gt2 = v3_len(m->def.gravity) * t * t;
     const wb_real *V = c->ref_v, *om = c->ref_om, *cc = c->ref_c;
     /* (I + S [om]x)^-1 b = (b - a x b + (a . b) a) / (1 + |a|^2), a = S om */
     const wb_real a[3] = { rs->S * om[0], rs->S * om[1], rs->S * om[2] }, aa = 1 + v3_dot(a, a);
@@ -1688,7 +1680,7 @@ int wb__contacts_recheck(wb_world *w, wb_real h)
     if (ns == 0 && nm == 0 && !due) return 0;
     const double t0 = now_ms();
     if (nm == 0 && !due) { /* off their paths alone */
-        r = repair(w, NULL, 0, soft, ns, h, 0, 0, &rs);
+        r = repair(w, NULL, 0, soft, ns, 0, 0, &rs);
         c->broad_ms += now_ms() - t0;
         if (!r) { c->n = 0; c->check = 0; return -1; }
         return 2;
@@ -1703,10 +1695,11 @@ int wb__contacts_recheck(wb_world *w, wb_real h)
      * at most) */
     const int32_t kleft = due ? (c->span < m->def.substeps - sub ? c->span : m->def.substeps - sub)
                               : m->def.substeps - sub;
+    const wb_real t = (wb_real)kleft * h;
     const wb_real margin = due ? (wb_real)0.25
                                : (wb_real)0.25 * (wb_real)(1 << (c->remakes_frame < 4 ? c->remakes_frame : 4));
     if (!due && nm <= REPAIR_MAX) {
-        r = repair(w, mv, nm, soft, ns, h, kleft, margin, &rs);
+        r = repair(w, mv, nm, soft, ns, t, margin, &rs);
         c->broad_ms += now_ms() - t0;
         if (!r) { c->n = 0; c->check = 0; return -1; }
         return 2;
