@@ -196,9 +196,10 @@ struct wb_world {
     wb_model m;
     wb_state s;
     wb_cache k;
-    /* each constraint type but distance: its struct (model, state and cache) declared in
-     * its own header, made by its file with the first constraint, freed by its destroy
-     * hook (ctype.h); NULL until the first */
+    /* each constraint type: its struct (model, state and cache) declared in its own
+     * header, made by its file with the first constraint, freed by its destroy hook
+     * (ctype.h); NULL until the first */
+    struct wb_distances *dist; /* distance constraints (distance.h) */
     struct wb_bends *bend;  /* bends (bend.h) */
     struct wb_volumes *vol; /* volume constraints (volume.h) */
     struct wb_neos *neo;    /* Neo-Hookean tets (tet.h) */
