@@ -209,9 +209,9 @@ static wb_status grow_particles(wb_world *w, int32_t need)
     if (need > WB_MAX_PARTICLES) return WB_ERR_LIMIT;
     int32_t cap = m->cap_p ? m->cap_p : 64;
     while (cap < need) cap = cap > WB_MAX_PARTICLES / 2 ? WB_MAX_PARTICLES : cap * 2;
-    if (!charge(w, cap, m->cap_d)) {
+    if (!charge(w, cap, ds->cap)) {
         cap = need; /* exact fit when doubling would cross the limit */
-        if (!charge(w, cap, m->cap_d)) return WB_ERR_NOMEM;
+        if (!charge(w, cap, ds->cap)) return WB_ERR_NOMEM;
     }
     const wb_soa arr[] = {
         { (void **)&m->inv_mass, sizeof(wb_real) }, { (void **)&m->w, sizeof(wb_real) },
@@ -350,25 +350,25 @@ static int slot_live(uint32_t gen) { return gen & 1u; }
 static wb_status grow_distances(wb_world *w, int32_t need)
 {
     wb_model *m = &w->m;
-    if (need <= m->cap_d) return WB_OK;
+    if (need <= ds->cap) return WB_OK;
     if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
-    int32_t cap = m->cap_d ? m->cap_d : 64;
+    int32_t cap = ds->cap ? ds->cap : 64;
     while (cap < need) cap = cap > WB_MAX_CONSTRAINTS / 2 ? WB_MAX_CONSTRAINTS : cap * 2;
     if (!charge(w, m->cap_p, cap)) {
         cap = need;
         if (!charge(w, m->cap_p, cap)) return WB_ERR_NOMEM;
     }
     const wb_soa arr[] = {
-        { (void **)&m->d_ij, 2 * sizeof(int32_t) }, { (void **)&m->d_alpha, sizeof(wb_real) },
-        { (void **)&m->d_beta, sizeof(wb_real) }, { (void **)&m->d_yield, sizeof(wb_real) },
-        { (void **)&m->d_creep, sizeof(wb_real) }, { (void **)&m->d_break, sizeof(wb_real) },
-        { (void **)&m->d_bforce, sizeof(wb_real) },
-        { (void **)&m->d_gen, sizeof(uint32_t) }, { (void **)&m->d_free, sizeof(int32_t) },
-        { (void **)&w->s.d_rest, sizeof(wb_real) }, { (void **)&w->s.d_broken, 1 },
-        { (void **)&w->k.slot_pack, sizeof(int32_t) },
+        { (void **)&ds->ij, 2 * sizeof(int32_t) }, { (void **)&ds->alpha, sizeof(wb_real) },
+        { (void **)&ds->beta, sizeof(wb_real) }, { (void **)&ds->yield, sizeof(wb_real) },
+        { (void **)&ds->creep, sizeof(wb_real) }, { (void **)&ds->break_strain, sizeof(wb_real) },
+        { (void **)&ds->bforce, sizeof(wb_real) },
+        { (void **)&ds->gen, sizeof(uint32_t) }, { (void **)&ds->free_slots, sizeof(int32_t) },
+        { (void **)&wb__dist(w->dist)->rest, sizeof(wb_real) }, { (void **)&wb__dist(w->dist)->broken, 1 },
+        { (void **)&wb__dist(w->dist)->slot_pack, sizeof(int32_t) },
     };
     if (WB_SOA_RESIZE(arr, cap) != WB_OK) return WB_ERR_NOMEM;
-    m->cap_d = cap;
+    ds->cap = cap;
     return WB_OK;
 }
 
@@ -376,9 +376,9 @@ static wb_status grow_distances(wb_world *w, int32_t need)
  * adding them cannot fail, so a builder never leaves half a body behind */
 wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra)
 {
-    if (w->m.np + np_extra > WB_MAX_PARTICLES || w->m.nd + nd_extra > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    if (w->m.np + np_extra > WB_MAX_PARTICLES || wb__dist(w->dist)->n + nd_extra > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
     wb_status st = grow_particles(w, w->m.np + (int32_t)np_extra);
-    if (st == WB_OK) st = grow_distances(w, w->m.nd + (int32_t)nd_extra);
+    if (st == WB_OK) st = grow_distances(w, wb__dist(w->dist)->n + (int32_t)nd_extra);
     return st;
 }
 
@@ -399,37 +399,37 @@ wb_distance_id wb_distance_add(wb_world *w, int32_t a, int32_t b, const wb_dista
     const wb_real rest = def->rest >= 0 ? def->rest : v3_len(d);
     wb_model *m = &w->m;
     int32_t slot;
-    if (m->nfree > 0) {
-        slot = m->d_free[--m->nfree];
+    if (ds->nfree > 0) {
+        slot = ds->free_slots[--ds->nfree];
     } else {
-        wb_status st = grow_distances(w, m->nd + 1);
+        wb_status st = grow_distances(w, ds->n + 1);
         if (st != WB_OK) { *status = st; return none; }
-        slot = m->nd++;
-        m->d_gen[slot] = 0;
+        slot = ds->n++;
+        ds->gen[slot] = 0;
     }
-    m->d_ij[2 * slot] = a;
-    m->d_ij[2 * slot + 1] = b;
-    m->d_alpha[slot] = def->compliance;
-    m->d_beta[slot] = def->damping;
-    m->d_yield[slot] = def->yield;
-    m->d_creep[slot] = def->creep;
-    m->d_break[slot] = def->break_strain;
-    m->d_bforce[slot] = def->break_force;
-    m->d_gen[slot]++; /* even -> odd: live */
-    w->s.d_rest[slot] = rest;
-    w->s.d_broken[slot] = 0;
-    w->k.slot_pack[slot] = -1;
-    m->nd_live++;
+    ds->ij[2 * slot] = a;
+    ds->ij[2 * slot + 1] = b;
+    ds->alpha[slot] = def->compliance;
+    ds->beta[slot] = def->damping;
+    ds->yield[slot] = def->yield;
+    ds->creep[slot] = def->creep;
+    ds->break_strain[slot] = def->break_strain;
+    ds->bforce[slot] = def->break_force;
+    ds->gen[slot]++; /* even -> odd: live */
+    wb__dist(w->dist)->rest[slot] = rest;
+    wb__dist(w->dist)->broken[slot] = 0;
+    wb__dist(w->dist)->slot_pack[slot] = -1;
+    ds->nlive++;
     m->topology_dirty = 1;
     *status = WB_OK;
-    wb_distance_id id = { (uint32_t)slot + 1, m->d_gen[slot] };
+    wb_distance_id id = { (uint32_t)slot + 1, ds->gen[slot] };
     return id;
 }
 
 bool wb_distance_valid(const wb_world *w, wb_distance_id c)
 {
-    if (c.index == 0 || c.index > (uint32_t)w->m.nd) return false;
-    uint32_t g = w->m.d_gen[c.index - 1];
+    if (c.index == 0 || c.index > (uint32_t)wb__dist(w->dist)->n) return false;
+    uint32_t g = wb__dist(w->dist)->gen[c.index - 1];
     return slot_live(g) && g == c.gen;
 }
 
@@ -438,47 +438,47 @@ bool wb_distance_valid(const wb_world *w, wb_distance_id c)
 void wb_distance_remove(wb_world *w, wb_distance_id c)
 {
     int32_t s = SLOT(w, c);
-    w->m.d_gen[s]++; /* odd -> even: dead, old handles stale */
-    w->m.d_free[w->m.nfree++] = s;
-    w->m.nd_live--;
+    wb__dist(w->dist)->gen[s]++; /* odd -> even: dead, old handles stale */
+    wb__dist(w->dist)->free_slots[wb__dist(w->dist)->nfree++] = s;
+    wb__dist(w->dist)->nlive--;
     w->m.topology_dirty = 1;
 }
 
 wb_real wb_distance_force(const wb_world *w, wb_distance_id c)
 {
     int32_t s = SLOT(w, c);
-    int32_t k = w->k.slot_pack[s];
-    if (k < 0 || k >= w->k.ns || w->k.s_lambda_stale) return 0; /* not stepped since it was made (or undone) */
+    int32_t k = wb__dist(w->dist)->slot_pack[s];
+    if (k < 0 || k >= wb__dist(w->dist)->ns || wb__dist(w->dist)->s_lambda_stale) return 0; /* not stepped since it was made (or undone) */
     const wb_real h = w->k.h_last; /* of the step that made lambda, whatever dt is now */
-    return fabs(w->k.s_lambda[k]) / (h * h);
+    return fabs(wb__dist(w->dist)->s_lambda[k]) / (h * h);
 }
 
-wb_real wb_distance_rest(const wb_world *w, wb_distance_id c) { return w->s.d_rest[SLOT(w, c)]; }
-bool wb_distance_broken(const wb_world *w, wb_distance_id c) { return w->s.d_broken[SLOT(w, c)] != 0; }
+wb_real wb_distance_rest(const wb_world *w, wb_distance_id c) { return wb__dist(w->dist)->rest[SLOT(w, c)]; }
+bool wb_distance_broken(const wb_world *w, wb_distance_id c) { return wb__dist(w->dist)->broken[SLOT(w, c)] != 0; }
 
 wb_real wb_distance_length(const wb_world *w, wb_distance_id c)
 {
     int32_t s = SLOT(w, c);
     wb_real d[3];
-    v3_sub(d, &w->s.x[3 * w->m.d_ij[2 * s + 1]], &w->s.x[3 * w->m.d_ij[2 * s]]);
+    v3_sub(d, &w->s.x[3 * wb__dist(w->dist)->ij[2 * s + 1]], &w->s.x[3 * wb__dist(w->dist)->ij[2 * s]]);
     return v3_len(d);
 }
 
 void wb_distance_particles(const wb_world *w, wb_distance_id c, int32_t *a, int32_t *b)
 {
     int32_t s = SLOT(w, c);
-    *a = w->m.d_ij[2 * s];
-    *b = w->m.d_ij[2 * s + 1];
+    *a = wb__dist(w->dist)->ij[2 * s];
+    *b = wb__dist(w->dist)->ij[2 * s + 1];
 }
 
-int32_t wb_distance_count(const wb_world *w) { return w->m.nd_live; }
+int32_t wb_distance_count(const wb_world *w) { return wb__dist(w->dist)->nlive; }
 
 wb_distance_id wb_distance_at(const wb_world *w, int32_t i)
 {
     /* live slots in slot order: O(nd) scan, fine for inspection and export */
-    for (int32_t s = 0; s < w->m.nd; s++) {
-        if (!slot_live(w->m.d_gen[s])) continue;
-        if (i-- == 0) { wb_distance_id id = { (uint32_t)s + 1, w->m.d_gen[s] }; return id; }
+    for (int32_t s = 0; s < wb__dist(w->dist)->n; s++) {
+        if (!slot_live(wb__dist(w->dist)->gen[s])) continue;
+        if (i-- == 0) { wb_distance_id id = { (uint32_t)s + 1, wb__dist(w->dist)->gen[s] }; return id; }
     }
     wb_distance_id none = { 0, 0 };
     return none;
@@ -487,14 +487,14 @@ wb_distance_id wb_distance_at(const wb_world *w, int32_t i)
 int32_t wb_distance_ids(const wb_world *w, wb_distance_id *out)
 {
     int32_t n = 0;
-    for (int32_t s = 0; s < w->m.nd; s++)
-        if (slot_live(w->m.d_gen[s])) { out[n].index = (uint32_t)s + 1; out[n].gen = w->m.d_gen[s]; n++; }
+    for (int32_t s = 0; s < wb__dist(w->dist)->n; s++)
+        if (slot_live(wb__dist(w->dist)->gen[s])) { out[n].index = (uint32_t)s + 1; out[n].gen = wb__dist(w->dist)->gen[s]; n++; }
     return n;
 }
 
 /* ---- events --------------------------------------------------------------------------- */
-int32_t wb_world_break_count(const wb_world *w) { return w->k.nbreaks; }
-wb_distance_id wb_world_break_at(const wb_world *w, int32_t i) { assert(i >= 0 && i < w->k.nbreaks); return w->k.breaks[i]; }
+int32_t wb_world_break_count(const wb_world *w) { return wb__dist(w->dist)->nbreaks; }
+wb_distance_id wb_world_break_at(const wb_world *w, int32_t i) { assert(i >= 0 && i < wb__dist(w->dist)->nbreaks); return wb__dist(w->dist)->breaks[i]; }
 
 /* ---- surfaces ------------------------------------------------------------------------ */
 /* room for one more surface of ntri triangles: after it, wb_surface_add cannot fail

@@ -36,9 +36,9 @@ static int32_t graph_brute(const wb_model *m, int32_t p)
     in[p] = 1;
     while (changed) {
         changed = 0;
-        for (int32_t s = 0; s < m->nd; s++) {
-            if (!(m->d_gen[s] & 1u)) continue;
-            const int32_t a = m->d_ij[2 * s], b = m->d_ij[2 * s + 1];
+        for (int32_t s = 0; s < ds->n; s++) {
+            if (!(ds->gen[s] & 1u)) continue;
+            const int32_t a = ds->ij[2 * s], b = ds->ij[2 * s + 1];
             if (m->group[a] > 0 || m->group[b] > 0 || in[a] == in[b]) continue;
             in[a] = in[b] = 1;
             changed = 1;
@@ -52,9 +52,9 @@ static int32_t graph_brute(const wb_model *m, int32_t p)
 
 static int linked(const wb_model *m, int32_t p, int32_t v)
 {
-    for (int32_t s = 0; s < m->nd; s++)
-        if ((m->d_gen[s] & 1u) && ((m->d_ij[2 * s] == p && m->d_ij[2 * s + 1] == v) ||
-                                   (m->d_ij[2 * s] == v && m->d_ij[2 * s + 1] == p)))
+    for (int32_t s = 0; s < ds->n; s++)
+        if ((ds->gen[s] & 1u) && ((ds->ij[2 * s] == p && ds->ij[2 * s + 1] == v) ||
+                                   (ds->ij[2 * s] == v && ds->ij[2 * s + 1] == p)))
             return 1;
     return 0;
 }
