@@ -1,16 +1,18 @@
-/* distance.c: the distance constraint type (the first of ctype.c's table): packing and
- * colouring of the live links into batches, their XPBD projection (Gauss-Seidel batch by
- * batch or Jacobi), plastic flow and breaking once per frame, and their elastic energy. The
- * slot arrays and the C API (wb_distance_*) live in world.c with the other model arrays;
- * this file owns the solver cache built from them (wb_cache's s_* arrays).
+/* distance.c: the distance constraint type (the first of ctype.c's table): its slots and
+ * the C API (wb_distance_*), packing and colouring of the live links into batches, their
+ * XPBD projection (Gauss-Seidel batch by batch or Jacobi), plastic flow and breaking once
+ * per frame, and their elastic energy. Its arrays are w->dist (distance.h), made with the
+ * first link.
  *
  * The batches are this file's own, not batch.h's: links are removed (slots freed, links
  * broken), so they are packed live ones only, the links meeting on a mirror plane are
  * split out as compounds projected together from the same positions (wb_split: a
  * symmetric scene stays symmetric), and the Jacobi solver runs over the same packing. */
+#include <assert.h>
 #include <stdlib.h>
 
 #include "ctype.h"
+#include "distance.h"
 #include "snapshot.h"
 #include "tet.h"
 #include "volume.h"
@@ -26,16 +28,231 @@ static int realloc_n(void **p, int32_t n, size_t elem)
 
 static int packable(const void *ud, int32_t s)
 {
-    const wb_world *w = ud;
-    return (wb__dist(w->dist)->gen[s] & 1u) && !wb__dist(w->dist)->broken[s];
+    const wb_distances *ds = ud;
+    return (ds->gen[s] & 1u) && !ds->broken[s];
 }
+
+/* ---- memory: the struct made with the first link ------------------------------------------ */
+/* bytes per slot over the arrays that grow with the slots (model, state, slot_pack) and
+ * the packed cache, for the memory limit */
+#define CONSTRAINT_BYTES (14 * sizeof(wb_real) + 42)
+
+static int slot_live(uint32_t gen) { return gen & 1u; }
+
+static int charge(wb_world *w, int32_t cap) { return wb__charge(w, &w->dist->charged, (size_t)cap * CONSTRAINT_BYTES); }
+
+/* room for need slots; the struct is made with the first (w->dist: NULL until then) */
+static wb_status grow_distances(wb_world *w, int32_t need)
+{
+    if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    if (!w->dist) {
+        if (need <= 0) return WB_OK;
+        wb_distances *ds = calloc(1, sizeof *ds);
+        if (!ds) return WB_ERR_NOMEM;
+        w->dist = ds;
+    }
+    wb_distances *ds = w->dist;
+    if (need <= ds->cap) return WB_OK;
+    int32_t cap = ds->cap ? ds->cap : 64;
+    while (cap < need) cap = cap > WB_MAX_CONSTRAINTS / 2 ? WB_MAX_CONSTRAINTS : cap * 2;
+    if (!charge(w, cap)) {
+        cap = need; /* exact fit when doubling would cross the limit */
+        if (!charge(w, cap)) return WB_ERR_NOMEM;
+    }
+    const wb_soa arr[] = {
+        { (void **)&ds->ij, 2 * sizeof(int32_t) }, { (void **)&ds->alpha, sizeof(wb_real) },
+        { (void **)&ds->beta, sizeof(wb_real) }, { (void **)&ds->yield, sizeof(wb_real) },
+        { (void **)&ds->creep, sizeof(wb_real) }, { (void **)&ds->break_strain, sizeof(wb_real) },
+        { (void **)&ds->bforce, sizeof(wb_real) },
+        { (void **)&ds->gen, sizeof(uint32_t) }, { (void **)&ds->free_slots, sizeof(int32_t) },
+        { (void **)&ds->rest, sizeof(wb_real) }, { (void **)&ds->broken, 1 },
+        { (void **)&ds->slot_pack, sizeof(int32_t) },
+    };
+    if (WB_SOA_RESIZE(arr, cap) != WB_OK) return WB_ERR_NOMEM;
+    ds->cap = cap;
+    return WB_OK;
+}
+
+wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra)
+{
+    const int32_t nd = wb__dist(w->dist)->n;
+    if (w->m.np + np_extra > WB_MAX_PARTICLES || nd + nd_extra > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    wb_status st = wb__particles_reserve(w, np_extra);
+    if (st == WB_OK) st = grow_distances(w, nd + (int32_t)nd_extra);
+    return st;
+}
+
+/* ---- the C API ---------------------------------------------------------------------------- */
+wb_distance_def wb_distance_default_def(void)
+{
+    wb_distance_def d = { 0, 0, -1, 0, 0, 0, 0 };
+    return d;
+}
+
+/* the options' rules: the one place they are decided (the binding and the JSON reader
+ * print what this finds) */
+static wb_fault distance_def_fault(const wb_distance_def *d)
+{
+    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return WB_FAULT_KEY("compliance", "must be >= 0");
+    if (!(d->damping >= 0) || !isfinite(d->damping)) return WB_FAULT_KEY("damping", "must be >= 0");
+    /* the solver works with squared lengths: a rest whose square overflows can never be met */
+    if (!isfinite(d->rest) || !isfinite(d->rest * d->rest))
+        return WB_FAULT_KEY("rest", "must be finite and below 1e154 (its square overflows)");
+    if (!(d->yield >= 0) || !isfinite(d->yield)) return WB_FAULT_KEY("yield", "must be >= 0");
+    if (!(d->creep >= 0) || !isfinite(d->creep)) return WB_FAULT_KEY("creep", "must be >= 0");
+    if (!(d->break_strain >= 0) || !isfinite(d->break_strain)) return WB_FAULT_KEY("break_strain", "must be >= 0");
+    if (!(d->break_force >= 0) || !isfinite(d->break_force)) return WB_FAULT_KEY("break_force", "must be >= 0");
+    return WB_NO_FAULT;
+}
+
+const char *wb_distance_def_check(const wb_distance_def *d)
+{
+    return distance_def_fault(d).msg;
+}
+
+/* the particles first (what it joins), then the options, then whether their distance has
+ * a finite square (the rest it derives obeys the rule a given one does) */
+wb_fault wb_distance_check(int32_t np, const wb_real *x, int32_t a, int32_t b, const wb_distance_def *d)
+{
+    if (a < 0 || a >= np) return WB_FAULT_AT(0, "particle out of range", "out of range");
+    if (b < 0 || b >= np) return WB_FAULT_AT(1, "particle out of range", "out of range");
+    if (a == b)
+        return WB_FAULT_AT(1, "a constraint needs two distinct particles", "a constraint needs two distinct particles");
+    const wb_fault f = distance_def_fault(d);
+    if (f.msg || !x) return f;
+    wb_real dx[3];
+    v3_sub(dx, &x[3 * b], &x[3 * a]);
+    if (!isfinite(v3_dot(dx, dx)))
+        return WB_FAULT_AT(-1, "the particles are too far apart (their distance squared overflows)",
+                           "too far apart (their distance squared overflows)");
+    return WB_NO_FAULT;
+}
+
+wb_distance_id wb_distance_add(wb_world *w, int32_t a, int32_t b, const wb_distance_def *def, wb_status *status)
+{
+    wb_distance_id none = { 0, 0 };
+    wb_status dummy;
+    if (!status) status = &dummy;
+    const wb_fault f = wb_distance_check(w->m.np, w->s.x, a, b, def);
+    if (f.msg) {
+        if (!f.key && f.corner < 0) wb__set_error("particles %d and %d are %s", a + 1, b + 1, f.why);
+        else wb__set_error("%s", f.msg);
+        *status = WB_ERR_ARG;
+        return none;
+    }
+    wb_real d[3];
+    v3_sub(d, &w->s.x[3 * b], &w->s.x[3 * a]);
+    const wb_real rest = def->rest >= 0 ? def->rest : v3_len(d);
+    int32_t slot;
+    if (w->dist && w->dist->nfree > 0) {
+        slot = w->dist->free_slots[--w->dist->nfree];
+    } else {
+        wb_status st = grow_distances(w, wb__dist(w->dist)->n + 1);
+        if (st != WB_OK) { *status = st; return none; }
+        slot = w->dist->n++;
+        w->dist->gen[slot] = 0;
+    }
+    wb_distances *ds = w->dist;
+    ds->ij[2 * slot] = a;
+    ds->ij[2 * slot + 1] = b;
+    ds->alpha[slot] = def->compliance;
+    ds->beta[slot] = def->damping;
+    ds->yield[slot] = def->yield;
+    ds->creep[slot] = def->creep;
+    ds->break_strain[slot] = def->break_strain;
+    ds->bforce[slot] = def->break_force;
+    ds->gen[slot]++; /* even -> odd: live */
+    ds->rest[slot] = rest;
+    ds->broken[slot] = 0;
+    ds->slot_pack[slot] = -1;
+    ds->nlive++;
+    w->m.topology_dirty = 1;
+    *status = WB_OK;
+    wb_distance_id id = { (uint32_t)slot + 1, ds->gen[slot] };
+    return id;
+}
+
+bool wb_distance_valid(const wb_world *w, wb_distance_id c)
+{
+    const wb_distances *ds = wb__dist(w->dist);
+    if (c.index == 0 || c.index > (uint32_t)ds->n) return false;
+    uint32_t g = ds->gen[c.index - 1];
+    return slot_live(g) && g == c.gen;
+}
+
+/* a valid handle's slot (so w->dist exists) */
+#define SLOT(w, c) (assert(wb_distance_valid((w), (c))), (int32_t)(c).index - 1)
+
+void wb_distance_remove(wb_world *w, wb_distance_id c)
+{
+    int32_t s = SLOT(w, c);
+    wb_distances *ds = w->dist;
+    ds->gen[s]++; /* odd -> even: dead, old handles stale */
+    ds->free_slots[ds->nfree++] = s;
+    ds->nlive--;
+    w->m.topology_dirty = 1;
+}
+
+wb_real wb_distance_force(const wb_world *w, wb_distance_id c)
+{
+    int32_t s = SLOT(w, c);
+    const wb_distances *ds = w->dist;
+    int32_t k = ds->slot_pack[s];
+    if (k < 0 || k >= ds->ns || ds->s_lambda_stale) return 0; /* not stepped since it was made (or undone) */
+    const wb_real h = w->k.h_last; /* of the step that made lambda, whatever dt is now */
+    return fabs(ds->s_lambda[k]) / (h * h);
+}
+
+wb_real wb_distance_rest(const wb_world *w, wb_distance_id c) { return w->dist->rest[SLOT(w, c)]; }
+bool wb_distance_broken(const wb_world *w, wb_distance_id c) { return w->dist->broken[SLOT(w, c)] != 0; }
+
+wb_real wb_distance_length(const wb_world *w, wb_distance_id c)
+{
+    int32_t s = SLOT(w, c);
+    wb_real d[3];
+    v3_sub(d, &w->s.x[3 * w->dist->ij[2 * s + 1]], &w->s.x[3 * w->dist->ij[2 * s]]);
+    return v3_len(d);
+}
+
+void wb_distance_particles(const wb_world *w, wb_distance_id c, int32_t *a, int32_t *b)
+{
+    int32_t s = SLOT(w, c);
+    *a = w->dist->ij[2 * s];
+    *b = w->dist->ij[2 * s + 1];
+}
+
+int32_t wb_distance_count(const wb_world *w) { return wb__dist(w->dist)->nlive; }
+
+wb_distance_id wb_distance_at(const wb_world *w, int32_t i)
+{
+    /* live slots in slot order: O(nd) scan, fine for inspection and export */
+    const wb_distances *ds = wb__dist(w->dist);
+    for (int32_t s = 0; s < ds->n; s++) {
+        if (!slot_live(ds->gen[s])) continue;
+        if (i-- == 0) { wb_distance_id id = { (uint32_t)s + 1, ds->gen[s] }; return id; }
+    }
+    wb_distance_id none = { 0, 0 };
+    return none;
+}
+
+int32_t wb_distance_ids(const wb_world *w, wb_distance_id *out)
+{
+    const wb_distances *ds = wb__dist(w->dist);
+    int32_t n = 0;
+    for (int32_t s = 0; s < ds->n; s++)
+        if (slot_live(ds->gen[s])) { out[n].index = (uint32_t)s + 1; out[n].gen = ds->gen[s]; n++; }
+    return n;
+}
+
+int32_t wb_world_break_count(const wb_world *w) { return wb__dist(w->dist)->nbreaks; }
+wb_distance_id wb_world_break_at(const wb_world *w, int32_t i) { assert(i >= 0 && i < wb_world_break_count(w)); return w->dist->breaks[i]; }
 
 /* ---- packing: rebuild the colour batches when the topology changed --------------------- */
 static wb_status colour(wb_world *w);
 
 /* alpha / h^2 per constraint for the substep h, and which constraints need none of the
  * vector path's masks (after s_wa, s_wc) */
-static void refresh_at(wb_cache *k, wb_real h)
+static void refresh_at(wb_distances *ds, wb_real h)
 {
     const wb_real inv_h2 = 1 / (h * h);
     for (int32_t i = 0; i < ds->ns; i++) {
@@ -51,7 +268,7 @@ static void refresh_at(wb_cache *k, wb_real h)
  * link is marked: they keep their full correction) */
 static int mark_backed(wb_world *w)
 {
-    wb_cache *k = &w->k;
+    wb_distances *ds = w->dist;
     const int32_t nv = wb_volume_count(w), nt = wb_tet_count(w), np = w->m.np;
     ds->s_backed_vt[0] = nv;
     ds->s_backed_vt[1] = nt;
@@ -71,8 +288,14 @@ static int mark_backed(wb_world *w)
  * pin, unpin, set mass and snapshot loads change m.w between steps only) */
 wb_status wb__colour(wb_world *w)
 {
-    wb_cache *k = &w->k;
+    wb_distances *ds = w->dist;
+    if (ds) ds->nbreaks = 0; /* the list reports the step about to run */
     const int recoloured = w->m.topology_dirty;
+    if (!ds) { /* no links: nothing to pack, the new topology taken as one would */
+        if (recoloured && w->k.pc) w->k.pc->keys_dirty = 1;
+        w->m.topology_dirty = 0;
+        return WB_OK;
+    }
     if (recoloured) {
         const wb_status st = colour(w);
         if (st != WB_OK) return st;
@@ -94,7 +317,7 @@ wb_status wb__colour(wb_world *w)
     }
     /* the solver's substep as it computes it; distance_project checks it too */
     const wb_real h = w->m.def.dt / w->m.def.substeps;
-    if (h != ds->s_at_h) refresh_at(k, h);
+    if (h != ds->s_at_h) refresh_at(ds, h);
     return WB_OK;
 }
 
@@ -102,10 +325,11 @@ static wb_status colour(wb_world *w)
 {
     wb_model *m = &w->m;
     wb_cache *k = &w->k;
+    wb_distances *ds = w->dist;
     if (k->pc) k->pc->keys_dirty = 1; /* the constraint pairs that self-collision skips */
 
     int32_t ns = 0;
-    for (int32_t s = 0; s < ds->n; s++) ns += packable(w, s);
+    for (int32_t s = 0; s < ds->n; s++) ns += packable(ds, s);
 
     uint8_t *colour = malloc((size_t)(ds->n > 0 ? ds->n : 1));
     int32_t count[WB_MAX_COLOURS + 1];
@@ -118,7 +342,7 @@ static wb_status colour(wb_world *w)
         !realloc_n((void **)&ds->s_jac, ns, 4 * sizeof(wb_real)) ||
         !realloc_n((void **)&ds->s_slot, ns, 3 * sizeof(int32_t) + 2) ||
         !realloc_n((void **)&ds->colour_start, WB_MAX_COLOURS + 2, sizeof(int32_t)) ||
-        !wb__colour_greedy(m, ds->ij, 2, ds->n, packable, w, colour, count, &split) ||
+        !wb__colour_greedy(m, ds->ij, 2, ds->n, packable, ds, colour, count, &split) ||
         !realloc_n((void **)&ds->comp_start, split.ncomp + 1 + 2 * split.n, sizeof(int32_t))) {
         free(colour);
         free(split.member);
@@ -149,7 +373,7 @@ static wb_status colour(wb_world *w)
         int32_t a = ds->ij[2 * s], b = ds->ij[2 * s + 1];
         ds->s_a[i] = a;
         ds->s_b[i] = b;
-        ds->s_rest[i] = wb__dist(w->dist)->rest[s];
+        ds->s_rest[i] = ds->rest[s];
         ds->s_alpha[i] = ds->alpha[s];
         ds->s_beta[i] = ds->beta[s];
         ds->s_lambda[i] = 0;
@@ -223,7 +447,7 @@ static wb_status colour(wb_world *w)
  * AVX-512 gathers and scatters measured slower than this scalar loop; the AVX2 path
  * below, with transposes, is faster: see project_range4.) */
 static inline __attribute__((always_inline)) void
-project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
+project_range(const wb_distances *ds, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
               wb_real *out, int32_t b, int32_t e, wb_real h, wb_real inv_h2, wb_real omega,
               const int damped, const int jacobi, const int fresh, const int split)
 {
@@ -357,7 +581,7 @@ offsets(const uint32_t *a, const uint32_t *c, size_t oa[4], size_t oc[4])
  * cloth128: noise); CH 32 or 128 (no difference). Earlier: prefetching 16 or 64
  * constraints ahead cost 0.3-0.5 ns. */
 static inline __attribute__((always_inline, target("avx2"))) void
-project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
+project_range4(const wb_distances *ds, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
                wb_real *out, int32_t b, int32_t e, wb_real h, wb_real inv_h2, wb_real omega,
                const int damped, const int jacobi, const int fresh)
 {
@@ -511,22 +735,22 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
         }
         i += cn;
     }
-    if (i < e) project_range(k, wv, x, xp, out, i, e, h, inv_h2, omega, damped, jacobi, fresh, 0);
+    if (i < e) project_range(ds, wv, x, xp, out, i, e, h, inv_h2, omega, damped, jacobi, fresh, 0);
 }
 
 static __attribute__((target("avx2"))) void
 project_distances_avx2(const wb_world *w, wb_real *dx, int32_t b, int32_t e, wb_real h, wb_real inv_h2)
 {
-    const wb_cache *k = &w->k;
+    const wb_distances *ds = w->dist;
     const wb_real *wv = w->m.w, *xp = w->s.x_prev, omega = w->m.def.relaxation;
     const int fresh = ds->s_lambda_stale;
     wb_real *x = w->s.x;
     if (dx) {
-        if (ds->any_damping) project_range4(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1, fresh);
-        else project_range4(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1, fresh);
+        if (ds->any_damping) project_range4(ds, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1, fresh);
+        else project_range4(ds, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1, fresh);
     } else {
-        if (ds->any_damping) project_range4(k, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0, fresh);
-        else project_range4(k, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0, fresh);
+        if (ds->any_damping) project_range4(ds, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0, fresh);
+        else project_range4(ds, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0, fresh);
     }
 }
 #endif
@@ -542,7 +766,7 @@ int wb__distance_simd(int on) { return wb__simd_set(&simd_state, on); }
 
 static void project_distances(const wb_world *w, wb_real *dx, int32_t b, int32_t e, wb_real h, wb_real inv_h2)
 {
-    const wb_cache *k = &w->k;
+    const wb_distances *ds = w->dist;
 #ifdef WB_DISTANCE_AVX2
     /* the vector lanes need a conflict-free batch: never the serial tail */
     if (e - b >= 4 && e <= ds->colour_start[ds->serial_start]) {
@@ -559,11 +783,11 @@ static void project_distances(const wb_world *w, wb_real *dx, int32_t b, int32_t
     const int fresh = ds->s_lambda_stale;
     wb_real *x = w->s.x;
     if (dx) {
-        if (ds->any_damping) project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1, fresh, 0);
-        else project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1, fresh, 0);
+        if (ds->any_damping) project_range(ds, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1, fresh, 0);
+        else project_range(ds, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1, fresh, 0);
     } else {
-        if (ds->any_damping) project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0, fresh, 0);
-        else project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0, fresh, 0);
+        if (ds->any_damping) project_range(ds, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0, fresh, 0);
+        else project_range(ds, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0, fresh, 0);
     }
 }
 
@@ -576,18 +800,18 @@ static void project_distances(const wb_world *w, wb_real *dx, int32_t b, int32_t
  * about one link's, not overshoot) */
 static void project_compounds(wb_world *w, wb_real h, wb_real inv_h2)
 {
-    wb_cache *k = &w->k;
+    const wb_distances *ds = w->dist;
     const wb_real *wv = w->m.w, *xp = w->s.x_prev;
     const int fresh = ds->s_lambda_stale;
-    wb_real *x = w->s.x, *dx = k->dx;
+    wb_real *x = w->s.x, *dx = w->k.dx;
     for (int32_t c = 0; c < ds->ncomp; c++) {
         const int32_t b = ds->comp_start[c], e = ds->comp_start[c + 1];
         for (int32_t i = b; i < e; i++) {
             v3_set(&dx[3 * ds->s_a[i]], 0, 0, 0);
             v3_set(&dx[3 * ds->s_b[i]], 0, 0, 0);
         }
-        if (ds->any_damping) project_range(k, wv, x, xp, dx, b, e, h, inv_h2, 1, 1, 0, fresh, 1);
-        else project_range(k, wv, x, xp, dx, b, e, h, inv_h2, 1, 0, 0, fresh, 1);
+        if (ds->any_damping) project_range(ds, wv, x, xp, dx, b, e, h, inv_h2, 1, 1, 0, fresh, 1);
+        else project_range(ds, wv, x, xp, dx, b, e, h, inv_h2, 1, 0, 0, fresh, 1);
         for (int32_t i = b; i < e; i++)
             for (int end = 0; end < 2; end++) {
                 const int32_t p = end ? ds->s_b[i] : ds->s_a[i];
@@ -609,7 +833,7 @@ static void dist_part(void *ctx, int32_t lo, int32_t hi)
 
 static void project_batches(wb_world *w, wb_real *dx, wb_real h, wb_real inv_h2)
 {
-    wb_cache *k = &w->k;
+    const wb_distances *ds = w->dist;
     for (int32_t c = 0; c < ds->ncolours; c++) {
         const int32_t b = ds->colour_start[c], e = ds->colour_start[c + 1];
         /* (the pool is asked for only here: a small scene never starts a thread) */
@@ -627,11 +851,13 @@ static void project_batches(wb_world *w, wb_real *dx, wb_real h, wb_real inv_h2)
 /* one iteration over every distance constraint */
 static void distance_project(wb_world *w, wb_real h)
 {
+    wb_distances *ds = w->dist;
+    if (!ds) return;
     wb_cache *k = &w->k;
     const wb_real inv_h2 = 1 / (h * h);
     const int32_t np = w->m.np;
     k->projections += ds->ns;
-    if (h != ds->s_at_h) refresh_at(k, h);
+    if (h != ds->s_at_h) refresh_at(ds, h);
     if (w->m.def.solver == WB_SOLVER_GAUSS_SEIDEL) {
         project_batches(w, NULL, h, inv_h2);
         project_compounds(w, h, inv_h2);
@@ -654,14 +880,17 @@ static void distance_project(wb_world *w, wb_real h)
  * writes every one, skipped constraints included (a memset of them all cost 2% of the
  * 128 x 128 cloth's frame); until it has, force() reads 0 (an undone frame, no
  * iterations) and distance_frame_end clears them. */
-static void distance_substep_begin(wb_world *w) { wb__dist(w->dist)->s_lambda_stale = 1; }
+static void distance_substep_begin(wb_world *w)
+{
+    if (w->dist) w->dist->s_lambda_stale = 1;
+}
 
 static void report_break(wb_world *w, int32_t s)
 {
-    wb_cache *k = &w->k;
-    wb__dist(w->dist)->broken[s] = 1;
+    wb_distances *ds = w->dist;
+    ds->broken[s] = 1;
     w->m.topology_dirty = 1;
-    wb_distance_id id = { (uint32_t)s + 1, wb__dist(w->dist)->gen[s] };
+    wb_distance_id id = { (uint32_t)s + 1, ds->gen[s] };
     wb_distance_id *q = wb__grow(ds->breaks, &ds->cap_breaks, ds->nbreaks + 1, sizeof *q);
     if (q) { ds->breaks = q; ds->breaks[ds->nbreaks++] = id; }
 }
@@ -670,10 +899,10 @@ static void report_break(wb_world *w, int32_t s)
  * on the multiplier of the frame's last substep (the force wb_distance_force reads) */
 static void distance_frame_end(wb_world *w)
 {
-    wb_model *m = &w->m;
-    wb_cache *k = &w->k;
-    const wb_real dt = m->def.dt, inv_h2 = 1 / (k->h_last * k->h_last);
-    if (!ds->any_frame_end) return; /* nothing can break or flow: no walk over them all */
+    wb_distances *ds = w->dist;
+    /* nothing can break or flow: no walk over them all */
+    if (!ds || !ds->any_frame_end) return;
+    const wb_real dt = w->m.def.dt, inv_h2 = 1 / (w->k.h_last * w->k.h_last);
     if (ds->s_lambda_stale && ds->ns > 0) { /* (no iterations: nothing projected) */
         memset(ds->s_lambda, 0, sizeof(wb_real) * (size_t)ds->ns);
         ds->s_lambda_stale = 0;
@@ -704,7 +933,7 @@ static void distance_frame_end(wb_world *w)
             const wb_real past = isinf(a) ? 1 : (a - y) / a;
             const wb_real r = rest + rate * (len - rest) * past;
             ds->s_rest[i] = r;
-            wb__dist(w->dist)->rest[s] = r;
+            ds->rest[s] = r;
         }
     }
 }
@@ -712,13 +941,14 @@ static void distance_frame_end(wb_world *w)
 /* elastic: U = C^2 / (2 alpha) for compliant constraints (alpha = 1/k) */
 static wb_real distance_energy(const wb_world *w)
 {
+    const wb_distances *ds = wb__dist(w->dist);
     wb_real pe = 0;
-    for (int32_t s = 0; s < wb__dist(w->dist)->n; s++) {
-        if (!packable(w, s) || wb__dist(w->dist)->alpha[s] <= 0) continue;
+    for (int32_t s = 0; s < ds->n; s++) {
+        if (!packable(ds, s) || ds->alpha[s] <= 0) continue;
         wb_real d[3];
-        v3_sub(d, &w->s.x[3 * wb__dist(w->dist)->ij[2 * s + 1]], &w->s.x[3 * wb__dist(w->dist)->ij[2 * s]]);
-        wb_real c = v3_len(d) - wb__dist(w->dist)->rest[s];
-        pe += c * c / (2 * wb__dist(w->dist)->alpha[s]);
+        v3_sub(d, &w->s.x[3 * ds->ij[2 * s + 1]], &w->s.x[3 * ds->ij[2 * s]]);
+        wb_real c = v3_len(d) - ds->rest[s];
+        pe += c * c / (2 * ds->alpha[s]);
     }
     return pe;
 }
@@ -728,30 +958,30 @@ static int32_t distance_count(const wb_world *w) { return wb__dist(w->dist)->nli
 /* every live link joins its two ends (a torn one too: they were neighbours) */
 static void distance_links(const wb_world *w, wb_link_fn fn, void *ud)
 {
-    const wb_model *m = &w->m;
+    const wb_distances *ds = wb__dist(w->dist);
     for (int32_t s = 0; s < ds->n; s++)
         if (ds->gen[s] & 1u) fn(ud, ds->ij[2 * s], ds->ij[2 * s + 1], 1);
 }
 
 /* ---- teardown and hash (ctype.h) ----------------------------------------------------------- */
-/* its model and state arrays live in the world's (core.h: they grow with the particles'
- * budget, world.c), its cache in the solver cache */
 static void distance_destroy(wb_world *w)
 {
-    wb_model *m = &w->m;
-    wb_state *s = &w->s;
-    wb_cache *k = &w->k;
+    wb_distances *ds = w->dist;
+    if (!ds) return;
     void *p[] = { ds->ij, ds->alpha, ds->beta, ds->yield, ds->creep, ds->break_strain, ds->bforce, ds->gen,
                   ds->free_slots, ds->rest, ds->broken, ds->colour_start, ds->comp_start, ds->s_a, ds->s_b, ds->s_rest,
                   ds->s_alpha, ds->s_beta, ds->s_lambda, ds->s_jac, ds->s_slot, ds->slot_pack, ds->breaks };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    free(ds);
+    w->dist = NULL;
 }
 
-/* the live ones' state (rest lengths, broken flags) in slot order */
+static size_t distance_charged(const wb_world *w) { return w->dist ? w->dist->charged : 0; }
+
 /* the packed links' largest |len - rest + alpha~ lambda| (a link's two gradients are unit) */
 static wb_real distance_residual(const wb_world *w, wb_real h)
 {
-    const wb_cache *k = &w->k;
+    const wb_distances *ds = wb__dist(w->dist);
     const wb_real *x = w->s.x, *wv = w->m.w, inv_h2 = 1 / (h * h);
     wb_real r = 0;
     for (int32_t i = 0; i < ds->ns; i++) {
@@ -766,10 +996,10 @@ static wb_real distance_residual(const wb_world *w, wb_real h)
     return r;
 }
 
+/* the live ones' state (rest lengths, broken flags) in slot order */
 static uint64_t distance_hash(const wb_world *w, uint64_t h)
 {
-    const wb_model *m = &w->m;
-    const wb_state *s = &w->s;
+    const wb_distances *ds = wb__dist(w->dist);
     for (int32_t i = 0; i < ds->n; i++) {
         if (!(ds->gen[i] & 1u)) continue;
         h = wb__fnv(h, &ds->rest[i], sizeof ds->rest[i]);
@@ -813,8 +1043,7 @@ wb_status wb_image_alloc_distances(wb_image *g, int32_t nd, int32_t nfree)
 
 static wb_status distance_image_save(const wb_world *w, wb_image *g)
 {
-    const wb_model *m = &w->m;
-    const wb_state *s = &w->s;
+    const wb_distances *ds = wb__dist(w->dist);
     wb_status st = wb_image_alloc_distances(g, ds->n, ds->nfree);
     if (st != WB_OK || ds->n == 0) return st;
     wb_image_distance *d = &g->dist;
@@ -896,8 +1125,8 @@ static wb_status distance_image_reserve(wb_world *w, const wb_image *g, const wb
 /* a new world takes the slots as they are (generations, free list: the same future) */
 static void put_exact(wb_world *w, const wb_image_distance *d)
 {
-    wb_model *m = &w->m;
-    wb_state *s = &w->s;
+    wb_distances *ds = w->dist; /* made by the reserve when there are slots */
+    if (!ds) return;
     const size_t n = (size_t)d->n;
     ds->n = d->n;
     ds->nlive = 0;
@@ -914,7 +1143,7 @@ static void put_exact(wb_world *w, const wb_image_distance *d)
         memcpy(ds->gen, d->gen, n * sizeof *ds->gen);
     }
     for (size_t i = 0; i < n; i++) {
-        wb__dist(w->dist)->slot_pack[i] = -1;
+        ds->slot_pack[i] = -1;
         ds->nlive += (int32_t)(d->gen[i] & 1u);
     }
     ds->nfree = d->nfree;
@@ -933,15 +1162,17 @@ static void distance_image_put(wb_world *w, const wb_image *g, const wb_image_at
         if (!(d->gen[i] & 1u)) continue;
         const wb_distance_def def = image_def(d, i);
         const wb_distance_id id = wb_distance_add(w, at->pshift + d->ij[2 * i], at->pshift + d->ij[2 * i + 1], &def, NULL);
-        wb__dist(w->dist)->broken[id.index - 1] = d->broken[i];
+        w->dist->broken[id.index - 1] = d->broken[i];
     }
 }
 
 static void distance_stats(const wb_world *w, wb_stats *st)
 {
-    st->distances = wb__dist(w->dist)->nlive;
-    for (int32_t s = 0; s < wb__dist(w->dist)->n; s++)
-        if ((wb__dist(w->dist)->gen[s] & 1u) && wb__dist(w->dist)->broken[s]) st->broken++;
+    const wb_distances *ds = wb__dist(w->dist);
+    st->distances = ds->nlive;
+    st->colours = ds->ncolours;
+    for (int32_t s = 0; s < ds->n; s++)
+        if ((ds->gen[s] & 1u) && ds->broken[s]) st->broken++;
 }
 
 const wb_ctype wb__distance_type = {
@@ -954,6 +1185,7 @@ const wb_ctype wb__distance_type = {
     .energy = distance_energy,
     .links = distance_links,
     .destroy = distance_destroy,
+    .charged = distance_charged,
     .stats = distance_stats,
     .hash = distance_hash,
     .image_free = distance_image_free,

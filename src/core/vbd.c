@@ -181,6 +181,7 @@ static int quads(int32_t np, const int32_t *q, int32_t n, int32_t **start_out, i
 static int build_adjacency(wb_world *w, struct wb_vbd *v)
 {
     const wb_model *m = &w->m;
+    const wb_distances *ds = wb__dist(w->dist);
     const int32_t np = m->np, nd = ds->n;
     int32_t *start = calloc((size_t)np + 1, sizeof *start);
     if (!start) return 0;
@@ -272,6 +273,7 @@ static int build_colours(wb_world *w, struct wb_vbd *v)
 static int rebuild_due(const wb_world *w, const struct wb_vbd *v)
 {
     const wb_model *m = &w->m;
+    const wb_distances *ds = wb__dist(w->dist);
     const int32_t nt = w->neo ? w->neo->n : 0;
     return m->topology_dirty || v->np != m->np || v->nd != ds->n || v->nt != nt || v->nb != wb_bend_count(w);
 }
@@ -287,6 +289,7 @@ int wb__vbd_prepare(wb_world *w)
         v->np = -1;
     }
     const wb_model *m = &w->m;
+    const wb_distances *ds = wb__dist(w->dist);
     const int32_t nt = w->neo ? w->neo->n : 0;
     if (rebuild_due(w, v)) {
         if (!build_adjacency(w, v) || !build_colours(w, v)) return 0;
@@ -632,7 +635,7 @@ static void put_entries(struct wb_vbd *v, int32_t s, const vbd_link *L)
 /* each link as the sweeps read it this substep (vbd_link), and the hard links' list */
 static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2, wb_real inv_h)
 {
-    const wb_model *m = &w->m;
+    const wb_distances *ds = wb__dist(w->dist);
     const wb_real *xp = w->s.x_prev;
     v->nhard = 0;
     /* volume constraints are projected after the sweeps: with rigid links they may hold
@@ -667,7 +670,7 @@ static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2, wb_real in
 
 static void dual_update(wb_world *w, struct wb_vbd *v)
 {
-    const wb_model *m = &w->m;
+    const wb_distances *ds = wb__dist(w->dist);
     const wb_real *x = w->s.x;
     for (int32_t q = 0; q < v->nhard; q++) {
         const int32_t s = v->hard[q], a = ds->ij[2 * s], b = ds->ij[2 * s + 1];
@@ -749,10 +752,9 @@ static void bend_dual_update(wb_world *w, struct wb_vbd *v, wb_real h)
  * last sweep; a soft bend's off / alpha (a hard one's: bend_dual_update) */
 static void write_forces(wb_world *w, const struct wb_vbd *v, wb_real h)
 {
-    wb_cache *k = &w->k;
-    const wb_model *m = &w->m;
+    wb_distances *ds = w->dist;
     const wb_real h2 = h * h;
-    for (int32_t i = 0; i < ds->ns; i++) {
+    for (int32_t i = 0; ds && i < ds->ns; i++) {
         const int32_t s = ds->s_slot[i];
         if (!link_live(w, s)) { ds->s_lambda[i] = 0; continue; }
         const wb_real alpha = ds->alpha[s];
@@ -764,7 +766,7 @@ static void write_forces(wb_world *w, const struct wb_vbd *v, wb_real h)
             ds->s_lambda[i] = -v->lam[s] * h2;
         }
     }
-    ds->s_lambda_stale = 0;
+    if (ds) ds->s_lambda_stale = 0;
     wb_bends *bs = w->bend;
     if (!bs || bs->dirty) return;
     for (int32_t b = 0; b < bs->n; b++) {

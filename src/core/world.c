@@ -1,11 +1,12 @@
-/* world.c: world lifetime, settings, particles and distance constraints. */
+/* world.c: world lifetime, settings, particles and surfaces; the helpers every owner calls
+ * (errors, warnings, growth, the memory budget). */
 #include <assert.h>
 #include <float.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "ctype.h"
+#include "core.h"
 
 static _Thread_local char wb_err[256];
 
@@ -178,10 +179,9 @@ void wb_world_set_interrupt(wb_world *w, int (*fn)(void *ud), void *ud)
 int64_t wb_world_frame(const wb_world *w) { return w->s.frame; }
 
 /* ---- particles ------------------------------------------------------------------- */
-/* bytes per particle and per constraint over all the arrays that grow with them
- * (model, state and solver cache), for the memory limit */
+/* bytes per particle over all the arrays that grow with them (model, state and solver
+ * cache), for the memory limit */
 #define PARTICLE_BYTES (25 * sizeof(wb_real) + 5 + 8 + 5)
-#define CONSTRAINT_BYTES (14 * sizeof(wb_real) + 42)
 
 int wb__charge(wb_world *w, size_t *charged, size_t want)
 {
@@ -195,11 +195,8 @@ int wb__charge(wb_world *w, size_t *charged, size_t want)
     return 1;
 }
 
-/* the particles' and distances' arrays at capacities (cap_p, cap_d), charged together */
-static int charge(wb_world *w, int64_t cap_p, int64_t cap_d)
-{
-    return wb__charge(w, &w->m.charged, (size_t)cap_p * PARTICLE_BYTES + (size_t)cap_d * CONSTRAINT_BYTES);
-}
+/* the particles' arrays at capacity cap_p */
+static int charge(wb_world *w, int64_t cap_p) { return wb__charge(w, &w->m.charged, (size_t)cap_p * PARTICLE_BYTES); }
 
 /* every per-particle array grows together; on failure nothing is lost */
 static wb_status grow_particles(wb_world *w, int32_t need)
@@ -209,9 +206,9 @@ static wb_status grow_particles(wb_world *w, int32_t need)
     if (need > WB_MAX_PARTICLES) return WB_ERR_LIMIT;
     int32_t cap = m->cap_p ? m->cap_p : 64;
     while (cap < need) cap = cap > WB_MAX_PARTICLES / 2 ? WB_MAX_PARTICLES : cap * 2;
-    if (!charge(w, cap, ds->cap)) {
+    if (!charge(w, cap)) {
         cap = need; /* exact fit when doubling would cross the limit */
-        if (!charge(w, cap, ds->cap)) return WB_ERR_NOMEM;
+        if (!charge(w, cap)) return WB_ERR_NOMEM;
     }
     const wb_soa arr[] = {
         { (void **)&m->inv_mass, sizeof(wb_real) }, { (void **)&m->w, sizeof(wb_real) },
@@ -226,6 +223,12 @@ static wb_status grow_particles(wb_world *w, int32_t need)
     if (WB_SOA_RESIZE(arr, cap) != WB_OK) return WB_ERR_NOMEM;
     m->cap_p = cap;
     return WB_OK;
+}
+
+wb_status wb__particles_reserve(wb_world *w, int64_t extra)
+{
+    if (w->m.np + extra > WB_MAX_PARTICLES) return WB_ERR_LIMIT;
+    return grow_particles(w, w->m.np + (int32_t)extra);
 }
 
 int32_t wb_particle_add(wb_world *w, const wb_real pos[3], const wb_real vel[3], wb_real mass, wb_real radius)
@@ -298,203 +301,6 @@ void wb_particle_unpin(wb_world *w, int32_t p)
     w->m.w[p] = w->m.inv_mass[p];
     w->m.w_gen++;
 }
-
-/* ---- distance constraints --------------------------------------------------------- */
-wb_distance_def wb_distance_default_def(void)
-{
-    wb_distance_def d = { 0, 0, -1, 0, 0, 0, 0 };
-    return d;
-}
-
-/* the options' rules: the one place they are decided (the binding and the JSON reader
- * print what this finds) */
-static wb_fault distance_def_fault(const wb_distance_def *d)
-{
-    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return WB_FAULT_KEY("compliance", "must be >= 0");
-    if (!(d->damping >= 0) || !isfinite(d->damping)) return WB_FAULT_KEY("damping", "must be >= 0");
-    /* the solver works with squared lengths: a rest whose square overflows can never be met */
-    if (!isfinite(d->rest) || !isfinite(d->rest * d->rest))
-        return WB_FAULT_KEY("rest", "must be finite and below 1e154 (its square overflows)");
-    if (!(d->yield >= 0) || !isfinite(d->yield)) return WB_FAULT_KEY("yield", "must be >= 0");
-    if (!(d->creep >= 0) || !isfinite(d->creep)) return WB_FAULT_KEY("creep", "must be >= 0");
-    if (!(d->break_strain >= 0) || !isfinite(d->break_strain)) return WB_FAULT_KEY("break_strain", "must be >= 0");
-    if (!(d->break_force >= 0) || !isfinite(d->break_force)) return WB_FAULT_KEY("break_force", "must be >= 0");
-    return WB_NO_FAULT;
-}
-
-const char *wb_distance_def_check(const wb_distance_def *d)
-{
-    return distance_def_fault(d).msg;
-}
-
-/* the particles first (what it joins), then the options, then whether their distance has
- * a finite square (the rest it derives obeys the rule a given one does) */
-wb_fault wb_distance_check(int32_t np, const wb_real *x, int32_t a, int32_t b, const wb_distance_def *d)
-{
-    if (a < 0 || a >= np) return WB_FAULT_AT(0, "particle out of range", "out of range");
-    if (b < 0 || b >= np) return WB_FAULT_AT(1, "particle out of range", "out of range");
-    if (a == b)
-        return WB_FAULT_AT(1, "a constraint needs two distinct particles", "a constraint needs two distinct particles");
-    const wb_fault f = distance_def_fault(d);
-    if (f.msg || !x) return f;
-    wb_real dx[3];
-    v3_sub(dx, &x[3 * b], &x[3 * a]);
-    if (!isfinite(v3_dot(dx, dx)))
-        return WB_FAULT_AT(-1, "the particles are too far apart (their distance squared overflows)",
-                           "too far apart (their distance squared overflows)");
-    return WB_NO_FAULT;
-}
-
-static int slot_live(uint32_t gen) { return gen & 1u; }
-
-static wb_status grow_distances(wb_world *w, int32_t need)
-{
-    wb_model *m = &w->m;
-    if (need <= ds->cap) return WB_OK;
-    if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
-    int32_t cap = ds->cap ? ds->cap : 64;
-    while (cap < need) cap = cap > WB_MAX_CONSTRAINTS / 2 ? WB_MAX_CONSTRAINTS : cap * 2;
-    if (!charge(w, m->cap_p, cap)) {
-        cap = need;
-        if (!charge(w, m->cap_p, cap)) return WB_ERR_NOMEM;
-    }
-    const wb_soa arr[] = {
-        { (void **)&ds->ij, 2 * sizeof(int32_t) }, { (void **)&ds->alpha, sizeof(wb_real) },
-        { (void **)&ds->beta, sizeof(wb_real) }, { (void **)&ds->yield, sizeof(wb_real) },
-        { (void **)&ds->creep, sizeof(wb_real) }, { (void **)&ds->break_strain, sizeof(wb_real) },
-        { (void **)&ds->bforce, sizeof(wb_real) },
-        { (void **)&ds->gen, sizeof(uint32_t) }, { (void **)&ds->free_slots, sizeof(int32_t) },
-        { (void **)&wb__dist(w->dist)->rest, sizeof(wb_real) }, { (void **)&wb__dist(w->dist)->broken, 1 },
-        { (void **)&wb__dist(w->dist)->slot_pack, sizeof(int32_t) },
-    };
-    if (WB_SOA_RESIZE(arr, cap) != WB_OK) return WB_ERR_NOMEM;
-    ds->cap = cap;
-    return WB_OK;
-}
-
-/* room for np_extra more particles and nd_extra more constraints: after it succeeds,
- * adding them cannot fail, so a builder never leaves half a body behind */
-wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra)
-{
-    if (w->m.np + np_extra > WB_MAX_PARTICLES || wb__dist(w->dist)->n + nd_extra > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
-    wb_status st = grow_particles(w, w->m.np + (int32_t)np_extra);
-    if (st == WB_OK) st = grow_distances(w, wb__dist(w->dist)->n + (int32_t)nd_extra);
-    return st;
-}
-
-wb_distance_id wb_distance_add(wb_world *w, int32_t a, int32_t b, const wb_distance_def *def, wb_status *status)
-{
-    wb_distance_id none = { 0, 0 };
-    wb_status dummy;
-    if (!status) status = &dummy;
-    const wb_fault f = wb_distance_check(w->m.np, w->s.x, a, b, def);
-    if (f.msg) {
-        if (!f.key && f.corner < 0) wb__set_error("particles %d and %d are %s", a + 1, b + 1, f.why);
-        else wb__set_error("%s", f.msg);
-        *status = WB_ERR_ARG;
-        return none;
-    }
-    wb_real d[3];
-    v3_sub(d, &w->s.x[3 * b], &w->s.x[3 * a]);
-    const wb_real rest = def->rest >= 0 ? def->rest : v3_len(d);
-    wb_model *m = &w->m;
-    int32_t slot;
-    if (ds->nfree > 0) {
-        slot = ds->free_slots[--ds->nfree];
-    } else {
-        wb_status st = grow_distances(w, ds->n + 1);
-        if (st != WB_OK) { *status = st; return none; }
-        slot = ds->n++;
-        ds->gen[slot] = 0;
-    }
-    ds->ij[2 * slot] = a;
-    ds->ij[2 * slot + 1] = b;
-    ds->alpha[slot] = def->compliance;
-    ds->beta[slot] = def->damping;
-    ds->yield[slot] = def->yield;
-    ds->creep[slot] = def->creep;
-    ds->break_strain[slot] = def->break_strain;
-    ds->bforce[slot] = def->break_force;
-    ds->gen[slot]++; /* even -> odd: live */
-    wb__dist(w->dist)->rest[slot] = rest;
-    wb__dist(w->dist)->broken[slot] = 0;
-    wb__dist(w->dist)->slot_pack[slot] = -1;
-    ds->nlive++;
-    m->topology_dirty = 1;
-    *status = WB_OK;
-    wb_distance_id id = { (uint32_t)slot + 1, ds->gen[slot] };
-    return id;
-}
-
-bool wb_distance_valid(const wb_world *w, wb_distance_id c)
-{
-    if (c.index == 0 || c.index > (uint32_t)wb__dist(w->dist)->n) return false;
-    uint32_t g = wb__dist(w->dist)->gen[c.index - 1];
-    return slot_live(g) && g == c.gen;
-}
-
-#define SLOT(w, c) (assert(wb_distance_valid((w), (c))), (int32_t)(c).index - 1)
-
-void wb_distance_remove(wb_world *w, wb_distance_id c)
-{
-    int32_t s = SLOT(w, c);
-    wb__dist(w->dist)->gen[s]++; /* odd -> even: dead, old handles stale */
-    wb__dist(w->dist)->free_slots[wb__dist(w->dist)->nfree++] = s;
-    wb__dist(w->dist)->nlive--;
-    w->m.topology_dirty = 1;
-}
-
-wb_real wb_distance_force(const wb_world *w, wb_distance_id c)
-{
-    int32_t s = SLOT(w, c);
-    int32_t k = wb__dist(w->dist)->slot_pack[s];
-    if (k < 0 || k >= wb__dist(w->dist)->ns || wb__dist(w->dist)->s_lambda_stale) return 0; /* not stepped since it was made (or undone) */
-    const wb_real h = w->k.h_last; /* of the step that made lambda, whatever dt is now */
-    return fabs(wb__dist(w->dist)->s_lambda[k]) / (h * h);
-}
-
-wb_real wb_distance_rest(const wb_world *w, wb_distance_id c) { return wb__dist(w->dist)->rest[SLOT(w, c)]; }
-bool wb_distance_broken(const wb_world *w, wb_distance_id c) { return wb__dist(w->dist)->broken[SLOT(w, c)] != 0; }
-
-wb_real wb_distance_length(const wb_world *w, wb_distance_id c)
-{
-    int32_t s = SLOT(w, c);
-    wb_real d[3];
-    v3_sub(d, &w->s.x[3 * wb__dist(w->dist)->ij[2 * s + 1]], &w->s.x[3 * wb__dist(w->dist)->ij[2 * s]]);
-    return v3_len(d);
-}
-
-void wb_distance_particles(const wb_world *w, wb_distance_id c, int32_t *a, int32_t *b)
-{
-    int32_t s = SLOT(w, c);
-    *a = wb__dist(w->dist)->ij[2 * s];
-    *b = wb__dist(w->dist)->ij[2 * s + 1];
-}
-
-int32_t wb_distance_count(const wb_world *w) { return wb__dist(w->dist)->nlive; }
-
-wb_distance_id wb_distance_at(const wb_world *w, int32_t i)
-{
-    /* live slots in slot order: O(nd) scan, fine for inspection and export */
-    for (int32_t s = 0; s < wb__dist(w->dist)->n; s++) {
-        if (!slot_live(wb__dist(w->dist)->gen[s])) continue;
-        if (i-- == 0) { wb_distance_id id = { (uint32_t)s + 1, wb__dist(w->dist)->gen[s] }; return id; }
-    }
-    wb_distance_id none = { 0, 0 };
-    return none;
-}
-
-int32_t wb_distance_ids(const wb_world *w, wb_distance_id *out)
-{
-    int32_t n = 0;
-    for (int32_t s = 0; s < wb__dist(w->dist)->n; s++)
-        if (slot_live(wb__dist(w->dist)->gen[s])) { out[n].index = (uint32_t)s + 1; out[n].gen = wb__dist(w->dist)->gen[s]; n++; }
-    return n;
-}
-
-/* ---- events --------------------------------------------------------------------------- */
-int32_t wb_world_break_count(const wb_world *w) { return wb__dist(w->dist)->nbreaks; }
-wb_distance_id wb_world_break_at(const wb_world *w, int32_t i) { assert(i >= 0 && i < wb__dist(w->dist)->nbreaks); return wb__dist(w->dist)->breaks[i]; }
 
 /* ---- surfaces ------------------------------------------------------------------------ */
 /* room for one more surface of ntri triangles: after it, wb_surface_add cannot fail

@@ -10,15 +10,16 @@
 
 #include "core/core.h"
 #include "core/batch.h"
+#include "core/distance.h"
 #include "test.h"
 
 static void check_colouring(wb_world *w)
 {
     const wb_model *m = &w->m;
-    const wb_cache *k = &w->k;
     /* a break at the end of the last step marks the batches dirty: rebuild as a step would */
     REQUIRE(wb__colour(w) == WB_OK);
     REQUIRE(!m->topology_dirty);
+    const wb_distances *ds = wb__dist(w->dist);
     /* ranges */
     REQUIRE(ds->ncolours >= 0 && ds->serial_start >= 0 && ds->serial_start <= ds->ncolours);
     CHECK_EQ(ds->ncolours > 0 ? ds->colour_start[0] : 0, 0);
@@ -178,7 +179,7 @@ static int *lattice_colours(const wb_world *w, int32_t first, int32_t np)
     int *col = malloc(sizeof *col * (size_t)np * (size_t)np);
     if (!col) return NULL;
     for (int32_t i = 0; i < np * np; i++) col[i] = -1;
-    const wb_cache *k = &w->k;
+    const wb_distances *ds = wb__dist(w->dist);
     for (int32_t c = 0; c < ds->ncolours; c++)
         for (int32_t i = ds->colour_start[c]; i < ds->colour_start[c + 1]; i++) {
             const int32_t a = ds->s_a[i] - first, b = ds->s_b[i] - first;
@@ -228,7 +229,7 @@ static void mirror_mismatches(int n, int ny, int on, int mism[3])
     int *col = lattice_colours(w, b.first, np);
     REQUIRE(col);
     /* a lattice's compounds are the 2 or 4 images meeting at a particle on a plane */
-    const wb_cache *k = &w->k;
+    const wb_distances *ds = wb__dist(w->dist);
     for (int32_t c = 0; c < ds->ncomp; c++) CHECK(ds->comp_start[c + 1] - ds->comp_start[c] <= 4);
     mism[2] = ds->ncomp;
     mism[0] = mism[1] = 0;

@@ -16,6 +16,7 @@
 #include <stdlib.h>
 
 #include "core/core.h"
+#include "core/distance.h"
 #include "test.h"
 
 int wb__distance_simd(int on); /* distance.c's internal switch */

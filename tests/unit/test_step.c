@@ -4,6 +4,7 @@
 #include <stdlib.h>
 
 #include "core/core.h"
+#include "core/distance.h"
 #include "test.h"
 
 TEST(free_fall_exact)

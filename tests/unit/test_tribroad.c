@@ -15,6 +15,7 @@
 
 #include "core/core.h"
 #include "core/broadphase.h"
+#include "core/distance.h"
 #include "core/tricontact.h"
 #include "test.h"
 
@@ -28,7 +29,7 @@ static double urand(void)
 /* ---- the rules, brute force --------------------------------------------------------------------- */
 /* a loose particle's graph, found here by a walk over the links (the world's distance
  * constraints: the tests make no other type): the least loose particle it reaches */
-static int32_t graph_brute(const wb_model *m, int32_t p)
+static int32_t graph_brute(const wb_model *m, const wb_distances *ds, int32_t p)
 {
     if (m->group[p] > 0) return m->group[p];
     int32_t least = p, changed = 1;
@@ -50,7 +51,7 @@ static int32_t graph_brute(const wb_model *m, int32_t p)
     return -1 - least;
 }
 
-static int linked(const wb_model *m, int32_t p, int32_t v)
+static int linked(const wb_distances *ds, int32_t p, int32_t v)
 {
     for (int32_t s = 0; s < ds->n; s++)
         if ((ds->gen[s] & 1u) && ((ds->ij[2 * s] == p && ds->ij[2 * s + 1] == v) ||
@@ -59,10 +60,10 @@ static int linked(const wb_model *m, int32_t p, int32_t v)
     return 0;
 }
 
-static int allowed(const wb_model *m, int32_t p, int32_t v, int *same)
+static int allowed(const wb_model *m, const wb_distances *ds, int32_t p, int32_t v, int *same)
 {
-    if (linked(m, p, v)) return 0;
-    if (graph_brute(m, p) != graph_brute(m, v)) return (m->cflags[p] & m->cflags[v] & WB_CF_COLLIDE) != 0;
+    if (linked(ds, p, v)) return 0;
+    if (graph_brute(m, ds, p) != graph_brute(m, ds, v)) return (m->cflags[p] & m->cflags[v] & WB_CF_COLLIDE) != 0;
     *same = 1;
     return m->group[p] == 0 || (m->cflags[p] & m->cflags[v] & WB_CF_SELF) != 0;
 }
@@ -122,7 +123,7 @@ static int brute_pair(const wb_world *w, int32_t p, int32_t t)
     if (p == v[0] || p == v[1] || p == v[2]) return 0;
     int same = 0;
     for (int k = 0; k < 3; k++)
-        if (!allowed(m, p, v[k], &same)) return 0;
+        if (!allowed(m, wb__dist(w->dist), p, v[k], &same)) return 0;
     if (m->group[p] == m->group[v[0]] && covered(m, t)) return 0;
     if (m->w[p] == 0 && m->w[v[0]] == 0 && m->w[v[1]] == 0 && m->w[v[2]] == 0) return 0;
     /* the plane, then the triangle, within rp + mv */
