@@ -269,3 +269,40 @@ TEST(colour_mirror_images_alike)
     mirror_mismatches(7, 3, 0, m);
     CHECK(m[0] > 0);
 }
+
+/* the distances' struct is made with the first link: a world without any has none
+ * (stepped by either solver, cloned), and what the links charged is given back */
+TEST(colour_distances_made_with_the_first_link)
+{
+    wb_memory mem = { 0, 0 };
+    wb_world_def wd = wb_world_default_def();
+    wd.memory = &mem;
+    for (int jacobi = 0; jacobi < 2; jacobi++) {
+        wd.solver = jacobi ? WB_SOLVER_JACOBI : WB_SOLVER_GAUSS_SEIDEL;
+        wb_world *w = wb_world_create(&wd);
+        REQUIRE(w);
+        const wb_real pos[4][3] = { { 0, 1, 0 }, { 1, 1, 0 }, { 0, 2, 0 }, { 0, 1, 1 } };
+        int32_t p[4];
+        for (int i = 0; i < 4; i++) p[i] = wb_particle_add(w, pos[i], NULL, 1, 0.01);
+        const wb_tet_def td = wb_tet_default_def();
+        REQUIRE(wb_tet_add(w, p, &td) >= 0);
+        for (int f = 0; f < 3; f++) REQUIRE(wb_world_step(w) == WB_OK);
+        CHECK(w->dist == NULL);
+        const wb_stats st = wb_world_stats(w);
+        CHECK_EQ(st.distances, 0);
+        CHECK_EQ(st.colours, 0);
+        wb_world *c = wb_world_clone(w);
+        REQUIRE(c);
+        CHECK(c->dist == NULL);
+        wb_world_destroy(c);
+        const wb_distance_def dd = wb_distance_default_def();
+        const wb_distance_id id = wb_distance_add(w, p[0], p[1], &dd, NULL);
+        REQUIRE(id.index != 0);
+        REQUIRE(w->dist != NULL);
+        CHECK(w->dist->charged > 0);
+        REQUIRE(wb_world_step(w) == WB_OK);
+        CHECK_EQ(wb_world_stats(w).distances, 1);
+        wb_world_destroy(w);
+        CHECK_EQ(mem.used, 0);
+    }
+}
