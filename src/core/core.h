@@ -1,10 +1,11 @@
 /* core.h: the world's internals, shared by the core files only.
  *
  * Model / state split (MuJoCo's mjModel / mjData): the model holds what a step does
- * not change (masses, topology, compliances, collider shapes, colour batches); the
- * state holds what it does (positions, velocities, plastic rest lengths, broken flags,
- * collider poses, time). The step reads the model and writes the state; the solver
- * cache (packed batches, multipliers) is scratch rebuilt from both. */
+ * not change (masses, topology, collider shapes); the state holds what it does
+ * (positions, velocities, collider poses, time); the solver cache is scratch rebuilt
+ * from both. These are the particles', colliders' and step's; each constraint type keeps
+ * its own model, state and cache (rest lengths, broken flags, colour batches,
+ * multipliers) in a struct of its own header, which the world points to. */
 #ifndef WB_CORE_H
 #define WB_CORE_H
 
@@ -48,25 +49,15 @@ typedef struct wb_model {
     wb_real *cfric;        /* (np) contact friction (Coulomb, static = dynamic) */
     wb_real *x0;           /* (np x 3) where it was created: rest neighbours never collide */
 
-    /* distance constraints by slot; a slot is live while d_gen is odd */
-    int32_t nd, cap_d, nd_live;
-    int32_t *d_ij;         /* (nd x 2) particles */
-    wb_real *d_alpha;      /* (nd) compliance */
-    wb_real *d_beta;       /* (nd) damping */
-    wb_real *d_yield, *d_creep, *d_break; /* (nd) plasticity and breaking */
-    wb_real *d_bforce;     /* (nd) force that breaks it, N; 0 = none */
-    uint32_t *d_gen;       /* (nd) generation: odd = live */
-    int32_t *d_free;       /* free slots (stack) */
-    int32_t nfree;
-
     /* colliders by slot */
     int32_t nc, cap_c;
     wb_cshape *c_shape; /* (nc) */
     uint32_t *c_gen;       /* (nc) odd = live */
 
-    int topology_dirty;    /* colour batches must be rebuilt */
+    int topology_dirty;    /* particles or links added, removed or broken: the links' batches
+                              and what is built over the links must be rebuilt */
     uint32_t w_gen;        /* bumped when w changes without a topology change (pin, unpin) */
-    size_t charged;        /* bytes charged to def.memory */
+    size_t charged;        /* bytes of the per-particle arrays charged to def.memory */
     size_t charged_mesh;   /* bytes of mesh colliders' copies, charged to def.memory too */
 
     /* surfaces: triangles over particles, concatenated */
@@ -85,8 +76,6 @@ typedef struct wb_collider_pose {
 
 typedef struct wb_state {
     wb_real *x, *x_prev, *v; /* (np x 3) */
-    wb_real *d_rest;       /* (nd) rest lengths (plastic flow changes them) */
-    uint8_t *d_broken;     /* (nd) */
     wb_collider_pose *c_pose; /* (nc) */
     double time;
     int64_t frame;
@@ -98,47 +87,17 @@ typedef struct wb_state {
 #define WB_CF_SELF 2u        /* collides with its own body (group > 0) */
 
 
-/* ---- solver cache: packed colour batches and per-step scratch ------------------------ */
+/* ---- solver cache: per-step scratch ------------------------------------------------ */
 typedef struct wb_cache {
-    int32_t ns;            /* packed constraints (live and not broken) */
-    int32_t ncolours;
-    int32_t *colour_start; /* (ncolours + 1) batch ranges */
-    int32_t serial_start;  /* batches from here on are projected serially (overflow colours) */
-    int32_t split_start;   /* the compounds (colour.c's split) fill [split_start, ns) */
-    int32_t ncomp;
-    int32_t *comp_start;   /* (ncomp + 1) compound bounds in packed order, then s_nsp */
-    int32_t *s_nsp;        /* (2 (ns - split_start)) members of its compound at each end */
-    int32_t *s_a, *s_b;    /* (ns) particles */
-    wb_real *s_rest, *s_alpha, *s_beta; /* (ns) */
-    wb_real *s_lambda;     /* (ns) multipliers of the current substep */
-    wb_real *s_jac;        /* (ns) Jacobi scale 1/max(n_a, n_b), n = constraints at a movable end */
-    /* the vector path's per-constraint data (distance.c), views into the allocations of
-     * s_jac (4 ns reals) and s_slot (3 ns int32 + ns bytes), freed with them: */
-    wb_real *s_wa, *s_wc;  /* (ns) m.w of each end, refreshed every step (wb__colour) */
-    wb_real *s_at;         /* (ns) alpha / h^2 for h = s_at_h */
-    uint32_t *s_oa, *s_oc; /* (ns) 3 a, 3 c: the ends' offsets in x */
-    uint8_t *s_ok;         /* (ns) 1: wa > 0, wc > 0 and alpha / h^2 finite (no masked case) */
-    uint8_t *s_backed;     /* (ns) 1: both ends are corners of volume or tet constraints (a
-                              compressed link's lengthening is bounded: distance.c) */
-    int32_t s_backed_vt[2]; /* the volume and tet counts s_backed was worked out for */
-    wb_real s_at_h;        /* the substep s_at and s_ok are for */
-    int32_t *s_slot;       /* (ns) constraint slot of each packed entry */
-    int32_t *slot_pack;    /* (nd) packed index of each slot, -1 when not packed */
-    int any_damping;
-    int s_lambda_stale;    /* s_lambda is the last substep's: the next projection reads it as 0
-                              and writes every one (distance.c); force() reads 0 */
-    int any_frame_end;     /* a packed distance constraint can break or flow (distance_frame_end) */
-    uint32_t s_w_gen;      /* the m.w_gen s_wa, s_wc were copied at */
-    wb_real *dx;           /* (np x 3) Jacobi accumulators */
-    int32_t *ncount;       /* (np) constraints per particle (for s_jac) */
+    /* per particle, grown with the particles: the distances' scratch (distance.c) */
+    wb_real *dx;           /* (np x 3) Jacobi and compound accumulators */
+    int32_t *ncount;       /* (np) links at each particle (for the Jacobi scale) */
     wb_real *x_save, *v_save; /* (np x 3) last finite frame, for recovery */
     void *c_sub;           /* (nc) collider poses at the substep's start and end, then (nc)
                               static planes (collide.c); cap_c_sub in bytes */
     int32_t cap_c_sub;
     wb_real *c_left;       /* (np) overlap with the colliders each particle kept (collide.c) */
     int32_t cap_c_left;
-    wb_distance_id *breaks;
-    int32_t nbreaks, cap_breaks;
     wb_real *c_save;       /* (nc x 7) collider poses at the frame's start, for undo */
     int32_t cap_c_save;
     wb_real h_last;        /* substep length of the last step (force readback) */
@@ -196,9 +155,10 @@ struct wb_world {
     wb_model m;
     wb_state s;
     wb_cache k;
-    /* each constraint type but distance: its struct (model, state and cache) declared in
-     * its own header, made by its file with the first constraint, freed by its destroy
-     * hook (ctype.h); NULL until the first */
+    /* each constraint type: its struct (model, state and cache) declared in its own
+     * header, made by its file with the first constraint, freed by its destroy hook
+     * (ctype.h); NULL until the first */
+    struct wb_distances *dist; /* distance constraints (distance.h) */
     struct wb_bends *bend;  /* bends (bend.h) */
     struct wb_volumes *vol; /* volume constraints (volume.h) */
     struct wb_neos *neo;    /* Neo-Hookean tets (tet.h) */
@@ -233,7 +193,6 @@ static inline int wb__simd_set(int *state, int on)
 }
 
 /* internal entry points */
-wb_status wb__colour(wb_world *w);                 /* distance.c: rebuild the distance batches if dirty */
 /* momentum.c: once per step before the types' prepare (0: out of memory, nothing kept this
  * step); after each substep's solve, every free body's angular momentum back as it was */
 int wb__momentum_prepare(wb_world *w);
@@ -274,7 +233,11 @@ void wb__contacts_friction(wb_world *w, wb_real h);
 void wb__contacts_settle(wb_world *w, wb_real h);
 void wb__tricontacts_load(wb_world *w, wb_real h, wb_real *load);
 void wb__tricontacts_static(wb_world *w, wb_real *load);
-wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra); /* world.c */
+/* world.c: room for extra more particles (after it, adding them cannot fail) */
+wb_status wb__particles_reserve(wb_world *w, int64_t extra);
+/* distance.c: room for np_extra more particles and nd_extra more links: after it, adding
+ * them cannot fail, so a builder never leaves half a body behind */
+wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra);
 /* A Neo-Hookean body's damping (builders.c, tets.c): a dashpot along a tet edge of rest
  * length `length`, a link whose spring is 1e-4 of the edge's own stiffness E L (so E stays
  * E to about 1e-4 per link) and whose damping beta acts in full: with alpha~ >> 1/m the

@@ -1,16 +1,18 @@
-/* distance.c: the distance constraint type (the first of ctype.c's table): packing and
- * colouring of the live links into batches, their XPBD projection (Gauss-Seidel batch by
- * batch or Jacobi), plastic flow and breaking once per frame, and their elastic energy. The
- * slot arrays and the C API (wb_distance_*) live in world.c with the other model arrays;
- * this file owns the solver cache built from them (wb_cache's s_* arrays).
+/* distance.c: the distance constraint type (the first of ctype.c's table): its slots and
+ * the C API (wb_distance_*), packing and colouring of the live links into batches, their
+ * XPBD projection (Gauss-Seidel batch by batch or Jacobi), plastic flow and breaking once
+ * per frame, and their elastic energy. Its arrays are w->dist (distance.h), made with the
+ * first link.
  *
  * The batches are this file's own, not batch.h's: links are removed (slots freed, links
  * broken), so they are packed live ones only, the links meeting on a mirror plane are
  * split out as compounds projected together from the same positions (wb_split: a
  * symmetric scene stays symmetric), and the Jacobi solver runs over the same packing. */
+#include <assert.h>
 #include <stdlib.h>
 
 #include "ctype.h"
+#include "distance.h"
 #include "snapshot.h"
 #include "tet.h"
 #include "volume.h"
@@ -26,24 +28,239 @@ static int realloc_n(void **p, int32_t n, size_t elem)
 
 static int packable(const void *ud, int32_t s)
 {
-    const wb_world *w = ud;
-    return (w->m.d_gen[s] & 1u) && !w->s.d_broken[s];
+    const wb_distances *ds = ud;
+    return (ds->gen[s] & 1u) && !ds->broken[s];
 }
+
+/* ---- memory: the struct made with the first link ------------------------------------------ */
+/* bytes per slot over the arrays that grow with the slots (model, state, slot_pack) and
+ * the packed cache, for the memory limit */
+#define CONSTRAINT_BYTES (14 * sizeof(wb_real) + 42)
+
+static int slot_live(uint32_t gen) { return gen & 1u; }
+
+static int charge(wb_world *w, int32_t cap) { return wb__charge(w, &w->dist->charged, (size_t)cap * CONSTRAINT_BYTES); }
+
+/* room for need slots; the struct is made with the first (w->dist: NULL until then) */
+static wb_status grow_distances(wb_world *w, int32_t need)
+{
+    if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    if (!w->dist) {
+        if (need <= 0) return WB_OK;
+        wb_distances *ds = calloc(1, sizeof *ds);
+        if (!ds) return WB_ERR_NOMEM;
+        w->dist = ds;
+    }
+    wb_distances *ds = w->dist;
+    if (need <= ds->cap) return WB_OK;
+    int32_t cap = ds->cap ? ds->cap : 64;
+    while (cap < need) cap = cap > WB_MAX_CONSTRAINTS / 2 ? WB_MAX_CONSTRAINTS : cap * 2;
+    if (!charge(w, cap)) {
+        cap = need; /* exact fit when doubling would cross the limit */
+        if (!charge(w, cap)) return WB_ERR_NOMEM;
+    }
+    const wb_soa arr[] = {
+        { (void **)&ds->ij, 2 * sizeof(int32_t) }, { (void **)&ds->alpha, sizeof(wb_real) },
+        { (void **)&ds->beta, sizeof(wb_real) }, { (void **)&ds->yield, sizeof(wb_real) },
+        { (void **)&ds->creep, sizeof(wb_real) }, { (void **)&ds->break_strain, sizeof(wb_real) },
+        { (void **)&ds->bforce, sizeof(wb_real) },
+        { (void **)&ds->gen, sizeof(uint32_t) }, { (void **)&ds->free_slots, sizeof(int32_t) },
+        { (void **)&ds->rest, sizeof(wb_real) }, { (void **)&ds->broken, 1 },
+        { (void **)&ds->slot_pack, sizeof(int32_t) },
+    };
+    if (WB_SOA_RESIZE(arr, cap) != WB_OK) return WB_ERR_NOMEM;
+    ds->cap = cap;
+    return WB_OK;
+}
+
+wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra)
+{
+    const int32_t nd = wb__dist(w->dist)->n;
+    if (w->m.np + np_extra > WB_MAX_PARTICLES || nd + nd_extra > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
+    wb_status st = wb__particles_reserve(w, np_extra);
+    if (st == WB_OK) st = grow_distances(w, nd + (int32_t)nd_extra);
+    return st;
+}
+
+/* ---- the C API ---------------------------------------------------------------------------- */
+wb_distance_def wb_distance_default_def(void)
+{
+    wb_distance_def d = { 0, 0, -1, 0, 0, 0, 0 };
+    return d;
+}
+
+/* the options' rules: the one place they are decided (the binding and the JSON reader
+ * print what this finds) */
+static wb_fault distance_def_fault(const wb_distance_def *d)
+{
+    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return WB_FAULT_KEY("compliance", "must be >= 0");
+    if (!(d->damping >= 0) || !isfinite(d->damping)) return WB_FAULT_KEY("damping", "must be >= 0");
+    /* the solver works with squared lengths: a rest whose square overflows can never be met */
+    if (!isfinite(d->rest) || !isfinite(d->rest * d->rest))
+        return WB_FAULT_KEY("rest", "must be finite and below 1e154 (its square overflows)");
+    if (!(d->yield >= 0) || !isfinite(d->yield)) return WB_FAULT_KEY("yield", "must be >= 0");
+    if (!(d->creep >= 0) || !isfinite(d->creep)) return WB_FAULT_KEY("creep", "must be >= 0");
+    if (!(d->break_strain >= 0) || !isfinite(d->break_strain)) return WB_FAULT_KEY("break_strain", "must be >= 0");
+    if (!(d->break_force >= 0) || !isfinite(d->break_force)) return WB_FAULT_KEY("break_force", "must be >= 0");
+    return WB_NO_FAULT;
+}
+
+const char *wb_distance_def_check(const wb_distance_def *d)
+{
+    return distance_def_fault(d).msg;
+}
+
+/* the particles first (what it joins), then the options, then whether their distance has
+ * a finite square (the rest it derives obeys the rule a given one does) */
+wb_fault wb_distance_check(int32_t np, const wb_real *x, int32_t a, int32_t b, const wb_distance_def *d)
+{
+    if (a < 0 || a >= np) return WB_FAULT_AT(0, "particle out of range", "out of range");
+    if (b < 0 || b >= np) return WB_FAULT_AT(1, "particle out of range", "out of range");
+    if (a == b)
+        return WB_FAULT_AT(1, "a constraint needs two distinct particles", "a constraint needs two distinct particles");
+    const wb_fault f = distance_def_fault(d);
+    if (f.msg || !x) return f;
+    wb_real dx[3];
+    v3_sub(dx, &x[3 * b], &x[3 * a]);
+    if (!isfinite(v3_dot(dx, dx)))
+        return WB_FAULT_AT(-1, "the particles are too far apart (their distance squared overflows)",
+                           "too far apart (their distance squared overflows)");
+    return WB_NO_FAULT;
+}
+
+wb_distance_id wb_distance_add(wb_world *w, int32_t a, int32_t b, const wb_distance_def *def, wb_status *status)
+{
+    wb_distance_id none = { 0, 0 };
+    wb_status dummy;
+    if (!status) status = &dummy;
+    const wb_fault f = wb_distance_check(w->m.np, w->s.x, a, b, def);
+    if (f.msg) {
+        if (!f.key && f.corner < 0) wb__set_error("particles %d and %d are %s", a + 1, b + 1, f.why);
+        else wb__set_error("%s", f.msg);
+        *status = WB_ERR_ARG;
+        return none;
+    }
+    wb_real d[3];
+    v3_sub(d, &w->s.x[3 * b], &w->s.x[3 * a]);
+    const wb_real rest = def->rest >= 0 ? def->rest : v3_len(d);
+    int32_t slot;
+    if (w->dist && w->dist->nfree > 0) {
+        slot = w->dist->free_slots[--w->dist->nfree];
+    } else {
+        wb_status st = grow_distances(w, wb__dist(w->dist)->n + 1);
+        if (st != WB_OK) { *status = st; return none; }
+        slot = w->dist->n++;
+        w->dist->gen[slot] = 0;
+    }
+    wb_distances *ds = w->dist;
+    ds->ij[2 * slot] = a;
+    ds->ij[2 * slot + 1] = b;
+    ds->alpha[slot] = def->compliance;
+    ds->beta[slot] = def->damping;
+    ds->yield[slot] = def->yield;
+    ds->creep[slot] = def->creep;
+    ds->break_strain[slot] = def->break_strain;
+    ds->bforce[slot] = def->break_force;
+    ds->gen[slot]++; /* even -> odd: live */
+    ds->rest[slot] = rest;
+    ds->broken[slot] = 0;
+    ds->slot_pack[slot] = -1;
+    ds->nlive++;
+    w->m.topology_dirty = 1;
+    *status = WB_OK;
+    wb_distance_id id = { (uint32_t)slot + 1, ds->gen[slot] };
+    return id;
+}
+
+bool wb_distance_valid(const wb_world *w, wb_distance_id c)
+{
+    const wb_distances *ds = wb__dist(w->dist);
+    if (c.index == 0 || c.index > (uint32_t)ds->n) return false;
+    uint32_t g = ds->gen[c.index - 1];
+    return slot_live(g) && g == c.gen;
+}
+
+/* a valid handle's slot (so w->dist exists) */
+#define SLOT(w, c) (assert(wb_distance_valid((w), (c))), (int32_t)(c).index - 1)
+
+void wb_distance_remove(wb_world *w, wb_distance_id c)
+{
+    int32_t s = SLOT(w, c);
+    wb_distances *ds = w->dist;
+    ds->gen[s]++; /* odd -> even: dead, old handles stale */
+    ds->free_slots[ds->nfree++] = s;
+    ds->nlive--;
+    w->m.topology_dirty = 1;
+}
+
+wb_real wb_distance_force(const wb_world *w, wb_distance_id c)
+{
+    int32_t s = SLOT(w, c);
+    const wb_distances *ds = w->dist;
+    int32_t k = ds->slot_pack[s];
+    if (k < 0 || k >= ds->ns || ds->s_lambda_stale) return 0; /* not stepped since it was made (or undone) */
+    const wb_real h = w->k.h_last; /* of the step that made lambda, whatever dt is now */
+    return fabs(ds->s_lambda[k]) / (h * h);
+}
+
+wb_real wb_distance_rest(const wb_world *w, wb_distance_id c) { return w->dist->rest[SLOT(w, c)]; }
+bool wb_distance_broken(const wb_world *w, wb_distance_id c) { return w->dist->broken[SLOT(w, c)] != 0; }
+
+wb_real wb_distance_length(const wb_world *w, wb_distance_id c)
+{
+    int32_t s = SLOT(w, c);
+    wb_real d[3];
+    v3_sub(d, &w->s.x[3 * w->dist->ij[2 * s + 1]], &w->s.x[3 * w->dist->ij[2 * s]]);
+    return v3_len(d);
+}
+
+void wb_distance_particles(const wb_world *w, wb_distance_id c, int32_t *a, int32_t *b)
+{
+    int32_t s = SLOT(w, c);
+    *a = w->dist->ij[2 * s];
+    *b = w->dist->ij[2 * s + 1];
+}
+
+int32_t wb_distance_count(const wb_world *w) { return wb__dist(w->dist)->nlive; }
+
+wb_distance_id wb_distance_at(const wb_world *w, int32_t i)
+{
+    /* live slots in slot order: O(nd) scan, fine for inspection and export */
+    const wb_distances *ds = wb__dist(w->dist);
+    for (int32_t s = 0; s < ds->n; s++) {
+        if (!slot_live(ds->gen[s])) continue;
+        if (i-- == 0) { wb_distance_id id = { (uint32_t)s + 1, ds->gen[s] }; return id; }
+    }
+    wb_distance_id none = { 0, 0 };
+    return none;
+}
+
+int32_t wb_distance_ids(const wb_world *w, wb_distance_id *out)
+{
+    const wb_distances *ds = wb__dist(w->dist);
+    int32_t n = 0;
+    for (int32_t s = 0; s < ds->n; s++)
+        if (slot_live(ds->gen[s])) { out[n].index = (uint32_t)s + 1; out[n].gen = ds->gen[s]; n++; }
+    return n;
+}
+
+int32_t wb_world_break_count(const wb_world *w) { return wb__dist(w->dist)->nbreaks; }
+wb_distance_id wb_world_break_at(const wb_world *w, int32_t i) { assert(i >= 0 && i < wb_world_break_count(w)); return w->dist->breaks[i]; }
 
 /* ---- packing: rebuild the colour batches when the topology changed --------------------- */
 static wb_status colour(wb_world *w);
 
 /* alpha / h^2 per constraint for the substep h, and which constraints need none of the
  * vector path's masks (after s_wa, s_wc) */
-static void refresh_at(wb_cache *k, wb_real h)
+static void refresh_at(wb_distances *ds, wb_real h)
 {
     const wb_real inv_h2 = 1 / (h * h);
-    for (int32_t i = 0; i < k->ns; i++) {
-        const wb_real at = k->s_alpha[i] * inv_h2;
-        k->s_at[i] = at;
-        k->s_ok[i] = k->s_wa[i] > 0 && k->s_wc[i] > 0 && !isinf(at);
+    for (int32_t i = 0; i < ds->ns; i++) {
+        const wb_real at = ds->s_alpha[i] * inv_h2;
+        ds->s_at[i] = at;
+        ds->s_ok[i] = ds->s_wa[i] > 0 && ds->s_wc[i] > 0 && !isinf(at);
     }
-    k->s_at_h = h;
+    ds->s_at_h = h;
 }
 
 /* which packed links have both ends on volume or tet constraints (s_backed): worked out
@@ -51,17 +268,17 @@ static void refresh_at(wb_cache *k, wb_real h)
  * link is marked: they keep their full correction) */
 static int mark_backed(wb_world *w)
 {
-    wb_cache *k = &w->k;
+    wb_distances *ds = w->dist;
     const int32_t nv = wb_volume_count(w), nt = wb_tet_count(w), np = w->m.np;
-    k->s_backed_vt[0] = nv;
-    k->s_backed_vt[1] = nt;
-    if (k->ns > 0) memset(k->s_backed, 0, (size_t)k->ns);
-    if (nv + nt == 0 || k->ns == 0) return 1;
+    ds->s_backed_vt[0] = nv;
+    ds->s_backed_vt[1] = nt;
+    if (ds->ns > 0) memset(ds->s_backed, 0, (size_t)ds->ns);
+    if (nv + nt == 0 || ds->ns == 0) return 1;
     uint8_t *on = calloc((size_t)(np > 0 ? np : 1), 1);
     if (!on) return 0;
     for (int64_t i = 0; i < 4 * (int64_t)nv; i++) on[w->vol->ijkl[i]] = 1;
     for (int64_t i = 0; i < 4 * (int64_t)nt; i++) on[w->neo->ijkl[i]] = 1;
-    for (int32_t i = 0; i < k->ns; i++) k->s_backed[i] = on[k->s_a[i]] & on[k->s_b[i]];
+    for (int32_t i = 0; i < ds->ns; i++) ds->s_backed[i] = on[ds->s_a[i]] & on[ds->s_b[i]];
     free(on);
     return 1;
 }
@@ -71,30 +288,36 @@ static int mark_backed(wb_world *w)
  * pin, unpin, set mass and snapshot loads change m.w between steps only) */
 wb_status wb__colour(wb_world *w)
 {
-    wb_cache *k = &w->k;
+    wb_distances *ds = w->dist;
+    if (ds) ds->nbreaks = 0; /* the list reports the step about to run */
     const int recoloured = w->m.topology_dirty;
+    if (!ds) { /* no links: nothing to pack, the new topology taken as one would */
+        if (recoloured && w->k.pc) w->k.pc->keys_dirty = 1;
+        w->m.topology_dirty = 0;
+        return WB_OK;
+    }
     if (recoloured) {
         const wb_status st = colour(w);
         if (st != WB_OK) return st;
     }
-    if ((recoloured || k->s_backed_vt[0] != wb_volume_count(w) || k->s_backed_vt[1] != wb_tet_count(w)) &&
+    if ((recoloured || ds->s_backed_vt[0] != wb_volume_count(w) || ds->s_backed_vt[1] != wb_tet_count(w)) &&
         !mark_backed(w))
         return WB_ERR_NOMEM;
     /* (only when they changed: the copy cost 3.5% of the 32x32 cloth's frame) */
-    if (recoloured || k->s_w_gen != w->m.w_gen) {
+    if (recoloured || ds->s_w_gen != w->m.w_gen) {
         const wb_real *wv = w->m.w;
-        const int32_t *restrict sa = k->s_a, *restrict sb = k->s_b;
-        wb_real *restrict wa = k->s_wa, *restrict wc = k->s_wc;
-        for (int32_t i = 0, n = k->ns; i < n; i++) {
+        const int32_t *restrict sa = ds->s_a, *restrict sb = ds->s_b;
+        wb_real *restrict wa = ds->s_wa, *restrict wc = ds->s_wc;
+        for (int32_t i = 0, n = ds->ns; i < n; i++) {
             wa[i] = wv[sa[i]];
             wc[i] = wv[sb[i]];
         }
-        k->s_w_gen = w->m.w_gen;
-        k->s_at_h = NAN; /* s_ok reads s_wa, s_wc */
+        ds->s_w_gen = w->m.w_gen;
+        ds->s_at_h = NAN; /* s_ok reads s_wa, s_wc */
     }
     /* the solver's substep as it computes it; distance_project checks it too */
     const wb_real h = w->m.def.dt / w->m.def.substeps;
-    if (h != k->s_at_h) refresh_at(k, h);
+    if (h != ds->s_at_h) refresh_at(ds, h);
     return WB_OK;
 }
 
@@ -102,82 +325,83 @@ static wb_status colour(wb_world *w)
 {
     wb_model *m = &w->m;
     wb_cache *k = &w->k;
+    wb_distances *ds = w->dist;
     if (k->pc) k->pc->keys_dirty = 1; /* the constraint pairs that self-collision skips */
 
     int32_t ns = 0;
-    for (int32_t s = 0; s < m->nd; s++) ns += packable(w, s);
+    for (int32_t s = 0; s < ds->n; s++) ns += packable(ds, s);
 
-    uint8_t *colour = malloc((size_t)(m->nd > 0 ? m->nd : 1));
+    uint8_t *colour = malloc((size_t)(ds->n > 0 ? ds->n : 1));
     int32_t count[WB_MAX_COLOURS + 1];
-    wb_split split = { 0, 0, 0, malloc(sizeof(int32_t) * (size_t)(m->nd > 0 ? m->nd : 1)),
-                       malloc(sizeof(int32_t) * ((size_t)m->nd + 1)) };
+    wb_split split = { 0, 0, 0, malloc(sizeof(int32_t) * (size_t)(ds->n > 0 ? ds->n : 1)),
+                       malloc(sizeof(int32_t) * ((size_t)ds->n + 1)) };
     if (!colour || !split.member || !split.comp_start ||
-        !realloc_n((void **)&k->s_a, ns, sizeof(int32_t)) || !realloc_n((void **)&k->s_b, ns, sizeof(int32_t)) ||
-        !realloc_n((void **)&k->s_rest, ns, sizeof(wb_real)) || !realloc_n((void **)&k->s_alpha, ns, sizeof(wb_real)) ||
-        !realloc_n((void **)&k->s_beta, ns, sizeof(wb_real)) || !realloc_n((void **)&k->s_lambda, ns, sizeof(wb_real)) ||
-        !realloc_n((void **)&k->s_jac, ns, 4 * sizeof(wb_real)) ||
-        !realloc_n((void **)&k->s_slot, ns, 3 * sizeof(int32_t) + 2) ||
-        !realloc_n((void **)&k->colour_start, WB_MAX_COLOURS + 2, sizeof(int32_t)) ||
-        !wb__colour_greedy(m, m->d_ij, 2, m->nd, packable, w, colour, count, &split) ||
-        !realloc_n((void **)&k->comp_start, split.ncomp + 1 + 2 * split.n, sizeof(int32_t))) {
+        !realloc_n((void **)&ds->s_a, ns, sizeof(int32_t)) || !realloc_n((void **)&ds->s_b, ns, sizeof(int32_t)) ||
+        !realloc_n((void **)&ds->s_rest, ns, sizeof(wb_real)) || !realloc_n((void **)&ds->s_alpha, ns, sizeof(wb_real)) ||
+        !realloc_n((void **)&ds->s_beta, ns, sizeof(wb_real)) || !realloc_n((void **)&ds->s_lambda, ns, sizeof(wb_real)) ||
+        !realloc_n((void **)&ds->s_jac, ns, 4 * sizeof(wb_real)) ||
+        !realloc_n((void **)&ds->s_slot, ns, 3 * sizeof(int32_t) + 2) ||
+        !realloc_n((void **)&ds->colour_start, WB_MAX_COLOURS + 2, sizeof(int32_t)) ||
+        !wb__colour_greedy(m, ds->ij, 2, ds->n, packable, ds, colour, count, &split) ||
+        !realloc_n((void **)&ds->comp_start, split.ncomp + 1 + 2 * split.n, sizeof(int32_t))) {
         free(colour);
         free(split.member);
         free(split.comp_start);
         return WB_ERR_NOMEM;
     }
-    k->s_wa = k->s_jac + ns;
-    k->s_wc = k->s_jac + 2 * ns;
-    k->s_at = k->s_jac + 3 * ns;
-    k->s_oa = (uint32_t *)(k->s_slot + ns);
-    k->s_oc = (uint32_t *)(k->s_slot + 2 * ns);
-    k->s_ok = (uint8_t *)(k->s_slot + 3 * ns);
-    k->s_backed = k->s_ok + ns;
-    k->s_at_h = NAN; /* none yet: h != NaN */
+    ds->s_wa = ds->s_jac + ns;
+    ds->s_wc = ds->s_jac + 2 * ns;
+    ds->s_at = ds->s_jac + 3 * ns;
+    ds->s_oa = (uint32_t *)(ds->s_slot + ns);
+    ds->s_oc = (uint32_t *)(ds->s_slot + 2 * ns);
+    ds->s_ok = (uint8_t *)(ds->s_slot + 3 * ns);
+    ds->s_backed = ds->s_ok + ns;
+    ds->s_at_h = NAN; /* none yet: h != NaN */
     int32_t start[WB_MAX_COLOURS + 1];
     /* the batches, then the compounds (colour.c) in their order */
-    k->split_start = wb__colour_ranges(count, k->colour_start, &k->ncolours, &k->serial_start, start);
-    k->ns = k->split_start + split.n;
-    k->ncomp = split.ncomp;
-    for (int32_t c = 0; c <= split.ncomp; c++) k->comp_start[c] = k->split_start + split.comp_start[c];
-    for (int32_t j = 0; j < split.n; j++) k->slot_pack[split.member[j]] = k->split_start + j;
-    k->any_damping = 0;
-    k->any_frame_end = 0;
+    ds->split_start = wb__colour_ranges(count, ds->colour_start, &ds->ncolours, &ds->serial_start, start);
+    ds->ns = ds->split_start + split.n;
+    ds->ncomp = split.ncomp;
+    for (int32_t c = 0; c <= split.ncomp; c++) ds->comp_start[c] = ds->split_start + split.comp_start[c];
+    for (int32_t j = 0; j < split.n; j++) ds->slot_pack[split.member[j]] = ds->split_start + j;
+    ds->any_damping = 0;
+    ds->any_frame_end = 0;
     for (int32_t i = 0; i < m->np; i++) k->ncount[i] = 0;
-    for (int32_t s = 0; s < m->nd; s++) {
-        if (colour[s] == WB_NO_COLOUR) { k->slot_pack[s] = -1; continue; }
-        int32_t i = colour[s] == WB_SPLIT_COLOUR ? k->slot_pack[s] : start[colour[s]]++;
-        int32_t a = m->d_ij[2 * s], b = m->d_ij[2 * s + 1];
-        k->s_a[i] = a;
-        k->s_b[i] = b;
-        k->s_rest[i] = w->s.d_rest[s];
-        k->s_alpha[i] = m->d_alpha[s];
-        k->s_beta[i] = m->d_beta[s];
-        k->s_lambda[i] = 0;
-        k->s_slot[i] = s;
-        k->s_oa[i] = 3 * (uint32_t)a;
-        k->s_oc[i] = 3 * (uint32_t)b;
-        k->slot_pack[s] = i;
+    for (int32_t s = 0; s < ds->n; s++) {
+        if (colour[s] == WB_NO_COLOUR) { ds->slot_pack[s] = -1; continue; }
+        int32_t i = colour[s] == WB_SPLIT_COLOUR ? ds->slot_pack[s] : start[colour[s]]++;
+        int32_t a = ds->ij[2 * s], b = ds->ij[2 * s + 1];
+        ds->s_a[i] = a;
+        ds->s_b[i] = b;
+        ds->s_rest[i] = ds->rest[s];
+        ds->s_alpha[i] = ds->alpha[s];
+        ds->s_beta[i] = ds->beta[s];
+        ds->s_lambda[i] = 0;
+        ds->s_slot[i] = s;
+        ds->s_oa[i] = 3 * (uint32_t)a;
+        ds->s_oc[i] = 3 * (uint32_t)b;
+        ds->slot_pack[s] = i;
         k->ncount[a]++;
         k->ncount[b]++;
-        if (m->d_beta[s] > 0 && m->d_alpha[s] > 0) k->any_damping = 1;
-        if (m->d_break[s] > 0 || m->d_yield[s] > 0 || m->d_bforce[s] > 0) k->any_frame_end = 1;
+        if (ds->beta[s] > 0 && ds->alpha[s] > 0) ds->any_damping = 1;
+        if (ds->break_strain[s] > 0 || ds->yield[s] > 0 || ds->bforce[s] > 0) ds->any_frame_end = 1;
     }
     /* Jacobi: a constraint's share is set by its busier movable end (an immovable
      * hub must not shrink its spokes' corrections) */
     for (int32_t i = 0; i < ns; i++) {
-        const int32_t a = k->s_a[i], b = k->s_b[i];
+        const int32_t a = ds->s_a[i], b = ds->s_b[i];
         const int32_t na = m->inv_mass[a] > 0 ? k->ncount[a] : 1, nb = m->inv_mass[b] > 0 ? k->ncount[b] : 1;
-        k->s_jac[i] = (wb_real)1 / (na > nb ? na : nb);
+        ds->s_jac[i] = (wb_real)1 / (na > nb ? na : nb);
     }
     /* a compound member's ends: how many of its compound's members meet there */
-    k->s_nsp = k->comp_start + k->ncomp + 1;
-    for (int32_t c = 0; c < k->ncomp; c++)
-        for (int32_t i = k->comp_start[c]; i < k->comp_start[c + 1]; i++) {
-            int32_t *n = &k->s_nsp[2 * (i - k->split_start)];
+    ds->s_nsp = ds->comp_start + ds->ncomp + 1;
+    for (int32_t c = 0; c < ds->ncomp; c++)
+        for (int32_t i = ds->comp_start[c]; i < ds->comp_start[c + 1]; i++) {
+            int32_t *n = &ds->s_nsp[2 * (i - ds->split_start)];
             n[0] = n[1] = 0;
-            for (int32_t j = k->comp_start[c]; j < k->comp_start[c + 1]; j++) {
-                n[0] += k->s_a[j] == k->s_a[i] || k->s_b[j] == k->s_a[i];
-                n[1] += k->s_a[j] == k->s_b[i] || k->s_b[j] == k->s_b[i];
+            for (int32_t j = ds->comp_start[c]; j < ds->comp_start[c + 1]; j++) {
+                n[0] += ds->s_a[j] == ds->s_a[i] || ds->s_b[j] == ds->s_a[i];
+                n[1] += ds->s_a[j] == ds->s_b[i] || ds->s_b[j] == ds->s_b[i];
             }
         }
     free(colour);
@@ -213,7 +437,7 @@ static wb_status colour(wb_world *w)
 /* Project the distance constraints [b, e) of the packed arrays (XPBD, Macklin et al.
  * 2016 eq. 18 with the damping of eq. 26). Gauss-Seidel updates positions in place;
  * Jacobi (out = dx) accumulates corrections computed from the same positions, each
- * scaled by omega / max(n_a, n_b) (k->s_jac) for both its ends, so that a pair's
+ * scaled by omega / max(n_a, n_b) (ds->s_jac) for both its ends, so that a pair's
  * corrections stay equal and opposite (momentum) and lambda is the multiplier
  * actually applied (force readback). Particles with w = 0 are never written, not
  * even with 0: -0.0 would turn +0.0, and immovable particles may be shared inside
@@ -223,21 +447,21 @@ static wb_status colour(wb_world *w)
  * AVX-512 gathers and scatters measured slower than this scalar loop; the AVX2 path
  * below, with transposes, is faster: see project_range4.) */
 static inline __attribute__((always_inline)) void
-project_range(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
+project_range(const wb_distances *ds, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
               wb_real *out, int32_t b, int32_t e, wb_real h, wb_real inv_h2, wb_real omega,
               const int damped, const int jacobi, const int fresh, const int split)
 {
-    const int32_t *restrict sa = k->s_a, *restrict sb = k->s_b;
-    const wb_real *restrict rest = k->s_rest, *restrict alpha = k->s_alpha, *restrict beta = k->s_beta;
-    const wb_real *restrict jac = k->s_jac;
-    const uint8_t *restrict backed = k->s_backed;
-    wb_real *restrict lambda = k->s_lambda;
+    const int32_t *restrict sa = ds->s_a, *restrict sb = ds->s_b;
+    const wb_real *restrict rest = ds->s_rest, *restrict alpha = ds->s_alpha, *restrict beta = ds->s_beta;
+    const wb_real *restrict jac = ds->s_jac;
+    const uint8_t *restrict backed = ds->s_backed;
+    wb_real *restrict lambda = ds->s_lambda;
     for (int32_t i = b; i < e; i++) {
         const int32_t ia = sa[i], ic = sb[i];
         const wb_real wa = wv[ia], wc = wv[ic], wsum = wa + wc;
         /* a compound member sees each shared end's mass split among the members there
          * (their corrections add up) */
-        const int32_t *nsp = split ? &k->s_nsp[2 * (i - k->split_start)] : NULL;
+        const int32_t *nsp = split ? &ds->s_nsp[2 * (i - ds->split_start)] : NULL;
         const wb_real wden = split ? wa * (wb_real)nsp[0] + wc * (wb_real)nsp[1] : wsum;
         const wb_real *xa = &x[3 * ia], *xc = &x[3 * ic];
         const wb_real d0 = xc[0] - xa[0], d1 = xc[1] - xa[1], d2 = xc[2] - xa[2];
@@ -357,13 +581,13 @@ offsets(const uint32_t *a, const uint32_t *c, size_t oa[4], size_t oc[4])
  * cloth128: noise); CH 32 or 128 (no difference). Earlier: prefetching 16 or 64
  * constraints ahead cost 0.3-0.5 ns. */
 static inline __attribute__((always_inline, target("avx2"))) void
-project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
+project_range4(const wb_distances *ds, const wb_real *restrict wv, wb_real *x, const wb_real *restrict xp,
                wb_real *out, int32_t b, int32_t e, wb_real h, wb_real inv_h2, wb_real omega,
                const int damped, const int jacobi, const int fresh)
 {
-    const uint32_t *restrict soa = k->s_oa, *restrict soc = k->s_oc;
-    const wb_real *restrict swa = k->s_wa, *restrict swc = k->s_wc;
-    wb_real *restrict lambda = k->s_lambda;
+    const uint32_t *restrict soa = ds->s_oa, *restrict soc = ds->s_oc;
+    const wb_real *restrict swa = ds->s_wa, *restrict swc = ds->s_wc;
+    wb_real *restrict lambda = ds->s_lambda;
     const __m256d zero = _mm256_setzero_pd(), tiny = _mm256_set1_pd(1e-24), inf = _mm256_set1_pd(INFINITY);
     const __m256d absmask = _mm256_castsi256_pd(_mm256_set1_epi64x(INT64_MAX));
     const __m256d vh = _mm256_set1_pd(h), vomega = _mm256_set1_pd(omega);
@@ -390,13 +614,13 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
                                                _mm256_mul_pd(d2, d2));
             __m256d live = _mm256_cmp_pd(len2, tiny, _CMP_NLT_UQ);
             uint32_t ok;
-            memcpy(&ok, &k->s_ok[j], sizeof ok);
+            memcpy(&ok, &ds->s_ok[j], sizeof ok);
             if (ok == 0x01010101u && _mm256_movemask_pd(live) == 15) {
                 wr[g / 4] = 0xff; /* every lane goes on and writes both ends */
             } else {
                 /* the lanes that go on: !(wsum == 0 || len2 < 1e-24) && !isinf(at), NaN going on */
                 const __m256d wa = _mm256_loadu_pd(&swa[j]), wc = _mm256_loadu_pd(&swc[j]);
-                const __m256d at = _mm256_loadu_pd(&k->s_at[j]);
+                const __m256d at = _mm256_loadu_pd(&ds->s_at[j]);
                 live = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(_mm256_add_pd(wa, wc), zero, _CMP_NEQ_UQ), live),
                                      _mm256_cmp_pd(_mm256_and_pd(at, absmask), inf, _CMP_NEQ_UQ));
                 const int wra = _mm256_movemask_pd(_mm256_and_pd(live, _mm256_cmp_pd(wa, zero, _CMP_GT_OQ)));
@@ -424,12 +648,12 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
             }
             const int32_t j = c0 + g;
             const __m256d wsum = _mm256_add_pd(_mm256_loadu_pd(&swa[j]), _mm256_loadu_pd(&swc[j]));
-            const __m256d at = _mm256_loadu_pd(&k->s_at[j]), len = _mm256_load_pd(&lv[g]);
+            const __m256d at = _mm256_loadu_pd(&ds->s_at[j]), len = _mm256_load_pd(&lv[g]);
             const __m256d lam = fresh ? zero : _mm256_loadu_pd(&lambda[j]);
-            __m256d num = _mm256_sub_pd(_mm256_sub_pd(_mm256_loadu_pd(&k->s_rest[j]), len), _mm256_mul_pd(at, lam));
+            __m256d num = _mm256_sub_pd(_mm256_sub_pd(_mm256_loadu_pd(&ds->s_rest[j]), len), _mm256_mul_pd(at, lam));
             __m256d den = _mm256_add_pd(wsum, at);
             if (damped) {
-                const __m256d gamma = _mm256_mul_pd(_mm256_mul_pd(at, _mm256_loadu_pd(&k->s_beta[j])), vh);
+                const __m256d gamma = _mm256_mul_pd(_mm256_mul_pd(at, _mm256_loadu_pd(&ds->s_beta[j])), vh);
                 const __m256d rel = _mm256_load_pd(&rv[g]);
                 const __m256d ginf = _mm256_cmp_pd(_mm256_and_pd(gamma, absmask), inf, _CMP_EQ_OQ);
                 const __m256d nfin = _mm256_sub_pd(num, _mm256_div_pd(_mm256_mul_pd(gamma, rel), len));
@@ -439,11 +663,11 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
                 den = _mm256_blendv_pd(dfin, wsum, ginf);
             }
             __m256d s = _mm256_div_pd(num, _mm256_mul_pd(den, len));
-            if (jacobi) s = _mm256_mul_pd(s, _mm256_mul_pd(vomega, _mm256_loadu_pd(&k->s_jac[j])));
+            if (jacobi) s = _mm256_mul_pd(s, _mm256_mul_pd(vomega, _mm256_loadu_pd(&ds->s_jac[j])));
             /* a compressed link's lengthening bent past STRETCH_FREE (project_range), the
              * same operations; the divisions only when a live lane needs them */
             uint32_t bk;
-            memcpy(&bk, &k->s_backed[j], sizeof bk);
+            memcpy(&bk, &ds->s_backed[j], sizeof bk);
             if (bk) {
                 const __m256i lanes = _mm256_cvtepu8_epi64(_mm_cvtsi32_si128((int)bk));
                 const __m256d e = _mm256_mul_pd(s, wsum);
@@ -511,22 +735,22 @@ project_range4(const wb_cache *k, const wb_real *restrict wv, wb_real *x, const 
         }
         i += cn;
     }
-    if (i < e) project_range(k, wv, x, xp, out, i, e, h, inv_h2, omega, damped, jacobi, fresh, 0);
+    if (i < e) project_range(ds, wv, x, xp, out, i, e, h, inv_h2, omega, damped, jacobi, fresh, 0);
 }
 
 static __attribute__((target("avx2"))) void
 project_distances_avx2(const wb_world *w, wb_real *dx, int32_t b, int32_t e, wb_real h, wb_real inv_h2)
 {
-    const wb_cache *k = &w->k;
+    const wb_distances *ds = w->dist;
     const wb_real *wv = w->m.w, *xp = w->s.x_prev, omega = w->m.def.relaxation;
-    const int fresh = k->s_lambda_stale;
+    const int fresh = ds->s_lambda_stale;
     wb_real *x = w->s.x;
     if (dx) {
-        if (k->any_damping) project_range4(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1, fresh);
-        else project_range4(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1, fresh);
+        if (ds->any_damping) project_range4(ds, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1, fresh);
+        else project_range4(ds, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1, fresh);
     } else {
-        if (k->any_damping) project_range4(k, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0, fresh);
-        else project_range4(k, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0, fresh);
+        if (ds->any_damping) project_range4(ds, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0, fresh);
+        else project_range4(ds, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0, fresh);
     }
 }
 #endif
@@ -542,10 +766,10 @@ int wb__distance_simd(int on) { return wb__simd_set(&simd_state, on); }
 
 static void project_distances(const wb_world *w, wb_real *dx, int32_t b, int32_t e, wb_real h, wb_real inv_h2)
 {
-    const wb_cache *k = &w->k;
+    const wb_distances *ds = w->dist;
 #ifdef WB_DISTANCE_AVX2
     /* the vector lanes need a conflict-free batch: never the serial tail */
-    if (e - b >= 4 && e <= k->colour_start[k->serial_start]) {
+    if (e - b >= 4 && e <= ds->colour_start[ds->serial_start]) {
         /* decided once, possibly by several threads at once (the same answer) */
         int v = __atomic_load_n(&simd_state, __ATOMIC_RELAXED);
         if (v < 0) v = wb__distance_simd(1);
@@ -556,14 +780,14 @@ static void project_distances(const wb_world *w, wb_real *dx, int32_t b, int32_t
     }
 #endif
     const wb_real *wv = w->m.w, *xp = w->s.x_prev, omega = w->m.def.relaxation;
-    const int fresh = k->s_lambda_stale;
+    const int fresh = ds->s_lambda_stale;
     wb_real *x = w->s.x;
     if (dx) {
-        if (k->any_damping) project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1, fresh, 0);
-        else project_range(k, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1, fresh, 0);
+        if (ds->any_damping) project_range(ds, wv, x, xp, dx, b, e, h, inv_h2, omega, 1, 1, fresh, 0);
+        else project_range(ds, wv, x, xp, dx, b, e, h, inv_h2, omega, 0, 1, fresh, 0);
     } else {
-        if (k->any_damping) project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0, fresh, 0);
-        else project_range(k, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0, fresh, 0);
+        if (ds->any_damping) project_range(ds, wv, x, xp, x, b, e, h, inv_h2, omega, 1, 0, fresh, 0);
+        else project_range(ds, wv, x, xp, x, b, e, h, inv_h2, omega, 0, 0, fresh, 0);
     }
 }
 
@@ -576,21 +800,21 @@ static void project_distances(const wb_world *w, wb_real *dx, int32_t b, int32_t
  * about one link's, not overshoot) */
 static void project_compounds(wb_world *w, wb_real h, wb_real inv_h2)
 {
-    wb_cache *k = &w->k;
+    const wb_distances *ds = w->dist;
     const wb_real *wv = w->m.w, *xp = w->s.x_prev;
-    const int fresh = k->s_lambda_stale;
-    wb_real *x = w->s.x, *dx = k->dx;
-    for (int32_t c = 0; c < k->ncomp; c++) {
-        const int32_t b = k->comp_start[c], e = k->comp_start[c + 1];
+    const int fresh = ds->s_lambda_stale;
+    wb_real *x = w->s.x, *dx = w->k.dx;
+    for (int32_t c = 0; c < ds->ncomp; c++) {
+        const int32_t b = ds->comp_start[c], e = ds->comp_start[c + 1];
         for (int32_t i = b; i < e; i++) {
-            v3_set(&dx[3 * k->s_a[i]], 0, 0, 0);
-            v3_set(&dx[3 * k->s_b[i]], 0, 0, 0);
+            v3_set(&dx[3 * ds->s_a[i]], 0, 0, 0);
+            v3_set(&dx[3 * ds->s_b[i]], 0, 0, 0);
         }
-        if (k->any_damping) project_range(k, wv, x, xp, dx, b, e, h, inv_h2, 1, 1, 0, fresh, 1);
-        else project_range(k, wv, x, xp, dx, b, e, h, inv_h2, 1, 0, 0, fresh, 1);
+        if (ds->any_damping) project_range(ds, wv, x, xp, dx, b, e, h, inv_h2, 1, 1, 0, fresh, 1);
+        else project_range(ds, wv, x, xp, dx, b, e, h, inv_h2, 1, 0, 0, fresh, 1);
         for (int32_t i = b; i < e; i++)
             for (int end = 0; end < 2; end++) {
-                const int32_t p = end ? k->s_b[i] : k->s_a[i];
+                const int32_t p = end ? ds->s_b[i] : ds->s_a[i];
                 if (!(wv[p] > 0)) continue;
                 v3_add(&x[3 * p], &x[3 * p], &dx[3 * p]);
                 v3_set(&dx[3 * p], 0, 0, 0);
@@ -609,11 +833,11 @@ static void dist_part(void *ctx, int32_t lo, int32_t hi)
 
 static void project_batches(wb_world *w, wb_real *dx, wb_real h, wb_real inv_h2)
 {
-    wb_cache *k = &w->k;
-    for (int32_t c = 0; c < k->ncolours; c++) {
-        const int32_t b = k->colour_start[c], e = k->colour_start[c + 1];
+    const wb_distances *ds = w->dist;
+    for (int32_t c = 0; c < ds->ncolours; c++) {
+        const int32_t b = ds->colour_start[c], e = ds->colour_start[c + 1];
         /* (the pool is asked for only here: a small scene never starts a thread) */
-        wb_pool *pool = c < k->serial_start && e - b >= 512 ? wb__world_pool(w) : NULL;
+        wb_pool *pool = c < ds->serial_start && e - b >= 512 ? wb__world_pool(w) : NULL;
         if (!pool) {
             project_distances(w, dx, b, e, h, inv_h2);
             continue;
@@ -627,15 +851,17 @@ static void project_batches(wb_world *w, wb_real *dx, wb_real h, wb_real inv_h2)
 /* one iteration over every distance constraint */
 static void distance_project(wb_world *w, wb_real h)
 {
+    wb_distances *ds = w->dist;
+    if (!ds) return;
     wb_cache *k = &w->k;
     const wb_real inv_h2 = 1 / (h * h);
     const int32_t np = w->m.np;
-    k->projections += k->ns;
-    if (h != k->s_at_h) refresh_at(k, h);
+    k->projections += ds->ns;
+    if (h != ds->s_at_h) refresh_at(ds, h);
     if (w->m.def.solver == WB_SOLVER_GAUSS_SEIDEL) {
         project_batches(w, NULL, h, inv_h2);
         project_compounds(w, h, inv_h2);
-        k->s_lambda_stale = 0;
+        ds->s_lambda_stale = 0;
         return;
     }
     /* Jacobi: every correction from the same positions, scaled per constraint
@@ -643,8 +869,8 @@ static void distance_project(wb_world *w, wb_real h)
     if (np == 0) return;
     memset(k->dx, 0, sizeof(wb_real) * 3 * (size_t)np);
     project_batches(w, k->dx, h, inv_h2);
-    if (k->ns > k->split_start) project_distances(w, k->dx, k->split_start, k->ns, h, inv_h2);
-    k->s_lambda_stale = 0;
+    if (ds->ns > ds->split_start) project_distances(w, k->dx, ds->split_start, ds->ns, h, inv_h2);
+    ds->s_lambda_stale = 0;
     const wb_real *wv = w->m.w;
     for (int32_t i = 0; i < np; i++)
         if (wv[i] > 0) v3_add(&w->s.x[3 * i], &w->s.x[3 * i], &k->dx[3 * i]);
@@ -654,57 +880,60 @@ static void distance_project(wb_world *w, wb_real h)
  * writes every one, skipped constraints included (a memset of them all cost 2% of the
  * 128 x 128 cloth's frame); until it has, force() reads 0 (an undone frame, no
  * iterations) and distance_frame_end clears them. */
-static void distance_substep_begin(wb_world *w) { w->k.s_lambda_stale = 1; }
+static void distance_substep_begin(wb_world *w)
+{
+    if (w->dist) w->dist->s_lambda_stale = 1;
+}
 
 static void report_break(wb_world *w, int32_t s)
 {
-    wb_cache *k = &w->k;
-    w->s.d_broken[s] = 1;
+    wb_distances *ds = w->dist;
+    ds->broken[s] = 1;
     w->m.topology_dirty = 1;
-    wb_distance_id id = { (uint32_t)s + 1, w->m.d_gen[s] };
-    wb_distance_id *q = wb__grow(k->breaks, &k->cap_breaks, k->nbreaks + 1, sizeof *q);
-    if (q) { k->breaks = q; k->breaks[k->nbreaks++] = id; }
+    wb_distance_id id = { (uint32_t)s + 1, ds->gen[s] };
+    wb_distance_id *q = wb__grow(ds->breaks, &ds->cap_breaks, ds->nbreaks + 1, sizeof *q);
+    if (q) { ds->breaks = q; ds->breaks[ds->nbreaks++] = id; }
 }
 
 /* plastic flow and breaking, once per frame on the frame's final lengths; break_force
  * on the multiplier of the frame's last substep (the force wb_distance_force reads) */
 static void distance_frame_end(wb_world *w)
 {
-    wb_model *m = &w->m;
-    wb_cache *k = &w->k;
-    const wb_real dt = m->def.dt, inv_h2 = 1 / (k->h_last * k->h_last);
-    if (!k->any_frame_end) return; /* nothing can break or flow: no walk over them all */
-    if (k->s_lambda_stale && k->ns > 0) { /* (no iterations: nothing projected) */
-        memset(k->s_lambda, 0, sizeof(wb_real) * (size_t)k->ns);
-        k->s_lambda_stale = 0;
+    wb_distances *ds = w->dist;
+    /* nothing can break or flow: no walk over them all */
+    if (!ds || !ds->any_frame_end) return;
+    const wb_real dt = w->m.def.dt, inv_h2 = 1 / (w->k.h_last * w->k.h_last);
+    if (ds->s_lambda_stale && ds->ns > 0) { /* (no iterations: nothing projected) */
+        memset(ds->s_lambda, 0, sizeof(wb_real) * (size_t)ds->ns);
+        ds->s_lambda_stale = 0;
     }
-    for (int32_t i = 0; i < k->ns; i++) {
-        const int32_t s = k->s_slot[i];
-        if (m->d_break[s] <= 0 && m->d_yield[s] <= 0 && m->d_bforce[s] <= 0) continue;
-        if (m->d_bforce[s] > 0 && fabs(k->s_lambda[i]) * inv_h2 > m->d_bforce[s]) {
+    for (int32_t i = 0; i < ds->ns; i++) {
+        const int32_t s = ds->s_slot[i];
+        if (ds->break_strain[s] <= 0 && ds->yield[s] <= 0 && ds->bforce[s] <= 0) continue;
+        if (ds->bforce[s] > 0 && fabs(ds->s_lambda[i]) * inv_h2 > ds->bforce[s]) {
             report_break(w, s);
             continue;
         }
-        if (m->d_break[s] <= 0 && m->d_yield[s] <= 0) continue;
+        if (ds->break_strain[s] <= 0 && ds->yield[s] <= 0) continue;
         wb_real d[3];
-        v3_sub(d, &w->s.x[3 * k->s_b[i]], &w->s.x[3 * k->s_a[i]]);
-        const wb_real len = v3_len(d), rest = k->s_rest[i];
+        v3_sub(d, &w->s.x[3 * ds->s_b[i]], &w->s.x[3 * ds->s_a[i]]);
+        const wb_real len = v3_len(d), rest = ds->s_rest[i];
         if (rest <= 0) continue;
         const wb_real strain = (len - rest) / rest;
-        if (m->d_break[s] > 0 && strain > m->d_break[s]) {
+        if (ds->break_strain[s] > 0 && strain > ds->break_strain[s]) {
             report_break(w, s);
             continue;
         }
-        const wb_real a = fabs(strain), y = m->d_yield[s];
+        const wb_real a = fabs(strain), y = ds->yield[s];
         if (y > 0 && a > y) {
             /* flow towards the current length by the part of the strain past yield */
-            const wb_real rate = m->d_creep[s] * dt < 1 ? m->d_creep[s] * dt : 1;
+            const wb_real rate = ds->creep[s] * dt < 1 ? ds->creep[s] * dt : 1;
             /* the part past yield, (a - y)/a; a rest so small that the strain overflows
              * (inf/inf = NaN would poison the rest for good) flows as if a were huge: 1 */
             const wb_real past = isinf(a) ? 1 : (a - y) / a;
             const wb_real r = rest + rate * (len - rest) * past;
-            k->s_rest[i] = r;
-            w->s.d_rest[s] = r;
+            ds->s_rest[i] = r;
+            ds->rest[s] = r;
         }
     }
 }
@@ -712,68 +941,69 @@ static void distance_frame_end(wb_world *w)
 /* elastic: U = C^2 / (2 alpha) for compliant constraints (alpha = 1/k) */
 static wb_real distance_energy(const wb_world *w)
 {
+    const wb_distances *ds = wb__dist(w->dist);
     wb_real pe = 0;
-    for (int32_t s = 0; s < w->m.nd; s++) {
-        if (!packable(w, s) || w->m.d_alpha[s] <= 0) continue;
+    for (int32_t s = 0; s < ds->n; s++) {
+        if (!packable(ds, s) || ds->alpha[s] <= 0) continue;
         wb_real d[3];
-        v3_sub(d, &w->s.x[3 * w->m.d_ij[2 * s + 1]], &w->s.x[3 * w->m.d_ij[2 * s]]);
-        wb_real c = v3_len(d) - w->s.d_rest[s];
-        pe += c * c / (2 * w->m.d_alpha[s]);
+        v3_sub(d, &w->s.x[3 * ds->ij[2 * s + 1]], &w->s.x[3 * ds->ij[2 * s]]);
+        wb_real c = v3_len(d) - ds->rest[s];
+        pe += c * c / (2 * ds->alpha[s]);
     }
     return pe;
 }
 
-static int32_t distance_count(const wb_world *w) { return w->m.nd_live; }
+static int32_t distance_count(const wb_world *w) { return wb__dist(w->dist)->nlive; }
 
 /* every live link joins its two ends (a torn one too: they were neighbours) */
 static void distance_links(const wb_world *w, wb_link_fn fn, void *ud)
 {
-    const wb_model *m = &w->m;
-    for (int32_t s = 0; s < m->nd; s++)
-        if (m->d_gen[s] & 1u) fn(ud, m->d_ij[2 * s], m->d_ij[2 * s + 1], 1);
+    const wb_distances *ds = wb__dist(w->dist);
+    for (int32_t s = 0; s < ds->n; s++)
+        if (ds->gen[s] & 1u) fn(ud, ds->ij[2 * s], ds->ij[2 * s + 1], 1);
 }
 
 /* ---- teardown and hash (ctype.h) ----------------------------------------------------------- */
-/* its model and state arrays live in the world's (core.h: they grow with the particles'
- * budget, world.c), its cache in the solver cache */
 static void distance_destroy(wb_world *w)
 {
-    wb_model *m = &w->m;
-    wb_state *s = &w->s;
-    wb_cache *k = &w->k;
-    void *p[] = { m->d_ij, m->d_alpha, m->d_beta, m->d_yield, m->d_creep, m->d_break, m->d_bforce, m->d_gen,
-                  m->d_free, s->d_rest, s->d_broken, k->colour_start, k->comp_start, k->s_a, k->s_b, k->s_rest,
-                  k->s_alpha, k->s_beta, k->s_lambda, k->s_jac, k->s_slot, k->slot_pack, k->breaks };
+    wb_distances *ds = w->dist;
+    if (!ds) return;
+    void *p[] = { ds->ij, ds->alpha, ds->beta, ds->yield, ds->creep, ds->break_strain, ds->bforce, ds->gen,
+                  ds->free_slots, ds->rest, ds->broken, ds->colour_start, ds->comp_start, ds->s_a, ds->s_b, ds->s_rest,
+                  ds->s_alpha, ds->s_beta, ds->s_lambda, ds->s_jac, ds->s_slot, ds->slot_pack, ds->breaks };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    free(ds);
+    w->dist = NULL;
 }
 
-/* the live ones' state (rest lengths, broken flags) in slot order */
+static size_t distance_charged(const wb_world *w) { return w->dist ? w->dist->charged : 0; }
+
 /* the packed links' largest |len - rest + alpha~ lambda| (a link's two gradients are unit) */
 static wb_real distance_residual(const wb_world *w, wb_real h)
 {
-    const wb_cache *k = &w->k;
+    const wb_distances *ds = wb__dist(w->dist);
     const wb_real *x = w->s.x, *wv = w->m.w, inv_h2 = 1 / (h * h);
     wb_real r = 0;
-    for (int32_t i = 0; i < k->ns; i++) {
-        const int32_t a = k->s_a[i], b = k->s_b[i];
+    for (int32_t i = 0; i < ds->ns; i++) {
+        const int32_t a = ds->s_a[i], b = ds->s_b[i];
         if (wv[a] + wv[b] == 0) continue;
         wb_real d[3];
         v3_sub(d, &x[3 * b], &x[3 * a]);
-        const wb_real at = k->s_alpha[i] * inv_h2, lam = k->s_lambda_stale ? 0 : k->s_lambda[i];
-        const wb_real ri = isinf(at) ? 0 : fabs(v3_len(d) - k->s_rest[i] + at * lam);
+        const wb_real at = ds->s_alpha[i] * inv_h2, lam = ds->s_lambda_stale ? 0 : ds->s_lambda[i];
+        const wb_real ri = isinf(at) ? 0 : fabs(v3_len(d) - ds->s_rest[i] + at * lam);
         r = ri > r ? ri : r;
     }
     return r;
 }
 
+/* the live ones' state (rest lengths, broken flags) in slot order */
 static uint64_t distance_hash(const wb_world *w, uint64_t h)
 {
-    const wb_model *m = &w->m;
-    const wb_state *s = &w->s;
-    for (int32_t i = 0; i < m->nd; i++) {
-        if (!(m->d_gen[i] & 1u)) continue;
-        h = wb__fnv(h, &s->d_rest[i], sizeof s->d_rest[i]);
-        h = wb__fnv(h, &s->d_broken[i], 1);
+    const wb_distances *ds = wb__dist(w->dist);
+    for (int32_t i = 0; i < ds->n; i++) {
+        if (!(ds->gen[i] & 1u)) continue;
+        h = wb__fnv(h, &ds->rest[i], sizeof ds->rest[i]);
+        h = wb__fnv(h, &ds->broken[i], 1);
     }
     return h;
 }
@@ -813,23 +1043,22 @@ wb_status wb_image_alloc_distances(wb_image *g, int32_t nd, int32_t nfree)
 
 static wb_status distance_image_save(const wb_world *w, wb_image *g)
 {
-    const wb_model *m = &w->m;
-    const wb_state *s = &w->s;
-    wb_status st = wb_image_alloc_distances(g, m->nd, m->nfree);
-    if (st != WB_OK || m->nd == 0) return st;
+    const wb_distances *ds = wb__dist(w->dist);
+    wb_status st = wb_image_alloc_distances(g, ds->n, ds->nfree);
+    if (st != WB_OK || ds->n == 0) return st;
     wb_image_distance *d = &g->dist;
-    const size_t n = (size_t)m->nd;
-    memcpy(d->ij, m->d_ij, 2 * n * sizeof *d->ij);
-    memcpy(d->alpha, m->d_alpha, n * sizeof(wb_real));
-    memcpy(d->beta, m->d_beta, n * sizeof(wb_real));
-    memcpy(d->yield, m->d_yield, n * sizeof(wb_real));
-    memcpy(d->creep, m->d_creep, n * sizeof(wb_real));
-    memcpy(d->break_strain, m->d_break, n * sizeof(wb_real));
-    memcpy(d->bforce, m->d_bforce, n * sizeof(wb_real));
-    memcpy(d->rest, s->d_rest, n * sizeof(wb_real));
-    memcpy(d->broken, s->d_broken, n);
-    memcpy(d->gen, m->d_gen, n * sizeof *d->gen);
-    if (m->nfree) memcpy(d->free_slots, m->d_free, (size_t)m->nfree * sizeof *d->free_slots);
+    const size_t n = (size_t)ds->n;
+    memcpy(d->ij, ds->ij, 2 * n * sizeof *d->ij);
+    memcpy(d->alpha, ds->alpha, n * sizeof(wb_real));
+    memcpy(d->beta, ds->beta, n * sizeof(wb_real));
+    memcpy(d->yield, ds->yield, n * sizeof(wb_real));
+    memcpy(d->creep, ds->creep, n * sizeof(wb_real));
+    memcpy(d->break_strain, ds->break_strain, n * sizeof(wb_real));
+    memcpy(d->bforce, ds->bforce, n * sizeof(wb_real));
+    memcpy(d->rest, ds->rest, n * sizeof(wb_real));
+    memcpy(d->broken, ds->broken, n);
+    memcpy(d->gen, ds->gen, n * sizeof *d->gen);
+    if (ds->nfree) memcpy(d->free_slots, ds->free_slots, (size_t)ds->nfree * sizeof *d->free_slots);
     return WB_OK;
 }
 
@@ -896,29 +1125,29 @@ static wb_status distance_image_reserve(wb_world *w, const wb_image *g, const wb
 /* a new world takes the slots as they are (generations, free list: the same future) */
 static void put_exact(wb_world *w, const wb_image_distance *d)
 {
-    wb_model *m = &w->m;
-    wb_state *s = &w->s;
+    wb_distances *ds = w->dist; /* made by the reserve when there are slots */
+    if (!ds) return;
     const size_t n = (size_t)d->n;
-    m->nd = d->n;
-    m->nd_live = 0;
+    ds->n = d->n;
+    ds->nlive = 0;
     if (n) {
-        memcpy(m->d_ij, d->ij, 2 * n * sizeof *m->d_ij);
-        memcpy(m->d_alpha, d->alpha, n * sizeof(wb_real));
-        memcpy(m->d_beta, d->beta, n * sizeof(wb_real));
-        memcpy(m->d_yield, d->yield, n * sizeof(wb_real));
-        memcpy(m->d_creep, d->creep, n * sizeof(wb_real));
-        memcpy(m->d_break, d->break_strain, n * sizeof(wb_real));
-        memcpy(m->d_bforce, d->bforce, n * sizeof(wb_real));
-        memcpy(s->d_rest, d->rest, n * sizeof(wb_real));
-        memcpy(s->d_broken, d->broken, n);
-        memcpy(m->d_gen, d->gen, n * sizeof *m->d_gen);
+        memcpy(ds->ij, d->ij, 2 * n * sizeof *ds->ij);
+        memcpy(ds->alpha, d->alpha, n * sizeof(wb_real));
+        memcpy(ds->beta, d->beta, n * sizeof(wb_real));
+        memcpy(ds->yield, d->yield, n * sizeof(wb_real));
+        memcpy(ds->creep, d->creep, n * sizeof(wb_real));
+        memcpy(ds->break_strain, d->break_strain, n * sizeof(wb_real));
+        memcpy(ds->bforce, d->bforce, n * sizeof(wb_real));
+        memcpy(ds->rest, d->rest, n * sizeof(wb_real));
+        memcpy(ds->broken, d->broken, n);
+        memcpy(ds->gen, d->gen, n * sizeof *ds->gen);
     }
     for (size_t i = 0; i < n; i++) {
-        w->k.slot_pack[i] = -1;
-        m->nd_live += (int32_t)(d->gen[i] & 1u);
+        ds->slot_pack[i] = -1;
+        ds->nlive += (int32_t)(d->gen[i] & 1u);
     }
-    m->nfree = d->nfree;
-    if (d->nfree) memcpy(m->d_free, d->free_slots, (size_t)d->nfree * sizeof *m->d_free);
+    ds->nfree = d->nfree;
+    if (d->nfree) memcpy(ds->free_slots, d->free_slots, (size_t)d->nfree * sizeof *ds->free_slots);
 }
 
 /* appended: the live ones added after w's (checked and reserved: cannot fail) */
@@ -933,15 +1162,17 @@ static void distance_image_put(wb_world *w, const wb_image *g, const wb_image_at
         if (!(d->gen[i] & 1u)) continue;
         const wb_distance_def def = image_def(d, i);
         const wb_distance_id id = wb_distance_add(w, at->pshift + d->ij[2 * i], at->pshift + d->ij[2 * i + 1], &def, NULL);
-        w->s.d_broken[id.index - 1] = d->broken[i];
+        w->dist->broken[id.index - 1] = d->broken[i];
     }
 }
 
 static void distance_stats(const wb_world *w, wb_stats *st)
 {
-    st->distances = w->m.nd_live;
-    for (int32_t s = 0; s < w->m.nd; s++)
-        if ((w->m.d_gen[s] & 1u) && w->s.d_broken[s]) st->broken++;
+    const wb_distances *ds = wb__dist(w->dist);
+    st->distances = ds->nlive;
+    st->colours = ds->ncolours;
+    for (int32_t s = 0; s < ds->n; s++)
+        if ((ds->gen[s] & 1u) && ds->broken[s]) st->broken++;
 }
 
 const wb_ctype wb__distance_type = {
@@ -954,6 +1185,7 @@ const wb_ctype wb__distance_type = {
     .energy = distance_energy,
     .links = distance_links,
     .destroy = distance_destroy,
+    .charged = distance_charged,
     .stats = distance_stats,
     .hash = distance_hash,
     .image_free = distance_image_free,

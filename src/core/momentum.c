@@ -38,6 +38,7 @@
 #include "core.h"
 #include "attach.h"
 #include "bend.h"
+#include "distance.h"
 #include "grab.h"
 #include "pressure.h"
 #include "shape_match.h"
@@ -108,8 +109,9 @@ static int build(wb_world *w)
     if (!grow((void **)&k->mc_body, &k->cap_mc_body, np, sizeof(int32_t))) return 0;
     int32_t *parent = k->mc_body;
     for (int32_t i = 0; i < np; i++) parent[i] = i;
-    for (int32_t s = 0; s < m->nd; s++)
-        if ((m->d_gen[s] & 1u) && !w->s.d_broken[s]) unite(parent, m->d_ij[2 * s], m->d_ij[2 * s + 1]);
+    const wb_distances *ds = wb__dist(w->dist);
+    for (int32_t s = 0; s < ds->n; s++)
+        if ((ds->gen[s] & 1u) && !ds->broken[s]) unite(parent, ds->ij[2 * s], ds->ij[2 * s + 1]);
     /* bends, broken or not: a body joined once too often is only kept a little less well */
     for (int32_t i = 0; i < wb_bend_count(w); i++) unite_all(parent, &w->bend->ij[4 * i], 4);
     for (int32_t i = 0; i < wb_volume_count(w); i++) unite_all(parent, &w->vol->ijkl[4 * i], 4);

@@ -1,16 +1,17 @@
 /* query.c: read-only measures of a world: energy, momenta, bounds, strain, hash, stats. */
 #include "ctype.h"
+#include "distance.h"
 #include "rigid.h"
 #include "vbd.h"
 
 static wb_real mass_of(const wb_world *w, int32_t i) { return w->m.w[i] > 0 ? 1 / w->m.w[i] : 0; }
 
-static int live(const wb_world *w, int32_t s) { return (w->m.d_gen[s] & 1u) && !w->s.d_broken[s]; }
+static int live(const wb_distances *ds, int32_t s) { return (ds->gen[s] & 1u) && !ds->broken[s]; }
 
-static wb_real slot_length(const wb_world *w, int32_t s)
+static wb_real slot_length(const wb_world *w, const wb_distances *ds, int32_t s)
 {
     wb_real d[3];
-    v3_sub(d, &w->s.x[3 * w->m.d_ij[2 * s + 1]], &w->s.x[3 * w->m.d_ij[2 * s]]);
+    v3_sub(d, &w->s.x[3 * ds->ij[2 * s + 1]], &w->s.x[3 * ds->ij[2 * s]]);
     return v3_len(d);
 }
 
@@ -92,10 +93,11 @@ bool wb_world_bounds(const wb_world *w, wb_real mn[3], wb_real mx[3])
 
 wb_real wb_world_max_strain(const wb_world *w)
 {
+    const wb_distances *ds = wb__dist(w->dist);
     wb_real best = 0;
-    for (int32_t s = 0; s < w->m.nd; s++) {
-        if (!live(w, s) || w->s.d_rest[s] <= 0) continue;
-        wb_real e = fabs(slot_length(w, s) - w->s.d_rest[s]) / w->s.d_rest[s];
+    for (int32_t s = 0; s < ds->n; s++) {
+        if (!live(ds, s) || ds->rest[s] <= 0) continue;
+        wb_real e = fabs(slot_length(w, ds, s) - ds->rest[s]) / ds->rest[s];
         if (e > best) best = e;
     }
     return best;
@@ -103,11 +105,12 @@ wb_real wb_world_max_strain(const wb_world *w)
 
 int32_t wb_world_distance_pairs(const wb_world *w, int32_t *ij, wb_real *strain)
 {
+    const wb_distances *ds = wb__dist(w->dist);
     int32_t n = 0;
-    for (int32_t s = 0; s < w->m.nd; s++) {
-        if (!live(w, s)) continue;
-        if (ij) { ij[2 * n] = w->m.d_ij[2 * s]; ij[2 * n + 1] = w->m.d_ij[2 * s + 1]; }
-        if (strain) strain[n] = w->s.d_rest[s] > 0 ? (slot_length(w, s) - w->s.d_rest[s]) / w->s.d_rest[s] : 0;
+    for (int32_t s = 0; s < ds->n; s++) {
+        if (!live(ds, s)) continue;
+        if (ij) { ij[2 * n] = ds->ij[2 * s]; ij[2 * n + 1] = ds->ij[2 * s + 1]; }
+        if (strain) strain[n] = ds->rest[s] > 0 ? (slot_length(w, ds, s) - ds->rest[s]) / ds->rest[s] : 0;
         n++;
     }
     return n;
@@ -192,7 +195,6 @@ wb_stats wb_world_stats(const wb_world *w)
     st.particles = w->m.np;
     for (int i = 0; i < wb__nctypes; i++) wb__ctypes[i]->stats(w, &st);
     st.colliders = wb_collider_count(w);
-    st.colours = w->k.ncolours;
     st.contacts = w->k.last_contacts;
     wb__contacts_stats(w, &st);
     st.projections = w->k.projections;

@@ -320,7 +320,7 @@ wb_world *wb_world_from_image(const wb_image *g, wb_status *status)
     wb_world *w = wb_world_create(&g->def);
     wb_colmesh **cms = calloc((size_t)(g->nc > 0 ? g->nc : 1), sizeof *cms);
     const wb_image_at at = { 1, 0, 0, NULL, NULL };
-    wb_status st = w && cms ? wb__reserve(w, g->np, 0) : WB_ERR_NOMEM;
+    wb_status st = w && cms ? wb__particles_reserve(w, g->np) : WB_ERR_NOMEM;
     if (st == WB_OK) st = grow_colliders(w, g->nc);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
     if (st == WB_OK) st = wb__rigid_reserve(w, g, 1);
@@ -406,7 +406,7 @@ wb_status wb_world_append_image(wb_world *w, const wb_image *g, wb_body *out)
     int32_t *rmap = calloc((size_t)(g->nrb > 0 ? g->nrb : 1), sizeof *rmap); /* the same for rigid bodies */
     if (!cms || !cmap || !rmap) { free(cms); free(cmap); free(rmap); return WB_ERR_NOMEM; }
     const wb_image_at at = { 0, m->np, m->nsurf, cmap, rmap };
-    wb_status st = wb__reserve(w, g->np, 0);
+    wb_status st = wb__particles_reserve(w, g->np);
     if (st == WB_OK) st = grow_colliders(w, m->nc + new_c);
     if (st == WB_OK) st = reserve_surfaces(w, g->nsurf, g->ntri);
     if (st == WB_OK) st = wb__rigid_reserve(w, g, 0);

@@ -434,7 +434,6 @@ wb_status wb_world_step(wb_world *w)
     const wb_world_def *d = &w->m.def;
     const wb_real dt = d->dt, h = dt / d->substeps;
     wb__rigids_save(w);
-    k->nbreaks = 0;
     k->projections = 0;
     k->h_last = h;
 

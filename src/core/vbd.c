@@ -153,7 +153,7 @@ void wb__vbd_destroy(wb_world *w)
 
 int wb__vbd_serves(const wb_ctype *t) { return t == &wb__distance_type || t == &wb__tet_type || t == &wb__bend_type; }
 
-static int link_live(const wb_world *w, int32_t s) { return (w->m.d_gen[s] & 1u) && !w->s.d_broken[s]; }
+static int link_live(const wb_world *w, int32_t s) { return (wb__dist(w->dist)->gen[s] & 1u) && !wb__dist(w->dist)->broken[s]; }
 
 /* each vertex's elements of four corners q (n x 4), as 4 element + corner (CSR) */
 static int quads(int32_t np, const int32_t *q, int32_t n, int32_t **start_out, int32_t **adj_out)
@@ -181,11 +181,12 @@ static int quads(int32_t np, const int32_t *q, int32_t n, int32_t **start_out, i
 static int build_adjacency(wb_world *w, struct wb_vbd *v)
 {
     const wb_model *m = &w->m;
-    const int32_t np = m->np, nd = m->nd;
+    const wb_distances *ds = wb__dist(w->dist);
+    const int32_t np = m->np, nd = ds->n;
     int32_t *start = calloc((size_t)np + 1, sizeof *start);
     if (!start) return 0;
     for (int32_t s = 0; s < nd; s++)
-        if (link_live(w, s)) start[m->d_ij[2 * s] + 1]++, start[m->d_ij[2 * s + 1] + 1]++;
+        if (link_live(w, s)) start[ds->ij[2 * s] + 1]++, start[ds->ij[2 * s + 1] + 1]++;
     for (int32_t i = 0; i < np; i++) start[i + 1] = start[i] + ((start[i + 1] + 3) & ~3);
     const size_t ne = (size_t)(start[np] > 0 ? start[np] : 1);
     int32_t *adj = malloc(sizeof *adj * ne), *adjo = malloc(sizeof *adjo * ne);
@@ -201,7 +202,7 @@ static int build_adjacency(wb_world *w, struct wb_vbd *v)
     memcpy(fill, start, sizeof *fill * (size_t)np);
     for (int32_t s = 0; s < nd; s++) {
         if (!link_live(w, s)) continue;
-        const int32_t a = m->d_ij[2 * s], b = m->d_ij[2 * s + 1];
+        const int32_t a = ds->ij[2 * s], b = ds->ij[2 * s + 1];
         epos[2 * s] = fill[a], adjo[fill[a]] = b, adj[fill[a]++] = s;
         epos[2 * s + 1] = fill[b], adjo[fill[b]] = a, adj[fill[b]++] = s;
     }
@@ -272,8 +273,9 @@ static int build_colours(wb_world *w, struct wb_vbd *v)
 static int rebuild_due(const wb_world *w, const struct wb_vbd *v)
 {
     const wb_model *m = &w->m;
+    const wb_distances *ds = wb__dist(w->dist);
     const int32_t nt = w->neo ? w->neo->n : 0;
-    return m->topology_dirty || v->np != m->np || v->nd != m->nd || v->nt != nt || v->nb != wb_bend_count(w);
+    return m->topology_dirty || v->np != m->np || v->nd != ds->n || v->nt != nt || v->nb != wb_bend_count(w);
 }
 
 int wb__vbd_prepare(wb_world *w)
@@ -287,27 +289,28 @@ int wb__vbd_prepare(wb_world *w)
         v->np = -1;
     }
     const wb_model *m = &w->m;
+    const wb_distances *ds = wb__dist(w->dist);
     const int32_t nt = w->neo ? w->neo->n : 0;
     if (rebuild_due(w, v)) {
         if (!build_adjacency(w, v) || !build_colours(w, v)) return 0;
         wb_real *y = realloc(v->y, sizeof *y * 3 * (size_t)(m->np > 0 ? m->np : 1));
         if (!y) return 0;
         v->y = y;
-        if (m->nd > v->cap_lam) {
-            wb_real *lam = realloc(v->lam, sizeof *lam * (size_t)m->nd);
+        if (ds->n > v->cap_lam) {
+            wb_real *lam = realloc(v->lam, sizeof *lam * (size_t)ds->n);
             if (lam) v->lam = lam;
-            wb_real *c0 = realloc(v->c0, sizeof *c0 * (size_t)m->nd);
+            wb_real *c0 = realloc(v->c0, sizeof *c0 * (size_t)ds->n);
             if (c0) v->c0 = c0;
-            vbd_link *lk = realloc(v->lk, sizeof *lk * (size_t)m->nd);
+            vbd_link *lk = realloc(v->lk, sizeof *lk * (size_t)ds->n);
             if (lk) v->lk = lk;
-            int32_t *hd = realloc(v->hard, sizeof *hd * (size_t)m->nd);
+            int32_t *hd = realloc(v->hard, sizeof *hd * (size_t)ds->n);
             if (hd) v->hard = hd;
             if (!lam || !c0 || !lk || !hd) return 0;
             /* new slots start with no multiplier and no error known (also in a world just
              * restored, whose image holds the errors of its own slots only) */
-            memset(v->lam + v->cap_lam, 0, sizeof *lam * (size_t)(m->nd - v->cap_lam));
-            for (int32_t q = v->cap_lam; q < m->nd; q++) v->c0[q] = (wb_real)NAN;
-            v->cap_lam = m->nd;
+            memset(v->lam + v->cap_lam, 0, sizeof *lam * (size_t)(ds->n - v->cap_lam));
+            for (int32_t q = v->cap_lam; q < ds->n; q++) v->c0[q] = (wb_real)NAN;
+            v->cap_lam = ds->n;
         }
         if (wb_bend_count(w) > v->cap_blam) {
             const size_t n = (size_t)wb_bend_count(w);
@@ -325,10 +328,10 @@ int wb__vbd_prepare(wb_world *w)
         }
         /* (a slot may hold another link now: its error is the one it starts with) */
         if (!v->restored)
-            for (int32_t q = 0; q < m->nd; q++) v->c0[q] = (wb_real)NAN;
+            for (int32_t q = 0; q < ds->n; q++) v->c0[q] = (wb_real)NAN;
         v->restored = 0;
         v->np = m->np;
-        v->nd = m->nd;
+        v->nd = ds->n;
         v->nt = nt;
         v->nb = wb_bend_count(w);
         wb_real *sv = realloc(v->save, sizeof *sv * (2 * (size_t)v->cap_lam + 2 * (size_t)v->cap_blam + 1));
@@ -616,7 +619,7 @@ static void sweep_part_ct(void *ctx, int32_t lo, int32_t hi) { sweep_body(ctx, l
 /* the inertia of a hard link's ends over the substep, 1 / (h^2 (w_i + w_j)) */
 static wb_real start_penalty(const wb_world *w, int32_t s, wb_real inv_h2)
 {
-    const wb_real wsum = w->m.w[w->m.d_ij[2 * s]] + w->m.w[w->m.d_ij[2 * s + 1]];
+    const wb_real wsum = w->m.w[wb__dist(w->dist)->ij[2 * s]] + w->m.w[wb__dist(w->dist)->ij[2 * s + 1]];
     return wsum > 0 ? inv_h2 / wsum : 0;
 }
 
@@ -632,7 +635,7 @@ static void put_entries(struct wb_vbd *v, int32_t s, const vbd_link *L)
 /* each link as the sweeps read it this substep (vbd_link), and the hard links' list */
 static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2, wb_real inv_h)
 {
-    const wb_model *m = &w->m;
+    const wb_distances *ds = wb__dist(w->dist);
     const wb_real *xp = w->s.x_prev;
     v->nhard = 0;
     /* volume constraints are projected after the sweeps: with rigid links they may hold
@@ -640,18 +643,18 @@ static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2, wb_real in
      * link that took back what the press pushed into it each substep fought them (a
      * lattice with tets squeezed to 60% blew up at 55 m/s): there every error is kept */
     const int keep_all = wb_volume_count(w) > 0;
-    for (int32_t s = 0; s < m->nd; s++) {
+    for (int32_t s = 0; s < ds->n; s++) {
         if (!link_live(w, s)) continue;
         vbd_link *L = &v->lk[s];
-        const wb_real alpha = m->d_alpha[s], rest = w->s.d_rest[s];
+        const wb_real alpha = ds->alpha[s], rest = wb__dist(w->dist)->rest[s];
         if (alpha > 0) {
             L->tgt = rest, L->kk = 1 / alpha, L->lm = 0;
-            L->dmp = m->d_beta[s] > 0 ? m->d_beta[s] * inv_h : 0;
+            L->dmp = ds->beta[s] > 0 ? ds->beta[s] * inv_h : 0;
             put_entries(v, s, L);
             continue;
         }
         wb_real d[3];
-        v3_sub(d, &xp[3 * m->d_ij[2 * s]], &xp[3 * m->d_ij[2 * s + 1]]);
+        v3_sub(d, &xp[3 * ds->ij[2 * s]], &xp[3 * ds->ij[2 * s + 1]]);
         /* the error kept is no more than the solve itself left: what the contacts and
          * colliders did to the link since (pushing a body's bottom up into it) is a load
          * it takes, not a drift to stabilise, or a block on the ground sags by 100 g h^2
@@ -667,16 +670,16 @@ static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2, wb_real in
 
 static void dual_update(wb_world *w, struct wb_vbd *v)
 {
-    const wb_model *m = &w->m;
+    const wb_distances *ds = wb__dist(w->dist);
     const wb_real *x = w->s.x;
     for (int32_t q = 0; q < v->nhard; q++) {
-        const int32_t s = v->hard[q], a = m->d_ij[2 * s], b = m->d_ij[2 * s + 1];
+        const int32_t s = v->hard[q], a = ds->ij[2 * s], b = ds->ij[2 * s + 1];
         vbd_link *L = &v->lk[s];
         wb_real d[3];
         v3_sub(d, &x[3 * a], &x[3 * b]);
         const wb_real l = v3_len(d);
         L->lm += L->kk * (l - L->tgt);
-        v->c0[s] = l - w->s.d_rest[s]; /* (before the types projected after the sweep) */
+        v->c0[s] = l - wb__dist(w->dist)->rest[s]; /* (before the types projected after the sweep) */
         const int32_t e = v->epos[2 * s], f = v->epos[2 * s + 1];
         v->elm[e] = v->elm[f] = L->lm;
     }
@@ -749,22 +752,21 @@ static void bend_dual_update(wb_world *w, struct wb_vbd *v, wb_real h)
  * last sweep; a soft bend's off / alpha (a hard one's: bend_dual_update) */
 static void write_forces(wb_world *w, const struct wb_vbd *v, wb_real h)
 {
-    wb_cache *k = &w->k;
-    const wb_model *m = &w->m;
+    wb_distances *ds = w->dist;
     const wb_real h2 = h * h;
-    for (int32_t i = 0; i < k->ns; i++) {
-        const int32_t s = k->s_slot[i];
-        if (!link_live(w, s)) { k->s_lambda[i] = 0; continue; }
-        const wb_real alpha = m->d_alpha[s];
+    for (int32_t i = 0; ds && i < ds->ns; i++) {
+        const int32_t s = ds->s_slot[i];
+        if (!link_live(w, s)) { ds->s_lambda[i] = 0; continue; }
+        const wb_real alpha = ds->alpha[s];
         if (alpha > 0) {
             wb_real d[3];
-            v3_sub(d, &w->s.x[3 * m->d_ij[2 * s]], &w->s.x[3 * m->d_ij[2 * s + 1]]);
-            k->s_lambda[i] = -(v3_len(d) - w->s.d_rest[s]) / alpha * h2;
+            v3_sub(d, &w->s.x[3 * ds->ij[2 * s]], &w->s.x[3 * ds->ij[2 * s + 1]]);
+            ds->s_lambda[i] = -(v3_len(d) - wb__dist(w->dist)->rest[s]) / alpha * h2;
         } else {
-            k->s_lambda[i] = -v->lam[s] * h2;
+            ds->s_lambda[i] = -v->lam[s] * h2;
         }
     }
-    k->s_lambda_stale = 0;
+    if (ds) ds->s_lambda_stale = 0;
     wb_bends *bs = w->bend;
     if (!bs || bs->dirty) return;
     for (int32_t b = 0; b < bs->n; b++) {
@@ -1029,8 +1031,8 @@ wb_status wb_image_alloc_vbd(wb_image *g, int32_t nd, int32_t nb)
 wb_status wb__vbd_image_of(const wb_world *w, wb_image *g)
 {
     const struct wb_vbd *v = w->vbd;
-    if (!v || w->m.def.solver != WB_SOLVER_VBD || (w->m.nd == 0 && wb_bend_count(w) == 0)) return WB_OK;
-    const int32_t nd = w->m.nd, nb = wb_bend_count(w);
+    if (!v || w->m.def.solver != WB_SOLVER_VBD || (wb__dist(w->dist)->n == 0 && wb_bend_count(w) == 0)) return WB_OK;
+    const int32_t nd = wb__dist(w->dist)->n, nb = wb_bend_count(w);
     if (wb_image_alloc_vbd(g, nd, nb) != WB_OK) return WB_ERR_NOMEM;
     /* (a world just restored has its image's errors for every slot it held) */
     const int32_t known = v->restored ? v->cap_lam : rebuild_due(w, v) ? 0 : v->nd;

@@ -1,11 +1,12 @@
-/* world.c: world lifetime, settings, particles and distance constraints. */
+/* world.c: world lifetime, settings, particles and surfaces; the helpers every owner calls
+ * (errors, warnings, growth, the memory budget). */
 #include <assert.h>
 #include <float.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "ctype.h"
+#include "core.h"
 
 static _Thread_local char wb_err[256];
 
@@ -178,10 +179,9 @@ void wb_world_set_interrupt(wb_world *w, int (*fn)(void *ud), void *ud)
 int64_t wb_world_frame(const wb_world *w) { return w->s.frame; }
 
 /* ---- particles ------------------------------------------------------------------- */
-/* bytes per particle and per constraint over all the arrays that grow with them
- * (model, state and solver cache), for the memory limit */
+/* bytes per particle over all the arrays that grow with them (model, state and solver
+ * cache), for the memory limit */
 #define PARTICLE_BYTES (25 * sizeof(wb_real) + 5 + 8 + 5)
-#define CONSTRAINT_BYTES (14 * sizeof(wb_real) + 42)
 
 int wb__charge(wb_world *w, size_t *charged, size_t want)
 {
@@ -195,11 +195,8 @@ int wb__charge(wb_world *w, size_t *charged, size_t want)
     return 1;
 }
 
-/* the particles' and distances' arrays at capacities (cap_p, cap_d), charged together */
-static int charge(wb_world *w, int64_t cap_p, int64_t cap_d)
-{
-    return wb__charge(w, &w->m.charged, (size_t)cap_p * PARTICLE_BYTES + (size_t)cap_d * CONSTRAINT_BYTES);
-}
+/* the particles' arrays at capacity cap_p */
+static int charge(wb_world *w, int64_t cap_p) { return wb__charge(w, &w->m.charged, (size_t)cap_p * PARTICLE_BYTES); }
 
 /* every per-particle array grows together; on failure nothing is lost */
 static wb_status grow_particles(wb_world *w, int32_t need)
@@ -209,9 +206,9 @@ static wb_status grow_particles(wb_world *w, int32_t need)
     if (need > WB_MAX_PARTICLES) return WB_ERR_LIMIT;
     int32_t cap = m->cap_p ? m->cap_p : 64;
     while (cap < need) cap = cap > WB_MAX_PARTICLES / 2 ? WB_MAX_PARTICLES : cap * 2;
-    if (!charge(w, cap, m->cap_d)) {
+    if (!charge(w, cap)) {
         cap = need; /* exact fit when doubling would cross the limit */
-        if (!charge(w, cap, m->cap_d)) return WB_ERR_NOMEM;
+        if (!charge(w, cap)) return WB_ERR_NOMEM;
     }
     const wb_soa arr[] = {
         { (void **)&m->inv_mass, sizeof(wb_real) }, { (void **)&m->w, sizeof(wb_real) },
@@ -226,6 +223,12 @@ static wb_status grow_particles(wb_world *w, int32_t need)
     if (WB_SOA_RESIZE(arr, cap) != WB_OK) return WB_ERR_NOMEM;
     m->cap_p = cap;
     return WB_OK;
+}
+
+wb_status wb__particles_reserve(wb_world *w, int64_t extra)
+{
+    if (w->m.np + extra > WB_MAX_PARTICLES) return WB_ERR_LIMIT;
+    return grow_particles(w, w->m.np + (int32_t)extra);
 }
 
 int32_t wb_particle_add(wb_world *w, const wb_real pos[3], const wb_real vel[3], wb_real mass, wb_real radius)
@@ -298,203 +301,6 @@ void wb_particle_unpin(wb_world *w, int32_t p)
     w->m.w[p] = w->m.inv_mass[p];
     w->m.w_gen++;
 }
-
-/* ---- distance constraints --------------------------------------------------------- */
-wb_distance_def wb_distance_default_def(void)
-{
-    wb_distance_def d = { 0, 0, -1, 0, 0, 0, 0 };
-    return d;
-}
-
-/* the options' rules: the one place they are decided (the binding and the JSON reader
- * print what this finds) */
-static wb_fault distance_def_fault(const wb_distance_def *d)
-{
-    if (!(d->compliance >= 0) || !isfinite(d->compliance)) return WB_FAULT_KEY("compliance", "must be >= 0");
-    if (!(d->damping >= 0) || !isfinite(d->damping)) return WB_FAULT_KEY("damping", "must be >= 0");
-    /* the solver works with squared lengths: a rest whose square overflows can never be met */
-    if (!isfinite(d->rest) || !isfinite(d->rest * d->rest))
-        return WB_FAULT_KEY("rest", "must be finite and below 1e154 (its square overflows)");
-    if (!(d->yield >= 0) || !isfinite(d->yield)) return WB_FAULT_KEY("yield", "must be >= 0");
-    if (!(d->creep >= 0) || !isfinite(d->creep)) return WB_FAULT_KEY("creep", "must be >= 0");
-    if (!(d->break_strain >= 0) || !isfinite(d->break_strain)) return WB_FAULT_KEY("break_strain", "must be >= 0");
-    if (!(d->break_force >= 0) || !isfinite(d->break_force)) return WB_FAULT_KEY("break_force", "must be >= 0");
-    return WB_NO_FAULT;
-}
-
-const char *wb_distance_def_check(const wb_distance_def *d)
-{
-    return distance_def_fault(d).msg;
-}
-
-/* the particles first (what it joins), then the options, then whether their distance has
- * a finite square (the rest it derives obeys the rule a given one does) */
-wb_fault wb_distance_check(int32_t np, const wb_real *x, int32_t a, int32_t b, const wb_distance_def *d)
-{
-    if (a < 0 || a >= np) return WB_FAULT_AT(0, "particle out of range", "out of range");
-    if (b < 0 || b >= np) return WB_FAULT_AT(1, "particle out of range", "out of range");
-    if (a == b)
-        return WB_FAULT_AT(1, "a constraint needs two distinct particles", "a constraint needs two distinct particles");
-    const wb_fault f = distance_def_fault(d);
-    if (f.msg || !x) return f;
-    wb_real dx[3];
-    v3_sub(dx, &x[3 * b], &x[3 * a]);
-    if (!isfinite(v3_dot(dx, dx)))
-        return WB_FAULT_AT(-1, "the particles are too far apart (their distance squared overflows)",
-                           "too far apart (their distance squared overflows)");
-    return WB_NO_FAULT;
-}
-
-static int slot_live(uint32_t gen) { return gen & 1u; }
-
-static wb_status grow_distances(wb_world *w, int32_t need)
-{
-    wb_model *m = &w->m;
-    if (need <= m->cap_d) return WB_OK;
-    if (need > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
-    int32_t cap = m->cap_d ? m->cap_d : 64;
-    while (cap < need) cap = cap > WB_MAX_CONSTRAINTS / 2 ? WB_MAX_CONSTRAINTS : cap * 2;
-    if (!charge(w, m->cap_p, cap)) {
-        cap = need;
-        if (!charge(w, m->cap_p, cap)) return WB_ERR_NOMEM;
-    }
-    const wb_soa arr[] = {
-        { (void **)&m->d_ij, 2 * sizeof(int32_t) }, { (void **)&m->d_alpha, sizeof(wb_real) },
-        { (void **)&m->d_beta, sizeof(wb_real) }, { (void **)&m->d_yield, sizeof(wb_real) },
-        { (void **)&m->d_creep, sizeof(wb_real) }, { (void **)&m->d_break, sizeof(wb_real) },
-        { (void **)&m->d_bforce, sizeof(wb_real) },
-        { (void **)&m->d_gen, sizeof(uint32_t) }, { (void **)&m->d_free, sizeof(int32_t) },
-        { (void **)&w->s.d_rest, sizeof(wb_real) }, { (void **)&w->s.d_broken, 1 },
-        { (void **)&w->k.slot_pack, sizeof(int32_t) },
-    };
-    if (WB_SOA_RESIZE(arr, cap) != WB_OK) return WB_ERR_NOMEM;
-    m->cap_d = cap;
-    return WB_OK;
-}
-
-/* room for np_extra more particles and nd_extra more constraints: after it succeeds,
- * adding them cannot fail, so a builder never leaves half a body behind */
-wb_status wb__reserve(wb_world *w, int64_t np_extra, int64_t nd_extra)
-{
-    if (w->m.np + np_extra > WB_MAX_PARTICLES || w->m.nd + nd_extra > WB_MAX_CONSTRAINTS) return WB_ERR_LIMIT;
-    wb_status st = grow_particles(w, w->m.np + (int32_t)np_extra);
-    if (st == WB_OK) st = grow_distances(w, w->m.nd + (int32_t)nd_extra);
-    return st;
-}
-
-wb_distance_id wb_distance_add(wb_world *w, int32_t a, int32_t b, const wb_distance_def *def, wb_status *status)
-{
-    wb_distance_id none = { 0, 0 };
-    wb_status dummy;
-    if (!status) status = &dummy;
-    const wb_fault f = wb_distance_check(w->m.np, w->s.x, a, b, def);
-    if (f.msg) {
-        if (!f.key && f.corner < 0) wb__set_error("particles %d and %d are %s", a + 1, b + 1, f.why);
-        else wb__set_error("%s", f.msg);
-        *status = WB_ERR_ARG;
-        return none;
-    }
-    wb_real d[3];
-    v3_sub(d, &w->s.x[3 * b], &w->s.x[3 * a]);
-    const wb_real rest = def->rest >= 0 ? def->rest : v3_len(d);
-    wb_model *m = &w->m;
-    int32_t slot;
-    if (m->nfree > 0) {
-        slot = m->d_free[--m->nfree];
-    } else {
-        wb_status st = grow_distances(w, m->nd + 1);
-        if (st != WB_OK) { *status = st; return none; }
-        slot = m->nd++;
-        m->d_gen[slot] = 0;
-    }
-    m->d_ij[2 * slot] = a;
-    m->d_ij[2 * slot + 1] = b;
-    m->d_alpha[slot] = def->compliance;
-    m->d_beta[slot] = def->damping;
-    m->d_yield[slot] = def->yield;
-    m->d_creep[slot] = def->creep;
-    m->d_break[slot] = def->break_strain;
-    m->d_bforce[slot] = def->break_force;
-    m->d_gen[slot]++; /* even -> odd: live */
-    w->s.d_rest[slot] = rest;
-    w->s.d_broken[slot] = 0;
-    w->k.slot_pack[slot] = -1;
-    m->nd_live++;
-    m->topology_dirty = 1;
-    *status = WB_OK;
-    wb_distance_id id = { (uint32_t)slot + 1, m->d_gen[slot] };
-    return id;
-}
-
-bool wb_distance_valid(const wb_world *w, wb_distance_id c)
-{
-    if (c.index == 0 || c.index > (uint32_t)w->m.nd) return false;
-    uint32_t g = w->m.d_gen[c.index - 1];
-    return slot_live(g) && g == c.gen;
-}
-
-#define SLOT(w, c) (assert(wb_distance_valid((w), (c))), (int32_t)(c).index - 1)
-
-void wb_distance_remove(wb_world *w, wb_distance_id c)
-{
-    int32_t s = SLOT(w, c);
-    w->m.d_gen[s]++; /* odd -> even: dead, old handles stale */
-    w->m.d_free[w->m.nfree++] = s;
-    w->m.nd_live--;
-    w->m.topology_dirty = 1;
-}
-
-wb_real wb_distance_force(const wb_world *w, wb_distance_id c)
-{
-    int32_t s = SLOT(w, c);
-    int32_t k = w->k.slot_pack[s];
-    if (k < 0 || k >= w->k.ns || w->k.s_lambda_stale) return 0; /* not stepped since it was made (or undone) */
-    const wb_real h = w->k.h_last; /* of the step that made lambda, whatever dt is now */
-    return fabs(w->k.s_lambda[k]) / (h * h);
-}
-
-wb_real wb_distance_rest(const wb_world *w, wb_distance_id c) { return w->s.d_rest[SLOT(w, c)]; }
-bool wb_distance_broken(const wb_world *w, wb_distance_id c) { return w->s.d_broken[SLOT(w, c)] != 0; }
-
-wb_real wb_distance_length(const wb_world *w, wb_distance_id c)
-{
-    int32_t s = SLOT(w, c);
-    wb_real d[3];
-    v3_sub(d, &w->s.x[3 * w->m.d_ij[2 * s + 1]], &w->s.x[3 * w->m.d_ij[2 * s]]);
-    return v3_len(d);
-}
-
-void wb_distance_particles(const wb_world *w, wb_distance_id c, int32_t *a, int32_t *b)
-{
-    int32_t s = SLOT(w, c);
-    *a = w->m.d_ij[2 * s];
-    *b = w->m.d_ij[2 * s + 1];
-}
-
-int32_t wb_distance_count(const wb_world *w) { return w->m.nd_live; }
-
-wb_distance_id wb_distance_at(const wb_world *w, int32_t i)
-{
-    /* live slots in slot order: O(nd) scan, fine for inspection and export */
-    for (int32_t s = 0; s < w->m.nd; s++) {
-        if (!slot_live(w->m.d_gen[s])) continue;
-        if (i-- == 0) { wb_distance_id id = { (uint32_t)s + 1, w->m.d_gen[s] }; return id; }
-    }
-    wb_distance_id none = { 0, 0 };
-    return none;
-}
-
-int32_t wb_distance_ids(const wb_world *w, wb_distance_id *out)
-{
-    int32_t n = 0;
-    for (int32_t s = 0; s < w->m.nd; s++)
-        if (slot_live(w->m.d_gen[s])) { out[n].index = (uint32_t)s + 1; out[n].gen = w->m.d_gen[s]; n++; }
-    return n;
-}
-
-/* ---- events --------------------------------------------------------------------------- */
-int32_t wb_world_break_count(const wb_world *w) { return w->k.nbreaks; }
-wb_distance_id wb_world_break_at(const wb_world *w, int32_t i) { assert(i >= 0 && i < w->k.nbreaks); return w->k.breaks[i]; }
 
 /* ---- surfaces ------------------------------------------------------------------------ */
 /* room for one more surface of ntri triangles: after it, wb_surface_add cannot fail

@@ -127,6 +127,7 @@
     X(colour_batches_valid)                      \
     X(colour_broken_constraints_unpacked)        \
     X(colour_mirror_images_alike)                \
+    X(colour_distances_made_with_the_first_link) \
     X(volume_tet_batches_valid)                  \
     X(volume_tet_threads_identical)              \
     X(bend_batches_valid)                        \

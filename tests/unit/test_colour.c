@@ -10,37 +10,38 @@
 
 #include "core/core.h"
 #include "core/batch.h"
+#include "core/distance.h"
 #include "test.h"
 
 static void check_colouring(wb_world *w)
 {
     const wb_model *m = &w->m;
-    const wb_cache *k = &w->k;
     /* a break at the end of the last step marks the batches dirty: rebuild as a step would */
     REQUIRE(wb__colour(w) == WB_OK);
     REQUIRE(!m->topology_dirty);
+    const wb_distances *ds = wb__dist(w->dist);
     /* ranges */
-    REQUIRE(k->ncolours >= 0 && k->serial_start >= 0 && k->serial_start <= k->ncolours);
-    CHECK_EQ(k->ncolours > 0 ? k->colour_start[0] : 0, 0);
-    CHECK_EQ(k->ncolours > 0 ? k->colour_start[k->ncolours] : 0, k->split_start);
-    for (int32_t c = 0; c < k->ncolours; c++) CHECK(k->colour_start[c] < k->colour_start[c + 1]);
+    REQUIRE(ds->ncolours >= 0 && ds->serial_start >= 0 && ds->serial_start <= ds->ncolours);
+    CHECK_EQ(ds->ncolours > 0 ? ds->colour_start[0] : 0, 0);
+    CHECK_EQ(ds->ncolours > 0 ? ds->colour_start[ds->ncolours] : 0, ds->split_start);
+    for (int32_t c = 0; c < ds->ncolours; c++) CHECK(ds->colour_start[c] < ds->colour_start[c + 1]);
     /* the compounds fill [split_start, ns), each a non-empty run of links joined through
      * shared movable particles, whose ends count the members meeting there */
-    REQUIRE(k->ncomp >= 0);
-    CHECK_EQ(k->comp_start[0], k->split_start);
-    CHECK_EQ(k->comp_start[k->ncomp], k->ns);
+    REQUIRE(ds->ncomp >= 0);
+    CHECK_EQ(ds->comp_start[0], ds->split_start);
+    CHECK_EQ(ds->comp_start[ds->ncomp], ds->ns);
     int bad_comp = 0;
-    for (int32_t c = 0; c < k->ncomp; c++) {
-        const int32_t b = k->comp_start[c], e = k->comp_start[c + 1];
+    for (int32_t c = 0; c < ds->ncomp; c++) {
+        const int32_t b = ds->comp_start[c], e = ds->comp_start[c + 1];
         if (e <= b) { bad_comp++; continue; }
         for (int32_t i = b; i < e; i++) {
             int n[2] = { 0, 0 }, joined = e - b == 1;
             for (int32_t j = b; j < e; j++) {
-                n[0] += k->s_a[j] == k->s_a[i] || k->s_b[j] == k->s_a[i];
-                n[1] += k->s_a[j] == k->s_b[i] || k->s_b[j] == k->s_b[i];
+                n[0] += ds->s_a[j] == ds->s_a[i] || ds->s_b[j] == ds->s_a[i];
+                n[1] += ds->s_a[j] == ds->s_b[i] || ds->s_b[j] == ds->s_b[i];
             }
             joined |= n[0] > 1 || n[1] > 1;
-            const int32_t *nsp = &k->s_nsp[2 * (i - k->split_start)];
+            const int32_t *nsp = &ds->s_nsp[2 * (i - ds->split_start)];
             bad_comp += !joined || nsp[0] != n[0] || nsp[1] != n[1];
         }
     }
@@ -50,9 +51,9 @@ static void check_colouring(wb_world *w)
     REQUIRE(owner);
     for (int32_t i = 0; i < m->np; i++) owner[i] = -1;
     int conflicts = 0;
-    for (int32_t c = 0; c < k->serial_start; c++)
-        for (int32_t i = k->colour_start[c]; i < k->colour_start[c + 1]; i++) {
-            const int32_t ends[2] = { k->s_a[i], k->s_b[i] };
+    for (int32_t c = 0; c < ds->serial_start; c++)
+        for (int32_t i = ds->colour_start[c]; i < ds->colour_start[c + 1]; i++) {
+            const int32_t ends[2] = { ds->s_a[i], ds->s_b[i] };
             for (int e = 0; e < 2; e++) {
                 const int32_t p = ends[e];
                 if (m->inv_mass[p] == 0) continue;
@@ -65,20 +66,20 @@ static void check_colouring(wb_world *w)
     /* packed exactly once */
     int32_t live = 0;
     int bad_map = 0, bad_data = 0;
-    for (int32_t s = 0; s < m->nd; s++) {
-        const int is_live = (m->d_gen[s] & 1u) && !w->s.d_broken[s];
-        const int32_t i = k->slot_pack[s];
+    for (int32_t s = 0; s < ds->n; s++) {
+        const int is_live = (ds->gen[s] & 1u) && !wb__dist(w->dist)->broken[s];
+        const int32_t i = ds->slot_pack[s];
         if (!is_live) { if (i != -1) bad_map++; continue; }
         live++;
-        if (i < 0 || i >= k->ns || k->s_slot[i] != s) { bad_map++; continue; }
-        if (k->s_a[i] != m->d_ij[2 * s] || k->s_b[i] != m->d_ij[2 * s + 1] || k->s_rest[i] != w->s.d_rest[s] ||
-            k->s_alpha[i] != m->d_alpha[s] || k->s_beta[i] != m->d_beta[s])
+        if (i < 0 || i >= ds->ns || ds->s_slot[i] != s) { bad_map++; continue; }
+        if (ds->s_a[i] != ds->ij[2 * s] || ds->s_b[i] != ds->ij[2 * s + 1] || ds->s_rest[i] != wb__dist(w->dist)->rest[s] ||
+            ds->s_alpha[i] != ds->alpha[s] || ds->s_beta[i] != ds->beta[s])
             bad_data++;
     }
-    CHECK_EQ(live, k->ns);
-    for (int32_t i = 0; i < k->ns; i++) {
-        const int32_t s = k->s_slot[i];
-        if (s < 0 || s >= m->nd || k->slot_pack[s] != i) bad_map++;
+    CHECK_EQ(live, ds->ns);
+    for (int32_t i = 0; i < ds->ns; i++) {
+        const int32_t s = ds->s_slot[i];
+        if (s < 0 || s >= ds->n || ds->slot_pack[s] != i) bad_map++;
     }
     CHECK_EQ(bad_map, 0);
     CHECK_EQ(bad_data, 0);
@@ -113,7 +114,7 @@ TEST(colour_batches_valid)
     }
     wb_world_step(w);
     check_colouring(w);
-    CHECK(w->k.ncolours >= 4);
+    CHECK(wb__dist(w->dist)->ncolours >= 4);
 
     /* a star around a movable hub with 100 spokes needs 100 colours: past the 64 of
      * the bit mask the rest go to the serial batch */
@@ -126,7 +127,7 @@ TEST(colour_batches_valid)
     }
     wb_world_step(w);
     check_colouring(w);
-    CHECK(w->k.serial_start < w->k.ncolours);
+    CHECK(wb__dist(w->dist)->serial_start < wb__dist(w->dist)->ncolours);
 
     /* edits: remove every third constraint, add a few, break none: rebuilt and valid */
     int32_t n = wb_distance_count(w);
@@ -166,7 +167,7 @@ TEST(colour_broken_constraints_unpacked)
     wb_stats st = wb_world_stats(w);
     CHECK_EQ(st.broken, broke);
     CHECK_EQ(st.distances, 6);
-    CHECK_EQ(w->k.ns, 6 - broke);
+    CHECK_EQ(wb__dist(w->dist)->ns, 6 - broke);
     wb_world_destroy(w);
 }
 
@@ -178,10 +179,10 @@ static int *lattice_colours(const wb_world *w, int32_t first, int32_t np)
     int *col = malloc(sizeof *col * (size_t)np * (size_t)np);
     if (!col) return NULL;
     for (int32_t i = 0; i < np * np; i++) col[i] = -1;
-    const wb_cache *k = &w->k;
-    for (int32_t c = 0; c < k->ncolours; c++)
-        for (int32_t i = k->colour_start[c]; i < k->colour_start[c + 1]; i++) {
-            const int32_t a = k->s_a[i] - first, b = k->s_b[i] - first;
+    const wb_distances *ds = wb__dist(w->dist);
+    for (int32_t c = 0; c < ds->ncolours; c++)
+        for (int32_t i = ds->colour_start[c]; i < ds->colour_start[c + 1]; i++) {
+            const int32_t a = ds->s_a[i] - first, b = ds->s_b[i] - first;
             col[a * np + b] = col[b * np + a] = c;
         }
     /* compounds touching none of the run they follow commute with it: a run projects as
@@ -190,13 +191,13 @@ static int *lattice_colours(const wb_world *w, int32_t first, int32_t np)
     if (!run) { free(col); return NULL; }
     for (int32_t p = 0; p < np; p++) run[p] = -1;
     int32_t cur = 0;
-    for (int32_t c = 0; c < k->ncomp; c++) {
+    for (int32_t c = 0; c < ds->ncomp; c++) {
         int shares = 0;
-        for (int32_t i = k->comp_start[c]; i < k->comp_start[c + 1]; i++)
-            shares |= run[k->s_a[i] - first] == cur || run[k->s_b[i] - first] == cur;
+        for (int32_t i = ds->comp_start[c]; i < ds->comp_start[c + 1]; i++)
+            shares |= run[ds->s_a[i] - first] == cur || run[ds->s_b[i] - first] == cur;
         if (shares) cur++;
-        for (int32_t i = k->comp_start[c]; i < k->comp_start[c + 1]; i++) {
-            const int32_t a = k->s_a[i] - first, b = k->s_b[i] - first;
+        for (int32_t i = ds->comp_start[c]; i < ds->comp_start[c + 1]; i++) {
+            const int32_t a = ds->s_a[i] - first, b = ds->s_b[i] - first;
             run[a] = run[b] = cur;
             col[a * np + b] = col[b * np + a] = 1000 + cur;
         }
@@ -228,9 +229,9 @@ static void mirror_mismatches(int n, int ny, int on, int mism[3])
     int *col = lattice_colours(w, b.first, np);
     REQUIRE(col);
     /* a lattice's compounds are the 2 or 4 images meeting at a particle on a plane */
-    const wb_cache *k = &w->k;
-    for (int32_t c = 0; c < k->ncomp; c++) CHECK(k->comp_start[c + 1] - k->comp_start[c] <= 4);
-    mism[2] = k->ncomp;
+    const wb_distances *ds = wb__dist(w->dist);
+    for (int32_t c = 0; c < ds->ncomp; c++) CHECK(ds->comp_start[c + 1] - ds->comp_start[c] <= 4);
+    mism[2] = ds->ncomp;
     mism[0] = mism[1] = 0;
     for (int32_t p = 0; p < np; p++)
         for (int32_t q = p + 1; q < np; q++) {
@@ -267,4 +268,41 @@ TEST(colour_mirror_images_alike)
     CHECK(m[2] > 0);
     mirror_mismatches(7, 3, 0, m);
     CHECK(m[0] > 0);
+}
+
+/* the distances' struct is made with the first link: a world without any has none
+ * (stepped by either solver, cloned), and what the links charged is given back */
+TEST(colour_distances_made_with_the_first_link)
+{
+    wb_memory mem = { 0, 0 };
+    wb_world_def wd = wb_world_default_def();
+    wd.memory = &mem;
+    for (int jacobi = 0; jacobi < 2; jacobi++) {
+        wd.solver = jacobi ? WB_SOLVER_JACOBI : WB_SOLVER_GAUSS_SEIDEL;
+        wb_world *w = wb_world_create(&wd);
+        REQUIRE(w);
+        const wb_real pos[4][3] = { { 0, 1, 0 }, { 1, 1, 0 }, { 0, 2, 0 }, { 0, 1, 1 } };
+        int32_t p[4];
+        for (int i = 0; i < 4; i++) p[i] = wb_particle_add(w, pos[i], NULL, 1, 0.01);
+        const wb_tet_def td = wb_tet_default_def();
+        REQUIRE(wb_tet_add(w, p, &td) >= 0);
+        for (int f = 0; f < 3; f++) REQUIRE(wb_world_step(w) == WB_OK);
+        CHECK(w->dist == NULL);
+        const wb_stats st = wb_world_stats(w);
+        CHECK_EQ(st.distances, 0);
+        CHECK_EQ(st.colours, 0);
+        wb_world *c = wb_world_clone(w);
+        REQUIRE(c);
+        CHECK(c->dist == NULL);
+        wb_world_destroy(c);
+        const wb_distance_def dd = wb_distance_default_def();
+        const wb_distance_id id = wb_distance_add(w, p[0], p[1], &dd, NULL);
+        REQUIRE(id.index != 0);
+        REQUIRE(w->dist != NULL);
+        CHECK(w->dist->charged > 0);
+        REQUIRE(wb_world_step(w) == WB_OK);
+        CHECK_EQ(wb_world_stats(w).distances, 1);
+        wb_world_destroy(w);
+        CHECK_EQ(mem.used, 0);
+    }
 }

@@ -16,6 +16,7 @@
 #include <stdlib.h>
 
 #include "core/core.h"
+#include "core/distance.h"
 #include "test.h"
 
 int wb__distance_simd(int on); /* distance.c's internal switch */
@@ -99,9 +100,9 @@ static wb_world *scene(int solver, int threads, int damped, int iterations)
 static int differing(const wb_world *a, const wb_world *b)
 {
     const int32_t n = wb_particle_count(a);
-    if (n != wb_particle_count(b) || a->k.ns != b->k.ns) return 1;
+    if (n != wb_particle_count(b) || wb__dist(a->dist)->ns != wb__dist(b->dist)->ns) return 1;
     return memcmp(wb_particle_positions(a), wb_particle_positions(b), sizeof(wb_real) * 3 * (size_t)n) != 0 ||
-           memcmp(a->k.s_lambda, b->k.s_lambda, sizeof(wb_real) * (size_t)a->k.ns) != 0;
+           memcmp(wb__dist(a->dist)->s_lambda, wb__dist(b->dist)->s_lambda, sizeof(wb_real) * (size_t)wb__dist(a->dist)->ns) != 0;
 }
 
 TEST(distance_simd_bit_identical_to_scalar)

@@ -15,6 +15,7 @@
 
 #include "core/core.h"
 #include "core/broadphase.h"
+#include "core/distance.h"
 #include "core/tricontact.h"
 #include "test.h"
 
@@ -28,7 +29,7 @@ static double urand(void)
 /* ---- the rules, brute force --------------------------------------------------------------------- */
 /* a loose particle's graph, found here by a walk over the links (the world's distance
  * constraints: the tests make no other type): the least loose particle it reaches */
-static int32_t graph_brute(const wb_model *m, int32_t p)
+static int32_t graph_brute(const wb_model *m, const wb_distances *ds, int32_t p)
 {
     if (m->group[p] > 0) return m->group[p];
     int32_t least = p, changed = 1;
@@ -36,9 +37,9 @@ static int32_t graph_brute(const wb_model *m, int32_t p)
     in[p] = 1;
     while (changed) {
         changed = 0;
-        for (int32_t s = 0; s < m->nd; s++) {
-            if (!(m->d_gen[s] & 1u)) continue;
-            const int32_t a = m->d_ij[2 * s], b = m->d_ij[2 * s + 1];
+        for (int32_t s = 0; s < ds->n; s++) {
+            if (!(ds->gen[s] & 1u)) continue;
+            const int32_t a = ds->ij[2 * s], b = ds->ij[2 * s + 1];
             if (m->group[a] > 0 || m->group[b] > 0 || in[a] == in[b]) continue;
             in[a] = in[b] = 1;
             changed = 1;
@@ -50,19 +51,19 @@ static int32_t graph_brute(const wb_model *m, int32_t p)
     return -1 - least;
 }
 
-static int linked(const wb_model *m, int32_t p, int32_t v)
+static int linked(const wb_distances *ds, int32_t p, int32_t v)
 {
-    for (int32_t s = 0; s < m->nd; s++)
-        if ((m->d_gen[s] & 1u) && ((m->d_ij[2 * s] == p && m->d_ij[2 * s + 1] == v) ||
-                                   (m->d_ij[2 * s] == v && m->d_ij[2 * s + 1] == p)))
+    for (int32_t s = 0; s < ds->n; s++)
+        if ((ds->gen[s] & 1u) && ((ds->ij[2 * s] == p && ds->ij[2 * s + 1] == v) ||
+                                   (ds->ij[2 * s] == v && ds->ij[2 * s + 1] == p)))
             return 1;
     return 0;
 }
 
-static int allowed(const wb_model *m, int32_t p, int32_t v, int *same)
+static int allowed(const wb_model *m, const wb_distances *ds, int32_t p, int32_t v, int *same)
 {
-    if (linked(m, p, v)) return 0;
-    if (graph_brute(m, p) != graph_brute(m, v)) return (m->cflags[p] & m->cflags[v] & WB_CF_COLLIDE) != 0;
+    if (linked(ds, p, v)) return 0;
+    if (graph_brute(m, ds, p) != graph_brute(m, ds, v)) return (m->cflags[p] & m->cflags[v] & WB_CF_COLLIDE) != 0;
     *same = 1;
     return m->group[p] == 0 || (m->cflags[p] & m->cflags[v] & WB_CF_SELF) != 0;
 }
@@ -122,7 +123,7 @@ static int brute_pair(const wb_world *w, int32_t p, int32_t t)
     if (p == v[0] || p == v[1] || p == v[2]) return 0;
     int same = 0;
     for (int k = 0; k < 3; k++)
-        if (!allowed(m, p, v[k], &same)) return 0;
+        if (!allowed(m, wb__dist(w->dist), p, v[k], &same)) return 0;
     if (m->group[p] == m->group[v[0]] && covered(m, t)) return 0;
     if (m->w[p] == 0 && m->w[v[0]] == 0 && m->w[v[1]] == 0 && m->w[v[2]] == 0) return 0;
     /* the plane, then the triangle, within rp + mv */
