@@ -61,8 +61,9 @@ struct wb_vbd {
                               types projected after it (NaN: not known), of which it keeps
                               VBD_STAB (AVBD's stabilisation) */
     vbd_link *lk;          /* (nd) what the sweep reads of each link, set each substep */
-    int32_t *hard;         /* the live hard and stiff links' slots, this substep */
-    int32_t nhard;
+    int32_t *hard;         /* (nd) the live hard links' slots, this substep, from the front
+                              (nhard), and the stiff ones' from the back (nstiff) */
+    int32_t nhard, nstiff;
     int32_t cap_lam;
     wb_real *blam, *bkpen; /* (nb, by slot) a hard bend's multiplier and penalty */
     wb_real *btg, *bc0;    /* (nb) a hard bend's target (the error it keeps this substep) and
@@ -637,7 +638,7 @@ static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2, wb_real in
 {
     const wb_model *m = &w->m;
     const wb_real *xp = w->s.x_prev;
-    v->nhard = 0;
+    v->nhard = v->nstiff = 0;
     /* volume constraints are projected after the sweeps: with rigid links they may hold
      * a body over-constrained (rigid links and incompressible tets under a press), and a
      * link that took back what the press pushed into it each substep fought them (a
@@ -647,36 +648,47 @@ static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2, wb_real in
         if (!link_live(w, s)) continue;
         vbd_link *L = &v->lk[s];
         const wb_real alpha = m->d_alpha[s], rest = w->s.d_rest[s], kap = VBD_LINK_K * start_penalty(w, s, inv_h2);
-        L->dmp = alpha > 0 && m->d_beta[s] > 0 ? m->d_beta[s] * inv_h : 0;
-        if (alpha > 0 && !(1 / alpha > kap)) { /* its own energy */
-            L->tgt = rest, L->kk = 1 / alpha, L->lm = 0;
-            v->lam[s] = 0, v->c0[s] = (wb_real)NAN;
+        wb_real d[3];
+        if (alpha > 0) {
+            L->dmp = m->d_beta[s] > 0 ? m->d_beta[s] * inv_h : 0;
+            if (!(1 / alpha > kap)) { /* its own energy */
+                L->tgt = rest, L->kk = 1 / alpha, L->lm = 0;
+                v->lam[s] = 0, v->c0[s] = (wb_real)NAN;
+                put_entries(v, s, L);
+                continue;
+            }
+            /* stiffer than a rigid link's penalty: as one (dual_update), its error C - alpha
+             * lambda */
+            const wb_real r = 1 / (1 + alpha * kap);
+            v3_sub(d, &xp[3 * m->d_ij[2 * s]], &xp[3 * m->d_ij[2 * s + 1]]);
+            const wb_real c = v3_len(d) - rest - alpha * v->lam[s], ce = v->c0[s];
+            const wb_real c0 = keep_all || !isfinite(ce) ? c : c * ce <= 0 ? 0 : fabs(c) < fabs(ce) ? c : ce;
+            L->tgt = rest + (keep_all ? VBD_STAB_VOL : VBD_STAB) * c0;
+            L->kk = kap * r, L->lm = r * v->lam[s];
             put_entries(v, s, L);
+            v->hard[m->nd - 1 - v->nstiff++] = s;
             continue;
         }
-        /* a rigid link, or one stiffer than its penalty (dual_update) */
-        const wb_real r = alpha > 0 ? 1 / (1 + alpha * kap) : 1;
-        wb_real d[3];
         v3_sub(d, &xp[3 * m->d_ij[2 * s]], &xp[3 * m->d_ij[2 * s + 1]]);
         /* the error kept is no more than the solve itself left: what the contacts and
          * colliders did to the link since (pushing a body's bottom up into it) is a load
          * it takes, not a drift to stabilise, or a block on the ground sags by 100 g h^2
          * a link (a 4 x 4 x 4 lattice's lowest links 17% short on a slope) */
-        const wb_real c = alpha > 0 ? v3_len(d) - rest - alpha * v->lam[s] : v3_len(d) - rest, ce = v->c0[s];
+        const wb_real c = v3_len(d) - rest, ce = v->c0[s];
         const wb_real c0 = keep_all || !isfinite(ce) ? c : c * ce <= 0 ? 0 : fabs(c) < fabs(ce) ? c : ce;
         L->tgt = rest + (keep_all ? VBD_STAB_VOL : VBD_STAB) * c0;
-        L->kk = alpha > 0 ? kap * r : kap, L->lm = alpha > 0 ? r * v->lam[s] : v->lam[s];
+        L->kk = kap, L->lm = v->lam[s], L->dmp = 0;
         put_entries(v, s, L);
         v->hard[v->nhard++] = s;
     }
 }
 
-/* After a sweep: a hard link's multiplier grows by k C. A stiff link (compliance alpha
- * below 1 / k, k the rigid links' penalty) is the augmented Lagrangian of its own energy,
- * C^2 / 2 alpha = min_z z^2 / 2 alpha with z = C: eliminating z, the sweep sees the force
- * r (lambda + k C) and the stiffness r k, r = 1 / (1 + alpha k), lambda its tension after
- * the last sweep, which at rest is C / alpha; its error is the compliant constraint's,
- * C - alpha lambda, kept as a hard link's. With its whole stiffness in the vertex step
+/* After the substep's last sweep: a hard link's multiplier grows by k C. A stiff link
+ * (compliance alpha with 1 / alpha above the rigid links' penalty k) goes through the
+ * augmented Lagrangian of its energy written as z^2 / 2 alpha under the constraint z = C:
+ * with z eliminated the sweep sees the force r (lambda + k C) and the stiffness r k,
+ * r = 1 / (1 + alpha k), lambda its tension after the last update (C / alpha at rest);
+ * its error, C - alpha lambda, is kept as a hard link's. With its whole stiffness in the vertex step
  * (1e6 N/m for a w:cloth's links of compliance 1e-6 at 20 substeps, 160 times that
  * penalty) one sweep left a vertex's neighbours far from where it assumed them: a cloth
  * hung by a row of pins gained energy until it blew up (max strain 0.1% after 0.3 s,
@@ -691,25 +703,29 @@ static void dual_update(wb_world *w, struct wb_vbd *v)
         wb_real d[3];
         v3_sub(d, &x[3 * a], &x[3 * b]);
         const wb_real l = v3_len(d);
-        if (m->d_alpha[s] > 0) {
-            const wb_real f = L->kk * (l - L->tgt) + L->lm;
-            v->lam[s] = f;
-            L->lm = (1 - m->d_alpha[s] * L->kk) * f;
-            v->c0[s] = l - w->s.d_rest[s] - m->d_alpha[s] * f;
-        } else {
-            L->lm += L->kk * (l - L->tgt);
-            v->c0[s] = l - w->s.d_rest[s]; /* (before the types projected after the sweep) */
-        }
+        L->lm += L->kk * (l - L->tgt);
+        v->c0[s] = l - w->s.d_rest[s]; /* (before the types projected after the sweep) */
         const int32_t e = v->epos[2 * s], f = v->epos[2 * s + 1];
         v->elm[e] = v->elm[f] = L->lm;
     }
+    for (int32_t q = m->nd - v->nstiff; q < m->nd; q++) {
+        const int32_t s = v->hard[q], a = m->d_ij[2 * s], b = m->d_ij[2 * s + 1];
+        vbd_link *L = &v->lk[s];
+        wb_real d[3];
+        v3_sub(d, &x[3 * a], &x[3 * b]);
+        const wb_real l = v3_len(d), f = L->kk * (l - L->tgt) + L->lm, alpha = m->d_alpha[s];
+        v->lam[s] = f;
+        L->lm = (1 - alpha * L->kk) * f;
+        v->c0[s] = l - w->s.d_rest[s] - alpha * f;
+        const int32_t e = v->epos[2 * s], g = v->epos[2 * s + 1];
+        v->elm[e] = v->elm[g] = L->lm;
+    }
 }
 
-/* the hard links' multipliers carried to the next substep */
-static void keep_multipliers(const wb_world *w, struct wb_vbd *v)
+/* the hard links' multipliers carried to the next substep (a stiff one's: dual_update) */
+static void keep_multipliers(struct wb_vbd *v)
 {
-    for (int32_t q = 0; q < v->nhard; q++)
-        if (!(w->m.d_alpha[v->hard[q]] > 0)) v->lam[v->hard[q]] = v->lk[v->hard[q]].lm; /* (a stiff one's: dual_update) */
+    for (int32_t q = 0; q < v->nhard; q++) v->lam[v->hard[q]] = v->lk[v->hard[q]].lm;
 }
 
 /* a hard bend's penalty: the inertia of its angle, 1 / (h^2 w sum |g|^2), with w its
@@ -1044,7 +1060,7 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     }
     keep_momentum(w, v, touch, inv_h2);
     if (v->ct_on) wb__vbdc_end(w, v->ct);
-    keep_multipliers(w, v);
+    keep_multipliers(v);
     write_forces(w, v, h);
     return v->residual;
 }
