@@ -56,10 +56,10 @@ struct wb_vbd {
     int serial_last;       /* the last colour holds vertices that may share a link (more
                               colours than a mask holds): it runs on one thread */
     wb_real *y;            /* (np x 3) the substep's prediction */
-    wb_real *lam;          /* (nd) a hard or stiff link's multiplier (a stiff one's: its tension) */
-    wb_real *c0;           /* (nd) a hard (stiff: C - alpha lam) link's error as the last sweep left it, before the
-                              types projected after it (NaN: not known), of which it keeps
-                              VBD_STAB (AVBD's stabilisation) */
+    wb_real *lam;          /* (nd) a hard link's multiplier (a stiff one's: its tension) */
+    wb_real *c0;           /* (nd) a hard link's error (a stiff one's: C - alpha lam) as the
+                              last sweep left it, before the types projected after it (NaN:
+                              not known), of which it keeps VBD_STAB (AVBD's stabilisation) */
     vbd_link *lk;          /* (nd) what the sweep reads of each link, set each substep */
     int32_t *hard;         /* (nd) the live hard links' slots, this substep, from the front
                               (nhard), and the stiff ones' from the back (nstiff) */
@@ -75,7 +75,8 @@ struct wb_vbd {
                               image holds what the saved world's next step starts from) */
     wb_real residual;      /* the last sweep's largest step, m */
     double *tsum;          /* (bodies x 4) each free body's mass and sum m (x - y), then
-                              (bodies) 1: it may touch an immovable particle */
+                              (bodies) 1: it may touch an immovable particle, then (bodies
+                              x 3) its momentum step's translation (keep_momentum) */
     int32_t cap_tsum;
     double *csum;          /* (bodies x 17) a free body's contacts in the vertex steps
                               (keep_momentum) */
@@ -688,11 +689,12 @@ static void warm_start(wb_world *w, struct wb_vbd *v, wb_real inv_h2, wb_real in
  * augmented Lagrangian of its energy written as z^2 / 2 alpha under the constraint z = C:
  * with z eliminated the sweep sees the force r (lambda + k C) and the stiffness r k,
  * r = 1 / (1 + alpha k), lambda its tension after the last update (C / alpha at rest);
- * its error, C - alpha lambda, is kept as a hard link's. With its whole stiffness in the vertex step
- * (1e6 N/m for a w:cloth's links of compliance 1e-6 at 20 substeps, 160 times that
- * penalty) one sweep left a vertex's neighbours far from where it assumed them: a cloth
- * hung by a row of pins gained energy until it blew up (max strain 0.1% after 0.3 s,
- * 11% after 1 s, particles at 20 m/s; stable at 10 iterations). As hard, at alpha = 0 */
+ * its error, C - alpha lambda, is kept as a hard link's. With its whole stiffness in the
+ * vertex step (1e6 N/m for a w:cloth's links of compliance 1e-6 at 20 substeps, 160 times
+ * that penalty) one sweep left a vertex's neighbours far from where it assumed them: a
+ * cloth hung by a row of pins gained energy until it blew up (max strain 0.1% after
+ * 0.3 s, 11% after 1 s, particles at 20 m/s; stable at 10 iterations). At alpha = 0 it is
+ * the hard link's update */
 static void dual_update(wb_world *w, struct wb_vbd *v)
 {
     const wb_model *m = &w->m;
@@ -953,7 +955,7 @@ static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch, wb_real inv_
             const double m = 1 / (double)wv[i];
             for (int c = 0; c < 3; c++) E[17 * b + 14 + c] += m * ((double)y[3 * i + c] - (double)xp[3 * i + c]);
         }
-        /* t (in E[17 b + 1..3] between the passes, after the sums) by Newton steps: the
+        /* the translation t (tb) by Newton steps until the pairs pushing are the same: the
          * contacts are piecewise linear along it, and one step with the Hessian of the pairs
          * pushing at the sweeps' end stopped short where some of them let go (a block on a
          * slab at 1.05 of its sticking angle kept 1.57 times its weight on its last two
@@ -985,7 +987,10 @@ static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch, wb_real inv_
                 for (int c = 0; c < 3; c++) fb[c] = (wb_real)(e[1 + c] - mh * (T[4 * b + 1 + c] + tb[3 * b + c]));
                 if (!solve3(Hb, fb, dt)) continue;
                 double d2 = 0, t2 = 0;
-                for (int c = 0; c < 3; c++) tb[3 * b + c] += dt[c], d2 += (double)dt[c] * dt[c], t2 += tb[3 * b + c] * tb[3 * b + c];
+                for (int c = 0; c < 3; c++) {
+                    tb[3 * b + c] += dt[c];
+                    d2 += (double)dt[c] * dt[c], t2 += tb[3 * b + c] * tb[3 * b + c];
+                }
                 more |= d2 > 1e-12 * t2;
             }
             if (!more) break;
@@ -1051,7 +1056,7 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
          * every sweep, they took in what the contacts and colliders projected after the
          * solve would push back anyway, as often as there were sweeps (two stacked blocks
          * of rigid links at 2 iterations: links 45% long within 2.5 s; a cloth of them
-         * draped on a sphere: 70%) */
+         * draped on a sphere: 72%) */
         if (last) dual_update(w, v);
         bend_dual_update(w, v, h);
         for (int t = 0; t < wb__nctypes; t++)
