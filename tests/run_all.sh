@@ -6,6 +6,7 @@
 #   (c) every scripts/*.lua for 5 frames        one test per example scene (pass = exit 0)
 #       the scenes that check their claim       run in full under wobble test
 #       the output of (b) and of those scenes   no warning/assert/error line that no test announced
+#       tests/scripts_vbd.sh                    those scenes again under solver = "vbd"
 #   (d) tests/cli/run.sh                        the command line in separate processes
 #       tests/cli/sandbox.sh                    escapes from the file rules, in separate processes
 #       tests/cli/extreme.sh                    extreme input (overflowing builders, rest lengths, KNN ties)
@@ -127,6 +128,7 @@ part "example scenes (scripts/*.lua, 5 frames)" examples
 part "example scenes that check their claim, in full" checked_examples
 cp "$TMP/log" "$TMP/checked.log"
 part "expected stderr of the checked example scenes is labelled" expected_noise "$TMP/checked.log"
+part "example scenes that check their claim, under VBD (tests/scripts_vbd.sh)" sh tests/scripts_vbd.sh "$BUILD"
 part "command line (tests/cli/run.sh)" sh tests/cli/run.sh "$BUILD"
 part "sandbox escapes (tests/cli/sandbox.sh)" sh tests/cli/sandbox.sh "$BUILD"
 part "extreme input from the command line (tests/cli/extreme.sh)" sh tests/cli/extreme.sh "$BUILD"

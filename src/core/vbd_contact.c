@@ -255,14 +255,18 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, c
     return 1;
 }
 
+/* (sh: i moved by it, NULL: where it is) */
 static inline __attribute__((always_inline)) void block(const wb_world *w, const wb_vbdc *c, const wb_real *lam, int32_t i,
-                                                        wb_real f[3], wb_real H[6], wb_real *fr)
+                                                        const wb_real *sh, wb_real f[3], wb_real H[6], wb_real *fr)
 {
     const wb_real *x = w->s.x, *xc = c->xc;
+    wb_real xi[3];
+    v3_copy(xi, &x[3 * i]);
+    if (sh) v3_add(xi, xi, sh);
     for (int32_t e = c->start[i]; e < c->start[i + 1]; e++) {
         const int32_t q = c->ent[e] >> 1, o = c->pij[2 * q + 1 - (c->ent[e] & 1)];
         wb_real d[3];
-        v3_sub(d, &x[3 * i], &xc[3 * o]);
+        v3_sub(d, xi, &xc[3 * o]);
         const wb_real l2 = v3_dot(d, d);
         if (!(l2 > 1e-24)) continue;
         const wb_real l = sqrt(l2), kk = c->kk[q], fn = lam[q] - kk * (l - c->tgt[q]), fl = c->fl[q];
@@ -283,7 +287,7 @@ static inline __attribute__((always_inline)) void block(const wb_world *w, const
 
 void wb__vbdc_block(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3], wb_real H[6])
 {
-    block(w, c, c->lam, i, f, H, NULL);
+    block(w, c, c->lam, i, NULL, f, H, NULL);
 }
 
 void wb__vbdc_friction(const wb_world *w, const wb_vbdc *c, int32_t i, const wb_real H[6], wb_real xi[3])
@@ -317,9 +321,10 @@ void wb__vbdc_friction(const wb_world *w, const wb_vbdc *c, int32_t i, const wb_
     v3_madd(xi, u, -(need <= cap ? 1 : cap / need));
 }
 
-void wb__vbdc_body(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3], wb_real H[6], wb_real fr[4])
+void wb__vbdc_body(const wb_world *w, const wb_vbdc *c, int32_t i, const wb_real sh[3], wb_real f[3], wb_real H[6],
+                   wb_real *fr)
 {
-    block(w, c, c->lamp, i, f, H, fr);
+    block(w, c, c->lamp, i, sh, f, H, fr);
 }
 
 /* pair q's gap C from its target where the particles are, and the force a multiplier

@@ -18,11 +18,12 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **c, wb_real h, const int32_t *order, co
 void wb__vbdc_block(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3], wb_real H[6]);
 /* after vertex i's Newton step to xi (H: its Hessian): its friction with its partners */
 void wb__vbdc_friction(const wb_world *w, const wb_vbdc *c, int32_t i, const wb_real H[6], wb_real xi[3]);
-/* vertex i's contact forces after the sweeps (the multipliers before the last update)
- * without friction, added to f and H; fr[0] += its friction's capacity, sum mu f_n (the
- * lagged forces), fr[1..3] += sum f_n n (the direction they push it): a body's momentum
- * step's */
-void wb__vbdc_body(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3], wb_real H[6], wb_real fr[4]);
+/* vertex i's contact forces after the sweeps (the multipliers before the last update),
+ * moved by sh, without friction, added to f and H; unless fr is NULL, fr[0] += its
+ * friction's capacity, sum mu f_n (the lagged forces), fr[1..3] += sum f_n n (the
+ * direction they push it): a body's momentum step's */
+void wb__vbdc_body(const wb_world *w, const wb_vbdc *c, int32_t i, const wb_real sh[3], wb_real f[3], wb_real H[6],
+                   wb_real *fr);
 /* after the sweeps and the momentum step: each pair's force where they left it (the
  * readout's, and the next substep's friction's) */
 void wb__vbdc_end(const wb_world *w, wb_vbdc *c);
