@@ -65,9 +65,10 @@ static inline const wb_distances *wb__dist(const wb_distances *d)
     return d ? d : &none;
 }
 
-/* prepare, once per step (the type's hook): pack and colour the live links when the
- * world's topology changed (m.topology_dirty, cleared here even without links), then
- * bring the packed copies of what may change between steps up to date */
+/* prepare, once per step (the type's hook): empty the list of links broken (it reports
+ * the step about to run), pack and colour the live links when the world's topology
+ * changed (m.topology_dirty, cleared here even without links), then bring the packed
+ * copies of what may change between steps up to date */
 wb_status wb__colour(wb_world *w);
 
 /* by slot, as the world keeps them: a slot is live while its generation is odd, and the

@@ -974,7 +974,7 @@ static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch, wb_real inv_
                 for (int c = 0; c < 10; c++) E[17 * b + c] = 0;
             for (int32_t q = 0; q < nc; q++) {
                 const int32_t b = body[cv[q]];
-                if (b < 0 || !(T[4 * b] > 0)) continue;
+                if (b < 0 || !(T[4 * b] > 0) || isnan(tb[3 * b])) continue;
                 wb_real f[3] = { 0, 0, 0 }, H[6] = { 0, 0, 0, 0, 0, 0 }, fr[4] = { 0, 0, 0, 0 }, sh[3];
                 for (int c = 0; c < 3; c++) sh[c] = (wb_real)tb[3 * b + c];
                 wb__vbdc_body(w, v->ct, cv[q], sh, f, H, pass == 0 ? fr : NULL);
@@ -992,7 +992,12 @@ static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch, wb_real inv_
                 wb_real Hb[6], fb[3], dt[3];
                 for (int c = 0; c < 6; c++) Hb[c] = (wb_real)(e[4 + c] + (c < 3 ? mh : 0));
                 for (int c = 0; c < 3; c++) fb[c] = (wb_real)(e[1 + c] - mh * (T[4 * b + 1 + c] + tb[3 * b + c]));
-                if (!solve3(Hb, fb, dt)) continue;
+                if (!solve3(Hb, fb, dt)) {
+                    /* singular at the first step (non-finite input): the body keeps the
+                     * plain move above, as one without such contacts */
+                    if (pass == 0) tb[3 * b] = NAN;
+                    continue;
+                }
                 double d2 = 0, t2 = 0;
                 for (int c = 0; c < 3; c++) {
                     tb[3 * b + c] += dt[c];
@@ -1004,7 +1009,7 @@ static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch, wb_real inv_
         }
         for (int32_t b = 0; b < nb; b++) {
             const double *e = &E[17 * b];
-            if (!(e[0] > 0)) continue;
+            if (!(e[0] > 0) || isnan(tb[3 * b])) continue;
             const double mh = T[4 * b] * inv_h2;
             wb_real t[3];
             for (int c = 0; c < 3; c++) t[c] = (wb_real)tb[3 * b + c];

@@ -67,12 +67,12 @@ static void check_colouring(wb_world *w)
     int32_t live = 0;
     int bad_map = 0, bad_data = 0;
     for (int32_t s = 0; s < ds->n; s++) {
-        const int is_live = (ds->gen[s] & 1u) && !wb__dist(w->dist)->broken[s];
+        const int is_live = (ds->gen[s] & 1u) && !ds->broken[s];
         const int32_t i = ds->slot_pack[s];
         if (!is_live) { if (i != -1) bad_map++; continue; }
         live++;
         if (i < 0 || i >= ds->ns || ds->s_slot[i] != s) { bad_map++; continue; }
-        if (ds->s_a[i] != ds->ij[2 * s] || ds->s_b[i] != ds->ij[2 * s + 1] || ds->s_rest[i] != wb__dist(w->dist)->rest[s] ||
+        if (ds->s_a[i] != ds->ij[2 * s] || ds->s_b[i] != ds->ij[2 * s + 1] || ds->s_rest[i] != ds->rest[s] ||
             ds->s_alpha[i] != ds->alpha[s] || ds->s_beta[i] != ds->beta[s])
             bad_data++;
     }
