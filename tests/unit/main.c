@@ -205,6 +205,7 @@
     NARROW_TESTS(X)                              \
     X(distance_simd_bit_identical_to_scalar)     \
     X(vbd_simd_bit_identical_to_scalar)          \
+    X(vbd_memory_charged_and_refused)            \
     X(momentum_simd_bit_identical_to_scalar)     \
     POOL_TESTS(X)                                \
     FUSED_TESTS(X)
