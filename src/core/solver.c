@@ -470,6 +470,14 @@ wb_status wb_world_step(wb_world *w)
         for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->substep_begin(w);
         const int measure = k->residual_on && sub + 1 == d->substeps;
         const wb_real r = d->solver == WB_SOLVER_VBD ? wb__vbd_solve(w, h) : solve_constraints(w, h, measure);
+        if (d->solver == WB_SOLVER_VBD && wb__vbd_failed(w)) {
+            /* its scratch refused by the memory budget: the world is left as the frame found it */
+            undo_particles(w);
+            for (int32_t c = 0; c < w->m.nc; c++) restore_collider(w, c);
+            wb__warn(w, "frame %lld: out of memory in the VBD solve; frame undone", (long long)w->s.frame + 1);
+            k->step_ms = now_ms() - t_begin;
+            return WB_ERR_NOMEM;
+        }
         if (sub + 1 == d->substeps) k->residual = r;
         wb__momentum_restore(w, h);
         solve += now_ms() - t0;

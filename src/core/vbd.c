@@ -83,6 +83,11 @@ struct wb_vbd {
     uint8_t *bmove;        /* (bodies) 1: its friction goes in its momentum step */
     wb_vbdc *ct;           /* the particle contacts in the vertex steps (vbd_contact.c) */
     int ct_on;             /* ct holds this substep's */
+    size_t charged;        /* the struct's and its arrays' bytes charged to def.memory, but for
+                              tsum, csum, bmove (charged_t) and ct (its own) */
+    size_t charged_t;
+    int nomem;             /* the last solve ran out of memory (the budget refused its
+                              scratch): the step undoes the frame (wb__vbd_failed) */
 };
 
 #define VBD_COLOURS 64
@@ -151,7 +156,9 @@ void wb__vbd_destroy(wb_world *w)
     free(v->tsum);
     free(v->csum);
     free(v->bmove);
-    wb__vbdc_destroy(v->ct);
+    wb__vbdc_destroy(w, v->ct);
+    wb__charge(w, &v->charged, 0);
+    wb__charge(w, &v->charged_t, 0);
     free(v);
     w->vbd = NULL;
 }
@@ -186,6 +193,21 @@ static int quads(int32_t np, const int32_t *q, int32_t n, int32_t **start_out, i
     return 1;
 }
 
+/* what prepare holds for np vertices, ne adjacency entries, nd link slots, nt tets, nb
+ * bends and the multipliers' capacities: the struct, the adjacency (adj_start, adj, adjo,
+ * the 4 entry arrays, epos, tadj, badj and their starts), the colouring (order,
+ * colour_start), y, the links' lam, c0, lk, hard, the bends' blam, bkpen, btg, bc0, save */
+static size_t model_bytes(int64_t np, int64_t ne, int64_t nd, int64_t nt, int64_t nb, int64_t cap_lam, int64_t cap_blam)
+{
+    const int64_t n1 = np > 0 ? np : 1;
+    const size_t r = sizeof(wb_real), i4 = sizeof(int32_t);
+    return sizeof(struct wb_vbd) + 3 * (size_t)(np + 1) * i4 + (size_t)ne * (2 * i4 + 4 * r) +
+           2 * (size_t)(nd > 0 ? nd : 1) * i4 + (size_t)(4 * nt > 0 ? 4 * nt : 1) * i4 +
+           (size_t)(4 * nb > 0 ? 4 * nb : 1) * i4 + (size_t)n1 * (i4 + 3 * r) + (VBD_COLOURS + 1) * i4 +
+           (size_t)cap_lam * (2 * r + sizeof(vbd_link) + i4) + (size_t)cap_blam * 4 * r +
+           (2 * (size_t)cap_lam + 2 * (size_t)cap_blam + 1) * r;
+}
+
 /* each vertex's links (CSR, each range padded to a multiple of 4 for the vector lanes) */
 static int build_adjacency(wb_world *w, struct wb_vbd *v)
 {
@@ -198,6 +220,13 @@ static int build_adjacency(wb_world *w, struct wb_vbd *v)
         if (link_live(w, s)) start[ds->ij[2 * s] + 1]++, start[ds->ij[2 * s + 1] + 1]++;
     for (int32_t i = 0; i < np; i++) start[i + 1] = start[i] + ((start[i + 1] + 3) & ~3);
     const size_t ne = (size_t)(start[np] > 0 ? start[np] : 1);
+    /* everything prepare holds for this model, charged before it is taken */
+    const int32_t nb = wb_bend_count(w);
+    if (!wb__charge(w, &v->charged, model_bytes(np, (int64_t)ne, nd, w->neo ? w->neo->n : 0, nb,
+                                                nd > v->cap_lam ? nd : v->cap_lam, nb > v->cap_blam ? nb : v->cap_blam))) {
+        free(start);
+        return 0;
+    }
     int32_t *adj = malloc(sizeof *adj * ne), *adjo = malloc(sizeof *adjo * ne);
     int32_t *epos = malloc(sizeof *epos * 2 * (size_t)(nd > 0 ? nd : 1));
     int32_t *fill = malloc(sizeof *fill * (size_t)(np > 0 ? np : 1));
@@ -297,6 +326,7 @@ int wb__vbd_prepare(wb_world *w)
         w->vbd = v;
         v->np = -1;
     }
+    v->nomem = 0;
     const wb_model *m = &w->m;
     const wb_distances *ds = wb__dist(w->dist);
     const int32_t nt = w->neo ? w->neo->n : 0;
@@ -832,12 +862,19 @@ static int touching(wb_world *w, struct wb_vbd *v)
     if (!k->mc_built || k->mc_nbody == 0) return 0;
     const int32_t nb = k->mc_nbody, *body = k->mc_body;
     if (nb > v->cap_tsum) {
+        if (!wb__charge(w, &v->charged_t, (sizeof(double) * 25 + 1) * (size_t)nb)) {
+            v->nomem = 1;
+            return 0;
+        }
         double *t = realloc(v->tsum, sizeof *t * 8 * (size_t)nb), *e = realloc(v->csum, sizeof *e * 17 * (size_t)nb);
         uint8_t *bm = realloc(v->bmove, (size_t)nb);
         if (t) v->tsum = t;
         if (e) v->csum = e;
         if (bm) v->bmove = bm;
-        if (!t || !e || !bm) return 0;
+        if (!t || !e || !bm) {
+            v->nomem = 1;
+            return 0;
+        }
         v->cap_tsum = nb;
     }
     double *T = v->tsum;
@@ -1044,11 +1081,14 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     start_guess(w, v, h, touch);
     warm_start(w, v, inv_h2, 1 / h);
     bend_warm_start(w, v, h);
-    /* the contacts in the vertex steps (out of memory: left to the projection after) */
+    /* the contacts in the vertex steps */
     if (touch)
         for (int32_t b = 0; b < w->k.mc_nbody; b++)
             v->bmove[b] = v->tsum[4 * w->k.mc_nbody + b] > 0 && v->tsum[4 * b] >= 0 && !(w->k.mc_acc[16 * b] < 0);
-    v->ct_on = wb__vbdc_begin(w, &v->ct, h, v->order, v->colour_start, v->ncolours, touch ? v->bmove : NULL) > 0;
+    const int got = wb__vbdc_begin(w, &v->ct, h, v->order, v->colour_start, v->ncolours, touch ? v->bmove : NULL);
+    v->ct_on = got > 0;
+    if (got < 0) v->nomem = 1;
+    if (v->nomem) return -1; /* (the step undoes the frame) */
     wb_vbdc *ct = v->ct_on ? v->ct : NULL;
     wb_pool *pool = wb__world_pool(w);
     for (int it = 0; it < w->m.def.iterations; it++) {
@@ -1088,6 +1128,8 @@ void wb__vbd_contacts_done(wb_world *w)
 }
 
 wb_real wb__vbd_residual(const wb_world *w) { return w->vbd ? w->vbd->residual : 0; }
+
+int wb__vbd_failed(const wb_world *w) { return w->vbd && w->vbd->nomem; }
 
 /* ---- snapshots ------------------------------------------------------------------------------- */
 void wb__vbd_image_free(wb_image *g)

@@ -17,6 +17,9 @@ void wb__vbd_destroy(wb_world *w);
 void wb__vbd_undo(wb_world *w);
 /* at a substep's end: the particle contacts' readout takes in the sweeps' forces */
 void wb__vbd_contacts_done(wb_world *w);
+/* 1 when the last wb__vbd_solve ran out of memory (the budget refused its scratch): it
+ * did nothing, and the step must undo its frame */
+int wb__vbd_failed(const wb_world *w);
 /* the last substep's residual: the largest Newton step of its last sweep, m */
 wb_real wb__vbd_residual(const wb_world *w);
 

@@ -83,18 +83,40 @@ struct wb_vbdc {
     int32_t *cv;             /* the vertices with contacts, by colour */
     int32_t *cvs;            /* (ncolours + 1) ranges of cv */
     int32_t cap_np, cap_pair, cap_col;
+    size_t charged;          /* its bytes charged to def.memory (given back by wb__vbdc_destroy) */
 };
 
-void wb__vbdc_destroy(wb_vbdc *c)
+void wb__vbdc_destroy(wb_world *w, wb_vbdc *c)
 {
     if (!c) return;
+    wb__charge(w, &c->charged, 0);
     free(c->start), free(c->ent), free(c->pij), free(c->tgt), free(c->kk), free(c->lam), free(c->mu);
     free(c->ov), free(c->ove), free(c->prev), free(c->fend), free(c->prevf), free(c->fl), free(c->lamp), free(c->sf), free(c->ks), free(c->xc), free(c->cv), free(c->cvs);
     free(c);
 }
 
-static int grow(wb_vbdc *c, int32_t np, int32_t npair, int32_t ncol)
+/* what c holds at these capacities: the struct, the per-vertex arrays (start, cv, xc), the
+ * per-pair ones (ent 2, pij 2, prev 2 ints; tgt, kk, lam, mu, ov, ove, fend, prevf, fl,
+ * lamp reals; sf 1 byte), the keys and the colour ranges */
+static size_t bytes_at(int64_t np, int64_t npair, int64_t ncol1, int64_t nks)
 {
+    return sizeof(wb_vbdc) + (size_t)np * (2 * sizeof(int32_t) + 3 * sizeof(wb_real)) + sizeof(int32_t) +
+           (size_t)npair * (6 * sizeof(int32_t) + 10 * sizeof(wb_real) + 1) + (size_t)nks * sizeof(vbdc_key) +
+           (size_t)ncol1 * sizeof(int32_t);
+}
+
+/* room for np vertices, npair pairs, ncol colours and nks keys, charged to the memory
+ * budget before it is taken; 0 when the budget refuses it or out of memory */
+static int grow(wb_world *w, wb_vbdc *c, int32_t np, int32_t npair, int32_t ncol, int32_t nks)
+{
+    const int32_t cnp = np > c->cap_np ? np : c->cap_np, cpair = npair > c->cap_pair ? npair : c->cap_pair;
+    const int32_t ccol = ncol + 1 > c->cap_col ? ncol + 1 : c->cap_col, cks = nks > c->cap_ks ? nks : c->cap_ks;
+    if (!wb__charge(w, &c->charged, bytes_at(cnp, cpair, ccol, cks))) return 0;
+    if (nks > c->cap_ks) {
+        vbdc_key *ks = realloc(c->ks, sizeof *ks * (size_t)nks);
+        if (!ks) return 0;
+        c->ks = ks, c->cap_ks = nks;
+    }
     if (np > c->cap_np) {
         int32_t *s = realloc(c->start, sizeof *s * ((size_t)np + 1)), *v = realloc(c->cv, sizeof *v * (size_t)np);
         if (s) c->start = s;
@@ -143,6 +165,18 @@ static int grow(wb_vbdc *c, int32_t np, int32_t npair, int32_t ncol)
     return 1;
 }
 
+/* candidate k is a pair it serves: one movable end (see the head of the file for why not
+ * two), closer than VBDC_NEAR (r_i + r_j) */
+static inline int near_pair(const wb_contacts *pc, const wb_real *x, const wb_real *wv, const wb_real *rad, int32_t k)
+{
+    const int32_t i = pc->ij[2 * k], j = pc->ij[2 * k + 1];
+    if (!(wv[i] > 0) == !(wv[j] > 0)) return 0;
+    const wb_real rn = (rad[i] + rad[j]) * VBDC_NEAR;
+    wb_real d[3];
+    v3_sub(d, &x[3 * i], &x[3 * j]);
+    return v3_dot(d, d) < rn * rn;
+}
+
 int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, const int32_t *colour_start,
                    int32_t ncolours, const uint8_t *bmoved)
 {
@@ -159,20 +193,28 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, c
         c->sorted = 0;
     }
     if (pc->n == 0) return 0;
+    const wb_model *m = &w->m;
+    const int32_t np = m->np;
+    const wb_real *x = w->s.x, *xp = w->s.x_prev, *wv = m->w, *rad = m->radius, *cf = m->cfric;
+    /* the pairs it serves, counted before anything is sized: a handful of the frame's
+     * candidates (a self-colliding cloth has hundreds of thousands and none of them) */
+    int32_t n = 0;
+    for (int32_t k = 0; k < pc->n; k++)
+        n += near_pair(pc, x, wv, rad, k);
+    if (n == 0) {
+        if (c) c->sorted = 1; /* (no pairs: none lagged into the next substep) */
+        return 0;
+    }
     if (!c) {
         c = calloc(1, sizeof *c);
         if (!c) return -1;
         *cp = c;
     }
-    const wb_model *m = &w->m;
-    const int32_t np = m->np;
-    vbdc_key *ks = pc->n > c->cap_ks ? realloc(c->ks, sizeof *ks * (size_t)pc->n) : c->ks;
-    if (ks) c->ks = ks, c->cap_ks = pc->n > c->cap_ks ? pc->n : c->cap_ks;
-    if (!ks || !grow(c, np, pc->n > c->nprev ? pc->n : c->nprev, ncolours)) {
+    if (!grow(w, c, np, n > c->nprev ? n : c->nprev, ncolours, n)) {
         c->nprev = 0;
         return -1;
     }
-    const wb_real *x = w->s.x, *xp = w->s.x_prev, *wv = m->w, *rad = m->radius, *cf = m->cfric;
+    vbdc_key *ks = c->ks;
     const wb_real step = m->def.max_depenetration * h, inv_h2 = 1 / (h * h);
     /* what each pair was left with by the last projection (contact.c), known within a
      * frame's list; a new list's rule otherwise */
@@ -181,15 +223,11 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, c
     memset(start, 0, sizeof *start * ((size_t)np + 1));
     /* the candidates near enough, in (i, j) order (the lag's and the readout's merge;
      * the broad phase's order is its own) */
-    int32_t n = 0, sorted = 1;
+    int sorted = 1;
+    n = 0;
     for (int32_t k = 0; k < pc->n; k++) {
+        if (!near_pair(pc, x, wv, rad, k)) continue;
         const int32_t i = pc->ij[2 * k], j = pc->ij[2 * k + 1];
-        /* one movable end: see the head of the file for why not two */
-        if (!(wv[i] > 0) == !(wv[j] > 0)) continue;
-        const wb_real rn = (rad[i] + rad[j]) * VBDC_NEAR;
-        wb_real d[3];
-        v3_sub(d, &x[3 * i], &x[3 * j]);
-        if (!(v3_dot(d, d) < rn * rn)) continue;
         ks[n].key = (uint64_t)i << 32 | (uint32_t)j, ks[n].k = k;
         if (n > 0 && ks[n - 1].key > ks[n].key) sorted = 0;
         n++;
@@ -222,7 +260,6 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, c
     }
     c->npair = n;
     c->sorted = 1;
-    if (n == 0) return 0;
     /* each pair's lagged normal force: the last substep's, where it had the pair (both
      * lists in (i, j) order) */
     for (int32_t q = 0, o = 0; q < n; q++) {

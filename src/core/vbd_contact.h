@@ -38,6 +38,7 @@ void wb__vbdc_dual(const wb_world *w, wb_vbdc *c);
 void wb__vbdc_refresh(const wb_world *w, wb_vbdc *c, int32_t ncolours);
 /* after the contacts' projection (contact.c): their reported forces take in the sweeps' */
 void wb__vbdc_readout(wb_world *w, const wb_vbdc *c);
-void wb__vbdc_destroy(wb_vbdc *c);
+/* (its charge given back) */
+void wb__vbdc_destroy(wb_world *w, wb_vbdc *c);
 
 #endif

@@ -87,6 +87,13 @@ run threads.lua
 bcheck "worlds of 256 threads, stepped (--memory-limit 100)" err "threads.lua:5: out of memory: creating a world" \
     !out "should not get here"
 LIMIT=200
+run vbd_world.lua
+bcheck "a VBD cloth whose solver's arrays do not fit: its step fails" out "built" \
+    err "vbd_world.lua:8: out of memory stepping the world" !out "stepped"
+run vbd_world.lua --set solver=gauss-seidel
+why=""
+[ "$code" = 0 ] && grep -qF stepped "$TMP/out.txt" || why="exit code $code, expected 0 and 'stepped'"
+OUT_FILE=$TMP/out.txt ERR_FILE=$TMP/err.txt result "the same cloth under XPBD steps within the limit (the check has power)" "$why"
 
 # ---- files read: a JSON config, the meshes its skins name, a video frame
 run json_big.lua

@@ -205,6 +205,8 @@
     NARROW_TESTS(X)                              \
     X(distance_simd_bit_identical_to_scalar)     \
     X(vbd_simd_bit_identical_to_scalar)          \
+    X(vbd_memory_charged_and_refused)            \
+    X(vbd_memory_contact_scratch_only_for_its_pairs) \
     X(momentum_simd_bit_identical_to_scalar)     \
     POOL_TESTS(X)                                \
     FUSED_TESTS(X)
