@@ -619,7 +619,7 @@ static void bend_project(wb_world *w, wb_real h)
     if (!b) return;
     w->k.projections += b->n;
     if (!(h == b->h_at)) pack_constants(b, h, 1 / (h * h));
-    wb__batches_run(&b->bt, w, 256, project_batch, b->s_slot, h);
+    wb__batches_run(&b->bt, w, 256, project_batch, NULL, b->s_slot, h);
 }
 
 /* U = C^2 / (2 alpha) for compliant bends (alpha = 1/k, k in N m / rad) */

@@ -859,7 +859,7 @@ static void tet_project(wb_world *w, wb_real h)
         }
         v->pd_h = h;
     }
-    wb__batches_run(&v->bt, w, 64, project_range, v->order, h);
+    wb__batches_run(&v->bt, w, 64, project_range, NULL, v->order, h);
     w->k.projections += v->n; /* a tet (both of its constraints) is one projection */
 }
 

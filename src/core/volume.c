@@ -250,7 +250,7 @@ static void vol_project(wb_world *w, wb_real h)
     wb_volumes *v = w->vol;
     if (!v) return;
     w->k.projections += v->n;
-    wb__batches_run(&v->bt, w, 256, project_range, v->order, h);
+    wb__batches_run(&v->bt, w, 256, project_range, NULL, v->order, h);
 }
 
 /* U = C^2 / (2 alpha) for compliant constraints; incompressible ones store none */
