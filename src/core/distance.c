@@ -207,13 +207,14 @@ wb_real wb_distance_force(const wb_world *w, wb_distance_id c)
 wb_real wb_distance_rest(const wb_world *w, wb_distance_id c) { return w->dist->rest[SLOT(w, c)]; }
 bool wb_distance_broken(const wb_world *w, wb_distance_id c) { return w->dist->broken[SLOT(w, c)] != 0; }
 
-wb_real wb_distance_length(const wb_world *w, wb_distance_id c)
+static wb_real slot_length(const wb_world *w, const wb_distances *ds, int32_t s)
 {
-    int32_t s = SLOT(w, c);
     wb_real d[3];
-    v3_sub(d, &w->s.x[3 * w->dist->ij[2 * s + 1]], &w->s.x[3 * w->dist->ij[2 * s]]);
+    v3_sub(d, &w->s.x[3 * ds->ij[2 * s + 1]], &w->s.x[3 * ds->ij[2 * s]]);
     return v3_len(d);
 }
+
+wb_real wb_distance_length(const wb_world *w, wb_distance_id c) { return slot_length(w, w->dist, SLOT(w, c)); }
 
 void wb_distance_particles(const wb_world *w, wb_distance_id c, int32_t *a, int32_t *b)
 {
@@ -243,6 +244,40 @@ int32_t wb_distance_ids(const wb_world *w, wb_distance_id *out)
     for (int32_t s = 0; s < ds->n; s++)
         if (slot_live(ds->gen[s])) { out[n].index = (uint32_t)s + 1; out[n].gen = ds->gen[s]; n++; }
     return n;
+}
+
+/* the live, unbroken links' largest |strain| */
+wb_real wb_world_max_strain(const wb_world *w)
+{
+    const wb_distances *ds = wb__dist(w->dist);
+    wb_real best = 0;
+    for (int32_t s = 0; s < ds->n; s++) {
+        if (!packable(ds, s) || ds->rest[s] <= 0) continue;
+        wb_real e = fabs(slot_length(w, ds, s) - ds->rest[s]) / ds->rest[s];
+        if (e > best) best = e;
+    }
+    return best;
+}
+
+/* the live, unbroken links' ends and strains, in slot order */
+int32_t wb_world_distance_pairs(const wb_world *w, int32_t *ij, wb_real *strain)
+{
+    const wb_distances *ds = wb__dist(w->dist);
+    int32_t n = 0;
+    for (int32_t s = 0; s < ds->n; s++) {
+        if (!packable(ds, s)) continue;
+        if (ij) { ij[2 * n] = ds->ij[2 * s]; ij[2 * n + 1] = ds->ij[2 * s + 1]; }
+        if (strain) strain[n] = ds->rest[s] > 0 ? (slot_length(w, ds, s) - ds->rest[s]) / ds->rest[s] : 0;
+        n++;
+    }
+    return n;
+}
+
+void wb__distance_joins(const wb_world *w, void (*fn)(void *ud, int32_t a, int32_t b), void *ud)
+{
+    const wb_distances *ds = wb__dist(w->dist);
+    for (int32_t s = 0; s < ds->n; s++)
+        if (packable(ds, s)) fn(ud, ds->ij[2 * s], ds->ij[2 * s + 1]);
 }
 
 int32_t wb_world_break_count(const wb_world *w) { return wb__dist(w->dist)->nbreaks; }

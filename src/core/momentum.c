@@ -83,6 +83,8 @@ static void unite(int32_t *parent, int32_t a, int32_t b)
     else if (b < a) parent[a] = b;
 }
 
+static void unite_pair(void *parent, int32_t a, int32_t b) { unite(parent, a, b); }
+
 static void unite_all(int32_t *parent, const int32_t *p, int k)
 {
     for (int j = 1; j < k; j++) unite(parent, p[0], p[j]);
@@ -109,9 +111,7 @@ static int build(wb_world *w)
     if (!grow((void **)&k->mc_body, &k->cap_mc_body, np, sizeof(int32_t))) return 0;
     int32_t *parent = k->mc_body;
     for (int32_t i = 0; i < np; i++) parent[i] = i;
-    const wb_distances *ds = wb__dist(w->dist);
-    for (int32_t s = 0; s < ds->n; s++)
-        if ((ds->gen[s] & 1u) && !ds->broken[s]) unite(parent, ds->ij[2 * s], ds->ij[2 * s + 1]);
+    wb__distance_joins(w, unite_pair, parent);
     /* bends, broken or not: a body joined once too often is only kept a little less well */
     for (int32_t i = 0; i < wb_bend_count(w); i++) unite_all(parent, &w->bend->ij[4 * i], 4);
     for (int32_t i = 0; i < wb_volume_count(w); i++) unite_all(parent, &w->vol->ijkl[4 * i], 4);
