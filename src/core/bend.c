@@ -662,6 +662,12 @@ static void bend_links(const wb_world *w, wb_link_fn fn, void *ud)
     if (w->bend) wb__link_quads(w->bend->ij, w->bend->n, fn, ud);
 }
 
+/* broken or not: a body joined once too often is only kept a little less well */
+static void bend_joins(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    if (w->bend) wb__join_elements(w->bend->ij, w->bend->n, 4, fn, ud);
+}
+
 /* ---- teardown, hash, snapshots (ctype.h) ------------------------------------------------ */
 static void bend_destroy(wb_world *w)
 {
@@ -810,6 +816,7 @@ const wb_ctype wb__bend_type = {
     .frame_end = bend_frame_end,
     .energy = bend_energy,
     .links = bend_links,
+    .joins = bend_joins,
     .destroy = bend_destroy,
     .charged = bend_charged,
     .stats = bend_stats,

@@ -273,13 +273,6 @@ int32_t wb_world_distance_pairs(const wb_world *w, int32_t *ij, wb_real *strain)
     return n;
 }
 
-void wb__distance_joins(const wb_world *w, void (*fn)(void *ud, int32_t a, int32_t b), void *ud)
-{
-    const wb_distances *ds = wb__dist(w->dist);
-    for (int32_t s = 0; s < ds->n; s++)
-        if (packable(ds, s)) fn(ud, ds->ij[2 * s], ds->ij[2 * s + 1]);
-}
-
 int32_t wb_world_break_count(const wb_world *w) { return wb__dist(w->dist)->nbreaks; }
 wb_distance_id wb_world_break_at(const wb_world *w, int32_t i) { assert(i >= 0 && i < wb_world_break_count(w)); return w->dist->breaks[i]; }
 
@@ -969,6 +962,14 @@ static void distance_links(const wb_world *w, wb_link_fn fn, void *ud)
         if (ds->gen[s] & 1u) fn(ud, ds->ij[2 * s], ds->ij[2 * s + 1], 1);
 }
 
+/* a body is held together by its live, unbroken links (in slot order) */
+static void distance_joins(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    const wb_distances *ds = wb__dist(w->dist);
+    for (int32_t s = 0; s < ds->n; s++)
+        if (packable(ds, s)) fn(ud, ds->ij[2 * s], ds->ij[2 * s + 1], 1);
+}
+
 /* ---- teardown and hash (ctype.h) ----------------------------------------------------------- */
 static void distance_destroy(wb_world *w)
 {
@@ -1191,6 +1192,7 @@ const wb_ctype wb__distance_type = {
     .frame_end = distance_frame_end,
     .energy = distance_energy,
     .links = distance_links,
+    .joins = distance_joins,
     .destroy = distance_destroy,
     .charged = distance_charged,
     .stats = distance_stats,

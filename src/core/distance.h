@@ -61,10 +61,6 @@ static inline const wb_distances *wb__dist(const wb_distances *d)
     return d ? d : &none;
 }
 
-/* the live, unbroken links' ends through fn(ud, a, b), in slot order: what holds a body
- * together (momentum.c) */
-void wb__distance_joins(const wb_world *w, void (*fn)(void *ud, int32_t a, int32_t b), void *ud);
-
 /* prepare, once per step (the type's hook): pack and colour the live links when the
  * world's topology changed (m.topology_dirty, cleared here even without links), then
  * bring the packed copies of what may change between steps up to date */

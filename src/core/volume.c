@@ -323,6 +323,11 @@ static void vol_links(const wb_world *w, wb_link_fn fn, void *ud)
     if (w->vol) wb__link_quads(w->vol->ijkl, w->vol->n, fn, ud);
 }
 
+static void vol_joins(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    if (w->vol) wb__join_elements(w->vol->ijkl, w->vol->n, 4, fn, ud);
+}
+
 /* ---- teardown, hash, snapshots (ctype.h) -------------------------------------------------- */
 static void vol_destroy(wb_world *w)
 {
@@ -428,6 +433,7 @@ const wb_ctype wb__volume_type = {
     .frame_end = vol_frame_end,
     .energy = vol_energy,
     .links = vol_links,
+    .joins = vol_joins,
     .destroy = vol_destroy,
     .charged = vol_charged,
     .stats = vol_stats,
