@@ -619,7 +619,7 @@ static void bend_project(wb_world *w, wb_real h)
     if (!b) return;
     w->k.projections += b->n;
     if (!(h == b->h_at)) pack_constants(b, h, 1 / (h * h));
-    wb__batches_run(&b->bt, w, 256, project_batch, b->s_slot, h);
+    wb__batches_run(&b->bt, w, 256, project_batch, NULL, b->s_slot, h);
 }
 
 /* U = C^2 / (2 alpha) for compliant bends (alpha = 1/k, k in N m / rad) */
@@ -660,6 +660,12 @@ static void bend_frame_end(wb_world *w)
 static void bend_links(const wb_world *w, wb_link_fn fn, void *ud)
 {
     if (w->bend) wb__link_quads(w->bend->ij, w->bend->n, fn, ud);
+}
+
+/* broken or not: a body joined once too often is only kept a little less well */
+static void bend_joins(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    if (w->bend) wb__join_elements(w->bend->ij, w->bend->n, 4, fn, ud);
 }
 
 /* ---- teardown, hash, snapshots (ctype.h) ------------------------------------------------ */
@@ -810,6 +816,7 @@ const wb_ctype wb__bend_type = {
     .frame_end = bend_frame_end,
     .energy = bend_energy,
     .links = bend_links,
+    .joins = bend_joins,
     .destroy = bend_destroy,
     .charged = bend_charged,
     .stats = bend_stats,

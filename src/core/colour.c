@@ -30,6 +30,19 @@
 #include "core.h"
 #include "batch.h"
 
+/* a constraint's colour: [0, WB_MAX_COLOURS] (WB_MAX_COLOURS: the serial overflow batch),
+ * or none (not live), or a compound's member */
+#define NO_COLOUR 255
+#define SPLIT_COLOUR 254
+
+/* the compounds of a colouring (wb_batch_def.compounds): member (n slots) gets their
+ * members compound by compound in visiting order, comp_start (n + 1 slots) the ncomp + 1
+ * compound bounds into member */
+typedef struct wb_split {
+    int32_t n, first, ncomp; /* members, coloured constraints (visit_order's), compounds */
+    int32_t *member, *comp_start;
+} wb_split;
+
 /* the visiting order: 0 creation order (tests: the colouring before mirror keys), 1 keys */
 static int symmetric = 1;
 
@@ -253,9 +266,12 @@ out:
     return nl;
 }
 
-int wb__colour_greedy(const wb_model *m, const int32_t *idx, int k, int32_t n,
-                      int (*live)(const void *ud, int32_t i), const void *ud, uint8_t *colour,
-                      int32_t count[WB_MAX_COLOURS + 1], wb_split *split)
+/* greedy colouring of the constraints live() accepts, in visiting order: the lowest colour
+ * free at every movable end; colour[i] gets NO_COLOUR, SPLIT_COLOUR or the colour, counted
+ * in count. 0 when out of memory */
+static int colour_greedy(const wb_model *m, const int32_t *idx, int k, int32_t n,
+                         int (*live)(const void *ud, int32_t i), const void *ud, uint8_t *colour,
+                         int32_t count[WB_MAX_COLOURS + 1], wb_split *split)
 {
     /* a bit per colour and particle: the colours its constraints already took */
     uint64_t *used = calloc((size_t)(m->np > 0 ? m->np : 1), sizeof *used);
@@ -276,8 +292,8 @@ int wb__colour_greedy(const wb_model *m, const int32_t *idx, int k, int32_t n,
             if (live(ud, i)) order[nl++] = i;
     }
     for (int c = 0; c <= WB_MAX_COLOURS; c++) count[c] = 0;
-    for (int32_t i = 0; i < n; i++) colour[i] = WB_NO_COLOUR;
-    for (int32_t j = 0; split && j < split->n; j++) colour[split->member[j]] = WB_SPLIT_COLOUR;
+    for (int32_t i = 0; i < n; i++) colour[i] = NO_COLOUR;
+    for (int32_t j = 0; split && j < split->n; j++) colour[split->member[j]] = SPLIT_COLOUR;
     /* the lowest colour free at every end; immovable particles never conflict */
     for (int32_t j = 0; j < nl; j++) {
         const int32_t i = order[j];
@@ -300,41 +316,75 @@ fail:
     return 0;
 }
 
-int32_t wb__colour_ranges(const int32_t count[WB_MAX_COLOURS + 1], int32_t *colour_start, int32_t *ncolours,
-                          int32_t *serial_start, int32_t start[WB_MAX_COLOURS + 1])
+/* batch ranges from the counts: colour_start (ncolours + 1), the first serial batch, and
+ * start[c] the first packed index of colour c; returns the packed total. Batches in colour
+ * order, constraints in slot order inside each */
+static int32_t colour_ranges(const int32_t count[WB_MAX_COLOURS + 1], wb_batches *b, int32_t start[WB_MAX_COLOURS + 1])
 {
-    /* batches in colour order, constraints in slot order inside each */
     int32_t nc = 0, pos = 0;
     for (int c = 0; c <= WB_MAX_COLOURS; c++) {
         start[c] = pos;
         if (count[c] > 0) {
-            colour_start[nc++] = pos;
-            if (c == WB_MAX_COLOURS) *serial_start = nc - 1;
+            b->colour_start[nc++] = pos;
+            if (c == WB_MAX_COLOURS) b->serial_start = nc - 1;
         }
         pos += count[c];
     }
-    if (count[WB_MAX_COLOURS] == 0) *serial_start = nc;
-    colour_start[nc] = pos;
-    *ncolours = nc;
+    if (count[WB_MAX_COLOURS] == 0) b->serial_start = nc;
+    b->colour_start[nc] = pos;
+    b->ncolours = nc;
     return pos;
 }
 
 /* ---- batches over a permutation (batch.h) ----------------------------------------------- */
 static int all_live(const void *ud, int32_t i) { (void)ud; (void)i; return 1; }
 
+int wb__batches_make(wb_batches *b, const wb_model *m, const wb_batch_def *d, int32_t *order)
+{
+    const int32_t n = d->n;
+    const size_t na = (size_t)(n > 0 ? n : 1);
+    uint8_t *colour = malloc(na);
+    int32_t count[WB_MAX_COLOURS + 1], start[WB_MAX_COLOURS + 1];
+    wb_split split = { 0, 0, 0, NULL, NULL }, *sp = NULL;
+    int ok = colour != NULL;
+    if (ok && d->compounds) {
+        /* (ncomp <= n: room for every bound up front) */
+        int32_t *cs = realloc(b->comp_start, sizeof *cs * (na + 1));
+        if (cs) b->comp_start = cs;
+        split.member = malloc(sizeof *split.member * na);
+        split.comp_start = malloc(sizeof *split.comp_start * (na + 1));
+        ok = cs && split.member && split.comp_start;
+        sp = &split;
+    }
+    ok = ok && colour_greedy(m, d->idx, d->k, n, d->live ? d->live : all_live, d->ud, colour, count, sp);
+    if (ok) {
+        const int32_t first = colour_ranges(count, b, start);
+        for (int32_t s = 0; s < n; s++)
+            if (colour[s] < SPLIT_COLOUR) order[start[colour[s]]++] = s;
+        /* then the compounds, in visit_order's order */
+        b->ncomp = split.ncomp;
+        if (split.n > 0) memcpy(order + first, split.member, sizeof *order * (size_t)split.n);
+        for (int32_t c = 0; sp && c <= split.ncomp; c++) b->comp_start[c] = first + split.comp_start[c];
+        b->norder = first + split.n;
+        b->n = n;
+    }
+    free(colour);
+    free(split.member);
+    free(split.comp_start);
+    return ok;
+}
+
 int wb__batches_build(wb_batches *b, const wb_model *m, const int32_t *idx, int k, int32_t n, int32_t *order)
 {
-    uint8_t *colour = malloc((size_t)(n > 0 ? n : 1));
-    int32_t count[WB_MAX_COLOURS + 1], start[WB_MAX_COLOURS + 1];
-    if (!colour || !wb__colour_greedy(m, idx, k, n, all_live, NULL, colour, count, NULL)) {
-        free(colour);
-        return 0;
-    }
-    wb__colour_ranges(count, b->colour_start, &b->ncolours, &b->serial_start, start);
-    for (int32_t s = 0; s < n; s++) order[start[colour[s]]++] = s;
-    free(colour);
-    b->n = n;
-    return 1;
+    const wb_batch_def d = { idx, k, n, NULL, NULL, 0 };
+    return wb__batches_make(b, m, &d, order);
+}
+
+void wb__batches_free(wb_batches *b)
+{
+    free(b->comp_start);
+    b->comp_start = NULL;
+    b->ncomp = 0;
 }
 
 typedef struct batch_job {
@@ -351,8 +401,8 @@ static void batch_part(void *ctx, int32_t lo, int32_t hi)
     j->f(j->w, j->order, j->lo + lo, j->lo + hi, j->h);
 }
 
-void wb__batches_run(const wb_batches *b, wb_world *w, int32_t min_par, wb_range_fn f, const int32_t *order,
-                     wb_real h)
+void wb__batches_run(const wb_batches *b, wb_world *w, int32_t min_par, wb_range_fn f, wb_range_fn fc,
+                     const int32_t *order, wb_real h)
 {
     for (int32_t c = 0; c < b->ncolours; c++) {
         const int32_t lo = b->colour_start[c], hi = b->colour_start[c + 1];
@@ -365,4 +415,5 @@ void wb__batches_run(const wb_batches *b, wb_world *w, int32_t min_par, wb_range
         batch_job j = { w, f, order, lo, h };
         wb__pool_for(pool, hi - lo, min_par / 2, batch_part, &j);
     }
+    if (fc && b->ncomp > 0) fc(w, order, b->colour_start[b->ncolours], b->norder, h);
 }

@@ -40,6 +40,11 @@ typedef struct wb_ctype {
      * docs/physics.md, "Contacts"); 0: they are one graph only (a cluster's chain).
      * May be NULL: none */
     void (*links)(const wb_world *w, wb_link_fn fn, void *ud);
+    /* the particle pairs that make its particles one body (momentum.c: a free body keeps
+     * its angular momentum), each through fn(ud, a, b, 1): not always its links (a broken
+     * link joins no body but its ends stay rest neighbours; a tether joins none). May be
+     * NULL: none */
+    void (*joins)(const wb_world *w, wb_link_fn fn, void *ud);
 
     /* the world's teardown: free the type's arrays (the world is freed after) */
     void (*destroy)(wb_world *w);
@@ -83,6 +88,14 @@ static inline void wb__link_quads(const int32_t *q, int32_t n, wb_link_fn fn, vo
     for (int32_t e = 0; e < n; e++)
         for (int a = 0; a < 3; a++)
             for (int b = a + 1; b < 4; b++) fn(ud, q[4 * e + a], q[4 * e + b], 1);
+}
+
+/* a joins hook's pairs for n elements of k particles each (q: n x k): the first with
+ * each of the others, enough to make them one body */
+static inline void wb__join_elements(const int32_t *q, int32_t n, int k, wb_link_fn fn, void *ud)
+{
+    for (int32_t e = 0; e < n; e++)
+        for (int j = 1; j < k; j++) fn(ud, q[(size_t)k * (size_t)e], q[(size_t)k * (size_t)e + (size_t)j], 1);
 }
 
 /* a type's check's faults (wb_fault): an option's, with its key (a string literal), and

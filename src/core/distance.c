@@ -4,10 +4,11 @@
  * per frame, and their elastic energy. Its arrays are w->dist (distance.h), made with the
  * first link.
  *
- * The batches are this file's own, not batch.h's: links are removed (slots freed, links
- * broken), so they are packed live ones only, the links meeting on a mirror plane are
- * split out as compounds projected together from the same positions (wb_split: a
- * symmetric scene stays symmetric), and the Jacobi solver runs over the same packing. */
+ * The batches are batch.h's, as every coloured type's: over the live, unbroken links only
+ * (links are removed and broken), with the links meeting on a mirror plane as compounds
+ * projected together from the same positions (a symmetric scene stays symmetric). What
+ * the kernels read is packed in the batches' order (s_slot), and the Jacobi solver runs
+ * over the same packing. */
 #include <assert.h>
 #include <stdlib.h>
 
@@ -206,13 +207,14 @@ wb_real wb_distance_force(const wb_world *w, wb_distance_id c)
 wb_real wb_distance_rest(const wb_world *w, wb_distance_id c) { return w->dist->rest[SLOT(w, c)]; }
 bool wb_distance_broken(const wb_world *w, wb_distance_id c) { return w->dist->broken[SLOT(w, c)] != 0; }
 
-wb_real wb_distance_length(const wb_world *w, wb_distance_id c)
+static wb_real slot_length(const wb_world *w, const wb_distances *ds, int32_t s)
 {
-    int32_t s = SLOT(w, c);
     wb_real d[3];
-    v3_sub(d, &w->s.x[3 * w->dist->ij[2 * s + 1]], &w->s.x[3 * w->dist->ij[2 * s]]);
+    v3_sub(d, &w->s.x[3 * ds->ij[2 * s + 1]], &w->s.x[3 * ds->ij[2 * s]]);
     return v3_len(d);
 }
+
+wb_real wb_distance_length(const wb_world *w, wb_distance_id c) { return slot_length(w, w->dist, SLOT(w, c)); }
 
 void wb_distance_particles(const wb_world *w, wb_distance_id c, int32_t *a, int32_t *b)
 {
@@ -241,6 +243,33 @@ int32_t wb_distance_ids(const wb_world *w, wb_distance_id *out)
     int32_t n = 0;
     for (int32_t s = 0; s < ds->n; s++)
         if (slot_live(ds->gen[s])) { out[n].index = (uint32_t)s + 1; out[n].gen = ds->gen[s]; n++; }
+    return n;
+}
+
+/* the live, unbroken links' largest |strain| */
+wb_real wb_world_max_strain(const wb_world *w)
+{
+    const wb_distances *ds = wb__dist(w->dist);
+    wb_real best = 0;
+    for (int32_t s = 0; s < ds->n; s++) {
+        if (!packable(ds, s) || ds->rest[s] <= 0) continue;
+        wb_real e = fabs(slot_length(w, ds, s) - ds->rest[s]) / ds->rest[s];
+        if (e > best) best = e;
+    }
+    return best;
+}
+
+/* the live, unbroken links' ends and strains, in slot order */
+int32_t wb_world_distance_pairs(const wb_world *w, int32_t *ij, wb_real *strain)
+{
+    const wb_distances *ds = wb__dist(w->dist);
+    int32_t n = 0;
+    for (int32_t s = 0; s < ds->n; s++) {
+        if (!packable(ds, s)) continue;
+        if (ij) { ij[2 * n] = ds->ij[2 * s]; ij[2 * n + 1] = ds->ij[2 * s + 1]; }
+        if (strain) strain[n] = ds->rest[s] > 0 ? (slot_length(w, ds, s) - ds->rest[s]) / ds->rest[s] : 0;
+        n++;
+    }
     return n;
 }
 
@@ -321,6 +350,8 @@ wb_status wb__colour(wb_world *w)
     return WB_OK;
 }
 
+/* the batches (batch.h) over the live, unbroken links, the links meeting on a mirror plane
+ * as compounds; then what the kernels read, packed in the batches' order (s_slot) */
 static wb_status colour(wb_world *w)
 {
     wb_model *m = &w->m;
@@ -331,24 +362,16 @@ static wb_status colour(wb_world *w)
     int32_t ns = 0;
     for (int32_t s = 0; s < ds->n; s++) ns += packable(ds, s);
 
-    uint8_t *colour = malloc((size_t)(ds->n > 0 ? ds->n : 1));
-    int32_t count[WB_MAX_COLOURS + 1];
-    wb_split split = { 0, 0, 0, malloc(sizeof(int32_t) * (size_t)(ds->n > 0 ? ds->n : 1)),
-                       malloc(sizeof(int32_t) * ((size_t)ds->n + 1)) };
-    if (!colour || !split.member || !split.comp_start ||
-        !realloc_n((void **)&ds->s_a, ns, sizeof(int32_t)) || !realloc_n((void **)&ds->s_b, ns, sizeof(int32_t)) ||
+    const wb_batch_def def = { ds->ij, 2, ds->n, packable, ds, 1 };
+    if (!realloc_n((void **)&ds->s_a, ns, sizeof(int32_t)) || !realloc_n((void **)&ds->s_b, ns, sizeof(int32_t)) ||
         !realloc_n((void **)&ds->s_rest, ns, sizeof(wb_real)) || !realloc_n((void **)&ds->s_alpha, ns, sizeof(wb_real)) ||
         !realloc_n((void **)&ds->s_beta, ns, sizeof(wb_real)) || !realloc_n((void **)&ds->s_lambda, ns, sizeof(wb_real)) ||
         !realloc_n((void **)&ds->s_jac, ns, 4 * sizeof(wb_real)) ||
         !realloc_n((void **)&ds->s_slot, ns, 3 * sizeof(int32_t) + 2) ||
-        !realloc_n((void **)&ds->colour_start, WB_MAX_COLOURS + 2, sizeof(int32_t)) ||
-        !wb__colour_greedy(m, ds->ij, 2, ds->n, packable, ds, colour, count, &split) ||
-        !realloc_n((void **)&ds->comp_start, split.ncomp + 1 + 2 * split.n, sizeof(int32_t))) {
-        free(colour);
-        free(split.member);
-        free(split.comp_start);
+        !wb__batches_make(&ds->bt, m, &def, ds->s_slot) ||
+        !realloc_n((void **)&ds->s_nsp, 2 * (ns - ds->bt.colour_start[ds->bt.ncolours]), sizeof(int32_t)))
         return WB_ERR_NOMEM;
-    }
+    assert(ds->bt.norder == ns);
     ds->s_wa = ds->s_jac + ns;
     ds->s_wc = ds->s_jac + 2 * ns;
     ds->s_at = ds->s_jac + 3 * ns;
@@ -357,27 +380,19 @@ static wb_status colour(wb_world *w)
     ds->s_ok = (uint8_t *)(ds->s_slot + 3 * ns);
     ds->s_backed = ds->s_ok + ns;
     ds->s_at_h = NAN; /* none yet: h != NaN */
-    int32_t start[WB_MAX_COLOURS + 1];
-    /* the batches, then the compounds (colour.c) in their order */
-    ds->split_start = wb__colour_ranges(count, ds->colour_start, &ds->ncolours, &ds->serial_start, start);
-    ds->ns = ds->split_start + split.n;
-    ds->ncomp = split.ncomp;
-    for (int32_t c = 0; c <= split.ncomp; c++) ds->comp_start[c] = ds->split_start + split.comp_start[c];
-    for (int32_t j = 0; j < split.n; j++) ds->slot_pack[split.member[j]] = ds->split_start + j;
+    ds->ns = ns;
     ds->any_damping = 0;
     ds->any_frame_end = 0;
     for (int32_t i = 0; i < m->np; i++) k->ncount[i] = 0;
-    for (int32_t s = 0; s < ds->n; s++) {
-        if (colour[s] == WB_NO_COLOUR) { ds->slot_pack[s] = -1; continue; }
-        int32_t i = colour[s] == WB_SPLIT_COLOUR ? ds->slot_pack[s] : start[colour[s]]++;
-        int32_t a = ds->ij[2 * s], b = ds->ij[2 * s + 1];
+    for (int32_t s = 0; s < ds->n; s++) ds->slot_pack[s] = -1;
+    for (int32_t i = 0; i < ns; i++) {
+        const int32_t s = ds->s_slot[i], a = ds->ij[2 * s], b = ds->ij[2 * s + 1];
         ds->s_a[i] = a;
         ds->s_b[i] = b;
         ds->s_rest[i] = ds->rest[s];
         ds->s_alpha[i] = ds->alpha[s];
         ds->s_beta[i] = ds->beta[s];
         ds->s_lambda[i] = 0;
-        ds->s_slot[i] = s;
         ds->s_oa[i] = 3 * (uint32_t)a;
         ds->s_oc[i] = 3 * (uint32_t)b;
         ds->slot_pack[s] = i;
@@ -394,19 +409,16 @@ static wb_status colour(wb_world *w)
         ds->s_jac[i] = (wb_real)1 / (na > nb ? na : nb);
     }
     /* a compound member's ends: how many of its compound's members meet there */
-    ds->s_nsp = ds->comp_start + ds->ncomp + 1;
-    for (int32_t c = 0; c < ds->ncomp; c++)
-        for (int32_t i = ds->comp_start[c]; i < ds->comp_start[c + 1]; i++) {
-            int32_t *n = &ds->s_nsp[2 * (i - ds->split_start)];
+    const int32_t *cs = ds->bt.comp_start, split_start = ds->bt.colour_start[ds->bt.ncolours];
+    for (int32_t c = 0; c < ds->bt.ncomp; c++)
+        for (int32_t i = cs[c]; i < cs[c + 1]; i++) {
+            int32_t *n = &ds->s_nsp[2 * (i - split_start)];
             n[0] = n[1] = 0;
-            for (int32_t j = ds->comp_start[c]; j < ds->comp_start[c + 1]; j++) {
+            for (int32_t j = cs[c]; j < cs[c + 1]; j++) {
                 n[0] += ds->s_a[j] == ds->s_a[i] || ds->s_b[j] == ds->s_a[i];
                 n[1] += ds->s_a[j] == ds->s_b[i] || ds->s_b[j] == ds->s_b[i];
             }
         }
-    free(colour);
-    free(split.member);
-    free(split.comp_start);
     m->topology_dirty = 0;
     return WB_OK;
 }
@@ -461,7 +473,7 @@ project_range(const wb_distances *ds, const wb_real *restrict wv, wb_real *x, co
         const wb_real wa = wv[ia], wc = wv[ic], wsum = wa + wc;
         /* a compound member sees each shared end's mass split among the members there
          * (their corrections add up) */
-        const int32_t *nsp = split ? &ds->s_nsp[2 * (i - ds->split_start)] : NULL;
+        const int32_t *nsp = split ? &ds->s_nsp[2 * (i - ds->bt.colour_start[ds->bt.ncolours])] : NULL;
         const wb_real wden = split ? wa * (wb_real)nsp[0] + wc * (wb_real)nsp[1] : wsum;
         const wb_real *xa = &x[3 * ia], *xc = &x[3 * ic];
         const wb_real d0 = xc[0] - xa[0], d1 = xc[1] - xa[1], d2 = xc[2] - xa[2];
@@ -769,7 +781,7 @@ static void project_distances(const wb_world *w, wb_real *dx, int32_t b, int32_t
     const wb_distances *ds = w->dist;
 #ifdef WB_DISTANCE_AVX2
     /* the vector lanes need a conflict-free batch: never the serial tail */
-    if (e - b >= 4 && e <= ds->colour_start[ds->serial_start]) {
+    if (e - b >= 4 && e <= ds->bt.colour_start[ds->bt.serial_start]) {
         /* decided once, possibly by several threads at once (the same answer) */
         int v = __atomic_load_n(&simd_state, __ATOMIC_RELAXED);
         if (v < 0) v = wb__distance_simd(1);
@@ -791,21 +803,37 @@ static void project_distances(const wb_world *w, wb_real *dx, int32_t b, int32_t
     }
 }
 
-/* Gauss-Seidel over the compounds, one after another, after the batches: a compound's
- * members are worked out from the same positions (into dx, zeroed at their ends before
- * and after) and applied together. A compound is its own mirror image, so is its update;
- * projected one by one, as a colouring would, the images would lean the way they follow
- * each other (a box dropped on a 7 x 4 x 7 block turned at 0.69 rad/s). Each shared end's
- * mass is split among the members there (mass splitting: their corrections add up to
- * about one link's, not overshoot) */
-static void project_compounds(wb_world *w, wb_real h, wb_real inv_h2)
+/* Jacobi's corrections go to dx, Gauss-Seidel's straight to x */
+static wb_real *jacobi_dx(const wb_world *w) { return w->m.def.solver == WB_SOLVER_GAUSS_SEIDEL ? NULL : w->k.dx; }
+
+/* packed [lo, hi) of one batch, or of a chunk of one (batch.h) */
+static void project_batch(wb_world *w, const int32_t *order, int32_t lo, int32_t hi, wb_real h)
 {
+    (void)order; /* the packed copies are in batch order already */
+    project_distances(w, jacobi_dx(w), lo, hi, h, 1 / (h * h));
+}
+
+/* The compounds, one after another, after the batches (batch.h gives them in one call,
+ * order[lo, hi) their whole range: a compound is a few links, and a call each cost 13%
+ * more instructions). Gauss-Seidel: a compound's members are worked out from the same
+ * positions (into dx, zeroed at their ends before and after) and applied together. A
+ * compound is its own mirror image, so is its update; projected one by one, as a
+ * colouring would, the images would lean the way they follow each other (a box dropped on
+ * a 7 x 4 x 7 block turned at 0.69 rad/s). Each shared end's mass is split among the
+ * members there (mass splitting: their corrections add up to about one link's, not
+ * overshoot). Jacobi: as any other range */
+static void project_compounds(wb_world *w, const int32_t *order, int32_t lo, int32_t hi, wb_real h)
+{
+    if (jacobi_dx(w)) {
+        project_batch(w, order, lo, hi, h);
+        return;
+    }
     const wb_distances *ds = w->dist;
-    const wb_real *wv = w->m.w, *xp = w->s.x_prev;
+    const wb_real *wv = w->m.w, *xp = w->s.x_prev, inv_h2 = 1 / (h * h);
     const int fresh = ds->s_lambda_stale;
     wb_real *x = w->s.x, *dx = w->k.dx;
-    for (int32_t c = 0; c < ds->ncomp; c++) {
-        const int32_t b = ds->comp_start[c], e = ds->comp_start[c + 1];
+    for (int32_t c = 0; c < ds->bt.ncomp; c++) {
+        const int32_t b = ds->bt.comp_start[c], e = ds->bt.comp_start[c + 1];
         for (int32_t i = b; i < e; i++) {
             v3_set(&dx[3 * ds->s_a[i]], 0, 0, 0);
             v3_set(&dx[3 * ds->s_b[i]], 0, 0, 0);
@@ -822,55 +850,26 @@ static void project_compounds(wb_world *w, wb_real h, wb_real inv_h2)
     }
 }
 
-/* one pass over every batch; batches before serial_start are conflict-free */
-typedef struct dist_job { wb_world *w; wb_real *dx; int32_t b; wb_real h, inv_h2; } dist_job;
-
-static void dist_part(void *ctx, int32_t lo, int32_t hi)
-{
-    const dist_job *j = ctx;
-    project_distances(j->w, j->dx, j->b + lo, j->b + hi, j->h, j->inv_h2);
-}
-
-static void project_batches(wb_world *w, wb_real *dx, wb_real h, wb_real inv_h2)
-{
-    const wb_distances *ds = w->dist;
-    for (int32_t c = 0; c < ds->ncolours; c++) {
-        const int32_t b = ds->colour_start[c], e = ds->colour_start[c + 1];
-        /* (the pool is asked for only here: a small scene never starts a thread) */
-        wb_pool *pool = c < ds->serial_start && e - b >= 512 ? wb__world_pool(w) : NULL;
-        if (!pool) {
-            project_distances(w, dx, b, e, h, inv_h2);
-            continue;
-        }
-        /* split the batch into contiguous chunks on the pool: disjoint writes */
-        dist_job j = { w, dx, b, h, inv_h2 };
-        wb__pool_for(pool, e - b, 256, dist_part, &j);
-    }
-}
-
-/* one iteration over every distance constraint */
+/* one iteration over every distance constraint: batch after batch in colour order, a
+ * batch of 512 or more in parallel chunks, then the compounds (batch.h) */
 static void distance_project(wb_world *w, wb_real h)
 {
     wb_distances *ds = w->dist;
     if (!ds) return;
     wb_cache *k = &w->k;
-    const wb_real inv_h2 = 1 / (h * h);
     const int32_t np = w->m.np;
     k->projections += ds->ns;
     if (h != ds->s_at_h) refresh_at(ds, h);
-    if (w->m.def.solver == WB_SOLVER_GAUSS_SEIDEL) {
-        project_batches(w, NULL, h, inv_h2);
-        project_compounds(w, h, inv_h2);
-        ds->s_lambda_stale = 0;
-        return;
-    }
     /* Jacobi: every correction from the same positions, scaled per constraint
      * (see project_range), then applied at once */
-    if (np == 0) return;
-    memset(k->dx, 0, sizeof(wb_real) * 3 * (size_t)np);
-    project_batches(w, k->dx, h, inv_h2);
-    if (ds->ns > ds->split_start) project_distances(w, k->dx, ds->split_start, ds->ns, h, inv_h2);
+    const int jacobi = jacobi_dx(w) != NULL;
+    if (jacobi) {
+        if (np == 0) return;
+        memset(k->dx, 0, sizeof(wb_real) * 3 * (size_t)np);
+    }
+    wb__batches_run(&ds->bt, w, 512, project_batch, project_compounds, ds->s_slot, h);
     ds->s_lambda_stale = 0;
+    if (!jacobi) return;
     const wb_real *wv = w->m.w;
     for (int32_t i = 0; i < np; i++)
         if (wv[i] > 0) v3_add(&w->s.x[3 * i], &w->s.x[3 * i], &k->dx[3 * i]);
@@ -963,15 +962,24 @@ static void distance_links(const wb_world *w, wb_link_fn fn, void *ud)
         if (ds->gen[s] & 1u) fn(ud, ds->ij[2 * s], ds->ij[2 * s + 1], 1);
 }
 
+/* a body is held together by its live, unbroken links (in slot order) */
+static void distance_joins(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    const wb_distances *ds = wb__dist(w->dist);
+    for (int32_t s = 0; s < ds->n; s++)
+        if (packable(ds, s)) fn(ud, ds->ij[2 * s], ds->ij[2 * s + 1], 1);
+}
+
 /* ---- teardown and hash (ctype.h) ----------------------------------------------------------- */
 static void distance_destroy(wb_world *w)
 {
     wb_distances *ds = w->dist;
     if (!ds) return;
     void *p[] = { ds->ij, ds->alpha, ds->beta, ds->yield, ds->creep, ds->break_strain, ds->bforce, ds->gen,
-                  ds->free_slots, ds->rest, ds->broken, ds->colour_start, ds->comp_start, ds->s_a, ds->s_b, ds->s_rest,
+                  ds->free_slots, ds->rest, ds->broken, ds->s_nsp, ds->s_a, ds->s_b, ds->s_rest,
                   ds->s_alpha, ds->s_beta, ds->s_lambda, ds->s_jac, ds->s_slot, ds->slot_pack, ds->breaks };
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
+    wb__batches_free(&ds->bt);
     free(ds);
     w->dist = NULL;
 }
@@ -1170,7 +1178,7 @@ static void distance_stats(const wb_world *w, wb_stats *st)
 {
     const wb_distances *ds = wb__dist(w->dist);
     st->distances = ds->nlive;
-    st->colours = ds->ncolours;
+    st->colours = ds->bt.ncolours;
     for (int32_t s = 0; s < ds->n; s++)
         if ((ds->gen[s] & 1u) && ds->broken[s]) st->broken++;
 }
@@ -1184,6 +1192,7 @@ const wb_ctype wb__distance_type = {
     .frame_end = distance_frame_end,
     .energy = distance_energy,
     .links = distance_links,
+    .joins = distance_joins,
     .destroy = distance_destroy,
     .charged = distance_charged,
     .stats = distance_stats,

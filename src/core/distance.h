@@ -3,11 +3,11 @@
 #ifndef WB_DISTANCE_H
 #define WB_DISTANCE_H
 
-#include "wobble.h"
+#include "batch.h"
 
 /* w->dist: NULL until the first one is made. Links are removed (their slots reused) and
- * broken, so the model is by slot, and the cache packs the live ones into colour batches
- * and the compounds of links meeting on a mirror plane (distance.c) */
+ * broken, so the model is by slot, and the batches (batch.h) order the live ones, with
+ * the links meeting on a mirror plane as compounds (distance.c) */
 typedef struct wb_distances {
     /* model, by slot: a slot is live while its generation is odd */
     int32_t n, cap, nlive; /* slots, their room, live ones */
@@ -25,15 +25,11 @@ typedef struct wb_distances {
     uint8_t *broken;       /* (n) */
     wb_distance_id *breaks; /* broken in the last step (reported after it) */
     int32_t nbreaks, cap_breaks;
-    /* cache: the packed colour batches, rebuilt when the world's topology changed */
-    int32_t ns;            /* packed constraints (live and not broken) */
-    int32_t ncolours;
-    int32_t *colour_start; /* (ncolours + 1) batch ranges */
-    int32_t serial_start;  /* batches from here on are projected serially (overflow colours) */
-    int32_t split_start;   /* the compounds (colour.c's split) fill [split_start, ns) */
-    int32_t ncomp;
-    int32_t *comp_start;   /* (ncomp + 1) compound bounds in packed order, then s_nsp */
-    int32_t *s_nsp;        /* (2 (ns - split_start)) members of its compound at each end */
+    /* cache: the colour batches (batch.h, with compounds) over s_slot, and what the
+     * kernels read packed in that order; rebuilt when the world's topology changed */
+    wb_batches bt;         /* batch ranges, then the compounds, into s_slot */
+    int32_t ns;            /* packed constraints (live and not broken): bt.norder */
+    int32_t *s_nsp;        /* (2 x compound members) members of its compound at each end */
     int32_t *s_a, *s_b;    /* (ns) particles */
     wb_real *s_rest, *s_alpha, *s_beta; /* (ns) */
     wb_real *s_lambda;     /* (ns) multipliers of the current substep */
@@ -48,7 +44,7 @@ typedef struct wb_distances {
                               compressed link's lengthening is bounded: distance.c) */
     int32_t s_backed_vt[2]; /* the volume and tet counts s_backed was worked out for */
     wb_real s_at_h;        /* the substep s_at and s_ok are for */
-    int32_t *s_slot;       /* (ns) constraint slot of each packed entry */
+    int32_t *s_slot;       /* (ns) constraint slot of each packed entry: the batches' order */
     int32_t *slot_pack;    /* (n) packed index of each slot, -1 when not packed */
     int any_damping;
     int s_lambda_stale;    /* s_lambda is the last substep's: the next projection reads it as 0

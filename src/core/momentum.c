@@ -35,15 +35,11 @@
  * for any thread count. */
 #include <stdlib.h>
 
-#include "core.h"
+#include "ctype.h"
 #include "attach.h"
-#include "bend.h"
-#include "distance.h"
 #include "grab.h"
 #include "pressure.h"
 #include "shape_match.h"
-#include "tet.h"
-#include "volume.h"
 #include "contact.h"
 #include "tricontact.h"
 
@@ -83,9 +79,10 @@ static void unite(int32_t *parent, int32_t a, int32_t b)
     else if (b < a) parent[a] = b;
 }
 
-static void unite_all(int32_t *parent, const int32_t *p, int k)
+static void unite_pair(void *parent, int32_t a, int32_t b, int joined)
 {
-    for (int j = 1; j < k; j++) unite(parent, p[0], p[j]);
+    (void)joined;
+    unite(parent, a, b);
 }
 
 /* what the bodies depend on, besides the distance topology (m.topology_dirty) */
@@ -109,17 +106,9 @@ static int build(wb_world *w)
     if (!grow((void **)&k->mc_body, &k->cap_mc_body, np, sizeof(int32_t))) return 0;
     int32_t *parent = k->mc_body;
     for (int32_t i = 0; i < np; i++) parent[i] = i;
-    const wb_distances *ds = wb__dist(w->dist);
-    for (int32_t s = 0; s < ds->n; s++)
-        if ((ds->gen[s] & 1u) && !ds->broken[s]) unite(parent, ds->ij[2 * s], ds->ij[2 * s + 1]);
-    /* bends, broken or not: a body joined once too often is only kept a little less well */
-    for (int32_t i = 0; i < wb_bend_count(w); i++) unite_all(parent, &w->bend->ij[4 * i], 4);
-    for (int32_t i = 0; i < wb_volume_count(w); i++) unite_all(parent, &w->vol->ijkl[4 * i], 4);
-    for (int32_t i = 0; i < wb_tet_count(w); i++) unite_all(parent, &w->neo->ijkl[4 * i], 4);
-    for (int32_t c = 0; c < wb_shape_match_count(w); c++)
-        unite_all(parent, &w->sm->ids[w->sm->start[c]], w->sm->start[c + 1] - w->sm->start[c]);
-    for (int32_t c = 0; c < wb_pressure_count(w); c++)
-        unite_all(parent, &w->pr->verts[w->pr->vstart[c]], w->pr->vstart[c + 1] - w->pr->vstart[c]);
+    /* each type's pairs that make one body (its joins hook) */
+    for (int t = 0; t < wb__nctypes; t++)
+        if (wb__ctypes[t]->joins) wb__ctypes[t]->joins(w, unite_pair, parent);
     /* number the bodies of two or more particles in order of their first particle; a
      * particle alone (no constraint) is nobody's: -1 */
     int32_t nb = 0;

@@ -192,6 +192,13 @@ static int32_t build(wb_world *w, int32_t s, wb_real pressure, wb_real alpha, wb
 /* ---- the type ------------------------------------------------------------------------------- */
 static int32_t pr_count(const wb_world *w) { return PR(w)->n; }
 
+/* a closed surface is one body (no links: its particles are not rest neighbours for it) */
+static void pr_joins(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    const wb_pressures *pr = PR(w);
+    for (int32_t c = 0; c < pr->n; c++) wb__join_elements(&pr->verts[pr->vstart[c]], 1, pr->vstart[c + 1] - pr->vstart[c], fn, ud);
+}
+
 static wb_status pr_prepare(wb_world *w)
 {
     wb_pressures *p = w->pr;
@@ -472,6 +479,7 @@ const wb_ctype wb__pressure_type = {
     .substep_begin = pr_substep_begin,
     .project = pr_project,
     .energy = pr_energy,
+    .joins = pr_joins,
     .destroy = pr_destroy,
     .charged = pr_charged,
     .stats = pr_stats,

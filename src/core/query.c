@@ -1,19 +1,9 @@
 /* query.c: read-only measures of a world: energy, momenta, bounds, strain, hash, stats. */
 #include "ctype.h"
-#include "distance.h"
 #include "rigid.h"
 #include "vbd.h"
 
 static wb_real mass_of(const wb_world *w, int32_t i) { return w->m.w[i] > 0 ? 1 / w->m.w[i] : 0; }
-
-static int live(const wb_distances *ds, int32_t s) { return (ds->gen[s] & 1u) && !ds->broken[s]; }
-
-static wb_real slot_length(const wb_world *w, const wb_distances *ds, int32_t s)
-{
-    wb_real d[3];
-    v3_sub(d, &w->s.x[3 * ds->ij[2 * s + 1]], &w->s.x[3 * ds->ij[2 * s]]);
-    return v3_len(d);
-}
 
 void wb_world_energy(const wb_world *w, wb_real *kinetic, wb_real *potential)
 {
@@ -89,31 +79,6 @@ bool wb_world_bounds(const wb_world *w, wb_real mn[3], wb_real mx[3])
             if (x > mx[c]) mx[c] = x;
         }
     return true;
-}
-
-wb_real wb_world_max_strain(const wb_world *w)
-{
-    const wb_distances *ds = wb__dist(w->dist);
-    wb_real best = 0;
-    for (int32_t s = 0; s < ds->n; s++) {
-        if (!live(ds, s) || ds->rest[s] <= 0) continue;
-        wb_real e = fabs(slot_length(w, ds, s) - ds->rest[s]) / ds->rest[s];
-        if (e > best) best = e;
-    }
-    return best;
-}
-
-int32_t wb_world_distance_pairs(const wb_world *w, int32_t *ij, wb_real *strain)
-{
-    const wb_distances *ds = wb__dist(w->dist);
-    int32_t n = 0;
-    for (int32_t s = 0; s < ds->n; s++) {
-        if (!live(ds, s)) continue;
-        if (ij) { ij[2 * n] = ds->ij[2 * s]; ij[2 * n + 1] = ds->ij[2 * s + 1]; }
-        if (strain) strain[n] = ds->rest[s] > 0 ? (slot_length(w, ds, s) - ds->rest[s]) / ds->rest[s] : 0;
-        n++;
-    }
-    return n;
 }
 
 /* FNV-1a over the bytes of the state: bit-identical states, identical hashes */

@@ -328,6 +328,13 @@ static void sm_links(const wb_world *w, wb_link_fn fn, void *ud)
         for (int32_t i = sm->start[c] + 1; i < sm->start[c + 1]; i++) fn(ud, sm->ids[i - 1], sm->ids[i], 0);
 }
 
+/* a cluster is one body */
+static void sm_joins(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    const wb_smatch *sm = SM(w);
+    for (int32_t c = 0; c < sm->n; c++) wb__join_elements(&sm->ids[sm->start[c]], 1, sm->start[c + 1] - sm->start[c], fn, ud);
+}
+
 
 /* ---- API ------------------------------------------------------------------------------------ */
 wb_shape_match_def wb_shape_match_default_def(void)
@@ -594,6 +601,7 @@ const wb_ctype wb__shape_type = {
     .frame_end = sm_frame_end,
     .energy = sm_energy,
     .links = sm_links,
+    .joins = sm_joins,
     .destroy = sm_destroy,
     .charged = sm_charged,
     .stats = sm_stats,

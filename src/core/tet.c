@@ -859,7 +859,7 @@ static void tet_project(wb_world *w, wb_real h)
         }
         v->pd_h = h;
     }
-    wb__batches_run(&v->bt, w, 64, project_range, v->order, h);
+    wb__batches_run(&v->bt, w, 64, project_range, NULL, v->order, h);
     w->k.projections += v->n; /* a tet (both of its constraints) is one projection */
 }
 
@@ -911,6 +911,11 @@ static void tet_links(const wb_world *w, wb_link_fn fn, void *ud)
     if (w->neo) wb__link_quads(w->neo->ijkl, w->neo->n, fn, ud);
 }
 
+static void tet_joins(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    if (w->neo) wb__join_elements(w->neo->ijkl, w->neo->n, 4, fn, ud);
+}
+
 /* ---- teardown and hash (ctype.h) --------------------------------------------------------- */
 static void tet_destroy(wb_world *w)
 {
@@ -950,6 +955,7 @@ const wb_ctype wb__tet_type = {
     .frame_end = tet_frame_end,
     .energy = tet_energy,
     .links = tet_links,
+    .joins = tet_joins,
     .destroy = tet_destroy,
     .charged = tet_charged,
     .stats = tet_stats,

@@ -250,7 +250,7 @@ static void vol_project(wb_world *w, wb_real h)
     wb_volumes *v = w->vol;
     if (!v) return;
     w->k.projections += v->n;
-    wb__batches_run(&v->bt, w, 256, project_range, v->order, h);
+    wb__batches_run(&v->bt, w, 256, project_range, NULL, v->order, h);
 }
 
 /* U = C^2 / (2 alpha) for compliant constraints; incompressible ones store none */
@@ -321,6 +321,11 @@ static void vol_frame_end(wb_world *w)
 static void vol_links(const wb_world *w, wb_link_fn fn, void *ud)
 {
     if (w->vol) wb__link_quads(w->vol->ijkl, w->vol->n, fn, ud);
+}
+
+static void vol_joins(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    if (w->vol) wb__join_elements(w->vol->ijkl, w->vol->n, 4, fn, ud);
 }
 
 /* ---- teardown, hash, snapshots (ctype.h) -------------------------------------------------- */
@@ -428,6 +433,7 @@ const wb_ctype wb__volume_type = {
     .frame_end = vol_frame_end,
     .energy = vol_energy,
     .links = vol_links,
+    .joins = vol_joins,
     .destroy = vol_destroy,
     .charged = vol_charged,
     .stats = vol_stats,

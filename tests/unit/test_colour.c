@@ -21,18 +21,19 @@ static void check_colouring(wb_world *w)
     REQUIRE(!m->topology_dirty);
     const wb_distances *ds = wb__dist(w->dist);
     /* ranges */
-    REQUIRE(ds->ncolours >= 0 && ds->serial_start >= 0 && ds->serial_start <= ds->ncolours);
-    CHECK_EQ(ds->ncolours > 0 ? ds->colour_start[0] : 0, 0);
-    CHECK_EQ(ds->ncolours > 0 ? ds->colour_start[ds->ncolours] : 0, ds->split_start);
-    for (int32_t c = 0; c < ds->ncolours; c++) CHECK(ds->colour_start[c] < ds->colour_start[c + 1]);
+    REQUIRE(ds->bt.ncolours >= 0 && ds->bt.serial_start >= 0 && ds->bt.serial_start <= ds->bt.ncolours);
+    CHECK_EQ(ds->bt.colour_start[0], 0);
+    const int32_t split_start = ds->bt.colour_start[ds->bt.ncolours];
+    CHECK_EQ(ds->bt.norder, ds->ns);
+    for (int32_t c = 0; c < ds->bt.ncolours; c++) CHECK(ds->bt.colour_start[c] < ds->bt.colour_start[c + 1]);
     /* the compounds fill [split_start, ns), each a non-empty run of links joined through
      * shared movable particles, whose ends count the members meeting there */
-    REQUIRE(ds->ncomp >= 0);
-    CHECK_EQ(ds->comp_start[0], ds->split_start);
-    CHECK_EQ(ds->comp_start[ds->ncomp], ds->ns);
+    REQUIRE(ds->bt.ncomp >= 0);
+    CHECK_EQ(ds->bt.comp_start[0], split_start);
+    CHECK_EQ(ds->bt.comp_start[ds->bt.ncomp], ds->ns);
     int bad_comp = 0;
-    for (int32_t c = 0; c < ds->ncomp; c++) {
-        const int32_t b = ds->comp_start[c], e = ds->comp_start[c + 1];
+    for (int32_t c = 0; c < ds->bt.ncomp; c++) {
+        const int32_t b = ds->bt.comp_start[c], e = ds->bt.comp_start[c + 1];
         if (e <= b) { bad_comp++; continue; }
         for (int32_t i = b; i < e; i++) {
             int n[2] = { 0, 0 }, joined = e - b == 1;
@@ -41,7 +42,7 @@ static void check_colouring(wb_world *w)
                 n[1] += ds->s_a[j] == ds->s_b[i] || ds->s_b[j] == ds->s_b[i];
             }
             joined |= n[0] > 1 || n[1] > 1;
-            const int32_t *nsp = &ds->s_nsp[2 * (i - ds->split_start)];
+            const int32_t *nsp = &ds->s_nsp[2 * (i - split_start)];
             bad_comp += !joined || nsp[0] != n[0] || nsp[1] != n[1];
         }
     }
@@ -51,8 +52,8 @@ static void check_colouring(wb_world *w)
     REQUIRE(owner);
     for (int32_t i = 0; i < m->np; i++) owner[i] = -1;
     int conflicts = 0;
-    for (int32_t c = 0; c < ds->serial_start; c++)
-        for (int32_t i = ds->colour_start[c]; i < ds->colour_start[c + 1]; i++) {
+    for (int32_t c = 0; c < ds->bt.serial_start; c++)
+        for (int32_t i = ds->bt.colour_start[c]; i < ds->bt.colour_start[c + 1]; i++) {
             const int32_t ends[2] = { ds->s_a[i], ds->s_b[i] };
             for (int e = 0; e < 2; e++) {
                 const int32_t p = ends[e];
@@ -114,7 +115,7 @@ TEST(colour_batches_valid)
     }
     wb_world_step(w);
     check_colouring(w);
-    CHECK(wb__dist(w->dist)->ncolours >= 4);
+    CHECK(wb__dist(w->dist)->bt.ncolours >= 4);
 
     /* a star around a movable hub with 100 spokes needs 100 colours: past the 64 of
      * the bit mask the rest go to the serial batch */
@@ -127,7 +128,7 @@ TEST(colour_batches_valid)
     }
     wb_world_step(w);
     check_colouring(w);
-    CHECK(wb__dist(w->dist)->serial_start < wb__dist(w->dist)->ncolours);
+    CHECK(wb__dist(w->dist)->bt.serial_start < wb__dist(w->dist)->bt.ncolours);
 
     /* edits: remove every third constraint, add a few, break none: rebuilt and valid */
     int32_t n = wb_distance_count(w);
@@ -180,8 +181,8 @@ static int *lattice_colours(const wb_world *w, int32_t first, int32_t np)
     if (!col) return NULL;
     for (int32_t i = 0; i < np * np; i++) col[i] = -1;
     const wb_distances *ds = wb__dist(w->dist);
-    for (int32_t c = 0; c < ds->ncolours; c++)
-        for (int32_t i = ds->colour_start[c]; i < ds->colour_start[c + 1]; i++) {
+    for (int32_t c = 0; c < ds->bt.ncolours; c++)
+        for (int32_t i = ds->bt.colour_start[c]; i < ds->bt.colour_start[c + 1]; i++) {
             const int32_t a = ds->s_a[i] - first, b = ds->s_b[i] - first;
             col[a * np + b] = col[b * np + a] = c;
         }
@@ -191,12 +192,12 @@ static int *lattice_colours(const wb_world *w, int32_t first, int32_t np)
     if (!run) { free(col); return NULL; }
     for (int32_t p = 0; p < np; p++) run[p] = -1;
     int32_t cur = 0;
-    for (int32_t c = 0; c < ds->ncomp; c++) {
+    for (int32_t c = 0; c < ds->bt.ncomp; c++) {
         int shares = 0;
-        for (int32_t i = ds->comp_start[c]; i < ds->comp_start[c + 1]; i++)
+        for (int32_t i = ds->bt.comp_start[c]; i < ds->bt.comp_start[c + 1]; i++)
             shares |= run[ds->s_a[i] - first] == cur || run[ds->s_b[i] - first] == cur;
         if (shares) cur++;
-        for (int32_t i = ds->comp_start[c]; i < ds->comp_start[c + 1]; i++) {
+        for (int32_t i = ds->bt.comp_start[c]; i < ds->bt.comp_start[c + 1]; i++) {
             const int32_t a = ds->s_a[i] - first, b = ds->s_b[i] - first;
             run[a] = run[b] = cur;
             col[a * np + b] = col[b * np + a] = 1000 + cur;
@@ -230,8 +231,8 @@ static void mirror_mismatches(int n, int ny, int on, int mism[3])
     REQUIRE(col);
     /* a lattice's compounds are the 2 or 4 images meeting at a particle on a plane */
     const wb_distances *ds = wb__dist(w->dist);
-    for (int32_t c = 0; c < ds->ncomp; c++) CHECK(ds->comp_start[c + 1] - ds->comp_start[c] <= 4);
-    mism[2] = ds->ncomp;
+    for (int32_t c = 0; c < ds->bt.ncomp; c++) CHECK(ds->bt.comp_start[c + 1] - ds->bt.comp_start[c] <= 4);
+    mism[2] = ds->bt.ncomp;
     mism[0] = mism[1] = 0;
     for (int32_t p = 0; p < np; p++)
         for (int32_t q = p + 1; q < np; q++) {

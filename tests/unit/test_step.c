@@ -93,8 +93,8 @@ static void determinism_case(wb_solver solver)
         if (f == 0) {
             /* the parallel path is really taken: some batch has >= 512 constraints */
             int32_t big = 0;
-            for (int32_t k = 0; k < wb__dist(b->dist)->serial_start; k++)
-                if (wb__dist(b->dist)->colour_start[k + 1] - wb__dist(b->dist)->colour_start[k] >= 512) big++;
+            for (int32_t k = 0; k < wb__dist(b->dist)->bt.serial_start; k++)
+                if (wb__dist(b->dist)->bt.colour_start[k + 1] - wb__dist(b->dist)->bt.colour_start[k] >= 512) big++;
             CHECK(big >= 2);
         }
     }
