@@ -258,6 +258,10 @@ void *wb__grow(void *ptr, int32_t *cap, int32_t need, size_t elem); /* world.c: 
 /* world.c, the one budget routine: charge `want` bytes in place of *charged to the world's
  * memory budget (def.memory); 0 (nothing charged) when it would pass the limit */
 int wb__charge(wb_world *w, size_t *charged, size_t want);
+/* world.c: the capacity for need items of per bytes each, doubled from cap (64 at first)
+ * up to max and charged to *charged (as wb__charge); an exact fit when doubling would
+ * cross the limit; -1 when even that is refused */
+int32_t wb__charge_cap(wb_world *w, size_t *charged, size_t per, int32_t cap, int32_t need, int32_t max);
 /* one array of a structure of arrays: where its pointer is, the bytes of an element */
 typedef struct { void **p; size_t elem; } wb_soa;
 /* world.c: each of the n arrays reallocated to cap elements; WB_ERR_NOMEM when one fails

@@ -40,8 +40,6 @@ static int packable(const void *ud, int32_t s)
 
 static int slot_live(uint32_t gen) { return gen & 1u; }
 
-static int charge(wb_world *w, int32_t cap) { return wb__charge(w, &w->dist->charged, (size_t)cap * CONSTRAINT_BYTES); }
-
 /* room for need slots; the struct is made with the first (w->dist: NULL until then) */
 static wb_status grow_distances(wb_world *w, int32_t need)
 {
@@ -54,12 +52,8 @@ static wb_status grow_distances(wb_world *w, int32_t need)
     }
     wb_distances *ds = w->dist;
     if (need <= ds->cap) return WB_OK;
-    int32_t cap = ds->cap ? ds->cap : 64;
-    while (cap < need) cap = cap > WB_MAX_CONSTRAINTS / 2 ? WB_MAX_CONSTRAINTS : cap * 2;
-    if (!charge(w, cap)) {
-        cap = need; /* exact fit when doubling would cross the limit */
-        if (!charge(w, cap)) return WB_ERR_NOMEM;
-    }
+    const int32_t cap = wb__charge_cap(w, &ds->charged, CONSTRAINT_BYTES, ds->cap, need, WB_MAX_CONSTRAINTS);
+    if (cap < 0) return WB_ERR_NOMEM;
     const wb_soa arr[] = {
         { (void **)&ds->ij, 2 * sizeof(int32_t) }, { (void **)&ds->alpha, sizeof(wb_real) },
         { (void **)&ds->beta, sizeof(wb_real) }, { (void **)&ds->yield, sizeof(wb_real) },

@@ -196,7 +196,13 @@ int wb__charge(wb_world *w, size_t *charged, size_t want)
 }
 
 /* the particles' arrays at capacity cap_p */
-static int charge(wb_world *w, int64_t cap_p) { return wb__charge(w, &w->m.charged, (size_t)cap_p * PARTICLE_BYTES); }
+int32_t wb__charge_cap(wb_world *w, size_t *charged, size_t per, int32_t cap, int32_t need, int32_t max)
+{
+    if (cap <= 0) cap = 64;
+    while (cap < need) cap = cap > max / 2 ? max : cap * 2;
+    if (wb__charge(w, charged, (size_t)cap * per)) return cap;
+    return wb__charge(w, charged, (size_t)need * per) ? need : -1;
+}
 
 /* every per-particle array grows together; on failure nothing is lost */
 static wb_status grow_particles(wb_world *w, int32_t need)
@@ -204,12 +210,8 @@ static wb_status grow_particles(wb_world *w, int32_t need)
     wb_model *m = &w->m;
     if (need <= m->cap_p) return WB_OK;
     if (need > WB_MAX_PARTICLES) return WB_ERR_LIMIT;
-    int32_t cap = m->cap_p ? m->cap_p : 64;
-    while (cap < need) cap = cap > WB_MAX_PARTICLES / 2 ? WB_MAX_PARTICLES : cap * 2;
-    if (!charge(w, cap)) {
-        cap = need; /* exact fit when doubling would cross the limit */
-        if (!charge(w, cap)) return WB_ERR_NOMEM;
-    }
+    const int32_t cap = wb__charge_cap(w, &m->charged, PARTICLE_BYTES, m->cap_p, need, WB_MAX_PARTICLES);
+    if (cap < 0) return WB_ERR_NOMEM;
     const wb_soa arr[] = {
         { (void **)&m->inv_mass, sizeof(wb_real) }, { (void **)&m->w, sizeof(wb_real) },
         { (void **)&m->radius, sizeof(wb_real) }, { (void **)&m->pinned, 1 },
