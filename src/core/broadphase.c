@@ -612,7 +612,8 @@ static int grid_each(const wb_broad *b, const wb_real *p, wb_real e, int (*fn)(v
 static int32_t new_pairs(wb_broad *b, int32_t np, int32_t *add, int32_t n, const int32_t *list, int32_t nl)
 {
     if (n > 1) {
-        if (b && n >= 64 && 16 * (int64_t)n >= np && grow((void **)&b->by_j, &b->cap_by_j, 2 * (int64_t)n, sizeof *b->by_j) &&
+        if (b && n >= 64 && 16 * (int64_t)n >= np &&
+            grow((void **)&b->by_j, &b->cap_by_j, 2 * (int64_t)n, sizeof *b->by_j) &&
             grow((void **)&b->cnt, &b->cap_cnt, (int64_t)np + 1, sizeof *b->cnt) &&
             grow((void **)&b->first, &b->cap_first, (int64_t)np + 1, sizeof *b->first)) {
             const pairbuf one = { add, n, n, 0, NULL, 0 };
