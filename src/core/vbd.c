@@ -81,6 +81,10 @@ struct wb_vbd {
     double *csum;          /* (bodies x 17) a free body's contacts in the vertex steps
                               (keep_momentum) */
     uint8_t *bmove;        /* (bodies) 1: its friction goes in its momentum step */
+    int32_t *bvar;         /* (bodies) its index among the free bodies that may touch another
+                              body's movable particle, moved with them (wb__vbdc_couple); -1 */
+    int32_t nvar;
+    double *vsum;          /* (nvar x 7) their masses, mean x - y and translations */
     wb_vbdc *ct;           /* the particle contacts in the vertex steps (vbd_contact.c) */
     int ct_on;             /* ct holds this substep's */
     size_t charged;        /* the struct's and its arrays' bytes charged to def.memory, but for
@@ -124,6 +128,12 @@ struct wb_vbd {
 /* at most this many Newton steps for a free body's translation with its contacts
  * (keep_momentum) */
 #define VBD_MOVE_STEPS 8
+/* two bodies with a pair closer than this times r_i + r_j where the substep starts were
+ * made inside each other: contact.c parts them, they are not moved together (measured,
+ * two blocks made with coincident layers: a particle flung at 1.24 m/s with them moved
+ * together; 0.5 of the contact distance: 0.88, as before; 0.95: blocks made interleaved
+ * gained 49 J where 12 are allowed) */
+#define VBD_MADE_DEEP ((wb_real)0.5)
 
 void wb__vbd_destroy(wb_world *w)
 {
@@ -156,6 +166,8 @@ void wb__vbd_destroy(wb_world *w)
     free(v->tsum);
     free(v->csum);
     free(v->bmove);
+    free(v->bvar);
+    free(v->vsum);
     wb__vbdc_destroy(w, v->ct);
     wb__charge(w, &v->charged, 0);
     wb__charge(w, &v->charged_t, 0);
@@ -853,25 +865,31 @@ static void write_forces(wb_world *w, const struct wb_vbd *v, wb_real h)
     }
 }
 
-/* v->tsum (bodies x 4) zeroed, with [4 b] = -1 for each body b that may touch a movable
- * particle of another body or a rigid body this frame (the contacts found for the frame);
- * 0 when there are no bodies (or no memory) */
+/* v->tsum (bodies x 4) zeroed, with [4 b] = -1 for each body b that may touch a rigid body,
+ * a movable particle of a body made deep inside it or a triangle held in part this frame
+ * (the contacts found for the frame), v->bvar numbering the free bodies that may touch
+ * another body's movable particles otherwise (moved together: couple); 0 when there are
+ * no bodies (or no memory) */
 static int touching(wb_world *w, struct wb_vbd *v)
 {
     const wb_cache *k = &w->k;
     if (!k->mc_built || k->mc_nbody == 0) return 0;
     const int32_t nb = k->mc_nbody, *body = k->mc_body;
     if (nb > v->cap_tsum) {
-        if (!wb__charge(w, &v->charged_t, (sizeof(double) * 25 + 1) * (size_t)nb)) {
+        if (!wb__charge(w, &v->charged_t, (sizeof(double) * 32 + sizeof(int32_t) + 1) * (size_t)nb)) {
             v->nomem = 1;
             return 0;
         }
         double *t = realloc(v->tsum, sizeof *t * 8 * (size_t)nb), *e = realloc(v->csum, sizeof *e * 17 * (size_t)nb);
+        double *vs = realloc(v->vsum, sizeof *vs * 7 * (size_t)nb);
         uint8_t *bm = realloc(v->bmove, (size_t)nb);
+        int32_t *bv = realloc(v->bvar, sizeof *bv * (size_t)nb);
         if (t) v->tsum = t;
         if (e) v->csum = e;
+        if (vs) v->vsum = vs;
         if (bm) v->bmove = bm;
-        if (!t || !e || !bm) {
+        if (bv) v->bvar = bv;
+        if (!t || !e || !vs || !bm || !bv) {
             v->nomem = 1;
             return 0;
         }
@@ -879,6 +897,7 @@ static int touching(wb_world *w, struct wb_vbd *v)
     }
     double *T = v->tsum;
     memset(T, 0, sizeof *T * 5 * (size_t)nb);
+    for (int32_t b = 0; b < nb; b++) v->bvar[b] = -1;
     /* only what moves outside the body counts: its own folds, loose particles and
      * immovable particles (a pinned slab, as a collider) keep the momentum the move keeps
      * (a block on a pinned slab at 0.95 of its sticking angle crept 26 mm in 1 s, then
@@ -898,20 +917,45 @@ static int touching(wb_world *w, struct wb_vbd *v)
             if (v3_dot(d, d) < rn * rn) T[4 * nb + body[wv[i] > 0 ? i : j]] = 1;
         }
         if (a < 0 || b < 0 || a == b) continue;
-        if (wv[j] > 0) T[4 * a] = -1;
-        if (wv[i] > 0) T[4 * b] = -1;
+        /* (marked here, numbered below; bodies made deep inside each other are contact.c's
+         * to part) */
+        wb_real e[3];
+        v3_sub(e, &xp[3 * i], &xp[3 * j]);
+        const wb_real rs = (rad[i] + rad[j]) * VBD_MADE_DEEP;
+        const int made = wb__vbdc_made(w, i, j) || v3_dot(e, e) < rs * rs;
+        if (wv[j] > 0) {
+            if (made) T[4 * a] = -1;
+            else if (v->bvar[a] < 0) v->bvar[a] = 0;
+        }
+        if (wv[i] > 0) {
+            if (made) T[4 * b] = -1;
+            else if (v->bvar[b] < 0) v->bvar[b] = 0;
+        }
     }
     const wb_tricontacts *tc = k->tc;
     for (int32_t c = 0; c < tc->n; c++) {
         const int32_t t = tc->pt[2 * c + 1], p[4] = { tc->pt[2 * c], w->m.tri[3 * t], w->m.tri[3 * t + 1], w->m.tri[3 * t + 2] };
         const int32_t a = body[p[0]], b = body[p[1]];
         if (a < 0 || b < 0 || a == b) continue;
-        if (wv[p[1]] > 0 || wv[p[2]] > 0 || wv[p[3]] > 0) T[4 * a] = -1;
-        if (wv[p[0]] > 0) T[4 * b] = -1;
+        /* (a triangle of one body, all its corners movable: in the coupled step) */
+        const int made = wb__vbdc_made(w, p[0], p[1]);
+        const int whole = !made && body[p[2]] == b && body[p[3]] == b && wv[p[1]] > 0 && wv[p[2]] > 0 && wv[p[3]] > 0;
+        if (whole) v->bvar[a] = v->bvar[a] < 0 ? 0 : v->bvar[a];
+        else if (wv[p[1]] > 0 || wv[p[2]] > 0 || wv[p[3]] > 0) T[4 * a] = -1;
+        if (wv[p[0]] > 0) {
+            if (made) T[4 * b] = -1;
+            else if (v->bvar[b] < 0) v->bvar[b] = 0;
+        }
     }
     if (w->rb)
         for (int32_t c = 0; c < w->rb->npct; c++)
             if (body[w->rb->pc[2 * c]] >= 0) T[4 * body[w->rb->pc[2 * c]]] = -1;
+    /* a free body that may touch another body's movable particle is moved with the bodies
+     * it may touch (keep_momentum), unless it is held or touches what that step does not
+     * take in (a rigid body, a triangle of another body) */
+    v->nvar = 0;
+    for (int32_t b = 0; b < nb; b++)
+        v->bvar[b] = v->bvar[b] == 0 && !(T[4 * b] < 0) && !(k->mc_acc[16 * b] < 0) ? v->nvar++ : -1;
     return 1;
 }
 
@@ -925,9 +969,9 @@ static int touching(wb_world *w, struct wb_vbd *v)
  * clamped strip swung on at 10 x 1, 0.63 m against 0.29; the bar crept to 0.8 mm at
  * 10 x 1). A body that nothing holds (no pin, attachment or grab) but that may touch
  * another body's movable particle or a rigid body (touching()) starts from the
- * prediction: the contacts projected after the
- * sweeps carry it and keep_momentum leaves it alone, so the gravity it follows is the one
- * its start has (from x + h v, a lattice made overlapping another was lifted 0.25 m
+ * prediction: the contacts carry it (after the sweeps, or in its momentum step with the
+ * bodies it touches) and where keep_momentum leaves it alone the gravity it follows is the
+ * one its start has (from x + h v, a lattice made overlapping another was lifted 0.25 m
  * instead of 0.15; from the adaptive start, a stack still moved after 4 s). So does a
  * free body near an immovable particle: its contacts in the vertex steps then push from
  * the start (from x + h v a Newton step did not see them, and their multipliers took 8
@@ -942,9 +986,36 @@ static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h, int touch)
         const int held = v->adj_start[i + 1] > v->adj_start[i] || v->tadj_start[i + 1] > v->tadj_start[i] ||
                          v->badj_start[i + 1] > v->badj_start[i];
         const int32_t b = body ? body[i] : -1;
-        const int from_y = touch && b >= 0 && !(w->k.mc_acc[16 * b] < 0) && (v->tsum[4 * b] < 0 || v->tsum[4 * w->k.mc_nbody + b] > 0);
+        const int from_y = touch && b >= 0 && !(w->k.mc_acc[16 * b] < 0) &&
+                           (v->tsum[4 * b] < 0 || v->tsum[4 * w->k.mc_nbody + b] > 0 || v->bvar[b] >= 0);
         if (!(wv[i] > 0) || !held || from_y) continue;
         v3_madd(&x[3 * i], g, -h * h);
+    }
+}
+
+/* The free bodies that may touch each other's movable particles (touching(): bvar) take
+ * together the Newton steps of the substep's energy along their translations with their
+ * contacts (wb__vbdc_couple): each pair's forces on its two bodies are equal and opposite,
+ * so the step keeps their momentum. Singular (non-finite input), they keep the plain
+ * move (T) */
+static void couple(wb_world *w, struct wb_vbd *v, wb_real h)
+{
+    const int32_t nb = w->k.mc_nbody, nv = v->nvar;
+    if (nv == 0) return;
+    double *T = v->tsum, *mass = v->vsum, *mean = mass + nv, *t = mean + 3 * (size_t)nv;
+    for (int32_t b = 0; b < nb; b++) {
+        const int32_t q = v->bvar[b];
+        if (q < 0) continue;
+        mass[q] = T[4 * b];
+        for (int c = 0; c < 3; c++) mean[3 * q + c] = T[4 * b + 1 + c];
+    }
+    const int done = wb__vbdc_couple(w, &v->ct, v->bvar, nv, mass, mean, t, h, VBD_MOVE_STEPS);
+    if (done < 0) v->nomem = 1; /* (the step undoes the frame) */
+    if (done <= 0) return;
+    for (int32_t b = 0; b < nb; b++) {
+        const int32_t q = v->bvar[b];
+        if (q < 0 || !(T[4 * b] > 0)) continue;
+        for (int c = 0; c < 3; c++) T[4 * b + 1 + c] = -t[3 * q + c];
     }
 }
 
@@ -956,14 +1027,16 @@ static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h, int touch)
  * neighbours does not feel: each sweep moves the body by m / (h^2 k) of what is left,
  * and the start (start_guess) would carry it). Serial, in particle order: the same bits
  * on any thread count. touch: touching() ran this substep (v->tsum holds its flags) */
-static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch, wb_real inv_h2)
+static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch, wb_real h)
 {
     const wb_cache *k = &w->k;
-    /* a body that may touch another body's movable particle or a rigid body this frame is
-     * left as the sweeps leave it (touching()): the particle contacts projected after the
-     * solve would take the step back from one side only (measured: two stacked lattices
-     * crept 3 cm off centre) */
+    /* a body that may touch a rigid body, or a body made deep inside it, this frame is left
+     * as the sweeps leave it (touching()): the contacts projected after the solve would take
+     * the step back from one side only (measured: two stacked lattices crept 3 cm off
+     * centre, when they were moved alone); one that may touch another body's movable
+     * particles is moved with it (couple) */
     if (!touch) return;
+    const wb_real inv_h2 = 1 / (h * h);
     const int32_t nb = k->mc_nbody, *body = k->mc_body;
     double *T = v->tsum;
     const wb_real *wv = w->m.w, *y = v->y;
@@ -1011,7 +1084,7 @@ static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch, wb_real inv_
                 for (int c = 0; c < 10; c++) E[17 * b + c] = 0;
             for (int32_t q = 0; q < nc; q++) {
                 const int32_t b = body[cv[q]];
-                if (b < 0 || !(T[4 * b] > 0) || isnan(tb[3 * b])) continue;
+                if (b < 0 || !(T[4 * b] > 0) || isnan(tb[3 * b]) || v->bvar[b] >= 0) continue;
                 wb_real f[3] = { 0, 0, 0 }, H[6] = { 0, 0, 0, 0, 0, 0 }, fr[4] = { 0, 0, 0, 0 }, sh[3];
                 for (int c = 0; c < 3; c++) sh[c] = (wb_real)tb[3 * b + c];
                 wb__vbdc_body(w, v->ct, cv[q], sh, f, H, pass == 0 ? fr : NULL);
@@ -1062,6 +1135,7 @@ static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch, wb_real inv_
             for (int c = 0; c < 3; c++) T[4 * b + 1 + c] = -t[c];
         }
     }
+    couple(w, v, h);
     for (int32_t i = 0; i < w->m.np; i++) {
         const int32_t b = body[i];
         if (b < 0 || !(T[4 * b] > 0) || !(wv[i] > 0)) continue;
@@ -1084,8 +1158,10 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     /* the contacts in the vertex steps */
     if (touch)
         for (int32_t b = 0; b < w->k.mc_nbody; b++)
-            v->bmove[b] = v->tsum[4 * w->k.mc_nbody + b] > 0 && v->tsum[4 * b] >= 0 && !(w->k.mc_acc[16 * b] < 0);
-    const int got = wb__vbdc_begin(w, &v->ct, h, v->order, v->colour_start, v->ncolours, touch ? v->bmove : NULL);
+            v->bmove[b] = v->tsum[4 * w->k.mc_nbody + b] > 0 && v->tsum[4 * b] >= 0 && !(w->k.mc_acc[16 * b] < 0) &&
+                          v->bvar[b] < 0;
+    const int got = wb__vbdc_begin(w, &v->ct, h, v->order, v->colour_start, v->ncolours, touch ? v->bmove : NULL,
+                                   touch && v->nvar > 0 ? v->bvar : NULL);
     v->ct_on = got > 0;
     if (got < 0) v->nomem = 1;
     if (v->nomem) return -1; /* (the step undoes the frame) */
@@ -1115,7 +1191,7 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
             if (!wb__vbd_serves(wb__ctypes[t])) wb__ctypes[t]->project(w, h);
         if (last) break;
     }
-    keep_momentum(w, v, touch, inv_h2);
+    keep_momentum(w, v, touch, h);
     if (v->ct_on) wb__vbdc_end(w, v->ct);
     keep_multipliers(v);
     write_forces(w, v, h);

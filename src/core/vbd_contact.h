@@ -13,7 +13,7 @@ typedef struct wb_vbdc wb_vbdc;
  * NULL): 1 for a body whose friction its momentum step takes (wb__vbdc_body), not the
  * vertex steps. */
 int wb__vbdc_begin(wb_world *w, wb_vbdc **c, wb_real h, const int32_t *order, const int32_t *colour_start,
-                   int32_t ncolours, const uint8_t *bmoved);
+                   int32_t ncolours, const uint8_t *bmoved, const int32_t *bvar);
 /* vertex i's contact forces and their Hessian added to f and H (H: xx, yy, zz, xy, xz, yz) */
 void wb__vbdc_block(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3], wb_real H[6]);
 /* after vertex i's Newton step to xi (H: its Hessian): its friction with its partners */
@@ -38,6 +38,17 @@ void wb__vbdc_dual(const wb_world *w, wb_vbdc *c);
 void wb__vbdc_refresh(const wb_world *w, wb_vbdc *c, int32_t ncolours);
 /* after the contacts' projection (contact.c): their reported forces take in the sweeps' */
 void wb__vbdc_readout(wb_world *w, const wb_vbdc *c);
+/* The nv bodies moved with their partners (bvar: a body's index among them, -1 none; mass,
+ * mean: each one's mass and mean x - y after the sweeps) take the Newton steps (at most
+ * steps) of the substep's energy along their translations with all their pairs and the
+ * triangle contacts between them (h: the substep; *c made if need be); t (nv x 3)
+ * gets each one's translation. 1 done, 0 singular (t not to be used), -1 out of memory */
+int wb__vbdc_couple(wb_world *w, wb_vbdc **c, const int32_t *bvar, int32_t nv, const double *mass, const double *mean,
+                    double *t, wb_real h, int32_t steps);
+/* particles p and q are of two groups contact.c moved apart whole in the last substep for
+ * an overlap they were made with: their contacts are its to take out (pushed pair by pair,
+ * blocks made interleaved flew apart at metres per second) */
+int wb__vbdc_made(const wb_world *w, int32_t p, int32_t q);
 /* (its charge given back) */
 void wb__vbdc_destroy(wb_world *w, wb_vbdc *c);
 
