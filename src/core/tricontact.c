@@ -117,8 +117,8 @@ wb_real wb__tri_closest(const wb_real p[3], const wb_real a[3], const wb_real b[
 }
 
 /* ---- projection -------------------------------------------------------------------------------------- */
-/* p's body and the triangle's are a pair contact.c moves apart this substep */
-static int made_moving(const wb_world *w, int32_t p, int32_t corner)
+/* p's body and the triangle's are a pair contact.c moves apart this substep (contact.h) */
+int wb__contacts_made(const wb_world *w, int32_t p, int32_t corner)
 {
     const wb_contacts *pc = w->k.pc;
     const int32_t g1 = w->m.group[p], g2 = w->m.group[corner];
@@ -169,7 +169,7 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
         /* two bodies made inside each other, which contact.c moves apart whole: theirs
          * to take out (a triangle's normal is no way out of a body made inside another:
          * it pushes the point deeper in as often as out); kept as it is until they stop */
-        if (made_moving(w, p, v[0])) continue;
+        if (wb__contacts_made(w, p, v[0])) continue;
         left[k] = 0;
         /* the side now and at the substep's start (the plane of the triangle then) */
         v3_sub(e1, xb, xa);

@@ -84,7 +84,7 @@ struct wb_vbd {
     int32_t *bvar;         /* (bodies) its index among the free bodies that may touch another
                               body's movable particle, moved with them (wb__vbdc_couple); -1 */
     int32_t nvar;
-    double *vsum;          /* (nvar x 7) their masses, mean x - y and translations */
+    double *vsum;          /* (nvar x (WB_VBDC_BS + 6)) their sums and moves (couple) */
     wb_vbdc *ct;           /* the particle contacts in the vertex steps (vbd_contact.c) */
     int ct_on;             /* ct holds this substep's */
     size_t charged;        /* the struct's and its arrays' bytes charged to def.memory, but for
@@ -876,12 +876,12 @@ static int touching(wb_world *w, struct wb_vbd *v)
     if (!k->mc_built || k->mc_nbody == 0) return 0;
     const int32_t nb = k->mc_nbody, *body = k->mc_body;
     if (nb > v->cap_tsum) {
-        if (!wb__charge(w, &v->charged_t, (sizeof(double) * 32 + sizeof(int32_t) + 1) * (size_t)nb)) {
+        if (!wb__charge(w, &v->charged_t, (sizeof(double) * (25 + WB_VBDC_BS + 6) + sizeof(int32_t) + 1) * (size_t)nb)) {
             v->nomem = 1;
             return 0;
         }
         double *t = realloc(v->tsum, sizeof *t * 8 * (size_t)nb), *e = realloc(v->csum, sizeof *e * 17 * (size_t)nb);
-        double *vs = realloc(v->vsum, sizeof *vs * 7 * (size_t)nb);
+        double *vs = realloc(v->vsum, sizeof *vs * (WB_VBDC_BS + 6) * (size_t)nb);
         uint8_t *bm = realloc(v->bmove, (size_t)nb);
         int32_t *bv = realloc(v->bvar, sizeof *bv * (size_t)nb);
         if (t) v->tsum = t;
@@ -922,7 +922,7 @@ static int touching(wb_world *w, struct wb_vbd *v)
         wb_real e[3];
         v3_sub(e, &xp[3 * i], &xp[3 * j]);
         const wb_real rs = (rad[i] + rad[j]) * VBD_MADE_DEEP;
-        const int made = wb__vbdc_made(w, i, j) || v3_dot(e, e) < rs * rs;
+        const int made = wb__contacts_made(w, i, j) || v3_dot(e, e) < rs * rs;
         if (wv[j] > 0) {
             if (made) T[4 * a] = -1;
             else if (v->bvar[a] < 0) v->bvar[a] = 0;
@@ -938,7 +938,7 @@ static int touching(wb_world *w, struct wb_vbd *v)
         const int32_t a = body[p[0]], b = body[p[1]];
         if (a < 0 || b < 0 || a == b) continue;
         /* (a triangle of one body, all its corners movable: in the coupled step) */
-        const int made = wb__vbdc_made(w, p[0], p[1]);
+        const int made = wb__contacts_made(w, p[0], p[1]);
         const int whole = !made && body[p[2]] == b && body[p[3]] == b && wv[p[1]] > 0 && wv[p[2]] > 0 && wv[p[3]] > 0;
         if (whole) v->bvar[a] = v->bvar[a] < 0 ? 0 : v->bvar[a];
         else if (wv[p[1]] > 0 || wv[p[2]] > 0 || wv[p[3]] > 0) T[4 * a] = -1;
@@ -994,29 +994,68 @@ static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h, int touch)
 }
 
 /* The free bodies that may touch each other's movable particles (touching(): bvar) take
- * together the Newton steps of the substep's energy along their translations with their
- * contacts (wb__vbdc_couple): each pair's forces on its two bodies are equal and opposite,
- * so the step keeps their momentum. Singular (non-finite input), they keep the plain
- * move (T) */
+ * together the Newton steps of the substep's energy along their rigid moves, a translation
+ * and a small turn each, with their contacts (wb__vbdc_couple): each contact's forces on
+ * its two bodies are equal and opposite, so the step keeps their momentum, and its
+ * inertia term their angular momentum but for the contacts' torques (the turns the sweeps'
+ * Gauss-Seidel gives a loaded body go: momentum.c leaves bodies that touch particles
+ * alone). Moved along their translations only, three blocks stacked tipped over: the
+ * contacts pushed their centres, not where they touch. Singular (non-finite input), they
+ * keep the plain move (T) */
 static void couple(wb_world *w, struct wb_vbd *v, wb_real h)
 {
-    const int32_t nb = w->k.mc_nbody, nv = v->nvar;
+    const int32_t nb = w->k.mc_nbody, nv = v->nvar, *body = w->k.mc_body;
     if (nv == 0) return;
-    double *T = v->tsum, *mass = v->vsum, *mean = mass + nv, *t = mean + 3 * (size_t)nv;
+    double *T = v->tsum, *bs = v->vsum, *u = bs + WB_VBDC_BS * (size_t)nv;
+    const wb_real *x = w->s.x, *y = v->y, *wv = w->m.w;
+    memset(bs, 0, sizeof *bs * WB_VBDC_BS * (size_t)nv);
     for (int32_t b = 0; b < nb; b++) {
         const int32_t q = v->bvar[b];
         if (q < 0) continue;
-        mass[q] = T[4 * b];
-        for (int c = 0; c < 3; c++) mean[3 * q + c] = T[4 * b + 1 + c];
+        bs[WB_VBDC_BS * q] = T[4 * b];
+        for (int c = 0; c < 3; c++) bs[WB_VBDC_BS * q + 1 + c] = T[4 * b + 1 + c];
     }
-    const int done = wb__vbdc_couple(w, &v->ct, v->bvar, nv, mass, mean, t, h, VBD_MOVE_STEPS);
+    /* centres, then the turn's sums about them */
+    for (int32_t i = 0; i < w->m.np; i++) {
+        const int32_t q = body[i] >= 0 ? v->bvar[body[i]] : -1;
+        if (q < 0 || !(wv[i] > 0)) continue;
+        for (int c = 0; c < 3; c++) bs[WB_VBDC_BS * q + 4 + c] += (double)x[3 * i + c] / wv[i];
+    }
+    for (int32_t q = 0; q < nv; q++)
+        for (int c = 0; c < 3; c++) bs[WB_VBDC_BS * q + 4 + c] /= bs[WB_VBDC_BS * q];
+    for (int32_t i = 0; i < w->m.np; i++) {
+        const int32_t q = body[i] >= 0 ? v->bvar[body[i]] : -1;
+        if (q < 0 || !(wv[i] > 0)) continue;
+        double *B = &bs[WB_VBDC_BS * q], r[3], d[3];
+        const double m = 1 / (double)wv[i];
+        for (int c = 0; c < 3; c++) r[c] = (double)x[3 * i + c] - B[4 + c], d[c] = (double)x[3 * i + c] - (double)y[3 * i + c];
+        B[7] += m * (r[1] * d[2] - r[2] * d[1]), B[8] += m * (r[2] * d[0] - r[0] * d[2]), B[9] += m * (r[0] * d[1] - r[1] * d[0]);
+        B[10] += m * (r[1] * r[1] + r[2] * r[2]), B[11] += m * (r[0] * r[0] + r[2] * r[2]), B[12] += m * (r[0] * r[0] + r[1] * r[1]);
+        B[13] -= m * r[0] * r[1], B[14] -= m * r[0] * r[2], B[15] -= m * r[1] * r[2];
+    }
+    const int done = wb__vbdc_couple(w, &v->ct, v->bvar, nv, bs, u, h, VBD_MOVE_STEPS);
     if (done < 0) v->nomem = 1; /* (the step undoes the frame) */
     if (done <= 0) return;
-    for (int32_t b = 0; b < nb; b++) {
-        const int32_t q = v->bvar[b];
-        if (q < 0 || !(T[4 * b] > 0)) continue;
-        for (int c = 0; c < 3; c++) T[4 * b + 1 + c] = -t[3 * q + c];
+    /* each moved: x = c + t + R(th) (x - c), the turn exact (Rodrigues, 1 - cos a as 2 sin^2
+     * a/2) so it keeps the body's shape; its momentum step done here (T[4 b] = 0:
+     * keep_momentum moves it no more) */
+    wb_real *xw = w->s.x;
+    for (int32_t i = 0; i < w->m.np; i++) {
+        const int32_t q = body[i] >= 0 ? v->bvar[body[i]] : -1;
+        if (q < 0 || !(wv[i] > 0)) continue;
+        const double *B = &bs[WB_VBDC_BS * q], *t = &u[6 * q], *th = &u[6 * q + 3];
+        const double a = sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2]);
+        double r[3], kr[3], k[3] = { 0, 0, 0 };
+        for (int c = 0; c < 3; c++) r[c] = (double)xw[3 * i + c] - B[4 + c];
+        if (a > 0)
+            for (int c = 0; c < 3; c++) k[c] = th[c] / a;
+        kr[0] = k[1] * r[2] - k[2] * r[1], kr[1] = k[2] * r[0] - k[0] * r[2], kr[2] = k[0] * r[1] - k[1] * r[0];
+        /* (the move, small, added once: one rounding a coordinate, the momentum's) */
+        const double sa = sin(a), h2 = sin(a / 2), vc = 2 * h2 * h2, kd = k[0] * r[0] + k[1] * r[1] + k[2] * r[2];
+        for (int c = 0; c < 3; c++) xw[3 * i + c] += (wb_real)(t[c] + (kr[c] * sa + (k[c] * kd - r[c]) * vc));
     }
+    for (int32_t b = 0; b < nb; b++)
+        if (v->bvar[b] >= 0) T[4 * b] = 0;
 }
 
 /* Each free body (momentum.c's: nothing outside the solve holds it) moved rigidly so that

@@ -27,15 +27,16 @@
  *
  * Free bodies touching each other (vbd.c's touching(): their movable particles, or a
  * point and a triangle whose corners all move) are moved together after the sweeps
- * (wb__vbdc_couple): the Newton steps of the substep's energy along their translations,
- * each pair and point-triangle contact between them a penalty (VBDC_K times its ends'
- * inertia, its multiplier 0: they are not in the sweeps) with Coulomb friction as a
- * tangential spring of the same stiffness capped at mu f_n, one linear system over the
- * bodies solved by conjugate gradients. Each contact's forces on its two bodies are equal
- * and opposite, so the step keeps their momentum whatever the order (Gauss-Seidel over
- * the bodies would not, as over the vertices). Moved alone, each by its own momentum step,
+ * (wb__vbdc_couple), each rigidly: the Newton steps of the substep's energy along their
+ * translations and small turns, each pair and point-triangle contact between them a
+ * penalty (VBDC_K times its ends' inertia, its multiplier 0: they are not in the sweeps)
+ * with Coulomb friction as a tangential spring of the same stiffness capped at mu f_n, one
+ * linear system over the bodies solved by conjugate gradients. Each contact's forces on
+ * its two bodies are equal and opposite, so the step keeps their momentum whatever the
+ * order (Gauss-Seidel over the bodies would not, as over the vertices). Moved each alone,
  * two stacked lattices crept 3 cm off centre; not moved at all, a block sliding on a free
- * slab lost a fifth of the momentum and a rope draped on another rested 2.2 mm low.
+ * slab lost a fifth of the momentum and a rope draped on another rested 2.2 mm low; moved
+ * along their translations only, three stacked blocks tipped over.
  *
  * The contacts projected after the sweeps (contact.c) still run and take what the
  * sweeps left (a penalty leaves 1 / (1 + VBDC_K) of a resting overlap); their friction
@@ -186,20 +187,6 @@ static int grow(wb_world *w, wb_vbdc *c, int32_t np, int32_t npair, int32_t ncol
     return 1;
 }
 
-/* groups g1 and g2 were moved apart whole by contact.c in the last substep for an overlap
- * they were made with: their contacts are its to take out (pushed pair by pair, blocks
- * made interleaved flew apart at metres per second) */
-int wb__vbdc_made(const wb_world *w, int32_t p, int32_t q)
-{
-    const wb_contacts *pc = w->k.pc;
-    const int32_t g1 = w->m.group[p], g2 = w->m.group[q];
-    if (pc->nmade == 0 || g1 <= 0 || g2 <= 0 || g1 == g2) return 0;
-    const int32_t a = g1 < g2 ? g1 : g2, b = g1 < g2 ? g2 : g1;
-    for (int32_t e = 0; e < pc->nmade; e++)
-        if (pc->made_ab[2 * e] == a && pc->made_ab[2 * e + 1] == b) return 1;
-    return 0;
-}
-
 /* candidate k is a pair it serves, closer than VBDC_NEAR (r_i + r_j): one movable end (see
  * the head of the file for why not two), or two movable ends of two bodies, one of them
  * moved with its partners (bvar: its index there, -1 none; NULL: no such bodies) */
@@ -210,7 +197,7 @@ static inline int near_pair(const wb_world *w, const wb_contacts *pc, const wb_r
     if (!(wv[i] > 0) == !(wv[j] > 0)) {
         if (!bvar || !(wv[i] > 0)) return 0;
         const int32_t a = body[i], b = body[j];
-        if (a < 0 || b < 0 || a == b || (bvar[a] < 0 && bvar[b] < 0) || wb__vbdc_made(w, i, j)) return 0;
+        if (a < 0 || b < 0 || a == b || (bvar[a] < 0 && bvar[b] < 0) || wb__contacts_made(w, i, j)) return 0;
         /* made overlapping (more than a substep's depenetration at its start): the
          * projection's to part slowly, pair by pair */
         const wb_real *xp = w->s.x_prev, rs = rad[i] + rad[j] - w->m.def.max_depenetration * step_h;
@@ -489,18 +476,13 @@ void wb__vbdc_readout(wb_world *w, const wb_vbdc *c)
     }
 }
 
-/* H d = f for a symmetric 3 x 3 H (xx, yy, zz, xy, xz, yz); 0 when singular */
-static int solve_sym3(const double H[6], const double f[3], double d[3])
+/* ---- the bodies moved together ------------------------------------------------------------- */
+/* A body's move in the coupled step is u = (t, th): its translation and a small turn about
+ * its centre c, so a point r = x - c of it moves by A u = t + th x r; a force f there is
+ * A^T f = (f, r x f) on it. */
+static inline void cross3(const double a[3], const double b[3], double out[3])
 {
-    const double a = H[0], b = H[1], c = H[2], xy = H[3], xz = H[4], yz = H[5];
-    const double c00 = b * c - yz * yz, c01 = xz * yz - xy * c, c02 = xy * yz - b * xz;
-    const double det = a * c00 + xy * c01 + xz * c02;
-    if (!(fabs(det) > 1e-300)) return 0;
-    const double c11 = a * c - xz * xz, c12 = xy * xz - a * yz, c22 = a * b - xy * xy, inv = 1 / det;
-    d[0] = (c00 * f[0] + c01 * f[1] + c02 * f[2]) * inv;
-    d[1] = (c01 * f[0] + c11 * f[1] + c12 * f[2]) * inv;
-    d[2] = (c02 * f[0] + c12 * f[1] + c22 * f[2]) * inv;
-    return 1;
+    out[0] = a[1] * b[2] - a[2] * b[1], out[1] = a[2] * b[0] - a[0] * b[2], out[2] = a[0] * b[1] - a[1] * b[0];
 }
 
 static inline void sym3_mul(const double H[6], const double u[3], double out[3])
@@ -510,35 +492,110 @@ static inline void sym3_mul(const double H[6], const double u[3], double out[3])
     out[2] = H[4] * u[0] + H[5] * u[1] + H[2] * u[2];
 }
 
-/* y = A u for the coupled step's matrix: each body's D u_b less, for each pair pushing
- * between two bodies of the step, its Hessian times the partner's u (hq: pair q's,
- * hq[6] < 0: not pushing) */
-static void couple_mul(int32_t npair, const int32_t *vi, const double *D, const double *hq, int32_t nv, const double *u,
-                       double *y)
+/* d = A u at r */
+static inline void a_mul(const double r[3], const double u[6], double d[3])
 {
-    for (int32_t b = 0; b < nv; b++) sym3_mul(&D[6 * b], &u[3 * b], &y[3 * b]);
-    for (int32_t q = 0; q < npair; q++) {
-        const int32_t a = vi[2 * q], b = vi[2 * q + 1];
-        if (a < 0 || b < 0 || hq[7 * q + 6] < 0) continue;
-        double ha[3], hb[3];
-        sym3_mul(&hq[7 * q], &u[3 * b], hb);
-        sym3_mul(&hq[7 * q], &u[3 * a], ha);
-        for (int k = 0; k < 3; k++) y[3 * a + k] -= hb[k], y[3 * b + k] -= ha[k];
+    cross3(&u[3], r, d);
+    for (int k = 0; k < 3; k++) d[k] += u[k];
+}
+
+/* y (6) += s A^T v at r */
+static inline void at_add(const double r[3], const double v[3], double s, double y[6])
+{
+    double m[3];
+    cross3(r, v, m);
+    for (int k = 0; k < 3; k++) y[k] += s * v[k], y[3 + k] += s * m[k];
+}
+
+/* D (6 x 6) += A^T H A at r (H: symmetric 3 x 3, xx, yy, zz, xy, xz, yz) */
+static void add_block(double D[36], const double r[3], const double H[6])
+{
+    double col[6][3], Hc[6][3];
+    for (int k = 0; k < 6; k++) {
+        double e[3] = { 0, 0, 0 };
+        e[k % 3] = 1;
+        if (k < 3) col[k][0] = e[0], col[k][1] = e[1], col[k][2] = e[2];
+        else cross3(e, r, col[k]);
+        sym3_mul(H, col[k], Hc[k]);
+    }
+    for (int i = 0; i < 6; i++)
+        for (int j = 0; j < 6; j++) D[6 * i + j] += col[i][0] * Hc[j][0] + col[i][1] * Hc[j][1] + col[i][2] * Hc[j][2];
+}
+
+/* the Cholesky factor L of a symmetric positive definite 6 x 6 D (lower, row-major); 0 when
+ * it is not */
+static int chol6(const double D[36], double L[36])
+{
+    for (int i = 0; i < 6; i++)
+        for (int j = 0; j <= i; j++) {
+            double s = D[6 * i + j];
+            for (int k = 0; k < j; k++) s -= L[6 * i + k] * L[6 * j + k];
+            if (i == j) {
+                if (!(s > 0)) return 0;
+                L[6 * i + i] = sqrt(s);
+            } else {
+                L[6 * i + j] = s / L[6 * j + j];
+            }
+        }
+    return 1;
+}
+
+static void chol6_solve(const double L[36], const double b[6], double x[6])
+{
+    double y[6];
+    for (int i = 0; i < 6; i++) {
+        double s = b[i];
+        for (int k = 0; k < i; k++) s -= L[6 * i + k] * y[k];
+        y[i] = s / L[6 * i + i];
+    }
+    for (int i = 5; i >= 0; i--) {
+        double s = y[i];
+        for (int k = i + 1; k < 6; k++) s -= L[6 * k + i] * x[k];
+        x[i] = s / L[6 * i + i];
     }
 }
 
-/* a contact of the coupled step pushing with fn > 0 along n (from b's side to a's), of
- * penalty kk, with its friction: the relative slip u over the substep across n held by a
- * tangential spring of the same stiffness while its force is within mu fn, else pushed
- * back by mu fn (its Hessian then the cone's, fn mu / |u_t| across u_t and n). Its force
- * goes to a (b: the opposite), its Hessian to H (sym. 3 x 3, H[6] = 1) and both bodies'
- * blocks D: each pair's forces equal and opposite, the step keeps the momentum */
-static void couple_add(int32_t a, int32_t b, const double n[3], double fn, double kk, double mu, const double u[3],
-                       double H[7], double *D, double *g)
+/* a contact record of the step (CQ doubles): its Hessian across its ends' points (sym. 3 x 3),
+ * 1 while it pushes (else -1), the points' offsets from their bodies' centres */
+#define CQ 13
+
+/* y = A u for the step's matrix: each body's block D times its u, less, for each contact
+ * pushing between two bodies of the step, A_a^T H A_b u_b on a and A_b^T H A_a u_a on b */
+static void couple_mul(int32_t ncq, const int32_t *vi, const double *D, const double *cq, int32_t nv, const double *u,
+                       double *y)
+{
+    for (int32_t b = 0; b < nv; b++)
+        for (int i = 0; i < 6; i++) {
+            double s = 0;
+            for (int j = 0; j < 6; j++) s += D[36 * b + 6 * i + j] * u[6 * b + j];
+            y[6 * b + i] = s;
+        }
+    for (int32_t q = 0; q < ncq; q++) {
+        const int32_t a = vi[2 * q], b = vi[2 * q + 1];
+        const double *o = &cq[CQ * q];
+        if (a < 0 || b < 0 || o[6] < 0) continue;
+        double da[3], db[3], ha[3], hb[3];
+        a_mul(o + 7, &u[6 * a], da);
+        a_mul(o + 10, &u[6 * b], db);
+        sym3_mul(o, db, hb);
+        sym3_mul(o, da, ha);
+        at_add(o + 7, hb, -1, &y[6 * a]);
+        at_add(o + 10, ha, -1, &y[6 * b]);
+    }
+}
+
+/* a contact of the step pushing with fn > 0 along n (from b's side to a's), of penalty kk,
+ * with its friction: the relative slip us over the substep across n held by a tangential
+ * spring of the same stiffness while its force is within mu fn, else pushed back by mu fn
+ * (its Hessian then the cone's, fn mu / |u_t| across u_t and n). Its force goes to a (b:
+ * the opposite), its Hessian to o (CQ record, whose offsets are set) and both bodies'
+ * blocks D: each contact's forces are equal and opposite, the step keeps the momentum */
+static void couple_add(int32_t a, int32_t b, const double n[3], double fn, double kk, double mu, const double us[3],
+                       double *o, double *D, double *g)
 {
     double f[3], ut[3];
-    const double un = u[0] * n[0] + u[1] * n[1] + u[2] * n[2];
-    for (int k = 0; k < 3; k++) ut[k] = u[k] - un * n[k], f[k] = fn * n[k];
+    const double un = us[0] * n[0] + us[1] * n[1] + us[2] * n[2];
+    for (int k = 0; k < 3; k++) ut[k] = us[k] - un * n[k], f[k] = fn * n[k];
     const double ul = sqrt(ut[0] * ut[0] + ut[1] * ut[1] + ut[2] * ut[2]), cap = mu * fn;
     double kt = 0, ks = 0, e[3] = { 0, 0, 0 }; /* across n, kt (I - n n^T) - ks e e^T */
     if (cap > 0 && ul > 0) {
@@ -551,17 +608,12 @@ static void couple_add(int32_t a, int32_t b, const double n[3], double fn, doubl
         }
     }
     const double kn = kk - kt;
+    double *H = o;
     H[0] = kn * n[0] * n[0] + kt - ks * e[0] * e[0], H[1] = kn * n[1] * n[1] + kt - ks * e[1] * e[1];
     H[2] = kn * n[2] * n[2] + kt - ks * e[2] * e[2], H[3] = kn * n[0] * n[1] - ks * e[0] * e[1];
     H[4] = kn * n[0] * n[2] - ks * e[0] * e[2], H[5] = kn * n[1] * n[2] - ks * e[1] * e[2], H[6] = 1;
-    for (int k = 0; k < 6; k++) {
-        if (a >= 0) D[6 * a + k] += H[k];
-        if (b >= 0) D[6 * b + k] += H[k];
-    }
-    for (int k = 0; k < 3; k++) {
-        if (a >= 0) g[3 * a + k] += f[k];
-        if (b >= 0) g[3 * b + k] -= f[k];
-    }
+    if (a >= 0) add_block(&D[36 * a], o + 7, H), at_add(o + 7, f, 1, &g[6 * a]);
+    if (b >= 0) add_block(&D[36 * b], o + 10, H), at_add(o + 10, f, -1, &g[6 * b]);
 }
 
 /* the triangle contacts between two bodies of the coupled step: a point of one body, a
@@ -573,14 +625,20 @@ static int tri_between(const wb_world *w, const int32_t *bvar, int32_t k, int32_
     const int32_t *body = w->k.mc_body, p = tc->pt[2 * k], *v = &w->m.tri[3 * tc->pt[2 * k + 1]];
     const wb_real *wv = w->m.w;
     const int32_t bp = body[p], bt = body[v[0]];
-    if (bp < 0 || bt < 0 || bp == bt || body[v[1]] != bt || body[v[2]] != bt || wb__vbdc_made(w, p, v[0])) return 0;
+    if (bp < 0 || bt < 0 || bp == bt || body[v[1]] != bt || body[v[2]] != bt || wb__contacts_made(w, p, v[0])) return 0;
     *a = wv[p] > 0 ? bvar[bp] : -1;
     *b = wv[v[0]] > 0 && wv[v[1]] > 0 && wv[v[2]] > 0 ? bvar[bt] : -1;
     return *a >= 0 || *b >= 0;
 }
 
-int wb__vbdc_couple(wb_world *w, wb_vbdc **cp, const int32_t *bvar, int32_t nv, const double *mass, const double *mean,
-                    double *t, wb_real h, int32_t steps)
+/* (a point's offset from the centre of body a of the step, 0 when it is not one) */
+static inline void offset(const double *bs, int32_t a, const wb_real *xq, double r[3])
+{
+    for (int k = 0; k < 3; k++) r[k] = a >= 0 ? (double)xq[k] - bs[WB_VBDC_BS * a + 4 + k] : 0;
+}
+
+int wb__vbdc_couple(wb_world *w, wb_vbdc **cp, const int32_t *bvar, int32_t nv, const double *bs, double *u, wb_real h,
+                    int32_t steps)
 {
     const int32_t *body = w->k.mc_body;
     const wb_real *x = w->s.x, *xp = w->s.x_prev, *wv = w->m.w, *rad = w->m.radius, *cf = w->m.cfric, inv_h2 = 1 / (h * h);
@@ -596,148 +654,168 @@ int wb__vbdc_couple(wb_world *w, wb_vbdc **cp, const int32_t *bvar, int32_t nv, 
         int32_t a, b;
         ntc += tri_between(w, bvar, k, &a, &b);
     }
-    const size_t need = 24 * (size_t)nv + 9 * (size_t)c->npair + 18 * (size_t)ntc;
+    const int32_t np2 = c->npair;
+    const size_t ncq = (size_t)np2 + (size_t)ntc;
+    const size_t need = 108 * (size_t)nv + (CQ + 1) * ncq + 10 * (size_t)ntc;
     if (need > c->cap_cs) {
         if (!wb__charge(w, &c->charged_cs, sizeof(double) * need)) return -1;
         double *cs = realloc(c->cs, sizeof *cs * need);
         if (!cs) return -1;
         c->cs = cs, c->cap_cs = need;
     }
-    double *D = c->cs, *g = D + 6 * (size_t)nv, *r = g + 3 * (size_t)nv, *z = r + 3 * (size_t)nv;
-    double *p = z + 3 * (size_t)nv, *Ap = p + 3 * (size_t)nv, *dt = Ap + 3 * (size_t)nv, *hq = dt + 3 * (size_t)nv;
-    /* (each pair's ends' indices in the step, -1: held where they are, as doubles' room) */
-    const int32_t np2 = c->npair;
-    int32_t *vi = (int32_t *)(hq + 7 * ((size_t)np2 + (size_t)ntc));
+    double *D = c->cs, *Lf = D + 36 * (size_t)nv, *g = Lf + 36 * (size_t)nv, *r = g + 6 * (size_t)nv;
+    double *z = r + 6 * (size_t)nv, *p = z + 6 * (size_t)nv, *Ap = p + 6 * (size_t)nv, *du = Ap + 6 * (size_t)nv;
+    double *cq = du + 6 * (size_t)nv;
+    /* (each contact's ends' bodies in the step, -1: held where they are, in doubles' room) */
+    int32_t *vi = (int32_t *)(cq + CQ * ncq);
     for (int32_t q = 0; q < np2; q++)
         for (int s = 0; s < 2; s++) {
             const int32_t i = c->pij[2 * q + s];
             vi[2 * q + s] = wv[i] > 0 && body[i] >= 0 ? bvar[body[i]] : -1;
+            offset(bs, vi[2 * q + s], &x[3 * i], &cq[CQ * q + 7 + 3 * s]);
         }
     /* each triangle contact near enough as a plane: its normal nn and the gap's base
-     * nn . (x_p - q) at t = 0 (the triangle only translates here: its closest point and
-     * normal stay), the target r_p less the overlap it keeps (wb__contact_depth's rule),
-     * its penalty over W = w_p + sum b_i^2 w_i; td: nn, base, target, k, the slip of
-     * p against its closest point over the substep at t = 0, mu (tricontact.c's) */
-    double *td = (double *)(vi + 2 * ((size_t)np2 + (size_t)ntc));
+     * nn . (x_p - q) at u = 0 (the triangle moves rigidly here: its closest point and
+     * normal are kept, linearised), the target r_p (a point made inside the other body is
+     * the projection's), its penalty over W = w_p + sum b_i^2 w_i; td: nn, base, target,
+     * k, the slip of p against its closest point over the substep at u = 0, mu
+     * (tricontact.c's) */
+    double *td = (double *)(vi + 2 * ncq);
     int32_t nt = 0;
     const wb_real step = w->m.def.max_depenetration * h;
     for (int32_t k = 0; k < tc->n; k++) {
         int32_t a, b;
         if (!tri_between(w, bvar, k, &a, &b)) continue;
-        const int32_t p = tc->pt[2 * k], *v = &w->m.tri[3 * tc->pt[2 * k + 1]];
-        const wb_real r = rad[p];
-        wb_real bc[3], q[3], d[3], e1[3], e2[3], n[3];
-        const wb_real d2 = wb__tri_closest(&x[3 * p], &x[3 * v[0]], &x[3 * v[1]], &x[3 * v[2]], bc, q);
-        v3_sub(d, &x[3 * p], q);
+        const int32_t pp = tc->pt[2 * k], *v = &w->m.tri[3 * tc->pt[2 * k + 1]];
+        const wb_real rr = rad[pp];
+        wb_real bc[3], q[3], d[3], e1[3], e2[3], n[3], dp[3];
+        const wb_real d2 = wb__tri_closest(&x[3 * pp], &x[3 * v[0]], &x[3 * v[1]], &x[3 * v[2]], bc, q);
+        v3_sub(d, &x[3 * pp], q);
         const wb_real dist = sqrt(d2);
         v3_sub(e1, &xp[3 * v[1]], &xp[3 * v[0]]);
         v3_sub(e2, &xp[3 * v[2]], &xp[3 * v[0]]);
         v3_cross(n, e1, e2);
-        wb_real dp[3];
-        v3_sub(dp, &xp[3 * p], &xp[3 * v[0]]);
+        v3_sub(dp, &xp[3 * pp], &xp[3 * v[0]]);
         const wb_real s_prev = v3_dot(dp, n), ln = v3_len(n);
-        double nn[3], base;
-        v3_sub(dp, &x[3 * p], &x[3 * v[0]]);
+        double nn[3];
+        v3_sub(dp, &x[3 * pp], &x[3 * v[0]]);
         if (ln > 0 && s_prev != 0 && v3_dot(dp, n) * s_prev < 0 && bc[0] > 0 && bc[1] > 0 && bc[2] > 0) {
             /* through the face since the substep began: back to the side it was on */
-            for (int c3 = 0; c3 < 3; c3++) nn[c3] = n[c3] / ln * (s_prev > 0 ? 1 : -1);
-        } else if (dist > r * (wb_real)1e-9 && dist < r * VBDC_NEAR) {
-            for (int c3 = 0; c3 < 3; c3++) nn[c3] = d[c3] / dist;
+            for (int k3 = 0; k3 < 3; k3++) nn[k3] = n[k3] / ln * (s_prev > 0 ? 1 : -1);
+        } else if (dist > rr * (wb_real)1e-9 && dist < rr * VBDC_NEAR) {
+            for (int k3 = 0; k3 < 3; k3++) nn[k3] = d[k3] / dist;
         } else {
             continue;
         }
-        base = nn[0] * d[0] + nn[1] * d[1] + nn[2] * d[2];
-        const wb_real W = wv[p] + bc[0] * bc[0] * wv[v[0]] + bc[1] * bc[1] * wv[v[1]] + bc[2] * bc[2] * wv[v[2]];
+        const wb_real W = wv[pp] + bc[0] * bc[0] * wv[v[0]] + bc[1] * bc[1] * wv[v[1]] + bc[2] * bc[2] * wv[v[2]];
         if (!(W > 0)) continue;
         wb_real bp[3], qp[3];
-        const wb_real d0 = r - sqrt(wb__tri_closest(&xp[3 * p], &xp[3 * v[0]], &xp[3 * v[1]], &xp[3 * v[2]], bp, qp));
-        /* a point made inside the other body: a triangle's normal is no way out of it
-         * (tricontact.c), its projection's to part slowly */
+        const wb_real d0 = rr - sqrt(wb__tri_closest(&xp[3 * pp], &xp[3 * v[0]], &xp[3 * v[1]], &xp[3 * v[2]], bp, qp));
         if (d0 > step) continue;
-        const wb_real keep = 0;
         double *o = &td[10 * (size_t)nt];
-        for (int c3 = 0; c3 < 3; c3++) {
-            o[c3] = nn[c3];
-            o[6 + c3] = (double)x[3 * p + c3] - (double)xp[3 * p + c3];
-            for (int e = 0; e < 3; e++) o[6 + c3] -= bc[e] * ((double)x[3 * v[e] + c3] - (double)xp[3 * v[e] + c3]);
+        for (int k3 = 0; k3 < 3; k3++) {
+            o[k3] = nn[k3];
+            o[6 + k3] = (double)x[3 * pp + k3] - (double)xp[3 * pp + k3];
+            for (int e = 0; e < 3; e++) o[6 + k3] -= bc[e] * ((double)x[3 * v[e] + k3] - (double)xp[3 * v[e] + k3]);
         }
-        o[3] = base, o[4] = r - keep, o[5] = VBDC_K * inv_h2 / W;
-        o[9] = (cf[p] + bc[0] * cf[v[0]] + bc[1] * cf[v[1]] + bc[2] * cf[v[2]]) / 2;
-        vi[2 * (np2 + nt)] = a, vi[2 * (np2 + nt) + 1] = b;
+        o[3] = nn[0] * d[0] + nn[1] * d[1] + nn[2] * d[2], o[4] = rr, o[5] = VBDC_K * inv_h2 / W;
+        o[9] = (cf[pp] + bc[0] * cf[v[0]] + bc[1] * cf[v[1]] + bc[2] * cf[v[2]]) / 2;
+        const size_t e = (size_t)np2 + (size_t)nt;
+        vi[2 * e] = a, vi[2 * e + 1] = b;
+        offset(bs, a, &x[3 * pp], &cq[CQ * e + 7]);
+        offset(bs, b, q, &cq[CQ * e + 10]);
         nt++;
     }
-    memset(t, 0, sizeof *t * 3 * (size_t)nv);
+    const int32_t nc = np2 + nt;
+    memset(u, 0, sizeof *u * 6 * (size_t)nv);
     for (int32_t pass = 0; pass < steps; pass++) {
+        /* each body's inertia: M / h^2 for t, I / h^2 for th (its least axis kept from 0: a
+         * rope's own axis), the gradient of sum m |x - y + A u|^2 / 2 h^2 */
         for (int32_t b = 0; b < nv; b++) {
-            const double mh = mass[b] * inv_h2;
-            D[6 * b] = D[6 * b + 1] = D[6 * b + 2] = mh, D[6 * b + 3] = D[6 * b + 4] = D[6 * b + 5] = 0;
-            for (int k = 0; k < 3; k++) g[3 * b + k] = -mh * (mean[3 * b + k] + t[3 * b + k]);
+            const double *B = &bs[WB_VBDC_BS * b], mh = B[0] * inv_h2, *I = &B[10];
+            const double reg = 1e-6 * (I[0] + I[1] + I[2]) / 3 + 1e-30;
+            double *Db = &D[36 * b], Ith[3];
+            memset(Db, 0, sizeof *Db * 36);
+            Db[0] = Db[7] = Db[14] = mh;
+            const double Is[6] = { I[0] + reg, I[1] + reg, I[2] + reg, I[3], I[4], I[5] };
+            const int ix[3][3] = { { 0, 3, 4 }, { 3, 1, 5 }, { 4, 5, 2 } };
+            for (int i = 0; i < 3; i++)
+                for (int j = 0; j < 3; j++) Db[6 * (3 + i) + 3 + j] = Is[ix[i][j]] * inv_h2;
+            sym3_mul(Is, &u[6 * b + 3], Ith);
+            for (int k = 0; k < 3; k++) {
+                g[6 * b + k] = -mh * (B[1 + k] + u[6 * b + k]);
+                g[6 * b + 3 + k] = -(B[7 + k] + Ith[k]) * inv_h2;
+            }
         }
         for (int32_t q = 0; q < np2; q++) {
             const int32_t a = vi[2 * q], b = vi[2 * q + 1], i = c->pij[2 * q], j = c->pij[2 * q + 1];
-            hq[7 * q + 6] = -1;
+            double *o = &cq[CQ * q];
+            o[6] = -1;
             if (a < 0 && b < 0) continue;
-            double d[3];
-            for (int k = 0; k < 3; k++)
-                d[k] = ((double)x[3 * i + k] + (a >= 0 ? t[3 * a + k] : 0)) - ((double)x[3 * j + k] + (b >= 0 ? t[3 * b + k] : 0));
+            double da[3] = { 0, 0, 0 }, db[3] = { 0, 0, 0 }, d[3], us[3];
+            if (a >= 0) a_mul(o + 7, &u[6 * a], da);
+            if (b >= 0) a_mul(o + 10, &u[6 * b], db);
+            for (int k = 0; k < 3; k++) {
+                d[k] = ((double)x[3 * i + k] + da[k]) - ((double)x[3 * j + k] + db[k]);
+                us[k] = ((double)x[3 * i + k] - (double)xp[3 * i + k] + da[k]) - ((double)x[3 * j + k] - (double)xp[3 * j + k] + db[k]);
+            }
             const double l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), kk = c->kk[q];
             if (!(l > 1e-12)) continue;
             const double fn = (double)c->lamp[q] - kk * (l - (double)c->tgt[q]);
             if (!(fn > 0)) continue;
             const double n[3] = { d[0] / l, d[1] / l, d[2] / l };
-            double u[3];
-            for (int k = 0; k < 3; k++)
-                u[k] = ((double)x[3 * i + k] - (double)xp[3 * i + k] + (a >= 0 ? t[3 * a + k] : 0)) -
-                       ((double)x[3 * j + k] - (double)xp[3 * j + k] + (b >= 0 ? t[3 * b + k] : 0));
-            couple_add(a, b, n, fn, kk, c->mu[q], u, &hq[7 * q], D, g);
+            couple_add(a, b, n, fn, kk, c->mu[q], us, o, D, g);
         }
         for (int32_t q = 0; q < nt; q++) {
-            const int32_t a = vi[2 * (np2 + q)], b = vi[2 * (np2 + q) + 1];
-            const double *o = &td[10 * (size_t)q];
-            double *H = &hq[7 * ((size_t)np2 + (size_t)q)];
-            double gap = o[3];
-            for (int k = 0; k < 3; k++) gap += o[k] * ((a >= 0 ? t[3 * a + k] : 0) - (b >= 0 ? t[3 * b + k] : 0));
-            const double fn = -o[5] * (gap - o[4]);
-            H[6] = -1;
+            const size_t e = (size_t)np2 + (size_t)q;
+            const int32_t a = vi[2 * e], b = vi[2 * e + 1];
+            const double *t = &td[10 * (size_t)q];
+            double *o = &cq[CQ * e];
+            double da[3] = { 0, 0, 0 }, db[3] = { 0, 0, 0 }, us[3];
+            if (a >= 0) a_mul(o + 7, &u[6 * a], da);
+            if (b >= 0) a_mul(o + 10, &u[6 * b], db);
+            double gap = t[3];
+            for (int k = 0; k < 3; k++) gap += t[k] * (da[k] - db[k]), us[k] = t[6 + k] + da[k] - db[k];
+            const double fn = -t[5] * (gap - t[4]);
+            o[6] = -1;
             if (!(fn > 0)) continue;
-            double u[3];
-            for (int k = 0; k < 3; k++) u[k] = o[6 + k] + (a >= 0 ? t[3 * a + k] : 0) - (b >= 0 ? t[3 * b + k] : 0);
-            couple_add(a, b, o, fn, o[5], o[9], u, H, D, g);
+            couple_add(a, b, t, fn, t[5], t[9], us, o, D, g);
         }
-        /* the Newton step, A dt = g, by conjugate gradients with each body's block as the
+        /* the Newton step, A du = g, by conjugate gradients with each body's block as the
          * preconditioner (serial, in body order: the same bits on any thread count) */
         double rz = 0, gg = 0;
         for (int32_t b = 0; b < nv; b++) {
-            if (!solve_sym3(&D[6 * b], &g[3 * b], &z[3 * b])) return 0;
-            for (int k = 0; k < 3; k++) {
-                dt[3 * b + k] = 0, r[3 * b + k] = g[3 * b + k], p[3 * b + k] = z[3 * b + k];
-                rz += r[3 * b + k] * z[3 * b + k], gg += g[3 * b + k] * g[3 * b + k];
+            if (!chol6(&D[36 * b], &Lf[36 * b])) return 0;
+            chol6_solve(&Lf[36 * b], &g[6 * b], &z[6 * b]);
+            for (int k = 0; k < 6; k++) {
+                du[6 * b + k] = 0, r[6 * b + k] = g[6 * b + k], p[6 * b + k] = z[6 * b + k];
+                rz += r[6 * b + k] * z[6 * b + k], gg += g[6 * b + k] * g[6 * b + k];
             }
         }
-        for (int32_t it = 0; it < 3 * nv + 20 && rz > 0; it++) {
-            couple_mul(np2 + nt, vi, D, hq, nv, p, Ap);
+        for (int32_t it = 0; it < 6 * nv + 20 && rz > 0; it++) {
+            couple_mul(nc, vi, D, cq, nv, p, Ap);
             double pAp = 0;
-            for (int32_t k = 0; k < 3 * nv; k++) pAp += p[k] * Ap[k];
+            for (int32_t k = 0; k < 6 * nv; k++) pAp += p[k] * Ap[k];
             if (!(pAp > 0)) break;
             const double al = rz / pAp;
             double rr = 0;
-            for (int32_t k = 0; k < 3 * nv; k++) dt[k] += al * p[k], r[k] -= al * Ap[k], rr += r[k] * r[k];
+            for (int32_t k = 0; k < 6 * nv; k++) du[k] += al * p[k], r[k] -= al * Ap[k], rr += r[k] * r[k];
             if (!(rr > 1e-30 * gg)) break;
             double rz1 = 0;
             for (int32_t b = 0; b < nv; b++) {
-                solve_sym3(&D[6 * b], &r[3 * b], &z[3 * b]);
-                for (int k = 0; k < 3; k++) rz1 += r[3 * b + k] * z[3 * b + k];
+                chol6_solve(&Lf[36 * b], &r[6 * b], &z[6 * b]);
+                for (int k = 0; k < 6; k++) rz1 += r[6 * b + k] * z[6 * b + k];
             }
             const double be = rz1 / rz;
             rz = rz1;
-            for (int32_t k = 0; k < 3 * nv; k++) p[k] = z[k] + be * p[k];
+            for (int32_t k = 0; k < 6 * nv; k++) p[k] = z[k] + be * p[k];
         }
-        double d2 = 0, t2 = 0;
-        for (int32_t k = 0; k < 3 * nv; k++) {
-            t[k] += dt[k];
-            d2 += dt[k] * dt[k], t2 += t[k] * t[k];
+        double d2 = 0, u2 = 0;
+        for (int32_t k = 0; k < 6 * nv; k++) {
+            u[k] += du[k];
+            d2 += du[k] * du[k], u2 += u[k] * u[k];
         }
-        if (!(d2 > 1e-24 * t2)) break;
+        if (!(d2 > 1e-24 * u2)) break;
     }
     return 1;
 }

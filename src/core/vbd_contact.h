@@ -38,17 +38,16 @@ void wb__vbdc_dual(const wb_world *w, wb_vbdc *c);
 void wb__vbdc_refresh(const wb_world *w, wb_vbdc *c, int32_t ncolours);
 /* after the contacts' projection (contact.c): their reported forces take in the sweeps' */
 void wb__vbdc_readout(wb_world *w, const wb_vbdc *c);
-/* The nv bodies moved with their partners (bvar: a body's index among them, -1 none; mass,
- * mean: each one's mass and mean x - y after the sweeps) take the Newton steps (at most
- * steps) of the substep's energy along their translations with all their pairs and the
- * triangle contacts between them (h: the substep; *c made if need be); t (nv x 3)
- * gets each one's translation. 1 done, 0 singular (t not to be used), -1 out of memory */
-int wb__vbdc_couple(wb_world *w, wb_vbdc **c, const int32_t *bvar, int32_t nv, const double *mass, const double *mean,
-                    double *t, wb_real h, int32_t steps);
-/* particles p and q are of two groups contact.c moved apart whole in the last substep for
- * an overlap they were made with: their contacts are its to take out (pushed pair by pair,
- * blocks made interleaved flew apart at metres per second) */
-int wb__vbdc_made(const wb_world *w, int32_t p, int32_t q);
+/* The nv bodies moved with their partners (bvar: a body's index among them, -1 none; bs:
+ * WB_VBDC_BS doubles each, its mass, mean x - y, centre c, sum m r x (x - y) and
+ * inertia sum m (|r|^2 E - r r^T) (xx, yy, zz, xy, xz, yz), r = x - c, after the sweeps)
+ * take the Newton steps (at most steps) of the substep's energy along their translations
+ * t and small turns th about c with all their pairs and the triangle contacts between them
+ * (h: the substep; *c made if need be); u (nv x 6) gets each one's t and th. 1 done, 0
+ * singular (u not to be used), -1 out of memory */
+#define WB_VBDC_BS 16
+int wb__vbdc_couple(wb_world *w, wb_vbdc **c, const int32_t *bvar, int32_t nv, const double *bs, double *u, wb_real h,
+                    int32_t steps);
 /* (its charge given back) */
 void wb__vbdc_destroy(wb_world *w, wb_vbdc *c);
 

@@ -78,9 +78,12 @@ TEST(vbd_memory_charged_and_refused)
     }
 }
 
-/* two cloths falling onto each other on a floor: hundreds of candidate pairs, none of which VBD takes into
- * its vertex steps (no immovable end), so its contact scratch takes no memory: the world
- * charges as much as with contacts off (it held arrays for every candidate of the frame) */
+/* two cloths falling onto each other on a floor, joined at a corner by a link (one body: its
+ * contacts with itself): hundreds of candidate pairs, none of which VBD takes into its
+ * vertex steps or its bodies' moves (no immovable end, no other body), so its contact
+ * scratch takes no memory: the world charges as much as with contacts off (it held arrays
+ * for every candidate of the frame). Two free cloths would be two bodies moved together
+ * with the pairs between them */
 static wb_world *stacked(wb_memory *mem, bool contacts)
 {
     wb_world_def d = wb_world_default_def();
@@ -103,6 +106,9 @@ static wb_world *stacked(wb_memory *mem, bool contacts)
         wb_body b;
         if (wb_cloth(w, &c, &b) != WB_OK) { wb_world_destroy(w); return NULL; }
     }
+    const wb_distance_def link = wb_distance_default_def();
+    wb_distance_add(w, 0, 24 * 24, &link, &st);
+    if (st != WB_OK) { wb_world_destroy(w); return NULL; }
     return w;
 }
 
