@@ -84,7 +84,7 @@ struct wb_vbd {
     int32_t *bvar;         /* (bodies) its index among the free bodies that may touch another
                               body's movable particle, moved with them (wb__vbdc_couple); -1 */
     int32_t nvar;
-    double *vsum;          /* (nvar x (WB_VBDC_BS + 6)) their sums and moves (couple) */
+    double *vsum;          /* (nvar x (WB_VBDC_BS + 11)) their sums, moves and turns (couple) */
     wb_vbdc *ct;           /* the particle contacts in the vertex steps (vbd_contact.c) */
     int ct_on;             /* ct holds this substep's */
     size_t charged;        /* the struct's and its arrays' bytes charged to def.memory, but for
@@ -876,12 +876,12 @@ static int touching(wb_world *w, struct wb_vbd *v)
     if (!k->mc_built || k->mc_nbody == 0) return 0;
     const int32_t nb = k->mc_nbody, *body = k->mc_body;
     if (nb > v->cap_tsum) {
-        if (!wb__charge(w, &v->charged_t, (sizeof(double) * (25 + WB_VBDC_BS + 6) + sizeof(int32_t) + 1) * (size_t)nb)) {
+        if (!wb__charge(w, &v->charged_t, (sizeof(double) * (25 + WB_VBDC_BS + 11) + sizeof(int32_t) + 1) * (size_t)nb)) {
             v->nomem = 1;
             return 0;
         }
         double *t = realloc(v->tsum, sizeof *t * 8 * (size_t)nb), *e = realloc(v->csum, sizeof *e * 17 * (size_t)nb);
-        double *vs = realloc(v->vsum, sizeof *vs * (WB_VBDC_BS + 6) * (size_t)nb);
+        double *vs = realloc(v->vsum, sizeof *vs * (WB_VBDC_BS + 11) * (size_t)nb);
         uint8_t *bm = realloc(v->bmove, (size_t)nb);
         int32_t *bv = realloc(v->bvar, sizeof *bv * (size_t)nb);
         if (t) v->tsum = t;
@@ -1040,19 +1040,22 @@ static void couple(wb_world *w, struct wb_vbd *v, wb_real h)
      * a/2) so it keeps the body's shape; its momentum step done here (T[4 b] = 0:
      * keep_momentum moves it no more) */
     wb_real *xw = w->s.x;
+    double *R = u + 6 * (size_t)nv; /* (nv x 5) each turn's axis k, sin a, 1 - cos a */
+    for (int32_t q = 0; q < nv; q++) {
+        const double *th = &u[6 * q + 3], a = sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2]), h2 = sin(a / 2);
+        for (int c = 0; c < 3; c++) R[5 * q + c] = a > 0 ? th[c] / a : 0;
+        R[5 * q + 3] = sin(a), R[5 * q + 4] = 2 * h2 * h2;
+    }
     for (int32_t i = 0; i < w->m.np; i++) {
         const int32_t q = body[i] >= 0 ? v->bvar[body[i]] : -1;
         if (q < 0 || !(wv[i] > 0)) continue;
-        const double *B = &bs[WB_VBDC_BS * q], *t = &u[6 * q], *th = &u[6 * q + 3];
-        const double a = sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2]);
-        double r[3], kr[3], k[3] = { 0, 0, 0 };
+        const double *B = &bs[WB_VBDC_BS * q], *t = &u[6 * q], *k = &R[5 * q];
+        double r[3], kr[3];
         for (int c = 0; c < 3; c++) r[c] = (double)xw[3 * i + c] - B[4 + c];
-        if (a > 0)
-            for (int c = 0; c < 3; c++) k[c] = th[c] / a;
         kr[0] = k[1] * r[2] - k[2] * r[1], kr[1] = k[2] * r[0] - k[0] * r[2], kr[2] = k[0] * r[1] - k[1] * r[0];
         /* (the move, small, added once: one rounding a coordinate, the momentum's) */
-        const double sa = sin(a), h2 = sin(a / 2), vc = 2 * h2 * h2, kd = k[0] * r[0] + k[1] * r[1] + k[2] * r[2];
-        for (int c = 0; c < 3; c++) xw[3 * i + c] += (wb_real)(t[c] + (kr[c] * sa + (k[c] * kd - r[c]) * vc));
+        const double kd = k[0] * r[0] + k[1] * r[1] + k[2] * r[2];
+        for (int c = 0; c < 3; c++) xw[3 * i + c] += (wb_real)(t[c] + (kr[c] * k[3] + (k[c] * kd - r[c]) * k[4]));
     }
     for (int32_t b = 0; b < nb; b++)
         if (v->bvar[b] >= 0) T[4 * b] = 0;
@@ -1205,16 +1208,21 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     if (got < 0) v->nomem = 1;
     if (v->nomem) return -1; /* (the step undoes the frame) */
     wb_vbdc *ct = v->ct_on ? v->ct : NULL;
+    /* (the sweeps' copy with contacts only when some vertex has one: the pairs between
+     * bodies moved together are not in them) */
+    int32_t nvc = 0;
+    if (ct) wb__vbdc_vertices(ct, v->ncolours, &nvc);
+    wb_vbdc *cs = nvc > 0 ? ct : NULL;
     wb_pool *pool = wb__world_pool(w);
     for (int it = 0; it < w->m.def.iterations; it++) {
-        sweep_job j = { w, v, inv_h2, 1 / h, NULL, 0, ct };
-        if (ct && it > 0) wb__vbdc_refresh(w, ct, v->ncolours);
+        sweep_job j = { w, v, inv_h2, 1 / h, NULL, 0, cs };
+        if (cs && it > 0) wb__vbdc_refresh(w, cs, v->ncolours);
         for (int32_t c = 0; c < v->ncolours; c++) {
             const int32_t lo = v->colour_start[c], n = v->colour_start[c + 1] - lo;
             j.vert = v->order + lo;
             const int serial = v->serial_last && c == v->ncolours - 1;
-            wb__pool_for(serial ? NULL : pool, n, 1024, ct ? sweep_part_ct : sweep_part, &j);
-            if (ct) wb__vbdc_colour_done(w, ct, c);
+            wb__pool_for(serial ? NULL : pool, n, 1024, cs ? sweep_part_ct : sweep_part, &j);
+            if (cs) wb__vbdc_colour_done(w, cs, c);
         }
         v->residual = sqrt(j.step);
         const int last = it + 1 == w->m.def.iterations || (w->m.def.tolerance > 0 && v->residual <= w->m.def.tolerance);
