@@ -1,4 +1,4 @@
--- contacts_api.lua: the Lua side of particle-particle contacts (issue 8): groups, the
+-- contacts_api.lua: the Lua side of particle-particle contacts: groups, the
 -- builders' contact options, w:set_self_collide, wobble.world{contacts}, the default
 -- radius, errors that change nothing, and snapshots that keep it all exactly.
 

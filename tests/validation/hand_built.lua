@@ -1,7 +1,7 @@
 -- hand_built.lua: particle graphs built by hand (w:particle + w:distance, the reference
 -- thesis's workflow) with the defaults: radius 0.02, contacts on.
 --
--- The rule (DESIGN.md §2, "Rest neighbours never touch"): two particles joined by a
+-- The rule (docs/physics.md, "Rest neighbours never touch"): two particles joined by a
 -- constraint, or created closer than r_i + r_j (or in touch) in one graph, are never a
 -- contact pair. Loose particles joined by constraints are one graph, which collides with
 -- itself under that rule and with every other graph and body. So a graph whose spacing
