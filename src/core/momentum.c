@@ -16,9 +16,9 @@
  * is thrown out from under the press.
  *
  * So after the solve, each connected body that nothing outside the solve holds (no
- * immovable or pinned particle, no attachment, no grab) and that touches no particle and no
- * rigid body this frame gets the rigid rotation, about its centre of mass at x~, that takes
- * its angular momentum back to what it was:
+ * immovable or pinned particle, no attachment, no grab) and that touches no particle (in
+ * touch after the solve) and no rigid body gets the rigid rotation, about its centre of
+ * mass at x~, that takes its angular momentum back to what it was:
  * with r = x~ - c and d = x - x~, L = sum m r x d, I = sum m (|r|^2 E - r r^T),
  * w = I^-1 L and x -= w x r, so that sum m r x (d - w x r) = L - I w = 0, and
  * sum m w x r = 0 keeps the linear momentum. Pinned bodies are left alone: their pins
@@ -408,6 +408,10 @@ void wb__turn_rate(const double S[6], const double L[3], double om[3])
     if (!(isfinite(om[0]) && isfinite(om[1]) && isfinite(om[2]))) om[0] = om[1] = om[2] = 0;
 }
 
+/* in touch, for the turn: within this much of r_i + r_j (the contacts leave a resting pair
+ * at r_i + r_j to round-off) */
+#define TOUCH ((wb_real)(1 + 1e-6))
+
 /* after the solve of a substep of length h: each free body's angular momentum back to
  * what it was before the solve (see the top of the file) */
 void wb__momentum_restore(wb_world *w, wb_real h)
@@ -420,17 +424,26 @@ void wb__momentum_restore(wb_world *w, wb_real h)
     double *acc = k->mc_acc;
     for (int32_t b = 0; b < k->mc_nbody; b++)
         if (acc[ACC * b] >= 0) memset(&acc[ACC * b], 0, ACC * sizeof(double));
-    /* a body whose particles may touch particles (its own folds, another body: this frame's
-     * contact candidates) is left as the solve leaves it: the contacts' friction holds its
-     * parts against each other, and a rigid turn of the whole would slip at every contact,
-     * which friction then takes back as a twist of the body (a self-colliding cloth heap,
-     * turned so, never comes to rest). So is one touching a rigid body. */
+    /* a body whose particles touch particles (its own folds, another body: the contact
+     * candidates in touch after the solve, to TOUCH) is left as the solve leaves it: the
+     * contacts' friction holds its parts against each other, and a rigid turn of the whole
+     * would slip at every contact, which friction then takes back as a twist of the body
+     * (a self-colliding cloth heap, turned so, never comes to rest). So is one touching a
+     * rigid body. A candidate merely near changes nothing: a body moves as it would
+     * without contacts, to the bit (a hand-built graph's promise) */
     const wb_contacts *pc = k->pc;
-    for (int32_t c = 0; c < pc->n; c++)
+    const wb_real *rad = w->m.radius;
+    for (int32_t c = 0; c < pc->n; c++) {
+        const int32_t i = pc->ij[2 * c], j = pc->ij[2 * c + 1];
+        if ((body[i] < 0 || acc[ACC * body[i]] < 0) && (body[j] < 0 || acc[ACC * body[j]] < 0)) continue;
+        const wb_real d0 = x[3 * j] - x[3 * i], d1 = x[3 * j + 1] - x[3 * i + 1], d2 = x[3 * j + 2] - x[3 * i + 2];
+        const wb_real r = (rad[i] + rad[j]) * TOUCH;
+        if (!(d0 * d0 + d1 * d1 + d2 * d2 < r * r)) continue;
         for (int e = 0; e < 2; e++) {
             const int32_t b = body[pc->ij[2 * c + e]];
             if (b >= 0 && acc[ACC * b] >= 0) acc[ACC * b] = -2;
         }
+    }
     const wb_tricontacts *tc = k->tc;
     for (int32_t c = 0; c < tc->n; c++) {
         const int32_t t = tc->pt[2 * c + 1], pts[4] = { tc->pt[2 * c], w->m.tri[3 * t], w->m.tri[3 * t + 1], w->m.tri[3 * t + 2] };
