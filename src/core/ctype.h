@@ -46,6 +46,10 @@ typedef struct wb_ctype {
      * link joins no body but its ends stay rest neighbours; a tether joins none). May be
      * NULL: none */
     void (*joins)(const wb_world *w, wb_link_fn fn, void *ud);
+    /* the particles its constraints hold to something outside the particles (a collider, a
+     * rigid body, a grab's target), each through fn(ud, p, p): momentum.c's body with one is
+     * not free. May be NULL: none */
+    void (*anchors)(const wb_world *w, wb_link_fn fn, void *ud);
 
     /* the world's teardown: free the type's arrays (the world is freed after) */
     void (*destroy)(wb_world *w);

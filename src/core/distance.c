@@ -300,8 +300,9 @@ static int mark_backed(wb_world *w)
     if (nv + nt == 0 || ds->ns == 0) return 1;
     uint8_t *on = calloc((size_t)(np > 0 ? np : 1), 1);
     if (!on) return 0;
-    for (int64_t i = 0; i < 4 * (int64_t)nv; i++) on[w->vol->ijkl[i]] = 1;
-    for (int64_t i = 0; i < 4 * (int64_t)nt; i++) on[w->neo->ijkl[i]] = 1;
+    const int32_t *vq = wb__volume_corners(w), *tq = wb__tet_corners(w);
+    for (int64_t i = 0; i < 4 * (int64_t)nv; i++) on[vq[i]] = 1;
+    for (int64_t i = 0; i < 4 * (int64_t)nt; i++) on[tq[i]] = 1;
     for (int32_t i = 0; i < ds->ns; i++) ds->s_backed[i] = on[ds->s_a[i]] & on[ds->s_b[i]];
     free(on);
     return 1;

@@ -1030,6 +1030,8 @@ static const wb_vbd_type tet_vbd_hooks = {
     .vertex = tvbd_vertex,
 };
 
+const int32_t *wb__tet_corners(const wb_world *w) { return w->neo ? w->neo->ijkl : NULL; }
+
 const wb_ctype wb__tet_type = {
     .name = "tet",
     .count = tet_count,
