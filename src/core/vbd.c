@@ -108,7 +108,10 @@ static struct wb_vbd *make(wb_world *w)
     w->vbd = v;
     v->np = -1;
     for (int t = 0; t < wb__vbd_nctypes; t++)
-        if (!(v->part[t] = wb__vbd_ctypes[t]->vbd->make())) return NULL; /* (freed with the world) */
+        if (!(v->part[t] = wb__vbd_ctypes[t]->vbd->make())) {
+            wb__vbd_destroy(w);
+            return NULL;
+        }
     return v;
 }
 
