@@ -36,9 +36,8 @@
 #include <stdlib.h>
 
 #include "ctype.h"
-#include "attach.h"
-#include "grab.h"
 #include "pressure.h"
+#include "rigid.h"
 #include "shape_match.h"
 #include "contact.h"
 #include "tricontact.h"
@@ -93,9 +92,9 @@ static void signature(const wb_world *w, int64_t sig[8])
     sig[2] = wb_volume_count(w);
     sig[3] = wb_tet_count(w);
     sig[4] = wb_shape_match_count(w);
-    sig[5] = w->sm ? w->sm->nids : 0;
+    sig[5] = wb__shape_match_members(w);
     sig[6] = wb_pressure_count(w);
-    sig[7] = w->pr ? w->pr->nverts : 0;
+    sig[7] = wb__pressure_vertices(w);
 }
 
 static int build(wb_world *w)
@@ -153,6 +152,14 @@ static int build(wb_world *w)
     return 1;
 }
 
+/* an anchors hook's particle (ud: the world's cache): its body is held */
+static void held(void *ud, int32_t p, int32_t q, int joined)
+{
+    (void)q, (void)joined;
+    wb_cache *k = ud;
+    if (k->mc_body[p] >= 0) k->mc_acc[ACC * k->mc_body[p]] = -1;
+}
+
 /* once per step, before the types' prepare (which clears m.topology_dirty): the bodies
  * when the topology changed, then which of them something outside the solve holds
  * (their acc[0] set to -1). 0 when out of memory (then nothing is restored this step) */
@@ -178,12 +185,8 @@ int wb__momentum_prepare(wb_world *w)
         k->mc_wgen = w->m.w_gen;
     }
     for (int32_t b = 0; b < k->mc_nbody; b++) acc[ACC * b] = k->mc_pinned[b] ? -1 : 0;
-    const wb_attaches *a = w->att;
-    for (int32_t s = 0; a && s < a->n; s++)
-        if ((a->gen[s] & 1u) && body[a->p[s]] >= 0) acc[ACC * body[a->p[s]]] = -1;
-    const wb_grabs *g = w->grab;
-    for (int32_t s = 0; g && s < g->n; s++)
-        if ((g->gen[s] & 1u) && g->kind[s] == WB_GRAB_PARTICLE && body[g->p[s]] >= 0) acc[ACC * body[g->p[s]]] = -1;
+    for (int t = 0; t < wb__nctypes; t++)
+        if (wb__ctypes[t]->anchors) wb__ctypes[t]->anchors(w, held, k);
     k->mc_free = 0;
     for (int32_t b = 0; b < k->mc_nbody; b++) k->mc_free += acc[ACC * b] == 0;
     return 1;
