@@ -1,5 +1,5 @@
 -- box_on_jelly.lua: a rigid box dropped on a block of jelly (two-way particle-rigid
--- contacts, issue 10): the box sinks into the jelly, which bulges (its tetrahedra keep
+-- contacts): the box sinks into the jelly, which bulges (its tetrahedra keep
 -- their volume) and pushes back until it holds the box, wobbling, above the ground. The
 -- box's weight goes into the jelly through the contacts, and the jelly's push into the
 -- box: a heavier box (--set mass=20) sinks deeper.

@@ -1,5 +1,5 @@
 -- cloth_heap.lua: a cloth dropped onto the floor folds into a heap on itself without
--- passing through (self-collision, issue 8). A 0.8 x 2 m sheet hangs straight down, its
+-- passing through (self-collision). A 0.8 x 2 m sheet hangs straight down, its
 -- lower edge just above the floor, rippled and swirling a little; let go, its lower part
 -- buckles on the floor and the rest falls onto it in folds. It is one body built with
 -- self_collide = true: its particles collide with each other except for the rest

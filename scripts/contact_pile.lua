@@ -1,5 +1,5 @@
 -- contact_pile.lua: twelve soft balls dropped into a box pile up instead of merging
--- (particle-particle contacts, issue 8). Each ball is a hollow icosphere (42 particles,
+-- (particle-particle contacts). Each ball is a hollow icosphere (42 particles,
 -- built here with wobble.mesh, subdivided once) turned into a body by w:from_mesh, with
 -- links to each particle's nearest neighbours across the inside so the shell keeps its
 -- shape; every ball is a contact group of its own, so balls push each other while a

@@ -1,5 +1,5 @@
 -- contact_stack.lua: three soft blocks dropped onto each other come to rest as a stack
--- (particle-particle contacts, issue 8): each block is a body of its own (its own
+-- (particle-particle contacts): each block is a body of its own (its own
 -- contact group), so they push instead of passing through. A particle's contact radius
 -- is half its body's spacing by default; the renderer draws each block's hull out by that
 -- radius, so the blocks are seen touching. Friction between the blocks keeps the stack from

@@ -2,7 +2,7 @@
 -- of several soft pieces, read from a JSON particle config (assets/logo.json: six letters
 -- of voxels, "WOBBLE", each its own part), crushed by a rigid box the script moves down,
 -- holds, and lifts again. The letters squash, bulge sideways into their neighbours and
--- push them (particle-particle contacts, issue 8: each letter is a contact group of its
+-- push them (particle-particle contacts: each letter is a contact group of its
 -- own) instead of flowing into them as in the thesis, then spring back. The file's
 -- particles have a radius of 10 mm, made for drawing; here they get half the voxel
 -- size (35 of 80 mm), so a particle can neither reach another letter's particles nor

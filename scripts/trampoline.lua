@@ -1,5 +1,5 @@
 -- trampoline.lua: boxes and a ball dropped on a cloth trampoline (two-way particle-rigid
--- contacts, issue 10). The sheet is pinned along its rim; the bodies land, stretch it,
+-- contacts). The sheet is pinned along its rim; the bodies land, stretch it,
 -- are thrown back up by it and settle on it, a dip under each. The cloth's particles push
 -- the bodies and the bodies push the cloth: with the sheet's collision off (--set collide=0,
 -- `collide = false` on the cloth) they fall through to the floor.

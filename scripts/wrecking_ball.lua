@@ -1,5 +1,5 @@
 -- wrecking_ball.lua: a rigid ball on a rope swings down and knocks over a tower of soft
--- blocks (issue 10: attachments to rigid bodies and two-way particle-rigid contacts). The
+-- blocks (attachments to rigid bodies and two-way particle-rigid contacts). The
 -- rope hangs from a pin; its last particle is attached to the ball (w:attach(p, ball)), so
 -- the rope pulls the ball round and the ball drags the rope; the ball hits the tower at
 -- the bottom of its swing and the blocks fly, each pushed by the ball and by the blocks

@@ -512,6 +512,14 @@ static void att_stats(const wb_world *w, wb_stats *st)
     st->attachments = wb_attach_count(w);
 }
 
+/* every live attachment holds its particle (its target gone or not: prepare retires it) */
+static void attach_anchors(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    const wb_attaches *a = w->att;
+    for (int32_t s = 0; a && s < a->n; s++)
+        if (a->gen[s] & 1u) fn(ud, a->p[s], a->p[s], 1);
+}
+
 const wb_ctype wb__attach_type = {
     .name = "attach",
     .count = att_count,
@@ -529,4 +537,5 @@ const wb_ctype wb__attach_type = {
     .image_reserve = att_image_reserve,
     .image_put = att_image_put,
     .residual = att_residual,
+    .anchors = attach_anchors,
 };

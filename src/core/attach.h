@@ -62,6 +62,10 @@ static inline int wb__attach_active(const wb_world *w, const wb_attaches *a, int
     return t >= 0 && t < w->m.nc && w->m.c_gen[t] == a->tgen[s];
 }
 
+/* the skip table below when a particle is attached (NULL: none; collide.c and
+ * rigid_particle.c, whose contacts with what a particle is attached to are skipped) */
+static inline const wb_attaches *wb__attach_skips(const wb_world *w) { return w->att && w->att->skip_np > 0 ? w->att : NULL; }
+
 /* collide.c: is particle i attached to collider slot c (no contact between them)? The
  * table holds collider slots c >= 0 and rigid bodies r as -1 - r */
 static inline int wb__attach_skip(const wb_attaches *a, int32_t i, int32_t c)

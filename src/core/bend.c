@@ -22,6 +22,7 @@
 #include "bend.h"
 #include "ctype.h"
 #include "snapshot.h"
+#include "vbd.h"
 
 #define PI_R ((wb_real)3.14159265358979323846)
 
@@ -79,9 +80,9 @@ static wb_real wrap(wb_real d)
     return d;
 }
 
-int wb__bend_off(const wb_world *w, int32_t b, wb_real *off, wb_real g[4][3]) { return wb__bend_off_at(w, w->s.x, b, off, g); }
-
-int wb__bend_off_at(const wb_world *w, const wb_real *x, int32_t b, wb_real *off, wb_real g[4][3])
+/* bend b's angle off its rest (the short way round) and its gradient on its four corners,
+ * at the positions x (np x 3) (the VBD energies); 0 when degenerate */
+static int bend_off_at(const wb_world *w, const wb_real *x, int32_t b, wb_real *off, wb_real g[4][3])
 {
     const int32_t *p = &w->bend->ij[4 * b];
     wb_real th;
@@ -89,6 +90,8 @@ int wb__bend_off_at(const wb_world *w, const wb_real *x, int32_t b, wb_real *off
     *off = wrap(th - w->bend->rest[b]);
     return 1;
 }
+
+static int bend_off(const wb_world *w, int32_t b, wb_real *off, wb_real g[4][3]) { return bend_off_at(w, w->s.x, b, off, g); }
 
 /* ---- memory --------------------------------------------------------------------------------- */
 static int charge(wb_world *w, int32_t cap) { return wb__charge(w, &w->bend->charged, (size_t)cap * BEND_BYTES); }
@@ -807,6 +810,257 @@ static void bend_stats(const wb_world *w, wb_stats *st)
     st->bends = wb_bend_count(w);
 }
 
+/* ---- the VBD solver's part (vbd.h) --------------------------------------------------------- */
+/* A hard bend is held as a hard link (distance.c): its multiplier carried whole from
+ * substep to substep, WB_VBD_STAB of its error kept, with its penalty VBD_BEND_K times the
+ * inertia of its angle (bend_start_penalty; rad, not m: the gradient of a 5 cm wing is
+ * 20 /m). That is the stiffness the bend has until its multiplier catches up: a clamped
+ * strip with rigid bends droops 0.55 m at 8, 12 mm at 512 and 1.4 mm at 4096 (10 x 1)
+ * before it straightens (512: what the suite ran with) */
+#define VBD_BEND_K ((wb_real)512)
+/* a bend keeps WB_VBD_STAB of its error per this much time (the default substep), a link
+ * per substep: per time, a rope of rigid links at 40 x 4 stretched 3.7% (3% allowed), the
+ * catenary at 40 x 1 read its tension 3.4% off and a hand-built cloth fell through its
+ * sphere (user/01-03); the clamped strip at 40 x 1 held its droop better (0.2873 m at
+ * frame 2400 against 0.2825, converged 0.2881) */
+#define VBD_STAB_T ((wb_real)1 / 600)
+
+/* the bends' part of the VBD solver's cache */
+typedef struct bend_vbd {
+    int32_t nb;            /* the bends it was built for */
+    wb_vbd_quads at;       /* the bends at each vertex, as 4 bend + corner */
+    wb_real *blam, *bkpen; /* (cap, by slot) a hard bend's multiplier and penalty */
+    wb_real *btg, *bc0;    /* (cap) a hard bend's target (the error it keeps this substep) and
+                              its error as the last sweep left it (NaN: not known) */
+    int32_t cap;
+    wb_real *save;         /* (2 cap + 1) blam and bc0 at the step's start (an undone frame) */
+    size_t charged;        /* its bytes charged to def.memory */
+} bend_vbd;
+
+static void *bvbd_make(void) { return calloc(1, sizeof(bend_vbd)); }
+
+static void bvbd_free(wb_world *w, void *part)
+{
+    bend_vbd *v = part;
+    wb__vbd_quads_free(&v->at);
+    free(v->blam), free(v->bkpen), free(v->btg), free(v->bc0), free(v->save);
+    wb__charge(w, &v->charged, 0);
+    free(v);
+}
+
+static int32_t bvbd_slots(const wb_world *w) { return wb_bend_count(w); }
+
+static int bvbd_build(wb_world *w, void *part)
+{
+    bend_vbd *v = part;
+    const int32_t nb = wb_bend_count(w), cap = nb > v->cap ? nb : v->cap;
+    const size_t bytes = sizeof *v + wb__vbd_quads_bytes(w->m.np, nb) + (size_t)cap * 4 * sizeof(wb_real) +
+                         (2 * (size_t)cap + 1) * sizeof(wb_real);
+    if (!wb__charge(w, &v->charged, bytes) || !wb__vbd_quads_build(&v->at, w->m.np, w->bend ? w->bend->ij : NULL, nb))
+        return 0;
+    if (cap > v->cap) {
+        const size_t n = (size_t)cap;
+        wb_real *bl = realloc(v->blam, sizeof *bl * n), *bk = realloc(v->bkpen, sizeof *bk * n);
+        if (bl) v->blam = bl;
+        if (bk) v->bkpen = bk;
+        wb_real *bt = realloc(v->btg, sizeof *bt * n), *bc = realloc(v->bc0, sizeof *bc * n);
+        if (bt) v->btg = bt;
+        if (bc) v->bc0 = bc;
+        if (!bl || !bk || !bt || !bc) return 0;
+        memset(v->blam + v->cap, 0, sizeof *bl * (n - (size_t)v->cap));
+        memset(v->bkpen + v->cap, 0, sizeof *bk * (n - (size_t)v->cap));
+        for (int32_t b = v->cap; b < cap; b++) v->btg[b] = 0, v->bc0[b] = (wb_real)NAN;
+    }
+    wb_real *sv = realloc(v->save, sizeof *sv * (2 * (size_t)cap + 1));
+    if (!sv) return 0;
+    v->save = sv;
+    v->cap = cap;
+    v->nb = nb;
+    return 1;
+}
+
+static uint64_t bvbd_neighbours(const wb_world *w, const void *part, int32_t i, const uint8_t *col)
+{
+    return wb__vbd_quads_colours(&((const bend_vbd *)part)->at, w->bend ? w->bend->ij : NULL, i, col);
+}
+
+static int bvbd_holds(const void *part, int32_t i) { return wb__vbd_quads_hold(&((const bend_vbd *)part)->at, i); }
+
+/* a bend's energy off^2 / (2 alpha) on corner k: Gauss-Newton, k g g^T; a rigid one (alpha
+ * 0) through the augmented Lagrangian, k (off - t)^2 / 2 + lambda (off - t), as a hard link
+ * (t: the error it keeps this substep).
+ * Its damping beta (N m s) on the angle's speed over the substep, as XPBD's */
+static void bend_block(const wb_world *w, const bend_vbd *v, int32_t q, wb_real inv_h, wb_real f[3], wb_real H[6])
+{
+    const int32_t b = q / 4, k = q % 4;
+    if (w->bend->broken[b]) return;
+    wb_real off, g[4][3];
+    if (!bend_off(w, b, &off, g)) return;
+    const wb_real a = w->bend->alpha[b], *gk = g[k];
+    wb_real kb = a > 0 ? 1 / a : v->bkpen[b], fm = a > 0 ? kb * off : kb * (off - v->btg[b]) + v->blam[b];
+    const wb_real beta = w->bend->beta[b];
+    if (a > 0 && beta > 0) {
+        const int32_t *p = &w->bend->ij[4 * b];
+        wb_real rel = 0;
+        for (int c = 0; c < 4; c++) {
+            wb_real u[3];
+            v3_sub(u, &w->s.x[3 * p[c]], &w->s.x_prev[3 * p[c]]);
+            rel += v3_dot(g[c], u);
+        }
+        fm += beta * rel * inv_h;
+        kb += beta * inv_h;
+    }
+    v3_madd(f, gk, -fm);
+    H[0] += kb * gk[0] * gk[0], H[1] += kb * gk[1] * gk[1], H[2] += kb * gk[2] * gk[2];
+    H[3] += kb * gk[0] * gk[1], H[4] += kb * gk[0] * gk[2], H[5] += kb * gk[1] * gk[2];
+}
+
+/* a hard bend's penalty: the inertia of its angle, 1 / (h^2 w sum |g|^2), with w its
+ * lightest movable corner's inverse mass over all four corners. Over the movable corners
+ * alone (sum w |g|^2) it grew without bound where they barely turn the angle (a row of
+ * pins along a cloth's edge: a hinge corner's gradient near 0), and the multiplier with it:
+ * a 9 x 9 cloth hung by an edge blew up in 5 frames */
+static wb_real bend_start_penalty(const wb_world *w, int32_t b, const wb_real g[4][3], wb_real inv_h2)
+{
+    const int32_t *p = &w->bend->ij[4 * b];
+    wb_real wm = 0, gg = 0;
+    for (int c = 0; c < 4; c++) {
+        wm = w->m.w[p[c]] > wm ? w->m.w[p[c]] : wm;
+        gg += v3_dot(g[c], g[c]);
+    }
+    return wm * gg > 0 ? inv_h2 / (wm * gg) : 0;
+}
+
+static int hard_bend(const wb_world *w, int32_t b) { return !w->bend->broken[b] && !(w->bend->alpha[b] > 0); }
+
+/* each hard bend's penalty and the error it keeps this substep, as the hard links' (distance.c):
+ * measured where the substep starts (x_prev), not at the sweeps' start: kept from the
+ * prediction, a bend took its swing in as error and the multiplier fed it back (the strip
+ * with rigid bends blew up within 5 s at any penalty). It keeps WB_VBD_STAB of it per
+ * VBD_STAB_T of time, not per substep: the multiplier integrates what is not kept, and at
+ * 0.999 a substep the strip at 40 x 1 (the rate 4 times the default's, 2.4 /s against
+ * its drag of 2 /s) swung up to 0.6 m in 50 s; so it held within 1.3 mm */
+static void bvbd_begin(wb_world *w, void *part, wb_real h)
+{
+    bend_vbd *v = part;
+    const wb_real inv_h2 = 1 / (h * h), keep = pow(WB_VBD_STAB, h / VBD_STAB_T);
+    for (int32_t b = 0; b < wb_bend_count(w); b++) {
+        wb_real off, g[4][3];
+        if (!hard_bend(w, b)) continue;
+        if (!bend_off_at(w, w->s.x_prev, b, &off, g)) { /* degenerate: no penalty this substep */
+            v->bkpen[b] = v->btg[b] = 0;
+            continue;
+        }
+        v->bkpen[b] = VBD_BEND_K * bend_start_penalty(w, b, g, inv_h2);
+        const wb_real ce = v->bc0[b];
+        const wb_real c0 = !isfinite(ce) ? 0 : off * ce <= 0 ? 0 : fabs(off) < fabs(ce) ? off : ce;
+        v->btg[b] = keep * c0;
+    }
+}
+
+/* a hard bend's multiplier after each sweep, as a hard link's after the last (distance.c); its torque (what force() and
+ * break_torque read, XPBD's multiplier lambda = -torque h^2) is the multiplier */
+static void bvbd_dual(wb_world *w, void *part, wb_real h, int last)
+{
+    (void)last;
+    bend_vbd *v = part;
+    wb_bends *bs = w->bend;
+    for (int32_t b = 0; b < wb_bend_count(w); b++) {
+        wb_real off, g[4][3];
+        if (!hard_bend(w, b) || !bend_off(w, b, &off, g)) continue;
+        v->blam[b] += v->bkpen[b] * (off - v->btg[b]);
+        v->bc0[b] = off;
+        if (!bs->dirty) bs->lambda[bs->pack[b]] = -v->blam[b] * h * h;
+    }
+}
+
+static void bvbd_vertex(const wb_world *w, const void *part, int32_t i, wb_real inv_h, wb_real f[3], wb_real H[6])
+{
+    const bend_vbd *v = part;
+    for (int32_t e = v->at.start[i]; e < v->at.start[i + 1]; e++) bend_block(w, v, v->at.adj[e], inv_h, f, H);
+}
+
+/* what force() and break_torque read of a soft bend, off / alpha (a hard one's:
+ * bvbd_dual) */
+static void bvbd_end(wb_world *w, void *part, wb_real h)
+{
+    (void)part;
+    wb_bends *bs = w->bend;
+    if (!bs || bs->dirty) return;
+    const wb_real h2 = h * h;
+    for (int32_t b = 0; b < bs->n; b++) {
+        wb_real off, g[4][3];
+        if (bs->broken[b] || !(bs->alpha[b] > 0)) continue;
+        bs->lambda[bs->pack[b]] = bend_off(w, b, &off, g) ? -off / bs->alpha[b] * h2 : 0;
+    }
+}
+
+static void bvbd_save(void *part)
+{
+    bend_vbd *v = part;
+    wb__vbd_keep(v->save, v->blam, v->bc0, v->cap, 0);
+}
+
+static void bvbd_undo(void *part)
+{
+    bend_vbd *v = part;
+    wb__vbd_keep(v->save, v->blam, v->bc0, v->cap, 1);
+}
+
+static wb_status bvbd_image_save(const wb_world *w, const void *part, wb_image *g, int stale)
+{
+    (void)stale;
+    const bend_vbd *v = part;
+    const int32_t nb = wb_bend_count(w);
+    if (nb == 0) return WB_OK;
+    g->vbd_blam = malloc(sizeof(wb_real) * (size_t)nb), g->vbd_bc0 = malloc(sizeof(wb_real) * (size_t)nb);
+    if (!g->vbd_blam || !g->vbd_bc0) return WB_ERR_NOMEM;
+    g->vbd_nb = nb;
+    for (int32_t b = 0; b < nb; b++) {
+        g->vbd_blam[b] = b < v->cap ? v->blam[b] : 0;
+        g->vbd_bc0[b] = b < v->cap ? v->bc0[b] : (wb_real)NAN;
+    }
+    return WB_OK;
+}
+
+static const char *bvbd_image_check(const wb_image *g)
+{
+    return wb__vbd_half_check(g->vbd_nb, g->bend.n, g->vbd_blam, g->vbd_bc0, "VBD bend multipliers: one per bend");
+}
+
+static wb_status bvbd_image_put(void *part, const wb_image *g)
+{
+    bend_vbd *v = part;
+    const size_t nb = (size_t)(g->vbd_nb > 0 ? g->vbd_nb : 1);
+    v->blam = malloc(sizeof *v->blam * nb), v->bkpen = calloc(nb, sizeof *v->bkpen);
+    v->btg = calloc(nb, sizeof *v->btg), v->bc0 = malloc(sizeof *v->bc0 * nb);
+    if (!v->blam || !v->bkpen || !v->btg || !v->bc0) return WB_ERR_NOMEM;
+    if (g->vbd_nb) {
+        memcpy(v->blam, g->vbd_blam, sizeof *v->blam * (size_t)g->vbd_nb);
+        memcpy(v->bc0, g->vbd_bc0, sizeof *v->bc0 * (size_t)g->vbd_nb);
+    }
+    v->cap = g->vbd_nb;
+    return WB_OK;
+}
+
+static const wb_vbd_type bend_vbd_hooks = {
+    .make = bvbd_make,
+    .free = bvbd_free,
+    .slots = bvbd_slots,
+    .build = bvbd_build,
+    .neighbours = bvbd_neighbours,
+    .holds = bvbd_holds,
+    .vertex = bvbd_vertex,
+    .begin = bvbd_begin,
+    .dual = bvbd_dual,
+    .end = bvbd_end,
+    .save = bvbd_save,
+    .undo = bvbd_undo,
+    .image_save = bvbd_image_save,
+    .image_check = bvbd_image_check,
+    .image_put = bvbd_image_put,
+};
+
 const wb_ctype wb__bend_type = {
     .name = "bend",
     .count = bend_count,
@@ -827,6 +1081,7 @@ const wb_ctype wb__bend_type = {
     .image_reserve = bend_image_reserve,
     .image_put = bend_image_put,
     .residual = bend_residual,
+    .vbd = &bend_vbd_hooks,
 };
 
 /* ---- hinges of a triangle list ----------------------------------------------------------------- */

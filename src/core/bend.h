@@ -56,10 +56,4 @@ wb_real wb__bend_angle_of(const wb_real *x, const int32_t *p, int *ok);
  * hinges p1 p2 p3 p4 into out (room for 3 ntri / 2 x 4), in edge order; -1 when out of memory */
 int32_t wb__bend_hinges(const int32_t *tri, int32_t ntri, int32_t *out);
 
-/* bend b's angle off its rest (the short way round) and its gradient on its four corners
- * (vbd.c's energies); 0 when degenerate */
-int wb__bend_off(const wb_world *w, int32_t b, wb_real *off, wb_real g[4][3]);
-/* the same at the positions x (np x 3) */
-int wb__bend_off_at(const wb_world *w, const wb_real *x, int32_t b, wb_real *off, wb_real g[4][3]);
-
 #endif

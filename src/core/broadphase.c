@@ -948,6 +948,125 @@ static void add_link(void *ud, int32_t a, int32_t b, int joined)
     }
 }
 
+/* Rest neighbours along a hand-built graph. Two loose particles of one graph that were
+ * made less than ALONG (r_i + r_j) apart, and are joined by a path along its constraints
+ * (the sum of its links' lengths where they were made) shorter than sqrt 2 ALONG
+ * (r_i + r_j), never touch either: a fold takes about pi r of the body to bring two layers
+ * 2r apart (ALONG = pi / 2), so such a pair only meets by the graph shearing or bunching,
+ * not by folding onto itself. The path bounds how far along the body they are: up to
+ * sqrt 2 longer than the straight line over a square net, while a pair made close across
+ * a fold (a coiled rope) has a far longer one. Without it a net 1.57 cm apart with the
+ * default radius 0.02 m touched its neighbours two cells off the diagonal (made 4.45 cm
+ * apart) where it sheared near a pin, 6 frames after it was let go. Each search stops
+ * after ALONG_MOST particles (a radius many times the spacing): past that only the
+ * created-closer rule holds. Keys of the pairs, added to u's; 0 when out of memory */
+#define ALONG 1.5707963267948966 /* pi / 2 */
+#define ALONG_PATH 1.4142135623730951 /* sqrt 2 */
+#define ALONG_MOST 256
+
+typedef struct along_item { wb_real d; int32_t j; } along_item;
+
+static void along_push(along_item *h, int32_t *n, along_item e)
+{
+    int32_t k = (*n)++;
+    while (k > 0) {
+        const int32_t up = (k - 1) / 2;
+        if (h[up].d < e.d || (h[up].d == e.d && h[up].j <= e.j)) break;
+        h[k] = h[up];
+        k = up;
+    }
+    h[k] = e;
+}
+
+static along_item along_pop(along_item *h, int32_t *n)
+{
+    const along_item top = h[0], e = h[--*n];
+    int32_t k = 0;
+    for (;;) {
+        int32_t c = 2 * k + 1;
+        if (c >= *n) break;
+        if (c + 1 < *n && (h[c + 1].d < h[c].d || (h[c + 1].d == h[c].d && h[c + 1].j < h[c].j))) c++;
+        if (e.d < h[c].d || (e.d == h[c].d && e.j <= h[c].j)) break;
+        h[k] = h[c];
+        k = c;
+    }
+    if (*n > 0) h[k] = e;
+    return top;
+}
+
+static int add_along(links_ud *u, int32_t nlinks)
+{
+    wb_contacts *c = u->c;
+    const wb_model *m = u->m;
+    const int32_t np = m->np;
+    wb_real rmax = 0;
+    for (int32_t i = 0; i < np; i++)
+        if (m->group[i] == 0 && m->radius[i] > rmax) rmax = m->radius[i];
+    if (!(rmax > 0) || nlinks == 0) return 1;
+    /* the loose particles' links as rows (each both ways) */
+    int32_t *row = calloc((size_t)np + 1, sizeof *row), *to = malloc(sizeof *to * 2 * (size_t)nlinks);
+    wb_real *len = malloc(sizeof *len * 2 * (size_t)nlinks), *dist = malloc(sizeof *dist * (size_t)np);
+    int32_t *seen = malloc(sizeof *seen * (size_t)np);
+    along_item *heap = malloc(sizeof *heap * (4 * (size_t)ALONG_MOST + 2 * (size_t)nlinks));
+    int ok = row && to && len && dist && seen && heap;
+    for (int32_t k = 0; ok && k < nlinks; k++) {
+        const int32_t a = (int32_t)(c->keys[k] >> 32), b = (int32_t)(uint32_t)c->keys[k];
+        if (m->group[a] == 0 && m->group[b] == 0) row[a + 1]++, row[b + 1]++;
+    }
+    for (int32_t i = 0; ok && i < np; i++) row[i + 1] += row[i];
+    for (int32_t k = 0; ok && k < nlinks; k++) {
+        const int32_t a = (int32_t)(c->keys[k] >> 32), b = (int32_t)(uint32_t)c->keys[k];
+        if (m->group[a] != 0 || m->group[b] != 0) continue;
+        wb_real d[3];
+        v3_sub(d, &m->x0[3 * b], &m->x0[3 * a]);
+        const wb_real l = v3_len(d);
+        to[row[a]] = b, len[row[a]++] = l;
+        to[row[b]] = a, len[row[b]++] = l;
+    }
+    for (int32_t i = np; ok && i > 0; i--) row[i] = row[i - 1];
+    if (ok) row[0] = 0;
+    for (int32_t i = 0; ok && i < np; i++) seen[i] = -1;
+    for (int32_t i = 0; ok && i < np; i++) {
+        if (row[i] == row[i + 1]) continue;
+        const wb_real bound = (wb_real)ALONG_PATH * ALONG * (m->radius[i] + rmax);
+        int32_t nh = 0, settled = 0;
+        dist[i] = 0;
+        seen[i] = i;
+        along_push(heap, &nh, (along_item){ 0, i });
+        while (nh > 0 && settled < ALONG_MOST) {
+            const along_item e = along_pop(heap, &nh);
+            if (e.d > dist[e.j]) continue; /* a longer way to one settled already */
+            settled++;
+            const int32_t j = e.j;
+            const wb_real rij = m->radius[i] + m->radius[j];
+            if (j != i && e.d < (wb_real)ALONG_PATH * ALONG * rij) {
+                wb_real d[3];
+                v3_sub(d, &m->x0[3 * j], &m->x0[3 * i]);
+                const wb_real dd = v3_dot(d, d), r = rij * WB_REST_TOUCH, a = ALONG * rij;
+                if (dd >= r * r && dd < a * a) { /* (the created-closer rule has the closer) */
+                    if (u->n == u->cap) {
+                        uint64_t *kk = wb__grow(c->keys, &c->cap_keys, (int64_t)u->n + 1, sizeof *kk);
+                        if (!kk) { ok = 0; break; }
+                        c->keys = kk;
+                        u->cap = c->cap_keys;
+                    }
+                    c->keys[u->n++] = pair_key(i, j);
+                }
+            }
+            for (int32_t q = row[j]; q < row[j + 1]; q++) {
+                const int32_t o = to[q];
+                const wb_real d = e.d + len[q];
+                if (!(d < bound) || (seen[o] == i && !(d < dist[o]))) continue;
+                seen[o] = i;
+                dist[o] = d;
+                if (nh < 4 * ALONG_MOST + 2 * nlinks) along_push(heap, &nh, (along_item){ d, o });
+            }
+        }
+    }
+    free(row); free(to); free(len); free(dist); free(seen); free(heap);
+    return ok;
+}
+
 /* what the pair rule asks (may_touch, tribroad.c's): every type's links as sorted keys,
  * each once, and the loose particles' graphs; 0 when out of memory */
 static int build_rules(wb_world *w)
@@ -961,7 +1080,7 @@ static int build_rules(wb_world *w)
     links_ud u = { c, m, 0, c->cap_keys, 0 };
     for (int t = 0; t < wb__nctypes && !u.fail; t++)
         if (wb__ctypes[t]->links) wb__ctypes[t]->links(w, add_link, &u);
-    if (u.fail) return 0;
+    if (u.fail || !add_along(&u, u.n)) return 0;
     for (int32_t i = 0; i < m->np; i++) g[i] = graph_root(g, i);
     if (u.n > 1) qsort(c->keys, (size_t)u.n, sizeof *c->keys, cmp_u64); /* keys is NULL while none */
     int32_t n = 0;

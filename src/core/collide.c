@@ -515,7 +515,7 @@ WB_INLINE void collide_range(collide_job *j, int32_t lo, int32_t hi, const int p
     const wb_real *restrict wv = m->w, *restrict rad = m->radius;
     wb_real *restrict x = w->s.x, *restrict v = w->s.v;
     wb_real *restrict xp = w->s.x_prev;
-    const wb_attaches *att = w->att && w->att->skip_np > 0 ? w->att : NULL; /* attached: no contact */
+    const wb_attaches *att = wb__attach_skips(w); /* attached: no contact */
     const wb_predict pr = fuse ? *j->next : (wb_predict){ 0, { 0, 0, 0 }, 0 };
     int64_t ncontacts = 0;
     int32_t bad = INT32_MAX;
@@ -826,7 +826,7 @@ int wb__collide_and_update(wb_world *w, wb_real h, wb_real f0, wb_real f1, const
     if (!cs) { wb__warn(w, "out of memory in collision"); return 0; }
     k->c_sub = cs;
     static_plane *pl = (static_plane *)(void *)&cs[m->nc > 0 ? m->nc : 1];
-    int planes = !k->no_fuse && !(w->att && w->att->skip_np > 0); /* (no_fuse: the tests' plain path) */
+    int planes = !k->no_fuse && !wb__attach_skips(w); /* (no_fuse: the tests' plain path) */
     for (int32_t c = 0; c < m->nc; c++) {
         if (!(m->c_gen[c] & 1u)) continue;
         sub_pose *sp = &cs[nlive++];

@@ -34,3 +34,13 @@ const wb_ctype *const wb__ctypes_hashed[] = {
 };
 _Static_assert(sizeof wb__ctypes_hashed / sizeof wb__ctypes_hashed[0] == sizeof wb__ctypes / sizeof wb__ctypes[0] + 1,
                "every type has its place in the hash");
+
+/* the types the VBD solver minimises itself (wb_ctype.vbd), in the order its vertex step
+ * adds their forces and Hessians (vbd.c): a VBD world's bits depend on it, so it is not
+ * the projection order either */
+const wb_ctype *const wb__vbd_ctypes[] = {
+    &wb__distance_type,
+    &wb__tet_type,
+    &wb__bend_type,
+};
+const int wb__vbd_nctypes = (int)(sizeof wb__vbd_ctypes / sizeof wb__vbd_ctypes[0]);

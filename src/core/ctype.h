@@ -1,13 +1,14 @@
 /* ctype.h: the constraint-type table (docs/architecture.md). One file per type in src/core/;
  * the step walks wb__ctypes[] in order, and so do the world's teardown (destroy.c), its
- * hash (query.c) and its snapshots (snapshot.c): a type's file is the one place that
- * names its arrays. */
+ * hash (query.c), its snapshots (snapshot.c) and the VBD solver (vbd.c, through wb_ctype.vbd):
+ * a type's file is the one place that names its arrays. */
 #ifndef WB_CTYPE_H
 #define WB_CTYPE_H
 #include "core.h"
 
 typedef void (*wb_link_fn)(void *ud, int32_t a, int32_t b, int joined);
 typedef struct wb_image wb_image; /* snapshot.h */
+typedef struct wb_vbd_type wb_vbd_type; /* vbd.h */
 
 /* where an image's items go in the world they are put into (snapshot.c) */
 typedef struct wb_image_at {
@@ -45,6 +46,10 @@ typedef struct wb_ctype {
      * link joins no body but its ends stay rest neighbours; a tether joins none). May be
      * NULL: none */
     void (*joins)(const wb_world *w, wb_link_fn fn, void *ud);
+    /* the particles its constraints hold to something outside the particles (a collider, a
+     * rigid body, a grab's target), each through fn(ud, p, p): momentum.c's body with one is
+     * not free. May be NULL: none */
+    void (*anchors)(const wb_world *w, wb_link_fn fn, void *ud);
 
     /* the world's teardown: free the type's arrays (the world is freed after) */
     void (*destroy)(wb_world *w);
@@ -68,6 +73,9 @@ typedef struct wb_ctype {
     /* its largest residual at the positions as they are, with the multipliers of the last
      * projection (h: its substep), in metres (wb__residual); may be NULL: none */
     wb_real (*residual)(const wb_world *w, wb_real h);
+    /* what the VBD solver minimises of it in its vertex steps (vbd.h); NULL: it is
+     * projected as in XPBD after each sweep. A type with it is listed in wb__vbd_ctypes */
+    const wb_vbd_type *vbd;
 } wb_ctype;
 
 /* every type's largest residual (query.c), for the iterations' early stop (solver.c) */
@@ -128,4 +136,8 @@ extern const int wb__nctypes;
 /* the same types in the order w:hash() feeds them in (query.c), wb__nctypes + 1 entries:
  * NULL stands for the colliders' poses */
 extern const wb_ctype *const wb__ctypes_hashed[];
+/* the types with VBD hooks, in the order the vertex step adds their forces (vbd.c), and
+ * their count */
+extern const wb_ctype *const wb__vbd_ctypes[];
+extern const int wb__vbd_nctypes;
 #endif

@@ -496,6 +496,27 @@ static void grab_stats(const wb_world *w, wb_stats *st)
     st->grabs = wb_grab_count(w);
 }
 
+wb_real wb__grab_speed(const wb_world *w, wb_real dt)
+{
+    const wb_grabs *gr = w->grab;
+    wb_real s = 0;
+    for (int32_t i = 0; gr && i < gr->n; i++) {
+        if (!(gr->gen[i] & 1u)) continue;
+        wb_real d[3];
+        v3_sub(d, &gr->target[3 * i], &gr->from[3 * i]);
+        s = fmax(s, v3_len(d) / dt);
+    }
+    return s;
+}
+
+/* a live grab of a particle holds it (a grab of a rigid body's point holds no particle) */
+static void grab_anchors(const wb_world *w, wb_link_fn fn, void *ud)
+{
+    const wb_grabs *g = w->grab;
+    for (int32_t s = 0; g && s < g->n; s++)
+        if ((g->gen[s] & 1u) && g->kind[s] == WB_GRAB_PARTICLE) fn(ud, g->p[s], g->p[s], 1);
+}
+
 const wb_ctype wb__grab_type = {
     .name = "grab",
     .count = grab_count,
@@ -514,4 +535,5 @@ const wb_ctype wb__grab_type = {
     .image_reserve = grab_image_reserve,
     .image_put = grab_image_put,
     .residual = grab_residual,
+    .anchors = grab_anchors,
 };

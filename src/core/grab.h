@@ -44,6 +44,10 @@ typedef struct wb_grabs {
 
 /* slot s is live and, for a rigid body's grab, the body still is (a removed body leaves
  * its grabs inert until the next step's prepare retires them; the hash and images skip them) */
+/* the fastest a grab's target moves over a frame of dt (from where it was to where the
+ * script put it), m/s; 0 with none (solver.c's bound on the frame's speeds) */
+wb_real wb__grab_speed(const wb_world *w, wb_real dt);
+
 static inline int wb__grab_active(const wb_world *w, const wb_grabs *g, int32_t s)
 {
     if (!(g->gen[s] & 1u)) return 0;

@@ -16,9 +16,9 @@
  * is thrown out from under the press.
  *
  * So after the solve, each connected body that nothing outside the solve holds (no
- * immovable or pinned particle, no attachment, no grab) and that touches no particle and no
- * rigid body this frame gets the rigid rotation, about its centre of mass at x~, that takes
- * its angular momentum back to what it was:
+ * immovable or pinned particle, no attachment, no grab) and that touches no particle (in
+ * touch after the solve) and no rigid body gets the rigid rotation, about its centre of
+ * mass at x~, that takes its angular momentum back to what it was:
  * with r = x~ - c and d = x - x~, L = sum m r x d, I = sum m (|r|^2 E - r r^T),
  * w = I^-1 L and x -= w x r, so that sum m r x (d - w x r) = L - I w = 0, and
  * sum m w x r = 0 keeps the linear momentum. Pinned bodies are left alone: their pins
@@ -36,9 +36,8 @@
 #include <stdlib.h>
 
 #include "ctype.h"
-#include "attach.h"
-#include "grab.h"
 #include "pressure.h"
+#include "rigid.h"
 #include "shape_match.h"
 #include "contact.h"
 #include "tricontact.h"
@@ -93,9 +92,9 @@ static void signature(const wb_world *w, int64_t sig[8])
     sig[2] = wb_volume_count(w);
     sig[3] = wb_tet_count(w);
     sig[4] = wb_shape_match_count(w);
-    sig[5] = w->sm ? w->sm->nids : 0;
+    sig[5] = wb__shape_match_members(w);
     sig[6] = wb_pressure_count(w);
-    sig[7] = w->pr ? w->pr->nverts : 0;
+    sig[7] = wb__pressure_vertices(w);
 }
 
 static int build(wb_world *w)
@@ -153,6 +152,14 @@ static int build(wb_world *w)
     return 1;
 }
 
+/* an anchors hook's particle (ud: the world's cache): its body is held */
+static void held(void *ud, int32_t p, int32_t q, int joined)
+{
+    (void)q, (void)joined;
+    wb_cache *k = ud;
+    if (k->mc_body[p] >= 0) k->mc_acc[ACC * k->mc_body[p]] = -1;
+}
+
 /* once per step, before the types' prepare (which clears m.topology_dirty): the bodies
  * when the topology changed, then which of them something outside the solve holds
  * (their acc[0] set to -1). 0 when out of memory (then nothing is restored this step) */
@@ -178,12 +185,8 @@ int wb__momentum_prepare(wb_world *w)
         k->mc_wgen = w->m.w_gen;
     }
     for (int32_t b = 0; b < k->mc_nbody; b++) acc[ACC * b] = k->mc_pinned[b] ? -1 : 0;
-    const wb_attaches *a = w->att;
-    for (int32_t s = 0; a && s < a->n; s++)
-        if ((a->gen[s] & 1u) && body[a->p[s]] >= 0) acc[ACC * body[a->p[s]]] = -1;
-    const wb_grabs *g = w->grab;
-    for (int32_t s = 0; g && s < g->n; s++)
-        if ((g->gen[s] & 1u) && g->kind[s] == WB_GRAB_PARTICLE && body[g->p[s]] >= 0) acc[ACC * body[g->p[s]]] = -1;
+    for (int t = 0; t < wb__nctypes; t++)
+        if (wb__ctypes[t]->anchors) wb__ctypes[t]->anchors(w, held, k);
     k->mc_free = 0;
     for (int32_t b = 0; b < k->mc_nbody; b++) k->mc_free += acc[ACC * b] == 0;
     return 1;
@@ -408,6 +411,10 @@ void wb__turn_rate(const double S[6], const double L[3], double om[3])
     if (!(isfinite(om[0]) && isfinite(om[1]) && isfinite(om[2]))) om[0] = om[1] = om[2] = 0;
 }
 
+/* in touch, for the turn: within this much of r_i + r_j (the contacts leave a resting pair
+ * at r_i + r_j to round-off) */
+#define TOUCH ((wb_real)(1 + 1e-6))
+
 /* after the solve of a substep of length h: each free body's angular momentum back to
  * what it was before the solve (see the top of the file) */
 void wb__momentum_restore(wb_world *w, wb_real h)
@@ -420,17 +427,26 @@ void wb__momentum_restore(wb_world *w, wb_real h)
     double *acc = k->mc_acc;
     for (int32_t b = 0; b < k->mc_nbody; b++)
         if (acc[ACC * b] >= 0) memset(&acc[ACC * b], 0, ACC * sizeof(double));
-    /* a body whose particles may touch particles (its own folds, another body: this frame's
-     * contact candidates) is left as the solve leaves it: the contacts' friction holds its
-     * parts against each other, and a rigid turn of the whole would slip at every contact,
-     * which friction then takes back as a twist of the body (a self-colliding cloth heap,
-     * turned so, never comes to rest). So is one touching a rigid body. */
+    /* a body whose particles touch particles (its own folds, another body: the contact
+     * candidates in touch after the solve, to TOUCH) is left as the solve leaves it: the
+     * contacts' friction holds its parts against each other, and a rigid turn of the whole
+     * would slip at every contact, which friction then takes back as a twist of the body
+     * (a self-colliding cloth heap, turned so, never comes to rest). So is one touching a
+     * rigid body. A candidate merely near changes nothing: a body moves as it would
+     * without contacts, to the bit (a hand-built graph's promise) */
     const wb_contacts *pc = k->pc;
-    for (int32_t c = 0; c < pc->n; c++)
+    const wb_real *rad = w->m.radius;
+    for (int32_t c = 0; c < pc->n; c++) {
+        const int32_t i = pc->ij[2 * c], j = pc->ij[2 * c + 1];
+        if ((body[i] < 0 || acc[ACC * body[i]] < 0) && (body[j] < 0 || acc[ACC * body[j]] < 0)) continue;
+        const wb_real d0 = x[3 * j] - x[3 * i], d1 = x[3 * j + 1] - x[3 * i + 1], d2 = x[3 * j + 2] - x[3 * i + 2];
+        const wb_real r = (rad[i] + rad[j]) * TOUCH;
+        if (!(d0 * d0 + d1 * d1 + d2 * d2 < r * r)) continue;
         for (int e = 0; e < 2; e++) {
             const int32_t b = body[pc->ij[2 * c + e]];
             if (b >= 0 && acc[ACC * b] >= 0) acc[ACC * b] = -2;
         }
+    }
     const wb_tricontacts *tc = k->tc;
     for (int32_t c = 0; c < tc->n; c++) {
         const int32_t t = tc->pt[2 * c + 1], pts[4] = { tc->pt[2 * c], w->m.tri[3 * t], w->m.tri[3 * t + 1], w->m.tri[3 * t + 2] };

@@ -472,6 +472,8 @@ static void pr_stats(const wb_world *w, wb_stats *st)
     st->pressures = wb_pressure_count(w);
 }
 
+int32_t wb__pressure_vertices(const wb_world *w) { return w->pr ? w->pr->nverts : 0; }
+
 const wb_ctype wb__pressure_type = {
     .name = "pressure",
     .count = pr_count,

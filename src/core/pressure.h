@@ -33,4 +33,7 @@ typedef struct wb_image_pressure {
     wb_real *pressure, *alpha, *v0; /* (n) factor, compliance, rest volume */
 } wb_image_pressure;
 
+/* the particles of all the surfaces together (momentum.c: its bodies change with them) */
+int32_t wb__pressure_vertices(const wb_world *w);
+
 #endif

@@ -99,7 +99,7 @@ void wb__rigid_particles_begin(wb_world *w)
     for (int32_t b = 0; b < nb; b++) low[b] = key[2 * b];
     int32_t *hits = slot + nb;
     const wb_real *x = w->s.x, *v = w->s.v;
-    const wb_attaches *att = w->att && w->att->skip_np > 0 ? w->att : NULL;
+    const wb_attaches *att = wb__attach_skips(w);
     for (int32_t i = 0; i < m->np; i++) {
         if (!(m->cflags[i] & WB_CF_COLLIDE)) continue;
         const wb_real reach = m->radius[i] * (wb_real)1.25 + v3_len(&v[3 * i]) * dt + g;

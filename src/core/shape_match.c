@@ -592,6 +592,8 @@ static void sm_stats(const wb_world *w, wb_stats *st)
     st->shape_matches = wb_shape_match_count(w);
 }
 
+int32_t wb__shape_match_members(const wb_world *w) { return w->sm ? w->sm->nids : 0; }
+
 const wb_ctype wb__shape_type = {
     .name = "shape_match",
     .count = sm_count,

@@ -34,4 +34,7 @@ typedef struct wb_image_smatch {
     wb_real *q;            /* (n x 4) rotation at the end of the last frame */
 } wb_image_smatch;
 
+/* the particles of all the clusters together (momentum.c: its bodies change with them) */
+int32_t wb__shape_match_members(const wb_world *w);
+
 #endif

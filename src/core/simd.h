@@ -1,5 +1,5 @@
-/* simd.h: the AVX2 loads the vector paths share (distance.c, vbd.c): the x, y, z of 4
- * particles as 3 vectors of lanes. Each row is loaded without its 4th double (maskload
+/* simd.h: the AVX2 loads the vector paths share (distance.c's, XPBD's and VBD's): the x, y,
+ * z of 4 particles as 3 vectors of lanes. Each row is loaded without its 4th double (maskload
  * does not touch it: the last particle ends the array), then the 4 rows transposed */
 #ifndef WB_SIMD_H
 #define WB_SIMD_H

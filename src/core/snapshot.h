@@ -82,13 +82,16 @@ typedef struct wb_image {
     int32_t nrb;           /* rigid bodies by slot: empty unless wb_image_alloc_rigids */
     wb_image_rigid *rb;    /* (nrb) */
     uint32_t *rb_gen;      /* (nrb) odd = live */
-    /* the VBD solver's multipliers (vbd.c), what its next substep starts from: empty (0, 0)
-     * in an XPBD world or a VBD world that has not stepped */
+    /* the VBD solver's multipliers (vbd.c; each half saved and put by its type's VBD hooks,
+     * distance.c and bend.c), what its next substep starts from: empty (0, 0) in an XPBD
+     * world or a VBD world that has not stepped */
     int32_t vbd_nd, vbd_nb;
     wb_real *vbd_lam, *vbd_c0;   /* (vbd_nd) by distance slot: a rigid link's multiplier and its
                                     error as the last sweep left it (NaN: not known) */
     wb_real *vbd_blam, *vbd_bc0; /* (vbd_nb) the same of each rigid bend */
 } wb_image;
+/* the image has a VBD section (either half) */
+static inline int wb__image_has_vbd(const wb_image *g) { return g->vbd_nd || g->vbd_nb; }
 /* vbd.c: the VBD section for nd distance slots and nb bends (uninitialised); WB_ERR_NOMEM
  * (the section left empty) */
 wb_status wb_image_alloc_vbd(wb_image *img, int32_t nd, int32_t nb);

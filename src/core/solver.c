@@ -328,13 +328,7 @@ static wb_real speed_scale(wb_world *w, wb_real dt, const scan_job *f)
     const wb_rigids *rb = w->rb;
     for (int32_t i = 0; rb && i < rb->n; i++)
         if (rb->gen[i] & 1u) s = fmax(s, v3_len(&rb->v[3 * i]) + v3_len(&rb->om[3 * i]) * rb->bound[i]);
-    const wb_grabs *gr = w->grab;
-    for (int32_t i = 0; gr && i < gr->n; i++) {
-        if (!(gr->gen[i] & 1u)) continue;
-        wb_real d[3];
-        v3_sub(d, &gr->target[3 * i], &gr->from[3 * i]);
-        s = fmax(s, v3_len(d) / dt);
-    }
+    s = fmax(s, wb__grab_speed(w, dt));
     /* pinned particles the script moves (between frames: against the last frame's end; 0
      * when none did, and s >= 0) */
     s = fmax(s, sqrt(k->bl_pin) / dt);

@@ -36,6 +36,7 @@
 #include "ctype.h"
 #include "snapshot.h"
 #include "tet.h"
+#include "vbd.h"
 
 /* a packed tet (tet.h pd): Dm^-1, 1/(mu V0 h^2), 1/(lam V0 h^2), 1 + mu/lam */
 #define PD 12
@@ -946,6 +947,91 @@ static void tet_stats(const wb_world *w, wb_stats *st)
     st->tets = wb_tet_count(w);
 }
 
+/* ---- the VBD solver's part (vbd.h) --------------------------------------------------------- */
+/* the tets at each vertex, as 4 tet + corner */
+typedef struct tet_vbd {
+    wb_vbd_quads at;
+    size_t charged;        /* its bytes charged to def.memory */
+} tet_vbd;
+
+static void *tvbd_make(void) { return calloc(1, sizeof(tet_vbd)); }
+
+static void tvbd_free(wb_world *w, void *part)
+{
+    tet_vbd *p = part;
+    wb__vbd_quads_free(&p->at);
+    wb__charge(w, &p->charged, 0);
+    free(p);
+}
+
+static int32_t tvbd_slots(const wb_world *w) { return w->neo ? w->neo->n : 0; }
+
+static int tvbd_build(wb_world *w, void *part)
+{
+    tet_vbd *p = part;
+    const int32_t n = tvbd_slots(w);
+    return wb__charge(w, &p->charged, sizeof *p + wb__vbd_quads_bytes(w->m.np, n)) &&
+           wb__vbd_quads_build(&p->at, w->m.np, w->neo ? w->neo->ijkl : NULL, n);
+}
+
+static uint64_t tvbd_neighbours(const wb_world *w, const void *part, int32_t i, const uint8_t *col)
+{
+    return wb__vbd_quads_colours(&((const tet_vbd *)part)->at, w->neo ? w->neo->ijkl : NULL, i, col);
+}
+
+static int tvbd_holds(const void *part, int32_t i) { return wb__vbd_quads_hold(&((const tet_vbd *)part)->at, i); }
+
+/* A Neo-Hookean tet's energy on corner k, in its constraint form (tet_project): V0 (mu/2 |F|^2 +
+ * lam/2 (det F - a)^2), a = 1 + mu/lam, F = sum_k x_k b_k^T (b_k: row k-1 of Dm^-1, b_0
+ * minus their sum). The first term is quadratic in x: its block is exact, mu V0 |b_k|^2 I;
+ * the second's is Gauss-Newton, lam V0 g g^T with g = cof(F) b_k (what is left, (det F -
+ * a) times J's second derivative, is indefinite: left out, as VBD does) */
+static void tet_block(const wb_world *w, int32_t q, wb_real f[3], wb_real H[6])
+{
+    const wb_neos *nv = w->neo;
+    const int32_t t = q / 4, k = q % 4, *p = &nv->ijkl[4 * t];
+    const wb_real *d = &nv->dminv[9 * t], *x = w->s.x, V = nv->v0[t], mu = nv->mu[t], lam = nv->lam[t];
+    wb_real F[9], e[3][3], b[3];
+    for (int c = 0; c < 3; c++) v3_sub(e[c], &x[3 * p[c + 1]], &x[3 * p[0]]);
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) F[3 * r + c] = e[0][r] * d[c] + e[1][r] * d[3 + c] + e[2][r] * d[6 + c];
+    if (k > 0) v3_copy(b, &d[3 * (k - 1)]);
+    else for (int c = 0; c < 3; c++) b[c] = -(d[c] + d[3 + c] + d[6 + c]);
+    /* the columns of F and of its cofactor */
+    const wb_real f0[3] = { F[0], F[3], F[6] }, f1[3] = { F[1], F[4], F[7] }, f2[3] = { F[2], F[5], F[8] };
+    wb_real c0[3], c1[3], c2[3], Fb[3], g[3];
+    v3_cross(c0, f1, f2);
+    v3_cross(c1, f2, f0);
+    v3_cross(c2, f0, f1);
+    for (int r = 0; r < 3; r++) {
+        Fb[r] = F[3 * r] * b[0] + F[3 * r + 1] * b[1] + F[3 * r + 2] * b[2];
+        g[r] = c0[r] * b[0] + c1[r] * b[1] + c2[r] * b[2];
+    }
+    const wb_real J = v3_dot(f0, c0), s = lam * V * (J - (1 + mu / lam)), kd = mu * V * v3_dot(b, b), kh = lam * V;
+    for (int r = 0; r < 3; r++) f[r] -= mu * V * Fb[r] + s * g[r];
+    H[0] += kd + kh * g[0] * g[0], H[1] += kd + kh * g[1] * g[1], H[2] += kd + kh * g[2] * g[2];
+    H[3] += kh * g[0] * g[1], H[4] += kh * g[0] * g[2], H[5] += kh * g[1] * g[2];
+}
+
+static void tvbd_vertex(const wb_world *w, const void *part, int32_t i, wb_real inv_h, wb_real f[3], wb_real H[6])
+{
+    (void)inv_h;
+    const wb_vbd_quads *a = &((const tet_vbd *)part)->at;
+    for (int32_t e = a->start[i]; e < a->start[i + 1]; e++) tet_block(w, a->adj[e], f, H);
+}
+
+static const wb_vbd_type tet_vbd_hooks = {
+    .make = tvbd_make,
+    .free = tvbd_free,
+    .slots = tvbd_slots,
+    .build = tvbd_build,
+    .neighbours = tvbd_neighbours,
+    .holds = tvbd_holds,
+    .vertex = tvbd_vertex,
+};
+
+const int32_t *wb__tet_corners(const wb_world *w) { return w->neo ? w->neo->ijkl : NULL; }
+
 const wb_ctype wb__tet_type = {
     .name = "tet",
     .count = tet_count,
@@ -966,4 +1052,5 @@ const wb_ctype wb__tet_type = {
     .image_reserve = tet_image_reserve,
     .image_put = tet_image_put,
     .residual = tet_residual,
+    .vbd = &tet_vbd_hooks,
 };

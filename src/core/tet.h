@@ -52,4 +52,7 @@ bool wb__tet_put_current(wb_world *w, const int32_t p[4], wb_real young, wb_real
  * its links' options */
 void wb__tet_plastic(wb_world *w, int32_t first, wb_real yield, wb_real creep);
 
+/* the tets' corners, wb_tet_count x 4 (NULL: none; distance.c's links backed by them) */
+const int32_t *wb__tet_corners(const wb_world *w);
+
 #endif

@@ -424,6 +424,8 @@ static void vol_stats(const wb_world *w, wb_stats *st)
     st->volumes = wb_volume_count(w);
 }
 
+const int32_t *wb__volume_corners(const wb_world *w) { return w->vol ? w->vol->ijkl : NULL; }
+
 const wb_ctype wb__volume_type = {
     .name = "volume",
     .count = vol_count,

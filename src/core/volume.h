@@ -43,4 +43,7 @@ void wb__volume_plastic(wb_world *w, int32_t first, wb_real yield, wb_real creep
 void wb__kuhn_tets(wb_world *w, int32_t base, int32_t sx, int32_t sy, int32_t sz, wb_real alpha,
                    wb_real young, wb_real poisson);
 
+/* the volumes' corners, wb_volume_count x 4 (NULL: none; distance.c's links backed by them) */
+const int32_t *wb__volume_corners(const wb_world *w);
+
 #endif

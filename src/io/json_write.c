@@ -60,7 +60,7 @@ static void write_snapshot(jw_out *o, const wb_image *g)
     fputs(",\n    \"collider_slots\": {\"generations\": ", f);
     jw_ints(f, "      ", g->c_gen, NULL, g->nc);
     fputc('}', f);
-    if (g->vbd_nd || g->vbd_nb) { /* (a VBD world that has stepped: others' files as they were) */
+    if (wb__image_has_vbd(g)) { /* (a VBD world that has stepped: others' files as they were) */
         fputs(",\n    \"vbd\": {\"multipliers\": ", f);
         reals(o, g->vbd_lam, g->vbd_nd);
         fputs(", \"errors\": ", f);

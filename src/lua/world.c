@@ -427,10 +427,16 @@ static int w_group(lua_State *L)
     return 1;
 }
 
-/* w:set_self_collide(group, bool): whether a body collides with itself */
+/* w:set_self_collide(group | body, bool): whether a body collides with itself (a body
+ * table, as the builders return it, stands for its group) */
 static int w_set_self_collide(lua_State *L)
 {
     wb_world *w = toworld(L);
+    if (lua_type(L, 2) == LUA_TTABLE) {
+        if (lua_getfield(L, 2, "group") != LUA_TNUMBER || !lua_isinteger(L, -1))
+            return luaL_argerror(L, 2, "group or body expected (the table has no integer 'group')");
+        lua_replace(L, 2);
+    }
     lua_Integer g = wbl_checkint(L, 2);
     if (g < 1 || g > WB_MAX_GROUP) return luaL_argerror(L, 2, "group must be a body's group (>= 1)");
     luaL_checktype(L, 3, LUA_TBOOLEAN);

@@ -1,4 +1,4 @@
--- bend.lua: the bending benchmark of issue 12. The 128x128 cloth of cloth128.lua (16 mm
+-- bend.lua: the bending benchmark. The 128x128 cloth of cloth128.lua (16 mm
 -- apart, 2 m across, total mass 1, structural + shear links: 48,641) with a dihedral bend
 -- on every interior edge (48,133 bends, compliance 100 rad/(N m) as the cloth scripts),
 -- unpinned, dropped from 1.2 m onto a sphere (radius 0.5, friction 0.3) over the ground:

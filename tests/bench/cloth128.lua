@@ -1,4 +1,4 @@
--- cloth128.lua: the cloth benchmark scenes of issue 12 (named after the main one).
+-- cloth128.lua: the cloth benchmark scenes (named after the main one).
 -- An n x n cloth (structural + shear links: one diagonal per cell, alternating; 48,641
 -- links at n = 128), 16 mm between neighbours (2 m across at n = 128), total mass 1,
 -- pinned at two corners of one edge, falls from 1 m onto a ground plane and swings on it:

@@ -1,4 +1,4 @@
--- contact_sheet.lua: the particle-triangle contact benchmark of issue 8. 400 small loose
+-- contact_sheet.lua: the particle-triangle contact benchmark. 400 small loose
 -- particles (radius 0.02, a 20 x 20 grid in three layers: 1200) rain onto a coarse cloth
 -- (17 x 17 particles 0.125 m apart, radius 0.02, pinned at its corners) that only its
 -- triangles can hold them on, and pile up on it: 1489 particles, 10 substeps x 2

@@ -1,4 +1,4 @@
--- contacts.lua: the contact benchmark of issue 8. 27 soft blocks (4x4x4 lattices, 64
+-- contacts.lua: the contact benchmark. 27 soft blocks (4x4x4 lattices, 64
 -- particles and 279 links each) dropped in a 3x3x3 heap into a box (a floor and four
 -- walls) pile up and push each other: 1728 particles, 10 substeps x 2 iterations,
 -- 300 frames, single thread (--set contacts=0: the same scene without contacts, for the ratio).

@@ -69,7 +69,7 @@ for s in $SCENES; do
     scene "$BUILD/wobble" "$s" $first
     first=0
 done
-scene "$BUILD/wobble" contacts 0 contacts_off contacts=0   # issue 8: what contacts add
+scene "$BUILD/wobble" contacts 0 contacts_off contacts=0   # what contacts add
 echo
 echo "== recording (tests/bench/record.lua: the demo scene at 1280x720 as --record draws it, to MP4; wall clock)"
 scene "$BUILD/wobble" record 1
@@ -83,7 +83,7 @@ if [ -n "$FLOAT" ]; then
     done
 fi
 
-# the other core busy: a spinning process beside the cloth scenes (issue 12: 2 threads
+# the other core busy: a spinning process beside the cloth scenes (2 threads
 # never more than 10% slower than one, also then). The spinner stops on any exit of this
 # script (trap) and, should the script be killed outright, by itself once its parent is gone.
 SPIN=
@@ -107,7 +107,7 @@ fig() {
     grep "\"scene\": \"$1\"" "$JSON" | grep "\"precision\": \"$2\"" | head -n 1 |
         sed -n "s/.*\"$3\": \([-0-9.e+]*\)[,}].*/\1/p"
 }
-# goal LABEL VALUE GOAL: one line of the goals of issue 12 (ratios, larger is better)
+# goal LABEL VALUE GOAL: one line of the goals (ratios, larger is better)
 goal() {
     awk -v l="$1" -v v="$2" -v g="$3" 'BEGIN {
         if (v == "") { printf "  %-46s %8s   goal %5.2f\n", l, "-", g; exit }
@@ -118,7 +118,7 @@ speedup() {  # wobble 1-thread ms / 2-thread ms of one scene
     [ -n "$a" ] && [ -n "$b" ] && awk -v a="$a" -v b="$b" 'BEGIN { printf "%.4f", a / b }'
 }
 echo
-echo "== the goals of issue 12 (ratios of this run; wall clock)"
+echo "== the goals (ratios of this run; wall clock)"
 goal "cloth128: Bullet / wobble, 1 thread" "$(fig cloth128 double bullet_ratio)" 12
 goal "cloth128: Bullet / wobble, 2 threads" "$(fig cloth128_t2 double bullet_ratio)" 18
 goal "cloth32 (3000 frames): Bullet / wobble" "$(fig cloth32 double bullet_ratio)" 4
@@ -135,7 +135,7 @@ if [ -n "$FLOAT" ]; then
             'BEGIN { if (v == "") printf "  %-46s %8s\n", l, "-"; else printf "  %-46s %8.2f\n", l, v }'
     done
 fi
-# the aims of issue 8 (smaller is better): the contact broad phase against one distance
+# the contacts' aims (smaller is better): the contact broad phase against one distance
 # sweep over the same particles, and what contacts add to the frame
 aim() {
     awk -v l="$1" -v v="$2" -v g="$3" 'BEGIN {
@@ -144,7 +144,7 @@ aim() {
 }
 row() { grep "\"scene\": \"$1\"" "$JSON" | head -n 1 | sed -n "s/.*\"$2\": \([-0-9.e+]*\)[,}].*/\1/p"; }
 echo
-echo "== the aims of issue 8 (contacts.lua; wall clock)"
+echo "== the aims of contacts (contacts.lua; wall clock)"
 aim "broad phase / one distance sweep" "$(row contacts broad_sweeps)" 1
 on=$(row contacts ms_per_frame) off=$(row contacts_off ms_per_frame)
 aim "frame with contacts / without" "$([ -n "$on" ] && [ -n "$off" ] && awk -v a="$on" -v b="$off" 'BEGIN { printf "%.4f", a / b }')" 2
@@ -155,6 +155,11 @@ aim "self128: self-colliding / not" "$(row self128 ratio_off)" 1.3
 aim "loose128: hand-built, contacts / none" "$(row loose128 ratio_off)" 1.3
 aim "heap128: self-colliding heap / not" "$(row heap128 ratio_off)" 3
 aim "drape128: self-colliding, draped / not" "$(row drape128 ratio_off)" 1.3
+# the cost of contacts per particle at each size, the same spacing: the largest over the
+# smallest (flat within 30%)
+aim "self32..self256: per particle, largest / least" "$(for s in self32 self64 self128_30 self256; do row $s ns_per_particle_contacts; done |
+    awk 'NF { v = $1 + 0; if (n == 0 || v < lo) lo = v; if (n == 0 || v > hi) hi = v; n++ }
+         END { if (n == 4 && lo > 0) printf "%.4f", hi / lo }')" 1.3
 # the recording's goal (larger is better): drawing and encoding, the simulation taken out
 echo
 echo "== the goal of recording (tests/bench/record.lua; wall clock)"

@@ -3,8 +3,9 @@
 -- for a hand-built one, at most 3x for a heap). 10 substeps x 1 iteration, one thread.
 --  self128   a w:cloth of 128 x 128 (2 m, radius half its spacing), pinned at two
 --            corners, swinging down for 60 frames: self_collide = true against false
---  self32, self64, self128_30, self256: the same for 30 frames at each size, with the
---            cost per particle of the contacts and of their broad phase (the aim: flat)
+--  self32, self64, self128_30, self256: the same spacing (2 m / 127) for 30 frames at
+--            each size (0.5 m to 4 m), with the cost per particle of the contacts and of
+--            their broad phase (the aim: flat)
 --  loose128  the same sheet built by hand (w:particle + w:distance: loose particles,
 --            default radius 0.02 > half the 1.57 cm spacing): contacts on against off
 --  drape128  a w:cloth of 128 x 128 (1.5 m) draped over a sphere on the floor (60 frames
@@ -17,10 +18,14 @@
 local bench = require("wobble.bench")
 local args = wobble.args
 
+-- an n x n cloth at self128's spacing (2 m at 128: the same radius and the same motion in
+-- radii at every size, so that the rows compare the cost of more particles, not of a
+-- finer cloth)
 local function hanging_n(n)
+  local L = 2 * (n - 1) / 127
   return function(self)
     local w = wobble.world{ threads = args.threads or 1 }
-    local c = w:cloth{ origin = {-1, 2, -1}, size = {2, 2}, res = {n, n}, mass = 1, self_collide = self }
+    local c = w:cloth{ origin = {-L / 2, 2, -L / 2}, size = {L, L}, res = {n, n}, mass = 1, self_collide = self }
     w:pin(c.particles[1])
     w:pin(c.particles[n])
     return w
@@ -113,8 +118,8 @@ local function scene(name, make, frames, what)
 end
 
 scene("self128", hanging, 60, "without self-collision")
--- the same hanging cloth at other sizes, the same 2 m (finer with size): the aim is a
--- flat cost per particle from 32^2 to 256^2 (within 30%)
+-- the same hanging cloth at other sizes, at the same spacing: the aim is a flat cost per
+-- particle from 32^2 to 256^2 (within 30%)
 scene("self32", hanging_n(32), 30, "without self-collision")
 scene("self64", hanging_n(64), 30, "without self-collision")
 scene("self128_30", hanging, 30, "without self-collision")

@@ -1,4 +1,4 @@
--- tets.lua: the Neo-Hookean benchmark of issue 9. A 20x20x20-cell block (21^3 = 9261
+-- tets.lua: the Neo-Hookean benchmark. A 20x20x20-cell block (21^3 = 9261
 -- particles, 48000 tets: 6 per cell, no links) of E = 1e5 Pa, nu = 0.3 dropped on the
 -- ground: 10 substeps x 1 iteration, 120 frames.
 --   tets      one thread (or --set threads=N)

@@ -1,5 +1,5 @@
 #!/bin/sh
-# tests/cli/bench.sh BUILD_DIR: `wobble bench` on a tiny configuration (issue 12): --json
+# tests/cli/bench.sh BUILD_DIR: `wobble bench` on a tiny configuration: --json
 # prints one strict JSON object per scene with the figures of the benchmark
 # (tests/cli/fixtures/bench_json_check.lua validates them), --set scenes picks scenes,
 # --frames N runs N frames; memory per particle is measured where /proc can be read; the

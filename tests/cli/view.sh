@@ -1,5 +1,5 @@
 #!/bin/sh
-# tests/cli/view.sh BUILD_DIR: `wobble view` (issue 11) in a real window: each check
+# tests/cli/view.sh BUILD_DIR: `wobble view` in a real window: each check
 # starts its own X server (Xvfb, no screen needed) and drives the mouse and keys with
 # xdotool. Proves: no display is a clear error (exit 2); the window opens and shows the
 # scene with its overlay (--screenshot); a drag grabs a particle (the input log has

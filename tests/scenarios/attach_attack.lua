@@ -1,4 +1,4 @@
--- attach_attack.lua: what the attack on attachments and grabs found (issue 10): the hash
+-- attach_attack.lua: what the attack on attachments and grabs found: the hash
 -- of a world whose attachment lost its collider equals its snapshot's; thousands of
 -- attachments and grabs are made and listed in linear time, dead slots reused lowest
 -- first.

@@ -1,4 +1,4 @@
--- contacts_api.lua: the Lua side of particle-particle contacts (issue 8): groups, the
+-- contacts_api.lua: the Lua side of particle-particle contacts: groups, the
 -- builders' contact options, w:set_self_collide, wobble.world{contacts}, the default
 -- radius, errors that change nothing, and snapshots that keep it all exactly.
 
@@ -45,6 +45,8 @@ test("bad contact options are refused, naming the key, changing nothing", functi
   expect.error(function() w:particle{ pos = {0, 0, 0}, group = 0.5 } end, "group")
   expect.error(function() w:set_self_collide(0, true) end, "group must be a body's group")
   expect.error(function() w:set_self_collide(l.group) end, "boolean expected")
+  expect.error(function() w:set_self_collide({}, true) end, "no integer 'group'")
+  expect.error(function() w:set_self_collide({ group = 1.5 }, true) end, "no integer 'group'")
   expect.error(function() wobble.world{ contacts = 1 } end, "contacts")
   expect.error(function() w:load_particles("../../assets/logo.json", { colide = true }) end, "colide")
   expect.eq(w:hash(), h)
@@ -68,6 +70,15 @@ test("w:set_self_collide turns a body's self-collision on and off", function()
   expect.gt(curl(true), 0, "w:set_self_collide(group, true)")
   expect.gt(curl(nil, true), 0, "self_collide = true")
   expect.eq(curl(false, true), 0, "w:set_self_collide(group, false)")
+  -- the body itself stands for its group
+  local w = wobble.world{ gravity = {0, 0, 0}, substeps = 1 }
+  local r = w:rope{ from = {0, 0, 0}, to = {1.2, 0, 0}, segments = 12, radius = 0.04 }
+  w:set_self_collide(r, true)
+  local step = 2 * math.pi / 12.4
+  local R = 0.05 / math.sin(step / 2)
+  for i, p in ipairs(r.particles) do w:set_position(p, R * math.cos(i * step), R * math.sin(i * step), 0) end
+  w:step()
+  expect.gt(w:stats().particle_contacts, 0, "w:set_self_collide(body, true)")
 end)
 
 test("collide = false: a body passes through others", function()

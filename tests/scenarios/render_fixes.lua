@@ -1,4 +1,4 @@
--- render_fixes.lua: the rendering faults found by looking at frames (issue 11 part 5),
+-- render_fixes.lua: the rendering faults found by looking at frames,
 -- each checked on pixels: the ground reaches the horizon, a tear shows the background,
 -- a voxel body's edges stay sharp, strain colours do not saturate and carry a legend,
 -- no shadow acne at a cloth's fold. Every check here failed before its fix.

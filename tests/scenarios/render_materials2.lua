@@ -1,4 +1,4 @@
--- render_materials2.lua: the materials layer draws every type (issue 9): a bend by its
+-- render_materials2.lua: the materials layer draws every type: a bend by its
 -- angle off its rest at its hinge (red bent further, blue opened flatter, full at pi/4),
 -- a Neo-Hookean tet by its shape change as well as its volume change (a shear keeps
 -- det F = 1 yet strains the material). Pixel by pixel, as render_materials.lua.

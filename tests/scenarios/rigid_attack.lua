@@ -1,4 +1,4 @@
--- rigid_attack.lua: what a careless or hostile user did to rigid bodies (issue 10) and
+-- rigid_attack.lua: what a careless or hostile user did to rigid bodies and
 -- what must happen: an error naming the place, and nothing changed.
 
 local function write(name, text)

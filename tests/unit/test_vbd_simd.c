@@ -1,4 +1,4 @@
-/* test_vbd_simd.c: the AVX2 path of VBD's vertex step (vbd.c: a vertex's links 4 at a
+/* test_vbd_simd.c: the AVX2 path of VBD's vertex step (distance.c: a vertex's links 4 at a
  * time) gives the same bits as the scalar loop: the same cloths stepped with the vector
  * path and with the scalar loop forced, every position compared bit for bit after each
  * frame. The scenes reach what the lanes mask or blend: pinned corners, coincident
@@ -11,7 +11,7 @@
 #include "core/core.h"
 #include "test.h"
 
-int wb__vbd_simd(int on); /* vbd.c's internal switch */
+int wb__distance_vbd_simd(int on); /* distance.c's internal switch for the VBD vertex step */
 
 static wb_world *scene(int threads, int damped, int iterations)
 {
@@ -48,16 +48,16 @@ static wb_world *scene(int threads, int damped, int iterations)
 
 TEST(vbd_simd_bit_identical_to_scalar)
 {
-    CHECK_SIMD_RUNS(wb__vbd_simd(1));
+    CHECK_SIMD_RUNS(wb__distance_vbd_simd(1));
     const int cases[][3] = { { 1, 0, 1 }, { 1, 1, 1 }, { 1, 1, 3 }, { 2, 0, 3 }, { 2, 1, 1 } };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
         wb_world *v = scene(cases[c][0], cases[c][1], cases[c][2]), *s = scene(cases[c][0], cases[c][1], cases[c][2]);
         REQUIRE(v && s);
         int diff = 0;
         for (int f = 0; f < 30 && !diff; f++) {
-            wb__vbd_simd(1);
+            wb__distance_vbd_simd(1);
             CHECK_EQ(wb_world_step(v), WB_OK);
-            wb__vbd_simd(0);
+            wb__distance_vbd_simd(0);
             CHECK_EQ(wb_world_step(s), WB_OK);
             const int32_t n = wb_particle_count(v);
             diff = memcmp(wb_particle_positions(v), wb_particle_positions(s), sizeof(wb_real) * 3 * (size_t)n) != 0;
@@ -66,5 +66,5 @@ TEST(vbd_simd_bit_identical_to_scalar)
         wb_world_destroy(v);
         wb_world_destroy(s);
     }
-    wb__vbd_simd(1);
+    wb__distance_vbd_simd(1);
 }

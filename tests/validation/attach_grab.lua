@@ -1,4 +1,4 @@
--- attach_grab.lua: grabs and attachments against physics (issue 10, parts 3 and 4).
+-- attach_grab.lua: grabs and attachments against physics.
 --
 -- Both are XPBD constraints C = x - target with a vector multiplier: compliance 0 puts
 -- the particle on its target at the end of every substep (to round-off), a compliant one

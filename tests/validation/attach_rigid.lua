@@ -1,4 +1,4 @@
--- attach_rigid.lua: particles attached to rigid bodies (issue 10, part 3): the body is
+-- attach_rigid.lua: particles attached to rigid bodies: the body is
 -- pulled back, two-way.
 --
 -- The attachment is the point constraint C = x_p - t (t: the body's point fixed in its

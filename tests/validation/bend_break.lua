@@ -1,4 +1,4 @@
--- bend_break.lua: break_torque on bends (issue 9 part 8) against a static load.
+-- bend_break.lua: break_torque on bends against a static load.
 --
 -- A hinge along z (p1 = (0,1,0), p2 = (0,1,1), both pinned) between a pinned wing p3 and a
 -- free wing p4 of mass m at horizontal distance d from the hinge, held level by a rigid

@@ -1,4 +1,4 @@
--- bending.lua: dihedral bending (w:bend, w:cloth{bend}) and break_force (issue 9) against
+-- bending.lua: dihedral bending (w:bend, w:cloth{bend}) and break_force against
 -- physics.
 --
 -- A bend keeps the angle between two triangles hinged on an edge (XPBD, compliance alpha

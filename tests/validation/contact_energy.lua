@@ -1,5 +1,5 @@
 -- contact_energy.lua: bodies made overlapping part without gaining energy from their
--- contacts (issue 8; src/core/contact.c, src/core/tricontact.c).
+-- contacts (src/core/contact.c, src/core/tricontact.c).
 --
 -- Overlap a pair already had is a position error: each pair pushes its overlap out at
 -- no more than max_depenetration (vmax, 0.25 m/s) and that push is no speed. What

@@ -1,5 +1,5 @@
--- contact_forces.lua: w:contacts(), the particle-particle contacts of the last substep
--- (issue 8), against statics.
+-- contact_forces.lua: w:contacts(), the particle-particle contacts of the last substep,
+-- against statics.
 --
 -- A contact's force is its XPBD multiplier over h^2: lambda = depth / (w_a + w_b),
 -- F = lambda / h^2 (src/core/contact.c). For a particle of mass m at rest on an immovable

@@ -1,4 +1,4 @@
--- contact_kinetic.lua: dynamic friction of particle and triangle contacts (issue 8)
+-- contact_kinetic.lua: dynamic friction of particle and triangle contacts
 -- against physics and against the collider contacts, whose rule it now follows.
 --
 -- The model (src/core/contact.c, tricontact.c): a pair sliding faster than one substep

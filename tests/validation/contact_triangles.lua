@@ -1,4 +1,4 @@
--- contact_triangles.lua: particle-triangle contacts (issue 8) against physics.
+-- contact_triangles.lua: particle-triangle contacts against physics.
 --
 -- The model (src/core/tricontact.c): every substep a particle closer than its radius r
 -- to a triangle of a registered surface (a cloth's sheet, a lattice's hull) that it may

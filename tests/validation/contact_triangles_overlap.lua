@@ -1,5 +1,5 @@
 -- contact_triangles_overlap.lua: a particle made inside its radius of a triangle is pushed
--- out gently, as a pair made overlapping is (issue 8; tests/validation/depenetration.lua).
+-- out gently, as a pair made overlapping is (tests/validation/depenetration.lua).
 --
 -- src/core/tricontact.c follows contact.c's rule for old overlap: what a particle and a
 -- triangle already overlapped by at a substep's start and were themselves left with (before

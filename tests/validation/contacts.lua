@@ -1,4 +1,4 @@
--- contacts.lua: particle-particle contacts (issue 8) against physics.
+-- contacts.lua: particle-particle contacts against physics.
 --
 -- The contact model (src/core/contact.c): every substep each candidate pair with
 -- |x_i - x_j| < r_i + r_j is pushed apart along its line to exactly r_i + r_j, the

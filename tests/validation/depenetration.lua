@@ -1,4 +1,4 @@
--- depenetration.lua: bodies made overlapping push apart gently (issue 8).
+-- depenetration.lua: bodies made overlapping push apart gently.
 --
 -- A pair's overlap at the start of a substep is a position error, not a collision:
 -- src/core/contact.c pushes it out at no more than max_depenetration (m/s, default

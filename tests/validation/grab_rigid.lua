@@ -1,4 +1,4 @@
--- grab_rigid.lua: grabbing rigid bodies (issue 10, part 4): w:grab(rb, target, {at}).
+-- grab_rigid.lua: grabbing rigid bodies: w:grab(rb, target, {at}).
 --
 -- The grab is the point constraint C = x_b - t (x_b: the body's point `at`, fixed in its
 -- frame), solved in 3D with the body's response matrix K = 1/M E - [d]x I^-1 [d]x at the

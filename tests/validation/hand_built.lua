@@ -1,7 +1,7 @@
 -- hand_built.lua: particle graphs built by hand (w:particle + w:distance, the reference
 -- thesis's workflow) with the defaults: radius 0.02, contacts on.
 --
--- The rule (DESIGN.md §2, "Rest neighbours never touch"): two particles joined by a
+-- The rule (docs/physics.md, "Rest neighbours never touch"): two particles joined by a
 -- constraint, or created closer than r_i + r_j (or in touch) in one graph, are never a
 -- contact pair. Loose particles joined by constraints are one graph, which collides with
 -- itself under that rule and with every other graph and body. So a graph whose spacing
@@ -130,8 +130,10 @@ end)
 
 test("a hand-built rope heaped on the floor does not pass through itself", function()
   -- a 1 m rope of 101 particles 1 cm apart, hanging vertical, dropped on the ground: it
-  -- piles up; every pair but rest neighbours (linked, or made within r_i + r_j: eight
-  -- apart or less) must keep r_i + r_j, to the 5% the links pull back after the contacts
+  -- piles up; every pair that can face another across a fold (more than pi r = 6.3 cm
+  -- apart along it: seven apart or more; the nearer are rest neighbours, made within
+  -- pi / 2 (r_i + r_j) along the rope) must keep r_i + r_j, to the 5% the links pull back
+  -- after the contacts
   local function heap(contacts)
     local w = wobble.world{ contacts = contacts, damping = 1 }
     w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0 }
@@ -141,12 +143,73 @@ test("a hand-built rope heaped on the floor does not pass through itself", funct
     w:run{ seconds = 2.5 }
     local worst = 0
     for i = 1, #ids do
-      for j = i + 5, #ids do worst = math.max(worst, 0.04 - dist(w, ids[i], ids[j])) end
+      for j = i + 7, #ids do worst = math.max(worst, 0.04 - dist(w, ids[i], ids[j])) end
     end
     return worst / 0.04
   end
   expect.lt(heap(true), 0.05, "deepest overlap of a non-neighbour pair, share of r_i + r_j")
   expect.gt(heap(false), 0.5, "without contacts the heap overlaps itself")
+end)
+
+test("a hand-built net sheared in its plane touches nothing; folded, it touches itself", function()
+  -- a 12 x 12 net of links 1.57 cm apart, the default radius 0.02: two cells off the
+  -- diagonal its particles are made 4.45 cm apart, just beyond r_i + r_j = 4 cm, and
+  -- shearing the net brings them closer (3.15 cm at 30 degrees). They are rest neighbours along
+  -- the net (made within pi / 2 (r_i + r_j), joined by 4 links), which only shearing or
+  -- bunching brings together, so the sheared net moves exactly as without contacts.
+  local n, s = 12, 2 / 127
+  local function net(contacts)
+    local w = wobble.world{ gravity = {0, 0, 0}, contacts = contacts }
+    local id = {}
+    for j = 0, n - 1 do
+      for i = 0, n - 1 do id[j * n + i] = w:particle{ pos = {i * s, 1, j * s}, mass = 0.01 } end
+    end
+    for j = 0, n - 1 do
+      for i = 0, n - 1 do
+        if i < n - 1 then w:distance(id[j * n + i], id[j * n + i + 1]) end
+        if j < n - 1 then w:distance(id[j * n + i], id[(j + 1) * n + i]) end
+      end
+    end
+    return w, id
+  end
+  local function place(w, id, at)
+    for j = 0, n - 1 do
+      for i = 0, n - 1 do w:set_position(id[j * n + i], at(i, j)) end
+    end
+  end
+  -- sheared: its columns turned by 30 degrees, every link at its length (the net has no
+  -- shear links, so it stays so)
+  local function sheared(i, j) return (i + 0.5 * j) * s, 1, j * s * math.sqrt(3) / 2 end
+  local a, pa = net(true)
+  local b, pb = net(false)
+  place(a, pa, sheared)
+  place(b, pb, sheared)
+  for _ = 1, 10 do
+    a:step()
+    b:step()
+    expect.eq(a:stats().particle_contacts, 0, "no contact in the sheared net")
+  end
+  local worst = 0
+  for k = 0, n * n - 1 do
+    local x1, y1, z1 = a:position(pa[k])
+    local x2, y2, z2 = b:position(pb[k])
+    worst = math.max(worst, math.abs(x1 - x2), math.abs(y1 - y2), math.abs(z1 - z2))
+  end
+  expect.eq(worst, 0, "the same positions as without contacts, bit for bit")
+  -- the same net folded in half, its upper half 3 cm over its lower one (closer than
+  -- r_i + r_j): the rows facing each other across the fold that are farther than pi r
+  -- along the net (rows 3 and 8, ...) touch and push the layers apart to 4 cm
+  local c, pc = net(true)
+  place(c, pc, function(i, j)
+    if j < n / 2 then return i * s, 1, j * s end
+    return i * s, 1.03, (n - 1 - j) * s
+  end)
+  c:step()
+  expect.gt(c:stats().particle_contacts, n, "the folded net touches itself")
+  for _ = 1, 30 do c:step() end
+  local _, ylow = c:position(pc[3 * n + 5])
+  local _, yhigh = c:position(pc[8 * n + 5])
+  expect.gt(yhigh - ylow, 0.04 * 0.95, "its layers pushed apart to r_i + r_j")
 end)
 
 test("a loose particle linked to a body hangs at its link's length", function()

@@ -1,5 +1,5 @@
 -- made_overlapping.lua: a body made overlapping a collider or a rigid body is not a
--- collision (DESIGN.md §2, "Made overlapping is not a collision").
+-- collision (docs/physics.md, "Made overlapping").
 --
 -- The builders give a particle half its body's spacing as contact radius, so a lattice
 -- made from y = 0 on the ground has its bottom layer half inside it. An overlap a

@@ -1,5 +1,5 @@
 -- made_stack.lua: two blocks made stacked into each other part gently at any depth
--- (DESIGN.md §2, "Made overlapping is not a collision"; src/core/contact.c, made_shift).
+-- (docs/physics.md, "Made overlapping"; src/core/contact.c, made_shift).
 --
 -- Two lattices of 4 x 4 x 4 particles, 0.6 m (spacing 0.2 m, the default radius r = 0.1 m,
 -- contact distance 2r = 0.2 m), 1 kg each: the lower one made resting on the ground

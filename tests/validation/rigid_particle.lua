@@ -1,4 +1,4 @@
--- rigid_particle.lua: two-way particle-rigid contacts (issue 10 part 2): a particle's sphere
+-- rigid_particle.lua: two-way particle-rigid contacts: a particle's sphere
 -- against a body's shape, projected with the particle's inverse mass and the body's
 -- generalized inverse mass at the point (Müller et al. 2020, eq. 2-3).
 --

@@ -1,4 +1,4 @@
--- rigid_pile.lua: a pile of 64 bodies poured into a bin (issue 10): the substep's broad
+-- rigid_pile.lua: a pile of 64 bodies poured into a bin: the substep's broad
 -- phase (body pairs by a sort and sweep on swept boxes, colliders culled by bounding
 -- spheres, rigid.c) must leave out no pair that touches. After 4 s no two bodies overlap
 -- by more than 2 mm and every body is inside the bin.
