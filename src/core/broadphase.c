@@ -1009,12 +1009,13 @@ static int add_along(links_ud *u, int32_t nlinks)
     int32_t *seen = malloc(sizeof *seen * (size_t)np);
     along_item *heap = malloc(sizeof *heap * (4 * (size_t)ALONG_MOST + 2 * (size_t)nlinks));
     int ok = row && to && len && dist && seen && heap;
-    for (int32_t k = 0; ok && k < nlinks; k++) {
+    if (!ok) goto done;
+    for (int32_t k = 0; k < nlinks; k++) {
         const int32_t a = (int32_t)(c->keys[k] >> 32), b = (int32_t)(uint32_t)c->keys[k];
         if (m->group[a] == 0 && m->group[b] == 0) row[a + 1]++, row[b + 1]++;
     }
-    for (int32_t i = 0; ok && i < np; i++) row[i + 1] += row[i];
-    for (int32_t k = 0; ok && k < nlinks; k++) {
+    for (int32_t i = 0; i < np; i++) row[i + 1] += row[i];
+    for (int32_t k = 0; k < nlinks; k++) {
         const int32_t a = (int32_t)(c->keys[k] >> 32), b = (int32_t)(uint32_t)c->keys[k];
         if (m->group[a] != 0 || m->group[b] != 0) continue;
         wb_real d[3];
@@ -1023,9 +1024,9 @@ static int add_along(links_ud *u, int32_t nlinks)
         to[row[a]] = b, len[row[a]++] = l;
         to[row[b]] = a, len[row[b]++] = l;
     }
-    for (int32_t i = np; ok && i > 0; i--) row[i] = row[i - 1];
-    if (ok) row[0] = 0;
-    for (int32_t i = 0; ok && i < np; i++) seen[i] = -1;
+    for (int32_t i = np; i > 0; i--) row[i] = row[i - 1];
+    row[0] = 0;
+    for (int32_t i = 0; i < np; i++) seen[i] = -1;
     for (int32_t i = 0; ok && i < np; i++) {
         if (row[i] == row[i + 1]) continue;
         const wb_real bound = (wb_real)ALONG_PATH * ALONG * (m->radius[i] + rmax);
@@ -1063,6 +1064,7 @@ static int add_along(links_ud *u, int32_t nlinks)
             }
         }
     }
+done:
     free(row); free(to); free(len); free(dist); free(seen); free(heap);
     return ok;
 }

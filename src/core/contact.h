@@ -131,9 +131,9 @@ typedef struct wb_contacts {
     uint64_t bm_gen;
 } wb_contacts;
 
-/* particles p and q are of two groups contact.c moved apart whole in the last substep for
- * an overlap they were made with (made_ab): their contacts are its to take out
- * (tricontact.c) */
+/* particles p and q are of two groups contact.c moves apart whole for an overlap they were
+ * made with (made_ab, as its latest projection found them): their contacts are its to take
+ * out (tricontact.c, vbd_contact.c) */
 int wb__contacts_made(const wb_world *w, int32_t p, int32_t q);
 
 /* rest neighbours (never a contact pair) include pairs made in touch: created r_i + r_j

@@ -442,10 +442,8 @@ void wb__momentum_restore(wb_world *w, wb_real h)
         const wb_real d0 = x[3 * j] - x[3 * i], d1 = x[3 * j + 1] - x[3 * i + 1], d2 = x[3 * j + 2] - x[3 * i + 2];
         const wb_real r = (rad[i] + rad[j]) * TOUCH;
         if (!(d0 * d0 + d1 * d1 + d2 * d2 < r * r)) continue;
-        for (int e = 0; e < 2; e++) {
-            const int32_t b = body[pc->ij[2 * c + e]];
-            if (b >= 0 && acc[ACC * b] >= 0) acc[ACC * b] = -2;
-        }
+        if (body[i] >= 0 && acc[ACC * body[i]] >= 0) acc[ACC * body[i]] = -2;
+        if (body[j] >= 0 && acc[ACC * body[j]] >= 0) acc[ACC * body[j]] = -2;
     }
     const wb_tricontacts *tc = k->tc;
     for (int32_t c = 0; c < tc->n; c++) {

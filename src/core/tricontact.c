@@ -117,7 +117,7 @@ wb_real wb__tri_closest(const wb_real p[3], const wb_real a[3], const wb_real b[
 }
 
 /* ---- projection -------------------------------------------------------------------------------------- */
-/* p's body and the triangle's are a pair contact.c moves apart this substep (contact.h) */
+/* p's body and the triangle's are a pair contact.c moves apart (contact.h) */
 int wb__contacts_made(const wb_world *w, int32_t p, int32_t corner)
 {
     const wb_contacts *pc = w->k.pc;

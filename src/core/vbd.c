@@ -65,8 +65,8 @@ struct wb_vbd {
     wb_vbdc *ct;           /* the particle contacts in the vertex steps (vbd_contact.c) */
     int ct_on;             /* ct holds this substep's */
     size_t charged;        /* the struct's and its arrays' bytes charged to def.memory, but for
-                              the parts (their own), tsum, csum, bmove (charged_t) and ct
-                              (its own) */
+                              the parts (their own), tsum, csum, bmove, bvar, vsum
+                              (charged_t) and ct (its own) */
     size_t charged_t;
     int nomem;             /* the last solve ran out of memory (the budget refused its
                               scratch): the step undoes the frame (wb__vbd_failed) */
@@ -375,7 +375,7 @@ static int touching(wb_world *w, struct wb_vbd *v)
             if (body[w->rb->pc[2 * c]] >= 0) T[4 * body[w->rb->pc[2 * c]]] = -1;
     /* a free body that may touch another body's movable particle is moved with the bodies
      * it may touch (keep_momentum), unless it is held or touches what that step does not
-     * take in (a rigid body, a triangle of another body) */
+     * take in (a rigid body, a triangle of another body held in part) */
     v->nvar = 0;
     for (int32_t b = 0; b < nb; b++)
         v->bvar[b] = v->bvar[b] == 0 && !(T[4 * b] < 0) && !(k->mc_acc[16 * b] < 0) ? v->nvar++ : -1;

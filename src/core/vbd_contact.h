@@ -7,11 +7,12 @@ typedef struct wb_vbdc wb_vbdc;
 
 /* Once a substep, after the sweeps' start: the frame's candidate pairs near enough to
  * touch during it, each vertex's list of them, and the copy its partners are read from.
- * order / colour_start / ncolours: the sweep's vertices by colour. Returns 1 when some
- * vertex has a contact (then call the others), 0 when none, -1 when out of memory (the
- * contacts after the sweeps still hold). *c is made on first use. bmoved (bodies, may be
- * NULL): 1 for a body whose friction its momentum step takes (wb__vbdc_body), not the
- * vertex steps. */
+ * order / colour_start / ncolours: the sweep's vertices by colour. Returns 1 when it holds
+ * pairs (then call the others; maybe none in the vertex steps, all of them between bodies
+ * moved together), 0 when none, -1 when out of memory (the contacts after the sweeps
+ * still hold). *c is made on first use. bmoved (bodies, may be NULL): 1 for a body whose
+ * friction its momentum step takes (wb__vbdc_body), not the vertex steps; bvar (bodies,
+ * may be NULL): a body's index among those moved together (wb__vbdc_couple), -1 none. */
 int wb__vbdc_begin(wb_world *w, wb_vbdc **c, wb_real h, const int32_t *order, const int32_t *colour_start,
                    int32_t ncolours, const uint8_t *bmoved, const int32_t *bvar);
 /* vertex i's contact forces and their Hessian added to f and H (H: xx, yy, zz, xy, xz, yz) */
