@@ -48,9 +48,11 @@ for _, p in ipairs(cloth.particles) do
   moved = math.max(moved, math.sqrt((x - b[1]) ^ 2 + (y - b[2]) ^ 2 + (z - b[3]) ^ 2))
 end
 
--- the self-collision rule's pairs (src/core/contact.c): not joined by a link and at least
--- r_i + r_j apart as built; of them, the closest now (over its contact distance 2 r) and
--- how many lie within 1.5 x 2 r (a fold lying on another: without folds, none)
+-- the self-collision rule's pairs (docs/physics.md, "Rest neighbours never touch"): not
+-- joined by a link, and at least pi/2 (r_i + r_j) = pi r apart as built (a pair made
+-- closer is joined along the links within sqrt 2 pi r here: the corners across each
+-- square's unlinked diagonal); of them, the closest now (over its contact distance 2 r)
+-- and how many lie within 1.5 x 2 r (a fold lying on another: without folds, none)
 local linked = {}
 for _, c in ipairs(w:distances()) do
   local a, b = c:particles()
@@ -62,7 +64,7 @@ for i, p in ipairs(cloth.particles) do
   for k = i + 1, #cloth.particles do
     local q = cloth.particles[k]
     local bp, bq = built[p], built[q]
-    if not linked[p * 100000 + q] and math.sqrt((bp[1] - bq[1]) ^ 2 + (bp[2] - bq[2]) ^ 2) >= 2 * r then
+    if not linked[p * 100000 + q] and math.sqrt((bp[1] - bq[1]) ^ 2 + (bp[2] - bq[2]) ^ 2) >= math.pi * r then
       local qx, qy, qz = w:position(q)
       local d = math.sqrt((px - qx) ^ 2 + (py - qy) ^ 2 + (pz - qz) ^ 2) / (2 * r)
       worst = math.min(worst, d)

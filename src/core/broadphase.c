@@ -948,7 +948,8 @@ static void add_link(void *ud, int32_t a, int32_t b, int joined)
     }
 }
 
-/* Rest neighbours along a hand-built graph. Two loose particles of one graph that were
+/* Rest neighbours along a hand-built graph or a self-colliding body. Two particles of one
+ * graph (or body) that were
  * made less than ALONG (r_i + r_j) apart, and are joined by a path along its constraints
  * (the sum of its links' lengths where they were made) shorter than sqrt 2 ALONG
  * (r_i + r_j), never touch either: a fold takes about pi r of the body to bring two layers
@@ -994,6 +995,13 @@ static along_item along_pop(along_item *h, int32_t *n)
     return top;
 }
 
+/* a link add_along walks: both ends loose, or both of one body that collides with
+ * itself (no other body pairs within itself) */
+static inline int along_link(const wb_model *m, int32_t a, int32_t b)
+{
+    return m->group[a] == m->group[b] && (m->group[a] == 0 || (m->cflags[a] & m->cflags[b] & WB_CF_SELF));
+}
+
 static int add_along(links_ud *u, int32_t nlinks)
 {
     wb_contacts *c = u->c;
@@ -1001,7 +1009,7 @@ static int add_along(links_ud *u, int32_t nlinks)
     const int32_t np = m->np;
     wb_real rmax = 0;
     for (int32_t i = 0; i < np; i++)
-        if (m->group[i] == 0 && m->radius[i] > rmax) rmax = m->radius[i];
+        if ((m->group[i] == 0 || (m->cflags[i] & WB_CF_SELF)) && m->radius[i] > rmax) rmax = m->radius[i];
     if (!(rmax > 0) || nlinks == 0) return 1;
     /* the loose particles' links as rows (each both ways) */
     int32_t *row = calloc((size_t)np + 1, sizeof *row), *to = malloc(sizeof *to * 2 * (size_t)nlinks);
@@ -1012,12 +1020,12 @@ static int add_along(links_ud *u, int32_t nlinks)
     if (!ok) goto done;
     for (int32_t k = 0; k < nlinks; k++) {
         const int32_t a = (int32_t)(c->keys[k] >> 32), b = (int32_t)(uint32_t)c->keys[k];
-        if (m->group[a] == 0 && m->group[b] == 0) row[a + 1]++, row[b + 1]++;
+        if (along_link(m, a, b)) row[a + 1]++, row[b + 1]++;
     }
     for (int32_t i = 0; i < np; i++) row[i + 1] += row[i];
     for (int32_t k = 0; k < nlinks; k++) {
         const int32_t a = (int32_t)(c->keys[k] >> 32), b = (int32_t)(uint32_t)c->keys[k];
-        if (m->group[a] != 0 || m->group[b] != 0) continue;
+        if (!along_link(m, a, b)) continue;
         wb_real d[3];
         v3_sub(d, &m->x0[3 * b], &m->x0[3 * a]);
         const wb_real l = v3_len(d);
