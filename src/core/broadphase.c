@@ -1077,6 +1077,73 @@ done:
     return ok;
 }
 
+static inline wb_real made_d2(const wb_model *m, int32_t i, int32_t j)
+{
+    wb_real d[3];
+    v3_sub(d, &m->x0[3 * j], &m->x0[3 * i]);
+    return v3_dot(d, d);
+}
+
+/* The rule's bounds by made distance (near2, far2), so that most pairs are decided
+ * without searching the keys: a hand-built net or a cloth finds its rest neighbours in
+ * the search every frame (a hundred and more a particle with the default radius over a
+ * fine net) and rejected each by a search of its keys. far2: the farthest a key of the
+ * particle was made. near2: the nearest a particle of its body or graph that is no rest
+ * neighbour was made, found by a search of the made positions within ALONG (r_i + r_j)
+ * (beyond that the along rule keeps none: the bound stops there, with the least radius).
+ * 0 when out of memory */
+static int one_graph_rule(const wb_world *w, int32_t i, int32_t j, int bounds);
+
+static int made_bounds(wb_world *w)
+{
+    wb_contacts *c = w->k.pc;
+    const wb_model *m = &w->m;
+    const int32_t np = m->np;
+    wb_real *n2 = wb__grow(c->near2, &c->cap_near2, np > 0 ? np : 1, sizeof *n2);
+    if (n2) c->near2 = n2;
+    wb_real *f2 = wb__grow(c->far2, &c->cap_far2, np > 0 ? np : 1, sizeof *f2);
+    if (f2) c->far2 = f2;
+    wb_real *reach = wb__grow(c->reach, &c->cap_reach, np > 0 ? np : 1, sizeof *reach);
+    if (reach) c->reach = reach;
+    if (!n2 || !f2 || !reach) return 0;
+    for (int32_t i = 0; i < np; i++) f2[i] = 0;
+    for (int32_t k = 0; k < c->nkeys; k++) {
+        const int32_t a = (int32_t)(c->keys[k] >> 32), b = (int32_t)(uint32_t)c->keys[k];
+        const wb_real d2 = made_d2(m, a, b);
+        f2[a] = d2 > f2[a] ? d2 : f2[a];
+        f2[b] = d2 > f2[b] ? d2 : f2[b];
+    }
+    /* the particles that pair within their body or graph (loose, or self-colliding), each
+     * searched to ALONG r_i, or half as far as its farthest key where that is nearer (a
+     * radius many times the spacing: the search then finds about as many particles as it
+     * has keys) */
+    wb_real rmin = INFINITY;
+    for (int32_t i = 0; i < np; i++) {
+        const int takes = (m->group[i] == 0 || (m->cflags[i] & WB_CF_SELF)) &&
+                          isfinite(m->x0[3 * i] + m->x0[3 * i + 1] + m->x0[3 * i + 2]);
+        const wb_real a = (wb_real)ALONG * m->radius[i], b = (wb_real)0.5 * sqrt(f2[i]);
+        reach[i] = takes ? (a < b ? a : b) : -1;
+        if (reach[i] >= 0 && reach[i] < rmin) rmin = reach[i];
+    }
+    for (int32_t i = 0; i < np; i++) {
+        /* every particle made within reach_i + rmin was searched (a millionth less: the
+         * search's own test of the distance may round the other way) */
+        const wb_real cap = (reach[i] + rmin) * (wb_real)(1 - 1e-6);
+        n2[i] = reach[i] >= 0 ? cap * cap : 0;
+    }
+    c->n = 0; /* (called with no list: wb__contacts_begin) */
+    const int32_t r = wb__broadphase(c, m->x0, reach, NULL, np, wb__world_pool(w), NULL, NULL);
+    for (int32_t k = 0; k < r; k++) {
+        const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];
+        if (wb__graph_of(c, m, i) != wb__graph_of(c, m, j) || !one_graph_rule(w, i, j, 0)) continue;
+        const wb_real d2 = made_d2(m, i, j);
+        n2[i] = d2 < n2[i] ? d2 : n2[i];
+        n2[j] = d2 < n2[j] ? d2 : n2[j];
+    }
+    c->n = 0;
+    return r >= 0;
+}
+
 /* what the pair rule asks (may_touch, tribroad.c's): every type's links as sorted keys,
  * each once, and the loose particles' graphs; 0 when out of memory */
 static int build_rules(wb_world *w)
@@ -1111,7 +1178,7 @@ static int build_rules(wb_world *w)
     memset(row, 0, sizeof *row * ((size_t)m->np + 1));
     for (int32_t k = 0; k < n; k++) row[(c->keys[k] >> 32) + 1]++;
     for (int32_t i = 0; i < m->np; i++) row[i + 1] += row[i];
-    return 1;
+    return made_bounds(w);
 }
 
 /* Self-collision by particles alone where they cover the surface (Macklin et al. 2014,
@@ -1214,24 +1281,34 @@ int wb__joined(const wb_contacts *c, int32_t i, int32_t j)
     return k < end && *k == key;
 }
 
+/* two particles of one body or graph; with bounds, most decided by their made distance
+ * alone (made_bounds), else by the keys (made_bounds works the bounds out so) */
+static int one_graph_rule(const wb_world *w, int32_t i, int32_t j, int bounds)
+{
+    const wb_model *m = &w->m;
+    const wb_contacts *c = w->k.pc;
+    if (m->group[i] > 0 && !(m->cflags[i] & m->cflags[j] & WB_CF_SELF)) return 0;
+    const wb_real d2 = made_d2(m, i, j);
+    if (bounds && (d2 < c->near2[i] || d2 < c->near2[j])) return 0;
+    const wb_real r = (m->radius[i] + m->radius[j]) * WB_REST_TOUCH;
+    if (d2 < r * r) return 0;
+    return (bounds && d2 > c->far2[i]) || !wb__joined(c, i, j);
+}
+
 /* The contact rule (docs/physics.md, "Contacts"): particles of two bodies (or graphs)
  * touch when both collide, unless a constraint joins them; of one, only when it collides
  * with itself (a loose graph always does), and never rest neighbours: joined, or made
  * closer than r_i + r_j (or in touch: WB_REST_TOUCH) */
-static int may_touch_rules(void *ud, int32_t i, int32_t j)
+static int rules(const wb_world *w, int32_t i, int32_t j, int bounds)
 {
-    const wb_world *w = ud;
     const wb_model *m = &w->m;
     const wb_contacts *c = w->k.pc;
     if (wb__graph_of(c, m, i) != wb__graph_of(c, m, j))
         return (m->cflags[i] & m->cflags[j] & WB_CF_COLLIDE) && !(c->cross && wb__joined(c, i, j));
-    if (m->group[i] > 0 && !(m->cflags[i] & m->cflags[j] & WB_CF_SELF)) return 0;
-    wb_real d[3];
-    v3_sub(d, &m->x0[3 * j], &m->x0[3 * i]);
-    const wb_real r = (m->radius[i] + m->radius[j]) * WB_REST_TOUCH;
-    if (v3_dot(d, d) < r * r) return 0;
-    return !wb__joined(c, i, j);
+    return one_graph_rule(w, i, j, bounds);
 }
+
+static int may_touch_rules(void *ud, int32_t i, int32_t j) { return rules(ud, i, j, 1); }
 
 /* ... and not both immovable (pins change from frame to frame; the rules do not) */
 static int movable_pair(void *ud, int32_t i, int32_t j)
@@ -1532,7 +1609,9 @@ void wb__broadphase_free(wb_contacts *c)
     c->skip = NULL;
     c->cap_skip = 0;
     free(c->key_row); free(c->path); free(c->dorm); free(c->dorm_row); free(c->dorm_at); free(c->dorm_on);
-    free(c->off_path); free(c->soft); free(c->qs);
+    free(c->off_path); free(c->soft); free(c->qs); free(c->near2); free(c->far2);
+    c->near2 = c->far2 = NULL;
+    c->cap_near2 = c->cap_far2 = 0;
     c->key_row = c->dorm = c->dorm_row = c->dorm_at = c->soft = c->qs = NULL;
     c->cap_qs = 0;
     c->path = NULL;
@@ -1857,7 +1936,8 @@ void wb__contacts_brute(wb_world *w)
             wb_real d[3];
             v3_sub(d, &x[3 * j], &x[3 * i]);
             const wb_real r = m->radius[i] + m->radius[j];
-            if (!(v3_dot(d, d) < r * r) || !may_touch(w, i, j)) continue;
+            /* (by the keys alone, not made_bounds: a bound too wide would show as a miss) */
+            if (!(v3_dot(d, d) < r * r) || !movable_pair(w, i, j) || !rules(w, i, j, 0)) continue;
             int32_t lo = 0, hi = c->n;
             while (lo < hi) {
                 const int32_t mid = lo + (hi - lo) / 2, a = c->ij[2 * mid], b = c->ij[2 * mid + 1];

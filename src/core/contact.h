@@ -53,6 +53,11 @@ typedef struct wb_contacts {
     int32_t nkeys, cap_keys;
     int32_t *key_row;      /* (np + 1) keys[key_row[a] .. key_row[a + 1]) are a's (a < b) */
     int32_t cap_key_row;
+    wb_real *near2, *far2; /* (np) squared made distances: every particle of i's body or
+                              graph made closer to it than near2 is a rest neighbour, and no
+                              constraint joins it to one made farther than far2 (the rule
+                              decided without a search of the keys) */
+    int32_t cap_near2, cap_far2;
     int32_t *graph;        /* (np) a loose particle's graph (the least particle of its
                               connected component over the links); its own index in a body */
     int32_t cap_graph;
