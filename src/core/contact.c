@@ -488,6 +488,7 @@ static int made_shift(wb_world *w, made *mb, const wb_real *left, wb_real step, 
 #define SWEEPS 4
 #define NEAR ((wb_real)1.1)
 #define SWEEP_TOL ((wb_real)1e-3)
+#define SWEEP_G ((wb_real)1e-3)
 static int32_t sweep(wb_world *w, wb_real h, int32_t *near, int32_t nn)
 {
     wb_contacts *c = w->k.pc;
@@ -495,8 +496,14 @@ static int32_t sweep(wb_world *w, wb_real h, int32_t *near, int32_t nn)
     wb_real *x = w->s.x, *nds = c->act_nd;
     const wb_real *xp = w->s.x_prev, *wv = m->w, *rad = m->radius, *left = c->left;
     int32_t was_touching = 0;
+    /* the sweeps stop early only once their corrections are small against what gravity
+     * moves a particle in a substep too: stopped at SWEEP_TOL x (r_i + r_j) alone (4e-5 m
+     * for particles of radius 2 cm, more than g h^2 = 2.7e-5 m at 10 substeps) a stack of
+     * three particles on an immovable one never came to rest (1 mm/s) and read 2.44,
+     * 1.58, 0.76 m g for 3, 2, 1 */
+    const wb_real gh2 = v3_len(m->def.gravity) * h * h * SWEEP_G;
     for (int s = 1; s < SWEEPS; s++) {
-        wb_real worst = 0;
+        wb_real worst = 0, worst_abs = 0;
         for (int32_t q = 0; q < nn; q++) {
             const int32_t e = near[q], k = e >= 0 ? c->act[e] : (-e - 1) >> 1;
             const int32_t i = c->ij[2 * k], j = c->ij[2 * k + 1];
@@ -513,6 +520,7 @@ static int32_t sweep(wb_world *w, wb_real h, int32_t *near, int32_t nn)
             if (wi > 0) v3_madd(xi, n, -depth * wi / wsum);
             if (wj > 0) v3_madd(xj, n, depth * wj / wsum);
             if (depth > worst * r) worst = depth / r;
+            if (depth > worst_abs) worst_abs = depth;
             /* old overlap: what the pair overlaps by at x_prev beyond its kept part, which
              * the made overlap of others, pushed out with x_prev since the pass, adds to */
             wb_real dp[3];
@@ -538,7 +546,7 @@ static int32_t sweep(wb_world *w, wb_real h, int32_t *near, int32_t nn)
             nds[ND * a + 5] = old;
             nds[ND * a + 6] = 0;
         }
-        if (worst < SWEEP_TOL) break;
+        if (worst < SWEEP_TOL && worst_abs < gh2) break;
     }
     return was_touching;
 }

@@ -61,6 +61,35 @@ test("a stack of three: the bottom contact carries 2 m g, the top one m g", func
   end
 end)
 
+test("stacks of 2 to 5 with the defaults (radius 0.02, 10 substeps): each contact carries the weight above it, at rest", function()
+  -- loose particles of 1 kg made touching on an immovable one: the same statics as above,
+  -- the bottom contact n m g; and no velocity left (each particle's corrections give back
+  -- exactly the g h^2 it fell: the positions repeat)
+  for n = 2, 5 do
+    local w = wobble.world{}
+    local base = w:particle{ pos = {0, 0.5, 0}, mass = 0 }
+    local q = {}
+    for i = 1, n do q[i] = w:particle{ pos = {0, 0.5 + 0.04 * i, 0}, mass = 1 } end
+    w:run{ seconds = 2 }
+    for _ = 1, 10 do
+      w:step()
+      local below = base
+      for i = 1, n do
+        local c = contact_between(w, below, q[i])
+        assert(c, "no contact under particle " .. i .. " of " .. n)
+        expect.near(c.force, (n - i + 1) * g, 1e-6 * n * g, "stack of " .. n .. ": contact under particle " .. i)
+        below = q[i]
+      end
+      local fastest = 0
+      for i = 1, n do
+        local vx, vy, vz = w:velocity(q[i])
+        fastest = math.max(fastest, math.abs(vx), math.abs(vy), math.abs(vz))
+      end
+      expect.lt(fastest, 1e-9, "stack of " .. n .. ": at rest")
+    end
+  end
+end)
+
 test("contacts off: w:contacts() is empty", function()
   local w = wobble.world{ gravity = {0, -g, 0}, contacts = false }
   w:particle{ pos = {0, 0, 0}, mass = 0, radius = r }
