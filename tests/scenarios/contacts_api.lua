@@ -46,6 +46,7 @@ test("bad contact options are refused, naming the key, changing nothing", functi
   expect.error(function() w:set_self_collide(0, true) end, "group must be a body's group")
   expect.error(function() w:set_self_collide(l.group) end, "boolean expected")
   expect.error(function() w:set_self_collide({}, true) end, "no integer 'group'")
+  expect.error(function() w:set_self_collide(99, true) end, "no particle is in group 99")
   expect.error(function() w:set_self_collide({ group = 1.5 }, true) end, "no integer 'group'")
   expect.error(function() wobble.world{ contacts = 1 } end, "contacts")
   expect.error(function() w:load_particles("../../assets/logo.json", { colide = true }) end, "colide")
