@@ -57,6 +57,9 @@ struct wb_vbd {
     double *csum;          /* (bodies x 17) a free body's contacts in the vertex steps
                               (keep_momentum) */
     uint8_t *bmove;        /* (bodies) 1: its friction goes in its momentum step */
+    uint8_t *bclear;       /* (bodies) 1: free and clear of every collider this substep
+                              (clear_of_colliders) */
+    double *bball;         /* (bodies x 8) its bounds' scratch (clear_of_colliders) */
     int32_t *bvar;         /* (bodies) its index among the free bodies that may touch another
                               body's movable particle, moved with them (wb__vbdc_couple); -1 */
     int32_t nvar;
@@ -65,8 +68,8 @@ struct wb_vbd {
     wb_vbdc *ct;           /* the particle contacts in the vertex steps (vbd_contact.c) */
     int ct_on;             /* ct holds this substep's */
     size_t charged;        /* the struct's and its arrays' bytes charged to def.memory, but for
-                              the parts (their own), tsum, csum, bmove, bvar, vsum
-                              (charged_t) and ct (its own) */
+                              the parts (their own), tsum, csum, bmove, bclear, bball,
+                              bvar, vsum (charged_t) and ct (its own) */
     size_t charged_t;
     int nomem;             /* the last solve ran out of memory (the budget refused its
                               scratch): the step undoes the frame (wb__vbd_failed) */
@@ -98,6 +101,8 @@ void wb__vbd_destroy(wb_world *w)
     free(v->tsum);
     free(v->csum);
     free(v->bmove);
+    free(v->bclear);
+    free(v->bball);
     free(v->bvar);
     free(v->vsum);
     wb__vbdc_destroy(w, v->ct);
@@ -299,20 +304,23 @@ static int touching(wb_world *w, struct wb_vbd *v)
     if (!k->mc_built || k->mc_nbody == 0) return 0;
     const int32_t nb = k->mc_nbody, *body = k->mc_body;
     if (nb > v->cap_tsum) {
-        if (!wb__charge(w, &v->charged_t, (sizeof(double) * (25 + WB_VBDC_BS + 14) + sizeof(int32_t) + 1) * (size_t)nb)) {
+        if (!wb__charge(w, &v->charged_t, (sizeof(double) * (33 + WB_VBDC_BS + 14) + sizeof(int32_t) + 2) * (size_t)nb)) {
             v->nomem = 1;
             return 0;
         }
         double *t = realloc(v->tsum, sizeof *t * 8 * (size_t)nb), *e = realloc(v->csum, sizeof *e * 17 * (size_t)nb);
         double *vs = realloc(v->vsum, sizeof *vs * (WB_VBDC_BS + 14) * (size_t)nb);
-        uint8_t *bm = realloc(v->bmove, (size_t)nb);
+        double *bb = realloc(v->bball, sizeof *bb * 8 * (size_t)nb);
+        uint8_t *bm = realloc(v->bmove, (size_t)nb), *bc = realloc(v->bclear, (size_t)nb);
         int32_t *bv = realloc(v->bvar, sizeof *bv * (size_t)nb);
         if (t) v->tsum = t;
         if (e) v->csum = e;
         if (vs) v->vsum = vs;
+        if (bb) v->bball = bb;
         if (bm) v->bmove = bm;
+        if (bc) v->bclear = bc;
         if (bv) v->bvar = bv;
-        if (!t || !e || !vs || !bm || !bv) {
+        if (!t || !e || !vs || !bb || !bm || !bc || !bv) {
             v->nomem = 1;
             return 0;
         }
@@ -382,33 +390,101 @@ static int touching(wb_world *w, struct wb_vbd *v)
     return 1;
 }
 
-/* The sweeps start from where its speed alone takes a vertex held by a constraint, the
- * prediction less this substep's gravity (x + h v; Chen et al. 2024 list it among their
- * starts), and a free vertex from the prediction, its minimum. A body held by pins or
- * its own links is then at rest a fixed point of a single sweep (from y itself, one sweep
- * a substep never reaches it: a bar of E = 1e7 hung at 18.6 mm where it stretches 0.049
- * mm). Chen et al.'s adaptive start, the prediction less the part of gravity a vertex did
- * not follow last substep, fed the swing of such a body back into its next start (the
- * clamped strip swung on at 10 x 1, 0.63 m against 0.29; the bar crept to 0.8 mm at
- * 10 x 1). A body that nothing holds (no pin, attachment or grab) but that may touch
+/* v->bclear: 1 for each free body (nothing outside the solve holds it) that no collider
+ * can reach this substep. Its ball, the box of its particles at the substep's start and
+ * at the prediction (centre c, half diagonal) grown by its largest radius and by its
+ * largest predicted move again (the solve moves a vertex off the prediction by about as
+ * much as the prediction moves it), is clear of a collider whose signed distance at c,
+ * at the frame's end pose, is past the ball's radius R by the collider's reach over the
+ * frame D = |p - p0| + a (R + |c - p| + |p - p0|), a its turn (a point of the surface
+ * within R of c at any time of the frame is at most a (its distance from the turn's
+ * centre) plus the shift from where it ends). Serial, in particle order. */
+static void clear_of_colliders(wb_world *w, struct wb_vbd *v)
+{
+    const wb_cache *k = &w->k;
+    const int32_t nb = k->mc_nbody, *body = k->mc_body;
+    const wb_real *x = w->s.x, *xp = w->s.x_prev, *rad = w->m.radius;
+    double *B = v->bball; /* (bodies x 8) lo, hi, largest radius, largest squared move */
+    int any = 0;
+    for (int32_t b = 0; b < nb; b++) {
+        v->bclear[b] = !(k->mc_acc[16 * b] < 0);
+        any |= v->bclear[b];
+        for (int c = 0; c < 3; c++) B[8 * b + c] = INFINITY, B[8 * b + 3 + c] = -INFINITY;
+        B[8 * b + 6] = B[8 * b + 7] = 0;
+    }
+    int live = 0;
+    for (int32_t s = 0; s < w->m.nc; s++) live |= (int)(w->m.c_gen[s] & 1u);
+    if (!any || !live) return;
+    for (int32_t i = 0; i < w->m.np; i++) {
+        const int32_t b = body[i];
+        if (b < 0 || !v->bclear[b]) continue;
+        double *o = &B[8 * b], m2 = 0;
+        for (int c = 0; c < 3; c++) {
+            const double a = x[3 * i + c], p = xp[3 * i + c];
+            o[c] = a < o[c] ? a : o[c], o[c] = p < o[c] ? p : o[c];
+            o[3 + c] = a > o[3 + c] ? a : o[3 + c], o[3 + c] = p > o[3 + c] ? p : o[3 + c];
+            m2 += (a - p) * (a - p);
+        }
+        o[6] = rad[i] > o[6] ? rad[i] : o[6];
+        o[7] = m2 > o[7] ? m2 : o[7];
+    }
+    for (int32_t b = 0; b < nb; b++) {
+        if (!v->bclear[b]) continue;
+        const double *o = &B[8 * b];
+        wb_real c[3], n[3];
+        double half = 0;
+        for (int q = 0; q < 3; q++) c[q] = (wb_real)(o[q] / 2 + o[3 + q] / 2), half += (o[3 + q] - o[q]) * (o[3 + q] - o[q]);
+        const double R = sqrt(half) / 2 + o[6] + sqrt(o[7]);
+        for (int32_t s = 0; s < w->m.nc && v->bclear[b]; s++) {
+            if (!(w->m.c_gen[s] & 1u)) continue;
+            const wb_collider_pose *cp = &w->s.c_pose[s];
+            wb_real e[3], f[3];
+            v3_sub(e, cp->p, cp->p0);
+            v3_sub(f, c, cp->p);
+            const double dot = fabs(cp->q0[0] * cp->q[0] + cp->q0[1] * cp->q[1] + cp->q0[2] * cp->q[2] + cp->q0[3] * cp->q[3]);
+            const double turn = 2 * acos(dot < 1 ? dot : 1), shift = v3_len(e);
+            const double D = shift + turn * (R + v3_len(f) + shift);
+            v->bclear[b] = wb__shape_distance(&w->m.c_shape[s], cp->p, cp->q, c, n) > R + D;
+        }
+    }
+}
+
+/* The sweeps start from the prediction y where nothing immovable can touch the body: a
+ * free body clear of every collider (clear_of_colliders) falls as it was made, y being
+ * its rigid move under gravity, where each vertex's energy is at its minimum. From the
+ * prediction less this substep's gravity (x + h v) one sweep of Gauss-Seidel moved each
+ * vertex only part of the way, the multipliers took the rest as tension, and a wavy
+ * chain of 80 rigid links fell bent (0.74 m off its shape after 1 s at 20 substeps).
+ * A vertex held by a constraint of a body that something holds (pins, attachments,
+ * grabs) or that may touch a collider starts from x + h v, where its speed alone takes
+ * it (Chen et al. 2024 list it among their starts): a body held at rest is then a fixed
+ * point of a single sweep (from y itself, one sweep a substep never reaches it: a bar
+ * of E = 1e7 hung at 18.6 mm where it stretches 0.049 mm), and one resting on a
+ * collider, which is projected after the sweeps, stays at rest (from y a hand-built
+ * cloth on a sphere blew up, a draped one did not settle). Chen et al.'s adaptive start,
+ * the prediction less the part of gravity a vertex did not follow last substep, fed the
+ * swing of such a body back into its next start (the clamped strip swung on at 10 x 1,
+ * 0.63 m against 0.29; the bar crept to 0.8 mm at 10 x 1). A free body that may touch
  * another body's movable particle or a rigid body (touching()) starts from the
- * prediction: the contacts carry it (after the sweeps, or in its momentum step with the
- * bodies it touches) and where keep_momentum leaves it alone the gravity it follows is the
- * one its start has (from x + h v, a lattice made overlapping another was lifted 0.25 m
- * instead of 0.15; from the adaptive start, a stack still moved after 4 s). So does a
- * free body near an immovable particle: its contacts in the vertex steps then push from
- * the start (from x + h v a Newton step did not see them, and their multipliers took 8
- * times the weight after it). A held one touching itself keeps x + h v (from y, a pinned
- * rope folding onto itself as it swung gained energy) */
+ * prediction too, near a collider or not: the contacts carry it (after the sweeps, or
+ * in its momentum step with the bodies it touches) and where keep_momentum leaves it
+ * alone the gravity it follows is the one its start has (from x + h v, a lattice made
+ * overlapping another was lifted 0.25 m instead of 0.15; from the adaptive start, a
+ * stack still moved after 4 s). So does a free body near an immovable particle: its
+ * contacts in the vertex steps then push from the start (from x + h v a Newton step did
+ * not see them, and their multipliers took 8 times the weight after it). A held one
+ * touching itself keeps x + h v (from y, a pinned rope folding onto itself as it swung
+ * gained energy) */
 static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h, int touch)
 {
     const wb_real *g = w->m.def.gravity, *wv = w->m.w;
     wb_real *x = w->s.x;
     const int32_t *body = w->k.mc_body;
+    if (touch) clear_of_colliders(w, v);
     for (int32_t i = 0; i < w->m.np; i++) {
         const int32_t b = body ? body[i] : -1;
         const int from_y = touch && b >= 0 && !(w->k.mc_acc[16 * b] < 0) &&
-                           (v->tsum[4 * b] < 0 || v->tsum[4 * w->k.mc_nbody + b] > 0 || v->bvar[b] >= 0);
+                           (v->bclear[b] || v->tsum[4 * b] < 0 || v->tsum[4 * w->k.mc_nbody + b] > 0 || v->bvar[b] >= 0);
         if (!(wv[i] > 0) || !v->held[i] || from_y) continue;
         v3_madd(&x[3 * i], g, -h * h);
     }
