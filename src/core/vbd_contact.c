@@ -732,25 +732,14 @@ int wb__vbdc_couple(wb_world *w, wb_vbdc **cp, const int32_t *bvar, int32_t nv, 
         const int32_t k = c->tk[3 * g], a = c->tk[3 * g + 1], b = c->tk[3 * g + 2];
         const int32_t pp = tc->pt[2 * k], *v = &w->m.tri[3 * tc->pt[2 * k + 1]];
         const wb_real rr = rad[pp];
-        wb_real bc[3], q[3], d[3], e1[3], e2[3], n[3], dp[3];
+        wb_real bc[3], q[3], d[3], n[3], ln, s_prev, s_now, nw[3], depth;
         const wb_real d2 = wb__tri_closest(&x[3 * pp], &x[3 * v[0]], &x[3 * v[1]], &x[3 * v[2]], bc, q);
         v3_sub(d, &x[3 * pp], q);
-        const wb_real dist = sqrt(d2);
-        v3_sub(e1, &xp[3 * v[1]], &xp[3 * v[0]]);
-        v3_sub(e2, &xp[3 * v[2]], &xp[3 * v[0]]);
-        v3_cross(n, e1, e2);
-        v3_sub(dp, &xp[3 * pp], &xp[3 * v[0]]);
-        const wb_real s_prev = v3_dot(dp, n), ln = v3_len(n);
-        double nn[3];
-        v3_sub(dp, &x[3 * pp], &x[3 * v[0]]);
-        if (ln > 0 && s_prev != 0 && v3_dot(dp, n) * s_prev < 0 && bc[0] > 0 && bc[1] > 0 && bc[2] > 0) {
-            /* through the face since the substep began: back to the side it was on */
-            for (int k3 = 0; k3 < 3; k3++) nn[k3] = n[k3] / ln * (s_prev > 0 ? 1 : -1);
-        } else if (dist > rr * (wb_real)1e-9 && dist < rr * WB_VBDC_NEAR) {
-            for (int k3 = 0; k3 < 3; k3++) nn[k3] = d[k3] / dist;
-        } else {
+        /* the projection's normal (wb__tri_normal), within the pairs' reach */
+        wb__tri_side(x, xp, pp, v, n, &ln, &s_prev, &s_now);
+        if (wb__tri_normal(x, xp, pp, v, n, ln, s_prev, s_now, bc, d, d2, sqrt(d2), rr, rr * WB_VBDC_NEAR, nw, &depth) <= 0)
             continue;
-        }
+        const double nn[3] = { nw[0], nw[1], nw[2] };
         const wb_real W = wv[pp] + bc[0] * bc[0] * wv[v[0]] + bc[1] * bc[1] * wv[v[1]] + bc[2] * bc[2] * wv[v[2]];
         if (!(W > 0)) continue;
         wb_real bp[3], qp[3];
