@@ -587,8 +587,8 @@ static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch, wb_real h)
      * as the sweeps leave it (touching()): the contacts projected after the solve would take
      * the step back from one side only (measured: two stacked lattices crept 3 cm off
      * centre, when they were moved alone); one that may touch another body's movable
-     * particles is moved with it (couple) */
-    if (!touch) return;
+     * particles is moved with it (couple); none free (a pinned cloth), nothing to do */
+    if (!touch || k->mc_free == 0) return;
     const wb_real inv_h2 = 1 / (h * h);
     const int32_t nb = k->mc_nbody, *body = k->mc_body;
     double *T = v->tsum;
