@@ -1335,8 +1335,9 @@ static int dvbd_holds(const void *part, int32_t i)
  * speed it stretches at over the substep, as XPBD's (a hard link has none there either);
  * its block is beta / h n n^T.
  * A vertex's links are summed in 4 lanes (link q into lane q % 4, the lanes added as
- * (0 + 1) + (2 + 3)): the AVX2 path below takes 4 links at once and gives these bits. */
-static void links_scalar(const wb_world *w, const dist_vbd *v, int32_t i, wb_real fs[3], wb_real hs[6])
+ * (0 + 1) + (2 + 3)), and that sum added into the vertex step's fs and hs: the AVX2 path
+ * below takes 4 links at once and gives these bits. */
+static inline void links_scalar(const wb_world *w, const dist_vbd *v, int32_t i, wb_real fs[3], wb_real hs[6])
 {
     wb_real F[3][4] = { { 0 } }, Hl[6][4] = { { 0 } };
     const wb_real *x = w->s.x, *xp = w->s.x_prev;
@@ -1360,8 +1361,8 @@ static void links_scalar(const wb_world *w, const dist_vbd *v, int32_t i, wb_rea
         Hl[0][c] += a * d0 * d0 + g, Hl[1][c] += a * d1 * d1 + g, Hl[2][c] += a * d2 * d2 + g;
         Hl[3][c] += a * d0 * d1, Hl[4][c] += a * d0 * d2, Hl[5][c] += a * d1 * d2;
     }
-    for (int c = 0; c < 3; c++) fs[c] = (F[c][0] + F[c][1]) + (F[c][2] + F[c][3]);
-    for (int c = 0; c < 6; c++) hs[c] = (Hl[c][0] + Hl[c][1]) + (Hl[c][2] + Hl[c][3]);
+    for (int c = 0; c < 3; c++) fs[c] += (F[c][0] + F[c][1]) + (F[c][2] + F[c][3]);
+    for (int c = 0; c < 6; c++) hs[c] += (Hl[c][0] + Hl[c][1]) + (Hl[c][2] + Hl[c][3]);
 }
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(WB_FLOAT)
@@ -1374,8 +1375,8 @@ static inline __attribute__((always_inline, target("avx2"))) void sum2(__m256d a
     _mm_storeu_pd(out, _mm_add_pd(_mm256_castpd256_pd128(t), _mm256_extractf128_pd(t, 1)));
 }
 
-static __attribute__((target("avx2"))) void links_avx2(const wb_world *w, const dist_vbd *v, int32_t i, wb_real fs[3],
-                                                       wb_real hs[6])
+static inline __attribute__((always_inline, target("avx2"))) void links_avx2(const wb_world *w, const dist_vbd *v, int32_t i,
+                                                                            wb_real fs[3], wb_real hs[6])
 {
     const wb_real *x = w->s.x, *xp = w->s.x_prev;
     const int32_t e0 = v->adj_start[i], n = v->adj_start[i + 1] - e0;
@@ -1389,8 +1390,10 @@ static __attribute__((target("avx2"))) void links_avx2(const wb_world *w, const 
         wb__load4(x, o, &d0, &d1, &d2);
         d0 = _mm256_sub_pd(xi, d0), d1 = _mm256_sub_pd(yi, d1), d2 = _mm256_sub_pd(zi, d2);
         const __m256d l2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2));
-        const __m256d live = _mm256_cmp_pd(l2, tiny, _CMP_GT_OQ);
-        const __m256d l = _mm256_sqrt_pd(l2), il = _mm256_div_pd(one, l);
+        /* a lane of no link (padding, or both ends at one point) gets 1 / l = 0: its force and
+         * Hessian are then +-0, which leave the sums' bits as they are (a sum from +0 is never
+         * -0), as the scalar loop that skips it */
+        const __m256d l = _mm256_sqrt_pd(l2), il = _mm256_and_pd(_mm256_div_pd(one, l), _mm256_cmp_pd(l2, tiny, _CMP_GT_OQ));
         const __m256d K = _mm256_loadu_pd(&v->ekk[e]), D = _mm256_loadu_pd(&v->edm[e]);
         __m256d fm = _mm256_add_pd(_mm256_mul_pd(K, _mm256_sub_pd(l, _mm256_loadu_pd(&v->etg[e]))), _mm256_loadu_pd(&v->elm[e]));
         __m256d kn = K;
@@ -1410,24 +1413,30 @@ static __attribute__((target("avx2"))) void links_avx2(const wb_world *w, const 
         const __m256d g = _mm256_and_pd(_mm256_mul_pd(fm, il), _mm256_cmp_pd(fm, zero, _CMP_GT_OQ));
         const __m256d a = _mm256_mul_pd(_mm256_mul_pd(_mm256_sub_pd(kn, g), il), il), fl = _mm256_mul_pd(fm, il);
         const __m256d ad0 = _mm256_mul_pd(a, d0), ad1 = _mm256_mul_pd(a, d1);
-        f0 = _mm256_sub_pd(f0, _mm256_and_pd(_mm256_mul_pd(fl, d0), live));
-        f1 = _mm256_sub_pd(f1, _mm256_and_pd(_mm256_mul_pd(fl, d1), live));
-        f2 = _mm256_sub_pd(f2, _mm256_and_pd(_mm256_mul_pd(fl, d2), live));
-        h0 = _mm256_add_pd(h0, _mm256_and_pd(_mm256_add_pd(_mm256_mul_pd(ad0, d0), g), live));
-        h1 = _mm256_add_pd(h1, _mm256_and_pd(_mm256_add_pd(_mm256_mul_pd(ad1, d1), g), live));
-        h2 = _mm256_add_pd(h2, _mm256_and_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_mul_pd(a, d2), d2), g), live));
-        h3 = _mm256_add_pd(h3, _mm256_and_pd(_mm256_mul_pd(ad0, d1), live));
-        h4 = _mm256_add_pd(h4, _mm256_and_pd(_mm256_mul_pd(ad0, d2), live));
-        h5 = _mm256_add_pd(h5, _mm256_and_pd(_mm256_mul_pd(ad1, d2), live));
+        f0 = _mm256_sub_pd(f0, _mm256_mul_pd(fl, d0));
+        f1 = _mm256_sub_pd(f1, _mm256_mul_pd(fl, d1));
+        f2 = _mm256_sub_pd(f2, _mm256_mul_pd(fl, d2));
+        h0 = _mm256_add_pd(h0, _mm256_add_pd(_mm256_mul_pd(ad0, d0), g));
+        h1 = _mm256_add_pd(h1, _mm256_add_pd(_mm256_mul_pd(ad1, d1), g));
+        h2 = _mm256_add_pd(h2, _mm256_add_pd(_mm256_mul_pd(_mm256_mul_pd(a, d2), d2), g));
+        h3 = _mm256_add_pd(h3, _mm256_mul_pd(ad0, d1));
+        h4 = _mm256_add_pd(h4, _mm256_mul_pd(ad0, d2));
+        h5 = _mm256_add_pd(h5, _mm256_mul_pd(ad1, d2));
     }
-    wb_real t[2];
-    sum2(f0, f1, fs);
-    sum2(f2, h0, t);
-    fs[2] = t[0], hs[0] = t[1];
-    sum2(h1, h2, hs + 1);
-    sum2(h3, h4, hs + 3);
-    sum2(h5, h5, t);
-    hs[5] = t[0];
+    wb_real t[10];
+    sum2(f0, f1, t);
+    sum2(f2, h0, t + 2);
+    sum2(h1, h2, t + 4);
+    sum2(h3, h4, t + 6);
+    sum2(h5, h5, t + 8);
+    fs[0] += t[0], fs[1] += t[1], fs[2] += t[2];
+    hs[0] += t[3], hs[1] += t[4], hs[2] += t[5], hs[3] += t[6], hs[4] += t[7], hs[5] += t[8];
+}
+
+static __attribute__((target("avx2"))) void links_avx2_run(const wb_world *w, const dist_vbd *v, const int32_t *vert,
+                                                           int32_t n, wb_real *f, wb_real *H)
+{
+    for (int32_t k = 0; k < n; k++) links_avx2(w, v, vert[k], &f[3 * k], &H[6 * k]);
 }
 #endif
 
@@ -1440,22 +1449,21 @@ static int vbd_simd_state = -1;
 int wb__distance_vbd_simd(int on);
 int wb__distance_vbd_simd(int on) { return wb__simd_set(&vbd_simd_state, on); }
 
-/* the vertex step at i: its links' force and Hessian added into f and H */
-static void dvbd_vertex(const wb_world *w, const void *part, int32_t i, wb_real inv_h, wb_real f[3], wb_real H[6])
+/* the vertex steps at vert[0 .. n): their links' forces and Hessians added into f and H */
+static void dvbd_vertex(const wb_world *w, const void *part, const int32_t *vert, int32_t n, wb_real inv_h, wb_real *f,
+                        wb_real *H)
 {
     (void)inv_h;
     const dist_vbd *v = part;
-    wb_real F[3], Hl[6];
 #ifdef WB_DISTANCE_VBD_AVX2
     int s = __atomic_load_n(&vbd_simd_state, __ATOMIC_RELAXED);
     if (s < 0) s = wb__distance_vbd_simd(1);
-    if (s) links_avx2(w, v, i, F, Hl);
-    else links_scalar(w, v, i, F, Hl);
-#else
-    links_scalar(w, v, i, F, Hl);
+    if (s) {
+        links_avx2_run(w, v, vert, n, f, H);
+        return;
+    }
 #endif
-    for (int c = 0; c < 3; c++) f[c] += F[c];
-    for (int c = 0; c < 6; c++) H[c] += Hl[c];
+    for (int32_t k = 0; k < n; k++) links_scalar(w, v, vert[k], &f[3 * k], &H[6 * k]);
 }
 
 /* the inertia of a hard link's ends over the substep, 1 / (h^2 (w_i + w_j)) */

@@ -235,7 +235,7 @@ void wb__vbd_undo(wb_world *w)
 
 /* ---- the vertex step ------------------------------------------------------------------------ */
 /* solve the symmetric 3 x 3 system H d = f (H: xx, yy, zz, xy, xz, yz); 0 when singular */
-static int solve3(const wb_real H[6], const wb_real f[3], wb_real d[3])
+static inline __attribute__((always_inline)) int solve3(const wb_real H[6], const wb_real f[3], wb_real d[3])
 {
     const wb_real a = H[0], b = H[1], c = H[2], xy = H[3], xz = H[4], yz = H[5];
     const wb_real c00 = b * c - yz * yz, c01 = xz * yz - xy * c, c02 = xy * yz - b * xz;
@@ -255,7 +255,14 @@ typedef struct sweep_job {
     const int32_t *vert;   /* the colour's vertices */
     wb_real step;          /* the largest step taken (max_into) */
     const wb_vbdc *ct;     /* the substep's contacts, NULL: none */
+    int32_t run;           /* vertices whose forces are found before any of them moves: VBD_RUN,
+                              1 in the last colour when it may hold neighbours (serial_last) */
 } sweep_job;
+
+/* A colour's vertices share no constraint, so the forces on a run of them can all be found
+ * before any moves (the same bits as one after another): each type's hook is called once a
+ * run, not once a vertex */
+#define VBD_RUN 64
 
 /* con: the substep has contacts in the vertex steps (two copies: the loop without them
  * stays as it was) */
@@ -265,28 +272,45 @@ static inline __attribute__((always_inline)) void sweep_body(void *ctx, int32_t 
     wb_world *w = j->w;
     const struct wb_vbd *v = j->v;
     wb_real *x = w->s.x;
-    const wb_real *wv = w->m.w;
+    const wb_real *wv = w->m.w, *y = v->y, inv_h2 = j->inv_h2, inv_h = j->inv_h;
+    const int32_t *vert = j->vert, run = j->run;
+    const int nact = v->nact;
+    const wb_vbd_type *const *act = v->act;
+    void *const *part = v->act_part;
     wb_real big = 0;
-    for (int32_t q = lo; q < hi; q++) {
-        const int32_t i = j->vert[q];
-        if (!(wv[i] > 0)) continue;
-        const wb_real mh = j->inv_h2 / wv[i];
-        /* the inertia term, then each type's constraints at i (0 + first: a sum starting at
-         * +0, as each type's own sums do, so the order of the terms is all that decides) */
-        wb_real f[3], H[6] = { mh, mh, mh, 0, 0, 0 }, d[3];
-        for (int c = 0; c < 3; c++) f[c] = (wb_real)0 + mh * (v->y[3 * i + c] - x[3 * i + c]);
-        for (int t = 0; t < v->nact; t++) v->act[t]->vertex(w, v->act_part[t], i, j->inv_h, f, H);
-        if (con) wb__vbdc_block(w, j->ct, i, f, H);
-        if (!solve3(H, f, d)) continue;
-        if (con) {
-            wb_real xn[3];
-            v3_add(xn, &x[3 * i], d);
-            wb__vbdc_friction(w, j->ct, i, H, xn);
-            v3_sub(d, xn, &x[3 * i]);
+    for (int32_t q0 = lo; q0 < hi; q0 += run) {
+        const int32_t q1 = hi - q0 > run ? q0 + run : hi;
+        int32_t idx[VBD_RUN], n = 0;
+        wb_real f[3 * VBD_RUN], H[6 * VBD_RUN];
+        /* the inertia term of each movable vertex, then each type's constraints at them (0 +
+         * first: a sum starting at +0, as each type's own sums do, so the order of the terms
+         * is all that decides) */
+        for (int32_t q = q0; q < q1; q++) {
+            const int32_t i = vert[q];
+            if (!(wv[i] > 0)) continue;
+            const wb_real mh = inv_h2 / wv[i], *xi = &x[3 * i], *yi = &y[3 * i];
+            wb_real *fk = &f[3 * n], *Hk = &H[6 * n];
+            fk[0] = (wb_real)0 + mh * (yi[0] - xi[0]), fk[1] = (wb_real)0 + mh * (yi[1] - xi[1]);
+            fk[2] = (wb_real)0 + mh * (yi[2] - xi[2]);
+            Hk[0] = Hk[1] = Hk[2] = mh, Hk[3] = Hk[4] = Hk[5] = 0;
+            idx[n++] = i;
         }
-        v3_add(&x[3 * i], &x[3 * i], d);
-        const wb_real dd = v3_dot(d, d);
-        big = dd > big ? dd : big;
+        for (int t = 0; t < nact; t++) act[t]->vertex(w, part[t], idx, n, inv_h, f, H);
+        for (int32_t k = 0; k < n; k++) {
+            const int32_t i = idx[k];
+            wb_real *fk = &f[3 * k], *Hk = &H[6 * k], d[3];
+            if (con) wb__vbdc_block(w, j->ct, i, fk, Hk);
+            if (!solve3(Hk, fk, d)) continue;
+            if (con) {
+                wb_real xn[3];
+                v3_add(xn, &x[3 * i], d);
+                wb__vbdc_friction(w, j->ct, i, Hk, xn);
+                v3_sub(d, xn, &x[3 * i]);
+            }
+            v3_add(&x[3 * i], &x[3 * i], d);
+            const wb_real dd = v3_dot(d, d);
+            big = dd > big ? dd : big;
+        }
     }
     wb_real cur;
     __atomic_load(&j->step, &cur, __ATOMIC_RELAXED);
@@ -726,12 +750,13 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     wb_vbdc *cs = nvc > 0 ? ct : NULL;
     wb_pool *pool = wb__world_pool(w);
     for (int it = 0; it < w->m.def.iterations; it++) {
-        sweep_job j = { w, v, inv_h2, 1 / h, NULL, 0, cs };
+        sweep_job j = { w, v, inv_h2, 1 / h, NULL, 0, cs, VBD_RUN };
         if (cs && it > 0) wb__vbdc_refresh(w, cs, v->ncolours);
         for (int32_t c = 0; c < v->ncolours; c++) {
             const int32_t lo = v->colour_start[c], n = v->colour_start[c + 1] - lo;
             j.vert = v->order + lo;
             const int serial = v->serial_last && c == v->ncolours - 1;
+            j.run = serial ? 1 : VBD_RUN;
             wb__pool_for(serial ? NULL : pool, n, 1024, cs ? sweep_part_ct : sweep_part, &j);
             if (cs) wb__vbdc_colour_done(w, cs, c);
         }
