@@ -1086,12 +1086,11 @@ static inline wb_real made_d2(const wb_model *m, int32_t i, int32_t j)
 
 /* The rule's bounds by made distance (near2, far2), so that most pairs are decided
  * without searching the keys: a hand-built net or a cloth finds its rest neighbours in
- * the search every frame (a hundred and more a particle with the default radius over a
- * fine net) and rejected each by a search of its keys. far2: the farthest a key of the
- * particle was made. near2: the nearest a particle of its body or graph that is no rest
- * neighbour was made, found by a search of the made positions within ALONG (r_i + r_j)
- * (beyond that the along rule keeps none: the bound stops there, with the least radius).
- * 0 when out of memory */
+ * the search every frame (dozens a particle with the default radius over a fine net) and
+ * rejected each by a search of its keys. far2: the farthest a key of the particle was
+ * made. near2: the nearest a particle of its body or graph that is no rest neighbour was
+ * made, found by one search of the made positions (below: as far as it was searched).
+ * Worked out with the rules; 0 when out of memory */
 static int one_graph_rule(const wb_world *w, int32_t i, int32_t j, int bounds);
 
 static int made_bounds(wb_world *w)
