@@ -291,8 +291,8 @@ static void sweep_part_ct(void *ctx, int32_t lo, int32_t hi) { sweep_body(ctx, l
 /* v->tsum (bodies x 4) zeroed, with [4 b] = -1 for each body b that may touch a rigid body,
  * a movable particle of a body made deep inside it or a triangle held in part this frame
  * (the contacts found for the frame), v->bvar numbering the free bodies that may touch
- * another body's movable particles otherwise (moved together: couple); 0 when there are
- * no bodies (or no memory) */
+ * another free body's movable particles otherwise (moved together: couple); 0 when there
+ * are no bodies (or no memory) */
 static int touching(wb_world *w, struct wb_vbd *v)
 {
     const wb_cache *k = &w->k;
@@ -341,18 +341,24 @@ static int touching(wb_world *w, struct wb_vbd *v)
         }
         if (a < 0 || b < 0 || a == b) continue;
         /* (marked here, numbered below; bodies made deep inside each other are contact.c's
-         * to part) */
+         * to part). A held body's movable particle puts no one in the coupled step: the
+         * step cannot move a held body, and as a wall there its particle gave the free
+         * body the pair's whole push, which the projection after the sweeps gives again
+         * and shares with the held end: a chain of rigid links dropped upright on a net
+         * pinned at its rim was stopped whole by its lowest contact and stood as a rod
+         * (chain_pile.lua: its top 0.62 m above free fall). The body keeps its momentum
+         * through the sweeps and the projection takes the pair, as on a collider */
         wb_real e[3];
         v3_sub(e, &xp[3 * i], &xp[3 * j]);
         const wb_real rs = (rad[i] + rad[j]) * VBD_MADE_DEEP;
         const int made = wb__contacts_made(w, i, j) || v3_dot(e, e) < rs * rs;
         if (wv[j] > 0) {
             if (made) T[4 * a] = -1;
-            else if (v->bvar[a] < 0) v->bvar[a] = 0;
+            else if (v->bvar[a] < 0 && !(k->mc_acc[16 * b] < 0)) v->bvar[a] = 0;
         }
         if (wv[i] > 0) {
             if (made) T[4 * b] = -1;
-            else if (v->bvar[b] < 0) v->bvar[b] = 0;
+            else if (v->bvar[b] < 0 && !(k->mc_acc[16 * a] < 0)) v->bvar[b] = 0;
         }
     }
     const wb_tricontacts *tc = k->tc;
@@ -360,22 +366,26 @@ static int touching(wb_world *w, struct wb_vbd *v)
         const int32_t t = tc->pt[2 * c + 1], p[4] = { tc->pt[2 * c], w->m.tri[3 * t], w->m.tri[3 * t + 1], w->m.tri[3 * t + 2] };
         const int32_t a = body[p[0]], b = body[p[1]];
         if (a < 0 || b < 0 || a == b) continue;
-        /* (a triangle of one body, all its corners movable: in the coupled step) */
+        /* (a triangle of one body, all its corners movable: in the coupled step unless that
+         * body is held, then the projection's as a held particle's) */
         const int made = wb__contacts_made(w, p[0], p[1]);
         const int whole = !made && body[p[2]] == b && body[p[3]] == b && wv[p[1]] > 0 && wv[p[2]] > 0 && wv[p[3]] > 0;
-        if (whole) v->bvar[a] = v->bvar[a] < 0 ? 0 : v->bvar[a];
-        else if (wv[p[1]] > 0 || wv[p[2]] > 0 || wv[p[3]] > 0) T[4 * a] = -1;
+        if (whole) {
+            if (!(k->mc_acc[16 * b] < 0)) v->bvar[a] = v->bvar[a] < 0 ? 0 : v->bvar[a];
+        } else if (wv[p[1]] > 0 || wv[p[2]] > 0 || wv[p[3]] > 0) {
+            T[4 * a] = -1;
+        }
         if (wv[p[0]] > 0) {
             if (made) T[4 * b] = -1;
-            else if (v->bvar[b] < 0) v->bvar[b] = 0;
+            else if (v->bvar[b] < 0 && !(k->mc_acc[16 * a] < 0)) v->bvar[b] = 0;
         }
     }
     if (w->rb)
         for (int32_t c = 0; c < w->rb->npct; c++)
             if (body[w->rb->pc[2 * c]] >= 0) T[4 * body[w->rb->pc[2 * c]]] = -1;
-    /* a free body that may touch another body's movable particle is moved with the bodies
-     * it may touch (keep_momentum), unless it is held or touches what that step does not
-     * take in (a rigid body, a triangle of another body held in part) */
+    /* a free body that may touch another free body's movable particle is moved with the
+     * bodies it may touch (keep_momentum), unless it is held or touches what that step does
+     * not take in (a rigid body, a triangle of another body held in part) */
     v->nvar = 0;
     for (int32_t b = 0; b < nb; b++)
         v->bvar[b] = v->bvar[b] == 0 && !(T[4 * b] < 0) && !(k->mc_acc[16 * b] < 0) ? v->nvar++ : -1;

@@ -188,8 +188,9 @@ static int grow(wb_world *w, wb_vbdc *c, int32_t np, int32_t npair, int32_t ncol
 }
 
 /* candidate k is a pair it serves, closer than VBDC_NEAR (r_i + r_j): one movable end (see
- * the head of the file for why not two), or two movable ends of two bodies, one of them
- * moved with its partners (bvar: its index there, -1 none; NULL: no such bodies) */
+ * the head of the file for why not two), or two movable ends of two bodies, neither held,
+ * one of them moved with its partners (bvar: its index there, -1 none; NULL: no such
+ * bodies) */
 static inline int near_pair(const wb_world *w, const wb_contacts *pc, const wb_real *x, const wb_real *wv, const wb_real *rad,
                             const int32_t *body, const int32_t *bvar, wb_real step_h, int32_t k)
 {
@@ -198,6 +199,9 @@ static inline int near_pair(const wb_world *w, const wb_contacts *pc, const wb_r
         if (!bvar || !(wv[i] > 0)) return 0;
         const int32_t a = body[i], b = body[j];
         if (a < 0 || b < 0 || a == b || (bvar[a] < 0 && bvar[b] < 0) || wb__contacts_made(w, i, j)) return 0;
+        /* (a held body's movable particle is no wall of the step: the projection's, vbd.c's
+         * touching()) */
+        if (w->k.mc_acc[16 * a] < 0 || w->k.mc_acc[16 * b] < 0) return 0;
         /* made overlapping (more than a substep's depenetration at its start): the
          * projection's to part slowly, pair by pair */
         const wb_real *xp = w->s.x_prev, rs = rad[i] + rad[j] - w->m.def.max_depenetration * step_h;
@@ -626,8 +630,11 @@ static int tri_between(const wb_world *w, const int32_t *bvar, int32_t k, int32_
     const wb_real *wv = w->m.w;
     const int32_t bp = body[p], bt = body[v[0]];
     if (bp < 0 || bt < 0 || bp == bt || body[v[1]] != bt || body[v[2]] != bt || wb__contacts_made(w, p, v[0])) return 0;
+    const int tmove = wv[v[0]] > 0 && wv[v[1]] > 0 && wv[v[2]] > 0;
+    /* (a held body's movable point or triangle is no wall of the step: the projection's) */
+    if ((wv[p] > 0 && w->k.mc_acc[16 * bp] < 0) || (tmove && w->k.mc_acc[16 * bt] < 0)) return 0;
     *a = wv[p] > 0 ? bvar[bp] : -1;
-    *b = wv[v[0]] > 0 && wv[v[1]] > 0 && wv[v[2]] > 0 ? bvar[bt] : -1;
+    *b = tmove ? bvar[bt] : -1;
     return *a >= 0 || *b >= 0;
 }
 
