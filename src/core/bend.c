@@ -974,10 +974,13 @@ static void bvbd_dual(wb_world *w, void *part, wb_real h, int last)
     }
 }
 
-static void bvbd_vertex(const wb_world *w, const void *part, int32_t i, wb_real inv_h, wb_real f[3], wb_real H[6])
+static void bvbd_vertex(const wb_world *w, const void *part, const int32_t *vert, int32_t n, wb_real inv_h, wb_real *f,
+                        wb_real *H)
 {
     const bend_vbd *v = part;
-    for (int32_t e = v->at.start[i]; e < v->at.start[i + 1]; e++) bend_block(w, v, v->at.adj[e], inv_h, f, H);
+    for (int32_t k = 0; k < n; k++)
+        for (int32_t e = v->at.start[vert[k]]; e < v->at.start[vert[k] + 1]; e++)
+            bend_block(w, v, v->at.adj[e], inv_h, &f[3 * k], &H[6 * k]);
 }
 
 /* what force() and break_torque read of a soft bend, off / alpha (a hard one's:

@@ -1206,7 +1206,8 @@ typedef struct dist_vbd {
     int32_t nd;            /* the slots it was built for */
     int32_t *adj_start;    /* (np + 1) each vertex's range of adj, padded to a multiple of 4 */
     int32_t *adj;          /* link slots touching each vertex (-1: padding) */
-    int32_t *adjo;         /* the other end of each of them (padding: the vertex itself) */
+    int32_t *adjo;         /* the other end j of each of them as its offset in x, 3 j (padding:
+                              the vertex itself) */
     wb_real *ekk, *etg, *elm, *edm; /* each entry's link as the sweep reads it (vbd_link's kk,
                               tgt, lm, dmp; padding 0): 4 entries in one load each */
     int32_t *epos;         /* (2 nd) the two entries of each link */
@@ -1218,6 +1219,7 @@ typedef struct dist_vbd {
     int32_t *hard;         /* (cap) the live hard links' slots, this substep, from the front
                               (nhard), and the stiff ones' from the back (nstiff) */
     int32_t nhard, nstiff, cap;
+    int damped;            /* some link has a damping in the vertex steps this substep */
     wb_real *save;         /* (2 cap + 1) lam and c0 at the step's start (an undone frame) */
     int restored;          /* made from a snapshot image: the next build keeps c0 (the image
                               holds what the saved world's next step starts from) */
@@ -1280,11 +1282,11 @@ static int dvbd_build(wb_world *w, void *part)
     for (int32_t s = 0; s < nd; s++) {
         if (!packable(ds, s)) continue;
         const int32_t a = ds->ij[2 * s], b = ds->ij[2 * s + 1];
-        epos[2 * s] = fill[a], adjo[fill[a]] = b, adj[fill[a]++] = s;
-        epos[2 * s + 1] = fill[b], adjo[fill[b]] = a, adj[fill[b]++] = s;
+        epos[2 * s] = fill[a], adjo[fill[a]] = 3 * b, adj[fill[a]++] = s;
+        epos[2 * s + 1] = fill[b], adjo[fill[b]] = 3 * a, adj[fill[b]++] = s;
     }
     for (int32_t i = 0; i < np; i++)
-        for (int32_t e = fill[i]; e < start[i + 1]; e++) adj[e] = -1, adjo[e] = i;
+        for (int32_t e = fill[i]; e < start[i + 1]; e++) adj[e] = -1, adjo[e] = 3 * i;
     free(fill);
     free(v->adj_start), free(v->adj), free(v->adjo), free(v->epos);
     free(v->ekk), free(v->etg), free(v->elm), free(v->edm);
@@ -1316,7 +1318,7 @@ static uint64_t dvbd_neighbours(const wb_world *w, const void *part, int32_t i, 
     uint64_t used = 0;
     for (int32_t e = v->adj_start[i]; e < v->adj_start[i + 1]; e++) {
         if (v->adj[e] < 0) continue;
-        const int32_t j = v->adjo[e];
+        const int32_t j = v->adjo[e] / 3;
         if (j < i) used |= (uint64_t)1 << col[j];
     }
     return used;
@@ -1335,23 +1337,24 @@ static int dvbd_holds(const void *part, int32_t i)
  * speed it stretches at over the substep, as XPBD's (a hard link has none there either);
  * its block is beta / h n n^T.
  * A vertex's links are summed in 4 lanes (link q into lane q % 4, the lanes added as
- * (0 + 1) + (2 + 3)): the AVX2 path below takes 4 links at once and gives these bits. */
-static void links_scalar(const wb_world *w, const dist_vbd *v, int32_t i, wb_real fs[3], wb_real hs[6])
+ * (0 + 1) + (2 + 3)), and that sum added into the vertex step's fs and hs: the AVX2 path
+ * below takes 4 links at once and gives these bits. */
+static inline void links_scalar(const wb_world *w, const dist_vbd *v, int32_t i, wb_real fs[3], wb_real hs[6])
 {
     wb_real F[3][4] = { { 0 } }, Hl[6][4] = { { 0 } };
     const wb_real *x = w->s.x, *xp = w->s.x_prev;
     const int32_t e0 = v->adj_start[i], n = v->adj_start[i + 1] - e0;
     for (int32_t q = 0; q < n; q++) {
         if (v->adj[e0 + q] < 0) continue;
-        const int32_t j = v->adjo[e0 + q], c = q & 3;
+        const int32_t j = v->adjo[e0 + q], c = q & 3; /* (3 j) */
         const vbd_link *L = &v->lk[v->adj[e0 + q]];
-        const wb_real d0 = x[3 * i] - x[3 * j], d1 = x[3 * i + 1] - x[3 * j + 1], d2 = x[3 * i + 2] - x[3 * j + 2];
+        const wb_real d0 = x[3 * i] - x[j], d1 = x[3 * i + 1] - x[j + 1], d2 = x[3 * i + 2] - x[j + 2];
         const wb_real l2 = d0 * d0 + d1 * d1 + d2 * d2;
         if (!(l2 > 1e-24)) continue;
         const wb_real l = sqrt(l2), il = 1 / l;
         wb_real fm = L->kk * (l - L->tgt) + L->lm, kn = L->kk;
         if (L->dmp > 0) {
-            const wb_real u = d0 * (xp[3 * j] - xp[3 * i]) + d1 * (xp[3 * j + 1] - xp[3 * i + 1]) + d2 * (xp[3 * j + 2] - xp[3 * i + 2]);
+            const wb_real u = d0 * (xp[j] - xp[3 * i]) + d1 * (xp[j + 1] - xp[3 * i + 1]) + d2 * (xp[j + 2] - xp[3 * i + 2]);
             fm = fm + L->dmp * (l + u * il);
             kn = kn + L->dmp;
         }
@@ -1360,8 +1363,8 @@ static void links_scalar(const wb_world *w, const dist_vbd *v, int32_t i, wb_rea
         Hl[0][c] += a * d0 * d0 + g, Hl[1][c] += a * d1 * d1 + g, Hl[2][c] += a * d2 * d2 + g;
         Hl[3][c] += a * d0 * d1, Hl[4][c] += a * d0 * d2, Hl[5][c] += a * d1 * d2;
     }
-    for (int c = 0; c < 3; c++) fs[c] = (F[c][0] + F[c][1]) + (F[c][2] + F[c][3]);
-    for (int c = 0; c < 6; c++) hs[c] = (Hl[c][0] + Hl[c][1]) + (Hl[c][2] + Hl[c][3]);
+    for (int c = 0; c < 3; c++) fs[c] += (F[c][0] + F[c][1]) + (F[c][2] + F[c][3]);
+    for (int c = 0; c < 6; c++) hs[c] += (Hl[c][0] + Hl[c][1]) + (Hl[c][2] + Hl[c][3]);
 }
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(WB_FLOAT)
@@ -1374,27 +1377,30 @@ static inline __attribute__((always_inline, target("avx2"))) void sum2(__m256d a
     _mm_storeu_pd(out, _mm_add_pd(_mm256_castpd256_pd128(t), _mm256_extractf128_pd(t, 1)));
 }
 
-static __attribute__((target("avx2"))) void links_avx2(const wb_world *w, const dist_vbd *v, int32_t i, wb_real fs[3],
-                                                       wb_real hs[6])
+/* one group of 4 of vertex i's links (entries e .. e + 3; xi: i's position in each lane)
+ * added into its lane sums s (f0, f1, f2, h0 .. h5). damped 0: no link of the part has a
+ * damping, whose test the loop then leaves out */
+static inline __attribute__((always_inline, target("avx2"))) void
+link_group(const wb_real *x, const wb_real *xp, const dist_vbd *v, int32_t i, int32_t e, const __m256d xi[3], __m256d s[9],
+           int damped)
 {
-    const wb_real *x = w->s.x, *xp = w->s.x_prev;
-    const int32_t e0 = v->adj_start[i], n = v->adj_start[i + 1] - e0;
-    __m256d f0 = _mm256_setzero_pd(), f1 = f0, f2 = f0, h0 = f0, h1 = f0, h2 = f0, h3 = f0, h4 = f0, h5 = f0;
-    const __m256d xi = _mm256_set1_pd(x[3 * i]), yi = _mm256_set1_pd(x[3 * i + 1]), zi = _mm256_set1_pd(x[3 * i + 2]);
     const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1), tiny = _mm256_set1_pd(1e-24);
-    for (int32_t q = 0; q < n; q += 4) {
-        const int32_t e = e0 + q, *j = &v->adjo[e];
-        const size_t o[4] = { 3 * (size_t)j[0], 3 * (size_t)j[1], 3 * (size_t)j[2], 3 * (size_t)j[3] };
-        __m256d d0, d1, d2;
-        wb__load4(x, o, &d0, &d1, &d2);
-        d0 = _mm256_sub_pd(xi, d0), d1 = _mm256_sub_pd(yi, d1), d2 = _mm256_sub_pd(zi, d2);
-        const __m256d l2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2));
-        const __m256d live = _mm256_cmp_pd(l2, tiny, _CMP_GT_OQ);
-        const __m256d l = _mm256_sqrt_pd(l2), il = _mm256_div_pd(one, l);
-        const __m256d K = _mm256_loadu_pd(&v->ekk[e]), D = _mm256_loadu_pd(&v->edm[e]);
-        __m256d fm = _mm256_add_pd(_mm256_mul_pd(K, _mm256_sub_pd(l, _mm256_loadu_pd(&v->etg[e]))), _mm256_loadu_pd(&v->elm[e]));
-        __m256d kn = K;
-        if (_mm256_movemask_pd(_mm256_cmp_pd(D, zero, _CMP_GT_OQ))) {
+    const int32_t *j = &v->adjo[e];
+    const size_t o[4] = { (size_t)j[0], (size_t)j[1], (size_t)j[2], (size_t)j[3] };
+    __m256d d0, d1, d2;
+    wb__load4(x, o, &d0, &d1, &d2);
+    d0 = _mm256_sub_pd(xi[0], d0), d1 = _mm256_sub_pd(xi[1], d1), d2 = _mm256_sub_pd(xi[2], d2);
+    const __m256d l2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2));
+    /* a lane of no link (padding, or both ends at one point) gets 1 / l = 0: its force and
+     * Hessian are then +-0, which leave the sums' bits as they are (a sum from +0 is never
+     * -0), as the scalar loop that skips it */
+    const __m256d l = _mm256_sqrt_pd(l2), il = _mm256_and_pd(_mm256_div_pd(one, l), _mm256_cmp_pd(l2, tiny, _CMP_GT_OQ));
+    const __m256d K = _mm256_loadu_pd(&v->ekk[e]);
+    __m256d fm = _mm256_add_pd(_mm256_mul_pd(K, _mm256_sub_pd(l, _mm256_loadu_pd(&v->etg[e]))), _mm256_loadu_pd(&v->elm[e]));
+    __m256d kn = K;
+    if (damped) {
+        const __m256d D = _mm256_loadu_pd(&v->edm[e]), on = _mm256_cmp_pd(D, zero, _CMP_GT_OQ);
+        if (_mm256_movemask_pd(on)) {
             /* the damped lanes only (a lane of dmp 0 would add 0 times a finite number: the
              * same fm, never -0, but the scalar loop does not add it) */
             __m256d u0, u1, u2;
@@ -1404,30 +1410,94 @@ static __attribute__((target("avx2"))) void links_avx2(const wb_world *w, const 
             u2 = _mm256_sub_pd(u2, _mm256_set1_pd(xp[3 * i + 2]));
             const __m256d u = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, u0), _mm256_mul_pd(d1, u1)), _mm256_mul_pd(d2, u2));
             const __m256d dfm = _mm256_mul_pd(D, _mm256_add_pd(l, _mm256_mul_pd(u, il)));
-            fm = _mm256_blendv_pd(fm, _mm256_add_pd(fm, dfm), _mm256_cmp_pd(D, zero, _CMP_GT_OQ));
-            kn = _mm256_blendv_pd(kn, _mm256_add_pd(kn, D), _mm256_cmp_pd(D, zero, _CMP_GT_OQ));
+            fm = _mm256_blendv_pd(fm, _mm256_add_pd(fm, dfm), on);
+            kn = _mm256_blendv_pd(kn, _mm256_add_pd(kn, D), on);
         }
-        const __m256d g = _mm256_and_pd(_mm256_mul_pd(fm, il), _mm256_cmp_pd(fm, zero, _CMP_GT_OQ));
-        const __m256d a = _mm256_mul_pd(_mm256_mul_pd(_mm256_sub_pd(kn, g), il), il), fl = _mm256_mul_pd(fm, il);
-        const __m256d ad0 = _mm256_mul_pd(a, d0), ad1 = _mm256_mul_pd(a, d1);
-        f0 = _mm256_sub_pd(f0, _mm256_and_pd(_mm256_mul_pd(fl, d0), live));
-        f1 = _mm256_sub_pd(f1, _mm256_and_pd(_mm256_mul_pd(fl, d1), live));
-        f2 = _mm256_sub_pd(f2, _mm256_and_pd(_mm256_mul_pd(fl, d2), live));
-        h0 = _mm256_add_pd(h0, _mm256_and_pd(_mm256_add_pd(_mm256_mul_pd(ad0, d0), g), live));
-        h1 = _mm256_add_pd(h1, _mm256_and_pd(_mm256_add_pd(_mm256_mul_pd(ad1, d1), g), live));
-        h2 = _mm256_add_pd(h2, _mm256_and_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_mul_pd(a, d2), d2), g), live));
-        h3 = _mm256_add_pd(h3, _mm256_and_pd(_mm256_mul_pd(ad0, d1), live));
-        h4 = _mm256_add_pd(h4, _mm256_and_pd(_mm256_mul_pd(ad0, d2), live));
-        h5 = _mm256_add_pd(h5, _mm256_and_pd(_mm256_mul_pd(ad1, d2), live));
     }
-    wb_real t[2];
-    sum2(f0, f1, fs);
-    sum2(f2, h0, t);
-    fs[2] = t[0], hs[0] = t[1];
-    sum2(h1, h2, hs + 1);
-    sum2(h3, h4, hs + 3);
-    sum2(h5, h5, t);
-    hs[5] = t[0];
+    const __m256d g = _mm256_and_pd(_mm256_mul_pd(fm, il), _mm256_cmp_pd(fm, zero, _CMP_GT_OQ));
+    const __m256d a = _mm256_mul_pd(_mm256_mul_pd(_mm256_sub_pd(kn, g), il), il), fl = _mm256_mul_pd(fm, il);
+    const __m256d ad0 = _mm256_mul_pd(a, d0), ad1 = _mm256_mul_pd(a, d1);
+    s[0] = _mm256_sub_pd(s[0], _mm256_mul_pd(fl, d0));
+    s[1] = _mm256_sub_pd(s[1], _mm256_mul_pd(fl, d1));
+    s[2] = _mm256_sub_pd(s[2], _mm256_mul_pd(fl, d2));
+    s[3] = _mm256_add_pd(s[3], _mm256_add_pd(_mm256_mul_pd(ad0, d0), g));
+    s[4] = _mm256_add_pd(s[4], _mm256_add_pd(_mm256_mul_pd(ad1, d1), g));
+    s[5] = _mm256_add_pd(s[5], _mm256_add_pd(_mm256_mul_pd(_mm256_mul_pd(a, d2), d2), g));
+    s[6] = _mm256_add_pd(s[6], _mm256_mul_pd(ad0, d1));
+    s[7] = _mm256_add_pd(s[7], _mm256_mul_pd(ad0, d2));
+    s[8] = _mm256_add_pd(s[8], _mm256_mul_pd(ad1, d2));
+}
+
+/* vertex i's position in each lane, its lane sums zeroed */
+static inline __attribute__((always_inline, target("avx2"))) void link_start(const wb_real *x, int32_t i, __m256d xi[3],
+                                                                            __m256d s[9])
+{
+    /* (written out: a loop over them kept the sums in memory at -O2) */
+    xi[0] = _mm256_set1_pd(x[3 * i]), xi[1] = _mm256_set1_pd(x[3 * i + 1]), xi[2] = _mm256_set1_pd(x[3 * i + 2]);
+    s[0] = s[1] = s[2] = s[3] = s[4] = s[5] = s[6] = s[7] = s[8] = _mm256_setzero_pd();
+}
+
+/* the lane sums added into the vertex step's fs and hs */
+static inline __attribute__((always_inline, target("avx2"))) void link_sums(const __m256d s[9], wb_real fs[3], wb_real hs[6])
+{
+    wb_real t[10];
+    sum2(s[0], s[1], t);
+    sum2(s[2], s[3], t + 2);
+    sum2(s[4], s[5], t + 4);
+    sum2(s[6], s[7], t + 6);
+    sum2(s[8], s[8], t + 8);
+    fs[0] += t[0], fs[1] += t[1], fs[2] += t[2];
+    hs[0] += t[3], hs[1] += t[4], hs[2] += t[5], hs[3] += t[6], hs[4] += t[7], hs[5] += t[8];
+}
+
+/* The vertices of a run two at a time, their groups interleaved, in a build for a core with
+ * 32 vector registers (AVX-512's; -march=native on such a machine, as make bench's): one
+ * vertex's groups are a chain of latencies (a square root and a division, then its sums)
+ * that the core ran mostly one vertex at a time, two independent chains side by side keep
+ * it busy (one iteration of the 128 x 128 cloth 11% faster). With 16 registers the two
+ * vertices' 18 sums spill, and it was 10% slower: one at a time there. Each vertex's sums
+ * are taken in the same order either way: the same bits */
+#ifdef __AVX512F__
+#define LINK_PAIRS 1
+#else
+#define LINK_PAIRS 0
+#endif
+static inline __attribute__((always_inline, target("avx2"))) void
+links_avx2(const wb_world *w, const dist_vbd *v, const int32_t *vert, int32_t n, wb_real *f, wb_real *H, int damped)
+{
+    const wb_real *x = w->s.x, *xp = w->s.x_prev;
+    int32_t k = 0;
+    for (; LINK_PAIRS && k + 1 < n; k += 2) {
+        const int32_t i = vert[k], i1 = vert[k + 1];
+        const int32_t e0 = v->adj_start[i], n0 = v->adj_start[i + 1] - e0;
+        const int32_t e1 = v->adj_start[i1], n1 = v->adj_start[i1 + 1] - e1;
+        __m256d xi[3], s[9], xi1[3], s1[9];
+        link_start(x, i, xi, s);
+        link_start(x, i1, xi1, s1);
+        int32_t q = 0;
+        for (; q < n0 && q < n1; q += 4) {
+            link_group(x, xp, v, i, e0 + q, xi, s, damped);
+            link_group(x, xp, v, i1, e1 + q, xi1, s1, damped);
+        }
+        for (int32_t r = q; r < n0; r += 4) link_group(x, xp, v, i, e0 + r, xi, s, damped);
+        for (int32_t r = q; r < n1; r += 4) link_group(x, xp, v, i1, e1 + r, xi1, s1, damped);
+        link_sums(s, &f[3 * k], &H[6 * k]);
+        link_sums(s1, &f[3 * (k + 1)], &H[6 * (k + 1)]);
+    }
+    for (; k < n; k++) {
+        const int32_t i = vert[k], e0 = v->adj_start[i], n0 = v->adj_start[i + 1] - e0;
+        __m256d xi[3], s[9];
+        link_start(x, i, xi, s);
+        for (int32_t q = 0; q < n0; q += 4) link_group(x, xp, v, i, e0 + q, xi, s, damped);
+        link_sums(s, &f[3 * k], &H[6 * k]);
+    }
+}
+
+static __attribute__((target("avx2"))) void links_avx2_run(const wb_world *w, const dist_vbd *v, const int32_t *vert,
+                                                           int32_t n, wb_real *f, wb_real *H)
+{
+    if (v->damped) links_avx2(w, v, vert, n, f, H, 1);
+    else links_avx2(w, v, vert, n, f, H, 0);
 }
 #endif
 
@@ -1440,22 +1510,21 @@ static int vbd_simd_state = -1;
 int wb__distance_vbd_simd(int on);
 int wb__distance_vbd_simd(int on) { return wb__simd_set(&vbd_simd_state, on); }
 
-/* the vertex step at i: its links' force and Hessian added into f and H */
-static void dvbd_vertex(const wb_world *w, const void *part, int32_t i, wb_real inv_h, wb_real f[3], wb_real H[6])
+/* the vertex steps at vert[0 .. n): their links' forces and Hessians added into f and H */
+static void dvbd_vertex(const wb_world *w, const void *part, const int32_t *vert, int32_t n, wb_real inv_h, wb_real *f,
+                        wb_real *H)
 {
     (void)inv_h;
     const dist_vbd *v = part;
-    wb_real F[3], Hl[6];
 #ifdef WB_DISTANCE_VBD_AVX2
     int s = __atomic_load_n(&vbd_simd_state, __ATOMIC_RELAXED);
     if (s < 0) s = wb__distance_vbd_simd(1);
-    if (s) links_avx2(w, v, i, F, Hl);
-    else links_scalar(w, v, i, F, Hl);
-#else
-    links_scalar(w, v, i, F, Hl);
+    if (s) {
+        links_avx2_run(w, v, vert, n, f, H);
+        return;
+    }
 #endif
-    for (int c = 0; c < 3; c++) f[c] += F[c];
-    for (int c = 0; c < 6; c++) H[c] += Hl[c];
+    for (int32_t k = 0; k < n; k++) links_scalar(w, v, vert[k], &f[3 * k], &H[6 * k]);
 }
 
 /* the inertia of a hard link's ends over the substep, 1 / (h^2 (w_i + w_j)) */
@@ -1481,6 +1550,7 @@ static void warm_start(wb_world *w, dist_vbd *v, wb_real inv_h2, wb_real inv_h)
     const wb_distances *ds = wb__dist(w->dist);
     const wb_real *xp = w->s.x_prev;
     v->nhard = v->nstiff = 0;
+    v->damped = 0;
     /* volume constraints are projected after the sweeps: with rigid links they may hold
      * a body over-constrained (rigid links and incompressible tets under a press), and a
      * link that took back what the press pushed into it each substep fought them (a
@@ -1493,6 +1563,7 @@ static void warm_start(wb_world *w, dist_vbd *v, wb_real inv_h2, wb_real inv_h)
         wb_real d[3];
         if (alpha > 0) {
             L->dmp = ds->beta[s] > 0 ? ds->beta[s] * inv_h : 0;
+            v->damped |= L->dmp > 0;
             if (!(1 / alpha > kap)) { /* its own energy */
                 L->tgt = rest, L->kk = 1 / alpha, L->lm = 0;
                 v->lam[s] = 0, v->c0[s] = (wb_real)NAN;

@@ -1013,11 +1013,13 @@ static void tet_block(const wb_world *w, int32_t q, wb_real f[3], wb_real H[6])
     H[3] += kh * g[0] * g[1], H[4] += kh * g[0] * g[2], H[5] += kh * g[1] * g[2];
 }
 
-static void tvbd_vertex(const wb_world *w, const void *part, int32_t i, wb_real inv_h, wb_real f[3], wb_real H[6])
+static void tvbd_vertex(const wb_world *w, const void *part, const int32_t *vert, int32_t n, wb_real inv_h, wb_real *f,
+                        wb_real *H)
 {
     (void)inv_h;
     const wb_vbd_quads *a = &((const tet_vbd *)part)->at;
-    for (int32_t e = a->start[i]; e < a->start[i + 1]; e++) tet_block(w, a->adj[e], f, H);
+    for (int32_t k = 0; k < n; k++)
+        for (int32_t e = a->start[vert[k]]; e < a->start[vert[k] + 1]; e++) tet_block(w, a->adj[e], &f[3 * k], &H[6 * k]);
 }
 
 static const wb_vbd_type tet_vbd_hooks = {

@@ -162,7 +162,7 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
         const int32_t p = c->pt[2 * k], *v = &m->tri[3 * c->pt[2 * k + 1]];
         wb_real *xs = &x[3 * p];
         const wb_real *xa = &x[3 * v[0]], *xb = &x[3 * v[1]], *xc = &x[3 * v[2]];
-        wb_real b[3], q[3], d[3], n[3], e1[3], e2[3];
+        wb_real b[3], q[3], d[3];
         const wb_real r = rad[p];
         /* what it was left with, until it is found overlapping again */
         wb_real lk = left[k];
@@ -172,59 +172,27 @@ void wb__tricontacts_project(wb_world *w, wb_real h)
         if (wb__contacts_made(w, p, v[0])) continue;
         left[k] = 0;
         /* the side now and at the substep's start (the plane of the triangle then) */
-        v3_sub(e1, xb, xa);
-        v3_sub(e2, xc, xa);
-        v3_cross(n, e1, e2);
-        const wb_real ln = v3_len(n);
-        wb_real s_prev = 0, s_now = 0;
-        if (ln > 0) {
-            wb_real f1[3], f2[3], np[3], dp[3];
-            v3_scale(n, n, 1 / ln);
-            v3_sub(f1, &xp[3 * v[1]], &xp[3 * v[0]]);
-            v3_sub(f2, &xp[3 * v[2]], &xp[3 * v[0]]);
-            v3_cross(np, f1, f2);
-            v3_sub(dp, &xp[3 * p], &xp[3 * v[0]]);
-            s_prev = v3_dot(dp, np);
-            v3_sub(d, xs, xa);
-            s_now = v3_dot(d, n);
-            /* on its side and farther than r from the plane: from the triangle too */
-            if (s_now * s_prev >= 0 && fabs(s_now) > r * (1 + (wb_real)1e-9)) continue;
-        }
+        wb_real n[3], ln, s_prev, s_now;
+        wb__tri_side(x, xp, p, v, n, &ln, &s_prev, &s_now);
+        /* on its side and farther than r from the plane: from the triangle too */
+        if (ln > 0 && s_now * s_prev >= 0 && fabs(s_now) > r * (1 + (wb_real)1e-9)) continue;
         const wb_real d2 = wb__tri_closest(xs, xa, xb, xc, b, q);
         const wb_real wp = wv[p], W = wp + b[0] * b[0] * wv[v[0]] + b[1] * b[1] * wv[v[1]] + b[2] * b[2] * wv[v[2]];
         if (W == 0) continue;
         v3_sub(d, xs, q);
         const wb_real dist = sqrt(d2);
-        /* crossed the plane over the triangle's face, within reach of it: it went through
-         * this substep (the relative motion bounds how far off it could have crossed).
-         * Beside an edge or a corner the plane's extension means nothing: a point in a
-         * valley between two triangles is below each one's extension and still outside */
-        int crossed = 0;
-        if (s_prev != 0 && s_now * s_prev < 0 && b[0] > 0 && b[1] > 0 && b[2] > 0) {
-            wb_real rel[3];
-            v3_sub(rel, xs, &xp[3 * p]);
-            for (int i = 0; i < 3; i++) v3_madd(rel, &x[3 * v[i]], -b[i]), v3_madd(rel, &xp[3 * v[i]], b[i]);
-            crossed = dist < r + v3_len(rel);
-        }
+        /* its normal and depth (through the plane over the face only: beside an edge or a
+         * corner the plane's extension means nothing, a point in a valley between two
+         * triangles is below each one's extension and still outside) */
         wb_real nn[3], depth;
-        if (crossed) {
-            v3_scale(nn, n, s_prev > 0 ? 1 : -1);
-            depth = r - v3_dot(d, nn);
-        } else if (!(d2 < r * r)) {
+        const int kind = wb__tri_normal(x, xp, p, v, n, ln, s_prev, s_now, b, d, d2, dist, r, r, nn, &depth);
+        if (kind == 0) {
             /* in touch (left at r by the last substep, to round-off): counted, nothing to do */
             const wb_real rt = r * (1 + (wb_real)1e-9);
             if (d2 <= rt * rt) touching++;
             continue;
-        } else if (dist > r * (wb_real)1e-9 || ln == 0) {
-            if (!(dist > 0)) continue; /* on a degenerate triangle: no direction */
-            v3_scale(nn, d, 1 / dist);
-            depth = r - dist;
-        } else {
-            /* on the sheet: back to the side it came from */
-            const wb_real side = s_prev < 0 || (s_prev == 0 && s_now < 0) ? -1 : 1;
-            v3_scale(nn, n, side);
-            depth = r - side * s_now;
         }
+        if (kind < 0) continue; /* on a degenerate triangle: no direction */
         if (!(depth > 0)) continue;
         /* the overlap it started the substep with: the same distance at x_prev (on the
          * side it was on then). Kept overlap goes out slowly, its push moving x_prev too;

@@ -57,16 +57,20 @@ struct wb_vbd {
     double *csum;          /* (bodies x 17) a free body's contacts in the vertex steps
                               (keep_momentum) */
     uint8_t *bmove;        /* (bodies) 1: its friction goes in its momentum step */
+    uint8_t *bclear;       /* (bodies) 1: free and clear of every collider this substep
+                              (clear_of_colliders) */
+    double *bball;         /* (bodies x 8) its bounds' scratch (clear_of_colliders) */
     int32_t *bvar;         /* (bodies) its index among the free bodies that may touch another
-                              body's movable particle, moved with them (wb__vbdc_couple); -1 */
+                              free body's movable particle, moved with them
+                              (wb__vbdc_couple); -1, or VBD_BY_HELD */
     int32_t nvar;
     double *vsum;          /* (nvar x (WB_VBDC_BS + 14)) their sums, moves, turns and rounding
                               (couple) */
     wb_vbdc *ct;           /* the particle contacts in the vertex steps (vbd_contact.c) */
     int ct_on;             /* ct holds this substep's */
     size_t charged;        /* the struct's and its arrays' bytes charged to def.memory, but for
-                              the parts (their own), tsum, csum, bmove, bvar, vsum
-                              (charged_t) and ct (its own) */
+                              the parts (their own), tsum, csum, bmove, bclear, bball,
+                              bvar, vsum (charged_t) and ct (its own) */
     size_t charged_t;
     int nomem;             /* the last solve ran out of memory (the budget refused its
                               scratch): the step undoes the frame (wb__vbd_failed) */
@@ -76,12 +80,19 @@ struct wb_vbd {
 /* at most this many Newton steps for a free body's translation with its contacts
  * (keep_momentum) */
 #define VBD_MOVE_STEPS 8
-/* two bodies with a pair closer than this times r_i + r_j where the substep starts were
- * made inside each other: contact.c parts them, they are not moved together (measured,
+/* two bodies with a pair closer than this times r_i + r_j where the substep starts (or
+ * in contact.c's list of bodies made inside each other) were made inside each other:
+ * contact.c parts them, they are not moved together; decided here alone (touching()). A
+ * pair of bodies moved together that only starts a substep deeper than depenetration
+ * parts in it is left to the projection pair by pair (vbd_contact.c's starts_deep). (Measured,
  * two blocks made with coincident layers: a particle flung at 1.24 m/s with them moved
  * together; 0.5 of the contact distance: 0.88, as before; 0.95: blocks made interleaved
  * gained 49 J where 12 are allowed) */
 #define VBD_MADE_DEEP ((wb_real)0.5)
+/* bvar of a free body in no coupled step that may touch a held body's movable particle:
+ * that pair is the projection's, as a collider's, and the body starts its sweeps as one
+ * near a collider (start_guess) */
+#define VBD_BY_HELD (-2)
 
 _Static_assert(VBD_COLOURS <= 64, "a vertex's neighbours' colours are one bit each of a uint64_t");
 
@@ -98,6 +109,8 @@ void wb__vbd_destroy(wb_world *w)
     free(v->tsum);
     free(v->csum);
     free(v->bmove);
+    free(v->bclear);
+    free(v->bball);
     free(v->bvar);
     free(v->vsum);
     wb__vbdc_destroy(w, v->ct);
@@ -227,7 +240,7 @@ void wb__vbd_undo(wb_world *w)
 
 /* ---- the vertex step ------------------------------------------------------------------------ */
 /* solve the symmetric 3 x 3 system H d = f (H: xx, yy, zz, xy, xz, yz); 0 when singular */
-static int solve3(const wb_real H[6], const wb_real f[3], wb_real d[3])
+static inline __attribute__((always_inline)) int solve3(const wb_real H[6], const wb_real f[3], wb_real d[3])
 {
     const wb_real a = H[0], b = H[1], c = H[2], xy = H[3], xz = H[4], yz = H[5];
     const wb_real c00 = b * c - yz * yz, c01 = xz * yz - xy * c, c02 = xy * yz - b * xz;
@@ -247,7 +260,14 @@ typedef struct sweep_job {
     const int32_t *vert;   /* the colour's vertices */
     wb_real step;          /* the largest step taken (max_into) */
     const wb_vbdc *ct;     /* the substep's contacts, NULL: none */
+    int32_t run;           /* vertices whose forces are found before any of them moves: VBD_RUN,
+                              1 in the last colour when it may hold neighbours (serial_last) */
 } sweep_job;
+
+/* A colour's vertices share no constraint, so the forces on a run of them can all be found
+ * before any moves (the same bits as one after another): each type's hook is called once a
+ * run, not once a vertex */
+#define VBD_RUN 64
 
 /* con: the substep has contacts in the vertex steps (two copies: the loop without them
  * stays as it was) */
@@ -257,28 +277,45 @@ static inline __attribute__((always_inline)) void sweep_body(void *ctx, int32_t 
     wb_world *w = j->w;
     const struct wb_vbd *v = j->v;
     wb_real *x = w->s.x;
-    const wb_real *wv = w->m.w;
+    const wb_real *wv = w->m.w, *y = v->y, inv_h2 = j->inv_h2, inv_h = j->inv_h;
+    const int32_t *vert = j->vert, run = j->run;
+    const int nact = v->nact;
+    const wb_vbd_type *const *act = v->act;
+    void *const *part = v->act_part;
     wb_real big = 0;
-    for (int32_t q = lo; q < hi; q++) {
-        const int32_t i = j->vert[q];
-        if (!(wv[i] > 0)) continue;
-        const wb_real mh = j->inv_h2 / wv[i];
-        /* the inertia term, then each type's constraints at i (0 + first: a sum starting at
-         * +0, as each type's own sums do, so the order of the terms is all that decides) */
-        wb_real f[3], H[6] = { mh, mh, mh, 0, 0, 0 }, d[3];
-        for (int c = 0; c < 3; c++) f[c] = (wb_real)0 + mh * (v->y[3 * i + c] - x[3 * i + c]);
-        for (int t = 0; t < v->nact; t++) v->act[t]->vertex(w, v->act_part[t], i, j->inv_h, f, H);
-        if (con) wb__vbdc_block(w, j->ct, i, f, H);
-        if (!solve3(H, f, d)) continue;
-        if (con) {
-            wb_real xn[3];
-            v3_add(xn, &x[3 * i], d);
-            wb__vbdc_friction(w, j->ct, i, H, xn);
-            v3_sub(d, xn, &x[3 * i]);
+    for (int32_t q0 = lo; q0 < hi; q0 += run) {
+        const int32_t q1 = hi - q0 > run ? q0 + run : hi;
+        int32_t idx[VBD_RUN], n = 0;
+        wb_real f[3 * VBD_RUN], H[6 * VBD_RUN];
+        /* the inertia term of each movable vertex, then each type's constraints at them (0 +
+         * first: a sum starting at +0, as each type's own sums do, so the order of the terms
+         * is all that decides) */
+        for (int32_t q = q0; q < q1; q++) {
+            const int32_t i = vert[q];
+            if (!(wv[i] > 0)) continue;
+            const wb_real mh = inv_h2 / wv[i], *xi = &x[3 * i], *yi = &y[3 * i];
+            wb_real *fk = &f[3 * n], *Hk = &H[6 * n];
+            fk[0] = (wb_real)0 + mh * (yi[0] - xi[0]), fk[1] = (wb_real)0 + mh * (yi[1] - xi[1]);
+            fk[2] = (wb_real)0 + mh * (yi[2] - xi[2]);
+            Hk[0] = Hk[1] = Hk[2] = mh, Hk[3] = Hk[4] = Hk[5] = 0;
+            idx[n++] = i;
         }
-        v3_add(&x[3 * i], &x[3 * i], d);
-        const wb_real dd = v3_dot(d, d);
-        big = dd > big ? dd : big;
+        for (int t = 0; t < nact; t++) act[t]->vertex(w, part[t], idx, n, inv_h, f, H);
+        for (int32_t k = 0; k < n; k++) {
+            const int32_t i = idx[k];
+            wb_real *fk = &f[3 * k], *Hk = &H[6 * k], d[3];
+            if (con) wb__vbdc_block(w, j->ct, i, fk, Hk);
+            if (!solve3(Hk, fk, d)) continue;
+            if (con) {
+                wb_real xn[3];
+                v3_add(xn, &x[3 * i], d);
+                wb__vbdc_friction(w, j->ct, i, Hk, xn);
+                v3_sub(d, xn, &x[3 * i]);
+            }
+            v3_add(&x[3 * i], &x[3 * i], d);
+            const wb_real dd = v3_dot(d, d);
+            big = dd > big ? dd : big;
+        }
     }
     wb_real cur;
     __atomic_load(&j->step, &cur, __ATOMIC_RELAXED);
@@ -288,31 +325,46 @@ static inline __attribute__((always_inline)) void sweep_body(void *ctx, int32_t 
 static void sweep_part(void *ctx, int32_t lo, int32_t hi) { sweep_body(ctx, lo, hi, 0); }
 static void sweep_part_ct(void *ctx, int32_t lo, int32_t hi) { sweep_body(ctx, lo, hi, 1); }
 
+/* body a may touch a movable particle (or a triangle whose corners all move) of body b:
+ * marked for the coupled step when b is free; when b is held, VBD_BY_HELD unless a is
+ * marked already (touching()) */
+static inline void by_partner(struct wb_vbd *v, const wb_cache *k, int32_t a, int32_t b)
+{
+    if (!(k->mc_acc[16 * b] < 0)) {
+        if (v->bvar[a] < 0) v->bvar[a] = 0;
+    } else if (v->bvar[a] == -1) {
+        v->bvar[a] = VBD_BY_HELD;
+    }
+}
+
 /* v->tsum (bodies x 4) zeroed, with [4 b] = -1 for each body b that may touch a rigid body,
  * a movable particle of a body made deep inside it or a triangle held in part this frame
  * (the contacts found for the frame), v->bvar numbering the free bodies that may touch
- * another free body's movable particles otherwise (moved together: couple); 0 when there
- * are no bodies (or no memory) */
+ * another free body's movable particles otherwise (moved together: couple), VBD_BY_HELD
+ * for one that may touch only a held body's; 0 when there are no bodies (or no memory) */
 static int touching(wb_world *w, struct wb_vbd *v)
 {
     const wb_cache *k = &w->k;
     if (!k->mc_built || k->mc_nbody == 0) return 0;
     const int32_t nb = k->mc_nbody, *body = k->mc_body;
     if (nb > v->cap_tsum) {
-        if (!wb__charge(w, &v->charged_t, (sizeof(double) * (25 + WB_VBDC_BS + 14) + sizeof(int32_t) + 1) * (size_t)nb)) {
+        if (!wb__charge(w, &v->charged_t, (sizeof(double) * (33 + WB_VBDC_BS + 14) + sizeof(int32_t) + 2) * (size_t)nb)) {
             v->nomem = 1;
             return 0;
         }
         double *t = realloc(v->tsum, sizeof *t * 8 * (size_t)nb), *e = realloc(v->csum, sizeof *e * 17 * (size_t)nb);
         double *vs = realloc(v->vsum, sizeof *vs * (WB_VBDC_BS + 14) * (size_t)nb);
-        uint8_t *bm = realloc(v->bmove, (size_t)nb);
+        double *bb = realloc(v->bball, sizeof *bb * 8 * (size_t)nb);
+        uint8_t *bm = realloc(v->bmove, (size_t)nb), *bc = realloc(v->bclear, (size_t)nb);
         int32_t *bv = realloc(v->bvar, sizeof *bv * (size_t)nb);
         if (t) v->tsum = t;
         if (e) v->csum = e;
         if (vs) v->vsum = vs;
+        if (bb) v->bball = bb;
         if (bm) v->bmove = bm;
+        if (bc) v->bclear = bc;
         if (bv) v->bvar = bv;
-        if (!t || !e || !vs || !bm || !bv) {
+        if (!t || !e || !vs || !bb || !bm || !bc || !bv) {
             v->nomem = 1;
             return 0;
         }
@@ -336,7 +388,7 @@ static int touching(wb_world *w, struct wb_vbd *v)
         if (!(wv[i] > 0) != !(wv[j] > 0) && body[wv[i] > 0 ? i : j] >= 0) {
             wb_real d[3];
             v3_sub(d, &xp[3 * i], &xp[3 * j]);
-            const wb_real rn = (rad[i] + rad[j]) * (wb_real)1.25;
+            const wb_real rn = (rad[i] + rad[j]) * WB_VBDC_NEAR;
             if (v3_dot(d, d) < rn * rn) T[4 * nb + body[wv[i] > 0 ? i : j]] = 1;
         }
         if (a < 0 || b < 0 || a == b) continue;
@@ -346,38 +398,37 @@ static int touching(wb_world *w, struct wb_vbd *v)
          * body the pair's whole push, which the projection after the sweeps gives again
          * and shares with the held end: a chain of rigid links dropped upright on a net
          * pinned at its rim was stopped whole by its lowest contact and stood as a rod
-         * (chain_pile.lua: its top 0.62 m above free fall). The body keeps its momentum
-         * through the sweeps and the projection takes the pair, as on a collider */
+         * (chain_pile.lua: its top 0.78 m above free fall). The body keeps its momentum
+         * through the sweeps and the projection takes the pair, as on a collider; it starts
+         * as near one (VBD_BY_HELD) */
         wb_real e[3];
         v3_sub(e, &xp[3 * i], &xp[3 * j]);
         const wb_real rs = (rad[i] + rad[j]) * VBD_MADE_DEEP;
         const int made = wb__contacts_made(w, i, j) || v3_dot(e, e) < rs * rs;
         if (wv[j] > 0) {
             if (made) T[4 * a] = -1;
-            else if (v->bvar[a] < 0 && !(k->mc_acc[16 * b] < 0)) v->bvar[a] = 0;
+            else by_partner(v, k, a, b);
         }
         if (wv[i] > 0) {
             if (made) T[4 * b] = -1;
-            else if (v->bvar[b] < 0 && !(k->mc_acc[16 * a] < 0)) v->bvar[b] = 0;
+            else by_partner(v, k, b, a);
         }
     }
     const wb_tricontacts *tc = k->tc;
     for (int32_t c = 0; c < tc->n; c++) {
         const int32_t t = tc->pt[2 * c + 1], p[4] = { tc->pt[2 * c], w->m.tri[3 * t], w->m.tri[3 * t + 1], w->m.tri[3 * t + 2] };
-        const int32_t a = body[p[0]], b = body[p[1]];
-        if (a < 0 || b < 0 || a == b) continue;
+        int32_t a, b;
+        const int kind = wb__vbdc_tri_kind(w, c, &a, &b);
+        if (!kind) continue;
         /* (a triangle of one body, all its corners movable: in the coupled step unless that
          * body is held, then the projection's as a held particle's) */
-        const int made = wb__contacts_made(w, p[0], p[1]);
-        const int whole = !made && body[p[2]] == b && body[p[3]] == b && wv[p[1]] > 0 && wv[p[2]] > 0 && wv[p[3]] > 0;
-        if (whole) {
-            if (!(k->mc_acc[16 * b] < 0)) v->bvar[a] = v->bvar[a] < 0 ? 0 : v->bvar[a];
-        } else if (wv[p[1]] > 0 || wv[p[2]] > 0 || wv[p[3]] > 0) {
-            T[4 * a] = -1;
-        }
+        const int made = kind & WB_VBDC_MADE;
+        const int whole = !made && (kind & WB_VBDC_WHOLE);
+        if (whole) by_partner(v, k, a, b);
+        else if (wv[p[1]] > 0 || wv[p[2]] > 0 || wv[p[3]] > 0) T[4 * a] = -1;
         if (wv[p[0]] > 0) {
             if (made) T[4 * b] = -1;
-            else if (v->bvar[b] < 0 && !(k->mc_acc[16 * a] < 0)) v->bvar[b] = 0;
+            else by_partner(v, k, b, a);
         }
     }
     if (w->rb)
@@ -388,37 +439,109 @@ static int touching(wb_world *w, struct wb_vbd *v)
      * not take in (a rigid body, a triangle of another body held in part) */
     v->nvar = 0;
     for (int32_t b = 0; b < nb; b++)
-        v->bvar[b] = v->bvar[b] == 0 && !(T[4 * b] < 0) && !(k->mc_acc[16 * b] < 0) ? v->nvar++ : -1;
+        v->bvar[b] = v->bvar[b] == 0 && !(T[4 * b] < 0) && !(k->mc_acc[16 * b] < 0) ? v->nvar++
+                     : v->bvar[b] == VBD_BY_HELD                                    ? VBD_BY_HELD
+                                                                                    : -1;
     return 1;
 }
 
-/* The sweeps start from where its speed alone takes a vertex held by a constraint, the
- * prediction less this substep's gravity (x + h v; Chen et al. 2024 list it among their
- * starts), and a free vertex from the prediction, its minimum. A body held by pins or
- * its own links is then at rest a fixed point of a single sweep (from y itself, one sweep
- * a substep never reaches it: a bar of E = 1e7 hung at 18.6 mm where it stretches 0.049
- * mm). Chen et al.'s adaptive start, the prediction less the part of gravity a vertex did
- * not follow last substep, fed the swing of such a body back into its next start (the
- * clamped strip swung on at 10 x 1, 0.63 m against 0.29; the bar crept to 0.8 mm at
- * 10 x 1). A body that nothing holds (no pin, attachment or grab) but that may touch
- * another body's movable particle or a rigid body (touching()) starts from the
- * prediction: the contacts carry it (after the sweeps, or in its momentum step with the
- * bodies it touches) and where keep_momentum leaves it alone the gravity it follows is the
- * one its start has (from x + h v, a lattice made overlapping another was lifted 0.25 m
- * instead of 0.15; from the adaptive start, a stack still moved after 4 s). So does a
- * free body near an immovable particle: its contacts in the vertex steps then push from
- * the start (from x + h v a Newton step did not see them, and their multipliers took 8
- * times the weight after it). A held one touching itself keeps x + h v (from y, a pinned
- * rope folding onto itself as it swung gained energy) */
+/* v->bclear: 1 for each free body (nothing outside the solve holds it) that no collider
+ * can reach this substep. Its ball, the box of its particles at the substep's start and
+ * at the prediction (centre c, half diagonal) grown by its largest radius and by its
+ * largest predicted move again (the solve moves a vertex off the prediction by about as
+ * much as the prediction moves it), is clear of a collider whose signed distance at c,
+ * at the frame's end pose, is past the ball's radius R by the collider's reach over the
+ * frame D = |p - p0| + a (R + |c - p| + |p - p0|), a its turn (a point of the surface
+ * within R of c at any time of the frame is at most a (its distance from the turn's
+ * centre) plus the shift from where it ends). Serial, in particle order. */
+static void clear_of_colliders(wb_world *w, struct wb_vbd *v)
+{
+    const wb_cache *k = &w->k;
+    const int32_t nb = k->mc_nbody, *body = k->mc_body;
+    const wb_real *x = w->s.x, *xp = w->s.x_prev, *rad = w->m.radius;
+    double *B = v->bball; /* (bodies x 8) lo, hi, largest radius, largest squared move */
+    int any = 0;
+    for (int32_t b = 0; b < nb; b++) {
+        v->bclear[b] = !(k->mc_acc[16 * b] < 0);
+        any |= v->bclear[b];
+        for (int c = 0; c < 3; c++) B[8 * b + c] = INFINITY, B[8 * b + 3 + c] = -INFINITY;
+        B[8 * b + 6] = B[8 * b + 7] = 0;
+    }
+    int live = 0;
+    for (int32_t s = 0; s < w->m.nc; s++) live |= (int)(w->m.c_gen[s] & 1u);
+    if (!any || !live) return;
+    for (int32_t i = 0; i < w->m.np; i++) {
+        const int32_t b = body[i];
+        if (b < 0 || !v->bclear[b]) continue;
+        double *o = &B[8 * b], m2 = 0;
+        for (int c = 0; c < 3; c++) {
+            const double a = x[3 * i + c], p = xp[3 * i + c];
+            o[c] = a < o[c] ? a : o[c], o[c] = p < o[c] ? p : o[c];
+            o[3 + c] = a > o[3 + c] ? a : o[3 + c], o[3 + c] = p > o[3 + c] ? p : o[3 + c];
+            m2 += (a - p) * (a - p);
+        }
+        o[6] = rad[i] > o[6] ? rad[i] : o[6];
+        o[7] = m2 > o[7] ? m2 : o[7];
+    }
+    for (int32_t b = 0; b < nb; b++) {
+        if (!v->bclear[b]) continue;
+        const double *o = &B[8 * b];
+        wb_real c[3], n[3];
+        double half = 0;
+        for (int q = 0; q < 3; q++) c[q] = (wb_real)(o[q] / 2 + o[3 + q] / 2), half += (o[3 + q] - o[q]) * (o[3 + q] - o[q]);
+        const double R = sqrt(half) / 2 + o[6] + sqrt(o[7]);
+        for (int32_t s = 0; s < w->m.nc && v->bclear[b]; s++) {
+            if (!(w->m.c_gen[s] & 1u)) continue;
+            const wb_collider_pose *cp = &w->s.c_pose[s];
+            wb_real e[3], f[3];
+            v3_sub(e, cp->p, cp->p0);
+            v3_sub(f, c, cp->p);
+            const double dot = fabs(cp->q0[0] * cp->q[0] + cp->q0[1] * cp->q[1] + cp->q0[2] * cp->q[2] + cp->q0[3] * cp->q[3]);
+            const double turn = 2 * acos(dot < 1 ? dot : 1), shift = v3_len(e);
+            const double D = shift + turn * (R + v3_len(f) + shift);
+            v->bclear[b] = wb__shape_distance(&w->m.c_shape[s], cp->p, cp->q, c, n) > R + D;
+        }
+    }
+}
+
+/* The sweeps start from the prediction y where nothing immovable can touch the body: a
+ * free body clear of every collider (clear_of_colliders) falls as it was made, y being
+ * its rigid move under gravity, where each vertex's energy is at its minimum. From the
+ * prediction less this substep's gravity (x + h v) one sweep of Gauss-Seidel moved each
+ * vertex only part of the way, the multipliers took the rest as tension, and a wavy
+ * chain of 80 rigid links fell bent (0.74 m off its shape after 1 s at 20 substeps).
+ * A vertex held by a constraint of a body that something holds (pins, attachments,
+ * grabs) or that may touch a collider (or a held body's movable particle: VBD_BY_HELD)
+ * starts from x + h v, where its speed alone takes it (Chen et al. 2024 list it among
+ * their starts): a body held at rest is then a fixed point of a single sweep (from y
+ * itself, one sweep a substep never reaches it: a bar
+ * of E = 1e7 hung at 18.6 mm where it stretches 0.049 mm), and one resting on a
+ * collider, which is projected after the sweeps, stays at rest (from y a hand-built
+ * cloth on a sphere blew up, a draped one did not settle). Chen et al.'s adaptive start,
+ * the prediction less the part of gravity a vertex did not follow last substep, fed the
+ * swing of such a body back into its next start (the clamped strip swung on at 10 x 1,
+ * 0.63 m against 0.29; the bar crept to 0.8 mm at 10 x 1). A free body that may touch
+ * another free body's movable particle or a rigid body (touching()) starts from the
+ * prediction too, near a collider or not: the contacts carry it (after the sweeps, or
+ * in its momentum step with the bodies it touches) and where keep_momentum leaves it
+ * alone the gravity it follows is the one its start has (from x + h v, a lattice made
+ * overlapping another was lifted 0.25 m instead of 0.15; from the adaptive start, a
+ * stack still moved after 4 s). So does a free body near an immovable particle: its
+ * contacts in the vertex steps then push from the start (from x + h v a Newton step did
+ * not see them, and their multipliers took 8 times the weight after it). A held one
+ * touching itself keeps x + h v (from y, a pinned rope folding onto itself as it swung
+ * gained energy) */
 static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h, int touch)
 {
     const wb_real *g = w->m.def.gravity, *wv = w->m.w;
     wb_real *x = w->s.x;
     const int32_t *body = w->k.mc_body;
+    if (touch) clear_of_colliders(w, v);
     for (int32_t i = 0; i < w->m.np; i++) {
         const int32_t b = body ? body[i] : -1;
         const int from_y = touch && b >= 0 && !(w->k.mc_acc[16 * b] < 0) &&
-                           (v->tsum[4 * b] < 0 || v->tsum[4 * w->k.mc_nbody + b] > 0 || v->bvar[b] >= 0);
+                           ((v->bclear[b] && v->bvar[b] != VBD_BY_HELD) || v->tsum[4 * b] < 0 ||
+                            v->tsum[4 * w->k.mc_nbody + b] > 0 || v->bvar[b] >= 0);
         if (!(wv[i] > 0) || !v->held[i] || from_y) continue;
         v3_madd(&x[3 * i], g, -h * h);
     }
@@ -517,8 +640,8 @@ static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch, wb_real h)
      * as the sweeps leave it (touching()): the contacts projected after the solve would take
      * the step back from one side only (measured: two stacked lattices crept 3 cm off
      * centre, when they were moved alone); one that may touch another body's movable
-     * particles is moved with it (couple) */
-    if (!touch) return;
+     * particles is moved with it (couple); none free (a pinned cloth), nothing to do */
+    if (!touch || k->mc_free == 0) return;
     const wb_real inv_h2 = 1 / (h * h);
     const int32_t nb = k->mc_nbody, *body = k->mc_body;
     double *T = v->tsum;
@@ -656,12 +779,13 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
     wb_vbdc *cs = nvc > 0 ? ct : NULL;
     wb_pool *pool = wb__world_pool(w);
     for (int it = 0; it < w->m.def.iterations; it++) {
-        sweep_job j = { w, v, inv_h2, 1 / h, NULL, 0, cs };
+        sweep_job j = { w, v, inv_h2, 1 / h, NULL, 0, cs, VBD_RUN };
         if (cs && it > 0) wb__vbdc_refresh(w, cs, v->ncolours);
         for (int32_t c = 0; c < v->ncolours; c++) {
             const int32_t lo = v->colour_start[c], n = v->colour_start[c + 1] - lo;
             j.vert = v->order + lo;
             const int serial = v->serial_last && c == v->ncolours - 1;
+            j.run = serial ? 1 : VBD_RUN;
             wb__pool_for(serial ? NULL : pool, n, 1024, cs ? sweep_part_ct : sweep_part, &j);
             if (cs) wb__vbdc_colour_done(w, cs, c);
         }

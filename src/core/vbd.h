@@ -41,9 +41,12 @@ typedef struct wb_vbd_type {
     /* the colours (col[j], a bit each) of the vertices j < i its constraints join to i */
     uint64_t (*neighbours)(const wb_world *w, const void *part, int32_t i, const uint8_t *col);
     int (*holds)(const void *part, int32_t i);      /* 1: a constraint of it holds vertex i */
-    /* the vertex step at i: its constraints' force on i and their 3 x 3 Hessian (xx, yy, zz,
-     * xy, xz, yz) added into f and H, at the positions as they are */
-    void (*vertex)(const wb_world *w, const void *part, int32_t i, wb_real inv_h, wb_real f[3], wb_real H[6]);
+    /* the vertex steps at vert[0 .. n), vertices that share no constraint (one colour's):
+     * each one's constraints' force on it and their 3 x 3 Hessian (xx, yy, zz, xy, xz, yz)
+     * added into f (n x 3) and H (n x 6), at the positions as they are (a call a run of
+     * vertices, not one each: the sweep's per-vertex calls were a sixth of its cost) */
+    void (*vertex)(const wb_world *w, const void *part, const int32_t *vert, int32_t n, wb_real inv_h, wb_real *f,
+                   wb_real *H);
     /* may be NULL (a type with no multipliers): */
     void (*begin)(wb_world *w, void *part, wb_real h);          /* a substep, before its sweeps */
     void (*dual)(wb_world *w, void *part, wb_real h, int last); /* after each sweep (last: the

@@ -57,9 +57,6 @@
 /* the penalty, in units of the inertia of the pair's ends over the substep
  * 1 / (h^2 (w_i + w_j)), as a rigid link's (vbd.c) */
 #define VBDC_K ((wb_real)8)
-/* a candidate whose ends are closer than this times r_i + r_j at the sweeps' start is in
- * the substep's contacts (the ones farther apart are left to the projection after) */
-#define VBDC_NEAR ((wb_real)1.25)
 
 typedef struct vbdc_key {
     uint64_t key; /* i << 32 | j */
@@ -100,8 +97,14 @@ struct wb_vbdc {
     int32_t *cvs;            /* (ncolours + 1) ranges of cv */
     int32_t cap_np, cap_pair, cap_col;
     size_t charged;          /* its bytes charged to def.memory (given back by wb__vbdc_destroy) */
-    double *cs;              /* wb__vbdc_couple's scratch: 24 a body, 7 a pair */
+    double *cs;              /* wb__vbdc_couple's scratch: 108 doubles a body, 20 a pair, 24 a
+                                triangle contact */
     size_t cap_cs, charged_cs;
+    int32_t *tk;             /* (ntk x 3) wb__vbdc_couple's triangle contacts between its
+                                bodies: candidate, the point's body in the step, the
+                                triangle's (-1: held where it is) */
+    int32_t cap_tk;
+    size_t charged_tk;
 };
 
 void wb__vbdc_destroy(wb_world *w, wb_vbdc *c)
@@ -109,7 +112,8 @@ void wb__vbdc_destroy(wb_world *w, wb_vbdc *c)
     if (!c) return;
     wb__charge(w, &c->charged, 0);
     wb__charge(w, &c->charged_cs, 0);
-    free(c->cs), free(c->bo);
+    wb__charge(w, &c->charged_tk, 0);
+    free(c->cs), free(c->tk), free(c->bo);
     free(c->start), free(c->ent), free(c->pij), free(c->tgt), free(c->kk), free(c->lam), free(c->mu);
     free(c->ov), free(c->ove), free(c->prev), free(c->fend), free(c->prevf), free(c->fl), free(c->lamp), free(c->sf), free(c->ks), free(c->xc), free(c->cv), free(c->cvs);
     free(c);
@@ -187,29 +191,35 @@ static int grow(wb_world *w, wb_vbdc *c, int32_t np, int32_t npair, int32_t ncol
     return 1;
 }
 
-/* candidate k is a pair it serves, closer than VBDC_NEAR (r_i + r_j): one movable end (see
- * the head of the file for why not two), or two movable ends of two bodies, neither held,
- * one of them moved with its partners (bvar: its index there, -1 none; NULL: no such
- * bodies) */
+/* A contact that starts the substep overlapping by more than what depenetration parts in
+ * it (d0 > max_depenetration h: contact.c's rule, wb__contact_depth) is the projection's to
+ * part slowly, pair by pair, not the coupled step's: the one test for particle pairs and
+ * point-triangle contacts. (Two bodies made inside each other are another thing, decided
+ * once, by vbd.c's touching(): neither is moved with the other.) */
+static inline int starts_deep(wb_real d0, wb_real step) { return d0 > step; }
+
+/* candidate k is a pair it serves, closer than WB_VBDC_NEAR (r_i + r_j): one movable end
+ * (see the head of the file for why not two), or two movable ends of two bodies, neither
+ * held, one of them moved with its partners (bvar: its index there, < 0 none; NULL: no
+ * such bodies), not starting deep (a pair of bodies made inside each other: touching() left
+ * neither in bvar) */
 static inline int near_pair(const wb_world *w, const wb_contacts *pc, const wb_real *x, const wb_real *wv, const wb_real *rad,
-                            const int32_t *body, const int32_t *bvar, wb_real step_h, int32_t k)
+                            const int32_t *body, const int32_t *bvar, wb_real step, int32_t k)
 {
     const int32_t i = pc->ij[2 * k], j = pc->ij[2 * k + 1];
     if (!(wv[i] > 0) == !(wv[j] > 0)) {
         if (!bvar || !(wv[i] > 0)) return 0;
         const int32_t a = body[i], b = body[j];
-        if (a < 0 || b < 0 || a == b || (bvar[a] < 0 && bvar[b] < 0) || wb__contacts_made(w, i, j)) return 0;
+        if (a < 0 || b < 0 || a == b || (bvar[a] < 0 && bvar[b] < 0)) return 0;
         /* (a held body's movable particle is no wall of the step: the projection's, vbd.c's
          * touching()) */
         if (w->k.mc_acc[16 * a] < 0 || w->k.mc_acc[16 * b] < 0) return 0;
-        /* made overlapping (more than a substep's depenetration at its start): the
-         * projection's to part slowly, pair by pair */
-        const wb_real *xp = w->s.x_prev, rs = rad[i] + rad[j] - w->m.def.max_depenetration * step_h;
+        const wb_real *xp = w->s.x_prev;
         wb_real e[3];
         v3_sub(e, &xp[3 * i], &xp[3 * j]);
-        if (v3_dot(e, e) < rs * rs) return 0;
+        if (starts_deep(rad[i] + rad[j] - v3_len(e), step)) return 0;
     }
-    const wb_real rn = (rad[i] + rad[j]) * VBDC_NEAR;
+    const wb_real rn = (rad[i] + rad[j]) * WB_VBDC_NEAR;
     wb_real d[3];
     v3_sub(d, &x[3 * i], &x[3 * j]);
     return v3_dot(d, d) < rn * rn;
@@ -234,42 +244,44 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, c
     const wb_model *m = &w->m;
     const int32_t np = m->np;
     const wb_real *x = w->s.x, *xp = w->s.x_prev, *wv = m->w, *rad = m->radius, *cf = m->cfric;
-    /* the pairs it serves, counted before anything is sized: a handful of the frame's
-     * candidates (a self-colliding cloth has hundreds of thousands and none of them) */
-    int32_t n = 0;
-    for (int32_t k = 0; k < pc->n; k++)
-        n += near_pair(w, pc, x, wv, rad, w->k.mc_body, bvar, h, k);
-    if (n == 0) {
-        if (c) c->sorted = 1; /* (no pairs: none lagged into the next substep) */
-        return 0;
-    }
     if (!c) {
         c = calloc(1, sizeof *c);
         if (!c) return -1;
         *cp = c;
+    }
+    /* the pairs it serves, in one pass: a handful of the frame's candidates (a
+     * self-colliding cloth has hundreds of thousands and none of them), their keys
+     * gathered in (i, j) order (the lag's and the readout's merge; the broad phase's order
+     * is its own) */
+    const wb_real step = m->def.max_depenetration * h;
+    int sorted = 1;
+    int32_t n = 0;
+    for (int32_t k = 0; k < pc->n; k++) {
+        if (!near_pair(w, pc, x, wv, rad, w->k.mc_body, bvar, step, k)) continue;
+        if (n == c->cap_ks && !grow(w, c, 0, 0, 0, n > 0 ? 2 * n : 64)) {
+            c->nprev = 0;
+            return -1;
+        }
+        const int32_t i = pc->ij[2 * k], j = pc->ij[2 * k + 1];
+        c->ks[n].key = (uint64_t)i << 32 | (uint32_t)j, c->ks[n].k = k;
+        if (n > 0 && c->ks[n - 1].key > c->ks[n].key) sorted = 0;
+        n++;
+    }
+    if (n == 0) {
+        c->sorted = 1; /* (no pairs: none lagged into the next substep) */
+        return 0;
     }
     if (!grow(w, c, np, n > c->nprev ? n : c->nprev, ncolours, n)) {
         c->nprev = 0;
         return -1;
     }
     vbdc_key *ks = c->ks;
-    const wb_real step = m->def.max_depenetration * h, inv_h2 = 1 / (h * h);
+    const wb_real inv_h2 = 1 / (h * h);
     /* what each pair was left with by the last projection (contact.c), known within a
      * frame's list; a new list's rule otherwise */
     const wb_real *left = !pc->fresh && pc->left && pc->cap_left >= pc->n ? pc->left : NULL;
     int32_t *start = c->start;
     memset(start, 0, sizeof *start * ((size_t)np + 1));
-    /* the candidates near enough, in (i, j) order (the lag's and the readout's merge;
-     * the broad phase's order is its own) */
-    int sorted = 1;
-    n = 0;
-    for (int32_t k = 0; k < pc->n; k++) {
-        if (!near_pair(w, pc, x, wv, rad, w->k.mc_body, bvar, h, k)) continue;
-        const int32_t i = pc->ij[2 * k], j = pc->ij[2 * k + 1];
-        ks[n].key = (uint64_t)i << 32 | (uint32_t)j, ks[n].k = k;
-        if (n > 0 && ks[n - 1].key > ks[n].key) sorted = 0;
-        n++;
-    }
     if (!sorted) qsort(ks, (size_t)n, sizeof *ks, by_key);
     for (int32_t q = 0; q < n; q++) {
         const int32_t k = ks[q].k, i = pc->ij[2 * k], j = pc->ij[2 * k + 1];
@@ -289,7 +301,7 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, c
         c->tgt[q] = r - keep;
         c->ov[q] = c->ove[q] = r - keep - l1;
         c->kk[q] = VBDC_K * inv_h2 / wsum;
-        c->lam[q] = 0;
+        c->lam[q] = c->lamp[q] = 0;
         c->mu[q] = (cf[i] + cf[j]) / 2;
         const int32_t mv = wv[i] > 0 ? i : j, b = bmoved && w->k.mc_body ? w->k.mc_body[mv] : -1;
         c->sf[q] = !(b >= 0 && bmoved[b]);
@@ -439,10 +451,8 @@ void wb__vbdc_colour_done(const wb_world *w, wb_vbdc *c, int32_t col)
 void wb__vbdc_dual(const wb_world *w, wb_vbdc *c)
 {
     for (int32_t q = 0; q < c->npair; q++) {
-        if (c->bo[q]) { /* (not in the sweeps: its penalty alone in the momentum step) */
-            c->lamp[q] = c->lam[q] = 0;
-            continue;
-        }
+        if (c->bo[q]) continue; /* (not in the sweeps: its penalty alone in the coupled step, its
+                                   multipliers left at begin's 0) */
         wb_real C;
         const wb_real f = pair_force(w->s.x, c, q, c->lam[q], &C);
         c->lamp[q] = c->lam[q];
@@ -620,21 +630,36 @@ static void couple_add(int32_t a, int32_t b, const double n[3], double fn, doubl
     if (b >= 0) add_block(&D[36 * b], o + 10, H), at_add(o + 10, f, -1, &g[6 * b]);
 }
 
-/* the triangle contacts between two bodies of the coupled step: a point of one body, a
- * triangle of another whose corners are all movable (a triangle held anywhere is left to
- * the projection after the solve, touching() marks its point's body) */
-static int tri_between(const wb_world *w, const int32_t *bvar, int32_t k, int32_t *a, int32_t *b)
+int wb__vbdc_tri_kind(const wb_world *w, int32_t k, int32_t *bp, int32_t *bt)
 {
     const wb_tricontacts *tc = w->k.tc;
     const int32_t *body = w->k.mc_body, p = tc->pt[2 * k], *v = &w->m.tri[3 * tc->pt[2 * k + 1]];
     const wb_real *wv = w->m.w;
-    const int32_t bp = body[p], bt = body[v[0]];
-    if (bp < 0 || bt < 0 || bp == bt || body[v[1]] != bt || body[v[2]] != bt || wb__contacts_made(w, p, v[0])) return 0;
-    const int tmove = wv[v[0]] > 0 && wv[v[1]] > 0 && wv[v[2]] > 0;
+    *bp = body[p], *bt = body[v[0]];
+    if (*bp < 0 || *bt < 0 || *bp == *bt) return 0;
+    int kind = WB_VBDC_TRI | (wb__contacts_made(w, p, v[0]) ? WB_VBDC_MADE : 0);
+    if (body[v[1]] == *bt && body[v[2]] == *bt) {
+        kind |= WB_VBDC_ONE;
+        if (wv[v[0]] > 0 && wv[v[1]] > 0 && wv[v[2]] > 0) kind |= WB_VBDC_WHOLE;
+    }
+    return kind;
+}
+
+/* the triangle contacts between two bodies of the coupled step: a point of one body, a
+ * triangle of another (all its corners that body's), not made inside each other; a
+ * triangle held anywhere stays where it is in the step (touching() keeps a point's body
+ * out of the step when the triangle is held only in part). *a, *b: the point's and the
+ * triangle's bodies in the step, -1 held; 1 when one of them is in it */
+static int tri_between(const wb_world *w, const int32_t *bvar, int32_t k, int32_t *a, int32_t *b)
+{
+    int32_t bp, bt;
+    const int kind = wb__vbdc_tri_kind(w, k, &bp, &bt);
+    if (!(kind & WB_VBDC_ONE) || (kind & WB_VBDC_MADE)) return 0;
     /* (a held body's movable point or triangle is no wall of the step: the projection's) */
-    if ((wv[p] > 0 && w->k.mc_acc[16 * bp] < 0) || (tmove && w->k.mc_acc[16 * bt] < 0)) return 0;
-    *a = wv[p] > 0 ? bvar[bp] : -1;
-    *b = tmove ? bvar[bt] : -1;
+    const int pmove = w->m.w[w->k.tc->pt[2 * k]] > 0;
+    if ((pmove && w->k.mc_acc[16 * bp] < 0) || ((kind & WB_VBDC_WHOLE) && w->k.mc_acc[16 * bt] < 0)) return 0;
+    *a = pmove ? bvar[bp] : -1;
+    *b = kind & WB_VBDC_WHOLE ? bvar[bt] : -1;
     return *a >= 0 || *b >= 0;
 }
 
@@ -656,14 +681,24 @@ int wb__vbdc_couple(wb_world *w, wb_vbdc **cp, const int32_t *bvar, int32_t nv, 
         (*cp)->sorted = 1;
     }
     wb_vbdc *c = *cp;
+    /* the triangle contacts between the bodies, gathered once (candidate, a, b) */
     int32_t ntc = 0;
     for (int32_t k = 0; k < tc->n; k++) {
         int32_t a, b;
-        ntc += tri_between(w, bvar, k, &a, &b);
+        if (!tri_between(w, bvar, k, &a, &b)) continue;
+        if (ntc == c->cap_tk) {
+            const int32_t cap = ntc > 0 ? 2 * ntc : 64;
+            if (!wb__charge(w, &c->charged_tk, sizeof(int32_t) * 3 * (size_t)cap)) return -1;
+            int32_t *t = realloc(c->tk, sizeof *t * 3 * (size_t)cap);
+            if (!t) return -1;
+            c->tk = t, c->cap_tk = cap;
+        }
+        c->tk[3 * ntc] = k, c->tk[3 * ntc + 1] = a, c->tk[3 * ntc + 2] = b;
+        ntc++;
     }
     const int32_t np2 = c->npair;
     const size_t ncq = (size_t)np2 + (size_t)ntc;
-    const size_t need = 108 * (size_t)nv + (CQ + 1) * ncq + 10 * (size_t)ntc;
+    const size_t need = 108 * (size_t)nv + (CQ + 1) * ncq + 10 * (size_t)ntc + 6 * (size_t)np2;
     if (need > c->cap_cs) {
         if (!wb__charge(w, &c->charged_cs, sizeof(double) * need)) return -1;
         double *cs = realloc(c->cs, sizeof *cs * need);
@@ -688,37 +723,34 @@ int wb__vbdc_couple(wb_world *w, wb_vbdc **cp, const int32_t *bvar, int32_t nv, 
      * k, the slip of p against its closest point over the substep at u = 0, mu
      * (tricontact.c's) */
     double *td = (double *)(vi + 2 * ncq);
+    /* (each pair's ends' moves over the substep so far, x - x_prev: the slip's base, the
+     * same at every Newton step) */
+    double *ev = td + 10 * (size_t)ntc;
+    for (int32_t q = 0; q < np2; q++)
+        for (int k = 0; k < 3; k++) {
+            const int32_t i = c->pij[2 * q], j = c->pij[2 * q + 1];
+            ev[6 * q + k] = (double)x[3 * i + k] - (double)xp[3 * i + k];
+            ev[6 * q + 3 + k] = (double)x[3 * j + k] - (double)xp[3 * j + k];
+        }
     int32_t nt = 0;
     const wb_real step = w->m.def.max_depenetration * h;
-    for (int32_t k = 0; k < tc->n; k++) {
-        int32_t a, b;
-        if (!tri_between(w, bvar, k, &a, &b)) continue;
+    for (int32_t g = 0; g < ntc; g++) {
+        const int32_t k = c->tk[3 * g], a = c->tk[3 * g + 1], b = c->tk[3 * g + 2];
         const int32_t pp = tc->pt[2 * k], *v = &w->m.tri[3 * tc->pt[2 * k + 1]];
         const wb_real rr = rad[pp];
-        wb_real bc[3], q[3], d[3], e1[3], e2[3], n[3], dp[3];
+        wb_real bc[3], q[3], d[3], n[3], ln, s_prev, s_now, nw[3], depth;
         const wb_real d2 = wb__tri_closest(&x[3 * pp], &x[3 * v[0]], &x[3 * v[1]], &x[3 * v[2]], bc, q);
         v3_sub(d, &x[3 * pp], q);
-        const wb_real dist = sqrt(d2);
-        v3_sub(e1, &xp[3 * v[1]], &xp[3 * v[0]]);
-        v3_sub(e2, &xp[3 * v[2]], &xp[3 * v[0]]);
-        v3_cross(n, e1, e2);
-        v3_sub(dp, &xp[3 * pp], &xp[3 * v[0]]);
-        const wb_real s_prev = v3_dot(dp, n), ln = v3_len(n);
-        double nn[3];
-        v3_sub(dp, &x[3 * pp], &x[3 * v[0]]);
-        if (ln > 0 && s_prev != 0 && v3_dot(dp, n) * s_prev < 0 && bc[0] > 0 && bc[1] > 0 && bc[2] > 0) {
-            /* through the face since the substep began: back to the side it was on */
-            for (int k3 = 0; k3 < 3; k3++) nn[k3] = n[k3] / ln * (s_prev > 0 ? 1 : -1);
-        } else if (dist > rr * (wb_real)1e-9 && dist < rr * VBDC_NEAR) {
-            for (int k3 = 0; k3 < 3; k3++) nn[k3] = d[k3] / dist;
-        } else {
+        /* the projection's normal (wb__tri_normal), within the pairs' reach */
+        wb__tri_side(x, xp, pp, v, n, &ln, &s_prev, &s_now);
+        if (wb__tri_normal(x, xp, pp, v, n, ln, s_prev, s_now, bc, d, d2, sqrt(d2), rr, rr * WB_VBDC_NEAR, nw, &depth) <= 0)
             continue;
-        }
+        const double nn[3] = { nw[0], nw[1], nw[2] };
         const wb_real W = wv[pp] + bc[0] * bc[0] * wv[v[0]] + bc[1] * bc[1] * wv[v[1]] + bc[2] * bc[2] * wv[v[2]];
         if (!(W > 0)) continue;
         wb_real bp[3], qp[3];
         const wb_real d0 = rr - sqrt(wb__tri_closest(&xp[3 * pp], &xp[3 * v[0]], &xp[3 * v[1]], &xp[3 * v[2]], bp, qp));
-        if (d0 > step) continue;
+        if (starts_deep(d0, step)) continue;
         double *o = &td[10 * (size_t)nt];
         for (int k3 = 0; k3 < 3; k3++) {
             o[k3] = nn[k3];
@@ -764,7 +796,7 @@ int wb__vbdc_couple(wb_world *w, wb_vbdc **cp, const int32_t *bvar, int32_t nv, 
             if (b >= 0) a_mul(o + 10, &u[6 * b], db);
             for (int k = 0; k < 3; k++) {
                 d[k] = ((double)x[3 * i + k] + da[k]) - ((double)x[3 * j + k] + db[k]);
-                us[k] = ((double)x[3 * i + k] - (double)xp[3 * i + k] + da[k]) - ((double)x[3 * j + k] - (double)xp[3 * j + k] + db[k]);
+                us[k] = (ev[6 * q + k] + da[k]) - (ev[6 * q + 3 + k] + db[k]);
             }
             const double l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), kk = c->kk[q];
             if (!(l > 1e-12)) continue;

@@ -5,6 +5,11 @@
 
 typedef struct wb_vbdc wb_vbdc;
 
+/* a candidate whose ends are closer than this times r_i + r_j at the sweeps' start is in
+ * the substep's contacts (the ones farther apart are left to the projection after); so is
+ * a body near an immovable particle (vbd.c's touching()) */
+#define WB_VBDC_NEAR ((wb_real)1.25)
+
 /* Once a substep, after the sweeps' start: the frame's candidate pairs near enough to
  * touch during it, each vertex's list of them, and the copy its partners are read from.
  * order / colour_start / ncolours: the sweep's vertices by colour. Returns 1 when it holds
@@ -49,6 +54,13 @@ void wb__vbdc_readout(wb_world *w, const wb_vbdc *c);
 #define WB_VBDC_BS 16
 int wb__vbdc_couple(wb_world *w, wb_vbdc **c, const int32_t *bvar, int32_t nv, const double *bs, double *u, wb_real h,
                     int32_t steps);
+/* A triangle contact candidate k between two bodies: *bp its point's body, *bt its
+ * triangle's (its first corner's). 0 when it is not between two bodies (a particle of no
+ * body, or one body); else WB_VBDC_TRI | WB_VBDC_MADE when the point and the triangle were
+ * made inside each other (contact.c's to part) | WB_VBDC_ONE when the corners are all of
+ * bt | WB_VBDC_WHOLE when they are also all movable (the triangle can be moved with bt). */
+enum { WB_VBDC_TRI = 1, WB_VBDC_MADE = 2, WB_VBDC_ONE = 4, WB_VBDC_WHOLE = 8 };
+int wb__vbdc_tri_kind(const wb_world *w, int32_t k, int32_t *bp, int32_t *bt);
 /* (its charge given back) */
 void wb__vbdc_destroy(wb_world *w, wb_vbdc *c);
 

@@ -11,8 +11,8 @@
 -- stop up the zig-zag's 11 degree joints: 0.25 - 0.29 m behind at 20 x 10). Before the
 -- fix, VBD moved a free body touching a held body's movable particles rigidly with its
 -- contacts, that particle a wall: the lowest contact stopped the whole chain, which stood
--- as a rod, its top 0.55 - 0.69 m above free fall at all those settings, on the net
--- 0.22 - 0.41 s late.
+-- as a rod, its top 0.69 - 0.79 m above free fall at all those settings, on the net
+-- 0.31 - 0.46 s late.
 
 local g = 9.81
 local YN = 0.5              -- the net's height
