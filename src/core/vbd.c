@@ -61,7 +61,8 @@ struct wb_vbd {
                               (clear_of_colliders) */
     double *bball;         /* (bodies x 8) its bounds' scratch (clear_of_colliders) */
     int32_t *bvar;         /* (bodies) its index among the free bodies that may touch another
-                              body's movable particle, moved with them (wb__vbdc_couple); -1 */
+                              free body's movable particle, moved with them
+                              (wb__vbdc_couple); -1, or VBD_BY_HELD */
     int32_t nvar;
     double *vsum;          /* (nvar x (WB_VBDC_BS + 14)) their sums, moves, turns and rounding
                               (couple) */
@@ -88,6 +89,10 @@ struct wb_vbd {
  * together; 0.5 of the contact distance: 0.88, as before; 0.95: blocks made interleaved
  * gained 49 J where 12 are allowed) */
 #define VBD_MADE_DEEP ((wb_real)0.5)
+/* bvar of a free body in no coupled step that may touch a held body's movable particle:
+ * that pair is the projection's, as a collider's, and the body starts its sweeps as one
+ * near a collider (start_guess) */
+#define VBD_BY_HELD (-2)
 
 _Static_assert(VBD_COLOURS <= 64, "a vertex's neighbours' colours are one bit each of a uint64_t");
 
@@ -320,11 +325,23 @@ static inline __attribute__((always_inline)) void sweep_body(void *ctx, int32_t 
 static void sweep_part(void *ctx, int32_t lo, int32_t hi) { sweep_body(ctx, lo, hi, 0); }
 static void sweep_part_ct(void *ctx, int32_t lo, int32_t hi) { sweep_body(ctx, lo, hi, 1); }
 
+/* body a may touch a movable particle (or a triangle whose corners all move) of body b:
+ * marked for the coupled step when b is free; when b is held, VBD_BY_HELD unless a is
+ * marked already (touching()) */
+static inline void by_partner(struct wb_vbd *v, const wb_cache *k, int32_t a, int32_t b)
+{
+    if (!(k->mc_acc[16 * b] < 0)) {
+        if (v->bvar[a] < 0) v->bvar[a] = 0;
+    } else if (v->bvar[a] == -1) {
+        v->bvar[a] = VBD_BY_HELD;
+    }
+}
+
 /* v->tsum (bodies x 4) zeroed, with [4 b] = -1 for each body b that may touch a rigid body,
  * a movable particle of a body made deep inside it or a triangle held in part this frame
  * (the contacts found for the frame), v->bvar numbering the free bodies that may touch
- * another body's movable particles otherwise (moved together: couple); 0 when there are
- * no bodies (or no memory) */
+ * another free body's movable particles otherwise (moved together: couple), VBD_BY_HELD
+ * for one that may touch only a held body's; 0 when there are no bodies (or no memory) */
 static int touching(wb_world *w, struct wb_vbd *v)
 {
     const wb_cache *k = &w->k;
@@ -376,18 +393,25 @@ static int touching(wb_world *w, struct wb_vbd *v)
         }
         if (a < 0 || b < 0 || a == b) continue;
         /* (marked here, numbered below; bodies made deep inside each other are contact.c's
-         * to part) */
+         * to part). A held body's movable particle puts no one in the coupled step: the
+         * step cannot move a held body, and as a wall there its particle gave the free
+         * body the pair's whole push, which the projection after the sweeps gives again
+         * and shares with the held end: a chain of rigid links dropped upright on a net
+         * pinned at its rim was stopped whole by its lowest contact and stood as a rod
+         * (chain_pile.lua: its top 0.78 m above free fall). The body keeps its momentum
+         * through the sweeps and the projection takes the pair, as on a collider; it starts
+         * as near one (VBD_BY_HELD) */
         wb_real e[3];
         v3_sub(e, &xp[3 * i], &xp[3 * j]);
         const wb_real rs = (rad[i] + rad[j]) * VBD_MADE_DEEP;
         const int made = wb__contacts_made(w, i, j) || v3_dot(e, e) < rs * rs;
         if (wv[j] > 0) {
             if (made) T[4 * a] = -1;
-            else if (v->bvar[a] < 0) v->bvar[a] = 0;
+            else by_partner(v, k, a, b);
         }
         if (wv[i] > 0) {
             if (made) T[4 * b] = -1;
-            else if (v->bvar[b] < 0) v->bvar[b] = 0;
+            else by_partner(v, k, b, a);
         }
     }
     const wb_tricontacts *tc = k->tc;
@@ -396,25 +420,28 @@ static int touching(wb_world *w, struct wb_vbd *v)
         int32_t a, b;
         const int kind = wb__vbdc_tri_kind(w, c, &a, &b);
         if (!kind) continue;
-        /* (a triangle of one body, all its corners movable: in the coupled step) */
+        /* (a triangle of one body, all its corners movable: in the coupled step unless that
+         * body is held, then the projection's as a held particle's) */
         const int made = kind & WB_VBDC_MADE;
         const int whole = !made && (kind & WB_VBDC_WHOLE);
-        if (whole) v->bvar[a] = v->bvar[a] < 0 ? 0 : v->bvar[a];
+        if (whole) by_partner(v, k, a, b);
         else if (wv[p[1]] > 0 || wv[p[2]] > 0 || wv[p[3]] > 0) T[4 * a] = -1;
         if (wv[p[0]] > 0) {
             if (made) T[4 * b] = -1;
-            else if (v->bvar[b] < 0) v->bvar[b] = 0;
+            else by_partner(v, k, b, a);
         }
     }
     if (w->rb)
         for (int32_t c = 0; c < w->rb->npct; c++)
             if (body[w->rb->pc[2 * c]] >= 0) T[4 * body[w->rb->pc[2 * c]]] = -1;
-    /* a free body that may touch another body's movable particle is moved with the bodies
-     * it may touch (keep_momentum), unless it is held or touches what that step does not
-     * take in (a rigid body, a triangle of another body held in part) */
+    /* a free body that may touch another free body's movable particle is moved with the
+     * bodies it may touch (keep_momentum), unless it is held or touches what that step does
+     * not take in (a rigid body, a triangle of another body held in part) */
     v->nvar = 0;
     for (int32_t b = 0; b < nb; b++)
-        v->bvar[b] = v->bvar[b] == 0 && !(T[4 * b] < 0) && !(k->mc_acc[16 * b] < 0) ? v->nvar++ : -1;
+        v->bvar[b] = v->bvar[b] == 0 && !(T[4 * b] < 0) && !(k->mc_acc[16 * b] < 0) ? v->nvar++
+                     : v->bvar[b] == VBD_BY_HELD                                    ? VBD_BY_HELD
+                                                                                    : -1;
     return 1;
 }
 
@@ -484,16 +511,17 @@ static void clear_of_colliders(wb_world *w, struct wb_vbd *v)
  * vertex only part of the way, the multipliers took the rest as tension, and a wavy
  * chain of 80 rigid links fell bent (0.74 m off its shape after 1 s at 20 substeps).
  * A vertex held by a constraint of a body that something holds (pins, attachments,
- * grabs) or that may touch a collider starts from x + h v, where its speed alone takes
- * it (Chen et al. 2024 list it among their starts): a body held at rest is then a fixed
- * point of a single sweep (from y itself, one sweep a substep never reaches it: a bar
+ * grabs) or that may touch a collider (or a held body's movable particle: VBD_BY_HELD)
+ * starts from x + h v, where its speed alone takes it (Chen et al. 2024 list it among
+ * their starts): a body held at rest is then a fixed point of a single sweep (from y
+ * itself, one sweep a substep never reaches it: a bar
  * of E = 1e7 hung at 18.6 mm where it stretches 0.049 mm), and one resting on a
  * collider, which is projected after the sweeps, stays at rest (from y a hand-built
  * cloth on a sphere blew up, a draped one did not settle). Chen et al.'s adaptive start,
  * the prediction less the part of gravity a vertex did not follow last substep, fed the
  * swing of such a body back into its next start (the clamped strip swung on at 10 x 1,
  * 0.63 m against 0.29; the bar crept to 0.8 mm at 10 x 1). A free body that may touch
- * another body's movable particle or a rigid body (touching()) starts from the
+ * another free body's movable particle or a rigid body (touching()) starts from the
  * prediction too, near a collider or not: the contacts carry it (after the sweeps, or
  * in its momentum step with the bodies it touches) and where keep_momentum leaves it
  * alone the gravity it follows is the one its start has (from x + h v, a lattice made
@@ -512,7 +540,8 @@ static void start_guess(wb_world *w, struct wb_vbd *v, wb_real h, int touch)
     for (int32_t i = 0; i < w->m.np; i++) {
         const int32_t b = body ? body[i] : -1;
         const int from_y = touch && b >= 0 && !(w->k.mc_acc[16 * b] < 0) &&
-                           (v->bclear[b] || v->tsum[4 * b] < 0 || v->tsum[4 * w->k.mc_nbody + b] > 0 || v->bvar[b] >= 0);
+                           ((v->bclear[b] && v->bvar[b] != VBD_BY_HELD) || v->tsum[4 * b] < 0 ||
+                            v->tsum[4 * w->k.mc_nbody + b] > 0 || v->bvar[b] >= 0);
         if (!(wv[i] > 0) || !v->held[i] || from_y) continue;
         v3_madd(&x[3 * i], g, -h * h);
     }

@@ -199,10 +199,10 @@ static int grow(wb_world *w, wb_vbdc *c, int32_t np, int32_t npair, int32_t ncol
 static inline int starts_deep(wb_real d0, wb_real step) { return d0 > step; }
 
 /* candidate k is a pair it serves, closer than WB_VBDC_NEAR (r_i + r_j): one movable end
- * (see the head of the file for why not two), or two movable ends of two bodies, one of
- * them moved with its partners (bvar: its index there, -1 none; NULL: no such bodies), not
- * starting deep (a pair of bodies made inside each other: touching() left neither in
- * bvar) */
+ * (see the head of the file for why not two), or two movable ends of two bodies, neither
+ * held, one of them moved with its partners (bvar: its index there, < 0 none; NULL: no
+ * such bodies), not starting deep (a pair of bodies made inside each other: touching() left
+ * neither in bvar) */
 static inline int near_pair(const wb_world *w, const wb_contacts *pc, const wb_real *x, const wb_real *wv, const wb_real *rad,
                             const int32_t *body, const int32_t *bvar, wb_real step, int32_t k)
 {
@@ -211,6 +211,9 @@ static inline int near_pair(const wb_world *w, const wb_contacts *pc, const wb_r
         if (!bvar || !(wv[i] > 0)) return 0;
         const int32_t a = body[i], b = body[j];
         if (a < 0 || b < 0 || a == b || (bvar[a] < 0 && bvar[b] < 0)) return 0;
+        /* (a held body's movable particle is no wall of the step: the projection's, vbd.c's
+         * touching()) */
+        if (w->k.mc_acc[16 * a] < 0 || w->k.mc_acc[16 * b] < 0) return 0;
         const wb_real *xp = w->s.x_prev;
         wb_real e[3];
         v3_sub(e, &xp[3 * i], &xp[3 * j]);
@@ -652,7 +655,10 @@ static int tri_between(const wb_world *w, const int32_t *bvar, int32_t k, int32_
     int32_t bp, bt;
     const int kind = wb__vbdc_tri_kind(w, k, &bp, &bt);
     if (!(kind & WB_VBDC_ONE) || (kind & WB_VBDC_MADE)) return 0;
-    *a = w->m.w[w->k.tc->pt[2 * k]] > 0 ? bvar[bp] : -1;
+    /* (a held body's movable point or triangle is no wall of the step: the projection's) */
+    const int pmove = w->m.w[w->k.tc->pt[2 * k]] > 0;
+    if ((pmove && w->k.mc_acc[16 * bp] < 0) || ((kind & WB_VBDC_WHOLE) && w->k.mc_acc[16 * bt] < 0)) return 0;
+    *a = pmove ? bvar[bp] : -1;
     *b = kind & WB_VBDC_WHOLE ? bvar[bt] : -1;
     return *a >= 0 || *b >= 0;
 }
