@@ -306,7 +306,7 @@ void wb_particle_set_friction(wb_world *w, int32_t p, wb_real mu); /* mu >= 0, f
 bool wb_particle_collides(const wb_world *w, int32_t p);
 /* the particles [b.first, b.first + b.count) into group b.group with these settings */
 void wb_body_set_contacts(wb_world *w, wb_body b, bool collide, bool self_collide, wb_real friction);
-void wb_group_set_self_collide(wb_world *w, int32_t group, bool on); /* every particle of the group */
+int32_t wb_group_set_self_collide(wb_world *w, int32_t group, bool on); /* every particle of the group; how many */
 bool wb_group_self_collide(const wb_world *w, int32_t group);  /* some particle of it self-collides */
 void wb_particle_set_radius(wb_world *w, int32_t p, wb_real r); /* r >= 0, finite */
 /* the mean over the body's particles of their shortest link, any constraint's (0 when none): the

@@ -89,14 +89,17 @@ wb_status wb__body_finish(wb_world *w, int32_t first, int32_t count, wb_body *ou
     return WB_OK;
 }
 
-void wb_group_set_self_collide(wb_world *w, int32_t group, bool on)
+int32_t wb_group_set_self_collide(wb_world *w, int32_t group, bool on)
 {
+    int32_t n = 0;
     for (int32_t i = 0; i < w->m.np; i++) {
         if (w->m.group[i] != group) continue;
         if (on) w->m.cflags[i] |= WB_CF_SELF;
         else w->m.cflags[i] &= (uint8_t)~WB_CF_SELF;
+        n++;
     }
-    if (w->k.pc) w->k.pc->scan_dirty = 1;
+    if (n > 0 && w->k.pc) w->k.pc->scan_dirty = 1;
+    return n;
 }
 
 bool wb_group_self_collide(const wb_world *w, int32_t group)

@@ -441,11 +441,8 @@ static int w_set_self_collide(lua_State *L)
     if (g < 1 || g > WB_MAX_GROUP) return luaL_argerror(L, 2, "group must be a body's group (>= 1)");
     luaL_checktype(L, 3, LUA_TBOOLEAN);
     /* a group no particle is in: a slip (particles joining it later are not changed) */
-    int32_t i = 0;
-    const int32_t np = wb_particle_count(w);
-    while (i < np && wb_particle_group(w, i) != (int32_t)g) i++;
-    if (i == np) return luaL_argerror(L, 2, lua_pushfstring(L, "no particle is in group %I", g));
-    wb_group_set_self_collide(w, (int32_t)g, lua_toboolean(L, 3));
+    if (wb_group_set_self_collide(w, (int32_t)g, lua_toboolean(L, 3)) == 0)
+        return luaL_argerror(L, 2, lua_pushfstring(L, "no particle is in group %I", g));
     return 0;
 }
 
