@@ -1029,6 +1029,22 @@ void wb__tricontacts_destroy(wb_world *w)
     w->k.tc = NULL;
 }
 
+/* whether no point may touch any triangle by the rules alone: every triangle closed to one
+ * body's points (tri_key), and every point of that body (a w:cloth whose spheres cover it,
+ * alone in its world but for colliders: no search, no quick answer) */
+static int none_possible(const wb_world *w)
+{
+    const wb_model *m = &w->m;
+    const wb_contacts *pc = w->k.pc;
+    const int32_t g = m->ntri > 0 ? tri_key(m, pc, 0) : 0;
+    if (g == 0) return 0;
+    for (int32_t t = 1; t < m->ntri; t++)
+        if (tri_key(m, pc, t) != g) return 0;
+    for (int32_t i = 0; i < m->np; i++)
+        if ((m->cflags[i] & (WB_CF_COLLIDE | WB_CF_SELF)) && m->group[i] != g) return 0;
+    return 1;
+}
+
 void wb__tricontacts_begin(wb_world *w)
 {
     const wb_model *m = &w->m;
@@ -1040,7 +1056,7 @@ void wb__tricontacts_begin(wb_world *w)
     c->broad_ms = 0;
     /* contact.c's scan of this frame: no pair of particles may touch, so no point a
      * triangle either (its corners' rules are the pairs'); one body costs nothing */
-    if (!m->def.contacts || m->ntri == 0 || m->np < 4 || !w->k.pc->possible) return;
+    if (!m->def.contacts || m->ntri == 0 || m->np < 4 || !w->k.pc->possible || none_possible(w)) return;
     const double t0 = now_ms();
     if (broadphase(w) < 0) {
         c->n = 0;

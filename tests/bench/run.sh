@@ -21,7 +21,7 @@ mkdir -p "$(dirname "$JSON")" && : >"$JSON" || exit 2
 SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2 scale32 scale64 scale128 scale256 scale512 contacts sheet tets tets_t2"
 FLOAT_SCENES="cloth128 cloth128_t2 cloth32 cloth32_t2"
 SCENES="$SCENES bend"   # the bending scene (tests/bench/bend.lua)
-SCENES="$SCENES self128 loose128 heap128 drape128"   # self-collision against none (tests/bench/self_collide.lua)
+SCENES="$SCENES self128 flat128 loose128 heap128 drape128"   # self-collision against none (tests/bench/self_collide.lua)
 SCENES="$SCENES self32 self64 self128_30 self256"   # ... per size (the cost per particle: flat)
 SCENES="$SCENES convergence"   # XPBD and VBD: error against CPU time (tests/bench/convergence.lua)
 
@@ -152,6 +152,7 @@ aim "frame with contacts / without" "$([ -n "$on" ] && [ -n "$off" ] && awk -v a
 echo
 echo "== the aims of self-collision (tests/bench/self_collide.lua; wall clock)"
 aim "self128: self-colliding / not" "$(row self128 ratio_off)" 1.3
+aim "flat128: self-colliding, lying flat / not" "$(row flat128 ratio_off)" 1.3
 aim "loose128: hand-built, contacts / none" "$(row loose128 ratio_off)" 1.3
 aim "heap128: self-colliding heap / not" "$(row heap128 ratio_off)" 3
 aim "drape128: self-colliding, draped / not" "$(row drape128 ratio_off)" 1.3

@@ -10,6 +10,8 @@
 --            default radius 0.02 > half the 1.57 cm spacing): contacts on against off
 --  drape128  a w:cloth of 128 x 128 (1.5 m) draped over a sphere on the floor (60 frames
 --            after it fell 3 cm onto it): self_collide = true against false
+--  flat128   a w:cloth of 128 x 128 (2 m) dropped 5 cm onto the floor, lying flat there
+--            for 60 frames (the issue's flat cloth): self_collide = true against false
 --  heap128   a w:cloth of 128 x 128 (1.5 m) hung straight down over the floor, rippled,
 --            let fall into a heap on itself for 120 frames: self_collide = true against
 --            false (without, the folds pass through each other)
@@ -47,6 +49,14 @@ local function hand_built(contacts)
   end
   w:pin(id[0])
   w:pin(id[n - 1])
+  return w
+end
+
+-- a flat cloth: dropped 5 cm onto the floor, where it lies
+local function lying(self)
+  local w = wobble.world{ threads = args.threads or 1 }
+  w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.5 }
+  w:cloth{ origin = {-1, 0.05, -1}, size = {2, 2}, res = {128, 128}, mass = 1, self_collide = self }
   return w
 end
 
@@ -124,6 +134,7 @@ scene("self32", hanging_n(32), 30, "without self-collision")
 scene("self64", hanging_n(64), 30, "without self-collision")
 scene("self128_30", hanging, 30, "without self-collision")
 scene("self256", hanging_n(256), 30, "without self-collision")
+scene("flat128", lying, 60, "without self-collision")
 scene("loose128", hand_built, 60, "contacts = false")
 scene("heap128", heap, 120, "without self-collision")
 scene("drape128", draped, 60, "without self-collision")
