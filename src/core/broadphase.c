@@ -40,6 +40,7 @@
 #include "ctype.h"
 #include "broadphase.h"
 #include "tricontact.h"
+#include "simd.h"
 
 static double now_ms(void)
 {
@@ -1857,6 +1858,45 @@ static inline int strays(const wb_contacts *c, const wb_real *x, const wb_real *
     return 2;
 }
 
+/* a particle into the substep's lists by what strays says of it: off its path (soft), past
+ * its reach (mv: counted past REPAIR_MAX, kept up to it) */
+static inline void sort_stray(int k, int32_t i, int32_t *soft, int32_t *ns, int32_t *mv, int32_t *nm)
+{
+    if (k == 1) soft[(*ns)++] = i;
+    else if (k == 2) {
+        if (*nm < REPAIR_MAX) mv[*nm] = i;
+        (*nm)++;
+    }
+}
+
+#ifdef WB_SIMD_H_AVX2
+/* The same pass with strays' first test (on its path) in AVX2: each particle's path as two
+ * vectors, (y, eps) and (u, 0), and its position as (x, 0), so that lane 3 of the deviation
+ * is -eps; the same operations in the same order as the scalar test (no fused
+ * multiply-adds), so the same decisions to the bit. The rest (off their paths) as
+ * strays. Returns the particles found on their paths */
+static __attribute__((target("avx2"))) int32_t check_avx2(const wb_contacts *c, const wb_real *x,
+                                                          const wb_real *rad, const ref_step *rs, int32_t np,
+                                                          int32_t *soft, int32_t *ns, int32_t *mv, int32_t *nm)
+{
+    const __m256d S = _mm256_set1_pd(rs->S);
+    int32_t on = 0;
+    for (int32_t i = 0; i < np; i++) {
+        if (c->reach[i] >= 0 && !c->off_path[i]) {
+            const wb_real *P = &c->path[8 * i];
+            const __m256d d = _mm256_sub_pd(_mm256_sub_pd(wb__load3(&x[3 * i]), _mm256_loadu_pd(P)),
+                                            _mm256_mul_pd(S, _mm256_loadu_pd(P + 4)));
+            const __m256d q = _mm256_mul_pd(d, d);
+            const __m128d lo = _mm256_castpd256_pd128(q), hi = _mm256_extractf128_pd(q, 1);
+            const __m128d dd = _mm_add_sd(_mm_add_sd(lo, _mm_unpackhi_pd(lo, lo)), hi);
+            if (_mm_comile_sd(dd, _mm_unpackhi_pd(hi, hi))) { on++; continue; }
+        }
+        sort_stray(strays(c, x, rad, rs, i), i, soft, ns, mv, nm);
+    }
+    return on;
+}
+#endif
+
 int wb__contacts_recheck(wb_world *w, wb_real h)
 {
     wb_model *m = &w->m;
@@ -1875,14 +1915,11 @@ int wb__contacts_recheck(wb_world *w, wb_real h)
     if (soft) c->soft = soft;
     if (mv) c->fix = mv;
     if (!soft || !mv) { c->n = 0; c->check = 0; return -1; }
-    for (int32_t i = 0; i < m->np; i++) {
-        const int k = strays(c, x, rad, &rs, i);
-        if (k == 1) soft[ns++] = i;
-        else if (k == 2) {
-            if (nm < REPAIR_MAX) mv[nm] = i;
-            nm++;
-        }
-    }
+#ifdef WB_SIMD_H_AVX2
+    if (!w->k.no_simd && __builtin_cpu_supports("avx2")) c->lanes += check_avx2(c, x, rad, &rs, m->np, soft, &ns, mv, &nm);
+    else
+#endif
+        for (int32_t i = 0; i < m->np; i++) sort_stray(strays(c, x, rad, &rs, i), i, soft, &ns, mv, &nm);
     /* a span ends here (list_span): the list for the next */
     const int due = sub > 0 && sub % c->span == 0;
     if (ns == 0 && nm == 0 && !due) return 0;

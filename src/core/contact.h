@@ -119,6 +119,7 @@ typedef struct wb_contacts {
     wb_real *left_old;
     int32_t cap_left_old;
     int64_t remakes;       /* lists made again within a frame (tests) */
+    int64_t lanes;         /* particles the substeps' check found on their paths in AVX2 (tests) */
     int32_t remakes_frame; /* ... within this frame */
     int32_t *fix, cap_fix; /* the particles that moved too far */
     int32_t *add, cap_add; /* (2 x) their new pairs */

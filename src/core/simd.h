@@ -5,6 +5,7 @@
 #define WB_SIMD_H
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(WB_FLOAT)
+#define WB_SIMD_H_AVX2 1 /* the functions below exist */
 #include <stddef.h>
 #include <immintrin.h>
 
