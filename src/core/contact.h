@@ -119,6 +119,9 @@ typedef struct wb_contacts {
     wb_real *left_old;
     int32_t cap_left_old;
     int64_t remakes;       /* lists made again within a frame (tests) */
+    uint8_t *grown;        /* (np) 1: the particle left its reach this frame (its margin grows
+                              with the frame's remakes; the others' stays) */
+    int32_t cap_grown;
     int64_t lanes;         /* particles the substeps' check found on their paths in AVX2 (tests) */
     int32_t remakes_frame; /* ... within this frame */
     int32_t *fix, cap_fix; /* the particles that moved too far */
