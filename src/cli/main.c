@@ -677,7 +677,8 @@ static void test_file(const char *path, const opts *o, tap *t) {
     }
     if (run_cases(L, path, t) == 0) {
         tap_result(t, EXIT_FAILED, path, "no test cases",
-                   "the file defines no test cases: call test(name, function() ... end)");
+                   "the file defines no test cases: call test(name, function() ... end) "
+                   "(a scene without them runs with `wobble run FILE`)");
     }
     close_test_state(L, t, path);
 }
