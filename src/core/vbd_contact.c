@@ -1,4 +1,4 @@
-/* vbd_contact.c: the particle-particle contacts as energies in VBD's vertex steps
+/* vbd_contact.c: the particle-particle and collider contacts as energies in VBD's vertex steps
  * (docs/physics.md, "VBD"), as Augmented Vertex Block Descent has them (Giles, Diaz,
  * Yuksel, SIGGRAPH 2025): each pair an inequality constraint C = |x_i - x_j| - target >= 0
  * with a penalty k and a multiplier lambda >= 0, its force on i along the pair's normal
@@ -19,11 +19,14 @@
  * momentum step (vbd.c's keep_momentum, wb__vbdc_body), which does the same for the
  * body's translation.
  *
- * Served: pairs of one movable and one immovable particle (a body on a pinned slab).
- * Pairs of two movable particles stay with the projection after the sweeps: Gauss-Seidel
- * over vertices gives the two ends unequal impulses, so a pair's momentum is not kept
- * (two particles meeting head-on at substeps = 1 left at 0.447 and 0.143 m/s where
- * perfectly inelastic is 0.143 for both; tests/validation/depenetration.lua).
+ * Served: pairs of one movable and one immovable particle (a body on a pinned slab); a
+ * held body's self-contacts (held_self) and its vertices' collider contacts, each a
+ * plane for the substep (gather_colliders), their friction with the current force for a
+ * self-contact. Other pairs of two movable particles stay with the projection after the
+ * sweeps: Gauss-Seidel over vertices gives the two ends unequal impulses, so a pair's
+ * momentum is not kept (two particles meeting head-on at substeps = 1 left at 0.447 and
+ * 0.143 m/s where perfectly inelastic is 0.143 for both; tests/validation/depenetration.lua);
+ * a held body's momentum is not kept anyway.
  *
  * Free bodies touching each other (vbd.c's touching(): their movable particles, or a
  * point and a triangle whose corners all move) are moved together after the sweeps
