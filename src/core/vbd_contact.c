@@ -309,6 +309,8 @@ static int32_t gather_colliders(wb_world *w, wb_vbdc *c, wb_real h, wb_real t0, 
     for (int32_t g = 0; g < c->ng; g++) c->gprevf[g] = c->gd[VBDC_GD * g + G_FEND];
     c->ng = 0;
     const wb_model *m = &w->m;
+    /* (no held body: none of its vertices to look at) */
+    if (!w->k.mc_built || w->k.mc_free == w->k.mc_nbody) return 0;
     int32_t live[64], nl = 0;
     for (int32_t s = 0; s < m->nc && nl < 64; s++)
         if ((m->c_gen[s] & 1u) && m->c_shape[s].shape != WB_SHAPE_MESH) live[nl++] = s;
@@ -356,11 +358,16 @@ static int32_t gather_colliders(wb_world *w, wb_vbdc *c, wb_real h, wb_real t0, 
             ng++;
         }
     }
-    /* each one's lagged normal force: the last substep's, where it had it */
+    /* each one's lagged normal force: the last substep's, where it had it; in a frame's
+     * first substep none (-1: the force where the Newton step puts it), so that a frame
+     * depends on nothing but the state a snapshot holds (a world loaded from w:save steps
+     * on bit for bit) */
     for (int32_t g = 0, o = 0; g < ng; g++) {
         const int32_t i = c->gis[2 * g], s = c->gis[2 * g + 1];
         while (o < c->ngprev && (c->gprev[2 * o] < i || (c->gprev[2 * o] == i && c->gprev[2 * o + 1] < s))) o++;
-        c->gd[VBDC_GD * g + G_FL] = o < c->ngprev && c->gprev[2 * o] == i && c->gprev[2 * o + 1] == s ? c->gprevf[o] : 0;
+        c->gd[VBDC_GD * g + G_FL] = !(t0 > 0)                                                              ? -1
+                                    : o < c->ngprev && c->gprev[2 * o] == i && c->gprev[2 * o + 1] == s ? c->gprevf[o]
+                                                                                                        : 0;
     }
     c->ng = ng;
     return ng;
@@ -581,6 +588,10 @@ void wb__vbdc_friction(const wb_world *w, const wb_vbdc *c, int32_t i, const wb_
             const int32_t g = -1 - c->ent[e];
             const wb_real *o = &c->gd[VBDC_GD * g];
             wb_real fl = o[G_FL];
+            if (fl < 0) {
+                const wb_real fnow = o[G_LAM] - o[G_K] * (v3_dot(&o[G_N], xi) - o[G_OFF]);
+                fl = fnow > 0 ? fnow : 0;
+            }
             if (!c->gsf[g] || !(o[G_MU] * fl > 0)) continue;
             cap += o[G_MU] * fl;
             v3_madd(N, &o[G_N], fl);
