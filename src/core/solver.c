@@ -463,7 +463,9 @@ wb_status wb_world_step(wb_world *w)
         /* TYPE HOOK: the constraint types, walked from the table (wb__ctypes) */
         for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->substep_begin(w);
         const int measure = k->residual_on && sub + 1 == d->substeps;
-        const wb_real r = d->solver == WB_SOLVER_VBD ? wb__vbd_solve(w, h) : solve_constraints(w, h, measure);
+        const wb_real r = d->solver == WB_SOLVER_VBD
+                              ? wb__vbd_solve(w, h, (wb_real)sub / d->substeps, (wb_real)(sub + 1) / d->substeps)
+                              : solve_constraints(w, h, measure);
         if (d->solver == WB_SOLVER_VBD && wb__vbd_failed(w)) {
             /* its scratch refused by the memory budget: the world is left as the frame found it */
             undo_particles(w);

@@ -43,6 +43,7 @@ struct wb_vbd {
     const wb_vbd_type *act[VBD_TYPES];
     void *act_part[VBD_TYPES];
     uint8_t *held;         /* (np) 1: a served constraint holds the vertex */
+    uint8_t *col;          /* (np) each vertex's colour */
     int32_t *order;        /* (np) the vertices by colour */
     int32_t *colour_start; /* (ncolours + 1) ranges of order */
     int32_t ncolours;
@@ -103,6 +104,7 @@ void wb__vbd_destroy(wb_world *w)
     for (int t = 0; t < wb__vbd_nctypes; t++)
         if (v->part[t]) wb__vbd_ctypes[t]->vbd->free(w, v->part[t]);
     free(v->held);
+    free(v->col);
     free(v->order);
     free(v->colour_start);
     free(v->y);
@@ -176,10 +178,11 @@ static int build_colours(wb_world *w, struct wb_vbd *v)
     int32_t fill[VBD_COLOURS];
     memcpy(fill, cs, sizeof fill);
     for (int32_t i = 0; i < np; i++) order[fill[col[i]]++] = i;
-    free(col);
+    free(v->col);
     free(v->order);
     free(v->colour_start);
     free(v->held);
+    v->col = col;
     v->order = order;
     v->colour_start = cs;
     v->held = held;
@@ -207,9 +210,9 @@ int wb__vbd_prepare(wb_world *w)
     if (rebuild_due(w, v)) {
         for (int t = 0; t < wb__vbd_nctypes; t++)
             if (!wb__vbd_ctypes[t]->vbd->build(w, v->part[t])) return 0;
-        /* the solver's own: the struct, held, order, y and colour_start */
+        /* the solver's own: the struct, held, col, order, y and colour_start */
         const size_t n1 = (size_t)(m->np > 0 ? m->np : 1);
-        if (!wb__charge(w, &v->charged, sizeof *v + n1 * (1 + sizeof(int32_t) + 3 * sizeof(wb_real)) +
+        if (!wb__charge(w, &v->charged, sizeof *v + n1 * (2 + sizeof(int32_t) + 3 * sizeof(wb_real)) +
                                             (VBD_COLOURS + 1) * sizeof(int32_t)) ||
             !build_colours(w, v))
             return 0;
@@ -693,8 +696,7 @@ static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch, wb_real h)
                 if (b < 0 || !(T[4 * b] > 0) || isnan(tb[3 * b]) || v->bvar[b] >= 0) continue;
                 wb_real f[3] = { 0, 0, 0 }, H[6] = { 0, 0, 0, 0, 0, 0 }, fr[4] = { 0, 0, 0, 0 }, sh[3];
                 for (int c = 0; c < 3; c++) sh[c] = (wb_real)tb[3 * b + c];
-                wb__vbdc_body(w, v->ct, cv[q], sh, f, H, pass == 0 ? fr : NULL);
-                E[17 * b] = 1;
+                if (wb__vbdc_body(w, v->ct, cv[q], sh, f, H, pass == 0 ? fr : NULL)) E[17 * b] = 1;
                 for (int c = 0; c < 3; c++) E[17 * b + 1 + c] += f[c];
                 for (int c = 0; c < 6; c++) E[17 * b + 4 + c] += H[c];
                 if (pass == 0)
@@ -749,7 +751,7 @@ static void keep_momentum(wb_world *w, struct wb_vbd *v, int touch, wb_real h)
     }
 }
 
-wb_real wb__vbd_solve(wb_world *w, wb_real h)
+wb_real wb__vbd_solve(wb_world *w, wb_real h, wb_real t0, wb_real t1)
 {
     struct wb_vbd *v = w->vbd;
     if (!v || v->np != w->m.np) return -1; /* (prepare failed: out of memory, warned there) */
@@ -766,7 +768,8 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h)
         for (int32_t b = 0; b < w->k.mc_nbody; b++)
             v->bmove[b] = v->tsum[4 * w->k.mc_nbody + b] > 0 && v->tsum[4 * b] >= 0 && !(w->k.mc_acc[16 * b] < 0) &&
                           v->bvar[b] < 0;
-    const int got = wb__vbdc_begin(w, &v->ct, h, v->order, v->colour_start, v->ncolours, touch ? v->bmove : NULL,
+    const int got = wb__vbdc_begin(w, &v->ct, h, t0, t1, v->order, v->colour_start, v->ncolours, v->col, v->held,
+                                   touch ? v->bmove : NULL,
                                    touch && v->nvar > 0 ? v->bvar : NULL);
     v->ct_on = got > 0;
     if (got < 0) v->nomem = 1;

@@ -6,8 +6,9 @@
 
 /* `iterations` sweeps of per-vertex Newton steps over the types it serves (the others
  * are projected as in XPBD after each sweep; fewer once the last sweep's largest step is
- * at most the tolerance); returns that step, the residual (m), or -1 */
-wb_real wb__vbd_solve(wb_world *w, wb_real h);
+ * at most the tolerance); t0, t1: the substep's start and end in the frame (the
+ * colliders' poses); returns that step, the residual (m), or -1 */
+wb_real wb__vbd_solve(wb_world *w, wb_real h, wb_real t0, wb_real t1);
 /* once per step before the types' prepare: the adjacency and colouring when the topology
  * changed; 0 when out of memory */
 int wb__vbd_prepare(wb_world *w);

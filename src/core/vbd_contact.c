@@ -1,4 +1,4 @@
-/* vbd_contact.c: the particle-particle contacts as energies in VBD's vertex steps
+/* vbd_contact.c: the particle-particle and collider contacts as energies in VBD's vertex steps
  * (docs/physics.md, "VBD"), as Augmented Vertex Block Descent has them (Giles, Diaz,
  * Yuksel, SIGGRAPH 2025): each pair an inequality constraint C = |x_i - x_j| - target >= 0
  * with a penalty k and a multiplier lambda >= 0, its force on i along the pair's normal
@@ -19,11 +19,14 @@
  * momentum step (vbd.c's keep_momentum, wb__vbdc_body), which does the same for the
  * body's translation.
  *
- * Served: pairs of one movable and one immovable particle (a body on a pinned slab).
- * Pairs of two movable particles stay with the projection after the sweeps: Gauss-Seidel
- * over vertices gives the two ends unequal impulses, so a pair's momentum is not kept
- * (two particles meeting head-on at substeps = 1 left at 0.447 and 0.143 m/s where
- * perfectly inelastic is 0.143 for both; tests/validation/depenetration.lua).
+ * Served: pairs of one movable and one immovable particle (a body on a pinned slab); a
+ * held body's self-contacts (held_self) and its vertices' collider contacts, each a
+ * plane for the substep (gather_colliders), their friction with the current force for a
+ * self-contact. Other pairs of two movable particles stay with the projection after the
+ * sweeps: Gauss-Seidel over vertices gives the two ends unequal impulses, so a pair's
+ * momentum is not kept (two particles meeting head-on at substeps = 1 left at 0.447 and
+ * 0.143 m/s where perfectly inelastic is 0.143 for both; tests/validation/depenetration.lua);
+ * a held body's momentum is not kept anyway.
  *
  * Free bodies touching each other (vbd.c's touching(): their movable particles, or a
  * point and a triangle whose corners all move) are moved together after the sweeps
@@ -50,7 +53,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "attach.h"
 #include "contact.h"
+#include "shape.h"
 #include "tricontact.h"
 #include "vbd_contact.h"
 
@@ -81,6 +86,7 @@ struct wb_vbdc {
     wb_real *fend, *prevf;   /* (npair) each pair's normal force as the substep's solve left
                                 it (wb__vbdc_end) */
     wb_real *lamp;           /* (npair) the multiplier before the last sweep's update */
+    wb_real *ke;             /* (npair x 2) each end's penalty in its vertex step (begin) */
     uint8_t *sf;             /* (npair) 1: its friction acts in the vertex steps (0: in its
                                 body's momentum step, vbd.c) */
     uint8_t *bo;             /* (npair) 1: two movable ends of two bodies, at least one of them
@@ -100,6 +106,16 @@ struct wb_vbdc {
     double *cs;              /* wb__vbdc_couple's scratch: 108 doubles a body, 20 a pair, 24 a
                                 triangle contact */
     size_t cap_cs, charged_cs;
+    /* the collider contacts in the vertex steps: vertex i against collider s (not a mesh),
+     * the surface as a plane over the substep, C = n . x - off >= 0 */
+    int32_t ng, cap_g, ngprev;
+    int32_t *gis, *gprev;    /* (ng x 2) vertex, collider slot, in that order; the last
+                                substep's, with gprevf */
+    wb_real *gd;             /* (ng x VBDC_GD) its record (G_ below) */
+    wb_real *gprevf;         /* (ngprev) the last substep's normal forces as it ended */
+    uint8_t *gsf;            /* (ng) 1: its friction acts in the vertex steps (0: its body's
+                                momentum step) */
+    size_t charged_g;
     int32_t *tk;             /* (ntk x 3) wb__vbdc_couple's triangle contacts between its
                                 bodies: candidate, the point's body in the step, the
                                 triangle's (-1: held where it is) */
@@ -107,15 +123,23 @@ struct wb_vbdc {
     size_t charged_tk;
 };
 
+/* a collider contact's record: its normal (3), the plane's offset, penalty, multiplier, the
+ * multiplier before the last sweep's update, friction, lagged normal force, force as the
+ * solve left it, and the surface's move over the substep at the contact (3) */
+enum { G_N = 0, G_OFF = 3, G_K, G_LAM, G_LAMP, G_MU, G_FL, G_FEND, G_MV, VBDC_GD = G_MV + 3 };
+
 void wb__vbdc_destroy(wb_world *w, wb_vbdc *c)
 {
     if (!c) return;
+    wb__charge(w, &c->charged_g, 0);
+    free(c->gis), free(c->gprev), free(c->gd), free(c->gprevf), free(c->gsf);
     wb__charge(w, &c->charged, 0);
     wb__charge(w, &c->charged_cs, 0);
     wb__charge(w, &c->charged_tk, 0);
     free(c->cs), free(c->tk), free(c->bo);
     free(c->start), free(c->ent), free(c->pij), free(c->tgt), free(c->kk), free(c->lam), free(c->mu);
     free(c->ov), free(c->ove), free(c->prev), free(c->fend), free(c->prevf), free(c->fl), free(c->lamp), free(c->sf), free(c->ks), free(c->xc), free(c->cv), free(c->cvs);
+    free(c->ke);
     free(c);
 }
 
@@ -125,7 +149,7 @@ void wb__vbdc_destroy(wb_world *w, wb_vbdc *c)
 static size_t bytes_at(int64_t np, int64_t npair, int64_t ncol1, int64_t nks)
 {
     return sizeof(wb_vbdc) + (size_t)np * (2 * sizeof(int32_t) + 3 * sizeof(wb_real)) + sizeof(int32_t) +
-           (size_t)npair * (6 * sizeof(int32_t) + 10 * sizeof(wb_real) + 2) + (size_t)nks * sizeof(vbdc_key) +
+           (size_t)npair * (6 * sizeof(int32_t) + 12 * sizeof(wb_real) + 2) + (size_t)nks * sizeof(vbdc_key) +
            (size_t)ncol1 * sizeof(int32_t);
 }
 
@@ -174,12 +198,13 @@ static int grow(wb_world *w, wb_vbdc *c, int32_t np, int32_t npair, int32_t ncol
         if (q[1]) c->prevf = q[1];
         q[2] = realloc(c->fl, sizeof(wb_real) * n);
         if (q[2]) c->fl = q[2];
-        wb_real *lp = realloc(c->lamp, sizeof *lp * n);
+        wb_real *lp = realloc(c->lamp, sizeof *lp * n), *ke = realloc(c->ke, sizeof *ke * 2 * n);
         if (lp) c->lamp = lp;
+        if (ke) c->ke = ke;
         uint8_t *sf = realloc(c->sf, n), *bo = realloc(c->bo, n);
         if (sf) c->sf = sf;
         if (bo) c->bo = bo;
-        if (!e || !p || !r[0] || !r[1] || !r[2] || !r[3] || !ov || !ove || !pv || !q[0] || !q[1] || !q[2] || !lp || !sf || !bo)
+        if (!e || !p || !r[0] || !r[1] || !r[2] || !r[3] || !ov || !ove || !pv || !q[0] || !q[1] || !q[2] || !lp || !ke || !sf || !bo)
             return 0;
         c->cap_pair = npair;
     }
@@ -198,16 +223,26 @@ static int grow(wb_world *w, wb_vbdc *c, int32_t np, int32_t npair, int32_t ncol
  * once, by vbd.c's touching(): neither is moved with the other.) */
 static inline int starts_deep(wb_real d0, wb_real step) { return d0 > step; }
 
-/* candidate k is a pair it serves, closer than WB_VBDC_NEAR (r_i + r_j): one movable end
- * (see the head of the file for why not two), or two movable ends of two bodies, neither
- * held, one of them moved with its partners (bvar: its index there, < 0 none; NULL: no
- * such bodies), not starting deep (a pair of bodies made inside each other: touching() left
- * neither in bvar) */
+/* i and j are of one body that something outside the solve holds (a pin, an attachment, a
+ * grab): a self-contact the vertex steps take (body: NULL when none is known). A free
+ * body's stay the projection's: its momentum step (vbd.c's keep_momentum) moves it rigidly
+ * after the sweeps, and with them in the sweeps a hand-built cloth dropped on a sphere
+ * gained energy (9.8 J to 25 J in 3 s) */
+static inline int held_self(const wb_world *w, const int32_t *body, int32_t i, int32_t j)
+{
+    return body && body[i] >= 0 && body[i] == body[j] && w->k.mc_acc[16 * body[i]] < 0;
+}
+
+/* candidate k is a pair it serves, closer than WB_VBDC_NEAR (r_i + r_j): one movable end,
+ * two movable ends of one held body (its self-contacts: see the head of the file), or two
+ * movable ends of two bodies, neither held, one of them moved with its partners (bvar: its
+ * index there, < 0 none; NULL: no such bodies), not starting deep (a pair of bodies made
+ * inside each other: touching() left neither in bvar). body: NULL when none is known */
 static inline int near_pair(const wb_world *w, const wb_contacts *pc, const wb_real *x, const wb_real *wv, const wb_real *rad,
                             const int32_t *body, const int32_t *bvar, wb_real step, int32_t k)
 {
     const int32_t i = pc->ij[2 * k], j = pc->ij[2 * k + 1];
-    if (!(wv[i] > 0) == !(wv[j] > 0)) {
+    if (!(wv[i] > 0) == !(wv[j] > 0) && !(wv[i] > 0 && held_self(w, body, i, j))) {
         if (!bvar || !(wv[i] > 0)) return 0;
         const int32_t a = body[i], b = body[j];
         if (a < 0 || b < 0 || a == b || (bvar[a] < 0 && bvar[b] < 0)) return 0;
@@ -225,8 +260,123 @@ static inline int near_pair(const wb_world *w, const wb_contacts *pc, const wb_r
     return v3_dot(d, d) < rn * rn;
 }
 
-int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, const int32_t *colour_start,
-                   int32_t ncolours, const uint8_t *bmoved, const int32_t *bvar)
+/* 1: a collider the vertex steps take (not a mesh) is in the world */
+static int any_collider(const wb_world *w)
+{
+    for (int32_t s = 0; s < w->m.nc; s++)
+        if ((w->m.c_gen[s] & 1u) && w->m.c_shape[s].shape != WB_SHAPE_MESH) return 1;
+    return 0;
+}
+
+/* room for ng collider contacts (and as many lagged ones), charged first; 0 when refused */
+static int grow_g(wb_world *w, wb_vbdc *c, int32_t ng)
+{
+    if (ng <= c->cap_g) return 1;
+    const int32_t cap = ng > 2 * c->cap_g ? ng : 2 * c->cap_g;
+    const size_t n = (size_t)cap;
+    if (!wb__charge(w, &c->charged_g, n * (4 * sizeof(int32_t) + (VBDC_GD + 1) * sizeof(wb_real) + 1))) return 0;
+    int32_t *a = realloc(c->gis, sizeof *a * 2 * n), *b = realloc(c->gprev, sizeof *b * 2 * n);
+    if (a) c->gis = a;
+    if (b) c->gprev = b;
+    wb_real *d = realloc(c->gd, sizeof *d * VBDC_GD * n), *f = realloc(c->gprevf, sizeof *f * n);
+    if (d) c->gd = d;
+    if (f) c->gprevf = f;
+    uint8_t *sf = realloc(c->gsf, n);
+    if (sf) c->gsf = sf;
+    if (!a || !b || !d || !f || !sf) return 0;
+    c->cap_g = cap;
+    return 1;
+}
+
+/* The collider contacts of the substep (t0, t1: its start and end in the frame): each
+ * movable vertex of a held body that a served constraint holds (held), within
+ * WB_VBDC_NEAR r_i of a collider's surface at the substep's end pose (meshes, and
+ * colliders past the first 64, are left to the projection; so are a free body's, which
+ * its momentum step would move back: a hand-built cloth dropped on a sphere slid off it,
+ * gaining 2.5 J, or with their friction in the vertex steps blew up, 141 J, as a free body
+ * near an immovable particle takes its friction in that step alone, or drifted 0.18 m off
+ * the sphere's axis), the surface linearised there as a plane through
+ * its closest point, the target r_i less the overlap it keeps (a made overlap parts at
+ * max_depenetration, as collide.c's rule), its penalty VBDC_K times the vertex's inertia
+ * over the substep (an immovable partner's), its friction lagged as the pairs'. In
+ * (vertex, collider) order: the lag's merge. Returns their count, -1 out of memory */
+static int32_t gather_colliders(wb_world *w, wb_vbdc *c, wb_real h, wb_real t0, wb_real t1, const uint8_t *held)
+{
+    /* the last substep's, for the lag */
+    int32_t *t = c->gprev;
+    c->gprev = c->gis, c->gis = t;
+    c->ngprev = c->ng;
+    for (int32_t g = 0; g < c->ng; g++) c->gprevf[g] = c->gd[VBDC_GD * g + G_FEND];
+    c->ng = 0;
+    const wb_model *m = &w->m;
+    /* (no held body: none of its vertices to look at) */
+    if (!w->k.mc_built || w->k.mc_free == w->k.mc_nbody) return 0;
+    int32_t live[64], nl = 0;
+    for (int32_t s = 0; s < m->nc && nl < 64; s++)
+        if ((m->c_gen[s] & 1u) && m->c_shape[s].shape != WB_SHAPE_MESH) live[nl++] = s;
+    if (nl == 0) return 0;
+    wb_real p0[64][3], q0[64][4], p1[64][3], q1[64][4];
+    for (int32_t k = 0; k < nl; k++) {
+        wb__collider_pose_at(&w->s.c_pose[live[k]], t0, p0[k], q0[k]);
+        wb__collider_pose_at(&w->s.c_pose[live[k]], t1, p1[k], q1[k]);
+    }
+    const wb_real *x = w->s.x, *xp = w->s.x_prev, *wv = m->w, *rad = m->radius, inv_h2 = 1 / (h * h);
+    const wb_real step = m->def.max_depenetration * h;
+    const int32_t *body = w->k.mc_built ? w->k.mc_body : NULL;
+    const wb_attaches *att = wb__attach_skips(w); /* attached: no contact */
+    int32_t ng = 0;
+    for (int32_t i = 0; i < m->np; i++) {
+        if (!(wv[i] > 0) || !held[i] || !(body && body[i] >= 0 && w->k.mc_acc[16 * body[i]] < 0)) continue;
+        for (int32_t k = 0; k < nl; k++) {
+            const int32_t s = live[k];
+            if (att && wb__attach_skip(att, i, s)) continue;
+            const wb_cshape *sh = &m->c_shape[s];
+            wb_real n[3];
+            const wb_real d = wb__shape_distance(sh, p1[k], q1[k], &x[3 * i], n);
+            if (!(d < WB_VBDC_NEAR * rad[i])) continue;
+            if (ng == c->cap_g && !grow_g(w, c, ng + 1)) return -1;
+            wb_real *o = &c->gd[VBDC_GD * ng], n0[3], ps[3];
+            /* the overlap it began the substep with, of which it keeps all but a step */
+            wb_real d0 = rad[i] - wb__shape_distance(sh, p0[k], q0[k], &xp[3 * i], n0), keep = d0 - step;
+            keep = !(keep > 0) ? 0 : keep;
+            /* the surface point, and where the collider's move took it from */
+            v3_copy(ps, &x[3 * i]);
+            v3_madd(ps, n, -d);
+            wb_real l[3], r0[3];
+            v3_sub(l, ps, p1[k]);
+            q_rotate_inv(q1[k], l, r0);
+            q_rotate(q0[k], r0, l);
+            v3_add(l, l, p0[k]);
+            v3_copy(&o[G_N], n);
+            o[G_OFF] = v3_dot(n, ps) + rad[i] - keep;
+            o[G_K] = VBDC_K * inv_h2 / wv[i];
+            o[G_LAM] = o[G_LAMP] = o[G_FEND] = 0;
+            o[G_MU] = sh->friction;
+            v3_sub(&o[G_MV], ps, l);
+            c->gis[2 * ng] = i, c->gis[2 * ng + 1] = s;
+            c->gsf[ng] = 1;
+            ng++;
+        }
+    }
+    /* each one's lagged normal force: the last substep's, where it had it; in a frame's
+     * first substep none (-1: the force where the Newton step puts it), so that a frame
+     * depends on nothing but the state a snapshot holds (a world loaded from w:save steps
+     * on bit for bit) */
+    for (int32_t g = 0, o = 0; g < ng; g++) {
+        const int32_t i = c->gis[2 * g], s = c->gis[2 * g + 1];
+        while (o < c->ngprev && (c->gprev[2 * o] < i || (c->gprev[2 * o] == i && c->gprev[2 * o + 1] < s))) o++;
+        c->gd[VBDC_GD * g + G_FL] = !(t0 > 0)                                                              ? -1
+                                    : o < c->ngprev && c->gprev[2 * o] == i && c->gprev[2 * o + 1] == s ? c->gprevf[o]
+                                                                                                        : 0;
+    }
+    c->ng = ng;
+    return ng;
+}
+
+int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, wb_real t0, wb_real t1, const int32_t *order,
+                   const int32_t *colour_start, int32_t ncolours, const uint8_t *vcol, const uint8_t *held,
+                   const uint8_t *bmoved,
+                   const int32_t *bvar)
 {
     const wb_contacts *pc = w->k.pc;
     wb_vbdc *c = *cp;
@@ -240,7 +390,10 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, c
         c->npair = 0;
         c->sorted = 0;
     }
-    if (pc->n == 0) return 0;
+    if (pc->n == 0 && !any_collider(w)) {
+        if (c) c->ng = 0;
+        return 0;
+    }
     const wb_model *m = &w->m;
     const int32_t np = m->np;
     const wb_real *x = w->s.x, *xp = w->s.x_prev, *wv = m->w, *rad = m->radius, *cf = m->cfric;
@@ -254,10 +407,11 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, c
      * gathered in (i, j) order (the lag's and the readout's merge; the broad phase's order
      * is its own) */
     const wb_real step = m->def.max_depenetration * h;
+    const int32_t *body = w->k.mc_built ? w->k.mc_body : NULL;
     int sorted = 1;
     int32_t n = 0;
     for (int32_t k = 0; k < pc->n; k++) {
-        if (!near_pair(w, pc, x, wv, rad, w->k.mc_body, bvar, step, k)) continue;
+        if (!near_pair(w, pc, x, wv, rad, body, bvar, step, k)) continue;
         if (n == c->cap_ks && !grow(w, c, 0, 0, 0, n > 0 ? 2 * n : 64)) {
             c->nprev = 0;
             return -1;
@@ -267,11 +421,19 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, c
         if (n > 0 && c->ks[n - 1].key > c->ks[n].key) sorted = 0;
         n++;
     }
-    if (n == 0) {
+    const int32_t ng = gather_colliders(w, c, h, t0, t1, held);
+    if (ng < 0) {
+        c->nprev = 0;
+        return -1;
+    }
+    if (n == 0 && ng == 0) {
         c->sorted = 1; /* (no pairs: none lagged into the next substep) */
         return 0;
     }
-    if (!grow(w, c, np, n > c->nprev ? n : c->nprev, ncolours, n)) {
+    /* (the entries, 2 a pair and 1 a collider contact, live in the pairs' room) */
+    int32_t want = n + (ng + 1) / 2;
+    want = want > c->nprev ? want : c->nprev;
+    if (!grow(w, c, np, want, ncolours, n)) {
         c->nprev = 0;
         return -1;
     }
@@ -300,12 +462,25 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, c
         c->pij[2 * q] = i, c->pij[2 * q + 1] = j;
         c->tgt[q] = r - keep;
         c->ov[q] = c->ove[q] = r - keep - l1;
+        const int self = wv[i] > 0 && wv[j] > 0 && held_self(w, body, i, j);
         c->kk[q] = VBDC_K * inv_h2 / wsum;
+        /* each end's penalty in its vertex step: the pair's, but for two movable ends of one
+         * colour (contacts are not in the colouring), which step at once from where the
+         * other was: each as if the other held, equal masses moved 0.8 of the overlap each
+         * (1.6 in all; deferring one end to a Gauss-Seidel step after the colours pushed the
+         * two unequally, and a rope dropped across another slid 15 mm along itself). Each
+         * sees the pair's penalty in series with the other's inertia, K / (h^2 (w_i + (1 +
+         * K) w_j)), so the two steps together are the pair's own implicit step, K / (1 + K)
+         * of the overlap shared by inverse mass (the ends' other constraints make it less) */
+        const int jac = self && vcol[i] == vcol[j];
+        c->ke[2 * q] = jac ? VBDC_K * inv_h2 / (wv[i] + (1 + VBDC_K) * wv[j]) : c->kk[q];
+        c->ke[2 * q + 1] = jac ? VBDC_K * inv_h2 / (wv[j] + (1 + VBDC_K) * wv[i]) : c->kk[q];
         c->lam[q] = c->lamp[q] = 0;
         c->mu[q] = (cf[i] + cf[j]) / 2;
         const int32_t mv = wv[i] > 0 ? i : j, b = bmoved && w->k.mc_body ? w->k.mc_body[mv] : -1;
-        c->sf[q] = !(b >= 0 && bmoved[b]);
-        c->bo[q] = wv[i] > 0 && wv[j] > 0;
+        /* (a self-contact's friction is the body's own: in the vertex steps) */
+        c->sf[q] = self || !(b >= 0 && bmoved[b]);
+        c->bo[q] = wv[i] > 0 && wv[j] > 0 && !self;
         if (c->bo[q]) continue;
         if (wv[i] > 0) start[i + 1]++;
         if (wv[j] > 0) start[j + 1]++;
@@ -319,9 +494,12 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, c
         while (o < c->nprev && (c->prev[2 * o] < i || (c->prev[2 * o] == i && c->prev[2 * o + 1] < j))) o++;
         c->fl[q] = o < c->nprev && c->prev[2 * o] == i && c->prev[2 * o + 1] == j ? c->prevf[o] : 0;
     }
+    for (int32_t g = 0; g < ng; g++) start[c->gis[2 * g] + 1]++;
     for (int32_t i = 0; i < np; i++) start[i + 1] += start[i];
     const int32_t nent = start[np];
-    /* fill from the end of each range backwards, pairs in reverse: each range in pair order */
+    /* fill from the end of each range backwards, colliders then pairs in reverse: each range
+     * its pairs in order, then its colliders (entry -1 - g) */
+    for (int32_t g = ng - 1; g >= 0; g--) c->ent[--start[c->gis[2 * g] + 1]] = -1 - g;
     for (int32_t q = n - 1; q >= 0; q--)
         for (int s = 1; s >= 0 && !c->bo[q]; s--) {
             const int32_t i = c->pij[2 * q + s];
@@ -344,21 +522,40 @@ int wb__vbdc_begin(wb_world *w, wb_vbdc **cp, wb_real h, const int32_t *order, c
     return 1;
 }
 
-/* (sh: i moved by it, NULL: where it is) */
-static inline __attribute__((always_inline)) void block(const wb_world *w, const wb_vbdc *c, const wb_real *lam, int32_t i,
-                                                        const wb_real *sh, wb_real f[3], wb_real H[6], wb_real *fr)
+/* (sh: i moved by it, its body's move, NULL: where it is; then its self-contacts, which
+ * the body's move does not change, are left out; returns the pairs taken) */
+static inline __attribute__((always_inline)) int block(const wb_world *w, const wb_vbdc *c, const wb_real *lam, int32_t i,
+                                                       const wb_real *sh, wb_real f[3], wb_real H[6], wb_real *fr)
 {
-    const wb_real *x = w->s.x, *xc = c->xc;
+    const wb_real *x = w->s.x, *xc = c->xc, *wv = w->m.w;
     wb_real xi[3];
+    int got = 0;
     v3_copy(xi, &x[3 * i]);
     if (sh) v3_add(xi, xi, sh);
     for (int32_t e = c->start[i]; e < c->start[i + 1]; e++) {
+        if (c->ent[e] < 0) {
+            /* a collider: the plane n . x = off */
+            const wb_real *o = &c->gd[VBDC_GD * (-1 - c->ent[e])], *n = &o[G_N], kk = o[G_K], fl = o[G_FL];
+            const wb_real fn = o[sh ? G_LAMP : G_LAM] - kk * (v3_dot(n, xi) - o[G_OFF]);
+            got = 1;
+            if (fr && fl > 0) {
+                fr[0] += o[G_MU] * fl;
+                v3_madd(&fr[1], n, fl);
+            }
+            if (!(fn > 0)) continue;
+            v3_madd(f, n, fn);
+            H[0] += kk * n[0] * n[0], H[1] += kk * n[1] * n[1], H[2] += kk * n[2] * n[2];
+            H[3] += kk * n[0] * n[1], H[4] += kk * n[0] * n[2], H[5] += kk * n[1] * n[2];
+            continue;
+        }
         const int32_t q = c->ent[e] >> 1, o = c->pij[2 * q + 1 - (c->ent[e] & 1)];
+        if (sh && wv[o] > 0) continue;
+        got = 1;
         wb_real d[3];
         v3_sub(d, xi, &xc[3 * o]);
         const wb_real l2 = v3_dot(d, d);
         if (!(l2 > 1e-24)) continue;
-        const wb_real l = sqrt(l2), kk = c->kk[q], fn = lam[q] - kk * (l - c->tgt[q]), fl = c->fl[q];
+        const wb_real l = sqrt(l2), kk = c->ke[c->ent[e]], fn = lam[q] - kk * (l - c->tgt[q]), fl = c->fl[q];
         if (!(fn > 0) && !(fr && fl > 0)) continue;
         wb_real n[3];
         v3_scale(n, d, 1 / l);
@@ -372,6 +569,7 @@ static inline __attribute__((always_inline)) void block(const wb_world *w, const
         H[0] += kk * n[0] * n[0], H[1] += kk * n[1] * n[1], H[2] += kk * n[2] * n[2];
         H[3] += kk * n[0] * n[1], H[4] += kk * n[0] * n[2], H[5] += kk * n[1] * n[2];
     }
+    return got;
 }
 
 void wb__vbdc_block(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3], wb_real H[6])
@@ -381,26 +579,60 @@ void wb__vbdc_block(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3]
 
 void wb__vbdc_friction(const wb_world *w, const wb_vbdc *c, int32_t i, const wb_real H[6], wb_real xi[3])
 {
-    const wb_real *xc = c->xc, *xp = w->s.x_prev;
-    wb_real cap = 0, N[3] = { 0, 0, 0 };
+    const wb_real *xc = c->xc, *xp = w->s.x_prev, *wv = w->m.w;
+    wb_real cap = 0, N[3] = { 0, 0, 0 }, mv[3] = { 0, 0, 0 }, fm = 0;
+    int moving = 0;
     for (int32_t e = c->start[i]; e < c->start[i + 1]; e++) {
+        if (c->ent[e] < 0) {
+            /* a collider: its surface's move over the substep is the partner's */
+            const int32_t g = -1 - c->ent[e];
+            const wb_real *o = &c->gd[VBDC_GD * g];
+            wb_real fl = o[G_FL];
+            if (fl < 0) {
+                const wb_real fnow = o[G_LAM] - o[G_K] * (v3_dot(&o[G_N], xi) - o[G_OFF]);
+                fl = fnow > 0 ? fnow : 0;
+            }
+            if (!c->gsf[g] || !(o[G_MU] * fl > 0)) continue;
+            cap += o[G_MU] * fl;
+            v3_madd(N, &o[G_N], fl);
+            fm += fl;
+            if (o[G_MV] != 0 || o[G_MV + 1] != 0 || o[G_MV + 2] != 0) v3_madd(mv, &o[G_MV], fl), moving = 1;
+            continue;
+        }
         const int32_t q = c->ent[e] >> 1, o = c->pij[2 * q + 1 - (c->ent[e] & 1)];
-        const wb_real fl = c->fl[q];
-        if (!c->sf[q] || !(c->mu[q] * fl > 0)) continue;
-        wb_real d[3];
+        wb_real fl = c->fl[q], d[3];
         v3_sub(d, xi, &xc[3 * o]);
         const wb_real l = v3_len(d);
+        if (wv[o] > 0) {
+            /* a movable partner: the force where the Newton step put it (implicit Euler's),
+             * not the last substep's, which for two movable ends carries a landing's
+             * penalty force (a fold landing on its cloth: 150 times the weight, its flap
+             * held where it landed, links stretched 49%) */
+            const wb_real fnow = c->lam[q] - c->ke[c->ent[e]] * (l - c->tgt[q]);
+            fl = fnow > 0 ? fnow : 0;
+        }
+        if (!c->sf[q] || !(c->mu[q] * fl > 0)) continue;
         if (!(l > 0)) continue;
         cap += c->mu[q] * fl;
         v3_madd(N, d, fl / l);
+        fm += fl;
+        if (wv[o] > 0) {
+            /* (a movable partner: its move over the substep, weighted by the force; an
+             * immovable one's is none) */
+            wb_real m[3];
+            v3_sub(m, &xc[3 * o], &xp[3 * o]);
+            v3_madd(mv, m, fl);
+            moving = 1;
+        }
     }
     const wb_real nl = v3_len(N);
     if (!(cap > 0) || !(nl > 0)) return;
     v3_scale(N, N, 1 / nl);
-    /* the slip over the substep across N (the partners are immovable) and the force that
-     * stops it, the vertex's Hessian times it */
+    /* the slip over the substep across N (against the movable partners' mean move, the
+     * others are immovable) and the force that stops it, the vertex's Hessian times it */
     wb_real u[3], Hu[3];
     v3_sub(u, xi, &xp[3 * i]);
+    if (moving) v3_madd(u, mv, -1 / fm);
     v3_madd(u, N, -v3_dot(u, N));
     Hu[0] = H[0] * u[0] + H[3] * u[1] + H[4] * u[2];
     Hu[1] = H[3] * u[0] + H[1] * u[1] + H[5] * u[2];
@@ -410,10 +642,10 @@ void wb__vbdc_friction(const wb_world *w, const wb_vbdc *c, int32_t i, const wb_
     v3_madd(xi, u, -(need <= cap ? 1 : cap / need));
 }
 
-void wb__vbdc_body(const wb_world *w, const wb_vbdc *c, int32_t i, const wb_real sh[3], wb_real f[3], wb_real H[6],
-                   wb_real *fr)
+int wb__vbdc_body(const wb_world *w, const wb_vbdc *c, int32_t i, const wb_real sh[3], wb_real f[3], wb_real H[6],
+                  wb_real *fr)
 {
-    block(w, c, c->lamp, i, sh, f, H, fr);
+    return block(w, c, c->lamp, i, sh, f, H, fr);
 }
 
 /* pair q's gap C from its target where the particles are, and the force a multiplier
@@ -427,8 +659,20 @@ static inline wb_real pair_force(const wb_real *x, const wb_vbdc *c, int32_t q, 
     return lm > 0 ? lm : 0;
 }
 
+/* collider contact g's force where the vertex is, from the multiplier base (at 0 or more) */
+static inline wb_real g_force(const wb_real *x, const wb_vbdc *c, int32_t g, wb_real base)
+{
+    const wb_real *o = &c->gd[VBDC_GD * g];
+    const wb_real lm = base - o[G_K] * (v3_dot(&o[G_N], &x[3 * c->gis[2 * g]]) - o[G_OFF]);
+    return lm > 0 ? lm : 0;
+}
+
 void wb__vbdc_end(const wb_world *w, wb_vbdc *c)
 {
+    for (int32_t g = 0; g < c->ng; g++) {
+        wb_real *o = &c->gd[VBDC_GD * g];
+        o[G_LAM] = o[G_FEND] = g_force(w->s.x, c, g, o[G_LAMP]);
+    }
     for (int32_t q = 0; q < c->npair; q++) {
         wb_real C;
         c->lam[q] = c->fend[q] = pair_force(w->s.x, c, q, c->lamp[q], &C);
@@ -450,6 +694,12 @@ void wb__vbdc_colour_done(const wb_world *w, wb_vbdc *c, int32_t col)
 
 void wb__vbdc_dual(const wb_world *w, wb_vbdc *c)
 {
+    for (int32_t g = 0; g < c->ng; g++) {
+        wb_real *o = &c->gd[VBDC_GD * g];
+        const wb_real f = g_force(w->s.x, c, g, o[G_LAM]);
+        o[G_LAMP] = o[G_LAM];
+        o[G_LAM] = f;
+    }
     for (int32_t q = 0; q < c->npair; q++) {
         if (c->bo[q]) continue; /* (not in the sweeps: its penalty alone in the coupled step, its
                                    multipliers left at begin's 0) */

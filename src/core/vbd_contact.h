@@ -11,15 +11,20 @@ typedef struct wb_vbdc wb_vbdc;
 #define WB_VBDC_NEAR ((wb_real)1.25)
 
 /* Once a substep, after the sweeps' start: the frame's candidate pairs near enough to
- * touch during it, each vertex's list of them, and the copy its partners are read from.
- * order / colour_start / ncolours: the sweep's vertices by colour. Returns 1 when it holds
+ * touch during it and the vertices near a collider (not a mesh; t0, t1: the substep's
+ * start and end in the frame, where the colliders are), each vertex's list of them, and
+ * the copy its partners are read from.
+ * order / colour_start / ncolours: the sweep's vertices by colour, vcol (np) each one's
+ * colour (a pair of two movable ends of one colour steps both at once), held (np) 1 for a vertex a served constraint holds (the others
+ * have nothing in the sweeps to fight a collider: theirs stay the projection's). Returns 1 when it holds
  * pairs (then call the others; maybe none in the vertex steps, all of them between bodies
  * moved together), 0 when none, -1 when out of memory (the contacts after the sweeps
  * still hold). *c is made on first use. bmoved (bodies, may be NULL): 1 for a body whose
  * friction its momentum step takes (wb__vbdc_body), not the vertex steps; bvar (bodies,
  * may be NULL): a body's index among those moved together (wb__vbdc_couple), -1 none. */
-int wb__vbdc_begin(wb_world *w, wb_vbdc **c, wb_real h, const int32_t *order, const int32_t *colour_start,
-                   int32_t ncolours, const uint8_t *bmoved, const int32_t *bvar);
+int wb__vbdc_begin(wb_world *w, wb_vbdc **c, wb_real h, wb_real t0, wb_real t1, const int32_t *order,
+                   const int32_t *colour_start, int32_t ncolours, const uint8_t *vcol, const uint8_t *held,
+                   const uint8_t *bmoved, const int32_t *bvar);
 /* vertex i's contact forces and their Hessian added to f and H (H: xx, yy, zz, xy, xz, yz) */
 void wb__vbdc_block(const wb_world *w, const wb_vbdc *c, int32_t i, wb_real f[3], wb_real H[6]);
 /* after vertex i's Newton step to xi (H: its Hessian): its friction with its partners */
@@ -27,9 +32,10 @@ void wb__vbdc_friction(const wb_world *w, const wb_vbdc *c, int32_t i, const wb_
 /* vertex i's contact forces after the sweeps (the multipliers before the last update),
  * moved by sh, without friction, added to f and H; unless fr is NULL, fr[0] += its
  * friction's capacity, sum mu f_n (the lagged forces), fr[1..3] += sum f_n n (the
- * direction they push it): a body's momentum step's */
-void wb__vbdc_body(const wb_world *w, const wb_vbdc *c, int32_t i, const wb_real sh[3], wb_real f[3], wb_real H[6],
-                   wb_real *fr);
+ * direction they push it): a body's momentum step's. Its self-contacts (a movable
+ * partner) are left out: the body's move does not change them. 1 when it has others */
+int wb__vbdc_body(const wb_world *w, const wb_vbdc *c, int32_t i, const wb_real sh[3], wb_real f[3], wb_real H[6],
+                  wb_real *fr);
 /* after the sweeps and the momentum step: each pair's force where they left it (the
  * readout's, and the next substep's friction's) */
 void wb__vbdc_end(const wb_world *w, wb_vbdc *c);
