@@ -388,6 +388,8 @@ typedef struct wb_stats {
                                  shape-matching cluster or a pressure body counts one) */
     double step_ms;           /* wall time of the last step */
     double solve_ms;          /* of which constraint projection */
+    double iterations_run;    /* iterations a substep of the last step ran, on average: the
+                                 world's iterations, or fewer where tolerance stopped them */
     int64_t warnings;         /* numerical trouble detected so far */
     int32_t attachments, grabs; /* live ones (attach.c, grab.c) */
     int32_t rigids;           /* live rigid bodies */

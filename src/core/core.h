@@ -112,6 +112,7 @@ typedef struct wb_cache {
     struct wb_contacts *pc;
     struct wb_tricontacts *tc;
     int64_t projections;
+    int64_t iters_run;     /* iterations the last step's substeps ran, summed (tolerance stops some) */
     double step_ms, solve_ms;
     int no_fuse;           /* tests: the plain order, the next substep's prediction never
                               fused into the collision pass (solver.c), nor the static-plane

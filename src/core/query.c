@@ -165,6 +165,7 @@ wb_stats wb_world_stats(const wb_world *w)
     st.projections = w->k.projections;
     st.step_ms = w->k.step_ms;
     st.solve_ms = w->k.solve_ms;
+    st.iterations_run = w->m.def.substeps > 0 ? (double)w->k.iters_run / w->m.def.substeps : 0;
     st.warnings = w->s.warnings;
     st.rigids = wb_rigid_count(w);
     st.rigid_contacts = wb_world_rigid_contact_count(w);

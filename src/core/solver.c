@@ -37,6 +37,7 @@ static wb_real solve_constraints(wb_world *w, wb_real h, int measure)
     wb_real r = -1;
     for (int it = 0; it < iterations; it++) {
         for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->project(w, h);
+        w->k.iters_run++;
         /* (a pass over every constraint: only when asked for) */
         if (tol > 0 || (measure && it + 1 == iterations)) r = wb__residual_all(w, h);
         if (tol > 0 && r <= tol) break;
@@ -429,6 +430,7 @@ wb_status wb_world_step(wb_world *w)
     const wb_real dt = d->dt, h = dt / d->substeps;
     wb__rigids_save(w);
     k->projections = 0;
+    k->iters_run = 0;
     k->h_last = h;
 
     /* kinematic colliders: where the script's velocities take them by the frame's end */

@@ -793,6 +793,7 @@ wb_real wb__vbd_solve(wb_world *w, wb_real h, wb_real t0, wb_real t1)
             if (cs) wb__vbdc_colour_done(w, cs, c);
         }
         v->residual = sqrt(j.step);
+        w->k.iters_run++;
         const int last = it + 1 == w->m.def.iterations || (w->m.def.tolerance > 0 && v->residual <= w->m.def.tolerance);
         if (ct) wb__vbdc_dual(w, ct);
         for (int t = 0; t < v->nact; t++)

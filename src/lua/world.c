@@ -491,6 +491,7 @@ static int w_stats(lua_State *L)
     SETI("warnings", s.warnings);
     SETI("substeps", d.substeps);
     SETI("iterations", d.iterations);
+    SETN("iterations_run", s.iterations_run);
     SETI("threads", d.threads);
     SETN("dt", d.dt);
     lua_pushstring(L, solver_names[d.solver]);

@@ -58,7 +58,7 @@ local function strip(iterations, tolerance)
     w:step()
     projections = projections + w:stats().projections
   end
-  return w:stats().residual, projections
+  return w:stats().residual, projections, w:stats().iterations_run
 end
 
 test("the residual falls as the iterations converge", function()
@@ -71,11 +71,16 @@ end)
 
 test("tolerance stops the iterations early", function()
   local tol = strip(10)
-  local _, full = strip(100)
-  local r, p = strip(100, tol)
-  print(string.format("# tolerance %.3g m: residual %.3g m, %d projections (100 iterations: %d)", tol, r, p, full))
+  local _, full, all = strip(100)
+  local r, p, ran = strip(100, tol)
+  print(string.format("# tolerance %.3g m: residual %.3g m, %d projections (100 iterations: %d), %.1f iterations a substep",
+                      tol, r, p, full, ran))
   expect.lt(p, full, "fewer projections than every iteration")
   expect.lt(r, 1.5 * tol, "a residual of about the tolerance")
+  -- w:stats().iterations_run: what the substeps ran, on average (the setting stays 100)
+  expect.eq(all, 100, "iterations run without a tolerance")
+  expect.lt(ran, 100, "iterations run with it")
+  expect.gt(ran, 1, "... more than one: the tolerance is the 10-iteration residual")
 end)
 
 test("tolerance must be a finite number >= 0", function()

@@ -194,3 +194,25 @@ test("free fall as XPBD's; the same on 1 and 2 threads", function()
   end
   expect.eq(hash(1), hash(2), "1 and 2 threads")
 end)
+
+-- tolerance stops VBD's sweeps early too: the strip falling for 0.5 s at up to 100
+-- iterations, with the tolerance at its 3-iteration residual (the largest step of the last
+-- sweep), runs fewer sweeps a substep (w:stats().iterations_run) and ends near it
+local function falling_strip(iterations, tolerance)
+  local w = wobble.world{ solver = "vbd", substeps = 10, iterations = iterations, tolerance = tolerance }
+  local c = w:cloth{ origin = { 0, 1, 0 }, size = { 1, 0.1 }, res = { 21, 3 }, compliance = 0, bend = 0.2, mass = 0.1 }
+  for _, p in ipairs(c.particles) do
+    if w:position(p) < 0.06 then w:pin(p) end
+  end
+  for _ = 1, 30 do w:step() end
+  return w:stats().residual, w:stats().iterations_run
+end
+
+test("tolerance stops the sweeps early", function()
+  local r3, ran3 = falling_strip(3)
+  local r, ran = falling_strip(100, r3)
+  print(string.format("# strip: 3 sweeps leave %.3g m; with that tolerance %.3g m after %.1f sweeps a substep", r3, r, ran))
+  expect.eq(ran3, 3, "sweeps a substep without a tolerance")
+  expect.lt(ran, 100, "sweeps with it")
+  expect.lt(r, 1.5 * r3, "a residual of about the tolerance")
+end)
