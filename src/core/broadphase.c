@@ -1942,12 +1942,12 @@ int wb__contacts_recheck(wb_world *w, wb_real h)
         c->remakes_frame++;
     }
     /* due: for the next span; else what is left of the frame, this substep included (the
-     * constraints moved some particle farther than its margin allowed: a particle that
-     * left its reach this frame has twice the margin each time, so that a frame makes the
-     * list again a few times at most: up to 4 radii for the few a repair mends, up to one
-     * radius when the list is made again; the others keep a quarter radius. Grown for
-     * every particle at once, the reaches of a heap landing on the floor searched the
-     * whole heap: 1.3 s for one frame of a 128 x 128 cloth) */
+     * constraints moved some particle farther than its margin allowed: the particles that
+     * left their reach this frame get a margin that doubles with the frame's remakes, so
+     * that a frame makes the list again a few times at most: up to 4 radii for the few a
+     * repair mends, up to one radius when the list is made again; the others keep a
+     * quarter radius. Grown for every particle at once, the reaches of a heap landing on
+     * the floor searched the whole heap: 1.3 s for one frame of a 128 x 128 cloth) */
     const int32_t kleft = due ? (c->span < m->def.substeps - sub ? c->span : m->def.substeps - sub)
                               : m->def.substeps - sub;
     const wb_real t = (wb_real)kleft * h;
