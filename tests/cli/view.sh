@@ -34,9 +34,11 @@ done
 # start_x: an X server of our own; Xvfb itself picks a free display number and writes it
 # to fd 3 (-displayfd), so two runs in parallel never share one (choosing the number
 # here raced: the loser's test then ran on the winner's server, gone when it ended);
-# sets DISPLAY and XPID
+# sets DISPLAY and XPID. -noreset: by default an X server resets when its last client
+# leaves, and a viewer connecting during that reset failed ("Failed to open display",
+# one case in a few full runs)
 start_x() {
-    Xvfb -displayfd 3 -screen 0 640x480x24 -nolisten tcp 3>"$TMP/xdisplay" >/dev/null 2>&1 &
+    Xvfb -displayfd 3 -noreset -screen 0 640x480x24 -nolisten tcp 3>"$TMP/xdisplay" >/dev/null 2>&1 &
     XPID=$!
     i=0
     while [ $i -lt 100 ]; do
@@ -62,6 +64,7 @@ stop_x() {
 
 # view ARGS...: the viewer in the background (stdout, stderr in $TMP/out, $TMP/err)
 view() {
+    kill -0 "$XPID" 2>/dev/null || { echo "# the X server ended; starting another"; start_x; }
     "$W" view "$@" >"$TMP/out" 2>"$TMP/err" &
     VPID=$!
 }
