@@ -1,6 +1,6 @@
 -- self_collide.lua: what self-collision costs, each scene against itself without it in the
--- same process (the goals of self-collision at scale: at most 1.3x for a hanging cloth and
--- for a hand-built one, at most 3x for a heap). 10 substeps x 1 iteration, one thread.
+-- same process (the goals of self-collision at scale: at most 1.3x for a hanging cloth, a
+-- flat one and a hand-built one lying flat, at most 3x for a heap). 10 substeps x 1 iteration, one thread.
 --  self128   a w:cloth of 128 x 128 (2 m, radius half its spacing), pinned at two
 --            corners, swinging down for 60 frames: self_collide = true against false
 --  self32, self64, self128_30, self256: the same spacing (2 m / 127) for 30 frames at
@@ -8,6 +8,9 @@
 --            their broad phase (the aim: flat)
 --  loose128  the same sheet built by hand (w:particle + w:distance: loose particles,
 --            default radius 0.02 > half the 1.57 cm spacing): contacts on against off
+--  looseflat128  that sheet dropped 5 cm onto the floor, lying flat there for 60 frames
+--            (the hand-built aim as the issue measured it: loose particles touching
+--            nothing but their neighbours): contacts on against off
 --  drape128  a w:cloth of 128 x 128 (1.5 m) draped over a sphere on the floor (60 frames
 --            after it fell 3 cm onto it): self_collide = true against false
 --  flat128   a w:cloth of 128 x 128 (2 m) dropped 5 cm onto the floor, lying flat there
@@ -35,11 +38,14 @@ local function hanging_n(n)
 end
 local hanging = hanging_n(128)
 
-local function hand_built(contacts)
+-- the 128 x 128 sheet built by hand at height y (loose particles, default radius): pinned
+-- at two corners, or over the floor
+local function hand_sheet(contacts, y, floor)
   local w = wobble.world{ threads = args.threads or 1, contacts = contacts }
+  if floor then w:collider{ shape = "plane", normal = {0, 1, 0}, offset = 0, friction = 0.5 } end
   local n, s, id = 128, 2 / 127, {}
   for j = 0, n - 1 do
-    for i = 0, n - 1 do id[j * n + i] = w:particle{ pos = {i * s - 1, 2, j * s - 1}, mass = 1 / (n * n) } end
+    for i = 0, n - 1 do id[j * n + i] = w:particle{ pos = {i * s - 1, y, j * s - 1}, mass = 1 / (n * n) } end
   end
   for j = 0, n - 1 do
     for i = 0, n - 1 do
@@ -47,10 +53,16 @@ local function hand_built(contacts)
       if j < n - 1 then w:distance(id[j * n + i], id[(j + 1) * n + i]) end
     end
   end
-  w:pin(id[0])
-  w:pin(id[n - 1])
+  if not floor then
+    w:pin(id[0])
+    w:pin(id[n - 1])
+  end
   return w
 end
+local function hand_built(contacts) return hand_sheet(contacts, 2, false) end
+-- dropped 5 cm onto the floor, lying flat there (the issue's hand-built aim: loose
+-- particles that touch nothing but their neighbours)
+local function hand_flat(contacts) return hand_sheet(contacts, 0.05, true) end
 
 -- a flat cloth: dropped 5 cm onto the floor, where it lies
 local function lying(self)
@@ -136,5 +148,6 @@ scene("self128_30", hanging, 30, "without self-collision")
 scene("self256", hanging_n(256), 30, "without self-collision")
 scene("flat128", lying, 60, "without self-collision")
 scene("loose128", hand_built, 60, "contacts = false")
+scene("looseflat128", hand_flat, 60, "contacts = false")
 scene("heap128", heap, 120, "without self-collision")
 scene("drape128", draped, 60, "without self-collision")
