@@ -38,9 +38,15 @@ static wb_real solve_constraints(wb_world *w, wb_real h, int measure)
     for (int it = 0; it < iterations; it++) {
         for (int t = 0; t < wb__nctypes; t++) wb__ctypes[t]->project(w, h);
         w->k.iters_run++;
-        /* (a pass over every constraint: only when asked for) */
-        if (tol > 0 || (measure && it + 1 == iterations)) r = wb__residual_all(w, h);
-        if (tol > 0 && r <= tol) break;
+        /* the residual is a pass over every constraint, about an iteration's cost: measured
+         * when asked for, and for the tolerance after each of the first 4 iterations, then
+         * every 4th and the last (a tolerance seldom reached cost twice the iterations when
+         * every one was checked; now at most 3 iterations run past the one that reached it) */
+        const int last = it + 1 == iterations;
+        if ((tol > 0 && (it < 4 || (it + 1) % 4 == 0 || last)) || (measure && last)) {
+            r = wb__residual_all(w, h);
+            if (tol > 0 && r <= tol) break;
+        }
     }
     return r;
 }

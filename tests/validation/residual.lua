@@ -18,7 +18,8 @@
 --     100, and at 100 it is below 1% of 1 iteration's.
 --  3. tolerance: the same strip at up to 100 iterations with tolerance = the 10-iteration
 --     residual stops early (fewer projections than 100 iterations) and ends with a
---     residual of at most ~ the tolerance (the check runs after each iteration; the step's
+--     residual of at most ~ the tolerance (checked after iterations 1-4, each 4th and the
+--     last, so up to 3 iterations past the one that reached it; the step's
 --     velocity update and later substeps move nothing the constraints see: 1.5x room).
 --  4. The switch-off: with the residual reporting 0 or the tolerance ignored, 2 and 3 fail.
 
