@@ -1544,7 +1544,7 @@ static void put_entries(dist_vbd *v, int32_t s, const vbd_link *L)
     }
 }
 
-/* A hard (or stiff) link with an end in a fold of its own body (wb__vbd_folds: in touch with
+/* A hard (or stiff) link with an end in a fold of its own body (k.vbd_fold: in touch with
  * a movable particle of that body, not a rest neighbour, where the substep starts) carries
  * only VBD_FOLD_CARRY of its multiplier into the substep. The contacts are projected after
  * the sweeps, and a link pulling on a particle caught in a fold (its ends held apart by
@@ -1580,7 +1580,7 @@ static void warm_start(wb_world *w, dist_vbd *v, wb_real inv_h2, wb_real inv_h)
      * link that took back what the press pushed into it each substep fought them (a
      * lattice with tets squeezed to 60% blew up at 55 m/s): there every error is kept */
     const int keep_all = wb_volume_count(w) > 0;
-    const uint8_t *fold = wb__vbd_folds(w);
+    const uint8_t *fold = w->k.vbd_fold;
     for (int32_t s = 0; s < ds->n; s++) {
         if (!packable(ds, s)) continue;
         vbd_link *L = &v->lk[s];

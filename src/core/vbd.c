@@ -44,7 +44,7 @@ struct wb_vbd {
     void *act_part[VBD_TYPES];
     uint8_t *held;         /* (np) 1: a served constraint holds the vertex */
     uint8_t *fold;         /* (np) 1: the vertex starts the substep touching a movable particle
-                              of its own body (touching(); wb__vbd_folds) */
+                              of its own body (touching(); the types read it as k.vbd_fold) */
     int nfold;             /* how many do */
     uint8_t *col;          /* (np) each vertex's colour */
     int32_t *order;        /* (np) the vertices by colour */
@@ -357,6 +357,7 @@ static int touching(wb_world *w, struct wb_vbd *v)
     const wb_cache *k = &w->k;
     if (v->nfold > 0) memset(v->fold, 0, (size_t)w->m.np);
     v->nfold = 0;
+    w->k.vbd_fold = NULL;
     if (!k->mc_built || k->mc_nbody == 0) return 0;
     const int32_t nb = k->mc_nbody, *body = k->mc_body;
     if (nb > v->cap_tsum) {
@@ -405,7 +406,7 @@ static int touching(wb_world *w, struct wb_vbd *v)
         }
         if (a >= 0 && a == b && wv[i] > 0 && wv[j] > 0) {
             /* a fold: two movable particles of one body in touch where the substep starts
-             * (wb__vbd_folds) */
+             * (k.vbd_fold) */
             wb_real d[3];
             v3_sub(d, &xp[3 * i], &xp[3 * j]);
             const wb_real r = rad[i] + rad[j];
@@ -458,6 +459,7 @@ static int touching(wb_world *w, struct wb_vbd *v)
     if (w->rb)
         for (int32_t c = 0; c < w->rb->npct; c++)
             if (body[w->rb->pc[2 * c]] >= 0) T[4 * body[w->rb->pc[2 * c]]] = -1;
+    w->k.vbd_fold = v->nfold > 0 ? v->fold : NULL;
     /* a free body that may touch another free body's movable particle is moved with the
      * bodies it may touch (keep_momentum), unless it is held or touches what that step does
      * not take in (a rigid body, a triangle of another body held in part) */
@@ -836,8 +838,6 @@ void wb__vbd_contacts_done(wb_world *w)
 }
 
 wb_real wb__vbd_residual(const wb_world *w) { return w->vbd ? w->vbd->residual : 0; }
-
-const uint8_t *wb__vbd_folds(const wb_world *w) { return w->vbd && w->vbd->nfold > 0 ? w->vbd->fold : NULL; }
 
 int wb__vbd_failed(const wb_world *w) { return w->vbd && w->vbd->nomem; }
 

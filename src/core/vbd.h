@@ -20,10 +20,6 @@ void wb__vbd_contacts_done(wb_world *w);
 /* 1 when the last wb__vbd_solve ran out of memory (the budget refused its scratch): it
  * did nothing, and the step must undo its frame */
 int wb__vbd_failed(const wb_world *w);
-/* during a solve (the types' begin): (np) 1 for a movable particle in touch with a movable
- * particle of its own body, not a rest neighbour, where the substep starts (a fold of a
- * cloth, a heap); NULL when none is */
-const uint8_t *wb__vbd_folds(const wb_world *w);
 /* the last substep's residual: the largest Newton step of its last sweep, m */
 wb_real wb__vbd_residual(const wb_world *w);
 
