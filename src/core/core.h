@@ -101,6 +101,10 @@ typedef struct wb_cache {
     wb_real *c_save;       /* (nc x 7) collider poses at the frame's start, for undo */
     int32_t cap_c_save;
     wb_real h_last;        /* substep length of the last step (force readback) */
+    const uint8_t *vbd_fold; /* (np) during a VBD solve, for the types' begin: 1 for a movable
+                                particle in touch with a movable particle of its own body (not
+                                a rest neighbour) where the substep starts; NULL when none is
+                                (vbd.c's touching()) */
     int residual_on;       /* the residual was asked for: each step measures it (query.c) */
     wb_real residual;      /* ... after the last substep's iterations (-1: not yet) */
     int (*interrupt)(void *);

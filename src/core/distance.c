@@ -1544,6 +1544,30 @@ static void put_entries(dist_vbd *v, int32_t s, const vbd_link *L)
     }
 }
 
+/* A hard (or stiff) link with an end in a fold of its own body (k.vbd_fold: in touch with
+ * a movable particle of that body, not a rest neighbour, where the substep starts) carries
+ * only VBD_FOLD_CARRY of its multiplier into the substep. The contacts are projected after
+ * the sweeps, and a link pulling on a particle caught in a fold (its ends held apart by
+ * what lies between them) cannot win: carried whole, its multiplier grew by k C every
+ * substep, a force no stretch had stored, which the fold's sliding turned into speed (a
+ * hand-built 20 x 20 net heaping on itself went from 1,980 J to 34,000, a 24 x 48 cloth
+ * never came to rest). Halved each substep it is bounded by twice what one substep adds
+ * (0.8: the net still gained 3,000 J; none carried: a chain of rigid links piling on a
+ * net was held up as a rod, its top 6.4 cm above free fall, tests/validation/chain_pile).
+ * Of its error such a link keeps at most VBD_FOLD_KEEP of its length: what it keeps is
+ * what lets it give way to the fold (keeping no more than it kept the substep before,
+ * the net gained 11,000 J; all that its sweep leaves, a cloth draped on a sphere had
+ * links 59% long after 3 s; 5%: a hand-built cloth dropped on a sphere slid off it,
+ * tests/validation/user/03). A plastic give, for as long as it touches */
+#define VBD_FOLD_CARRY ((wb_real)0.5)
+#define VBD_FOLD_KEEP ((wb_real)0.08)
+static inline wb_real fold_keep(wb_real c0, int folded, wb_real rest)
+{
+    if (!folded) return c0;
+    const wb_real cm = VBD_FOLD_KEEP * rest;
+    return c0 > cm ? cm : c0 < -cm ? -cm : c0;
+}
+
 /* each link as the sweeps read it this substep (vbd_link), and the hard links' list */
 static void warm_start(wb_world *w, dist_vbd *v, wb_real inv_h2, wb_real inv_h)
 {
@@ -1556,9 +1580,14 @@ static void warm_start(wb_world *w, dist_vbd *v, wb_real inv_h2, wb_real inv_h)
      * link that took back what the press pushed into it each substep fought them (a
      * lattice with tets squeezed to 60% blew up at 55 m/s): there every error is kept */
     const int keep_all = wb_volume_count(w) > 0;
+    const uint8_t *fold = w->k.vbd_fold;
     for (int32_t s = 0; s < ds->n; s++) {
         if (!packable(ds, s)) continue;
         vbd_link *L = &v->lk[s];
+        /* a link with an end in a fold starts from no multiplier and keeps at most
+         * VBD_FOLD_KEEP of its length as error (fold_keep) */
+        const int folded = fold && (fold[ds->ij[2 * s]] || fold[ds->ij[2 * s + 1]]);
+        if (folded) v->lam[s] *= VBD_FOLD_CARRY;
         const wb_real alpha = ds->alpha[s], rest = ds->rest[s], kap = VBD_LINK_K * start_penalty(w, s, inv_h2);
         wb_real d[3];
         if (alpha > 0) {
@@ -1575,7 +1604,8 @@ static void warm_start(wb_world *w, dist_vbd *v, wb_real inv_h2, wb_real inv_h)
             const wb_real r = 1 / (1 + alpha * kap);
             v3_sub(d, &xp[3 * ds->ij[2 * s]], &xp[3 * ds->ij[2 * s + 1]]);
             const wb_real c = v3_len(d) - rest - alpha * v->lam[s], ce = v->c0[s];
-            const wb_real c0 = keep_all || !isfinite(ce) ? c : c * ce <= 0 ? 0 : fabs(c) < fabs(ce) ? c : ce;
+            const wb_real c0 = fold_keep(keep_all || !isfinite(ce) ? c : c * ce <= 0 ? 0 : fabs(c) < fabs(ce) ? c : ce,
+                                         folded, rest);
             L->tgt = rest + (keep_all ? VBD_STAB_VOL : WB_VBD_STAB) * c0;
             L->kk = kap * r, L->lm = r * v->lam[s];
             put_entries(v, s, L);
@@ -1588,7 +1618,8 @@ static void warm_start(wb_world *w, dist_vbd *v, wb_real inv_h2, wb_real inv_h)
          * it takes, not a drift to stabilise, or a block on the ground sags by 100 g h^2
          * a link (a 4 x 4 x 4 lattice's lowest links 17% short on a slope) */
         const wb_real c = v3_len(d) - rest, ce = v->c0[s];
-        const wb_real c0 = keep_all || !isfinite(ce) ? c : c * ce <= 0 ? 0 : fabs(c) < fabs(ce) ? c : ce;
+        const wb_real c0 = fold_keep(keep_all || !isfinite(ce) ? c : c * ce <= 0 ? 0 : fabs(c) < fabs(ce) ? c : ce,
+                                     folded, rest);
         L->tgt = rest + (keep_all ? VBD_STAB_VOL : WB_VBD_STAB) * c0;
         L->kk = kap, L->lm = v->lam[s], L->dmp = 0;
         put_entries(v, s, L);

@@ -43,6 +43,9 @@ struct wb_vbd {
     const wb_vbd_type *act[VBD_TYPES];
     void *act_part[VBD_TYPES];
     uint8_t *held;         /* (np) 1: a served constraint holds the vertex */
+    uint8_t *fold;         /* (np) 1: the vertex starts the substep touching a movable particle
+                              of its own body (touching(); the types read it as k.vbd_fold) */
+    int nfold;             /* how many do */
     uint8_t *col;          /* (np) each vertex's colour */
     int32_t *order;        /* (np) the vertices by colour */
     int32_t *colour_start; /* (ncolours + 1) ranges of order */
@@ -104,6 +107,7 @@ void wb__vbd_destroy(wb_world *w)
     for (int t = 0; t < wb__vbd_nctypes; t++)
         if (v->part[t]) wb__vbd_ctypes[t]->vbd->free(w, v->part[t]);
     free(v->held);
+    free(v->fold);
     free(v->col);
     free(v->order);
     free(v->colour_start);
@@ -153,9 +157,9 @@ static int build_colours(wb_world *w, struct wb_vbd *v)
     uint8_t *col = malloc((size_t)(np > 0 ? np : 1));
     int32_t *order = malloc(sizeof *order * (size_t)(np > 0 ? np : 1));
     int32_t *cs = calloc(VBD_COLOURS + 1, sizeof *cs);
-    uint8_t *held = malloc((size_t)(np > 0 ? np : 1));
-    if (!col || !order || !cs || !held) {
-        free(col), free(order), free(cs), free(held);
+    uint8_t *held = malloc((size_t)(np > 0 ? np : 1)), *fold = calloc((size_t)(np > 0 ? np : 1), 1);
+    if (!col || !order || !cs || !held || !fold) {
+        free(col), free(order), free(cs), free(held), free(fold);
         return 0;
     }
     int overflow = 0, ncol = 0;
@@ -182,6 +186,9 @@ static int build_colours(wb_world *w, struct wb_vbd *v)
     free(v->order);
     free(v->colour_start);
     free(v->held);
+    free(v->fold);
+    v->fold = fold;
+    v->nfold = 0;
     v->col = col;
     v->order = order;
     v->colour_start = cs;
@@ -210,9 +217,9 @@ int wb__vbd_prepare(wb_world *w)
     if (rebuild_due(w, v)) {
         for (int t = 0; t < wb__vbd_nctypes; t++)
             if (!wb__vbd_ctypes[t]->vbd->build(w, v->part[t])) return 0;
-        /* the solver's own: the struct, held, col, order, y and colour_start */
+        /* the solver's own: the struct, held, fold, col, order, y and colour_start */
         const size_t n1 = (size_t)(m->np > 0 ? m->np : 1);
-        if (!wb__charge(w, &v->charged, sizeof *v + n1 * (2 + sizeof(int32_t) + 3 * sizeof(wb_real)) +
+        if (!wb__charge(w, &v->charged, sizeof *v + n1 * (3 + sizeof(int32_t) + 3 * sizeof(wb_real)) +
                                             (VBD_COLOURS + 1) * sizeof(int32_t)) ||
             !build_colours(w, v))
             return 0;
@@ -348,6 +355,9 @@ static inline void by_partner(struct wb_vbd *v, const wb_cache *k, int32_t a, in
 static int touching(wb_world *w, struct wb_vbd *v)
 {
     const wb_cache *k = &w->k;
+    if (v->nfold > 0) memset(v->fold, 0, (size_t)w->m.np);
+    v->nfold = 0;
+    w->k.vbd_fold = NULL;
     if (!k->mc_built || k->mc_nbody == 0) return 0;
     const int32_t nb = k->mc_nbody, *body = k->mc_body;
     if (nb > v->cap_tsum) {
@@ -394,6 +404,18 @@ static int touching(wb_world *w, struct wb_vbd *v)
             const wb_real rn = (rad[i] + rad[j]) * WB_VBDC_NEAR;
             if (v3_dot(d, d) < rn * rn) T[4 * nb + body[wv[i] > 0 ? i : j]] = 1;
         }
+        if (a >= 0 && a == b && wv[i] > 0 && wv[j] > 0) {
+            /* a fold: two movable particles of one body in touch where the substep starts
+             * (k.vbd_fold) */
+            wb_real d[3];
+            v3_sub(d, &xp[3 * i], &xp[3 * j]);
+            const wb_real r = rad[i] + rad[j];
+            if (v3_dot(d, d) < r * r) {
+                v->nfold += !v->fold[i] + !v->fold[j];
+                v->fold[i] = v->fold[j] = 1;
+            }
+            continue;
+        }
         if (a < 0 || b < 0 || a == b) continue;
         /* (marked here, numbered below; bodies made deep inside each other are contact.c's
          * to part). A held body's movable particle puts no one in the coupled step: the
@@ -437,6 +459,7 @@ static int touching(wb_world *w, struct wb_vbd *v)
     if (w->rb)
         for (int32_t c = 0; c < w->rb->npct; c++)
             if (body[w->rb->pc[2 * c]] >= 0) T[4 * body[w->rb->pc[2 * c]]] = -1;
+    w->k.vbd_fold = v->nfold > 0 ? v->fold : NULL;
     /* a free body that may touch another free body's movable particle is moved with the
      * bodies it may touch (keep_momentum), unless it is held or touches what that step does
      * not take in (a rigid body, a triangle of another body held in part) */
