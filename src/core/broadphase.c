@@ -680,9 +680,16 @@ static int mend_grid(void *ctx, int32_t j)
 
 /* the particles that left their skin (up to nbad of them in bad; past that nbad + 1), or
  * -1 when the list cannot serve at all (other particles, skip keys or rules, or a particle
- * that joined or left) */
+ * that joined or left). With hot (the list's gaps known: gap_ok), in the same pass: which
+ * particles may be in a pair that passes the distance test now, how many in *nhot. Pair
+ * (i, j) passes only if |x_i - x_j| < reach_i + reach_j; M keeps distances, so
+ * |x_i - x_j| >= L_ij - |e_i| - |e_j| (L_ij: their list distance, e = x - M(X)), and one
+ * of the two has |e| + reach > L_ij / 2 >= its half. A particle is cold when
+ * |e| + reach < half less a millionth, and less 1e-9 of the coordinates' size (M's
+ * round-off and the pair test's are far below both): a pair of two cold ones fails the
+ * test to the bit. */
 static int32_t list_strays(const wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t n,
-                           uint64_t gen, const wb_motion *mo, int32_t *bad, int32_t nbad)
+                           uint64_t gen, const wb_motion *mo, int32_t *bad, int32_t nbad, uint8_t *hot, int32_t *nhot)
 {
     if (b->vn != n || n == 0 || b->bare || b->vgen != gen) return -1;
     const wb_real *X = b->vx, *R = b->vr;
@@ -690,7 +697,10 @@ static int32_t list_strays(const wb_broad *b, const wb_real *x, const wb_real *r
     if (skip && memcmp(skip, K, sizeof *K * (size_t)n)) return -1;
     for (int32_t i = 0; !skip && i < n; i++)
         if (K[i] != 0) return -1;
-    int32_t nb = 0;
+    int32_t nb = 0, nh = 0;
+    const wb_real *half = b->half;
+    const wb_real size = fabs(mo->c[0]) + fabs(mo->c[1]) + fabs(mo->c[2]) + fabs(mo->C[0]) + fabs(mo->C[1]) +
+                         fabs(mo->C[2]);
     for (int32_t i = 0; i < n; i++) {
         /* takes_part(i) == (R[i] >= 0), its cheap half first: one that was left out (R < 0)
          * must still be; one that took part must have a reach >= 0 and finite, and a
@@ -698,6 +708,7 @@ static int32_t list_strays(const wb_broad *b, const wb_real *x, const wb_real *r
         const wb_real Ri = R[i], ri = reach[i];
         if (Ri < 0) {
             if (takes_part(x, reach, i)) return -1;
+            if (hot) hot[i] = 0; /* in no pair */
             continue;
         }
         if (!(ri >= 0) || !(ri < INFINITY)) return -1;
@@ -708,20 +719,45 @@ static int32_t list_strays(const wb_broad *b, const wb_real *x, const wb_real *r
         const wb_real slack = (Ri - ri) * (wb_real)0.999;
         /* round-off in the pair distances: a slack far above the coordinates' ulps */
         const wb_real mag = fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + Ri;
-        if (!(d0 * d0 + d1 * d1 + d2 * d2 <= slack * slack) || !(slack > (wb_real)1e-9 * mag)) {
+        const wb_real dd = d0 * d0 + d1 * d1 + d2 * d2;
+        if (!(dd <= slack * slack) || !(slack > (wb_real)1e-9 * mag)) {
             if (!isfinite(d0 + d1 + d2)) return -1;
             if (nb == nbad) return nbad + 1;
             bad[nb++] = i;
         }
+        if (hot) {
+            const wb_real g = half[i] * (1 - (wb_real)1e-6) - ri - (wb_real)1e-9 * (mag + size);
+            const int h = !(g > 0 && dd < g * g);
+            hot[i] = (uint8_t)h;
+            nh += h;
+        }
     }
+    if (nhot) *nhot = nh;
     return nb;
 }
 
-static int list_valid(const wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t n,
-                      uint64_t gen, const wb_motion *mo)
+/* each particle's half (above) for the list as it is; 0 when out of memory */
+static int list_gaps(wb_broad *b, int32_t n)
 {
-    return list_strays(b, x, reach, skip, n, gen, mo, NULL, 0) == 0;
+    if (!grow((void **)&b->half, &b->cap_half, n, sizeof *b->half) ||
+        !grow((void **)&b->hot, &b->cap_hot, n, sizeof *b->hot))
+        return 0;
+    wb_real *half = b->half;
+    const wb_real *X = b->vx;
+    for (int32_t i = 0; i < n; i++) half[i] = INFINITY; /* the least squared distance first */
+    const int32_t *ij = b->list.ij;
+    for (int32_t k = 0; k < b->list.n; k++) {
+        const int32_t i = ij[2 * k], j = ij[2 * k + 1];
+        const wb_real d0 = X[3 * j] - X[3 * i], d1 = X[3 * j + 1] - X[3 * i + 1], d2 = X[3 * j + 2] - X[3 * i + 2];
+        const wb_real dd = d0 * d0 + d1 * d1 + d2 * d2;
+        if (dd < half[i]) half[i] = dd;
+        if (dd < half[j]) half[j] = dd;
+    }
+    for (int32_t i = 0; i < n; i++) half[i] = (wb_real)0.5 * sqrt(half[i]);
+    b->gap_ok = 1;
+    return 1;
 }
+
 
 /* The kept list mended where few particles left their skin (a cloth sliding slowly over a
  * sphere): each one's list position and reach made again from where it is (M^-1 x, in the
@@ -807,21 +843,27 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
     wb_broad *b = c->bp;
     wb_motion mo;
     motion_identity(&mo);
-    int valid = list_valid(b, x, reach, skip, n, gen, &mo);
+    /* particles that may be in a passing pair, known when the list serves unmended: -1
+     * (every pair tested) otherwise */
+    int32_t nhot = -1;
+    uint8_t *hot = b->gap_ok && !c->no_gaps ? b->hot : NULL;
+    int valid = list_strays(b, x, reach, skip, n, gen, &mo, NULL, 0, hot, &nhot) == 0;
     if (!valid && b->vn == n && !b->bare && b->vgen == gen && motion_fit(b, x, n, &mo)) {
         /* a few particles out of their skin: the list mended for them (up to 1 in 32, and
          * 1 in 8 mended since it was built) */
         const int32_t most = n / 32 > 16 ? n / 32 : 16;
         int32_t *bad = wb__grow(b->bad, &b->cap_bad, most, sizeof *bad);
         if (bad) b->bad = bad;
-        const int32_t nb = bad ? list_strays(b, x, reach, skip, n, gen, &mo, bad, most) : -1;
+        const int32_t nb = bad ? list_strays(b, x, reach, skip, n, gen, &mo, bad, most, hot, &nhot) : -1;
         valid = nb == 0;
         if (nb > 0 && nb <= most && b->lgrid && b->lfull && b->nmoved + nb <= n / 8 + 16) {
             if (!mend_list(b, x, reach, skip, n, &mo, bad, nb, keep, ud)) return -1;
             b->mends++;
+            b->gap_ok = 0;
             valid = 1;
         }
     }
+    if (!valid || !hot || b->gap_ok == 0) nhot = -1;
     if (valid) {
         b->mo = mo;
         b->used = 1;
@@ -857,6 +899,7 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
         if (n > 0) memcpy(b->vx, x, sizeof *x * 3 * (size_t)n);
         b->list.n = 0;
         b->lgrid = 0;
+        b->gap_ok = 0;
         /* keep's rules applied in the search (the list is rebuilt when they change); a list
          * without a skin serves this call alone (its distance test below passes every pair) */
         b->bare = !skin;
@@ -869,8 +912,12 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
     if (!grow((void **)&c->ij, &c->cap, 2 * ((int64_t)c->n + b->list.n), sizeof *c->ij)) return -1;
     int32_t *out = c->ij, at = c->n;
     const int32_t *ij = b->list.ij;
-    for (int32_t k = 0; k < b->list.n; k++) {
+    if (nhot >= 0) b->gap_calls++, b->gap_quiet += nhot == 0;
+    /* a pair of two cold particles fails below: none tested when every particle is cold */
+    const int32_t npair = nhot == 0 ? 0 : b->list.n;
+    for (int32_t k = 0; k < npair; k++) {
         const int32_t i = ij[2 * k], j = ij[2 * k + 1];
+        if (nhot > 0 && !(hot[i] | hot[j])) continue;
         const wb_real *p = &x[3 * i], *q = &x[3 * j];
         const wb_real d0 = q[0] - p[0], d1 = q[1] - p[1], d2 = q[2] - p[2], r = reach[i] + reach[j];
         if (d0 * d0 + d1 * d1 + d2 * d2 >= r * r) continue;
@@ -880,6 +927,9 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
         at++;
     }
     c->n = at;
+    /* the gaps of a list just built or mended, for the next calls (a list without a skin
+     * serves this call alone) */
+    if (!b->gap_ok && !b->bare && !c->no_gaps && !list_gaps(b, n)) return -1;
     return c->n;
 }
 
@@ -1634,6 +1684,7 @@ void wb__broadphase_free(wb_contacts *c)
     free(b->runs); free(b->boxes); free(b->first); free(b->by_j); free(b->cnt); free(b->rowr);
     free(b->vx); free(b->vr); free(b->vskip); free(b->list.ij); free(b->list.hit);
     free(b->moved); free(b->is_moved); free(b->bad); free(b->mend.ij); free(b->mend.hit);
+    free(b->half); free(b->hot);
     for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
     free(b->out);
     free(b);
