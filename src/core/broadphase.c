@@ -1194,6 +1194,34 @@ static int made_bounds(wb_world *w)
     return r >= 0;
 }
 
+/* n keys of particles below np sorted, by two counting sorts (by the greater particle,
+ * then stably by the less): linear, where a comparison sort of a cloth's ~300k keys took
+ * most of the rules' build; 0 when out of memory */
+static int sort_keys(uint64_t *keys, int32_t n, int32_t np)
+{
+    for (int32_t k = 0; k < n; k++)
+        if ((uint32_t)(keys[k] >> 32) >= (uint32_t)np || (uint32_t)keys[k] >= (uint32_t)np) {
+            qsort(keys, (size_t)n, sizeof *keys, cmp_u64); /* (not a particle's: never so far) */
+            return 1;
+        }
+    uint64_t *tmp = malloc(sizeof *tmp * (size_t)n);
+    int32_t *at = malloc(sizeof *at * ((size_t)np + 1));
+    const int ok = tmp && at;
+    for (int pass = 0; ok && pass < 2; pass++) {
+        /* pass 0: keys into tmp by their low half; pass 1: back by their high half */
+        const uint64_t *src = pass ? tmp : keys;
+        uint64_t *dst = pass ? keys : tmp;
+        const int shift = pass ? 32 : 0;
+        memset(at, 0, sizeof *at * ((size_t)np + 1));
+        for (int32_t k = 0; k < n; k++) at[(uint32_t)(src[k] >> shift) + 1]++;
+        for (int32_t i = 0; i < np; i++) at[i + 1] += at[i];
+        for (int32_t k = 0; k < n; k++) dst[at[(uint32_t)(src[k] >> shift)]++] = src[k];
+    }
+    free(tmp);
+    free(at);
+    return ok;
+}
+
 /* what the pair rule asks (may_touch, tribroad.c's): every type's links as sorted keys,
  * each once, and the loose particles' graphs; 0 when out of memory */
 static int build_rules(wb_world *w)
@@ -1209,7 +1237,7 @@ static int build_rules(wb_world *w)
         if (wb__ctypes[t]->links) wb__ctypes[t]->links(w, add_link, &u);
     if (u.fail || !add_along(&u, u.n)) return 0;
     for (int32_t i = 0; i < m->np; i++) g[i] = graph_root(g, i);
-    if (u.n > 1) qsort(c->keys, (size_t)u.n, sizeof *c->keys, cmp_u64); /* keys is NULL while none */
+    if (u.n > 1 && !sort_keys(c->keys, u.n, m->np)) return 0; /* keys is NULL while none */
     int32_t n = 0;
     c->cross = 0;
     for (int32_t k = 0; k < u.n; k++) {
