@@ -558,25 +558,76 @@ static inline void motion_apply(const wb_motion *mo, const wb_real *X, wb_real o
     for (int a = 0; a < 3; a++) out[a] = mo->c[a] + mo->Q[3 * a] * r0 + mo->Q[3 * a + 1] * r1 + mo->Q[3 * a + 2] * r2;
 }
 
-/* M fitted to the particles that took part (vr >= 0) and are finite now; 0 when none */
-static int motion_fit(wb_broad *b, const wb_real *x, int32_t n, wb_motion *mo)
+#ifdef WB_SIMD_H_AVX2
+/* motion_fit's two sums in AVX2, a particle's x, y, z as the lanes of one vector: each lane
+ * the scalar sum's operations in its order (no fused multiply-adds), so the same bits */
+static __attribute__((target("avx2"))) int32_t fit_sums_avx2(const wb_broad *b, const wb_real *x, int32_t n,
+                                                             double C[3], double c[3], wb_real A[9])
 {
-    double C[3] = { 0, 0, 0 }, c[3] = { 0, 0, 0 };
+    const wb_real *vr = b->vr, *vx = b->vx;
+    __m256d sC = _mm256_setzero_pd(), sc = sC;
     int32_t k = 0;
     for (int32_t i = 0; i < n; i++) {
-        const wb_real *p = &x[3 * i], *X = &b->vx[3 * i];
-        if (!(b->vr[i] >= 0) || !isfinite(p[0] + p[1] + p[2])) continue;
-        for (int a = 0; a < 3; a++) C[a] += X[a], c[a] += p[a];
+        const wb_real *p = &x[3 * i];
+        if (!(vr[i] >= 0) || !isfinite(p[0] + p[1] + p[2])) continue;
+        sC = _mm256_add_pd(sC, wb__load3(&vx[3 * i]));
+        sc = _mm256_add_pd(sc, wb__load3(p));
         k++;
     }
     if (k == 0) return 0;
-    for (int a = 0; a < 3; a++) C[a] /= k, c[a] /= k;
-    wb_real A[9] = { 0 };
+    double t[4];
+    _mm256_storeu_pd(t, sC);
+    for (int a = 0; a < 3; a++) C[a] = t[a] / k;
+    _mm256_storeu_pd(t, sc);
+    for (int a = 0; a < 3; a++) c[a] = t[a] / k;
+    const __m256d vC = _mm256_set_pd(0, C[2], C[1], C[0]), vc = _mm256_set_pd(0, c[2], c[1], c[0]);
+    __m256d A0 = _mm256_setzero_pd(), A1 = A0, A2 = A0; /* rows of A */
     for (int32_t i = 0; i < n; i++) {
-        const wb_real *p = &x[3 * i], *X = &b->vx[3 * i];
-        if (!(b->vr[i] >= 0) || !isfinite(p[0] + p[1] + p[2])) continue;
-        for (int a = 0; a < 3; a++)
-            for (int e = 0; e < 3; e++) A[3 * a + e] += (wb_real)((p[a] - c[a]) * (X[e] - C[e]));
+        const wb_real *p = &x[3 * i];
+        if (!(vr[i] >= 0) || !isfinite(p[0] + p[1] + p[2])) continue;
+        const __m256d dX = _mm256_sub_pd(wb__load3(&vx[3 * i]), vC), dp = _mm256_sub_pd(wb__load3(p), vc);
+        A0 = _mm256_add_pd(A0, _mm256_mul_pd(_mm256_permute4x64_pd(dp, 0x00), dX));
+        A1 = _mm256_add_pd(A1, _mm256_mul_pd(_mm256_permute4x64_pd(dp, 0x55), dX));
+        A2 = _mm256_add_pd(A2, _mm256_mul_pd(_mm256_permute4x64_pd(dp, 0xaa), dX));
+    }
+    _mm256_storeu_pd(t, A0);
+    memcpy(&A[0], t, 3 * sizeof *A);
+    _mm256_storeu_pd(t, A1);
+    memcpy(&A[3], t, 3 * sizeof *A);
+    _mm256_storeu_pd(t, A2);
+    memcpy(&A[6], t, 3 * sizeof *A);
+    return k;
+}
+#endif
+
+/* M fitted to the particles that took part (vr >= 0) and are finite now; 0 when none */
+static int motion_fit(wb_broad *b, const wb_real *x, int32_t n, wb_motion *mo, int simd)
+{
+    double C[3] = { 0, 0, 0 }, c[3] = { 0, 0, 0 };
+    wb_real A[9] = { 0 };
+#ifdef WB_SIMD_H_AVX2
+    if (simd && __builtin_cpu_supports("avx2")) {
+        if (!fit_sums_avx2(b, x, n, C, c, A)) return 0;
+        b->fits_simd++;
+    } else
+#endif
+    {
+        (void)simd;
+        int32_t k = 0;
+        for (int32_t i = 0; i < n; i++) {
+            const wb_real *p = &x[3 * i], *X = &b->vx[3 * i];
+            if (!(b->vr[i] >= 0) || !isfinite(p[0] + p[1] + p[2])) continue;
+            for (int a = 0; a < 3; a++) C[a] += X[a], c[a] += p[a];
+            k++;
+        }
+        if (k == 0) return 0;
+        for (int a = 0; a < 3; a++) C[a] /= k, c[a] /= k;
+        for (int32_t i = 0; i < n; i++) {
+            const wb_real *p = &x[3 * i], *X = &b->vx[3 * i];
+            if (!(b->vr[i] >= 0) || !isfinite(p[0] + p[1] + p[2])) continue;
+            for (int a = 0; a < 3; a++)
+                for (int e = 0; e < 3; e++) A[3 * a + e] += (wb_real)((p[a] - c[a]) * (X[e] - C[e]));
+        }
     }
     wb_extract_rotation(A, b->mq, 20);
     wb_quat_to_matrix(b->mq, mo->Q);
@@ -848,7 +899,7 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
     int32_t nhot = -1;
     uint8_t *hot = b->gap_ok && !c->no_gaps ? b->hot : NULL;
     int valid = list_strays(b, x, reach, skip, n, gen, &mo, NULL, 0, hot, &nhot) == 0;
-    if (!valid && b->vn == n && !b->bare && b->vgen == gen && motion_fit(b, x, n, &mo)) {
+    if (!valid && b->vn == n && !b->bare && b->vgen == gen && motion_fit(b, x, n, &mo, !c->no_simd)) {
         /* a few particles out of their skin: the list mended for them (up to 1 in 32, and
          * 1 in 8 mended since it was built) */
         const int32_t most = n / 32 > 16 ? n / 32 : 16;
@@ -1677,6 +1728,7 @@ static int32_t make_list(wb_world *w, wb_real h, int32_t kmax, wb_real margin, i
     }
     memcpy(xf, w->s.x, sizeof *xf * 3 * (size_t)m->np);
     c->n = 0;
+    c->no_simd = w->k.no_simd;
     int32_t r = wb__broadphase_kept(c, w->s.x, reach, skip, m->np, wb__world_pool(w), may_touch_rules, c->rules_gen,
                                     movable_pair, w);
     if (r >= 0 && !split_dormant(c, m, r)) r = -1;

@@ -88,6 +88,7 @@ struct wb_broad {
     wb_real *half; int32_t cap_half;
     uint8_t *hot; int32_t cap_hot;
     int gap_ok;
+    int64_t fits_simd;                 /* tests: motions fitted in AVX2 */
     int64_t gap_calls, gap_quiet;      /* tests: calls filtered by hot particles; of them,
                                           with none (no pair tested) */
 };

@@ -128,6 +128,7 @@ typedef struct wb_contacts {
     int32_t *add, cap_add; /* (2 x) their new pairs */
     int32_t *fixed, cap_fixed, nfixed; /* the particles mended this frame */
     int no_recheck;        /* tests: the list is not checked within the frame */
+    int no_simd;           /* the kept list's motion fitted without AVX2 (the world's no_simd) */
     int no_gaps;           /* tests: the kept list's every pair tested every call (broadphase.c) */
     int brute;             /* tests: each substep, every touching pair that may touch is looked
                               for in the list; missed counts those it lacks */

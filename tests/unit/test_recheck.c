@@ -217,13 +217,19 @@ TEST(recheck_simd_bits)
         wb_world_step(b);
         same = memcmp(a->s.x, b->s.x, bytes) == 0 && memcmp(a->s.v, b->s.v, bytes) == 0 &&
                a->k.pc->remakes == b->k.pc->remakes && a->k.pc->n == b->k.pc->n;
+        /* the kept list's motion fit (it decides only whether the list serves, which the
+         * positions would not show): the same rotation and motion to the bit */
+        const wb_broad *ba = a->k.pc->bp, *bb = b->k.pc->bp;
+        same = same && ba && bb && memcmp(ba->mq, bb->mq, sizeof ba->mq) == 0 &&
+               memcmp(&ba->mo, &bb->mo, sizeof ba->mo) == 0 && ba->rebuilds == bb->rebuilds && ba->mends == bb->mends;
         if (!same) printf("    frame %d differs\n", f);
     }
     CHECK(same);
     CHECK(a->k.pc->remakes > 0); /* the scene does leave the paths */
     CHECK_EQ(b->k.pc->lanes, 0);
+    CHECK_EQ(b->k.pc->bp->fits_simd, 0);
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(WB_FLOAT)
-    if (__builtin_cpu_supports("avx2")) CHECK(a->k.pc->lanes > 0);
+    if (__builtin_cpu_supports("avx2")) CHECK(a->k.pc->lanes > 0 && a->k.pc->bp->fits_simd > 0);
     else printf("# no AVX2 here: both ran the scalar check\n");
 #endif
     wb_world_destroy(a);
