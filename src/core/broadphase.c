@@ -1518,14 +1518,120 @@ static inline void ref_rel(const wb_contacts *c, const ref_step *rs, const wb_re
     for (int a = 0; a < 3; a++) u[a] = (movable ? v[a] : 0) - q[a];
 }
 
+static void keep_reference(wb_contacts *c, const double V[3], const double om[3], const double cc[3])
+{
+    for (int a = 0; a < 3; a++) c->ref_v[a] = (wb_real)V[a], c->ref_om[a] = (wb_real)om[a], c->ref_c[a] = (wb_real)cc[a];
+}
+
+#ifdef WB_SIMD_H_AVX2
+/* a + b of lanes 0-2 in the scalar order, (a0 + a1) + a2 */
+static inline __attribute__((always_inline, target("avx2"))) double hsum3(__m256d q)
+{
+    const __m128d lo = _mm256_castpd256_pd128(q), hi = _mm256_extractf128_pd(q, 1);
+    return _mm_cvtsd_f64(_mm_add_sd(_mm_add_sd(lo, _mm_unpackhi_pd(lo, lo)), hi));
+}
+
+/* lanes (1, 2, 0) and (2, 0, 1) of a 3-vector: its cross products */
+#define YZX(a) _mm256_permute4x64_pd(a, 0xC9)
+#define ZXY(a) _mm256_permute4x64_pd(a, 0xD2)
+
+/* fit_reference with a particle's x, y, z as the lanes of one vector, each lane the scalar
+ * code's operations in its order (no fused multiply-adds): the same bits. Its last pass
+ * works out each candidate's velocity from the reference either way (fitted or standing
+ * still) and leaves the one kept in reach, as make_list's ref_rel and v3_len_fast would
+ * (1; 0: not done, make_list does it). c->spd: scratch */
+static __attribute__((target("avx2"))) int fit_reference_avx2(wb_world *w, wb_real *reach, wb_real t)
+{
+    wb_contacts *c = w->k.pc;
+    const wb_model *m = &w->m;
+    const wb_real *x = w->s.x, *v = w->s.v, *wv = m->w;
+    const int32_t np = m->np;
+    double M = 0;
+    __m256d mx = _mm256_setzero_pd(), mv = mx;
+    for (int32_t i = 0; i < np; i++) {
+        if (reach[i] < 0 || !(wv[i] > 0)) continue;
+        const double mi = 1 / (double)wv[i];
+        const __m256d vm = _mm256_set1_pd(mi);
+        M += mi;
+        mx = _mm256_add_pd(mx, _mm256_mul_pd(vm, wb__load3(&x[3 * i])));
+        mv = _mm256_add_pd(mv, _mm256_mul_pd(vm, wb__load3(&v[3 * i])));
+    }
+    if (!(M > 0) || !isfinite(M)) return 0;
+    const __m256d vM = _mm256_set1_pd(M), vcc = _mm256_div_pd(mx, vM), vV = _mm256_div_pd(mv, vM);
+    double cc[4], V[4];
+    _mm256_storeu_pd(cc, vcc);
+    _mm256_storeu_pd(V, vV);
+    /* L, and sum m r r^T as its diagonal (xx yy zz) and (xy xz yz) */
+    __m256d L = _mm256_setzero_pd(), Id = L, Io = L;
+    for (int32_t i = 0; i < np; i++) {
+        if (reach[i] < 0 || !(wv[i] > 0)) continue;
+        const double mi = 1 / (double)wv[i];
+        const __m256d vm = _mm256_set1_pd(mi);
+        const __m256d r = _mm256_sub_pd(wb__load3(&x[3 * i]), vcc), u = _mm256_sub_pd(wb__load3(&v[3 * i]), vV);
+        L = _mm256_add_pd(L, _mm256_mul_pd(vm, _mm256_sub_pd(_mm256_mul_pd(YZX(r), ZXY(u)), _mm256_mul_pd(ZXY(r), YZX(u)))));
+        const __m256d mr = _mm256_mul_pd(vm, r);
+        Id = _mm256_add_pd(Id, _mm256_mul_pd(mr, r));
+        /* (mi r0) r1, (mi r0) r2, (mi r1) r2 */
+        Io = _mm256_add_pd(Io, _mm256_mul_pd(_mm256_permute4x64_pd(mr, 0x10), _mm256_permute4x64_pd(r, 0x29)));
+    }
+    double Lv[4], Ia[4], Ib[4], om[3];
+    _mm256_storeu_pd(Lv, L);
+    _mm256_storeu_pd(Ia, Id);
+    _mm256_storeu_pd(Ib, Io);
+    const double I[6] = { Ia[0], Ia[1], Ia[2], Ib[0], Ib[1], Ib[2] };
+    wb__turn_rate(I, Lv, om);
+    if (!(isfinite(V[0] + V[1] + V[2] + om[0] + om[1] + om[2] + cc[0] + cc[1] + cc[2]))) return 0;
+    wb_real *spd = wb__grow(c->spd, &c->cap_spd, 2 * (int64_t)np, sizeof *spd);
+    if (spd) c->spd = spd;
+    int odd = !spd; /* some speed not worked out here: make_list's pass does them all */
+    const __m256d vom = _mm256_set_pd(0, om[2], om[1], om[0]), zero = _mm256_setzero_pd();
+    const __m256d omy = YZX(vom), omz = ZXY(vom);
+    double with = 0, without = 0;
+    for (int32_t i = 0; i < np; i++) {
+        if (reach[i] < 0) continue;
+        const __m256d xi = wb__load3(&x[3 * i]), r = _mm256_sub_pd(xi, vcc);
+        const int mov = wv[i] > 0;
+        const __m256d vi = mov ? wb__load3(&v[3 * i]) : zero;
+        /* V + om x r as V[0] + om[1] r[2] - om[2] r[1], ... */
+        const __m256d u = _mm256_sub_pd(vi, _mm256_sub_pd(_mm256_add_pd(vV, _mm256_mul_pd(omy, ZXY(r))),
+                                                          _mm256_mul_pd(omz, YZX(r))));
+        const double uu = hsum3(_mm256_mul_pd(u, u)), vv = hsum3(_mm256_mul_pd(vi, vi));
+        const double r0 = 1.25 * m->radius[i], a = r0 + sqrt(uu) * t, b = r0 + (mov ? sqrt(vv) : 0) * t;
+        with += a * a * a;
+        without += b * b * b;
+        if (odd) continue;
+        /* v3_len_fast of u (fitted), of the velocity (standing still: r = x exactly, so
+         * u = v - (0 + 0 r2 - 0 r1) = v while x is finite) */
+        if (!(uu < 1e300) || !(vv < 1e300) || !isfinite(x[3 * i] + x[3 * i + 1] + x[3 * i + 2])) {
+            odd = 1;
+            continue;
+        }
+        spd[2 * i] = sqrt(uu);
+        spd[2 * i + 1] = sqrt(vv);
+    }
+    const int keep = with < (double)0.25 * without;
+    if (keep) keep_reference(c, V, om, cc);
+    if (odd) return 0;
+    for (int32_t i = 0; i < np; i++)
+        if (reach[i] >= 0) reach[i] = spd[2 * i + !keep];
+    return 1;
+}
+#undef YZX
+#undef ZXY
+#endif
+
 /* the reference fitted to the candidates (reach >= 0) at x with velocities v; kept only
- * where it shrinks the volume their reaches search (below) */
-static void fit_reference(wb_world *w, const wb_real *reach, wb_real t)
+ * where it shrinks the volume their reaches search (below). 1 when it also left each
+ * candidate's speed from the reference in reach (its AVX2 form) */
+static int fit_reference(wb_world *w, wb_real *reach, wb_real t)
 {
     wb_contacts *c = w->k.pc;
     const wb_model *m = &w->m;
     const wb_real *x = w->s.x, *v = w->s.v, *wv = m->w;
     for (int a = 0; a < 3; a++) c->ref_v[a] = c->ref_om[a] = c->ref_c[a] = 0;
+#ifdef WB_SIMD_H_AVX2
+    if (!w->k.no_simd && __builtin_cpu_supports("avx2")) return fit_reference_avx2(w, reach, t);
+#endif
     double M = 0, mx[3] = { 0, 0, 0 }, mv[3] = { 0, 0, 0 };
     for (int32_t i = 0; i < m->np; i++) {
         if (reach[i] < 0 || !(wv[i] > 0)) continue;
@@ -1533,7 +1639,7 @@ static void fit_reference(wb_world *w, const wb_real *reach, wb_real t)
         M += mi;
         for (int a = 0; a < 3; a++) mx[a] += mi * x[3 * i + a], mv[a] += mi * v[3 * i + a];
     }
-    if (!(M > 0) || !isfinite(M)) return;
+    if (!(M > 0) || !isfinite(M)) return 0;
     const double cc[3] = { mx[0] / M, mx[1] / M, mx[2] / M }, V[3] = { mv[0] / M, mv[1] / M, mv[2] / M };
     double L[3] = { 0, 0, 0 }, I[6] = { 0, 0, 0, 0, 0, 0 }; /* sum m r r^T: xx yy zz xy xz yz */
     for (int32_t i = 0; i < m->np; i++) {
@@ -1549,7 +1655,7 @@ static void fit_reference(wb_world *w, const wb_real *reach, wb_real t)
     }
     double om[3];
     wb__turn_rate(I, L, om);
-    if (!(isfinite(V[0] + V[1] + V[2] + om[0] + om[1] + om[2] + cc[0] + cc[1] + cc[2]))) return;
+    if (!(isfinite(V[0] + V[1] + V[2] + om[0] + om[1] + om[2] + cc[0] + cc[1] + cc[2]))) return 0;
     /* what the search costs with the fit and without: the sum of the reaches' cubes (the
      * volume each one searches; a few large reaches cost more than their sum says), an
      * immovable particle's counting how far the reference leaves it */
@@ -1572,8 +1678,8 @@ static void fit_reference(wb_world *w, const wb_real *reach, wb_real t)
      * (measured: a cloth heap where only part still falls, 124 -> 146 ms a frame with the
      * fit kept whenever it was smaller at all; 0.1 threw away half of a hand-built
      * sheet's gain) */
-    if (!(with < (double)0.25 * without)) return;
-    for (int a = 0; a < 3; a++) c->ref_v[a] = (wb_real)V[a], c->ref_om[a] = (wb_real)om[a], c->ref_c[a] = (wb_real)cc[a];
+    if (with < (double)0.25 * without) keep_reference(c, V, om, cc);
+    return 0;
 }
 
 /* Straight paths. Each particle is also checked against the straight line its velocity
@@ -1697,7 +1803,7 @@ static int32_t make_list(wb_world *w, wb_real h, int32_t kmax, wb_real margin, i
         reach[i] = (f & WB_CF_COLLIDE) || (gi > 0 && (f & WB_CF_SELF)) ? 0 : -1;
         skip[i] = gi > 0 && !(f & WB_CF_SELF) ? gi : 0;
     }
-    fit_reference(w, reach, h * kmax);
+    const int have = fit_reference(w, reach, h * kmax);
     c->ref_k0 = k0;
     const ref_step rs0 = { 0, 1 };
     /* each candidate's speed from the reference (in reach for now), and their mean motion
@@ -1707,9 +1813,11 @@ static int32_t make_list(wb_world *w, wb_real h, int32_t kmax, wb_real margin, i
     const wb_real g = v3_len(m->def.gravity);
     for (int32_t i = 0; i < m->np; i++) {
         if (reach[i] < 0) continue;
-        wb_real u[3];
-        ref_rel(c, &rs0, &w->s.x[3 * i], &v[3 * i], m->w[i] > 0, u);
-        reach[i] = v3_len_fast(u);
+        if (!have) {
+            wb_real u[3];
+            ref_rel(c, &rs0, &w->s.x[3 * i], &v[3 * i], m->w[i] > 0, u);
+            reach[i] = v3_len_fast(u);
+        }
         if (k0 == 0 && m->radius[i] > 0) /* (a remake within the frame keeps its span) */
             motion += (reach[i] * h * kmax + g * h * h * kmax * kmax) / m->radius[i], nmov++;
     }
@@ -1743,7 +1851,9 @@ void wb__broadphase_free(wb_contacts *c)
     c->skip = NULL;
     c->cap_skip = 0;
     free(c->key_row); free(c->path); free(c->dorm); free(c->dorm_row); free(c->dorm_at); free(c->dorm_on);
-    free(c->off_path); free(c->soft); free(c->qs); free(c->near2); free(c->far2); free(c->grown);
+    free(c->off_path); free(c->soft); free(c->qs); free(c->near2); free(c->far2); free(c->grown); free(c->spd);
+    c->spd = NULL;
+    c->cap_spd = 0;
     c->grown = NULL;
     c->cap_grown = 0;
     c->near2 = c->far2 = NULL;
