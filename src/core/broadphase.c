@@ -2118,6 +2118,18 @@ static inline void sort_stray(int k, int32_t i, int32_t *soft, int32_t *ns, int3
 }
 
 #ifdef WB_SIMD_H_AVX2
+/* rows r0..r3 of 4 doubles into columns c0..c3 */
+static inline __attribute__((always_inline, target("avx2"))) void
+wb__transpose4x4(__m256d r0, __m256d r1, __m256d r2, __m256d r3, __m256d *c0, __m256d *c1, __m256d *c2, __m256d *c3)
+{
+    const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
+    const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+    *c0 = _mm256_permute2f128_pd(t0, t2, 0x20);
+    *c1 = _mm256_permute2f128_pd(t1, t3, 0x20);
+    *c2 = _mm256_permute2f128_pd(t0, t2, 0x31);
+    *c3 = _mm256_permute2f128_pd(t1, t3, 0x31);
+}
+
 /* The same pass with strays' first test (on its path) in AVX2: each particle's path as two
  * vectors, (y, eps) and (u, 0), and its position as (x, 0), so that lane 3 of the deviation
  * is -eps; the same operations in the same order as the scalar test (no fused
@@ -2133,8 +2145,40 @@ static __attribute__((target("avx2"))) int32_t check_avx2(wb_contacts *c, const 
     const wb_real *reach = c->reach, *path = c->path;
     const uint8_t *off = c->off_path;
     uint8_t *grown = c->grown;
-    int32_t on = 0;
-    for (int32_t i = 0; i < np; i++) {
+    int32_t on = 0, i = 0;
+    /* four particles at a time, their coordinates as lanes (the same operations per lane);
+     * the lanes not found on their paths (or no candidates, or off their paths) go to
+     * strays one by one, in order */
+    const __m256d zero = _mm256_setzero_pd();
+    for (; i + 4 <= np; i += 4) {
+        uint32_t off4;
+        memcpy(&off4, &off[i], sizeof off4);
+        int go = _mm256_movemask_pd(_mm256_cmp_pd(_mm256_loadu_pd(&reach[i]), zero, _CMP_GE_OQ));
+        for (int l = 0; off4 && l < 4; l++)
+            if (off[i + l]) go &= ~(1 << l);
+        int in = 0;
+        if (go) {
+            __m256d X, Y, Z, P0, P1, P2, E, U0, U1, U2, U3;
+            const wb_real *xi = &x[3 * (size_t)i];
+            wb__transpose4(wb__load3(xi), wb__load3(xi + 3), wb__load3(xi + 6), wb__load3(xi + 9), &X, &Y, &Z);
+            const wb_real *P = &path[8 * (size_t)i];
+            wb__transpose4x4(_mm256_loadu_pd(P), _mm256_loadu_pd(P + 8), _mm256_loadu_pd(P + 16), _mm256_loadu_pd(P + 24),
+                             &P0, &P1, &P2, &E);
+            wb__transpose4x4(_mm256_loadu_pd(P + 4), _mm256_loadu_pd(P + 12), _mm256_loadu_pd(P + 20),
+                             _mm256_loadu_pd(P + 28), &U0, &U1, &U2, &U3);
+            const __m256d d0 = _mm256_sub_pd(_mm256_sub_pd(X, P0), _mm256_mul_pd(S, U0));
+            const __m256d d1 = _mm256_sub_pd(_mm256_sub_pd(Y, P1), _mm256_mul_pd(S, U1));
+            const __m256d d2 = _mm256_sub_pd(_mm256_sub_pd(Z, P2), _mm256_mul_pd(S, U2));
+            const __m256d dd = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2));
+            in = go & _mm256_movemask_pd(_mm256_cmp_pd(dd, _mm256_mul_pd(E, E), _CMP_LE_OQ));
+        }
+        if (in == 15) { on += 4; continue; }
+        for (int l = 0; l < 4; l++) {
+            if (in >> l & 1) { on++; continue; }
+            sort_stray(strays(c, x, rad, rs, i + l), i + l, soft, ns, mv, nm, grown);
+        }
+    }
+    for (; i < np; i++) {
         if (reach[i] >= 0 && !off[i]) {
             const wb_real *P = &path[8 * i];
             const __m256d d = _mm256_sub_pd(_mm256_sub_pd(wb__load3(&x[3 * i]), _mm256_loadu_pd(P)),

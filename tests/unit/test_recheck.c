@@ -205,9 +205,11 @@ TEST(contact_check_follows_reference_motion)
 /* The substeps' check in AVX2 (broadphase.c, check_avx2) decides as the scalar one, to the
  * bit: the stiff heap above (particles off their paths and past their reaches every few
  * substeps) stepped both ways, the same state, lists and remakes every frame */
-TEST(recheck_simd_bits)
+/* n x n: 32 (the vector check's groups of four alone) and 31 (one particle left for the
+ * one-at-a-time tail) */
+static void simd_bits(int n)
 {
-    wb_world *a = heap(32), *b = heap(32);
+    wb_world *a = heap(n), *b = heap(n);
     REQUIRE(a && b);
     b->k.no_simd = 1;
     const size_t bytes = sizeof(wb_real) * 3 * (size_t)a->m.np;
@@ -240,6 +242,12 @@ TEST(recheck_simd_bits)
 #endif
     wb_world_destroy(a);
     wb_world_destroy(b);
+}
+
+TEST(recheck_simd_bits)
+{
+    simd_bits(32);
+    simd_bits(31);
 }
 
 /* A hand-built sheet of loose particles (the default radius over a spacing of 1.57 cm)
