@@ -49,6 +49,15 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
+#ifdef WB_SIMD_H_AVX2
+/* lanes 0-2 summed in the scalar order, (q0 + q1) + q2 */
+static inline __attribute__((always_inline, target("avx2"))) double hsum3(__m256d q)
+{
+    const __m128d lo = _mm256_castpd256_pd128(q), hi = _mm256_extractf128_pd(q, 1);
+    return _mm_cvtsd_f64(_mm_add_sd(_mm_add_sd(lo, _mm_unpackhi_pd(lo, lo)), hi));
+}
+#endif
+
 /* below this many particles in the grid the scan stays on one thread (a parallel
  * region costs more than it saves) */
 #define PAR_MIN 1024
@@ -729,6 +738,68 @@ static int mend_grid(void *ctx, int32_t j)
     return 1;
 }
 
+/* list_strays' verdict on particle i from its deviation from M (dd: its square, ds: the
+ * sum of its coordinates) and mag (its size, |p|_1 + R_i): 1 out of its skin, 0 within,
+ * -1 the list cannot serve; hot[i] as above (hot: NULL, not worked out) */
+static inline __attribute__((always_inline)) int stray_verdict(const wb_broad *b, const wb_real *x,
+                                                               const wb_real *reach, int32_t i, wb_real dd, wb_real ds,
+                                                               wb_real mag, wb_real size, uint8_t *hot, int32_t *nh)
+{
+    /* takes_part(i) == (R[i] >= 0), its cheap half first: one that was left out (R < 0)
+     * must still be; one that took part must have a reach >= 0 and finite, and a position
+     * within its slack (a position not finite fails one of the two tests) */
+    const wb_real Ri = b->vr[i], ri = reach[i];
+    if (Ri < 0) {
+        if (takes_part(x, reach, i)) return -1;
+        if (hot) hot[i] = 0; /* in no pair */
+        return 0;
+    }
+    if (!(ri >= 0) || !(ri < INFINITY)) return -1;
+    const wb_real slack = (Ri - ri) * (wb_real)0.999;
+    /* round-off in the pair distances: a slack far above the coordinates' ulps */
+    const int out = !(dd <= slack * slack) || !(slack > (wb_real)1e-9 * mag);
+    if (out && !isfinite(ds)) return -1;
+    if (hot) {
+        const wb_real g = b->half[i] * (1 - (wb_real)1e-6) - ri - (wb_real)1e-9 * (mag + size);
+        const int h = !(g > 0 && dd < g * g);
+        hot[i] = (uint8_t)h;
+        *nh += h;
+    }
+    return out;
+}
+
+#ifdef WB_SIMD_H_AVX2
+/* list_strays' pass with each deviation in AVX2 (x, y, z as lanes; M's rows as
+ * ((c + Q0 r0) + Q1 r1) + Q2 r2, motion_apply's order; no fused multiply-adds): the
+ * same bits */
+static __attribute__((target("avx2"))) int32_t strays_pass_avx2(const wb_broad *b, const wb_real *x,
+                                                                const wb_real *reach, int32_t n, const wb_motion *mo,
+                                                                wb_real size, int32_t *bad, int32_t nbad, uint8_t *hot,
+                                                                int32_t *nh)
+{
+    const wb_real *Q = mo->Q, *X = b->vx, *R = b->vr;
+    const __m256d C = _mm256_set_pd(0, mo->C[2], mo->C[1], mo->C[0]), c = _mm256_set_pd(0, mo->c[2], mo->c[1], mo->c[0]);
+    const __m256d Q0 = _mm256_set_pd(0, Q[6], Q[3], Q[0]), Q1 = _mm256_set_pd(0, Q[7], Q[4], Q[1]),
+                  Q2 = _mm256_set_pd(0, Q[8], Q[5], Q[2]), sign = _mm256_set1_pd(-0.0);
+    int32_t nb = 0;
+    for (int32_t i = 0; i < n; i++) {
+        const __m256d r = _mm256_sub_pd(wb__load3(&X[3 * i]), C), p = wb__load3(&x[3 * i]);
+        const __m256d y = _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(c, _mm256_mul_pd(Q0, _mm256_permute4x64_pd(r, 0x00))),
+                                                      _mm256_mul_pd(Q1, _mm256_permute4x64_pd(r, 0x55))),
+                                        _mm256_mul_pd(Q2, _mm256_permute4x64_pd(r, 0xaa)));
+        const __m256d d = _mm256_sub_pd(p, y);
+        const int k = stray_verdict(b, x, reach, i, hsum3(_mm256_mul_pd(d, d)), hsum3(d),
+                                    hsum3(_mm256_andnot_pd(sign, p)) + R[i], size, hot, nh);
+        if (k < 0) return -1;
+        if (k) {
+            if (nb == nbad) return nbad + 1;
+            bad[nb++] = i;
+        }
+    }
+    return nb;
+}
+#endif
+
 /* the particles that left their skin (up to nbad of them in bad; past that nbad + 1), or
  * -1 when the list cannot serve at all (other particles, skip keys or rules, or a particle
  * that joined or left). With hot (the list's gaps known: gap_ok), in the same pass: which
@@ -738,9 +809,10 @@ static int mend_grid(void *ctx, int32_t j)
  * of the two has |e| + reach > L_ij / 2 >= its half. A particle is cold when
  * |e| + reach < half less a millionth, and less 1e-9 of the coordinates' size (M's
  * round-off and the pair test's are far below both): a pair of two cold ones fails the
- * test to the bit. */
+ * test to the bit. simd: the pass in AVX2 where the machine has it */
 static int32_t list_strays(const wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t n,
-                           uint64_t gen, const wb_motion *mo, int32_t *bad, int32_t nbad, uint8_t *hot, int32_t *nhot)
+                           uint64_t gen, const wb_motion *mo, int32_t *bad, int32_t nbad, uint8_t *hot, int32_t *nhot,
+                           int simd)
 {
     if (b->vn != n || n == 0 || b->bare || b->vgen != gen) return -1;
     const wb_real *X = b->vx, *R = b->vr;
@@ -749,41 +821,29 @@ static int32_t list_strays(const wb_broad *b, const wb_real *x, const wb_real *r
     for (int32_t i = 0; !skip && i < n; i++)
         if (K[i] != 0) return -1;
     int32_t nb = 0, nh = 0;
-    const wb_real *half = b->half;
     const wb_real size = fabs(mo->c[0]) + fabs(mo->c[1]) + fabs(mo->c[2]) + fabs(mo->C[0]) + fabs(mo->C[1]) +
                          fabs(mo->C[2]);
-    for (int32_t i = 0; i < n; i++) {
-        /* takes_part(i) == (R[i] >= 0), its cheap half first: one that was left out (R < 0)
-         * must still be; one that took part must have a reach >= 0 and finite, and a
-         * position within its slack (a position not finite fails one of the two tests) */
-        const wb_real Ri = R[i], ri = reach[i];
-        if (Ri < 0) {
-            if (takes_part(x, reach, i)) return -1;
-            if (hot) hot[i] = 0; /* in no pair */
-            continue;
-        }
-        if (!(ri >= 0) || !(ri < INFINITY)) return -1;
-        const wb_real *p = &x[3 * i];
-        wb_real y[3];
-        motion_apply(mo, &X[3 * i], y);
-        const wb_real d0 = p[0] - y[0], d1 = p[1] - y[1], d2 = p[2] - y[2];
-        const wb_real slack = (Ri - ri) * (wb_real)0.999;
-        /* round-off in the pair distances: a slack far above the coordinates' ulps */
-        const wb_real mag = fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + Ri;
-        const wb_real dd = d0 * d0 + d1 * d1 + d2 * d2;
-        if (!(dd <= slack * slack) || !(slack > (wb_real)1e-9 * mag)) {
-            if (!isfinite(d0 + d1 + d2)) return -1;
-            if (nb == nbad) return nbad + 1;
-            bad[nb++] = i;
-        }
-        if (hot) {
-            const wb_real g = half[i] * (1 - (wb_real)1e-6) - ri - (wb_real)1e-9 * (mag + size);
-            const int h = !(g > 0 && dd < g * g);
-            hot[i] = (uint8_t)h;
-            nh += h;
+#ifdef WB_SIMD_H_AVX2
+    if (simd && __builtin_cpu_supports("avx2")) nb = strays_pass_avx2(b, x, reach, n, mo, size, bad, nbad, hot, &nh);
+    else
+#endif
+    {
+        (void)simd;
+        for (int32_t i = 0; i < n; i++) {
+            const wb_real *p = &x[3 * i];
+            wb_real y[3];
+            motion_apply(mo, &X[3 * i], y);
+            const wb_real d0 = p[0] - y[0], d1 = p[1] - y[1], d2 = p[2] - y[2];
+            const int k = stray_verdict(b, x, reach, i, d0 * d0 + d1 * d1 + d2 * d2, d0 + d1 + d2,
+                                        fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + R[i], size, hot, &nh);
+            if (k < 0) return -1;
+            if (k) {
+                if (nb == nbad) return nbad + 1;
+                bad[nb++] = i;
+            }
         }
     }
-    if (nhot) *nhot = nh;
+    if (nb >= 0 && nb <= nbad && nhot) *nhot = nh;
     return nb;
 }
 
@@ -898,14 +958,14 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
      * (every pair tested) otherwise */
     int32_t nhot = -1;
     uint8_t *hot = b->gap_ok && !c->no_gaps ? b->hot : NULL;
-    int valid = list_strays(b, x, reach, skip, n, gen, &mo, NULL, 0, hot, &nhot) == 0;
+    int valid = list_strays(b, x, reach, skip, n, gen, &mo, NULL, 0, hot, &nhot, !c->no_simd) == 0;
     if (!valid && b->vn == n && !b->bare && b->vgen == gen && motion_fit(b, x, n, &mo, !c->no_simd)) {
         /* a few particles out of their skin: the list mended for them (up to 1 in 32, and
          * 1 in 8 mended since it was built) */
         const int32_t most = n / 32 > 16 ? n / 32 : 16;
         int32_t *bad = wb__grow(b->bad, &b->cap_bad, most, sizeof *bad);
         if (bad) b->bad = bad;
-        const int32_t nb = bad ? list_strays(b, x, reach, skip, n, gen, &mo, bad, most, hot, &nhot) : -1;
+        const int32_t nb = bad ? list_strays(b, x, reach, skip, n, gen, &mo, bad, most, hot, &nhot, !c->no_simd) : -1;
         valid = nb == 0;
         if (nb > 0 && nb <= most && b->lgrid && b->lfull && b->nmoved + nb <= n / 8 + 16) {
             if (!mend_list(b, x, reach, skip, n, &mo, bad, nb, keep, ud)) return -1;
@@ -1524,13 +1584,6 @@ static void keep_reference(wb_contacts *c, const double V[3], const double om[3]
 }
 
 #ifdef WB_SIMD_H_AVX2
-/* a + b of lanes 0-2 in the scalar order, (a0 + a1) + a2 */
-static inline __attribute__((always_inline, target("avx2"))) double hsum3(__m256d q)
-{
-    const __m128d lo = _mm256_castpd256_pd128(q), hi = _mm256_extractf128_pd(q, 1);
-    return _mm_cvtsd_f64(_mm_add_sd(_mm_add_sd(lo, _mm_unpackhi_pd(lo, lo)), hi));
-}
-
 /* lanes (1, 2, 0) and (2, 0, 1) of a 3-vector: its cross products */
 #define YZX(a) _mm256_permute4x64_pd(a, 0xC9)
 #define ZXY(a) _mm256_permute4x64_pd(a, 0xD2)
