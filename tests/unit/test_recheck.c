@@ -77,7 +77,8 @@ TEST(contact_list_complete_every_substep)
  * pinned corners (immovable particles, which the reference leaves behind) into a ball
  * in its way, and one thrown tumbling onto the floor (the floor stops its leading edge
  * while the rest still turns over it). */
-static wb_world *swinging(int spin)
+/* a world of the defaults with a floor at y = 0 */
+static wb_world *floor_world(void)
 {
     wb_world_def d = wb_world_default_def();
     wb_world *w = wb_world_create(&d);
@@ -87,6 +88,14 @@ static wb_world *swinging(int spin)
     floor.offset = 0;
     wb_status st;
     wb_collider_add(w, &floor, &st);
+    return w;
+}
+
+static wb_world *swinging(int spin)
+{
+    wb_world *w = floor_world();
+    if (!w) return NULL;
+    wb_status st;
     wb_cloth_def c = wb_cloth_default_def();
     v3_set(c.origin, -0.5, spin ? 0.6 : 1.2, -0.5);
     c.size[0] = c.size[1] = 1;
@@ -205,6 +214,13 @@ TEST(contact_check_follows_reference_motion)
 /* The substeps' check in AVX2 (broadphase.c, check_avx2) decides as the scalar one, to the
  * bit: the stiff heap above (particles off their paths and past their reaches every few
  * substeps) stepped both ways, the same state, lists and remakes every frame */
+/* the two worlds' particles at the same positions and velocities, to the bit */
+static int same_bits(const wb_world *a, const wb_world *b)
+{
+    const size_t bytes = sizeof(wb_real) * 3 * (size_t)a->m.np;
+    return a->m.np == b->m.np && memcmp(a->s.x, b->s.x, bytes) == 0 && memcmp(a->s.v, b->s.v, bytes) == 0;
+}
+
 /* n x n: 32 (the vector check's groups of four alone) and 31 (one particle left for the
  * one-at-a-time tail) */
 static void simd_bits(int n)
@@ -212,12 +228,11 @@ static void simd_bits(int n)
     wb_world *a = heap(n), *b = heap(n);
     REQUIRE(a && b);
     b->k.no_simd = 1;
-    const size_t bytes = sizeof(wb_real) * 3 * (size_t)a->m.np;
     int same = 1;
     for (int f = 0; f < 60 && same; f++) {
         wb_world_step(a);
         wb_world_step(b);
-        same = memcmp(a->s.x, b->s.x, bytes) == 0 && memcmp(a->s.v, b->s.v, bytes) == 0 &&
+        same = same_bits(a, b) &&
                a->k.pc->remakes == b->k.pc->remakes && a->k.pc->n == b->k.pc->n;
         /* the kept list's motion fit (it decides only whether the list serves, which the
          * positions would not show): the same rotation and motion to the bit */
@@ -257,14 +272,9 @@ TEST(recheck_simd_bits)
  * have run (the gaps kill it otherwise) */
 static wb_world *loose_sheet(int n, wb_real y)
 {
-    wb_world_def def = wb_world_default_def();
-    wb_world *w = wb_world_create(&def);
+    wb_world *w = floor_world();
     if (!w) return NULL;
-    wb_collider_def floor = wb_collider_default_def(WB_SHAPE_PLANE);
-    v3_set(floor.normal, 0, 1, 0);
-    floor.offset = 0;
     wb_status st;
-    wb_collider_add(w, &floor, &st);
     const wb_real s = 2.0 / 127;
     for (int j = 0; j < n; j++)
         for (int i = 0; i < n; i++) {
@@ -286,12 +296,11 @@ TEST(contact_list_gaps_same_bits)
     REQUIRE(a && b);
     REQUIRE(wb__contacts_make(a) && wb__contacts_make(b));
     b->k.pc->no_gaps = 1;
-    const size_t bytes = sizeof(wb_real) * 3 * (size_t)a->m.np;
     int same = 1;
     for (int f = 0; f < 40 && same; f++) {
         wb_world_step(a);
         wb_world_step(b);
-        same = memcmp(a->s.x, b->s.x, bytes) == 0 && memcmp(a->s.v, b->s.v, bytes) == 0 &&
+        same = same_bits(a, b) &&
                a->k.pc->n == b->k.pc->n && a->k.pc->nd == b->k.pc->nd &&
                memcmp(a->k.pc->ij, b->k.pc->ij, sizeof(int32_t) * 2 * (size_t)a->k.pc->n) == 0;
         if (!same) printf("    frame %d differs\n", f);
@@ -316,13 +325,12 @@ TEST(contact_reference_simd_bits)
     REQUIRE(a && b);
     b->k.no_simd = 1;
     REQUIRE(wb__contacts_make(a) && wb__contacts_make(b));
-    const size_t bytes = sizeof(wb_real) * 3 * (size_t)a->m.np;
     int same = 1, kept = 0, still = 0;
     for (int f = 0; f < 40 && same; f++) {
         wb_world_step(a);
         wb_world_step(b);
         const wb_contacts *ca = a->k.pc, *cb = b->k.pc;
-        same = memcmp(a->s.x, b->s.x, bytes) == 0 && memcmp(a->s.v, b->s.v, bytes) == 0 &&
+        same = same_bits(a, b) &&
                memcmp(ca->ref_v, cb->ref_v, sizeof ca->ref_v) == 0 &&
                memcmp(ca->ref_om, cb->ref_om, sizeof ca->ref_om) == 0 &&
                memcmp(ca->ref_c, cb->ref_c, sizeof ca->ref_c) == 0 &&
