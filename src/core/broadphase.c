@@ -952,8 +952,10 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
 {
     if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
     wb_broad *b = c->bp;
-    wb_motion mo;
-    motion_identity(&mo);
+    /* tried first under the motion it last served with (identity for a new list): a
+     * cloth come to rest keeps it, and needs no fit */
+    wb_motion mo = b->mo;
+    if (b->vn == 0) motion_identity(&mo);
     /* particles that may be in a passing pair, known when the list serves unmended: -1
      * (every pair tested) otherwise */
     int32_t nhot = -1;
