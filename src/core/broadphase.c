@@ -1795,6 +1795,7 @@ static int split_dormant(wb_contacts *c, const wb_model *m, int32_t r)
         return 0;
     int32_t *row = c->dorm_row;
     memset(row, 0, sizeof *row * ((size_t)np + 1));
+    if (nd == 0) return 1; /* (every row empty) */
     for (int32_t q = 0; q < 2 * nd; q++) row[d[q] + 1]++;
     for (int32_t i = 0; i < np; i++) row[i + 1] += row[i];
     for (int32_t q = 0; q < nd; q++) {
