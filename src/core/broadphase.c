@@ -1159,6 +1159,39 @@ static along_item along_pop(along_item *h, int32_t *n)
     return top;
 }
 
+/* add_along's queue of (d, j), the least first (ties: the lesser j, a strict order: one
+ * particle is queued again only nearer). While short, a sorted run [head, n): a new item
+ * is mostly among the farthest, a few moves from the end, where a heap's pop costs a
+ * sift through its levels; past ALONG_RUN items the run (sorted, so a heap already) goes
+ * on as a binary heap. Either pops the items in the same order */
+#define ALONG_RUN 32
+typedef struct along_queue { along_item *a; int32_t head, n, heap; } along_queue;
+
+static inline int32_t along_size(const along_queue *q) { return q->n - q->head; }
+
+static inline void along_add(along_queue *q, along_item e)
+{
+    if (!q->heap && q->n - q->head >= ALONG_RUN) {
+        memmove(q->a, q->a + q->head, sizeof *q->a * (size_t)(q->n - q->head));
+        q->n -= q->head;
+        q->head = 0;
+        q->heap = 1;
+    }
+    if (q->heap) {
+        along_push(q->a, &q->n, e);
+        return;
+    }
+    int32_t k = q->n++;
+    for (; k > q->head && (e.d < q->a[k - 1].d || (e.d == q->a[k - 1].d && e.j < q->a[k - 1].j)); k--)
+        q->a[k] = q->a[k - 1];
+    q->a[k] = e;
+}
+
+static inline along_item along_next(along_queue *q)
+{
+    return q->heap ? along_pop(q->a, &q->n) : q->a[q->head++];
+}
+
 /* a link add_along walks: both ends loose, or both of one body that collides with
  * itself (no other body pairs within itself) */
 static inline int along_link(const wb_model *m, int32_t a, int32_t b)
@@ -1202,12 +1235,14 @@ static int add_along(links_ud *u, int32_t nlinks)
     for (int32_t i = 0; ok && i < np; i++) {
         if (row[i] == row[i + 1]) continue;
         const wb_real bound = (wb_real)ALONG_PATH * ALONG * (m->radius[i] + rmax);
-        int32_t nh = 0, settled = 0;
+        /* (a run: at most 1 + 2 nlinks items are ever queued, fewer than heap holds) */
+        along_queue qu = { heap, 0, 0, c->along_heap };
+        int32_t settled = 0;
         dist[i] = 0;
         seen[i] = i;
-        along_push(heap, &nh, (along_item){ 0, i });
-        while (nh > 0 && settled < ALONG_MOST) {
-            const along_item e = along_pop(heap, &nh);
+        along_add(&qu, (along_item){ 0, i });
+        while (along_size(&qu) > 0 && settled < ALONG_MOST) {
+            const along_item e = along_next(&qu);
             if (e.d > dist[e.j]) continue; /* a longer way to one settled already */
             settled++;
             const int32_t j = e.j;
@@ -1232,9 +1267,10 @@ static int add_along(links_ud *u, int32_t nlinks)
                 if (!(d < bound) || (seen[o] == i && !(d < dist[o]))) continue;
                 seen[o] = i;
                 dist[o] = d;
-                if (nh < 4 * ALONG_MOST + 2 * nlinks) along_push(heap, &nh, (along_item){ d, o });
+                if (along_size(&qu) < 4 * ALONG_MOST + 2 * nlinks) along_add(&qu, (along_item){ d, o });
             }
         }
+        c->along_heaps += qu.heap;
     }
 done:
     free(row); free(to); free(len); free(dist); free(seen); free(heap);

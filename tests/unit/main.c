@@ -53,6 +53,7 @@
     X(recheck_simd_bits)                                 \
     X(contact_list_gaps_same_bits)                       \
     X(contact_reference_simd_bits)                       \
+    X(contact_rules_queue_same_keys)                     \
     X(contact_list_complete_with_reference_motion)       \
     X(contact_check_follows_reference_motion)            \
     X(contact_clone_keeps_groups)

@@ -270,7 +270,7 @@ TEST(recheck_simd_bits)
  * reach. The list's gaps (broadphase.c, list_gaps) skip testing them; the same world
  * with every pair tested each frame must stay the same to the bit, and the skip must
  * have run (the gaps kill it otherwise) */
-static wb_world *loose_sheet(int n, wb_real y)
+static wb_world *loose_sheet(int n, wb_real y, wb_real r)
 {
     wb_world *w = floor_world();
     if (!w) return NULL;
@@ -279,7 +279,7 @@ static wb_world *loose_sheet(int n, wb_real y)
     for (int j = 0; j < n; j++)
         for (int i = 0; i < n; i++) {
             const wb_real p[3] = { i * s, y, j * s };
-            wb_particle_add(w, p, NULL, 1.0 / (n * n), 0.02);
+            wb_particle_add(w, p, NULL, 1.0 / (n * n), r);
         }
     const wb_distance_def d = wb_distance_default_def();
     for (int j = 0; j < n; j++)
@@ -292,7 +292,7 @@ static wb_world *loose_sheet(int n, wb_real y)
 
 TEST(contact_list_gaps_same_bits)
 {
-    wb_world *a = loose_sheet(40, 0.05), *b = loose_sheet(40, 0.05);
+    wb_world *a = loose_sheet(40, 0.05, 0.02), *b = loose_sheet(40, 0.05, 0.02);
     REQUIRE(a && b);
     REQUIRE(wb__contacts_make(a) && wb__contacts_make(b));
     b->k.pc->no_gaps = 1;
@@ -321,7 +321,7 @@ TEST(contact_list_gaps_same_bits)
  * still; the same reference and reaches to the bit as the scalar fit's, either way */
 TEST(contact_reference_simd_bits)
 {
-    wb_world *a = loose_sheet(24, 0.6), *b = loose_sheet(24, 0.6);
+    wb_world *a = loose_sheet(24, 0.6, 0.02), *b = loose_sheet(24, 0.6, 0.02);
     REQUIRE(a && b);
     b->k.no_simd = 1;
     REQUIRE(wb__contacts_make(a) && wb__contacts_make(b));
@@ -344,4 +344,33 @@ TEST(contact_reference_simd_bits)
     CHECK(kept > 0 && still > 0);
     wb_world_destroy(a);
     wb_world_destroy(b);
+}
+
+/* The rules' search along the links from every particle (add_along) queues in a short
+ * sorted run, and goes on as a heap past a few dozen items: the same keys and made-distance
+ * bounds as with a heap throughout, for the default radius (every search a run) and a
+ * radius of 3 spacings (long queues: some go on as a heap) */
+TEST(contact_rules_queue_same_keys)
+{
+    const wb_real radius[2] = { 0.02, 0.05 };
+    for (int k = 0; k < 2; k++) {
+        wb_world *a = loose_sheet(30, 0.05, radius[k]), *b = loose_sheet(30, 0.05, radius[k]);
+        REQUIRE(a && b);
+        REQUIRE(wb__contacts_make(a) && wb__contacts_make(b));
+        b->k.pc->along_heap = 1;
+        REQUIRE(wb__contact_rules(a) && wb__contact_rules(b));
+        const wb_contacts *ca = a->k.pc, *cb = b->k.pc;
+        const size_t np = (size_t)a->m.np;
+        CHECK(ca->nkeys > 0 && ca->nkeys == cb->nkeys);
+        CHECK(memcmp(ca->keys, cb->keys, sizeof *ca->keys * (size_t)ca->nkeys) == 0);
+        CHECK(memcmp(ca->near2, cb->near2, sizeof *ca->near2 * np) == 0);
+        CHECK(memcmp(ca->far2, cb->far2, sizeof *ca->far2 * np) == 0);
+        printf("# radius %g: %d keys, searches gone on as a heap %lld of %zu\n", radius[k], ca->nkeys,
+               (long long)ca->along_heaps, np);
+        if (k == 0) CHECK_EQ(ca->along_heaps, 0);
+        else CHECK(ca->along_heaps > 0);
+        CHECK_EQ(cb->along_heaps, (int64_t)np);
+        wb_world_destroy(a);
+        wb_world_destroy(b);
+    }
 }
