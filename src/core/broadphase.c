@@ -49,6 +49,15 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
+#ifdef WB_SIMD_H_AVX2
+/* lanes 0-2 summed in the scalar order, (q0 + q1) + q2 */
+static inline __attribute__((always_inline, target("avx2"))) double hsum3(__m256d q)
+{
+    const __m128d lo = _mm256_castpd256_pd128(q), hi = _mm256_extractf128_pd(q, 1);
+    return _mm_cvtsd_f64(_mm_add_sd(_mm_add_sd(lo, _mm_unpackhi_pd(lo, lo)), hi));
+}
+#endif
+
 /* below this many particles in the grid the scan stays on one thread (a parallel
  * region costs more than it saves) */
 #define PAR_MIN 1024
@@ -558,25 +567,76 @@ static inline void motion_apply(const wb_motion *mo, const wb_real *X, wb_real o
     for (int a = 0; a < 3; a++) out[a] = mo->c[a] + mo->Q[3 * a] * r0 + mo->Q[3 * a + 1] * r1 + mo->Q[3 * a + 2] * r2;
 }
 
-/* M fitted to the particles that took part (vr >= 0) and are finite now; 0 when none */
-static int motion_fit(wb_broad *b, const wb_real *x, int32_t n, wb_motion *mo)
+#ifdef WB_SIMD_H_AVX2
+/* motion_fit's two sums in AVX2, a particle's x, y, z as the lanes of one vector: each lane
+ * the scalar sum's operations in its order (no fused multiply-adds), so the same bits */
+static __attribute__((target("avx2"))) int32_t fit_sums_avx2(const wb_broad *b, const wb_real *x, int32_t n,
+                                                             double C[3], double c[3], wb_real A[9])
 {
-    double C[3] = { 0, 0, 0 }, c[3] = { 0, 0, 0 };
+    const wb_real *vr = b->vr, *vx = b->vx;
+    __m256d sC = _mm256_setzero_pd(), sc = sC;
     int32_t k = 0;
     for (int32_t i = 0; i < n; i++) {
-        const wb_real *p = &x[3 * i], *X = &b->vx[3 * i];
-        if (!(b->vr[i] >= 0) || !isfinite(p[0] + p[1] + p[2])) continue;
-        for (int a = 0; a < 3; a++) C[a] += X[a], c[a] += p[a];
+        const wb_real *p = &x[3 * i];
+        if (!(vr[i] >= 0) || !isfinite(p[0] + p[1] + p[2])) continue;
+        sC = _mm256_add_pd(sC, wb__load3(&vx[3 * i]));
+        sc = _mm256_add_pd(sc, wb__load3(p));
         k++;
     }
     if (k == 0) return 0;
-    for (int a = 0; a < 3; a++) C[a] /= k, c[a] /= k;
-    wb_real A[9] = { 0 };
+    double t[4];
+    _mm256_storeu_pd(t, sC);
+    for (int a = 0; a < 3; a++) C[a] = t[a] / k;
+    _mm256_storeu_pd(t, sc);
+    for (int a = 0; a < 3; a++) c[a] = t[a] / k;
+    const __m256d vC = _mm256_set_pd(0, C[2], C[1], C[0]), vc = _mm256_set_pd(0, c[2], c[1], c[0]);
+    __m256d A0 = _mm256_setzero_pd(), A1 = A0, A2 = A0; /* rows of A */
     for (int32_t i = 0; i < n; i++) {
-        const wb_real *p = &x[3 * i], *X = &b->vx[3 * i];
-        if (!(b->vr[i] >= 0) || !isfinite(p[0] + p[1] + p[2])) continue;
-        for (int a = 0; a < 3; a++)
-            for (int e = 0; e < 3; e++) A[3 * a + e] += (wb_real)((p[a] - c[a]) * (X[e] - C[e]));
+        const wb_real *p = &x[3 * i];
+        if (!(vr[i] >= 0) || !isfinite(p[0] + p[1] + p[2])) continue;
+        const __m256d dX = _mm256_sub_pd(wb__load3(&vx[3 * i]), vC), dp = _mm256_sub_pd(wb__load3(p), vc);
+        A0 = _mm256_add_pd(A0, _mm256_mul_pd(_mm256_permute4x64_pd(dp, 0x00), dX));
+        A1 = _mm256_add_pd(A1, _mm256_mul_pd(_mm256_permute4x64_pd(dp, 0x55), dX));
+        A2 = _mm256_add_pd(A2, _mm256_mul_pd(_mm256_permute4x64_pd(dp, 0xaa), dX));
+    }
+    _mm256_storeu_pd(t, A0);
+    memcpy(&A[0], t, 3 * sizeof *A);
+    _mm256_storeu_pd(t, A1);
+    memcpy(&A[3], t, 3 * sizeof *A);
+    _mm256_storeu_pd(t, A2);
+    memcpy(&A[6], t, 3 * sizeof *A);
+    return k;
+}
+#endif
+
+/* M fitted to the particles that took part (vr >= 0) and are finite now; 0 when none */
+static int motion_fit(wb_broad *b, const wb_real *x, int32_t n, wb_motion *mo, int simd)
+{
+    double C[3] = { 0, 0, 0 }, c[3] = { 0, 0, 0 };
+    wb_real A[9] = { 0 };
+#ifdef WB_SIMD_H_AVX2
+    if (simd && __builtin_cpu_supports("avx2")) {
+        if (!fit_sums_avx2(b, x, n, C, c, A)) return 0;
+        b->fits_simd++;
+    } else
+#endif
+    {
+        (void)simd;
+        int32_t k = 0;
+        for (int32_t i = 0; i < n; i++) {
+            const wb_real *p = &x[3 * i], *X = &b->vx[3 * i];
+            if (!(b->vr[i] >= 0) || !isfinite(p[0] + p[1] + p[2])) continue;
+            for (int a = 0; a < 3; a++) C[a] += X[a], c[a] += p[a];
+            k++;
+        }
+        if (k == 0) return 0;
+        for (int a = 0; a < 3; a++) C[a] /= k, c[a] /= k;
+        for (int32_t i = 0; i < n; i++) {
+            const wb_real *p = &x[3 * i], *X = &b->vx[3 * i];
+            if (!(b->vr[i] >= 0) || !isfinite(p[0] + p[1] + p[2])) continue;
+            for (int a = 0; a < 3; a++)
+                for (int e = 0; e < 3; e++) A[3 * a + e] += (wb_real)((p[a] - c[a]) * (X[e] - C[e]));
+        }
     }
     wb_extract_rotation(A, b->mq, 20);
     wb_quat_to_matrix(b->mq, mo->Q);
@@ -678,11 +738,81 @@ static int mend_grid(void *ctx, int32_t j)
     return 1;
 }
 
+/* list_strays' verdict on particle i from its deviation from M (dd: its square, ds: the
+ * sum of its coordinates) and mag (its size, |p|_1 + R_i): 1 out of its skin, 0 within,
+ * -1 the list cannot serve; hot[i] as above (hot: NULL, not worked out) */
+static inline __attribute__((always_inline)) int stray_verdict(const wb_broad *b, const wb_real *x,
+                                                               const wb_real *reach, int32_t i, wb_real dd, wb_real ds,
+                                                               wb_real mag, wb_real size, uint8_t *hot, int32_t *nh)
+{
+    /* takes_part(i) == (R[i] >= 0), its cheap half first: one that was left out (R < 0)
+     * must still be; one that took part must have a reach >= 0 and finite, and a position
+     * within its slack (a position not finite fails one of the two tests) */
+    const wb_real Ri = b->vr[i], ri = reach[i];
+    if (Ri < 0) {
+        if (takes_part(x, reach, i)) return -1;
+        if (hot) hot[i] = 0; /* in no pair */
+        return 0;
+    }
+    if (!(ri >= 0) || !(ri < INFINITY)) return -1;
+    const wb_real slack = (Ri - ri) * (wb_real)0.999;
+    /* round-off in the pair distances: a slack far above the coordinates' ulps */
+    const int out = !(dd <= slack * slack) || !(slack > (wb_real)1e-9 * mag);
+    if (out && !isfinite(ds)) return -1;
+    if (hot) {
+        const wb_real g = b->half[i] * (1 - (wb_real)1e-6) - ri - (wb_real)1e-9 * (mag + size);
+        const int h = !(g > 0 && dd < g * g);
+        hot[i] = (uint8_t)h;
+        *nh += h;
+    }
+    return out;
+}
+
+#ifdef WB_SIMD_H_AVX2
+/* list_strays' pass with each deviation in AVX2 (x, y, z as lanes; M's rows as
+ * ((c + Q0 r0) + Q1 r1) + Q2 r2, motion_apply's order; no fused multiply-adds): the
+ * same bits */
+static __attribute__((target("avx2"))) int32_t strays_pass_avx2(const wb_broad *b, const wb_real *x,
+                                                                const wb_real *reach, int32_t n, const wb_motion *mo,
+                                                                wb_real size, int32_t *bad, int32_t nbad, uint8_t *hot,
+                                                                int32_t *nh)
+{
+    const wb_real *Q = mo->Q, *X = b->vx, *R = b->vr;
+    const __m256d C = _mm256_set_pd(0, mo->C[2], mo->C[1], mo->C[0]), c = _mm256_set_pd(0, mo->c[2], mo->c[1], mo->c[0]);
+    const __m256d Q0 = _mm256_set_pd(0, Q[6], Q[3], Q[0]), Q1 = _mm256_set_pd(0, Q[7], Q[4], Q[1]),
+                  Q2 = _mm256_set_pd(0, Q[8], Q[5], Q[2]), sign = _mm256_set1_pd(-0.0);
+    int32_t nb = 0;
+    for (int32_t i = 0; i < n; i++) {
+        const __m256d r = _mm256_sub_pd(wb__load3(&X[3 * i]), C), p = wb__load3(&x[3 * i]);
+        const __m256d y = _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(c, _mm256_mul_pd(Q0, _mm256_permute4x64_pd(r, 0x00))),
+                                                      _mm256_mul_pd(Q1, _mm256_permute4x64_pd(r, 0x55))),
+                                        _mm256_mul_pd(Q2, _mm256_permute4x64_pd(r, 0xaa)));
+        const __m256d d = _mm256_sub_pd(p, y);
+        const int k = stray_verdict(b, x, reach, i, hsum3(_mm256_mul_pd(d, d)), hsum3(d),
+                                    hsum3(_mm256_andnot_pd(sign, p)) + R[i], size, hot, nh);
+        if (k < 0) return -1;
+        if (k) {
+            if (nb == nbad) return nbad + 1;
+            bad[nb++] = i;
+        }
+    }
+    return nb;
+}
+#endif
+
 /* the particles that left their skin (up to nbad of them in bad; past that nbad + 1), or
  * -1 when the list cannot serve at all (other particles, skip keys or rules, or a particle
- * that joined or left) */
+ * that joined or left). With hot (the list's gaps known: gap_ok), in the same pass: which
+ * particles may be in a pair that passes the distance test now, how many in *nhot. Pair
+ * (i, j) passes only if |x_i - x_j| < reach_i + reach_j; M keeps distances, so
+ * |x_i - x_j| >= L_ij - |e_i| - |e_j| (L_ij: their list distance, e = x - M(X)), and one
+ * of the two has |e| + reach > L_ij / 2 >= its half. A particle is cold when
+ * |e| + reach < half less a millionth, and less 1e-9 of the coordinates' size (M's
+ * round-off and the pair test's are far below both): a pair of two cold ones fails the
+ * test to the bit. simd: the pass in AVX2 where the machine has it */
 static int32_t list_strays(const wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t n,
-                           uint64_t gen, const wb_motion *mo, int32_t *bad, int32_t nbad)
+                           uint64_t gen, const wb_motion *mo, int32_t *bad, int32_t nbad, uint8_t *hot, int32_t *nhot,
+                           int simd)
 {
     if (b->vn != n || n == 0 || b->bare || b->vgen != gen) return -1;
     const wb_real *X = b->vx, *R = b->vr;
@@ -690,38 +820,55 @@ static int32_t list_strays(const wb_broad *b, const wb_real *x, const wb_real *r
     if (skip && memcmp(skip, K, sizeof *K * (size_t)n)) return -1;
     for (int32_t i = 0; !skip && i < n; i++)
         if (K[i] != 0) return -1;
-    int32_t nb = 0;
-    for (int32_t i = 0; i < n; i++) {
-        /* takes_part(i) == (R[i] >= 0), its cheap half first: one that was left out (R < 0)
-         * must still be; one that took part must have a reach >= 0 and finite, and a
-         * position within its slack (a position not finite fails one of the two tests) */
-        const wb_real Ri = R[i], ri = reach[i];
-        if (Ri < 0) {
-            if (takes_part(x, reach, i)) return -1;
-            continue;
-        }
-        if (!(ri >= 0) || !(ri < INFINITY)) return -1;
-        const wb_real *p = &x[3 * i];
-        wb_real y[3];
-        motion_apply(mo, &X[3 * i], y);
-        const wb_real d0 = p[0] - y[0], d1 = p[1] - y[1], d2 = p[2] - y[2];
-        const wb_real slack = (Ri - ri) * (wb_real)0.999;
-        /* round-off in the pair distances: a slack far above the coordinates' ulps */
-        const wb_real mag = fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + Ri;
-        if (!(d0 * d0 + d1 * d1 + d2 * d2 <= slack * slack) || !(slack > (wb_real)1e-9 * mag)) {
-            if (!isfinite(d0 + d1 + d2)) return -1;
-            if (nb == nbad) return nbad + 1;
-            bad[nb++] = i;
+    int32_t nb = 0, nh = 0;
+    const wb_real size = fabs(mo->c[0]) + fabs(mo->c[1]) + fabs(mo->c[2]) + fabs(mo->C[0]) + fabs(mo->C[1]) +
+                         fabs(mo->C[2]);
+#ifdef WB_SIMD_H_AVX2
+    if (simd && __builtin_cpu_supports("avx2")) nb = strays_pass_avx2(b, x, reach, n, mo, size, bad, nbad, hot, &nh);
+    else
+#endif
+    {
+        (void)simd;
+        for (int32_t i = 0; i < n; i++) {
+            const wb_real *p = &x[3 * i];
+            wb_real y[3];
+            motion_apply(mo, &X[3 * i], y);
+            const wb_real d0 = p[0] - y[0], d1 = p[1] - y[1], d2 = p[2] - y[2];
+            const int k = stray_verdict(b, x, reach, i, d0 * d0 + d1 * d1 + d2 * d2, d0 + d1 + d2,
+                                        fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + R[i], size, hot, &nh);
+            if (k < 0) return -1;
+            if (k) {
+                if (nb == nbad) return nbad + 1;
+                bad[nb++] = i;
+            }
         }
     }
+    if (nb >= 0 && nb <= nbad && nhot) *nhot = nh;
     return nb;
 }
 
-static int list_valid(const wb_broad *b, const wb_real *x, const wb_real *reach, const int32_t *skip, int32_t n,
-                      uint64_t gen, const wb_motion *mo)
+/* each particle's half (above) for the list as it is; 0 when out of memory */
+static int list_gaps(wb_broad *b, int32_t n)
 {
-    return list_strays(b, x, reach, skip, n, gen, mo, NULL, 0) == 0;
+    if (!grow((void **)&b->half, &b->cap_half, n, sizeof *b->half) ||
+        !grow((void **)&b->hot, &b->cap_hot, n, sizeof *b->hot))
+        return 0;
+    wb_real *half = b->half;
+    const wb_real *X = b->vx;
+    for (int32_t i = 0; i < n; i++) half[i] = INFINITY; /* the least squared distance first */
+    const int32_t *ij = b->list.ij;
+    for (int32_t k = 0; k < b->list.n; k++) {
+        const int32_t i = ij[2 * k], j = ij[2 * k + 1];
+        const wb_real d0 = X[3 * j] - X[3 * i], d1 = X[3 * j + 1] - X[3 * i + 1], d2 = X[3 * j + 2] - X[3 * i + 2];
+        const wb_real dd = d0 * d0 + d1 * d1 + d2 * d2;
+        if (dd < half[i]) half[i] = dd;
+        if (dd < half[j]) half[j] = dd;
+    }
+    for (int32_t i = 0; i < n; i++) half[i] = (wb_real)0.5 * sqrt(half[i]);
+    b->gap_ok = 1;
+    return 1;
 }
+
 
 /* The kept list mended where few particles left their skin (a cloth sliding slowly over a
  * sphere): each one's list position and reach made again from where it is (M^-1 x, in the
@@ -805,23 +952,31 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
 {
     if (!c->bp && !(c->bp = calloc(1, sizeof *c->bp))) return -1;
     wb_broad *b = c->bp;
-    wb_motion mo;
-    motion_identity(&mo);
-    int valid = list_valid(b, x, reach, skip, n, gen, &mo);
-    if (!valid && b->vn == n && !b->bare && b->vgen == gen && motion_fit(b, x, n, &mo)) {
+    /* tried first under the motion it last served with (identity for a new list): a
+     * cloth come to rest keeps it, and needs no fit */
+    wb_motion mo = b->mo;
+    if (b->vn == 0) motion_identity(&mo);
+    /* particles that may be in a passing pair, known when the list serves unmended: -1
+     * (every pair tested) otherwise */
+    int32_t nhot = -1;
+    uint8_t *hot = b->gap_ok && !c->no_gaps ? b->hot : NULL;
+    int valid = list_strays(b, x, reach, skip, n, gen, &mo, NULL, 0, hot, &nhot, !c->no_simd) == 0;
+    if (!valid && b->vn == n && !b->bare && b->vgen == gen && motion_fit(b, x, n, &mo, !c->no_simd)) {
         /* a few particles out of their skin: the list mended for them (up to 1 in 32, and
          * 1 in 8 mended since it was built) */
         const int32_t most = n / 32 > 16 ? n / 32 : 16;
         int32_t *bad = wb__grow(b->bad, &b->cap_bad, most, sizeof *bad);
         if (bad) b->bad = bad;
-        const int32_t nb = bad ? list_strays(b, x, reach, skip, n, gen, &mo, bad, most) : -1;
+        const int32_t nb = bad ? list_strays(b, x, reach, skip, n, gen, &mo, bad, most, hot, &nhot, !c->no_simd) : -1;
         valid = nb == 0;
         if (nb > 0 && nb <= most && b->lgrid && b->lfull && b->nmoved + nb <= n / 8 + 16) {
             if (!mend_list(b, x, reach, skip, n, &mo, bad, nb, keep, ud)) return -1;
             b->mends++;
+            b->gap_ok = 0;
             valid = 1;
         }
     }
+    if (!valid || !hot || b->gap_ok == 0) nhot = -1;
     if (valid) {
         b->mo = mo;
         b->used = 1;
@@ -857,6 +1012,7 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
         if (n > 0) memcpy(b->vx, x, sizeof *x * 3 * (size_t)n);
         b->list.n = 0;
         b->lgrid = 0;
+        b->gap_ok = 0;
         /* keep's rules applied in the search (the list is rebuilt when they change); a list
          * without a skin serves this call alone (its distance test below passes every pair) */
         b->bare = !skin;
@@ -869,8 +1025,12 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
     if (!grow((void **)&c->ij, &c->cap, 2 * ((int64_t)c->n + b->list.n), sizeof *c->ij)) return -1;
     int32_t *out = c->ij, at = c->n;
     const int32_t *ij = b->list.ij;
-    for (int32_t k = 0; k < b->list.n; k++) {
+    if (nhot >= 0) b->gap_calls++, b->gap_quiet += nhot == 0;
+    /* a pair of two cold particles fails below: none tested when every particle is cold */
+    const int32_t npair = nhot == 0 ? 0 : b->list.n;
+    for (int32_t k = 0; k < npair; k++) {
         const int32_t i = ij[2 * k], j = ij[2 * k + 1];
+        if (nhot > 0 && !(hot[i] | hot[j])) continue;
         const wb_real *p = &x[3 * i], *q = &x[3 * j];
         const wb_real d0 = q[0] - p[0], d1 = q[1] - p[1], d2 = q[2] - p[2], r = reach[i] + reach[j];
         if (d0 * d0 + d1 * d1 + d2 * d2 >= r * r) continue;
@@ -880,6 +1040,9 @@ int32_t wb__broadphase_kept(wb_contacts *c, const wb_real *x, const wb_real *rea
         at++;
     }
     c->n = at;
+    /* the gaps of a list just built or mended, for the next calls (a list without a skin
+     * serves this call alone) */
+    if (!b->gap_ok && !b->bare && !c->no_gaps && !list_gaps(b, n)) return -1;
     return c->n;
 }
 
@@ -996,6 +1159,39 @@ static along_item along_pop(along_item *h, int32_t *n)
     return top;
 }
 
+/* add_along's queue of (d, j), the least first (ties: the lesser j, a strict order: one
+ * particle is queued again only nearer). While short, a sorted run [head, n): a new item
+ * is mostly among the farthest, a few moves from the end, where a heap's pop costs a
+ * sift through its levels; past ALONG_RUN items the run (sorted, so a heap already) goes
+ * on as a binary heap. Either pops the items in the same order */
+#define ALONG_RUN 32
+typedef struct along_queue { along_item *a; int32_t head, n, heap; } along_queue;
+
+static inline int32_t along_size(const along_queue *q) { return q->n - q->head; }
+
+static inline void along_add(along_queue *q, along_item e)
+{
+    if (!q->heap && q->n - q->head >= ALONG_RUN) {
+        memmove(q->a, q->a + q->head, sizeof *q->a * (size_t)(q->n - q->head));
+        q->n -= q->head;
+        q->head = 0;
+        q->heap = 1;
+    }
+    if (q->heap) {
+        along_push(q->a, &q->n, e);
+        return;
+    }
+    int32_t k = q->n++;
+    for (; k > q->head && (e.d < q->a[k - 1].d || (e.d == q->a[k - 1].d && e.j < q->a[k - 1].j)); k--)
+        q->a[k] = q->a[k - 1];
+    q->a[k] = e;
+}
+
+static inline along_item along_next(along_queue *q)
+{
+    return q->heap ? along_pop(q->a, &q->n) : q->a[q->head++];
+}
+
 /* a link add_along walks: both ends loose, or both of one body that collides with
  * itself (no other body pairs within itself) */
 static inline int along_link(const wb_model *m, int32_t a, int32_t b)
@@ -1039,12 +1235,14 @@ static int add_along(links_ud *u, int32_t nlinks)
     for (int32_t i = 0; ok && i < np; i++) {
         if (row[i] == row[i + 1]) continue;
         const wb_real bound = (wb_real)ALONG_PATH * ALONG * (m->radius[i] + rmax);
-        int32_t nh = 0, settled = 0;
+        /* (a run: at most 1 + 2 nlinks items are ever queued, fewer than heap holds) */
+        along_queue qu = { heap, 0, 0, c->along_heap };
+        int32_t settled = 0;
         dist[i] = 0;
         seen[i] = i;
-        along_push(heap, &nh, (along_item){ 0, i });
-        while (nh > 0 && settled < ALONG_MOST) {
-            const along_item e = along_pop(heap, &nh);
+        along_add(&qu, (along_item){ 0, i });
+        while (along_size(&qu) > 0 && settled < ALONG_MOST) {
+            const along_item e = along_next(&qu);
             if (e.d > dist[e.j]) continue; /* a longer way to one settled already */
             settled++;
             const int32_t j = e.j;
@@ -1069,9 +1267,10 @@ static int add_along(links_ud *u, int32_t nlinks)
                 if (!(d < bound) || (seen[o] == i && !(d < dist[o]))) continue;
                 seen[o] = i;
                 dist[o] = d;
-                if (nh < 4 * ALONG_MOST + 2 * nlinks) along_push(heap, &nh, (along_item){ d, o });
+                if (along_size(&qu) < 4 * ALONG_MOST + 2 * nlinks) along_add(&qu, (along_item){ d, o });
             }
         }
+        c->along_heaps += qu.heap;
     }
 done:
     free(row); free(to); free(len); free(dist); free(seen); free(heap);
@@ -1144,6 +1343,34 @@ static int made_bounds(wb_world *w)
     return r >= 0;
 }
 
+/* n keys of particles below np sorted, by two counting sorts (by the greater particle,
+ * then stably by the less): linear, where a comparison sort of a cloth's ~300k keys took
+ * most of the rules' build; 0 when out of memory */
+static int sort_keys(uint64_t *keys, int32_t n, int32_t np)
+{
+    for (int32_t k = 0; k < n; k++)
+        if ((uint32_t)(keys[k] >> 32) >= (uint32_t)np || (uint32_t)keys[k] >= (uint32_t)np) {
+            qsort(keys, (size_t)n, sizeof *keys, cmp_u64); /* (not a particle's: never so far) */
+            return 1;
+        }
+    uint64_t *tmp = malloc(sizeof *tmp * (size_t)n);
+    int32_t *at = malloc(sizeof *at * ((size_t)np + 1));
+    const int ok = tmp && at;
+    for (int pass = 0; ok && pass < 2; pass++) {
+        /* pass 0: keys into tmp by their low half; pass 1: back by their high half */
+        const uint64_t *src = pass ? tmp : keys;
+        uint64_t *dst = pass ? keys : tmp;
+        const int shift = pass ? 32 : 0;
+        memset(at, 0, sizeof *at * ((size_t)np + 1));
+        for (int32_t k = 0; k < n; k++) at[(uint32_t)(src[k] >> shift) + 1]++;
+        for (int32_t i = 0; i < np; i++) at[i + 1] += at[i];
+        for (int32_t k = 0; k < n; k++) dst[at[(uint32_t)(src[k] >> shift)]++] = src[k];
+    }
+    free(tmp);
+    free(at);
+    return ok;
+}
+
 /* what the pair rule asks (may_touch, tribroad.c's): every type's links as sorted keys,
  * each once, and the loose particles' graphs; 0 when out of memory */
 static int build_rules(wb_world *w)
@@ -1159,7 +1386,7 @@ static int build_rules(wb_world *w)
         if (wb__ctypes[t]->links) wb__ctypes[t]->links(w, add_link, &u);
     if (u.fail || !add_along(&u, u.n)) return 0;
     for (int32_t i = 0; i < m->np; i++) g[i] = graph_root(g, i);
-    if (u.n > 1) qsort(c->keys, (size_t)u.n, sizeof *c->keys, cmp_u64); /* keys is NULL while none */
+    if (u.n > 1 && !sort_keys(c->keys, u.n, m->np)) return 0; /* keys is NULL while none */
     int32_t n = 0;
     c->cross = 0;
     for (int32_t k = 0; k < u.n; k++) {
@@ -1389,14 +1616,113 @@ static inline void ref_rel(const wb_contacts *c, const ref_step *rs, const wb_re
     for (int a = 0; a < 3; a++) u[a] = (movable ? v[a] : 0) - q[a];
 }
 
+static void keep_reference(wb_contacts *c, const double V[3], const double om[3], const double cc[3])
+{
+    for (int a = 0; a < 3; a++) c->ref_v[a] = (wb_real)V[a], c->ref_om[a] = (wb_real)om[a], c->ref_c[a] = (wb_real)cc[a];
+}
+
+#ifdef WB_SIMD_H_AVX2
+/* lanes (1, 2, 0) and (2, 0, 1) of a 3-vector: its cross products */
+#define YZX(a) _mm256_permute4x64_pd(a, 0xC9)
+#define ZXY(a) _mm256_permute4x64_pd(a, 0xD2)
+
+/* fit_reference with a particle's x, y, z as the lanes of one vector, each lane the scalar
+ * code's operations in its order (no fused multiply-adds): the same bits. Its last pass
+ * works out each candidate's velocity from the reference either way (fitted or standing
+ * still) and leaves the one kept in reach, as make_list's ref_rel and v3_len_fast would
+ * (1; 0: not done, make_list does it). c->spd: scratch */
+static __attribute__((target("avx2"))) int fit_reference_avx2(wb_world *w, wb_real *reach, wb_real t)
+{
+    wb_contacts *c = w->k.pc;
+    const wb_model *m = &w->m;
+    const wb_real *x = w->s.x, *v = w->s.v, *wv = m->w;
+    const int32_t np = m->np;
+    double M = 0;
+    __m256d mx = _mm256_setzero_pd(), mv = mx;
+    for (int32_t i = 0; i < np; i++) {
+        if (reach[i] < 0 || !(wv[i] > 0)) continue;
+        const double mi = 1 / (double)wv[i];
+        const __m256d vm = _mm256_set1_pd(mi);
+        M += mi;
+        mx = _mm256_add_pd(mx, _mm256_mul_pd(vm, wb__load3(&x[3 * i])));
+        mv = _mm256_add_pd(mv, _mm256_mul_pd(vm, wb__load3(&v[3 * i])));
+    }
+    if (!(M > 0) || !isfinite(M)) return 0;
+    const __m256d vM = _mm256_set1_pd(M), vcc = _mm256_div_pd(mx, vM), vV = _mm256_div_pd(mv, vM);
+    double cc[4], V[4];
+    _mm256_storeu_pd(cc, vcc);
+    _mm256_storeu_pd(V, vV);
+    /* L, and sum m r r^T as its diagonal (xx yy zz) and (xy xz yz) */
+    __m256d L = _mm256_setzero_pd(), Id = L, Io = L;
+    for (int32_t i = 0; i < np; i++) {
+        if (reach[i] < 0 || !(wv[i] > 0)) continue;
+        const double mi = 1 / (double)wv[i];
+        const __m256d vm = _mm256_set1_pd(mi);
+        const __m256d r = _mm256_sub_pd(wb__load3(&x[3 * i]), vcc), u = _mm256_sub_pd(wb__load3(&v[3 * i]), vV);
+        L = _mm256_add_pd(L, _mm256_mul_pd(vm, _mm256_sub_pd(_mm256_mul_pd(YZX(r), ZXY(u)), _mm256_mul_pd(ZXY(r), YZX(u)))));
+        const __m256d mr = _mm256_mul_pd(vm, r);
+        Id = _mm256_add_pd(Id, _mm256_mul_pd(mr, r));
+        /* (mi r0) r1, (mi r0) r2, (mi r1) r2 */
+        Io = _mm256_add_pd(Io, _mm256_mul_pd(_mm256_permute4x64_pd(mr, 0x10), _mm256_permute4x64_pd(r, 0x29)));
+    }
+    double Lv[4], Ia[4], Ib[4], om[3];
+    _mm256_storeu_pd(Lv, L);
+    _mm256_storeu_pd(Ia, Id);
+    _mm256_storeu_pd(Ib, Io);
+    const double I[6] = { Ia[0], Ia[1], Ia[2], Ib[0], Ib[1], Ib[2] };
+    wb__turn_rate(I, Lv, om);
+    if (!(isfinite(V[0] + V[1] + V[2] + om[0] + om[1] + om[2] + cc[0] + cc[1] + cc[2]))) return 0;
+    wb_real *spd = wb__grow(c->spd, &c->cap_spd, 2 * (int64_t)np, sizeof *spd);
+    if (spd) c->spd = spd;
+    int odd = !spd; /* some speed not worked out here: make_list's pass does them all */
+    const __m256d vom = _mm256_set_pd(0, om[2], om[1], om[0]), zero = _mm256_setzero_pd();
+    const __m256d omy = YZX(vom), omz = ZXY(vom);
+    double with = 0, without = 0;
+    for (int32_t i = 0; i < np; i++) {
+        if (reach[i] < 0) continue;
+        const __m256d xi = wb__load3(&x[3 * i]), r = _mm256_sub_pd(xi, vcc);
+        const int mov = wv[i] > 0;
+        const __m256d vi = mov ? wb__load3(&v[3 * i]) : zero;
+        /* V + om x r as V[0] + om[1] r[2] - om[2] r[1], ... */
+        const __m256d u = _mm256_sub_pd(vi, _mm256_sub_pd(_mm256_add_pd(vV, _mm256_mul_pd(omy, ZXY(r))),
+                                                          _mm256_mul_pd(omz, YZX(r))));
+        const double uu = hsum3(_mm256_mul_pd(u, u)), vv = hsum3(_mm256_mul_pd(vi, vi));
+        const double r0 = 1.25 * m->radius[i], a = r0 + sqrt(uu) * t, b = r0 + (mov ? sqrt(vv) : 0) * t;
+        with += a * a * a;
+        without += b * b * b;
+        if (odd) continue;
+        /* v3_len_fast of u (fitted), of the velocity (standing still: r = x exactly, so
+         * u = v - (0 + 0 r2 - 0 r1) = v while x is finite) */
+        if (!(uu < 1e300) || !(vv < 1e300) || !isfinite(x[3 * i] + x[3 * i + 1] + x[3 * i + 2])) {
+            odd = 1;
+            continue;
+        }
+        spd[2 * i] = sqrt(uu);
+        spd[2 * i + 1] = sqrt(vv);
+    }
+    const int keep = with < (double)0.25 * without;
+    if (keep) keep_reference(c, V, om, cc);
+    if (odd) return 0;
+    for (int32_t i = 0; i < np; i++)
+        if (reach[i] >= 0) reach[i] = spd[2 * i + !keep];
+    return 1;
+}
+#undef YZX
+#undef ZXY
+#endif
+
 /* the reference fitted to the candidates (reach >= 0) at x with velocities v; kept only
- * where it shrinks the volume their reaches search (below) */
-static void fit_reference(wb_world *w, const wb_real *reach, wb_real t)
+ * where it shrinks the volume their reaches search (below). 1 when it also left each
+ * candidate's speed from the reference in reach (its AVX2 form) */
+static int fit_reference(wb_world *w, wb_real *reach, wb_real t)
 {
     wb_contacts *c = w->k.pc;
     const wb_model *m = &w->m;
     const wb_real *x = w->s.x, *v = w->s.v, *wv = m->w;
     for (int a = 0; a < 3; a++) c->ref_v[a] = c->ref_om[a] = c->ref_c[a] = 0;
+#ifdef WB_SIMD_H_AVX2
+    if (!w->k.no_simd && __builtin_cpu_supports("avx2")) return fit_reference_avx2(w, reach, t);
+#endif
     double M = 0, mx[3] = { 0, 0, 0 }, mv[3] = { 0, 0, 0 };
     for (int32_t i = 0; i < m->np; i++) {
         if (reach[i] < 0 || !(wv[i] > 0)) continue;
@@ -1404,7 +1730,7 @@ static void fit_reference(wb_world *w, const wb_real *reach, wb_real t)
         M += mi;
         for (int a = 0; a < 3; a++) mx[a] += mi * x[3 * i + a], mv[a] += mi * v[3 * i + a];
     }
-    if (!(M > 0) || !isfinite(M)) return;
+    if (!(M > 0) || !isfinite(M)) return 0;
     const double cc[3] = { mx[0] / M, mx[1] / M, mx[2] / M }, V[3] = { mv[0] / M, mv[1] / M, mv[2] / M };
     double L[3] = { 0, 0, 0 }, I[6] = { 0, 0, 0, 0, 0, 0 }; /* sum m r r^T: xx yy zz xy xz yz */
     for (int32_t i = 0; i < m->np; i++) {
@@ -1420,7 +1746,7 @@ static void fit_reference(wb_world *w, const wb_real *reach, wb_real t)
     }
     double om[3];
     wb__turn_rate(I, L, om);
-    if (!(isfinite(V[0] + V[1] + V[2] + om[0] + om[1] + om[2] + cc[0] + cc[1] + cc[2]))) return;
+    if (!(isfinite(V[0] + V[1] + V[2] + om[0] + om[1] + om[2] + cc[0] + cc[1] + cc[2]))) return 0;
     /* what the search costs with the fit and without: the sum of the reaches' cubes (the
      * volume each one searches; a few large reaches cost more than their sum says), an
      * immovable particle's counting how far the reference leaves it */
@@ -1443,8 +1769,8 @@ static void fit_reference(wb_world *w, const wb_real *reach, wb_real t)
      * (measured: a cloth heap where only part still falls, 124 -> 146 ms a frame with the
      * fit kept whenever it was smaller at all; 0.1 threw away half of a hand-built
      * sheet's gain) */
-    if (!(with < (double)0.25 * without)) return;
-    for (int a = 0; a < 3; a++) c->ref_v[a] = (wb_real)V[a], c->ref_om[a] = (wb_real)om[a], c->ref_c[a] = (wb_real)cc[a];
+    if (with < (double)0.25 * without) keep_reference(c, V, om, cc);
+    return 0;
 }
 
 /* Straight paths. Each particle is also checked against the straight line its velocity
@@ -1505,6 +1831,7 @@ static int split_dormant(wb_contacts *c, const wb_model *m, int32_t r)
         return 0;
     int32_t *row = c->dorm_row;
     memset(row, 0, sizeof *row * ((size_t)np + 1));
+    if (nd == 0) return 1; /* (every row empty) */
     for (int32_t q = 0; q < 2 * nd; q++) row[d[q] + 1]++;
     for (int32_t i = 0; i < np; i++) row[i + 1] += row[i];
     for (int32_t q = 0; q < nd; q++) {
@@ -1568,7 +1895,7 @@ static int32_t make_list(wb_world *w, wb_real h, int32_t kmax, wb_real margin, i
         reach[i] = (f & WB_CF_COLLIDE) || (gi > 0 && (f & WB_CF_SELF)) ? 0 : -1;
         skip[i] = gi > 0 && !(f & WB_CF_SELF) ? gi : 0;
     }
-    fit_reference(w, reach, h * kmax);
+    const int have = fit_reference(w, reach, h * kmax);
     c->ref_k0 = k0;
     const ref_step rs0 = { 0, 1 };
     /* each candidate's speed from the reference (in reach for now), and their mean motion
@@ -1578,9 +1905,11 @@ static int32_t make_list(wb_world *w, wb_real h, int32_t kmax, wb_real margin, i
     const wb_real g = v3_len(m->def.gravity);
     for (int32_t i = 0; i < m->np; i++) {
         if (reach[i] < 0) continue;
-        wb_real u[3];
-        ref_rel(c, &rs0, &w->s.x[3 * i], &v[3 * i], m->w[i] > 0, u);
-        reach[i] = v3_len_fast(u);
+        if (!have) {
+            wb_real u[3];
+            ref_rel(c, &rs0, &w->s.x[3 * i], &v[3 * i], m->w[i] > 0, u);
+            reach[i] = v3_len_fast(u);
+        }
         if (k0 == 0 && m->radius[i] > 0) /* (a remake within the frame keeps its span) */
             motion += (reach[i] * h * kmax + g * h * h * kmax * kmax) / m->radius[i], nmov++;
     }
@@ -1599,6 +1928,7 @@ static int32_t make_list(wb_world *w, wb_real h, int32_t kmax, wb_real margin, i
     }
     memcpy(xf, w->s.x, sizeof *xf * 3 * (size_t)m->np);
     c->n = 0;
+    c->no_simd = w->k.no_simd;
     int32_t r = wb__broadphase_kept(c, w->s.x, reach, skip, m->np, wb__world_pool(w), may_touch_rules, c->rules_gen,
                                     movable_pair, w);
     if (r >= 0 && !split_dormant(c, m, r)) r = -1;
@@ -1613,7 +1943,9 @@ void wb__broadphase_free(wb_contacts *c)
     c->skip = NULL;
     c->cap_skip = 0;
     free(c->key_row); free(c->path); free(c->dorm); free(c->dorm_row); free(c->dorm_at); free(c->dorm_on);
-    free(c->off_path); free(c->soft); free(c->qs); free(c->near2); free(c->far2); free(c->grown);
+    free(c->off_path); free(c->soft); free(c->qs); free(c->near2); free(c->far2); free(c->grown); free(c->spd);
+    c->spd = NULL;
+    c->cap_spd = 0;
     c->grown = NULL;
     c->cap_grown = 0;
     c->near2 = c->far2 = NULL;
@@ -1634,6 +1966,7 @@ void wb__broadphase_free(wb_contacts *c)
     free(b->runs); free(b->boxes); free(b->first); free(b->by_j); free(b->cnt); free(b->rowr);
     free(b->vx); free(b->vr); free(b->vskip); free(b->list.ij); free(b->list.hit);
     free(b->moved); free(b->is_moved); free(b->bad); free(b->mend.ij); free(b->mend.hit);
+    free(b->half); free(b->hot);
     for (int t = 0; t < b->nout; t++) free(b->out[t].ij), free(b->out[t].hit);
     free(b->out);
     free(b);
@@ -1877,6 +2210,18 @@ static inline void sort_stray(int k, int32_t i, int32_t *soft, int32_t *ns, int3
 }
 
 #ifdef WB_SIMD_H_AVX2
+/* rows r0..r3 of 4 doubles into columns c0..c3 */
+static inline __attribute__((always_inline, target("avx2"))) void
+wb__transpose4x4(__m256d r0, __m256d r1, __m256d r2, __m256d r3, __m256d *c0, __m256d *c1, __m256d *c2, __m256d *c3)
+{
+    const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
+    const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+    *c0 = _mm256_permute2f128_pd(t0, t2, 0x20);
+    *c1 = _mm256_permute2f128_pd(t1, t3, 0x20);
+    *c2 = _mm256_permute2f128_pd(t0, t2, 0x31);
+    *c3 = _mm256_permute2f128_pd(t1, t3, 0x31);
+}
+
 /* The same pass with strays' first test (on its path) in AVX2: each particle's path as two
  * vectors, (y, eps) and (u, 0), and its position as (x, 0), so that lane 3 of the deviation
  * is -eps; the same operations in the same order as the scalar test (no fused
@@ -1892,8 +2237,40 @@ static __attribute__((target("avx2"))) int32_t check_avx2(wb_contacts *c, const 
     const wb_real *reach = c->reach, *path = c->path;
     const uint8_t *off = c->off_path;
     uint8_t *grown = c->grown;
-    int32_t on = 0;
-    for (int32_t i = 0; i < np; i++) {
+    int32_t on = 0, i = 0;
+    /* four particles at a time, their coordinates as lanes (the same operations per lane);
+     * the lanes not found on their paths (or no candidates, or off their paths) go to
+     * strays one by one, in order */
+    const __m256d zero = _mm256_setzero_pd();
+    for (; i + 4 <= np; i += 4) {
+        uint32_t off4;
+        memcpy(&off4, &off[i], sizeof off4);
+        int go = _mm256_movemask_pd(_mm256_cmp_pd(_mm256_loadu_pd(&reach[i]), zero, _CMP_GE_OQ));
+        for (int l = 0; off4 && l < 4; l++)
+            if (off[i + l]) go &= ~(1 << l);
+        int in = 0;
+        if (go) {
+            __m256d X, Y, Z, P0, P1, P2, E, U0, U1, U2, U3;
+            const wb_real *xi = &x[3 * (size_t)i];
+            wb__transpose4(wb__load3(xi), wb__load3(xi + 3), wb__load3(xi + 6), wb__load3(xi + 9), &X, &Y, &Z);
+            const wb_real *P = &path[8 * (size_t)i];
+            wb__transpose4x4(_mm256_loadu_pd(P), _mm256_loadu_pd(P + 8), _mm256_loadu_pd(P + 16), _mm256_loadu_pd(P + 24),
+                             &P0, &P1, &P2, &E);
+            wb__transpose4x4(_mm256_loadu_pd(P + 4), _mm256_loadu_pd(P + 12), _mm256_loadu_pd(P + 20),
+                             _mm256_loadu_pd(P + 28), &U0, &U1, &U2, &U3);
+            const __m256d d0 = _mm256_sub_pd(_mm256_sub_pd(X, P0), _mm256_mul_pd(S, U0));
+            const __m256d d1 = _mm256_sub_pd(_mm256_sub_pd(Y, P1), _mm256_mul_pd(S, U1));
+            const __m256d d2 = _mm256_sub_pd(_mm256_sub_pd(Z, P2), _mm256_mul_pd(S, U2));
+            const __m256d dd = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2));
+            in = go & _mm256_movemask_pd(_mm256_cmp_pd(dd, _mm256_mul_pd(E, E), _CMP_LE_OQ));
+        }
+        if (in == 15) { on += 4; continue; }
+        for (int l = 0; l < 4; l++) {
+            if (in >> l & 1) { on++; continue; }
+            sort_stray(strays(c, x, rad, rs, i + l), i + l, soft, ns, mv, nm, grown);
+        }
+    }
+    for (; i < np; i++) {
         if (reach[i] >= 0 && !off[i]) {
             const wb_real *P = &path[8 * i];
             const __m256d d = _mm256_sub_pd(_mm256_sub_pd(wb__load3(&x[3 * i]), _mm256_loadu_pd(P)),

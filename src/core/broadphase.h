@@ -81,6 +81,16 @@ struct wb_broad {
     wb_grid lg;
     int32_t lm;
     wb_real lrmax;
+    /* half the least list distance of each particle to its partners in the list (list
+     * positions; INFINITY: none), for the current list (gap_ok): a pair can only pass the
+     * call's distance test where one of its particles moved that far from the list,
+     * reach included (hot; list_strays) */
+    wb_real *half; int32_t cap_half;
+    uint8_t *hot; int32_t cap_hot;
+    int gap_ok;
+    int64_t fits_simd;                 /* tests: motions fitted in AVX2 */
+    int64_t gap_calls, gap_quiet;      /* tests: calls filtered by hot particles; of them,
+                                          with none (no pair tested) */
 };
 /* its scratch freed (contact.c's teardown; the tests' own lists) */
 void wb__broadphase_free(wb_contacts *c);

@@ -128,6 +128,13 @@ typedef struct wb_contacts {
     int32_t *add, cap_add; /* (2 x) their new pairs */
     int32_t *fixed, cap_fixed, nfixed; /* the particles mended this frame */
     int no_recheck;        /* tests: the list is not checked within the frame */
+    wb_real *spd;          /* (np x 2) scratch: speeds from the fitted and the still reference */
+    int32_t cap_spd;
+    int no_simd;           /* the kept list's motion fitted without AVX2 (the world's no_simd) */
+    int along_heap;        /* tests: the rules' searches along the links queue in a heap from
+                              the start (broadphase.c, add_along) */
+    int64_t along_heaps;   /* tests: those searches that went on as a heap */
+    int no_gaps;           /* tests: the kept list's every pair tested every call (broadphase.c) */
     int brute;             /* tests: each substep, every touching pair that may touch is looked
                               for in the list; missed counts those it lacks */
     int64_t missed;

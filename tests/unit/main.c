@@ -51,6 +51,9 @@
     X(contact_self_collision_skips_rest_neighbours)      \
     X(contact_list_complete_every_substep)               \
     X(recheck_simd_bits)                                 \
+    X(contact_list_gaps_same_bits)                       \
+    X(contact_reference_simd_bits)                       \
+    X(contact_rules_queue_same_keys)                     \
     X(contact_list_complete_with_reference_motion)       \
     X(contact_check_follows_reference_motion)            \
     X(contact_clone_keeps_groups)

@@ -77,7 +77,8 @@ TEST(contact_list_complete_every_substep)
  * pinned corners (immovable particles, which the reference leaves behind) into a ball
  * in its way, and one thrown tumbling onto the floor (the floor stops its leading edge
  * while the rest still turns over it). */
-static wb_world *swinging(int spin)
+/* a world of the defaults with a floor at y = 0 */
+static wb_world *floor_world(void)
 {
     wb_world_def d = wb_world_default_def();
     wb_world *w = wb_world_create(&d);
@@ -87,6 +88,14 @@ static wb_world *swinging(int spin)
     floor.offset = 0;
     wb_status st;
     wb_collider_add(w, &floor, &st);
+    return w;
+}
+
+static wb_world *swinging(int spin)
+{
+    wb_world *w = floor_world();
+    if (!w) return NULL;
+    wb_status st;
     wb_cloth_def c = wb_cloth_default_def();
     v3_set(c.origin, -0.5, spin ? 0.6 : 1.2, -0.5);
     c.size[0] = c.size[1] = 1;
@@ -205,27 +214,163 @@ TEST(contact_check_follows_reference_motion)
 /* The substeps' check in AVX2 (broadphase.c, check_avx2) decides as the scalar one, to the
  * bit: the stiff heap above (particles off their paths and past their reaches every few
  * substeps) stepped both ways, the same state, lists and remakes every frame */
-TEST(recheck_simd_bits)
+/* the two worlds' particles at the same positions and velocities, to the bit */
+static int same_bits(const wb_world *a, const wb_world *b)
 {
-    wb_world *a = heap(32), *b = heap(32);
+    const size_t bytes = sizeof(wb_real) * 3 * (size_t)a->m.np;
+    return a->m.np == b->m.np && memcmp(a->s.x, b->s.x, bytes) == 0 && memcmp(a->s.v, b->s.v, bytes) == 0;
+}
+
+/* n x n: 32 (the vector check's groups of four alone) and 31 (one particle left for the
+ * one-at-a-time tail) */
+static void simd_bits(int n)
+{
+    wb_world *a = heap(n), *b = heap(n);
     REQUIRE(a && b);
     b->k.no_simd = 1;
-    const size_t bytes = sizeof(wb_real) * 3 * (size_t)a->m.np;
     int same = 1;
     for (int f = 0; f < 60 && same; f++) {
         wb_world_step(a);
         wb_world_step(b);
-        same = memcmp(a->s.x, b->s.x, bytes) == 0 && memcmp(a->s.v, b->s.v, bytes) == 0 &&
+        same = same_bits(a, b) &&
                a->k.pc->remakes == b->k.pc->remakes && a->k.pc->n == b->k.pc->n;
+        /* the kept list's motion fit (it decides only whether the list serves, which the
+         * positions would not show): the same rotation and motion to the bit */
+        const wb_broad *ba = a->k.pc->bp, *bb = b->k.pc->bp;
+        /* and the reference motion with the reaches measured from it (fit_reference) */
+        const wb_contacts *ca = a->k.pc, *cb = b->k.pc;
+        same = same && memcmp(ca->ref_v, cb->ref_v, sizeof ca->ref_v) == 0 &&
+               memcmp(ca->ref_om, cb->ref_om, sizeof ca->ref_om) == 0 &&
+               memcmp(ca->ref_c, cb->ref_c, sizeof ca->ref_c) == 0 &&
+               memcmp(ca->reach, cb->reach, sizeof(wb_real) * (size_t)a->m.np) == 0;
+        same = same && ba && bb && memcmp(ba->mq, bb->mq, sizeof ba->mq) == 0 &&
+               memcmp(&ba->mo, &bb->mo, sizeof ba->mo) == 0 && ba->rebuilds == bb->rebuilds && ba->mends == bb->mends;
         if (!same) printf("    frame %d differs\n", f);
     }
     CHECK(same);
     CHECK(a->k.pc->remakes > 0); /* the scene does leave the paths */
     CHECK_EQ(b->k.pc->lanes, 0);
+    CHECK_EQ(b->k.pc->bp->fits_simd, 0);
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(WB_FLOAT)
-    if (__builtin_cpu_supports("avx2")) CHECK(a->k.pc->lanes > 0);
+    if (__builtin_cpu_supports("avx2")) CHECK(a->k.pc->lanes > 0 && a->k.pc->bp->fits_simd > 0);
     else printf("# no AVX2 here: both ran the scalar check\n");
 #endif
     wb_world_destroy(a);
     wb_world_destroy(b);
+}
+
+TEST(recheck_simd_bits)
+{
+    simd_bits(32);
+    simd_bits(31);
+}
+
+/* A hand-built sheet of loose particles (the default radius over a spacing of 1.57 cm)
+ * dropped onto the floor, where it lies: its kept list holds pairs that never come within
+ * reach. The list's gaps (broadphase.c, list_gaps) skip testing them; the same world
+ * with every pair tested each frame must stay the same to the bit, and the skip must
+ * have run (the gaps kill it otherwise) */
+static wb_world *loose_sheet(int n, wb_real y, wb_real r)
+{
+    wb_world *w = floor_world();
+    if (!w) return NULL;
+    wb_status st;
+    const wb_real s = 2.0 / 127;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            const wb_real p[3] = { i * s, y, j * s };
+            wb_particle_add(w, p, NULL, 1.0 / (n * n), r);
+        }
+    const wb_distance_def d = wb_distance_default_def();
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            if (i < n - 1) wb_distance_add(w, j * n + i, j * n + i + 1, &d, &st);
+            if (j < n - 1) wb_distance_add(w, j * n + i, (j + 1) * n + i, &d, &st);
+        }
+    return w;
+}
+
+TEST(contact_list_gaps_same_bits)
+{
+    wb_world *a = loose_sheet(40, 0.05, 0.02), *b = loose_sheet(40, 0.05, 0.02);
+    REQUIRE(a && b);
+    REQUIRE(wb__contacts_make(a) && wb__contacts_make(b));
+    b->k.pc->no_gaps = 1;
+    int same = 1;
+    for (int f = 0; f < 40 && same; f++) {
+        wb_world_step(a);
+        wb_world_step(b);
+        same = same_bits(a, b) &&
+               a->k.pc->n == b->k.pc->n && a->k.pc->nd == b->k.pc->nd &&
+               memcmp(a->k.pc->ij, b->k.pc->ij, sizeof(int32_t) * 2 * (size_t)a->k.pc->n) == 0;
+        if (!same) printf("    frame %d differs\n", f);
+    }
+    CHECK(same);
+    REQUIRE(a->k.pc->bp && b->k.pc->bp);
+    printf("# listed pairs %d; calls through the gaps %lld, with no pair tested %lld\n", a->k.pc->bp->list.n,
+           (long long)a->k.pc->bp->gap_calls, (long long)a->k.pc->bp->gap_quiet);
+    CHECK(a->k.pc->bp->list.n > 1000); /* pairs listed that no call tested */
+    CHECK(a->k.pc->bp->gap_quiet > 20);
+    CHECK_EQ(b->k.pc->bp->gap_calls, 0);
+    wb_world_destroy(a);
+    wb_world_destroy(b);
+}
+
+/* the reference motion fitted in AVX2 (fit_reference) and the speeds it leaves: the loose
+ * sheet falls 60 cm as one, so the fit is kept while it falls and dropped once it lies
+ * still; the same reference and reaches to the bit as the scalar fit's, either way */
+TEST(contact_reference_simd_bits)
+{
+    wb_world *a = loose_sheet(24, 0.6, 0.02), *b = loose_sheet(24, 0.6, 0.02);
+    REQUIRE(a && b);
+    b->k.no_simd = 1;
+    REQUIRE(wb__contacts_make(a) && wb__contacts_make(b));
+    int same = 1, kept = 0, still = 0;
+    for (int f = 0; f < 40 && same; f++) {
+        wb_world_step(a);
+        wb_world_step(b);
+        const wb_contacts *ca = a->k.pc, *cb = b->k.pc;
+        same = same_bits(a, b) &&
+               memcmp(ca->ref_v, cb->ref_v, sizeof ca->ref_v) == 0 &&
+               memcmp(ca->ref_om, cb->ref_om, sizeof ca->ref_om) == 0 &&
+               memcmp(ca->ref_c, cb->ref_c, sizeof ca->ref_c) == 0 &&
+               memcmp(ca->reach, cb->reach, sizeof(wb_real) * (size_t)a->m.np) == 0;
+        if (!same) printf("    frame %d differs\n", f);
+        kept += ca->ref_v[1] != 0;
+        still += ca->ref_v[1] == 0;
+    }
+    CHECK(same);
+    printf("# frames with the reference kept %d, without %d\n", kept, still);
+    CHECK(kept > 0 && still > 0);
+    wb_world_destroy(a);
+    wb_world_destroy(b);
+}
+
+/* The rules' search along the links from every particle (add_along) queues in a short
+ * sorted run, and goes on as a heap past a few dozen items: the same keys and made-distance
+ * bounds as with a heap throughout, for the default radius (every search a run) and a
+ * radius of 3 spacings (long queues: some go on as a heap) */
+TEST(contact_rules_queue_same_keys)
+{
+    const wb_real radius[2] = { 0.02, 0.05 };
+    for (int k = 0; k < 2; k++) {
+        wb_world *a = loose_sheet(30, 0.05, radius[k]), *b = loose_sheet(30, 0.05, radius[k]);
+        REQUIRE(a && b);
+        REQUIRE(wb__contacts_make(a) && wb__contacts_make(b));
+        b->k.pc->along_heap = 1;
+        REQUIRE(wb__contact_rules(a) && wb__contact_rules(b));
+        const wb_contacts *ca = a->k.pc, *cb = b->k.pc;
+        const size_t np = (size_t)a->m.np;
+        CHECK(ca->nkeys > 0 && ca->nkeys == cb->nkeys);
+        CHECK(memcmp(ca->keys, cb->keys, sizeof *ca->keys * (size_t)ca->nkeys) == 0);
+        CHECK(memcmp(ca->near2, cb->near2, sizeof *ca->near2 * np) == 0);
+        CHECK(memcmp(ca->far2, cb->far2, sizeof *ca->far2 * np) == 0);
+        printf("# radius %g: %d keys, searches gone on as a heap %lld of %zu\n", radius[k], ca->nkeys,
+               (long long)ca->along_heaps, np);
+        if (k == 0) CHECK_EQ(ca->along_heaps, 0);
+        else CHECK(ca->along_heaps > 0);
+        CHECK_EQ(cb->along_heaps, (int64_t)np);
+        wb_world_destroy(a);
+        wb_world_destroy(b);
+    }
 }
